@@ -1,0 +1,2 @@
+//! EHA drain-oil thermal protection core (`#![no_std]`).
+#![no_std]
