@@ -27,7 +27,8 @@ pub struct Lng {
     pub charge_m3: f64,
     /// Valve opening threshold, °C (paper: 40 °C).
     pub open_above_c: f64,
-    /// Valve closing threshold, °C (hysteresis band below the opening threshold; assumed 2 K).
+    /// Valve closing threshold, °C (not in the paper: a 4 K band, chosen so the
+    /// valve cycles about once a minute instead of every few seconds).
     pub close_below_c: f64,
 }
 
@@ -43,7 +44,7 @@ impl Default for Lng {
             flow_kg_per_s: 1.2e-3,
             charge_m3: 5e-3,
             open_above_c: 40.0,
-            close_below_c: 38.0,
+            close_below_c: 36.0,
         }
     }
 }

@@ -9,6 +9,7 @@
 //! eqs. 20–25), [`model`] (the right-hand side), [`plant`] (the stiff solver),
 //! [`scenario`] (paper cases, missions, replay), [`sim`] (runs and outputs).
 
+pub mod calibrate;
 pub mod cooling;
 pub mod fluid;
 pub mod heat;

@@ -331,7 +331,10 @@ impl Model {
         // Heat sources (losses) into their nodes.
         add(Node::Winding, l.copper);
         add(Node::Motor, l.iron + l.bearing);
-        add(Node::Case, l.leakage + l.mechanical + l.churning);
+        let hp = if op.p_a >= op.p_b { Node::Outlet } else { Node::Inlet };
+        let f_out = rig.pump.mech_to_outlet;
+        add(Node::Case, l.leakage + (1.0 - f_out) * l.mechanical + l.churning);
+        add(hp, f_out * l.mechanical);
         add(Node::Loop, l.line + l.valves);
         add(Node::BallOil, l.needle);
         add(Node::Actuator, l.act_leak + l.act_friction);
@@ -377,7 +380,6 @@ impl Model {
         let m_c = rho * qc.abs();
         let f = hydraulics::flows(rig, op, self.k_leak(tc(Node::Case)));
         let m_l = rho * (hydraulics::soft_pos(f.leak_a, 1e-9) + hydraulics::soft_pos(f.leak_b, 1e-9));
-        let hp = if op.p_a >= op.p_b { Node::Outlet } else { Node::Inlet };
         let ring: &[Node] = match (op.circuit, qc >= 0.0) {
             (Circuit::Throttle, true) => &[Node::Loop, Node::Inlet, Node::Outlet, Node::BallOil],
             (Circuit::Throttle, false) => &[Node::Loop, Node::BallOil, Node::Outlet, Node::Inlet],
