@@ -124,7 +124,7 @@ impl<N: Num> Model<N> {
         let d = discretise(p);
         let mut coef = [[N::coef_from_f64(0.0).ok_or(ConfigError::CoefficientRange)?; N_COLS]; N_NODES];
         for (cr, dr) in coef.iter_mut().zip(d.iter()) {
-            if dr.iter().map(|x| libm::fabs(*x)).sum::<f64>() >= 1.0 {
+            if dr.iter().map(|x| libm::fabs(*x)).sum::<f64>() >= N::MAX_ROW_SUM {
                 return Err(ConfigError::CoefficientRange);
             }
             for (c, x) in cr.iter_mut().zip(dr.iter()) {

@@ -24,6 +24,9 @@ pub trait Num: Copy + PartialOrd + core::fmt::Debug {
     type Scale: Copy + core::fmt::Debug;
     /// Zero.
     const ZERO: Self;
+    /// Largest allowed Σ|coefficient| of one discretised row (fixed point: keeps the
+    /// `i64` accumulation free of overflow; floating point: unbounded).
+    const MAX_ROW_SUM: f64;
     /// Conversion at init (saturating for fixed point).
     fn from_f64(x: f64) -> Self;
     /// Coefficient conversion at init; `None` when `x` is outside the coefficient range.
@@ -65,6 +68,7 @@ impl Num for f64 {
     type State = f64;
     type Scale = f64;
     const ZERO: Self = 0.0;
+    const MAX_ROW_SUM: f64 = f64::INFINITY;
     fn from_f64(x: f64) -> Self { x }
     fn coef_from_f64(x: f64) -> Option<f64> { x.is_finite().then_some(x) }
     fn scale_from_f64(x: f64) -> Option<f64> { x.is_finite().then_some(x) }
@@ -126,6 +130,7 @@ impl Num for f32 {
     type State = F32State;
     type Scale = f32;
     const ZERO: Self = 0.0;
+    const MAX_ROW_SUM: f64 = f64::INFINITY;
     fn from_f64(x: f64) -> Self { x as f32 }
     fn coef_from_f64(x: f64) -> Option<f32> { x.is_finite().then_some(x as f32) }
     fn scale_from_f64(x: f64) -> Option<f32> { x.is_finite().then_some(x as f32) }
@@ -190,6 +195,7 @@ impl Num for Fx {
     type State = FxState;
     type Scale = FxScale;
     const ZERO: Self = Fx::ZERO;
+    const MAX_ROW_SUM: f64 = 1.0;
     fn from_f64(x: f64) -> Self { Fx::saturating_from_num(x) }
     fn coef_from_f64(x: f64) -> Option<FxCoef> { FxCoef::checked_from_num(x) }
     fn scale_from_f64(x: f64) -> Option<FxScale> { FxScale::checked_from_num(x) }
