@@ -160,7 +160,7 @@ proptest! {
     #[test]
     fn record_roundtrip_and_single_bit_corruption(
         temps in proptest::array::uniform6(-40.0f32..200.0), amb in -40.0f32..80.0,
-        used in any::<u64>(), faults_w in any::<u16>(), step in any::<u32>(), bit in 0usize..(56 * 8),
+        used in any::<u32>(), faults_w in any::<u16>(), step in any::<u32>(), bit in 0usize..(52 * 8),
     ) {
         let r = ThermalRecord::new(temps, amb, used, faults_w, step);
         prop_assert_eq!(r.classify(), RecordStatus::Valid);
@@ -168,14 +168,15 @@ proptest! {
         let mut b = bytes;
         b[bit / 8] ^= 1 << (bit % 8);
         let c = record_from_bytes(&b);
-        // Padding-free layout: bytes 48..52 are `reserved`, 52..56 the CRC; every bit counts.
+        // Padding-free layout: bytes 44..48 are `reserved`, 48..52 the CRC; every bit counts.
         prop_assert_eq!(c.classify(), RecordStatus::Corrupt, "flip of bit {} undetected", bit);
     }
 }
 
-fn record_bytes(r: &ThermalRecord) -> [u8; 56] {
-    let mut b = [0u8; 56];
-    b[0..8].copy_from_slice(&r.lng_used_mj.to_le_bytes());
+fn record_bytes(r: &ThermalRecord) -> [u8; 52] {
+    let mut b = [0u8; 52];
+    b[0..4].copy_from_slice(&r.lng_used_cj.to_le_bytes());
+    b[4..8].copy_from_slice(&r.step.to_le_bytes());
     b[8..12].copy_from_slice(&r.magic.to_le_bytes());
     b[12..14].copy_from_slice(&r.version.to_le_bytes());
     b[14..16].copy_from_slice(&r.faults.to_le_bytes());
@@ -183,28 +184,27 @@ fn record_bytes(r: &ThermalRecord) -> [u8; 56] {
         b[16 + 4 * i..20 + 4 * i].copy_from_slice(&t.to_le_bytes());
     }
     b[40..44].copy_from_slice(&r.ambient_c.to_le_bytes());
-    b[44..48].copy_from_slice(&r.step.to_le_bytes());
-    b[48..52].copy_from_slice(&r.reserved.to_le_bytes());
-    b[52..56].copy_from_slice(&r.crc.to_le_bytes());
+    b[44..48].copy_from_slice(&r.reserved.to_le_bytes());
+    b[48..52].copy_from_slice(&r.crc.to_le_bytes());
     b
 }
 
-fn record_from_bytes(b: &[u8; 56]) -> ThermalRecord {
+fn record_from_bytes(b: &[u8; 52]) -> ThermalRecord {
     let u32_at = |i: usize| u32::from_le_bytes(b[i..i + 4].try_into().unwrap());
     let mut temps = [0.0f32; 6];
     for (i, t) in temps.iter_mut().enumerate() {
         *t = f32::from_bits(u32_at(16 + 4 * i));
     }
     ThermalRecord {
-        lng_used_mj: u64::from_le_bytes(b[0..8].try_into().unwrap()),
+        lng_used_cj: u32_at(0),
+        step: u32_at(4),
         magic: u32_at(8),
         version: u16::from_le_bytes([b[12], b[13]]),
         faults: u16::from_le_bytes([b[14], b[15]]),
         temps_c: temps,
         ambient_c: f32::from_bits(u32_at(40)),
-        step: u32_at(44),
-        reserved: u32_at(48),
-        crc: u32_at(52),
+        reserved: u32_at(44),
+        crc: u32_at(48),
     }
 }
 
