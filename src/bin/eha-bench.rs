@@ -179,6 +179,10 @@ mod fw {
         let Some(scales) = InputScales::<Real>::new() else { semihosting::process::exit(106) };
         model.set_temperatures(&[16.0; 6], 16.0);
 
+        // Stack used by boot + init (f64 matrix exponential), then repaint to measure
+        // the step loop alone (its figure includes main's own frame).
+        let init_stack = stack_high_water();
+        paint_stack();
         let mut g_stats = Stats::new();
         let mut m_stats = Stats::new();
         let mut noise = 1u32;
@@ -229,7 +233,7 @@ mod fw {
         m_stats.report("Model::step", ovh);
         eprintln!("Guard::new (ZOH expm, f64): {} instructions", init_ticks * 10 / 256);
         eprintln!("snapshot+store record: {} instructions", (save.saturating_sub(ovh) as u64 * 10) / 256);
-        eprintln!("stack high-water mark: {} bytes", stack_high_water());
+        eprintln!("stack high-water mark: boot+init {} bytes, step loop {} bytes", init_stack, stack_high_water());
         let dc = (last.drain_c * 1000.0) as i32;
         eprintln!(
             "final drain {}.{:03} degC, valve {}, faults {:#06x}, model drain {} mK, first open step {:?}",
