@@ -90,19 +90,25 @@ pub struct Model<N: Num> {
 /// Discretised matrices in `f64`: row `i` = `[(Ad - I)_i·, Bd_i·]`, `Bd` per kW.
 pub fn discretise(p: &ReducedParams) -> [[f64; N_COLS]; N_NODES] {
     let mut m = [[0.0f64; N_AUG]; N_AUG];
-    for i in 0..N_NODES {
-        let c = p.capacity_j_per_k[i];
-        let mut diag = p.ambient_w_per_k[i];
-        for j in 0..N_NODES {
+    let node_data = p
+        .capacity_j_per_k
+        .iter()
+        .zip(p.ambient_w_per_k.iter())
+        .zip(p.conductance_w_per_k.iter().zip(p.loss_split.iter()));
+    for (i, (row, ((c, g_amb), (g_row, split_row)))) in m.iter_mut().zip(node_data).enumerate() {
+        let k = S_PER_STEP / c;
+        let mut diag = *g_amb;
+        for (j, (mij, g)) in row.iter_mut().zip(g_row.iter()).enumerate() {
             if j != i {
-                let g = p.conductance_w_per_k[i][j];
                 diag += g;
-                m[i][j] = g / c * S_PER_STEP;
+                *mij = g * k;
             }
         }
-        m[i][i] = -diag / c * S_PER_STEP;
-        for l in 0..N_LOSSES {
-            m[i][N_NODES + l] = p.loss_split[i][l] * W_PER_KW / c * S_PER_STEP;
+        if let Some(d) = row.get_mut(i) {
+            *d = -diag * k;
+        }
+        for (mij, share) in row.iter_mut().skip(N_NODES).zip(split_row.iter()) {
+            *mij = share * W_PER_KW * k;
         }
     }
     let e = expm1m(&m);

@@ -42,6 +42,8 @@ impl Valve {
     /// open. Otherwise: open when `drain_c > open_c`, close when `drain_c < close_c`,
     /// each only after `dwell_steps` since the last toggle. A NaN temperature keeps it
     /// open / opens it. Returns `Some(new_state)` when the command changed.
+    // `!(x < c)` is deliberate: it is true for NaN (stay open), unlike `x >= c`.
+    #[allow(clippy::neg_cmp_op_on_partial_ord)]
     pub fn update(&mut self, drain_c: f32, force_open: bool, cfg: &ValveConfig) -> Option<bool> {
         self.since_toggle_steps = self.since_toggle_steps.saturating_add(1);
         let force = force_open || drain_c.is_nan();
@@ -83,6 +85,7 @@ impl AlarmConfig {
 }
 
 /// Alarm with hysteresis; returns `Some(new_state)` on change. NaN raises it.
+#[allow(clippy::neg_cmp_op_on_partial_ord)]
 pub fn alarm_update(active: &mut bool, drain_c: f32, cfg: &AlarmConfig) -> Option<bool> {
     let want = if drain_c.is_nan() {
         true
