@@ -202,6 +202,7 @@ impl<N: Num> GuardOf<N> {
 
     /// One 10 ms step with a new sample. Never panics; any invalid channel latches a
     /// fault, opens the valve in this same step and is replaced by its worst case.
+    #[inline(never)]
     pub fn step(&mut self, s: &Sample) -> Output {
         self.missing = 0;
         let c = validate::check(s, &self.prev, self.prev_ok, &self.limits);
