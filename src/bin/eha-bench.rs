@@ -229,6 +229,9 @@ mod fw {
         let build = if cfg!(feature = "fixed-point") { "fixed-point Q9.23/Q0.32/Q9.55" } else { "f32" };
         eprintln!("EHA-BENCH build: {}", build);
         eprintln!("timing overhead: {} ticks (subtracted)", ovh);
+        eprintln!("size_of Guard {} B, Model {} B, ThermalRecord {} B",
+            core::mem::size_of::<Guard>(), core::mem::size_of::<Model<Real>>(),
+            core::mem::size_of::<eha_guard::ThermalRecord>());
         g_stats.report("Guard::step", ovh);
         m_stats.report("Model::step", ovh);
         eprintln!("Guard::new (ZOH expm, f64): {} instructions", init_ticks * 10 / 256);
