@@ -2,12 +2,12 @@
 //! 10 ms tick. The only API the firmware main loop needs (docs/contracts.md).
 
 use crate::memory::{Restore, ThermalRecord};
-use crate::model::{InputScales, Model};
+use crate::model::{InputScales, Model, ModelInputN};
 use crate::num::Num;
 use crate::params::{ReducedParams, N_NODES};
-use crate::protection::{alarm_update, AlarmConfig, LngBudget, LngConfig, Valve, ValveConfig};
+use crate::protection::{alarm_update_with, AlarmConfig, LngBudget, LngConfig, Valve, ValveConfig};
 use crate::trace::{RestoreKind, Trace, TraceBuf};
-use crate::validate::{self, InputLimits, CH_ALL, CH_POSITION};
+use crate::validate::{self, Channels, InputLimits, LimitsN, CH_ALL, CH_POSITION};
 
 /// Fault bits of [`Output::faults`]. Bits 0-6 are latched until the clear rule
 /// ([`GuardOf::clear_faults`]); bit 7 is a live status; bits 8-13 name the latched
@@ -119,18 +119,49 @@ pub type Real = crate::num::Fx;
 /// The guard of the firmware build's number type.
 pub type Guard = GuardOf<Real>;
 
+/// Protection thresholds converted to the model number type (degC).
+#[derive(Clone, Copy, Debug)]
+struct Thresholds<N> {
+    open: N,
+    close: N,
+    alarm: N,
+    clear: N,
+}
+
+/// Everything the step needs that exists only with usable parameters.
+#[derive(Clone, Copy, Debug)]
+struct Core<N: Num> {
+    model: Model<N>,
+    scales: InputScales<N>,
+    limits: LimitsN<N>,
+    th: Thresholds<N>,
+}
+
+impl<N: Num> Core<N> {
+    fn new(config: &GuardConfig) -> Option<Self> {
+        let model = Model::<N>::new(&config.params).ok()?;
+        let scales = InputScales::<N>::new()?;
+        let limits = LimitsN::new(&config.limits, &scales)?;
+        let t = [config.valve.open_c, config.valve.close_c, config.alarm.alarm_c, config.alarm.clear_c];
+        if t.iter().any(|x| !x.is_finite() || x.abs() >= 250.0) {
+            return None;
+        }
+        let f = |x: f32| N::from_f64(x as f64);
+        let th = Thresholds { open: f(t[0]), close: f(t[1]), alarm: f(t[2]), clear: f(t[3]) };
+        Some(Core { model, scales, limits, th })
+    }
+}
+
 /// The guard, generic over the model number type (`f64` for host tests).
 #[derive(Clone, Debug)]
 pub struct GuardOf<N: Num> {
-    core: Option<(Model<N>, InputScales<N>)>,
-    limits: InputLimits,
-    valve_cfg: ValveConfig,
-    alarm_cfg: AlarmConfig,
+    core: Option<Core<N>>,
+    dwell_steps: u32,
     stale_steps: u32,
     clear_valid_steps: u32,
     latched: u16,
     bad_ch: u8,
-    prev: Sample,
+    prev: Channels<N>,
     prev_ok: u8,
     missing: u32,
     valid_run: u32,
@@ -148,20 +179,15 @@ impl<N: Num> GuardOf<N> {
     /// [`crate::memory`]. Never fails: unusable parameters give a CONFIG fault and a
     /// permanently fail-safe guard (valve open, alarm, derate).
     pub fn new(config: &GuardConfig, restore: Restore) -> Self {
-        let core = match (Model::<N>::new(&config.params), InputScales::<N>::new()) {
-            (Ok(m), Some(s)) => Some((m, s)),
-            _ => None,
-        };
+        let core = Core::<N>::new(config);
         let mut g = GuardOf {
             latched: if core.is_none() { faults::CONFIG } else { 0 },
             core,
-            limits: config.limits,
-            valve_cfg: config.valve,
-            alarm_cfg: config.alarm,
+            dwell_steps: config.valve.dwell_steps,
             stale_steps: config.stale_steps,
             clear_valid_steps: config.clear_valid_steps,
             bad_ch: 0,
-            prev: Sample::default(),
+            prev: [N::ZERO; 6],
             prev_ok: 0,
             missing: 0,
             valid_run: 0,
@@ -176,8 +202,8 @@ impl<N: Num> GuardOf<N> {
         let kind = match restore {
             Restore::Cold => RestoreKind::Cold,
             Restore::Warm(r) => {
-                if let Some((m, _)) = g.core.as_mut() {
-                    m.set_temperatures(&r.temps_c, r.ambient_c);
+                if let Some(c) = g.core.as_mut() {
+                    c.model.set_temperatures(&r.temps_c, r.ambient_c);
                 }
                 g.have_ambient = true;
                 g.lng.set_used_cj(r.lng_used_cj);
@@ -187,8 +213,8 @@ impl<N: Num> GuardOf<N> {
             }
             Restore::Corrupt => {
                 let t = config.alarm.alarm_c;
-                if let Some((m, _)) = g.core.as_mut() {
-                    m.set_temperatures(&[t; N_NODES], t);
+                if let Some(c) = g.core.as_mut() {
+                    c.model.set_temperatures(&[t; N_NODES], t);
                 }
                 g.have_ambient = true;
                 g.lng.set_used_cj(u32::MAX);
@@ -205,7 +231,9 @@ impl<N: Num> GuardOf<N> {
     #[inline(never)]
     pub fn step(&mut self, s: &Sample) -> Output {
         self.missing = 0;
-        let c = validate::check(s, &self.prev, self.prev_ok, &self.limits);
+        let Some(core) = self.core.as_ref() else { return self.advance(None, 0) };
+        let (v, nonfinite) = validate::convert(s, &core.scales);
+        let c = validate::check(&v, nonfinite, &self.prev, self.prev_ok, &core.limits);
         let mut new_bits = 0u16;
         if c.range {
             new_bits |= faults::RANGE;
@@ -218,11 +246,12 @@ impl<N: Num> GuardOf<N> {
         }
         self.bad_ch |= c.bad;
         self.valid_run = if c.bad == 0 { self.valid_run.saturating_add(1) } else { 0 };
-        let prev_pos = if self.prev_ok & CH_POSITION != 0 { Some(self.prev.position_mm) } else { None };
-        let u = validate::substitute(s, self.bad_ch, prev_pos, &self.limits);
-        self.prev = *s;
+        let [_, _, _, _, prev_pos, _] = self.prev;
+        let prev_pos = if self.prev_ok & CH_POSITION != 0 { Some(prev_pos) } else { None };
+        let u = validate::substitute(&v, self.bad_ch, prev_pos, &core.limits);
+        self.prev = v;
         self.prev_ok = !c.bad & CH_ALL;
-        self.advance(&u, new_bits)
+        self.advance(Some(&u), new_bits)
     }
 
     /// One 10 ms step without a new sample: inputs are held (piston work taken as
@@ -237,30 +266,41 @@ impl<N: Num> GuardOf<N> {
             new_bits |= faults::STALE;
             self.bad_ch = CH_ALL;
         }
-        let u = validate::substitute(&self.prev, self.bad_ch, None, &self.limits);
-        self.advance(&u, new_bits)
+        let u = self.core.as_ref().map(|c| validate::substitute(&self.prev, self.bad_ch, None, &c.limits));
+        self.advance(u.as_ref(), new_bits)
     }
 
-    fn advance(&mut self, u: &crate::model::ModelInput, new_bits: u16) -> Output {
+    #[inline(always)]
+    fn advance(&mut self, u: Option<&ModelInputN<N>>, new_bits: u16) -> Output {
         let newly = new_bits & !self.latched;
         self.latched |= new_bits;
         if newly != 0 {
             self.trace.write(Trace::Fault { step: self.step, new_bits: newly | ((self.bad_ch as u16) << faults::CH_SHIFT) });
         }
-        let (drain_c, loss_w) = match self.core.as_mut() {
-            Some((m, sc)) => {
+        let force = self.latched != 0;
+        let (drain_c, loss_cj, valve_ev, alarm_ev) = match (self.core.as_mut(), u) {
+            (Some(c), Some(u)) => {
                 if !self.have_ambient {
-                    m.set_temperatures(&[u.ambient_c; N_NODES], u.ambient_c);
+                    c.model.set_uniform(u.ambient_c);
                     self.have_ambient = true;
                 }
-                m.step(u, sc);
-                (m.drain_c().to_f32(), m.last_total_kw().to_f32() * 1000.0)
+                c.model.step_n(u);
+                let d = c.model.drain_c();
+                let th = &c.th;
+                let v = self.valve.update_with(d, force, th.open, th.close, self.dwell_steps);
+                let a = alarm_update_with(&mut self.alarm, d, th.alarm, th.clear);
+                // Total loss kW → cJ per 10 ms step (= W), never negative.
+                let cj = c.model.last_total_kw().round_times(1000).max(0) as u32;
+                (d.to_f32(), cj, v, a)
             }
-            None => (DRAIN_C_UNKNOWN, 0.0),
+            _ => {
+                let v = self.valve.update_with(DRAIN_C_UNKNOWN, true, 0.0, 0.0, self.dwell_steps);
+                self.alarm = true;
+                (DRAIN_C_UNKNOWN, 0, v, None)
+            }
         };
         let drain_c = if drain_c.is_finite() { drain_c } else { DRAIN_C_UNKNOWN };
-        let force = self.latched != 0;
-        if let Some(open) = self.valve.update(drain_c, force, &self.valve_cfg) {
+        if let Some(open) = valve_ev {
             let t = if open {
                 Trace::ValveOpen { step: self.step, drain_c, forced: force }
             } else {
@@ -268,12 +308,11 @@ impl<N: Num> GuardOf<N> {
             };
             self.trace.write(t);
         }
-        if let Some(a) = alarm_update(&mut self.alarm, drain_c, &self.alarm_cfg) {
+        if let Some(a) = alarm_ev {
             let t = if a { Trace::Alarm { step: self.step, drain_c } } else { Trace::AlarmClear { step: self.step, drain_c } };
             self.trace.write(t);
         }
-        let loss_w = if loss_w.is_finite() && loss_w > 0.0 { loss_w } else { 0.0 };
-        self.lng.update(self.valve.is_open(), loss_w);
+        self.lng.update_cj(self.valve.is_open(), loss_cj);
         let low = self.lng.is_low();
         if low && !self.lng_low {
             self.trace.write(Trace::LngLow { step: self.step, remaining_kg: self.lng.remaining_kg() });
@@ -283,11 +322,11 @@ impl<N: Num> GuardOf<N> {
         Output {
             drain_c,
             valve_open: self.valve.is_open(),
-            alarm: self.alarm || self.core.is_none(),
-            derate: self.alarm || self.core.is_none(),
+            alarm: self.alarm,
+            derate: self.alarm,
             faults: self.faults(),
             lng_remaining_kg: self.lng.remaining_kg(),
-            lng_seconds_left: self.lng.seconds_left(loss_w),
+            lng_seconds_left: self.lng.seconds_left_cj(loss_cj),
         }
     }
 
@@ -332,11 +371,11 @@ impl<N: Num> GuardOf<N> {
     pub fn snapshot(&self) -> ThermalRecord {
         let mut temps = [0.0f32; N_NODES];
         let mut amb = 0.0;
-        if let Some((m, _)) = self.core.as_ref() {
-            for (o, t) in temps.iter_mut().zip(m.temperatures_c().iter()) {
+        if let Some(c) = self.core.as_ref() {
+            for (o, t) in temps.iter_mut().zip(c.model.temperatures_c().iter()) {
                 *o = t.to_f32();
             }
-            amb = m.ambient_c().to_f32();
+            amb = c.model.ambient_c().to_f32();
         }
         ThermalRecord::new(temps, amb, self.lng.used_cj(), self.faults() & !faults::LNG_LOW, self.step)
     }
@@ -348,7 +387,7 @@ impl<N: Num> GuardOf<N> {
 
     /// The model, when the parameters were usable.
     pub fn model(&self) -> Option<&Model<N>> {
-        self.core.as_ref().map(|(m, _)| m)
+        self.core.as_ref().map(|c| &c.model)
     }
 
     /// Steps taken since boot (10 ms each, wraps after 497 days).

@@ -41,6 +41,21 @@ pub struct ModelInput {
     pub ambient_c: f32,
 }
 
+/// One step of inputs in model units and the model's number type.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ModelInputN<N> {
+    /// Motor phase current, hA (100 A).
+    pub current_ha: N,
+    /// Pump port pressure difference `p_A - p_B`, hbar (10 MPa).
+    pub dp_hbar: N,
+    /// Motor speed, hrad/s (100 rad/s), signed.
+    pub speed_hrads: N,
+    /// Piston position change over the step, mm.
+    pub dpos_mm: N,
+    /// Ambient temperature, degC.
+    pub ambient_c: N,
+}
+
 /// Why a parameter set cannot be turned into a model of the chosen number type.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(any(target_os = "none", feature = "defmt"), derive(defmt::Format))]
@@ -189,6 +204,14 @@ impl<N: Num> Model<N> {
         })
     }
 
+    /// Sets every node and the ambient to `t_c` (degC, model number type): cold start.
+    pub fn set_uniform(&mut self, t_c: N) {
+        self.ambient_c = t_c;
+        for th in self.temp.iter_mut() {
+            *th = N::state(t_c);
+        }
+    }
+
     /// Sets every node's absolute temperature (degC) and the ambient it refers to.
     pub fn set_temperatures(&mut self, temps_c: &[f32; N_NODES], ambient_c: f32) {
         let one = self.k.one;
@@ -236,13 +259,22 @@ impl<N: Num> Model<N> {
 
     /// Advances one step of [`S_PER_STEP`] with inputs held (ZOH). Never panics.
     pub fn step(&mut self, u: &ModelInput, s: &InputScales<N>) {
-        let amb = N::from_f32_scaled(u.ambient_c, s.one);
+        self.step_n(&ModelInputN {
+            current_ha: N::from_f32_scaled(u.current_a, s.ha_per_a),
+            dp_hbar: N::from_f32_scaled(u.dp_bar, s.hbar_per_bar),
+            speed_hrads: N::from_f32_scaled(u.speed_rpm, s.hrads_per_rpm),
+            dpos_mm: N::from_f32_scaled(u.dpos_mm, s.one),
+            ambient_c: N::from_f32_scaled(u.ambient_c, s.one),
+        });
+    }
+
+    /// [`Model::step`] with inputs already in model units (the guard's path).
+    #[inline(always)]
+    pub fn step_n(&mut self, u: &ModelInputN<N>) {
+        let amb = u.ambient_c;
         self.ambient_c = amb;
-        let i_ha = N::from_f32_scaled(u.current_a, s.ha_per_a);
-        let dp = N::from_f32_scaled(u.dp_bar, s.hbar_per_bar);
-        let w = N::from_f32_scaled(u.speed_rpm, s.hrads_per_rpm);
-        let dx = N::from_f32_scaled(u.dpos_mm, s.one);
-        let p = self.losses_kw(i_ha, dp, w, dx);
+        let dp = u.dp_hbar;
+        let p = self.losses_kw(u.current_ha, dp, u.speed_hrads, u.dpos_mm);
         self.last_loss_kw = p;
         let th = &self.temp;
         let x: [N; N_COLS] = [

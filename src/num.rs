@@ -61,6 +61,8 @@ pub trait Num: Copy + PartialOrd + core::fmt::Debug {
     fn accumulate<const K: usize>(s: Self::State, c: &[Self::Coef; K], v: &[Self; K]) -> Self::State;
     /// `s + a b` at full accumulator precision.
     fn add_product(s: Self::State, a: Self, b: Self) -> Self::State;
+    /// `round(self · k)` as an integer (saturating; NaN → 0).
+    fn round_times(self, k: i32) -> i32;
 }
 
 impl Num for f64 {
@@ -88,6 +90,7 @@ impl Num for f64 {
         s + c.iter().zip(v.iter()).fold(0.0, |a, (c, v)| a + c * v)
     }
     fn add_product(s: f64, a: f64, b: f64) -> f64 { s + a * b }
+    fn round_times(self, k: i32) -> i32 { libm::round(self * k as f64) as i32 }
 }
 
 /// Compensated `f32` state: value `hi` plus the rounding residue `lo` (|lo| <= ulp(hi)/2).
@@ -155,6 +158,12 @@ impl Num for f32 {
     }
     #[inline(always)]
     fn add_product(s: F32State, a: f32, b: f32) -> F32State { two_sum(s, a * b) }
+    #[inline(always)]
+    fn round_times(self, k: i32) -> i32 {
+        let y = self * k as f32;
+        // `as` saturates and maps NaN to 0; round half away from zero.
+        (if y >= 0.0 { y + 0.5 } else { y - 0.5 }) as i32
+    }
 }
 
 /// Fixed-point model value: Q9.23 in an `i32` (`I9F23`): range [-256, 256),
@@ -268,6 +277,11 @@ impl Num for Fx {
         let p = a.to_bits() as i64 * b.to_bits() as i64;
         let p55 = p.saturating_mul(1 << 9);
         FxState::from_bits(s.to_bits().saturating_add(p55))
+    }
+    #[inline(always)]
+    fn round_times(self, k: i32) -> i32 {
+        let p = self.to_bits() as i64 * k as i64;
+        sat_i32((p + (1 << 22)) >> 23)
     }
 }
 
