@@ -111,7 +111,7 @@ impl<N: Num> LimitsN<N> {
             .zip(rt.iter().zip(s.iter().zip(s64.iter())))
         {
             let k = *k as f32;
-            if !(ok(a * k) && ok(b * k) && ok(c * k)) || !(a <= b) || !(*c >= 0.0) {
+            if !(ok(a * k) && ok(b * k) && ok(c * k) && a <= b && *c >= 0.0) {
                 return None;
             }
             *o_lo = cv(*a, *sc);
