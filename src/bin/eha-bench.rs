@@ -19,7 +19,8 @@ mod fw {
     use cortex_m::peripheral::{syst::SystClkSource, SYST};
     use cortex_m_rt::{entry, exception, ExceptionFrame};
     use defmt_semihosting as _;
-    use eha_guard::model::{InputScales, Model, ModelInput};
+    use eha_guard::model::{InputScales, Model, ModelInput, ModelInputN};
+    use eha_guard::validate::{self, Channels, LimitsN, CH_ALL};
     use eha_guard::{Guard, GuardConfig, Real, Restore, Sample};
     use semihosting::eprintln;
 
@@ -138,6 +139,14 @@ mod fw {
         m.step(u, s);
     }
 
+    /// Validation alone: convert + range/rate checks + worst-case substitution.
+    #[inline(never)]
+    fn validate_step(s: &Sample, prev: &Channels<Real>, sc: &InputScales<Real>, lim: &LimitsN<Real>) -> ModelInputN<Real> {
+        let (v, nf) = validate::convert(s, sc);
+        let c = validate::check(&v, nf, prev, CH_ALL, lim);
+        validate::substitute(&v, c.bad, Some(v[4]), lim)
+    }
+
     #[inline(never)]
     fn guard_step(g: &mut Guard, s: &Sample) -> eha_guard::Output {
         g.step(s)
@@ -195,8 +204,11 @@ mod fw {
         // the step loop alone (its figure includes main's own frame).
         let init_stack = stack_high_water();
         paint_stack();
+        let Some(limits) = LimitsN::<Real>::new(&GuardConfig::DEFAULT.limits, &scales) else { semihosting::process::exit(107) };
+        let mut prev_ch: Channels<Real> = validate::convert(&sample(0, &mut 1), &scales).0;
         let mut g_stats = Stats::new();
         let mut m_stats = Stats::new();
+        let mut v_stats = Stats::new();
         let mut noise = 1u32;
         let mut prev_pos = 0.0f32;
         let mut last = eha_guard::Output::default();
@@ -225,6 +237,15 @@ mod fw {
 
             let w0 = WRAPS.load(Ordering::Relaxed);
             let t0 = now();
+            let vu = validate_step(core::hint::black_box(&s), &prev_ch, &scales, &limits);
+            if let Some(t) = elapsed(t0, w0) {
+                v_stats.add(t);
+            }
+            core::hint::black_box(vu);
+            prev_ch = validate::convert(&s, &scales).0;
+
+            let w0 = WRAPS.load(Ordering::Relaxed);
+            let t0 = now();
             model_step(&mut model, core::hint::black_box(&u), &scales);
             if let Some(t) = elapsed(t0, w0) {
                 m_stats.add(t);
@@ -246,6 +267,7 @@ mod fw {
             core::mem::size_of::<eha_guard::ThermalRecord>());
         g_stats.report("Guard::step", ovh);
         m_stats.report("Model::step", ovh);
+        v_stats.report("validation (convert+check+substitute)", ovh);
         eprintln!("Guard::new (ZOH expm, f64): {} instructions", init_ticks * 10 / 256);
         eprintln!("snapshot+store record: {} instructions", (save.saturating_sub(ovh) as u64 * 10) / 256);
         eprintln!("stack high-water mark: boot+init {} bytes, step loop {} bytes", init_stack, stack_high_water());
