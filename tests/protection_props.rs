@@ -296,3 +296,38 @@ fn trace_ring_keeps_newest_32() {
     let steps: Vec<u32> = t.iter().map(|e| match e { eha_guard::trace::Trace::Fault { step, .. } => *step, _ => u32::MAX }).collect();
     assert_eq!(steps, (8..40).collect::<Vec<_>>());
 }
+
+#[test]
+fn stale_input_integrates_worst_case_loss() {
+    // After STALE every channel takes its worst case: copper loss at 340.5 A is
+    // 3 × 340.5² × 0.074 × (1 + 0.00393 (T_w − 25)) W, and the drain estimate keeps
+    // rising faster than under the nominal Case-1 input it replaced.
+    let cfg = GuardConfig::DEFAULT;
+    let mut g = GuardOf::<f64>::new(&cfg, Restore::Cold);
+    for _ in 0..100 {
+        g.step(&nominal());
+    }
+    let mut nominal_g = g.clone();
+    for _ in 0..cfg.stale_steps {
+        g.step_missing();
+    }
+    let t_w = g.model().unwrap().temperatures_c()[0];
+    let o0 = g.step_missing();
+    let p = g.model().unwrap().last_losses_kw();
+    let p_cu_expect = 3.0 * 340.5f64.powi(2) * 0.074 * (1.0 + 0.00393 * (t_w - 25.0)) / 1e3;
+    assert!((p[0] - p_cu_expect).abs() < 1e-6 * p_cu_expect, "copper {} kW vs {} kW", p[0], p_cu_expect);
+    // Throttling at the full pressure span (355 bar) and 6000 rpm, no piston work.
+    let dp_pa = 355e5;
+    let q = 6000.0 * 2.0 * std::f64::consts::PI / 60.0 * eha_guard::params::DEFAULT.displacement_m3_per_rad;
+    let p_throttle = (dp_pa * q / 1e3) - p[2];
+    assert!((p[4] - p_throttle).abs() < 1e-6 * p_throttle, "throttle {} kW vs {} kW", p[4], p_throttle);
+    assert!(o0.valve_open && o0.faults & faults::STALE != 0);
+    let mut o = o0;
+    let mut n = o0;
+    for _ in 0..500 {
+        o = g.step_missing();
+        n = nominal_g.step(&nominal());
+    }
+    println!("5 s after STALE: fail-safe drain {:.4} degC, nominal {:.4} degC (from {:.4})", o.drain_c, n.drain_c, o0.drain_c);
+    assert!(o.drain_c - o0.drain_c > 10.0 * (n.drain_c - o0.drain_c).max(1e-3), "fail-safe {} vs nominal {}", o.drain_c, n.drain_c);
+}
