@@ -252,6 +252,23 @@ mod fw {
             }
         }
 
+        // Fault path: one NaN current sample, then 200 valid samples with the fault
+        // latched (worst-case current substituted, valve forced open, trace written).
+        let mut f_stats = Stats::new();
+        for k in 0..201u32 {
+            let mut s = sample(STEPS / 2 - 1, &mut noise);
+            if k == 0 {
+                s.current_a = f32::NAN;
+            }
+            let w0 = WRAPS.load(Ordering::Relaxed);
+            let t0 = now();
+            let out = guard_step(&mut guard, core::hint::black_box(&s));
+            if let Some(t) = elapsed(t0, w0) {
+                f_stats.add(t);
+            }
+            last = core::hint::black_box(out);
+        }
+
         // Thermal-memory save (snapshot + CRC + no-init write).
         let w0 = WRAPS.load(Ordering::Relaxed);
         let t0 = now();
@@ -266,6 +283,7 @@ mod fw {
             core::mem::size_of::<Guard>(), core::mem::size_of::<Model<Real>>(),
             core::mem::size_of::<eha_guard::ThermalRecord>());
         g_stats.report("Guard::step", ovh);
+        f_stats.report("Guard::step, fault latched (NaN current then worst case)", ovh);
         m_stats.report("Model::step", ovh);
         v_stats.report("validation (convert+check+substitute)", ovh);
         eprintln!("Guard::new (ZOH expm, f64): {} instructions", init_ticks * 10 / 256);
