@@ -10,7 +10,9 @@ fn main() {
     println!("cargo:rerun-if-changed=build.rs");
     println!("cargo:rerun-if-changed=boards/mps2/memory.x");
     println!("cargo:rerun-if-changed=boards/stm32f411/memory.x");
-    let Some(out) = env::var_os("OUT_DIR").map(PathBuf::from) else { return };
+    let Some(out) = env::var_os("OUT_DIR").map(PathBuf::from) else {
+        return;
+    };
     let src = if env::var_os("CARGO_FEATURE_BOARD_STM32F4").is_some() {
         "boards/stm32f411/memory.x"
     } else {

@@ -142,13 +142,28 @@ impl<N: Num> Core<N> {
         let model = Model::<N>::new(&config.params).ok()?;
         let scales = InputScales::<N>::new()?;
         let limits = LimitsN::new(&config.limits, &scales)?;
-        let t = [config.valve.open_c, config.valve.close_c, config.alarm.alarm_c, config.alarm.clear_c];
+        let t = [
+            config.valve.open_c,
+            config.valve.close_c,
+            config.alarm.alarm_c,
+            config.alarm.clear_c,
+        ];
         if t.iter().any(|x| !x.is_finite() || x.abs() >= 250.0) {
             return None;
         }
         let f = |x: f32| N::from_f64(x as f64);
-        let th = Thresholds { open: f(t[0]), close: f(t[1]), alarm: f(t[2]), clear: f(t[3]) };
-        Some(Core { model, scales, limits, th })
+        let th = Thresholds {
+            open: f(t[0]),
+            close: f(t[1]),
+            alarm: f(t[2]),
+            clear: f(t[3]),
+        };
+        Some(Core {
+            model,
+            scales,
+            limits,
+            th,
+        })
     }
 }
 
@@ -231,7 +246,9 @@ impl<N: Num> GuardOf<N> {
     #[inline(never)]
     pub fn step(&mut self, s: &Sample) -> Output {
         self.missing = 0;
-        let Some(core) = self.core.as_ref() else { return self.advance(None, 0) };
+        let Some(core) = self.core.as_ref() else {
+            return self.advance(None, 0);
+        };
         let (v, nonfinite) = validate::convert(s, &core.scales);
         let c = validate::check(&v, nonfinite, &self.prev, self.prev_ok, &core.limits);
         let mut new_bits = 0u16;
@@ -245,9 +262,17 @@ impl<N: Num> GuardOf<N> {
             new_bits |= faults::NON_FINITE;
         }
         self.bad_ch |= c.bad;
-        self.valid_run = if c.bad == 0 { self.valid_run.saturating_add(1) } else { 0 };
+        self.valid_run = if c.bad == 0 {
+            self.valid_run.saturating_add(1)
+        } else {
+            0
+        };
         let [_, _, _, _, prev_pos, _] = self.prev;
-        let prev_pos = if self.prev_ok & CH_POSITION != 0 { Some(prev_pos) } else { None };
+        let prev_pos = if self.prev_ok & CH_POSITION != 0 {
+            Some(prev_pos)
+        } else {
+            None
+        };
         let u = validate::substitute(&v, self.bad_ch, prev_pos, &core.limits);
         self.prev = v;
         self.prev_ok = !c.bad & CH_ALL;
@@ -266,7 +291,10 @@ impl<N: Num> GuardOf<N> {
             new_bits |= faults::STALE;
             self.bad_ch = CH_ALL;
         }
-        let u = self.core.as_ref().map(|c| validate::substitute(&self.prev, self.bad_ch, None, &c.limits));
+        let u = self
+            .core
+            .as_ref()
+            .map(|c| validate::substitute(&self.prev, self.bad_ch, None, &c.limits));
         self.advance(u.as_ref(), new_bits)
     }
 
@@ -275,7 +303,10 @@ impl<N: Num> GuardOf<N> {
         let newly = new_bits & !self.latched;
         self.latched |= new_bits;
         if newly != 0 {
-            self.trace.write(Trace::Fault { step: self.step, new_bits: newly | ((self.bad_ch as u16) << faults::CH_SHIFT) });
+            self.trace.write(Trace::Fault {
+                step: self.step,
+                new_bits: newly | ((self.bad_ch as u16) << faults::CH_SHIFT),
+            });
         }
         let force = self.latched != 0;
         let (drain_c, loss_cj, valve_ev, alarm_ev) = match (self.core.as_mut(), u) {
@@ -287,35 +318,63 @@ impl<N: Num> GuardOf<N> {
                 c.model.step_n(u);
                 let d = c.model.drain_c();
                 let th = &c.th;
-                let v = self.valve.update_with(d, force, th.open, th.close, self.dwell_steps);
+                let v = self
+                    .valve
+                    .update_with(d, force, th.open, th.close, self.dwell_steps);
                 let a = alarm_update_with(&mut self.alarm, d, th.alarm, th.clear);
                 // Total loss kW → cJ per 10 ms step (= W), never negative.
                 let cj = c.model.last_total_kw().round_times(1000).max(0) as u32;
                 (d.to_f32(), cj, v, a)
             }
             _ => {
-                let v = self.valve.update_with(DRAIN_C_UNKNOWN, true, 0.0, 0.0, self.dwell_steps);
+                let v = self
+                    .valve
+                    .update_with(DRAIN_C_UNKNOWN, true, 0.0, 0.0, self.dwell_steps);
                 self.alarm = true;
                 (DRAIN_C_UNKNOWN, 0, v, None)
             }
         };
-        let drain_c = if drain_c.is_finite() { drain_c } else { DRAIN_C_UNKNOWN };
+        let drain_c = if drain_c.is_finite() {
+            drain_c
+        } else {
+            DRAIN_C_UNKNOWN
+        };
         if let Some(open) = valve_ev {
             let t = if open {
-                Trace::ValveOpen { step: self.step, drain_c, forced: force }
+                Trace::ValveOpen {
+                    step: self.step,
+                    drain_c,
+                    forced: force,
+                }
             } else {
-                Trace::ValveClose { step: self.step, drain_c }
+                Trace::ValveClose {
+                    step: self.step,
+                    drain_c,
+                }
             };
             self.trace.write(t);
         }
         if let Some(a) = alarm_ev {
-            let t = if a { Trace::Alarm { step: self.step, drain_c } } else { Trace::AlarmClear { step: self.step, drain_c } };
+            let t = if a {
+                Trace::Alarm {
+                    step: self.step,
+                    drain_c,
+                }
+            } else {
+                Trace::AlarmClear {
+                    step: self.step,
+                    drain_c,
+                }
+            };
             self.trace.write(t);
         }
         self.lng.update_cj(self.valve.is_open(), loss_cj);
         let low = self.lng.is_low();
         if low && !self.lng_low {
-            self.trace.write(Trace::LngLow { step: self.step, remaining_kg: self.lng.remaining_kg() });
+            self.trace.write(Trace::LngLow {
+                step: self.step,
+                remaining_kg: self.lng.remaining_kg(),
+            });
         }
         self.lng_low = low;
         self.step = self.step.wrapping_add(1);
@@ -332,7 +391,9 @@ impl<N: Num> GuardOf<N> {
 
     /// Present fault word (see [`faults`]).
     pub fn faults(&self) -> u16 {
-        self.latched | ((self.bad_ch as u16) << faults::CH_SHIFT) | if self.lng_low { faults::LNG_LOW } else { 0 }
+        self.latched
+            | ((self.bad_ch as u16) << faults::CH_SHIFT)
+            | if self.lng_low { faults::LNG_LOW } else { 0 }
     }
 
     /// **Clear rule.** Latched faults (except CONFIG) clear only through this explicit
@@ -348,7 +409,10 @@ impl<N: Num> GuardOf<N> {
         self.latched &= faults::CONFIG;
         self.bad_ch = 0;
         if bits != 0 {
-            self.trace.write(Trace::FaultsCleared { step: self.step, bits });
+            self.trace.write(Trace::FaultsCleared {
+                step: self.step,
+                bits,
+            });
         }
         true
     }
@@ -357,7 +421,10 @@ impl<N: Num> GuardOf<N> {
     pub fn report_actuator_fault(&mut self) {
         if self.latched & faults::ACTUATOR == 0 {
             self.latched |= faults::ACTUATOR;
-            self.trace.write(Trace::Fault { step: self.step, new_bits: faults::ACTUATOR });
+            self.trace.write(Trace::Fault {
+                step: self.step,
+                new_bits: faults::ACTUATOR,
+            });
         }
     }
 
@@ -377,7 +444,13 @@ impl<N: Num> GuardOf<N> {
             }
             amb = c.model.ambient_c().to_f32();
         }
-        ThermalRecord::new(temps, amb, self.lng.used_cj(), self.faults() & !faults::LNG_LOW, self.step)
+        ThermalRecord::new(
+            temps,
+            amb,
+            self.lng.used_cj(),
+            self.faults() & !faults::LNG_LOW,
+            self.step,
+        )
     }
 
     /// The event trace (most recent [`crate::trace::TRACE_LEN`] events).

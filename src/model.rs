@@ -10,7 +10,7 @@
 use crate::linalg::expm1m;
 use crate::num::Num;
 use crate::params::{
-    ReducedParams, N_LOSSES, N_NODES, NODE_DRAIN, NODE_LOOP_OIL, NODE_WINDING, S_PER_STEP,
+    ReducedParams, NODE_DRAIN, NODE_LOOP_OIL, NODE_WINDING, N_LOSSES, N_NODES, S_PER_STEP,
 };
 
 /// Columns of one discretised row: 6 node temperatures then 5 losses.
@@ -71,14 +71,14 @@ pub enum ConfigError {
 /// Loss constants in model units (kW from hA, hbar, hrad/s, mm/step).
 #[derive(Clone, Copy, Debug)]
 struct LossK<N: Num> {
-    cu0: N,   // m R0 (1 - 25 alpha), kW/hA^2
-    cu1: N,   // m R0 alpha, kW/(hA^2 K)
-    fe1: N,   // kW/(hrad/s)
-    fe2: N,   // kW/(hrad/s)^2
-    fe15: N,  // kW/(hrad/s)^1.5
-    leak: N,  // kW/hbar^2
-    k_mu: N,  // 1/K
-    t_mu: N,  // degC
+    cu0: N,  // m R0 (1 - 25 alpha), kW/hA^2
+    cu1: N,  // m R0 alpha, kW/(hA^2 K)
+    fe1: N,  // kW/(hrad/s)
+    fe2: N,  // kW/(hrad/s)^2
+    fe15: N, // kW/(hrad/s)^1.5
+    leak: N, // kW/hbar^2
+    k_mu: N, // 1/K
+    t_mu: N, // degC
     use_mu: bool,
     mech: N,  // kW/(hbar hrad/s)
     kq: N,    // kW/(hbar hrad/s): D·1e6
@@ -142,7 +142,8 @@ impl<N: Num> Model<N> {
             return Err(ConfigError::Implausible);
         }
         let d = discretise(p);
-        let mut coef = [[N::coef_from_f64(0.0).ok_or(ConfigError::CoefficientRange)?; N_COLS]; N_NODES];
+        let mut coef =
+            [[N::coef_from_f64(0.0).ok_or(ConfigError::CoefficientRange)?; N_COLS]; N_NODES];
         for (cr, dr) in coef.iter_mut().zip(d.iter()) {
             if dr.iter().map(|x| libm::fabs(*x)).sum::<f64>() >= N::MAX_ROW_SUM {
                 return Err(ConfigError::CoefficientRange);
@@ -170,7 +171,10 @@ impl<N: Num> Model<N> {
             -c5 / (c3 + c5),
             c3 / (c3 + c5),
         ];
-        if consts.iter().any(|x| !x.is_finite() || libm::fabs(*x) >= 250.0) {
+        if consts
+            .iter()
+            .any(|x| !x.is_finite() || libm::fabs(*x) >= 250.0)
+        {
             return Err(ConfigError::ConstantRange);
         }
         let f = N::from_f64;
@@ -298,7 +302,12 @@ impl<N: Num> Model<N> {
         // (relative error < x^4/120: 8e-7 at x = 0.1; x ≈ 1e-3 at 60 bar).
         let k = &self.k;
         let xe = k.ex_k.mul(dp.abs());
-        let phi = xe.mul(k.one.sub(xe.mul(k.half).mul(k.one.sub(xe.mul(k.third).mul(k.one.sub(xe.mul(k.quarter)))))));
+        let phi = xe.mul(
+            k.one.sub(
+                xe.mul(k.half)
+                    .mul(k.one.sub(xe.mul(k.third).mul(k.one.sub(xe.mul(k.quarter))))),
+            ),
+        );
         let d = N::value(self.temp[NODE_LOOP_OIL]).sub(N::value(self.temp[NODE_DRAIN]));
         let q = phi.mul(d);
         self.temp[NODE_LOOP_OIL] = N::add_product(self.temp[NODE_LOOP_OIL], q, k.ex_w3);

@@ -58,7 +58,11 @@ pub trait Num: Copy + PartialOrd + core::fmt::Debug {
     /// Present value of a state accumulator.
     fn value(s: Self::State) -> Self;
     /// `s + Σ c_k v_k`: the discretised state update row.
-    fn accumulate<const K: usize>(s: Self::State, c: &[Self::Coef; K], v: &[Self; K]) -> Self::State;
+    fn accumulate<const K: usize>(
+        s: Self::State,
+        c: &[Self::Coef; K],
+        v: &[Self; K],
+    ) -> Self::State;
     /// `s + a b` at full accumulator precision.
     fn add_product(s: Self::State, a: Self, b: Self) -> Self::State;
     /// `round(self · k)` as an integer (saturating; NaN → 0).
@@ -71,26 +75,64 @@ impl Num for f64 {
     type Scale = f64;
     const ZERO: Self = 0.0;
     const MAX_ROW_SUM: f64 = f64::INFINITY;
-    fn from_f64(x: f64) -> Self { x }
-    fn coef_from_f64(x: f64) -> Option<f64> { x.is_finite().then_some(x) }
-    fn scale_from_f64(x: f64) -> Option<f64> { x.is_finite().then_some(x) }
-    fn from_f32_scaled(x: f32, s: f64) -> Self { x as f64 * s }
-    fn to_f32(self) -> f32 { self as f32 }
-    fn to_f64(self) -> f64 { self }
-    fn add(self, o: Self) -> Self { self + o }
-    fn sub(self, o: Self) -> Self { self - o }
-    fn mul(self, o: Self) -> Self { self * o }
-    fn abs(self) -> Self { libm::fabs(self) }
-    fn max0(self) -> Self { if self > 0.0 { self } else { 0.0 } }
-    fn sqrt_abs(self) -> Self { libm::sqrt(libm::fabs(self)) }
-    fn exp(self) -> Self { libm::exp(self) }
-    fn state(x: Self) -> f64 { x }
-    fn value(s: f64) -> Self { s }
+    fn from_f64(x: f64) -> Self {
+        x
+    }
+    fn coef_from_f64(x: f64) -> Option<f64> {
+        x.is_finite().then_some(x)
+    }
+    fn scale_from_f64(x: f64) -> Option<f64> {
+        x.is_finite().then_some(x)
+    }
+    fn from_f32_scaled(x: f32, s: f64) -> Self {
+        x as f64 * s
+    }
+    fn to_f32(self) -> f32 {
+        self as f32
+    }
+    fn to_f64(self) -> f64 {
+        self
+    }
+    fn add(self, o: Self) -> Self {
+        self + o
+    }
+    fn sub(self, o: Self) -> Self {
+        self - o
+    }
+    fn mul(self, o: Self) -> Self {
+        self * o
+    }
+    fn abs(self) -> Self {
+        libm::fabs(self)
+    }
+    fn max0(self) -> Self {
+        if self > 0.0 {
+            self
+        } else {
+            0.0
+        }
+    }
+    fn sqrt_abs(self) -> Self {
+        libm::sqrt(libm::fabs(self))
+    }
+    fn exp(self) -> Self {
+        libm::exp(self)
+    }
+    fn state(x: Self) -> f64 {
+        x
+    }
+    fn value(s: f64) -> Self {
+        s
+    }
     fn accumulate<const K: usize>(s: f64, c: &[f64; K], v: &[f64; K]) -> f64 {
         s + c.iter().zip(v.iter()).fold(0.0, |a, (c, v)| a + c * v)
     }
-    fn add_product(s: f64, a: f64, b: f64) -> f64 { s + a * b }
-    fn round_times(self, k: i32) -> i32 { libm::round(self * k as f64) as i32 }
+    fn add_product(s: f64, a: f64, b: f64) -> f64 {
+        s + a * b
+    }
+    fn round_times(self, k: i32) -> i32 {
+        libm::round(self * k as f64) as i32
+    }
 }
 
 /// Compensated `f32` state: value `hi` plus the rounding residue `lo` (|lo| <= ulp(hi)/2).
@@ -106,7 +148,10 @@ pub struct F32State {
 fn two_sum(s: F32State, d: f32) -> F32State {
     let y = d + s.lo;
     let t = s.hi + y;
-    F32State { hi: t, lo: y - (t - s.hi) }
+    F32State {
+        hi: t,
+        lo: y - (t - s.hi),
+    }
 }
 
 /// Square root of a non-negative finite `f32` without libm's bit-by-bit routine:
@@ -128,36 +173,72 @@ impl Num for f32 {
     type Scale = f32;
     const ZERO: Self = 0.0;
     const MAX_ROW_SUM: f64 = f64::INFINITY;
-    fn from_f64(x: f64) -> Self { x as f32 }
-    fn coef_from_f64(x: f64) -> Option<f32> { x.is_finite().then_some(x as f32) }
-    fn scale_from_f64(x: f64) -> Option<f32> { x.is_finite().then_some(x as f32) }
+    fn from_f64(x: f64) -> Self {
+        x as f32
+    }
+    fn coef_from_f64(x: f64) -> Option<f32> {
+        x.is_finite().then_some(x as f32)
+    }
+    fn scale_from_f64(x: f64) -> Option<f32> {
+        x.is_finite().then_some(x as f32)
+    }
     #[inline(always)]
-    fn from_f32_scaled(x: f32, s: f32) -> Self { x * s }
-    fn to_f32(self) -> f32 { self }
-    fn to_f64(self) -> f64 { self as f64 }
+    fn from_f32_scaled(x: f32, s: f32) -> Self {
+        x * s
+    }
+    fn to_f32(self) -> f32 {
+        self
+    }
+    fn to_f64(self) -> f64 {
+        self as f64
+    }
     #[inline(always)]
-    fn add(self, o: Self) -> Self { self + o }
+    fn add(self, o: Self) -> Self {
+        self + o
+    }
     #[inline(always)]
-    fn sub(self, o: Self) -> Self { self - o }
+    fn sub(self, o: Self) -> Self {
+        self - o
+    }
     #[inline(always)]
-    fn mul(self, o: Self) -> Self { self * o }
+    fn mul(self, o: Self) -> Self {
+        self * o
+    }
     #[inline(always)]
-    fn abs(self) -> Self { libm::fabsf(self) }
+    fn abs(self) -> Self {
+        libm::fabsf(self)
+    }
     #[inline(always)]
-    fn max0(self) -> Self { if self > 0.0 { self } else { 0.0 } }
+    fn max0(self) -> Self {
+        if self > 0.0 {
+            self
+        } else {
+            0.0
+        }
+    }
     #[inline(always)]
-    fn sqrt_abs(self) -> Self { sqrt_f32(libm::fabsf(self)) }
-    fn exp(self) -> Self { libm::expf(self) }
-    fn state(x: Self) -> F32State { F32State { hi: x, lo: 0.0 } }
+    fn sqrt_abs(self) -> Self {
+        sqrt_f32(libm::fabsf(self))
+    }
+    fn exp(self) -> Self {
+        libm::expf(self)
+    }
+    fn state(x: Self) -> F32State {
+        F32State { hi: x, lo: 0.0 }
+    }
     #[inline(always)]
-    fn value(s: F32State) -> Self { s.hi }
+    fn value(s: F32State) -> Self {
+        s.hi
+    }
     #[inline(always)]
     fn accumulate<const K: usize>(s: F32State, c: &[f32; K], v: &[f32; K]) -> F32State {
         let d = c.iter().zip(v.iter()).fold(0.0f32, |a, (c, v)| a + c * v);
         two_sum(s, d)
     }
     #[inline(always)]
-    fn add_product(s: F32State, a: f32, b: f32) -> F32State { two_sum(s, a * b) }
+    fn add_product(s: F32State, a: f32, b: f32) -> F32State {
+        two_sum(s, a * b)
+    }
     #[inline(always)]
     fn round_times(self, k: i32) -> i32 {
         let y = self * k as f32;
@@ -202,14 +283,22 @@ fn f32_times_q30_to_q23(x: f32, s_raw: i32) -> i32 {
         if frac != 0 {
             return 0;
         }
-        return if (b >> 31 != 0) == (s_raw < 0) { i32::MAX } else { i32::MIN };
+        return if (b >> 31 != 0) == (s_raw < 0) {
+            i32::MAX
+        } else {
+            i32::MIN
+        };
     }
     let m = if e == 0 { frac } else { frac | 0x0080_0000 } as i64;
     let p = m * s_raw as i64; // |p| < 2^24 · 2^31
     let sh = e - 157;
     let mag = if sh >= 0 {
         if sh > 8 || p.unsigned_abs() >= (1u64 << (62 - sh)) {
-            if p < 0 { i64::MIN } else { i64::MAX }
+            if p < 0 {
+                i64::MIN
+            } else {
+                i64::MAX
+            }
         } else {
             p << sh
         }
@@ -218,7 +307,11 @@ fn f32_times_q30_to_q23(x: f32, s_raw: i32) -> i32 {
     } else {
         0
     };
-    let v = if b >> 31 != 0 { mag.saturating_neg() } else { mag };
+    let v = if b >> 31 != 0 {
+        mag.saturating_neg()
+    } else {
+        mag
+    };
     sat_i32(v)
 }
 
@@ -229,7 +322,9 @@ fn isqrt_u32(n: u32) -> u32 {
     let bits = 32 - n.leading_zeros();
     let mut x = 1u32 << bits.div_ceil(2).min(16);
     loop {
-        let Some(nz) = core::num::NonZeroU32::new(x) else { return 0 };
+        let Some(nz) = core::num::NonZeroU32::new(x) else {
+            return 0;
+        };
         let y = (x + n / nz) >> 1;
         if y >= x {
             return x;
@@ -246,29 +341,55 @@ impl Num for Fx {
     const MAX_ROW_SUM: f64 = 1.0;
     fn from_f64(x: f64) -> Self {
         // checked (NaN → None) instead of saturating_from_num, which panics on NaN.
-        Fx::checked_from_num(x).unwrap_or(if x > 0.0 { Fx::MAX } else if x < 0.0 { Fx::MIN } else { Fx::ZERO })
+        Fx::checked_from_num(x).unwrap_or(if x > 0.0 {
+            Fx::MAX
+        } else if x < 0.0 {
+            Fx::MIN
+        } else {
+            Fx::ZERO
+        })
     }
-    fn coef_from_f64(x: f64) -> Option<FxCoef> { FxCoef::checked_from_num(x) }
-    fn scale_from_f64(x: f64) -> Option<FxScale> { FxScale::checked_from_num(x) }
+    fn coef_from_f64(x: f64) -> Option<FxCoef> {
+        FxCoef::checked_from_num(x)
+    }
+    fn scale_from_f64(x: f64) -> Option<FxScale> {
+        FxScale::checked_from_num(x)
+    }
     #[inline(always)]
     fn from_f32_scaled(x: f32, s: FxScale) -> Self {
         Fx::from_bits(f32_times_q30_to_q23(x, s.to_bits()))
     }
-    fn to_f32(self) -> f32 { self.to_num::<f32>() }
-    fn to_f64(self) -> f64 { self.to_num::<f64>() }
+    fn to_f32(self) -> f32 {
+        self.to_num::<f32>()
+    }
+    fn to_f64(self) -> f64 {
+        self.to_num::<f64>()
+    }
     #[inline(always)]
-    fn add(self, o: Self) -> Self { self.saturating_add(o) }
+    fn add(self, o: Self) -> Self {
+        self.saturating_add(o)
+    }
     #[inline(always)]
-    fn sub(self, o: Self) -> Self { self.saturating_sub(o) }
+    fn sub(self, o: Self) -> Self {
+        self.saturating_sub(o)
+    }
     #[inline(always)]
     fn mul(self, o: Self) -> Self {
         let p = self.to_bits() as i64 * o.to_bits() as i64;
         Fx::from_bits(sat_i32((p + (1 << 22)) >> 23))
     }
     #[inline(always)]
-    fn abs(self) -> Self { self.saturating_abs() }
+    fn abs(self) -> Self {
+        self.saturating_abs()
+    }
     #[inline(always)]
-    fn max0(self) -> Self { if self > Fx::ZERO { self } else { Fx::ZERO } }
+    fn max0(self) -> Self {
+        if self > Fx::ZERO {
+            self
+        } else {
+            Fx::ZERO
+        }
+    }
     #[inline(always)]
     fn sqrt_abs(self) -> Self {
         // sqrt(v 2^-23) 2^23 = sqrt(v 2^23): normalise v << s (s odd, so 23 - s is even)
@@ -287,8 +408,15 @@ impl Num for Fx {
         let out = if e >= 0 { r << e } else { r >> -e };
         Fx::from_bits(out as i32)
     }
-    fn exp(self) -> Self { Fx::from_bits(f32_times_q30_to_q23(libm::expf(self.to_num::<f32>()), 1 << 30)) }
-    fn state(x: Self) -> FxState { FxState::from_bits((x.to_bits() as i64) << 32) }
+    fn exp(self) -> Self {
+        Fx::from_bits(f32_times_q30_to_q23(
+            libm::expf(self.to_num::<f32>()),
+            1 << 30,
+        ))
+    }
+    fn state(x: Self) -> FxState {
+        FxState::from_bits((x.to_bits() as i64) << 32)
+    }
     #[inline(always)]
     fn value(s: FxState) -> Self {
         // Round to nearest Q9.23 (add half an LSB before taking the high word).
@@ -298,10 +426,9 @@ impl Num for Fx {
     #[inline(always)]
     fn accumulate<const K: usize>(s: FxState, c: &[FxCoef; K], v: &[Self; K]) -> FxState {
         // |Σ c| < 0.5 is checked at init, so |Σ c v| < 2^31 · 2^31: no i64 overflow.
-        let d = c
-            .iter()
-            .zip(v.iter())
-            .fold(0i64, |a, (c, v)| a.wrapping_add(c.to_bits() as i64 * v.to_bits() as i64));
+        let d = c.iter().zip(v.iter()).fold(0i64, |a, (c, v)| {
+            a.wrapping_add(c.to_bits() as i64 * v.to_bits() as i64)
+        });
         FxState::from_bits(s.to_bits().saturating_add(d))
     }
     #[inline(always)]
@@ -382,7 +509,10 @@ mod tests {
             while x < 1e7 {
                 for &xv in &[x, -x] {
                     let got = Fx::from_f32_scaled(xv, s).to_bits() as i64;
-                    let exact = (xv as f64 * sq * 8_388_608.0).round().clamp(i32::MIN as f64, i32::MAX as f64) as i64;
+                    let exact = (xv as f64 * sq * 8_388_608.0)
+                        .round()
+                        .clamp(i32::MIN as f64, i32::MAX as f64)
+                        as i64;
                     assert!((got - exact).abs() <= 1, "x {xv} s {sc}: {got} vs {exact}");
                 }
                 x *= 3.7;
@@ -412,7 +542,10 @@ mod tests {
         assert!((Fx::MIN.sqrt_abs().to_f64() - 16.0).abs() < 1e-3);
         for n in [0u32, 1, 2, 3, 4, 15, 16, 17, 65535, 65536, u32::MAX] {
             let r = isqrt_u32(n) as u64;
-            assert!(r * r <= n as u64 && (r + 1) * (r + 1) > n as u64, "isqrt({n}) = {r}");
+            assert!(
+                r * r <= n as u64 && (r + 1) * (r + 1) > n as u64,
+                "isqrt({n}) = {r}"
+            );
         }
     }
 

@@ -93,8 +93,14 @@ impl ReducedParams {
     /// Physical plausibility check: capacities > 0, conductances >= 0 and symmetric,
     /// split columns sum to 1 within 1e-9, all finite. `true` when usable.
     pub fn is_plausible(&self) -> bool {
-        let caps = self.capacity_j_per_k.iter().all(|c| c.is_finite() && *c > 0.0);
-        let amb = self.ambient_w_per_k.iter().all(|g| g.is_finite() && *g >= 0.0);
+        let caps = self
+            .capacity_j_per_k
+            .iter()
+            .all(|c| c.is_finite() && *c > 0.0);
+        let amb = self
+            .ambient_w_per_k
+            .iter()
+            .all(|g| g.is_finite() && *g >= 0.0);
         let mut sym = true;
         for (i, row) in self.conductance_w_per_k.iter().enumerate() {
             for (j, g) in row.iter().enumerate() {

@@ -96,12 +96,52 @@ impl<N: Num> LimitsN<N> {
     pub fn new(l: &InputLimits, sc: &InputScales<N>) -> Option<Self> {
         let ok = |x: f32| x.is_finite() && x.abs() < 250.0;
         let cv = |x: f32, s: N::Scale| N::from_f32_scaled(x, s);
-        let lo = [-l.current_a_max, l.pressure_bar_min, l.pressure_bar_min, -l.speed_rpm_max, l.position_mm_min, l.ambient_c_min];
-        let hi = [l.current_a_max, l.pressure_bar_max, l.pressure_bar_max, l.speed_rpm_max, l.position_mm_max, l.ambient_c_max];
-        let rt = [l.current_a_per_step, l.pressure_bar_per_step, l.pressure_bar_per_step, l.speed_rpm_per_step, l.position_mm_per_step, l.ambient_c_per_step];
-        let s = [sc.ha_per_a, sc.hbar_per_bar, sc.hbar_per_bar, sc.hrads_per_rpm, sc.one, sc.one];
-        let s64 = [crate::model::HA_PER_A, crate::model::HBAR_PER_BAR, crate::model::HBAR_PER_BAR, crate::model::HRADS_PER_RPM, 1.0, 1.0];
-        let mut out = LimitsN { lo: [N::ZERO; 6], hi: [N::ZERO; 6], rate: [N::ZERO; 6], p_span: N::ZERO };
+        let lo = [
+            -l.current_a_max,
+            l.pressure_bar_min,
+            l.pressure_bar_min,
+            -l.speed_rpm_max,
+            l.position_mm_min,
+            l.ambient_c_min,
+        ];
+        let hi = [
+            l.current_a_max,
+            l.pressure_bar_max,
+            l.pressure_bar_max,
+            l.speed_rpm_max,
+            l.position_mm_max,
+            l.ambient_c_max,
+        ];
+        let rt = [
+            l.current_a_per_step,
+            l.pressure_bar_per_step,
+            l.pressure_bar_per_step,
+            l.speed_rpm_per_step,
+            l.position_mm_per_step,
+            l.ambient_c_per_step,
+        ];
+        let s = [
+            sc.ha_per_a,
+            sc.hbar_per_bar,
+            sc.hbar_per_bar,
+            sc.hrads_per_rpm,
+            sc.one,
+            sc.one,
+        ];
+        let s64 = [
+            crate::model::HA_PER_A,
+            crate::model::HBAR_PER_BAR,
+            crate::model::HBAR_PER_BAR,
+            crate::model::HRADS_PER_RPM,
+            1.0,
+            1.0,
+        ];
+        let mut out = LimitsN {
+            lo: [N::ZERO; 6],
+            hi: [N::ZERO; 6],
+            rate: [N::ZERO; 6],
+            p_span: N::ZERO,
+        };
         for ((((o_lo, o_hi), o_rt), (a, b)), (c, (sc, k))) in out
             .lo
             .iter_mut()
@@ -140,8 +180,22 @@ pub struct Check {
 /// whose `f32` is NaN or infinite (tested on the bits: exponent all ones).
 #[inline(always)]
 pub fn convert<N: Num>(s: &Sample, sc: &InputScales<N>) -> (Channels<N>, u8) {
-    let raw = [s.current_a, s.p_a_bar, s.p_b_bar, s.speed_rpm, s.position_mm, s.ambient_c];
-    let scale = [sc.ha_per_a, sc.hbar_per_bar, sc.hbar_per_bar, sc.hrads_per_rpm, sc.one, sc.one];
+    let raw = [
+        s.current_a,
+        s.p_a_bar,
+        s.p_b_bar,
+        s.speed_rpm,
+        s.position_mm,
+        s.ambient_c,
+    ];
+    let scale = [
+        sc.ha_per_a,
+        sc.hbar_per_bar,
+        sc.hbar_per_bar,
+        sc.hrads_per_rpm,
+        sc.one,
+        sc.one,
+    ];
     let mut v = [N::ZERO; 6];
     let mut nonfinite = 0u8;
     for (i, ((o, x), k)) in v.iter_mut().zip(raw.iter()).zip(scale.iter()).enumerate() {
@@ -156,7 +210,17 @@ pub fn convert<N: Num>(s: &Sample, sc: &InputScales<N>) -> (Channels<N>, u8) {
 
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn check_one<N: Num>(x: N, p: N, lo: N, hi: N, r: N, bit: u8, skip: u8, prev_ok: u8, c: &mut Check) {
+fn check_one<N: Num>(
+    x: N,
+    p: N,
+    lo: N,
+    hi: N,
+    r: N,
+    bit: u8,
+    skip: u8,
+    prev_ok: u8,
+    c: &mut Check,
+) {
     if skip & bit != 0 {
         return;
     }
@@ -176,8 +240,18 @@ fn check_one<N: Num>(x: N, p: N, lo: N, hi: N, r: N, bit: u8, skip: u8, prev_ok:
 /// `prev_ok` (rate is only checked against valid previous values). Written out per
 /// channel (no loop) so that it compiles to straight-line code.
 #[inline(always)]
-pub fn check<N: Num>(v: &Channels<N>, nonfinite: u8, prev: &Channels<N>, prev_ok: u8, lim: &LimitsN<N>) -> Check {
-    let mut c = Check { non_finite: nonfinite != 0, bad: nonfinite, ..Check::default() };
+pub fn check<N: Num>(
+    v: &Channels<N>,
+    nonfinite: u8,
+    prev: &Channels<N>,
+    prev_ok: u8,
+    lim: &LimitsN<N>,
+) -> Check {
+    let mut c = Check {
+        non_finite: nonfinite != 0,
+        bad: nonfinite,
+        ..Check::default()
+    };
     let [x0, x1, x2, x3, x4, x5] = *v;
     let [p0, p1, p2, p3, p4, p5] = *prev;
     let [l0, l1, l2, l3, l4, l5] = lim.lo;
@@ -202,14 +276,23 @@ pub fn check<N: Num>(v: &Channels<N>, nonfinite: u8, prev: &Channels<N>, prev_ok
 /// ambient gives the maximum ambient. Valid channels are used as they are.
 /// `prev_pos` is the last valid position (`None` → no derivative, `dpos = 0`).
 #[inline(always)]
-pub fn substitute<N: Num>(v: &Channels<N>, bad: u8, prev_pos: Option<N>, lim: &LimitsN<N>) -> ModelInputN<N> {
+pub fn substitute<N: Num>(
+    v: &Channels<N>,
+    bad: u8,
+    prev_pos: Option<N>,
+    lim: &LimitsN<N>,
+) -> ModelInputN<N> {
     let [i, pa, pb, w, x, amb] = *v;
     let [_, _, _, _, _, amb_max] = lim.hi;
     let [i_max, _, _, w_max, _, _] = lim.hi;
     let current = if bad & CH_CURRENT != 0 { i_max } else { i };
     let speed_ok = bad & CH_SPEED == 0;
     let dp = if bad & (CH_P_A | CH_P_B) != 0 {
-        if speed_ok && w < N::ZERO { N::ZERO.sub(lim.p_span) } else { lim.p_span }
+        if speed_ok && w < N::ZERO {
+            N::ZERO.sub(lim.p_span)
+        } else {
+            lim.p_span
+        }
     } else {
         pa.sub(pb)
     };
@@ -225,5 +308,11 @@ pub fn substitute<N: Num>(v: &Channels<N>, bad: u8, prev_pos: Option<N>, lim: &L
         _ => N::ZERO,
     };
     let ambient = if bad & CH_AMBIENT != 0 { amb_max } else { amb };
-    ModelInputN { current_ha: current, dp_hbar: dp, speed_hrads: speed, dpos_mm: dpos, ambient_c: ambient }
+    ModelInputN {
+        current_ha: current,
+        dp_hbar: dp,
+        speed_hrads: speed,
+        dpos_mm: dpos,
+        ambient_c: ambient,
+    }
 }

@@ -111,7 +111,12 @@ mod fw {
             let out = service(&mut board, &mut guard);
             if guard.steps() % 100 == 0 {
                 noinit::store(&guard.snapshot());
-                defmt::info!("drain {} degC valve {} faults {=u16:#x}", out.drain_c, out.valve_open, out.faults);
+                defmt::info!(
+                    "drain {} degC valve {} faults {=u16:#x}",
+                    out.drain_c,
+                    out.valve_open,
+                    out.faults
+                );
             }
         }
     }
