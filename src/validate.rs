@@ -229,7 +229,7 @@ fn check_one<N: Num>(
         c.bad |= bit;
     } else if prev_ok & bit != 0 {
         let d = x.sub(p);
-        if !(d <= r && d >= N::ZERO.sub(r)) {
+        if !(d.abs() <= r) {
             c.rate = true;
             c.bad |= bit;
         }
