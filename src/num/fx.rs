@@ -189,6 +189,16 @@ impl Num for Fx {
         FxState::from_bits(s.to_bits().saturating_add(d))
     }
     #[inline(always)]
+    fn accumulate_plus<const K: usize>(
+        s: FxState,
+        c: &[FxCoef; K],
+        v: &[Self; K],
+        a: Self,
+        b: Self,
+    ) -> FxState {
+        Self::add_product(Self::accumulate(s, c, v), a, b)
+    }
+    #[inline(always)]
     fn add_product(s: FxState, a: Self, b: Self) -> FxState {
         // Q9.23 × Q9.23 = Q18.46; shift left 9 to Q.55 (saturating).
         let p = a.to_bits() as i64 * b.to_bits() as i64;

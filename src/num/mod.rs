@@ -66,6 +66,14 @@ pub trait Num: Copy + PartialOrd + core::fmt::Debug {
     ) -> Self::State;
     /// `s + a b` at full accumulator precision.
     fn add_product(s: Self::State, a: Self, b: Self) -> Self::State;
+    /// `s + Σ c_k v_k + a b` with one rounding step into the state.
+    fn accumulate_plus<const K: usize>(
+        s: Self::State,
+        c: &[Self::Coef; K],
+        v: &[Self; K],
+        a: Self,
+        b: Self,
+    ) -> Self::State;
     /// `round(self · k)` as an integer (saturating; NaN → 0).
     fn round_times(self, k: i32) -> i32;
 }
@@ -127,6 +135,9 @@ impl Num for f64 {
     }
     fn accumulate<const K: usize>(s: f64, c: &[f64; K], v: &[f64; K]) -> f64 {
         s + c.iter().zip(v.iter()).fold(0.0, |a, (c, v)| a + c * v)
+    }
+    fn accumulate_plus<const K: usize>(s: f64, c: &[f64; K], v: &[f64; K], a: f64, b: f64) -> f64 {
+        Self::accumulate(s, c, v) + a * b
     }
     fn add_product(s: f64, a: f64, b: f64) -> f64 {
         s + a * b
@@ -234,6 +245,20 @@ impl Num for f32 {
     #[inline(always)]
     fn accumulate<const K: usize>(s: F32State, c: &[f32; K], v: &[f32; K]) -> F32State {
         let d = c.iter().zip(v.iter()).fold(0.0f32, |a, (c, v)| a + c * v);
+        two_sum(s, d)
+    }
+    #[inline(always)]
+    fn accumulate_plus<const K: usize>(
+        s: F32State,
+        c: &[f32; K],
+        v: &[f32; K],
+        a: f32,
+        b: f32,
+    ) -> F32State {
+        let d = c
+            .iter()
+            .zip(v.iter())
+            .fold(a * b, |acc, (c, v)| acc + c * v);
         two_sum(s, d)
     }
     #[inline(always)]
