@@ -210,6 +210,8 @@ pub fn convert<N: Num>(s: &Sample, sc: &InputScales<N>) -> (Channels<N>, u8) {
 
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
+// `!(d.abs() <= r)` is deliberate: a NaN difference (not reachable) counts as a fault.
+#[allow(clippy::neg_cmp_op_on_partial_ord)]
 fn check_one<N: Num>(
     x: N,
     p: N,
