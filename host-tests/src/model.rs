@@ -436,9 +436,6 @@ impl Model {
         dy[E_LOSS] = l.total();
         dy[E_AMB] = q_amb;
         dy[E_LNG] = q_lng;
-        if std::env::var("EHA_DEBUG_RHS").is_ok() && dy.iter().chain(y.iter()).any(|v| !v.is_finite()) {
-            eprintln!("non-finite at t={t}: y={y:?} dy={dy:?}");
-        }
     }
 
     /// Energy stored in the nodes relative to the state `y0`, J.

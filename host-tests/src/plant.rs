@@ -294,10 +294,6 @@ impl Plant {
         let mut y_buf = vec![0.0; N_STATE];
         'outer: while !ctl.stop && snap.t < t_end - 1e-9 {
             let here = solver.state().t;
-            if std::env::var("EHA_DEBUG_STEPS").is_ok() {
-                let st = solver.state();
-                eprintln!("t={:.6} h={:.3e} y={:?}", st.t, st.h, &st.y.batch_as_slice(0)[..5]);
-            }
             let reason = solver.step().map_err(err(here))?;
             let t_now = solver.state().t;
             // Callbacks at the segment ends inside this step, by interpolation.
