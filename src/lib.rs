@@ -1,2 +1,4 @@
 //! EHA drain-oil thermal protection core (`#![no_std]`).
 #![no_std]
+
+pub mod protocol;
