@@ -241,25 +241,54 @@ impl RejectReason {
 /// One sensor sample for one guard step (the wire form of the guard's `Sample`).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Request {
+    /// Sequence number (wrapping).
     pub seq: u16,
+    /// Motor phase current, A rms.
     pub current_a: f32,
+    /// Pump port A pressure, bar (gauge).
     pub p_a_bar: f32,
+    /// Pump port B pressure, bar (gauge).
     pub p_b_bar: f32,
+    /// Motor/pump speed, rpm (signed).
     pub speed_rpm: f32,
+    /// Piston position, mm.
     pub position_mm: f32,
+    /// Ambient air temperature, degC.
     pub ambient_c: f32,
 }
 
-/// What the guard reports after a step (the wire form of the guard's `Output`).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct GuardOutput {
-    pub drain_c: f32,
-    pub valve_open: bool,
-    pub alarm: bool,
-    pub derate: bool,
-    pub faults: u16,
-    pub lng_remaining_kg: f32,
-    pub lng_seconds_left: f32,
+/// What the guard reports after a step: the guard's own [`crate::Output`].
+pub type GuardOutput = crate::Output;
+
+impl Request {
+    /// The guard's sample carried by this frame.
+    pub fn sample(&self) -> crate::Sample {
+        crate::Sample {
+            current_a: self.current_a,
+            p_a_bar: self.p_a_bar,
+            p_b_bar: self.p_b_bar,
+            speed_rpm: self.speed_rpm,
+            position_mm: self.position_mm,
+            ambient_c: self.ambient_c,
+        }
+    }
+}
+
+/// Most missed steps replayed into the guard for one sequence gap. After
+/// `stale_steps` (5) misses the STALE fault has latched and the guard runs on
+/// worst-case inputs; a longer gap would only spend time, so it is capped.
+pub const MAX_MISSED_STEPS: u16 = 100;
+
+/// The firmware's core step for one accepted frame, shared by the firmware
+/// binary and the host SIL twin so both run exactly the same code: frames
+/// the sequence numbers say were lost count as missed samples
+/// ([`crate::GuardOf::step_missing`], at most [`MAX_MISSED_STEPS`]), then
+/// the guard steps on the frame's sample.
+pub fn step_guard<N: crate::num::Num>(guard: &mut crate::GuardOf<N>, req: &Request, skipped: u16) -> GuardOutput {
+    for _ in 0..skipped.min(MAX_MISSED_STEPS) {
+        let _ = guard.step_missing();
+    }
+    guard.step(&req.sample())
 }
 
 impl GuardOutput {
@@ -281,10 +310,15 @@ impl GuardOutput {
 /// Rejection and acceptance counters (saturating).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Counters {
+    /// Frames rejected for a CRC mismatch.
     pub rejected_crc: u16,
+    /// Frames rejected for framing: COBS, length, overflow, unknown kind.
     pub rejected_framing: u16,
+    /// Frames rejected as duplicate or older than the last accepted one.
     pub rejected_sequence: u16,
+    /// Sequence numbers skipped by accepted frames (lost frames).
     pub skipped: u16,
+    /// Accepted frames (guard steps).
     pub accepted: u32,
 }
 
@@ -310,9 +344,13 @@ pub enum ReplyKind {
 /// A reply frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Reply {
+    /// Step, reject or done.
     pub kind: ReplyKind,
+    /// Sequence number (see [`ReplyKind`]).
     pub seq: u16,
+    /// Guard output (the last one for reject/done).
     pub out: GuardOutput,
+    /// Counters after this frame.
     pub counters: Counters,
     /// Core-clock ticks spent in the guard step (0 when not measured).
     pub step_ticks: u32,
@@ -321,10 +359,15 @@ pub struct Reply {
 /// Errors of the host-side decoders.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum DecodeError {
+    /// Malformed COBS or too short.
     Cobs,
+    /// Longer than any valid frame.
     Overflow,
+    /// CRC mismatch.
     Crc,
+    /// Wrong payload length.
     Length,
+    /// Unknown kind byte.
     Kind,
 }
 
@@ -505,6 +548,7 @@ pub struct Deframer {
 pub type Payload = Vec<u8, MAX_RAW>;
 
 impl Deframer {
+    /// An idle deframer.
     pub const fn new() -> Self {
         Self { buf: Vec::new(), overflow: false }
     }
@@ -565,6 +609,7 @@ fn sat_inc(c: &mut u16) {
 }
 
 impl Link {
+    /// A fresh link: no sequence yet, counters zero.
     pub const fn new() -> Self {
         Self {
             rx: Deframer::new(),
@@ -608,7 +653,7 @@ impl Link {
     /// and `send` gets the encoded reply. Never panics, never blocks.
     pub fn push_bytes<S, W>(&mut self, bytes: &[u8], mut step: S, mut send: W)
     where
-        S: FnMut(&Request) -> (GuardOutput, u32),
+        S: FnMut(&Request, u16) -> (GuardOutput, u32),
         W: FnMut(&Reply, &[u8]),
     {
         for &b in bytes {
@@ -620,7 +665,7 @@ impl Link {
 
     fn handle<S>(&mut self, res: Result<Payload, DecodeError>, step: &mut S) -> Reply
     where
-        S: FnMut(&Request) -> (GuardOutput, u32),
+        S: FnMut(&Request, u16) -> (GuardOutput, u32),
     {
         let reject_seq = self.last_seq.unwrap_or(0);
         let req = match res.and_then(|p| Request::from_payload(&p)) {
@@ -633,18 +678,19 @@ impl Link {
                 return self.reply(ReplyKind::Reject(e.reason()), reject_seq, 0);
             }
         };
+        let mut gap = 0;
         if let Some(last) = self.last_seq {
             let ahead = req.seq.wrapping_sub(last);
             if ahead == 0 || ahead > 0x8000 {
                 sat_inc(&mut self.counters.rejected_sequence);
                 return self.reply(ReplyKind::Reject(RejectReason::Sequence), req.seq, 0);
             }
-            let gap = ahead - 1;
+            gap = ahead - 1;
             self.counters.skipped = self.counters.skipped.saturating_add(gap);
         }
         self.last_seq = Some(req.seq);
         self.counters.accepted = self.counters.accepted.saturating_add(1);
-        let (out, ticks) = step(&req);
+        let (out, ticks) = step(&req, gap);
         self.last_out = out;
         self.reply(ReplyKind::Step, req.seq, ticks)
     }
@@ -759,7 +805,7 @@ mod tests {
         let mut replies = std::vec::Vec::new();
         link.push_bytes(
             bytes,
-            |r| (GuardOutput { drain_c: r.seq as f32, ..Default::default() }, 0),
+            |r, _| (GuardOutput { drain_c: r.seq as f32, ..Default::default() }, 0),
             |rep, _| replies.push(*rep),
         );
         replies
@@ -796,7 +842,7 @@ mod tests {
         bad[3] ^= 0x40;
         let mut stepped = false;
         let mut replies = std::vec::Vec::new();
-        l.push_bytes(&bad, |_| { stepped = true; (GuardOutput::default(), 0) }, |r, _| replies.push(*r));
+        l.push_bytes(&bad, |_, _| { stepped = true; (GuardOutput::default(), 0) }, |r, _| replies.push(*r));
         assert!(!stepped);
         assert!(matches!(replies[0].kind, ReplyKind::Reject(RejectReason::Crc | RejectReason::Cobs)));
         assert_eq!(replies[0].out.drain_c, 1.0);
