@@ -50,12 +50,26 @@ impl PlantSensors {
     }
 }
 
-/// A plant that can be stepped in lockstep with the firmware.
+/// What the loop tells the plant after one step.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StepControl {
+    /// Keep going with this LNG valve command during the next step.
+    Valve(bool),
+    /// Stop now (the run ended or failed).
+    Stop,
+}
+
+/// A plant that can run in lockstep with the firmware. The plant owns the
+/// time loop (a stiff solver keeps its state across steps): it calls
+/// `on_step(t_s, sensors)` at `t0, t0 + dt, …` up to `t_end` and applies the
+/// returned valve command during the following step.
 pub trait PlantModel {
-    fn sensors(&self) -> PlantSensors;
-    fn set_lng_valve(&mut self, open: bool);
-    fn advance(&mut self, dt_s: f64) -> anyhow::Result<()>;
-    fn time_s(&self) -> f64;
+    fn run(
+        &mut self,
+        dt_s: f64,
+        t_end_s: f64,
+        on_step: &mut dyn FnMut(f64, &PlantSensors) -> StepControl,
+    ) -> anyhow::Result<()>;
 }
 
 /// The thing that answers request frames: the firmware in QEMU or the SIL core.
@@ -103,7 +117,8 @@ pub struct LoopFailure {
     pub error: anyhow::Error,
 }
 
-/// Run plant and target in lockstep. On failure the records so far are returned with the error.
+/// Run plant and target in lockstep for `opts.steps()` firmware steps. On
+/// failure the records so far are returned with the error.
 pub fn run_closed_loop(
     plant: &mut dyn PlantModel,
     target: &mut dyn Target,
@@ -111,24 +126,45 @@ pub fn run_closed_loop(
 ) -> Result<Vec<StepRecord>, LoopFailure> {
     let n = opts.steps();
     let mut records = Vec::with_capacity(n as usize);
-    for k in 0..n {
-        let t_s = plant.time_s();
-        let sensors = plant.sensors();
+    let mut failure: Option<anyhow::Error> = None;
+    let mut on_step = |t_s: f64, sensors: &PlantSensors| -> StepControl {
+        let k = records.len() as u64;
+        if k >= n {
+            return StepControl::Stop;
+        }
         let request = sensors.request((k & 0xFFFF) as u16);
         let reply = match target.exchange(&request.encode(), k) {
             Ok(r) => r,
-            Err(e) => return Err(LoopFailure { records, error: e.into() }),
+            Err(e) => {
+                failure = Some(e.into());
+                return StepControl::Stop;
+            }
         };
         if reply.kind != ReplyKind::Step || reply.seq != request.seq {
             let what = format!("expected a step reply to seq {}, got {:?} for seq {}", request.seq, reply.kind, reply.seq);
-            return Err(LoopFailure { records, error: PilError::Protocol { step: k, what }.into() });
+            failure = Some(PilError::Protocol { step: k, what }.into());
+            return StepControl::Stop;
         }
-        plant.set_lng_valve(reply.out.valve_open);
-        if let Err(e) = plant.advance(opts.step_s) {
-            records.push(StepRecord { t_s, sensors, request, reply });
-            return Err(LoopFailure { records, error: e.context(format!("plant failed to advance at t = {t_s} s")) });
+        records.push(StepRecord { t_s, sensors: *sensors, request, reply });
+        if records.len() as u64 >= n {
+            StepControl::Stop
+        } else {
+            StepControl::Valve(reply.out.valve_open)
         }
-        records.push(StepRecord { t_s, sensors, request, reply });
+    };
+    // One extra step of plant time so the plant offers all n samples.
+    let t_end = opts.duration_s + opts.step_s;
+    let res = plant.run(opts.step_s, t_end, &mut on_step);
+    if let Some(error) = failure {
+        return Err(LoopFailure { records, error });
+    }
+    if let Err(e) = res {
+        let t = records.last().map_or(0.0, |r| r.t_s);
+        return Err(LoopFailure { records, error: e.context(format!("plant failed after t = {t} s")) });
+    }
+    if (records.len() as u64) < n {
+        let error = anyhow::anyhow!("plant stopped after {} of {n} steps", records.len());
+        return Err(LoopFailure { records, error });
     }
     Ok(records)
 }

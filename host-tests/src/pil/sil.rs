@@ -11,7 +11,7 @@ pub struct SilTarget<F> {
     core: F,
 }
 
-impl<F: FnMut(&Request) -> GuardOutput> SilTarget<F> {
+impl<F: FnMut(&Request, u16) -> GuardOutput> SilTarget<F> {
     pub fn new(core: F) -> Self {
         Self { link: Link::new(), core }
     }
@@ -21,11 +21,29 @@ impl<F: FnMut(&Request) -> GuardOutput> SilTarget<F> {
     }
 }
 
-impl<F: FnMut(&Request) -> GuardOutput> Target for SilTarget<F> {
+impl<F: FnMut(&Request, u16) -> GuardOutput> Target for SilTarget<F> {
     fn exchange(&mut self, wire: &[u8], step: u64) -> Result<Reply, PilError> {
         let Self { link, core } = self;
         let mut got = None;
-        link.push_bytes(wire, |r| (core(r), 0), |rep, _| got = Some(*rep));
+        link.push_bytes(wire, |r, gap| (core(r, gap), 0), |rep, _| got = Some(*rep));
         got.ok_or_else(|| PilError::Protocol { step, what: "SIL link produced no reply to a frame".into() })
+    }
+}
+
+/// The firmware's core for `build`, on the host: the same `GuardOf<N>` with
+/// the same number type, configuration and boot rule (cold: QEMU starts
+/// with zeroed RAM, which reads as an absent thermal record) and the same
+/// [`eha_guard::protocol::step_guard`].
+pub fn sil_core(build: super::Build) -> Box<dyn FnMut(&Request, u16) -> GuardOutput> {
+    use eha_guard::{GuardConfig, GuardOf, Restore};
+    match build {
+        super::Build::F32 => {
+            let mut g = GuardOf::<f32>::new(&GuardConfig::DEFAULT, Restore::Cold);
+            Box::new(move |r, gap| eha_guard::protocol::step_guard(&mut g, r, gap))
+        }
+        super::Build::Fixed => {
+            let mut g = GuardOf::<eha_guard::num::Fx>::new(&GuardConfig::DEFAULT, Restore::Cold);
+            Box::new(move |r, gap| eha_guard::protocol::step_guard(&mut g, r, gap))
+        }
     }
 }
