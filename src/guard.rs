@@ -180,7 +180,7 @@ impl<N: Num> GuardOf<N> {
                     m.set_temperatures(&r.temps_c, r.ambient_c);
                 }
                 g.have_ambient = true;
-                g.lng.set_used_mj(r.lng_used_mj);
+                g.lng.set_used_cj(r.lng_used_cj);
                 g.latched |= r.faults & faults::LATCHED & !faults::CONFIG;
                 g.bad_ch = ((r.faults >> faults::CH_SHIFT) as u8) & CH_ALL;
                 RestoreKind::Warm
@@ -191,7 +191,7 @@ impl<N: Num> GuardOf<N> {
                     m.set_temperatures(&[t; N_NODES], t);
                 }
                 g.have_ambient = true;
-                g.lng.set_used_mj(u64::MAX);
+                g.lng.set_used_cj(u32::MAX);
                 g.latched |= faults::MEMORY_CORRUPT;
                 RestoreKind::Corrupt
             }
@@ -337,7 +337,7 @@ impl<N: Num> GuardOf<N> {
             }
             amb = m.ambient_c().to_f32();
         }
-        ThermalRecord::new(temps, amb, self.lng.used_mj(), self.faults() & !faults::LNG_LOW, self.step)
+        ThermalRecord::new(temps, amb, self.lng.used_cj(), self.faults() & !faults::LNG_LOW, self.step)
     }
 
     /// The event trace (most recent [`crate::trace::TRACE_LEN`] events).

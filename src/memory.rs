@@ -26,12 +26,14 @@ pub const VERSION: u16 = 1;
 /// Plausible stored temperature range, degC (anything else is treated as corrupt).
 pub const PLAUSIBLE_C: (f32, f32) = (-80.0, 250.0);
 
-/// Persistent thermal record, 56 bytes, no implicit padding.
+/// Persistent thermal record, 52 bytes, no implicit padding.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C)]
 pub struct ThermalRecord {
-    /// LNG heat-sink energy used, mJ.
-    pub lng_used_mj: u64,
+    /// LNG heat-sink energy used, cJ (0.01 J).
+    pub lng_used_cj: u32,
+    /// Guard step counter at save time.
+    pub step: u32,
     /// [`MAGIC`] when written by this firmware.
     pub magic: u32,
     /// [`VERSION`].
@@ -42,9 +44,7 @@ pub struct ThermalRecord {
     pub temps_c: [f32; N_NODES],
     /// Ambient the temperatures were referred to, degC.
     pub ambient_c: f32,
-    /// Guard step counter at save time.
-    pub step: u32,
-    /// Reserved (zero), keeps the size a multiple of 8 without padding.
+    /// Reserved (zero).
     pub reserved: u32,
     /// CRC-32 (IEEE) of all preceding bytes, little endian field order.
     pub crc: u32,
@@ -87,7 +87,7 @@ pub fn crc32(data: &[u8]) -> u32 {
 impl ThermalRecord {
     /// An all-zero record (not valid: no magic).
     pub const EMPTY: ThermalRecord = ThermalRecord {
-        lng_used_mj: 0,
+        lng_used_cj: 0,
         magic: 0,
         version: 0,
         faults: 0,
@@ -100,7 +100,8 @@ impl ThermalRecord {
 
     fn body_crc(&self) -> u32 {
         let mut c = 0xFFFF_FFFF;
-        c = crc32_update(c, &self.lng_used_mj.to_le_bytes());
+        c = crc32_update(c, &self.lng_used_cj.to_le_bytes());
+        c = crc32_update(c, &self.step.to_le_bytes());
         c = crc32_update(c, &self.magic.to_le_bytes());
         c = crc32_update(c, &self.version.to_le_bytes());
         c = crc32_update(c, &self.faults.to_le_bytes());
@@ -108,14 +109,13 @@ impl ThermalRecord {
             c = crc32_update(c, &t.to_bits().to_le_bytes());
         }
         c = crc32_update(c, &self.ambient_c.to_bits().to_le_bytes());
-        c = crc32_update(c, &self.step.to_le_bytes());
         c = crc32_update(c, &self.reserved.to_le_bytes());
         !c
     }
 
     /// Builds a sealed record (magic, version, CRC filled in).
-    pub fn new(temps_c: [f32; N_NODES], ambient_c: f32, lng_used_mj: u64, faults: u16, step: u32) -> Self {
-        let mut r = ThermalRecord { lng_used_mj, magic: MAGIC, version: VERSION, faults, temps_c, ambient_c, step, reserved: 0, crc: 0 };
+    pub fn new(temps_c: [f32; N_NODES], ambient_c: f32, lng_used_cj: u32, faults: u16, step: u32) -> Self {
+        let mut r = ThermalRecord { lng_used_cj, magic: MAGIC, version: VERSION, faults, temps_c, ambient_c, step, reserved: 0, crc: 0 };
         r.crc = r.body_crc();
         r
     }
@@ -210,7 +210,7 @@ mod tests {
 
     #[test]
     fn record_has_no_padding() {
-        // 8 + 4 + 2 + 2 + 6*4 + 4 + 4 + 4 + 4 = 56 bytes of fields.
-        assert_eq!(core::mem::size_of::<ThermalRecord>(), 56);
+        // 4 + 4 + 4 + 2 + 2 + 6*4 + 4 + 4 + 4 = 52 bytes of fields.
+        assert_eq!(core::mem::size_of::<ThermalRecord>(), 52);
     }
 }

@@ -1,12 +1,11 @@
 //! Reduced-order thermal model: 6 nodes, losses from the actuator signals,
 //! exact zero-order-hold step (docs/contracts.md).
 //!
-//! The state is carried as `theta = T - T_amb` (K above the present ambient).
-//! Because the Laplacian annihilates constants, `Bd_amb = (I - Ad) 1` exactly, so
-//! `T(k+1) - T_amb(k) = Ad (T(k) - T_amb(k)) + Bd p(k)`: the ambient input needs
-//! no matrix column, only a shift of `theta` when the ambient sample changes.
-//! The step is then `theta += (Ad - I) theta + Bd p` (66 multiply-adds) followed by
-//! the flow-dependent drain <-> loop-oil exchange (operator splitting).
+//! The state is the absolute node temperature `T` (degC). Because the Laplacian
+//! annihilates constants, `Bd_amb = (I - Ad) 1` exactly, so
+//! `T(k+1) = T(k) + (Ad - I) (T(k) - T_amb(k)) + Bd p(k)`: the ambient input needs
+//! no matrix column. The step is these 66 multiply-adds on `theta = T - T_amb`,
+//! followed by the flow-dependent drain <-> loop-oil exchange (operator splitting).
 
 use crate::linalg::expm1m;
 use crate::num::Num;
@@ -81,7 +80,7 @@ struct LossK<N: Num> {
 /// The reduced-order model in number type `N` (`f64`, `f32` or [`crate::num::Fx`]).
 #[derive(Clone, Copy, Debug)]
 pub struct Model<N: Num> {
-    theta: [N::State; N_NODES],
+    temp: [N::State; N_NODES],
     ambient_c: N,
     coef: [[N::Coef; N_COLS]; N_NODES],
     k: LossK<N>,
@@ -116,7 +115,7 @@ pub fn discretise(p: &ReducedParams) -> [[f64; N_COLS]; N_NODES] {
 
 impl<N: Num> Model<N> {
     /// Builds the model once from SI parameters: exact ZOH via the matrix
-    /// exponential in `f64`, then conversion to `N`. Starts at ambient (`theta = 0`).
+    /// exponential in `f64`, then conversion to `N`. Starts at 0 degC everywhere.
     pub fn new(p: &ReducedParams) -> Result<Self, ConfigError> {
         if !p.is_plausible() {
             return Err(ConfigError::Implausible);
@@ -176,7 +175,7 @@ impl<N: Num> Model<N> {
             one: f(1.0),
         };
         Ok(Model {
-            theta: [N::state(N::ZERO); N_NODES],
+            temp: [N::state(N::ZERO); N_NODES],
             ambient_c: N::ZERO,
             coef,
             k,
@@ -193,31 +192,20 @@ impl<N: Num> Model<N> {
             None => N::ZERO,
         };
         self.ambient_c = amb;
-        for (th, t) in self.theta.iter_mut().zip(temps_c.iter()) {
+        for (th, t) in self.temp.iter_mut().zip(temps_c.iter()) {
             let tv = match s {
                 Some(s) => N::from_f32_scaled(*t, s),
                 None => N::ZERO,
             };
-            *th = N::add_product(N::state(N::ZERO), tv.sub(amb), one);
+            *th = N::add_product(N::state(N::ZERO), tv, one);
         }
-    }
-
-    /// Moves the ambient reference to `ambient_c` keeping absolute temperatures.
-    #[inline(always)]
-    fn shift_ambient(&mut self, new_amb: N) {
-        let shift = self.ambient_c.sub(new_amb);
-        let one = self.k.one;
-        for th in self.theta.iter_mut() {
-            *th = N::add_product(*th, shift, one);
-        }
-        self.ambient_c = new_amb;
     }
 
     /// Losses `[copper, iron, leakage, mechanical, throttling]` in kW (eqs. 1, 2, 5-8, 11).
     #[inline(always)]
     pub fn losses_kw(&self, i_ha: N, dp_hbar: N, w_hrads: N, dpos_mm: N) -> [N; N_LOSSES] {
         let k = &self.k;
-        let t_w = N::value(self.theta[NODE_WINDING]).add(self.ambient_c);
+        let t_w = N::value(self.temp[NODE_WINDING]);
         // eq. (1): m I^2 R0 (1 + alpha (T_w - 25))
         let p_cu = i_ha.mul(i_ha).mul(k.cu0.add(k.cu1.mul(t_w)));
         // eq. (2) with f ∝ w and constant B_m
@@ -226,7 +214,7 @@ impl<N: Num> Model<N> {
         // eqs. (5)-(7): K dp^2 / mu(T) (ratio to the reference viscosity)
         let mut p_leak = k.leak.mul(dp_hbar).mul(dp_hbar);
         if k.use_mu {
-            let t_d = N::value(self.theta[NODE_DRAIN]).add(self.ambient_c);
+            let t_d = N::value(self.temp[NODE_DRAIN]);
             p_leak = p_leak.mul(k.k_mu.mul(t_d.sub(k.t_mu)).exp());
         }
         // eq. (8): eta_m (D dp) w
@@ -243,28 +231,28 @@ impl<N: Num> Model<N> {
     /// Advances one step of [`S_PER_STEP`] with inputs held (ZOH). Never panics.
     pub fn step(&mut self, u: &ModelInput, s: &InputScales<N>) {
         let amb = N::from_f32_scaled(u.ambient_c, s.one);
-        self.shift_ambient(amb);
+        self.ambient_c = amb;
         let i_ha = N::from_f32_scaled(u.current_a, s.ha_per_a);
         let dp = N::from_f32_scaled(u.dp_bar, s.hbar_per_bar);
         let w = N::from_f32_scaled(u.speed_rpm, s.hrads_per_rpm);
         let dx = N::from_f32_scaled(u.dpos_mm, s.one);
         let p = self.losses_kw(i_ha, dp, w, dx);
         self.last_loss_kw = p;
-        let th = &self.theta;
+        let th = &self.temp;
         let x: [N; N_COLS] = [
-            N::value(th[0]),
-            N::value(th[1]),
-            N::value(th[2]),
-            N::value(th[3]),
-            N::value(th[4]),
-            N::value(th[5]),
+            N::value(th[0]).sub(amb),
+            N::value(th[1]).sub(amb),
+            N::value(th[2]).sub(amb),
+            N::value(th[3]).sub(amb),
+            N::value(th[4]).sub(amb),
+            N::value(th[5]).sub(amb),
             p[0],
             p[1],
             p[2],
             p[3],
             p[4],
         ];
-        for (t, c) in self.theta.iter_mut().zip(self.coef.iter()) {
+        for (t, c) in self.temp.iter_mut().zip(self.coef.iter()) {
             *t = N::accumulate(*t, c, &x);
         }
         // Drain <-> loop-oil exchange with g = g_od1 |dp|, exact two-node solution:
@@ -273,23 +261,23 @@ impl<N: Num> Model<N> {
         let k = &self.k;
         let xe = k.ex_k.mul(dp.abs());
         let phi = xe.mul(k.one.sub(xe.mul(k.half).mul(k.one.sub(xe.mul(k.third).mul(k.one.sub(xe.mul(k.quarter)))))));
-        let d = N::value(self.theta[NODE_LOOP_OIL]).sub(N::value(self.theta[NODE_DRAIN]));
+        let d = N::value(self.temp[NODE_LOOP_OIL]).sub(N::value(self.temp[NODE_DRAIN]));
         let q = phi.mul(d);
-        self.theta[NODE_LOOP_OIL] = N::add_product(self.theta[NODE_LOOP_OIL], q, k.ex_w3);
-        self.theta[NODE_DRAIN] = N::add_product(self.theta[NODE_DRAIN], q, k.ex_w5);
+        self.temp[NODE_LOOP_OIL] = N::add_product(self.temp[NODE_LOOP_OIL], q, k.ex_w3);
+        self.temp[NODE_DRAIN] = N::add_product(self.temp[NODE_DRAIN], q, k.ex_w5);
     }
 
     /// Predicted drain-oil temperature, degC.
     #[inline(always)]
     pub fn drain_c(&self) -> N {
-        N::value(self.theta[NODE_DRAIN]).add(self.ambient_c)
+        N::value(self.temp[NODE_DRAIN])
     }
 
     /// All node temperatures, degC, in contract order.
     pub fn temperatures_c(&self) -> [N; N_NODES] {
         let mut t = [N::ZERO; N_NODES];
-        for (o, th) in t.iter_mut().zip(self.theta.iter()) {
-            *o = N::value(*th).add(self.ambient_c);
+        for (o, th) in t.iter_mut().zip(self.temp.iter()) {
+            *o = N::value(*th);
         }
         t
     }

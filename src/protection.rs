@@ -140,10 +140,12 @@ impl LngConfig {
 
 /// Reported seconds-left when the dissipation is (near) zero, s (finite cap).
 pub const LNG_SECONDS_CAP: f32 = 1.0e9;
-/// Energy bookkeeping unit: mJ per W per 10 ms step.
-const MJ_PER_W_STEP: f32 = 1000.0 * crate::params::S_PER_STEP as f32;
+/// Energy bookkeeping unit: centijoule (cJ) per W per 10 ms step.
+const CJ_PER_W_STEP: f32 = 100.0 * crate::params::S_PER_STEP as f32;
 
-/// LNG budget: heat absorbed while the valve is open, integrated exactly in mJ.
+/// LNG budget: heat absorbed while the valve is open, integrated exactly in
+/// centijoules in a `u32` (FPU-only conversions; 1 kW adds 1000 cJ per step with
+/// ±0.5 cJ unbiased rounding; capacity up to 4.29e7 J ≈ 97 L of LNG, saturating).
 ///
 /// Heat absorbed per step = the model's present total loss (eq. 23, `Q = P_sum t`):
 /// the cooler is sized so that the heat sink equals the heat produced (section IV),
@@ -151,22 +153,22 @@ const MJ_PER_W_STEP: f32 = 1000.0 * crate::params::S_PER_STEP as f32;
 /// the cooler absorbs less (conservative for the remaining-LNG report).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LngBudget {
-    used_mj: u64,
-    capacity_mj: u64,
-    low_mj: u64,
-    j_per_kg: f32,
+    used_cj: u32,
+    capacity_cj: u32,
+    low_cj: u32,
+    kg_per_cj: f32,
 }
 
 impl LngBudget {
     /// Full charge per `cfg`.
     pub fn new(cfg: &LngConfig) -> Self {
-        let j_per_kg = cfg.j_per_kg();
-        let cap_j = cfg.charge_kg() as f64 * j_per_kg as f64;
+        let j_per_kg = cfg.j_per_kg() as f64;
+        let cap_cj = cfg.charge_kg() as f64 * j_per_kg * 100.0;
         LngBudget {
-            used_mj: 0,
-            capacity_mj: (cap_j * 1e3) as u64,
-            low_mj: (cap_j * 1e3 * cfg.low_fraction as f64) as u64,
-            j_per_kg,
+            used_cj: 0,
+            capacity_cj: cap_cj as u32,
+            low_cj: (cap_cj * cfg.low_fraction as f64) as u32,
+            kg_per_cj: (0.01 / j_per_kg) as f32,
         }
     }
 
@@ -175,29 +177,29 @@ impl LngBudget {
     pub fn update(&mut self, valve_open: bool, loss_w: f32) {
         if valve_open {
             // `as` saturates: NaN → 0, negative → 0 (the model never reports either).
-            let mj = (loss_w * MJ_PER_W_STEP + 0.5) as u64;
-            self.used_mj = self.used_mj.saturating_add(mj);
+            let cj = (loss_w * CJ_PER_W_STEP + 0.5) as u32;
+            self.used_cj = self.used_cj.saturating_add(cj);
         }
     }
 
-    /// Heat absorbed so far, mJ.
-    pub fn used_mj(&self) -> u64 {
-        self.used_mj
+    /// Heat absorbed so far, cJ (0.01 J).
+    pub fn used_cj(&self) -> u32 {
+        self.used_cj
     }
 
-    /// Restores the used energy (thermal memory), mJ.
-    pub fn set_used_mj(&mut self, mj: u64) {
-        self.used_mj = mj;
+    /// Restores the used energy (thermal memory), cJ.
+    pub fn set_used_cj(&mut self, cj: u32) {
+        self.used_cj = cj;
     }
 
     /// Remaining heat-sink energy, J.
     pub fn remaining_j(&self) -> f32 {
-        self.capacity_mj.saturating_sub(self.used_mj) as f32 * 1e-3
+        self.capacity_cj.saturating_sub(self.used_cj) as f32 * 0.01
     }
 
     /// Remaining LNG, kg (eq. 24 inverted).
     pub fn remaining_kg(&self) -> f32 {
-        self.remaining_j() / self.j_per_kg
+        self.capacity_cj.saturating_sub(self.used_cj) as f32 * self.kg_per_cj
     }
 
     /// Seconds of cooling left at the present dissipation `loss_w`, s (capped at
@@ -214,6 +216,6 @@ impl LngBudget {
 
     /// `true` when remaining < the low threshold.
     pub fn is_low(&self) -> bool {
-        self.capacity_mj.saturating_sub(self.used_mj) < self.low_mj
+        self.capacity_cj.saturating_sub(self.used_cj) < self.low_cj
     }
 }
