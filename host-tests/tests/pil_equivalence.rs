@@ -1,11 +1,10 @@
 //! The firmware in QEMU answers exactly like the same core code on the host
 //! (SIL), frame by frame, for both numeric builds.
 //!
-//! Open loop here (the closed-loop scenarios are in `pil_scenarios.rs`): a
-//! fixed 600 s input sequence at the firmware's 10 ms step (60,000 frames),
-//! hard heating (valve opens) followed by a pressure drop (valve closes), with injected
-//! lost frames (sequence gaps → missed steps), a non-finite and an
-//! out-of-range sample, so the fault paths are compared too.
+//! Open loop here (the closed-loop scenarios are in `pil_scenarios.rs`): the
+//! drill sequence of `eha_sim::pil::drill` (60,000 frames at the firmware's
+//! 10 ms step, valve open/close, lost frames, non-finite and out-of-range
+//! samples), so the fault paths are compared too.
 //!
 //! Tolerance: none. Both builds must be bit-identical. For the fixed-point
 //! build that is the requirement. For f32 it is what we measure and keep:
@@ -22,42 +21,10 @@ use eha_sim::pil::report::compare;
 use eha_sim::pil::sil::{sil_core, SilTarget};
 use eha_sim::pil::{firmware_for_tests, require_qemu, Build, QemuOptions, QemuSession, Target};
 
-const STEPS: u32 = 60_000;
+const STEPS: u32 = eha_sim::pil::drill::STEPS;
 
-/// The input sequence: (sequence number, sample).
 fn inputs() -> Vec<Request> {
-    let mut v = Vec::with_capacity(STEPS as usize);
-    let mut seq: u16 = 0;
-    for k in 0..STEPS {
-        let t = k as f32 * 0.01;
-        // Hard throttling (140 bar, 60 A) until 250 s heats the drain past the
-        // 40 °C valve threshold, then 10 bar lets it cool; the piston moves slowly.
-        let hot = t < 250.0;
-        let dp = if hot { 140.0 } else { 10.0 };
-        let mut r = Request {
-            seq,
-            current_a: if hot { 60.0 } else { 5.0 },
-            p_a_bar: 2.0 + dp,
-            p_b_bar: 2.0,
-            speed_rpm: 500.0,
-            position_mm: 20.0 * (0.05 * t).sin(),
-            ambient_c: 16.0,
-        };
-        if k == 50_000 {
-            r.current_a = f32::NAN; // non-finite input
-        }
-        if k == 55_000 {
-            r.p_a_bar = 5000.0; // out of range
-        }
-        v.push(r);
-        // Lost frames: gaps of 3 and of 10 sequence numbers.
-        seq = seq.wrapping_add(match k {
-            10_000 => 4,
-            45_000 => 11,
-            _ => 1,
-        });
-    }
-    v
+    eha_sim::pil::drill::inputs()
 }
 
 fn run_qemu(build: Build, reqs: &[Request]) -> (Vec<Reply>, f64) {

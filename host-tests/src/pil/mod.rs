@@ -8,6 +8,7 @@
 //! the host), which is the bit-for-bit oracle for the firmware's replies.
 
 pub mod defmt_log;
+pub mod drill;
 pub mod firmware;
 pub mod qemu;
 pub mod report;
@@ -259,4 +260,29 @@ pub fn firmware_for_tests(build: Build) -> std::path::PathBuf {
     let elf = build_firmware(build).unwrap_or_else(|e| panic!("building the {} firmware: {e:#}", build.name()));
     map.insert(build, elf.clone());
     elf
+}
+
+/// An open-loop firmware session: fixed frames in, replies out.
+#[derive(Debug)]
+pub struct OpenLoopRun {
+    pub build: Build,
+    pub replies: Vec<Reply>,
+    pub done: Reply,
+    pub log: Vec<defmt_log::LogLine>,
+    pub wall: Duration,
+    pub icount: bool,
+}
+
+/// Send `requests` one by one in lockstep, then end the input and collect
+/// the completion marker and the decoded defmt log.
+pub fn run_open_loop(qemu: &QemuOptions, requests: &[Request]) -> anyhow::Result<OpenLoopRun> {
+    let start = Instant::now();
+    let mut s = QemuSession::spawn(qemu)?;
+    let mut replies = Vec::with_capacity(requests.len());
+    for (k, r) in requests.iter().enumerate() {
+        replies.push(s.exchange(&r.encode(), k as u64)?);
+    }
+    let end = s.finish(requests.len() as u64)?;
+    let log = defmt_log::decode(&qemu.elf, &end.defmt)?;
+    Ok(OpenLoopRun { build: qemu.build, replies, done: end.done, log, wall: start.elapsed(), icount: qemu.icount })
 }

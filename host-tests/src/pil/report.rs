@@ -250,3 +250,44 @@ pub fn write_log(path: &Path, log: &[super::defmt_log::LogLine]) -> Result<()> {
     }
     std::fs::write(path, s).with_context(|| format!("writing {}", path.display()))
 }
+
+/// Deterministic transcript of an open-loop run (golden output): a row every
+/// `every` steps and at every change of valve/alarm/faults, the counters,
+/// the instruction counts and the decoded defmt log.
+pub fn open_loop_transcript(run: &super::OpenLoopRun, step_s: f64, every: usize) -> String {
+    let mut t = String::new();
+    let _ = writeln!(t, "build {} machine {} frames {}", run.build.name(), run.build.machine(), run.replies.len());
+    let _ = writeln!(t, "{:>8} {:>6} {:>12} {:>5} {:>5} {:>6} {:>8}", "time_s", "seq", "fw_drain_c", "valve", "alarm", "faults", "lng_kg");
+    let mut prev: Option<&Reply> = None;
+    for (k, r) in run.replies.iter().enumerate() {
+        let changed = prev.is_some_and(|p| p.out.flags() != r.out.flags() || p.out.faults != r.out.faults);
+        if k % every == 0 || changed {
+            let _ = writeln!(
+                t,
+                "{:>8.2} {:>6} {:>12.4} {:>5} {:>5} {:>#6x} {:>8.4}{}",
+                k as f64 * step_s,
+                r.seq,
+                r.out.drain_c,
+                u8::from(r.out.valve_open),
+                u8::from(r.out.alarm),
+                r.out.faults,
+                r.out.lng_remaining_kg,
+                if changed { "  <- change" } else { "" }
+            );
+        }
+        prev = Some(r);
+    }
+    let c = run.done.counters;
+    let _ = writeln!(t, "done: accepted {} skipped {} rejected crc {} framing {} sequence {}", c.accepted, c.skipped, c.rejected_crc, c.rejected_framing, c.rejected_sequence);
+    if run.icount && !run.replies.is_empty() {
+        let instr: Vec<f64> = run.replies.iter().map(|r| f64::from(r.step_ticks) / TICKS_PER_INSTRUCTION).collect();
+        let mean = instr.iter().sum::<f64>() / instr.len() as f64;
+        let max = instr.iter().copied().fold(0.0, f64::max);
+        let _ = writeln!(t, "instructions per step (icount): mean {mean:.0} max {max:.0}");
+    }
+    t.push_str("defmt log:\n");
+    for l in &run.log {
+        let _ = writeln!(t, "  {l}");
+    }
+    t
+}
