@@ -11,7 +11,7 @@
 //! fixed-point range: temperature degC (or K), power kW, current hA (100 A),
 //! pressure hbar (10 MPa), speed hrad/s (100 rad/s), position mm.
 
-use fixed::types::{I0F32, I20F12, I2F30, I9F23, I9F55};
+use fixed::types::{I0F32, I2F30, I9F23, I9F55};
 
 /// Arithmetic the model needs from its number type. All methods are total
 /// (no panics): the fixed-point instantiation saturates at its documented range.
@@ -169,9 +169,6 @@ pub type FxCoef = I0F32;
 pub type FxState = I9F55;
 /// Fixed-point input scale: Q2.30 in an `i32` (`I2F30`): range [-2, 2), resolution 9.3e-10.
 pub type FxScale = I2F30;
-/// Intermediate wire format for `f32` → fixed conversion: Q20.12 in an `i32`
-/// (`I20F12`): range ±524288, resolution 2.4e-4 (covers 10000 rpm, 400 bar, 340 A).
-pub type FxWire = I20F12;
 
 #[inline(always)]
 fn sat_i32(x: i64) -> i32 {
@@ -184,21 +181,53 @@ fn sat_i32(x: i64) -> i32 {
     }
 }
 
+/// `x · s` with `x` an `f32` and `s` a Q2.30 scale, to Q9.23 bits, integer-only
+/// (no soft-float, no panic): `x = ±m 2^(e-150)`, so `x s 2^23 = ±m s 2^(e-157)`.
+/// Rounds half up; saturates at the Q9.23 range; NaN gives 0, ±inf saturates.
+#[inline(always)]
+fn f32_times_q30_to_q23(x: f32, s_raw: i32) -> i32 {
+    let b = x.to_bits();
+    let e = ((b >> 23) & 0xff) as i32;
+    let frac = b & 0x007f_ffff;
+    if e == 0xff {
+        if frac != 0 {
+            return 0;
+        }
+        return if (b >> 31 != 0) == (s_raw < 0) { i32::MAX } else { i32::MIN };
+    }
+    let m = if e == 0 { frac } else { frac | 0x0080_0000 } as i64;
+    let p = m * s_raw as i64; // |p| < 2^24 · 2^31
+    let sh = e - 157;
+    let mag = if sh >= 0 {
+        if sh > 8 || p.unsigned_abs() >= (1u64 << (62 - sh)) {
+            if p < 0 { i64::MIN } else { i64::MAX }
+        } else {
+            p << sh
+        }
+    } else if sh > -63 {
+        (p + (1i64 << (-sh - 1))) >> -sh
+    } else {
+        0
+    };
+    let v = if b >> 31 != 0 { mag.saturating_neg() } else { mag };
+    sat_i32(v)
+}
+
 impl Num for Fx {
     type Coef = FxCoef;
     type State = FxState;
     type Scale = FxScale;
     const ZERO: Self = Fx::ZERO;
     const MAX_ROW_SUM: f64 = 1.0;
-    fn from_f64(x: f64) -> Self { Fx::saturating_from_num(x) }
+    fn from_f64(x: f64) -> Self {
+        // checked (NaN → None) instead of saturating_from_num, which panics on NaN.
+        Fx::checked_from_num(x).unwrap_or(if x > 0.0 { Fx::MAX } else if x < 0.0 { Fx::MIN } else { Fx::ZERO })
+    }
     fn coef_from_f64(x: f64) -> Option<FxCoef> { FxCoef::checked_from_num(x) }
     fn scale_from_f64(x: f64) -> Option<FxScale> { FxScale::checked_from_num(x) }
     #[inline(always)]
     fn from_f32_scaled(x: f32, s: FxScale) -> Self {
-        let w = FxWire::saturating_from_num(x).to_bits() as i64;
-        // Q20.12 × Q2.30 = Q.42 → Q9.23: shift 19 with round-half-up.
-        let p = w * s.to_bits() as i64;
-        Fx::from_bits(sat_i32((p + (1 << 18)) >> 19))
+        Fx::from_bits(f32_times_q30_to_q23(x, s.to_bits()))
     }
     fn to_f32(self) -> f32 { self.to_num::<f32>() }
     fn to_f64(self) -> f64 { self.to_num::<f64>() }
@@ -216,7 +245,7 @@ impl Num for Fx {
     #[inline(always)]
     fn max0(self) -> Self { if self > Fx::ZERO { self } else { Fx::ZERO } }
     fn sqrt_abs(self) -> Self { self.saturating_abs().checked_sqrt().unwrap_or(Fx::ZERO) }
-    fn exp(self) -> Self { Fx::saturating_from_num(libm::expf(self.to_num::<f32>())) }
+    fn exp(self) -> Self { Fx::from_bits(f32_times_q30_to_q23(libm::expf(self.to_num::<f32>()), 1 << 30)) }
     fn state(x: Self) -> FxState { FxState::from_bits((x.to_bits() as i64) << 32) }
     #[inline(always)]
     fn value(s: FxState) -> Self {
@@ -293,6 +322,31 @@ mod tests {
             x *= 1.37;
         }
         assert_eq!(f32::sqrt_abs(0.0), 0.0);
+    }
+
+    #[test]
+    fn fixed_input_conversion_matches_f64_and_saturates() {
+        // Against f64 rounding of x·s to Q9.23 over many magnitudes and both signs:
+        // the scale itself is Q2.30 (error ≤ 4.7e-10 relative to 1), so allow 1 LSB + that.
+        for &sc in &[0.01f64, 1.0, 1.047e-3, -0.5, 1.9] {
+            let s = Fx::scale_from_f64(sc).unwrap();
+            let sq = s.to_num::<f64>();
+            let mut x = 1e-9f32;
+            while x < 1e7 {
+                for &xv in &[x, -x] {
+                    let got = Fx::from_f32_scaled(xv, s).to_bits() as i64;
+                    let exact = (xv as f64 * sq * 8_388_608.0).round().clamp(i32::MIN as f64, i32::MAX as f64) as i64;
+                    assert!((got - exact).abs() <= 1, "x {xv} s {sc}: {got} vs {exact}");
+                }
+                x *= 3.7;
+            }
+        }
+        let one = Fx::scale_from_f64(1.0).unwrap();
+        assert_eq!(Fx::from_f32_scaled(f32::NAN, one), Fx::ZERO);
+        assert_eq!(Fx::from_f32_scaled(f32::INFINITY, one), Fx::MAX);
+        assert_eq!(Fx::from_f32_scaled(f32::NEG_INFINITY, one), Fx::MIN);
+        assert_eq!(Fx::from_f32_scaled(1e30, one), Fx::MAX);
+        assert_eq!(Fx::from_f32_scaled(0.0, one), Fx::ZERO);
     }
 
     #[test]
