@@ -10,7 +10,10 @@
 pub mod defmt_log;
 pub mod drill;
 pub mod firmware;
+pub mod plot;
 pub mod qemu;
+pub mod reference;
+pub mod cli;
 pub mod report;
 pub mod sil;
 
