@@ -62,6 +62,7 @@ pub fn scenario(name: &str, duration_s: f64, needle_bar: f64) -> Result<Scenario
 /// Run the PIL demo and print its summary.
 pub fn run(args: &PilArgs) -> Result<()> {
     let build: Build = args.build.parse()?;
+    let qemu_version = super::qemu::ensure_qemu()?;
     let scen = scenario(&args.scenario, args.duration, args.needle_bar)?;
     let elf = match &args.elf {
         Some(p) => p.clone(),
@@ -88,7 +89,7 @@ pub fn run(args: &PilArgs) -> Result<()> {
         ]
     };
     eprintln!(
-        "running {} s of the {} scenario in lockstep with the firmware in QEMU {} ({} steps of {} s) ...",
+        "running {} s of the {} scenario in lockstep with the firmware in {qemu_version} {} ({} steps of {} s) ...",
         args.duration,
         args.scenario,
         build.machine(),

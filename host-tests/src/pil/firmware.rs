@@ -68,6 +68,7 @@ pub fn workspace_root() -> PathBuf {
 /// that runs us (`$CARGO`) when there is one; output goes to the same target
 /// directory as the host build (`$CARGO_TARGET_DIR` or `<workspace>/target`).
 pub fn build_firmware(build: Build) -> Result<PathBuf> {
+    ensure_target(build)?;
     let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
     let root = workspace_root();
     let mut cmd = Command::new(&cargo);
@@ -99,4 +100,25 @@ pub fn build_firmware(build: Build) -> Result<PathBuf> {
         }
     }
     bail!("firmware build succeeded but cargo reported no eha-fw executable")
+}
+
+/// Make sure the Rust target of `build` is installed (rustup does not add the
+/// targets of `rust-toolchain.toml` by itself when auto-install is off): runs
+/// `rustup target add` when it is missing. Without rustup, the build's own
+/// error says what is missing.
+pub fn ensure_target(build: Build) -> Result<()> {
+    let root = workspace_root();
+    let Ok(out) = Command::new("rustup").current_dir(&root).args(["target", "list", "--installed"]).stdin(Stdio::null()).output() else {
+        return Ok(()); // no rustup: let cargo report a missing target
+    };
+    if String::from_utf8_lossy(&out.stdout).lines().any(|l| l.trim() == build.target()) {
+        return Ok(());
+    }
+    eprintln!("installing the Rust target {} (rustup target add) ...", build.target());
+    let st = Command::new("rustup").current_dir(&root).args(["target", "add", build.target()]).stdin(Stdio::null()).status()
+        .context("running rustup target add")?;
+    if !st.success() {
+        bail!("`rustup target add {}` failed ({st})", build.target());
+    }
+    Ok(())
 }

@@ -93,6 +93,28 @@ pub fn qemu_available() -> Result<String, PilError> {
     }
 }
 
+/// For the interactive command: install QEMU with apt-get when it is missing
+/// and we can (root, Debian-like system); otherwise say exactly what to do.
+pub fn ensure_qemu() -> Result<String, PilError> {
+    match qemu_available() {
+        Err(PilError::QemuMissing) => {}
+        other => return other,
+    }
+    let is_root = Command::new("id").arg("-u").output().is_ok_and(|o| String::from_utf8_lossy(&o.stdout).trim() == "0");
+    let has_apt = Command::new("apt-get").arg("--version").stdout(Stdio::null()).status().is_ok_and(|s| s.success());
+    if !(is_root && has_apt) {
+        return Err(PilError::QemuMissing);
+    }
+    eprintln!("qemu-system-arm not found: installing it (apt-get install -y qemu-system-arm) ...");
+    let ok = |args: &[&str]| {
+        Command::new("apt-get").args(args).env("DEBIAN_FRONTEND", "noninteractive").stdin(Stdio::null()).status().is_ok_and(|s| s.success())
+    };
+    if !ok(&["install", "-y", "qemu-system-arm"]) && !(ok(&["update"]) && ok(&["install", "-y", "qemu-system-arm"])) {
+        return Err(PilError::QemuMissing);
+    }
+    qemu_available()
+}
+
 /// What a finished session leaves behind.
 #[derive(Debug)]
 pub struct SessionEnd {
