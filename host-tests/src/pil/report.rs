@@ -111,6 +111,12 @@ pub fn summary_text(run: &PilRun, s: &Summary) -> String {
     let _ = writeln!(t, "frames              : accepted {}, rejected crc {} framing {} sequence {}, skipped {}", c.accepted, c.rejected_crc, c.rejected_framing, c.rejected_sequence, c.skipped);
     let ev: Vec<String> = s.valve_events.iter().map(|(t, o)| format!("{} at {t:.1} s", if *o { "open" } else { "close" })).collect();
     let _ = writeln!(t, "LNG valve events    : {}", if ev.is_empty() { "none".into() } else { ev.join(", ") });
+    let crossing = run.records.iter().find(|r| r.sensors.t_drain_c >= 40.0).map(|r| r.t_s);
+    let _ = writeln!(
+        t,
+        "reference drain 40°C: {}",
+        crossing.map_or("never reached".to_string(), |c| format!("reached at {c:.1} s (where a perfect guard would open)"))
+    );
     let _ = writeln!(t, "LNG used            : {:.4} kg ({:.4} kg left)", s.lng_used_kg, s.lng_remaining_kg);
     let _ = writeln!(t, "peak drain          : reference {:.3} °C, firmware {:.3} °C", s.peak_ref_c, s.peak_fw_c);
     let _ = writeln!(t, "max |fw − ref|      : {:.3} K (max under-prediction {:.3} K)", s.max_abs_err_k, s.max_under_k);
