@@ -34,7 +34,11 @@ pub fn service<B: Board, N: Num>(board: &mut B, guard: &mut GuardOf<N>) -> Outpu
         Some(s) => guard.step(&s),
         None => guard.step_missing(),
     };
-    let r = if out.valve_open { board.valve().set_high() } else { board.valve().set_low() };
+    let r = if out.valve_open {
+        board.valve().set_high()
+    } else {
+        board.valve().set_low()
+    };
     if r.is_err() {
         guard.report_actuator_fault();
     }

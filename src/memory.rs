@@ -51,6 +51,8 @@ pub struct ThermalRecord {
 }
 
 /// Nibble table of the reflected CRC-32 (IEEE, polynomial 0xEDB88320).
+/// Built at compile time (an out-of-range index would be a compile error).
+#[allow(clippy::indexing_slicing)]
 const CRC_NIBBLE: [u32; 16] = {
     let mut t = [0u32; 16];
     let mut i = 0;
@@ -58,7 +60,11 @@ const CRC_NIBBLE: [u32; 16] = {
         let mut c = i as u32;
         let mut k = 0;
         while k < 4 {
-            c = if c & 1 != 0 { (c >> 1) ^ 0xEDB8_8320 } else { c >> 1 };
+            c = if c & 1 != 0 {
+                (c >> 1) ^ 0xEDB8_8320
+            } else {
+                c >> 1
+            };
             k += 1;
         }
         t[i] = c;
@@ -114,8 +120,24 @@ impl ThermalRecord {
     }
 
     /// Builds a sealed record (magic, version, CRC filled in).
-    pub fn new(temps_c: [f32; N_NODES], ambient_c: f32, lng_used_cj: u32, faults: u16, step: u32) -> Self {
-        let mut r = ThermalRecord { lng_used_cj, magic: MAGIC, version: VERSION, faults, temps_c, ambient_c, step, reserved: 0, crc: 0 };
+    pub fn new(
+        temps_c: [f32; N_NODES],
+        ambient_c: f32,
+        lng_used_cj: u32,
+        faults: u16,
+        step: u32,
+    ) -> Self {
+        let mut r = ThermalRecord {
+            lng_used_cj,
+            magic: MAGIC,
+            version: VERSION,
+            faults,
+            temps_c,
+            ambient_c,
+            step,
+            reserved: 0,
+            crc: 0,
+        };
         r.crc = r.body_crc();
         r
     }
@@ -133,7 +155,8 @@ impl ThermalRecord {
             .iter()
             .chain(core::iter::once(&self.ambient_c))
             .all(|t| t.is_finite() && *t >= lo && *t <= hi);
-        if self.version == VERSION && self.reserved == 0 && self.crc == self.body_crc() && plausible {
+        if self.version == VERSION && self.reserved == 0 && self.crc == self.body_crc() && plausible
+        {
             RecordStatus::Valid
         } else {
             RecordStatus::Corrupt
@@ -194,7 +217,9 @@ pub mod noinit {
     /// Writes the record to no-init RAM.
     pub fn store(r: &ThermalRecord) {
         // SAFETY: as in `load`; the static is only touched from the main loop.
-        unsafe { core::ptr::write_volatile(core::ptr::addr_of_mut!(RECORD).cast::<ThermalRecord>(), *r) }
+        unsafe {
+            core::ptr::write_volatile(core::ptr::addr_of_mut!(RECORD).cast::<ThermalRecord>(), *r)
+        }
     }
 }
 

@@ -10,8 +10,11 @@
 use crate::linalg::expm1m;
 use crate::num::Num;
 use crate::params::{
-    ReducedParams, N_LOSSES, N_NODES, NODE_DRAIN, NODE_LOOP_OIL, NODE_WINDING, S_PER_STEP,
+    ReducedParams, NODE_DRAIN, NODE_LOOP_OIL, NODE_WINDING, N_LOSSES, N_NODES, S_PER_STEP,
 };
+
+// `step_n` destructures the state with the loop oil at 3 and the drain at 5.
+const _: () = assert!(NODE_LOOP_OIL == 3 && NODE_DRAIN == 5);
 
 /// Columns of one discretised row: 6 node temperatures then 5 losses.
 pub const N_COLS: usize = N_NODES + N_LOSSES;
@@ -41,6 +44,21 @@ pub struct ModelInput {
     pub ambient_c: f32,
 }
 
+/// One step of inputs in model units and the model's number type.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ModelInputN<N> {
+    /// Motor phase current, hA (100 A).
+    pub current_ha: N,
+    /// Pump port pressure difference `p_A - p_B`, hbar (10 MPa).
+    pub dp_hbar: N,
+    /// Motor speed, hrad/s (100 rad/s), signed.
+    pub speed_hrads: N,
+    /// Piston position change over the step, mm.
+    pub dpos_mm: N,
+    /// Ambient temperature, degC.
+    pub ambient_c: N,
+}
+
 /// Why a parameter set cannot be turned into a model of the chosen number type.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(any(target_os = "none", feature = "defmt"), derive(defmt::Format))]
@@ -56,14 +74,14 @@ pub enum ConfigError {
 /// Loss constants in model units (kW from hA, hbar, hrad/s, mm/step).
 #[derive(Clone, Copy, Debug)]
 struct LossK<N: Num> {
-    cu0: N,   // m R0 (1 - 25 alpha), kW/hA^2
-    cu1: N,   // m R0 alpha, kW/(hA^2 K)
-    fe1: N,   // kW/(hrad/s)
-    fe2: N,   // kW/(hrad/s)^2
-    fe15: N,  // kW/(hrad/s)^1.5
-    leak: N,  // kW/hbar^2
-    k_mu: N,  // 1/K
-    t_mu: N,  // degC
+    cu0: N,  // m R0 (1 - 25 alpha), kW/hA^2
+    cu1: N,  // m R0 alpha, kW/(hA^2 K)
+    fe1: N,  // kW/(hrad/s)
+    fe2: N,  // kW/(hrad/s)^2
+    fe15: N, // kW/(hrad/s)^1.5
+    leak: N, // kW/hbar^2
+    k_mu: N, // 1/K
+    t_mu: N, // degC
     use_mu: bool,
     mech: N,  // kW/(hbar hrad/s)
     kq: N,    // kW/(hbar hrad/s): D·1e6
@@ -90,19 +108,25 @@ pub struct Model<N: Num> {
 /// Discretised matrices in `f64`: row `i` = `[(Ad - I)_i·, Bd_i·]`, `Bd` per kW.
 pub fn discretise(p: &ReducedParams) -> [[f64; N_COLS]; N_NODES] {
     let mut m = [[0.0f64; N_AUG]; N_AUG];
-    for i in 0..N_NODES {
-        let c = p.capacity_j_per_k[i];
-        let mut diag = p.ambient_w_per_k[i];
-        for j in 0..N_NODES {
+    let node_data = p
+        .capacity_j_per_k
+        .iter()
+        .zip(p.ambient_w_per_k.iter())
+        .zip(p.conductance_w_per_k.iter().zip(p.loss_split.iter()));
+    for (i, (row, ((c, g_amb), (g_row, split_row)))) in m.iter_mut().zip(node_data).enumerate() {
+        let k = S_PER_STEP / c;
+        let mut diag = *g_amb;
+        for (j, (mij, g)) in row.iter_mut().zip(g_row.iter()).enumerate() {
             if j != i {
-                let g = p.conductance_w_per_k[i][j];
                 diag += g;
-                m[i][j] = g / c * S_PER_STEP;
+                *mij = g * k;
             }
         }
-        m[i][i] = -diag / c * S_PER_STEP;
-        for l in 0..N_LOSSES {
-            m[i][N_NODES + l] = p.loss_split[i][l] * W_PER_KW / c * S_PER_STEP;
+        if let Some(d) = row.get_mut(i) {
+            *d = -diag * k;
+        }
+        for (mij, share) in row.iter_mut().skip(N_NODES).zip(split_row.iter()) {
+            *mij = share * W_PER_KW * k;
         }
     }
     let e = expm1m(&m);
@@ -121,7 +145,8 @@ impl<N: Num> Model<N> {
             return Err(ConfigError::Implausible);
         }
         let d = discretise(p);
-        let mut coef = [[N::coef_from_f64(0.0).ok_or(ConfigError::CoefficientRange)?; N_COLS]; N_NODES];
+        let mut coef =
+            [[N::coef_from_f64(0.0).ok_or(ConfigError::CoefficientRange)?; N_COLS]; N_NODES];
         for (cr, dr) in coef.iter_mut().zip(d.iter()) {
             if dr.iter().map(|x| libm::fabs(*x)).sum::<f64>() >= N::MAX_ROW_SUM {
                 return Err(ConfigError::CoefficientRange);
@@ -149,7 +174,10 @@ impl<N: Num> Model<N> {
             -c5 / (c3 + c5),
             c3 / (c3 + c5),
         ];
-        if consts.iter().any(|x| !x.is_finite() || libm::fabs(*x) >= 250.0) {
+        if consts
+            .iter()
+            .any(|x| !x.is_finite() || libm::fabs(*x) >= 250.0)
+        {
             return Err(ConfigError::ConstantRange);
         }
         let f = N::from_f64;
@@ -181,6 +209,14 @@ impl<N: Num> Model<N> {
             k,
             last_loss_kw: [N::ZERO; N_LOSSES],
         })
+    }
+
+    /// Sets every node and the ambient to `t_c` (degC, model number type): cold start.
+    pub fn set_uniform(&mut self, t_c: N) {
+        self.ambient_c = t_c;
+        for th in self.temp.iter_mut() {
+            *th = N::state(t_c);
+        }
     }
 
     /// Sets every node's absolute temperature (degC) and the ambient it refers to.
@@ -230,13 +266,22 @@ impl<N: Num> Model<N> {
 
     /// Advances one step of [`S_PER_STEP`] with inputs held (ZOH). Never panics.
     pub fn step(&mut self, u: &ModelInput, s: &InputScales<N>) {
-        let amb = N::from_f32_scaled(u.ambient_c, s.one);
+        self.step_n(&ModelInputN {
+            current_ha: N::from_f32_scaled(u.current_a, s.ha_per_a),
+            dp_hbar: N::from_f32_scaled(u.dp_bar, s.hbar_per_bar),
+            speed_hrads: N::from_f32_scaled(u.speed_rpm, s.hrads_per_rpm),
+            dpos_mm: N::from_f32_scaled(u.dpos_mm, s.one),
+            ambient_c: N::from_f32_scaled(u.ambient_c, s.one),
+        });
+    }
+
+    /// [`Model::step`] with inputs already in model units (the guard's path).
+    #[inline(always)]
+    pub fn step_n(&mut self, u: &ModelInputN<N>) {
+        let amb = u.ambient_c;
         self.ambient_c = amb;
-        let i_ha = N::from_f32_scaled(u.current_a, s.ha_per_a);
-        let dp = N::from_f32_scaled(u.dp_bar, s.hbar_per_bar);
-        let w = N::from_f32_scaled(u.speed_rpm, s.hrads_per_rpm);
-        let dx = N::from_f32_scaled(u.dpos_mm, s.one);
-        let p = self.losses_kw(i_ha, dp, w, dx);
+        let dp = u.dp_hbar;
+        let p = self.losses_kw(u.current_ha, dp, u.speed_hrads, u.dpos_mm);
         self.last_loss_kw = p;
         let th = &self.temp;
         let x: [N; N_COLS] = [
@@ -252,19 +297,29 @@ impl<N: Num> Model<N> {
             p[3],
             p[4],
         ];
-        for (t, c) in self.temp.iter_mut().zip(self.coef.iter()) {
-            *t = N::accumulate(*t, c, &x);
-        }
-        // Drain <-> loop-oil exchange with g = g_od1 |dp|, exact two-node solution:
-        // the difference decays by exp(-x); 1 - exp(-x) by its 4-term series
-        // (relative error < x^4/120: 8e-7 at x = 0.1; x ≈ 1e-3 at 60 bar).
+        // Drain <-> loop-oil exchange with g = g_od1 |dp|, exact two-node solution on
+        // the step's initial state: the difference decays by exp(-x); 1 - exp(-x) by its
+        // 4-term series (relative error < x^4/120: 8e-7 at x = 0.1; x ≈ 1e-3 at 60 bar).
+        // It is added in the same state update as the ZOH step (operator splitting with
+        // both parts evaluated at the step start; first order, like sequential splitting).
         let k = &self.k;
         let xe = k.ex_k.mul(dp.abs());
-        let phi = xe.mul(k.one.sub(xe.mul(k.half).mul(k.one.sub(xe.mul(k.third).mul(k.one.sub(xe.mul(k.quarter)))))));
-        let d = N::value(self.temp[NODE_LOOP_OIL]).sub(N::value(self.temp[NODE_DRAIN]));
-        let q = phi.mul(d);
-        self.temp[NODE_LOOP_OIL] = N::add_product(self.temp[NODE_LOOP_OIL], q, k.ex_w3);
-        self.temp[NODE_DRAIN] = N::add_product(self.temp[NODE_DRAIN], q, k.ex_w5);
+        let phi = xe.mul(
+            k.one.sub(
+                xe.mul(k.half)
+                    .mul(k.one.sub(xe.mul(k.third).mul(k.one.sub(xe.mul(k.quarter))))),
+            ),
+        );
+        let [_, _, _, x_loop, _, x_drain, ..] = x;
+        let q = phi.mul(x_loop.sub(x_drain));
+        let [c0, c1, c2, c3, c4, c5] = &self.coef;
+        let [t0, t1, t2, t3, t4, t5] = &mut self.temp;
+        *t0 = N::accumulate(*t0, c0, &x);
+        *t1 = N::accumulate(*t1, c1, &x);
+        *t2 = N::accumulate(*t2, c2, &x);
+        *t3 = N::accumulate_plus(*t3, c3, &x, q, k.ex_w3);
+        *t4 = N::accumulate(*t4, c4, &x);
+        *t5 = N::accumulate_plus(*t5, c5, &x, q, k.ex_w5);
     }
 
     /// Predicted drain-oil temperature, degC.

@@ -93,29 +93,35 @@ impl ReducedParams {
     /// Physical plausibility check: capacities > 0, conductances >= 0 and symmetric,
     /// split columns sum to 1 within 1e-9, all finite. `true` when usable.
     pub fn is_plausible(&self) -> bool {
-        let caps = self.capacity_j_per_k.iter().all(|c| c.is_finite() && *c > 0.0);
-        let amb = self.ambient_w_per_k.iter().all(|g| g.is_finite() && *g >= 0.0);
+        let caps = self
+            .capacity_j_per_k
+            .iter()
+            .all(|c| c.is_finite() && *c > 0.0);
+        let amb = self
+            .ambient_w_per_k
+            .iter()
+            .all(|g| g.is_finite() && *g >= 0.0);
         let mut sym = true;
         for (i, row) in self.conductance_w_per_k.iter().enumerate() {
             for (j, g) in row.iter().enumerate() {
-                let gt = self.conductance_w_per_k[j][i];
-                if i != j && (!g.is_finite() || *g < 0.0 || *g != gt) {
+                let gt = self.conductance_w_per_k.get(j).and_then(|r| r.get(i));
+                if i != j && (!g.is_finite() || *g < 0.0 || gt != Some(g)) {
                     sym = false;
                 }
             }
         }
+        let mut col_sum = [0.0f64; N_LOSSES];
         let mut split = true;
-        for l in 0..N_LOSSES {
-            let mut s = 0.0;
-            for row in self.loss_split.iter() {
-                if !row[l].is_finite() || row[l] < 0.0 {
+        for row in self.loss_split.iter() {
+            for (s, x) in col_sum.iter_mut().zip(row.iter()) {
+                if !x.is_finite() || *x < 0.0 {
                     split = false;
                 }
-                s += row[l];
+                *s += x;
             }
-            if (s - 1.0).abs() > 1e-9 {
-                split = false;
-            }
+        }
+        if col_sum.iter().any(|s| (s - 1.0).abs() > 1e-9) {
+            split = false;
         }
         let scalars = [
             self.phases,

@@ -17,7 +17,11 @@ pub struct ValveConfig {
 
 impl ValveConfig {
     /// 40 degC open, 38 degC close, 2 s dwell.
-    pub const DEFAULT: ValveConfig = ValveConfig { open_c: 40.0, close_c: 38.0, dwell_steps: 200 };
+    pub const DEFAULT: ValveConfig = ValveConfig {
+        open_c: 40.0,
+        close_c: 38.0,
+        dwell_steps: 200,
+    };
 }
 
 /// LNG valve state machine.
@@ -30,7 +34,10 @@ pub struct Valve {
 impl Valve {
     /// Closed, dwell already elapsed (a first opening is not delayed).
     pub const fn new() -> Self {
-        Valve { open: false, since_toggle_steps: u32::MAX }
+        Valve {
+            open: false,
+            since_toggle_steps: u32::MAX,
+        }
     }
 
     /// `true` when commanded open.
@@ -43,16 +50,38 @@ impl Valve {
     /// each only after `dwell_steps` since the last toggle. A NaN temperature keeps it
     /// open / opens it. Returns `Some(new_state)` when the command changed.
     pub fn update(&mut self, drain_c: f32, force_open: bool, cfg: &ValveConfig) -> Option<bool> {
+        self.update_with(
+            drain_c,
+            force_open,
+            cfg.open_c,
+            cfg.close_c,
+            cfg.dwell_steps,
+        )
+    }
+
+    /// [`Valve::update`] for any ordered number type (thresholds in the same type).
+    /// An unordered value (NaN) forces the valve open.
+    // `!(x < c)` is deliberate: it is true for NaN (stay open), unlike `x >= c`.
+    #[allow(clippy::neg_cmp_op_on_partial_ord)]
+    #[inline(always)]
+    pub fn update_with<T: PartialOrd>(
+        &mut self,
+        drain: T,
+        force_open: bool,
+        open_above: T,
+        close_below: T,
+        dwell_steps: u32,
+    ) -> Option<bool> {
         self.since_toggle_steps = self.since_toggle_steps.saturating_add(1);
-        let force = force_open || drain_c.is_nan();
+        let force = force_open || drain.partial_cmp(&drain).is_none();
         let want = if force {
             true
         } else if self.open {
-            !(drain_c < cfg.close_c)
+            !(drain < close_below)
         } else {
-            drain_c > cfg.open_c
+            drain > open_above
         };
-        if want != self.open && (force || self.since_toggle_steps >= cfg.dwell_steps) {
+        if want != self.open && (force || self.since_toggle_steps >= dwell_steps) {
             self.open = want;
             self.since_toggle_steps = 0;
             Some(want)
@@ -79,17 +108,32 @@ pub struct AlarmConfig {
 
 impl AlarmConfig {
     /// 60 degC raise, 58 degC clear.
-    pub const DEFAULT: AlarmConfig = AlarmConfig { alarm_c: 60.0, clear_c: 58.0 };
+    pub const DEFAULT: AlarmConfig = AlarmConfig {
+        alarm_c: 60.0,
+        clear_c: 58.0,
+    };
 }
 
 /// Alarm with hysteresis; returns `Some(new_state)` on change. NaN raises it.
 pub fn alarm_update(active: &mut bool, drain_c: f32, cfg: &AlarmConfig) -> Option<bool> {
-    let want = if drain_c.is_nan() {
+    alarm_update_with(active, drain_c, cfg.alarm_c, cfg.clear_c)
+}
+
+/// [`alarm_update`] for any ordered number type. An unordered value raises it.
+#[allow(clippy::neg_cmp_op_on_partial_ord)]
+#[inline(always)]
+pub fn alarm_update_with<T: PartialOrd>(
+    active: &mut bool,
+    drain: T,
+    alarm_above: T,
+    clear_below: T,
+) -> Option<bool> {
+    let want = if drain.partial_cmp(&drain).is_none() {
         true
     } else if *active {
-        !(drain_c < cfg.clear_c)
+        !(drain < clear_below)
     } else {
-        drain_c > cfg.alarm_c
+        drain > alarm_above
     };
     if want != *active {
         *active = want;
@@ -182,6 +226,25 @@ impl LngBudget {
         }
     }
 
+    /// Adds one step of absorbed heat, `cj` centijoules (= W for a 10 ms step), when open.
+    #[inline(always)]
+    pub fn update_cj(&mut self, valve_open: bool, cj: u32) {
+        if valve_open {
+            self.used_cj = self.used_cj.saturating_add(cj);
+        }
+    }
+
+    /// Seconds left at a dissipation of `cj_per_step` cJ per 10 ms step (= W), integer
+    /// division (resolution 10 ms), capped at [`LNG_SECONDS_CAP`] when below 1 W.
+    #[inline(always)]
+    pub fn seconds_left_cj(&self, cj_per_step: u32) -> f32 {
+        if cj_per_step == 0 {
+            return LNG_SECONDS_CAP;
+        }
+        let steps = self.capacity_cj.saturating_sub(self.used_cj) / cj_per_step;
+        steps as f32 * crate::params::S_PER_STEP as f32
+    }
+
     /// Heat absorbed so far, cJ (0.01 J).
     pub fn used_cj(&self) -> u32 {
         self.used_cj
@@ -208,7 +271,11 @@ impl LngBudget {
         let r = self.remaining_j();
         if loss_w > 1e-3 {
             let s = r / loss_w;
-            if s < LNG_SECONDS_CAP { s } else { LNG_SECONDS_CAP }
+            if s < LNG_SECONDS_CAP {
+                s
+            } else {
+                LNG_SECONDS_CAP
+            }
         } else {
             LNG_SECONDS_CAP
         }

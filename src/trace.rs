@@ -1,7 +1,7 @@
 //! Event trace: a fixed-size ring buffer of protection events (hubris-style
 //! `Trace` enum), kept in RAM and readable by a debugger or over defmt.
 
-use heapless::HistoryBuf;
+use heapless::Deque;
 
 /// Capacity of the trace ring buffer, events (oldest are overwritten).
 pub const TRACE_LEN: usize = 32;
@@ -84,5 +84,47 @@ pub enum Trace {
     },
 }
 
-/// Ring buffer of the most recent [`TRACE_LEN`] events.
-pub type TraceBuf = HistoryBuf<Trace, TRACE_LEN>;
+/// Ring buffer of the most recent [`TRACE_LEN`] events (oldest dropped when full).
+///
+/// Built on `heapless::Deque`, whose accessors are unchecked internally, so that the
+/// step path has no bounds-check panic (`HistoryBuf::write` indexes with a check).
+#[derive(Clone, Debug, Default)]
+pub struct TraceBuf {
+    q: Deque<Trace, TRACE_LEN>,
+}
+
+impl TraceBuf {
+    /// Empty buffer.
+    pub const fn new() -> Self {
+        TraceBuf { q: Deque::new() }
+    }
+
+    /// Appends an event, dropping the oldest when full.
+    pub fn write(&mut self, t: Trace) {
+        if self.q.is_full() {
+            let _ = self.q.pop_front();
+        }
+        // Cannot fail: there is room after the pop above.
+        let _ = self.q.push_back(t);
+    }
+
+    /// Events, oldest first.
+    pub fn iter(&self) -> impl Iterator<Item = &Trace> {
+        self.q.iter()
+    }
+
+    /// Most recent event.
+    pub fn recent(&self) -> Option<&Trace> {
+        self.q.back()
+    }
+
+    /// Number of stored events.
+    pub fn len(&self) -> usize {
+        self.q.len()
+    }
+
+    /// `true` when no event is stored.
+    pub fn is_empty(&self) -> bool {
+        self.q.is_empty()
+    }
+}

@@ -11,7 +11,14 @@ use eha_guard::{GuardConfig, GuardOf, Output, Sample};
 use proptest::prelude::*;
 
 fn nominal() -> Sample {
-    Sample { current_a: 30.0, p_a_bar: 65.0, p_b_bar: 5.0, speed_rpm: 500.0, position_mm: 0.0, ambient_c: 16.0 }
+    Sample {
+        current_a: 30.0,
+        p_a_bar: 65.0,
+        p_b_bar: 5.0,
+        speed_rpm: 500.0,
+        position_mm: 0.0,
+        ambient_c: 16.0,
+    }
 }
 
 fn finite(o: &Output) -> bool {
@@ -50,7 +57,11 @@ fn run_all<N: eha_guard::num::Num>(seq: &[Option<Sample>]) -> Result<(), TestCas
         prop_assert!(finite(&o), "non-finite output {:?}", o);
         prop_assert!(o.lng_remaining_kg >= 0.0 && o.lng_remaining_kg <= 2.1501);
         if o.faults & faults::LATCHED != 0 {
-            prop_assert!(o.valve_open, "latched fault {:#x} but valve closed", o.faults);
+            prop_assert!(
+                o.valve_open,
+                "latched fault {:#x} but valve closed",
+                o.faults
+            );
         }
     }
     Ok(())
@@ -214,25 +225,45 @@ fn boot_rules_cold_warm_corrupt() {
     // Cold: starts at the first ambient sample (16 degC), valve closed.
     let mut g = GuardOf::<f32>::new(&cfg, Restore::from_record(&ThermalRecord::EMPTY));
     let o = g.step(&nominal());
-    assert!((o.drain_c - 16.0).abs() < 0.01 && !o.valve_open, "cold: {o:?}");
+    assert!(
+        (o.drain_c - 16.0).abs() < 0.01 && !o.valve_open,
+        "cold: {o:?}"
+    );
     // Warm: 45 degC record restored although the ambient is 16 degC → valve opens.
-    let rec = ThermalRecord::new([50.0, 45.0, 46.0, 44.0, 30.0, 45.0], 20.0, 1_000_000, 0, 123);
+    let rec = ThermalRecord::new(
+        [50.0, 45.0, 46.0, 44.0, 30.0, 45.0],
+        20.0,
+        1_000_000,
+        0,
+        123,
+    );
     let mut g = GuardOf::<f32>::new(&cfg, Restore::from_record(&rec));
     let o = g.step(&nominal());
-    assert!((o.drain_c - 45.0).abs() < 0.05 && o.valve_open && o.faults == 0, "warm: {o:?}");
+    assert!(
+        (o.drain_c - 45.0).abs() < 0.05 && o.valve_open && o.faults == 0,
+        "warm: {o:?}"
+    );
     // Snapshot → record → restore round trip keeps the drain within 1e-4 K.
     let snap = g.snapshot();
     assert_eq!(snap.classify(), RecordStatus::Valid);
     let mut g2 = GuardOf::<f32>::new(&cfg, Restore::from_record(&snap));
     let (a, b) = (g.step(&nominal()), g2.step(&nominal()));
-    assert!((a.drain_c - b.drain_c).abs() < 1e-4, "{} vs {}", a.drain_c, b.drain_c);
+    assert!(
+        (a.drain_c - b.drain_c).abs() < 1e-4,
+        "{} vs {}",
+        a.drain_c,
+        b.drain_c
+    );
     // Corrupt: conservative 60 degC start, valve open, MEMORY_CORRUPT latched, LNG empty.
     let mut bad = rec;
     bad.temps_c[5] = 20.0;
     assert_eq!(bad.classify(), RecordStatus::Corrupt);
     let mut g = GuardOf::<f32>::new(&cfg, Restore::from_record(&bad));
     let o = g.step(&nominal());
-    assert!((o.drain_c - 60.0).abs() < 0.05 && o.valve_open, "corrupt: {o:?}");
+    assert!(
+        (o.drain_c - 60.0).abs() < 0.05 && o.valve_open,
+        "corrupt: {o:?}"
+    );
     assert!(o.faults & faults::MEMORY_CORRUPT != 0 && o.lng_remaining_kg == 0.0);
 }
 
@@ -261,7 +292,11 @@ fn lng_budget_arithmetic() {
     for _ in 0..60_000 {
         b.update(true, 1500.0);
     }
-    assert!(b.is_low() && b.remaining_kg() < 0.43, "{}", b.remaining_kg());
+    assert!(
+        b.is_low() && b.remaining_kg() < 0.43,
+        "{}",
+        b.remaining_kg()
+    );
 }
 
 #[test]
@@ -280,6 +315,88 @@ fn case1_60bar_opens_valve_by_temperature() {
     assert_eq!(o.faults & faults::LATCHED, 0);
     let k = opened.expect("60 bar for an hour must open the valve");
     assert!(o.lng_remaining_kg < 2.15, "LNG used while open");
-    let ev = g.trace().oldest_ordered().find(|e| matches!(e, eha_guard::trace::Trace::ValveOpen { .. }));
-    assert!(matches!(ev, Some(eha_guard::trace::Trace::ValveOpen { forced: false, drain_c, .. }) if *drain_c > 40.0), "{ev:?} at {k}");
+    let ev = g
+        .trace()
+        .iter()
+        .find(|e| matches!(e, eha_guard::trace::Trace::ValveOpen { .. }));
+    assert!(
+        matches!(ev, Some(eha_guard::trace::Trace::ValveOpen { forced: false, drain_c, .. }) if *drain_c > 40.0),
+        "{ev:?} at {k}"
+    );
+}
+
+#[test]
+fn trace_ring_keeps_newest_32() {
+    // 40 alarm raise/clear events through a stale-free fault-free guard are hard to
+    // provoke; exercise the ring directly: 40 writes keep the last 32 in order.
+    let mut t = eha_guard::trace::TraceBuf::new();
+    for k in 0..40u32 {
+        t.write(eha_guard::trace::Trace::Fault {
+            step: k,
+            new_bits: 1,
+        });
+    }
+    assert_eq!(t.len(), eha_guard::trace::TRACE_LEN);
+    let steps: Vec<u32> = t
+        .iter()
+        .map(|e| match e {
+            eha_guard::trace::Trace::Fault { step, .. } => *step,
+            _ => u32::MAX,
+        })
+        .collect();
+    assert_eq!(steps, (8..40).collect::<Vec<_>>());
+}
+
+#[test]
+fn stale_input_integrates_worst_case_loss() {
+    // After STALE every channel takes its worst case: copper loss at 340.5 A is
+    // 3 × 340.5² × 0.074 × (1 + 0.00393 (T_w − 25)) W, and the drain estimate keeps
+    // rising faster than under the nominal Case-1 input it replaced.
+    let cfg = GuardConfig::DEFAULT;
+    let mut g = GuardOf::<f64>::new(&cfg, Restore::Cold);
+    for _ in 0..100 {
+        g.step(&nominal());
+    }
+    let mut nominal_g = g.clone();
+    for _ in 0..cfg.stale_steps {
+        g.step_missing();
+    }
+    let t_w = g.model().unwrap().temperatures_c()[0];
+    let o0 = g.step_missing();
+    let p = g.model().unwrap().last_losses_kw();
+    let p_cu_expect = 3.0 * 340.5f64.powi(2) * 0.074 * (1.0 + 0.00393 * (t_w - 25.0)) / 1e3;
+    assert!(
+        (p[0] - p_cu_expect).abs() < 1e-6 * p_cu_expect,
+        "copper {} kW vs {} kW",
+        p[0],
+        p_cu_expect
+    );
+    // Throttling at the full pressure span (355 bar) and 6000 rpm, no piston work.
+    let dp_pa = 355e5;
+    let q = 6000.0 * 2.0 * std::f64::consts::PI / 60.0
+        * eha_guard::params::DEFAULT.displacement_m3_per_rad;
+    let p_throttle = (dp_pa * q / 1e3) - p[2];
+    assert!(
+        (p[4] - p_throttle).abs() < 1e-6 * p_throttle,
+        "throttle {} kW vs {} kW",
+        p[4],
+        p_throttle
+    );
+    assert!(o0.valve_open && o0.faults & faults::STALE != 0);
+    let mut o = o0;
+    let mut n = o0;
+    for _ in 0..500 {
+        o = g.step_missing();
+        n = nominal_g.step(&nominal());
+    }
+    println!(
+        "5 s after STALE: fail-safe drain {:.4} degC, nominal {:.4} degC (from {:.4})",
+        o.drain_c, n.drain_c, o0.drain_c
+    );
+    assert!(
+        o.drain_c - o0.drain_c > 10.0 * (n.drain_c - o0.drain_c).max(1e-3),
+        "fail-safe {} vs nominal {}",
+        o.drain_c,
+        n.drain_c
+    );
 }

@@ -19,7 +19,8 @@ mod fw {
     use cortex_m::peripheral::{syst::SystClkSource, SYST};
     use cortex_m_rt::{entry, exception, ExceptionFrame};
     use defmt_semihosting as _;
-    use eha_guard::model::{InputScales, Model, ModelInput};
+    use eha_guard::model::{InputScales, Model, ModelInput, ModelInputN};
+    use eha_guard::validate::{self, Channels, LimitsN, CH_ALL};
     use eha_guard::{Guard, GuardConfig, Real, Restore, Sample};
     use semihosting::eprintln;
 
@@ -83,7 +84,14 @@ mod fw {
         *noise = noise.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
         let n = ((*noise >> 9) as f32 / 8_388_608.0 - 0.5) * 0.2;
         if k < STEPS / 2 {
-            Sample { current_a: 30.0 + n, p_a_bar: 65.0 + n, p_b_bar: 5.0, speed_rpm: 500.0 + n, position_mm: n * 0.01, ambient_c: 16.0 }
+            Sample {
+                current_a: 30.0 + n,
+                p_a_bar: 65.0 + n,
+                p_b_bar: 5.0,
+                speed_rpm: 500.0 + n,
+                position_mm: n * 0.01,
+                ambient_c: 16.0,
+            }
         } else {
             let w = 2.0 * core::f32::consts::PI * 0.2;
             let t = k as f32 * 0.01;
@@ -111,7 +119,12 @@ mod fw {
 
     impl Stats {
         const fn new() -> Self {
-            Stats { min: u32::MAX, max: 0, sum: 0, n: 0 }
+            Stats {
+                min: u32::MAX,
+                max: 0,
+                sum: 0,
+                n: 0,
+            }
         }
         fn add(&mut self, ticks: u32) {
             self.min = self.min.min(ticks);
@@ -126,9 +139,39 @@ mod fw {
             let mean10 = (self.sum.saturating_sub(overhead as u64 * n) * 100) / (256 * n);
             eprintln!(
                 "{}: instructions/step min {} mean {}.{} max {} (n = {})",
-                name, i(self.min as u64), mean10 / 10, mean10 % 10, i(self.max as u64), self.n
+                name,
+                i(self.min as u64),
+                mean10 / 10,
+                mean10 % 10,
+                i(self.max as u64),
+                self.n
             );
         }
+    }
+
+    /// Opaque call boundary: keeps the inlined model work inside the timed window
+    /// (volatile SysTick reads do not order ordinary computation).
+    #[inline(never)]
+    fn model_step(m: &mut Model<Real>, u: &ModelInput, s: &InputScales<Real>) {
+        m.step(u, s);
+    }
+
+    /// Validation alone: convert + range/rate checks + worst-case substitution.
+    #[inline(never)]
+    fn validate_step(
+        s: &Sample,
+        prev: &Channels<Real>,
+        sc: &InputScales<Real>,
+        lim: &LimitsN<Real>,
+    ) -> ModelInputN<Real> {
+        let (v, nf) = validate::convert(s, sc);
+        let c = validate::check(&v, nf, prev, CH_ALL, lim);
+        validate::substitute(&v, c.bad, Some(v[4]), lim)
+    }
+
+    #[inline(never)]
+    fn guard_step(g: &mut Guard, s: &Sample) -> eha_guard::Output {
+        g.step(s)
     }
 
     #[inline(always)]
@@ -149,7 +192,9 @@ mod fw {
     #[entry]
     fn main() -> ! {
         paint_stack();
-        let Some(mut p) = cortex_m::Peripherals::take() else { semihosting::process::exit(104) };
+        let Some(mut p) = cortex_m::Peripherals::take() else {
+            semihosting::process::exit(104)
+        };
         p.SYST.set_clock_source(SystClkSource::Core);
         p.SYST.set_reload(0x00FF_FFFF);
         p.SYST.clear_current();
@@ -175,12 +220,25 @@ mod fw {
         let wraps = WRAPS.load(Ordering::Relaxed) - w0;
         let init_ticks = wraps as u64 * 0x0100_0000 + (t0.wrapping_sub(t1) & 0x00FF_FFFF) as u64;
 
-        let Ok(mut model) = Model::<Real>::new(&eha_guard::params::DEFAULT) else { semihosting::process::exit(105) };
-        let Some(scales) = InputScales::<Real>::new() else { semihosting::process::exit(106) };
+        let Ok(mut model) = Model::<Real>::new(&eha_guard::params::DEFAULT) else {
+            semihosting::process::exit(105)
+        };
+        let Some(scales) = InputScales::<Real>::new() else {
+            semihosting::process::exit(106)
+        };
         model.set_temperatures(&[16.0; 6], 16.0);
 
+        // Stack used by boot + init (f64 matrix exponential), then repaint to measure
+        // the step loop alone (its figure includes main's own frame).
+        let init_stack = stack_high_water();
+        paint_stack();
+        let Some(limits) = LimitsN::<Real>::new(&GuardConfig::DEFAULT.limits, &scales) else {
+            semihosting::process::exit(107)
+        };
+        let mut prev_ch: Channels<Real> = validate::convert(&sample(0, &mut 1), &scales).0;
         let mut g_stats = Stats::new();
         let mut m_stats = Stats::new();
+        let mut v_stats = Stats::new();
         let mut noise = 1u32;
         let mut prev_pos = 0.0f32;
         let mut last = eha_guard::Output::default();
@@ -198,7 +256,7 @@ mod fw {
 
             let w0 = WRAPS.load(Ordering::Relaxed);
             let t0 = now();
-            let out = guard.step(core::hint::black_box(&s));
+            let out = guard_step(&mut guard, core::hint::black_box(&s));
             if let Some(t) = elapsed(t0, w0) {
                 g_stats.add(t);
             }
@@ -209,10 +267,36 @@ mod fw {
 
             let w0 = WRAPS.load(Ordering::Relaxed);
             let t0 = now();
-            model.step(core::hint::black_box(&u), &scales);
+            let vu = validate_step(core::hint::black_box(&s), &prev_ch, &scales, &limits);
+            if let Some(t) = elapsed(t0, w0) {
+                v_stats.add(t);
+            }
+            core::hint::black_box(vu);
+            prev_ch = validate::convert(&s, &scales).0;
+
+            let w0 = WRAPS.load(Ordering::Relaxed);
+            let t0 = now();
+            model_step(&mut model, core::hint::black_box(&u), &scales);
             if let Some(t) = elapsed(t0, w0) {
                 m_stats.add(t);
             }
+        }
+
+        // Fault path: one NaN current sample, then 200 valid samples with the fault
+        // latched (worst-case current substituted, valve forced open, trace written).
+        let mut f_stats = Stats::new();
+        for k in 0..201u32 {
+            let mut s = sample(STEPS / 2 - 1, &mut noise);
+            if k == 0 {
+                s.current_a = f32::NAN;
+            }
+            let w0 = WRAPS.load(Ordering::Relaxed);
+            let t0 = now();
+            let out = guard_step(&mut guard, core::hint::black_box(&s));
+            if let Some(t) = elapsed(t0, w0) {
+                f_stats.add(t);
+            }
+            last = core::hint::black_box(out);
         }
 
         // Thermal-memory save (snapshot + CRC + no-init write).
@@ -222,14 +306,39 @@ mod fw {
         eha_guard::memory::noinit::store(&rec);
         let save = elapsed(t0, w0).unwrap_or(0);
 
-        let build = if cfg!(feature = "fixed-point") { "fixed-point Q9.23/Q0.32/Q9.55" } else { "f32" };
+        let build = if cfg!(feature = "fixed-point") {
+            "fixed-point Q9.23/Q0.32/Q9.55"
+        } else {
+            "f32"
+        };
         eprintln!("EHA-BENCH build: {}", build);
         eprintln!("timing overhead: {} ticks (subtracted)", ovh);
+        eprintln!(
+            "size_of Guard {} B, Model {} B, ThermalRecord {} B",
+            core::mem::size_of::<Guard>(),
+            core::mem::size_of::<Model<Real>>(),
+            core::mem::size_of::<eha_guard::ThermalRecord>()
+        );
         g_stats.report("Guard::step", ovh);
+        f_stats.report(
+            "Guard::step, fault latched (NaN current then worst case)",
+            ovh,
+        );
         m_stats.report("Model::step", ovh);
-        eprintln!("Guard::new (ZOH expm, f64): {} instructions", init_ticks * 10 / 256);
-        eprintln!("snapshot+store record: {} instructions", (save.saturating_sub(ovh) as u64 * 10) / 256);
-        eprintln!("stack high-water mark: {} bytes", stack_high_water());
+        v_stats.report("validation (convert+check+substitute)", ovh);
+        eprintln!(
+            "Guard::new (ZOH expm, f64): {} instructions",
+            init_ticks * 10 / 256
+        );
+        eprintln!(
+            "snapshot+store record: {} instructions",
+            (save.saturating_sub(ovh) as u64 * 10) / 256
+        );
+        eprintln!(
+            "stack high-water mark: boot+init {} bytes, step loop {} bytes",
+            init_stack,
+            stack_high_water()
+        );
         let dc = (last.drain_c * 1000.0) as i32;
         eprintln!(
             "final drain {}.{:03} degC, valve {}, faults {:#06x}, model drain {} mK, first open step {:?}",
