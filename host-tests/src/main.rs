@@ -1,31 +1,46 @@
-//! `eha-sim`: command-line front end of the reference simulation and the
-//! processor-in-the-loop harness.
+//! `eha-sim`: command line of the reference simulation and its tools.
 
 use clap::{Parser, Subcommand};
+use eha_sim::cli;
+use std::process::ExitCode;
 
-#[derive(Debug, Parser)]
-#[command(name = "eha-sim", version, about = "EHA thermal reference simulation and firmware PIL harness")]
+#[derive(Parser)]
+#[command(name = "eha-sim", version, about = "EHA thermal reference simulation (Liu et al.) and tools")]
 struct Cli {
     #[command(subcommand)]
-    command: Command,
+    cmd: Cmd,
 }
 
-#[derive(Debug, Subcommand)]
-enum Command {
-    /// Run the firmware in QEMU in closed loop with the reference plant (PIL).
+#[derive(Subcommand)]
+enum Cmd {
+    /// Simulate a paper case or a mission; write CSV (shared format + internal channels).
+    Simulate(cli::SimulateArgs),
+    /// Size the LNG charge by eqs. (23)-(25).
+    SizeLng(cli::SizeLngArgs),
+    /// Sweep one parameter over values, runs in parallel.
+    Sweep(cli::SweepArgs),
+    /// Refit the calibrated parameters to Table 4, Table 5 and Fig. 15.
+    Calibrate(cli::CalibrateArgs),
+    /// Print the default (calibrated paper) rig as TOML.
+    Rig,
+    /// Run the firmware in QEMU in closed loop with the reference plant (processor in the loop).
     Pil(eha_sim::pil::cli::PilArgs),
 }
 
-fn main() -> std::process::ExitCode {
-    let cli = Cli::parse();
-    let res = match &cli.command {
-        Command::Pil(a) => eha_sim::pil::cli::run(a),
+fn main() -> ExitCode {
+    let res = match Cli::parse().cmd {
+        Cmd::Simulate(a) => cli::run_simulate(&a),
+        Cmd::SizeLng(a) => cli::run_size_lng(&a),
+        Cmd::Sweep(a) => cli::run_sweep(&a),
+        Cmd::Calibrate(a) => cli::run_calibrate(&a),
+        Cmd::Rig => cli::run_rig(),
+        Cmd::Pil(a) => eha_sim::pil::cli::run(&a),
     };
     match res {
-        Ok(()) => std::process::ExitCode::SUCCESS,
+        Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e:#}");
-            std::process::ExitCode::FAILURE
+            ExitCode::FAILURE
         }
     }
 }
