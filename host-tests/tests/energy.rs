@@ -1,0 +1,53 @@
+//! Energy bookkeeping: the integrated losses equal the energy stored in the
+//! nodes plus the heat to ambient plus the heat to the LNG, within 0.1 %
+//! (issue acceptance). A failure means a conductance, advection or source
+//! term that does not conserve energy.
+
+use eha_sim::rig::Rig;
+use eha_sim::scenario::Scenario;
+use eha_sim::sim::{simulate, SimOptions};
+
+fn check(rig: &Rig, sc: Scenario) {
+    let out = simulate(rig, &sc, &SimOptions { output_interval_s: 10.0, control_interval_s: 0.1 }).expect("runs");
+    let g = |c: &str| out.last(c).expect("channel");
+    let (loss, stored, amb, lng) = (g("e_loss_j"), g("e_stored_j"), g("e_ambient_j"), g("e_lng_j"));
+    let rel = (loss - stored - amb - lng).abs() / loss;
+    println!("{}: losses {loss:.0} J = stored {stored:.0} + ambient {amb:.0} + LNG {lng:.0} (rel. mismatch {rel:.2e})", out.name);
+    assert!(rel < 1e-3, "{}: mismatch {rel}", out.name);
+}
+
+#[test]
+fn energy_closes_in_case1_60bar() {
+    check(&Rig::default(), Scenario::Case1 { needle_bar: 60.0, duration_s: 600.0 });
+}
+
+#[test]
+fn energy_closes_with_lng_cooling() {
+    check(&Rig::default(), Scenario::Lng { duration_s: 600.0 });
+}
+
+#[test]
+fn energy_closes_in_case2_servo() {
+    check(&Rig::default(), Scenario::Case2 { duration_s: 200.0 });
+}
+
+/// With every extension switched on (temperature-dependent viscosity and
+/// resistance, dead-end sensor, Coulomb friction, churning, motor–pump
+/// conduction, unlogged air) the bookkeeping still closes.
+#[test]
+fn energy_closes_with_all_extensions() {
+    let mut rig = Rig::default();
+    for s in [
+        "ext.winding_resistance_temperature=0.00393",
+        "ext.viscosity_temperature=true",
+        "ext.sensor_lag=60",
+        "ext.coulomb_friction=150",
+        "ext.churning_loss=1e-4",
+        "ext.motor_pump_conduction=2",
+        "ext.forced_convection=5",
+    ] {
+        rig.set_override(s).expect("override");
+    }
+    check(&rig, Scenario::Case1 { needle_bar: 40.0, duration_s: 600.0 });
+    check(&rig, Scenario::Case2 { duration_s: 100.0 });
+}
