@@ -20,6 +20,7 @@ pub mod model;
 pub mod num;
 pub mod params;
 pub mod protection;
+pub mod protocol;
 pub mod trace;
 pub mod validate;
 

@@ -18,6 +18,7 @@ pub mod hydraulics;
 pub mod losses;
 pub mod model;
 pub mod network;
+pub mod pil;
 pub mod plant;
 pub mod rig;
 pub mod scenario;

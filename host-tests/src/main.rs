@@ -23,6 +23,8 @@ enum Cmd {
     Calibrate(cli::CalibrateArgs),
     /// Print the default (calibrated paper) rig as TOML.
     Rig,
+    /// Run the firmware in QEMU in closed loop with the reference plant (processor in the loop).
+    Pil(eha_sim::pil::cli::PilArgs),
 }
 
 fn main() -> ExitCode {
@@ -32,6 +34,7 @@ fn main() -> ExitCode {
         Cmd::Sweep(a) => cli::run_sweep(&a),
         Cmd::Calibrate(a) => cli::run_calibrate(&a),
         Cmd::Rig => cli::run_rig(),
+        Cmd::Pil(a) => eha_sim::pil::cli::run(&a),
     };
     match res {
         Ok(()) => ExitCode::SUCCESS,

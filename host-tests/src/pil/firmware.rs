@@ -1,0 +1,124 @@
+//! Building the firmware ELF with a nested `cargo build` (the same commands
+//! as the `cargo fw-build` / `cargo fw-build-m3` aliases).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+
+use anyhow::{bail, Context, Result};
+
+/// The two numeric builds of the firmware.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Build {
+    /// f32 with libm, Cortex-M4F, QEMU `mps2-an386`.
+    F32,
+    /// Fixed point (`fixed` crate), Cortex-M3 without FPU, QEMU `mps2-an385`.
+    Fixed,
+}
+
+impl Build {
+    pub fn target(self) -> &'static str {
+        match self {
+            Build::F32 => "thumbv7em-none-eabihf",
+            Build::Fixed => "thumbv7m-none-eabi",
+        }
+    }
+    pub fn machine(self) -> &'static str {
+        match self {
+            Build::F32 => "mps2-an386",
+            Build::Fixed => "mps2-an385",
+        }
+    }
+    pub fn cpu(self) -> &'static str {
+        match self {
+            Build::F32 => "cortex-m4",
+            Build::Fixed => "cortex-m3",
+        }
+    }
+    pub fn name(self) -> &'static str {
+        match self {
+            Build::F32 => "f32",
+            Build::Fixed => "fixed-point",
+        }
+    }
+    fn features(self) -> &'static [&'static str] {
+        match self {
+            Build::F32 => &[],
+            Build::Fixed => &["--features", "fixed-point"],
+        }
+    }
+}
+
+impl std::str::FromStr for Build {
+    type Err = anyhow::Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s {
+            "f32" => Ok(Build::F32),
+            "fixed" | "fixed-point" => Ok(Build::Fixed),
+            _ => bail!("unknown firmware build {s:?} (expected f32 or fixed)"),
+        }
+    }
+}
+
+/// The workspace root (the firmware crate's directory).
+pub fn workspace_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).parent().map(Path::to_path_buf).unwrap_or_else(|| PathBuf::from(".."))
+}
+
+/// Build the firmware (release) and return the ELF path. Uses the `cargo`
+/// that runs us (`$CARGO`) when there is one; output goes to the same target
+/// directory as the host build (`$CARGO_TARGET_DIR` or `<workspace>/target`).
+pub fn build_firmware(build: Build) -> Result<PathBuf> {
+    ensure_target(build)?;
+    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let root = workspace_root();
+    let mut cmd = Command::new(&cargo);
+    cmd.current_dir(&root)
+        .args(["build", "--release", "-p", "eha-guard", "--bin", "eha-fw", "--target", build.target()])
+        .args(build.features())
+        .args(["--message-format", "json-render-diagnostics"])
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::inherit());
+    // Flags meant for the host build must not leak into the firmware build.
+    cmd.env_remove("RUSTFLAGS").env_remove("CARGO_ENCODED_RUSTFLAGS");
+    let out = cmd.output().with_context(|| format!("running {cargo:?} to build the firmware in {}", root.display()))?;
+    if !out.status.success() {
+        bail!(
+            "firmware build failed ({}): cargo build --release -p eha-guard --bin eha-fw --target {} {} (see the compiler output above)",
+            out.status,
+            build.target(),
+            build.features().join(" ")
+        );
+    }
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    for line in stdout.lines().rev() {
+        let Ok(v) = serde_json::from_str::<serde_json::Value>(line) else { continue };
+        if v["reason"] == "compiler-artifact" && v["target"]["name"] == "eha-fw" {
+            if let Some(exe) = v["executable"].as_str() {
+                return Ok(PathBuf::from(exe));
+            }
+        }
+    }
+    bail!("firmware build succeeded but cargo reported no eha-fw executable")
+}
+
+/// Make sure the Rust target of `build` is installed (rustup does not add the
+/// targets of `rust-toolchain.toml` by itself when auto-install is off): runs
+/// `rustup target add` when it is missing. Without rustup, the build's own
+/// error says what is missing.
+pub fn ensure_target(build: Build) -> Result<()> {
+    let root = workspace_root();
+    let Ok(out) = Command::new("rustup").current_dir(&root).args(["target", "list", "--installed"]).stdin(Stdio::null()).output() else {
+        return Ok(()); // no rustup: let cargo report a missing target
+    };
+    if String::from_utf8_lossy(&out.stdout).lines().any(|l| l.trim() == build.target()) {
+        return Ok(());
+    }
+    eprintln!("installing the Rust target {} (rustup target add) ...", build.target());
+    let st = Command::new("rustup").current_dir(&root).args(["target", "add", build.target()]).stdin(Stdio::null()).status()
+        .context("running rustup target add")?;
+    if !st.success() {
+        bail!("`rustup target add {}` failed ({st})", build.target());
+    }
+    Ok(())
+}

@@ -1,0 +1,118 @@
+//! Closed-loop PIL scenarios: the firmware in QEMU drives the reference
+//! plant's LNG valve in lockstep, at the firmware's own 10 ms step.
+//!
+//! - Fig. 15 (Case 1 at 60 bar with the LNG exchanger), 300 s: the valve
+//!   opening (≈110 s in the paper) is inside the run;
+//! - Case 2 (26.4 °C, 20 mm 0.2 Hz sine), 120 s.
+//!
+//! Each checks, with the tolerance and its source:
+//! - the run completes: completion marker, every frame accepted, none rejected;
+//! - every firmware reply equals the host SIL run of the same core code on the
+//!   same frames bit for bit (f32 build; see `pil_equivalence.rs` for why no
+//!   tolerance is needed);
+//! - accuracy against the reference (issue 3): max |fw − ref drain| ≤ 1.0 K,
+//!   under-prediction ≤ 0.5 K; valve switching within 2 s of switching on the
+//!   reference's true drain temperature (40 °C threshold).
+//! The accuracy bounds depend on the identified firmware parameters: the
+//! mechanics/SIL tests always run and print the accuracy numbers; the bound
+//! checks are `#[ignore]`d (shown as ignored, with the reason) until the fw
+//! branch's parameters are identified against this plant.
+
+use eha_sim::pil::report::{compare, Summary};
+use eha_sim::pil::sil::{sil_core, SilTarget};
+use eha_sim::pil::{firmware_for_tests, replay, require_qemu, run_pil, Build, LoopOptions, PilRun, QemuOptions};
+use eha_sim::plant::Plant;
+use eha_sim::rig::Rig;
+use eha_sim::scenario::Scenario;
+
+const VALVE_OPEN_C: f64 = 40.0;
+
+fn run(scenario: Scenario, duration_s: f64) -> PilRun {
+    require_qemu();
+    let elf = firmware_for_tests(Build::F32);
+    let mut q = QemuOptions::new(Build::F32, &elf);
+    q.icount = false;
+    let mut plant = Plant::new(&Rig::default(), &scenario).unwrap_or_else(|e| panic!("plant: {e}"));
+    let opts = LoopOptions { step_s: eha_guard::params::S_PER_STEP, duration_s };
+    let run = run_pil(&mut plant, &q, &opts).unwrap_or_else(|f| panic!("{f}"));
+    assert_eq!(run.records.len() as u64, opts.steps());
+    assert_eq!(run.done.counters.accepted as usize, run.records.len());
+    assert_eq!(run.done.counters.rejected(), 0);
+    run
+}
+
+fn check_sil(run: &PilRun) {
+    let mut sil = SilTarget::new(sil_core(run.build));
+    let host = replay(&run.records, &mut sil).unwrap();
+    let fw: Vec<_> = run.records.iter().map(|r| r.reply).collect();
+    let c = compare(&fw, &host);
+    assert_eq!(c.identical, c.steps, "firmware differs from SIL first at step {:?}", c.first_difference);
+}
+
+/// First time the reference's true drain temperature reaches `c`.
+fn first_crossing(run: &PilRun, c: f64) -> Option<f64> {
+    run.records.iter().find(|r| r.sensors.t_drain_c >= c).map(|r| r.t_s)
+}
+
+fn report(name: &str, run: &PilRun) -> Summary {
+    let s = Summary::of(&run.records, false);
+    eprintln!(
+        "{name}: {} steps in {:.2} s wall; valve events {:?}; max |fw-ref| {:.3} K; max under {:.3} K; LNG used {:.4} kg; ref crossing 40 C at {:?} s",
+        s.steps,
+        run.wall.as_secs_f64(),
+        s.valve_events,
+        s.max_abs_err_k,
+        s.max_under_k,
+        s.lng_used_kg,
+        first_crossing(run, VALVE_OPEN_C)
+    );
+    s
+}
+
+fn check_accuracy(s: &Summary) {
+    assert!(s.max_abs_err_k <= 1.0, "max |fw − ref| = {:.3} K > 1.0 K (issue 3 bound)", s.max_abs_err_k);
+    assert!(s.max_under_k <= 0.5, "under-prediction {:.3} K > 0.5 K (issue 3 bound)", s.max_under_k);
+}
+
+#[test]
+fn fig15_lng_case_closed_loop() {
+    let run = run(Scenario::Lng { duration_s: 300.0 }, 300.0);
+    let s = report("Fig. 15 LNG", &run);
+    check_sil(&run);
+    // The reference drain temperature reaches the 40 °C threshold inside the run.
+    assert!(first_crossing(&run, VALVE_OPEN_C).is_some_and(|t| t < 250.0), "the run must contain the valve-opening phase");
+    // Whatever the firmware commanded reached the plant: LNG is used iff it opened the valve.
+    let opened = s.valve_events.iter().any(|(_, o)| *o);
+    assert_eq!(opened, s.lng_used_kg > 0.0);
+}
+
+#[test]
+fn case2_closed_loop() {
+    let run = run(Scenario::Case2 { duration_s: 120.0 }, 120.0);
+    report("Case 2", &run);
+    check_sil(&run);
+}
+
+const NEEDS_PARAMS: &str = "issue-3 accuracy bounds need the firmware parameters identified against the reference plant (fw branch); run with --ignored";
+
+#[test]
+#[ignore = "issue-3 accuracy bounds need the firmware parameters identified against the reference plant (fw branch); run with --ignored"]
+fn fig15_lng_case_meets_accuracy_bounds() {
+    eprintln!("{NEEDS_PARAMS}");
+    let run = run(Scenario::Lng { duration_s: 300.0 }, 300.0);
+    let s = report("Fig. 15 LNG", &run);
+    let open = s.valve_events.iter().find(|(_, o)| *o).map(|(t, _)| *t).expect("the firmware opened the LNG valve within 300 s");
+    let truth = first_crossing(&run, VALVE_OPEN_C).expect("reference drain reached 40 °C");
+    assert!((open - truth).abs() <= 2.0, "valve opened at {open:.2} s, reference crossed 40 °C at {truth:.2} s (bound 2 s)");
+    assert!(s.lng_used_kg > 0.0, "LNG must be used while the valve is open");
+    check_accuracy(&s);
+}
+
+#[test]
+#[ignore = "issue-3 accuracy bounds need the firmware parameters identified against the reference plant (fw branch); run with --ignored"]
+fn case2_meets_accuracy_bounds() {
+    eprintln!("{NEEDS_PARAMS}");
+    let run = run(Scenario::Case2 { duration_s: 120.0 }, 120.0);
+    let s = report("Case 2", &run);
+    check_accuracy(&s);
+}
