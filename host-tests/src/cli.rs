@@ -120,7 +120,29 @@ pub fn run_simulate(a: &SimulateArgs) -> Result<()> {
         println!("  LNG valve opens at {:?} s, closes at {:?} s", out.valve_open_times_s, out.valve_close_times_s);
     }
     println!("  wrote {}", csv.display());
+    let png = csv.with_extension("png");
+    plot_run(&out, &png)?;
+    println!("  wrote {}", png.display());
     Ok(())
+}
+
+/// PNG of a run: the pump ports and drain, the surface points, the losses.
+pub fn plot_run(out: &SimOutput, png: &Path) -> Result<()> {
+    let series = |names: &[&str]| -> Vec<(String, Vec<(f64, f64)>)> {
+        names
+            .iter()
+            .filter_map(|n| out.get(n).map(|v| (n.to_string(), out.time_s.iter().copied().zip(v.iter().copied()).collect())))
+            .collect()
+    };
+    let panels = [
+        crate::plot::Panel { y_label: "oil, °C".into(), series: series(&["t_inlet_c", "t_outlet_c", "t_drain_c", "t_oil_c", "t_loop_oil_c"]) },
+        crate::plot::Panel {
+            y_label: "surface, °C".into(),
+            series: series(&["t_motor_c", "t_pump_c", "t_block_c", "t_ballvalve_c", "t_winding_c", "t_actuator_c"]),
+        },
+        crate::plot::Panel { y_label: "loss, W".into(), series: series(&["p_cu_w", "p_fe_w", "p_leak_w", "p_mech_w", "p_throttle_w", "p_line_w", "p_total_w"]) },
+    ];
+    crate::plot::lines(png, &format!("EHA reference simulation: {}", out.name), &panels)
 }
 
 /// `size-lng`: LNG charge by eqs. (23)–(25).

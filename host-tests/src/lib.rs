@@ -20,6 +20,7 @@ pub mod model;
 pub mod network;
 pub mod pil;
 pub mod plant;
+pub mod plot;
 pub mod rig;
 pub mod scenario;
 pub mod sim;

@@ -7,19 +7,10 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, Result};
 use plotters::prelude::*;
-use plotters::style::{register_font, FontStyle};
 
 use super::StepRecord;
 
-fn font() -> Result<()> {
-    static ONCE: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
-    let ok = *ONCE.get_or_init(|| register_font("sans-serif", FontStyle::Normal, dejavu::sans::regular()).is_ok());
-    if ok {
-        Ok(())
-    } else {
-        Err(anyhow!("could not load the embedded DejaVu Sans font"))
-    }
-}
+use crate::plot::font;
 
 /// Write the plot to `path` (PNG). Returns its path.
 pub fn plot_if_available(records: &[StepRecord], path: &Path) -> Result<Option<PathBuf>> {
