@@ -164,12 +164,14 @@ mod tests {
         assert!((effectiveness(2.0, 1e-12) - b).abs() < 1e-15);
     }
 
-    /// Balanced unmixed cross-flow exchanger, NTU = 1, C* = 1: 0.4764 from
-    /// eq. (21) by hand; the exact series solution is 0.476 (Incropera Fig. 11.18).
+    /// Balanced unmixed cross-flow exchanger, NTU = 1, C* = 1: eq. (21) gives
+    /// 1 − exp(e⁻¹ − 1) = 0.4685; the exact series solution is 0.476
+    /// (Incropera Fig. 11.18). Eq. (21) is the approximate closed form, good to
+    /// about 2 % there.
     #[test]
     fn effectiveness_balanced_crossflow() {
         let e = effectiveness(1.0, 1.0);
         assert!((e - (1.0 - ((-1.0f64).exp() - 1.0).exp())).abs() < 1e-12);
-        assert!((e - 0.476).abs() < 0.005, "{e}");
+        assert!((e - 0.476).abs() / 0.476 < 0.02, "{e}");
     }
 }
