@@ -1,0 +1,197 @@
+//! Fluid properties: ISO VG 46 hydraulic oil and dry air.
+//!
+//! The paper (Table 2) names the oil grade only; the property laws below are
+//! the standard ones for mineral ISO VG 46 oil. Every constant states its
+//! source. Temperatures are in °C, pressures in Pa, SI everywhere else.
+
+use serde::{Deserialize, Serialize};
+
+/// Kelvin offset, K.
+pub const KELVIN_OFFSET: f64 = 273.15;
+/// Standard gravity, m/s².
+pub const G_M_PER_S2: f64 = 9.80665;
+
+/// ASTM D341 (Walther) viscosity–temperature line:
+/// `log10(log10(ν + 0.7)) = a − b·log10(T_K)` with ν in cSt (mm²/s).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Walther {
+    /// Intercept `a` of the Walther line (dimensionless).
+    pub a: f64,
+    /// Slope `b` of the Walther line (dimensionless).
+    pub b: f64,
+}
+
+impl Walther {
+    /// Walther line through two (temperature °C, kinematic viscosity cSt) points,
+    /// as ASTM D341 prescribes (usually the 40 °C and 100 °C grade points).
+    pub fn through(t1_c: f64, nu1_cst: f64, t2_c: f64, nu2_cst: f64) -> Self {
+        let y1 = (nu1_cst + 0.7).log10().log10();
+        let y2 = (nu2_cst + 0.7).log10().log10();
+        let x1 = (t1_c + KELVIN_OFFSET).log10();
+        let x2 = (t2_c + KELVIN_OFFSET).log10();
+        let b = (y1 - y2) / (x2 - x1);
+        let a = y1 + b * x1;
+        Self { a, b }
+    }
+
+    /// Kinematic viscosity at `t_c` °C, in cSt (mm²/s).
+    pub fn nu_cst(&self, t_c: f64) -> f64 {
+        let x = (t_c + KELVIN_OFFSET).log10();
+        10f64.powf(10f64.powf(self.a - self.b * x)) - 0.7
+    }
+}
+
+/// Hydraulic oil properties (ISO VG 46 by default).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Oil {
+    /// Kinematic viscosity at 40 °C, cSt (ISO 3448 grade midpoint: 46).
+    pub nu40_cst: f64,
+    /// Kinematic viscosity at 100 °C, cSt (typical VG 46 mineral oil: 6.8).
+    pub nu100_cst: f64,
+    /// Density at 15 °C and 0 bar, kg/m³ (typical VG 46 mineral oil: 872).
+    pub rho15_kg_per_m3: f64,
+    /// Volumetric thermal expansion coefficient, 1/K (mineral oil: 6.5e-4).
+    pub expansion_per_k: f64,
+    /// Isothermal secant bulk modulus of the pure oil, Pa (mineral oil: 1.6e9).
+    pub bulk_modulus_pa: f64,
+    /// Specific heat at 20 °C, J/(kg·K) (mineral oil: 1880).
+    pub cp20_j_per_kg_k: f64,
+    /// Slope of the specific heat with temperature, J/(kg·K²) (mineral oil: 3.7).
+    pub cp_slope_j_per_kg_k2: f64,
+    /// Thermal conductivity at 0 °C, W/(m·K) (mineral oil: 0.134).
+    pub k0_w_per_m_k: f64,
+    /// Slope of the conductivity, W/(m·K²) (mineral oil: −7e-5).
+    pub k_slope_w_per_m_k2: f64,
+}
+
+impl Default for Oil {
+    fn default() -> Self {
+        Self {
+            nu40_cst: 46.0,
+            nu100_cst: 6.8,
+            rho15_kg_per_m3: 872.0,
+            expansion_per_k: 6.5e-4,
+            bulk_modulus_pa: 1.6e9,
+            cp20_j_per_kg_k: 1880.0,
+            cp_slope_j_per_kg_k2: 3.7,
+            k0_w_per_m_k: 0.134,
+            k_slope_w_per_m_k2: -7.0e-5,
+        }
+    }
+}
+
+impl Oil {
+    /// The oil's Walther line through its 40 °C and 100 °C viscosities.
+    pub fn walther(&self) -> Walther {
+        Walther::through(40.0, self.nu40_cst, 100.0, self.nu100_cst)
+    }
+
+    /// Kinematic viscosity at `t_c`, m²/s (ASTM D341 Walther relation).
+    pub fn nu_m2_per_s(&self, t_c: f64) -> f64 {
+        self.walther().nu_cst(t_c) * 1e-6
+    }
+
+    /// Density at `t_c` °C and gauge pressure `p_pa`, kg/m³
+    /// (linear thermal expansion, linear compressibility).
+    pub fn rho(&self, t_c: f64, p_pa: f64) -> f64 {
+        self.rho15_kg_per_m3 * (1.0 - self.expansion_per_k * (t_c - 15.0)) * (1.0 + p_pa / self.bulk_modulus_pa)
+    }
+
+    /// Dynamic viscosity at `t_c`, Pa·s (μ = ν·ρ at 0 bar).
+    pub fn mu_pa_s(&self, t_c: f64) -> f64 {
+        self.nu_m2_per_s(t_c) * self.rho(t_c, 0.0)
+    }
+
+    /// Specific heat at `t_c`, J/(kg·K) (linear in temperature).
+    pub fn cp(&self, t_c: f64) -> f64 {
+        self.cp20_j_per_kg_k + self.cp_slope_j_per_kg_k2 * (t_c - 20.0)
+    }
+
+    /// Specific enthalpy relative to 20 °C, J/kg: ∫cp dT, exact for the linear cp.
+    /// Used so that advection and storage conserve energy exactly.
+    pub fn enthalpy(&self, t_c: f64) -> f64 {
+        let d = t_c - 20.0;
+        self.cp20_j_per_kg_k * d + 0.5 * self.cp_slope_j_per_kg_k2 * d * d
+    }
+
+    /// Thermal conductivity at `t_c`, W/(m·K).
+    pub fn k(&self, t_c: f64) -> f64 {
+        self.k0_w_per_m_k + self.k_slope_w_per_m_k2 * t_c
+    }
+
+    /// Prandtl number at `t_c` with kinematic viscosity `nu` (m²/s) (Table 1: Pr = μ·cp/k).
+    pub fn prandtl(&self, t_c: f64, nu: f64) -> f64 {
+        nu * self.rho(t_c, 0.0) * self.cp(t_c) / self.k(t_c)
+    }
+}
+
+/// Dry air at 1 atm: the outside medium of the free- and forced-convection
+/// correlations (eqs. 15, 16 and the ram-air model).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AirProps {
+    /// Kinematic viscosity, m²/s.
+    pub nu: f64,
+    /// Thermal conductivity, W/(m·K).
+    pub k: f64,
+    /// Prandtl number.
+    pub pr: f64,
+    /// Volumetric expansion coefficient 1/T of an ideal gas, 1/K.
+    pub beta: f64,
+}
+
+/// Air properties at film temperature `t_c` °C and 101325 Pa
+/// (Sutherland's law for μ, ideal-gas density, linear fits for k and cp that
+/// match the standard tables to < 1 % between −20 and 150 °C).
+pub fn air(t_c: f64) -> AirProps {
+    let t_k = t_c + KELVIN_OFFSET;
+    let mu = 1.716e-5 * (t_k / 273.15).powf(1.5) * (273.15 + 110.4) / (t_k + 110.4);
+    let rho = 101_325.0 / (287.05 * t_k);
+    let k = 0.02414 + 7.4e-5 * t_c;
+    let cp = 1005.0 + 0.02 * t_c;
+    AirProps { nu: mu / rho, k, pr: mu * cp / k, beta: 1.0 / t_k }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Published ASTM D341 check vector: 32 cSt at 40 °C and 5.4 cSt at 100 °C
+    /// give 8.5 cSt at 80 °C. The tolerance of 1 % is the issue's; the chart
+    /// reading itself is quoted to two significant figures.
+    #[test]
+    fn walther_reproduces_the_published_vector_within_1_percent() {
+        let w = Walther::through(40.0, 32.0, 100.0, 5.4);
+        let nu80 = w.nu_cst(80.0);
+        assert!((nu80 - 8.5).abs() / 8.5 < 0.01, "nu(80 °C) = {nu80} cSt");
+    }
+
+    /// The line must pass through its own grade points (to 1e-9 relative:
+    /// only floating-point round-off).
+    #[test]
+    fn walther_passes_through_the_grade_points() {
+        let oil = Oil::default();
+        let w = oil.walther();
+        assert!((w.nu_cst(40.0) - 46.0).abs() / 46.0 < 1e-9);
+        assert!((w.nu_cst(100.0) - 6.8).abs() / 6.8 < 1e-9);
+    }
+
+    /// Air at 20 °C: ν = 1.516e-5 m²/s, k = 0.0257 W/(m·K), Pr = 0.71 in the
+    /// standard tables (Incropera A.4, interpolated); 2 % covers the fits.
+    #[test]
+    fn air_properties_match_tables() {
+        let a = air(20.0);
+        assert!((a.nu - 1.516e-5).abs() / 1.516e-5 < 0.02, "nu {}", a.nu);
+        assert!((a.k - 0.0257).abs() / 0.0257 < 0.02, "k {}", a.k);
+        assert!((a.pr - 0.71).abs() / 0.71 < 0.02, "pr {}", a.pr);
+    }
+
+    /// Enthalpy is the integral of cp: its finite difference equals cp to 1e-6.
+    #[test]
+    fn enthalpy_is_the_integral_of_cp() {
+        let oil = Oil::default();
+        let t = 47.0;
+        let d = (oil.enthalpy(t + 1e-3) - oil.enthalpy(t - 1e-3)) / 2e-3;
+        assert!((d - oil.cp(t)).abs() / oil.cp(t) < 1e-6);
+    }
+}

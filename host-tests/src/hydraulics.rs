@@ -1,0 +1,216 @@
+//! Hydraulics and mechanics: pump flows, the Case 1 throttle path, the
+//! cylinder with its spring–damper load, chamber pressures with bulk
+//! modulus, relief and check valves, the position loop of Case 2.
+
+use crate::rig::Rig;
+use crate::scenario::{Circuit, Mission};
+use std::f64::consts::PI;
+
+/// Index of the hydraulic states in the state vector.
+pub mod ix {
+    /// Port-A line (and chamber A) pressure, Pa gauge.
+    pub const PA: usize = 0;
+    /// Port-B line (and chamber B) pressure, Pa gauge.
+    pub const PB: usize = 1;
+    /// Piston position, m.
+    pub const X: usize = 2;
+    /// Piston velocity, m/s.
+    pub const V: usize = 3;
+    /// Motor (= pump shaft) speed, rad/s.
+    pub const OMEGA: usize = 4;
+    /// Number of hydraulic states.
+    pub const N: usize = 5;
+}
+
+/// Reference flow at which the needle valve is set (500 rpm, paper Case 1), rpm.
+pub const NEEDLE_SET_RPM: f64 = 500.0;
+
+/// Smooth positive part ½(x + √(x² + w²)): a valve's opening characteristic
+/// with a transition width `w` (keeps the right-hand side differentiable for
+/// the stiff solver).
+pub fn soft_pos(x: f64, w: f64) -> f64 {
+    0.5 * (x + (x * x + w * w).sqrt())
+}
+
+/// Smooth absolute value √(x² + w²) − w.
+pub fn soft_abs(x: f64, w: f64) -> f64 {
+    (x * x + w * w).sqrt() - w
+}
+
+/// The hydraulic operating point: everything the losses and the thermal
+/// network need from the hydraulic side at one instant.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct OpPoint {
+    /// Shaft speed, rad/s.
+    pub omega: f64,
+    /// Port A pressure, Pa gauge.
+    pub p_a: f64,
+    /// Port B pressure, Pa gauge.
+    pub p_b: f64,
+    /// Pump case pressure, Pa gauge (the accumulator's).
+    pub p_case: f64,
+    /// Piston position, m.
+    pub x: f64,
+    /// Piston velocity, m/s.
+    pub v: f64,
+    /// Flow through the throttle path A → B, m³/s.
+    pub q_path: f64,
+    /// Motor current, A rms.
+    pub current_a: f64,
+    /// Hydraulic circuit.
+    pub circuit: Circuit,
+    /// Ambient temperature, °C.
+    pub ambient_c: f64,
+    /// Air speed over the housings, m/s (logged ram air plus unlogged extension air).
+    pub air_mps: f64,
+}
+
+impl OpPoint {
+    /// Circulation flow through the ring of oil nodes, m³/s (signed: positive
+    /// A-ward through the pump): the throttle flow in Case 1, the piston's
+    /// swept flow in Case 2.
+    pub fn circulation(&self, rig: &Rig) -> f64 {
+        match self.circuit {
+            Circuit::Throttle => self.q_path,
+            Circuit::Servo => rig.actuator.ram_area_m2 * self.v,
+        }
+    }
+}
+
+/// Needle-valve orifice coefficient K (m³/s/√Pa) for a setting of `bar` at
+/// the 500 rpm reference flow; `None` when fully open (0 bar).
+pub fn needle_k(rig: &Rig, bar: f64) -> Option<f64> {
+    if bar <= 1e-3 {
+        None
+    } else {
+        let q_ref = rig.displacement_m3_per_rad() * NEEDLE_SET_RPM * 2.0 * PI / 60.0;
+        Some(q_ref / (bar * 1e5).sqrt())
+    }
+}
+
+/// Pressure drop of the throttle path at flow `q`: line friction and local
+/// losses (eq. 10) plus the needle orifice, Pa. Returns (line part, needle part).
+pub fn path_dp(rig: &Rig, q: f64, nu: f64, needle: Option<f64>) -> (f64, f64) {
+    let rho = rig.oil.rho(40.0, 0.0);
+    let line = rig.hydraulics.path.dp_pa(q, nu, rho);
+    let needle_dp = needle.map_or(0.0, |k| q * q.abs() / (k * k));
+    (line, needle_dp)
+}
+
+/// Flow of the throttle path A → B for a pressure difference `dp` (Pa),
+/// m³/s: the inverse of Δp = R₁·q + R₂·q·|q|, with R₁ the laminar
+/// (Hagen–Poiseuille, λ = 64/Re) resistance of the path's line and R₂ its
+/// local losses Σξ plus the needle orifice. The path runs laminar at the rig's
+/// flows (Re ≈ 500 at 9.5 L/min); the line heat itself is evaluated by eq. (10)
+/// with the regime-dependent friction factor.
+pub fn path_flow(rig: &Rig, dp: f64, nu: f64, needle: Option<f64>) -> f64 {
+    let line = &rig.hydraulics.path;
+    let rho = rig.oil.rho(40.0, 0.0);
+    let a = line.area_m2();
+    let r1 = 128.0 * nu * rho * line.length_m / (PI * line.diameter_m.powi(4));
+    let r2 = rho * line.local_loss_coeff / (2.0 * a * a) + needle.map_or(0.0, |k| 1.0 / (k * k));
+    let m = dp.abs();
+    dp.signum() * 2.0 * m / (r1 + (r1 * r1 + 4.0 * r2 * m).sqrt())
+}
+
+/// Flows of the pump and valves at an operating point, m³/s.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Flows {
+    /// Geometric pump flow D·ω (into A), m³/s.
+    pub geometric: f64,
+    /// Leakage from port A to the case, m³/s.
+    pub leak_a: f64,
+    /// Leakage from port B to the case, m³/s.
+    pub leak_b: f64,
+    /// Check-valve flow from the accumulator into A, B, m³/s.
+    pub check_a: f64,
+    /// Check-valve flow into B.
+    pub check_b: f64,
+    /// Relief flow A → B.
+    pub relief_ab: f64,
+    /// Relief flow B → A.
+    pub relief_ba: f64,
+    /// Actuator cross-piston leakage A → B (eq. 11), m³/s.
+    pub act_leak: f64,
+}
+
+/// Pump, valve and actuator flows at `op` with the pump leakage conductance `k_leak`.
+pub fn flows(rig: &Rig, op: &OpPoint, k_leak: f64) -> Flows {
+    let h = &rig.hydraulics;
+    let w = 0.3e5; // valve transition width, Pa
+    let dp = op.p_a - op.p_b;
+    Flows {
+        geometric: rig.displacement_m3_per_rad() * op.omega,
+        leak_a: k_leak * (op.p_a - op.p_case),
+        leak_b: k_leak * (op.p_b - op.p_case),
+        check_a: h.check_gain * soft_pos(h.accumulator_pa - op.p_a, w),
+        check_b: h.check_gain * soft_pos(h.accumulator_pa - op.p_b, w),
+        relief_ab: h.relief_gain * soft_pos(dp - h.relief_crack_pa, w),
+        relief_ba: h.relief_gain * soft_pos(-dp - h.relief_crack_pa, w),
+        act_leak: match op.circuit {
+            Circuit::Servo => rig.actuator.leak_m3_per_s_pa * dp,
+            Circuit::Throttle => 0.0,
+        },
+    }
+}
+
+/// Motor shaft torque: pump load D·Δp plus the friction torques of eq. (8),
+/// churning and bearings (opposing the motion), N·m.
+pub fn shaft_torque(rig: &Rig, op: &OpPoint, friction_w: f64) -> f64 {
+    let d = rig.displacement_m3_per_rad();
+    let sign = op.omega / (op.omega * op.omega + 1e-4).sqrt();
+    let w = op.omega.abs().max(1.0);
+    d * (op.p_a - op.p_b) + sign * friction_w / w
+}
+
+/// Speed command of the drive, rad/s: the mission's speed in Case 1; in
+/// Case 2 the position loop ω = (A·ẋ_ref + A·K_p·(x_ref − x))/D with a smooth
+/// speed limit.
+pub fn speed_command(rig: &Rig, m: &Mission, t: f64, x: f64) -> f64 {
+    let wmax = rig.motor.max_speed_rpm * 2.0 * PI / 60.0;
+    let raw = match m.circuit {
+        Circuit::Throttle => m.speed_rpm.at(t) * 2.0 * PI / 60.0,
+        Circuit::Servo => {
+            let (xr, vr) = m.position.at(t);
+            let a = rig.actuator.ram_area_m2;
+            (a * vr + a * rig.actuator.position_gain_per_s * (xr - x)) / rig.displacement_m3_per_rad()
+        }
+    };
+    wmax * (raw / wmax).tanh()
+}
+
+/// Derivatives of the hydraulic states (`y` = full state, `dy` = its
+/// derivative), given the operating point `op` and flows `f`.
+pub fn derivatives(rig: &Rig, m: &Mission, t: f64, y: &[f64], op: &OpPoint, f: &Flows, nu: f64, dy: &mut [f64]) {
+    let act = &rig.actuator;
+    let beta = rig.hydraulics.bulk_modulus_pa;
+    let v_line = rig.hydraulics.line_volume_m3;
+    let (q_cyl, v_a, v_b) = match op.circuit {
+        Circuit::Servo => {
+            let half = 0.5 * act.stroke_m;
+            (act.ram_area_m2 * op.v, v_line + act.ram_area_m2 * (half + op.x), v_line + act.ram_area_m2 * (half - op.x))
+        }
+        Circuit::Throttle => (0.0, v_line, v_line),
+    };
+    let relief_net = f.relief_ab - f.relief_ba;
+    let q_path = op.q_path;
+    let _ = (y, nu);
+    dy[ix::PA] = beta / v_a * (f.geometric - f.leak_a - q_path - q_cyl - f.act_leak + f.check_a - relief_net);
+    dy[ix::PB] = beta / v_b * (-f.geometric - f.leak_b + q_path + q_cyl + f.act_leak + f.check_b + relief_net);
+    match op.circuit {
+        Circuit::Throttle => {
+            dy[ix::X] = 0.0;
+            dy[ix::V] = 0.0;
+        }
+        Circuit::Servo => {
+            let coulomb = rig.ext.coulomb_friction.map_or(0.0, |fc| fc * (op.v / 1e-3).tanh());
+            let force = act.ram_area_m2 * (op.p_a - op.p_b)
+                - act.spring_n_per_m * op.x
+                - (act.damping_n_s_per_m + act.viscous_friction_n_s_per_m) * op.v
+                - coulomb;
+            dy[ix::X] = op.v;
+            dy[ix::V] = force / act.load_mass_kg;
+        }
+    }
+    dy[ix::OMEGA] = (speed_command(rig, m, t, op.x) - op.omega) / rig.motor.speed_time_constant_s;
+}

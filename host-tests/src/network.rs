@@ -1,0 +1,160 @@
+//! Thermal network: the nodes of the lumped model, their heat capacities
+//! (Table 2 masses) and the conductances between them (eqs. 12–19),
+//! evaluated at the current temperatures and flows.
+
+use crate::heat::{self, h_forced_plate, h_free_cube, h_free_cylinder, h_mixed, radiation_w, series};
+use crate::rig::Rig;
+
+/// Thermal nodes. Index into the temperature part of the state.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(usize)]
+pub enum Node {
+    /// Motor winding (copper).
+    Winding = 0,
+    /// Motor housing: Point 1 of the rig.
+    Motor,
+    /// Pump housing: Point 3.
+    Pump,
+    /// Oil in the pump case, which leaves through the drain port.
+    Case,
+    /// Oil in the pump inlet port passage (port B in forward flow).
+    Inlet,
+    /// Oil in the pump outlet port passage (port A in forward flow).
+    Outlet,
+    /// Circulating oil in the main-block passages, hoses and accumulator side.
+    Loop,
+    /// Main valve block: Point 4.
+    MainBlock,
+    /// Ball/needle-valve block: Point 5.
+    BallBlock,
+    /// Oil in the ball/needle-valve block, where the throttling heat appears.
+    BallOil,
+    /// Oil at the manifold temperature sensor.
+    Sensor,
+    /// Actuator (cylinder body with its oil).
+    Actuator,
+}
+
+/// Number of thermal nodes.
+pub const N_NODES: usize = 12;
+
+/// All nodes in index order.
+pub const NODES: [Node; N_NODES] = [
+    Node::Winding,
+    Node::Motor,
+    Node::Pump,
+    Node::Case,
+    Node::Inlet,
+    Node::Outlet,
+    Node::Loop,
+    Node::MainBlock,
+    Node::BallBlock,
+    Node::BallOil,
+    Node::Sensor,
+    Node::Actuator,
+];
+
+impl Node {
+    /// Channel name of the node temperature in outputs (°C).
+    pub fn channel(self) -> &'static str {
+        match self {
+            Node::Winding => "t_winding_c",
+            Node::Motor => "t_motor_c",
+            Node::Pump => "t_pump_c",
+            Node::Case => "t_drain_c",
+            Node::Inlet => "t_inlet_c",
+            Node::Outlet => "t_outlet_c",
+            Node::Loop => "t_loop_oil_c",
+            Node::MainBlock => "t_block_c",
+            Node::BallBlock => "t_ballvalve_c",
+            Node::BallOil => "t_ball_oil_c",
+            Node::Sensor => "t_oil_c",
+            Node::Actuator => "t_actuator_c",
+        }
+    }
+
+    /// Whether the node is oil (capacity from the oil's cp(T)) or metal.
+    pub fn is_oil(self) -> bool {
+        matches!(self, Node::Case | Node::Inlet | Node::Outlet | Node::Loop | Node::BallOil | Node::Sensor)
+    }
+}
+
+/// Masses of the nodes, kg (oil masses at the 40 °C density) and, for
+/// metal nodes, their specific heats, J/(kg·K).
+pub fn masses(rig: &Rig) -> [(f64, f64); N_NODES] {
+    let rho = rig.oil.rho(40.0, 0.0) * rig.nuisance.oil_capacity_scale;
+    let ms = rig.nuisance.metal_capacity_scale;
+    let m = &rig.motor;
+    [
+        (m.winding_mass_kg * ms, m.winding_cp),
+        ((m.mass_kg - m.winding_mass_kg) * ms, m.body_cp),
+        (rig.pump.mass_kg * ms, rig.pump.cp),
+        (rho * rig.pump.case_oil_m3, 0.0),
+        (rho * rig.pump.port_oil_m3, 0.0),
+        (rho * rig.pump.port_oil_m3, 0.0),
+        (rho * rig.blocks.loop_oil_m3, 0.0),
+        (rig.blocks.main_mass_kg * ms, rig.blocks.cp),
+        (rig.blocks.ball_mass_kg * ms, rig.blocks.cp),
+        (rho * rig.blocks.ball_oil_m3, 0.0),
+        (rho * rig.blocks.sensor_oil_m3, 0.0),
+        (rig.actuator.body_mass_kg * ms, rig.actuator.body_cp),
+    ]
+}
+
+/// Oil-to-metal conductance of a duct: forced convection by eqs. (13)/(14)
+/// (h = Nu·k/d, eq. 12) on the wetted area π·d·L·scale, W/K.
+pub fn duct_conductance(rig: &Rig, q_m3_per_s: f64, d: f64, len: f64, area_scale: f64, t_oil: f64, nu: f64) -> f64 {
+    let re = heat::reynolds(q_m3_per_s, d, nu);
+    let pr = rig.oil.prandtl(t_oil, nu);
+    let h = heat::nu_tube(re, pr, d / len) * rig.oil.k(t_oil) / d;
+    h * std::f64::consts::PI * d * len * area_scale * rig.nuisance.inner_scale
+}
+
+/// Outer surfaces exchanging heat with ambient.
+#[derive(Debug, Clone, Copy)]
+pub enum Shape {
+    /// Horizontal cylinder of the given outer diameter, eq. (15).
+    Cylinder(f64),
+    /// Cube-like block of the given side, eq. (16).
+    Cube(f64),
+}
+
+/// The metal nodes that see the air: node, area m², shape.
+pub fn surfaces(rig: &Rig) -> [(Node, f64, Shape); 5] {
+    let side = |a: f64| (a / 6.0).sqrt();
+    [
+        (Node::Motor, rig.motor.area_m2, Shape::Cylinder(rig.motor.diameter_m)),
+        (Node::Pump, rig.pump.area_m2, Shape::Cylinder(rig.pump.diameter_m)),
+        (Node::MainBlock, rig.blocks.main_area_m2, Shape::Cube(side(rig.blocks.main_area_m2))),
+        (Node::BallBlock, rig.blocks.ball_area_m2, Shape::Cube(side(rig.blocks.ball_area_m2))),
+        (Node::Actuator, rig.actuator.area_m2, Shape::Cylinder(rig.actuator.diameter_m)),
+    ]
+}
+
+/// Convective coefficient of an outer surface: free convection (eq. 15 or
+/// 16) combined with forced convection at `air_mps` (ram air), W/(m²·K).
+pub fn h_outer(rig: &Rig, shape: Shape, t_wall: f64, t_air: f64, air_mps: f64) -> f64 {
+    let free = match shape {
+        Shape::Cylinder(d) => h_free_cylinder(t_wall, t_air, d),
+        Shape::Cube(a) => h_free_cube(t_wall, t_air, a),
+    };
+    if air_mps > 0.0 {
+        h_mixed(free, h_forced_plate(air_mps, rig.outside.ram_run_length_m, rig.outside.ram_property_c))
+    } else {
+        free
+    }
+}
+
+/// Heat flow from a surface to ambient: convection (eq. 12) + radiation
+/// (eq. 19), times the nuisance outer scale, W.
+pub fn q_outer(rig: &Rig, area: f64, shape: Shape, t_wall: f64, t_air: f64, air_mps: f64) -> f64 {
+    let conv = h_outer(rig, shape, t_wall, t_air, air_mps) * area * (t_wall - t_air);
+    (conv + radiation_w(rig.outside.emissivity, area, t_wall, t_air)) * rig.nuisance.outer_scale
+}
+
+/// Conductance through a block wall in series with the oil film, eq. (18)
+/// in series with eq. (12), W/K.
+pub fn block_path(rig: &Rig, film_w_per_k: f64, block_area_m2: f64) -> f64 {
+    let a = (block_area_m2 / 6.0).sqrt();
+    series(film_w_per_k, heat::g_plane_wall(rig.blocks.steel_k, a, rig.blocks.wall_m))
+}

@@ -1,0 +1,369 @@
+//! The plant: the full model integrated by diffsol's adaptive BDF (a stiff
+//! solver with error control), advanced in lockstep segments with a
+//! callback at every segment end. The offline simulation, the firmware
+//! comparisons and the QEMU processor-in-the-loop runs all drive the model
+//! through [`Plant::run`].
+
+use crate::hydraulics::{ix, OpPoint};
+use crate::model::{Drive, Losses, Model, E_AMB, E_LNG, E_LOSS, N_STATE, T0};
+use crate::network::{Node, N_NODES};
+use crate::rig::Rig;
+use crate::scenario::{Scenario, ValveRule};
+use diffsol::{NalgebraLU, NalgebraMat, OdeBuilder, OdeSolverMethod, OdeSolverStopReason};
+use std::cell::Cell;
+
+/// Errors of a simulation.
+#[derive(Debug, thiserror::Error)]
+pub enum SimError {
+    /// The ODE solver failed (step size underflow, Newton divergence, ...).
+    #[error("solver failed at t = {t:.3} s: {message}")]
+    Solver {
+        /// Time reached, s.
+        t: f64,
+        /// diffsol's message.
+        message: String,
+    },
+    /// The scenario is not simulable (empty replay, bad duration, ...).
+    #[error("invalid scenario: {0}")]
+    Scenario(String),
+    /// The step callback asked to stop with an error.
+    #[error("{0}")]
+    Callback(String),
+}
+
+/// Relative tolerance of the BDF error control.
+pub const RTOL: f64 = 1e-6;
+
+/// Per-state absolute tolerances: 1 Pa, 1e-12 m³/s, 1 µm, 1 µm/s, 1e-5 rad/s,
+/// 1e-5 K, 1e-3 J.
+pub fn atol() -> Vec<f64> {
+    let mut a = vec![1e-5; N_STATE];
+    a[ix::PA] = 1.0;
+    a[ix::PB] = 1.0;
+    a[ix::X] = 1e-6;
+    a[ix::V] = 1e-6;
+    a[ix::OMEGA] = 1e-5;
+    for e in [E_LOSS, E_AMB, E_LNG] {
+        a[e] = 1e-3;
+    }
+    a
+}
+
+/// Typical magnitudes of the states, used to scale the finite-difference
+/// Jacobian–vector products.
+fn typical() -> Vec<f64> {
+    let mut s = vec![1.0; N_STATE];
+    s[ix::PA] = 1e6;
+    s[ix::PB] = 1e6;
+    s[ix::X] = 1e-2;
+    s[ix::V] = 1e-2;
+    s[ix::OMEGA] = 10.0;
+    for t in s.iter_mut().skip(T0).take(N_NODES) {
+        *t = 50.0;
+    }
+    for e in [E_LOSS, E_AMB, E_LNG] {
+        s[e] = 1e5;
+    }
+    s
+}
+
+/// What the model shows at one instant: the operating point, every node
+/// temperature, every loss and the energy integrals.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Snapshot {
+    /// Time, s.
+    pub t: f64,
+    /// Hydraulic operating point.
+    pub op: OpPoint,
+    /// Node temperatures, °C, in [`crate::network::NODES`] order.
+    pub temps: [f64; N_NODES],
+    /// Losses, W.
+    pub losses: Losses,
+    /// LNG valve open.
+    pub lng_open: bool,
+    /// Integrated losses, J.
+    pub e_loss_j: f64,
+    /// Integrated heat to ambient, J.
+    pub e_amb_j: f64,
+    /// Integrated heat to the LNG, J.
+    pub e_lng_j: f64,
+    /// Energy stored in the nodes since the start, J.
+    pub stored_j: f64,
+    /// LNG used since the start, kg (eq. 24).
+    pub lng_used_kg: f64,
+}
+
+impl Snapshot {
+    /// Temperature of a node, °C.
+    pub fn temp(&self, n: Node) -> f64 {
+        self.temps[n as usize]
+    }
+}
+
+/// What a step callback returns.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Control {
+    /// New LNG valve command (None: unchanged).
+    pub lng_valve: Option<bool>,
+    /// Stop the run after this step.
+    pub stop: bool,
+}
+
+/// Solver statistics of a run.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Stats {
+    /// Right-hand-side evaluations (including those of Jacobian products).
+    pub rhs_evals: u64,
+    /// Accepted solver steps.
+    pub steps: u64,
+}
+
+/// The plant: model plus state.
+#[derive(Debug)]
+pub struct Plant {
+    model: Model,
+    y: Vec<f64>,
+    y0: Vec<f64>,
+    t: f64,
+    stats: Stats,
+}
+
+impl Plant {
+    /// A plant for `scenario` on `rig`, at rest at ambient.
+    pub fn new(rig: &Rig, scenario: &Scenario) -> Result<Self, SimError> {
+        let drive = match scenario {
+            Scenario::Replay(r) => {
+                if r.time_s.len() < 2 {
+                    return Err(SimError::Scenario("replay needs at least two samples".into()));
+                }
+                Drive::Replay(crate::model::ReplayDrive::new(r.clone()))
+            }
+            other => Drive::Mission(other.mission().ok_or_else(|| SimError::Scenario("no mission".into()))?),
+        };
+        let model = Model::new(rig.clone(), drive);
+        let y = model.initial_state();
+        let t = match &model.drive {
+            Drive::Replay(r) => r.inputs().time_s.first().copied().unwrap_or(0.0),
+            Drive::Mission(_) => 0.0,
+        };
+        Ok(Self { y0: y.clone(), y, t, model, stats: Stats::default() })
+    }
+
+    /// The model.
+    pub fn model(&self) -> &Model {
+        &self.model
+    }
+
+    /// Current time, s.
+    pub fn time_s(&self) -> f64 {
+        self.t
+    }
+
+    /// Solver statistics so far.
+    pub fn stats(&self) -> Stats {
+        self.stats
+    }
+
+    /// Set the LNG valve.
+    pub fn set_lng_valve(&mut self, open: bool) {
+        self.model.lng_open.set(open);
+    }
+
+    /// Snapshot of the current state.
+    pub fn snapshot(&self) -> Snapshot {
+        snapshot(&self.model, self.t, &self.y, &self.y0)
+    }
+
+    /// Advance to `t_end` in segments of `dt_s`, calling `on_step` with the
+    /// snapshot at the start and at the end of every segment; the callback
+    /// may command the LNG valve (used during the next segment) or stop.
+    /// Schedule breakpoints (steps of speed, pressure, ambient) are hit exactly.
+    pub fn run<F>(&mut self, dt_s: f64, t_end: f64, mut on_step: F) -> Result<(), SimError>
+    where
+        F: FnMut(&Snapshot) -> Result<Control, SimError>,
+    {
+        if !(dt_s > 0.0 && dt_s.is_finite()) {
+            return Err(SimError::Scenario(format!("step {dt_s} s must be > 0")));
+        }
+        let model = &self.model;
+        let evals = Cell::new(0u64);
+        let scale = typical();
+        let rhs = |x: &[f64], _p: &[f64], t: f64, y: &mut [f64]| {
+            evals.set(evals.get() + 1);
+            model.rhs(t, x, y);
+        };
+        let mut xp = vec![0.0; N_STATE];
+        let mut f0 = vec![0.0; N_STATE];
+        let xp_cell = std::cell::RefCell::new((xp.as_mut_slice(), f0.as_mut_slice()));
+        let jac = |x: &[f64], _p: &[f64], t: f64, v: &[f64], y: &mut [f64]| {
+            // Forward-difference J·v with a step scaled to the state magnitudes.
+            let mut guard = xp_cell.borrow_mut();
+            let (xp, f0) = &mut *guard;
+            let vmax = v.iter().zip(x.iter().zip(&scale)).map(|(vi, (xi, s))| vi.abs() / (xi.abs() + s)).fold(0.0, f64::max);
+            if vmax == 0.0 {
+                y.iter_mut().for_each(|yi| *yi = 0.0);
+                return;
+            }
+            let eps = 1e-7 / vmax;
+            for i in 0..x.len() {
+                xp[i] = x[i] + eps * v[i];
+            }
+            evals.set(evals.get() + 2);
+            model.rhs(t, x, f0);
+            model.rhs(t, xp, y);
+            for i in 0..y.len() {
+                y[i] = (y[i] - f0[i]) / eps;
+            }
+        };
+        let y_init = self.y.clone();
+        let t_start = self.t;
+        let problem = OdeBuilder::<NalgebraMat<f64>>::new()
+            .t0(t_start)
+            .rtol(RTOL)
+            .atol(atol())
+            .h0(1e-4)
+            .rhs_implicit(rhs, jac)
+            .init(move |_p, _t, y| y.copy_from_slice(&y_init), N_STATE)
+            .build()
+            .map_err(|e| SimError::Solver { t: t_start, message: e.to_string() })?;
+        let mut solver = problem.bdf::<NalgebraLU<f64>>().map_err(|e| SimError::Solver { t: t_start, message: e.to_string() })?;
+        let err = |t: f64| move |e: diffsol::DiffsolError| SimError::Solver { t, message: e.to_string() };
+        let mut stops = breakpoints(&model.drive, t_start, t_end);
+        stops.push(t_end);
+        let mut stops = stops.into_iter();
+        let mut stop = stops.next().unwrap_or(t_end);
+        solver.set_stop_time(stop).map_err(err(t_start))?;
+        let mut snap = snapshot(model, t_start, &self.y, &self.y0);
+        let mut ctl = on_step(&snap)?;
+        if let Some(v) = ctl.lng_valve {
+            model.lng_open.set(v);
+        }
+        let mut k: u64 = 1;
+        let mut t_cb = t_start + dt_s;
+        let mut y_buf = vec![0.0; N_STATE];
+        'outer: while !ctl.stop && snap.t < t_end - 1e-9 {
+            let here = solver.state().t;
+            let reason = solver.step().map_err(err(here))?;
+            let t_now = solver.state().t;
+            // Callbacks at the segment ends inside this step, by interpolation.
+            while !ctl.stop && t_cb <= t_now + 1e-9 && t_cb <= t_end + 1e-9 {
+                let tc = t_cb.min(t_now);
+                if (tc - t_now).abs() <= 1e-9 {
+                    y_buf.copy_from_slice(solver.state().y.batch_as_slice(0));
+                } else {
+                    let yi = solver.interpolate(tc).map_err(err(tc))?;
+                    y_buf.copy_from_slice(yi.batch_as_slice(0));
+                }
+                snap = snapshot(model, tc, &y_buf, &self.y0);
+                ctl = on_step(&snap)?;
+                k += 1;
+                t_cb = t_start + k as f64 * dt_s;
+                let change = ctl.lng_valve.filter(|&v| v != model.lng_open.get());
+                if change.is_some() || ctl.stop {
+                    // Pin the solver at the callback time before acting.
+                    if tc < t_now - 1e-9 {
+                        solver.state_mut_back(tc).map_err(err(tc))?;
+                    }
+                    if let Some(v) = change {
+                        model.lng_open.set(v);
+                    }
+                    if ctl.stop {
+                        break 'outer;
+                    }
+                    continue 'outer;
+                }
+            }
+            if matches!(reason, OdeSolverStopReason::TstopReached) {
+                match stops.next() {
+                    Some(s) => {
+                        stop = s;
+                        solver.set_stop_time(stop).map_err(err(t_now))?;
+                    }
+                    None => break,
+                }
+            }
+        }
+        let _ = stop;
+        self.stats.steps += solver.get_statistics().number_of_steps as u64;
+        let st = solver.state();
+        self.t = st.t;
+        self.y.copy_from_slice(st.y.batch_as_slice(0));
+        self.stats.rhs_evals += evals.get();
+        Ok(())
+    }
+
+    /// The scenario's own valve rule (thermostat or logged command), detached
+    /// from the plant so that a run's callback can evaluate it.
+    pub fn valve_rule(&self) -> RuleEval {
+        RuleEval {
+            rule: self.model.valve_rule(),
+            lng: self.model.rig.lng,
+            replay: match &self.model.drive {
+                Drive::Replay(r) => Some(r.clone()),
+                Drive::Mission(_) => None,
+            },
+        }
+    }
+}
+
+/// A scenario's valve rule, evaluated on snapshots.
+#[derive(Debug, Clone)]
+pub struct RuleEval {
+    rule: ValveRule,
+    lng: crate::cooling::Lng,
+    replay: Option<crate::model::ReplayDrive>,
+}
+
+impl RuleEval {
+    /// The valve command at a snapshot (None: leave it to the caller).
+    pub fn command(&self, snap: &Snapshot) -> Option<bool> {
+        let next = |t: f64| crate::cooling::valve_next(snap.lng_open, t, &self.lng);
+        match self.rule {
+            ValveRule::None => Some(false),
+            ValveRule::LoopOil => Some(next(snap.temp(Node::Loop))),
+            ValveRule::Drain => Some(next(snap.temp(Node::Case))),
+            ValveRule::External => self.replay.as_ref().map(|r| r.lng_open(snap.t)),
+        }
+    }
+}
+
+fn breakpoints(drive: &Drive, t0: f64, t1: f64) -> Vec<f64> {
+    let mut v: Vec<f64> = match drive {
+        Drive::Mission(m) => m
+            .ambient_c
+            .breakpoints()
+            .chain(m.speed_rpm.breakpoints())
+            .chain(m.needle_bar.breakpoints())
+            .chain(m.air_speed_mps.breakpoints())
+            .chain(match &m.position {
+                crate::scenario::PositionRef::Profile(s) => s.0.iter().map(|p| p.0).collect::<Vec<_>>(),
+                crate::scenario::PositionRef::Sine { .. } => vec![],
+            })
+            .collect(),
+        Drive::Replay(r) => r.inputs().time_s.clone(),
+    };
+    v.retain(|&b| b > t0 && b < t1);
+    v.sort_by(f64::total_cmp);
+    v.dedup();
+    v
+}
+
+/// Snapshot of state `y` at `t` (with `y0` the initial state for the stored energy).
+pub fn snapshot(model: &Model, t: f64, y: &[f64], y0: &[f64]) -> Snapshot {
+    let op = model.op_point(t, y);
+    let mut temps = [0.0; N_NODES];
+    temps.copy_from_slice(&y[T0..T0 + N_NODES]);
+    let losses = model.losses(t, &op, &temps);
+    Snapshot {
+        t,
+        op,
+        temps,
+        losses,
+        lng_open: model.lng_open.get(),
+        e_loss_j: y[E_LOSS],
+        e_amb_j: y[E_AMB],
+        e_lng_j: y[E_LNG],
+        stored_j: model.stored_energy(y0, y),
+        lng_used_kg: y[E_LNG] / model.rig.lng.heat_per_kg(),
+    }
+}

@@ -1,0 +1,206 @@
+//! Offline simulation runs: a scenario in, time series of every channel out
+//! (the shared measured-data columns plus the model's internal channels).
+
+use crate::network::{Node, NODES};
+use crate::plant::{Control, Plant, SimError, Snapshot, Stats};
+use crate::rig::Rig;
+use crate::scenario::Scenario;
+use std::io::Write;
+use std::path::Path;
+
+/// Options of an offline run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SimOptions {
+    /// Output sample interval, s.
+    pub output_interval_s: f64,
+    /// Interval at which the scenario's valve rule is evaluated, s.
+    pub control_interval_s: f64,
+}
+
+impl Default for SimOptions {
+    fn default() -> Self {
+        Self { output_interval_s: 1.0, control_interval_s: 0.1 }
+    }
+}
+
+/// Columns of the shared measured-data format, in its order.
+pub const MEASURED_COLUMNS: [&str; 14] = [
+    "time_s",
+    "speed_rpm",
+    "current_a",
+    "p_a_bar",
+    "p_b_bar",
+    "ambient_c",
+    "position_mm",
+    "t_motor_c",
+    "t_pump_c",
+    "t_block_c",
+    "t_ballvalve_c",
+    "t_oil_c",
+    "lng_valve",
+    "air_speed_mps",
+];
+
+/// Every channel of a snapshot as (name, value): the measured-format
+/// channels first (without `time_s`), then the internal ones.
+pub fn channels(s: &Snapshot) -> Vec<(&'static str, f64)> {
+    let op = &s.op;
+    let mut v = vec![
+        ("speed_rpm", op.omega * 60.0 / (2.0 * std::f64::consts::PI)),
+        ("current_a", op.current_a),
+        ("p_a_bar", op.p_a * 1e-5),
+        ("p_b_bar", op.p_b * 1e-5),
+        ("ambient_c", op.ambient_c),
+        ("position_mm", op.x * 1e3),
+        ("t_motor_c", s.temp(Node::Motor)),
+        ("t_pump_c", s.temp(Node::Pump)),
+        ("t_block_c", s.temp(Node::MainBlock)),
+        ("t_ballvalve_c", s.temp(Node::BallBlock)),
+        ("t_oil_c", s.temp(Node::Sensor)),
+        ("lng_valve", if s.lng_open { 1.0 } else { 0.0 }),
+        ("air_speed_mps", op.air_mps),
+    ];
+    for n in NODES {
+        if !matches!(n, Node::Motor | Node::Pump | Node::MainBlock | Node::BallBlock | Node::Sensor) {
+            v.push((n.channel(), s.temp(n)));
+        }
+    }
+    v.extend(s.losses.channels());
+    v.extend([
+        ("p_total_w", s.losses.total()),
+        ("e_loss_j", s.e_loss_j),
+        ("e_ambient_j", s.e_amb_j),
+        ("e_lng_j", s.e_lng_j),
+        ("e_stored_j", s.stored_j),
+        ("lng_used_kg", s.lng_used_kg),
+        ("velocity_mm_s", op.v * 1e3),
+        ("q_path_l_min", op.q_path * 6e4),
+    ]);
+    v
+}
+
+/// Result of an offline run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimOutput {
+    /// Scenario name.
+    pub name: String,
+    /// Output times, s.
+    pub time_s: Vec<f64>,
+    /// Channels, in [`channels`] order.
+    pub columns: Vec<(String, Vec<f64>)>,
+    /// Solver statistics.
+    pub stats: Stats,
+    /// Times at which the LNG valve opened (s).
+    pub valve_open_times_s: Vec<f64>,
+    /// Times at which the LNG valve closed (s).
+    pub valve_close_times_s: Vec<f64>,
+}
+
+impl SimOutput {
+    /// A channel by name.
+    pub fn get(&self, name: &str) -> Option<&[f64]> {
+        if name == "time_s" {
+            return Some(&self.time_s);
+        }
+        self.columns.iter().find(|(n, _)| n == name).map(|(_, v)| v.as_slice())
+    }
+
+    /// Last value of a channel.
+    pub fn last(&self, name: &str) -> Option<f64> {
+        self.get(name).and_then(|v| v.last().copied())
+    }
+
+    /// Maximum of a channel.
+    pub fn max(&self, name: &str) -> Option<f64> {
+        self.get(name).map(|v| v.iter().copied().fold(f64::NEG_INFINITY, f64::max))
+    }
+
+    /// Value of a channel interpolated at `t`.
+    pub fn at(&self, name: &str, t: f64) -> Option<f64> {
+        let v = self.get(name)?;
+        let i = self.time_s.partition_point(|&x| x <= t);
+        match (i.checked_sub(1).and_then(|j| self.time_s.get(j).zip(v.get(j))), self.time_s.get(i).zip(v.get(i))) {
+            (Some((ta, a)), Some((tb, b))) => Some(a + (b - a) * (t - ta) / (tb - ta)),
+            (Some((_, a)), None) => Some(*a),
+            (None, Some((_, b))) => Some(*b),
+            (None, None) => None,
+        }
+    }
+
+    /// Write the run as CSV: the shared measured-data columns first (so any
+    /// reader of that format can read it), then the internal channels as
+    /// extra columns, with `# key: value` metadata.
+    pub fn write_csv(&self, path: &Path, meta: &[(&str, String)]) -> std::io::Result<()> {
+        let mut f = std::io::BufWriter::new(std::fs::File::create(path)?);
+        for (k, v) in meta {
+            writeln!(f, "# {k}: {v}")?;
+        }
+        let mut w = csv::Writer::from_writer(f);
+        let mut header = vec!["time_s".to_string()];
+        header.extend(self.columns.iter().map(|(n, _)| n.clone()));
+        w.write_record(&header)?;
+        for (i, t) in self.time_s.iter().enumerate() {
+            let mut row = vec![format!("{t:.3}")];
+            for (name, col) in &self.columns {
+                let x = col.get(i).copied().unwrap_or(f64::NAN);
+                row.push(if name == "lng_valve" { format!("{x:.0}") } else { format!("{x:.6}") });
+            }
+            w.write_record(&row)?;
+        }
+        w.flush()?;
+        Ok(())
+    }
+}
+
+/// Run `scenario` on `rig` and sample every channel.
+pub fn simulate(rig: &Rig, scenario: &Scenario, opt: &SimOptions) -> Result<SimOutput, SimError> {
+    let mut plant = Plant::new(rig, scenario)?;
+    let name = match scenario.mission() {
+        Some(m) => m.name,
+        None => match scenario {
+            Scenario::Replay(r) => r.name.clone(),
+            _ => "run".into(),
+        },
+    };
+    let t0 = plant.time_s();
+    let t_end = t0 + scenario.duration_s() - if matches!(scenario, Scenario::Replay(_)) { t0 } else { 0.0 };
+    let dt = opt.control_interval_s.min(opt.output_interval_s);
+    let every = (opt.output_interval_s / dt).round().max(1.0) as u64;
+    let mut out = SimOutput {
+        name,
+        time_s: vec![],
+        columns: vec![],
+        stats: Stats::default(),
+        valve_open_times_s: vec![],
+        valve_close_times_s: vec![],
+    };
+    let mut k: u64 = 0;
+    let mut last_open = false;
+    let rule = plant.valve_rule();
+    plant.run(dt, t_end, |s| {
+        let cmd = rule.command(s);
+        if k % every == 0 || s.t >= t_end - 1e-9 {
+            let ch = channels(s);
+            if out.columns.is_empty() {
+                out.columns = ch.iter().map(|(n, _)| (n.to_string(), Vec::new())).collect();
+            }
+            out.time_s.push(s.t);
+            for ((_, col), (_, v)) in out.columns.iter_mut().zip(ch) {
+                col.push(v);
+            }
+        }
+        if let Some(open) = cmd {
+            if open && !last_open {
+                out.valve_open_times_s.push(s.t);
+            }
+            if !open && last_open {
+                out.valve_close_times_s.push(s.t);
+            }
+            last_open = open;
+        }
+        k += 1;
+        Ok(Control { lng_valve: cmd, stop: false })
+    })?;
+    out.stats = plant.stats();
+    Ok(out)
+}
