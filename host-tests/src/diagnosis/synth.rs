@@ -22,6 +22,36 @@ pub enum SynthScenario {
     Servo,
     /// Throttle mission with speed and needle-pressure steps.
     ThrottleSteps,
+    /// Servo mission: triangular position profile whose amplitude
+    /// (10–25 mm) and half-period (2–5 s) change every cycle.
+    ServoProfile,
+    /// Throttle mission: speed steps 1000–2000 rpm every 100–250 s at low
+    /// needle pressure (5–25 bar), the regime where speed losses dominate.
+    SpeedSweep,
+}
+
+impl SynthScenario {
+    /// Every scenario.
+    pub const ALL: [SynthScenario; 5] = [
+        SynthScenario::Case1Pressure,
+        SynthScenario::Servo,
+        SynthScenario::ThrottleSteps,
+        SynthScenario::ServoProfile,
+        SynthScenario::SpeedSweep,
+    ];
+
+    /// Whether `hidden` can act at all in this scenario: Coulomb friction
+    /// needs a moving piston (servo circuit); churning (∝ ω^2.5) needs the
+    /// high shaft speeds of the throttle missions with speed steps. Other
+    /// pairs are physically valid in every scenario.
+    pub fn can_show(self, hidden: Candidate) -> bool {
+        let servo = matches!(self, SynthScenario::Servo | SynthScenario::ServoProfile);
+        match hidden {
+            Candidate::CoulombFriction => servo,
+            Candidate::ChurningLoss => matches!(self, SynthScenario::ThrottleSteps | SynthScenario::SpeedSweep),
+            _ => true,
+        }
+    }
 }
 
 /// How far the generating rig is from the diagnosis baseline.
@@ -123,29 +153,61 @@ fn mission(c: &SynthCase, rng: &mut ChaCha8Rng) -> Mission {
             ..base
         },
         SynthScenario::ThrottleSteps => {
-            // Four segments, each a random speed (500–2000 rpm) and needle
-            // pressure (10–60 bar), stepping at random times.
+            // Four segments, each a random speed (300–1200 rpm) and needle
+            // pressure drop (10–100 bar at that speed), stepping at random
+            // times.
             let mut ts: Vec<f64> = (0..3).map(|_| rng.random_range(0.1..0.9) * d).collect();
             ts.sort_by(f64::total_cmp);
-            let (mut sp, mut nb) = (vec![], vec![]);
-            let mut t_prev = 0.0;
-            for k in 0..4 {
-                let (s, p) = (rng.random_range(500.0..2000.0), rng.random_range(10.0..60.0));
-                if k > 0 {
-                    sp.push((t_prev, s));
-                    nb.push((t_prev, p));
-                } else {
-                    sp.push((0.0, s));
-                    nb.push((0.0, p));
-                }
-                let t_end = if k < 3 { ts[k] } else { d };
-                sp.push((t_end, s));
-                nb.push((t_end, p));
-                t_prev = t_end;
+            ts.push(d);
+            let segs: Vec<(f64, f64)> = ts.iter().map(|&t| (t, 0.0)).collect();
+            let (sp, nb) = steps(&segs, rng, (300.0, 1200.0), (10.0, 100.0));
+            Mission { speed_rpm: sp, needle_bar: nb, ..base }
+        }
+        SynthScenario::ServoProfile => {
+            let (mut pts, mut t) = (vec![(0.0, 0.0)], 0.0);
+            while t < d {
+                let (a, h) = (rng.random_range(0.010..0.025), rng.random_range(2.0..5.0));
+                pts.push((t + h / 2.0, a));
+                pts.push((t + 1.5 * h, -a));
+                pts.push((t + 2.0 * h, 0.0));
+                t += 2.0 * h;
             }
-            Mission { speed_rpm: Schedule(sp), needle_bar: Schedule(nb), ..base }
+            Mission {
+                circuit: Circuit::Servo,
+                speed_rpm: Schedule::constant(0.0),
+                needle_bar: Schedule::constant(0.0),
+                position: PositionRef::Profile(Schedule(pts)),
+                ..base
+            }
+        }
+        SynthScenario::SpeedSweep => {
+            let (mut ends, mut t) = (vec![], 0.0);
+            while t < d {
+                t = (t + rng.random_range(100.0..250.0)).min(d);
+                ends.push((t, 0.0));
+            }
+            let (sp, nb) = steps(&ends, rng, (1000.0, 2000.0), (5.0, 25.0));
+            Mission { speed_rpm: sp, needle_bar: nb, ..base }
         }
     }
+}
+
+/// Speed and needle schedules of piecewise-constant segments ending at
+/// `ends` (times, s): each segment draws a speed (rpm) in `speed` and a
+/// needle pressure drop at that speed (bar) in `dp`. The needle is an
+/// orifice set at the 500 rpm flow (`eha_sim::hydraulics::needle_k`), so
+/// its setting is dp·(500/n)²; this keeps the pressure below the relief
+/// valves at every speed.
+fn steps(ends: &[(f64, f64)], rng: &mut ChaCha8Rng, speed: (f64, f64), dp: (f64, f64)) -> (Schedule, Schedule) {
+    let (mut sp, mut nb, mut t0) = (vec![], vec![], 0.0);
+    for &(t1, _) in ends {
+        let (n, p) = (rng.random_range(speed.0..speed.1), rng.random_range(dp.0..dp.1));
+        let setting = p * (500.0 / n).powi(2);
+        sp.extend([(t0, n), (t1, n)]);
+        nb.extend([(t0, setting), (t1, setting)]);
+        t0 = t1;
+    }
+    (Schedule(sp), Schedule(nb))
 }
 
 /// The generating rig of `c`: default rig, nuisance (and structure)
@@ -217,7 +279,7 @@ pub fn generate(c: &SynthCase) -> Result<(MeasuredRun, Truth), String> {
     let mut run = MeasuredRun::new(keep.iter().map(|&i| out.time_s[i]).collect());
     run.push_meta("rig", "synthetic");
     run.push_meta("note", "generated by eha_sim::diagnosis::synth");
-    let servo = c.scenario == SynthScenario::Servo;
+    let servo = matches!(c.scenario, SynthScenario::Servo | SynthScenario::ServoProfile);
     for ch in Channel::ALL {
         if ch == Channel::LngValve || ch == Channel::AirSpeedMps || (ch == Channel::PositionMm && !servo) {
             continue;
