@@ -1,2 +1,27 @@
 //! EHA drain-oil thermal protection core (`#![no_std]`).
+//!
+//! Reduced-order thermal model of an electro-hydrostatic actuator (Liu et al.,
+//! losses eqs. 1-11) stepped every 10 ms with an exact zero-order hold, LNG valve
+//! protection (section IV, eqs. 20-25, Table 6), input validation with a
+//! conservative fail-safe, an event trace and thermal memory across resets.
+//!
+//! Module map: [`params`] (SI parameters) → [`model`] (discretised model, generic
+//! over [`num::Num`]: `f64`, `f32`, fixed point) → [`validate`], [`protection`],
+//! [`trace`], [`memory`] → [`guard`] (`Guard::new`, `Guard::step`) → [`board`].
 #![no_std]
+#![warn(missing_docs)]
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing))]
+
+pub mod board;
+pub mod guard;
+pub mod linalg;
+pub mod memory;
+pub mod model;
+pub mod num;
+pub mod params;
+pub mod protection;
+pub mod trace;
+pub mod validate;
+
+pub use guard::{faults, Guard, GuardConfig, GuardOf, Output, Real, Sample};
+pub use memory::{Restore, ThermalRecord};

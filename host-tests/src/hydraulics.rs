@@ -32,6 +32,19 @@ pub fn soft_pos(x: f64, w: f64) -> f64 {
     0.5 * (x + (x * x + w * w).sqrt())
 }
 
+/// Valve opening ramp with no leakage tail: 0 below 0, x²/(2w) on [0, w],
+/// x − w/2 above (continuously differentiable, so Newton's iteration sees no
+/// kink, and exactly closed below the cracking point).
+pub fn ramp(x: f64, w: f64) -> f64 {
+    if x <= 0.0 {
+        0.0
+    } else if x < w {
+        x * x / (2.0 * w)
+    } else {
+        x - 0.5 * w
+    }
+}
+
 /// Smooth absolute value √(x² + w²) − w.
 pub fn soft_abs(x: f64, w: f64) -> f64 {
     (x * x + w * w).sqrt() - w
@@ -143,10 +156,10 @@ pub fn flows(rig: &Rig, op: &OpPoint, k_leak: f64) -> Flows {
         geometric: rig.displacement_m3_per_rad() * op.omega,
         leak_a: k_leak * (op.p_a - op.p_case),
         leak_b: k_leak * (op.p_b - op.p_case),
-        check_a: h.check_gain * soft_pos(h.accumulator_pa - op.p_a, w),
-        check_b: h.check_gain * soft_pos(h.accumulator_pa - op.p_b, w),
-        relief_ab: h.relief_gain * soft_pos(dp - h.relief_crack_pa, w),
-        relief_ba: h.relief_gain * soft_pos(-dp - h.relief_crack_pa, w),
+        check_a: h.check_gain * ramp(h.accumulator_pa - op.p_a, w),
+        check_b: h.check_gain * ramp(h.accumulator_pa - op.p_b, w),
+        relief_ab: h.relief_gain * ramp(dp - h.relief_crack_pa, w),
+        relief_ba: h.relief_gain * ramp(-dp - h.relief_crack_pa, w),
         act_leak: match op.circuit {
             Circuit::Servo => rig.actuator.leak_m3_per_s_pa * dp,
             Circuit::Throttle => 0.0,

@@ -1,10 +1,11 @@
 //! `eha-sim`: command line of the reference simulation and its tools.
 
 use clap::{Parser, Subcommand};
+use eha_sim::cli;
 use std::process::ExitCode;
 
 #[derive(Parser)]
-#[command(name = "eha-sim", version, about = "EHA thermal reference simulation and tools")]
+#[command(name = "eha-sim", version, about = "EHA thermal reference simulation (Liu et al.) and tools")]
 struct Cli {
     #[command(subcommand)]
     cmd: Cmd,
@@ -12,6 +13,16 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Cmd {
+    /// Simulate a paper case or a mission; write CSV (shared format + internal channels).
+    Simulate(cli::SimulateArgs),
+    /// Size the LNG charge by eqs. (23)-(25).
+    SizeLng(cli::SizeLngArgs),
+    /// Sweep one parameter over values, runs in parallel.
+    Sweep(cli::SweepArgs),
+    /// Refit the calibrated parameters to Table 4, Table 5 and Fig. 15.
+    Calibrate(cli::CalibrateArgs),
+    /// Print the default (calibrated paper) rig as TOML.
+    Rig,
     /// Diagnose a measured run: what the model gets wrong, the cause, the gain.
     Diagnose(eha_sim::diagnosis::cli::DiagnoseArgs),
     /// Hidden-effect sweep: synthetic runs with one effect each, diagnosed blind.
@@ -19,8 +30,21 @@ enum Cmd {
 }
 
 fn main() -> ExitCode {
-    match Cli::parse().cmd {
-        Cmd::Diagnose(a) => eha_sim::diagnosis::cli::run(&a),
-        Cmd::DiagnoseSweep(a) => eha_sim::diagnosis::sweep::run(&a),
+    let res = match Cli::parse().cmd {
+        Cmd::Simulate(a) => cli::run_simulate(&a),
+        Cmd::SizeLng(a) => cli::run_size_lng(&a),
+        Cmd::Sweep(a) => cli::run_sweep(&a),
+        Cmd::Calibrate(a) => cli::run_calibrate(&a),
+        Cmd::Rig => cli::run_rig(),
+        // Own exit codes: 0 diagnosis made (none included), 2 bad input.
+        Cmd::Diagnose(a) => return eha_sim::diagnosis::cli::run(&a),
+        Cmd::DiagnoseSweep(a) => return eha_sim::diagnosis::sweep::run(&a),
+    };
+    match res {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
     }
 }

@@ -31,6 +31,9 @@ pub enum SimError {
     Callback(String),
 }
 
+/// Newton convergence failures allowed over one run (see [`Plant::run`]).
+pub const MAX_NEWTON_FAILURES: usize = 1_000_000;
+
 /// Relative tolerance of the BDF error control.
 pub const RTOL: f64 = 1e-6;
 
@@ -97,6 +100,49 @@ impl Snapshot {
     /// Temperature of a node, °C.
     pub fn temp(&self, n: Node) -> f64 {
         self.temps[n as usize]
+    }
+}
+
+/// The signals the actuator controller has (the firmware's inputs), plus the
+/// true drain temperature it tries to estimate.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sensors {
+    /// Time, s.
+    pub t: f64,
+    /// Motor current, A rms.
+    pub current_a: f64,
+    /// Port A pressure, bar gauge.
+    pub p_a_bar: f64,
+    /// Port B pressure, bar gauge.
+    pub p_b_bar: f64,
+    /// Motor speed, rpm.
+    pub speed_rpm: f64,
+    /// Piston position, mm.
+    pub position_mm: f64,
+    /// Ambient, °C.
+    pub ambient_c: f64,
+    /// True drain-port (pump case) oil temperature, °C.
+    pub t_drain_c: f64,
+    /// True circulating-oil temperature, °C.
+    pub t_loop_oil_c: f64,
+    /// LNG valve open.
+    pub lng_open: bool,
+}
+
+impl From<&Snapshot> for Sensors {
+    fn from(s: &Snapshot) -> Self {
+        Sensors {
+            t: s.t,
+            current_a: s.op.current_a,
+            p_a_bar: s.op.p_a * 1e-5,
+            p_b_bar: s.op.p_b * 1e-5,
+            speed_rpm: s.op.omega * 60.0 / (2.0 * std::f64::consts::PI),
+            position_mm: s.op.x * 1e3,
+            ambient_c: s.op.ambient_c,
+            t_drain_c: s.temp(Node::Case),
+            t_loop_oil_c: s.temp(Node::Loop),
+            lng_open: s.lng_open,
+        }
     }
 }
 
@@ -217,7 +263,7 @@ impl Plant {
         };
         let y_init = self.y.clone();
         let t_start = self.t;
-        let problem = OdeBuilder::<NalgebraMat<f64>>::new()
+        let mut problem = OdeBuilder::<NalgebraMat<f64>>::new()
             .t0(t_start)
             .rtol(RTOL)
             .atol(atol())
@@ -226,6 +272,11 @@ impl Plant {
             .init(move |_p, _t, y| y.copy_from_slice(&y_init), N_STATE)
             .build()
             .map_err(|e| SimError::Solver { t: t_start, message: e.to_string() })?;
+        // diffsol 0.18 counts Newton convergence failures over the whole run
+        // (its statistics are never reset), not per step as its doc says; a
+        // long run with many valve events would hit the default 50. A real
+        // failure still ends in the minimum-step error.
+        problem.ode_options.max_nonlinear_solver_failures = MAX_NEWTON_FAILURES;
         let mut solver = problem.bdf::<NalgebraLU<f64>>().map_err(|e| SimError::Solver { t: t_start, message: e.to_string() })?;
         let err = |t: f64| move |e: diffsol::DiffsolError| SimError::Solver { t, message: e.to_string() };
         let mut stops = breakpoints(&model.drive, t_start, t_end);
@@ -290,6 +341,19 @@ impl Plant {
         self.y.copy_from_slice(st.y.batch_as_slice(0));
         self.stats.rhs_evals += evals.get();
         Ok(())
+    }
+
+    /// Advance by `dt_s` with the valve held. Convenient for lockstep use;
+    /// each call restarts the BDF history, so [`Plant::run`] with a callback is
+    /// much cheaper for long lockstep runs.
+    pub fn advance(&mut self, dt_s: f64) -> Result<(), SimError> {
+        let t_end = self.t + dt_s;
+        self.run(dt_s, t_end, |_| Ok(Control::default()))
+    }
+
+    /// What the actuator controller measures now.
+    pub fn sensors(&self) -> Sensors {
+        Sensors::from(&self.snapshot())
     }
 
     /// The scenario's own valve rule (thermostat or logged command), detached

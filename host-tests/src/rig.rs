@@ -167,7 +167,8 @@ pub struct Blocks {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Hydraulics {
-    /// Effective bulk modulus of oil plus hoses, Pa (assumed).
+    /// Effective bulk modulus of oil plus hoses, Pa (assumed 7e8: pure oil
+    /// is 1.6e9; hose compliance and entrained air halve it and more).
     pub bulk_modulus_pa: f64,
     /// Oil volume of each pump-port line up to the valves, m³ (assumed).
     pub line_volume_m3: f64,
@@ -325,15 +326,15 @@ impl Default for Rig {
                     port_gap_m: 12e-6,
                     port_seal_m: 0.005,
                 },
-                eta_m: 0.498_643,
-                mech_to_outlet: 0.767_798,
+                eta_m: 0.498_260,
+                mech_to_outlet: 0.768_027,
                 mass_kg: 20.0,
                 cp: 460.0,
                 area_m2: 0.1,
                 diameter_m: 0.12,
                 case_oil_m3: 0.15e-3,
                 port_oil_m3: 0.05e-3,
-                case_wetted_m2: 0.004_898_90,
+                case_wetted_m2: 0.004_902_15,
                 case_gap_m: 0.01,
                 rotor_radius_m: 0.03,
                 port_d_m: 0.012,
@@ -346,10 +347,10 @@ impl Default for Rig {
                 ball_mass_kg: 30.0,
                 ball_area_m2: 0.08,
                 cp: 460.0,
-                loop_oil_m3: 1.674_413e-3,
+                loop_oil_m3: 1.674_796e-3,
                 loop_d_m: 0.010,
                 loop_len_m: 1.0,
-                loop_area_scale: 6.563_94,
+                loop_area_scale: 6.559_07,
                 ball_oil_m3: 0.05e-3,
                 ball_d_m: 0.008,
                 ball_len_m: 0.3,
@@ -360,7 +361,7 @@ impl Default for Rig {
                 steel_k: 45.0,
             },
             hydraulics: Hydraulics {
-                bulk_modulus_pa: 1.0e9,
+                bulk_modulus_pa: 7.0e8,
                 line_volume_m3: 0.15e-3,
                 accumulator_pa: 5e5,
                 check_gain: 1e-9,
@@ -382,7 +383,7 @@ impl Default for Rig {
                 diameter_m: 0.09,
                 position_gain_per_s: 20.0,
             },
-            outside: Outside { emissivity: 0.85, ram_run_length_m: 0.334, ram_property_c: 16.0 },
+            outside: Outside { emissivity: 0.85, ram_run_length_m: 0.352_009, ram_property_c: 16.0 },
             lng: Lng::default(),
             nuisance: Nuisance { outer_scale: 1.0, inner_scale: 1.0, metal_capacity_scale: 1.0, oil_capacity_scale: 1.0 },
             ext: Extensions::default(),

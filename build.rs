@@ -1,0 +1,26 @@
+//! Selects the linker memory map and puts it on the linker search path as
+//! `memory.x` (cortex-m-rt's `link.x` INCLUDEs it). Default (QEMU mps2-an385/an386,
+//! 256 KiB flash at 0, 64 KiB RAM): `boards/mps2/memory.x`. With feature
+//! `board-stm32f4`: `boards/stm32f411/memory.x`. There is deliberately no
+//! `memory.x` in the package root: the linker searches its working directory
+//! (the workspace root) first, which would override the board's map.
+use std::{env, fs, path::PathBuf};
+
+fn main() {
+    println!("cargo:rerun-if-changed=build.rs");
+    println!("cargo:rerun-if-changed=boards/mps2/memory.x");
+    println!("cargo:rerun-if-changed=boards/stm32f411/memory.x");
+    let Some(out) = env::var_os("OUT_DIR").map(PathBuf::from) else {
+        return;
+    };
+    let src = if env::var_os("CARGO_FEATURE_BOARD_STM32F4").is_some() {
+        "boards/stm32f411/memory.x"
+    } else {
+        "boards/mps2/memory.x"
+    };
+    if let Ok(bytes) = fs::read(src) {
+        if fs::write(out.join("memory.x"), bytes).is_ok() {
+            println!("cargo:rustc-link-search={}", out.display());
+        }
+    }
+}

@@ -1,0 +1,270 @@
+//! Command-line subcommands of the reference simulation: `simulate`,
+//! `size-lng`, `sweep`, `calibrate` and `rig`.
+
+use crate::calibrate::{calibrate, PAPER};
+use crate::cooling::size;
+use crate::rig::Rig;
+use crate::scenario::{read_mission_csv, Scenario, ValveRule};
+use crate::sim::{simulate, SimOptions, SimOutput};
+use anyhow::{bail, Context, Result};
+use clap::{Args, ValueEnum};
+use indicatif::{ProgressBar, ProgressStyle};
+use rayon::prelude::*;
+use std::path::{Path, PathBuf};
+
+/// Rig selection shared by the subcommands.
+#[derive(Debug, Args, Clone)]
+pub struct RigArgs {
+    /// Rig parameter file (TOML); default: the calibrated paper rig.
+    #[arg(long)]
+    pub rig: Option<PathBuf>,
+    /// Override a parameter, e.g. `--set pump.eta_m=0.3` or `--set ext.sensor_lag=60`.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
+}
+
+impl RigArgs {
+    /// Load the rig and apply the overrides.
+    pub fn load(&self) -> Result<Rig> {
+        let mut rig = match &self.rig {
+            Some(p) => Rig::from_toml_file(p)?,
+            None => Rig::default(),
+        };
+        for s in &self.set {
+            rig.set_override(s)?;
+        }
+        Ok(rig)
+    }
+}
+
+/// Paper scenarios.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Case {
+    /// Case 1: 500 rpm through the needle valve, 16 °C.
+    Case1,
+    /// Case 2: closed-loop 20 mm / 0.2 Hz sine against the spring, 26.4 °C.
+    Case2,
+    /// Fig. 15: Case 1 at 60 bar with the LNG exchanger.
+    Lng,
+}
+
+/// `simulate`: run a scenario, write CSV (+ PNG).
+#[derive(Debug, Args)]
+pub struct SimulateArgs {
+    /// Paper scenario (ignored with --mission).
+    #[arg(long, value_enum, default_value = "case1")]
+    pub scenario: Case,
+    /// Needle-valve pressure for Case 1, bar.
+    #[arg(long, default_value_t = 60.0)]
+    pub needle_bar: f64,
+    /// Duration, s.
+    #[arg(long, default_value_t = 600.0)]
+    pub duration_s: f64,
+    /// Mission CSV of inputs (`time_s,speed_rpm,needle_bar,position_mm,ambient_c,air_speed_mps`).
+    #[arg(long)]
+    pub mission: Option<PathBuf>,
+    /// Output sample interval, s.
+    #[arg(long, default_value_t = 1.0)]
+    pub output_interval_s: f64,
+    /// Output directory.
+    #[arg(long, default_value = "out")]
+    pub out: PathBuf,
+    #[command(flatten)]
+    /// Rig.
+    pub rig: RigArgs,
+}
+
+/// The scenario a `simulate` invocation asks for.
+pub fn scenario_of(a: &SimulateArgs) -> Result<Scenario> {
+    if let Some(m) = &a.mission {
+        return Ok(Scenario::Mission(read_mission_csv(m, ValveRule::None)?));
+    }
+    Ok(match a.scenario {
+        Case::Case1 => Scenario::Case1 { needle_bar: a.needle_bar, duration_s: a.duration_s },
+        Case::Case2 => Scenario::Case2 { duration_s: a.duration_s },
+        Case::Lng => Scenario::Lng { duration_s: a.duration_s },
+    })
+}
+
+/// Write a run's CSV beside a summary, returning the CSV path.
+pub fn write_run(out: &SimOutput, rig: &Rig, dir: &Path) -> Result<PathBuf> {
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let csv = dir.join(format!("{}.csv", out.name));
+    out.write_csv(
+        &csv,
+        &[
+            ("rig", "liu2024 EHA rig (reference simulation)".into()),
+            ("case", out.name.clone()),
+            ("ambient_c", format!("{:.2}", out.get("ambient_c").and_then(|a| a.first().copied()).unwrap_or(f64::NAN))),
+            ("note", format!("eha-sim {} reference model; extensions {:?}", env!("CARGO_PKG_VERSION"), rig.ext)),
+        ],
+    )
+    .with_context(|| format!("writing {}", csv.display()))?;
+    Ok(csv)
+}
+
+/// Run `simulate`.
+pub fn run_simulate(a: &SimulateArgs) -> Result<()> {
+    let rig = a.rig.load()?;
+    let sc = scenario_of(a)?;
+    let t = std::time::Instant::now();
+    let out = simulate(&rig, &sc, &SimOptions { output_interval_s: a.output_interval_s, control_interval_s: 0.1 })?;
+    let wall = t.elapsed();
+    let csv = write_run(&out, &rig, &a.out)?;
+    println!("{}: {:.0} s simulated in {:.1} ms ({} rhs evaluations, {} steps)", out.name, sc.duration_s(), wall.as_secs_f64() * 1e3, out.stats.rhs_evals, out.stats.steps);
+    for ch in ["t_inlet_c", "t_outlet_c", "t_drain_c", "t_pump_c", "t_motor_c", "t_block_c", "t_ballvalve_c", "t_oil_c"] {
+        println!("  {ch:<14} final {:7.2} °C   max {:7.2} °C", out.last(ch).unwrap_or(f64::NAN), out.max(ch).unwrap_or(f64::NAN));
+    }
+    println!("  total loss at end {:.0} W; LNG used {:.3} kg", out.last("p_total_w").unwrap_or(0.0), out.last("lng_used_kg").unwrap_or(0.0));
+    if !out.valve_open_times_s.is_empty() {
+        println!("  LNG valve opens at {:?} s, closes at {:?} s", out.valve_open_times_s, out.valve_close_times_s);
+    }
+    println!("  wrote {}", csv.display());
+    Ok(())
+}
+
+/// `size-lng`: LNG charge by eqs. (23)–(25).
+#[derive(Debug, Args)]
+pub struct SizeLngArgs {
+    /// Heat power to absorb, W (paper: 1500). Omit with --from-model.
+    #[arg(long)]
+    pub power_w: Option<f64>,
+    /// Take the power from the model's total loss at the end of Case 1 at this needle pressure, bar.
+    #[arg(long)]
+    pub from_model_bar: Option<f64>,
+    /// Mission time, s (680 s reproduces the paper's 2.3 L at 1.5 kW).
+    #[arg(long, default_value_t = 680.0)]
+    pub mission_s: f64,
+    /// Redundancy factor (paper: 2).
+    #[arg(long, default_value_t = 2.0)]
+    pub redundancy: f64,
+    #[command(flatten)]
+    /// Rig.
+    pub rig: RigArgs,
+}
+
+/// Run `size-lng`.
+pub fn run_size_lng(a: &SizeLngArgs) -> Result<()> {
+    let rig = a.rig.load()?;
+    let p = match (a.power_w, a.from_model_bar) {
+        (Some(p), None) => p,
+        (None, Some(bar)) => {
+            let out = simulate(&rig, &Scenario::Case1 { needle_bar: bar, duration_s: 600.0 }, &SimOptions::default())?;
+            out.last("p_total_w").unwrap_or(f64::NAN)
+        }
+        (None, None) => 1500.0,
+        (Some(_), Some(_)) => bail!("give either --power-w or --from-model-bar"),
+    };
+    if !(p > 0.0 && a.mission_s > 0.0 && a.redundancy >= 1.0) {
+        bail!("power ({p} W) and mission time ({} s) must be > 0, redundancy ≥ 1", a.mission_s);
+    }
+    let s = size(&rig.lng, p, a.mission_s, a.redundancy);
+    println!("heat power P_sum        {:10.1} W", p);
+    println!("mission time t_m        {:10.1} s", a.mission_s);
+    println!("heat sink Q_LNG (23)    {:10.1} kJ", s.heat_j / 1e3);
+    println!("LNG per kg (24)         {:10.1} kJ/kg", rig.lng.heat_per_kg() / 1e3);
+    println!("LNG mass M_LNG (24)     {:10.3} kg", s.mass_kg);
+    println!("LNG volume V_LNG (25)   {:10.3} L", s.volume_m3 * 1e3);
+    println!("with redundancy x{:<4}   {:10.3} L = {:.3} kg", a.redundancy, s.volume_with_redundancy_m3 * 1e3, s.mass_with_redundancy_kg);
+    println!("configured charge       {:10.3} L = {:.3} kg, lasts {:.0} s at this power", rig.lng.charge_m3 * 1e3, rig.lng.charge_kg(), rig.lng.mission_time_s(p, rig.lng.charge_m3));
+    Ok(())
+}
+
+/// `sweep`: one parameter over a range, Case 1 (or Case 2) runs in parallel.
+#[derive(Debug, Args)]
+pub struct SweepArgs {
+    /// Parameter key, e.g. `pump.eta_m`, or `needle_bar` for the needle pressure.
+    #[arg(long)]
+    pub param: String,
+    /// Values, comma separated (e.g. `0,20,40,60`).
+    #[arg(long, value_delimiter = ',', required = true)]
+    pub values: Vec<f64>,
+    /// Scenario.
+    #[arg(long, value_enum, default_value = "case1")]
+    pub scenario: Case,
+    /// Needle pressure of Case 1, bar.
+    #[arg(long, default_value_t = 60.0)]
+    pub needle_bar: f64,
+    /// Duration, s.
+    #[arg(long, default_value_t = 600.0)]
+    pub duration_s: f64,
+    /// Output CSV.
+    #[arg(long, default_value = "out/sweep.csv")]
+    pub out: PathBuf,
+    #[command(flatten)]
+    /// Rig.
+    pub rig: RigArgs,
+}
+
+/// Run `sweep`.
+pub fn run_sweep(a: &SweepArgs) -> Result<()> {
+    let base = a.rig.load()?;
+    let bar = ProgressBar::new(a.values.len() as u64);
+    bar.set_style(ProgressStyle::with_template("{bar:40} {pos}/{len} runs {elapsed}").unwrap_or_else(|_| ProgressStyle::default_bar()));
+    let channels = ["t_inlet_c", "t_outlet_c", "t_drain_c", "t_pump_c", "t_motor_c", "t_block_c", "t_ballvalve_c", "t_oil_c", "p_total_w"];
+    let rows: Vec<Result<Vec<f64>>> = a
+        .values
+        .par_iter()
+        .map(|&v| {
+            let mut rig = base.clone();
+            let mut needle = a.needle_bar;
+            if a.param == "needle_bar" {
+                needle = v;
+            } else {
+                rig.set_override(&format!("{}={v}", a.param))?;
+            }
+            let sc = match a.scenario {
+                Case::Case1 => Scenario::Case1 { needle_bar: needle, duration_s: a.duration_s },
+                Case::Case2 => Scenario::Case2 { duration_s: a.duration_s },
+                Case::Lng => Scenario::Lng { duration_s: a.duration_s },
+            };
+            let out = simulate(&rig, &sc, &SimOptions { output_interval_s: 10.0, control_interval_s: 0.1 })?;
+            bar.inc(1);
+            Ok(std::iter::once(v).chain(channels.iter().map(|c| out.last(c).unwrap_or(f64::NAN))).collect())
+        })
+        .collect();
+    bar.finish_and_clear();
+    if let Some(dir) = a.out.parent() {
+        std::fs::create_dir_all(dir)?;
+    }
+    let mut w = csv::Writer::from_path(&a.out).with_context(|| format!("writing {}", a.out.display()))?;
+    let mut header = vec![a.param.clone()];
+    header.extend(channels.iter().map(|c| c.to_string()));
+    w.write_record(&header)?;
+    println!("{}", header.join("  "));
+    for r in rows {
+        let r = r?;
+        w.write_record(r.iter().map(|x| format!("{x:.4}")))?;
+        println!("{}", r.iter().map(|x| format!("{x:8.2}")).collect::<Vec<_>>().join("  "));
+    }
+    w.flush()?;
+    println!("wrote {}", a.out.display());
+    Ok(())
+}
+
+/// `calibrate`: refit the calibrated parameters to the paper's numbers.
+#[derive(Debug, Args)]
+pub struct CalibrateArgs {
+    #[command(flatten)]
+    /// Starting rig.
+    pub rig: RigArgs,
+}
+
+/// Run `calibrate`.
+pub fn run_calibrate(a: &CalibrateArgs) -> Result<()> {
+    let rig = a.rig.load()?;
+    let c = calibrate(&rig, &PAPER)?;
+    println!("target  {:?}", PAPER);
+    println!("before  {:?}", c.before);
+    println!("after   {:?}", c.after);
+    for (n, v) in &c.values {
+        println!("  {n} = {v:.6e}");
+    }
+    Ok(())
+}
+
+/// Print the default rig as TOML (a starting point for a rig file).
+pub fn run_rig() -> Result<()> {
+    print!("{}", Rig::default().to_toml());
+    Ok(())
+}

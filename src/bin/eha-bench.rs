@@ -1,0 +1,354 @@
+//! Benchmark firmware: instructions per `Guard::step` and `Model::step` in QEMU,
+//! stack high-water mark, init cost. Run with `cargo fw-bench` (M4F, f32) or
+//! `cargo fw-bench-m3` (M3, fixed point); see `docs/firmware-numbers.md`.
+//!
+//! Method (../shared/toolchain-notes.md): QEMU `-icount shift=10,align=off,sleep=off`
+//! makes every instruction 1.024 us of virtual time; SysTick runs on the 25 MHz core
+//! clock, so instructions = SysTick ticks / 25.6. The timing overhead (two SysTick
+//! reads) is measured on an empty region and subtracted. Report on semihosting
+//! stderr; completion marker `EHA-BENCH-DONE`; exit codes: 0 ok, 101 panic,
+//! 102 HardFault, 103 other exception, 104 no peripherals.
+#![cfg_attr(target_os = "none", no_std, no_main)]
+
+#[cfg(not(target_os = "none"))]
+fn main() {}
+
+#[cfg(target_os = "none")]
+mod fw {
+    use core::sync::atomic::{AtomicU32, Ordering};
+    use cortex_m::peripheral::{syst::SystClkSource, SYST};
+    use cortex_m_rt::{entry, exception, ExceptionFrame};
+    use defmt_semihosting as _;
+    use eha_guard::model::{InputScales, Model, ModelInput, ModelInputN};
+    use eha_guard::validate::{self, Channels, LimitsN, CH_ALL};
+    use eha_guard::{Guard, GuardConfig, Real, Restore, Sample};
+    use semihosting::eprintln;
+
+    const STEPS: u32 = 6000;
+    const PAINT: u32 = 0xDEAD_BEEF;
+    static WRAPS: AtomicU32 = AtomicU32::new(0);
+
+    extern "C" {
+        static _stack_end: u32;
+        static _stack_start: u32;
+    }
+
+    #[exception]
+    fn SysTick() {
+        WRAPS.fetch_add(1, Ordering::Relaxed);
+    }
+
+    #[exception]
+    unsafe fn HardFault(_ef: &ExceptionFrame) -> ! {
+        semihosting::process::exit(102)
+    }
+
+    #[exception]
+    unsafe fn DefaultHandler(_irqn: i16) {
+        semihosting::process::exit(103)
+    }
+
+    #[panic_handler]
+    fn panic(_: &core::panic::PanicInfo) -> ! {
+        semihosting::process::exit(101)
+    }
+
+    /// Fills the unused stack (from its lowest address up to 256 bytes below SP).
+    #[inline(never)]
+    fn paint_stack() {
+        let lo = core::ptr::addr_of!(_stack_end) as usize;
+        let sp = cortex_m::register::msp::read() as usize;
+        let mut p = lo;
+        while p + 256 < sp {
+            // SAFETY: [lo, sp - 256) is unused stack below the live frames.
+            unsafe { core::ptr::write_volatile(p as *mut u32, PAINT) };
+            p += 4;
+        }
+    }
+
+    /// Bytes of stack ever used: top minus the lowest overwritten paint word.
+    fn stack_high_water() -> u32 {
+        let lo = core::ptr::addr_of!(_stack_end) as usize;
+        let hi = core::ptr::addr_of!(_stack_start) as usize;
+        let mut p = lo;
+        // SAFETY: reading our own stack region word by word.
+        while p < hi && unsafe { core::ptr::read_volatile(p as *const u32) } == PAINT {
+            p += 4;
+        }
+        (hi - p) as u32
+    }
+
+    /// Deterministic input: 0-30 s Case 1 (60 bar, 500 rpm, 30 A) with small noise,
+    /// 30-60 s sinusoidal servo (20 mm, 0.2 Hz) against the Table 3 spring.
+    fn sample(k: u32, noise: &mut u32) -> Sample {
+        *noise = noise.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+        let n = ((*noise >> 9) as f32 / 8_388_608.0 - 0.5) * 0.2;
+        if k < STEPS / 2 {
+            Sample {
+                current_a: 30.0 + n,
+                p_a_bar: 65.0 + n,
+                p_b_bar: 5.0,
+                speed_rpm: 500.0 + n,
+                position_mm: n * 0.01,
+                ambient_c: 16.0,
+            }
+        } else {
+            let w = 2.0 * core::f32::consts::PI * 0.2;
+            let t = k as f32 * 0.01;
+            let x = 20.0 * libm::sinf(w * t);
+            let v = 20.0 * w * libm::cosf(w * t);
+            let dp = (245.0 * x + 15.0 * v) / 1.52681e-3 / 1e5;
+            let rpm = 1.52681e-3 * v * 1e-3 / 3.0239e-6 * 60.0 / (2.0 * core::f32::consts::PI);
+            Sample {
+                current_a: 5.0 + libm::fabsf(dp) * 0.3,
+                p_a_bar: 20.0 + if dp > 0.0 { dp } else { 0.0 },
+                p_b_bar: 20.0 + if dp < 0.0 { -dp } else { 0.0 },
+                speed_rpm: rpm,
+                position_mm: x,
+                ambient_c: 16.0,
+            }
+        }
+    }
+
+    struct Stats {
+        min: u32,
+        max: u32,
+        sum: u64,
+        n: u32,
+    }
+
+    impl Stats {
+        const fn new() -> Self {
+            Stats {
+                min: u32::MAX,
+                max: 0,
+                sum: 0,
+                n: 0,
+            }
+        }
+        fn add(&mut self, ticks: u32) {
+            self.min = self.min.min(ticks);
+            self.max = self.max.max(ticks);
+            self.sum += ticks as u64;
+            self.n += 1;
+        }
+        /// Prints min / mean / max instructions (ticks / 25.6) minus `overhead` ticks.
+        fn report(&self, name: &str, overhead: u32) {
+            let n = self.n.max(1) as u64;
+            let i = |t: u64| (t.saturating_sub(overhead as u64) * 10) / 256;
+            let mean10 = (self.sum.saturating_sub(overhead as u64 * n) * 100) / (256 * n);
+            eprintln!(
+                "{}: instructions/step min {} mean {}.{} max {} (n = {})",
+                name,
+                i(self.min as u64),
+                mean10 / 10,
+                mean10 % 10,
+                i(self.max as u64),
+                self.n
+            );
+        }
+    }
+
+    /// Opaque call boundary: keeps the inlined model work inside the timed window
+    /// (volatile SysTick reads do not order ordinary computation).
+    #[inline(never)]
+    fn model_step(m: &mut Model<Real>, u: &ModelInput, s: &InputScales<Real>) {
+        m.step(u, s);
+    }
+
+    /// Validation alone: convert + range/rate checks + worst-case substitution.
+    #[inline(never)]
+    fn validate_step(
+        s: &Sample,
+        prev: &Channels<Real>,
+        sc: &InputScales<Real>,
+        lim: &LimitsN<Real>,
+    ) -> ModelInputN<Real> {
+        let (v, nf) = validate::convert(s, sc);
+        let c = validate::check(&v, nf, prev, CH_ALL, lim);
+        validate::substitute(&v, c.bad, Some(v[4]), lim)
+    }
+
+    #[inline(never)]
+    fn guard_step(g: &mut Guard, s: &Sample) -> eha_guard::Output {
+        g.step(s)
+    }
+
+    #[inline(always)]
+    fn now() -> u32 {
+        SYST::get_current()
+    }
+
+    /// Elapsed ticks of the down-counting 24-bit SysTick, `None` if it wrapped.
+    #[inline(always)]
+    fn elapsed(t0: u32, w0: u32) -> Option<u32> {
+        let t1 = now();
+        if WRAPS.load(Ordering::Relaxed) != w0 {
+            return None;
+        }
+        Some(t0.wrapping_sub(t1) & 0x00FF_FFFF)
+    }
+
+    #[entry]
+    fn main() -> ! {
+        paint_stack();
+        let Some(mut p) = cortex_m::Peripherals::take() else {
+            semihosting::process::exit(104)
+        };
+        p.SYST.set_clock_source(SystClkSource::Core);
+        p.SYST.set_reload(0x00FF_FFFF);
+        p.SYST.clear_current();
+        p.SYST.enable_interrupt();
+        p.SYST.enable_counter();
+
+        // Timing overhead of an empty region.
+        let mut empty = Stats::new();
+        for _ in 0..100 {
+            let w0 = WRAPS.load(Ordering::Relaxed);
+            let t0 = now();
+            if let Some(t) = elapsed(t0, w0) {
+                empty.add(t);
+            }
+        }
+        let ovh = empty.min;
+
+        // Init cost: ZOH matrices via the f64 matrix exponential (wrap-counted).
+        let w0 = WRAPS.load(Ordering::Relaxed);
+        let t0 = now();
+        let mut guard = Guard::new(&GuardConfig::DEFAULT, Restore::Cold);
+        let t1 = now();
+        let wraps = WRAPS.load(Ordering::Relaxed) - w0;
+        let init_ticks = wraps as u64 * 0x0100_0000 + (t0.wrapping_sub(t1) & 0x00FF_FFFF) as u64;
+
+        let Ok(mut model) = Model::<Real>::new(&eha_guard::params::DEFAULT) else {
+            semihosting::process::exit(105)
+        };
+        let Some(scales) = InputScales::<Real>::new() else {
+            semihosting::process::exit(106)
+        };
+        model.set_temperatures(&[16.0; 6], 16.0);
+
+        // Stack used by boot + init (f64 matrix exponential), then repaint to measure
+        // the step loop alone (its figure includes main's own frame).
+        let init_stack = stack_high_water();
+        paint_stack();
+        let Some(limits) = LimitsN::<Real>::new(&GuardConfig::DEFAULT.limits, &scales) else {
+            semihosting::process::exit(107)
+        };
+        let mut prev_ch: Channels<Real> = validate::convert(&sample(0, &mut 1), &scales).0;
+        let mut g_stats = Stats::new();
+        let mut m_stats = Stats::new();
+        let mut v_stats = Stats::new();
+        let mut noise = 1u32;
+        let mut prev_pos = 0.0f32;
+        let mut last = eha_guard::Output::default();
+        let mut opened_at = None;
+        for k in 0..STEPS {
+            let s = sample(k, &mut noise);
+            let u = ModelInput {
+                current_a: s.current_a,
+                dp_bar: s.p_a_bar - s.p_b_bar,
+                speed_rpm: s.speed_rpm,
+                dpos_mm: s.position_mm - prev_pos,
+                ambient_c: s.ambient_c,
+            };
+            prev_pos = s.position_mm;
+
+            let w0 = WRAPS.load(Ordering::Relaxed);
+            let t0 = now();
+            let out = guard_step(&mut guard, core::hint::black_box(&s));
+            if let Some(t) = elapsed(t0, w0) {
+                g_stats.add(t);
+            }
+            last = core::hint::black_box(out);
+            if last.valve_open && opened_at.is_none() {
+                opened_at = Some(k);
+            }
+
+            let w0 = WRAPS.load(Ordering::Relaxed);
+            let t0 = now();
+            let vu = validate_step(core::hint::black_box(&s), &prev_ch, &scales, &limits);
+            if let Some(t) = elapsed(t0, w0) {
+                v_stats.add(t);
+            }
+            core::hint::black_box(vu);
+            prev_ch = validate::convert(&s, &scales).0;
+
+            let w0 = WRAPS.load(Ordering::Relaxed);
+            let t0 = now();
+            model_step(&mut model, core::hint::black_box(&u), &scales);
+            if let Some(t) = elapsed(t0, w0) {
+                m_stats.add(t);
+            }
+        }
+
+        // Fault path: one NaN current sample, then 200 valid samples with the fault
+        // latched (worst-case current substituted, valve forced open, trace written).
+        let mut f_stats = Stats::new();
+        for k in 0..201u32 {
+            let mut s = sample(STEPS / 2 - 1, &mut noise);
+            if k == 0 {
+                s.current_a = f32::NAN;
+            }
+            let w0 = WRAPS.load(Ordering::Relaxed);
+            let t0 = now();
+            let out = guard_step(&mut guard, core::hint::black_box(&s));
+            if let Some(t) = elapsed(t0, w0) {
+                f_stats.add(t);
+            }
+            last = core::hint::black_box(out);
+        }
+
+        // Thermal-memory save (snapshot + CRC + no-init write).
+        let w0 = WRAPS.load(Ordering::Relaxed);
+        let t0 = now();
+        let rec = guard.snapshot();
+        eha_guard::memory::noinit::store(&rec);
+        let save = elapsed(t0, w0).unwrap_or(0);
+
+        let build = if cfg!(feature = "fixed-point") {
+            "fixed-point Q9.23/Q0.32/Q9.55"
+        } else {
+            "f32"
+        };
+        eprintln!("EHA-BENCH build: {}", build);
+        eprintln!("timing overhead: {} ticks (subtracted)", ovh);
+        eprintln!(
+            "size_of Guard {} B, Model {} B, ThermalRecord {} B",
+            core::mem::size_of::<Guard>(),
+            core::mem::size_of::<Model<Real>>(),
+            core::mem::size_of::<eha_guard::ThermalRecord>()
+        );
+        g_stats.report("Guard::step", ovh);
+        f_stats.report(
+            "Guard::step, fault latched (NaN current then worst case)",
+            ovh,
+        );
+        m_stats.report("Model::step", ovh);
+        v_stats.report("validation (convert+check+substitute)", ovh);
+        eprintln!(
+            "Guard::new (ZOH expm, f64): {} instructions",
+            init_ticks * 10 / 256
+        );
+        eprintln!(
+            "snapshot+store record: {} instructions",
+            (save.saturating_sub(ovh) as u64 * 10) / 256
+        );
+        eprintln!(
+            "stack high-water mark: boot+init {} bytes, step loop {} bytes",
+            init_stack,
+            stack_high_water()
+        );
+        let dc = (last.drain_c * 1000.0) as i32;
+        eprintln!(
+            "final drain {}.{:03} degC, valve {}, faults {:#06x}, model drain {} mK, first open step {:?}",
+            dc / 1000, (dc % 1000).abs(), last.valve_open, last.faults,
+            (model.drain_c().to_f32() * 1000.0) as i32, opened_at
+        );
+        defmt::info!("EHA-BENCH-DONE");
+        eprintln!("EHA-BENCH-DONE");
+        semihosting::process::exit(0)
+    }
+
+    use eha_guard::num::Num as _;
+}

@@ -1,0 +1,373 @@
+//! `Guard`: validation + model + protection + trace + thermal memory, one call per
+//! 10 ms tick. The only API the firmware main loop needs (docs/contracts.md).
+
+mod types;
+pub use types::{faults, GuardConfig, Output, Sample, DRAIN_C_UNKNOWN};
+
+use crate::memory::{Restore, ThermalRecord};
+use crate::model::{InputScales, Model, ModelInputN};
+use crate::num::Num;
+use crate::params::N_NODES;
+use crate::protection::{alarm_update_with, LngBudget, LngConfig, Valve};
+use crate::trace::{RestoreKind, Trace, TraceBuf};
+use crate::validate::{self, Channels, LimitsN, CH_ALL, CH_POSITION};
+
+/// Number type of the firmware build: `f32`, or [`crate::num::Fx`] with `fixed-point`.
+#[cfg(not(feature = "fixed-point"))]
+pub type Real = f32;
+/// Number type of the firmware build: `f32`, or [`crate::num::Fx`] with `fixed-point`.
+#[cfg(feature = "fixed-point")]
+pub type Real = crate::num::Fx;
+
+/// The guard of the firmware build's number type.
+pub type Guard = GuardOf<Real>;
+
+/// Protection thresholds converted to the model number type (degC).
+#[derive(Clone, Copy, Debug)]
+struct Thresholds<N> {
+    open: N,
+    close: N,
+    alarm: N,
+    clear: N,
+}
+
+/// Everything the step needs that exists only with usable parameters.
+#[derive(Clone, Copy, Debug)]
+struct Core<N: Num> {
+    model: Model<N>,
+    scales: InputScales<N>,
+    limits: LimitsN<N>,
+    th: Thresholds<N>,
+}
+
+impl<N: Num> Core<N> {
+    fn new(config: &GuardConfig) -> Option<Self> {
+        let model = Model::<N>::new(&config.params).ok()?;
+        let scales = InputScales::<N>::new()?;
+        let limits = LimitsN::new(&config.limits, &scales)?;
+        let t = [
+            config.valve.open_c,
+            config.valve.close_c,
+            config.alarm.alarm_c,
+            config.alarm.clear_c,
+        ];
+        if t.iter().any(|x| !x.is_finite() || x.abs() >= 250.0) {
+            return None;
+        }
+        let f = |x: f32| N::from_f64(x as f64);
+        let th = Thresholds {
+            open: f(t[0]),
+            close: f(t[1]),
+            alarm: f(t[2]),
+            clear: f(t[3]),
+        };
+        Some(Core {
+            model,
+            scales,
+            limits,
+            th,
+        })
+    }
+}
+
+/// The guard, generic over the model number type (`f64` for host tests).
+#[derive(Clone, Debug)]
+pub struct GuardOf<N: Num> {
+    core: Option<Core<N>>,
+    dwell_steps: u32,
+    stale_steps: u32,
+    clear_valid_steps: u32,
+    latched: u16,
+    bad_ch: u8,
+    prev: Channels<N>,
+    prev_ok: u8,
+    missing: u32,
+    valid_run: u32,
+    have_ambient: bool,
+    valve: Valve,
+    alarm: bool,
+    lng: LngBudget,
+    lng_low: bool,
+    step: u32,
+    trace: TraceBuf,
+}
+
+impl<N: Num> GuardOf<N> {
+    /// Builds the model once (matrix exponential) and applies the boot rule of
+    /// [`crate::memory`]. Never fails: unusable parameters give a CONFIG fault and a
+    /// permanently fail-safe guard (valve open, alarm, derate).
+    pub fn new(config: &GuardConfig, restore: Restore) -> Self {
+        let core = Core::<N>::new(config);
+        let mut g = GuardOf {
+            latched: if core.is_none() { faults::CONFIG } else { 0 },
+            core,
+            dwell_steps: config.valve.dwell_steps,
+            stale_steps: config.stale_steps,
+            clear_valid_steps: config.clear_valid_steps,
+            bad_ch: 0,
+            prev: [N::ZERO; 6],
+            prev_ok: 0,
+            missing: 0,
+            valid_run: 0,
+            have_ambient: false,
+            valve: Valve::new(),
+            alarm: false,
+            lng: LngBudget::new(&config.lng),
+            lng_low: false,
+            step: 0,
+            trace: TraceBuf::new(),
+        };
+        let kind = match restore {
+            Restore::Cold => RestoreKind::Cold,
+            Restore::Warm(r) => {
+                if let Some(c) = g.core.as_mut() {
+                    c.model.set_temperatures(&r.temps_c, r.ambient_c);
+                }
+                g.have_ambient = true;
+                g.lng.set_used_cj(r.lng_used_cj);
+                g.latched |= r.faults & faults::LATCHED & !faults::CONFIG;
+                g.bad_ch = ((r.faults >> faults::CH_SHIFT) as u8) & CH_ALL;
+                RestoreKind::Warm
+            }
+            Restore::Corrupt => {
+                let t = config.alarm.alarm_c;
+                if let Some(c) = g.core.as_mut() {
+                    c.model.set_temperatures(&[t; N_NODES], t);
+                }
+                g.have_ambient = true;
+                g.lng.set_used_cj(u32::MAX);
+                g.latched |= faults::MEMORY_CORRUPT;
+                RestoreKind::Corrupt
+            }
+        };
+        g.trace.write(Trace::Restore { step: 0, kind });
+        g
+    }
+
+    /// One 10 ms step with a new sample. Never panics; any invalid channel latches a
+    /// fault, opens the valve in this same step and is replaced by its worst case.
+    #[inline(never)]
+    pub fn step(&mut self, s: &Sample) -> Output {
+        self.missing = 0;
+        let Some(core) = self.core.as_ref() else {
+            return self.advance(None, 0);
+        };
+        let (v, nonfinite) = validate::convert(s, &core.scales);
+        let c = validate::check(&v, nonfinite, &self.prev, self.prev_ok, &core.limits);
+        let mut new_bits = 0u16;
+        if c.range {
+            new_bits |= faults::RANGE;
+        }
+        if c.rate {
+            new_bits |= faults::RATE;
+        }
+        if c.non_finite {
+            new_bits |= faults::NON_FINITE;
+        }
+        self.bad_ch |= c.bad;
+        self.valid_run = if c.bad == 0 {
+            self.valid_run.saturating_add(1)
+        } else {
+            0
+        };
+        let [_, _, _, _, prev_pos, _] = self.prev;
+        let prev_pos = if self.prev_ok & CH_POSITION != 0 {
+            Some(prev_pos)
+        } else {
+            None
+        };
+        let u = validate::substitute(&v, self.bad_ch, prev_pos, &core.limits);
+        self.prev = v;
+        self.prev_ok = !c.bad & CH_ALL;
+        self.advance(Some(&u), new_bits)
+    }
+
+    /// One 10 ms step without a new sample: inputs are held (piston work taken as
+    /// zero); after `stale_steps` consecutive misses the STALE fault latches and every
+    /// channel takes its worst case.
+    pub fn step_missing(&mut self) -> Output {
+        self.missing = self.missing.saturating_add(1);
+        self.valid_run = 0;
+        self.prev_ok = 0;
+        let mut new_bits = 0;
+        if self.missing >= self.stale_steps {
+            new_bits |= faults::STALE;
+            self.bad_ch = CH_ALL;
+        }
+        let u = self
+            .core
+            .as_ref()
+            .map(|c| validate::substitute(&self.prev, self.bad_ch, None, &c.limits));
+        self.advance(u.as_ref(), new_bits)
+    }
+
+    #[inline(always)]
+    fn advance(&mut self, u: Option<&ModelInputN<N>>, new_bits: u16) -> Output {
+        let newly = new_bits & !self.latched;
+        self.latched |= new_bits;
+        if newly != 0 {
+            self.trace.write(Trace::Fault {
+                step: self.step,
+                new_bits: newly | ((self.bad_ch as u16) << faults::CH_SHIFT),
+            });
+        }
+        let force = self.latched != 0;
+        let (drain_c, loss_cj, valve_ev, alarm_ev) = match (self.core.as_mut(), u) {
+            (Some(c), Some(u)) => {
+                if !self.have_ambient {
+                    c.model.set_uniform(u.ambient_c);
+                    self.have_ambient = true;
+                }
+                c.model.step_n(u);
+                let d = c.model.drain_c();
+                let th = &c.th;
+                let v = self
+                    .valve
+                    .update_with(d, force, th.open, th.close, self.dwell_steps);
+                let a = alarm_update_with(&mut self.alarm, d, th.alarm, th.clear);
+                // Total loss kW → cJ per 10 ms step (= W), never negative.
+                let cj = c.model.last_total_kw().round_times(1000).max(0) as u32;
+                (d.to_f32(), cj, v, a)
+            }
+            _ => {
+                let v = self
+                    .valve
+                    .update_with(DRAIN_C_UNKNOWN, true, 0.0, 0.0, self.dwell_steps);
+                self.alarm = true;
+                (DRAIN_C_UNKNOWN, 0, v, None)
+            }
+        };
+        let drain_c = if drain_c.is_finite() {
+            drain_c
+        } else {
+            DRAIN_C_UNKNOWN
+        };
+        if let Some(open) = valve_ev {
+            let t = if open {
+                Trace::ValveOpen {
+                    step: self.step,
+                    drain_c,
+                    forced: force,
+                }
+            } else {
+                Trace::ValveClose {
+                    step: self.step,
+                    drain_c,
+                }
+            };
+            self.trace.write(t);
+        }
+        if let Some(a) = alarm_ev {
+            let t = if a {
+                Trace::Alarm {
+                    step: self.step,
+                    drain_c,
+                }
+            } else {
+                Trace::AlarmClear {
+                    step: self.step,
+                    drain_c,
+                }
+            };
+            self.trace.write(t);
+        }
+        self.lng.update_cj(self.valve.is_open(), loss_cj);
+        let low = self.lng.is_low();
+        if low && !self.lng_low {
+            self.trace.write(Trace::LngLow {
+                step: self.step,
+                remaining_kg: self.lng.remaining_kg(),
+            });
+        }
+        self.lng_low = low;
+        self.step = self.step.wrapping_add(1);
+        Output {
+            drain_c,
+            valve_open: self.valve.is_open(),
+            alarm: self.alarm,
+            derate: self.alarm,
+            faults: self.faults(),
+            lng_remaining_kg: self.lng.remaining_kg(),
+            lng_seconds_left: self.lng.seconds_left_cj(loss_cj),
+        }
+    }
+
+    /// Present fault word (see [`faults`]).
+    pub fn faults(&self) -> u16 {
+        self.latched
+            | ((self.bad_ch as u16) << faults::CH_SHIFT)
+            | if self.lng_low { faults::LNG_LOW } else { 0 }
+    }
+
+    /// **Clear rule.** Latched faults (except CONFIG) clear only through this explicit
+    /// call (maintenance / operator command), and only if the last
+    /// `clear_valid_steps` samples (1 s by default) were all valid and none is missing.
+    /// The thermal estimate is *not* reset: it relaxes from its conservative value.
+    /// Returns `true` when the faults were cleared.
+    pub fn clear_faults(&mut self) -> bool {
+        if self.missing != 0 || self.valid_run < self.clear_valid_steps {
+            return false;
+        }
+        let bits = (self.latched & !faults::CONFIG) | ((self.bad_ch as u16) << faults::CH_SHIFT);
+        self.latched &= faults::CONFIG;
+        self.bad_ch = 0;
+        if bits != 0 {
+            self.trace.write(Trace::FaultsCleared {
+                step: self.step,
+                bits,
+            });
+        }
+        true
+    }
+
+    /// Marks an actuator (valve pin) error reported by the board: latches ACTUATOR.
+    pub fn report_actuator_fault(&mut self) {
+        if self.latched & faults::ACTUATOR == 0 {
+            self.latched |= faults::ACTUATOR;
+            self.trace.write(Trace::Fault {
+                step: self.step,
+                new_bits: faults::ACTUATOR,
+            });
+        }
+    }
+
+    /// Refills the LNG budget (new charge installed).
+    pub fn refill_lng(&mut self, cfg: &LngConfig) {
+        self.lng = LngBudget::new(cfg);
+        self.lng_low = false;
+    }
+
+    /// Thermal-memory record of the present state (sealed with its CRC).
+    pub fn snapshot(&self) -> ThermalRecord {
+        let mut temps = [0.0f32; N_NODES];
+        let mut amb = 0.0;
+        if let Some(c) = self.core.as_ref() {
+            for (o, t) in temps.iter_mut().zip(c.model.temperatures_c().iter()) {
+                *o = t.to_f32();
+            }
+            amb = c.model.ambient_c().to_f32();
+        }
+        ThermalRecord::new(
+            temps,
+            amb,
+            self.lng.used_cj(),
+            self.faults() & !faults::LNG_LOW,
+            self.step,
+        )
+    }
+
+    /// The event trace (most recent [`crate::trace::TRACE_LEN`] events).
+    pub fn trace(&self) -> &TraceBuf {
+        &self.trace
+    }
+
+    /// The model, when the parameters were usable.
+    pub fn model(&self) -> Option<&Model<N>> {
+        self.core.as_ref().map(|c| &c.model)
+    }
+
+    /// Steps taken since boot (10 ms each, wraps after 497 days).
+    pub fn steps(&self) -> u32 {
+        self.step
+    }
+}

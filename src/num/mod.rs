@@ -1,0 +1,302 @@
+//! Number types of the model: one generic code path, three instantiations.
+//!
+//! * `f64` — design/reference instantiation for host tests.
+//! * `f32` (libm) — Cortex-M4F build. The state is a compensated pair
+//!   ([`F32State`]): per-step increments of slow nodes are ~1e-5 K, only a few
+//!   f32 ulps at 40 degC (ulp 3.8e-6 K); a plain f32 state would stagnate up to
+//!   ~0.2 K away from equilibrium (|dx| < ulp/2 with time constants of 1e5 steps).
+//! * [`Fx`] (`fixed` crate) — FPU-less Cortex-M3 build (feature `fixed-point`).
+//!
+//! Model units are chosen so that every quantity is O(1..100) and fits the
+//! fixed-point range: temperature degC (or K), power kW, current hA (100 A),
+//! pressure hbar (10 MPa), speed hrad/s (100 rad/s), position mm.
+
+mod fx;
+pub use fx::{Fx, FxCoef, FxScale, FxState};
+
+/// Arithmetic the model needs from its number type. All methods are total
+/// (no panics): the fixed-point instantiation saturates at its documented range.
+pub trait Num: Copy + PartialOrd + core::fmt::Debug {
+    /// Discretised matrix coefficient type (entries of `Ad - I` and `Bd`).
+    type Coef: Copy + core::fmt::Debug;
+    /// High-precision state accumulator type.
+    type State: Copy + core::fmt::Debug;
+    /// Input scale factor type (wire unit → model unit).
+    type Scale: Copy + core::fmt::Debug;
+    /// Zero.
+    const ZERO: Self;
+    /// Largest allowed Σ|coefficient| of one discretised row (fixed point: keeps the
+    /// `i64` accumulation free of overflow; floating point: unbounded).
+    const MAX_ROW_SUM: f64;
+    /// Conversion at init (saturating for fixed point).
+    fn from_f64(x: f64) -> Self;
+    /// Coefficient conversion at init; `None` when `x` is outside the coefficient range.
+    fn coef_from_f64(x: f64) -> Option<Self::Coef>;
+    /// Scale conversion at init; `None` when outside the scale range.
+    fn scale_from_f64(x: f64) -> Option<Self::Scale>;
+    /// Wire value (finite, validated) times scale → model unit. Saturating.
+    fn from_f32_scaled(x: f32, s: Self::Scale) -> Self;
+    /// To `f32` (wire units for outputs).
+    fn to_f32(self) -> f32;
+    /// To `f64` (tests, diagnostics).
+    fn to_f64(self) -> f64;
+    /// Sum (saturating for fixed point).
+    fn add(self, o: Self) -> Self;
+    /// Difference (saturating for fixed point).
+    fn sub(self, o: Self) -> Self;
+    /// Product (saturating for fixed point).
+    fn mul(self, o: Self) -> Self;
+    /// Absolute value.
+    fn abs(self) -> Self;
+    /// `max(self, 0)`.
+    fn max0(self) -> Self;
+    /// Square root of `|self|`.
+    fn sqrt_abs(self) -> Self;
+    /// `exp(self)` (only used when the viscosity exponent is non-zero).
+    fn exp(self) -> Self;
+    /// State accumulator holding `x`.
+    fn state(x: Self) -> Self::State;
+    /// Present value of a state accumulator.
+    fn value(s: Self::State) -> Self;
+    /// `s + Σ c_k v_k`: the discretised state update row.
+    fn accumulate<const K: usize>(
+        s: Self::State,
+        c: &[Self::Coef; K],
+        v: &[Self; K],
+    ) -> Self::State;
+    /// `s + a b` at full accumulator precision.
+    fn add_product(s: Self::State, a: Self, b: Self) -> Self::State;
+    /// `s + Σ c_k v_k + a b` with one rounding step into the state.
+    fn accumulate_plus<const K: usize>(
+        s: Self::State,
+        c: &[Self::Coef; K],
+        v: &[Self; K],
+        a: Self,
+        b: Self,
+    ) -> Self::State;
+    /// `round(self · k)` as an integer (saturating; NaN → 0).
+    fn round_times(self, k: i32) -> i32;
+}
+
+impl Num for f64 {
+    type Coef = f64;
+    type State = f64;
+    type Scale = f64;
+    const ZERO: Self = 0.0;
+    const MAX_ROW_SUM: f64 = f64::INFINITY;
+    fn from_f64(x: f64) -> Self {
+        x
+    }
+    fn coef_from_f64(x: f64) -> Option<f64> {
+        x.is_finite().then_some(x)
+    }
+    fn scale_from_f64(x: f64) -> Option<f64> {
+        x.is_finite().then_some(x)
+    }
+    fn from_f32_scaled(x: f32, s: f64) -> Self {
+        x as f64 * s
+    }
+    fn to_f32(self) -> f32 {
+        self as f32
+    }
+    fn to_f64(self) -> f64 {
+        self
+    }
+    fn add(self, o: Self) -> Self {
+        self + o
+    }
+    fn sub(self, o: Self) -> Self {
+        self - o
+    }
+    fn mul(self, o: Self) -> Self {
+        self * o
+    }
+    fn abs(self) -> Self {
+        libm::fabs(self)
+    }
+    fn max0(self) -> Self {
+        if self > 0.0 {
+            self
+        } else {
+            0.0
+        }
+    }
+    fn sqrt_abs(self) -> Self {
+        libm::sqrt(libm::fabs(self))
+    }
+    fn exp(self) -> Self {
+        libm::exp(self)
+    }
+    fn state(x: Self) -> f64 {
+        x
+    }
+    fn value(s: f64) -> Self {
+        s
+    }
+    fn accumulate<const K: usize>(s: f64, c: &[f64; K], v: &[f64; K]) -> f64 {
+        s + c.iter().zip(v.iter()).fold(0.0, |a, (c, v)| a + c * v)
+    }
+    fn accumulate_plus<const K: usize>(s: f64, c: &[f64; K], v: &[f64; K], a: f64, b: f64) -> f64 {
+        Self::accumulate(s, c, v) + a * b
+    }
+    fn add_product(s: f64, a: f64, b: f64) -> f64 {
+        s + a * b
+    }
+    fn round_times(self, k: i32) -> i32 {
+        libm::round(self * k as f64) as i32
+    }
+}
+
+/// Compensated `f32` state: value `hi` plus the rounding residue `lo` (|lo| <= ulp(hi)/2).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct F32State {
+    /// Rounded value, degC.
+    pub hi: f32,
+    /// Residue not yet representable in `hi`, K.
+    pub lo: f32,
+}
+
+#[inline(always)]
+fn two_sum(s: F32State, d: f32) -> F32State {
+    let y = d + s.lo;
+    let t = s.hi + y;
+    F32State {
+        hi: t,
+        lo: y - (t - s.hi),
+    }
+}
+
+/// Square root of a non-negative finite `f32` without libm's bit-by-bit routine:
+/// reciprocal square root by the 0x5f375a86 seed and three Newton steps (relative
+/// error < 2e-7, i.e. at f32 rounding; ~15 FPU instructions), times `x`. `sqrt(0) = 0`.
+#[inline(always)]
+fn sqrt_f32(x: f32) -> f32 {
+    let mut y = f32::from_bits(0x5f37_5a86u32.wrapping_sub(x.to_bits() >> 1));
+    let h = 0.5 * x;
+    y *= 1.5 - h * y * y;
+    y *= 1.5 - h * y * y;
+    y *= 1.5 - h * y * y;
+    x * y
+}
+
+impl Num for f32 {
+    type Coef = f32;
+    type State = F32State;
+    type Scale = f32;
+    const ZERO: Self = 0.0;
+    const MAX_ROW_SUM: f64 = f64::INFINITY;
+    fn from_f64(x: f64) -> Self {
+        x as f32
+    }
+    fn coef_from_f64(x: f64) -> Option<f32> {
+        x.is_finite().then_some(x as f32)
+    }
+    fn scale_from_f64(x: f64) -> Option<f32> {
+        x.is_finite().then_some(x as f32)
+    }
+    #[inline(always)]
+    fn from_f32_scaled(x: f32, s: f32) -> Self {
+        x * s
+    }
+    fn to_f32(self) -> f32 {
+        self
+    }
+    fn to_f64(self) -> f64 {
+        self as f64
+    }
+    #[inline(always)]
+    fn add(self, o: Self) -> Self {
+        self + o
+    }
+    #[inline(always)]
+    fn sub(self, o: Self) -> Self {
+        self - o
+    }
+    #[inline(always)]
+    fn mul(self, o: Self) -> Self {
+        self * o
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        libm::fabsf(self)
+    }
+    #[inline(always)]
+    fn max0(self) -> Self {
+        if self > 0.0 {
+            self
+        } else {
+            0.0
+        }
+    }
+    #[inline(always)]
+    fn sqrt_abs(self) -> Self {
+        sqrt_f32(libm::fabsf(self))
+    }
+    fn exp(self) -> Self {
+        libm::expf(self)
+    }
+    fn state(x: Self) -> F32State {
+        F32State { hi: x, lo: 0.0 }
+    }
+    #[inline(always)]
+    fn value(s: F32State) -> Self {
+        s.hi
+    }
+    #[inline(always)]
+    fn accumulate<const K: usize>(s: F32State, c: &[f32; K], v: &[f32; K]) -> F32State {
+        let d = c.iter().zip(v.iter()).fold(0.0f32, |a, (c, v)| a + c * v);
+        two_sum(s, d)
+    }
+    #[inline(always)]
+    fn accumulate_plus<const K: usize>(
+        s: F32State,
+        c: &[f32; K],
+        v: &[f32; K],
+        a: f32,
+        b: f32,
+    ) -> F32State {
+        let d = c
+            .iter()
+            .zip(v.iter())
+            .fold(a * b, |acc, (c, v)| acc + c * v);
+        two_sum(s, d)
+    }
+    #[inline(always)]
+    fn add_product(s: F32State, a: f32, b: f32) -> F32State {
+        two_sum(s, a * b)
+    }
+    #[inline(always)]
+    fn round_times(self, k: i32) -> i32 {
+        let y = self * k as f32;
+        // `as` saturates and maps NaN to 0; round half away from zero.
+        (if y >= 0.0 { y + 0.5 } else { y - 0.5 }) as i32
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    #[test]
+    fn f32_state_keeps_sub_ulp_increments() {
+        // 1e5 increments of 1e-6 K at 40 degC (ulp 3.8e-6) must add up to 0.1 K.
+        let mut s = f32::state(40.0);
+        for _ in 0..100_000 {
+            s = f32::accumulate(s, &[1e-6f32], &[1.0f32]);
+        }
+        let got = f32::value(s) as f64 - 40.0;
+        assert!((got - 0.1).abs() < 1e-5, "{got}");
+    }
+
+    #[test]
+    fn fast_sqrt_matches_libm() {
+        // 1e-6 .. 1e4 covers |w| in hrad/s; 3e-7 relative is ~2 f32 ulps.
+        let mut x = 1e-6f32;
+        while x < 1e4 {
+            let r = f32::sqrt_abs(x) as f64;
+            let e = libm::sqrt(x as f64);
+            assert!(((r - e) / e).abs() < 3e-7, "sqrt({x}) = {r} vs {e}");
+            x *= 1.37;
+        }
+        assert_eq!(f32::sqrt_abs(0.0), 0.0);
+    }
+}

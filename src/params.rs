@@ -1,0 +1,217 @@
+//! SI parameters of the reduced-order thermal model (design side, `f64`).
+//!
+//! Everything here is plain SI (J/K, W/K, ohm, m^3/rad, ...) so that an
+//! identification procedure in `host-tests` can set every field from `f64`
+//! values and regenerate [`DEFAULT`] with plain literals. The firmware never
+//! steps with these numbers directly: [`crate::model::Model::new`] turns them
+//! once into discretised coefficients of the firmware's number type.
+//!
+//! Node order (fixed, see `docs/contracts.md`): `0 winding, 1 motor housing,
+//! 2 pump housing, 3 loop oil, 4 valve block, 5 drain oil`.
+//! Loss order: `0 copper, 1 iron, 2 leakage, 3 mechanical, 4 throttling`.
+
+/// Number of thermal states (nodes) of the reduced model.
+pub const N_NODES: usize = 6;
+/// Number of loss inputs (copper, iron, leakage, mechanical, throttling).
+pub const N_LOSSES: usize = 5;
+
+/// Node index: motor winding (copper + stator teeth).
+pub const NODE_WINDING: usize = 0;
+/// Node index: motor housing (measurement Point 1).
+pub const NODE_MOTOR: usize = 1;
+/// Node index: pump housing (measurement Point 3).
+pub const NODE_PUMP: usize = 2;
+/// Node index: circulating (loop) oil.
+pub const NODE_LOOP_OIL: usize = 3;
+/// Node index: valve block metal (Points 4 + 5 lumped).
+pub const NODE_BLOCK: usize = 4;
+/// Node index: drain oil in the pump case (the protected temperature).
+pub const NODE_DRAIN: usize = 5;
+
+/// Fixed model step: 10 ms (100 Hz), s. Every discretised coefficient assumes it.
+pub const S_PER_STEP: f64 = 0.01;
+
+/// Reduced-order model parameters, SI units, `f64`.
+///
+/// Continuous model (contracts.md): `C dT/dt = -(L + diag(g_amb)) T + E p + g_amb T_amb`
+/// with `L` the graph Laplacian of [`ReducedParams::conductance_w_per_k`],
+/// `E` = [`ReducedParams::loss_split`] and the losses `p` of eqs. (1)-(11).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ReducedParams {
+    /// Heat capacity of each node, J/K (must be > 0).
+    pub capacity_j_per_k: [f64; N_NODES],
+    /// Symmetric node-to-node conductance, W/K; diagonal ignored. Includes the
+    /// constant drain <-> loop-oil conductance `g_od0` at `[3][5]`/`[5][3]`.
+    pub conductance_w_per_k: [[f64; N_NODES]; N_NODES],
+    /// Conductance of each node to ambient (free convection + radiation), W/K.
+    pub ambient_w_per_k: [f64; N_NODES],
+    /// Share of each loss (column) deposited in each node (row), dimensionless;
+    /// each column sums to 1 so that energy is conserved.
+    pub loss_split: [[f64; N_LOSSES]; N_NODES],
+    /// Number of motor phases `m` in eq. (1).
+    pub phases: f64,
+    /// Phase resistance at 25 degC `R0`, ohm (eq. 1).
+    pub r0_ohm: f64,
+    /// Temperature coefficient of the winding resistance, 1/K (0 = constant R).
+    pub alpha_r_per_k: f64,
+    /// Iron loss, hysteresis-like term: `P = k_fe1 |w|`, W/(rad/s) (eq. 2, f ∝ w).
+    pub k_fe1_w_s_per_rad: f64,
+    /// Iron loss, eddy term: `P = k_fe2 w^2`, W/(rad/s)^2 (eq. 2).
+    pub k_fe2_w_s2_per_rad2: f64,
+    /// Iron loss, excess term: `P = k_fe15 |w|^1.5`, W/(rad/s)^1.5 (eq. 2).
+    pub k_fe15_w_per_rad15: f64,
+    /// Leakage loss coefficient `P_leak = K_leak dp^2 mu_ratio`, W/Pa^2 (eqs. 5-7).
+    pub k_leak_w_per_pa2: f64,
+    /// Viscosity-temperature exponent: `mu_ratio = exp(k_mu (T_drain - T_ref))`, 1/K
+    /// (0 when viscosity is held constant, as in the reference baseline).
+    pub k_mu_per_k: f64,
+    /// Reference temperature of the viscosity ratio, degC.
+    pub t_mu_ref_c: f64,
+    /// Pump mechanical loss coefficient `eta_m` (eq. 8: `P = eta_m D |dp| |w|`), dimensionless.
+    pub eta_m: f64,
+    /// Pump displacement per radian, m^3/rad (19 cm^3/rev / 2 pi).
+    pub displacement_m3_per_rad: f64,
+    /// Effective ram area of the double-rod cylinder, m^2 (Table 3: 1526.81 mm^2).
+    pub ram_area_m2: f64,
+    /// Constant drain <-> loop-oil conductance `g_od0`, W/K (also in the matrix; kept
+    /// here so identification can set it in one place, see [`ReducedParams::with_g_od0`]).
+    pub g_od0_w_per_k: f64,
+    /// Flow-dependent drain <-> loop-oil conductance `g_od1 |dp|`, W/(K Pa)
+    /// (leakage advection, applied as an exact two-node exchange per step).
+    pub g_od1_w_per_k_pa: f64,
+}
+
+impl ReducedParams {
+    /// Returns a copy with `g_od0` written into both the field and the matrix entries.
+    pub const fn with_g_od0(mut self, g_w_per_k: f64) -> Self {
+        self.g_od0_w_per_k = g_w_per_k;
+        self.conductance_w_per_k[NODE_LOOP_OIL][NODE_DRAIN] = g_w_per_k;
+        self.conductance_w_per_k[NODE_DRAIN][NODE_LOOP_OIL] = g_w_per_k;
+        self
+    }
+
+    /// Physical plausibility check: capacities > 0, conductances >= 0 and symmetric,
+    /// split columns sum to 1 within 1e-9, all finite. `true` when usable.
+    pub fn is_plausible(&self) -> bool {
+        let caps = self
+            .capacity_j_per_k
+            .iter()
+            .all(|c| c.is_finite() && *c > 0.0);
+        let amb = self
+            .ambient_w_per_k
+            .iter()
+            .all(|g| g.is_finite() && *g >= 0.0);
+        let mut sym = true;
+        for (i, row) in self.conductance_w_per_k.iter().enumerate() {
+            for (j, g) in row.iter().enumerate() {
+                let gt = self.conductance_w_per_k.get(j).and_then(|r| r.get(i));
+                if i != j && (!g.is_finite() || *g < 0.0 || gt != Some(g)) {
+                    sym = false;
+                }
+            }
+        }
+        let mut col_sum = [0.0f64; N_LOSSES];
+        let mut split = true;
+        for row in self.loss_split.iter() {
+            for (s, x) in col_sum.iter_mut().zip(row.iter()) {
+                if !x.is_finite() || *x < 0.0 {
+                    split = false;
+                }
+                *s += x;
+            }
+        }
+        if col_sum.iter().any(|s| (s - 1.0).abs() > 1e-9) {
+            split = false;
+        }
+        let scalars = [
+            self.phases,
+            self.r0_ohm,
+            self.alpha_r_per_k,
+            self.k_fe1_w_s_per_rad,
+            self.k_fe2_w_s2_per_rad2,
+            self.k_fe15_w_per_rad15,
+            self.k_leak_w_per_pa2,
+            self.k_mu_per_k,
+            self.t_mu_ref_c,
+            self.eta_m,
+            self.displacement_m3_per_rad,
+            self.ram_area_m2,
+            self.g_od0_w_per_k,
+            self.g_od1_w_per_k_pa,
+        ]
+        .iter()
+        .all(|x| x.is_finite());
+        caps && amb && sym && split && scalars && self.g_od1_w_per_k_pa >= 0.0
+    }
+}
+
+/// Default (pre-identification) parameters, reasoned from the paper's Tables 2, 3, 6.
+///
+/// Capacities: winding ≈ 10 kg Cu·385 + stator teeth → 4.0 kJ/K; motor housing the
+/// remaining ≈ 65 kg at ≈ 500 J/(kg K) → 32.5 kJ/K; pump 20 kg steel·460 → 9.2 kJ/K;
+/// loop oil 3 L ISO VG 46 (0.87 kg/L, 1.9 kJ/(kg K)) → 4.96 kJ/K; valve block 190 kg
+/// steel·460 → 87.4 kJ/K; drain oil ≈ 0.3 L in the pump case → 0.5 kJ/K.
+/// Ambient: h ≈ 10 W/(m^2 K) on 0.5 (motor), 0.1 (pump), 0.44 m^2 (block), pipes 1 W/K.
+/// Leakage: ≈ 0.5 L/min at 60 bar → 50 W → K_leak = 1.39e-12 W/Pa^2; advection
+/// g_od1 = rho c_p K_leak = 870·1900·1.39e-12 = 2.3e-6 W/(K Pa).
+/// Split: copper → winding; iron 30 % winding / 70 % housing; leakage → drain oil;
+/// mechanical 50/50 pump housing / drain oil; throttling 80 % loop oil / 20 % block.
+/// THIS CONSTANT IS REGENERATED BY THE IDENTIFICATION TOOL: keep plain literals.
+pub const DEFAULT: ReducedParams = ReducedParams {
+    capacity_j_per_k: [4000.0, 32500.0, 9200.0, 4960.0, 87400.0, 500.0],
+    conductance_w_per_k: [
+        [0.0, 15.0, 0.0, 0.0, 0.0, 0.0],
+        [15.0, 0.0, 2.0, 0.0, 0.0, 0.0],
+        [0.0, 2.0, 0.0, 10.0, 0.0, 30.0],
+        [0.0, 0.0, 10.0, 0.0, 40.0, 5.0],
+        [0.0, 0.0, 0.0, 40.0, 0.0, 0.0],
+        [0.0, 0.0, 30.0, 5.0, 0.0, 0.0],
+    ],
+    ambient_w_per_k: [0.0, 5.0, 1.0, 1.0, 4.4, 0.0],
+    loss_split: [
+        [1.0, 0.3, 0.0, 0.0, 0.0],
+        [0.0, 0.7, 0.0, 0.0, 0.0],
+        [0.0, 0.0, 0.0, 0.5, 0.0],
+        [0.0, 0.0, 0.0, 0.0, 0.8],
+        [0.0, 0.0, 0.0, 0.0, 0.2],
+        [0.0, 0.0, 1.0, 0.5, 0.0],
+    ],
+    phases: 3.0,
+    r0_ohm: 0.074,
+    alpha_r_per_k: 0.00393,
+    k_fe1_w_s_per_rad: 0.05,
+    k_fe2_w_s2_per_rad2: 0.0002,
+    k_fe15_w_per_rad15: 0.005,
+    k_leak_w_per_pa2: 1.39e-12,
+    k_mu_per_k: 0.0,
+    t_mu_ref_c: 40.0,
+    eta_m: 0.05,
+    displacement_m3_per_rad: 3.0239439187142e-6,
+    ram_area_m2: 1.52681e-3,
+    g_od0_w_per_k: 5.0,
+    g_od1_w_per_k_pa: 2.3e-6,
+};
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn default_is_plausible_and_displacement_matches_table2() {
+        assert!(DEFAULT.is_plausible());
+        // 19 cm^3/rev = 19e-6 m^3 / (2 pi rad); 1e-15 relative is f64 literal rounding.
+        let d = 19e-6 / (2.0 * core::f64::consts::PI);
+        assert!((DEFAULT.displacement_m3_per_rad - d).abs() < 1e-15);
+        assert_eq!(DEFAULT.conductance_w_per_k[3][5], DEFAULT.g_od0_w_per_k);
+    }
+
+    #[test]
+    fn implausible_split_is_rejected() {
+        let mut p = DEFAULT;
+        p.loss_split[0][0] = 0.9; // copper column now sums to 0.9: energy not conserved
+        assert!(!p.is_plausible());
+        let mut q = DEFAULT;
+        q.capacity_j_per_k[5] = 0.0;
+        assert!(!q.is_plausible());
+    }
+}

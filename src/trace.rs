@@ -1,0 +1,130 @@
+//! Event trace: a fixed-size ring buffer of protection events (hubris-style
+//! `Trace` enum), kept in RAM and readable by a debugger or over defmt.
+
+use heapless::Deque;
+
+/// Capacity of the trace ring buffer, events (oldest are overwritten).
+pub const TRACE_LEN: usize = 32;
+
+/// How the thermal state was initialised at boot (see [`crate::memory`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(any(target_os = "none", feature = "defmt"), derive(defmt::Format))]
+pub enum RestoreKind {
+    /// Cold boot: every node starts at the first ambient sample.
+    Cold,
+    /// Warm/watchdog reset: a valid record was restored.
+    Warm,
+    /// A record was present but failed its magic/CRC/plausibility check:
+    /// conservative start (every node at the alarm temperature, valve open).
+    Corrupt,
+}
+
+/// One protection event. `step` is the guard's step counter (10 ms ticks) at the event;
+/// temperatures are the predicted drain temperature in degC.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(any(target_os = "none", feature = "defmt"), derive(defmt::Format))]
+pub enum Trace {
+    /// Thermal state initialised (cold / warm / corrupt record).
+    Restore {
+        /// Step counter.
+        step: u32,
+        /// Kind of start.
+        kind: RestoreKind,
+    },
+    /// LNG valve commanded open (threshold crossed or forced by a fault).
+    ValveOpen {
+        /// Step counter.
+        step: u32,
+        /// Predicted drain temperature, degC.
+        drain_c: f32,
+        /// `true` when a fault forced it, `false` when the temperature did.
+        forced: bool,
+    },
+    /// LNG valve commanded closed (below the hysteresis band, dwell elapsed).
+    ValveClose {
+        /// Step counter.
+        step: u32,
+        /// Predicted drain temperature, degC.
+        drain_c: f32,
+    },
+    /// Over-temperature alarm raised (drain > alarm threshold): derate requested.
+    Alarm {
+        /// Step counter.
+        step: u32,
+        /// Predicted drain temperature, degC.
+        drain_c: f32,
+    },
+    /// Over-temperature alarm cleared (drain below alarm threshold - hysteresis).
+    AlarmClear {
+        /// Step counter.
+        step: u32,
+        /// Predicted drain temperature, degC.
+        drain_c: f32,
+    },
+    /// New fault bits latched (see [`crate::guard::faults`]).
+    Fault {
+        /// Step counter.
+        step: u32,
+        /// Bits newly set this step.
+        new_bits: u16,
+    },
+    /// Latched faults cleared by the explicit clear rule.
+    FaultsCleared {
+        /// Step counter.
+        step: u32,
+        /// Bits that were cleared.
+        bits: u16,
+    },
+    /// LNG remaining fell below the low threshold.
+    LngLow {
+        /// Step counter.
+        step: u32,
+        /// Remaining LNG, kg.
+        remaining_kg: f32,
+    },
+}
+
+/// Ring buffer of the most recent [`TRACE_LEN`] events (oldest dropped when full).
+///
+/// Built on `heapless::Deque`, whose accessors are unchecked internally, so that the
+/// step path has no bounds-check panic (`HistoryBuf::write` indexes with a check).
+#[derive(Clone, Debug, Default)]
+pub struct TraceBuf {
+    q: Deque<Trace, TRACE_LEN>,
+}
+
+impl TraceBuf {
+    /// Empty buffer.
+    pub const fn new() -> Self {
+        TraceBuf { q: Deque::new() }
+    }
+
+    /// Appends an event, dropping the oldest when full.
+    pub fn write(&mut self, t: Trace) {
+        if self.q.is_full() {
+            let _ = self.q.pop_front();
+        }
+        // Cannot fail: there is room after the pop above.
+        let _ = self.q.push_back(t);
+    }
+
+    /// Events, oldest first.
+    pub fn iter(&self) -> impl Iterator<Item = &Trace> {
+        self.q.iter()
+    }
+
+    /// Most recent event.
+    pub fn recent(&self) -> Option<&Trace> {
+        self.q.back()
+    }
+
+    /// Number of stored events.
+    pub fn len(&self) -> usize {
+        self.q.len()
+    }
+
+    /// `true` when no event is stored.
+    pub fn is_empty(&self) -> bool {
+        self.q.is_empty()
+    }
+}

@@ -1,0 +1,320 @@
+//! Input validation (non-finite, range, rate of change) and the worst-case
+//! substitution used by the fail-safe path.
+//!
+//! Each wire channel is first tested for NaN/inf on its bits, then converted once
+//! to the model's number type and unit (hA, hbar, hrad/s, mm, degC); range and rate
+//! checks run on the converted values, so the fixed-point build needs no soft-float.
+//! Nothing is clamped silently: a channel that fails a check is reported as a fault
+//! bit and, while the fault is latched, replaced by its *worst-case* value (maximum
+//! loss), so the thermal estimate keeps rising conservatively.
+
+use crate::guard::Sample;
+use crate::model::{InputScales, ModelInputN};
+use crate::num::Num;
+
+/// Channel bit: motor current.
+pub const CH_CURRENT: u8 = 1 << 0;
+/// Channel bit: port A pressure.
+pub const CH_P_A: u8 = 1 << 1;
+/// Channel bit: port B pressure.
+pub const CH_P_B: u8 = 1 << 2;
+/// Channel bit: motor speed.
+pub const CH_SPEED: u8 = 1 << 3;
+/// Channel bit: piston position.
+pub const CH_POSITION: u8 = 1 << 4;
+/// Channel bit: ambient temperature.
+pub const CH_AMBIENT: u8 = 1 << 5;
+/// All six channels.
+pub const CH_ALL: u8 = 0x3f;
+
+/// Plausible ranges and per-step (10 ms) rates of the inputs, wire units.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct InputLimits {
+    /// Max |current|, A rms (Table 2: 340.5 A). Also the worst-case substitute.
+    pub current_a_max: f32,
+    /// Min port pressure, bar (gauge; slight vacuum allowed).
+    pub pressure_bar_min: f32,
+    /// Max port pressure, bar (relief setting).
+    pub pressure_bar_max: f32,
+    /// Max |speed|, rpm.
+    pub speed_rpm_max: f32,
+    /// Min piston position, mm (stroke ±50 mm, Table 2, plus margin).
+    pub position_mm_min: f32,
+    /// Max piston position, mm.
+    pub position_mm_max: f32,
+    /// Min ambient, degC.
+    pub ambient_c_min: f32,
+    /// Max ambient, degC. Also the worst-case ambient substitute.
+    pub ambient_c_max: f32,
+    /// Max |change| of current per step, A.
+    pub current_a_per_step: f32,
+    /// Max |change| of a port pressure per step, bar.
+    pub pressure_bar_per_step: f32,
+    /// Max |change| of speed per step, rpm.
+    pub speed_rpm_per_step: f32,
+    /// Max |change| of position per step, mm (0.5 m/s piston speed).
+    pub position_mm_per_step: f32,
+    /// Max |change| of ambient per step, K.
+    pub ambient_c_per_step: f32,
+}
+
+impl InputLimits {
+    /// Defaults from Tables 2-3 and the rig: 340.5 A, -5..350 bar, 6000 rpm, ±55 mm,
+    /// -60..85 degC; rates: 200 A, 150 bar, 3000 rpm, 5 mm, 1 K per 10 ms.
+    pub const DEFAULT: InputLimits = InputLimits {
+        current_a_max: 340.5,
+        pressure_bar_min: -5.0,
+        pressure_bar_max: 350.0,
+        speed_rpm_max: 6000.0,
+        position_mm_min: -55.0,
+        position_mm_max: 55.0,
+        ambient_c_min: -60.0,
+        ambient_c_max: 85.0,
+        current_a_per_step: 200.0,
+        pressure_bar_per_step: 150.0,
+        speed_rpm_per_step: 3000.0,
+        position_mm_per_step: 5.0,
+        ambient_c_per_step: 1.0,
+    };
+}
+
+/// The six channels in model units, order `[current hA, p_A hbar, p_B hbar,
+/// speed hrad/s, position mm, ambient degC]` (bit `i` of the `CH_*` masks).
+pub type Channels<N> = [N; 6];
+
+/// [`InputLimits`] converted once to model units.
+#[derive(Clone, Copy, Debug)]
+pub struct LimitsN<N: Num> {
+    lo: Channels<N>,
+    hi: Channels<N>,
+    rate: Channels<N>,
+    p_span: N,
+}
+
+impl<N: Num> LimitsN<N> {
+    /// Converts `l`; `None` when a limit does not fit the number type (|x| ≥ 250).
+    pub fn new(l: &InputLimits, sc: &InputScales<N>) -> Option<Self> {
+        let ok = |x: f32| x.is_finite() && x.abs() < 250.0;
+        let cv = |x: f32, s: N::Scale| N::from_f32_scaled(x, s);
+        let lo = [
+            -l.current_a_max,
+            l.pressure_bar_min,
+            l.pressure_bar_min,
+            -l.speed_rpm_max,
+            l.position_mm_min,
+            l.ambient_c_min,
+        ];
+        let hi = [
+            l.current_a_max,
+            l.pressure_bar_max,
+            l.pressure_bar_max,
+            l.speed_rpm_max,
+            l.position_mm_max,
+            l.ambient_c_max,
+        ];
+        let rt = [
+            l.current_a_per_step,
+            l.pressure_bar_per_step,
+            l.pressure_bar_per_step,
+            l.speed_rpm_per_step,
+            l.position_mm_per_step,
+            l.ambient_c_per_step,
+        ];
+        let s = [
+            sc.ha_per_a,
+            sc.hbar_per_bar,
+            sc.hbar_per_bar,
+            sc.hrads_per_rpm,
+            sc.one,
+            sc.one,
+        ];
+        let s64 = [
+            crate::model::HA_PER_A,
+            crate::model::HBAR_PER_BAR,
+            crate::model::HBAR_PER_BAR,
+            crate::model::HRADS_PER_RPM,
+            1.0,
+            1.0,
+        ];
+        let mut out = LimitsN {
+            lo: [N::ZERO; 6],
+            hi: [N::ZERO; 6],
+            rate: [N::ZERO; 6],
+            p_span: N::ZERO,
+        };
+        for ((((o_lo, o_hi), o_rt), (a, b)), (c, (sc, k))) in out
+            .lo
+            .iter_mut()
+            .zip(out.hi.iter_mut())
+            .zip(out.rate.iter_mut())
+            .zip(lo.iter().zip(hi.iter()))
+            .zip(rt.iter().zip(s.iter().zip(s64.iter())))
+        {
+            let k = *k as f32;
+            if !(ok(a * k) && ok(b * k) && ok(c * k) && a <= b && *c >= 0.0) {
+                return None;
+            }
+            *o_lo = cv(*a, *sc);
+            *o_hi = cv(*b, *sc);
+            *o_rt = cv(*c, *sc);
+        }
+        out.p_span = cv(l.pressure_bar_max - l.pressure_bar_min, sc.hbar_per_bar);
+        Some(out)
+    }
+}
+
+/// Result of checking one sample: which fault classes and which channels failed.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Check {
+    /// Some channel is NaN or infinite.
+    pub non_finite: bool,
+    /// Some channel is outside its plausible range.
+    pub range: bool,
+    /// Some channel changed faster than its rate limit.
+    pub rate: bool,
+    /// Channels that failed any check (`CH_*` bits).
+    pub bad: u8,
+}
+
+/// Converts a sample to model units; returns the values and the mask of channels
+/// whose `f32` is NaN or infinite (tested on the bits: exponent all ones).
+#[inline(always)]
+pub fn convert<N: Num>(s: &Sample, sc: &InputScales<N>) -> (Channels<N>, u8) {
+    let raw = [
+        s.current_a,
+        s.p_a_bar,
+        s.p_b_bar,
+        s.speed_rpm,
+        s.position_mm,
+        s.ambient_c,
+    ];
+    let scale = [
+        sc.ha_per_a,
+        sc.hbar_per_bar,
+        sc.hbar_per_bar,
+        sc.hrads_per_rpm,
+        sc.one,
+        sc.one,
+    ];
+    let mut v = [N::ZERO; 6];
+    let mut nonfinite = 0u8;
+    for (i, ((o, x), k)) in v.iter_mut().zip(raw.iter()).zip(scale.iter()).enumerate() {
+        if x.to_bits() & 0x7f80_0000 == 0x7f80_0000 {
+            nonfinite |= 1 << i;
+        } else {
+            *o = N::from_f32_scaled(*x, *k);
+        }
+    }
+    (v, nonfinite)
+}
+
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+// `!(d.abs() <= r)` is deliberate: a NaN difference (not reachable) counts as a fault.
+#[allow(clippy::neg_cmp_op_on_partial_ord)]
+fn check_one<N: Num>(
+    x: N,
+    p: N,
+    lo: N,
+    hi: N,
+    r: N,
+    bit: u8,
+    skip: u8,
+    prev_ok: u8,
+    c: &mut Check,
+) {
+    if skip & bit != 0 {
+        return;
+    }
+    if !(x >= lo && x <= hi) {
+        c.range = true;
+        c.bad |= bit;
+    } else if prev_ok & bit != 0 {
+        let d = x.sub(p);
+        if !(d.abs() <= r) {
+            c.rate = true;
+            c.bad |= bit;
+        }
+    }
+}
+
+/// Checks converted channels: range, then rate against `prev` for the channels in
+/// `prev_ok` (rate is only checked against valid previous values). Written out per
+/// channel (no loop) so that it compiles to straight-line code.
+#[inline(always)]
+pub fn check<N: Num>(
+    v: &Channels<N>,
+    nonfinite: u8,
+    prev: &Channels<N>,
+    prev_ok: u8,
+    lim: &LimitsN<N>,
+) -> Check {
+    let mut c = Check {
+        non_finite: nonfinite != 0,
+        bad: nonfinite,
+        ..Check::default()
+    };
+    let [x0, x1, x2, x3, x4, x5] = *v;
+    let [p0, p1, p2, p3, p4, p5] = *prev;
+    let [l0, l1, l2, l3, l4, l5] = lim.lo;
+    let [h0, h1, h2, h3, h4, h5] = lim.hi;
+    let [r0, r1, r2, r3, r4, r5] = lim.rate;
+    let (nf, ok) = (nonfinite, prev_ok);
+    check_one(x0, p0, l0, h0, r0, CH_CURRENT, nf, ok, &mut c);
+    check_one(x1, p1, l1, h1, r1, CH_P_A, nf, ok, &mut c);
+    check_one(x2, p2, l2, h2, r2, CH_P_B, nf, ok, &mut c);
+    check_one(x3, p3, l3, h3, r3, CH_SPEED, nf, ok, &mut c);
+    check_one(x4, p4, l4, h4, r4, CH_POSITION, nf, ok, &mut c);
+    check_one(x5, p5, l5, h5, r5, CH_AMBIENT, nf, ok, &mut c);
+    c
+}
+
+/// Model inputs for one step after worst-case substitution of the `bad` channels.
+///
+/// Worst case = maximum heat: current at its maximum; a bad pressure gives the
+/// full pressure span with the sign that makes `dp·w` positive (all pump power
+/// throttled); a bad speed gives the maximum speed with the sign of `dp`; a bad
+/// position gives zero piston work (`dpos = 0`: nothing leaves as work); a bad
+/// ambient gives the maximum ambient. Valid channels are used as they are.
+/// `prev_pos` is the last valid position (`None` → no derivative, `dpos = 0`).
+#[inline(always)]
+pub fn substitute<N: Num>(
+    v: &Channels<N>,
+    bad: u8,
+    prev_pos: Option<N>,
+    lim: &LimitsN<N>,
+) -> ModelInputN<N> {
+    let [i, pa, pb, w, x, amb] = *v;
+    let [_, _, _, _, _, amb_max] = lim.hi;
+    let [i_max, _, _, w_max, _, _] = lim.hi;
+    let current = if bad & CH_CURRENT != 0 { i_max } else { i };
+    let speed_ok = bad & CH_SPEED == 0;
+    let dp = if bad & (CH_P_A | CH_P_B) != 0 {
+        if speed_ok && w < N::ZERO {
+            N::ZERO.sub(lim.p_span)
+        } else {
+            lim.p_span
+        }
+    } else {
+        pa.sub(pb)
+    };
+    let speed = if speed_ok {
+        w
+    } else if dp < N::ZERO {
+        N::ZERO.sub(w_max)
+    } else {
+        w_max
+    };
+    let dpos = match prev_pos {
+        Some(p) if bad & CH_POSITION == 0 => x.sub(p),
+        _ => N::ZERO,
+    };
+    let ambient = if bad & CH_AMBIENT != 0 { amb_max } else { amb };
+    ModelInputN {
+        current_ha: current,
+        dp_hbar: dp,
+        speed_hrads: speed,
+        dpos_mm: dpos,
+        ambient_c: ambient,
+    }
+}

@@ -1,0 +1,402 @@
+//! Property tests of the protection layer: no panics / finite outputs for arbitrary
+//! input sequences, same-step fail-safe, valve hysteresis and dwell under noise,
+//! latching and the clear rule, thermal-memory CRC, LNG arithmetic.
+mod common;
+
+use eha_guard::faults;
+use eha_guard::memory::{RecordStatus, Restore, ThermalRecord};
+use eha_guard::num::Fx;
+use eha_guard::protection::{LngBudget, LngConfig, Valve, ValveConfig};
+use eha_guard::{GuardConfig, GuardOf, Output, Sample};
+use proptest::prelude::*;
+
+fn nominal() -> Sample {
+    Sample {
+        current_a: 30.0,
+        p_a_bar: 65.0,
+        p_b_bar: 5.0,
+        speed_rpm: 500.0,
+        position_mm: 0.0,
+        ambient_c: 16.0,
+    }
+}
+
+fn finite(o: &Output) -> bool {
+    o.drain_c.is_finite() && o.lng_remaining_kg.is_finite() && o.lng_seconds_left.is_finite()
+}
+
+/// Any f32, with the special values strongly represented.
+fn any_f32() -> impl Strategy<Value = f32> {
+    prop_oneof![
+        3 => -400.0f32..400.0,
+        1 => Just(f32::NAN),
+        1 => Just(f32::INFINITY),
+        1 => Just(f32::NEG_INFINITY),
+        1 => Just(f32::MAX),
+        1 => Just(-f32::MAX),
+        1 => any::<f32>(),
+    ]
+}
+
+fn any_sample() -> impl Strategy<Value = Option<Sample>> {
+    prop_oneof![
+        1 => Just(None),
+        8 => (any_f32(), any_f32(), any_f32(), any_f32(), any_f32(), any_f32()).prop_map(|(a, b, c, d, e, f)| Some(Sample {
+            current_a: a, p_a_bar: b, p_b_bar: c, speed_rpm: d * 20.0, position_mm: e * 0.1, ambient_c: f * 0.2
+        })),
+    ]
+}
+
+fn run_all<N: eha_guard::num::Num>(seq: &[Option<Sample>]) -> Result<(), TestCaseError> {
+    let mut g = GuardOf::<N>::new(&GuardConfig::DEFAULT, Restore::Cold);
+    for s in seq {
+        let o = match s {
+            Some(s) => g.step(s),
+            None => g.step_missing(),
+        };
+        prop_assert!(finite(&o), "non-finite output {:?}", o);
+        prop_assert!(o.lng_remaining_kg >= 0.0 && o.lng_remaining_kg <= 2.1501);
+        if o.faults & faults::LATCHED != 0 {
+            prop_assert!(
+                o.valve_open,
+                "latched fault {:#x} but valve closed",
+                o.faults
+            );
+        }
+    }
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
+
+    #[test]
+    fn arbitrary_inputs_never_panic_and_stay_finite(seq in proptest::collection::vec(any_sample(), 1..300)) {
+        run_all::<f32>(&seq)?;
+        run_all::<Fx>(&seq)?;
+        run_all::<f64>(&seq)?;
+    }
+
+    #[test]
+    fn out_of_range_or_non_finite_opens_valve_in_same_step(
+        warm in 1usize..50, ch in 0usize..6,
+        bad in prop_oneof![Just(f32::NAN), Just(f32::INFINITY), Just(1e6f32), Just(-1e6f32)],
+    ) {
+        let mut g = GuardOf::<f32>::new(&GuardConfig::DEFAULT, Restore::Cold);
+        for _ in 0..warm {
+            let o = g.step(&nominal());
+            prop_assert!(!o.valve_open && o.faults == 0, "nominal must be quiet: {:?}", o);
+        }
+        let mut s = nominal();
+        match ch {
+            0 => s.current_a = bad, 1 => s.p_a_bar = bad, 2 => s.p_b_bar = bad,
+            3 => s.speed_rpm = bad, 4 => s.position_mm = bad, _ => s.ambient_c = bad,
+        }
+        let o = g.step(&s);
+        prop_assert!(o.valve_open, "valve must open in the faulting step");
+        let class = if bad.is_finite() { faults::RANGE } else { faults::NON_FINITE };
+        prop_assert!(o.faults & class != 0, "fault bits {:#x}", o.faults);
+        prop_assert!(o.faults & (1 << (faults::CH_SHIFT as usize + ch)) != 0, "channel bit missing {:#x}", o.faults);
+    }
+
+    #[test]
+    fn stale_input_opens_valve_when_declared(warm in 1usize..50) {
+        let cfg = GuardConfig::DEFAULT;
+        let mut g = GuardOf::<f32>::new(&cfg, Restore::Cold);
+        for _ in 0..warm {
+            g.step(&nominal());
+        }
+        for k in 1..=cfg.stale_steps {
+            let o = g.step_missing();
+            if k < cfg.stale_steps {
+                prop_assert!(!o.valve_open && o.faults & faults::STALE == 0, "not stale yet at {}", k);
+            } else {
+                prop_assert!(o.valve_open && o.faults & faults::STALE != 0, "stale at {} must open: {:?}", k, o);
+            }
+        }
+    }
+
+    #[test]
+    fn noise_gives_at_most_one_toggle_per_dwell(seed in any::<u64>(), mean in 37.0f32..41.0) {
+        // Gaussian noise sigma = 0.5 K (Box-Muller on a 64-bit LCG) around `mean`.
+        let cfg = ValveConfig::DEFAULT;
+        let mut v = Valve::new();
+        let mut x = seed | 1;
+        let mut uni = move || { x = x.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407); ((x >> 11) as f64 + 0.5) / (1u64 << 53) as f64 };
+        let mut toggles: Vec<usize> = Vec::new();
+        for k in 0..20_000 {
+            let n = (-2.0 * uni().ln()).sqrt() * (2.0 * std::f64::consts::PI * uni()).cos();
+            let t = mean + 0.5 * n as f32;
+            if v.update(t, false, &cfg).is_some() {
+                toggles.push(k);
+            }
+        }
+        for w in toggles.windows(2) {
+            prop_assert!(w[1] - w[0] >= cfg.dwell_steps as usize, "toggles {} steps apart < dwell {}", w[1] - w[0], cfg.dwell_steps);
+        }
+    }
+
+    #[test]
+    fn hysteresis_band(ts in proptest::collection::vec(30.0f32..50.0, 1..2000)) {
+        // With the dwell at zero the valve state must be exactly the hysteresis relay.
+        let cfg = ValveConfig { dwell_steps: 0, ..ValveConfig::DEFAULT };
+        let mut v = Valve::new();
+        let mut open = false;
+        for t in ts {
+            v.update(t, false, &cfg);
+            if t > 40.0 { open = true; }
+            if t < 38.0 { open = false; }
+            prop_assert_eq!(v.is_open(), open, "t = {}", t);
+        }
+    }
+
+    #[test]
+    fn faults_latch_until_explicit_clear(valid_after in 0u32..250) {
+        let cfg = GuardConfig::DEFAULT;
+        let mut g = GuardOf::<f32>::new(&cfg, Restore::Cold);
+        g.step(&nominal());
+        let mut s = nominal();
+        s.p_a_bar = f32::NAN;
+        g.step(&s);
+        for _ in 0..valid_after {
+            let o = g.step(&nominal());
+            prop_assert!(o.valve_open && o.faults & faults::NON_FINITE != 0, "fault must stay latched");
+        }
+        let cleared = g.clear_faults();
+        prop_assert_eq!(cleared, valid_after >= cfg.clear_valid_steps, "clear rule: {} valid steps", valid_after);
+        let o = g.step(&nominal());
+        prop_assert_eq!(o.faults & faults::LATCHED == 0, cleared);
+    }
+
+    #[test]
+    fn record_roundtrip_and_single_bit_corruption(
+        temps in proptest::array::uniform6(-40.0f32..200.0), amb in -40.0f32..80.0,
+        used in any::<u32>(), faults_w in any::<u16>(), step in any::<u32>(), bit in 0usize..(52 * 8),
+    ) {
+        let r = ThermalRecord::new(temps, amb, used, faults_w, step);
+        prop_assert_eq!(r.classify(), RecordStatus::Valid);
+        let bytes = record_bytes(&r);
+        let mut b = bytes;
+        b[bit / 8] ^= 1 << (bit % 8);
+        let c = record_from_bytes(&b);
+        // Padding-free layout: bytes 44..48 are `reserved`, 48..52 the CRC; every bit counts.
+        prop_assert_eq!(c.classify(), RecordStatus::Corrupt, "flip of bit {} undetected", bit);
+    }
+}
+
+fn record_bytes(r: &ThermalRecord) -> [u8; 52] {
+    let mut b = [0u8; 52];
+    b[0..4].copy_from_slice(&r.lng_used_cj.to_le_bytes());
+    b[4..8].copy_from_slice(&r.step.to_le_bytes());
+    b[8..12].copy_from_slice(&r.magic.to_le_bytes());
+    b[12..14].copy_from_slice(&r.version.to_le_bytes());
+    b[14..16].copy_from_slice(&r.faults.to_le_bytes());
+    for (i, t) in r.temps_c.iter().enumerate() {
+        b[16 + 4 * i..20 + 4 * i].copy_from_slice(&t.to_le_bytes());
+    }
+    b[40..44].copy_from_slice(&r.ambient_c.to_le_bytes());
+    b[44..48].copy_from_slice(&r.reserved.to_le_bytes());
+    b[48..52].copy_from_slice(&r.crc.to_le_bytes());
+    b
+}
+
+fn record_from_bytes(b: &[u8; 52]) -> ThermalRecord {
+    let u32_at = |i: usize| u32::from_le_bytes(b[i..i + 4].try_into().unwrap());
+    let mut temps = [0.0f32; 6];
+    for (i, t) in temps.iter_mut().enumerate() {
+        *t = f32::from_bits(u32_at(16 + 4 * i));
+    }
+    ThermalRecord {
+        lng_used_cj: u32_at(0),
+        step: u32_at(4),
+        magic: u32_at(8),
+        version: u16::from_le_bytes([b[12], b[13]]),
+        faults: u16::from_le_bytes([b[14], b[15]]),
+        temps_c: temps,
+        ambient_c: f32::from_bits(u32_at(40)),
+        reserved: u32_at(44),
+        crc: u32_at(48),
+    }
+}
+
+#[test]
+fn boot_rules_cold_warm_corrupt() {
+    let cfg = GuardConfig::DEFAULT;
+    // Cold: starts at the first ambient sample (16 degC), valve closed.
+    let mut g = GuardOf::<f32>::new(&cfg, Restore::from_record(&ThermalRecord::EMPTY));
+    let o = g.step(&nominal());
+    assert!(
+        (o.drain_c - 16.0).abs() < 0.01 && !o.valve_open,
+        "cold: {o:?}"
+    );
+    // Warm: 45 degC record restored although the ambient is 16 degC → valve opens.
+    let rec = ThermalRecord::new(
+        [50.0, 45.0, 46.0, 44.0, 30.0, 45.0],
+        20.0,
+        1_000_000,
+        0,
+        123,
+    );
+    let mut g = GuardOf::<f32>::new(&cfg, Restore::from_record(&rec));
+    let o = g.step(&nominal());
+    assert!(
+        (o.drain_c - 45.0).abs() < 0.05 && o.valve_open && o.faults == 0,
+        "warm: {o:?}"
+    );
+    // Snapshot → record → restore round trip keeps the drain within 1e-4 K.
+    let snap = g.snapshot();
+    assert_eq!(snap.classify(), RecordStatus::Valid);
+    let mut g2 = GuardOf::<f32>::new(&cfg, Restore::from_record(&snap));
+    let (a, b) = (g.step(&nominal()), g2.step(&nominal()));
+    assert!(
+        (a.drain_c - b.drain_c).abs() < 1e-4,
+        "{} vs {}",
+        a.drain_c,
+        b.drain_c
+    );
+    // Corrupt: conservative 60 degC start, valve open, MEMORY_CORRUPT latched, LNG empty.
+    let mut bad = rec;
+    bad.temps_c[5] = 20.0;
+    assert_eq!(bad.classify(), RecordStatus::Corrupt);
+    let mut g = GuardOf::<f32>::new(&cfg, Restore::from_record(&bad));
+    let o = g.step(&nominal());
+    assert!(
+        (o.drain_c - 60.0).abs() < 0.05 && o.valve_open,
+        "corrupt: {o:?}"
+    );
+    assert!(o.faults & faults::MEMORY_CORRUPT != 0 && o.lng_remaining_kg == 0.0);
+}
+
+#[test]
+fn lng_budget_arithmetic() {
+    let c = LngConfig::DEFAULT;
+    // Eq. (25): 5 L × 430 kg/m^3 = 2.15 kg. Eq. (24): 509e3 + 2.9e3 × 180 = 1.031e6 J/kg.
+    assert!((c.charge_kg() - 2.15).abs() < 1e-6);
+    assert!((c.j_per_kg() - 1.031e6).abs() < 0.5);
+    // Eq. (23): 1.5 kW for 600 s with the valve open uses 9e5 J = 0.8729 kg.
+    let mut b = LngBudget::new(&c);
+    for _ in 0..60_000 {
+        b.update(true, 1500.0);
+    }
+    let used = 2.15 - b.remaining_kg();
+    assert!((used - 9e5 / 1.031e6).abs() < 1e-5, "used {used} kg");
+    // Seconds left at 1.5 kW: remaining energy / power.
+    let left = b.seconds_left(1500.0);
+    let expect = (2.15 * 1.031e6 - 9e5) / 1500.0;
+    assert!((left - expect as f32).abs() < 0.5, "{left} s vs {expect}");
+    // Closed valve uses nothing; LNG-low below 20 % (0.43 kg).
+    let r = b.remaining_kg();
+    b.update(false, 1500.0);
+    assert_eq!(b.remaining_kg(), r);
+    assert!(!b.is_low());
+    for _ in 0..60_000 {
+        b.update(true, 1500.0);
+    }
+    assert!(
+        b.is_low() && b.remaining_kg() < 0.43,
+        "{}",
+        b.remaining_kg()
+    );
+}
+
+#[test]
+fn case1_60bar_opens_valve_by_temperature() {
+    // Case 1 at 60 bar heats the drain past 40 degC: the valve opens by temperature (not
+    // forced), an LNG use is booked, and no fault is raised.
+    let mut g = GuardOf::<f32>::new(&GuardConfig::DEFAULT, Restore::Cold);
+    let mut opened = None;
+    let mut o = Output::default();
+    for k in 0..360_000 {
+        o = g.step(&nominal());
+        if o.valve_open && opened.is_none() {
+            opened = Some(k);
+        }
+    }
+    assert_eq!(o.faults & faults::LATCHED, 0);
+    let k = opened.expect("60 bar for an hour must open the valve");
+    assert!(o.lng_remaining_kg < 2.15, "LNG used while open");
+    let ev = g
+        .trace()
+        .iter()
+        .find(|e| matches!(e, eha_guard::trace::Trace::ValveOpen { .. }));
+    assert!(
+        matches!(ev, Some(eha_guard::trace::Trace::ValveOpen { forced: false, drain_c, .. }) if *drain_c > 40.0),
+        "{ev:?} at {k}"
+    );
+}
+
+#[test]
+fn trace_ring_keeps_newest_32() {
+    // 40 alarm raise/clear events through a stale-free fault-free guard are hard to
+    // provoke; exercise the ring directly: 40 writes keep the last 32 in order.
+    let mut t = eha_guard::trace::TraceBuf::new();
+    for k in 0..40u32 {
+        t.write(eha_guard::trace::Trace::Fault {
+            step: k,
+            new_bits: 1,
+        });
+    }
+    assert_eq!(t.len(), eha_guard::trace::TRACE_LEN);
+    let steps: Vec<u32> = t
+        .iter()
+        .map(|e| match e {
+            eha_guard::trace::Trace::Fault { step, .. } => *step,
+            _ => u32::MAX,
+        })
+        .collect();
+    assert_eq!(steps, (8..40).collect::<Vec<_>>());
+}
+
+#[test]
+fn stale_input_integrates_worst_case_loss() {
+    // After STALE every channel takes its worst case: copper loss at 340.5 A is
+    // 3 × 340.5² × 0.074 × (1 + 0.00393 (T_w − 25)) W, and the drain estimate keeps
+    // rising faster than under the nominal Case-1 input it replaced.
+    let cfg = GuardConfig::DEFAULT;
+    let mut g = GuardOf::<f64>::new(&cfg, Restore::Cold);
+    for _ in 0..100 {
+        g.step(&nominal());
+    }
+    let mut nominal_g = g.clone();
+    for _ in 0..cfg.stale_steps {
+        g.step_missing();
+    }
+    let t_w = g.model().unwrap().temperatures_c()[0];
+    let o0 = g.step_missing();
+    let p = g.model().unwrap().last_losses_kw();
+    let p_cu_expect = 3.0 * 340.5f64.powi(2) * 0.074 * (1.0 + 0.00393 * (t_w - 25.0)) / 1e3;
+    assert!(
+        (p[0] - p_cu_expect).abs() < 1e-6 * p_cu_expect,
+        "copper {} kW vs {} kW",
+        p[0],
+        p_cu_expect
+    );
+    // Throttling at the full pressure span (355 bar) and 6000 rpm, no piston work.
+    let dp_pa = 355e5;
+    let q = 6000.0 * 2.0 * std::f64::consts::PI / 60.0
+        * eha_guard::params::DEFAULT.displacement_m3_per_rad;
+    let p_throttle = (dp_pa * q / 1e3) - p[2];
+    assert!(
+        (p[4] - p_throttle).abs() < 1e-6 * p_throttle,
+        "throttle {} kW vs {} kW",
+        p[4],
+        p_throttle
+    );
+    assert!(o0.valve_open && o0.faults & faults::STALE != 0);
+    let mut o = o0;
+    let mut n = o0;
+    for _ in 0..500 {
+        o = g.step_missing();
+        n = nominal_g.step(&nominal());
+    }
+    println!(
+        "5 s after STALE: fail-safe drain {:.4} degC, nominal {:.4} degC (from {:.4})",
+        o.drain_c, n.drain_c, o0.drain_c
+    );
+    assert!(
+        o.drain_c - o0.drain_c > 10.0 * (n.drain_c - o0.drain_c).max(1e-3),
+        "fail-safe {} vs nominal {}",
+        o.drain_c,
+        n.drain_c
+    );
+}
