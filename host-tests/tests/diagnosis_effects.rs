@@ -53,8 +53,8 @@ use SynthScenario::{Case1Pressure, Servo, ServoProfile, SpeedSweep, ThrottleStep
 #[test]
 fn hidden_winding_resistance_temperature_is_named() {
     check(&[
-        case("winding-resistance-temperature", ThrottleSteps, Nuisance, 11),
-        case("winding-resistance-temperature", SpeedSweep, Structure, 12),
+        case("winding-resistance-temperature", Case1Pressure, Nuisance, 11),
+        case("winding-resistance-temperature", ThrottleSteps, Structure, 12),
     ]);
 }
 

@@ -27,6 +27,9 @@ pub struct DiagnoseOptions {
     /// Channels whose calibrated-baseline held-out RMSE is below this, K,
     /// are at the noise floor and do not count for the gain.
     pub gain_floor_k: f64,
+    /// Minimum absolute held-out RMSE reduction on the gain channel, K (the
+    /// order of the sensor noise: smaller gains are not evidence).
+    pub min_gain_k: f64,
     /// Largest lag of the residual/regressor cross-correlation, s.
     pub max_lag_s: f64,
     /// Lags of the Ljung–Box test.
@@ -39,9 +42,10 @@ impl Default for DiagnoseOptions {
             train_fraction: 0.7,
             points_per_channel: 150,
             fit: FitOptions::default(),
-            min_delta_bic: 10.0,
+            min_delta_bic: 25.0,
             min_heldout_gain: 0.3,
             gain_floor_k: 0.15,
+            min_gain_k: 0.1,
             max_lag_s: 120.0,
             ljung_box_lags: 20,
         }
@@ -224,9 +228,12 @@ pub fn diagnose(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions) -> 
     let nominal = sim.simulate(&nominal_v, Candidate::None, &[]).map_err(DiagnoseError::Baseline)?;
     let base = fit(sim, run, &pts, Candidate::None, &nominal_v, o.fit)
         .ok_or_else(|| DiagnoseError::Baseline("no valid residuals at the nominal parameters".into()))?;
+    // Every candidate is fitted jointly with the nuisance set from the
+    // nominal values: starting from the calibrated baseline would inherit
+    // the distortions the nuisance set took on to mimic the missing effect.
     let fits: Vec<Option<FitResult>> = Candidate::EXTENSIONS
         .par_iter()
-        .map(|&c| fit(sim, run, &pts, c, &base.nuisance, o.fit))
+        .map(|&c| fit(sim, run, &pts, c, &nominal_v, o.fit))
         .collect();
     let m_before = metrics(run, &base.series, split, o.ljung_box_lags);
     let n = pts.len();
@@ -249,13 +256,13 @@ pub fn diagnose(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions) -> 
         let m = metrics(run, &f.series, split, o.ljung_box_lags);
         let k = nuis_specs.len() + f.ext.len();
         let b = bic(f.rss, n, k);
-        let (mut gain, mut gch) = (f64::NEG_INFINITY, String::new());
+        let (mut gain, mut gain_k, mut gch) = (f64::NEG_INFINITY, 0.0, String::new());
         for cb in &m_before.channels {
             let Some(ca) = m.channel(&cb.channel) else { continue };
             if cb.heldout_rmse_k >= o.gain_floor_k {
                 let g = 1.0 - ca.heldout_rmse_k / cb.heldout_rmse_k;
                 if g > gain {
-                    (gain, gch) = (g, cb.channel.clone());
+                    (gain, gain_k, gch) = (g, cb.heldout_rmse_k - ca.heldout_rmse_k, cb.channel.clone());
                 }
             }
         }
@@ -270,7 +277,7 @@ pub fn diagnose(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions) -> 
             heldout_gain: gain,
             gain_channel: gch,
             params: named(&sim.extension_params(f.candidate), &f.ext),
-            qualifies: bic_none - b >= o.min_delta_bic && gain >= o.min_heldout_gain && pooled_ok,
+            qualifies: bic_none - b >= o.min_delta_bic && gain >= o.min_heldout_gain && gain_k >= o.min_gain_k && pooled_ok,
         });
         done.push((f, m));
     }

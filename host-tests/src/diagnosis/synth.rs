@@ -103,14 +103,15 @@ pub fn magnitude_range(c: Candidate) -> (f64, f64) {
         Candidate::WindingResistanceTemperature => (3.0e-3, 4.3e-3),
         // dead-end pocket (Figs. 9–10): minutes
         Candidate::SensorLag => (60.0, 240.0),
-        // piston-seal Coulomb friction of a 1527 mm² ram, N
-        Candidate::CoulombFriction => (300.0, 800.0),
-        // churning ∝ ω^2.5, a few 10 W at 1500 rpm (ω^2.5 ≈ 3.2e5)
-        Candidate::ChurningLoss => (1.0e-4, 2.5e-4),
+        // piston-seal Coulomb friction of a 1527 mm² ram, N (2–4 % of
+        // its 30 kN force at 200 bar)
+        Candidate::CoulombFriction => (500.0, 1200.0),
+        // churning ∝ ω^2.5, 60–150 W at 1500 rpm (ω^2.5 ≈ 3.2e5)
+        Candidate::ChurningLoss => (2.0e-4, 5.0e-4),
         // flange conduction, W/K
         Candidate::MotorPumpConduction => (3.0, 8.0),
-        // unlogged fan / draught, m/s
-        Candidate::ForcedConvection => (3.0, 8.0),
+        // unlogged fan / draught, m/s (Table 5 ram air is 15–50 m/s)
+        Candidate::ForcedConvection => (5.0, 12.0),
         Candidate::ViscosityTemperature | Candidate::None => (1.0, 1.0),
     }
 }
