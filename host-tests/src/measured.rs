@@ -151,12 +151,12 @@ impl fmt::Display for Channel {
 #[derive(Debug, thiserror::Error)]
 pub enum MeasuredError {
     /// The file could not be opened, read or written.
-    #[error("{file}: {source}")]
+    #[error("{file}: {error}")]
     Io {
         /// File name as given.
         file: String,
         /// Underlying I/O error.
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// The file has no header row.
     #[error("{file}: no header row (expected `time_s,speed_rpm,current_a,p_a_bar,p_b_bar,ambient_c,...`)")]
@@ -392,7 +392,7 @@ impl MeasuredRun {
     /// with shortest round-trip decimal numbers, empty cells for `None`.
     pub fn write<W: Write>(&self, w: W) -> Result<(), MeasuredError> {
         self.validate("<output>")?;
-        let io = |e: std::io::Error| MeasuredError::Io { file: "<output>".into(), source: e };
+        let io = |e: std::io::Error| MeasuredError::Io { file: "<output>".into(), error: e };
         let mut w = w;
         for m in &self.metadata {
             if m.key.is_empty() {
@@ -421,7 +421,7 @@ impl MeasuredRun {
     /// Writes the run to `path` (see [`MeasuredRun::write`]).
     pub fn write_file(&self, path: impl AsRef<Path>) -> Result<(), MeasuredError> {
         let p = path.as_ref();
-        let f = std::fs::File::create(p).map_err(|e| MeasuredError::Io { file: p.display().to_string(), source: e })?;
+        let f = std::fs::File::create(p).map_err(|e| MeasuredError::Io { file: p.display().to_string(), error: e })?;
         self.write(std::io::BufWriter::new(f))
     }
 
@@ -432,7 +432,7 @@ impl MeasuredRun {
         let mut s = String::new();
         std::fs::File::open(p)
             .and_then(|mut f| f.read_to_string(&mut s))
-            .map_err(|e| MeasuredError::Io { file: name.clone(), source: e })?;
+            .map_err(|e| MeasuredError::Io { file: name.clone(), error: e })?;
         parse_str(&name, &s)
     }
 

@@ -2,7 +2,7 @@
 //! simulation with one extension switched on at a random realistic
 //! magnitude, nuisance multipliers perturbed ±10–20 % (and, in the
 //! `structure` cases, every node mass and the winding conductance changed
-//! individually by ×0.7…1.4, which the baseline's global multipliers cannot
+//! individually by ×0.8…1.25, which the baseline's global multipliers cannot
 //! represent), σ = 0.1 K sensor noise, 12-bit quantisation, dropped rows and
 //! cells; then the diagnosis runs blind on the default rig.
 //!

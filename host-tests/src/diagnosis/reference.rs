@@ -47,11 +47,11 @@ pub fn replay_inputs(run: &MeasuredRun, name: &str) -> Result<ReplayInputs, Refe
 /// Nuisance set (calibrated on every fit, log-space, within a factor 2 of
 /// the rig file — the prior a thermal engineer has on a new rig):
 /// `outer_scale` (free convection + radiation conductances), `inner_scale`
-/// (oil-to-metal conductances), `oil_capacity_scale` (see
-/// `eha_sim::rig::Nuisance`), and the heat capacities of the metal
-/// components as multipliers on the rig's masses: `motor_mass_scale`,
-/// `pump_mass_scale`, `block_mass_scale` (main and ball-valve blocks
-/// together). The rig's global `metal_capacity_scale` stays as given.
+/// (oil-to-metal conductances), `metal_capacity_scale`,
+/// `oil_capacity_scale` (see `eha_sim::rig::Nuisance`). A richer set (per
+/// component capacities, 6 parameters) was tried and rejected: it absorbs
+/// the effects themselves (forced convection, viscosity and churning were
+/// then no longer identified).
 ///
 /// Candidate parameters (ranges are the physically plausible ones):
 /// `alpha_per_k` 1e-4…1e-2 1/K (copper 3.9e-3), viscosity-temperature none
@@ -88,12 +88,8 @@ impl ReferenceModel {
         let mut r = self.rig.clone();
         r.nuisance.outer_scale = nuis[0];
         r.nuisance.inner_scale = nuis[1];
-        r.nuisance.oil_capacity_scale = nuis[2];
-        // Per-component heat capacities (masses) of the metal nodes.
-        r.motor.mass_kg = self.rig.motor.mass_kg * nuis[3];
-        r.pump.mass_kg = self.rig.pump.mass_kg * nuis[4];
-        r.blocks.main_mass_kg = self.rig.blocks.main_mass_kg * nuis[5];
-        r.blocks.ball_mass_kg = self.rig.blocks.ball_mass_kg * nuis[5];
+        r.nuisance.metal_capacity_scale = nuis[2];
+        r.nuisance.oil_capacity_scale = nuis[3];
         let e = &mut r.ext;
         let x = ext.first().copied();
         match c {
@@ -120,10 +116,8 @@ impl Simulator for ReferenceModel {
         vec![
             p("outer_scale", n.outer_scale),
             p("inner_scale", n.inner_scale),
+            p("metal_capacity_scale", n.metal_capacity_scale),
             p("oil_capacity_scale", n.oil_capacity_scale),
-            p("motor_mass_scale", 1.0),
-            p("pump_mass_scale", 1.0),
-            p("block_mass_scale", 1.0),
         ]
     }
 

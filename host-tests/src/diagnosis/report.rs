@@ -57,6 +57,11 @@ impl DiagnosisJson {
     }
 }
 
+/// A parameter value with 4 significant digits (scientific when small).
+fn num(v: f64) -> String {
+    if v != 0.0 && (v.abs() < 0.01 || v.abs() >= 1e5) { format!("{v:.3e}") } else { format!("{v:.4}") }
+}
+
 fn metrics_table(s: &mut String, title: &str, m: &Metrics) {
     let _ = writeln!(s, "\n**{title}** (pooled: training {:.3} K, held-out {:.3} K)\n", m.train_rmse_k, m.heldout_rmse_k);
     let _ = writeln!(s, "| channel | RMSE train (K) | RMSE held-out (K) | bias (K) | max error (K) | Ljung–Box Q | p |");
@@ -77,7 +82,7 @@ pub fn report_markdown(d: &Diagnosis, source: &str, pngs: &[String]) -> String {
     let _ = writeln!(s, "# Diagnosis of `{source}`\n");
     let _ = writeln!(s, "**Cause: `{}`**", d.cause.name());
     for (n, v, u) in &d.params {
-        let _ = writeln!(s, "- fitted `{n}` = {v:.4} {u}");
+        let _ = writeln!(s, "- fitted `{n}` = {} {u}", num(*v));
     }
     let _ = writeln!(
         s,
@@ -90,7 +95,7 @@ pub fn report_markdown(d: &Diagnosis, source: &str, pngs: &[String]) -> String {
     let _ = writeln!(s, "| cause | BIC | ΔBIC vs none | RMSE train (K) | RMSE held-out (K) | best channel gain | qualifies | fitted |");
     let _ = writeln!(s, "|---|---:|---:|---:|---:|---|---|---|");
     for r in &d.ranking {
-        let p: Vec<String> = r.params.iter().map(|(n, v, u)| format!("{n}={v:.3} {u}")).collect();
+        let p: Vec<String> = r.params.iter().map(|(n, v, u)| format!("{n}={} {u}", num(*v))).collect();
         let _ = writeln!(
             s,
             "| `{}` | {:.1} | {:.1} | {:.3} | {:.3} | {:.0} % {} | {} | {} |",

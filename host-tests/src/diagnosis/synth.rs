@@ -60,7 +60,7 @@ pub enum Mismatch {
     /// Only the four nuisance multipliers are perturbed (±10–20 %).
     Nuisance,
     /// Also every node's mass and the winding/sensor conductances are
-    /// changed individually (×0.7…1.4), which the global multipliers of the
+    /// changed individually (×0.8…1.25), which the global multipliers of the
     /// baseline cannot represent.
     Structure,
 }
@@ -220,7 +220,7 @@ pub fn truth_rig(c: &SynthCase, rng: &mut ChaCha8Rng) -> (Rig, f64) {
     r.nuisance.metal_capacity_scale *= perturb(rng);
     r.nuisance.oil_capacity_scale *= perturb(rng);
     if c.mismatch == Mismatch::Structure {
-        let mut f = || rng.random_range(0.7..1.4);
+        let mut f = || rng.random_range(0.8..1.25);
         r.motor.mass_kg *= f();
         r.pump.mass_kg *= f();
         r.blocks.main_mass_kg *= f();
