@@ -12,10 +12,12 @@
 pub mod calibrate;
 pub mod cli;
 pub mod cooling;
+pub mod diagnosis;
 pub mod fluid;
 pub mod heat;
 pub mod hydraulics;
 pub mod losses;
+pub mod measured;
 pub mod model;
 pub mod network;
 pub mod pil;

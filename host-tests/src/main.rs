@@ -25,6 +25,10 @@ enum Cmd {
     Rig,
     /// Run the firmware in QEMU in closed loop with the reference plant (processor in the loop).
     Pil(eha_sim::pil::cli::PilArgs),
+    /// Diagnose a measured run: what the model gets wrong, the cause, the gain.
+    Diagnose(eha_sim::diagnosis::cli::DiagnoseArgs),
+    /// Hidden-effect sweep: synthetic runs with one effect each, diagnosed blind.
+    DiagnoseSweep(eha_sim::diagnosis::sweep::SweepArgs),
 }
 
 fn main() -> ExitCode {
@@ -35,6 +39,9 @@ fn main() -> ExitCode {
         Cmd::Calibrate(a) => cli::run_calibrate(&a),
         Cmd::Rig => cli::run_rig(),
         Cmd::Pil(a) => eha_sim::pil::cli::run(&a),
+        // Own exit codes: 0 diagnosis made (none included), 2 bad input.
+        Cmd::Diagnose(a) => return eha_sim::diagnosis::cli::run(&a),
+        Cmd::DiagnoseSweep(a) => return eha_sim::diagnosis::sweep::run(&a),
     };
     match res {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,0 +1,326 @@
+//! The diagnosis procedure of issue 5: baseline, calibration on the
+//! training window, residual analysis, candidate fits ranked by BIC with
+//! held-out improvement, and the winner's before/after errors.
+
+use super::fit::{fit, FitOptions, FitResult, Point};
+use super::model::{Candidate, SimSeries, Simulator};
+use super::regressors::regressors;
+use super::stats::{bias, bic, cross_correlation, ljung_box, max_abs, rmse, LjungBox};
+use crate::measured::{Channel, MeasuredRun};
+use rayon::prelude::*;
+
+/// Settings of one diagnosis.
+#[derive(Debug, Clone, Copy)]
+pub struct DiagnoseOptions {
+    /// Fraction of the run (by time) used for training; the rest, at least
+    /// 30 %, is held out.
+    pub train_fraction: f64,
+    /// Fit points per temperature channel (uniformly thinned training rows).
+    pub points_per_channel: usize,
+    /// Budget of each least-squares fit.
+    pub fit: FitOptions,
+    /// Minimum BIC decrease against the calibrated baseline to name a cause.
+    pub min_delta_bic: f64,
+    /// Minimum relative held-out RMSE reduction, on the channel it helps
+    /// most, to name a cause (0.3 = 30 %).
+    pub min_heldout_gain: f64,
+    /// Channels whose calibrated-baseline held-out RMSE is below this, K,
+    /// are at the noise floor and do not count for the gain.
+    pub gain_floor_k: f64,
+    /// Minimum absolute held-out RMSE reduction on the gain channel, K (the
+    /// order of the sensor noise: smaller gains are not evidence).
+    pub min_gain_k: f64,
+    /// Largest lag of the residual/regressor cross-correlation, s.
+    pub max_lag_s: f64,
+    /// Lags of the Ljung–Box test.
+    pub ljung_box_lags: usize,
+}
+
+impl Default for DiagnoseOptions {
+    fn default() -> Self {
+        DiagnoseOptions {
+            train_fraction: 0.7,
+            points_per_channel: 150,
+            fit: FitOptions::default(),
+            min_delta_bic: 25.0,
+            min_heldout_gain: 0.3,
+            gain_floor_k: 0.15,
+            min_gain_k: 0.1,
+            max_lag_s: 120.0,
+            ljung_box_lags: 20,
+        }
+    }
+}
+
+/// Errors of one channel, K (simulated − measured).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct ChannelMetrics {
+    /// Channel name.
+    pub channel: String,
+    /// RMSE on the training window, K.
+    pub train_rmse_k: f64,
+    /// RMSE on the held-out window, K.
+    pub heldout_rmse_k: f64,
+    /// Mean residual over the run, K.
+    pub bias_k: f64,
+    /// Largest absolute residual over the run, K.
+    pub max_error_k: f64,
+    /// Ljung–Box test of the residuals over the run.
+    pub ljung_box: LjungBox,
+}
+
+/// Errors of one model over every measured temperature channel.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Metrics {
+    /// Per channel.
+    pub channels: Vec<ChannelMetrics>,
+    /// Pooled RMSE over all channels, training window, K.
+    pub train_rmse_k: f64,
+    /// Pooled RMSE over all channels, held-out window, K.
+    pub heldout_rmse_k: f64,
+}
+
+impl Metrics {
+    /// The metrics of channel `name`.
+    pub fn channel(&self, name: &str) -> Option<&ChannelMetrics> {
+        self.channels.iter().find(|c| c.channel == name)
+    }
+}
+
+/// One row of the ranking: a candidate's fit and its evidence.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct RankEntry {
+    /// Candidate name.
+    pub cause: String,
+    /// BIC on the training fit points.
+    pub bic: f64,
+    /// Pooled held-out RMSE, K.
+    pub heldout_rmse_k: f64,
+    /// Pooled training RMSE, K.
+    pub train_rmse_k: f64,
+    /// BIC decrease against the calibrated baseline.
+    pub delta_bic: f64,
+    /// Largest relative held-out RMSE reduction over the channels above the
+    /// noise floor, and that channel.
+    pub heldout_gain: f64,
+    /// Channel of `heldout_gain`.
+    pub gain_channel: String,
+    /// Fitted extension parameters (name, value, unit).
+    pub params: Vec<(String, f64, String)>,
+    /// Whether it passes both the BIC and the held-out test.
+    pub qualifies: bool,
+}
+
+/// Peak cross-correlation of one channel's residual with one regressor.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct XCorr {
+    /// Residual channel.
+    pub channel: String,
+    /// Regressor name.
+    pub regressor: String,
+    /// Correlation at lag 0.
+    pub rho0: f64,
+    /// Largest |correlation| over the lags (signed).
+    pub peak_rho: f64,
+    /// Lag of the peak, s (regressor leading the residual).
+    pub peak_lag_s: f64,
+}
+
+/// The full result of a diagnosis.
+#[derive(Debug, Clone)]
+pub struct Diagnosis {
+    /// The named cause (`Candidate::None` when nothing qualifies).
+    pub cause: Candidate,
+    /// Fitted parameters of the cause (name, value, unit).
+    pub params: Vec<(String, f64, String)>,
+    /// Calibrated nuisance values of the baseline (name, value, unit).
+    pub nuisance_before: Vec<(String, f64, String)>,
+    /// Nuisance values refitted with the cause switched on.
+    pub nuisance_after: Vec<(String, f64, String)>,
+    /// Baseline at nominal nuisance values.
+    pub nominal: Metrics,
+    /// Calibrated baseline ("before").
+    pub before: Metrics,
+    /// Calibrated model with the cause switched on ("after").
+    pub after: Metrics,
+    /// All candidates and `none`, best BIC first.
+    pub ranking: Vec<RankEntry>,
+    /// Residual/regressor cross-correlations of the calibrated baseline.
+    pub xcorr: Vec<XCorr>,
+    /// Start of the held-out window, s.
+    pub split_time_s: f64,
+    /// Series for the plots: nominal, before, after.
+    pub series: [SimSeries; 3],
+    /// Model runs spent.
+    pub sims: usize,
+}
+
+/// Why a diagnosis could not be made (bad input, not a modelling result).
+#[derive(Debug, thiserror::Error)]
+pub enum DiagnoseError {
+    /// The run has no measured temperature channel to compare with.
+    #[error("the measured file has no temperature channel (t_motor_c, t_pump_c, t_block_c, t_ballvalve_c, t_oil_c)")]
+    NoTemperature,
+    /// Too few rows for a training and a held-out window.
+    #[error("the measured file has {0} rows; at least 20 are needed for training and held-out windows")]
+    TooShort(usize),
+    /// The baseline model does not run on these inputs.
+    #[error("the baseline model fails on these inputs: {0}")]
+    Baseline(String),
+}
+
+fn metrics(run: &MeasuredRun, s: &SimSeries, split: f64, lb_lags: usize) -> Metrics {
+    let mut channels = Vec::new();
+    let (mut tr, mut ho) = (Vec::new(), Vec::new());
+    for ch in Channel::TEMPERATURES {
+        let (Some(m), Some(y)) = (run.get(ch), s.channels.get(&ch)) else { continue };
+        let r: Vec<Option<f64>> = m.iter().zip(y).map(|(m, y)| m.map(|m| y - m)).collect();
+        let (rt, rh): (Vec<_>, Vec<_>) = r.iter().zip(&run.time_s).partition(|(_, t)| **t < split);
+        let rt: Vec<Option<f64>> = rt.into_iter().map(|x| *x.0).collect();
+        let rh: Vec<Option<f64>> = rh.into_iter().map(|x| *x.0).collect();
+        if rmse(&r).is_none() {
+            continue;
+        }
+        tr.extend(rt.iter().copied());
+        ho.extend(rh.iter().copied());
+        channels.push(ChannelMetrics {
+            channel: ch.name().into(),
+            train_rmse_k: rmse(&rt).unwrap_or(f64::NAN),
+            heldout_rmse_k: rmse(&rh).unwrap_or(f64::NAN),
+            bias_k: bias(&r).unwrap_or(f64::NAN),
+            max_error_k: max_abs(&r).unwrap_or(f64::NAN),
+            ljung_box: ljung_box(&r, lb_lags),
+        });
+    }
+    Metrics { channels, train_rmse_k: rmse(&tr).unwrap_or(f64::NAN), heldout_rmse_k: rmse(&ho).unwrap_or(f64::NAN) }
+}
+
+/// Training fit points: present temperature samples before `split`, thinned
+/// uniformly to at most `per_channel` per channel.
+fn fit_points(run: &MeasuredRun, split: f64, per_channel: usize) -> Vec<Point> {
+    let mut pts = Vec::new();
+    for ch in Channel::TEMPERATURES {
+        let Some(m) = run.get(ch) else { continue };
+        let rows: Vec<usize> = (0..run.len()).filter(|&i| run.time_s[i] < split && m[i].is_some()).collect();
+        let step = rows.len().div_ceil(per_channel.max(1)).max(1);
+        pts.extend(rows.iter().step_by(step).map(|&i| (ch, i)));
+    }
+    pts
+}
+
+fn named(specs: &[super::model::ParamSpec], v: &[f64]) -> Vec<(String, f64, String)> {
+    specs.iter().zip(v).map(|(s, v)| (s.name.clone(), *v, s.unit.clone())).collect()
+}
+
+/// Diagnoses `run` against the model `sim` (see the module doc).
+pub fn diagnose(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions) -> Result<Diagnosis, DiagnoseError> {
+    if !Channel::TEMPERATURES.iter().any(|c| run.get(*c).is_some_and(|v| v.iter().any(Option::is_some))) {
+        return Err(DiagnoseError::NoTemperature);
+    }
+    if run.len() < 20 {
+        return Err(DiagnoseError::TooShort(run.len()));
+    }
+    let (t0, t1) = (run.time_s[0], run.time_s[run.len() - 1]);
+    let split = t0 + o.train_fraction.min(0.7) * (t1 - t0);
+    let pts = fit_points(run, split, o.points_per_channel);
+    let nuis_specs = sim.nuisance();
+    let nominal_v: Vec<f64> = nuis_specs.iter().map(|s| s.start).collect();
+    let nominal = sim.simulate(&nominal_v, Candidate::None, &[]).map_err(DiagnoseError::Baseline)?;
+    let base = fit(sim, run, &pts, Candidate::None, &nominal_v, o.fit)
+        .ok_or_else(|| DiagnoseError::Baseline("no valid residuals at the nominal parameters".into()))?;
+    // Every candidate is fitted jointly with the nuisance set from the
+    // nominal values: starting from the calibrated baseline would inherit
+    // the distortions the nuisance set took on to mimic the missing effect.
+    let fits: Vec<Option<FitResult>> = Candidate::EXTENSIONS
+        .par_iter()
+        .map(|&c| fit(sim, run, &pts, c, &nominal_v, o.fit))
+        .collect();
+    let m_before = metrics(run, &base.series, split, o.ljung_box_lags);
+    let n = pts.len();
+    let bic_none = bic(base.rss, n, nuis_specs.len());
+    let mut ranking = vec![RankEntry {
+        cause: "none".into(),
+        bic: bic_none,
+        heldout_rmse_k: m_before.heldout_rmse_k,
+        train_rmse_k: m_before.train_rmse_k,
+        delta_bic: 0.0,
+        heldout_gain: 0.0,
+        gain_channel: String::new(),
+        params: vec![],
+        qualifies: false,
+    }];
+    let mut sims = 1 + base.sims;
+    let mut done: Vec<(FitResult, Metrics)> = Vec::new();
+    for f in fits.into_iter().flatten() {
+        sims += f.sims;
+        let m = metrics(run, &f.series, split, o.ljung_box_lags);
+        let k = nuis_specs.len() + f.ext.len();
+        let b = bic(f.rss, n, k);
+        let (mut gain, mut gain_k, mut gch) = (f64::NEG_INFINITY, 0.0, String::new());
+        for cb in &m_before.channels {
+            let Some(ca) = m.channel(&cb.channel) else { continue };
+            if cb.heldout_rmse_k >= o.gain_floor_k {
+                let g = 1.0 - ca.heldout_rmse_k / cb.heldout_rmse_k;
+                if g > gain {
+                    (gain, gain_k, gch) = (g, cb.heldout_rmse_k - ca.heldout_rmse_k, cb.channel.clone());
+                }
+            }
+        }
+        let gain = if gain.is_finite() { gain } else { 0.0 };
+        let pooled_ok = m.heldout_rmse_k < m_before.heldout_rmse_k;
+        ranking.push(RankEntry {
+            cause: f.candidate.name().into(),
+            bic: b,
+            heldout_rmse_k: m.heldout_rmse_k,
+            train_rmse_k: m.train_rmse_k,
+            delta_bic: bic_none - b,
+            heldout_gain: gain,
+            gain_channel: gch,
+            params: named(&sim.extension_params(f.candidate), &f.ext),
+            qualifies: bic_none - b >= o.min_delta_bic && gain >= o.min_heldout_gain && gain_k >= o.min_gain_k && pooled_ok,
+        });
+        done.push((f, m));
+    }
+    ranking.sort_by(|a, b| a.bic.total_cmp(&b.bic));
+    let winner = ranking.iter().find(|r| r.qualifies).and_then(|r| Candidate::from_name(&r.cause));
+    let (cause, after_fit, m_after) = match winner.and_then(|w| done.iter().find(|(f, _)| f.candidate == w)) {
+        Some((f, m)) => (f.candidate, f.clone(), m.clone()),
+        None => (Candidate::None, base.clone(), m_before.clone()),
+    };
+    let xcorr = cross_correlations(run, &base.series, o.max_lag_s);
+    let m_nominal = metrics(run, &nominal, split, o.ljung_box_lags);
+    Ok(Diagnosis {
+        cause,
+        params: named(&sim.extension_params(cause), &after_fit.ext),
+        nuisance_before: named(&nuis_specs, &base.nuisance),
+        nuisance_after: named(&nuis_specs, &after_fit.nuisance),
+        nominal: m_nominal,
+        before: m_before,
+        after: m_after,
+        ranking,
+        xcorr,
+        split_time_s: split,
+        series: [nominal, base.series.clone(), after_fit.series],
+        sims,
+    })
+}
+
+/// Cross-correlation of every channel's calibrated-baseline residual with
+/// every regressor of [`regressors`], lags 0…`max_lag_s`.
+fn cross_correlations(run: &MeasuredRun, base: &SimSeries, max_lag_s: f64) -> Vec<XCorr> {
+    let regs = regressors(run, base);
+    let dt = (run.time_s[run.len() - 1] - run.time_s[0]) / (run.len() - 1) as f64;
+    let max_lag = ((max_lag_s / dt).round() as usize).min(run.len() / 3);
+    let mut out = Vec::new();
+    for ch in Channel::TEMPERATURES {
+        let Some(m) = run.get(ch) else { continue };
+        let Some(y) = base.channels.get(&ch) else { continue };
+        let r: Vec<Option<f64>> = m.iter().zip(y).map(|(m, y)| m.map(|m| y - m)).collect();
+        for (name, u) in &regs {
+            let cc = cross_correlation(&r, u, max_lag);
+            let (k, peak) = cc.iter().enumerate().fold((0, 0.0f64), |b, (k, v)| if v.abs() > b.1.abs() { (k, *v) } else { b });
+            out.push(XCorr { channel: ch.name().into(), regressor: name.clone(), rho0: cc[0], peak_rho: peak, peak_lag_s: k as f64 * dt });
+        }
+    }
+    out
+}

@@ -1,0 +1,20 @@
+//! Diagnosis of a measured run against the reference model (issue 5):
+//! drive the model with the measured inputs, calibrate a nuisance set on a
+//! training window, show where and how the residuals are structured, fit
+//! every candidate extension, name the cause by BIC plus held-out gain, and
+//! report the before/after errors.
+
+pub mod analysis;
+pub mod fit;
+pub mod model;
+pub mod plot;
+pub mod regressors;
+pub mod report;
+pub mod reference;
+pub mod stats;
+pub mod sweep;
+pub mod synth;
+pub mod cli;
+
+pub use analysis::{diagnose, DiagnoseError, DiagnoseOptions, Diagnosis};
+pub use model::{Candidate, ParamSpec, SimSeries, Simulator};

@@ -1,0 +1,112 @@
+//! The model interface the diagnosis fits: candidate extensions, fitted
+//! parameters and the [`Simulator`] trait that the reference model (or any
+//! other model) implements.
+
+use crate::measured::Channel;
+use std::collections::BTreeMap;
+
+/// A candidate model extension (issue 2, "Model extensions"); `None` is the
+/// baseline. Names are the exact strings of issue 5.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Candidate {
+    /// Copper resistance rising with winding temperature, R = R0(1+α(T−T0)) (eq. 1).
+    WindingResistanceTemperature,
+    /// Oil viscosity following ASTM D341 instead of its 40 °C value (eqs. 5–7).
+    ViscosityTemperature,
+    /// Manifold oil sensor in a dead-end pocket, first-order lag (paper Figs. 9–10).
+    SensorLag,
+    /// Non-linear (Coulomb) actuator friction (paper Case 2).
+    CoulombFriction,
+    /// Pump churning loss ∝ ω^2.5 (eq. 8 mechanical-loss term).
+    ChurningLoss,
+    /// Direct conduction between motor and pump housings (Point 2 joint).
+    MotorPumpConduction,
+    /// Unlogged forced convection over the housings (eqs. 17–19, Table 5).
+    ForcedConvection,
+    /// No extension: the baseline.
+    None,
+}
+
+impl Candidate {
+    /// The extensions tried by the diagnosis, in report order.
+    pub const EXTENSIONS: [Candidate; 7] = [
+        Candidate::WindingResistanceTemperature,
+        Candidate::ViscosityTemperature,
+        Candidate::SensorLag,
+        Candidate::CoulombFriction,
+        Candidate::ChurningLoss,
+        Candidate::MotorPumpConduction,
+        Candidate::ForcedConvection,
+    ];
+
+    /// Exact name used in reports, JSON and tests.
+    pub fn name(self) -> &'static str {
+        match self {
+            Candidate::WindingResistanceTemperature => "winding-resistance-temperature",
+            Candidate::ViscosityTemperature => "viscosity-temperature",
+            Candidate::SensorLag => "sensor-lag",
+            Candidate::CoulombFriction => "coulomb-friction",
+            Candidate::ChurningLoss => "churning-loss",
+            Candidate::MotorPumpConduction => "motor-pump-conduction",
+            Candidate::ForcedConvection => "forced-convection",
+            Candidate::None => "none",
+        }
+    }
+
+    /// The candidate with exact name `s`.
+    pub fn from_name(s: &str) -> Option<Candidate> {
+        Candidate::EXTENSIONS.into_iter().chain([Candidate::None]).find(|c| c.name() == s)
+    }
+}
+
+impl std::fmt::Display for Candidate {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A fitted parameter: strictly positive, fitted in log space between
+/// `lo` and `hi`, starting from `start`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ParamSpec {
+    /// Name as reported (e.g. `h_out_scale`, `sensor_tau_s`).
+    pub name: String,
+    /// Unit of the value (e.g. `1`, `s`, `W/K`).
+    pub unit: String,
+    /// Initial guess.
+    pub start: f64,
+    /// Lower bound (> 0).
+    pub lo: f64,
+    /// Upper bound.
+    pub hi: f64,
+}
+
+impl ParamSpec {
+    /// A parameter spec with `start` inside `[lo, hi]`, all > 0.
+    pub fn new(name: &str, unit: &str, start: f64, lo: f64, hi: f64) -> Self {
+        ParamSpec { name: name.into(), unit: unit.into(), start, lo, hi }
+    }
+}
+
+/// Simulated series at the measured sample times: the temperature channels
+/// (°C) plus named internal series used as regressors (`t_winding_c`, …).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SimSeries {
+    /// Simulated measured-format channels, one value per measured time.
+    pub channels: BTreeMap<Channel, Vec<f64>>,
+    /// Internal series (same length), by the reference model's names.
+    pub internals: BTreeMap<String, Vec<f64>>,
+}
+
+/// A model the diagnosis can drive with the measured inputs. `nuisance` and
+/// `ext` are the values of [`Simulator::nuisance`] and
+/// [`Simulator::extension_params`] in order.
+pub trait Simulator: Sync {
+    /// The nuisance set calibrated on every fit (documented by the model).
+    fn nuisance(&self) -> Vec<ParamSpec>;
+    /// The parameters of candidate `c` (empty for [`Candidate::None`]).
+    fn extension_params(&self, c: Candidate) -> Vec<ParamSpec>;
+    /// Runs the model with candidate `c` switched on, returning the series
+    /// at the measured times, or a message when the model fails.
+    fn simulate(&self, nuisance: &[f64], c: Candidate, ext: &[f64]) -> Result<SimSeries, String>;
+}

@@ -1,0 +1,153 @@
+//! The reference simulation (`eha_sim::sim`) as a [`Simulator`]: replay of
+//! the measured inputs, the rig's four nuisance multipliers as the
+//! calibrated set, and one parameter per candidate extension.
+
+use super::model::{Candidate, ParamSpec, SimSeries, Simulator};
+use crate::measured::{Channel, MeasuredRun};
+use crate::rig::Rig;
+use crate::scenario::{ReplayInputs, Scenario};
+use crate::sim::{simulate, SimOptions};
+
+/// Errors building the replay model from a measured run.
+#[derive(Debug, thiserror::Error)]
+pub enum ReferenceError {
+    /// A required input column has no sample at all.
+    #[error("input column `{0}` has no sample; the model cannot be driven")]
+    EmptyInput(&'static str),
+    /// The rig does not validate or the baseline does not run.
+    #[error("reference model: {0}")]
+    Model(String),
+}
+
+/// Replay inputs from the input columns of `run`: gaps bridged by linear
+/// interpolation between the neighbouring samples, held constant before the
+/// first and after the last sample (see [`MeasuredRun::value_at`]).
+pub fn replay_inputs(run: &MeasuredRun, name: &str) -> Result<ReplayInputs, ReferenceError> {
+    let col = |ch: Channel| -> Option<Vec<f64>> {
+        run.get(ch)?;
+        run.time_s.iter().map(|&t| run.value_at(ch, t)).collect()
+    };
+    let req = |ch: Channel| col(ch).ok_or(ReferenceError::EmptyInput(ch.name()));
+    Ok(ReplayInputs {
+        name: name.into(),
+        time_s: run.time_s.clone(),
+        speed_rpm: req(Channel::SpeedRpm)?,
+        current_a: req(Channel::CurrentA)?,
+        p_a_bar: req(Channel::PABar)?,
+        p_b_bar: req(Channel::PBBar)?,
+        ambient_c: req(Channel::AmbientC)?,
+        position_mm: col(Channel::PositionMm),
+        air_speed_mps: col(Channel::AirSpeedMps),
+        lng_valve: col(Channel::LngValve),
+    })
+}
+
+/// The reference model driven by one measured run.
+///
+/// Nuisance set (calibrated on every fit, log-space, within a factor 2 of
+/// the rig file — the prior a thermal engineer has on a new rig):
+/// `outer_scale` (free convection + radiation conductances), `inner_scale`
+/// (oil-to-metal conductances), `metal_capacity_scale`,
+/// `oil_capacity_scale` (see `eha_sim::rig::Nuisance`). A richer set (per
+/// component capacities, 6 parameters) was tried and rejected: it absorbs
+/// the effects themselves (forced convection, viscosity and churning were
+/// then no longer identified).
+///
+/// Candidate parameters (ranges are the physically plausible ones):
+/// `alpha_per_k` 1e-4…1e-2 1/K (copper 3.9e-3), viscosity-temperature none
+/// (a switch), `sensor_tau_s` 1…1000 s, `coulomb_n` 1…3000 N,
+/// `churning_w_per_rad2_5` 1e-7…1e-2 W/(rad/s)^2.5, `conduction_w_per_k`
+/// 0.01…50 W/K, `air_speed_mps` 0.2…40 m/s.
+pub struct ReferenceModel {
+    rig: Rig,
+    scenario: Scenario,
+    times: Vec<f64>,
+    opts: SimOptions,
+}
+
+impl ReferenceModel {
+    /// Builds the replay model of `run` on `rig`, checking that the baseline
+    /// runs.
+    pub fn new(rig: Rig, run: &MeasuredRun) -> Result<Self, ReferenceError> {
+        rig.validate().map_err(|e| ReferenceError::Model(e.to_string()))?;
+        let inputs = replay_inputs(run, run.meta("rig").unwrap_or("measured"))?;
+        let span = run.time_s[run.len() - 1] - run.time_s[0];
+        // Output every ~1/400 of the run (≥ 0.5 s): the thermal time
+        // constants are minutes, linear interpolation between outputs is
+        // far below the 0.1 K sensor noise.
+        let dt = (span / 400.0).clamp(0.5, 5.0);
+        let opts = SimOptions { output_interval_s: dt, control_interval_s: dt };
+        let m = ReferenceModel { rig, scenario: Scenario::Replay(inputs), times: run.time_s.clone(), opts };
+        let n: Vec<f64> = m.nuisance().iter().map(|p| p.start).collect();
+        m.simulate(&n, Candidate::None, &[]).map_err(ReferenceError::Model)?;
+        Ok(m)
+    }
+
+    /// The rig with nuisance values `nuis` and candidate `c` at `ext`.
+    pub fn rig_for(&self, nuis: &[f64], c: Candidate, ext: &[f64]) -> Rig {
+        let mut r = self.rig.clone();
+        r.nuisance.outer_scale = nuis[0];
+        r.nuisance.inner_scale = nuis[1];
+        r.nuisance.metal_capacity_scale = nuis[2];
+        r.nuisance.oil_capacity_scale = nuis[3];
+        let e = &mut r.ext;
+        let x = ext.first().copied();
+        match c {
+            Candidate::WindingResistanceTemperature => e.winding_resistance_temperature = x,
+            Candidate::ViscosityTemperature => e.viscosity_temperature = true,
+            Candidate::SensorLag => e.sensor_lag = x,
+            Candidate::CoulombFriction => e.coulomb_friction = x,
+            Candidate::ChurningLoss => e.churning_loss = x,
+            Candidate::MotorPumpConduction => e.motor_pump_conduction = x,
+            Candidate::ForcedConvection => e.forced_convection = x,
+            Candidate::None => {}
+        }
+        r
+    }
+}
+
+/// Internal series kept for the regressors.
+const INTERNALS: [&str; 5] = ["t_winding_c", "t_drain_c", "t_motor_c", "t_pump_c", "t_loop_oil_c"];
+
+impl Simulator for ReferenceModel {
+    fn nuisance(&self) -> Vec<ParamSpec> {
+        let n = &self.rig.nuisance;
+        let p = |name: &str, v: f64| ParamSpec::new(name, "1", v, v / 2.0, v * 2.0);
+        vec![
+            p("outer_scale", n.outer_scale),
+            p("inner_scale", n.inner_scale),
+            p("metal_capacity_scale", n.metal_capacity_scale),
+            p("oil_capacity_scale", n.oil_capacity_scale),
+        ]
+    }
+
+    fn extension_params(&self, c: Candidate) -> Vec<ParamSpec> {
+        match c {
+            Candidate::WindingResistanceTemperature => vec![ParamSpec::new("alpha_per_k", "1/K", 2e-3, 1e-4, 1e-2)],
+            Candidate::SensorLag => vec![ParamSpec::new("sensor_tau_s", "s", 30.0, 1.0, 1000.0)],
+            Candidate::CoulombFriction => vec![ParamSpec::new("coulomb_n", "N", 150.0, 1.0, 3000.0)],
+            Candidate::ChurningLoss => vec![ParamSpec::new("churning_w_per_rad2_5", "W/(rad/s)^2.5", 2e-4, 1e-7, 1e-2)],
+            Candidate::MotorPumpConduction => vec![ParamSpec::new("conduction_w_per_k", "W/K", 1.0, 0.01, 50.0)],
+            Candidate::ForcedConvection => vec![ParamSpec::new("air_speed_mps", "m/s", 3.0, 0.2, 40.0)],
+            Candidate::ViscosityTemperature | Candidate::None => vec![],
+        }
+    }
+
+    fn simulate(&self, nuisance: &[f64], c: Candidate, ext: &[f64]) -> Result<SimSeries, String> {
+        let rig = self.rig_for(nuisance, c, ext);
+        let out = simulate(&rig, &self.scenario, &self.opts).map_err(|e| e.to_string())?;
+        let mut s = SimSeries::default();
+        let sample = |name: &str| -> Option<Vec<f64>> { self.times.iter().map(|&t| out.at(name, t)).collect() };
+        for ch in Channel::TEMPERATURES {
+            if let Some(v) = sample(ch.name()) {
+                s.channels.insert(ch, v);
+            }
+        }
+        for name in INTERNALS {
+            if let Some(v) = sample(name) {
+                s.internals.insert(name.into(), v);
+            }
+        }
+        Ok(s)
+    }
+}

@@ -1,0 +1,154 @@
+//! Writing a diagnosis: `diagnosis.json` (the machine-readable verdict with
+//! exactly the keys of issue 5) and `report.md` (the evidence, with PNGs).
+
+use super::analysis::{Diagnosis, Metrics};
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// One ranking row of `diagnosis.json`.
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize, PartialEq)]
+pub struct RankingJson {
+    /// Candidate name.
+    pub cause: String,
+    /// BIC on the training fit points (lower is better).
+    pub bic: f64,
+    /// Pooled held-out RMSE over the temperature channels, K.
+    pub heldout_rmse_k: f64,
+}
+
+/// `diagnosis.json`: exactly the top-level keys of issue 5. RMSEs are pooled
+/// over every measured temperature channel, K; "before" is the calibrated
+/// baseline, "after" the model with `cause` switched on (equal to "before"
+/// when `cause` is `none`).
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize, PartialEq)]
+pub struct DiagnosisJson {
+    /// Named cause (candidate name or `none`).
+    pub cause: String,
+    /// Fitted parameters of the cause, name → value (units in report.md).
+    pub parameters: std::collections::BTreeMap<String, f64>,
+    /// Training-window RMSE before, K.
+    pub rmse_before_k: f64,
+    /// Training-window RMSE after, K.
+    pub rmse_after_k: f64,
+    /// Held-out RMSE before, K.
+    pub heldout_rmse_before_k: f64,
+    /// Held-out RMSE after, K.
+    pub heldout_rmse_after_k: f64,
+    /// Every candidate and `none`, best BIC first.
+    pub ranking: Vec<RankingJson>,
+}
+
+impl DiagnosisJson {
+    /// The JSON verdict of `d`.
+    pub fn from_diagnosis(d: &Diagnosis) -> Self {
+        DiagnosisJson {
+            cause: d.cause.name().into(),
+            parameters: d.params.iter().map(|(n, v, _)| (n.clone(), *v)).collect(),
+            rmse_before_k: d.before.train_rmse_k,
+            rmse_after_k: d.after.train_rmse_k,
+            heldout_rmse_before_k: d.before.heldout_rmse_k,
+            heldout_rmse_after_k: d.after.heldout_rmse_k,
+            ranking: d
+                .ranking
+                .iter()
+                .map(|r| RankingJson { cause: r.cause.clone(), bic: r.bic, heldout_rmse_k: r.heldout_rmse_k })
+                .collect(),
+        }
+    }
+}
+
+/// A parameter value with 4 significant digits (scientific when small).
+fn num(v: f64) -> String {
+    if v != 0.0 && (v.abs() < 0.01 || v.abs() >= 1e5) { format!("{v:.3e}") } else { format!("{v:.4}") }
+}
+
+fn metrics_table(s: &mut String, title: &str, m: &Metrics) {
+    let _ = writeln!(s, "\n**{title}** (pooled: training {:.3} K, held-out {:.3} K)\n", m.train_rmse_k, m.heldout_rmse_k);
+    let _ = writeln!(s, "| channel | RMSE train (K) | RMSE held-out (K) | bias (K) | max error (K) | Ljung–Box Q | p |");
+    let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---:|");
+    for c in &m.channels {
+        let _ = writeln!(
+            s,
+            "| `{}` | {:.3} | {:.3} | {:+.3} | {:.3} | {:.0} | {:.2e} |",
+            c.channel, c.train_rmse_k, c.heldout_rmse_k, c.bias_k, c.max_error_k, c.ljung_box.q, c.ljung_box.p_value
+        );
+    }
+}
+
+/// The Markdown report of `d` for the measured file `source`; `pngs` are
+/// the plot file names (relative to the report) to embed.
+pub fn report_markdown(d: &Diagnosis, source: &str, pngs: &[String]) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "# Diagnosis of `{source}`\n");
+    let _ = writeln!(s, "**Cause: `{}`**", d.cause.name());
+    for (n, v, u) in &d.params {
+        let _ = writeln!(s, "- fitted `{n}` = {} {u}", num(*v));
+    }
+    let _ = writeln!(
+        s,
+        "\nTraining window: before {:.2} s; held-out window: from {:.2} s (last ≥ 30 % of the run). \
+         RMSE pooled over temperature channels: training {:.3} → {:.3} K, held-out {:.3} → {:.3} K ({} model runs).",
+        d.split_time_s, d.split_time_s, d.before.train_rmse_k, d.after.train_rmse_k, d.before.heldout_rmse_k,
+        d.after.heldout_rmse_k, d.sims
+    );
+    let _ = writeln!(s, "\n## Ranking (BIC on the training window, held-out check)\n");
+    let _ = writeln!(s, "| cause | BIC | ΔBIC vs none | RMSE train (K) | RMSE held-out (K) | best channel gain | qualifies | fitted |");
+    let _ = writeln!(s, "|---|---:|---:|---:|---:|---|---|---|");
+    for r in &d.ranking {
+        let p: Vec<String> = r.params.iter().map(|(n, v, u)| format!("{n}={} {u}", num(*v))).collect();
+        let _ = writeln!(
+            s,
+            "| `{}` | {:.1} | {:.1} | {:.3} | {:.3} | {:.0} % {} | {} | {} |",
+            r.cause, r.bic, r.delta_bic, r.train_rmse_k, r.heldout_rmse_k, 100.0 * r.heldout_gain, r.gain_channel,
+            if r.qualifies { "yes" } else { "no" }, p.join(", ")
+        );
+    }
+    let _ = writeln!(s, "\n## Errors per channel\n");
+    metrics_table(&mut s, "Baseline at nominal parameters", &d.nominal);
+    metrics_table(&mut s, "Calibrated baseline (before)", &d.before);
+    metrics_table(&mut s, &format!("With `{}` (after)", d.cause.name()), &d.after);
+    let _ = writeln!(s, "\n## Calibrated nuisance parameters\n\n| parameter | before | after | unit |\n|---|---:|---:|---|");
+    for ((n, b, u), (_, a, _)) in d.nuisance_before.iter().zip(&d.nuisance_after) {
+        let _ = writeln!(s, "| `{n}` | {b:.4} | {a:.4} | {u} |");
+    }
+    let _ = writeln!(s, "\n## Residual cross-correlation with physical regressors (calibrated baseline)\n");
+    let _ = writeln!(s, "Peak |ρ| over lags 0…lag_max (regressor leading the residual); ρ at lag 0 in brackets.\n");
+    let regs: Vec<String> = {
+        let mut v: Vec<String> = d.xcorr.iter().map(|x| x.regressor.clone()).collect();
+        v.dedup();
+        v.sort();
+        v.dedup();
+        v
+    };
+    let _ = writeln!(s, "| channel | {} |", regs.join(" | "));
+    let _ = writeln!(s, "|---|{}", "---|".repeat(regs.len()));
+    let mut chans: Vec<String> = d.xcorr.iter().map(|x| x.channel.clone()).collect();
+    chans.dedup();
+    for ch in chans {
+        let cells: Vec<String> = regs
+            .iter()
+            .map(|r| {
+                d.xcorr
+                    .iter()
+                    .find(|x| &x.channel == &ch && &x.regressor == r)
+                    .map(|x| format!("{:+.2} @{:.0}s ({:+.2})", x.peak_rho, x.peak_lag_s, x.rho0))
+                    .unwrap_or_default()
+            })
+            .collect();
+        let _ = writeln!(s, "| `{ch}` | {} |", cells.join(" | "));
+    }
+    let _ = writeln!(s, "\n## Plots\n");
+    for p in pngs {
+        let _ = writeln!(s, "![{p}]({p})\n");
+    }
+    s
+}
+
+/// Writes `report.md`, `diagnosis.json` and the PNGs of `d` into `out`.
+pub fn write_outputs(d: &Diagnosis, run: &crate::measured::MeasuredRun, source: &str, out: &Path) -> std::io::Result<()> {
+    std::fs::create_dir_all(out)?;
+    let pngs = super::plot::write_plots(d, run, out).map_err(|e| std::io::Error::other(e.to_string()))?;
+    std::fs::write(out.join("report.md"), report_markdown(d, source, &pngs))?;
+    let j = serde_json::to_string_pretty(&DiagnosisJson::from_diagnosis(d)).map_err(std::io::Error::other)?;
+    std::fs::write(out.join("diagnosis.json"), j + "\n")
+}

@@ -1,0 +1,142 @@
+//! Hidden-effect cases end to end: generate a synthetic run
+//! ([`super::synth`]), diagnose it blind with the baseline rig, and score
+//! the verdict. Used by the tests and by `eha-sim diagnose-sweep` (the large
+//! sweep, too slow for the default test run).
+
+use super::analysis::{diagnose, DiagnoseOptions};
+use super::model::Candidate;
+use super::reference::ReferenceModel;
+use super::synth::{generate, Mismatch, SynthCase, SynthScenario};
+use crate::rig::Rig;
+use rayon::prelude::*;
+use std::process::ExitCode;
+
+/// Score of one hidden-effect case.
+#[derive(Debug, Clone)]
+pub struct CaseResult {
+    /// The case.
+    pub case: SynthCase,
+    /// The cause the diagnosis named.
+    pub named: Candidate,
+    /// Hidden magnitude.
+    pub magnitude: f64,
+    /// Channel the hidden effect changes most (truth side), its imprint, K.
+    pub affected: Option<(String, f64)>,
+    /// Held-out RMSE on the affected channel before → after, K.
+    pub affected_heldout_k: Option<(f64, f64)>,
+    /// Pooled held-out RMSE before → after, K.
+    pub pooled_heldout_k: (f64, f64),
+    /// Fitted extension parameters.
+    pub params: Vec<(String, f64, String)>,
+    /// Wall time of the diagnosis, s.
+    pub seconds: f64,
+    /// Model runs.
+    pub sims: usize,
+}
+
+impl CaseResult {
+    /// Relative held-out RMSE reduction on the affected channel.
+    pub fn affected_gain(&self) -> Option<f64> {
+        self.affected_heldout_k.map(|(b, a)| 1.0 - a / b)
+    }
+
+    /// One-line summary.
+    pub fn line(&self) -> String {
+        format!(
+            "hidden {:<31} {:?}/{:?} seed {:>3}: named {:<31} affected {:<14} gain {:>6} held-out {:.3}->{:.3} K  {:.0} s, {} runs",
+            self.case.hidden.name(),
+            self.case.scenario,
+            self.case.mismatch,
+            self.case.seed,
+            self.named.name(),
+            self.affected.as_ref().map_or("-".into(), |a| format!("{} ({:.2} K)", a.0, a.1)),
+            self.affected_gain().map_or("-".into(), |g| format!("{:.0} %", 100.0 * g)),
+            self.pooled_heldout_k.0,
+            self.pooled_heldout_k.1,
+            self.seconds,
+            self.sims
+        )
+    }
+}
+
+/// Generates and diagnoses one case with the default rig as baseline.
+pub fn run_case(case: SynthCase, o: &DiagnoseOptions) -> Result<CaseResult, String> {
+    let (run, truth) = generate(&case)?;
+    let t = std::time::Instant::now();
+    let model = ReferenceModel::new(Rig::default(), &run).map_err(|e| e.to_string())?;
+    let d = diagnose(&run, &model, o).map_err(|e| e.to_string())?;
+    let affected = truth.affected.map(|(c, v)| (c.name().to_string(), v));
+    let affected_heldout_k = affected.as_ref().and_then(|(c, _)| {
+        Some((d.before.channel(c)?.heldout_rmse_k, d.after.channel(c)?.heldout_rmse_k))
+    });
+    Ok(CaseResult {
+        case,
+        named: d.cause,
+        magnitude: truth.magnitude,
+        affected,
+        affected_heldout_k,
+        pooled_heldout_k: (d.before.heldout_rmse_k, d.after.heldout_rmse_k),
+        params: d.params,
+        seconds: t.elapsed().as_secs_f64(),
+        sims: d.sims,
+    })
+}
+
+/// Arguments of `diagnose-sweep`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct SweepArgs {
+    /// Seeds per (effect, scenario, mismatch) combination.
+    #[arg(long, default_value_t = 2)]
+    pub seeds: u64,
+    /// Run duration, s.
+    #[arg(long, default_value_t = 1800.0)]
+    pub duration: f64,
+    /// Logger sample interval, s.
+    #[arg(long, default_value_t = 2.0)]
+    pub sample: f64,
+}
+
+/// Every (effect incl. none, scenario, mismatch, seed) combination.
+pub fn sweep_cases(a: &SweepArgs) -> Vec<SynthCase> {
+    let mut v = Vec::new();
+    for hidden in Candidate::EXTENSIONS.into_iter().chain([Candidate::None]) {
+        for scenario in SynthScenario::ALL.into_iter().filter(|s| s.can_show(hidden)) {
+            for mismatch in [Mismatch::Nuisance, Mismatch::Structure] {
+                for seed in 0..a.seeds {
+                    v.push(SynthCase { hidden, scenario, mismatch, seed: 1000 + seed, duration_s: a.duration, sample_s: a.sample });
+                }
+            }
+        }
+    }
+    v
+}
+
+/// Runs the sweep, prints one line per case and the totals; exit 0 always
+/// (it is a measurement, not a test).
+pub fn run(a: &SweepArgs) -> ExitCode {
+    let cases = sweep_cases(a);
+    let bar = indicatif::ProgressBar::new(cases.len() as u64);
+    let res: Vec<Result<CaseResult, String>> = cases
+        .par_iter()
+        .map(|c| {
+            let r = run_case(*c, &DiagnoseOptions::default());
+            bar.inc(1);
+            r
+        })
+        .collect();
+    bar.finish_and_clear();
+    let (mut ok, mut n) = (0, 0);
+    for r in &res {
+        match r {
+            Ok(r) => {
+                n += 1;
+                let hit = r.named == r.case.hidden;
+                ok += hit as usize;
+                println!("{} {}", if hit { "OK  " } else { "MISS" }, r.line());
+            }
+            Err(e) => println!("ERR  {e}"),
+        }
+    }
+    println!("identified {ok} of {n} cases");
+    ExitCode::SUCCESS
+}

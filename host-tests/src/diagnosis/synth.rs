@@ -1,0 +1,310 @@
+//! Seeded generator of synthetic "measured" runs with one hidden effect:
+//! the reference simulation with one extension switched on (magnitude drawn
+//! from a realistic range), nuisance multipliers perturbed by ±10–20 %,
+//! optionally per-node capacities and conductances the baseline does not
+//! know, then sensor noise (σ = 0.1 K), 12-bit quantisation and dropped
+//! samples. Used by the diagnosis tests and the `diagnose-sweep` command.
+
+use super::model::Candidate;
+use crate::measured::{Channel, MeasuredRun};
+use crate::rig::Rig;
+use crate::scenario::{Circuit, Mission, PositionRef, Schedule, Scenario, ValveRule};
+use crate::sim::{simulate, SimOptions};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+/// Operating scenario of a synthetic run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SynthScenario {
+    /// Case 1 throttle circuit, 500 rpm, needle valve at 20–60 bar.
+    Case1Pressure,
+    /// Servo circuit: closed-loop sine tracking (amplitude, frequency drawn).
+    Servo,
+    /// Throttle mission with speed and needle-pressure steps.
+    ThrottleSteps,
+    /// Servo mission: triangular position profile whose amplitude
+    /// (10–25 mm) and half-period (2–5 s) change every cycle.
+    ServoProfile,
+    /// Throttle mission: speed steps 1000–2000 rpm every 100–250 s at low
+    /// needle pressure (5–25 bar), the regime where speed losses dominate.
+    SpeedSweep,
+}
+
+impl SynthScenario {
+    /// Every scenario.
+    pub const ALL: [SynthScenario; 5] = [
+        SynthScenario::Case1Pressure,
+        SynthScenario::Servo,
+        SynthScenario::ThrottleSteps,
+        SynthScenario::ServoProfile,
+        SynthScenario::SpeedSweep,
+    ];
+
+    /// Whether `hidden` can act at all in this scenario: Coulomb friction
+    /// needs a moving piston (servo circuit); churning (∝ ω^2.5) needs the
+    /// high shaft speeds of the throttle missions with speed steps. Other
+    /// pairs are physically valid in every scenario.
+    pub fn can_show(self, hidden: Candidate) -> bool {
+        let servo = matches!(self, SynthScenario::Servo | SynthScenario::ServoProfile);
+        match hidden {
+            Candidate::CoulombFriction => servo,
+            Candidate::ChurningLoss => matches!(self, SynthScenario::ThrottleSteps | SynthScenario::SpeedSweep),
+            _ => true,
+        }
+    }
+}
+
+/// How far the generating rig is from the diagnosis baseline.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Mismatch {
+    /// Only the four nuisance multipliers are perturbed (±10–20 %).
+    Nuisance,
+    /// Also every node's mass and the winding/sensor conductances are
+    /// changed individually (×0.8…1.25), which the global multipliers of the
+    /// baseline cannot represent.
+    Structure,
+}
+
+/// One synthetic case.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SynthCase {
+    /// The hidden effect (`None` for a clean run).
+    pub hidden: Candidate,
+    /// Scenario.
+    pub scenario: SynthScenario,
+    /// Nuisance physics of the generator.
+    pub mismatch: Mismatch,
+    /// Seed of every random draw.
+    pub seed: u64,
+    /// Run duration, s.
+    pub duration_s: f64,
+    /// Logger sample interval, s.
+    pub sample_s: f64,
+}
+
+/// What the generator did (never shown to the diagnosis).
+#[derive(Debug, Clone)]
+pub struct Truth {
+    /// Hidden effect magnitude (extension parameter; 1 for the switch).
+    pub magnitude: f64,
+    /// Generating rig.
+    pub rig: Rig,
+    /// The channel the hidden effect changes most (RMS difference between
+    /// the generator with and without the effect over the last 30 % of the
+    /// run), with that RMS difference, K. `None` for clean runs.
+    pub affected: Option<(Channel, f64)>,
+}
+
+/// Realistic magnitude range of each extension (its parameter's unit in
+/// `eha_sim::rig::Extensions`).
+pub fn magnitude_range(c: Candidate) -> (f64, f64) {
+    match c {
+        // copper: 3.9e-3 1/K; alloys and winding hot spots 3e-3…4.3e-3
+        Candidate::WindingResistanceTemperature => (3.0e-3, 4.3e-3),
+        // dead-end pocket (Figs. 9–10): minutes
+        Candidate::SensorLag => (60.0, 240.0),
+        // piston-seal Coulomb friction of a 1527 mm² ram, N (2–4 % of
+        // its 30 kN force at 200 bar)
+        Candidate::CoulombFriction => (500.0, 1200.0),
+        // churning ∝ ω^2.5, 60–150 W at 1500 rpm (ω^2.5 ≈ 3.2e5)
+        Candidate::ChurningLoss => (2.0e-4, 5.0e-4),
+        // flange conduction, W/K
+        Candidate::MotorPumpConduction => (3.0, 8.0),
+        // unlogged fan / draught, m/s (Table 5 ram air is 15–50 m/s)
+        Candidate::ForcedConvection => (5.0, 12.0),
+        Candidate::ViscosityTemperature | Candidate::None => (1.0, 1.0),
+    }
+}
+
+fn gauss(rng: &mut ChaCha8Rng) -> f64 {
+    let (u1, u2): (f64, f64) = (rng.random::<f64>().max(1e-300), rng.random());
+    (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
+}
+
+fn perturb(rng: &mut ChaCha8Rng) -> f64 {
+    let m = rng.random_range(0.10..0.20);
+    if rng.random_bool(0.5) { 1.0 + m } else { 1.0 - m }
+}
+
+fn mission(c: &SynthCase, rng: &mut ChaCha8Rng) -> Mission {
+    let d = c.duration_s;
+    let amb = rng.random_range(14.0..28.0);
+    let base = Mission {
+        name: format!("synth-{:?}-{}", c.scenario, c.seed),
+        circuit: Circuit::Throttle,
+        duration_s: d,
+        ambient_c: Schedule::constant(amb),
+        speed_rpm: Schedule::constant(500.0),
+        needle_bar: Schedule::constant(60.0),
+        position: PositionRef::Profile(Schedule::constant(0.0)),
+        air_speed_mps: Schedule::constant(0.0),
+        valve: ValveRule::None,
+    };
+    match c.scenario {
+        SynthScenario::Case1Pressure => Mission { needle_bar: Schedule::constant([20.0, 40.0, 60.0][rng.random_range(0..3)]), ..base },
+        SynthScenario::Servo => Mission {
+            circuit: Circuit::Servo,
+            speed_rpm: Schedule::constant(0.0),
+            needle_bar: Schedule::constant(0.0),
+            position: PositionRef::Sine {
+                amplitude_m: rng.random_range(0.015..0.025),
+                freq_hz: rng.random_range(0.15..0.3),
+                offset_m: 0.0,
+            },
+            ..base
+        },
+        SynthScenario::ThrottleSteps => {
+            // Four segments, each a random speed (300–1200 rpm) and needle
+            // pressure drop (10–100 bar at that speed), stepping at random
+            // times.
+            let mut ts: Vec<f64> = (0..3).map(|_| rng.random_range(0.1..0.9) * d).collect();
+            ts.sort_by(f64::total_cmp);
+            ts.push(d);
+            let segs: Vec<(f64, f64)> = ts.iter().map(|&t| (t, 0.0)).collect();
+            let (sp, nb) = steps(&segs, rng, (300.0, 1200.0), (10.0, 100.0));
+            Mission { speed_rpm: sp, needle_bar: nb, ..base }
+        }
+        SynthScenario::ServoProfile => {
+            let (mut pts, mut t) = (vec![(0.0, 0.0)], 0.0);
+            while t < d {
+                let (a, h) = (rng.random_range(0.010..0.025), rng.random_range(2.0..5.0));
+                pts.push((t + h / 2.0, a));
+                pts.push((t + 1.5 * h, -a));
+                pts.push((t + 2.0 * h, 0.0));
+                t += 2.0 * h;
+            }
+            Mission {
+                circuit: Circuit::Servo,
+                speed_rpm: Schedule::constant(0.0),
+                needle_bar: Schedule::constant(0.0),
+                position: PositionRef::Profile(Schedule(pts)),
+                ..base
+            }
+        }
+        SynthScenario::SpeedSweep => {
+            let (mut ends, mut t) = (vec![], 0.0);
+            while t < d {
+                t = (t + rng.random_range(100.0..250.0)).min(d);
+                ends.push((t, 0.0));
+            }
+            let (sp, nb) = steps(&ends, rng, (1000.0, 2000.0), (5.0, 25.0));
+            Mission { speed_rpm: sp, needle_bar: nb, ..base }
+        }
+    }
+}
+
+/// Speed and needle schedules of piecewise-constant segments ending at
+/// `ends` (times, s): each segment draws a speed (rpm) in `speed` and a
+/// needle pressure drop at that speed (bar) in `dp`. The needle is an
+/// orifice set at the 500 rpm flow (`eha_sim::hydraulics::needle_k`), so
+/// its setting is dp·(500/n)²; this keeps the pressure below the relief
+/// valves at every speed.
+fn steps(ends: &[(f64, f64)], rng: &mut ChaCha8Rng, speed: (f64, f64), dp: (f64, f64)) -> (Schedule, Schedule) {
+    let (mut sp, mut nb, mut t0) = (vec![], vec![], 0.0);
+    for &(t1, _) in ends {
+        let (n, p) = (rng.random_range(speed.0..speed.1), rng.random_range(dp.0..dp.1));
+        let setting = p * (500.0 / n).powi(2);
+        sp.extend([(t0, n), (t1, n)]);
+        nb.extend([(t0, setting), (t1, setting)]);
+        t0 = t1;
+    }
+    (Schedule(sp), Schedule(nb))
+}
+
+/// The generating rig of `c`: default rig, nuisance (and structure)
+/// perturbed, the hidden extension on at a drawn magnitude.
+pub fn truth_rig(c: &SynthCase, rng: &mut ChaCha8Rng) -> (Rig, f64) {
+    let mut r = Rig::default();
+    r.nuisance.outer_scale *= perturb(rng);
+    r.nuisance.inner_scale *= perturb(rng);
+    r.nuisance.metal_capacity_scale *= perturb(rng);
+    r.nuisance.oil_capacity_scale *= perturb(rng);
+    if c.mismatch == Mismatch::Structure {
+        let mut f = || rng.random_range(0.8..1.25);
+        r.motor.mass_kg *= f();
+        r.pump.mass_kg *= f();
+        r.blocks.main_mass_kg *= f();
+        r.blocks.ball_mass_kg *= f();
+        r.actuator.body_mass_kg *= f();
+        r.motor.winding_to_housing_w_per_k *= f();
+    }
+    let (lo, hi) = magnitude_range(c.hidden);
+    let m = if hi > lo { rng.random_range(lo..hi) } else { lo };
+    let e = &mut r.ext;
+    match c.hidden {
+        Candidate::WindingResistanceTemperature => e.winding_resistance_temperature = Some(m),
+        Candidate::ViscosityTemperature => e.viscosity_temperature = true,
+        Candidate::SensorLag => e.sensor_lag = Some(m),
+        Candidate::CoulombFriction => e.coulomb_friction = Some(m),
+        Candidate::ChurningLoss => e.churning_loss = Some(m),
+        Candidate::MotorPumpConduction => e.motor_pump_conduction = Some(m),
+        Candidate::ForcedConvection => e.forced_convection = Some(m),
+        Candidate::None => {}
+    }
+    (r, m)
+}
+
+/// 12-bit quantisation of a temperature over the sensor span 0…200 °C
+/// (LSB 0.049 K).
+pub fn quantise(t_c: f64) -> f64 {
+    let lsb = 200.0 / 4095.0;
+    ((t_c / lsb).round() * lsb).clamp(0.0, 200.0)
+}
+
+/// Generates the measured run of case `c`.
+pub fn generate(c: &SynthCase) -> Result<(MeasuredRun, Truth), String> {
+    let mut rng = ChaCha8Rng::seed_from_u64(c.seed);
+    let m = mission(c, &mut rng);
+    let (rig, magnitude) = truth_rig(c, &mut rng);
+    // Servo runs move the piston at up to 0.3 Hz: log them at 0.5 s at most
+    // (the format's "0.1 s for sinusoidal runs"), else the logged position,
+    // whose derivative drives the replay, is aliased.
+    let servo = matches!(c.scenario, SynthScenario::Servo | SynthScenario::ServoProfile);
+    let sample = if servo { c.sample_s.min(0.5) } else { c.sample_s };
+    let opts = SimOptions { output_interval_s: sample, control_interval_s: sample.min(0.5) };
+    let scenario = Scenario::Mission(m);
+    let out = simulate(&rig, &scenario, &opts).map_err(|e| e.to_string())?;
+    let affected = if c.hidden == Candidate::None {
+        None
+    } else {
+        let mut off = rig.clone();
+        off.ext = Default::default();
+        let o2 = simulate(&off, &scenario, &opts).map_err(|e| e.to_string())?;
+        let t_split = out.time_s[0] + 0.7 * (out.time_s[out.time_s.len() - 1] - out.time_s[0]);
+        Channel::TEMPERATURES
+            .into_iter()
+            .filter_map(|ch| {
+                let (a, b) = (out.get(ch.name())?, o2.get(ch.name())?);
+                let d: Vec<f64> = (0..a.len()).filter(|&i| out.time_s[i] >= t_split).map(|i| (a[i] - b[i]).powi(2)).collect();
+                Some((ch, (d.iter().sum::<f64>() / d.len().max(1) as f64).sqrt()))
+            })
+            .max_by(|x, y| x.1.total_cmp(&y.1))
+    };
+    // Logger: a few whole rows dropped (1 %), a few single cells empty (0.5 %).
+    let keep: Vec<usize> = (0..out.time_s.len()).filter(|&i| i == 0 || !rng.random_bool(0.01)).collect();
+    let mut run = MeasuredRun::new(keep.iter().map(|&i| out.time_s[i]).collect());
+    run.push_meta("rig", "synthetic");
+    run.push_meta("note", "generated by eha_sim::diagnosis::synth");
+    for ch in Channel::ALL {
+        if ch == Channel::LngValve || ch == Channel::AirSpeedMps || (ch == Channel::PositionMm && !servo) {
+            continue;
+        }
+        let Some(v) = out.get(ch.name()) else { continue };
+        let col: Vec<Option<f64>> = keep
+            .iter()
+            .map(|&i| {
+                let x = v[i];
+                if ch.is_temperature() {
+                    let drop = rng.random_bool(0.005);
+                    let y = quantise(x + 0.1 * gauss(&mut rng));
+                    (!drop).then_some(y)
+                } else {
+                    Some(x)
+                }
+            })
+            .collect();
+        run.set(ch, col);
+    }
+    run.validate("synthetic").map_err(|e| e.to_string())?;
+    Ok((run, Truth { magnitude, rig, affected }))
+}
