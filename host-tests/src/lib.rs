@@ -14,6 +14,7 @@ pub mod cooling;
 pub mod fluid;
 pub mod heat;
 pub mod hydraulics;
+pub mod identify;
 pub mod losses;
 pub mod model;
 pub mod network;
