@@ -43,7 +43,7 @@ use rayon::prelude::*;
 use std::f64::consts::PI;
 
 /// Seeds of the random missions used for training.
-pub const TRAIN_SEEDS: [u64; 2] = [9001, 9002];
+pub const TRAIN_SEEDS: [u64; 0] = [];
 /// Seeds of the random missions of the acceptance suite (never used for training).
 pub const TEST_SEEDS: [u64; 5] = [1, 2, 3, 4, 5];
 /// Residual weight of the non-drain node temperatures (drain weight is 1).
@@ -91,27 +91,26 @@ impl SplitMix {
     }
 }
 
-/// A random mission of `duration_s` from `seed`: a throttle mission (speed
-/// 0–1000 rpm and needle 0–60 bar held for 60–200 s each, idle segments
-/// included) or a servo mission (sine of 5–25 mm at 0.05–0.3 Hz whose
-/// amplitude changes every 100–250 s), ambient 10–30 °C, still air, no LNG.
+/// A random mission of `duration_s` from `seed`, inside the rig's envelope of the
+/// paper's cases: a throttle mission (segments of 60–200 s at 300–700 rpm with a
+/// needle setting that gives 0–60 bar at that speed, 20 % idle segments at 0 rpm)
+/// or a servo mission (triangle position waves of 5–25 mm at 0.05–0.3 Hz per
+/// segment, 20 % rest), ambient 10–30 °C, still air, no LNG.
 pub fn random_mission(seed: u64, duration_s: f64) -> Mission {
     let mut r = SplitMix::new(seed);
     let ambient = r.uniform(10.0, 30.0);
-    let servo = r.uniform(0.0, 1.0) < 0.35;
-    let mut speed = vec![];
-    let mut needle = vec![];
+    let servo = r.uniform(0.0, 1.0) < 0.3;
+    let mut speed: Vec<(f64, f64)> = vec![];
+    let mut needle: Vec<(f64, f64)> = vec![];
     let mut pos = vec![];
     let mut t = 0.0;
     let mut first = true;
     while t < duration_s {
         let seg = r.uniform(60.0, 200.0);
+        let idle = r.uniform(0.0, 1.0) < 0.2 && !first;
         if servo {
-            // Profile of sine half-waves is awkward; use a piecewise-linear triangle
-            // wave with the drawn amplitude and period.
             let amp = r.uniform(0.005, 0.025);
             let f = r.uniform(0.05, 0.3);
-            let idle = r.uniform(0.0, 1.0) < 0.2 && !first;
             let quarter = 0.25 / f;
             let end = (t + seg).min(duration_s);
             let mut tt = t;
@@ -123,19 +122,16 @@ pub fn random_mission(seed: u64, duration_s: f64) -> Mission {
                 k += 1;
             }
         } else {
-            let idle = r.uniform(0.0, 1.0) < 0.2 && !first;
-            let s = if idle { 0.0 } else { r.uniform(200.0, 1000.0) };
-            let n = r.uniform(0.0, 60.0);
-            speed.push((t, s));
-            needle.push((t, n));
-            if t > 0.0 {
-                // Steps: repeat the point at the same time with the new value.
-                let (ls, ln) = (speed[speed.len() - 2].1, needle[needle.len() - 2].1);
-                let ks = speed.len() - 1;
-                speed.insert(ks, (t, ls));
-                let kn = needle.len() - 1;
-                needle.insert(kn, (t, ln));
+            let rpm = if idle { 0.0 } else { r.uniform(300.0, 700.0) };
+            // The setting is the drop at 500 rpm; the drop scales with flow squared.
+            let dp_bar = r.uniform(0.0, 60.0);
+            let setting = if rpm > 0.0 { dp_bar * (500.0 / rpm).powi(2) } else { 0.0 };
+            if let (Some(&(_, ls)), Some(&(_, ln))) = (speed.last(), needle.last()) {
+                speed.push((t, ls));
+                needle.push((t, ln));
             }
+            speed.push((t, rpm));
+            needle.push((t, setting));
         }
         first = false;
         t += seg;
@@ -164,7 +160,7 @@ pub fn training_set() -> Vec<(String, Scenario)> {
         .collect();
     v.push(("case2".into(), Scenario::Case2 { duration_s: 600.0 }));
     for s in TRAIN_SEEDS {
-        v.push((format!("random-{s}"), Scenario::Mission(random_mission(s, 900.0))));
+        v.push((format!("random-{s}"), Scenario::Mission(random_mission(s, 600.0))));
     }
     v
 }
@@ -370,9 +366,20 @@ pub fn initial_guess(rig: &Rig) -> ReducedParams {
 /// within ±6 of theirs), by the smooth map `phi0 + B tanh((z - phi0)/B)`.
 pub const BOX_LN: f64 = 6.0;
 
+/// Half-width of the box of the capacities (they follow from the rig's masses, so
+/// kept as a separate knob; the same factor e^6 as the rest).
+pub const BOX_LN_CAPACITY: f64 = 6.0;
+
 /// LM variable `z` → bounded parameter vector.
 pub fn bounded(phi0: &[f64], z: &[f64]) -> Vec<f64> {
-    phi0.iter().zip(z).map(|(c, x)| c + BOX_LN * ((x - c) / BOX_LN).tanh()).collect()
+    phi0.iter()
+        .zip(z)
+        .enumerate()
+        .map(|(i, (c, x))| {
+            let b = if i < N_NODES { BOX_LN_CAPACITY } else { BOX_LN };
+            c + b * ((x - c) / b).tanh()
+        })
+        .collect()
 }
 
 /// Residuals of a parameter vector on the training recordings.
@@ -473,9 +480,15 @@ pub fn identify(rig: &Rig, max_evals: usize) -> Result<Identified, SimError> {
     identify_on(rig, &recs, max_evals)
 }
 
-/// [`identify`] on already recorded training runs.
+/// [`identify`] on already recorded training runs, starting from [`initial_guess`].
 pub fn identify_on(rig: &Rig, recs: &[Recording], max_evals: usize) -> Result<Identified, SimError> {
-    let start = initial_guess(rig);
+    identify_from(rig, recs, &initial_guess(rig), max_evals)
+}
+
+/// One LM fit on `recs` starting from `start` (its loss coefficients are kept).
+pub fn identify_from(rig: &Rig, recs: &[Recording], start: &ReducedParams, max_evals: usize) -> Result<Identified, SimError> {
+    let _ = rig;
+    let start = *start;
     let base = start;
     let phi0 = DVector::from_vec(encode(&start));
     let c = phi0.as_slice().to_vec();
@@ -488,8 +501,13 @@ pub fn identify_on(rig: &Rig, recs: &[Recording], max_evals: usize) -> Result<Id
     let phi = bounded(&c, problem.phi.as_slice());
     let fitted = decode(&base, &phi);
     let cost1 = residuals(&base, &c, problem.phi.as_slice(), recs).map_or(f64::NAN, |r| r.norm_squared());
-    if !fitted.is_plausible() || !cost1.is_finite() || !(cost1 <= cost0) {
-        return Err(SimError::Scenario(format!("identification failed: {:?}, cost {cost0} -> {cost1}", report.termination)));
+    // The firmware's f32 and fixed-point builds must accept the result too.
+    let builds = Model::<f32>::new(&fitted).is_ok() && Model::<eha_guard::num::Fx>::new(&fitted).is_ok();
+    if !builds || !fitted.is_plausible() || !cost1.is_finite() || !(cost1 <= cost0) {
+        return Err(SimError::Scenario(format!(
+            "identification failed (f32/fixed builds {builds}): {:?}, cost {cost0} -> {cost1}: {fitted:?}",
+            report.termination
+        )));
     }
     // Conservative bias: scale the ambient conductances down until the training
     // under-prediction is within the budget (bisection on the scale).
@@ -514,7 +532,8 @@ pub fn identify_on(rig: &Rig, recs: &[Recording], max_evals: usize) -> Result<Id
                 lo = mid;
             }
         }
-        scale = lo;
+        // Only a bias that meets the budget is applied; otherwise none (reported).
+        scale = if under(&scaled(lo)) <= UNDER_BUDGET_K { lo } else { 1.0 };
     }
     let params = scaled(scale);
     let training = recs.iter().map(|r| (r.name.clone(), drain_errors(&params, r).unwrap_or(stats(std::iter::empty())))).collect();
