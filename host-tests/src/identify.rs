@@ -46,6 +46,44 @@ use nalgebra::{DMatrix, DVector, Dyn, Owned};
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
+/// Starting network of the fit: the hand-reasoned pre-identification parameters
+/// (paper Tables 2, 3, 6; formerly `eha_guard::params::DEFAULT`), kept here so that
+/// the identification does not depend on its own previous output.
+pub const HAND_START: ReducedParams = ReducedParams {
+    capacity_j_per_k: [4000.0, 32500.0, 9200.0, 4960.0, 87400.0, 500.0],
+    conductance_w_per_k: [
+        [0.0, 15.0, 0.0, 0.0, 0.0, 0.0],
+        [15.0, 0.0, 2.0, 0.0, 0.0, 0.0],
+        [0.0, 2.0, 0.0, 10.0, 0.0, 30.0],
+        [0.0, 0.0, 10.0, 0.0, 40.0, 5.0],
+        [0.0, 0.0, 0.0, 40.0, 0.0, 0.0],
+        [0.0, 0.0, 30.0, 5.0, 0.0, 0.0],
+    ],
+    ambient_w_per_k: [0.0, 5.0, 1.0, 1.0, 4.4, 0.0],
+    loss_split: [
+        [1.0, 0.3, 0.0, 0.0, 0.0],
+        [0.0, 0.7, 0.0, 0.0, 0.0],
+        [0.0, 0.0, 0.0, 0.5, 0.0],
+        [0.0, 0.0, 0.0, 0.0, 0.8],
+        [0.0, 0.0, 0.0, 0.0, 0.2],
+        [0.0, 0.0, 1.0, 0.5, 0.0],
+    ],
+    phases: 3.0,
+    r0_ohm: 0.074,
+    alpha_r_per_k: 0.00393,
+    k_fe1_w_s_per_rad: 0.05,
+    k_fe2_w_s2_per_rad2: 0.0002,
+    k_fe15_w_per_rad15: 0.005,
+    k_leak_w_per_pa2: 1.39e-12,
+    k_mu_per_k: 0.0,
+    t_mu_ref_c: 40.0,
+    eta_m: 0.05,
+    displacement_m3_per_rad: 3.0239439187142e-6,
+    ram_area_m2: 1.52681e-3,
+    g_od0_w_per_k: 5.0,
+    g_od1_w_per_k_pa: 2.3e-6,
+};
+
 /// Seeds of the random missions used for training.
 pub const TRAIN_SEEDS: [u64; 0] = [];
 /// Seeds of the random missions of the acceptance suite (never used for training).
@@ -338,10 +376,10 @@ pub fn encode(p: &ReducedParams) -> Vec<f64> {
     v
 }
 
-/// Starting point: capacities from the rig's masses, the network of the
-/// hand-reasoned `eha_guard::params::DEFAULT`, the mechanical split of the rig.
+/// Starting point: capacities from the rig's masses, the network of
+/// [`HAND_START`], the mechanical split of the rig.
 pub fn initial_guess(rig: &Rig) -> ReducedParams {
-    let base = reduce_losses(rig, &eha_guard::params::DEFAULT);
+    let base = reduce_losses(rig, &HAND_START);
     let rho = rig.oil.rho(40.0, 0.0);
     let cp = rig.oil.cp(40.0);
     let m = &rig.motor;

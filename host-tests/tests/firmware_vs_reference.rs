@@ -127,7 +127,7 @@ fn case2_drain_within_bounds() {
 
 /// Five random missions never used for identification.
 #[test]
-#[ignore = "fails: measured max |e| 1.9/6.5/0.7/0.6/0.7 K, under-prediction up to 6.5 K (random-2, idle at 0 rpm): the 6-node structure has no speed-dependent drain-pump exchange (see docs/identification.md)"]
+#[ignore = "fails: measured max |e| 2.36/7.13/0.31/0.50/0.66 K, under-prediction up to 7.1 K (random-2, pump stopped 120 s): the 6-node structure has no speed-dependent drain-pump exchange (see docs/identification.md)"]
 fn random_missions_drain_within_bounds() {
     let rows = report(&["random-"]);
     assert_eq!(rows.len(), TEST_SEEDS.len());
@@ -210,7 +210,6 @@ fn compare_events(name: &str, fw: &[(f64, bool)], truth: &[(f64, bool)]) -> (boo
 /// exchanger commanded by the guard vs by the thermostat on the true drain. Before
 /// the first opening the two plants are identical, so this isolates the estimate.
 #[test]
-#[ignore = "fails narrowly: LNG case first opening 76.32 s vs 78.38 s on the true drain (2.06 s > 2 s)"]
 fn valve_first_opening_within_2s() {
     let cases = [("lng", Scenario::Lng { duration_s: DURATION_S }), ("load-then-idle", load_then_idle())];
     let results: Vec<_> = cases
@@ -261,7 +260,7 @@ fn valve_switching_times_match_true_drain() {
 /// thermostat on the true drain, on every non-LNG acceptance run. Opening and
 /// closing both occur in the missions that cross 40 °C and fall below 38 °C.
 #[test]
-#[ignore = "fails: worst open-loop switching difference 4.27 s over 9 events (random missions, see docs/identification.md)"]
+#[ignore = "fails: random-2 closes early at 299 s while the true drain stays above 38 C (under-prediction at standstill); worst timing difference 5.11 s (random-4) (see docs/identification.md)"]
 fn valve_switching_open_loop_within_2s() {
     let cfg = GuardConfig::DEFAULT;
     let mut worst = 0.0f64;
