@@ -104,8 +104,8 @@ fn exchange_splitting_error_is_small() {
 
 #[test]
 fn steady_state_energy_balance() {
-    // Faster plant (capacities / 100 → slowest tau ≈ 120 s): after 2000 s at constant
-    // losses the heat to ambient equals the losses (energy conservation of the
+    // Faster plant (capacities / 100): after 2000 s at constant losses the heat to
+    // ambient plus the rate of storage equals the losses (energy conservation of the
     // discretisation and of the loss split). Budget 0.05 % of the 1 kW-class loss.
     let mut p = DEFAULT;
     for c in p.capacity_j_per_k.iter_mut() {
@@ -124,13 +124,27 @@ fn steady_state_energy_balance() {
     for _ in 0..200_000 {
         m.step(&u, &sc);
     }
+    // Energy conservation without assuming every node has settled (the identified
+    // parameters have near-zero ambient conductance on the pump and block, whose
+    // time constants exceed the run): losses = heat to ambient + rate of storage,
+    // the storage rate measured over one more step (midpoint ambient flow).
+    let t_before = m.temperatures_c();
+    m.step(&u, &sc);
+    let t_after = m.temperatures_c();
     let loss_w: f64 = m.last_losses_kw().iter().sum::<f64>() * 1e3;
-    let out_w: f64 = m
-        .temperatures_c()
+    let stored_w: f64 = t_before
         .iter()
-        .zip(p.ambient_w_per_k.iter())
-        .map(|(t, g)| g * (t - 16.0))
+        .zip(t_after.iter())
+        .zip(p.capacity_j_per_k.iter())
+        .map(|((a, b), c)| c * (b - a) / eha_guard::params::S_PER_STEP)
         .sum();
+    let out_w: f64 = t_before
+        .iter()
+        .zip(t_after.iter())
+        .zip(p.ambient_w_per_k.iter())
+        .map(|((a, b), g)| g * (0.5 * (a + b) - 16.0))
+        .sum::<f64>()
+        + stored_w;
     assert!(
         loss_w > 500.0 && loss_w < 2000.0,
         "Case 1 60 bar loss {loss_w} W (paper: 0.7 kW pump-side, 1.5 kW total)"

@@ -16,6 +16,7 @@ pub mod diagnosis;
 pub mod fluid;
 pub mod heat;
 pub mod hydraulics;
+pub mod identify;
 pub mod losses;
 pub mod measured;
 pub mod model;
