@@ -1,9 +1,11 @@
 //! The open-loop "drill" input sequence used by the PIL equivalence and
 //! golden-output tests: 600 s at the firmware's 10 ms step (60,000 frames).
 //!
-//! - 0–250 s: hard throttling (140 bar, 60 A, 500 rpm): the predicted drain
-//!   temperature crosses 40 °C and the LNG valve opens (about 193 s);
-//! - from 250 s: 10 bar, 5 A: the prediction falls and the valve closes;
+//! - 0–100 s: hard throttling (140 bar, 60 A, 500 rpm): the predicted drain
+//!   temperature crosses 40 °C and the LNG valve opens (about 19 s with the
+//!   identified parameters);
+//! - from 100 s: 10 bar, 5 A: the prediction falls and the valve closes
+//!   before the first fault at 450 s;
 //! - step 10,000: 3 lost frames (sequence gap, missed steps, below `stale_steps`);
 //! - step 45,000: 10 lost frames (STALE fault latches, fail-safe valve open);
 //! - step 50,000: a NaN current (non-finite fault); step 55,000: 5000 bar (range fault).
@@ -20,7 +22,7 @@ pub fn inputs() -> Vec<Request> {
     let mut seq: u16 = 0;
     for k in 0..STEPS {
         let t = k as f32 * 0.01;
-        let hot = t < 250.0;
+        let hot = t < 100.0;
         let dp = if hot { 140.0 } else { 10.0 };
         let mut r = Request {
             seq,
