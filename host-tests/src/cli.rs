@@ -63,6 +63,10 @@ pub struct SimulateArgs {
     /// Mission CSV of inputs (`time_s,speed_rpm,needle_bar,position_mm,ambient_c,air_speed_mps`).
     #[arg(long)]
     pub mission: Option<PathBuf>,
+    /// Replay the input columns (speed, pressures, current, ambient, position)
+    /// of a measured-data file (shared format).
+    #[arg(long, conflicts_with = "mission")]
+    pub replay: Option<PathBuf>,
     /// Output sample interval, s.
     #[arg(long, default_value_t = 1.0)]
     pub output_interval_s: f64,
@@ -78,6 +82,11 @@ pub struct SimulateArgs {
 pub fn scenario_of(a: &SimulateArgs) -> Result<Scenario> {
     if let Some(m) = &a.mission {
         return Ok(Scenario::Mission(read_mission_csv(m, ValveRule::None)?));
+    }
+    if let Some(p) = &a.replay {
+        let run = crate::measured::MeasuredRun::read_file(p)?;
+        let name = p.file_stem().map_or("replay".into(), |s| format!("replay-{}", s.to_string_lossy()));
+        return Ok(Scenario::Replay(crate::diagnosis::reference::replay_inputs(&run, &name)?));
     }
     Ok(match a.scenario {
         Case::Case1 => Scenario::Case1 { needle_bar: a.needle_bar, duration_s: a.duration_s },
