@@ -48,6 +48,17 @@ pub enum Case {
     Lng,
 }
 
+impl Case {
+    /// The scenario of this paper case.
+    pub fn scenario(self, needle_bar: f64, duration_s: f64) -> Scenario {
+        match self {
+            Case::Case1 => Scenario::Case1 { needle_bar, duration_s },
+            Case::Case2 => Scenario::Case2 { duration_s },
+            Case::Lng => Scenario::Lng { duration_s },
+        }
+    }
+}
+
 /// `simulate`: run a scenario, write CSV (+ PNG).
 #[derive(Debug, Args)]
 pub struct SimulateArgs {
@@ -88,11 +99,7 @@ pub fn scenario_of(a: &SimulateArgs) -> Result<Scenario> {
         let name = p.file_stem().map_or("replay".into(), |s| format!("replay-{}", s.to_string_lossy()));
         return Ok(Scenario::Replay(crate::diagnosis::reference::replay_inputs(&run, &name)?));
     }
-    Ok(match a.scenario {
-        Case::Case1 => Scenario::Case1 { needle_bar: a.needle_bar, duration_s: a.duration_s },
-        Case::Case2 => Scenario::Case2 { duration_s: a.duration_s },
-        Case::Lng => Scenario::Lng { duration_s: a.duration_s },
-    })
+    Ok(a.scenario.scenario(a.needle_bar, a.duration_s))
 }
 
 /// Write a run's CSV beside a summary, returning the CSV path.
@@ -244,11 +251,7 @@ pub fn run_sweep(a: &SweepArgs) -> Result<()> {
             } else {
                 rig.set_override(&format!("{}={v}", a.param))?;
             }
-            let sc = match a.scenario {
-                Case::Case1 => Scenario::Case1 { needle_bar: needle, duration_s: a.duration_s },
-                Case::Case2 => Scenario::Case2 { duration_s: a.duration_s },
-                Case::Lng => Scenario::Lng { duration_s: a.duration_s },
-            };
+            let sc = a.scenario.scenario(needle, a.duration_s);
             let out = simulate(&rig, &sc, &SimOptions { output_interval_s: 10.0, control_interval_s: 0.1 })?;
             bar.inc(1);
             Ok(std::iter::once(v).chain(channels.iter().map(|c| out.last(c).unwrap_or(f64::NAN))).collect())
