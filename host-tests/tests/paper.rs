@@ -50,7 +50,7 @@ fn table5_pump_shell_and_drain_fall_with_air_speed() {
     let paper = [(0.0, 25.38, 59.67), (15.0, 24.78, 59.14), (30.0, 24.32, 58.84), (50.0, 23.82, 58.57)];
     let mut prev: Option<(f64, f64)> = None;
     for (v, shell_p, drain_p) in paper {
-        let mut rig = Rig::default();
+        let rig = Rig::default();
         let mut sc = Scenario::Case1 { needle_bar: 60.0, duration_s: 600.0 }.mission().expect("mission");
         sc.air_speed_mps = eha_sim::scenario::Schedule::constant(v);
         rig.validate().expect("rig");
