@@ -12,8 +12,9 @@ use crate::plant::SimError;
 use crate::rig::Rig;
 use crate::scenario::Scenario;
 use crate::sim::{simulate, SimOptions};
-use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
-use nalgebra::{DMatrix, DVector, Dyn, Owned};
+use crate::lsq::FdProblem;
+use levenberg_marquardt::LevenbergMarquardt;
+use nalgebra::DVector;
 
 /// The calibration targets (paper values).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -83,56 +84,6 @@ fn encode(rig: &Rig) -> DVector<f64> {
     ])
 }
 
-struct Problem {
-    base: Rig,
-    phi: DVector<f64>,
-    target: Targets,
-    evals: usize,
-}
-
-impl Problem {
-    fn res(&mut self, phi: &DVector<f64>) -> Option<DVector<f64>> {
-        self.evals += 1;
-        let rig = apply(&self.base, phi).ok()?;
-        let m = evaluate(&rig).ok()?;
-        Some(DVector::from_vec(residuals(&m, &self.target).to_vec()))
-    }
-}
-
-impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem {
-    type ResidualStorage = Owned<f64, Dyn>;
-    type JacobianStorage = Owned<f64, Dyn, Dyn>;
-    type ParameterStorage = Owned<f64, Dyn>;
-
-    fn set_params(&mut self, p: &DVector<f64>) {
-        self.phi.copy_from(p);
-    }
-
-    fn params(&self) -> DVector<f64> {
-        self.phi.clone()
-    }
-
-    fn residuals(&self) -> Option<DVector<f64>> {
-        let mut me = Problem { base: self.base.clone(), phi: self.phi.clone(), target: self.target, evals: 0 };
-        let phi = self.phi.clone();
-        me.res(&phi)
-    }
-
-    fn jacobian(&self) -> Option<DMatrix<f64>> {
-        let mut me = Problem { base: self.base.clone(), phi: self.phi.clone(), target: self.target, evals: 0 };
-        let phi = self.phi.clone();
-        let r0 = me.res(&phi)?;
-        let mut j = DMatrix::zeros(r0.len(), phi.len());
-        for k in 0..phi.len() {
-            let mut p = phi.clone();
-            p[k] += 1e-4;
-            let r = me.res(&p)?;
-            j.set_column(k, &((r - &r0) / 1e-4));
-        }
-        Some(j)
-    }
-}
-
 /// Result of a calibration.
 #[derive(Debug, Clone)]
 pub struct Calibration {
@@ -149,12 +100,16 @@ pub struct Calibration {
 /// Calibrate [`PARAMS`] of `base` to `target`.
 pub fn calibrate(base: &Rig, target: &Targets) -> Result<Calibration, SimError> {
     let before = evaluate(base)?;
-    let problem = Problem { base: base.clone(), phi: encode(base), target: *target, evals: 0 };
-    let (problem, report) = LevenbergMarquardt::new().with_patience(20).minimize(problem);
+    let res = |phi: &[f64]| {
+        let rig = apply(base, &DVector::from_column_slice(phi)).ok()?;
+        let m = evaluate(&rig).ok()?;
+        Some(DVector::from_vec(residuals(&m, target).to_vec()))
+    };
+    let (problem, report) = LevenbergMarquardt::new().with_patience(20).minimize(FdProblem::new(res, encode(base), 1e-4));
     if !report.termination.was_successful() {
         eprintln!("calibration: {:?}", report.termination);
     }
-    let rig = apply(base, &problem.phi)?;
+    let rig = apply(base, problem.x())?;
     let after = evaluate(&rig)?;
     let values = PARAMS
         .iter()

@@ -41,8 +41,9 @@ use crate::rig::Rig;
 use crate::scenario::{Circuit, Mission, PositionRef, Scenario, Schedule, ValveRule};
 use eha_guard::model::{Model, ModelInputN, HA_PER_A, HBAR_PER_BAR, HRADS_PER_RPM};
 use eha_guard::params::{ReducedParams, N_LOSSES, N_NODES, S_PER_STEP};
-use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
-use nalgebra::{DMatrix, DVector, Dyn, Owned};
+use crate::lsq::FdProblem;
+use levenberg_marquardt::LevenbergMarquardt;
+use nalgebra::DVector;
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
@@ -444,52 +445,6 @@ fn residuals(base: &ReducedParams, phi0: &[f64], z: &[f64], recs: &[Recording]) 
     v.iter().all(|x| x.is_finite()).then_some(v)
 }
 
-struct Problem<'a> {
-    base: ReducedParams,
-    phi0: Vec<f64>,
-    phi: DVector<f64>,
-    recs: &'a [Recording],
-}
-
-impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
-    type ResidualStorage = Owned<f64, Dyn>;
-    type JacobianStorage = Owned<f64, Dyn, Dyn>;
-    type ParameterStorage = Owned<f64, Dyn>;
-
-    fn set_params(&mut self, p: &DVector<f64>) {
-        self.phi.copy_from(p);
-    }
-
-    fn params(&self) -> DVector<f64> {
-        self.phi.clone()
-    }
-
-    fn residuals(&self) -> Option<DVector<f64>> {
-        residuals(&self.base, &self.phi0, self.phi.as_slice(), self.recs)
-    }
-
-    fn jacobian(&self) -> Option<DMatrix<f64>> {
-        let r0 = residuals(&self.base, &self.phi0, self.phi.as_slice(), self.recs)?;
-        if std::env::var_os("EHA_IDENTIFY_VERBOSE").is_some() {
-            eprintln!("identify: cost {:.4}", r0.norm_squared());
-        }
-        let h = 1e-5;
-        let cols: Vec<Option<DVector<f64>>> = (0..self.phi.len())
-            .into_par_iter()
-            .map(|k| {
-                let mut p = self.phi.clone();
-                p[k] += h;
-                residuals(&self.base, &self.phi0, p.as_slice(), self.recs).map(|r| (r - &r0) / h)
-            })
-            .collect();
-        let mut j = DMatrix::zeros(r0.len(), self.phi.len());
-        for (k, c) in cols.into_iter().enumerate() {
-            j.set_column(k, &c?);
-        }
-        Some(j)
-    }
-}
-
 /// Result of [`identify`].
 #[derive(Debug, Clone)]
 pub struct Identified {
@@ -534,14 +489,14 @@ pub fn identify_from(recs: &[Recording], start: &ReducedParams, max_evals: usize
     let phi0 = DVector::from_vec(encode(&start));
     let c = phi0.as_slice().to_vec();
     let cost0 = residuals(&base, &c, &c, recs).map_or(f64::NAN, |r| r.norm_squared());
-    let problem = Problem { base, phi0: c.clone(), phi: phi0, recs };
+    let problem = FdProblem::new(|z: &[f64]| residuals(&base, &c, z, recs), phi0, 1e-5);
     let lm = LevenbergMarquardt::new()
         .with_stepbound(0.5)
         .with_patience(if max_evals == 0 { 100 } else { max_evals.div_ceil(N_PHI + 1).max(1) });
     let (problem, report) = lm.minimize(problem);
-    let phi = bounded(&c, problem.phi.as_slice());
+    let phi = bounded(&c, problem.x().as_slice());
     let fitted = decode(&base, &phi);
-    let cost1 = residuals(&base, &c, problem.phi.as_slice(), recs).map_or(f64::NAN, |r| r.norm_squared());
+    let cost1 = residuals(&base, &c, problem.x().as_slice(), recs).map_or(f64::NAN, |r| r.norm_squared());
     // The firmware's f32 and fixed-point builds must accept the result too.
     let builds = Model::<f32>::new(&fitted).is_ok() && Model::<eha_guard::num::Fx>::new(&fitted).is_ok();
     if !builds || !fitted.is_plausible() || !cost1.is_finite() || cost1 > cost0 {

@@ -18,6 +18,7 @@ pub mod heat;
 pub mod hydraulics;
 pub mod identify;
 pub mod losses;
+pub mod lsq;
 pub mod measured;
 pub mod model;
 pub mod network;

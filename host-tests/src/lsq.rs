@@ -1,0 +1,66 @@
+//! A least-squares problem defined by its residual function, with a
+//! forward-difference Jacobian (columns evaluated in parallel), for the
+//! `levenberg-marquardt` crate. Shared by the paper calibration
+//! ([`crate::calibrate`]) and the firmware identification
+//! ([`crate::identify`]).
+
+use levenberg_marquardt::LeastSquaresProblem;
+use nalgebra::{DMatrix, DVector, Dyn, Owned};
+use rayon::prelude::*;
+
+/// Residual function `r(x)` (None when the model cannot be evaluated there)
+/// at parameters `x`, with the forward-difference step `step` in x's units.
+pub struct FdProblem<F> {
+    residual: F,
+    x: DVector<f64>,
+    step: f64,
+}
+
+impl<F> FdProblem<F>
+where
+    F: Fn(&[f64]) -> Option<DVector<f64>> + Sync,
+{
+    /// A problem starting at `x0`.
+    pub fn new(residual: F, x0: DVector<f64>, step: f64) -> Self {
+        Self { residual, x: x0, step }
+    }
+
+    /// The current parameters.
+    pub fn x(&self) -> &DVector<f64> {
+        &self.x
+    }
+}
+
+impl<F> LeastSquaresProblem<f64, Dyn, Dyn> for FdProblem<F>
+where
+    F: Fn(&[f64]) -> Option<DVector<f64>> + Sync,
+{
+    type ResidualStorage = Owned<f64, Dyn>;
+    type JacobianStorage = Owned<f64, Dyn, Dyn>;
+    type ParameterStorage = Owned<f64, Dyn>;
+
+    fn set_params(&mut self, x: &DVector<f64>) {
+        self.x.copy_from(x);
+    }
+
+    fn params(&self) -> DVector<f64> {
+        self.x.clone()
+    }
+
+    fn residuals(&self) -> Option<DVector<f64>> {
+        (self.residual)(self.x.as_slice())
+    }
+
+    fn jacobian(&self) -> Option<DMatrix<f64>> {
+        let r0 = (self.residual)(self.x.as_slice())?;
+        let cols: Option<Vec<DVector<f64>>> = (0..self.x.len())
+            .into_par_iter()
+            .map(|k| {
+                let mut x = self.x.clone();
+                x[k] += self.step;
+                (self.residual)(x.as_slice()).map(|r| (r - &r0) / self.step)
+            })
+            .collect();
+        Some(DMatrix::from_columns(&cols?))
+    }
+}
