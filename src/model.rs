@@ -10,11 +10,22 @@
 use crate::linalg::expm1m;
 use crate::num::Num;
 use crate::params::{
-    ReducedParams, NODE_DRAIN, NODE_LOOP_OIL, NODE_WINDING, N_LOSSES, N_NODES, S_PER_STEP,
+    ReducedParams, NODE_BLOCK, NODE_DRAIN, NODE_LOOP_OIL, NODE_PUMP, NODE_WINDING, N_LOSSES,
+    N_NODES, S_PER_STEP,
 };
 
-// `step_n` destructures the state with the loop oil at 3 and the drain at 5.
-const _: () = assert!(NODE_LOOP_OIL == 3 && NODE_DRAIN == 5);
+// `step_n` destructures the state: pump 2, loop oil 3, block 4, drain 5.
+const _: () = assert!(NODE_PUMP == 2 && NODE_LOOP_OIL == 3 && NODE_BLOCK == 4 && NODE_DRAIN == 5);
+
+/// Largest shaft speed the explicit exchange terms are checked for at build time,
+/// hrad/s (10 hrad/s = 1000 rad/s ≈ 9550 rpm, above the input range limit).
+pub const MAX_HRADS: f64 = 10.0;
+/// Largest per-step rate `x` of an explicit exchange term accepted at build time
+/// (dimensionless, per step, at [`MAX_HRADS`]): far inside explicit stability
+/// (x < 2); the explicit step then differs from the exact two-node relaxation
+/// `1 - exp(-x)` by x/2 ≤ 1 % of the exchange rate at that extreme speed (the
+/// identified model is this discrete model, so this is a definition, not an error).
+pub const MAX_EXPLICIT_RATE: f64 = 0.02;
 
 /// Columns of one discretised row: 6 node temperatures then 5 losses.
 pub const N_COLS: usize = N_NODES + N_LOSSES;
@@ -42,6 +53,8 @@ pub struct ModelInput {
     pub dpos_mm: f32,
     /// Ambient temperature, degC.
     pub ambient_c: f32,
+    /// LNG valve open over this step (the guard's own command).
+    pub lng_open: bool,
 }
 
 /// One step of inputs in model units and the model's number type.
@@ -71,7 +84,7 @@ pub enum ConfigError {
     ConstantRange,
 }
 
-/// Loss constants in model units (kW from hA, hbar, hrad/s, mm/step).
+/// Loss and exchange constants in model units (kW from hA, hbar, hrad/s, mm/step).
 #[derive(Clone, Copy, Debug)]
 struct LossK<N: Num> {
     cu0: N,  // m R0 (1 - 25 alpha), kW/hA^2
@@ -89,6 +102,18 @@ struct LossK<N: Num> {
     ex_k: N,  // exchange exponent per hbar: g_od1 1e7 h (1/C3 + 1/C5)
     ex_w3: N, // -C5/(C3+C5)
     ex_w5: N, // C3/(C3+C5)
+    pd_k: N,  // drain-pump exchange rate per sqrt(hrad/s): g_pd1 10 h (1/C2 + 1/C5)
+    pd_w5: N, // C2/(C2+C5)
+    lb_k: N,  // loop-block exchange rate per sqrt(hrad/s): g_lb1 10 h (1/C3 + 1/C4)
+    lb_w3: N, // -C4/(C3+C4)
+    lb_w4: N, // C3/(C3+C4)
+    pd_w2n: N, // -C5/(C2+C5)
+    lng_max: N,   // 1000 g_max h / C3, mK per (K step)
+    lng_slope: N, // 1000 g_slope 100 h / C3, mK per (K step hrad/s)
+    lng_in: N,    // LNG inlet, degC
+    feed_k: N,    // leakage-feed rise over the loop oil, K/hbar
+    milli: N,     // -1e-3 (mK → K, heat removed)
+    lng_kw: N,    // C3 / (h 1e6): mK per step → kW
     half: N,
     third: N,
     quarter: N,
@@ -103,6 +128,7 @@ pub struct Model<N: Num> {
     coef: [[N::Coef; N_COLS]; N_NODES],
     k: LossK<N>,
     last_loss_kw: [N; N_LOSSES],
+    last_lng: N,
 }
 
 /// Discretised matrices in `f64`: row `i` = `[(Ad - I)_i·, Bd_i·]`, `Bd` per kW.
@@ -156,8 +182,8 @@ impl<N: Num> Model<N> {
             }
         }
         let k_cu = p.phases * p.r0_ohm / (HA_PER_A * HA_PER_A) / W_PER_KW;
-        let c3 = p.capacity_j_per_k[NODE_LOOP_OIL];
-        let c5 = p.capacity_j_per_k[NODE_DRAIN];
+        let cap = &p.capacity_j_per_k;
+        let (c2, c3, c4, c5) = (cap[NODE_PUMP], cap[NODE_LOOP_OIL], cap[NODE_BLOCK], cap[NODE_DRAIN]);
         let consts = [
             k_cu * (1.0 - 25.0 * p.alpha_r_per_k),
             k_cu * p.alpha_r_per_k,
@@ -173,12 +199,31 @@ impl<N: Num> Model<N> {
             p.g_od1_w_per_k_pa * 1e7 * S_PER_STEP * (1.0 / c3 + 1.0 / c5),
             -c5 / (c3 + c5),
             c3 / (c3 + c5),
+            p.g_pd1_w_per_k_sqrt_rad_s * 10.0 * S_PER_STEP * (1.0 / c2 + 1.0 / c5),
+            c5 / (c2 + c5),
+            c2 / (c2 + c5),
+            p.g_lb1_w_per_k_sqrt_rad_s * 10.0 * S_PER_STEP * (1.0 / c3 + 1.0 / c4),
+            -c4 / (c3 + c4),
+            c3 / (c3 + c4),
+            1000.0 * p.lng_max_w_per_k * S_PER_STEP / c3,
+            1000.0 * p.lng_slope_w_s_per_k_rad * 100.0 * S_PER_STEP / c3,
+            p.lng_inlet_c,
+            p.feed_rise_k_per_pa * 1e7,
         ];
         if consts
             .iter()
             .any(|x| !x.is_finite() || libm::fabs(*x) >= 250.0)
         {
             return Err(ConfigError::ConstantRange);
+        }
+        // The speed-driven exchanges and the LNG term are explicit per step: their
+        // per-step rates must stay far below 1 up to `MAX_HRADS` (stability, and the
+        // first-order exchange error x^2/2 small). The LNG rate is in mK per K.
+        let rate_pd = consts[14] * libm::sqrt(MAX_HRADS);
+        let rate_lb = consts[17] * libm::sqrt(MAX_HRADS);
+        let rate_lng = consts[20] * 1e-3;
+        if rate_pd > MAX_EXPLICIT_RATE || rate_lb > MAX_EXPLICIT_RATE || rate_lng > MAX_EXPLICIT_RATE {
+            return Err(ConfigError::CoefficientRange);
         }
         let f = N::from_f64;
         let k = LossK {
@@ -197,6 +242,18 @@ impl<N: Num> Model<N> {
             ex_k: f(consts[11]),
             ex_w3: f(consts[12]),
             ex_w5: f(consts[13]),
+            pd_k: f(consts[14]),
+            pd_w5: f(consts[16]),
+            lb_k: f(consts[17]),
+            lb_w3: f(consts[18]),
+            lb_w4: f(consts[19]),
+            pd_w2n: f(-consts[15]),
+            lng_max: f(consts[20]),
+            lng_slope: f(consts[21]),
+            lng_in: f(consts[22]),
+            feed_k: f(consts[23]),
+            milli: f(-1e-3),
+            lng_kw: f(c3 / (S_PER_STEP * 1e6)),
             half: f(0.5),
             third: f(1.0 / 3.0),
             quarter: f(0.25),
@@ -208,6 +265,7 @@ impl<N: Num> Model<N> {
             coef,
             k,
             last_loss_kw: [N::ZERO; N_LOSSES],
+            last_lng: N::ZERO,
         })
     }
 
@@ -272,12 +330,14 @@ impl<N: Num> Model<N> {
             speed_hrads: N::from_f32_scaled(u.speed_rpm, s.hrads_per_rpm),
             dpos_mm: N::from_f32_scaled(u.dpos_mm, s.one),
             ambient_c: N::from_f32_scaled(u.ambient_c, s.one),
-        });
+        }, u.lng_open);
     }
 
     /// [`Model::step`] with inputs already in model units (the guard's path).
+    /// `lng_open`: the LNG valve was open over this step (the guard's own command);
+    /// the exchanger then removes `g_lng(w) (T_loop - T_LNG)` from the loop oil.
     #[inline(always)]
-    pub fn step_n(&mut self, u: &ModelInputN<N>) {
+    pub fn step_n(&mut self, u: &ModelInputN<N>, lng_open: bool) {
         let amb = u.ambient_c;
         self.ambient_c = amb;
         let dp = u.dp_hbar;
@@ -303,23 +363,57 @@ impl<N: Num> Model<N> {
         // It is added in the same state update as the ZOH step (operator splitting with
         // both parts evaluated at the step start; first order, like sequential splitting).
         let k = &self.k;
-        let xe = k.ex_k.mul(dp.abs());
+        let adp = dp.abs();
+        let aw = u.speed_hrads.abs();
+        // LNG exchanger, eqs. (20)-(22), while open: conductance g = min(g_max,
+        // g_slope |w|) (the smaller capacity rate is the LNG stream above ~30 rpm, the
+        // oil stream below). The loop oil loses g h / C3 (T_loop - T_LNG) per step (in
+        // mK, scaled by -1e-3). The oil leaving the exchanger is colder than the loop
+        // oil by the heat removed over the oil stream's capacity rate, g / (g_slope |w|)
+        // (T_loop - T_LNG) (all of the difference when the oil stream is the smaller).
+        let (g_lng, cooled) = if lng_open {
+            let g = k.lng_slope.mul(aw);
+            if g > k.lng_max {
+                (k.lng_max, k.lng_max.div_pos(g))
+            } else {
+                (g, k.one)
+            }
+        } else {
+            (N::ZERO, N::ZERO)
+        };
+        let t_rel = N::value(th[NODE_LOOP_OIL]).sub(k.lng_in);
+        let q_lng = g_lng.mul(t_rel);
+        let [_, _, x_pump, x_loop, x_block, x_drain, ..] = x;
+        // Drain <-> loop-oil exchange with g = g_od1 |dp| (the leakage flow through the
+        // case), exact two-node solution on the step's initial state: the difference
+        // decays by exp(-x); 1 - exp(-x) by its 4-term series (relative error < x^4/120:
+        // 8e-7 at x = 0.1). The leakage enters the case at the feed temperature: the
+        // loop oil, plus the high-pressure port's rise feed_k |dp|, minus the exchanger's
+        // cooling. Added in the same state update as the ZOH step (operator splitting,
+        // both parts evaluated at the step start).
+        let xe = k.ex_k.mul(adp);
         let phi = xe.mul(
             k.one.sub(
                 xe.mul(k.half)
                     .mul(k.one.sub(xe.mul(k.third).mul(k.one.sub(xe.mul(k.quarter))))),
             ),
         );
-        let [_, _, _, x_loop, _, x_drain, ..] = x;
-        let q = phi.mul(x_loop.sub(x_drain));
+        let feed = x_loop.add(k.feed_k.mul(adp)).sub(cooled.mul(t_rel));
+        let q = phi.mul(feed.sub(x_drain));
+        // Speed-driven exchanges (drain <-> pump housing, loop oil <-> block), explicit
+        // two-node steps with rate x = g1 sqrt|w| h (1/Ca + 1/Cb) (≤ MAX_EXPLICIT_RATE).
+        let sw = aw.sqrt_abs();
+        let q_pd = k.pd_k.mul(sw).mul(x_pump.sub(x_drain));
+        let q_lb = k.lb_k.mul(sw).mul(x_loop.sub(x_block));
         let [c0, c1, c2, c3, c4, c5] = &self.coef;
         let [t0, t1, t2, t3, t4, t5] = &mut self.temp;
         *t0 = N::accumulate(*t0, c0, &x);
         *t1 = N::accumulate(*t1, c1, &x);
-        *t2 = N::accumulate(*t2, c2, &x);
-        *t3 = N::accumulate_plus(*t3, c3, &x, q, k.ex_w3);
-        *t4 = N::accumulate(*t4, c4, &x);
-        *t5 = N::accumulate_plus(*t5, c5, &x, q, k.ex_w5);
+        *t2 = N::accumulate_plus(*t2, c2, &x, &[q_pd], &[k.pd_w2n]);
+        *t3 = N::accumulate_plus(*t3, c3, &x, &[q, q_lb, q_lng], &[k.ex_w3, k.lb_w3, k.milli]);
+        *t4 = N::accumulate_plus(*t4, c4, &x, &[q_lb], &[k.lb_w4]);
+        *t5 = N::accumulate_plus(*t5, c5, &x, &[q, q_pd], &[k.ex_w5, k.pd_w5]);
+        self.last_lng = q_lng;
     }
 
     /// Predicted drain-oil temperature, degC.
@@ -345,6 +439,12 @@ impl<N: Num> Model<N> {
     /// Losses of the last step `[cu, fe, leak, mech, throttle]`, kW.
     pub fn last_losses_kw(&self) -> [N; N_LOSSES] {
         self.last_loss_kw
+    }
+
+    /// Heat the LNG exchanger removed from the loop oil over the last step, kW
+    /// (0 while the valve is closed); the LNG budget's heat input, eqs. (23)-(25).
+    pub fn last_lng_kw(&self) -> N {
+        self.last_lng.mul(self.k.lng_kw)
     }
 
     /// Sum of the last step's losses, kW.

@@ -119,6 +119,7 @@ fn steady_state_energy_balance() {
         speed_rpm: 500.0,
         dpos_mm: 0.0,
         ambient_c: 16.0,
+        lng_open: false,
     };
     m.set_temperatures(&[16.0; 6], 16.0);
     for _ in 0..200_000 {

@@ -3,15 +3,19 @@
 //! and five random missions whose seeds (`identify::TEST_SEEDS`) were not used to
 //! identify the parameters (`identify::TRAIN_SEEDS`).
 //!
-//! The firmware side is the guard itself (`GuardOf<f64>`, validation included)
-//! fed the reference's sensor signals as f32 wire samples every 10 ms, with the
-//! identified `eha_guard::params::DEFAULT`. Every reference run is recorded once
-//! (in parallel) and shared by the tests of this file.
+//! Every run is **closed loop**, as on the actuator: the guard (`GuardOf<f64>`,
+//! validation included, identified `eha_guard::params::DEFAULT`) is fed the
+//! reference's sensor signals as f32 wire samples every 10 ms and its valve
+//! command drives the reference's LNG exchanger. The guard's model credits the
+//! exchanger's cooling while its own valve is open, so an open-loop comparison
+//! against a plant whose exchanger does not follow the guard would be meaningless.
+//! Every run is made once (in parallel) and shared by the tests of this file.
 
+use eha_guard::model::{InputScales, Model, ModelInput};
 use eha_guard::num::{Fx, Num};
 use eha_guard::protection::Valve;
 use eha_guard::{GuardConfig, GuardOf, Restore, Sample};
-use eha_sim::identify::{random_mission, record, stats, ErrorStats, Recording, TEST_SEEDS};
+use eha_sim::identify::{random_mission, stats, ErrorStats, TEST_SEEDS};
 use eha_sim::plant::{Control, Plant, Sensors};
 use eha_sim::rig::Rig;
 use eha_sim::scenario::{Mission, Scenario, Schedule};
@@ -26,6 +30,8 @@ const MAX_ABS_K: f64 = 1.0;
 const GOAL_K: f64 = 0.5;
 /// Issue bound on drain under-prediction, K.
 const MAX_UNDER_K: f64 = 0.5;
+/// Issue bound on a valve switching time against switching on the true drain, s.
+const MAX_SWITCH_S: f64 = 2.0;
 
 fn scenarios() -> Vec<(String, Scenario)> {
     let mut v: Vec<(String, Scenario)> = [0.0, 20.0, 40.0, 60.0]
@@ -40,12 +46,52 @@ fn scenarios() -> Vec<(String, Scenario)> {
     v
 }
 
-fn recordings() -> &'static [Recording] {
-    static R: OnceLock<Vec<Recording>> = OnceLock::new();
-    R.get_or_init(|| {
-        let rig = Rig::default();
-        scenarios().par_iter().map(|(n, s)| record(&rig, n, s).expect("reference run")).collect()
-    })
+/// One closed-loop run: the reference plant with its exchanger commanded by the
+/// guard (or, for the comparison runs, by a thermostat on the true drain).
+struct Run {
+    name: String,
+    /// Sensor snapshots at `t = k·10 ms`, `k = 0..=n` (valve state included).
+    sensors: Vec<Sensors>,
+    /// Guard drain prediction after sample `k` (compared with the truth at `k+1`), °C.
+    pred: Vec<f64>,
+    /// OR of the guard's fault words over the run.
+    faults: u16,
+    /// Valve events (time s, open) of the commanding side.
+    events: Vec<(f64, bool)>,
+}
+
+/// Runs `scenario` in closed loop; the valve follows the guard (`by_guard`) or the
+/// guard's own hysteresis and dwell applied to the true drain temperature.
+fn closed_loop(name: &str, scenario: &Scenario, by_guard: bool) -> Run {
+    let rig = Rig::default();
+    let mut plant = Plant::new(&rig, scenario).expect("plant");
+    let cfg = GuardConfig::DEFAULT;
+    let mut guard = GuardOf::<f64>::new(&cfg, Restore::Cold);
+    let mut valve = Valve::new();
+    let mut run = Run { name: name.into(), sensors: vec![], pred: vec![], faults: 0, events: vec![] };
+    let mut open = false;
+    plant
+        .run(0.01, scenario.duration_s(), |snap| {
+            let s = Sensors::from(snap);
+            let o = guard.step(&sample(&s));
+            run.faults |= o.faults;
+            run.pred.push(o.drain_c as f64);
+            valve.update(s.t_drain_c as f32, false, &cfg.valve);
+            let want = if by_guard { o.valve_open } else { valve.is_open() };
+            if want != open {
+                run.events.push((s.t, want));
+                open = want;
+            }
+            run.sensors.push(s);
+            Ok(Control { lng_valve: Some(want), stop: false })
+        })
+        .expect("run");
+    run
+}
+
+fn runs() -> &'static [Run] {
+    static R: OnceLock<Vec<Run>> = OnceLock::new();
+    R.get_or_init(|| scenarios().par_iter().map(|(n, s)| closed_loop(n, s, true)).collect())
 }
 
 fn sample(s: &Sensors) -> Sample {
@@ -59,14 +105,16 @@ fn sample(s: &Sensors) -> Sample {
     }
 }
 
-/// Drain predictions of the guard in number type `N` (element k: after sample k),
-/// and the fault word at the end.
-fn guard_drain<N: Num>(rec: &Recording) -> (Vec<f64>, u16) {
+/// Drain predictions of a guard in number type `N` replaying the sensor stream of
+/// a run (element k: after sample k), and the fault word at the end. The guard
+/// credits cooling by its own valve; on the f64 guard's run that is the valve
+/// the plant had (up to the f64 guard's own switching steps).
+fn guard_drain<N: Num>(run: &Run) -> (Vec<f64>, u16) {
     let mut g = GuardOf::<N>::new(&GuardConfig::DEFAULT, Restore::Cold);
-    let n = rec.sensors.len() - 1;
+    let n = run.sensors.len() - 1;
     let mut out = Vec::with_capacity(n);
     let mut faults = 0;
-    for s in &rec.sensors[..n] {
+    for s in &run.sensors[..n] {
         let o = g.step(&sample(s));
         faults |= o.faults;
         out.push(o.drain_c as f64);
@@ -74,19 +122,15 @@ fn guard_drain<N: Num>(rec: &Recording) -> (Vec<f64>, u16) {
     (out, faults)
 }
 
-fn drain_stats(rec: &Recording) -> (ErrorStats, u16) {
-    let (pred, faults) = guard_drain::<f64>(rec);
-    (stats(pred.iter().zip(rec.sensors.iter().skip(1)).map(|(p, s)| p - s.t_drain_c)), faults)
+fn drain_stats(run: &Run) -> ErrorStats {
+    stats(run.pred.iter().zip(run.sensors.iter().skip(1)).map(|(p, s)| p - s.t_drain_c))
 }
 
 fn report(names: &[&str]) -> Vec<(String, ErrorStats, u16)> {
-    let rows: Vec<_> = recordings()
-        .par_iter()
+    let rows: Vec<_> = runs()
+        .iter()
         .filter(|r| names.iter().any(|n| r.name.starts_with(n)))
-        .map(|r| {
-            let (e, f) = drain_stats(r);
-            (r.name.clone(), e, f)
-        })
+        .map(|r| (r.name.clone(), drain_stats(r), r.faults))
         .collect();
     for (n, e, f) in &rows {
         println!(
@@ -127,70 +171,41 @@ fn case2_drain_within_bounds() {
 
 /// Five random missions never used for identification.
 #[test]
-#[ignore = "fails: measured max |e| 2.36/7.13/0.31/0.50/0.66 K, under-prediction up to 7.1 K (random-2, pump stopped 120 s): the 6-node structure has no speed-dependent drain-pump exchange (see docs/identification.md)"]
 fn random_missions_drain_within_bounds() {
     let rows = report(&["random-"]);
     assert_eq!(rows.len(), TEST_SEEDS.len());
     assert_bounds(&rows);
 }
 
-/// The LNG case (Fig. 15, valve on the loop-oil thermostat). The reduced model has
-/// no LNG input: the exchanger's heat removal is invisible to it, so once the valve
-/// opens it over-predicts the drain (conservative, but outside the 1 K bound).
+/// The LNG case (Fig. 15: 60 bar, 600 s), the exchanger commanded by the guard.
 #[test]
-#[ignore = "reduced model has no LNG-cooling input: over-predicts by several K once the exchanger runs (see docs/identification.md)"]
 fn lng_case_drain_within_bounds() {
-    assert_bounds(&report(&["lng"]));
+    let rows = report(&["lng"]);
+    assert_eq!(rows.len(), 1);
+    assert_bounds(&rows);
 }
 
-/// f32 within 0.01 K and fixed point within 0.1 K of f64, on a reference run (Case 1, 60 bar).
+/// f32 within 0.01 K and fixed point within 0.1 K of f64, on two runs: Case 1 at
+/// 60 bar (largest losses) and the LNG case (exchanger credit switching).
 #[test]
 fn number_types_agree_on_a_reference_run() {
-    let rec = recordings().iter().find(|r| r.name == "case1-60bar").expect("run");
-    let (d64, _) = guard_drain::<f64>(rec);
-    let (d32, _) = guard_drain::<f32>(rec);
-    let (dfx, _) = guard_drain::<Fx>(rec);
-    let e32 = d64.iter().zip(&d32).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
-    let efx = d64.iter().zip(&dfx).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
-    println!("case1-60bar: |f32 - f64| max {e32:.2e} K, |fixed - f64| max {efx:.2e} K");
-    // Issue: f32 within 0.01 K of f64.
-    assert!(e32 <= 0.01, "f32 {e32} K");
-    // Issue: fixed point within 0.1 K of f64.
-    assert!(efx <= 0.1, "fixed {efx} K");
+    for name in ["case1-60bar", "lng"] {
+        let run = runs().iter().find(|r| r.name == name).expect("run");
+        let (d64, _) = guard_drain::<f64>(run);
+        let (d32, _) = guard_drain::<f32>(run);
+        let (dfx, _) = guard_drain::<Fx>(run);
+        let e32 = d64.iter().zip(&d32).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+        let efx = d64.iter().zip(&dfx).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+        println!("{name}: |f32 - f64| max {e32:.2e} K, |fixed - f64| max {efx:.2e} K");
+        // Issue: f32 within 0.01 K of f64.
+        assert!(e32 <= 0.01, "{name}: f32 {e32} K");
+        // Issue: fixed point within 0.1 K of f64.
+        assert!(efx <= 0.1, "{name}: fixed {efx} K");
+    }
 }
 
-/// Valve switching: the reference with its LNG exchanger commanded (a) by the
-/// guard's predicted drain and (b) by the same hysteresis/dwell
-/// (`GuardConfig::DEFAULT.valve`) on the reference's true drain. Switching times
-/// must agree within 2 s (issue). Two missions: the LNG case (60 bar, 600 s) and a
-/// 60 bar load followed by idle, so that both an opening and a closing occur.
-fn valve_events(scenario: &Scenario, by_guard: bool) -> Vec<(f64, bool)> {
-    let rig = Rig::default();
-    let mut plant = Plant::new(&rig, scenario).expect("plant");
-    let cfg = GuardConfig::DEFAULT;
-    let mut guard = GuardOf::<f64>::new(&cfg, Restore::Cold);
-    let mut valve = Valve::new();
-    let mut events = vec![];
-    let mut open = false;
-    plant
-        .run(0.01, scenario.duration_s(), |snap| {
-            let s = Sensors::from(snap);
-            let want = if by_guard {
-                guard.step(&sample(&s)).valve_open
-            } else {
-                valve.update(s.t_drain_c as f32, false, &cfg.valve);
-                valve.is_open()
-            };
-            if want != open {
-                events.push((s.t, want));
-                open = want;
-            }
-            Ok(Control { lng_valve: Some(want), stop: false })
-        })
-        .expect("run");
-    events
-}
-
+/// A 60 bar load with the exchanger available, then idle at 0 rpm: both an
+/// opening and a closing with the pump stopped.
 fn load_then_idle() -> Scenario {
     let mut m: Mission = Scenario::Lng { duration_s: 900.0 }.mission().expect("mission");
     m.name = "lng-load-then-idle".into();
@@ -198,101 +213,126 @@ fn load_then_idle() -> Scenario {
     Scenario::Mission(m)
 }
 
-fn compare_events(name: &str, fw: &[(f64, bool)], truth: &[(f64, bool)]) -> (bool, f64) {
-    println!("{name}: firmware events   {:?}", fw.iter().map(|(t, o)| format!("{t:.2}{}", if *o { "+" } else { "-" })).collect::<Vec<_>>());
-    println!("{name}: true-drain events {:?}", truth.iter().map(|(t, o)| format!("{t:.2}{}", if *o { "+" } else { "-" })).collect::<Vec<_>>());
-    let same = fw.len() == truth.len() && fw.iter().zip(truth).all(|(a, b)| a.1 == b.1);
-    let worst = fw.iter().zip(truth).map(|(a, b)| (a.0 - b.0).abs()).fold(0.0, f64::max);
-    (same, worst)
+fn fmt_events(e: &[(f64, bool)]) -> String {
+    e.iter().map(|(t, o)| format!("{t:.2}{}", if *o { "+" } else { "-" })).collect::<Vec<_>>().join(" ")
 }
 
-/// Closed loop, first opening: the LNG case and the load-then-idle mission with the
-/// exchanger commanded by the guard vs by the thermostat on the true drain. Before
-/// the first opening the two plants are identical, so this isolates the estimate.
+/// Closed loop, first opening, on every acceptance run plus load-then-idle: the
+/// plant's exchanger commanded by the guard vs by the same hysteresis and dwell on
+/// the true drain. Before the first opening the two plants are identical, so this
+/// isolates the estimate. A run in which neither opens passes; one that opens
+/// while the other does not fails.
 #[test]
 fn valve_first_opening_within_2s() {
-    let cases = [("lng", Scenario::Lng { duration_s: DURATION_S }), ("load-then-idle", load_then_idle())];
-    let results: Vec<_> = cases
+    let mut cases = scenarios();
+    cases.push(("load-then-idle".into(), load_then_idle()));
+    let rows: Vec<_> = cases
         .par_iter()
         .map(|(n, sc)| {
-            let (a, b) = rayon::join(|| valve_events(sc, true), || valve_events(sc, false));
-            (n, a, b)
+            let (a, b) = rayon::join(|| closed_loop(n, sc, true), || closed_loop(n, sc, false));
+            (n.clone(), a.events, b.events)
         })
         .collect();
-    for (n, fw, truth) in &results {
-        compare_events(n, fw, truth);
-        let (f, t) = (fw.first().expect("firmware opens"), truth.first().expect("thermostat opens"));
-        let d = (f.0 - t.0).abs();
-        println!("{n}: first opening firmware {:.2} s, true drain {:.2} s, difference {d:.2} s", f.0, t.0);
-        // Issue: switching within 2 s of switching on the true drain temperature.
-        assert!(f.1 && t.1 && d <= 2.0, "{n}: first opening differs by {d:.2} s");
-    }
-}
-
-/// Closed loop, every switching event. The reduced model has no LNG-cooling input,
-/// so after the first opening its drain keeps rising while the cooled reference
-/// drain falls: the closings cannot match.
-#[test]
-#[ignore = "reduced model has no LNG-cooling input: after the first opening the guard's estimate ignores the exchanger and the valve never closes on time (see docs/identification.md)"]
-fn valve_switching_times_match_true_drain() {
-    let cases = [("lng", Scenario::Lng { duration_s: DURATION_S }), ("load-then-idle", load_then_idle())];
-    let results: Vec<_> = cases
-        .par_iter()
-        .map(|(n, sc)| {
-            let (a, b) = rayon::join(|| valve_events(sc, true), || valve_events(sc, false));
-            (n, a, b)
-        })
-        .collect();
-    let mut ok = true;
-    let mut worst = 0.0f64;
-    for (n, fw, truth) in &results {
-        let (same, w) = compare_events(n, fw, truth);
-        ok &= same;
-        worst = worst.max(w);
-    }
-    println!("worst switching-time difference {worst:.2} s");
-    assert!(ok, "event sequences differ");
-    // Issue: switching times within 2 s of switching on the true drain temperature.
-    assert!(worst <= 2.0, "switching time difference {worst:.2} s > 2 s");
-}
-
-/// Open loop (no exchanger effect): the guard's valve command vs the same
-/// thermostat on the true drain, on every non-LNG acceptance run. Opening and
-/// closing both occur in the missions that cross 40 °C and fall below 38 °C.
-#[test]
-#[ignore = "fails: random-2 closes early at 299 s while the true drain stays above 38 C (under-prediction at standstill); worst timing difference 5.11 s (random-4) (see docs/identification.md)"]
-fn valve_switching_open_loop_within_2s() {
-    let cfg = GuardConfig::DEFAULT;
-    let mut worst = 0.0f64;
-    let mut ok = true;
-    let mut n_events = 0;
-    for rec in recordings().iter().filter(|r| r.name != "lng") {
-        let mut g = GuardOf::<f64>::new(&cfg, Restore::Cold);
-        let mut v = Valve::new();
-        let (mut fw, mut truth) = (vec![], vec![]);
-        let (mut of, mut ot) = (false, false);
-        for s in &rec.sensors {
-            let o = g.step(&sample(s)).valve_open;
-            v.update(s.t_drain_c as f32, false, &cfg.valve);
-            if o != of {
-                fw.push((s.t, o));
-                of = o;
+    let mut failures = vec![];
+    for (n, fw, truth) in &rows {
+        match (fw.first(), truth.first()) {
+            (None, None) => println!("{n}: no opening on either side"),
+            (Some(f), Some(t)) => {
+                let d = (f.0 - t.0).abs();
+                println!("{n}: first opening firmware {:.2} s, true drain {:.2} s, difference {d:.2} s", f.0, t.0);
+                // Issue: switching within 2 s of switching on the true drain temperature.
+                if !(f.1 && t.1 && d <= MAX_SWITCH_S) {
+                    failures.push(format!("{n}: {d:.2} s"));
+                }
             }
-            if v.is_open() != ot {
-                truth.push((s.t, v.is_open()));
-                ot = v.is_open();
-            }
+            (f, t) => failures.push(format!("{n}: firmware {f:?}, true drain {t:?}")),
         }
+    }
+    assert!(failures.is_empty(), "first openings: {}", failures.join(", "));
+}
+
+/// Largest time between each event of `a` and the nearest event of `b` in the same
+/// direction (infinite when `b` has none in that direction).
+fn worst_match(a: &[(f64, bool)], b: &[(f64, bool)]) -> f64 {
+    a.iter()
+        .map(|(t, o)| b.iter().filter(|(_, p)| p == o).map(|(u, _)| (t - u).abs()).fold(f64::INFINITY, f64::min))
+        .fold(0.0, f64::max)
+}
+
+/// The guard's estimator and valve logic riding along on a thermostat-driven run:
+/// the f64 model (identified `DEFAULT`, the guard's unit conversions) is stepped on
+/// the run's sensor stream and credited with the exchanger exactly when the plant's
+/// valve was open; the guard's hysteresis and dwell act on its estimate. Returns
+/// the events (time s, open) that the guard would have commanded.
+fn estimator_events(run: &Run) -> Vec<(f64, bool)> {
+    let cfg = GuardConfig::DEFAULT;
+    let mut m = Model::<f64>::new(&cfg.params).expect("model");
+    let sc = InputScales::<f64>::new().expect("scales");
+    let mut v = Valve::new();
+    let mut events = vec![];
+    let mut open = false;
+    let n = run.sensors.len() - 1;
+    for k in 0..n {
+        let (s, next) = (&run.sensors[k], &run.sensors[k + 1]);
+        if k == 0 {
+            m.set_uniform(s.ambient_c);
+        }
+        let w = sample(s);
+        let dpos = if k == 0 { 0.0 } else { w.position_mm - sample(&run.sensors[k - 1]).position_mm };
+        let u = ModelInput {
+            current_a: w.current_a,
+            dp_bar: w.p_a_bar - w.p_b_bar,
+            speed_rpm: w.speed_rpm,
+            dpos_mm: dpos,
+            ambient_c: w.ambient_c,
+            lng_open: next.lng_open,
+        };
+        m.step(&u, &sc);
+        v.update(m.drain_c() as f32, false, &cfg.valve);
+        if v.is_open() != open {
+            open = v.is_open();
+            events.push((s.t, open));
+        }
+    }
+    events
+}
+
+/// Every switching event, on every acceptance run plus load-then-idle: the plant's
+/// exchanger follows the guard's hysteresis and dwell (`GuardConfig::DEFAULT.valve`)
+/// applied to the **true** drain, and the guard's estimator rides along on the same
+/// run ([`estimator_events`]). Each event must have a partner in the same direction
+/// within 2 s, both ways (a missing or extra event fails). Sharing one plant
+/// trajectory isolates the estimate: two separately closed loops drift apart after
+/// the first event, and a loop closed by the guard need not carry the true drain
+/// across the lower threshold at all.
+#[test]
+#[ignore = "fails: events where the true drain grazes a threshold (peaks < 0.1 K above 40 C before the thermostat's exchanger turns it) have no partner, because the estimate is 0.1-0.3 K under there (Case 1 40/60 bar, LNG, random-1/2/3, load-then-idle); where both sides switch, the times differ by 0.05-4.6 s (random-4 worst). First openings are within 2 s (valve_first_opening_within_2s)."]
+fn valve_switching_times_match_true_drain() {
+    let mut cases = scenarios();
+    cases.push(("load-then-idle".into(), load_then_idle()));
+    let rows: Vec<_> = cases
+        .par_iter()
+        .map(|(n, sc)| {
+            let truth = closed_loop(n, sc, false);
+            (n.clone(), estimator_events(&truth), truth.events)
+        })
+        .collect();
+    let mut worst = 0.0f64;
+    let mut n_events = 0;
+    let mut failures = vec![];
+    for (n, fw, truth) in &rows {
         if fw.is_empty() && truth.is_empty() {
             continue;
         }
         n_events += truth.len();
-        let (same, w) = compare_events(&rec.name, &fw, &truth);
-        ok &= same;
+        let w = worst_match(fw, truth).max(worst_match(truth, fw));
+        println!("{n}: estimator {} | true drain {} | worst {w:.2} s", fmt_events(fw), fmt_events(truth));
         worst = worst.max(w);
+        // Issue: switching times within 2 s of switching on the true drain temperature.
+        if w > MAX_SWITCH_S {
+            failures.push(format!("{n}: {w:.2} s"));
+        }
     }
-    println!("open loop: {n_events} true-drain events, worst difference {worst:.2} s");
-    assert!(ok, "event sequences differ");
-    // Issue: switching times within 2 s of switching on the true drain temperature.
-    assert!(worst <= 2.0, "switching time difference {worst:.2} s > 2 s");
+    println!("{n_events} true-drain events, worst difference {worst:.2} s");
+    assert!(failures.is_empty(), "switching time differences > {MAX_SWITCH_S} s: {}", failures.join(", "));
 }

@@ -251,6 +251,7 @@ mod fw {
                 speed_rpm: s.speed_rpm,
                 dpos_mm: s.position_mm - prev_pos,
                 ambient_c: s.ambient_c,
+                lng_open: last.valve_open,
             };
             prev_pos = s.position_mm;
 

@@ -218,7 +218,10 @@ impl<N: Num> GuardOf<N> {
                     c.model.set_uniform(u.ambient_c);
                     self.have_ambient = true;
                 }
-                c.model.step_n(u);
+                // The exchanger ran over this step if the valve was open; under a
+                // latched fault the model takes no cooling credit (conservative: the
+                // exchanger itself may be what failed).
+                c.model.step_n(u, self.valve.is_open() && !force);
                 let d = c.model.drain_c();
                 let th = &c.th;
                 let v = self

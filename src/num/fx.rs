@@ -165,6 +165,13 @@ impl Num for Fx {
         let out = if e >= 0 { r << e } else { r >> -e };
         Fx::from_bits(out as i32)
     }
+    fn div_pos(self, d: Self) -> Self {
+        if d > Fx::ZERO {
+            self.checked_div(d).unwrap_or(Fx::MAX)
+        } else {
+            Fx::ZERO
+        }
+    }
     fn exp(self) -> Self {
         Fx::from_bits(f32_times_q30_to_q23(
             libm::expf(self.to_num::<f32>()),
@@ -189,14 +196,16 @@ impl Num for Fx {
         FxState::from_bits(s.to_bits().saturating_add(d))
     }
     #[inline(always)]
-    fn accumulate_plus<const K: usize>(
+    fn accumulate_plus<const K: usize, const M: usize>(
         s: FxState,
         c: &[FxCoef; K],
         v: &[Self; K],
-        a: Self,
-        b: Self,
+        a: &[Self; M],
+        b: &[Self; M],
     ) -> FxState {
-        Self::add_product(Self::accumulate(s, c, v), a, b)
+        a.iter()
+            .zip(b.iter())
+            .fold(Self::accumulate(s, c, v), |s, (a, b)| Self::add_product(s, *a, *b))
     }
     #[inline(always)]
     fn add_product(s: FxState, a: Self, b: Self) -> FxState {

@@ -54,6 +54,9 @@ pub trait Num: Copy + PartialOrd + core::fmt::Debug {
     fn sqrt_abs(self) -> Self;
     /// `exp(self)` (only used when the viscosity exponent is non-zero).
     fn exp(self) -> Self;
+    /// `self / d` for `d > 0` (callers guarantee it); zero when `d` is zero or the
+    /// quotient does not exist, saturating for fixed point. Never panics.
+    fn div_pos(self, d: Self) -> Self;
     /// State accumulator holding `x`.
     fn state(x: Self) -> Self::State;
     /// Present value of a state accumulator.
@@ -66,13 +69,13 @@ pub trait Num: Copy + PartialOrd + core::fmt::Debug {
     ) -> Self::State;
     /// `s + a b` at full accumulator precision.
     fn add_product(s: Self::State, a: Self, b: Self) -> Self::State;
-    /// `s + Σ c_k v_k + a b` with one rounding step into the state.
-    fn accumulate_plus<const K: usize>(
+    /// `s + Σ c_k v_k + Σ a_m b_m` with one rounding step into the state.
+    fn accumulate_plus<const K: usize, const M: usize>(
         s: Self::State,
         c: &[Self::Coef; K],
         v: &[Self; K],
-        a: Self,
-        b: Self,
+        a: &[Self; M],
+        b: &[Self; M],
     ) -> Self::State;
     /// `round(self · k)` as an integer (saturating; NaN → 0).
     fn round_times(self, k: i32) -> i32;
@@ -127,6 +130,13 @@ impl Num for f64 {
     fn exp(self) -> Self {
         libm::exp(self)
     }
+    fn div_pos(self, d: Self) -> Self {
+        if d > 0.0 {
+            self / d
+        } else {
+            0.0
+        }
+    }
     fn state(x: Self) -> f64 {
         x
     }
@@ -136,8 +146,14 @@ impl Num for f64 {
     fn accumulate<const K: usize>(s: f64, c: &[f64; K], v: &[f64; K]) -> f64 {
         s + c.iter().zip(v.iter()).fold(0.0, |a, (c, v)| a + c * v)
     }
-    fn accumulate_plus<const K: usize>(s: f64, c: &[f64; K], v: &[f64; K], a: f64, b: f64) -> f64 {
-        Self::accumulate(s, c, v) + a * b
+    fn accumulate_plus<const K: usize, const M: usize>(
+        s: f64,
+        c: &[f64; K],
+        v: &[f64; K],
+        a: &[f64; M],
+        b: &[f64; M],
+    ) -> f64 {
+        Self::accumulate(s, c, v) + a.iter().zip(b.iter()).fold(0.0, |acc, (a, b)| acc + a * b)
     }
     fn add_product(s: f64, a: f64, b: f64) -> f64 {
         s + a * b
@@ -235,6 +251,14 @@ impl Num for f32 {
     fn exp(self) -> Self {
         libm::expf(self)
     }
+    #[inline(always)]
+    fn div_pos(self, d: Self) -> Self {
+        if d > 0.0 {
+            self / d
+        } else {
+            0.0
+        }
+    }
     fn state(x: Self) -> F32State {
         F32State { hi: x, lo: 0.0 }
     }
@@ -248,17 +272,15 @@ impl Num for f32 {
         two_sum(s, d)
     }
     #[inline(always)]
-    fn accumulate_plus<const K: usize>(
+    fn accumulate_plus<const K: usize, const M: usize>(
         s: F32State,
         c: &[f32; K],
         v: &[f32; K],
-        a: f32,
-        b: f32,
+        a: &[f32; M],
+        b: &[f32; M],
     ) -> F32State {
-        let d = c
-            .iter()
-            .zip(v.iter())
-            .fold(a * b, |acc, (c, v)| acc + c * v);
+        let e = a.iter().zip(b.iter()).fold(0.0f32, |acc, (a, b)| acc + a * b);
+        let d = c.iter().zip(v.iter()).fold(e, |acc, (c, v)| acc + c * v);
         two_sum(s, d)
     }
     #[inline(always)]

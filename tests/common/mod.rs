@@ -52,5 +52,6 @@ pub fn to_input(s: &Sample, prev: Option<&Sample>) -> ModelInput {
         speed_rpm: s.speed_rpm,
         dpos_mm: prev.map(|p| s.position_mm - p.position_mm).unwrap_or(0.0),
         ambient_c: s.ambient_c,
+        lng_open: false,
     }
 }
