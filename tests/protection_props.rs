@@ -243,17 +243,17 @@ fn boot_rules_cold_warm_corrupt() {
         (o.drain_c - 45.0).abs() < 0.05 && o.valve_open && o.faults == 0,
         "warm: {o:?}"
     );
-    // Snapshot → record → restore round trip keeps the drain within 1e-4 K.
+    // Snapshot → record → restore round trip keeps every node within 1e-4 K. (The
+    // valve state is not in the record: after a reset the valve output restarts
+    // closed, so the restored guard's first step takes no exchanger credit, while
+    // `g` keeps its open valve; comparing their next outputs would compare that.)
     let snap = g.snapshot();
     assert_eq!(snap.classify(), RecordStatus::Valid);
-    let mut g2 = GuardOf::<f32>::new(&cfg, Restore::from_record(&snap));
-    let (a, b) = (g.step(&nominal()), g2.step(&nominal()));
-    assert!(
-        (a.drain_c - b.drain_c).abs() < 1e-4,
-        "{} vs {}",
-        a.drain_c,
-        b.drain_c
-    );
+    let g2 = GuardOf::<f32>::new(&cfg, Restore::from_record(&snap));
+    let snap2 = g2.snapshot();
+    for (a, b) in snap.temps_c.iter().zip(snap2.temps_c.iter()) {
+        assert!((a - b).abs() < 1e-4, "{a} vs {b}");
+    }
     // Corrupt: conservative 60 degC start, valve open, MEMORY_CORRUPT latched, LNG empty.
     let mut bad = rec;
     bad.temps_c[5] = 20.0;
