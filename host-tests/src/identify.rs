@@ -642,10 +642,11 @@ pub fn render_params_rs(id: &Identified) -> String {
     s.push_str("/// Default parameters, identified from the reference simulation (`eha_sim::identify`,\n");
     s.push_str("/// docs/identification.md): loss coefficients reduced from `Rig::default()`\n");
     s.push_str("/// (R constant, iron eq. 2 with f = p w / 2 pi, K_leak = gap conductance at 40 degC,\n");
-    s.push_str("/// eta_m, D, A); capacities, conductances, ambient conductances, the mechanical and\n");
-    s.push_str("/// throttling splits and g_od1 fitted by Levenberg-Marquardt on log-parameters to the\n");
-    s.push_str("/// drain temperature of the training runs (Case 1 at 10/30/50 bar, Case 2, random\n");
-    s.push_str(&format!("/// missions {:?}).\n", TRAIN_SEEDS));
+    s.push_str("/// eta_m, D, A; LNG exchanger eqs. 20-22 at 300 rpm); capacities, conductances, ambient\n");
+    s.push_str("/// conductances, the mechanical and throttling splits, g_od1, g_pd1, g_lb1 and the feed\n");
+    s.push_str("/// rise fitted by Levenberg-Marquardt on log-parameters to the drain temperature of the\n");
+    s.push_str(&format!("/// training runs (Case 1 at 10/30/50 bar, Case 2, random missions {:?}, and the\n", TRAIN_SEEDS));
+    s.push_str("/// drain-thermostat LNG runs of `LNG_TRAINING`).\n");
     if id.ambient_scale < 1.0 {
         s.push_str(&format!(
             "/// Conservative bias: ambient conductances scaled by {:.4} (fit x {:.4}) so that the\n/// training under-prediction stays within {UNDER_BUDGET_K} K.\n",
