@@ -11,7 +11,6 @@
 //! against a plant whose exchanger does not follow the guard would be meaningless.
 //! Every run is made once (in parallel) and shared by the tests of this file.
 
-use eha_guard::model::{InputScales, Model, ModelInput};
 use eha_guard::num::{Fx, Num};
 use eha_guard::protection::Valve;
 use eha_guard::{GuardConfig, GuardOf, Restore, Sample};
@@ -217,7 +216,9 @@ fn fmt_events(e: &[(f64, bool)]) -> String {
     e.iter().map(|(t, o)| format!("{t:.2}{}", if *o { "+" } else { "-" })).collect::<Vec<_>>().join(" ")
 }
 
-/// Closed loop, first opening, on every acceptance run plus load-then-idle: the
+/// Closed loop, first opening (event 0 of [`valve_switching_times_match_true_drain`],
+/// the one every run shares with an uncontrolled plant), on every acceptance run
+/// plus load-then-idle: the
 /// plant's exchanger commanded by the guard vs by the same hysteresis and dwell on
 /// the true drain. Before the first opening the two plants are identical, so this
 /// isolates the estimate. A run in which neither opens passes; one that opens
@@ -259,82 +260,97 @@ fn worst_match(a: &[(f64, bool)], b: &[(f64, bool)]) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// The guard's estimator and valve logic riding along on a thermostat-driven run:
-/// the f64 model (identified `DEFAULT`, the guard's unit conversions) is stepped on
-/// the run's sensor stream and credited with the exchanger exactly when the plant's
-/// valve was open; the guard's hysteresis and dwell act on its estimate. Returns
-/// the events (time s, open) that the guard would have commanded.
-fn estimator_events(run: &Run) -> Vec<(f64, bool)> {
+/// Counterfactual switching time of guard event `i` of a guard-driven run: the plant
+/// is driven by the guard's own commands up to its previous event (or t = 0), from
+/// where a thermostat with the guard's hysteresis and dwell on the **true** drain
+/// takes over in the same valve state; returns when that thermostat first switches
+/// (None: not before the end of the run). Same plant, same state, same valve
+/// history up to the branch point: the difference to the guard's event is the
+/// switching delay due to the estimate alone.
+fn thermostat_from_branch(scenario: &Scenario, events: &[(f64, bool)], i: usize) -> Option<f64> {
+    let (branch_t, open_at_branch) = if i == 0 { (f64::NEG_INFINITY, false) } else { events[i - 1] };
+    let rig = Rig::default();
+    let mut plant = Plant::new(&rig, scenario).expect("plant");
     let cfg = GuardConfig::DEFAULT;
-    let mut m = Model::<f64>::new(&cfg.params).expect("model");
-    let sc = InputScales::<f64>::new().expect("scales");
-    let mut v = Valve::new();
-    let mut events = vec![];
-    let mut open = false;
-    let n = run.sensors.len() - 1;
-    for k in 0..n {
-        let (s, next) = (&run.sensors[k], &run.sensors[k + 1]);
-        if k == 0 {
-            m.set_uniform(s.ambient_c);
-        }
-        let w = sample(s);
-        let dpos = if k == 0 { 0.0 } else { w.position_mm - sample(&run.sensors[k - 1]).position_mm };
-        let u = ModelInput {
-            current_a: w.current_a,
-            dp_bar: w.p_a_bar - w.p_b_bar,
-            speed_rpm: w.speed_rpm,
-            dpos_mm: dpos,
-            ambient_c: w.ambient_c,
-            lng_open: next.lng_open,
-        };
-        m.step(&u, &sc);
-        v.update(m.drain_c() as f32, false, &cfg.valve);
-        if v.is_open() != open {
-            open = v.is_open();
-            events.push((s.t, open));
-        }
-    }
-    events
+    let mut valve = Valve::new();
+    let mut branched = false;
+    let mut switched = None;
+    plant
+        .run(0.01, scenario.duration_s(), |snap| {
+            let s = Sensors::from(snap);
+            // Commands up to the branch: the guard's (state after its last event ≤ t).
+            if !branched && s.t < branch_t - 1e-9 {
+                let open = events.iter().take_while(|(t, _)| *t <= s.t + 1e-9).last().is_some_and(|e| e.1);
+                return Ok(Control { lng_valve: Some(open), stop: false });
+            }
+            if !branched {
+                branched = true;
+                if open_at_branch {
+                    valve.update(f32::NAN, true, &cfg.valve); // forced open: dwell counts from here
+                }
+            }
+            let before = valve.is_open();
+            valve.update(s.t_drain_c as f32, false, &cfg.valve);
+            if valve.is_open() != before {
+                switched = Some(s.t);
+                return Ok(Control { lng_valve: Some(valve.is_open()), stop: true });
+            }
+            Ok(Control { lng_valve: Some(valve.is_open()), stop: false })
+        })
+        .expect("run");
+    switched
 }
 
-/// Every switching event, on every acceptance run plus load-then-idle: the plant's
-/// exchanger follows the guard's hysteresis and dwell (`GuardConfig::DEFAULT.valve`)
-/// applied to the **true** drain, and the guard's estimator rides along on the same
-/// run ([`estimator_events`]). Each event must have a partner in the same direction
-/// within 2 s, both ways (a missing or extra event fails). Sharing one plant
-/// trajectory isolates the estimate: two separately closed loops drift apart after
-/// the first event, and a loop closed by the guard need not carry the true drain
-/// across the lower threshold at all.
+/// Every switching event, on every acceptance run plus load-then-idle: each event
+/// of the guard-driven closed loop against [`thermostat_from_branch`], the time a
+/// thermostat on the true drain would have switched from the same plant state and
+/// valve history. Issue: within 2 s.
 #[test]
-#[ignore = "fails: events where the true drain grazes a threshold (peaks < 0.1 K above 40 C before the thermostat's exchanger turns it) have no partner, because the estimate is 0.1-0.3 K under there (Case 1 40/60 bar, LNG, random-1/2/3, load-then-idle); where both sides switch, the times differ by 0.05-4.6 s (random-4 worst). First openings are within 2 s (valve_first_opening_within_2s)."]
+#[ignore = "fails: 72 of 80 events within 2 s; 8 exceed it: early (conservative) openings at slow heating slopes, 3.7/5.1 s (random-1) and 4.9/3.7 s (random-4), and late-side closings 2.6 s (first LNG cycle at 60 bar, random-1). 0.1-0.2 K of estimate error at 0.03-0.1 K/s slopes; the 2 s bound asks for ~0.05-0.1 K at every crossing"]
 fn valve_switching_times_match_true_drain() {
     let mut cases = scenarios();
     cases.push(("load-then-idle".into(), load_then_idle()));
-    let rows: Vec<_> = cases
+    let guard_runs: Vec<(String, Scenario, Vec<(f64, bool)>)> = cases
         .par_iter()
         .map(|(n, sc)| {
-            let truth = closed_loop(n, sc, false);
-            (n.clone(), estimator_events(&truth), truth.events)
+            let ev = match runs().iter().find(|r| &r.name == n) {
+                Some(r) => r.events.clone(),
+                None => closed_loop(n, sc, true).events,
+            };
+            (n.clone(), sc.clone(), ev)
         })
         .collect();
+    let jobs: Vec<(usize, usize)> =
+        guard_runs.iter().enumerate().flat_map(|(r, (_, _, ev))| (0..ev.len()).map(move |i| (r, i))).collect();
+    let mut results: Vec<(usize, usize, Option<f64>)> = jobs
+        .par_iter()
+        .map(|&(r, i)| (r, i, thermostat_from_branch(&guard_runs[r].1, &guard_runs[r].2, i)))
+        .collect();
+    results.sort_by_key(|x| (x.0, x.1));
     let mut worst = 0.0f64;
-    let mut n_events = 0;
     let mut failures = vec![];
-    for (n, fw, truth) in &rows {
-        if fw.is_empty() && truth.is_empty() {
+    for (r, (n, _, ev)) in guard_runs.iter().enumerate() {
+        if ev.is_empty() {
             continue;
         }
-        n_events += truth.len();
-        let w = worst_match(fw, truth).max(worst_match(truth, fw));
-        println!("{n}: estimator {} | true drain {} | worst {w:.2} s", fmt_events(fw), fmt_events(truth));
-        worst = worst.max(w);
-        // Issue: switching times within 2 s of switching on the true drain temperature.
-        if w > MAX_SWITCH_S {
-            failures.push(format!("{n}: {w:.2} s"));
-        }
+        let diffs: Vec<String> = results
+            .iter()
+            .filter(|x| x.0 == r)
+            .map(|&(_, i, t)| {
+                let (te, open) = ev[i];
+                let d = t.map_or(f64::INFINITY, |t| te - t);
+                worst = worst.max(d.abs());
+                // Issue: switching times within 2 s of switching on the true drain.
+                if d.abs() > MAX_SWITCH_S {
+                    failures.push(format!("{n} event {i} ({}) at {te:.2} s: {d:+.2} s", if open { "open" } else { "close" }));
+                }
+                format!("{te:.1}{}{d:+.2}", if open { "+" } else { "-" })
+            })
+            .collect();
+        println!("{n}: guard event (time, direction, minus thermostat) {}", diffs.join(" "));
     }
-    println!("{n_events} true-drain events, worst difference {worst:.2} s");
-    assert!(failures.is_empty(), "switching time differences > {MAX_SWITCH_S} s: {}", failures.join(", "));
+    println!("{} events, worst |difference| {worst:.2} s", results.len());
+    assert!(failures.is_empty(), "switching time differences > {MAX_SWITCH_S} s:\n{}", failures.join("\n"));
 }
 
 /// The reduced model's LNG conductance (`ReducedParams::lng_w_per_k`, reduced from
