@@ -188,7 +188,9 @@ fn mission(c: &SynthCase, rng: &mut ChaCha8Rng) -> Mission {
         }
         SynthScenario::ServoProfile => {
             // Duty segments of 120–240 s alternate between brisk motion
-            // (20–40 mm, half-period 1.5–3 s) and slow small moves (5–12 mm,
+            // (20–40 mm, half-period 1.5–3 s; faster triangles alias at the
+            // 0.5 s logging: the replay then misses 0.2 K on every channel)
+            // and slow small moves (5–12 mm,
             // half-period 3–6 s).
             let (mut pts, mut t, mut brisk) = (vec![(0.0, 0.0)], 0.0, rng.random_bool(0.5));
             while t < d {
