@@ -25,7 +25,7 @@ pub enum SynthScenario {
     ThrottleSteps,
     /// Servo mission: triangular position profile whose amplitude and
     /// half-period change every cycle, in duty segments of 120–240 s that
-    /// alternate between brisk motion (20–40 mm, half-period 1.5–3 s) and
+    /// alternate between brisk motion (20–40 mm, half-period 2–3 s) and
     /// slow small moves (5–12 mm, 3–6 s).
     ServoProfile,
     /// Throttle mission: speed steps 1000–2000 rpm every 100–250 s at low
@@ -188,16 +188,16 @@ fn mission(c: &SynthCase, rng: &mut ChaCha8Rng) -> Mission {
         }
         SynthScenario::ServoProfile => {
             // Duty segments of 120–240 s alternate between brisk motion
-            // (20–40 mm, half-period 1.5–3 s; faster triangles alias at the
-            // 0.5 s logging: the replay then misses 0.2 K on every channel)
-            // and slow small moves (5–12 mm,
-            // half-period 3–6 s).
+            // (20–40 mm, half-period 2–3 s; faster triangles alias at the
+            // 0.5 s logging: with 1.5 s half-periods the replay test missed
+            // 0.31 K on t_oil_c) and slow small moves (5–12 mm, half-period
+            // 3–6 s).
             let (mut pts, mut t, mut brisk) = (vec![(0.0, 0.0)], 0.0, rng.random_bool(0.5));
             while t < d {
                 let t_seg = t + rng.random_range(120.0..240.0);
                 while t < t_seg.min(d) {
                     let (a, h) = if brisk {
-                        (rng.random_range(0.020..0.040), rng.random_range(1.5..3.0))
+                        (rng.random_range(0.020..0.040), rng.random_range(2.0..3.0))
                     } else {
                         (rng.random_range(0.005..0.012), rng.random_range(3.0..6.0))
                     };
