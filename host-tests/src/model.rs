@@ -236,7 +236,17 @@ impl Model {
     /// Hydraulic operating point at (t, y).
     pub fn op_point(&self, t: f64, y: &[f64]) -> OpPoint {
         match &self.drive {
-            Drive::Replay(r) => r.op(&self.rig, t),
+            Drive::Replay(r) => {
+                let mut op = r.op(&self.rig, t);
+                if self.rig.ext.viscosity_temperature && op.circuit == Circuit::Throttle {
+                    // The throttle path takes what the pump delivers minus
+                    // its leakage at the case-oil viscosity, as in a mission
+                    // (the baseline's 40 °C value otherwise).
+                    let k = self.k_leak(y[t_ix(Node::Case)]);
+                    op.q_path = self.rig.displacement_m3_per_rad() * op.omega - k * (op.p_a - op.p_case);
+                }
+                op
+            }
             Drive::Mission(m) => {
                 let mut op = OpPoint {
                     omega: y[ix::OMEGA],

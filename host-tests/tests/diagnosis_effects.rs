@@ -1,21 +1,27 @@
 //! Hidden-effect tests of the diagnosis (issue 5). Each case: the reference
 //! simulation with one extension switched on at a random realistic
-//! magnitude, nuisance multipliers perturbed ±10–20 % (and, in the
-//! `structure` cases, every node mass and the winding conductance changed
-//! individually by ×0.8…1.25, which the baseline's global multipliers cannot
-//! represent), σ = 0.1 K sensor noise, 12-bit quantisation, dropped rows and
-//! cells; then the diagnosis runs blind on the default rig.
+//! magnitude (`eha_sim::diagnosis::synth::magnitude_range`), nuisance
+//! multipliers perturbed ±10–20 % (and, in the `Structure` cases, every node
+//! mass and the winding conductance changed individually by ×0.8…1.25,
+//! which the baseline's global multipliers cannot represent), σ = 0.1 K
+//! sensor noise, 12-bit quantisation, dropped rows and cells; then the
+//! diagnosis runs blind on the default rig. The test names say which effect
+//! is hidden; the diagnosis only sees the measured run.
 //!
 //! Assertions and why:
-//! - the named cause equals the hidden one (`none` for clean runs: no false
-//!   discovery);
-//! - the held-out RMSE of the channel the effect changes most falls by at
-//!   least 50 % once the named extension is switched on (issue 5).
+//! - the named cause equals the hidden one — every candidate in at least
+//!   two scenarios, chosen to excite it (issue 5); `none` for runs without a
+//!   hidden effect, with the nuisance physics as in the rig file or
+//!   different from it (no false discovery);
+//! - the held-out RMSE of the channel the effect changes most (measured on
+//!   the generator: with vs without the effect over the last 30 %) falls by
+//!   at least 50 % once the named extension is switched on (issue 5).
 //!
-//! The cases are short (1200 s, 2 s logging) so the default run stays
-//! modest; the larger sweep is `eha-sim diagnose-sweep` (and the `#[ignore]`d
-//! test at the end). Run in release mode: the model is an adaptive BDF
-//! solve, ~50 ms per run optimised.
+//! Seeds are fixed (one per case, chosen before the method changes and not
+//! re-drawn); how the method does over other draws is the sweep
+//! (`eha-sim diagnose-sweep`, and the `#[ignore]`d test at the end), whose
+//! hit rates are in docs/diagnosis.md. Run in release mode: each case is
+//! ~600–1000 model runs of 20–40 ms (throttle) or 0.2–0.5 s (servo).
 
 use eha_sim::diagnosis::sweep::{run_case, CaseResult};
 use eha_sim::diagnosis::synth::{Mismatch, SynthCase, SynthScenario};
@@ -48,38 +54,18 @@ fn check(cases: &[SynthCase]) {
 }
 
 use Mismatch::{Nuisance, Structure};
-use SynthScenario::{Case1Pressure, Servo, ServoProfile, SpeedSweep, ThrottleSteps};
+use SynthScenario::{AirSteps, Case1Pressure, LoadCycles, ServoProfile, SpeedSweep, ThrottleSteps};
 
+/// Dead-end oil sensor: a lag of minutes on t_oil_c, visible in any run.
 #[test]
 fn hidden_sensor_lag_is_named() {
-    check(&[
-        case("sensor-lag", Case1Pressure, Nuisance, 31),
-        case("sensor-lag", ThrottleSteps, Structure, 32),
-    ]);
+    check(&[case("sensor-lag", Case1Pressure, Nuisance, 31), case("sensor-lag", ThrottleSteps, Structure, 32)]);
 }
 
+/// Copper resistance rising with temperature: extra heat ∝ I²·(T_w − 25 °C)
+/// in the winding. Case 1 (constant current, the winding warming) and
+/// current steps (throttle pressure steps).
 #[test]
-#[ignore = "known miss: with servo runs logged at 0.5 s both cases are named none (0.5 K imprint on t_oil_c); they were named correctly only while 2 s logging aliased the piston speed"]
-fn hidden_coulomb_friction_is_named() {
-    check(&[case("coulomb-friction", Servo, Nuisance, 41), case("coulomb-friction", ServoProfile, Structure, 42)]);
-}
-
-#[test]
-fn hidden_churning_loss_is_named() {
-    check(&[case("churning-loss", ThrottleSteps, Nuisance, 51), case("churning-loss", SpeedSweep, Structure, 52)]);
-}
-
-#[test]
-fn no_hidden_effect_gives_none_when_only_nuisance_differs() {
-    check(&[case("none", Case1Pressure, Nuisance, 81), case("none", ThrottleSteps, Nuisance, 82)]);
-}
-
-// Known misses, measured with the final settings (see docs/diagnosis.md,
-// "Measured identification"). They are kept runnable with `--ignored` so
-// that an improvement of the method shows up; each names what was observed.
-
-#[test]
-#[ignore = "known miss: Case 1 named motor-pump-conduction (0.38 K imprint on t_motor_c)"]
 fn hidden_winding_resistance_temperature_is_named() {
     check(&[
         case("winding-resistance-temperature", Case1Pressure, Nuisance, 11),
@@ -87,17 +73,47 @@ fn hidden_winding_resistance_temperature_is_named() {
     ]);
 }
 
+/// Viscosity following the oil temperature: leakage heat (∝ Δp²/μ(T)) moves
+/// from the throttle to the pump case as the oil warms, and the oil film
+/// conductances change. Needs high pressure while the oil warms: load
+/// cycles to 70–100 bar. In Case 1 (≤ 60 bar) and in the random throttle
+/// steps the nuisance calibration absorbs it (see the ignored test below).
 #[test]
-#[ignore = "known miss: Case 1 named none (absorbed by the nuisance set), steps named winding-resistance-temperature"]
 fn hidden_viscosity_temperature_is_named() {
     check(&[
-        case("viscosity-temperature", Case1Pressure, Nuisance, 21),
-        case("viscosity-temperature", ThrottleSteps, Structure, 22),
+        case("viscosity-temperature", LoadCycles, Nuisance, 21),
+        case("viscosity-temperature", LoadCycles, Structure, 22),
     ]);
 }
 
 #[test]
-#[ignore = "known miss: named correctly in both, but the held-out gain on t_pump_c is -7 % in the structure case"]
+#[ignore = "measured miss: in random throttle steps (10–100 bar) the viscosity effect is absorbed by the nuisance set (nuisance case: none, calibrated baseline already 0.158 K on t_oil_c, best channel gain 17 %; structure case: named winding-resistance-temperature with alpha at its 1e-2 bound)"]
+fn hidden_viscosity_temperature_in_throttle_steps() {
+    check(&[
+        case("viscosity-temperature", ThrottleSteps, Nuisance, 23),
+        case("viscosity-temperature", ThrottleSteps, Structure, 22),
+    ]);
+}
+
+/// Coulomb seal friction: heat F·|v| in the actuator, carried to the oil by
+/// the tidal exchange. Servo missions with duty segments (brisk / slow
+/// motion) so that the friction heat changes in steps.
+#[test]
+#[ignore = "measured miss: both cases named none. Nuisance case (554 N): 0.38 K imprint on t_oil_c, calibrated baseline already at 0.150 K, no candidate qualifies. Structure case (942 N): coulomb-friction fitted 565 N, dBIC 92, t_oil_c 0.280 -> ~0.11 K (61 %), but pooled held-out only 0.169 -> 0.142 K (16 % < 20 %). With faster brisk segments (half-period 1.5-3 s) both were named (56 % / 42 % on t_oil_c) but the 0.5 s logging aliases and the replay test fails (0.31 K). Slow: 300-600 s per servo case."]
+fn hidden_coulomb_friction_is_named() {
+    check(&[case("coulomb-friction", ServoProfile, Nuisance, 41), case("coulomb-friction", ServoProfile, Structure, 42)]);
+}
+
+/// Churning ∝ ω^2.5: needs shaft-speed changes (a constant-speed run cannot
+/// tell it from a pump capacity error, so the diagnosis does not name it
+/// there).
+#[test]
+fn hidden_churning_loss_is_named() {
+    check(&[case("churning-loss", ThrottleSteps, Nuisance, 51), case("churning-loss", SpeedSweep, Structure, 52)]);
+}
+
+/// Flange conduction motor → pump: the pump follows the motor.
+#[test]
 fn hidden_motor_pump_conduction_is_named() {
     check(&[
         case("motor-pump-conduction", Case1Pressure, Nuisance, 61),
@@ -105,28 +121,58 @@ fn hidden_motor_pump_conduction_is_named() {
     ]);
 }
 
+/// Unlogged draught over the housings: Case 1 in still air, and Case 1
+/// with logged ram-air steps (the hidden draught adds to the logged air,
+/// so the missing cooling changes with the logged air speed).
 #[test]
-#[ignore = "known miss: Case 1 named motor-pump-conduction (outer_scale absorbs most of the air speed)"]
 fn hidden_forced_convection_is_named() {
+    check(&[case("forced-convection", Case1Pressure, Nuisance, 71), case("forced-convection", AirSteps, Nuisance, 71)]);
+}
+
+#[test]
+#[ignore = "measured miss: with per-node capacities off the baseline, a 5.5 m/s draught in the ram-air run is named none (the forced-convection fit gains 14 % on the best channel, motor-pump-conduction 26 %)"]
+fn hidden_forced_convection_with_structure_mismatch() {
+    check(&[case("forced-convection", AirSteps, Structure, 72)]);
+}
+
+/// No hidden effect, nuisance multipliers off the rig file: `none`.
+#[test]
+fn no_hidden_effect_gives_none_when_only_nuisance_differs() {
     check(&[
-        case("forced-convection", Case1Pressure, Nuisance, 71),
-        case("forced-convection", ThrottleSteps, Structure, 72),
+        case("none", Case1Pressure, Nuisance, 81),
+        case("none", ThrottleSteps, Nuisance, 82),
+        case("none", LoadCycles, Nuisance, 85),
     ]);
 }
 
+/// No hidden effect, per-node capacities and the winding conductance off
+/// the baseline (`Structure`): still `none`. These were false discoveries
+/// before the pooled held-out gain and the churning identifiability rule.
 #[test]
-#[ignore = "known false discoveries: with per-node capacities off the baseline, coulomb-friction (servo) and motor-pump-conduction (speed sweep) are named"]
 fn no_hidden_effect_gives_none_when_structure_differs() {
-    check(&[case("none", Servo, Structure, 83), case("none", SpeedSweep, Structure, 84)]);
+    check(&[
+        case("none", SpeedSweep, Structure, 84),
+        case("none", LoadCycles, Structure, 86),
+        case("none", AirSteps, Structure, 88),
+    ]);
+}
+
+/// The same in a servo mission (no false Coulomb friction or churning).
+/// Passes (measured: none, best candidate ΔBIC < 1), ignored only because a
+/// servo replay diagnosis takes 100–300 s.
+#[test]
+#[ignore = "slow: servo replay, 100-300 s"]
+fn no_hidden_effect_gives_none_in_servo_when_structure_differs() {
+    check(&[case("none", ServoProfile, Structure, 83)]);
 }
 
 /// The large sweep: every effect × scenario × mismatch × 2 seeds, 1800 s
-/// runs (~100 cases, several minutes on 2 cores). Also available as
-/// `eha-sim diagnose-sweep`.
+/// runs (~200 cases, hours on 2 cores with the servo runs). Also available
+/// as `eha-sim diagnose-sweep`.
 #[test]
 #[ignore]
 fn large_hidden_effect_sweep() {
-    let a = eha_sim::diagnosis::sweep::SweepArgs { seeds: 2, duration: 1800.0, sample: 2.0 };
+    let a = eha_sim::diagnosis::sweep::SweepArgs { seeds: 2, duration: 1800.0, sample: 2.0, no_servo: false };
     let cases = eha_sim::diagnosis::sweep::sweep_cases(&a);
     check(&cases);
 }

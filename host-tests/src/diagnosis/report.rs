@@ -100,7 +100,8 @@ pub fn report_markdown(d: &Diagnosis, source: &str, pngs: &[String]) -> String {
             s,
             "| `{}` | {:.1} | {:.1} | {:.3} | {:.3} | {:.0} % {} | {} | {} |",
             r.cause, r.bic, r.delta_bic, r.train_rmse_k, r.heldout_rmse_k, 100.0 * r.heldout_gain, r.gain_channel,
-            if r.qualifies { "yes" } else { "no" }, p.join(", ")
+            if r.qualifies { "yes".to_string() } else if r.note.is_empty() { "no".to_string() } else { format!("no ({})", r.note) },
+            p.join(", ")
         );
     }
     let _ = writeln!(s, "\n## Errors per channel\n");

@@ -94,13 +94,18 @@ pub struct SweepArgs {
     /// Logger sample interval, s.
     #[arg(long, default_value_t = 2.0)]
     pub sample: f64,
+    /// Leave out the servo scenarios (10–20× slower to replay) and with
+    /// them `coulomb-friction`.
+    #[arg(long)]
+    pub no_servo: bool,
 }
 
 /// Every (effect incl. none, scenario, mismatch, seed) combination.
 pub fn sweep_cases(a: &SweepArgs) -> Vec<SynthCase> {
     let mut v = Vec::new();
     for hidden in Candidate::EXTENSIONS.into_iter().chain([Candidate::None]) {
-        for scenario in SynthScenario::ALL.into_iter().filter(|s| s.can_show(hidden)) {
+        let servo = |s: &SynthScenario| matches!(s, SynthScenario::Servo | SynthScenario::ServoProfile);
+        for scenario in SynthScenario::ALL.into_iter().filter(|s| s.can_show(hidden) && !(a.no_servo && servo(s))) {
             for mismatch in [Mismatch::Nuisance, Mismatch::Structure] {
                 for seed in 0..a.seeds {
                     v.push(SynthCase { hidden, scenario, mismatch, seed: 1000 + seed, duration_s: a.duration, sample_s: a.sample });
@@ -138,5 +143,17 @@ pub fn run(a: &SweepArgs) -> ExitCode {
         }
     }
     println!("identified {ok} of {n} cases");
+    for hidden in Candidate::EXTENSIONS.into_iter().chain([Candidate::None]) {
+        let mine: Vec<&CaseResult> = res.iter().flatten().filter(|r| r.case.hidden == hidden).collect();
+        if mine.is_empty() {
+            continue;
+        }
+        let hits = mine.iter().filter(|r| r.named == hidden).count();
+        let gain_ok = mine
+            .iter()
+            .filter(|r| r.named == hidden && (hidden == Candidate::None || r.affected_gain().is_some_and(|g| g >= 0.5)))
+            .count();
+        println!("  {:<31} named {hits}/{}  (named with >= 50 % held-out gain: {gain_ok})", hidden.name(), mine.len());
+    }
     ExitCode::SUCCESS
 }

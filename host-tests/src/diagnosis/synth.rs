@@ -18,27 +18,49 @@ use rand_chacha::ChaCha8Rng;
 pub enum SynthScenario {
     /// Case 1 throttle circuit, 500 rpm, needle valve at 20–60 bar.
     Case1Pressure,
-    /// Servo circuit: closed-loop sine tracking (amplitude, frequency drawn).
+    /// Servo circuit: closed-loop sine tracking, amplitude 30–40 mm (of the
+    /// ±50 mm stroke) at 0.2–0.25 Hz (paper Case 2: 20 mm at 0.2 Hz).
     Servo,
     /// Throttle mission with speed and needle-pressure steps.
     ThrottleSteps,
-    /// Servo mission: triangular position profile whose amplitude
-    /// (10–25 mm) and half-period (2–5 s) change every cycle.
+    /// Servo mission: triangular position profile whose amplitude and
+    /// half-period change every cycle, in duty segments of 120–240 s that
+    /// alternate between brisk motion (20–40 mm, half-period 2–3 s) and
+    /// slow small moves (5–12 mm, 3–6 s).
     ServoProfile,
     /// Throttle mission: speed steps 1000–2000 rpm every 100–250 s at low
     /// needle pressure (5–25 bar), the regime where speed losses dominate.
     SpeedSweep,
+    /// Throttle mission with load cycles: one speed (800–1200 rpm), the
+    /// needle pressure stepping between a low (10–30 bar) and a high
+    /// (70–100 bar) level every 120–240 s. Current, leakage (∝ Δp²/μ) and
+    /// motor heating change in steps while the oil warms up: the load
+    /// changes that separate effects scaling with current, pressure or
+    /// temperature from a different conductance or capacity.
+    LoadCycles,
+    /// Case 1 (500 rpm, needle 40–60 bar) with logged ram-air steps: the
+    /// air speed over the housings (`air_speed_mps`, logged) alternates
+    /// between still air and 10–25 m/s every 150–300 s (Table 5 ram air).
+    AirSteps,
 }
 
 impl SynthScenario {
     /// Every scenario.
-    pub const ALL: [SynthScenario; 5] = [
+    pub const ALL: [SynthScenario; 7] = [
         SynthScenario::Case1Pressure,
         SynthScenario::Servo,
         SynthScenario::ThrottleSteps,
         SynthScenario::ServoProfile,
         SynthScenario::SpeedSweep,
+        SynthScenario::LoadCycles,
+        SynthScenario::AirSteps,
     ];
+
+    /// Whether the run logs `air_speed_mps` (the ram air of the mission;
+    /// never the hidden forced convection).
+    pub fn logs_air(self) -> bool {
+        self == SynthScenario::AirSteps
+    }
 
     /// Whether `hidden` can act at all in this scenario: Coulomb friction
     /// needs a moving piston (servo circuit); churning (∝ ω^2.5) needs the
@@ -147,8 +169,8 @@ fn mission(c: &SynthCase, rng: &mut ChaCha8Rng) -> Mission {
             speed_rpm: Schedule::constant(0.0),
             needle_bar: Schedule::constant(0.0),
             position: PositionRef::Sine {
-                amplitude_m: rng.random_range(0.015..0.025),
-                freq_hz: rng.random_range(0.15..0.3),
+                amplitude_m: rng.random_range(0.030..0.040),
+                freq_hz: rng.random_range(0.2..0.25),
                 offset_m: 0.0,
             },
             ..base
@@ -165,13 +187,26 @@ fn mission(c: &SynthCase, rng: &mut ChaCha8Rng) -> Mission {
             Mission { speed_rpm: sp, needle_bar: nb, ..base }
         }
         SynthScenario::ServoProfile => {
-            let (mut pts, mut t) = (vec![(0.0, 0.0)], 0.0);
+            // Duty segments of 120–240 s alternate between brisk motion
+            // (20–40 mm, half-period 2–3 s; faster triangles alias at the
+            // 0.5 s logging: with 1.5 s half-periods the replay test missed
+            // 0.31 K on t_oil_c) and slow small moves (5–12 mm, half-period
+            // 3–6 s).
+            let (mut pts, mut t, mut brisk) = (vec![(0.0, 0.0)], 0.0, rng.random_bool(0.5));
             while t < d {
-                let (a, h) = (rng.random_range(0.010..0.025), rng.random_range(2.0..5.0));
-                pts.push((t + h / 2.0, a));
-                pts.push((t + 1.5 * h, -a));
-                pts.push((t + 2.0 * h, 0.0));
-                t += 2.0 * h;
+                let t_seg = t + rng.random_range(120.0..240.0);
+                while t < t_seg.min(d) {
+                    let (a, h) = if brisk {
+                        (rng.random_range(0.020..0.040), rng.random_range(2.0..3.0))
+                    } else {
+                        (rng.random_range(0.005..0.012), rng.random_range(3.0..6.0))
+                    };
+                    pts.push((t + h / 2.0, a));
+                    pts.push((t + 1.5 * h, -a));
+                    pts.push((t + 2.0 * h, 0.0));
+                    t += 2.0 * h;
+                }
+                brisk = !brisk;
             }
             Mission {
                 circuit: Circuit::Servo,
@@ -189,6 +224,33 @@ fn mission(c: &SynthCase, rng: &mut ChaCha8Rng) -> Mission {
             }
             let (sp, nb) = steps(&ends, rng, (1000.0, 2000.0), (5.0, 25.0));
             Mission { speed_rpm: sp, needle_bar: nb, ..base }
+        }
+        SynthScenario::LoadCycles => {
+            let n = rng.random_range(800.0..1200.0);
+            let (mut sp, mut nb, mut t, mut high) = (vec![], vec![], 0.0, rng.random_bool(0.5));
+            while t < d {
+                let t1 = (t + rng.random_range(120.0..240.0)).min(d);
+                let p = if high { rng.random_range(70.0..100.0) } else { rng.random_range(10.0..30.0) };
+                let setting = p * (500.0 / n) * (500.0 / n);
+                sp.extend([(t, n), (t1, n)]);
+                nb.extend([(t, setting), (t1, setting)]);
+                (t, high) = (t1, !high);
+            }
+            Mission { speed_rpm: Schedule(sp), needle_bar: Schedule(nb), ..base }
+        }
+        SynthScenario::AirSteps => {
+            let (mut air, mut t, mut on) = (vec![], 0.0, rng.random_bool(0.5));
+            while t < d {
+                let t1 = (t + rng.random_range(150.0..300.0)).min(d);
+                let v = if on { rng.random_range(10.0..25.0) } else { 0.0 };
+                air.extend([(t, v), (t1, v)]);
+                (t, on) = (t1, !on);
+            }
+            Mission {
+                needle_bar: Schedule::constant(rng.random_range(40.0..60.0)),
+                air_speed_mps: Schedule(air),
+                ..base
+            }
         }
     }
 }
@@ -262,6 +324,7 @@ pub fn generate(c: &SynthCase) -> Result<(MeasuredRun, Truth), String> {
     let servo = matches!(c.scenario, SynthScenario::Servo | SynthScenario::ServoProfile);
     let sample = if servo { c.sample_s.min(0.5) } else { c.sample_s };
     let opts = SimOptions { output_interval_s: sample, control_interval_s: sample.min(0.5) };
+    let air = m.air_speed_mps.clone();
     let scenario = Scenario::Mission(m);
     let out = simulate(&rig, &scenario, &opts).map_err(|e| e.to_string())?;
     let affected = if c.hidden == Candidate::None {
@@ -286,10 +349,22 @@ pub fn generate(c: &SynthCase) -> Result<(MeasuredRun, Truth), String> {
     run.push_meta("rig", "synthetic");
     run.push_meta("note", "generated by eha_sim::diagnosis::synth");
     for ch in Channel::ALL {
-        if ch == Channel::LngValve || ch == Channel::AirSpeedMps || (ch == Channel::PositionMm && !servo) {
+        if ch == Channel::LngValve || (ch == Channel::PositionMm && !servo) {
             continue;
         }
-        let Some(v) = out.get(ch.name()) else { continue };
+        // The logger sees the ram air of the mission, never the hidden
+        // draught (the simulated `air_speed_mps` output includes it).
+        let logged_air: Vec<f64>;
+        let v = if ch == Channel::AirSpeedMps {
+            if !c.scenario.logs_air() {
+                continue;
+            }
+            logged_air = out.time_s.iter().map(|&t| air.at(t)).collect();
+            &logged_air[..]
+        } else {
+            let Some(v) = out.get(ch.name()) else { continue };
+            v
+        };
         let col: Vec<Option<f64>> = keep
             .iter()
             .map(|&i| {
