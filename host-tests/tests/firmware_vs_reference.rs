@@ -212,10 +212,6 @@ fn load_then_idle() -> Scenario {
     Scenario::Mission(m)
 }
 
-fn fmt_events(e: &[(f64, bool)]) -> String {
-    e.iter().map(|(t, o)| format!("{t:.2}{}", if *o { "+" } else { "-" })).collect::<Vec<_>>().join(" ")
-}
-
 /// Closed loop, first opening (event 0 of [`valve_switching_times_match_true_drain`],
 /// the one every run shares with an uncontrolled plant), on every acceptance run
 /// plus load-then-idle: the
@@ -250,14 +246,6 @@ fn valve_first_opening_within_2s() {
         }
     }
     assert!(failures.is_empty(), "first openings: {}", failures.join(", "));
-}
-
-/// Largest time between each event of `a` and the nearest event of `b` in the same
-/// direction (infinite when `b` has none in that direction).
-fn worst_match(a: &[(f64, bool)], b: &[(f64, bool)]) -> f64 {
-    a.iter()
-        .map(|(t, o)| b.iter().filter(|(_, p)| p == o).map(|(u, _)| (t - u).abs()).fold(f64::INFINITY, f64::min))
-        .fold(0.0, f64::max)
 }
 
 /// Counterfactual switching time of guard event `i` of a guard-driven run: the plant
