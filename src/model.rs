@@ -298,13 +298,20 @@ impl<N: Num> Model<N> {
     /// Losses `[copper, iron, leakage, mechanical, throttling]` in kW (eqs. 1, 2, 5-8, 11).
     #[inline(always)]
     pub fn losses_kw(&self, i_ha: N, dp_hbar: N, w_hrads: N, dpos_mm: N) -> [N; N_LOSSES] {
+        self.losses_with(i_ha, dp_hbar, w_hrads, dpos_mm, &Magnitudes::of(dp_hbar, w_hrads))
+    }
+
+    /// [`Model::losses_kw`] with the input magnitudes already taken (the step shares
+    /// them with its exchanges).
+    #[inline(always)]
+    fn losses_with(&self, i_ha: N, dp_hbar: N, w_hrads: N, dpos_mm: N, m: &Magnitudes<N>) -> [N; N_LOSSES] {
         let k = &self.k;
         let t_w = N::value(self.temp[NODE_WINDING]);
         // eq. (1): m I^2 R0 (1 + alpha (T_w - 25))
         let p_cu = i_ha.mul(i_ha).mul(k.cu0.add(k.cu1.mul(t_w)));
         // eq. (2) with f ∝ w and constant B_m
-        let aw = w_hrads.abs();
-        let p_fe = aw.mul(k.fe1.add(k.fe2.mul(aw)).add(k.fe15.mul(aw.sqrt_abs())));
+        let aw = m.aw;
+        let p_fe = aw.mul(k.fe1.add(k.fe2.mul(aw)).add(k.fe15.mul(m.sw)));
         // eqs. (5)-(7): K dp^2 / mu(T) (ratio to the reference viscosity)
         let mut p_leak = k.leak.mul(dp_hbar).mul(dp_hbar);
         if k.use_mu {
@@ -312,8 +319,7 @@ impl<N: Num> Model<N> {
             p_leak = p_leak.mul(k.k_mu.mul(t_d.sub(k.t_mu)).exp());
         }
         // eq. (8): eta_m (D dp) w
-        let adp = dp_hbar.abs();
-        let p_mech = k.mech.mul(adp).mul(aw);
+        let p_mech = k.mech.mul(m.adp).mul(aw);
         // eq. (11) generalised: dp (D w - Q_leak) - dp A v, never negative (no heat sink)
         let p_hyd = dp_hbar
             .mul(k.kq.mul(w_hrads).sub(k.kv.mul(dpos_mm)))
@@ -341,7 +347,8 @@ impl<N: Num> Model<N> {
         let amb = u.ambient_c;
         self.ambient_c = amb;
         let dp = u.dp_hbar;
-        let p = self.losses_kw(u.current_ha, dp, u.speed_hrads, u.dpos_mm);
+        let mag = Magnitudes::of(dp, u.speed_hrads);
+        let p = self.losses_with(u.current_ha, dp, u.speed_hrads, u.dpos_mm, &mag);
         self.last_loss_kw = p;
         let th = &self.temp;
         let x: [N; N_COLS] = [
@@ -363,8 +370,7 @@ impl<N: Num> Model<N> {
         // It is added in the same state update as the ZOH step (operator splitting with
         // both parts evaluated at the step start; first order, like sequential splitting).
         let k = &self.k;
-        let adp = dp.abs();
-        let aw = u.speed_hrads.abs();
+        let Magnitudes { aw, sw, adp } = mag;
         // LNG exchanger, eqs. (20)-(22), while open: conductance g = min(g_max,
         // g_slope |w|) (the smaller capacity rate is the LNG stream above ~30 rpm, the
         // oil stream below). The loop oil loses g h / C3 (T_loop - T_LNG) per step (in
@@ -402,7 +408,6 @@ impl<N: Num> Model<N> {
         let q = phi.mul(feed.sub(x_drain));
         // Speed-driven exchanges (drain <-> pump housing, loop oil <-> block), explicit
         // two-node steps with rate x = g1 sqrt|w| h (1/Ca + 1/Cb) (≤ MAX_EXPLICIT_RATE).
-        let sw = aw.sqrt_abs();
         let q_pd = k.pd_k.mul(sw).mul(x_pump.sub(x_drain));
         let q_lb = k.lb_k.mul(sw).mul(x_loop.sub(x_block));
         let [c0, c1, c2, c3, c4, c5] = &self.coef;
@@ -453,6 +458,23 @@ impl<N: Num> Model<N> {
     }
 }
 
+/// Magnitudes of one step's inputs, taken once and shared by the losses and the
+/// exchanges: `|w|`, `sqrt|w|` (hrad/s, hrad/s^0.5) and `|dp|` (hbar).
+#[derive(Clone, Copy, Debug)]
+struct Magnitudes<N> {
+    aw: N,
+    sw: N,
+    adp: N,
+}
+
+impl<N: Num> Magnitudes<N> {
+    #[inline(always)]
+    fn of(dp_hbar: N, w_hrads: N) -> Self {
+        let aw = w_hrads.abs();
+        Magnitudes { aw, sw: aw.sqrt_abs(), adp: dp_hbar.abs() }
+    }
+}
+
 /// Wire → model unit scales in the number type (built once).
 #[derive(Clone, Copy, Debug)]
 pub struct InputScales<N: Num> {
@@ -467,6 +489,13 @@ pub struct InputScales<N: Num> {
 }
 
 impl<N: Num> InputScales<N> {
+    /// The scale of each sample channel, in channel order `[current, p_A, p_B,
+    /// speed, position, ambient]` (`validate::CH_*`).
+    #[inline(always)]
+    pub fn per_channel(&self) -> [N::Scale; 6] {
+        [self.ha_per_a, self.hbar_per_bar, self.hbar_per_bar, self.hrads_per_rpm, self.one, self.one]
+    }
+
     /// Builds the scales; `None` only if the number type cannot hold them.
     pub fn new() -> Option<Self> {
         Some(InputScales {

@@ -120,14 +120,7 @@ impl<N: Num> LimitsN<N> {
             l.position_mm_per_step,
             l.ambient_c_per_step,
         ];
-        let s = [
-            sc.ha_per_a,
-            sc.hbar_per_bar,
-            sc.hbar_per_bar,
-            sc.hrads_per_rpm,
-            sc.one,
-            sc.one,
-        ];
+        let s = sc.per_channel();
         let s64 = [
             crate::model::HA_PER_A,
             crate::model::HBAR_PER_BAR,
@@ -188,14 +181,7 @@ pub fn convert<N: Num>(s: &Sample, sc: &InputScales<N>) -> (Channels<N>, u8) {
         s.position_mm,
         s.ambient_c,
     ];
-    let scale = [
-        sc.ha_per_a,
-        sc.hbar_per_bar,
-        sc.hbar_per_bar,
-        sc.hrads_per_rpm,
-        sc.one,
-        sc.one,
-    ];
+    let scale = sc.per_channel();
     let mut v = [N::ZERO; 6];
     let mut nonfinite = 0u8;
     for (i, ((o, x), k)) in v.iter_mut().zip(raw.iter()).zip(scale.iter()).enumerate() {

@@ -1,7 +1,7 @@
 //! Closed-loop LNG case with the guard (f64) commanding the exchanger: prints the
 //! true drain, the guard's estimate and the valve every 2.5 s around the cycles.
 //! `cargo run --release -p eha-sim --example lng_probe`
-use eha_guard::{GuardConfig, GuardOf, Restore, Sample};
+use eha_guard::{GuardConfig, GuardOf, Restore};
 use eha_sim::plant::{Control, Plant, Sensors};
 use eha_sim::rig::Rig;
 use eha_sim::scenario::Scenario;
@@ -18,14 +18,7 @@ fn main() -> anyhow::Result<()> {
             println!("{:7.2}  true {:7.3}  pred(prev) {:7.3}  err {:+.3}  loop {:7.3}  valve {}", s.t, s.t_drain_c, last_pred, last_pred - s.t_drain_c, s.t_loop_oil_c, s.lng_open as u8);
         }
         k += 1;
-        let o = g.step(&Sample {
-            current_a: s.current_a as f32,
-            p_a_bar: s.p_a_bar as f32,
-            p_b_bar: s.p_b_bar as f32,
-            speed_rpm: s.speed_rpm as f32,
-            position_mm: s.position_mm as f32,
-            ambient_c: s.ambient_c as f32,
-        });
+        let o = g.step(&s.sample());
         last_pred = o.drain_c as f64;
         Ok(Control { lng_valve: Some(o.valve_open), stop: false })
     })?;

@@ -48,6 +48,20 @@ pub enum Case {
     Lng,
 }
 
+/// A paper case with its needle pressure and duration (shared by `simulate` and `sweep`).
+#[derive(Debug, Args)]
+pub struct CaseArgs {
+    /// Paper scenario (`simulate`: ignored with --mission or --replay).
+    #[arg(long, value_enum, default_value = "case1")]
+    pub scenario: Case,
+    /// Needle-valve pressure for Case 1, bar.
+    #[arg(long, default_value_t = 60.0)]
+    pub needle_bar: f64,
+    /// Duration, s.
+    #[arg(long, default_value_t = 600.0)]
+    pub duration_s: f64,
+}
+
 impl Case {
     /// The scenario of this paper case.
     pub fn scenario(self, needle_bar: f64, duration_s: f64) -> Scenario {
@@ -62,15 +76,9 @@ impl Case {
 /// `simulate`: run a scenario, write CSV (+ PNG).
 #[derive(Debug, Args)]
 pub struct SimulateArgs {
-    /// Paper scenario (ignored with --mission).
-    #[arg(long, value_enum, default_value = "case1")]
-    pub scenario: Case,
-    /// Needle-valve pressure for Case 1, bar.
-    #[arg(long, default_value_t = 60.0)]
-    pub needle_bar: f64,
-    /// Duration, s.
-    #[arg(long, default_value_t = 600.0)]
-    pub duration_s: f64,
+    #[command(flatten)]
+    /// Paper case.
+    pub case: CaseArgs,
     /// Mission CSV of inputs (`time_s,speed_rpm,needle_bar,position_mm,ambient_c,air_speed_mps`).
     #[arg(long)]
     pub mission: Option<PathBuf>,
@@ -99,7 +107,7 @@ pub fn scenario_of(a: &SimulateArgs) -> Result<Scenario> {
         let name = p.file_stem().map_or("replay".into(), |s| format!("replay-{}", s.to_string_lossy()));
         return Ok(Scenario::Replay(crate::diagnosis::reference::replay_inputs(&run, &name)?));
     }
-    Ok(a.scenario.scenario(a.needle_bar, a.duration_s))
+    Ok(a.case.scenario.scenario(a.case.needle_bar, a.case.duration_s))
 }
 
 /// Write a run's CSV beside a summary, returning the CSV path.
@@ -217,15 +225,9 @@ pub struct SweepArgs {
     /// Values, comma separated (e.g. `0,20,40,60`).
     #[arg(long, value_delimiter = ',', required = true)]
     pub values: Vec<f64>,
-    /// Scenario.
-    #[arg(long, value_enum, default_value = "case1")]
-    pub scenario: Case,
-    /// Needle pressure of Case 1, bar.
-    #[arg(long, default_value_t = 60.0)]
-    pub needle_bar: f64,
-    /// Duration, s.
-    #[arg(long, default_value_t = 600.0)]
-    pub duration_s: f64,
+    #[command(flatten)]
+    /// Paper case.
+    pub case: CaseArgs,
     /// Output CSV.
     #[arg(long, default_value = "out/sweep.csv")]
     pub out: PathBuf,
@@ -245,13 +247,13 @@ pub fn run_sweep(a: &SweepArgs) -> Result<()> {
         .par_iter()
         .map(|&v| {
             let mut rig = base.clone();
-            let mut needle = a.needle_bar;
+            let mut needle = a.case.needle_bar;
             if a.param == "needle_bar" {
                 needle = v;
             } else {
                 rig.set_override(&format!("{}={v}", a.param))?;
             }
-            let sc = a.scenario.scenario(needle, a.duration_s);
+            let sc = a.case.scenario.scenario(needle, a.case.duration_s);
             let out = simulate(&rig, &sc, &SimOptions { output_interval_s: 10.0, control_interval_s: 0.1 })?;
             bar.inc(1);
             Ok(std::iter::once(v).chain(channels.iter().map(|c| out.last(c).unwrap_or(f64::NAN))).collect())

@@ -187,6 +187,21 @@ pub struct Sensors {
     pub lng_open: bool,
 }
 
+impl Sensors {
+    /// The firmware's wire sample of these signals (f32, the units of
+    /// `eha_guard::Sample`), as a controller would send them every step.
+    pub fn sample(&self) -> eha_guard::Sample {
+        eha_guard::Sample {
+            current_a: self.current_a as f32,
+            p_a_bar: self.p_a_bar as f32,
+            p_b_bar: self.p_b_bar as f32,
+            speed_rpm: self.speed_rpm as f32,
+            position_mm: self.position_mm as f32,
+            ambient_c: self.ambient_c as f32,
+        }
+    }
+}
+
 impl From<&Snapshot> for Sensors {
     fn from(s: &Snapshot) -> Self {
         Sensors {

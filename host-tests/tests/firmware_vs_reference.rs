@@ -13,7 +13,7 @@
 
 use eha_guard::num::{Fx, Num};
 use eha_guard::protection::Valve;
-use eha_guard::{GuardConfig, GuardOf, Restore, Sample};
+use eha_guard::{GuardConfig, GuardOf, Restore};
 use eha_sim::identify::{random_mission, stats, ErrorStats, TEST_SEEDS};
 use eha_sim::plant::{Control, Plant, Sensors};
 use eha_sim::rig::Rig;
@@ -72,7 +72,7 @@ fn closed_loop(name: &str, scenario: &Scenario, by_guard: bool) -> Run {
     plant
         .run(0.01, scenario.duration_s(), |snap| {
             let s = Sensors::from(snap);
-            let o = guard.step(&sample(&s));
+            let o = guard.step(&s.sample());
             run.faults |= o.faults;
             run.pred.push(o.drain_c as f64);
             valve.update(s.t_drain_c as f32, false, &cfg.valve);
@@ -93,17 +93,6 @@ fn runs() -> &'static [Run] {
     R.get_or_init(|| scenarios().par_iter().map(|(n, s)| closed_loop(n, s, true)).collect())
 }
 
-fn sample(s: &Sensors) -> Sample {
-    Sample {
-        current_a: s.current_a as f32,
-        p_a_bar: s.p_a_bar as f32,
-        p_b_bar: s.p_b_bar as f32,
-        speed_rpm: s.speed_rpm as f32,
-        position_mm: s.position_mm as f32,
-        ambient_c: s.ambient_c as f32,
-    }
-}
-
 /// Drain predictions of a guard in number type `N` replaying the sensor stream of
 /// a run (element k: after sample k), and the fault word at the end. The guard
 /// credits cooling by its own valve; on the f64 guard's run that is the valve
@@ -114,7 +103,7 @@ fn guard_drain<N: Num>(run: &Run) -> (Vec<f64>, u16) {
     let mut out = Vec::with_capacity(n);
     let mut faults = 0;
     for s in &run.sensors[..n] {
-        let o = g.step(&sample(s));
+        let o = g.step(&s.sample());
         faults |= o.faults;
         out.push(o.drain_c as f64);
     }
