@@ -35,12 +35,19 @@ fn case(hidden: &str, scenario: SynthScenario, mismatch: Mismatch, seed: u64) ->
 
 /// Runs the cases in parallel and checks the verdict and the gain.
 fn check(cases: &[SynthCase]) {
-    let results: Vec<Result<CaseResult, String>> =
-        cases.par_iter().map(|c| run_case(*c, &DiagnoseOptions::default())).collect();
+    let results: Vec<Result<CaseResult, String>> = cases
+        .par_iter()
+        .map(|c| {
+            let r = run_case(*c, &DiagnoseOptions::default());
+            if let Ok(r) = &r {
+                eprintln!("{} magnitude {:.4}\n{}", r.line(), r.magnitude, r.detail());
+            }
+            r
+        })
+        .collect();
     let mut failures = Vec::new();
     for r in results {
         let r = r.expect("case must generate and diagnose");
-        eprintln!("{}", r.line());
         if r.named != r.case.hidden {
             failures.push(format!("wrong cause: {}", r.line()));
         } else if r.case.hidden != Candidate::None {
@@ -175,4 +182,19 @@ fn large_hidden_effect_sweep() {
     let a = eha_sim::diagnosis::sweep::SweepArgs { seeds: 2, duration: 1800.0, sample: 2.0, no_servo: false };
     let cases = eha_sim::diagnosis::sweep::sweep_cases(&a);
     check(&cases);
+}
+
+#[test]
+#[ignore]
+fn probe_hold_move() {
+    use SynthScenario::ServoHoldMove;
+    let which = std::env::var("PROBE").unwrap_or_default();
+    let all = [
+        case("coulomb-friction", ServoHoldMove, Nuisance, 45),
+        case("coulomb-friction", ServoHoldMove, Structure, 46),
+        case("none", ServoHoldMove, Structure, 89),
+        case("none", ServoHoldMove, Nuisance, 90),
+    ];
+    let sel: Vec<SynthCase> = all.iter().enumerate().filter(|(i, _)| which.is_empty() || which.contains(&i.to_string())).map(|(_, c)| *c).collect();
+    check(&sel);
 }

@@ -117,6 +117,8 @@ pub struct RankEntry {
     pub heldout_gain: f64,
     /// Channel of `heldout_gain`.
     pub gain_channel: String,
+    /// Held-out RMSE of every measured temperature channel, K.
+    pub channel_heldout_k: Vec<(String, f64)>,
     /// Fitted extension parameters (name, value, unit).
     pub params: Vec<(String, f64, String)>,
     /// Whether it passes both the BIC and the held-out test.
@@ -328,6 +330,7 @@ pub fn diagnose(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions) -> 
         delta_bic: 0.0,
         heldout_gain: 0.0,
         gain_channel: String::new(),
+        channel_heldout_k: m_before.channels.iter().map(|c| (c.channel.clone(), c.heldout_rmse_k)).collect(),
         params: vec![],
         qualifies: false,
         note: String::new(),
@@ -359,6 +362,7 @@ pub fn diagnose(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions) -> 
             delta_bic: bic_none - b,
             heldout_gain: gain,
             gain_channel: gch,
+            channel_heldout_k: m.channels.iter().map(|c| (c.channel.clone(), c.heldout_rmse_k)).collect(),
             params: named(&sim.extension_params(f.candidate), &f.ext),
             qualifies: ident.is_ok()
                 && bic_none - b >= o.min_delta_bic

@@ -32,12 +32,45 @@ pub struct CaseResult {
     pub seconds: f64,
     /// Model runs.
     pub sims: usize,
+    /// The diagnosis ranking (every candidate's evidence), best BIC first.
+    pub ranking: Vec<super::analysis::RankEntry>,
 }
 
 impl CaseResult {
     /// Relative held-out RMSE reduction on the affected channel.
     pub fn affected_gain(&self) -> Option<f64> {
         self.affected_heldout_k.map(|(b, a)| 1.0 - a / b)
+    }
+
+    /// The ranking, one line per candidate: ΔBIC, best-channel held-out
+    /// gain, pooled held-out gain, the held-out RMSE of every channel (K)
+    /// and whether it qualified.
+    pub fn detail(&self) -> String {
+        let none = self.ranking.iter().find(|r| r.cause == "none");
+        let pooled0 = none.map_or(f64::NAN, |r| r.heldout_rmse_k);
+        let mut s = String::new();
+        for r in &self.ranking {
+            let ch: Vec<String> = r
+                .channel_heldout_k
+                .iter()
+                .map(|(c, v)| format!("{}={v:.3}", c.trim_start_matches("t_").trim_end_matches("_c")))
+                .collect();
+            let p: Vec<String> = r.params.iter().map(|(n, v, _)| format!("{n}={v:.4}")).collect();
+            s += &format!(
+                "    {:<31} dBIC {:>8.1} best {:>4.0} % {:<13} pooled {:>4.0} % ({:.3} K) [{}] {}{} {}\n",
+                r.cause,
+                r.delta_bic,
+                100.0 * r.heldout_gain,
+                r.gain_channel,
+                100.0 * (1.0 - r.heldout_rmse_k / pooled0),
+                r.heldout_rmse_k,
+                ch.join(" "),
+                if r.qualifies { "QUALIFIES" } else { "-" },
+                if r.note.is_empty() { String::new() } else { format!(" ({})", r.note) },
+                p.join(" ")
+            );
+        }
+        s
     }
 
     /// One-line summary.
@@ -79,6 +112,7 @@ pub fn run_case(case: SynthCase, o: &DiagnoseOptions) -> Result<CaseResult, Stri
         params: d.params,
         seconds: t.elapsed().as_secs_f64(),
         sims: d.sims,
+        ranking: d.ranking,
     })
 }
 
@@ -104,7 +138,7 @@ pub struct SweepArgs {
 pub fn sweep_cases(a: &SweepArgs) -> Vec<SynthCase> {
     let mut v = Vec::new();
     for hidden in Candidate::EXTENSIONS.into_iter().chain([Candidate::None]) {
-        let servo = |s: &SynthScenario| matches!(s, SynthScenario::Servo | SynthScenario::ServoProfile);
+        let servo = |s: &SynthScenario| s.is_servo();
         for scenario in SynthScenario::ALL.into_iter().filter(|s| s.can_show(hidden) && !(a.no_servo && servo(s))) {
             for mismatch in [Mismatch::Nuisance, Mismatch::Structure] {
                 for seed in 0..a.seeds {

@@ -38,6 +38,18 @@ pub enum SynthScenario {
     /// changes that separate effects scaling with current, pressure or
     /// temperature from a different conductance or capacity.
     LoadCycles,
+    /// Servo mission that separates the seal-friction heat from the load:
+    /// duty segments of 120–240 s alternate between *holding* a deflection
+    /// of 25–40 mm against the spring (the aerodynamic load of a trimmed
+    /// surface: 40–64 bar, high current and leakage, the piston still) and
+    /// *manoeuvring* about the centre (triangles of 15–25 mm, half-period
+    /// 1.0–1.6 s: piston speed 0.02–0.05 m/s at low pressure). Copper and
+    /// leakage heat are high while the piston stands, the friction heat
+    /// F·|v| only while it moves, so the two cannot stand in for each other
+    /// through a conductance or a capacity (in `ServoProfile` both grow with
+    /// the stroke). Logged at 0.1 s (the format's interval for sinusoidal
+    /// runs): the replay takes the piston speed from the logged position.
+    ServoHoldMove,
     /// Case 1 (500 rpm, needle 40–60 bar) with logged ram-air steps: the
     /// air speed over the housings (`air_speed_mps`, logged) alternates
     /// between still air and 10–25 m/s every 150–300 s (Table 5 ram air).
@@ -46,7 +58,7 @@ pub enum SynthScenario {
 
 impl SynthScenario {
     /// Every scenario.
-    pub const ALL: [SynthScenario; 7] = [
+    pub const ALL: [SynthScenario; 8] = [
         SynthScenario::Case1Pressure,
         SynthScenario::Servo,
         SynthScenario::ThrottleSteps,
@@ -54,6 +66,7 @@ impl SynthScenario {
         SynthScenario::SpeedSweep,
         SynthScenario::LoadCycles,
         SynthScenario::AirSteps,
+        SynthScenario::ServoHoldMove,
     ];
 
     /// Whether the run logs `air_speed_mps` (the ram air of the mission;
@@ -62,14 +75,30 @@ impl SynthScenario {
         self == SynthScenario::AirSteps
     }
 
+    /// Whether the run is a servo mission (piston moving, position logged).
+    pub fn is_servo(self) -> bool {
+        matches!(self, SynthScenario::Servo | SynthScenario::ServoProfile | SynthScenario::ServoHoldMove)
+    }
+
+    /// Logger interval of this scenario for a requested interval
+    /// `sample_s`, s: servo runs at most 0.5 s (faster logging would alias
+    /// the position, whose derivative drives the replay), the hold/move
+    /// manoeuvres (half-periods down to 1 s) at most 0.1 s.
+    pub fn log_interval_s(self, sample_s: f64) -> f64 {
+        match self {
+            SynthScenario::ServoHoldMove => sample_s.min(0.1),
+            s if s.is_servo() => sample_s.min(0.5),
+            _ => sample_s,
+        }
+    }
+
     /// Whether `hidden` can act at all in this scenario: Coulomb friction
     /// needs a moving piston (servo circuit); churning (∝ ω^2.5) needs the
     /// high shaft speeds of the throttle missions with speed steps. Other
     /// pairs are physically valid in every scenario.
     pub fn can_show(self, hidden: Candidate) -> bool {
-        let servo = matches!(self, SynthScenario::Servo | SynthScenario::ServoProfile);
         match hidden {
-            Candidate::CoulombFriction => servo,
+            Candidate::CoulombFriction => self.is_servo(),
             Candidate::ChurningLoss => matches!(self, SynthScenario::ThrottleSteps | SynthScenario::SpeedSweep),
             _ => true,
         }
@@ -216,6 +245,32 @@ fn mission(c: &SynthCase, rng: &mut ChaCha8Rng) -> Mission {
                 ..base
             }
         }
+        SynthScenario::ServoHoldMove => {
+            let (mut pts, mut t, mut hold) = (vec![(0.0, 0.0)], 0.0, rng.random_bool(0.5));
+            while t < d {
+                let t_seg = (t + rng.random_range(120.0..240.0)).min(d);
+                if hold {
+                    // 2 s ramp out, hold, 2 s ramp back to the centre.
+                    let x = rng.random_range(0.025..0.040) * if rng.random_bool(0.5) { 1.0 } else { -1.0 };
+                    pts.extend([(t + 2.0, x), ((t_seg - 2.0).max(t + 2.0), x), (t_seg.max(t + 4.0), 0.0)]);
+                    t = t_seg.max(t + 4.0);
+                } else {
+                    while t < t_seg {
+                        let (a, h) = (rng.random_range(0.015..0.025), rng.random_range(1.0..1.6));
+                        pts.extend([(t + h / 2.0, a), (t + 1.5 * h, -a), (t + 2.0 * h, 0.0)]);
+                        t += 2.0 * h;
+                    }
+                }
+                hold = !hold;
+            }
+            Mission {
+                circuit: Circuit::Servo,
+                speed_rpm: Schedule::constant(0.0),
+                needle_bar: Schedule::constant(0.0),
+                position: PositionRef::Profile(Schedule(pts)),
+                ..base
+            }
+        }
         SynthScenario::SpeedSweep => {
             let (mut ends, mut t) = (vec![], 0.0);
             while t < d {
@@ -318,11 +373,8 @@ pub fn generate(c: &SynthCase) -> Result<(MeasuredRun, Truth), String> {
     let mut rng = ChaCha8Rng::seed_from_u64(c.seed);
     let m = mission(c, &mut rng);
     let (rig, magnitude) = truth_rig(c, &mut rng);
-    // Servo runs move the piston at up to 0.3 Hz: log them at 0.5 s at most
-    // (the format's "0.1 s for sinusoidal runs"), else the logged position,
-    // whose derivative drives the replay, is aliased.
-    let servo = matches!(c.scenario, SynthScenario::Servo | SynthScenario::ServoProfile);
-    let sample = if servo { c.sample_s.min(0.5) } else { c.sample_s };
+    let servo = c.scenario.is_servo();
+    let sample = c.scenario.log_interval_s(c.sample_s);
     let opts = SimOptions { output_interval_s: sample, control_interval_s: sample.min(0.5) };
     let air = m.air_speed_mps.clone();
     let scenario = Scenario::Mission(m);
