@@ -61,7 +61,7 @@ fn check(cases: &[SynthCase]) {
 }
 
 use Mismatch::{Nuisance, Structure};
-use SynthScenario::{AirSteps, Case1Pressure, LoadCycles, ServoProfile, SpeedSweep, ThrottleSteps};
+use SynthScenario::{AirSteps, Case1Pressure, LoadCycles, ServoGust, ServoHoldMove, ServoProfile, SpeedSweep, ThrottleSteps};
 
 /// Dead-end oil sensor: a lag of minutes on t_oil_c, visible in any run.
 #[test]
@@ -102,12 +102,28 @@ fn hidden_viscosity_temperature_in_throttle_steps() {
     ]);
 }
 
-/// Coulomb seal friction: heat F·|v| in the actuator, carried to the oil by
-/// the tidal exchange. Servo missions with duty segments (brisk / slow
-/// motion) so that the friction heat changes in steps.
+/// Coulomb seal friction: heat F·|v| in the actuator body, carried to the
+/// oil by the tidal exchange. It needs servo missions in which the piston
+/// speed does not follow the load: holding a deflection against the spring
+/// alternating with manoeuvres about the centre (`ServoHoldMove`), and
+/// gust rejection about trims drawn independently of the gusts
+/// (`ServoGust`), both logged at 0.1 s. Measured: 722 N named at 667 N,
+/// t_oil_c 0.275 → 0.102 K (63 %); 968 N named at 1533 N, t_oil_c
+/// 0.247 → 0.106 K (57 %). 250–380 s per case.
 #[test]
-#[ignore = "measured miss: both cases named none. Nuisance case (554 N): 0.38 K imprint on t_oil_c, calibrated baseline already at 0.150 K, no candidate qualifies. Structure case (942 N): coulomb-friction fitted 565 N, dBIC 92, t_oil_c 0.280 -> ~0.11 K (61 %), but pooled held-out only 0.169 -> 0.142 K (16 % < 20 %). With faster brisk segments (half-period 1.5-3 s) both were named (56 % / 42 % on t_oil_c) but the 0.5 s logging aliases and the replay test fails (0.31 K). Slow: 300-600 s per servo case."]
 fn hidden_coulomb_friction_is_named() {
+    check(&[case("coulomb-friction", ServoHoldMove, Nuisance, 45), case("coulomb-friction", ServoGust, Nuisance, 47)]);
+}
+
+#[test]
+#[ignore = "measured miss: with per-node capacities off the baseline both named none. Hold/move (1198 N): coulomb-friction fitted 1399 N, dBIC 174, t_oil_c 0.326 -> 0.158 K (51 %), but t_motor_c 0.156 -> 0.278 K and t_pump_c 0.250 -> 0.276 K, pooled held-out 4 % < 20 %. Gusts (535 N): 0.46 K imprint, calibrated baseline already at 0.102 K on t_oil_c (coulomb dBIC 159, pooled 10 %). Slow: 300 s per case."]
+fn hidden_coulomb_friction_with_structure_mismatch() {
+    check(&[case("coulomb-friction", ServoHoldMove, Structure, 46), case("coulomb-friction", ServoGust, Structure, 48)]);
+}
+
+#[test]
+#[ignore = "measured miss: in ServoProfile (brisk and slow duty segments, logged at 0.5 s) the friction heat grows with the stroke together with the load losses. Nuisance case (554 N): 0.38 K imprint on t_oil_c, calibrated baseline already at 0.150 K, named none. Structure case (942 N): coulomb-friction fitted 565 N, dBIC 92, t_oil_c -61 %, but pooled held-out 16 % < 20 %: none. Slow: 300-600 s per case."]
+fn hidden_coulomb_friction_in_servo_profile() {
     check(&[case("coulomb-friction", ServoProfile, Nuisance, 41), case("coulomb-friction", ServoProfile, Structure, 42)]);
 }
 
@@ -164,12 +180,19 @@ fn no_hidden_effect_gives_none_when_structure_differs() {
     ]);
 }
 
-/// The same in a servo mission (no false Coulomb friction or churning).
-/// Passes (measured: none, best candidate ΔBIC < 1), ignored only because a
-/// servo replay diagnosis takes 100–300 s.
+/// The same in the servo missions that name Coulomb friction: no false
+/// Coulomb friction or churning (measured: none; best candidate ΔBIC 13.7
+/// (hold/move, Coulomb 174 N) and −4.0 (gusts)).
+#[test]
+fn no_hidden_effect_gives_none_in_servo_when_structure_differs() {
+    check(&[case("none", ServoHoldMove, Structure, 89), case("none", ServoGust, Structure, 91)]);
+}
+
+/// And in the brisk/slow servo profile. Passes (measured: none, best
+/// candidate ΔBIC < 1), ignored only because this replay takes 100–300 s.
 #[test]
 #[ignore = "slow: servo replay, 100-300 s"]
-fn no_hidden_effect_gives_none_in_servo_when_structure_differs() {
+fn no_hidden_effect_gives_none_in_servo_profile_when_structure_differs() {
     check(&[case("none", ServoProfile, Structure, 83)]);
 }
 
@@ -184,17 +207,15 @@ fn large_hidden_effect_sweep() {
     check(&cases);
 }
 
+
 #[test]
 #[ignore]
-fn probe_hold_move() {
-    use SynthScenario::ServoHoldMove;
-    let which = std::env::var("PROBE").unwrap_or_default();
-    let all = [
-        case("coulomb-friction", ServoHoldMove, Nuisance, 45),
-        case("coulomb-friction", ServoHoldMove, Structure, 46),
-        case("none", ServoHoldMove, Structure, 89),
-        case("none", ServoHoldMove, Nuisance, 90),
-    ];
-    let sel: Vec<SynthCase> = all.iter().enumerate().filter(|(i, _)| which.is_empty() || which.contains(&i.to_string())).map(|(_, c)| *c).collect();
-    check(&sel);
+fn probe_viscosity() {
+    use SynthScenario::PressureSpeedSteps;
+    check(&[
+        case("viscosity-temperature", PressureSpeedSteps, Nuisance, 25),
+        case("viscosity-temperature", PressureSpeedSteps, Structure, 26),
+        case("none", PressureSpeedSteps, Nuisance, 92),
+        case("none", PressureSpeedSteps, Structure, 93),
+    ]);
 }

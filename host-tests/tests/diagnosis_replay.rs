@@ -3,7 +3,8 @@
 //! scenario, the generator's own rig replayed from the logged inputs must
 //! match the logged temperatures to within 0.3 K RMS per channel: the logged
 //! data carry σ = 0.1 K noise plus 12-bit quantisation (0.049 K LSB), and the
-//! inputs are logged every 2 s (servo runs 0.5 s) and interpolated linearly.
+//! inputs are logged every 2 s (servo runs 0.5 s, the hold/move and gust
+//! missions 0.1 s) and interpolated linearly.
 //! With servo runs logged at 2 s (below Nyquist for the 0.3 Hz piston
 //! motion) this test failed at 0.314 K on the oil sensor; hence the 0.5 s.
 

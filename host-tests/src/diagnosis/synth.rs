@@ -50,6 +50,24 @@ pub enum SynthScenario {
     /// the stroke). Logged at 0.1 s (the format's interval for sinusoidal
     /// runs): the replay takes the piston speed from the logged position.
     ServoHoldMove,
+    /// Servo mission of a trimmed surface in gusts: duty segments of
+    /// 120–240 s, each at its own trim deflection (−25…25 mm, held against
+    /// the spring), alternately calm (the piston still at the trim) and
+    /// gusty (the position loop rejecting gusts: triangles of 10–18 mm about
+    /// the trim, half-period 0.7–1.2 s, piston speed 0.02–0.05 m/s). The
+    /// load losses follow the trim, the friction heat F·|v| the gusts, and
+    /// the two are drawn independently. Logged at 0.1 s. (First drawn with
+    /// 4–8 mm gusts about trims of ±35 mm: 0.01–0.03 m/s left an imprint of
+    /// 0.18–0.24 K on t_oil_c, which the calibration took up: both Coulomb
+    /// cases named `none`.)
+    ServoGust,
+    /// Throttle mission at high pressure with speed steps: the needle set
+    /// for a drop of 70–100 bar (drawn once) at every speed, the shaft
+    /// speed stepping between 500 and 1200 rpm every 120–240 s. The heat
+    /// Δp·D·ω steps with the speed while the leakage part (∝ Δp²/μ) does
+    /// not, and the oil warms by tens of kelvin, so a leakage that grows as
+    /// the oil thins shows against the speed steps.
+    PressureSpeedSteps,
     /// Case 1 (500 rpm, needle 40–60 bar) with logged ram-air steps: the
     /// air speed over the housings (`air_speed_mps`, logged) alternates
     /// between still air and 10–25 m/s every 150–300 s (Table 5 ram air).
@@ -58,7 +76,7 @@ pub enum SynthScenario {
 
 impl SynthScenario {
     /// Every scenario.
-    pub const ALL: [SynthScenario; 8] = [
+    pub const ALL: [SynthScenario; 10] = [
         SynthScenario::Case1Pressure,
         SynthScenario::Servo,
         SynthScenario::ThrottleSteps,
@@ -67,6 +85,8 @@ impl SynthScenario {
         SynthScenario::LoadCycles,
         SynthScenario::AirSteps,
         SynthScenario::ServoHoldMove,
+        SynthScenario::ServoGust,
+        SynthScenario::PressureSpeedSteps,
     ];
 
     /// Whether the run logs `air_speed_mps` (the ram air of the mission;
@@ -77,7 +97,10 @@ impl SynthScenario {
 
     /// Whether the run is a servo mission (piston moving, position logged).
     pub fn is_servo(self) -> bool {
-        matches!(self, SynthScenario::Servo | SynthScenario::ServoProfile | SynthScenario::ServoHoldMove)
+        matches!(
+            self,
+            SynthScenario::Servo | SynthScenario::ServoProfile | SynthScenario::ServoHoldMove | SynthScenario::ServoGust
+        )
     }
 
     /// Logger interval of this scenario for a requested interval
@@ -86,7 +109,7 @@ impl SynthScenario {
     /// manoeuvres (half-periods down to 1 s) at most 0.1 s.
     pub fn log_interval_s(self, sample_s: f64) -> f64 {
         match self {
-            SynthScenario::ServoHoldMove => sample_s.min(0.1),
+            SynthScenario::ServoHoldMove | SynthScenario::ServoGust => sample_s.min(0.1),
             s if s.is_servo() => sample_s.min(0.5),
             _ => sample_s,
         }
@@ -99,7 +122,9 @@ impl SynthScenario {
     pub fn can_show(self, hidden: Candidate) -> bool {
         match hidden {
             Candidate::CoulombFriction => self.is_servo(),
-            Candidate::ChurningLoss => matches!(self, SynthScenario::ThrottleSteps | SynthScenario::SpeedSweep),
+            Candidate::ChurningLoss => {
+                matches!(self, SynthScenario::ThrottleSteps | SynthScenario::SpeedSweep | SynthScenario::PressureSpeedSteps)
+            }
             _ => true,
         }
     }
@@ -271,6 +296,34 @@ fn mission(c: &SynthCase, rng: &mut ChaCha8Rng) -> Mission {
                 ..base
             }
         }
+        SynthScenario::ServoGust => {
+            let (mut pts, mut t, mut gusty) = (vec![(0.0, 0.0)], 0.0, rng.random_bool(0.5));
+            while t < d {
+                let t_seg = (t + rng.random_range(120.0..240.0)).min(d);
+                // 3 s move to the segment's trim, then calm or gusts about it.
+                let x1 = rng.random_range(-0.025..0.025);
+                pts.push((t + 3.0, x1));
+                t += 3.0;
+                while t < t_seg {
+                    if gusty {
+                        let (a, h) = (rng.random_range(0.010..0.018), rng.random_range(0.7..1.2));
+                        pts.extend([(t + h / 2.0, x1 + a), (t + 1.5 * h, x1 - a), (t + 2.0 * h, x1)]);
+                        t += 2.0 * h;
+                    } else {
+                        t = t_seg;
+                        pts.push((t, x1));
+                    }
+                }
+                gusty = !gusty;
+            }
+            Mission {
+                circuit: Circuit::Servo,
+                speed_rpm: Schedule::constant(0.0),
+                needle_bar: Schedule::constant(0.0),
+                position: PositionRef::Profile(Schedule(pts)),
+                ..base
+            }
+        }
         SynthScenario::SpeedSweep => {
             let (mut ends, mut t) = (vec![], 0.0);
             while t < d {
@@ -290,6 +343,19 @@ fn mission(c: &SynthCase, rng: &mut ChaCha8Rng) -> Mission {
                 sp.extend([(t, n), (t1, n)]);
                 nb.extend([(t, setting), (t1, setting)]);
                 (t, high) = (t1, !high);
+            }
+            Mission { speed_rpm: Schedule(sp), needle_bar: Schedule(nb), ..base }
+        }
+        SynthScenario::PressureSpeedSteps => {
+            let p = rng.random_range(70.0..100.0);
+            let (mut sp, mut nb, mut t) = (vec![], vec![], 0.0);
+            while t < d {
+                let t1 = (t + rng.random_range(120.0..240.0)).min(d);
+                let n: f64 = rng.random_range(500.0..1200.0);
+                let setting = p * (500.0 / n).powi(2);
+                sp.extend([(t, n), (t1, n)]);
+                nb.extend([(t, setting), (t1, setting)]);
+                t = t1;
             }
             Mission { speed_rpm: Schedule(sp), needle_bar: Schedule(nb), ..base }
         }
