@@ -61,7 +61,10 @@ fn check(cases: &[SynthCase]) {
 }
 
 use Mismatch::{Nuisance, Structure};
-use SynthScenario::{AirSteps, Case1Pressure, LoadCycles, ServoGust, ServoHoldMove, ServoProfile, SpeedSweep, ThrottleSteps};
+use SynthScenario::{
+    AirSteps, Case1Pressure, LoadCycles, PressureSpeedSteps, ServoGust, ServoHoldMove, ServoProfile, SpeedSweep,
+    ThrottleSteps,
+};
 
 /// Dead-end oil sensor: a lag of minutes on t_oil_c, visible in any run.
 #[test]
@@ -83,13 +86,16 @@ fn hidden_winding_resistance_temperature_is_named() {
 /// Viscosity following the oil temperature: leakage heat (∝ Δp²/μ(T)) moves
 /// from the throttle to the pump case as the oil warms, and the oil film
 /// conductances change. Needs high pressure while the oil warms: load
-/// cycles to 70–100 bar. In Case 1 (≤ 60 bar) and in the random throttle
+/// cycles to 70–100 bar, and speed steps at a 70–100 bar drop
+/// (`PressureSpeedSteps`). In Case 1 (≤ 60 bar) and in the random throttle
 /// steps the nuisance calibration absorbs it (see the ignored test below).
 #[test]
 fn hidden_viscosity_temperature_is_named() {
     check(&[
         case("viscosity-temperature", LoadCycles, Nuisance, 21),
         case("viscosity-temperature", LoadCycles, Structure, 22),
+        case("viscosity-temperature", PressureSpeedSteps, Nuisance, 25),
+        case("viscosity-temperature", PressureSpeedSteps, Structure, 26),
     ]);
 }
 
@@ -165,6 +171,7 @@ fn no_hidden_effect_gives_none_when_only_nuisance_differs() {
         case("none", Case1Pressure, Nuisance, 81),
         case("none", ThrottleSteps, Nuisance, 82),
         case("none", LoadCycles, Nuisance, 85),
+        case("none", PressureSpeedSteps, Nuisance, 92),
     ]);
 }
 
@@ -178,6 +185,12 @@ fn no_hidden_effect_gives_none_when_structure_differs() {
         case("none", LoadCycles, Structure, 86),
         case("none", AirSteps, Structure, 88),
     ]);
+}
+
+#[test]
+#[ignore = "measured false discovery: high-pressure speed steps (70-100 bar, 500-1200 rpm) with per-node capacities off the baseline and nothing hidden are named churning-loss (9e-4 W/(rad/s)^2.5, dBIC 1173, pooled held-out 0.928 -> 0.318 K, t_block_c 1.41 -> 0.38 K): the oil and blocks warm by tens of kelvin, the capacity errors leave ~1 K on the housings, and a speed-dependent pump heat fits them"]
+fn no_hidden_effect_in_high_pressure_speed_steps_with_structure_mismatch() {
+    check(&[case("none", PressureSpeedSteps, Structure, 93)]);
 }
 
 /// The same in the servo missions that name Coulomb friction: no false
@@ -208,14 +221,3 @@ fn large_hidden_effect_sweep() {
 }
 
 
-#[test]
-#[ignore]
-fn probe_viscosity() {
-    use SynthScenario::PressureSpeedSteps;
-    check(&[
-        case("viscosity-temperature", PressureSpeedSteps, Nuisance, 25),
-        case("viscosity-temperature", PressureSpeedSteps, Structure, 26),
-        case("none", PressureSpeedSteps, Nuisance, 92),
-        case("none", PressureSpeedSteps, Structure, 93),
-    ]);
-}

@@ -66,7 +66,9 @@ pub enum SynthScenario {
     /// speed stepping between 500 and 1200 rpm every 120–240 s. The heat
     /// Δp·D·ω steps with the speed while the leakage part (∝ Δp²/μ) does
     /// not, and the oil warms by tens of kelvin, so a leakage that grows as
-    /// the oil thins shows against the speed steps.
+    /// the oil thins shows against the speed steps. (Also drawn at 50–80 bar
+    /// and 400–900 rpm: viscosity was then named `none` in the nuisance case,
+    /// 46 % on t_oil_c and 3 % pooled.)
     PressureSpeedSteps,
     /// Case 1 (500 rpm, needle 40–60 bar) with logged ram-air steps: the
     /// air speed over the housings (`air_speed_mps`, logged) alternates
