@@ -138,8 +138,7 @@ pub struct SweepArgs {
 pub fn sweep_cases(a: &SweepArgs) -> Vec<SynthCase> {
     let mut v = Vec::new();
     for hidden in Candidate::EXTENSIONS.into_iter().chain([Candidate::None]) {
-        let servo = |s: &SynthScenario| s.is_servo();
-        for scenario in SynthScenario::ALL.into_iter().filter(|s| s.can_show(hidden) && !(a.no_servo && servo(s))) {
+        for scenario in SynthScenario::ALL.into_iter().filter(|s| s.can_show(hidden) && !(a.no_servo && s.is_servo())) {
             for mismatch in [Mismatch::Nuisance, Mismatch::Structure] {
                 for seed in 0..a.seeds {
                     v.push(SynthCase { hidden, scenario, mismatch, seed: 1000 + seed, duration_s: a.duration, sample_s: a.sample });

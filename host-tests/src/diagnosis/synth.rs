@@ -106,9 +106,9 @@ impl SynthScenario {
     }
 
     /// Logger interval of this scenario for a requested interval
-    /// `sample_s`, s: servo runs at most 0.5 s (faster logging would alias
+    /// `sample_s`, s: servo runs at most 0.5 s (slower logging would alias
     /// the position, whose derivative drives the replay), the hold/move
-    /// manoeuvres (half-periods down to 1 s) at most 0.1 s.
+    /// and gust missions (half-periods down to 0.7 s) at most 0.1 s.
     pub fn log_interval_s(self, sample_s: f64) -> f64 {
         match self {
             SynthScenario::ServoHoldMove | SynthScenario::ServoGust => sample_s.min(0.1),
@@ -257,20 +257,11 @@ fn mission(c: &SynthCase, rng: &mut ChaCha8Rng) -> Mission {
                     } else {
                         (rng.random_range(0.005..0.012), rng.random_range(3.0..6.0))
                     };
-                    pts.push((t + h / 2.0, a));
-                    pts.push((t + 1.5 * h, -a));
-                    pts.push((t + 2.0 * h, 0.0));
-                    t += 2.0 * h;
+                    t = triangle(&mut pts, t, 0.0, a, h);
                 }
                 brisk = !brisk;
             }
-            Mission {
-                circuit: Circuit::Servo,
-                speed_rpm: Schedule::constant(0.0),
-                needle_bar: Schedule::constant(0.0),
-                position: PositionRef::Profile(Schedule(pts)),
-                ..base
-            }
+            servo_mission(pts, base)
         }
         SynthScenario::ServoHoldMove => {
             let (mut pts, mut t, mut hold) = (vec![(0.0, 0.0)], 0.0, rng.random_bool(0.5));
@@ -284,19 +275,12 @@ fn mission(c: &SynthCase, rng: &mut ChaCha8Rng) -> Mission {
                 } else {
                     while t < t_seg {
                         let (a, h) = (rng.random_range(0.015..0.025), rng.random_range(1.0..1.6));
-                        pts.extend([(t + h / 2.0, a), (t + 1.5 * h, -a), (t + 2.0 * h, 0.0)]);
-                        t += 2.0 * h;
+                        t = triangle(&mut pts, t, 0.0, a, h);
                     }
                 }
                 hold = !hold;
             }
-            Mission {
-                circuit: Circuit::Servo,
-                speed_rpm: Schedule::constant(0.0),
-                needle_bar: Schedule::constant(0.0),
-                position: PositionRef::Profile(Schedule(pts)),
-                ..base
-            }
+            servo_mission(pts, base)
         }
         SynthScenario::ServoGust => {
             let (mut pts, mut t, mut gusty) = (vec![(0.0, 0.0)], 0.0, rng.random_bool(0.5));
@@ -309,8 +293,7 @@ fn mission(c: &SynthCase, rng: &mut ChaCha8Rng) -> Mission {
                 while t < t_seg {
                     if gusty {
                         let (a, h) = (rng.random_range(0.010..0.018), rng.random_range(0.7..1.2));
-                        pts.extend([(t + h / 2.0, x1 + a), (t + 1.5 * h, x1 - a), (t + 2.0 * h, x1)]);
-                        t += 2.0 * h;
+                        t = triangle(&mut pts, t, x1, a, h);
                     } else {
                         t = t_seg;
                         pts.push((t, x1));
@@ -318,13 +301,7 @@ fn mission(c: &SynthCase, rng: &mut ChaCha8Rng) -> Mission {
                 }
                 gusty = !gusty;
             }
-            Mission {
-                circuit: Circuit::Servo,
-                speed_rpm: Schedule::constant(0.0),
-                needle_bar: Schedule::constant(0.0),
-                position: PositionRef::Profile(Schedule(pts)),
-                ..base
-            }
+            servo_mission(pts, base)
         }
         SynthScenario::SpeedSweep => {
             let (mut ends, mut t) = (vec![], 0.0);
@@ -341,7 +318,7 @@ fn mission(c: &SynthCase, rng: &mut ChaCha8Rng) -> Mission {
             while t < d {
                 let t1 = (t + rng.random_range(120.0..240.0)).min(d);
                 let p = if high { rng.random_range(70.0..100.0) } else { rng.random_range(10.0..30.0) };
-                let setting = p * (500.0 / n) * (500.0 / n);
+                let setting = needle_setting(p, n);
                 sp.extend([(t, n), (t1, n)]);
                 nb.extend([(t, setting), (t1, setting)]);
                 (t, high) = (t1, !high);
@@ -354,7 +331,7 @@ fn mission(c: &SynthCase, rng: &mut ChaCha8Rng) -> Mission {
             while t < d {
                 let t1 = (t + rng.random_range(120.0..240.0)).min(d);
                 let n: f64 = rng.random_range(500.0..1200.0);
-                let setting = p * (500.0 / n).powi(2);
+                let setting = needle_setting(p, n);
                 sp.extend([(t, n), (t1, n)]);
                 nb.extend([(t, setting), (t1, setting)]);
                 t = t1;
@@ -378,6 +355,33 @@ fn mission(c: &SynthCase, rng: &mut ChaCha8Rng) -> Mission {
     }
 }
 
+/// One triangle of the position reference about `centre` (m): up by
+/// `a` (m) at `t + h/2`, down to `centre − a` at `t + 3h/2`, back to the
+/// centre at `t + 2h` (`h` the half-period, s). Returns its end time, s.
+fn triangle(pts: &mut Vec<(f64, f64)>, t: f64, centre: f64, a: f64, h: f64) -> f64 {
+    pts.extend([(t + h / 2.0, centre + a), (t + 1.5 * h, centre - a), (t + 2.0 * h, centre)]);
+    t + 2.0 * h
+}
+
+/// A servo-circuit mission following the piecewise-linear position
+/// reference `pts` (time s, position m), the rest as `base`.
+fn servo_mission(pts: Vec<(f64, f64)>, base: Mission) -> Mission {
+    Mission {
+        circuit: Circuit::Servo,
+        speed_rpm: Schedule::constant(0.0),
+        needle_bar: Schedule::constant(0.0),
+        position: PositionRef::Profile(Schedule(pts)),
+        ..base
+    }
+}
+
+/// Needle setting (its drop at the 500 rpm flow, bar) that gives a drop of
+/// `dp` bar at `n` rpm: the needle is an orifice
+/// (`eha_sim::hydraulics::needle_k`), so the drop scales with n².
+fn needle_setting(dp: f64, n: f64) -> f64 {
+    dp * (500.0 / n).powi(2)
+}
+
 /// Speed and needle schedules of piecewise-constant segments ending at
 /// `ends` (times, s): each segment draws a speed (rpm) in `speed` and a
 /// needle pressure drop at that speed (bar) in `dp`. The needle is an
@@ -388,7 +392,7 @@ fn steps(ends: &[(f64, f64)], rng: &mut ChaCha8Rng, speed: (f64, f64), dp: (f64,
     let (mut sp, mut nb, mut t0) = (vec![], vec![], 0.0);
     for &(t1, _) in ends {
         let (n, p) = (rng.random_range(speed.0..speed.1), rng.random_range(dp.0..dp.1));
-        let setting = p * (500.0 / n).powi(2);
+        let setting = needle_setting(p, n);
         sp.extend([(t0, n), (t1, n)]);
         nb.extend([(t0, setting), (t1, setting)]);
         t0 = t1;
