@@ -25,6 +25,7 @@ pub mod network;
 pub mod pil;
 pub mod plant;
 pub mod plot;
+pub mod reduce;
 pub mod rig;
 pub mod scenario;
 pub mod sim;

@@ -219,6 +219,15 @@ impl Num for Fx {
         let p = self.to_bits() as i64 * k as i64;
         sat_i32((p + (1 << 22)) >> 23)
     }
+    #[inline(always)]
+    fn split_floor(self) -> (i32, Self) {
+        let b = self.to_bits();
+        if b < 0 {
+            (0, Fx::ZERO)
+        } else {
+            (b >> 23, Fx::from_bits(b & 0x007f_ffff))
+        }
+    }
 }
 
 #[cfg(test)]

@@ -79,6 +79,9 @@ pub trait Num: Copy + PartialOrd + core::fmt::Debug {
     ) -> Self::State;
     /// `round(self · k)` as an integer (saturating; NaN → 0).
     fn round_times(self, k: i32) -> i32;
+    /// `(floor(x), x - floor(x))` for finite `x >= 0`; `(0, 0)` for negative or NaN
+    /// input; saturates the integer part at `i32::MAX` (fraction then 0).
+    fn split_floor(self) -> (i32, Self);
 }
 
 impl Num for f64 {
@@ -160,6 +163,16 @@ impl Num for f64 {
     }
     fn round_times(self, k: i32) -> i32 {
         libm::round(self * k as f64) as i32
+    }
+    fn split_floor(self) -> (i32, Self) {
+        if self >= 0.0 && self < i32::MAX as f64 {
+            let i = libm::floor(self);
+            (i as i32, self - i)
+        } else if self >= i32::MAX as f64 {
+            (i32::MAX, 0.0)
+        } else {
+            (0, 0.0)
+        }
     }
 }
 
@@ -292,6 +305,18 @@ impl Num for f32 {
         let y = self * k as f32;
         // `as` saturates and maps NaN to 0; round half away from zero.
         (if y >= 0.0 { y + 0.5 } else { y - 0.5 }) as i32
+    }
+    #[inline(always)]
+    fn split_floor(self) -> (i32, Self) {
+        if (0.0..2.0e9).contains(&self) {
+            // truncation is the floor for non-negative values
+            let i = self as i32;
+            (i, self - i as f32)
+        } else if self >= 2.0e9 {
+            (i32::MAX, 0.0)
+        } else {
+            (0, 0.0)
+        }
     }
 }
 

@@ -1,0 +1,315 @@
+//! Reduction of the reference model to the firmware's reduced-order model
+//! ([`eha_guard::rom::RomParams`]): every parameter is computed from the rig, none
+//! is fitted (docs/reduction.md).
+//!
+//! 1. **States.** The reference's 12 thermal nodes: the motor's winding and
+//!    housing have no thermal path to the pump side (the `motor-pump-conduction`
+//!    extension is off in the baseline), so they leave the state; the inlet and
+//!    outlet port passages, the ball-valve oil and the sensor pocket (≤ 0.085 kJ/K
+//!    against ≈ 0.26 kW/K of circulation, time constants ≈ 0.3 s) become
+//!    quasi-steady links of the oil ring. Six states remain: pump housing, case
+//!    (drain) oil, loop oil, main block, ball-valve block, actuator body.
+//! 2. **Capacities** from the rig's masses and specific heats; the oil's from its
+//!    volumes with `rho c_p(T)` evaluated in the firmware.
+//! 3. **Losses** (eqs. 1-11): the same coefficients as the reference (gap
+//!    conductance at 40 °C, `eta_m`, the outlet share, the throttle path's laminar and
+//!    local resistances, the actuator's leakage and seal friction, R, iron terms).
+//! 4. **Conductances** (eqs. 12-14, 18, 20-22): the reference's correlations with
+//!    oil properties at 40 °C, tabulated over flow (or shaft speed for the case oil)
+//!    on [`N_TABLE`] points uniform in `sqrt(q)`.
+//! 5. **Outer surfaces** (eqs. 15, 16, 19): the free-convection coefficient of each
+//!    surface fitted as `h = c0 + c1 |ΔT|^(1/4)` over ΔT ∈ [0.05, 40] K at 20 °C air
+//!    ([`fit_free_convection`]); radiation `eps sigma A` exact, linearised in the
+//!    firmware about the mean of wall and air. Ram air is not an input.
+//! 6. **Discretisation**: the nominal Jacobian `A` of the reduced model itself at
+//!    500 rpm, 30 bar, all nodes at 40 °C in 20 °C air, by central differences
+//!    ([`nominal_jacobian`]); the firmware builds `Phi = h phi1(h A)` from it.
+
+use crate::heat;
+use crate::network::{self, Shape};
+use crate::rig::Rig;
+use eha_guard::rom::{Model, RomParams, TickInput, HBAR_PER_BAR, HRADS_PER_RPM, N_NODES, N_TABLE};
+use std::f64::consts::PI;
+
+/// Shaft speed of the last table point, rpm (the guard's speed range limit).
+pub const TABLE_MAX_RPM: f64 = 6000.0;
+/// Oil temperature at which the film correlations are evaluated, °C.
+pub const FILM_PROPERTY_C: f64 = 40.0;
+/// Air temperature of the free-convection fit, °C.
+pub const FIT_AIR_C: f64 = 20.0;
+
+/// Grid point `j` of a table ending at `x_max`: `x_max (j / (N_TABLE - 1))^2`.
+pub fn grid(x_max: f64, j: usize) -> f64 {
+    let u = j as f64 / (N_TABLE - 1) as f64;
+    x_max * u * u
+}
+
+fn table(x_max: f64, f: impl Fn(f64) -> f64) -> [f64; N_TABLE] {
+    let mut t = [0.0; N_TABLE];
+    for (j, v) in t.iter_mut().enumerate() {
+        *v = f(grid(x_max, j));
+    }
+    t
+}
+
+/// Least-squares fit of `h(ΔT) = c0 + c1 ΔT^(1/4)` to a free-convection law over
+/// ΔT ∈ [0.05, 40] K (log-spaced) at [`FIT_AIR_C`]; returns `(c0, c1)` with
+/// `c0 >= 0` (refitted as `c1 ΔT^(1/4)` alone when the two-term fit gives `c0 < 0`).
+pub fn fit_free_convection(h: impl Fn(f64) -> f64) -> (f64, f64) {
+    let (mut s11, mut s12, mut s22, mut b1, mut b2) = (0.0, 0.0, 0.0, 0.0, 0.0);
+    let mut dt = 0.05;
+    while dt <= 40.0 {
+        let y = h(dt);
+        let x = dt.powf(0.25);
+        s11 += 1.0;
+        s12 += x;
+        s22 += x * x;
+        b1 += y;
+        b2 += y * x;
+        dt *= 1.05;
+    }
+    let det = s11 * s22 - s12 * s12;
+    let c0 = (b1 * s22 - b2 * s12) / det;
+    if c0 >= 0.0 {
+        (c0, (s11 * b2 - s12 * b1) / det)
+    } else {
+        // h must stay positive down to dT -> 0: the one-term law c1 dT^(1/4)
+        (0.0, b2 / s22)
+    }
+}
+
+/// The reduced parameters of `rig` (steps 1-5); the Jacobian is left at zero.
+pub fn reduce_without_jacobian(rig: &Rig) -> RomParams {
+    let oil = &rig.oil;
+    let p = &rig.pump;
+    let b = &rig.blocks;
+    let a = &rig.actuator;
+    let m = &rig.motor;
+    let ms = rig.nuisance.metal_capacity_scale;
+    let rho = oil.rho(40.0, 0.0) * rig.nuisance.oil_capacity_scale;
+    let nu = oil.nu_m2_per_s(FILM_PROPERTY_C);
+    let d = rig.displacement_m3_per_rad();
+    let w_max = TABLE_MAX_RPM * PI / 30.0;
+    let q_max = d * w_max;
+    let duct = |q: f64, dd: f64, len: f64, scale: f64| network::duct_conductance(rig, q, dd, len, scale, FILM_PROPERTY_C, nu);
+    let case_area = PI * p.case_gap_m * p.case_gap_m * 10.0;
+    let g_case = table(w_max, |w| {
+        let q_rot = w * p.rotor_radius_m * PI * 0.25 * p.case_gap_m * p.case_gap_m;
+        duct(q_rot, p.case_gap_m, p.case_gap_m * 10.0, 1.0) / case_area * p.case_wetted_m2
+    });
+    let g_port = table(q_max, |q| duct(q, p.port_d_m, p.port_len_m, p.port_area_scale));
+    let g_loop = table(q_max, |q| network::block_path(rig, duct(q, b.loop_d_m, b.loop_len_m, b.loop_area_scale), b.main_area_m2));
+    let g_ball = table(q_max, |q| network::block_path(rig, duct(q, b.ball_d_m, b.ball_len_m, 1.0), b.ball_area_m2));
+    let rho_cp40 = rho * oil.cp(40.0);
+    let t_ref = 100.0;
+    let g_lng = table(q_max, |q| rig.lng.exchanger_w(rho_cp40 * q, t_ref) / (t_ref - rig.lng.inlet_c));
+    // outer surfaces of the pump, main block, ball block, actuator
+    let side = |area: f64| (area / 6.0).sqrt();
+    let surfaces = [
+        (p.area_m2, Shape::Cylinder(p.diameter_m)),
+        (b.main_area_m2, Shape::Cube(side(b.main_area_m2))),
+        (b.ball_area_m2, Shape::Cube(side(b.ball_area_m2))),
+        (a.area_m2, Shape::Cylinder(a.diameter_m)),
+    ];
+    let mut outer_w_per_k = [0.0; 4];
+    let mut outer_quarter = [0.0; 4];
+    let mut outer_rad = [0.0; 4];
+    let os = rig.nuisance.outer_scale;
+    for (i, (area, shape)) in surfaces.iter().enumerate() {
+        let (c0, c1) = fit_free_convection(|dt| network::h_outer(rig, *shape, FIT_AIR_C + dt, FIT_AIR_C, 0.0));
+        outer_w_per_k[i] = c0 * area * os;
+        outer_quarter[i] = c1 * area * os;
+        outer_rad[i] = heat::SIGMA_W_PER_M2_K4 * rig.outside.emissivity * area * os;
+    }
+    let line = &rig.hydraulics.path;
+    let la = line.area_m2();
+    let fe = &m.iron;
+    let c = fe.pole_pairs / (2.0 * PI);
+    let k_mu = if rig.ext.viscosity_temperature {
+        // K ∝ 1/mu: d ln K / dT at the reference temperature (central difference)
+        let k = |t: f64| p.gaps.conductance(oil.mu_pa_s(t)).ln();
+        (k(41.0) - k(39.0)) / 2.0
+    } else {
+        0.0
+    };
+    RomParams {
+        pump_j_per_k: p.mass_kg * ms * p.cp,
+        main_block_j_per_k: b.main_mass_kg * ms * b.cp,
+        ball_block_j_per_k: b.ball_mass_kg * ms * b.cp,
+        actuator_j_per_k: a.body_mass_kg * ms * a.body_cp,
+        case_oil_m3: p.case_oil_m3,
+        loop_oil_m3: b.loop_oil_m3 + b.sensor_oil_m3,
+        port_oil_m3: p.port_oil_m3,
+        ball_oil_m3: b.ball_oil_m3,
+        rho_kg_per_m3: rho,
+        cp20_j_per_kg_k: oil.cp20_j_per_kg_k,
+        cp_slope_j_per_kg_k2: oil.cp_slope_j_per_kg_k2,
+        displacement_m3_per_rad: d,
+        eta_m: p.eta_m,
+        mech_to_outlet: p.mech_to_outlet,
+        k_leak_m3_per_s_pa: p.gaps.conductance(oil.mu_pa_s(40.0)),
+        case_pressure_pa: rig.hydraulics.accumulator_pa,
+        k_mu_per_k: k_mu,
+        t_mu_ref_c: 40.0,
+        line_r1_pa_s_per_m3: 128.0 * nu * rho * line.length_m / (PI * line.diameter_m.powi(4)),
+        line_r2_pa_s2_per_m6: rho * line.local_loss_coeff / (2.0 * la * la),
+        ram_area_m2: a.ram_area_m2,
+        act_leak_m3_per_s_pa: a.leak_m3_per_s_pa,
+        act_friction_n_s_per_m: a.viscous_friction_n_s_per_m,
+        phases: m.phases,
+        r_ohm: m.r25_ohm,
+        k_fe1_w_s_per_rad: fe.k_h * fe.b_peak_t * fe.b_peak_t * c,
+        k_fe2_w_s2_per_rad2: fe.k_c * fe.b_peak_t * fe.b_peak_t * c * c,
+        k_fe15_w_per_rad15: fe.k_e * (fe.b_peak_t * c).powf(1.5),
+        speed_table_max_rad_s: w_max,
+        flow_table_max_m3_per_s: q_max,
+        g_case_w_per_k: g_case,
+        g_port_w_per_k: g_port,
+        g_loop_block_w_per_k: g_loop,
+        g_ball_block_w_per_k: g_ball,
+        g_lng_w_per_k: g_lng,
+        lng_inlet_c: rig.lng.inlet_c,
+        outer_w_per_k,
+        outer_quarter_w_per_k125: outer_quarter,
+        outer_rad_w_per_k4: outer_rad,
+        nominal_jacobian_per_s: [[0.0; N_NODES]; N_NODES],
+    }
+}
+
+/// Nominal operating point of the Jacobian: 500 rpm, 30 bar across the pump
+/// (port A 35 bar, B at the 5 bar case pressure), no piston motion, 20 °C air.
+pub fn nominal_input() -> TickInput<f64> {
+    TickInput {
+        current_ha: 0.0,
+        p_a_hbar: 35.0 * HBAR_PER_BAR,
+        p_b_hbar: 5.0 * HBAR_PER_BAR,
+        speed_hrads: 500.0 * HRADS_PER_RPM,
+        dpos_mm: 0.0,
+        ambient_c: FIT_AIR_C,
+    }
+}
+
+/// Jacobian of the reduced model's right-hand side at [`nominal_input`] with every
+/// node at 40 °C (central differences of ±0.01 K), 1/s.
+pub fn nominal_jacobian(p: &RomParams) -> Option<[[f64; N_NODES]; N_NODES]> {
+    let model = Model::<f64>::new(p).ok()?;
+    let u = nominal_input();
+    let t0 = [40.0; N_NODES];
+    let h = 0.01;
+    let mut a = [[0.0; N_NODES]; N_NODES];
+    for j in 0..N_NODES {
+        let (mut tp, mut tm) = (t0, t0);
+        tp[j] += h;
+        tm[j] -= h;
+        let fp = model.derivative(&tp, &u, false);
+        let fm = model.derivative(&tm, &u, false);
+        for i in 0..N_NODES {
+            a[i][j] = (fp[i] - fm[i]) / (2.0 * h);
+        }
+    }
+    Some(a)
+}
+
+/// The whole reduction (steps 1-6). `None` if the rig gives parameters the firmware
+/// model rejects.
+pub fn reduce(rig: &Rig) -> Option<RomParams> {
+    let mut p = reduce_without_jacobian(rig);
+    p.nominal_jacobian_per_s = nominal_jacobian(&p)?;
+    Model::<f64>::new(&p).ok()?;
+    Some(p)
+}
+
+fn lit(x: f64) -> String {
+    let s = format!("{x:?}");
+    if s.contains('.') || s.contains('e') || s.contains("inf") || s.contains("NaN") {
+        s
+    } else {
+        format!("{s}.0")
+    }
+}
+
+fn row(r: &[f64]) -> String {
+    format!("[{}]", r.iter().map(|x| lit(*x)).collect::<Vec<_>>().join(", "))
+}
+
+/// The `DEFAULT` constant of `src/rom/params.rs` (doc comment and item) for `p`.
+pub fn render_params_rs(p: &RomParams) -> String {
+    let mut s = String::new();
+    s.push_str("/// Default parameters, reduced from the reference rig `Rig::default()` by\n");
+    s.push_str("/// `eha_sim::reduce` (docs/reduction.md): nothing is fitted to simulation output.\n");
+    s.push_str("/// THIS CONSTANT IS REGENERATED BY `cargo run --release -p eha-sim --example reduce`:\n");
+    s.push_str("/// keep plain literals.\n");
+    s.push_str("pub const DEFAULT: RomParams = RomParams {\n");
+    let scalars: [(&str, f64); 31] = [
+        ("pump_j_per_k", p.pump_j_per_k),
+        ("main_block_j_per_k", p.main_block_j_per_k),
+        ("ball_block_j_per_k", p.ball_block_j_per_k),
+        ("actuator_j_per_k", p.actuator_j_per_k),
+        ("case_oil_m3", p.case_oil_m3),
+        ("loop_oil_m3", p.loop_oil_m3),
+        ("port_oil_m3", p.port_oil_m3),
+        ("ball_oil_m3", p.ball_oil_m3),
+        ("rho_kg_per_m3", p.rho_kg_per_m3),
+        ("cp20_j_per_kg_k", p.cp20_j_per_kg_k),
+        ("cp_slope_j_per_kg_k2", p.cp_slope_j_per_kg_k2),
+        ("displacement_m3_per_rad", p.displacement_m3_per_rad),
+        ("eta_m", p.eta_m),
+        ("mech_to_outlet", p.mech_to_outlet),
+        ("k_leak_m3_per_s_pa", p.k_leak_m3_per_s_pa),
+        ("case_pressure_pa", p.case_pressure_pa),
+        ("k_mu_per_k", p.k_mu_per_k),
+        ("t_mu_ref_c", p.t_mu_ref_c),
+        ("line_r1_pa_s_per_m3", p.line_r1_pa_s_per_m3),
+        ("line_r2_pa_s2_per_m6", p.line_r2_pa_s2_per_m6),
+        ("ram_area_m2", p.ram_area_m2),
+        ("act_leak_m3_per_s_pa", p.act_leak_m3_per_s_pa),
+        ("act_friction_n_s_per_m", p.act_friction_n_s_per_m),
+        ("phases", p.phases),
+        ("r_ohm", p.r_ohm),
+        ("k_fe1_w_s_per_rad", p.k_fe1_w_s_per_rad),
+        ("k_fe2_w_s2_per_rad2", p.k_fe2_w_s2_per_rad2),
+        ("k_fe15_w_per_rad15", p.k_fe15_w_per_rad15),
+        ("speed_table_max_rad_s", p.speed_table_max_rad_s),
+        ("flow_table_max_m3_per_s", p.flow_table_max_m3_per_s),
+        ("lng_inlet_c", p.lng_inlet_c),
+    ];
+    for (name, v) in scalars.iter() {
+        s.push_str(&format!("    {name}: {},\n", lit(*v)));
+    }
+    for (name, t) in [
+        ("g_case_w_per_k", &p.g_case_w_per_k),
+        ("g_port_w_per_k", &p.g_port_w_per_k),
+        ("g_loop_block_w_per_k", &p.g_loop_block_w_per_k),
+        ("g_ball_block_w_per_k", &p.g_ball_block_w_per_k),
+        ("g_lng_w_per_k", &p.g_lng_w_per_k),
+    ] {
+        s.push_str(&format!("    {name}: {},\n", row(t)));
+    }
+    s.push_str(&format!("    outer_w_per_k: {},\n", row(&p.outer_w_per_k)));
+    s.push_str(&format!("    outer_quarter_w_per_k125: {},\n", row(&p.outer_quarter_w_per_k125)));
+    s.push_str(&format!("    outer_rad_w_per_k4: {},\n", row(&p.outer_rad_w_per_k4)));
+    s.push_str("    nominal_jacobian_per_s: [\n");
+    for r in &p.nominal_jacobian_per_s {
+        s.push_str(&format!("        {},\n", row(r)));
+    }
+    s.push_str("    ],\n};\n");
+    s
+}
+
+/// Replaces the `DEFAULT` item (from its doc comment to the closing `};`) in the
+/// text of `src/rom/params.rs` with `rendered`. `None` if the item is not found.
+pub fn splice_params_rs(file: &str, rendered: &str) -> Option<String> {
+    let item = file.find("pub const DEFAULT: RomParams")?;
+    let mut start = item;
+    let mut lines: Vec<&str> = file[..item].split_inclusive('\n').collect();
+    while let Some(l) = lines.last() {
+        if l.trim_start().starts_with("///") {
+            start -= l.len();
+            lines.pop();
+        } else {
+            break;
+        }
+    }
+    let end = item + file[item..].find("\n};\n")? + 4;
+    Some(format!("{}{}{}", &file[..start], rendered, &file[end..]))
+}

@@ -1,0 +1,716 @@
+//! Reduced-order thermal model of the EHA's pump side: six slow nodes, the
+//! quasi-steady oil ring, losses of eqs. (1)-(11) from the controller's signals,
+//! conductances of eqs. (12)-(19) and the LNG exchanger of eqs. (20)-(22).
+//!
+//! Multi-rate: [`Model::accumulate`] takes one 10 ms tick of inputs and sums its
+//! losses and flows; every [`TICKS_PER_STEP`] ticks [`Model::update`] advances the
+//! temperatures by one model step of [`S_PER_STEP`] with the tick means.
+//!
+//! Reduction of the reference network (docs/firmware.md):
+//! * the motor (winding, housing) has no thermal path to the pump side in the
+//!   reference, so it is not a state; copper and iron losses enter only the
+//!   dissipation total of the LNG budget (eq. 23);
+//! * the pump's inlet and outlet port passages and the ball-valve passage hold
+//!   ≈ 0.08 kJ/K each against a circulating ≈ 0.26 kW/K: they are quasi-steady
+//!   links of the ring, solved in flow order each step, moving at the ring's rate;
+//!   the loop node keeps the ring's energy (what the links store is taken from it);
+//! * the drain is fed from the high-pressure port; the exchanger's cooling reaches
+//!   that port after the transport time of the port passages, `(C_in + C_out) / (m c_p)`.
+//!
+//! Time stepping: exponential Euler (exact zero-order hold of the linear part):
+//! `T(k+1) = T(k) + Phi F(T(k), u(k))`, `Phi = h phi1(h A)` from the matrix
+//! exponential of the nominal Jacobian `A`, built once at init.
+
+pub mod params;
+mod ring;
+pub mod table;
+
+use crate::linalg::expm1m;
+use crate::num::Num;
+pub use params::{
+    RomParams, N_NODES, N_TABLE, NODE_ACTUATOR, NODE_BALL_BLOCK, NODE_DRAIN, NODE_LOOP, NODE_MAIN_BLOCK, NODE_PUMP,
+    OUTER_NODES, S_PER_STEP, S_PER_TICK, TICKS_PER_STEP,
+};
+use ring::{Ring, RingIn};
+
+/// Wire → model unit: A → hA.
+pub const HA_PER_A: f64 = 0.01;
+/// Wire → model unit: bar → hbar (10 MPa).
+pub const HBAR_PER_BAR: f64 = 0.01;
+/// Wire → model unit: rpm → hrad/s (100 rad/s).
+pub const HRADS_PER_RPM: f64 = 2.0 * core::f64::consts::PI / 60.0 / 100.0;
+/// Pa per hbar.
+const PA_PER_HBAR: f64 = 1e7;
+/// L per m^3.
+const L_PER_M3: f64 = 1e3;
+/// kW per W.
+const KW_PER_W: f64 = 1e-3;
+/// Longest transport delay of the exchanger's effect, model steps (the history is a `u32`).
+const MAX_DELAY_STEPS: i32 = 31;
+
+/// One tick of validated inputs in model units (hA, hbar, hrad/s, mm, degC).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TickInput<N> {
+    /// Motor phase current, hA (100 A) rms.
+    pub current_ha: N,
+    /// Port A pressure, hbar gauge.
+    pub p_a_hbar: N,
+    /// Port B pressure, hbar gauge.
+    pub p_b_hbar: N,
+    /// Shaft speed, hrad/s (signed; positive delivers into port A).
+    pub speed_hrads: N,
+    /// Piston position change over this tick, mm (signed).
+    pub dpos_mm: N,
+    /// Ambient air temperature, degC.
+    pub ambient_c: N,
+}
+
+/// Why a parameter set cannot be turned into a model of the chosen number type.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(any(target_os = "none", feature = "defmt"), derive(defmt::Format))]
+pub enum ConfigError {
+    /// [`RomParams::is_plausible`] failed.
+    Implausible,
+    /// A discretised coefficient or row sum exceeds the coefficient format.
+    CoefficientRange,
+    /// A constant exceeds the value format.
+    ConstantRange,
+}
+
+/// Sums over the ticks of the present model step (model units; divided by the tick
+/// count at the step).
+#[derive(Clone, Copy, Debug)]
+struct Sums<N> {
+    leak_kw: N,
+    mech_kw: N,
+    line_kw: N,
+    needle_kw: N,
+    act_kw: N,
+    copper_kw: N,
+    leak_lps: N,
+    pump_lps: N,
+    abs_pump_lps: N,
+    abs_thr_lps: N,
+    abs_act_lps: N,
+    abs_speed: N,
+    dp: N,
+    ambient: N,
+    ticks: u32,
+}
+
+impl<N: Num> Sums<N> {
+    const ZERO: Self = Sums {
+        leak_kw: N::ZERO,
+        mech_kw: N::ZERO,
+        line_kw: N::ZERO,
+        needle_kw: N::ZERO,
+        act_kw: N::ZERO,
+        copper_kw: N::ZERO,
+        leak_lps: N::ZERO,
+        pump_lps: N::ZERO,
+        abs_pump_lps: N::ZERO,
+        abs_thr_lps: N::ZERO,
+        abs_act_lps: N::ZERO,
+        abs_speed: N::ZERO,
+        dp: N::ZERO,
+        ambient: N::ZERO,
+        ticks: 0,
+    };
+}
+
+impl<N: Num> Sums<N> {
+    /// Every sum times `f` (the tick means for `f = 1 / ticks`).
+    #[inline(always)]
+    fn scaled(&self, f: N) -> Self {
+        Sums {
+            leak_kw: self.leak_kw.mul(f),
+            mech_kw: self.mech_kw.mul(f),
+            line_kw: self.line_kw.mul(f),
+            needle_kw: self.needle_kw.mul(f),
+            act_kw: self.act_kw.mul(f),
+            copper_kw: self.copper_kw.mul(f),
+            leak_lps: self.leak_lps.mul(f),
+            pump_lps: self.pump_lps.mul(f),
+            abs_pump_lps: self.abs_pump_lps.mul(f),
+            abs_thr_lps: self.abs_thr_lps.mul(f),
+            abs_act_lps: self.abs_act_lps.mul(f),
+            abs_speed: self.abs_speed.mul(f),
+            dp: self.dp.mul(f),
+            ambient: self.ambient.mul(f),
+            ticks: self.ticks,
+        }
+    }
+}
+
+/// Result of [`Model::rhs`].
+#[derive(Clone, Copy, Debug)]
+struct Rhs<N> {
+    rates: [N; N_NODES],
+    links: [N; 3],
+    ring_rate: N,
+    total_kw: N,
+    lng_kw: N,
+    heat_kw: N,
+    outer_kw: N,
+}
+
+/// Constants in model units (built once).
+#[derive(Clone, Copy, Debug)]
+struct Consts<N> {
+    // tick: flows L/s, powers kW from hA, hbar, hrad/s, mm per tick
+    p_case: N,    // hbar
+    k_lf: N,      // leak flow, L/s per hbar
+    k_lp: N,      // leak power, kW per hbar^2
+    k_mech: N,    // kW per (hbar hrad/s)
+    k_q: N,       // pump flow, L/s per hrad/s
+    k_a: N,       // piston flow, L/s per mm/tick
+    k_dpq: N,     // kW per (hbar L/s)
+    r1: N,        // kW per (L/s)^2
+    r2: N,        // kW per (L/s)^3
+    k_al: N,      // actuator leakage, kW per hbar^2
+    k_fr: N,      // piston friction, kW per (mm/tick)^2
+    k_cu: N,      // copper, kW per hA^2
+    fe1: N,       // iron, kW per hrad/s
+    fe2: N,       // kW per (hrad/s)^2
+    fe15: N,      // kW per (hrad/s)^1.5
+    // step
+    inv_ticks: N, // 1 / TICKS_PER_STEP
+    q_scale: N,   // (N_TABLE-1) / sqrt(q_max), per sqrt(L/s)
+    w_scale: N,   // (N_TABLE-1) / sqrt(w_max), per sqrt(hrad/s)
+    rc0: N,       // rho c_p at 0 degC, kJ/(L K)
+    rc1: N,       // d(rho c_p)/dT, kJ/(L K^2)
+    irc0: N,      // 1/(rho c_p) linearised about 40 degC: irc0 - irc1 T, L K/kJ
+    irc1: N,
+    inv_v_case: N, // 1/L
+    inv_v_loop: N, // 1/L
+    inv_n: [N; TICKS_PER_STEP as usize + 1], // 1/n for partial steps (inv_n[0] = 0)
+    v_port: N,    // L
+    v_ball: N,    // L
+    inv_v_ring: N, // 1 / (V_loop + 2 V_port + V_ball), 1/L
+    inv_c: [N; N_NODES], // 1/C of the metal nodes, K/kJ (oil nodes unused)
+    f_out: N,
+    f_case: N,    // 1 - f_out
+    lng_in: N,    // degC
+    k_mu: N,
+    t_mu: N,
+    use_mu: bool,
+    ga: [N; 4],   // outer, kW/K
+    gb: [N; 4],   // outer, kW/K^1.25
+    gr: [N; 4],   // outer radiation 4 eps sigma A 1e6, kW/(K hK^3)
+    h: N,         // s
+    inv_h: N,     // 1/s
+    half: N,
+    hundredth: N,
+    k_offset_hk: N, // 273.15 / 100
+    one: N,
+}
+
+/// The reduced-order model in number type `N` (`f64`, `f32` or [`crate::num::Fx`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Model<N: Num> {
+    temp: [N::State; N_NODES],
+    /// Quasi-steady link temperatures of the last step: inlet, outlet, ball oil, degC.
+    links: [N; 3],
+    /// Ring rate of the last step, K/s.
+    ring_rate: N,
+    /// Exchanger credit of the past steps, bit k = step k ago.
+    lng_hist: u32,
+    ambient_c: N,
+    sums: Sums<N>,
+    phi: [[N::Coef; N_NODES]; N_NODES],
+    k: Consts<N>,
+    g_case: [N; N_TABLE],
+    g_port: [N; N_TABLE],
+    g_loop: [N; N_TABLE],
+    g_ball: [N; N_TABLE],
+    g_lng: [N; N_TABLE],
+    last_total_kw: N,
+    last_lng_kw: N,
+    last_heat_kw: N,
+    last_outer_kw: N,
+}
+
+/// `Phi = h phi1(h A) = integral_0^h exp(A s) ds`, from the exponential of the
+/// augmented matrix `[[A h, I h], [0, 0]]` (upper-right block).
+pub fn etd_matrix(a: &[[f64; N_NODES]; N_NODES], h: f64) -> [[f64; N_NODES]; N_NODES] {
+    const M: usize = 2 * N_NODES;
+    let mut aug = [[0.0f64; M]; M];
+    for (i, (row, arow)) in aug.iter_mut().zip(a.iter()).enumerate() {
+        for (x, v) in row.iter_mut().zip(arow.iter()) {
+            *x = v * h;
+        }
+        if let Some(x) = row.get_mut(N_NODES + i) {
+            *x = h;
+        }
+    }
+    let e = expm1m(&aug);
+    let mut phi = [[0.0; N_NODES]; N_NODES];
+    for (prow, erow) in phi.iter_mut().zip(e.iter()) {
+        for (p, x) in prow.iter_mut().zip(erow.iter().skip(N_NODES)) {
+            *p = *x;
+        }
+    }
+    phi
+}
+
+impl<N: Num> Model<N> {
+    /// Builds the model once from SI parameters: constants in model units, tables,
+    /// and the exact-ZOH matrix (matrix exponential in `f64`). Starts at 0 degC.
+    pub fn new(p: &RomParams) -> Result<Self, ConfigError> {
+        if !p.is_plausible() {
+            return Err(ConfigError::Implausible);
+        }
+        let phi64 = etd_matrix(&p.nominal_jacobian_per_s, S_PER_STEP);
+        let mut phi = [[N::coef_from_f64(0.0).ok_or(ConfigError::CoefficientRange)?; N_NODES]; N_NODES];
+        for (pr, dr) in phi.iter_mut().zip(phi64.iter()) {
+            if dr.iter().map(|x| libm::fabs(*x)).sum::<f64>() >= N::MAX_ROW_SUM {
+                return Err(ConfigError::CoefficientRange);
+            }
+            for (c, x) in pr.iter_mut().zip(dr.iter()) {
+                *c = N::coef_from_f64(*x).ok_or(ConfigError::CoefficientRange)?;
+            }
+        }
+        let d = p.displacement_m3_per_rad;
+        let kl = p.k_leak_m3_per_s_pa;
+        let rho_cp40 = p.rho_cp(40.0) * 1e-6; // kJ/(L K)
+        let rc1 = p.rho_kg_per_m3 * p.cp_slope_j_per_kg_k2 * 1e-6;
+        let rc0 = p.rho_cp(0.0) * 1e-6;
+        let q_max = p.flow_table_max_m3_per_s * L_PER_M3;
+        let w_max = p.speed_table_max_rad_s * 0.01;
+        let n1 = (N_TABLE - 1) as f64;
+        let v_ring = (p.loop_oil_m3 + 2.0 * p.port_oil_m3 + p.ball_oil_m3) * L_PER_M3;
+        let caps_kj = [p.pump_j_per_k, 0.0, 0.0, p.main_block_j_per_k, p.ball_block_j_per_k, p.actuator_j_per_k];
+        let mut inv_c64 = [0.0; N_NODES];
+        for (o, c) in inv_c64.iter_mut().zip(caps_kj.iter()) {
+            if *c > 0.0 {
+                *o = 1e3 / c;
+            }
+        }
+        let outer = |a: &[f64; 4], s: f64| {
+            let mut o = [0.0; 4];
+            for (o, x) in o.iter_mut().zip(a.iter()) {
+                *o = x * s;
+            }
+            o
+        };
+        let ga = outer(&p.outer_w_per_k, KW_PER_W);
+        let gb = outer(&p.outer_quarter_w_per_k125, KW_PER_W);
+        let gr = outer(&p.outer_rad_w_per_k4, 4.0 * 1e6 * KW_PER_W);
+        let scalars = [
+            p.case_pressure_pa / PA_PER_HBAR,
+            kl * PA_PER_HBAR * L_PER_M3,
+            kl * PA_PER_HBAR * PA_PER_HBAR * KW_PER_W,
+            p.eta_m * d * PA_PER_HBAR * 100.0 * KW_PER_W,
+            d * 100.0 * L_PER_M3,
+            p.ram_area_m2 * 1e-3 / S_PER_TICK * L_PER_M3,
+            PA_PER_HBAR / L_PER_M3 * KW_PER_W,
+            p.line_r1_pa_s_per_m3 / (L_PER_M3 * L_PER_M3) * KW_PER_W,
+            p.line_r2_pa_s2_per_m6 / (L_PER_M3 * L_PER_M3 * L_PER_M3) * KW_PER_W,
+            p.act_leak_m3_per_s_pa * PA_PER_HBAR * PA_PER_HBAR * KW_PER_W,
+            p.act_friction_n_s_per_m * (1e-3 / S_PER_TICK) * (1e-3 / S_PER_TICK) * KW_PER_W,
+            p.phases * p.r_ohm / (HA_PER_A * HA_PER_A) * KW_PER_W,
+            p.k_fe1_w_s_per_rad * 100.0 * KW_PER_W,
+            p.k_fe2_w_s2_per_rad2 * 1e4 * KW_PER_W,
+            p.k_fe15_w_per_rad15 * 1e3 * KW_PER_W,
+            n1 / libm::sqrt(q_max),
+            n1 / libm::sqrt(w_max),
+            rc0,
+            rc1,
+            // 1/(rc40 + rc1 (T - 40)) ≈ (1/rc40)(1 - (rc1/rc40)(T - 40)) = irc0 - irc1 T
+            (1.0 + 40.0 * rc1 / rho_cp40) / rho_cp40,
+            rc1 / (rho_cp40 * rho_cp40),
+            1.0 / (p.case_oil_m3 * L_PER_M3),
+            1.0 / (p.loop_oil_m3 * L_PER_M3),
+            p.port_oil_m3 * L_PER_M3,
+            p.ball_oil_m3 * L_PER_M3,
+            1.0 / v_ring,
+            p.lng_inlet_c,
+            p.k_mu_per_k,
+            p.t_mu_ref_c,
+        ];
+        if scalars.iter().chain(ga.iter()).chain(gb.iter()).chain(gr.iter()).chain(inv_c64.iter()).any(|x| !x.is_finite() || libm::fabs(*x) >= 250.0) {
+            return Err(ConfigError::ConstantRange);
+        }
+        let f = N::from_f64;
+        let s = |i: usize| f(scalars.get(i).copied().unwrap_or(0.0));
+        let arr4 = |a: &[f64; 4]| [f(a[0]), f(a[1]), f(a[2]), f(a[3])];
+        let mut inv_n = [N::ZERO; TICKS_PER_STEP as usize + 1];
+        for (j, o) in inv_n.iter_mut().enumerate().skip(1) {
+            *o = f(1.0 / j as f64);
+        }
+        let mut inv_c = [N::ZERO; N_NODES];
+        for (o, x) in inv_c.iter_mut().zip(inv_c64.iter()) {
+            *o = f(*x);
+        }
+        let k = Consts {
+            p_case: s(0),
+            k_lf: s(1),
+            k_lp: s(2),
+            k_mech: s(3),
+            k_q: s(4),
+            k_a: s(5),
+            k_dpq: s(6),
+            r1: s(7),
+            r2: s(8),
+            k_al: s(9),
+            k_fr: s(10),
+            k_cu: s(11),
+            fe1: s(12),
+            fe2: s(13),
+            fe15: s(14),
+            inv_ticks: f(1.0 / TICKS_PER_STEP as f64),
+            q_scale: s(15),
+            w_scale: s(16),
+            rc0: s(17),
+            rc1: s(18),
+            irc0: s(19),
+            irc1: s(20),
+            inv_v_case: s(21),
+            inv_v_loop: s(22),
+            inv_n,
+            v_port: s(23),
+            v_ball: s(24),
+            inv_v_ring: s(25),
+            inv_c,
+            f_out: f(p.mech_to_outlet),
+            f_case: f(1.0 - p.mech_to_outlet),
+            lng_in: s(26),
+            k_mu: s(27),
+            t_mu: s(28),
+            use_mu: p.k_mu_per_k != 0.0,
+            ga: arr4(&ga),
+            gb: arr4(&gb),
+            gr: arr4(&gr),
+            h: f(S_PER_STEP),
+            inv_h: f(1.0 / S_PER_STEP),
+            half: f(0.5),
+            hundredth: f(0.01),
+            k_offset_hk: f(2.7315),
+            one: f(1.0),
+        };
+        let tables = [
+            &p.g_case_w_per_k,
+            &p.g_port_w_per_k,
+            &p.g_loop_block_w_per_k,
+            &p.g_ball_block_w_per_k,
+            &p.g_lng_w_per_k,
+        ];
+        if tables.iter().any(|t| t.iter().any(|g| g * KW_PER_W >= 250.0)) {
+            return Err(ConfigError::ConstantRange);
+        }
+        Ok(Model {
+            temp: [N::state(N::ZERO); N_NODES],
+            links: [N::ZERO; 3],
+            ring_rate: N::ZERO,
+            lng_hist: 0,
+            ambient_c: N::ZERO,
+            sums: Sums::ZERO,
+            phi,
+            k,
+            g_case: table::to_kw(&p.g_case_w_per_k),
+            g_port: table::to_kw(&p.g_port_w_per_k),
+            g_loop: table::to_kw(&p.g_loop_block_w_per_k),
+            g_ball: table::to_kw(&p.g_ball_block_w_per_k),
+            g_lng: table::to_kw(&p.g_lng_w_per_k),
+            last_total_kw: N::ZERO,
+            last_lng_kw: N::ZERO,
+            last_heat_kw: N::ZERO,
+            last_outer_kw: N::ZERO,
+        })
+    }
+
+    /// Sets every node, the ring links and the ambient to `t_c` (degC): cold start.
+    pub fn set_uniform(&mut self, t_c: N) {
+        self.ambient_c = t_c;
+        for th in self.temp.iter_mut() {
+            *th = N::state(t_c);
+        }
+        self.links = [t_c; 3];
+        self.ring_rate = N::ZERO;
+    }
+
+    /// Sets every node's temperature (degC, node order) and the ambient (warm
+    /// restore); the ring links start at the loop temperature.
+    pub fn set_temperatures(&mut self, temps_c: &[N; N_NODES], ambient_c: N) {
+        self.ambient_c = ambient_c;
+        for (th, t) in self.temp.iter_mut().zip(temps_c.iter()) {
+            *th = N::state(*t);
+        }
+        let tl = temps_c.get(NODE_LOOP).copied().unwrap_or(ambient_c);
+        self.links = [tl; 3];
+        self.ring_rate = N::ZERO;
+    }
+
+    /// Accumulates one 10 ms tick (losses of eqs. 5-11 and the flows at this tick's
+    /// inputs). Returns `true` when [`TICKS_PER_STEP`] ticks are summed: the caller
+    /// then calls [`Model::update`].
+    #[inline(always)]
+    pub fn accumulate(&mut self, u: &TickInput<N>) -> bool {
+        let k = &self.k;
+        let s = &mut self.sums;
+        let dpa = u.p_a_hbar.sub(k.p_case);
+        let dpb = u.p_b_hbar.sub(k.p_case);
+        let dp = u.p_a_hbar.sub(u.p_b_hbar);
+        let aw = u.speed_hrads.abs();
+        // eqs. (5)-(7): each port leaks K (p - p_case) into the case; heat K dp^2.
+        s.leak_kw = s.leak_kw.add(k.k_lp.mul(dpa.mul(dpa).add(dpb.mul(dpb))));
+        s.leak_lps = s.leak_lps.add(k.k_lf.mul(dpa.max0().add(dpb.max0())));
+        // eq. (8): eta_m D |dp| |w|
+        s.mech_kw = s.mech_kw.add(k.k_mech.mul(dp.abs()).mul(aw));
+        // pump delivery into A, piston flow, throttled remainder (eqs. 10-11)
+        let q_pump = k.k_q.mul(u.speed_hrads).sub(k.k_lf.mul(dpa));
+        let q_act = k.k_a.mul(u.dpos_mm);
+        let q_thr = q_pump.sub(q_act);
+        let aq_thr = q_thr.abs();
+        let line = q_thr.mul(q_thr).mul(k.r1.add(k.r2.mul(aq_thr)));
+        let needle = k.k_dpq.mul(dp).mul(q_thr).sub(line).max0();
+        s.line_kw = s.line_kw.add(line);
+        s.needle_kw = s.needle_kw.add(needle);
+        // eq. (11) and the piston's viscous seal friction, into the actuator body
+        s.act_kw = s.act_kw.add(k.k_al.mul(dp).mul(dp).add(k.k_fr.mul(u.dpos_mm).mul(u.dpos_mm)));
+        // eq. (1), constant R (dissipation total only)
+        s.copper_kw = s.copper_kw.add(k.k_cu.mul(u.current_ha).mul(u.current_ha));
+        s.pump_lps = s.pump_lps.add(q_pump);
+        s.abs_pump_lps = s.abs_pump_lps.add(q_pump.abs());
+        s.abs_thr_lps = s.abs_thr_lps.add(aq_thr);
+        s.abs_act_lps = s.abs_act_lps.add(q_act.abs());
+        s.abs_speed = s.abs_speed.add(aw);
+        s.dp = s.dp.add(dp);
+        s.ambient = s.ambient.add(u.ambient_c);
+        s.ticks += 1;
+        s.ticks >= TICKS_PER_STEP
+    }
+
+    /// One model step of [`S_PER_STEP`] with the means of the accumulated ticks.
+    /// `lng_open`: the exchanger ran over this step (the guard's own valve, no fault).
+    /// Never panics; without accumulated ticks it does nothing.
+    pub fn update(&mut self, lng_open: bool) {
+        let ticks = self.sums.ticks;
+        if ticks == 0 {
+            return;
+        }
+        let inv = self.k.inv_n.get(ticks as usize).copied().unwrap_or(self.k.inv_ticks);
+        let m = self.sums.scaled(inv);
+        self.sums = Sums::ZERO;
+        self.ambient_c = m.ambient;
+        let t = self.temperatures_c();
+        self.lng_hist = (self.lng_hist << 1) | u32::from(lng_open);
+        let r = self.rhs(&t, &m, self.lng_hist, Some(self.links), self.ring_rate);
+        self.links = r.links;
+        self.ring_rate = r.ring_rate;
+        self.last_total_kw = r.total_kw;
+        self.last_lng_kw = r.lng_kw;
+        self.last_heat_kw = r.heat_kw;
+        self.last_outer_kw = r.outer_kw;
+        let [p0, p1, p2, p3, p4, p5] = &self.phi;
+        let [s0, s1, s2, s3, s4, s5] = &mut self.temp;
+        *s0 = N::accumulate(*s0, p0, &r.rates);
+        *s1 = N::accumulate(*s1, p1, &r.rates);
+        *s2 = N::accumulate(*s2, p2, &r.rates);
+        *s3 = N::accumulate(*s3, p3, &r.rates);
+        *s4 = N::accumulate(*s4, p4, &r.rates);
+        *s5 = N::accumulate(*s5, p5, &r.rates);
+    }
+
+    /// Right-hand side `dT/dt` (K/s, node order) at temperatures `t` with every tick
+    /// at inputs `u`, the ring in steady flow (links stored nothing, no transport lag):
+    /// the function whose Jacobian at the nominal point is `A` (reduction tool).
+    pub fn derivative(&self, t: &[N; N_NODES], u: &TickInput<N>, lng_open: bool) -> [N; N_NODES] {
+        let mut probe = *self;
+        probe.sums = Sums::ZERO;
+        let _ = probe.accumulate(u);
+        let m = probe.sums.scaled(self.k.one);
+        self.rhs(t, &m, u32::from(lng_open), None, N::ZERO).rates
+    }
+
+    /// Heat balances of the six nodes for one step (tick means `m`). `hist`: exchanger
+    /// credit of the past steps (bit 0 = this step). `links`: the link temperatures of
+    /// the last step (energy they store leaves the loop); `None` for steady flow.
+    #[inline(always)]
+    fn rhs(&self, t: &[N; N_NODES], m: &Sums<N>, hist: u32, links: Option<[N; 3]>, rate: N) -> Rhs<N> {
+        let k = &self.k;
+        let amb = m.ambient;
+        let [t_p, t_c, t_l, t_mb, t_bb, t_a] = *t;
+        // viscosity ratio of the leakage (eqs. 5-7), at the case-oil temperature
+        let mu = if k.use_mu { k.k_mu.mul(t_c.sub(k.t_mu)).exp() } else { k.one };
+        let leak_kw = m.leak_kw.mul(mu);
+        let leak_lps = m.leak_lps.mul(mu);
+        let mech_kw = m.mech_kw;
+        let aq = m.abs_pump_lps;
+        let aw = m.abs_speed;
+        // conductances of eqs. (12)-(14), (20)-(22) at this step's flows
+        let at_q = table::locate(aq, k.q_scale, k.one);
+        let at_w = table::locate(aw, k.w_scale, k.one);
+        let at_l = table::locate(aq.add(leak_lps), k.q_scale, k.one);
+        let g_case = table::value(&self.g_case, &at_w);
+        let g_port = table::value(&self.g_port, &at_q);
+        let g_loop = table::value(&self.g_loop, &at_q);
+        let g_ball = table::value(&self.g_ball, &at_q);
+        let g_lng = table::value(&self.g_lng, &at_l);
+        // oil capacity rates, kW/K
+        let rc_l = k.rc0.add(k.rc1.mul(t_l));
+        let m_c = rc_l.mul(aq);
+        let m_thr = rc_l.mul(if m.abs_thr_lps < aq { m.abs_thr_lps } else { aq });
+        let m_l = rc_l.mul(leak_lps);
+        let g_tidal = rc_l.mul(m.abs_act_lps);
+        // transport delay of the exchanger's effect to the high-pressure port
+        let delay = k.v_port.add(k.v_port).mul(rc_l).div_pos(m_c.add(m_l).mul(k.h)).round_times(1);
+        let delay = delay.clamp(0, MAX_DELAY_STEPS);
+        let lng_open = hist & 1 == 1;
+        let lng_at_port = (hist >> (delay as u32)) & 1 == 1;
+        let q_lng_full = g_lng.mul(t_l.sub(k.lng_in));
+        let ring = Ring::solve(&RingIn {
+            t_loop: t_l,
+            t_pump: t_p,
+            t_ball_block: t_bb,
+            m_c,
+            m_thr,
+            m_l,
+            g_port,
+            g_ball,
+            q_lng: if lng_open { q_lng_full } else { N::ZERO },
+            q_lng_port: if lng_at_port { q_lng_full } else { N::ZERO },
+            p_hp: k.f_out.mul(mech_kw),
+            p_needle: m.needle_kw,
+            c_port: rc_l.mul(k.v_port),
+            c_ball: rc_l.mul(k.v_ball),
+            rate,
+            forward: m.pump_lps >= N::ZERO,
+            hp_is_a: m.dp >= N::ZERO,
+            one: k.one,
+        });
+        // leakage advection case <-> ring at the mean specific heat of the two temperatures
+        let m_lk = k.rc0.add(k.rc1.mul(ring.t_feed.add(t_c).mul(k.half))).mul(leak_lps);
+        let adv = m_lk.mul(ring.t_feed.sub(t_c));
+        let outer = [self.outer(0, t_p, amb), self.outer(1, t_mb, amb), self.outer(2, t_bb, amb), self.outer(3, t_a, amb)];
+        let [o_p, o_mb, o_bb, o_a] = outer;
+        let q_pump = g_case
+            .mul(t_c.sub(t_p))
+            .add(g_port.mul(ring.t_in.sub(t_p)))
+            .add(g_port.mul(ring.t_out.sub(t_p)))
+            .sub(o_p);
+        let q_case = leak_kw.add(k.f_case.mul(mech_kw)).add(g_case.mul(t_p.sub(t_c))).add(adv);
+        let q_ring = m
+            .line_kw
+            .add(m.needle_kw)
+            .add(k.f_out.mul(mech_kw))
+            .add(g_port.mul(t_p.sub(ring.t_in)))
+            .add(g_port.mul(t_p.sub(ring.t_out)))
+            .add(g_ball.mul(t_bb.sub(ring.t_ball)))
+            .add(g_loop.mul(t_mb.sub(t_l)))
+            .sub(adv)
+            .sub(ring.q_lng)
+            .add(g_tidal.mul(t_a.sub(t_l)));
+        // energy kept by the ring: what the links stored since the last step leaves the loop
+        let stored = match links {
+            Some([li, lo, lb]) => {
+                let c_port = rc_l.mul(k.v_port);
+                c_port
+                    .mul(ring.t_in.sub(li))
+                    .add(c_port.mul(ring.t_out.sub(lo)))
+                    .add(rc_l.mul(k.v_ball).mul(ring.t_ball.sub(lb)))
+            }
+            None => N::ZERO,
+        };
+        let inv_rc_l = k.irc0.sub(k.irc1.mul(t_l));
+        let inv_rc_c = k.irc0.sub(k.irc1.mul(t_c));
+        let q_loop = q_ring.sub(stored.mul(k.inv_h));
+        let q_mb = g_loop.mul(t_l.sub(t_mb)).sub(o_mb);
+        let q_bb = g_ball.mul(ring.t_ball.sub(t_bb)).sub(o_bb);
+        let q_act = m.act_kw.add(g_tidal.mul(t_l.sub(t_a))).sub(o_a);
+        let ic = &k.inv_c;
+        let rates = [
+            q_pump.mul(ic[NODE_PUMP]),
+            q_case.mul(inv_rc_c).mul(k.inv_v_case),
+            q_loop.mul(inv_rc_l).mul(k.inv_v_loop),
+            q_mb.mul(ic[NODE_MAIN_BLOCK]),
+            q_bb.mul(ic[NODE_BALL_BLOCK]),
+            q_act.mul(ic[NODE_ACTUATOR]),
+        ];
+        // dissipation total (eq. 23's P_sum): every loss of eqs. (1)-(11)
+        let iron = aw.mul(k.fe1.add(k.fe2.mul(aw)).add(k.fe15.mul(aw.sqrt_abs())));
+        let heat_kw = leak_kw.add(mech_kw).add(m.line_kw).add(m.needle_kw).add(m.act_kw);
+        let total_kw = m.copper_kw.add(iron).add(heat_kw);
+        Rhs {
+            rates,
+            links: [ring.t_in, ring.t_out, ring.t_ball],
+            ring_rate: q_ring.mul(inv_rc_l).mul(k.inv_v_ring),
+            total_kw,
+            lng_kw: ring.q_lng,
+            heat_kw,
+            outer_kw: o_p.add(o_mb).add(o_bb).add(o_a),
+        }
+    }
+
+    /// Heat from outer surface `i` of [`OUTER_NODES`] to the air, kW: free convection
+    /// `(c0 + c1 |dT|^(1/4)) A dT` (eqs. 15-16) plus radiation linearised about the
+    /// mean of wall and air, `4 eps sigma A T_m^3 dT` (eq. 19, within 0.1 % here).
+    #[inline(always)]
+    fn outer(&self, i: usize, t_wall: N, t_air: N) -> N {
+        let k = &self.k;
+        let (Some(ga), Some(gb), Some(gr)) = (k.ga.get(i), k.gb.get(i), k.gr.get(i)) else {
+            return N::ZERO;
+        };
+        let dt = t_wall.sub(t_air);
+        let q4 = dt.sqrt_abs().sqrt_abs();
+        let tm = t_air.add(dt.mul(k.half)).mul(k.hundredth).add(k.k_offset_hk);
+        ga.add(gb.mul(q4)).add(gr.mul(tm).mul(tm).mul(tm)).mul(dt)
+    }
+
+    /// Advances one model step with every tick at the same inputs (tests, tools).
+    pub fn step(&mut self, u: &TickInput<N>, lng_open: bool) {
+        while !self.accumulate(u) {}
+        self.update(lng_open);
+    }
+
+    /// Predicted drain (case) oil temperature, degC.
+    #[inline(always)]
+    pub fn drain_c(&self) -> N {
+        self.temp.get(NODE_DRAIN).map_or(N::ZERO, |s| N::value(*s))
+    }
+
+    /// All node temperatures, degC, in node order.
+    pub fn temperatures_c(&self) -> [N; N_NODES] {
+        let mut t = [N::ZERO; N_NODES];
+        for (o, th) in t.iter_mut().zip(self.temp.iter()) {
+            *o = N::value(*th);
+        }
+        t
+    }
+
+    /// Quasi-steady ring links of the last step: inlet port, outlet port, ball-valve oil, degC.
+    pub fn links_c(&self) -> [N; 3] {
+        self.links
+    }
+
+    /// Ambient of the last step, degC.
+    pub fn ambient_c(&self) -> N {
+        self.ambient_c
+    }
+
+    /// Ticks accumulated towards the next model step.
+    pub fn pending_ticks(&self) -> u32 {
+        self.sums.ticks
+    }
+
+    /// Sum of the last step's losses (eqs. 1-11), kW: the dissipation `P_sum` of eq. (23).
+    pub fn last_total_kw(&self) -> N {
+        self.last_total_kw
+    }
+
+    /// Heat of the last step's pump-side losses (eqs. 5-11: leakage, mechanical, line,
+    /// throttling, actuator), kW: what heats the six nodes.
+    pub fn last_heat_kw(&self) -> N {
+        self.last_heat_kw
+    }
+
+    /// Heat the outer surfaces gave to the air over the last step (eqs. 15, 16, 19), kW.
+    pub fn last_outer_kw(&self) -> N {
+        self.last_outer_kw
+    }
+
+    /// Heat the LNG exchanger removed from the oil over the last step, kW (0 when closed).
+    pub fn last_lng_kw(&self) -> N {
+        self.last_lng_kw
+    }
+}
