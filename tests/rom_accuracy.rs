@@ -63,7 +63,7 @@ fn run<N: Num>(steps: usize) -> Vec<f64> {
         if m.accumulate(&u) {
             let t = k as f64 * 0.01;
             let open = (50.0..80.0).contains(&t) || (120.0..150.0).contains(&t) || (450.0..500.0).contains(&t);
-            m.update(open);
+            m.update(if open { 10 } else { 0 });
             out.push(m.drain_c().to_f64());
         }
     }
@@ -150,7 +150,7 @@ fn energy_balance_closes() {
         prev = w.position_mm;
         if m.accumulate(&u) {
             let t = k as f64 * 0.01;
-            m.update((120.0..150.0).contains(&t));
+            m.update(if (120.0..150.0).contains(&t) { 10 } else { 0 });
             heat += m.last_heat_kw() * S_PER_STEP;
             outer += m.last_outer_kw() * S_PER_STEP;
             lng += m.last_lng_kw() * S_PER_STEP;

@@ -65,6 +65,38 @@ pub struct TickInput<N> {
     pub ambient_c: N,
 }
 
+/// Wire → model unit scales in the number type (built once).
+#[derive(Clone, Copy, Debug)]
+pub struct InputScales<N: Num> {
+    /// A → hA.
+    pub ha_per_a: N::Scale,
+    /// bar → hbar.
+    pub hbar_per_bar: N::Scale,
+    /// rpm → hrad/s.
+    pub hrads_per_rpm: N::Scale,
+    /// Unity (mm, degC).
+    pub one: N::Scale,
+}
+
+impl<N: Num> InputScales<N> {
+    /// The scale of each sample channel, in channel order `[current, p_A, p_B,
+    /// speed, position, ambient]` (`validate::CH_*`).
+    #[inline(always)]
+    pub fn per_channel(&self) -> [N::Scale; 6] {
+        [self.ha_per_a, self.hbar_per_bar, self.hbar_per_bar, self.hrads_per_rpm, self.one, self.one]
+    }
+
+    /// Builds the scales; `None` only if the number type cannot hold them.
+    pub fn new() -> Option<Self> {
+        Some(InputScales {
+            ha_per_a: N::scale_from_f64(HA_PER_A)?,
+            hbar_per_bar: N::scale_from_f64(HBAR_PER_BAR)?,
+            hrads_per_rpm: N::scale_from_f64(HRADS_PER_RPM)?,
+            one: N::scale_from_f64(1.0)?,
+        })
+    }
+}
+
 /// Why a parameter set cannot be turned into a model of the chosen number type.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(any(target_os = "none", feature = "defmt"), derive(defmt::Format))]
@@ -184,6 +216,7 @@ struct Consts<N> {
     inv_v_case: N, // 1/L
     inv_v_loop: N, // 1/L
     inv_n: [N; TICKS_PER_STEP as usize + 1], // 1/n for partial steps (inv_n[0] = 0)
+    count: [N; TICKS_PER_STEP as usize + 1], // n
     v_port: N,    // L
     v_ball: N,    // L
     inv_v_ring: N, // 1 / (V_loop + 2 V_port + V_ball), 1/L
@@ -335,8 +368,12 @@ impl<N: Num> Model<N> {
         let s = |i: usize| f(scalars.get(i).copied().unwrap_or(0.0));
         let arr4 = |a: &[f64; 4]| [f(a[0]), f(a[1]), f(a[2]), f(a[3])];
         let mut inv_n = [N::ZERO; TICKS_PER_STEP as usize + 1];
-        for (j, o) in inv_n.iter_mut().enumerate().skip(1) {
-            *o = f(1.0 / j as f64);
+        let mut count = [N::ZERO; TICKS_PER_STEP as usize + 1];
+        for (j, (o, c)) in inv_n.iter_mut().zip(count.iter_mut()).enumerate() {
+            if j > 0 {
+                *o = f(1.0 / j as f64);
+            }
+            *c = f(j as f64);
         }
         let mut inv_c = [N::ZERO; N_NODES];
         for (o, x) in inv_c.iter_mut().zip(inv_c64.iter()) {
@@ -368,6 +405,7 @@ impl<N: Num> Model<N> {
             inv_v_case: s(21),
             inv_v_loop: s(22),
             inv_n,
+            count,
             v_port: s(23),
             v_ball: s(24),
             inv_v_ring: s(25),
@@ -429,14 +467,18 @@ impl<N: Num> Model<N> {
         self.ring_rate = N::ZERO;
     }
 
-    /// Sets every node's temperature (degC, node order) and the ambient (warm
-    /// restore); the ring links start at the loop temperature.
-    pub fn set_temperatures(&mut self, temps_c: &[N; N_NODES], ambient_c: N) {
-        self.ambient_c = ambient_c;
+    /// Sets every node's temperature (degC, node order) and the ambient from `f32`
+    /// (warm restore, thermal memory); the ring links start at the loop temperature.
+    pub fn set_temperatures(&mut self, temps_c: &[f32; N_NODES], ambient_c: f32) {
+        let conv = |x: f32| match N::scale_from_f64(1.0) {
+            Some(s) => N::from_f32_scaled(x, s),
+            None => N::ZERO,
+        };
+        self.ambient_c = conv(ambient_c);
         for (th, t) in self.temp.iter_mut().zip(temps_c.iter()) {
-            *th = N::state(*t);
+            *th = N::state(conv(*t));
         }
-        let tl = temps_c.get(NODE_LOOP).copied().unwrap_or(ambient_c);
+        let tl = temps_c.get(NODE_LOOP).map_or(self.ambient_c, |t| conv(*t));
         self.links = [tl; 3];
         self.ring_rate = N::ZERO;
     }
@@ -482,20 +524,24 @@ impl<N: Num> Model<N> {
     }
 
     /// One model step of [`S_PER_STEP`] with the means of the accumulated ticks.
-    /// `lng_open`: the exchanger ran over this step (the guard's own valve, no fault).
+    /// `lng_ticks`: ticks of this step over which the exchanger ran (the guard's own
+    /// valve, no fault latched); its heat is credited for that share of the step.
     /// Never panics; without accumulated ticks it does nothing.
-    pub fn update(&mut self, lng_open: bool) {
+    pub fn update(&mut self, lng_ticks: u32) {
         let ticks = self.sums.ticks;
         if ticks == 0 {
             return;
         }
-        let inv = self.k.inv_n.get(ticks as usize).copied().unwrap_or(self.k.inv_ticks);
+        let k = &self.k;
+        let inv = k.inv_n.get(ticks as usize).copied().unwrap_or(k.inv_ticks);
+        let on = lng_ticks.min(ticks);
+        let share = k.inv_n.get(ticks as usize).copied().unwrap_or(k.inv_ticks).mul(k.count.get(on as usize).copied().unwrap_or(k.one));
         let m = self.sums.scaled(inv);
         self.sums = Sums::ZERO;
         self.ambient_c = m.ambient;
         let t = self.temperatures_c();
-        self.lng_hist = (self.lng_hist << 1) | u32::from(lng_open);
-        let r = self.rhs(&t, &m, self.lng_hist, Some(self.links), self.ring_rate);
+        self.lng_hist = (self.lng_hist << 1) | u32::from(2 * on >= ticks && on > 0);
+        let r = self.rhs(&t, &m, self.lng_hist, share, Some(self.links), self.ring_rate);
         self.links = r.links;
         self.ring_rate = r.ring_rate;
         self.last_total_kw = r.total_kw;
@@ -520,14 +566,16 @@ impl<N: Num> Model<N> {
         probe.sums = Sums::ZERO;
         let _ = probe.accumulate(u);
         let m = probe.sums.scaled(self.k.one);
-        self.rhs(t, &m, u32::from(lng_open), None, N::ZERO).rates
+        let share = if lng_open { self.k.one } else { N::ZERO };
+        self.rhs(t, &m, u32::from(lng_open), share, None, N::ZERO).rates
     }
 
     /// Heat balances of the six nodes for one step (tick means `m`). `hist`: exchanger
-    /// credit of the past steps (bit 0 = this step). `links`: the link temperatures of
-    /// the last step (energy they store leaves the loop); `None` for steady flow.
+    /// credit of the past steps (bit 0 = this step, for the transport delay), `share`:
+    /// the credited share of this step. `links`: the link temperatures of the last
+    /// step (energy they store leaves the loop); `None` for steady flow.
     #[inline(always)]
-    fn rhs(&self, t: &[N; N_NODES], m: &Sums<N>, hist: u32, links: Option<[N; 3]>, rate: N) -> Rhs<N> {
+    fn rhs(&self, t: &[N; N_NODES], m: &Sums<N>, hist: u32, share: N, links: Option<[N; 3]>, rate: N) -> Rhs<N> {
         let k = &self.k;
         let amb = m.ambient;
         let [t_p, t_c, t_l, t_mb, t_bb, t_a] = *t;
@@ -556,7 +604,6 @@ impl<N: Num> Model<N> {
         // transport delay of the exchanger's effect to the high-pressure port
         let delay = k.v_port.add(k.v_port).mul(rc_l).div_pos(m_c.add(m_l).mul(k.h)).round_times(1);
         let delay = delay.clamp(0, MAX_DELAY_STEPS);
-        let lng_open = hist & 1 == 1;
         let lng_at_port = (hist >> (delay as u32)) & 1 == 1;
         let q_lng_full = g_lng.mul(t_l.sub(k.lng_in));
         let ring = Ring::solve(&RingIn {
@@ -568,7 +615,7 @@ impl<N: Num> Model<N> {
             m_l,
             g_port,
             g_ball,
-            q_lng: if lng_open { q_lng_full } else { N::ZERO },
+            q_lng: q_lng_full.mul(share),
             q_lng_port: if lng_at_port { q_lng_full } else { N::ZERO },
             p_hp: k.f_out.mul(mech_kw),
             p_needle: m.needle_kw,
@@ -660,7 +707,7 @@ impl<N: Num> Model<N> {
     /// Advances one model step with every tick at the same inputs (tests, tools).
     pub fn step(&mut self, u: &TickInput<N>, lng_open: bool) {
         while !self.accumulate(u) {}
-        self.update(lng_open);
+        self.update(if lng_open { TICKS_PER_STEP } else { 0 });
     }
 
     /// Predicted drain (case) oil temperature, degC.
