@@ -28,8 +28,19 @@ pub const NODE_BLOCK: usize = 4;
 /// Node index: drain oil in the pump case (the protected temperature).
 pub const NODE_DRAIN: usize = 5;
 
-/// Fixed model step: 10 ms (100 Hz), s. Every discretised coefficient assumes it.
-pub const S_PER_STEP: f64 = 0.01;
+/// Sample tick: 10 ms (100 Hz), s. `Guard::step` is called once per tick; inputs are
+/// validated and the losses and exchange drivers accumulated every tick.
+pub const S_PER_TICK: f64 = 0.01;
+/// Ticks per model step (multi-rate step, docs/firmware.md): the thermal model is
+/// advanced once every `TICKS_PER_STEP` ticks with the tick-averaged inputs.
+/// 10 ticks = 100 ms: the fastest thermal time constant of the model (the drain oil,
+/// 296 J/K against ≈ 7 W/K at 60 bar / 500 rpm: ≈ 40 s) is 400 model steps.
+pub const TICKS_PER_STEP: u32 = 10;
+/// Model step: `TICKS_PER_STEP` × [`S_PER_TICK`] = 100 ms, s. Every discretised
+/// coefficient (the exact ZOH matrices, the explicit exchange rates) assumes it.
+pub const S_PER_STEP: f64 = 0.1;
+const _: () = assert!(TICKS_PER_STEP >= 1 && TICKS_PER_STEP <= 64);
+const _: () = assert!(S_PER_STEP == S_PER_TICK * TICKS_PER_STEP as f64);
 
 /// Reduced-order model parameters, SI units, `f64`.
 ///

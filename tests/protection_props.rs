@@ -361,8 +361,18 @@ fn stale_input_integrates_worst_case_loss() {
     for _ in 0..cfg.stale_steps {
         g.step_missing();
     }
+    // Multi-rate: the model step averages its ticks' losses. Go on to the next model
+    // step boundary, then one whole model step of worst-case ticks only; the copper
+    // loss uses the winding temperature at that step.
+    let mut o0 = g.step_missing();
+    while g.model().unwrap().pending_ticks() != 0 {
+        o0 = g.step_missing();
+    }
     let t_w = g.model().unwrap().temperatures_c()[0];
-    let o0 = g.step_missing();
+    for _ in 0..eha_guard::params::TICKS_PER_STEP {
+        o0 = g.step_missing();
+    }
+    assert_eq!(g.model().unwrap().pending_ticks(), 0);
     let p = g.model().unwrap().last_losses_kw();
     // R and its temperature coefficient from the configured parameters (the identified
     // DEFAULT has a constant R, as the reference baseline).

@@ -1,5 +1,11 @@
 //! `Guard`: validation + model + protection + trace + thermal memory, one call per
-//! 10 ms tick. The only API the firmware main loop needs (docs/contracts.md).
+//! 10 ms tick (docs/firmware.md).
+//!
+//! Multi-rate: every tick validates the sample (same-tick fault latching and
+//! fail-safe valve opening), substitutes worst cases and accumulates the tick's
+//! losses and exchange drivers ([`Model::tick_n`]); every
+//! [`crate::params::TICKS_PER_STEP`] ticks the model advances one 100 ms step and the
+//! valve/alarm hysteresis, dwell, LNG budget and trace run on the new estimate.
 
 mod types;
 pub use types::{faults, GuardConfig, Output, Sample, DRAIN_C_UNKNOWN};
@@ -7,7 +13,7 @@ pub use types::{faults, GuardConfig, Output, Sample, DRAIN_C_UNKNOWN};
 use crate::memory::{Restore, ThermalRecord};
 use crate::model::{InputScales, Model, ModelInputN};
 use crate::num::Num;
-use crate::params::N_NODES;
+use crate::params::{N_NODES, TICKS_PER_STEP};
 use crate::protection::{alarm_update_with, LngBudget, LngConfig, Valve};
 use crate::trace::{RestoreKind, Trace, TraceBuf};
 use crate::validate::{self, Channels, LimitsN, CH_ALL, CH_POSITION};
@@ -74,7 +80,8 @@ impl<N: Num> Core<N> {
 #[derive(Clone, Debug)]
 pub struct GuardOf<N: Num> {
     core: Option<Core<N>>,
-    dwell_steps: u32,
+    /// Valve dwell in model steps (the configured ticks, rounded up).
+    dwell_model_steps: u32,
     stale_steps: u32,
     clear_valid_steps: u32,
     latched: u16,
@@ -83,12 +90,21 @@ pub struct GuardOf<N: Num> {
     prev_ok: u8,
     missing: u32,
     valid_run: u32,
-    have_ambient: bool,
+    /// `false` until the first tick: a cold start takes that tick's ambient, and the
+    /// protection is evaluated once on the initial (or restored) estimate.
+    started: bool,
+    cold: bool,
+    /// Ticks of the present model step with the valve commanded open (LNG budget).
+    open_ticks: u32,
     valve: Valve,
     alarm: bool,
     lng: LngBudget,
     lng_low: bool,
     step: u32,
+    /// Output fields that change only at a model step.
+    drain_c: f32,
+    lng_remaining_kg: f32,
+    lng_seconds_left: f32,
     trace: TraceBuf,
 }
 
@@ -101,7 +117,7 @@ impl<N: Num> GuardOf<N> {
         let mut g = GuardOf {
             latched: if core.is_none() { faults::CONFIG } else { 0 },
             core,
-            dwell_steps: config.valve.dwell_steps,
+            dwell_model_steps: config.valve.dwell_steps.div_ceil(TICKS_PER_STEP),
             stale_steps: config.stale_steps,
             clear_valid_steps: config.clear_valid_steps,
             bad_ch: 0,
@@ -109,12 +125,17 @@ impl<N: Num> GuardOf<N> {
             prev_ok: 0,
             missing: 0,
             valid_run: 0,
-            have_ambient: false,
+            started: false,
+            cold: true,
+            open_ticks: 0,
             valve: Valve::new(),
             alarm: false,
             lng: LngBudget::new(&config.lng),
             lng_low: false,
             step: 0,
+            drain_c: DRAIN_C_UNKNOWN,
+            lng_remaining_kg: 0.0,
+            lng_seconds_left: 0.0,
             trace: TraceBuf::new(),
         };
         let kind = match restore {
@@ -123,7 +144,7 @@ impl<N: Num> GuardOf<N> {
                 if let Some(c) = g.core.as_mut() {
                     c.model.set_temperatures(&r.temps_c, r.ambient_c);
                 }
-                g.have_ambient = true;
+                g.cold = false;
                 g.lng.set_used_cj(r.lng_used_cj);
                 g.latched |= r.faults & faults::LATCHED & !faults::CONFIG;
                 g.bad_ch = ((r.faults >> faults::CH_SHIFT) as u8) & CH_ALL;
@@ -134,21 +155,43 @@ impl<N: Num> GuardOf<N> {
                 if let Some(c) = g.core.as_mut() {
                     c.model.set_temperatures(&[t; N_NODES], t);
                 }
-                g.have_ambient = true;
+                g.cold = false;
                 g.lng.set_used_cj(u32::MAX);
                 g.latched |= faults::MEMORY_CORRUPT;
                 RestoreKind::Corrupt
             }
         };
+        g.lng_remaining_kg = g.lng.remaining_kg();
+        g.lng_seconds_left = g.lng.seconds_left_cj(0);
         g.trace.write(Trace::Restore { step: 0, kind });
         g
     }
 
-    /// One 10 ms step with a new sample. Never panics; any invalid channel latches a
-    /// fault, opens the valve in this same step and is replaced by its worst case.
+    /// One 10 ms tick with a new sample. Never panics; any invalid channel latches a
+    /// fault, opens the valve in this same tick and is replaced by its worst case.
     #[inline(never)]
     pub fn step(&mut self, s: &Sample) -> Output {
         self.missing = 0;
+        let Some(core) = self.core.as_ref() else {
+            return self.advance(None, 0);
+        };
+        // Fast path: every channel in range and within its rate, all previous values
+        // valid, no channel latched bad. Anything else is classified below.
+        let (v, ok) = validate::convert_check(s, &self.prev, &core.scales, &core.limits);
+        if ok & (self.prev_ok == CH_ALL) & (self.bad_ch == 0) {
+            self.valid_run = self.valid_run.saturating_add(1);
+            let u = validate::direct(&v, &self.prev);
+            self.prev = v;
+            return self.advance(Some(&u), 0);
+        }
+        self.step_classify(s)
+    }
+
+    /// [`GuardOf::step`] off the fast path: classifies the sample (distinct fault and
+    /// channel bits) and substitutes worst cases.
+    #[inline(never)]
+    #[cold]
+    fn step_classify(&mut self, s: &Sample) -> Output {
         let Some(core) = self.core.as_ref() else {
             return self.advance(None, 0);
         };
@@ -182,7 +225,7 @@ impl<N: Num> GuardOf<N> {
         self.advance(Some(&u), new_bits)
     }
 
-    /// One 10 ms step without a new sample: inputs are held (piston work taken as
+    /// One 10 ms tick without a new sample: inputs are held (piston work taken as
     /// zero); after `stale_steps` consecutive misses the STALE fault latches and every
     /// channel takes its worst case.
     pub fn step_missing(&mut self) -> Output {
@@ -201,6 +244,9 @@ impl<N: Num> GuardOf<N> {
         self.advance(u.as_ref(), new_bits)
     }
 
+    /// The per-tick part after validation: fault latching and the same-tick
+    /// fail-safe opening, then the model's tick accumulation, and the model step
+    /// with the protection every `TICKS_PER_STEP` ticks.
     #[inline(always)]
     fn advance(&mut self, u: Option<&ModelInputN<N>>, new_bits: u16) -> Output {
         let newly = new_bits & !self.latched;
@@ -212,39 +258,95 @@ impl<N: Num> GuardOf<N> {
             });
         }
         let force = self.latched != 0;
-        let (drain_c, loss_cj, valve_ev, alarm_ev) = match (self.core.as_mut(), u) {
-            (Some(c), Some(u)) => {
-                if !self.have_ambient {
-                    c.model.set_uniform(u.ambient_c);
-                    self.have_ambient = true;
+        if force && self.valve.force_open() {
+            self.trace.write(Trace::ValveOpen {
+                step: self.step,
+                drain_c: self.drain_c,
+                forced: true,
+            });
+        }
+        match u {
+            Some(u) if self.core.is_some() => {
+                if !self.started {
+                    self.start(u.ambient_c, force);
                 }
-                // The exchanger ran over this step if the valve was open; under a
+                let open = self.valve.is_open();
+                self.open_ticks += open as u32;
+                // The exchanger runs over this tick if the valve is open; under a
                 // latched fault the model takes no cooling credit (conservative: the
                 // exchanger itself may be what failed).
-                c.model.step_n(u, self.valve.is_open() && !force);
-                let d = c.model.drain_c();
-                let th = &c.th;
-                let v = self
-                    .valve
-                    .update_with(d, force, th.open, th.close, self.dwell_steps);
-                let a = alarm_update_with(&mut self.alarm, d, th.alarm, th.clear);
-                // Total loss kW → cJ per 10 ms step (= W), never negative.
-                let cj = c.model.last_total_kw().round_times(1000).max(0) as u32;
-                (d.to_f32(), cj, v, a)
+                let full = match self.core.as_mut() {
+                    Some(c) => c.model.tick_n(u, open & !force),
+                    None => false,
+                };
+                if full {
+                    self.model_step(force);
+                }
             }
             _ => {
-                let v = self
-                    .valve
-                    .update_with(DRAIN_C_UNKNOWN, true, 0.0, 0.0, self.dwell_steps);
                 self.alarm = true;
-                (DRAIN_C_UNKNOWN, 0, v, None)
+                self.drain_c = DRAIN_C_UNKNOWN;
             }
+        }
+        self.step = self.step.wrapping_add(1);
+        Output {
+            drain_c: self.drain_c,
+            valve_open: self.valve.is_open(),
+            alarm: self.alarm,
+            derate: self.alarm,
+            faults: self.faults(),
+            lng_remaining_kg: self.lng_remaining_kg,
+            lng_seconds_left: self.lng_seconds_left,
+        }
+    }
+
+    /// First tick: a cold start takes every node to this tick's ambient; then the
+    /// protection is evaluated once on the initial (or restored) estimate, so that a
+    /// warm restore above the threshold opens the valve at once.
+    #[cold]
+    #[inline(never)]
+    fn start(&mut self, ambient_c: N, force: bool) {
+        self.started = true;
+        if self.cold {
+            if let Some(c) = self.core.as_mut() {
+                c.model.set_uniform(ambient_c);
+            }
+        }
+        self.protect(force, 0);
+    }
+
+    /// Every `TICKS_PER_STEP` ticks: the model step, then the protection.
+    #[inline(never)]
+    fn model_step(&mut self, force: bool) {
+        let Some(c) = self.core.as_mut() else {
+            return;
         };
+        c.model.update();
+        // Mean total loss kW → cJ per 10 ms tick (= W), never negative.
+        let cj = c.model.last_total_kw().round_times(1000).max(0) as u32;
+        self.protect(force, cj);
+    }
+
+    /// Valve hysteresis and dwell, alarm, LNG budget (the model step's ticks with the
+    /// valve open at `cj` centijoules per tick) and the outputs that change only here.
+    #[inline(always)]
+    fn protect(&mut self, force: bool, cj: u32) {
+        let Some(c) = self.core.as_ref() else {
+            return;
+        };
+        let d = c.model.drain_c();
+        let th = &c.th;
+        let valve_ev = self
+            .valve
+            .update_with(d, force, th.open, th.close, self.dwell_model_steps);
+        let alarm_ev = alarm_update_with(&mut self.alarm, d, th.alarm, th.clear);
+        let drain_c = d.to_f32();
         let drain_c = if drain_c.is_finite() {
             drain_c
         } else {
             DRAIN_C_UNKNOWN
         };
+        self.drain_c = drain_c;
         if let Some(open) = valve_ev {
             let t = if open {
                 Trace::ValveOpen {
@@ -274,7 +376,8 @@ impl<N: Num> GuardOf<N> {
             };
             self.trace.write(t);
         }
-        self.lng.update_cj(self.valve.is_open(), loss_cj);
+        self.lng.update_cj_ticks(cj, self.open_ticks);
+        self.open_ticks = 0;
         let low = self.lng.is_low();
         if low && !self.lng_low {
             self.trace.write(Trace::LngLow {
@@ -283,16 +386,8 @@ impl<N: Num> GuardOf<N> {
             });
         }
         self.lng_low = low;
-        self.step = self.step.wrapping_add(1);
-        Output {
-            drain_c,
-            valve_open: self.valve.is_open(),
-            alarm: self.alarm,
-            derate: self.alarm,
-            faults: self.faults(),
-            lng_remaining_kg: self.lng.remaining_kg(),
-            lng_seconds_left: self.lng.seconds_left_cj(loss_cj),
-        }
+        self.lng_remaining_kg = self.lng.remaining_kg();
+        self.lng_seconds_left = self.lng.seconds_left_cj(cj);
     }
 
     /// Present fault word (see [`faults`]).
@@ -369,7 +464,7 @@ impl<N: Num> GuardOf<N> {
         self.core.as_ref().map(|c| &c.model)
     }
 
-    /// Steps taken since boot (10 ms each, wraps after 497 days).
+    /// Ticks taken since boot (10 ms each, wraps after 497 days).
     pub fn steps(&self) -> u32 {
         self.step
     }
