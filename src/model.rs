@@ -130,8 +130,6 @@ struct LossK<N: Num> {
 struct TickSums<N: Num> {
     /// Current squared, hA^2 (copper loss at the model step's winding temperature).
     i2: N::Acc,
-    /// Iron loss, kW.
-    fe: N::Acc,
     /// Leakage loss, kW.
     leak: N::Acc,
     /// `|dp| |w|`, hbar hrad/s (mechanical loss times `eta_m D` at the model step).
@@ -140,14 +138,12 @@ struct TickSums<N: Num> {
     hyd: N::Acc,
     /// `|dp|`, hbar (drain <-> leakage-feed exchange).
     adp: N::Acc,
-    /// `sqrt|w|`, hrad/s^0.5 (speed-driven exchanges).
-    sw: N::Acc,
-    /// `|w|`, hrad/s (LNG conductance).
+    /// `|w|`, hrad/s (iron loss, speed-driven exchanges, LNG conductance).
     aw: N::Acc,
     /// Ambient, degC.
     amb: N::Acc,
-    /// One per tick with the LNG exchanger credited.
-    lng: N::Acc,
+    /// Ticks with the LNG exchanger credited.
+    lng: u32,
     /// Ticks accumulated.
     n: u32,
 }
@@ -155,15 +151,13 @@ struct TickSums<N: Num> {
 impl<N: Num> TickSums<N> {
     const EMPTY: Self = TickSums {
         i2: N::ACC_ZERO,
-        fe: N::ACC_ZERO,
         leak: N::ACC_ZERO,
         mech: N::ACC_ZERO,
         hyd: N::ACC_ZERO,
         adp: N::ACC_ZERO,
-        sw: N::ACC_ZERO,
         aw: N::ACC_ZERO,
         amb: N::ACC_ZERO,
-        lng: N::ACC_ZERO,
+        lng: 0,
         n: 0,
     };
 }
@@ -181,6 +175,8 @@ pub struct Model<N: Num> {
     last_loss_kw: [N; N_LOSSES],
     last_drivers: [N; 3],
     last_lng: N,
+    /// `n / TICKS_PER_STEP` for n = 0 ..= TICKS_PER_STEP (credited LNG fraction).
+    lng_frac: [N; TICKS_PER_STEP as usize + 1],
     /// Pump, loop-oil, block and drain temperatures at the last model step's start
     /// (midpoint extrapolation of the exchanges), degC.
     prev_ex: [N; 4],
@@ -319,8 +315,12 @@ impl<N: Num> Model<N> {
             last_loss_kw: [N::ZERO; N_LOSSES],
             last_drivers: [N::ZERO; 3],
             last_lng: N::ZERO,
+            lng_frac: [N::ZERO; TICKS_PER_STEP as usize + 1],
             prev_ex: [N::ZERO; 4],
         };
+        for (i, fr) in m.lng_frac.iter_mut().enumerate() {
+            *fr = f(i as f64 / TICKS_PER_STEP as f64);
+        }
         m.state_was_set();
         Ok(m)
     }
@@ -375,38 +375,24 @@ impl<N: Num> Model<N> {
         self.state_was_set();
     }
 
-    /// Losses `[copper, iron, leakage, mechanical, throttling]` of one tick in kW
-    /// (eqs. 1, 2, 5-8, 11) at the present node temperatures; `dpos_mm` is the
-    /// position change over the tick.
+    /// Losses `[copper, iron, leakage, mechanical, throttling]` in kW (eqs. 1, 2, 5-8,
+    /// 11) of a model step whose ticks all have these inputs, at the present node
+    /// temperatures; `dpos_mm` is the position change over one tick.
     pub fn losses_kw(&self, i_ha: N, dp_hbar: N, w_hrads: N, dpos_mm: N) -> [N; N_LOSSES] {
         let k = &self.k;
-        let m = Magnitudes::of(dp_hbar, w_hrads);
+        let (adp, aw) = (dp_hbar.abs(), w_hrads.abs());
         let t_w = N::value(self.temp[NODE_WINDING]);
-        let (p_fe, p_leak, p_hyd) = self.tick_losses(dp_hbar, w_hrads, dpos_mm, &m);
+        let p_leak = self.leak_eff.mul(dp_hbar).mul(dp_hbar);
         [
             i_ha.mul(i_ha).mul(k.cu0.add(k.cu1.mul(t_w))),
-            p_fe,
+            aw.mul(k.fe1.add(k.fe2.mul(aw)).add(k.fe15.mul(aw.sqrt_abs()))),
             p_leak,
-            k.mech.mul(m.adp).mul(m.aw),
-            p_hyd,
+            k.mech.mul(adp.mul(aw)),
+            dp_hbar
+                .mul(k.kq.mul(w_hrads).sub(k.kv.mul(dpos_mm)))
+                .sub(p_leak)
+                .max0(),
         ]
-    }
-
-    /// Iron, leakage and throttling loss of one tick, kW.
-    #[inline(always)]
-    fn tick_losses(&self, dp_hbar: N, w_hrads: N, dpos_mm: N, m: &Magnitudes<N>) -> (N, N, N) {
-        let k = &self.k;
-        // eq. (2) with f ∝ w and constant B_m
-        let aw = m.aw;
-        let p_fe = aw.mul(k.fe1.add(k.fe2.mul(aw)).add(k.fe15.mul(m.sw)));
-        // eqs. (5)-(7): K dp^2 / mu(T) (viscosity ratio held over the model step)
-        let p_leak = self.leak_eff.mul(dp_hbar).mul(dp_hbar);
-        // eq. (11) generalised: dp (D w - Q_leak) - dp A v, never negative (no heat sink)
-        let p_hyd = dp_hbar
-            .mul(k.kq.mul(w_hrads).sub(k.kv.mul(dpos_mm)))
-            .sub(p_leak)
-            .max0();
-        (p_fe, p_leak, p_hyd)
     }
 
     /// One 10 ms tick with inputs in wire units: [`Model::tick_n`], then
@@ -435,32 +421,33 @@ impl<N: Num> Model<N> {
         full
     }
 
-    /// Accumulates one 10 ms tick: its iron, leakage and throttling losses (the
-    /// throttling floored at 0 for this tick), `I^2`, `|dp| |w|`, the exchange drivers
-    /// `|dp|`, `sqrt|w|`, `|w|`, the ambient, and whether the LNG exchanger ran over
-    /// the tick (`lng_open`: the guard's own command, no credit under a fault).
-    /// Returns `true` when [`crate::params::TICKS_PER_STEP`] ticks are accumulated:
-    /// the caller must then call [`Model::update`] before the next tick.
+    /// Accumulates one 10 ms tick: its leakage and throttling losses (the throttling
+    /// floored at 0 for this tick), `I^2`, `|dp| |w|`, the drivers `|dp|` and `|w|`,
+    /// the ambient, and whether the LNG exchanger ran over the tick (`lng_open`: the
+    /// guard's own command, no credit under a fault). Returns `true` when
+    /// [`crate::params::TICKS_PER_STEP`] ticks are accumulated: the caller must then
+    /// call [`Model::update`] before the next tick.
     #[inline(always)]
     #[must_use]
     pub fn tick_n(&mut self, u: &ModelInputN<N>, lng_open: bool) -> bool {
+        let k = &self.k;
         let dp = u.dp_hbar;
-        let mag = Magnitudes::of(dp, u.speed_hrads);
-        let (p_fe, p_leak, p_hyd) = self.tick_losses(dp, u.speed_hrads, u.dpos_mm, &mag);
+        let w = u.speed_hrads;
+        let (adp, aw) = (dp.abs(), w.abs());
         let i = u.current_ha;
+        // eqs. (5)-(7): K dp^2 / mu(T) (viscosity ratio held over the model step)
+        let p_leak = self.leak_eff.mul(dp).mul(dp);
+        // eq. (11) generalised: dp (D w - Q_leak) - dp A v, never negative (no heat sink)
+        let p_hyd = dp.mul(k.kq.mul(w).sub(k.kv.mul(u.dpos_mm))).sub(p_leak).max0();
         let s = &mut self.sums;
         s.i2 = N::acc(s.i2, i.mul(i));
-        s.fe = N::acc(s.fe, p_fe);
         s.leak = N::acc(s.leak, p_leak);
-        s.mech = N::acc(s.mech, mag.adp.mul(mag.aw));
+        s.mech = N::acc(s.mech, adp.mul(aw));
         s.hyd = N::acc(s.hyd, p_hyd);
-        s.adp = N::acc(s.adp, mag.adp);
-        s.sw = N::acc(s.sw, mag.sw);
-        s.aw = N::acc(s.aw, mag.aw);
+        s.adp = N::acc(s.adp, adp);
+        s.aw = N::acc(s.aw, aw);
         s.amb = N::acc(s.amb, u.ambient_c);
-        if lng_open {
-            s.lng = N::acc(s.lng, self.k.one);
-        }
+        s.lng += lng_open as u32;
         s.n += 1;
         s.n >= TICKS_PER_STEP
     }
@@ -478,15 +465,18 @@ impl<N: Num> Model<N> {
         let mean = N::acc_mean;
         let amb = mean(s.amb);
         self.ambient_c = amb;
-        let (adp, sw, aw) = (mean(s.adp), mean(s.sw), mean(s.aw));
+        let (adp, aw) = (mean(s.adp), mean(s.aw));
+        let sw = aw.sqrt_abs();
         self.last_drivers = [adp, sw, aw];
         let k = &self.k;
         let th = &self.temp;
         // eq. (1): m I^2 R0 (1 + alpha (T_w - 25)), with the mean of I^2
         let t_w = N::value(th[NODE_WINDING]);
+        // eq. (2) with f ∝ w and constant B_m, at the step's mean |w|
+        let p_fe = aw.mul(k.fe1.add(k.fe2.mul(aw)).add(k.fe15.mul(sw)));
         let p = [
             mean(s.i2).mul(k.cu0.add(k.cu1.mul(t_w))),
-            mean(s.fe),
+            p_fe,
             mean(s.leak),
             k.mech.mul(mean(s.mech)),
             mean(s.hyd),
@@ -499,7 +489,7 @@ impl<N: Num> Model<N> {
         // loop oil by the heat removed over the oil stream's capacity rate, g / (g_slope
         // |w|) (T_loop - T_LNG) (all of the difference when the oil stream is the
         // smaller), for the same fraction f.
-        let f = mean(s.lng);
+        let f = self.lng_frac.get(s.lng as usize).copied().unwrap_or(k.one);
         let (g_lng, cooled) = if f > N::ZERO {
             let g = k.lng_slope.mul(aw);
             if g > k.lng_max {
@@ -611,23 +601,6 @@ impl<N: Num> Model<N> {
     /// Sum of the last model step's losses (mean over its ticks), kW.
     pub fn last_total_kw(&self) -> N {
         self.last_loss_kw.iter().fold(N::ZERO, |a, p| a.add(*p))
-    }
-}
-
-/// Magnitudes of one tick's inputs, taken once and shared by the losses and the
-/// exchange drivers: `|w|`, `sqrt|w|` (hrad/s, hrad/s^0.5) and `|dp|` (hbar).
-#[derive(Clone, Copy, Debug)]
-struct Magnitudes<N> {
-    aw: N,
-    sw: N,
-    adp: N,
-}
-
-impl<N: Num> Magnitudes<N> {
-    #[inline(always)]
-    fn of(dp_hbar: N, w_hrads: N) -> Self {
-        let aw = w_hrads.abs();
-        Magnitudes { aw, sw: aw.sqrt_abs(), adp: dp_hbar.abs() }
     }
 }
 

@@ -89,25 +89,31 @@ pub struct GuardOf<N: Num> {
     prev: Channels<N>,
     prev_ok: u8,
     missing: u32,
-    valid_run: u32,
+    /// Tick index from which every sample was present and valid (the run of valid
+    /// samples of the clear rule is `step - valid_since`).
+    valid_since: u32,
     /// `false` until the first tick: a cold start takes that tick's ambient, and the
     /// protection is evaluated once on the initial (or restored) estimate.
     started: bool,
     cold: bool,
     /// Ticks of the present model step with the valve commanded open (LNG budget).
     open_ticks: u32,
+    /// Mean loss of the last model step, cJ per tick (= W).
+    last_cj: u32,
     valve: Valve,
     alarm: bool,
     lng: LngBudget,
     lng_low: bool,
     step: u32,
-    /// Output fields that change only at a model step.
-    drain_c: f32,
-    lng_remaining_kg: f32,
-    lng_seconds_left: f32,
+    /// The outputs, refreshed whenever one of them changes (fault latching, the
+    /// fail-safe opening, a model step, clear/refill): a tick on the fast path
+    /// returns them as they are.
+    out: Output,
     trace: TraceBuf,
 }
 
+/// Invariant kept by every place that latches a fault: `latched != 0` implies the
+/// valve is commanded open, so the per-tick fast path needs no fail-safe check.
 impl<N: Num> GuardOf<N> {
     /// Builds the model once (matrix exponential) and applies the boot rule of
     /// [`crate::memory`]. Never fails: unusable parameters give a CONFIG fault and a
@@ -124,18 +130,20 @@ impl<N: Num> GuardOf<N> {
             prev: [N::ZERO; 6],
             prev_ok: 0,
             missing: 0,
-            valid_run: 0,
+            valid_since: 0,
             started: false,
             cold: true,
             open_ticks: 0,
+            last_cj: 0,
             valve: Valve::new(),
             alarm: false,
             lng: LngBudget::new(&config.lng),
             lng_low: false,
             step: 0,
-            drain_c: DRAIN_C_UNKNOWN,
-            lng_remaining_kg: 0.0,
-            lng_seconds_left: 0.0,
+            out: Output {
+                drain_c: DRAIN_C_UNKNOWN,
+                ..Output::default()
+            },
             trace: TraceBuf::new(),
         };
         let kind = match restore {
@@ -161,9 +169,8 @@ impl<N: Num> GuardOf<N> {
                 RestoreKind::Corrupt
             }
         };
-        g.lng_remaining_kg = g.lng.remaining_kg();
-        g.lng_seconds_left = g.lng.seconds_left_cj(0);
         g.trace.write(Trace::Restore { step: 0, kind });
+        g.refresh_out();
         g
     }
 
@@ -171,29 +178,31 @@ impl<N: Num> GuardOf<N> {
     /// fault, opens the valve in this same tick and is replaced by its worst case.
     #[inline(never)]
     pub fn step(&mut self, s: &Sample) -> Output {
-        self.missing = 0;
-        let Some(core) = self.core.as_ref() else {
-            return self.advance(None, 0);
-        };
-        // Fast path: every channel in range and within its rate, all previous values
-        // valid, no channel latched bad. Anything else is classified below.
-        let (v, ok) = validate::convert_check(s, &self.prev, &core.scales, &core.limits);
-        if ok & (self.prev_ok == CH_ALL) & (self.bad_ch == 0) {
-            self.valid_run = self.valid_run.saturating_add(1);
-            let u = validate::direct(&v, &self.prev);
-            self.prev = v;
-            return self.advance(Some(&u), 0);
+        if let Some(core) = self.core.as_ref() {
+            // Fast path: every channel in range and within its rate, every previous
+            // value valid (so this is not the first tick), no channel latched bad.
+            // Nothing to latch, the valve is not forced by this tick (an earlier
+            // latched fault has already opened it), the outputs only change at a
+            // model step. Anything else is classified by `step_slow`.
+            let (v, ok) = validate::convert_check(s, &self.prev, &core.scales, &core.limits);
+            if ok & (self.prev_ok == CH_ALL) & (self.bad_ch == 0) {
+                self.missing = 0;
+                let u = validate::direct(&v, &self.prev);
+                self.prev = v;
+                return self.tick(&u);
+            }
         }
-        self.step_classify(s)
+        self.step_slow(s)
     }
 
     /// [`GuardOf::step`] off the fast path: classifies the sample (distinct fault and
-    /// channel bits) and substitutes worst cases.
+    /// channel bits), substitutes worst cases, latches and forces the valve open.
     #[inline(never)]
     #[cold]
-    fn step_classify(&mut self, s: &Sample) -> Output {
+    fn step_slow(&mut self, s: &Sample) -> Output {
+        self.missing = 0;
         let Some(core) = self.core.as_ref() else {
-            return self.advance(None, 0);
+            return self.slow_tail(None, 0);
         };
         let (v, nonfinite) = validate::convert(s, &core.scales);
         let c = validate::check(&v, nonfinite, &self.prev, self.prev_ok, &core.limits);
@@ -208,11 +217,9 @@ impl<N: Num> GuardOf<N> {
             new_bits |= faults::NON_FINITE;
         }
         self.bad_ch |= c.bad;
-        self.valid_run = if c.bad == 0 {
-            self.valid_run.saturating_add(1)
-        } else {
-            0
-        };
+        if c.bad != 0 {
+            self.valid_since = self.step.wrapping_add(1);
+        }
         let [_, _, _, _, prev_pos, _] = self.prev;
         let prev_pos = if self.prev_ok & CH_POSITION != 0 {
             Some(prev_pos)
@@ -222,7 +229,7 @@ impl<N: Num> GuardOf<N> {
         let u = validate::substitute(&v, self.bad_ch, prev_pos, &core.limits);
         self.prev = v;
         self.prev_ok = !c.bad & CH_ALL;
-        self.advance(Some(&u), new_bits)
+        self.slow_tail(Some(&u), new_bits)
     }
 
     /// One 10 ms tick without a new sample: inputs are held (piston work taken as
@@ -230,7 +237,7 @@ impl<N: Num> GuardOf<N> {
     /// channel takes its worst case.
     pub fn step_missing(&mut self) -> Output {
         self.missing = self.missing.saturating_add(1);
-        self.valid_run = 0;
+        self.valid_since = self.step.wrapping_add(1);
         self.prev_ok = 0;
         let mut new_bits = 0;
         if self.missing >= self.stale_steps {
@@ -241,14 +248,13 @@ impl<N: Num> GuardOf<N> {
             .core
             .as_ref()
             .map(|c| validate::substitute(&self.prev, self.bad_ch, None, &c.limits));
-        self.advance(u.as_ref(), new_bits)
+        self.slow_tail(u.as_ref(), new_bits)
     }
 
-    /// The per-tick part after validation: fault latching and the same-tick
-    /// fail-safe opening, then the model's tick accumulation, and the model step
-    /// with the protection every `TICKS_PER_STEP` ticks.
-    #[inline(always)]
-    fn advance(&mut self, u: Option<&ModelInputN<N>>, new_bits: u16) -> Output {
+    /// Slow-path tail: latches `new_bits` and opens the valve at once when any fault
+    /// is latched (fail-safe in the same tick), starts the model on the first tick,
+    /// then the common tick.
+    fn slow_tail(&mut self, u: Option<&ModelInputN<N>>, new_bits: u16) -> Output {
         let newly = new_bits & !self.latched;
         self.latched |= new_bits;
         if newly != 0 {
@@ -257,47 +263,51 @@ impl<N: Num> GuardOf<N> {
                 new_bits: newly | ((self.bad_ch as u16) << faults::CH_SHIFT),
             });
         }
-        let force = self.latched != 0;
-        if force && self.valve.force_open() {
+        if self.latched != 0 && self.valve.force_open() {
             self.trace.write(Trace::ValveOpen {
                 step: self.step,
-                drain_c: self.drain_c,
+                drain_c: self.out.drain_c,
                 forced: true,
             });
         }
         match u {
             Some(u) if self.core.is_some() => {
                 if !self.started {
-                    self.start(u.ambient_c, force);
+                    self.start(u.ambient_c);
                 }
-                let open = self.valve.is_open();
-                self.open_ticks += open as u32;
-                // The exchanger runs over this tick if the valve is open; under a
-                // latched fault the model takes no cooling credit (conservative: the
-                // exchanger itself may be what failed).
-                let full = match self.core.as_mut() {
-                    Some(c) => c.model.tick_n(u, open & !force),
-                    None => false,
-                };
-                if full {
-                    self.model_step(force);
-                }
+                self.refresh_out();
+                self.tick(u)
             }
             _ => {
+                // No model (CONFIG): fail-safe outputs, nothing to estimate.
                 self.alarm = true;
-                self.drain_c = DRAIN_C_UNKNOWN;
+                self.out.drain_c = DRAIN_C_UNKNOWN;
+                self.refresh_out();
+                self.step = self.step.wrapping_add(1);
+                self.out
             }
         }
-        self.step = self.step.wrapping_add(1);
-        Output {
-            drain_c: self.drain_c,
-            valve_open: self.valve.is_open(),
-            alarm: self.alarm,
-            derate: self.alarm,
-            faults: self.faults(),
-            lng_remaining_kg: self.lng_remaining_kg,
-            lng_seconds_left: self.lng_seconds_left,
+    }
+
+    /// The per-tick part common to both paths: the model's tick accumulation, and
+    /// every `TICKS_PER_STEP` ticks the model step with the protection.
+    #[inline(always)]
+    fn tick(&mut self, u: &ModelInputN<N>) -> Output {
+        let open = self.valve.is_open();
+        self.open_ticks += open as u32;
+        // The exchanger runs over this tick if the valve is open; under a latched
+        // fault the model takes no cooling credit (conservative: the exchanger itself
+        // may be what failed).
+        let credit = open & (self.latched == 0);
+        let full = match self.core.as_mut() {
+            Some(c) => c.model.tick_n(u, credit),
+            None => false,
+        };
+        if full {
+            self.model_step();
         }
+        self.step = self.step.wrapping_add(1);
+        self.out
     }
 
     /// First tick: a cold start takes every node to this tick's ambient; then the
@@ -305,35 +315,40 @@ impl<N: Num> GuardOf<N> {
     /// warm restore above the threshold opens the valve at once.
     #[cold]
     #[inline(never)]
-    fn start(&mut self, ambient_c: N, force: bool) {
+    fn start(&mut self, ambient_c: N) {
         self.started = true;
         if self.cold {
             if let Some(c) = self.core.as_mut() {
                 c.model.set_uniform(ambient_c);
             }
         }
-        self.protect(force, 0);
+        self.protect(0);
     }
 
     /// Every `TICKS_PER_STEP` ticks: the model step, then the protection.
     #[inline(never)]
-    fn model_step(&mut self, force: bool) {
+    fn model_step(&mut self) {
         let Some(c) = self.core.as_mut() else {
             return;
         };
         c.model.update();
         // Mean total loss kW → cJ per 10 ms tick (= W), never negative.
         let cj = c.model.last_total_kw().round_times(1000).max(0) as u32;
-        self.protect(force, cj);
+        // The valid run of the clear rule is `step - valid_since`; keep it from
+        // wrapping (2^30 ticks = 124 days is far above any clear_valid_steps).
+        if self.step.wrapping_sub(self.valid_since) > 1 << 30 {
+            self.valid_since = self.step.wrapping_sub(1 << 30);
+        }
+        self.protect(cj);
     }
 
     /// Valve hysteresis and dwell, alarm, LNG budget (the model step's ticks with the
     /// valve open at `cj` centijoules per tick) and the outputs that change only here.
-    #[inline(always)]
-    fn protect(&mut self, force: bool, cj: u32) {
+    fn protect(&mut self, cj: u32) {
         let Some(c) = self.core.as_ref() else {
             return;
         };
+        let force = self.latched != 0;
         let d = c.model.drain_c();
         let th = &c.th;
         let valve_ev = self
@@ -346,7 +361,7 @@ impl<N: Num> GuardOf<N> {
         } else {
             DRAIN_C_UNKNOWN
         };
-        self.drain_c = drain_c;
+        self.out.drain_c = drain_c;
         if let Some(open) = valve_ev {
             let t = if open {
                 Trace::ValveOpen {
@@ -378,6 +393,7 @@ impl<N: Num> GuardOf<N> {
         }
         self.lng.update_cj_ticks(cj, self.open_ticks);
         self.open_ticks = 0;
+        self.last_cj = cj;
         let low = self.lng.is_low();
         if low && !self.lng_low {
             self.trace.write(Trace::LngLow {
@@ -386,8 +402,20 @@ impl<N: Num> GuardOf<N> {
             });
         }
         self.lng_low = low;
-        self.lng_remaining_kg = self.lng.remaining_kg();
-        self.lng_seconds_left = self.lng.seconds_left_cj(cj);
+        self.refresh_out();
+    }
+
+    /// Rebuilds the cached outputs from the present state.
+    fn refresh_out(&mut self) {
+        self.out = Output {
+            drain_c: self.out.drain_c,
+            valve_open: self.valve.is_open(),
+            alarm: self.alarm,
+            derate: self.alarm,
+            faults: self.faults(),
+            lng_remaining_kg: self.lng.remaining_kg(),
+            lng_seconds_left: self.lng.seconds_left_cj(self.last_cj),
+        };
     }
 
     /// Present fault word (see [`faults`]).
@@ -403,7 +431,8 @@ impl<N: Num> GuardOf<N> {
     /// The thermal estimate is *not* reset: it relaxes from its conservative value.
     /// Returns `true` when the faults were cleared.
     pub fn clear_faults(&mut self) -> bool {
-        if self.missing != 0 || self.valid_run < self.clear_valid_steps {
+        let valid_run = self.step.wrapping_sub(self.valid_since);
+        if self.missing != 0 || valid_run < self.clear_valid_steps {
             return false;
         }
         let bits = (self.latched & !faults::CONFIG) | ((self.bad_ch as u16) << faults::CH_SHIFT);
@@ -415,10 +444,12 @@ impl<N: Num> GuardOf<N> {
                 bits,
             });
         }
+        self.refresh_out();
         true
     }
 
-    /// Marks an actuator (valve pin) error reported by the board: latches ACTUATOR.
+    /// Marks an actuator (valve pin) error reported by the board: latches ACTUATOR
+    /// and commands the valve open at once (fail-safe).
     pub fn report_actuator_fault(&mut self) {
         if self.latched & faults::ACTUATOR == 0 {
             self.latched |= faults::ACTUATOR;
@@ -427,12 +458,21 @@ impl<N: Num> GuardOf<N> {
                 new_bits: faults::ACTUATOR,
             });
         }
+        if self.valve.force_open() {
+            self.trace.write(Trace::ValveOpen {
+                step: self.step,
+                drain_c: self.out.drain_c,
+                forced: true,
+            });
+        }
+        self.refresh_out();
     }
 
     /// Refills the LNG budget (new charge installed).
     pub fn refill_lng(&mut self, cfg: &LngConfig) {
         self.lng = LngBudget::new(cfg);
         self.lng_low = false;
+        self.refresh_out();
     }
 
     /// Thermal-memory record of the present state (sealed with its CRC).
