@@ -39,11 +39,10 @@ pub const MAX_HBAR: f64 = 4.0;
 pub const MAX_EXPLICIT_RATE: f64 = 0.02;
 
 /// Nodes that exchange input-dependent heat (pump housing, loop oil, valve block,
-/// drain): each has a power-injection column in the discretised rows.
+/// drain).
 pub const EXCHANGE_NODES: [usize; 4] = [NODE_PUMP, NODE_LOOP_OIL, NODE_BLOCK, NODE_DRAIN];
-/// Columns of one discretised row: 6 node temperatures, 5 losses, then the power
-/// injected into the 4 [`EXCHANGE_NODES`] by the input-dependent exchanges.
-pub const N_COLS: usize = N_NODES + N_LOSSES + EXCHANGE_NODES.len();
+/// Columns of one discretised row: 6 node temperatures then 5 losses.
+pub const N_COLS: usize = N_NODES + N_LOSSES;
 const N_AUG: usize = N_COLS;
 
 /// Wire-unit → model-unit scale of current: A → hA (100 A).
@@ -123,6 +122,8 @@ struct LossK<N: Num> {
     feed_k: N,    // leakage-feed rise over the loop oil, K/hbar
     half: N,
     one: N,
+    /// `1000 h / C` of the [`EXCHANGE_NODES`]: K per step per kW exchanged.
+    ex_in: [N; 4],
 }
 
 /// Per-tick sums over the ticks of the present model step (reset by [`Model::update`]).
@@ -140,9 +141,8 @@ struct TickSums<N: Num> {
     adp: N::Acc,
     /// `|w|`, hrad/s (iron loss, speed-driven exchanges, LNG conductance).
     aw: N::Acc,
-    /// Ambient, degC.
-    amb: N::Acc,
-    /// Ticks with the LNG exchanger credited.
+    /// Ticks with the LNG exchanger credited ([`Model::step_n`] only; the guard
+    /// counts them itself).
     lng: u32,
     /// Ticks accumulated.
     n: u32,
@@ -156,7 +156,6 @@ impl<N: Num> TickSums<N> {
         hyd: N::ACC_ZERO,
         adp: N::ACC_ZERO,
         aw: N::ACC_ZERO,
-        amb: N::ACC_ZERO,
         lng: 0,
         n: 0,
     };
@@ -183,8 +182,7 @@ pub struct Model<N: Num> {
 }
 
 /// Discretised matrices in `f64` for the model step [`S_PER_STEP`]: row `i` =
-/// `[(Ad - I)_i·, Bd_i·, Bx_i·]`, `Bd` per kW of each loss (split over the nodes),
-/// `Bx` per kW injected into each of the [`EXCHANGE_NODES`] (`h φ1(hA) C^-1`).
+/// `[(Ad - I)_i·, Bd_i·]`, `Bd` per kW of each loss (split over the nodes).
 pub fn discretise(p: &ReducedParams) -> [[f64; N_COLS]; N_NODES] {
     let mut m = [[0.0f64; N_AUG]; N_AUG];
     let node_data = p
@@ -206,11 +204,6 @@ pub fn discretise(p: &ReducedParams) -> [[f64; N_COLS]; N_NODES] {
         }
         for (mij, share) in row.iter_mut().skip(N_NODES).zip(split_row.iter()) {
             *mij = share * W_PER_KW * k;
-        }
-        for (mij, node) in row.iter_mut().skip(N_NODES + N_LOSSES).zip(EXCHANGE_NODES.iter()) {
-            if *node == i {
-                *mij = W_PER_KW * k;
-            }
         }
     }
     let e = expm1m(&m);
@@ -304,6 +297,12 @@ impl<N: Num> Model<N> {
             feed_k: f(consts[17]),
             half: f(0.5),
             one: f(1.0),
+            ex_in: [
+                f(W_PER_KW * h / c2),
+                f(W_PER_KW * h / c3),
+                f(W_PER_KW * h / c4),
+                f(W_PER_KW * h / c5),
+            ],
         };
         let mut m = Model {
             temp: [N::state(N::ZERO); N_NODES],
@@ -411,25 +410,27 @@ impl<N: Num> Model<N> {
         )
     }
 
-    /// [`Model::step`] with inputs already in model units.
+    /// [`Model::step`] with inputs already in model units: [`Model::tick_n`], the
+    /// tick counted as credited with the LNG exchanger when `lng_open`, and
+    /// [`Model::update`] with that count when the model step is complete.
     #[inline(always)]
     pub fn step_n(&mut self, u: &ModelInputN<N>, lng_open: bool) -> bool {
-        let full = self.tick_n(u, lng_open);
+        self.sums.lng += lng_open as u32;
+        let full = self.tick_n(u);
         if full {
-            self.update();
+            self.update(self.sums.lng);
         }
         full
     }
 
     /// Accumulates one 10 ms tick: its leakage and throttling losses (the throttling
-    /// floored at 0 for this tick), `I^2`, `|dp| |w|`, the drivers `|dp|` and `|w|`,
-    /// the ambient, and whether the LNG exchanger ran over the tick (`lng_open`: the
-    /// guard's own command, no credit under a fault). Returns `true` when
-    /// [`crate::params::TICKS_PER_STEP`] ticks are accumulated: the caller must then
-    /// call [`Model::update`] before the next tick.
+    /// floored at 0 for this tick), `I^2`, `|dp| |w|`, the drivers `|dp|` and `|w|`;
+    /// the ambient of the tick is kept (the model step uses the last tick's). Returns
+    /// `true` when [`crate::params::TICKS_PER_STEP`] ticks are accumulated: the caller
+    /// must then call [`Model::update`] before the next tick.
     #[inline(always)]
     #[must_use]
-    pub fn tick_n(&mut self, u: &ModelInputN<N>, lng_open: bool) -> bool {
+    pub fn tick_n(&mut self, u: &ModelInputN<N>) -> bool {
         let k = &self.k;
         let dp = u.dp_hbar;
         let w = u.speed_hrads;
@@ -446,8 +447,7 @@ impl<N: Num> Model<N> {
         s.hyd = N::acc(s.hyd, p_hyd);
         s.adp = N::acc(s.adp, adp);
         s.aw = N::acc(s.aw, aw);
-        s.amb = N::acc(s.amb, u.ambient_c);
-        s.lng += lng_open as u32;
+        self.ambient_c = u.ambient_c;
         s.n += 1;
         s.n >= TICKS_PER_STEP
     }
@@ -458,13 +458,14 @@ impl<N: Num> Model<N> {
     }
 
     /// Advances one model step of [`S_PER_STEP`] with the tick-averaged inputs of the
-    /// accumulated ticks held (exact ZOH for the linear part), plus the explicit
-    /// input-dependent exchanges; clears the tick sums. Never panics.
-    pub fn update(&mut self) {
+    /// accumulated ticks held (exact ZOH for the linear part) and the last tick's
+    /// ambient, plus the explicit input-dependent exchanges, with the LNG exchanger
+    /// credited over `lng_ticks` of the step's ticks; clears the tick sums. Never
+    /// panics.
+    pub fn update(&mut self, lng_ticks: u32) {
         let s = core::mem::replace(&mut self.sums, TickSums::EMPTY);
         let mean = N::acc_mean;
-        let amb = mean(s.amb);
-        self.ambient_c = amb;
+        let amb = self.ambient_c;
         let (adp, aw) = (mean(s.adp), mean(s.aw));
         let sw = aw.sqrt_abs();
         self.last_drivers = [adp, sw, aw];
@@ -489,7 +490,7 @@ impl<N: Num> Model<N> {
         // loop oil by the heat removed over the oil stream's capacity rate, g / (g_slope
         // |w|) (T_loop - T_LNG) (all of the difference when the oil stream is the
         // smaller), for the same fraction f.
-        let f = self.lng_frac.get(s.lng as usize).copied().unwrap_or(k.one);
+        let f = self.lng_frac.get(lng_ticks as usize).copied().unwrap_or(k.one);
         let (g_lng, cooled) = if f > N::ZERO {
             let g = k.lng_slope.mul(aw);
             if g > k.lng_max {
@@ -528,34 +529,40 @@ impl<N: Num> Model<N> {
         // the step's mean of the ticks' sqrt|w|.
         let q_pd = k.pd_g.mul(sw).mul(x_pump.sub(x_drain));
         let q_lb = k.lb_g.mul(sw).mul(x_loop.sub(x_block));
-        // Exponential Euler: the exchange powers (kW, evaluated at the step start) are
-        // held over the step like the losses and enter through `Bx = h φ1(hA) C^-1`,
-        // so that a steady state of the continuous model is a fixed point of the step.
+        // The exchange powers (kW), held over the step, change their nodes by
+        // δ = h C^-1 q. Exponential Euler would add h φ1(hA) C^-1 q; to second order
+        // in h that is δ + (Ad - I) δ/2, so the matrix product takes θ + δ/2 (a
+        // steady state of the continuous model is then a fixed point of the step to
+        // O(h^2); with δ alone, h/2 A δ is missing and the slow metal nodes
+        // integrate it: 4e-3 K against the RK4 reference instead of 3e-5 K).
+        let [e2, e3, e4, e5] = k.ex_in;
+        let d2 = e2.mul(N::ZERO.sub(q_pd));
+        let d3 = e3.mul(N::ZERO.sub(q_ex).sub(q_lb).sub(q_lng));
+        let d4 = e4.mul(q_lb);
+        let d5 = e5.mul(q_ex.add(q_pd));
+        let h = k.half;
         let x: [N; N_COLS] = [
             N::value(th[0]).sub(amb),
             N::value(th[1]).sub(amb),
-            t_now[0].sub(amb),
-            t_now[1].sub(amb),
-            t_now[2].sub(amb),
-            t_now[3].sub(amb),
+            t_now[0].sub(amb).add(h.mul(d2)),
+            t_now[1].sub(amb).add(h.mul(d3)),
+            t_now[2].sub(amb).add(h.mul(d4)),
+            t_now[3].sub(amb).add(h.mul(d5)),
             p[0],
             p[1],
             p[2],
             p[3],
             p[4],
-            N::ZERO.sub(q_pd),
-            N::ZERO.sub(q_ex).sub(q_lb).sub(q_lng),
-            q_lb,
-            q_ex.add(q_pd),
         ];
+        let one = k.one;
         let [c0, c1, c2, c3, c4, c5] = &self.coef;
         let [t0, t1, t2, t3, t4, t5] = &mut self.temp;
         *t0 = N::accumulate(*t0, c0, &x);
         *t1 = N::accumulate(*t1, c1, &x);
-        *t2 = N::accumulate(*t2, c2, &x);
-        *t3 = N::accumulate(*t3, c3, &x);
-        *t4 = N::accumulate(*t4, c4, &x);
-        *t5 = N::accumulate(*t5, c5, &x);
+        *t2 = N::apply(*t2, N::dot(c2, &x), &[d2], &[one]);
+        *t3 = N::apply(*t3, N::dot(c3, &x), &[d3], &[one]);
+        *t4 = N::apply(*t4, N::dot(c4, &x), &[d4], &[one]);
+        *t5 = N::apply(*t5, N::dot(c5, &x), &[d5], &[one]);
         self.last_lng = q_lng;
         self.refresh_leak();
     }

@@ -154,13 +154,13 @@ mod fw {
     /// Opaque call boundaries: keep the inlined model work inside the timed window
     /// (volatile SysTick reads do not order ordinary computation).
     #[inline(never)]
-    fn model_tick(m: &mut Model<Real>, u: &ModelInputN<Real>, lng_open: bool) -> bool {
-        m.tick_n(u, lng_open)
+    fn model_tick(m: &mut Model<Real>, u: &ModelInputN<Real>) -> bool {
+        m.tick_n(u)
     }
 
     #[inline(never)]
-    fn model_update(m: &mut Model<Real>) {
-        m.update();
+    fn model_update(m: &mut Model<Real>, lng_ticks: u32) {
+        m.update(lng_ticks);
     }
 
     /// Validation alone, fast path: convert + combined range/rate check + inputs.
@@ -269,6 +269,7 @@ mod fw {
         let mut prev_pos = 0.0f32;
         let mut last = eha_guard::Output::default();
         let mut opened_at = None;
+        let mut lng_ticks = 0u32;
         for k in 0..STEPS {
             let s = sample(k, &mut noise);
             let u = ModelInput {
@@ -323,14 +324,16 @@ mod fw {
             };
             let w0 = WRAPS.load(Ordering::Relaxed);
             let t0 = now();
-            let full = model_tick(&mut model, core::hint::black_box(&un), u.lng_open);
+            let full = model_tick(&mut model, core::hint::black_box(&un));
             if let Some(t) = elapsed(t0, w0) {
                 mt_stats.add(t);
             }
+            lng_ticks += u.lng_open as u32;
             if full {
                 let w0 = WRAPS.load(Ordering::Relaxed);
                 let t0 = now();
-                model_update(&mut model);
+                model_update(&mut model, core::hint::black_box(lng_ticks));
+                lng_ticks = 0;
                 if let Some(t) = elapsed(t0, w0) {
                     mu_stats.add(t);
                 }

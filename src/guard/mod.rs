@@ -96,8 +96,12 @@ pub struct GuardOf<N: Num> {
     /// protection is evaluated once on the initial (or restored) estimate.
     started: bool,
     cold: bool,
-    /// Ticks of the present model step with the valve commanded open (LNG budget).
-    open_ticks: u32,
+    /// Tick from which the present valve and credit state hold in this model step.
+    mark: u32,
+    /// Ticks of this model step before `mark` with the valve commanded open (LNG
+    /// budget), and with the exchanger credited (open, no fault latched).
+    open_acc: u32,
+    credit_acc: u32,
     /// Mean loss of the last model step, cJ per tick (= W).
     last_cj: u32,
     valve: Valve,
@@ -133,7 +137,9 @@ impl<N: Num> GuardOf<N> {
             valid_since: 0,
             started: false,
             cold: true,
-            open_ticks: 0,
+            mark: 0,
+            open_acc: 0,
+            credit_acc: 0,
             last_cj: 0,
             valve: Valve::new(),
             alarm: false,
@@ -179,20 +185,38 @@ impl<N: Num> GuardOf<N> {
     #[inline(never)]
     pub fn step(&mut self, s: &Sample) -> Output {
         if let Some(core) = self.core.as_ref() {
-            // Fast path: every channel in range and within its rate, every previous
-            // value valid (so this is not the first tick), no channel latched bad.
-            // Nothing to latch, the valve is not forced by this tick (an earlier
-            // latched fault has already opened it), the outputs only change at a
-            // model step. Anything else is classified by `step_slow`.
+            // Fast path: every channel in range and within its rate and every previous
+            // value valid (so this is not the first tick). Nothing to latch, the valve
+            // is not forced by this tick (an earlier latched fault has already opened
+            // it), the outputs only change at a model step. Channels latched bad by an
+            // earlier fault still take their worst case. Anything else is classified
+            // by `step_slow`.
             let (v, ok) = validate::convert_check(s, &self.prev, &core.scales, &core.limits);
-            if ok & (self.prev_ok == CH_ALL) & (self.bad_ch == 0) {
-                self.missing = 0;
-                let u = validate::direct(&v, &self.prev);
+            if ok & (self.prev_ok == CH_ALL) {
+                // `missing` is 0 here: a missing tick clears `prev_ok`.
+                let u = if self.bad_ch == 0 {
+                    validate::direct(&v, &self.prev)
+                } else {
+                    Self::substitute_latched(&v, &self.prev, self.bad_ch, &core.limits)
+                };
                 self.prev = v;
                 return self.tick(&u);
             }
         }
         self.step_slow(s)
+    }
+
+    /// Fast-path inputs while channels are latched bad: their worst cases.
+    #[inline(never)]
+    #[cold]
+    fn substitute_latched(
+        v: &Channels<N>,
+        prev: &Channels<N>,
+        bad_ch: u8,
+        limits: &LimitsN<N>,
+    ) -> ModelInputN<N> {
+        let [_, _, _, _, prev_pos, _] = *prev;
+        validate::substitute(v, bad_ch, Some(prev_pos), limits)
     }
 
     /// [`GuardOf::step`] off the fast path: classifies the sample (distinct fault and
@@ -255,6 +279,8 @@ impl<N: Num> GuardOf<N> {
     /// is latched (fail-safe in the same tick), starts the model on the first tick,
     /// then the common tick.
     fn slow_tail(&mut self, u: Option<&ModelInputN<N>>, new_bits: u16) -> Output {
+        // The valve / credit state may change for this tick: count the ticks before.
+        self.settle(self.step);
         let newly = new_bits & !self.latched;
         self.latched |= new_bits;
         if newly != 0 {
@@ -293,14 +319,8 @@ impl<N: Num> GuardOf<N> {
     /// every `TICKS_PER_STEP` ticks the model step with the protection.
     #[inline(always)]
     fn tick(&mut self, u: &ModelInputN<N>) -> Output {
-        let open = self.valve.is_open();
-        self.open_ticks += open as u32;
-        // The exchanger runs over this tick if the valve is open; under a latched
-        // fault the model takes no cooling credit (conservative: the exchanger itself
-        // may be what failed).
-        let credit = open & (self.latched == 0);
         let full = match self.core.as_mut() {
-            Some(c) => c.model.tick_n(u, credit),
+            Some(c) => c.model.tick_n(u),
             None => false,
         };
         if full {
@@ -317,21 +337,46 @@ impl<N: Num> GuardOf<N> {
     #[inline(never)]
     fn start(&mut self, ambient_c: N) {
         self.started = true;
+        self.settle(self.step);
         if self.cold {
             if let Some(c) = self.core.as_mut() {
                 c.model.set_uniform(ambient_c);
             }
         }
-        self.protect(0);
+        self.protect(0, 0);
+    }
+
+    /// Adds the ticks from `mark` up to (not including) `upto` to the open / credited
+    /// counts in the present valve and fault state. Called before anything changes
+    /// that state, so the counts need no per-tick work: the valve command changes
+    /// only at a model step and on the slow path (forced open), the credit also when
+    /// faults latch or clear.
+    fn settle(&mut self, upto: u32) {
+        let n = upto.wrapping_sub(self.mark);
+        if self.valve.is_open() {
+            self.open_acc = self.open_acc.wrapping_add(n);
+            if self.latched == 0 {
+                // The exchanger runs over these ticks; under a latched fault the model
+                // takes no cooling credit (conservative: the exchanger itself may be
+                // what failed).
+                self.credit_acc = self.credit_acc.wrapping_add(n);
+            }
+        }
+        self.mark = upto;
     }
 
     /// Every `TICKS_PER_STEP` ticks: the model step, then the protection.
     #[inline(never)]
     fn model_step(&mut self) {
+        // This tick belongs to the model step that ends now, in the state it had.
+        self.settle(self.step.wrapping_add(1));
+        let (open_ticks, credit_ticks) = (self.open_acc, self.credit_acc);
+        self.open_acc = 0;
+        self.credit_acc = 0;
         let Some(c) = self.core.as_mut() else {
             return;
         };
-        c.model.update();
+        c.model.update(credit_ticks);
         // Mean total loss kW → cJ per 10 ms tick (= W), never negative.
         let cj = c.model.last_total_kw().round_times(1000).max(0) as u32;
         // The valid run of the clear rule is `step - valid_since`; keep it from
@@ -339,12 +384,13 @@ impl<N: Num> GuardOf<N> {
         if self.step.wrapping_sub(self.valid_since) > 1 << 30 {
             self.valid_since = self.step.wrapping_sub(1 << 30);
         }
-        self.protect(cj);
+        self.protect(cj, open_ticks);
     }
 
-    /// Valve hysteresis and dwell, alarm, LNG budget (the model step's ticks with the
-    /// valve open at `cj` centijoules per tick) and the outputs that change only here.
-    fn protect(&mut self, cj: u32) {
+    /// Valve hysteresis and dwell, alarm, LNG budget (`open_ticks` ticks of the model
+    /// step with the valve open, at `cj` centijoules per tick) and the outputs that
+    /// change only here.
+    fn protect(&mut self, cj: u32, open_ticks: u32) {
         let Some(c) = self.core.as_ref() else {
             return;
         };
@@ -391,8 +437,7 @@ impl<N: Num> GuardOf<N> {
             };
             self.trace.write(t);
         }
-        self.lng.update_cj_ticks(cj, self.open_ticks);
-        self.open_ticks = 0;
+        self.lng.update_cj_ticks(cj, open_ticks);
         self.last_cj = cj;
         let low = self.lng.is_low();
         if low && !self.lng_low {
@@ -436,6 +481,7 @@ impl<N: Num> GuardOf<N> {
             return false;
         }
         let bits = (self.latched & !faults::CONFIG) | ((self.bad_ch as u16) << faults::CH_SHIFT);
+        self.settle(self.step);
         self.latched &= faults::CONFIG;
         self.bad_ch = 0;
         if bits != 0 {
@@ -451,6 +497,7 @@ impl<N: Num> GuardOf<N> {
     /// Marks an actuator (valve pin) error reported by the board: latches ACTUATOR
     /// and commands the valve open at once (fail-safe).
     pub fn report_actuator_fault(&mut self) {
+        self.settle(self.step);
         if self.latched & faults::ACTUATOR == 0 {
             self.latched |= faults::ACTUATOR;
             self.trace.write(Trace::Fault {
