@@ -43,15 +43,15 @@ fn sat_i32(x: i64) -> i32 {
 
 /// `x · s` with `x` an `f32` and `s` a Q2.30 scale, to Q9.23 bits, integer-only
 /// (no soft-float, no panic): `x = ±m 2^(e-150)`, so `x s 2^23 = ±m s 2^(e-157)`.
-/// Rounds half up; saturates at the Q9.23 range; NaN gives 0, ±inf saturates.
+/// Rounds half up; saturates at the Q9.23 range; NaN gives `nan`, ±inf saturates.
 #[inline(always)]
-fn f32_times_q30_to_q23(x: f32, s_raw: i32) -> i32 {
+fn f32_times_q30_to_q23(x: f32, s_raw: i32, nan: i32) -> i32 {
     let b = x.to_bits();
     let e = ((b >> 23) & 0xff) as i32;
     let frac = b & 0x007f_ffff;
     if e == 0xff {
         if frac != 0 {
-            return 0;
+            return nan;
         }
         return if (b >> 31 != 0) == (s_raw < 0) {
             i32::MAX
@@ -131,17 +131,13 @@ impl Num for Fx {
     }
     #[inline(always)]
     fn from_f32_scaled(x: f32, s: FxScale) -> Self {
-        Fx::from_bits(f32_times_q30_to_q23(x, s.to_bits()))
+        Fx::from_bits(f32_times_q30_to_q23(x, s.to_bits(), 0))
     }
     #[inline(always)]
     fn from_sample(x: f32, s: FxScale) -> Self {
         // NaN → the format minimum (below every range limit, |limit| < 250); ±inf
-        // saturates to MAX/MIN (outside every range too).
-        if x.is_nan() {
-            Fx::MIN
-        } else {
-            Fx::from_bits(f32_times_q30_to_q23(x, s.to_bits()))
-        }
+        // saturates to MAX/MIN (outside every range too). Integer-only.
+        Fx::from_bits(f32_times_q30_to_q23(x, s.to_bits(), i32::MIN))
     }
     #[inline(always)]
     fn acc(a: FxAcc, x: Self) -> FxAcc {
@@ -212,6 +208,7 @@ impl Num for Fx {
         Fx::from_bits(f32_times_q30_to_q23(
             libm::expf(self.to_num::<f32>()),
             1 << 30,
+            0,
         ))
     }
     fn state(x: Self) -> FxState {
@@ -316,6 +313,11 @@ mod tests {
         }
         let one = Fx::scale_from_f64(1.0).unwrap();
         assert_eq!(Fx::from_f32_scaled(f32::NAN, one), Fx::ZERO);
+        // Validation's conversion: NaN below every range limit, the rest as above.
+        assert_eq!(Fx::from_sample(f32::NAN, one), Fx::MIN);
+        assert_eq!(Fx::from_sample(-f32::NAN, one), Fx::MIN);
+        assert_eq!(Fx::from_sample(f32::INFINITY, one), Fx::MAX);
+        assert_eq!(Fx::from_sample(12.5, one), Fx::from_f32_scaled(12.5, one));
         assert_eq!(Fx::from_f32_scaled(f32::INFINITY, one), Fx::MAX);
         assert_eq!(Fx::from_f32_scaled(f32::NEG_INFINITY, one), Fx::MIN);
         assert_eq!(Fx::from_f32_scaled(1e30, one), Fx::MAX);
