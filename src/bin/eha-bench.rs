@@ -399,8 +399,14 @@ mod fw {
         fm_stats.report("  fault latched, ticks with the model step", ovh);
         mt_stats.report("Model::tick_n (tick accumulation)", ovh);
         mu_stats.report("Model::update (model step)", ovh);
-        v_stats.report("validation, fast path (convert+combined check+inputs)", ovh);
-        vc_stats.report("validation, classifying path (convert+check+substitute)", ovh);
+        v_stats.report(
+            "validation, fast path (convert+combined check+inputs; standalone call)",
+            ovh,
+        );
+        vc_stats.report(
+            "validation, classifying path (convert+check+substitute; standalone call)",
+            ovh,
+        );
         eprintln!(
             "Guard::new (ZOH expm, f64): {} instructions",
             init_ticks * 10 / 256
