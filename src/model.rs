@@ -1,19 +1,22 @@
 //! Reduced-order thermal model: 6 nodes, losses from the actuator signals,
 //! multi-rate exact zero-order-hold step (docs/firmware.md).
 //!
-//! **Multi-rate.** Every 10 ms tick ([`Model::tick_n`]) the five losses of the tick
-//! are evaluated from that tick's inputs (the throttling floor `max0` per tick) and
-//! summed, together with the exchange drivers `|dp|`, `sqrt|w|`, `|w|`, the ambient
-//! and the ticks with the LNG exchanger credited. Every
+//! **Multi-rate.** Every 10 ms tick ([`Model::tick_n`]) the tick's leakage and
+//! throttling losses (the throttling floor `max0` per tick), `I^2`, `|dp| |w|` and
+//! the exchange drivers `|dp|`, `|w|` are summed. Every
 //! [`crate::params::TICKS_PER_STEP`] ticks ([`Model::update`]) the state advances one
-//! model step of [`S_PER_STEP`] (100 ms) with the tick-averaged inputs held (ZOH).
-//! Copper loss uses the summed `I^2` and the winding temperature at the model step.
+//! model step of [`S_PER_STEP`] (100 ms) with the tick-averaged inputs held (ZOH):
+//! copper loss from the mean `I^2` and the winding temperature at the model step,
+//! iron loss and `sqrt|w|` from the mean `|w|`, the LNG credit over the given
+//! number of the step's ticks, the last tick's ambient.
 //!
 //! The state is the absolute node temperature `T` (degC). Because the Laplacian
 //! annihilates constants, `Bd_amb = (I - Ad) 1` exactly, so
 //! `T(k+1) = T(k) + (Ad - I) (T(k) - T_amb(k)) + Bd p(k)`: the ambient input needs
 //! no matrix column. The step is these 66 multiply-adds on `theta = T - T_amb`,
-//! followed by the flow-dependent exchanges (operator splitting).
+//! plus the input-dependent exchanges as powers held over the step, to second
+//! order in h (midpoint-extrapolated temperatures; the product takes
+//! `theta + delta/2`, `delta = h C^-1 q`).
 
 use crate::linalg::expm1m;
 use crate::num::Num;
