@@ -1,9 +1,11 @@
 //! EHA drain-oil thermal protection core (`#![no_std]`).
 //!
 //! Reduced-order thermal model of an electro-hydrostatic actuator (Liu et al.,
-//! losses eqs. 1-11) stepped every 10 ms with an exact zero-order hold, LNG valve
-//! protection (section IV, eqs. 20-25, Table 6), input validation with a
-//! conservative fail-safe, an event trace and thermal memory across resets.
+//! losses eqs. 1-11), multi-rate: inputs validated and losses accumulated every
+//! 10 ms tick, the model advanced every 100 ms with an exact zero-order hold of
+//! the tick means; LNG valve protection (section IV, eqs. 20-25, Table 6), input
+//! validation with a conservative fail-safe in the same tick, an event trace and
+//! thermal memory across resets.
 //!
 //! Module map: [`params`] (SI parameters) → [`model`] (discretised model, generic
 //! over [`num::Num`]: `f64`, `f32`, fixed point) → [`validate`], [`protection`],

@@ -10,8 +10,10 @@ pub struct ValveConfig {
     /// Closes when the predicted drain temperature falls below this, degC.
     /// The 2 K band is 4 sigma of the 0.5 K sensor noise the issue specifies.
     pub close_c: f32,
-    /// Minimum time between two temperature-driven toggles, steps (200 = 2 s).
-    /// A forced (fail-safe) opening ignores the dwell.
+    /// Minimum time between two temperature-driven toggles, 10 ms ticks (200 = 2 s).
+    /// A forced (fail-safe) opening ignores the dwell. The guard decides on
+    /// temperature once per model step and counts the dwell in model steps
+    /// (`dwell_steps / TICKS_PER_STEP`, rounded up: 20 steps of 100 ms).
     pub dwell_steps: u32,
 }
 
@@ -41,13 +43,28 @@ impl Valve {
     }
 
     /// `true` when commanded open.
+    #[inline(always)]
     pub fn is_open(&self) -> bool {
         self.open
     }
 
-    /// One step. `force_open` (faults, non-finite estimate) opens at once and holds it
+    /// Fail-safe opening (a latched fault), at once, ignoring the dwell. Returns
+    /// `true` when the command changed (the dwell then counts from here).
+    #[inline(always)]
+    pub fn force_open(&mut self) -> bool {
+        if self.open {
+            false
+        } else {
+            self.open = true;
+            self.since_toggle_steps = 0;
+            true
+        }
+    }
+
+    /// One decision (the dwell counts calls: 10 ms ticks here, model steps in the
+    /// guard). `force_open` (faults, non-finite estimate) opens at once and holds it
     /// open. Otherwise: open when `drain_c > open_c`, close when `drain_c < close_c`,
-    /// each only after `dwell_steps` since the last toggle. A NaN temperature keeps it
+    /// each only after `dwell_steps` calls since the last toggle. A NaN temperature keeps it
     /// open / opens it. Returns `Some(new_state)` when the command changed.
     pub fn update(&mut self, drain_c: f32, force_open: bool, cfg: &ValveConfig) -> Option<bool> {
         self.update_with(
@@ -184,14 +201,15 @@ impl LngConfig {
 
 /// Reported seconds-left when the dissipation is (near) zero, s (finite cap).
 pub const LNG_SECONDS_CAP: f32 = 1.0e9;
-/// Energy bookkeeping unit: centijoule (cJ) per W per 10 ms step.
-const CJ_PER_W_STEP: f32 = 100.0 * crate::params::S_PER_STEP as f32;
+/// Energy bookkeeping unit: centijoule (cJ) per W per 10 ms tick.
+const CJ_PER_W_TICK: f32 = 100.0 * crate::params::S_PER_TICK as f32;
 
 /// LNG budget: heat absorbed while the valve is open, integrated exactly in
-/// centijoules in a `u32` (FPU-only conversions; 1 kW adds 1000 cJ per step with
-/// ±0.5 cJ unbiased rounding; capacity up to 4.29e7 J ≈ 97 L of LNG, saturating).
+/// centijoules in a `u32` (FPU-only conversions; 1 kW adds 1000 cJ per 10 ms tick
+/// with ±0.5 cJ unbiased rounding; capacity up to 4.29e7 J ≈ 97 L of LNG, saturating).
 ///
-/// Heat absorbed per step = the model's present total loss (eq. 23, `Q = P_sum t`):
+/// Heat absorbed per tick = the model's total loss (eq. 23, `Q = P_sum t`; the guard
+/// books a model step's mean loss for each of its ticks with the valve open):
 /// the cooler is sized so that the heat sink equals the heat produced (section IV),
 /// so while it is open it absorbs the dissipation. This over-estimates LNG use when
 /// the cooler absorbs less (conservative for the remaining-LNG report).
@@ -216,17 +234,17 @@ impl LngBudget {
         }
     }
 
-    /// Adds one step of absorbed heat at `loss_w` (W) when `valve_open`.
+    /// Adds one 10 ms tick of absorbed heat at `loss_w` (W) when `valve_open`.
     #[inline]
     pub fn update(&mut self, valve_open: bool, loss_w: f32) {
         if valve_open {
             // `as` saturates: NaN → 0, negative → 0 (the model never reports either).
-            let cj = (loss_w * CJ_PER_W_STEP + 0.5) as u32;
+            let cj = (loss_w * CJ_PER_W_TICK + 0.5) as u32;
             self.used_cj = self.used_cj.saturating_add(cj);
         }
     }
 
-    /// Adds one step of absorbed heat, `cj` centijoules (= W for a 10 ms step), when open.
+    /// Adds one tick of absorbed heat, `cj` centijoules (= W for a 10 ms tick), when open.
     #[inline(always)]
     pub fn update_cj(&mut self, valve_open: bool, cj: u32) {
         if valve_open {
@@ -234,15 +252,21 @@ impl LngBudget {
         }
     }
 
-    /// Seconds left at a dissipation of `cj_per_step` cJ per 10 ms step (= W), integer
+    /// Adds `open_ticks` ticks of absorbed heat at `cj_per_tick` centijoules each.
+    #[inline(always)]
+    pub fn update_cj_ticks(&mut self, cj_per_tick: u32, open_ticks: u32) {
+        self.used_cj = self.used_cj.saturating_add(cj_per_tick.saturating_mul(open_ticks));
+    }
+
+    /// Seconds left at a dissipation of `cj_per_tick` cJ per 10 ms tick (= W), integer
     /// division (resolution 10 ms), capped at [`LNG_SECONDS_CAP`] when below 1 W.
     #[inline(always)]
-    pub fn seconds_left_cj(&self, cj_per_step: u32) -> f32 {
-        if cj_per_step == 0 {
+    pub fn seconds_left_cj(&self, cj_per_tick: u32) -> f32 {
+        if cj_per_tick == 0 {
             return LNG_SECONDS_CAP;
         }
-        let steps = self.capacity_cj.saturating_sub(self.used_cj) / cj_per_step;
-        steps as f32 * crate::params::S_PER_STEP as f32
+        let ticks = self.capacity_cj.saturating_sub(self.used_cj) / cj_per_tick;
+        ticks as f32 * crate::params::S_PER_TICK as f32
     }
 
     /// Heat absorbed so far, cJ (0.01 J).

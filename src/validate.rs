@@ -27,7 +27,7 @@ pub const CH_AMBIENT: u8 = 1 << 5;
 /// All six channels.
 pub const CH_ALL: u8 = 0x3f;
 
-/// Plausible ranges and per-step (10 ms) rates of the inputs, wire units.
+/// Plausible ranges and per-tick (10 ms) rates of the inputs, wire units.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct InputLimits {
     /// Max |current|, A rms (Table 2: 340.5 A). Also the worst-case substitute.
@@ -46,15 +46,15 @@ pub struct InputLimits {
     pub ambient_c_min: f32,
     /// Max ambient, degC. Also the worst-case ambient substitute.
     pub ambient_c_max: f32,
-    /// Max |change| of current per step, A.
+    /// Max |change| of current per tick, A.
     pub current_a_per_step: f32,
-    /// Max |change| of a port pressure per step, bar.
+    /// Max |change| of a port pressure per tick, bar.
     pub pressure_bar_per_step: f32,
-    /// Max |change| of speed per step, rpm.
+    /// Max |change| of speed per tick, rpm.
     pub speed_rpm_per_step: f32,
-    /// Max |change| of position per step, mm (0.5 m/s piston speed).
+    /// Max |change| of position per tick, mm (0.5 m/s piston speed).
     pub position_mm_per_step: f32,
-    /// Max |change| of ambient per step, K.
+    /// Max |change| of ambient per tick, K.
     pub ambient_c_per_step: f32,
 }
 
@@ -192,6 +192,57 @@ pub fn convert<N: Num>(s: &Sample, sc: &InputScales<N>) -> (Channels<N>, u8) {
         }
     }
     (v, nonfinite)
+}
+
+/// The fast path of the per-tick validation: converts a sample (non-finite values
+/// become values that fail the range test, [`Num::from_sample`]) and checks every
+/// channel's range and its rate against `prev` in one combined test, without
+/// classifying. Returns the channels and `true` when all twelve tests pass. Only
+/// meaningful when every previous value is valid (`prev_ok == CH_ALL`); on `false`
+/// the caller classifies the sample with [`convert`] and [`check`] (the distinct
+/// fault bits and channel bits), which give the same verdict.
+#[inline(always)]
+pub fn convert_check<N: Num>(
+    s: &Sample,
+    prev: &Channels<N>,
+    sc: &InputScales<N>,
+    lim: &LimitsN<N>,
+) -> (Channels<N>, bool) {
+    let x = [
+        N::from_sample(s.current_a, sc.ha_per_a),
+        N::from_sample(s.p_a_bar, sc.hbar_per_bar),
+        N::from_sample(s.p_b_bar, sc.hbar_per_bar),
+        N::from_sample(s.speed_rpm, sc.hrads_per_rpm),
+        N::from_sample(s.position_mm, sc.one),
+        N::from_sample(s.ambient_c, sc.one),
+    ];
+    let mut ok = true;
+    for ((((x, p), lo), hi), r) in x
+        .iter()
+        .zip(prev.iter())
+        .zip(lim.lo.iter())
+        .zip(lim.hi.iter())
+        .zip(lim.rate.iter())
+    {
+        // Non-short-circuit `&`: straight-line code; NaN fails every comparison.
+        ok &= (*x >= *lo) & (*x <= *hi) & (x.sub(*p).abs() <= *r);
+    }
+    (x, ok)
+}
+
+/// Model inputs of a tick whose sample passed [`convert_check`] with every channel
+/// valid and no channel latched bad: `dp = p_A - p_B`, `dpos = x - x_prev`.
+#[inline(always)]
+pub fn direct<N: Num>(v: &Channels<N>, prev: &Channels<N>) -> ModelInputN<N> {
+    let [i, pa, pb, w, x, amb] = *v;
+    let [_, _, _, _, x_prev, _] = *prev;
+    ModelInputN {
+        current_ha: i,
+        dp_hbar: pa.sub(pb),
+        speed_hrads: w,
+        dpos_mm: x.sub(x_prev),
+        ambient_c: amb,
+    }
 }
 
 #[inline(always)]

@@ -361,8 +361,18 @@ fn stale_input_integrates_worst_case_loss() {
     for _ in 0..cfg.stale_steps {
         g.step_missing();
     }
+    // Multi-rate: the model step averages its ticks' losses. Go on to the next model
+    // step boundary, then one whole model step of worst-case ticks only; the copper
+    // loss uses the winding temperature at that step.
+    let mut o0 = g.step_missing();
+    while g.model().unwrap().pending_ticks() != 0 {
+        o0 = g.step_missing();
+    }
     let t_w = g.model().unwrap().temperatures_c()[0];
-    let o0 = g.step_missing();
+    for _ in 0..eha_guard::params::TICKS_PER_STEP {
+        o0 = g.step_missing();
+    }
+    assert_eq!(g.model().unwrap().pending_ticks(), 0);
     let p = g.model().unwrap().last_losses_kw();
     // R and its temperature coefficient from the configured parameters (the identified
     // DEFAULT has a constant R, as the reference baseline).
@@ -402,4 +412,38 @@ fn stale_input_integrates_worst_case_loss() {
         o.drain_c,
         n.drain_c
     );
+}
+
+#[test]
+fn guard_dwell_is_two_seconds_at_the_model_step() {
+    // The guard decides on temperature once per 100 ms model step and counts the
+    // dwell in model steps: consecutive temperature-driven toggles of the guard's
+    // valve are at least `dwell_steps` ticks (2 s) apart. A narrow band just above
+    // the ambient and alternating load / idle make the estimate cross it often.
+    let mut cfg = GuardConfig::DEFAULT;
+    cfg.valve.open_c = 16.3;
+    cfg.valve.close_c = 16.25;
+    let mut g = GuardOf::<f32>::new(&cfg, Restore::Cold);
+    let load = nominal();
+    let idle = Sample { current_a: 0.0, p_a_bar: 5.0, p_b_bar: 5.0, speed_rpm: 500.0, ..nominal() };
+    for k in 0..20_000u32 {
+        let o = g.step(if (k / 150) % 2 == 0 { &load } else { &idle });
+        assert_eq!(o.faults & faults::LATCHED, 0);
+    }
+    let toggles: Vec<u32> = g
+        .trace()
+        .iter()
+        .filter_map(|e| match e {
+            eha_guard::trace::Trace::ValveOpen { step, forced: false, .. } => Some(*step),
+            eha_guard::trace::Trace::ValveClose { step, .. } => Some(*step),
+            _ => None,
+        })
+        .collect();
+    println!("valve toggles at ticks {toggles:?}");
+    assert!(toggles.len() >= 6, "the band must be crossed repeatedly: {toggles:?}");
+    for w in toggles.windows(2) {
+        assert!(w[1] - w[0] >= cfg.valve.dwell_steps, "toggles {} ticks apart < {}", w[1] - w[0], cfg.valve.dwell_steps);
+    }
+    // Decisions fall on model-step ticks (the 10th of each model step).
+    assert!(toggles.iter().all(|t| (t + 1) % eha_guard::params::TICKS_PER_STEP == 0), "{toggles:?}");
 }

@@ -13,7 +13,7 @@
 //!    30 and 50 bar and Case 2 (600 s each), plus the seeded random missions of
 //!    [`TRAIN_SEEDS`] (none at present: adding idle missions degraded the paper
 //!    cases, see docs/identification.md), each recorded at the firmware's 10 ms
-//!    step ([`record`]). The acceptance suite's random missions use the disjoint
+//!    tick ([`record`]). The acceptance suite's random missions use the disjoint
 //!    seeds [`TEST_SEEDS`].
 //! 3. **Model.** The reduced model is [`eha_guard::model::Model<f64>`] itself,
 //!    driven by the reference's sensor signals (current, port pressures, speed,
@@ -40,7 +40,7 @@ use crate::plant::{Control, Plant, Sensors, SimError};
 use crate::rig::Rig;
 use crate::scenario::{Circuit, Mission, PositionRef, Scenario, Schedule, ValveRule};
 use eha_guard::model::{Model, ModelInputN, HA_PER_A, HBAR_PER_BAR, HRADS_PER_RPM};
-use eha_guard::params::{ReducedParams, N_LOSSES, N_NODES, S_PER_STEP};
+use eha_guard::params::{ReducedParams, N_LOSSES, N_NODES, S_PER_TICK, TICKS_PER_STEP};
 use crate::lsq::FdProblem;
 use levenberg_marquardt::LevenbergMarquardt;
 use nalgebra::DVector;
@@ -105,14 +105,16 @@ pub const W_OTHER: f64 = 0.1;
 pub const UNDER_BUDGET_K: f64 = 0.3;
 /// Residual of every sample for a parameter set the firmware model rejects, K.
 pub const INFEASIBLE_K: f64 = 1e3;
-/// Residual sampling interval, firmware steps (1 s).
+/// Residual sampling interval, firmware ticks (1 s; a whole number of model steps,
+/// so the residuals compare states right after a model step).
 pub const RESIDUAL_EVERY: usize = 100;
+const _: () = assert!(RESIDUAL_EVERY % TICKS_PER_STEP as usize == 0);
 
 /// Reference nodes compared with the reduced nodes (contract order
 /// winding, motor, pump, loop oil, valve block, drain).
 pub const NODE_MAP: [Node; N_NODES] = [Node::Winding, Node::Motor, Node::Pump, Node::Loop, Node::MainBlock, Node::Case];
 
-/// One reference run recorded at the firmware step.
+/// One reference run recorded at the firmware's 10 ms tick.
 #[derive(Debug, Clone)]
 pub struct Recording {
     /// Run name.
@@ -240,14 +242,14 @@ pub fn training_set() -> Vec<TrainingRun> {
     v
 }
 
-/// Run the reference at the firmware step with the scenario's own valve rule and
+/// Run the reference at the firmware's 10 ms tick with the scenario's own valve rule and
 /// record the sensor signals and the mapped node temperatures.
 pub fn record(rig: &Rig, name: &str, scenario: &Scenario) -> Result<Recording, SimError> {
     let mut plant = Plant::new(rig, scenario)?;
     let rule = plant.valve_rule();
     let mut sensors = vec![];
     let mut temps = vec![];
-    plant.run(S_PER_STEP, scenario.duration_s(), |snap| {
+    plant.run(S_PER_TICK, scenario.duration_s(), |snap| {
         sensors.push(Sensors::from(snap));
         let mut t = [0.0; N_NODES];
         for (o, n) in t.iter_mut().zip(NODE_MAP) {
@@ -259,7 +261,7 @@ pub fn record(rig: &Rig, name: &str, scenario: &Scenario) -> Result<Recording, S
     Ok(Recording { name: name.into(), sensors, temps })
 }
 
-/// The reduced model's inputs (model units) for firmware step `k` of a recording:
+/// The reduced model's inputs (model units) for firmware tick `k` of a recording:
 /// the sample at `t_k`, position change since `t_{k-1}` (as the guard computes it).
 pub fn model_input(rec: &Recording, k: usize) -> ModelInputN<f64> {
     let s = &rec.sensors[k];
@@ -273,22 +275,31 @@ pub fn model_input(rec: &Recording, k: usize) -> ModelInputN<f64> {
     }
 }
 
-/// LNG valve state of the reference over firmware step `k` (from `t_k` to
+/// LNG valve state of the reference over firmware tick `k` (from `t_k` to
 /// `t_{k+1}`): the state the snapshot at `t_{k+1}` reports.
 pub fn lng_during(rec: &Recording, k: usize) -> bool {
     rec.sensors.get(k + 1).is_some_and(|s| s.lng_open)
 }
 
-/// Simulate the reduced model (f64) on a recording: cold start at the first
-/// ambient, one step per sample; element `k` is the state after the step from
-/// sample `k`, compared with the reference at `t_{k+1}`.
+/// Simulate the reduced model (f64) on a recording exactly as the guard drives it:
+/// cold start at the first ambient, every 10 ms tick accumulated
+/// ([`Model::tick_n`]), and every [`TICKS_PER_STEP`] ticks the model step
+/// ([`Model::update`]) with the count of that step's ticks during which the LNG
+/// exchanger ran ([`lng_during`]). Element `k` is the state after tick `k` (the last
+/// model step's, held between model steps as the guard's output holds it),
+/// compared with the reference at `t_{k+1}`.
 pub fn simulate_reduced(p: &ReducedParams, rec: &Recording) -> Option<Vec<[f64; N_NODES]>> {
     let mut m = Model::<f64>::new(p).ok()?;
     m.set_uniform(rec.sensors.first()?.ambient_c);
     let n = rec.sensors.len().saturating_sub(1);
     let mut out = Vec::with_capacity(n);
+    let mut lng_ticks = 0u32;
     for k in 0..n {
-        m.step_n(&model_input(rec, k), lng_during(rec, k));
+        lng_ticks += u32::from(lng_during(rec, k));
+        if m.tick_n(&model_input(rec, k)) {
+            m.update(lng_ticks);
+            lng_ticks = 0;
+        }
         out.push(m.temperatures_c());
     }
     Some(out)

@@ -30,7 +30,7 @@ fn run(scenario: Scenario, duration_s: f64) -> PilRun {
     let mut q = QemuOptions::new(Build::F32, &elf);
     q.icount = false;
     let mut plant = Plant::new(&Rig::default(), &scenario).unwrap_or_else(|e| panic!("plant: {e}"));
-    let opts = LoopOptions { step_s: eha_guard::params::S_PER_STEP, duration_s };
+    let opts = LoopOptions { step_s: eha_guard::params::S_PER_TICK, duration_s };
     let run = run_pil(&mut plant, &q, &opts).unwrap_or_else(|f| panic!("{f}"));
     assert_eq!(run.records.len() as u64, opts.steps());
     assert_eq!(run.done.counters.accepted as usize, run.records.len());

@@ -31,7 +31,7 @@ fn closed_loop(open_c: Option<f32>) -> (Vec<StepRecord>, Plant) {
     let mut sil = SilTarget::new(move |r: &eha_guard::protocol::Request, gap| core(r, gap));
     let duration_s = 120.0;
     let mut plant = Plant::new(&Rig::default(), &Scenario::Lng { duration_s }).unwrap();
-    let opts = LoopOptions { step_s: eha_guard::params::S_PER_STEP, duration_s };
+    let opts = LoopOptions { step_s: eha_guard::params::S_PER_TICK, duration_s };
     let records = run_closed_loop(&mut plant, &mut sil, &opts).unwrap_or_else(|f| panic!("{:#}", f.error));
     (records, plant)
 }

@@ -1,5 +1,6 @@
-//! Benchmark firmware: instructions per `Guard::step` and `Model::step` in QEMU,
-//! stack high-water mark, init cost. Run with `cargo fw-bench` (M4F, f32) or
+//! Benchmark firmware: instructions per `Guard::step` (per 10 ms tick, split into
+//! ticks with and without the 100 ms model step), `Model::tick_n` and
+//! `Model::update` in QEMU, stack high-water mark, init cost. Run with `cargo fw-bench` (M4F, f32) or
 //! `cargo fw-bench-m3` (M3, fixed point); see `docs/firmware-numbers.md`.
 //!
 //! Method (../shared/toolchain-notes.md): QEMU `-icount shift=10,align=off,sleep=off`
@@ -20,6 +21,7 @@ mod fw {
     use cortex_m_rt::{entry, exception, ExceptionFrame};
     use defmt_semihosting as _;
     use eha_guard::model::{InputScales, Model, ModelInput, ModelInputN};
+    use eha_guard::num::Num;
     use eha_guard::validate::{self, Channels, LimitsN, CH_ALL};
     use eha_guard::{Guard, GuardConfig, Real, Restore, Sample};
     use semihosting::eprintln;
@@ -149,16 +151,34 @@ mod fw {
         }
     }
 
-    /// Opaque call boundary: keeps the inlined model work inside the timed window
+    /// Opaque call boundaries: keep the inlined model work inside the timed window
     /// (volatile SysTick reads do not order ordinary computation).
     #[inline(never)]
-    fn model_step(m: &mut Model<Real>, u: &ModelInput, s: &InputScales<Real>) {
-        m.step(u, s);
+    fn model_tick(m: &mut Model<Real>, u: &ModelInputN<Real>) -> bool {
+        m.tick_n(u)
     }
 
-    /// Validation alone: convert + range/rate checks + worst-case substitution.
+    #[inline(never)]
+    fn model_update(m: &mut Model<Real>, lng_ticks: u32) {
+        m.update(lng_ticks);
+    }
+
+    /// Validation alone, fast path: convert + combined range/rate check + inputs.
     #[inline(never)]
     fn validate_step(
+        s: &Sample,
+        prev: &Channels<Real>,
+        sc: &InputScales<Real>,
+        lim: &LimitsN<Real>,
+    ) -> (ModelInputN<Real>, bool) {
+        let (v, ok) = validate::convert_check(s, prev, sc, lim);
+        (validate::direct(&v, prev), ok)
+    }
+
+    /// Validation, classifying path (a failed sample): convert + per-channel
+    /// range/rate/non-finite classification + worst-case substitution.
+    #[inline(never)]
+    fn validate_classify(
         s: &Sample,
         prev: &Channels<Real>,
         sc: &InputScales<Real>,
@@ -236,13 +256,20 @@ mod fw {
             semihosting::process::exit(107)
         };
         let mut prev_ch: Channels<Real> = validate::convert(&sample(0, &mut 1), &scales).0;
+        // Guard::step over all ticks, over the ticks without a model step, and over
+        // the ticks that end a model step (every TICKS_PER_STEP-th).
         let mut g_stats = Stats::new();
-        let mut m_stats = Stats::new();
+        let mut gt_stats = Stats::new();
+        let mut gm_stats = Stats::new();
+        let mut mt_stats = Stats::new();
+        let mut mu_stats = Stats::new();
         let mut v_stats = Stats::new();
+        let mut vc_stats = Stats::new();
         let mut noise = 1u32;
         let mut prev_pos = 0.0f32;
         let mut last = eha_guard::Output::default();
         let mut opened_at = None;
+        let mut lng_ticks = 0u32;
         for k in 0..STEPS {
             let s = sample(k, &mut noise);
             let u = ModelInput {
@@ -260,6 +287,11 @@ mod fw {
             let out = guard_step(&mut guard, core::hint::black_box(&s));
             if let Some(t) = elapsed(t0, w0) {
                 g_stats.add(t);
+                if guard.model().map_or(0, |m| m.pending_ticks()) == 0 {
+                    gm_stats.add(t);
+                } else {
+                    gt_stats.add(t);
+                }
             }
             last = core::hint::black_box(out);
             if last.valve_open && opened_at.is_none() {
@@ -273,19 +305,46 @@ mod fw {
                 v_stats.add(t);
             }
             core::hint::black_box(vu);
-            prev_ch = validate::convert(&s, &scales).0;
-
             let w0 = WRAPS.load(Ordering::Relaxed);
             let t0 = now();
-            model_step(&mut model, core::hint::black_box(&u), &scales);
+            let vc = validate_classify(core::hint::black_box(&s), &prev_ch, &scales, &limits);
             if let Some(t) = elapsed(t0, w0) {
-                m_stats.add(t);
+                vc_stats.add(t);
+            }
+            core::hint::black_box(vc);
+            prev_ch = validate::convert(&s, &scales).0;
+
+            // The model alone, in wire units converted as the guard converts them.
+            let un = ModelInputN {
+                current_ha: Real::from_f32_scaled(u.current_a, scales.ha_per_a),
+                dp_hbar: Real::from_f32_scaled(u.dp_bar, scales.hbar_per_bar),
+                speed_hrads: Real::from_f32_scaled(u.speed_rpm, scales.hrads_per_rpm),
+                dpos_mm: Real::from_f32_scaled(u.dpos_mm, scales.one),
+                ambient_c: Real::from_f32_scaled(u.ambient_c, scales.one),
+            };
+            let w0 = WRAPS.load(Ordering::Relaxed);
+            let t0 = now();
+            let full = model_tick(&mut model, core::hint::black_box(&un));
+            if let Some(t) = elapsed(t0, w0) {
+                mt_stats.add(t);
+            }
+            lng_ticks += u.lng_open as u32;
+            if full {
+                let w0 = WRAPS.load(Ordering::Relaxed);
+                let t0 = now();
+                model_update(&mut model, core::hint::black_box(lng_ticks));
+                lng_ticks = 0;
+                if let Some(t) = elapsed(t0, w0) {
+                    mu_stats.add(t);
+                }
             }
         }
 
         // Fault path: one NaN current sample, then 200 valid samples with the fault
         // latched (worst-case current substituted, valve forced open, trace written).
         let mut f_stats = Stats::new();
+        let mut ft_stats = Stats::new();
+        let mut fm_stats = Stats::new();
         for k in 0..201u32 {
             let mut s = sample(STEPS / 2 - 1, &mut noise);
             if k == 0 {
@@ -296,6 +355,11 @@ mod fw {
             let out = guard_step(&mut guard, core::hint::black_box(&s));
             if let Some(t) = elapsed(t0, w0) {
                 f_stats.add(t);
+                if guard.model().map_or(0, |m| m.pending_ticks()) == 0 {
+                    fm_stats.add(t);
+                } else {
+                    ft_stats.add(t);
+                }
             }
             last = core::hint::black_box(out);
         }
@@ -308,7 +372,7 @@ mod fw {
         let save = elapsed(t0, w0).unwrap_or(0);
 
         let build = if cfg!(feature = "fixed-point") {
-            "fixed-point Q9.23/Q0.32/Q9.55"
+            "fixed-point Q9.23/Q2.30/Q9.55"
         } else {
             "f32"
         };
@@ -320,13 +384,29 @@ mod fw {
             core::mem::size_of::<Model<Real>>(),
             core::mem::size_of::<eha_guard::ThermalRecord>()
         );
-        g_stats.report("Guard::step", ovh);
+        eprintln!(
+            "model step: every {} ticks of 10 ms",
+            eha_guard::params::TICKS_PER_STEP
+        );
+        g_stats.report("Guard::step, every tick", ovh);
+        gt_stats.report("Guard::step, ticks without a model step", ovh);
+        gm_stats.report("Guard::step, ticks with the model step", ovh);
         f_stats.report(
-            "Guard::step, fault latched (NaN current then worst case)",
+            "Guard::step, fault latched (NaN current then worst case), every tick",
             ovh,
         );
-        m_stats.report("Model::step", ovh);
-        v_stats.report("validation (convert+check+substitute)", ovh);
+        ft_stats.report("  fault latched, ticks without a model step", ovh);
+        fm_stats.report("  fault latched, ticks with the model step", ovh);
+        mt_stats.report("Model::tick_n (tick accumulation)", ovh);
+        mu_stats.report("Model::update (model step)", ovh);
+        v_stats.report(
+            "validation, fast path (convert+combined check+inputs; standalone call)",
+            ovh,
+        );
+        vc_stats.report(
+            "validation, classifying path (convert+check+substitute; standalone call)",
+            ovh,
+        );
         eprintln!(
             "Guard::new (ZOH expm, f64): {} instructions",
             init_ticks * 10 / 256
@@ -351,5 +431,4 @@ mod fw {
         semihosting::process::exit(0)
     }
 
-    use eha_guard::num::Num as _;
 }

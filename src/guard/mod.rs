@@ -1,5 +1,11 @@
 //! `Guard`: validation + model + protection + trace + thermal memory, one call per
-//! 10 ms tick. The only API the firmware main loop needs (docs/contracts.md).
+//! 10 ms tick (docs/firmware.md).
+//!
+//! Multi-rate: every tick validates the sample (same-tick fault latching and
+//! fail-safe valve opening), substitutes worst cases and accumulates the tick's
+//! losses and exchange drivers ([`Model::tick_n`]); every
+//! [`crate::params::TICKS_PER_STEP`] ticks the model advances one 100 ms step and the
+//! valve/alarm hysteresis, dwell, LNG budget and trace run on the new estimate.
 
 mod types;
 pub use types::{faults, GuardConfig, Output, Sample, DRAIN_C_UNKNOWN};
@@ -7,7 +13,7 @@ pub use types::{faults, GuardConfig, Output, Sample, DRAIN_C_UNKNOWN};
 use crate::memory::{Restore, ThermalRecord};
 use crate::model::{InputScales, Model, ModelInputN};
 use crate::num::Num;
-use crate::params::N_NODES;
+use crate::params::{N_NODES, TICKS_PER_STEP};
 use crate::protection::{alarm_update_with, LngBudget, LngConfig, Valve};
 use crate::trace::{RestoreKind, Trace, TraceBuf};
 use crate::validate::{self, Channels, LimitsN, CH_ALL, CH_POSITION};
@@ -74,7 +80,8 @@ impl<N: Num> Core<N> {
 #[derive(Clone, Debug)]
 pub struct GuardOf<N: Num> {
     core: Option<Core<N>>,
-    dwell_steps: u32,
+    /// Valve dwell in model steps (the configured ticks, rounded up).
+    dwell_model_steps: u32,
     stale_steps: u32,
     clear_valid_steps: u32,
     latched: u16,
@@ -82,16 +89,35 @@ pub struct GuardOf<N: Num> {
     prev: Channels<N>,
     prev_ok: u8,
     missing: u32,
-    valid_run: u32,
-    have_ambient: bool,
+    /// Tick index from which every sample was present and valid (the run of valid
+    /// samples of the clear rule is `step - valid_since`).
+    valid_since: u32,
+    /// `false` until the first tick: a cold start takes that tick's ambient, and the
+    /// protection is evaluated once on the initial (or restored) estimate.
+    started: bool,
+    cold: bool,
+    /// Tick from which the present valve and credit state hold in this model step.
+    mark: u32,
+    /// Ticks of this model step before `mark` with the valve commanded open (LNG
+    /// budget), and with the exchanger credited (open, no fault latched).
+    open_acc: u32,
+    credit_acc: u32,
+    /// Mean loss of the last model step, cJ per tick (= W).
+    last_cj: u32,
     valve: Valve,
     alarm: bool,
     lng: LngBudget,
     lng_low: bool,
     step: u32,
+    /// The outputs, refreshed whenever one of them changes (fault latching, the
+    /// fail-safe opening, a model step, clear/refill): a tick on the fast path
+    /// returns them as they are.
+    out: Output,
     trace: TraceBuf,
 }
 
+/// Invariant kept by every place that latches a fault: `latched != 0` implies the
+/// valve is commanded open, so the per-tick fast path needs no fail-safe check.
 impl<N: Num> GuardOf<N> {
     /// Builds the model once (matrix exponential) and applies the boot rule of
     /// [`crate::memory`]. Never fails: unusable parameters give a CONFIG fault and a
@@ -101,20 +127,29 @@ impl<N: Num> GuardOf<N> {
         let mut g = GuardOf {
             latched: if core.is_none() { faults::CONFIG } else { 0 },
             core,
-            dwell_steps: config.valve.dwell_steps,
+            dwell_model_steps: config.valve.dwell_steps.div_ceil(TICKS_PER_STEP),
             stale_steps: config.stale_steps,
             clear_valid_steps: config.clear_valid_steps,
             bad_ch: 0,
             prev: [N::ZERO; 6],
             prev_ok: 0,
             missing: 0,
-            valid_run: 0,
-            have_ambient: false,
+            valid_since: 0,
+            started: false,
+            cold: true,
+            mark: 0,
+            open_acc: 0,
+            credit_acc: 0,
+            last_cj: 0,
             valve: Valve::new(),
             alarm: false,
             lng: LngBudget::new(&config.lng),
             lng_low: false,
             step: 0,
+            out: Output {
+                drain_c: DRAIN_C_UNKNOWN,
+                ..Output::default()
+            },
             trace: TraceBuf::new(),
         };
         let kind = match restore {
@@ -123,7 +158,7 @@ impl<N: Num> GuardOf<N> {
                 if let Some(c) = g.core.as_mut() {
                     c.model.set_temperatures(&r.temps_c, r.ambient_c);
                 }
-                g.have_ambient = true;
+                g.cold = false;
                 g.lng.set_used_cj(r.lng_used_cj);
                 g.latched |= r.faults & faults::LATCHED & !faults::CONFIG;
                 g.bad_ch = ((r.faults >> faults::CH_SHIFT) as u8) & CH_ALL;
@@ -134,23 +169,64 @@ impl<N: Num> GuardOf<N> {
                 if let Some(c) = g.core.as_mut() {
                     c.model.set_temperatures(&[t; N_NODES], t);
                 }
-                g.have_ambient = true;
+                g.cold = false;
                 g.lng.set_used_cj(u32::MAX);
                 g.latched |= faults::MEMORY_CORRUPT;
                 RestoreKind::Corrupt
             }
         };
         g.trace.write(Trace::Restore { step: 0, kind });
+        g.refresh_out();
         g
     }
 
-    /// One 10 ms step with a new sample. Never panics; any invalid channel latches a
-    /// fault, opens the valve in this same step and is replaced by its worst case.
+    /// One 10 ms tick with a new sample. Never panics; any invalid channel latches a
+    /// fault, opens the valve in this same tick and is replaced by its worst case.
     #[inline(never)]
     pub fn step(&mut self, s: &Sample) -> Output {
+        if let Some(core) = self.core.as_ref() {
+            // Fast path: every channel in range and within its rate and every previous
+            // value valid (so this is not the first tick). Nothing to latch, the valve
+            // is not forced by this tick (an earlier latched fault has already opened
+            // it), the outputs only change at a model step. Channels latched bad by an
+            // earlier fault still take their worst case. Anything else is classified
+            // by `step_slow`.
+            let (v, ok) = validate::convert_check(s, &self.prev, &core.scales, &core.limits);
+            if ok & (self.prev_ok == CH_ALL) {
+                // `missing` is 0 here: a missing tick clears `prev_ok`.
+                let u = if self.bad_ch == 0 {
+                    validate::direct(&v, &self.prev)
+                } else {
+                    Self::substitute_latched(&v, &self.prev, self.bad_ch, &core.limits)
+                };
+                self.prev = v;
+                return self.tick(&u);
+            }
+        }
+        self.step_slow(s)
+    }
+
+    /// Fast-path inputs while channels are latched bad: their worst cases.
+    #[inline(never)]
+    #[cold]
+    fn substitute_latched(
+        v: &Channels<N>,
+        prev: &Channels<N>,
+        bad_ch: u8,
+        limits: &LimitsN<N>,
+    ) -> ModelInputN<N> {
+        let [_, _, _, _, prev_pos, _] = *prev;
+        validate::substitute(v, bad_ch, Some(prev_pos), limits)
+    }
+
+    /// [`GuardOf::step`] off the fast path: classifies the sample (distinct fault and
+    /// channel bits), substitutes worst cases, latches and forces the valve open.
+    #[inline(never)]
+    #[cold]
+    fn step_slow(&mut self, s: &Sample) -> Output {
         self.missing = 0;
         let Some(core) = self.core.as_ref() else {
-            return self.advance(None, 0);
+            return self.slow_tail(None, 0);
         };
         let (v, nonfinite) = validate::convert(s, &core.scales);
         let c = validate::check(&v, nonfinite, &self.prev, self.prev_ok, &core.limits);
@@ -165,11 +241,9 @@ impl<N: Num> GuardOf<N> {
             new_bits |= faults::NON_FINITE;
         }
         self.bad_ch |= c.bad;
-        self.valid_run = if c.bad == 0 {
-            self.valid_run.saturating_add(1)
-        } else {
-            0
-        };
+        if c.bad != 0 {
+            self.valid_since = self.step.wrapping_add(1);
+        }
         let [_, _, _, _, prev_pos, _] = self.prev;
         let prev_pos = if self.prev_ok & CH_POSITION != 0 {
             Some(prev_pos)
@@ -179,15 +253,15 @@ impl<N: Num> GuardOf<N> {
         let u = validate::substitute(&v, self.bad_ch, prev_pos, &core.limits);
         self.prev = v;
         self.prev_ok = !c.bad & CH_ALL;
-        self.advance(Some(&u), new_bits)
+        self.slow_tail(Some(&u), new_bits)
     }
 
-    /// One 10 ms step without a new sample: inputs are held (piston work taken as
+    /// One 10 ms tick without a new sample: inputs are held (piston work taken as
     /// zero); after `stale_steps` consecutive misses the STALE fault latches and every
     /// channel takes its worst case.
     pub fn step_missing(&mut self) -> Output {
         self.missing = self.missing.saturating_add(1);
-        self.valid_run = 0;
+        self.valid_since = self.step.wrapping_add(1);
         self.prev_ok = 0;
         let mut new_bits = 0;
         if self.missing >= self.stale_steps {
@@ -198,11 +272,15 @@ impl<N: Num> GuardOf<N> {
             .core
             .as_ref()
             .map(|c| validate::substitute(&self.prev, self.bad_ch, None, &c.limits));
-        self.advance(u.as_ref(), new_bits)
+        self.slow_tail(u.as_ref(), new_bits)
     }
 
-    #[inline(always)]
-    fn advance(&mut self, u: Option<&ModelInputN<N>>, new_bits: u16) -> Output {
+    /// Slow-path tail: latches `new_bits` and opens the valve at once when any fault
+    /// is latched (fail-safe in the same tick), starts the model on the first tick,
+    /// then the common tick.
+    fn slow_tail(&mut self, u: Option<&ModelInputN<N>>, new_bits: u16) -> Output {
+        // The valve / credit state may change for this tick: count the ticks before.
+        self.settle(self.step);
         let newly = new_bits & !self.latched;
         self.latched |= new_bits;
         if newly != 0 {
@@ -211,40 +289,125 @@ impl<N: Num> GuardOf<N> {
                 new_bits: newly | ((self.bad_ch as u16) << faults::CH_SHIFT),
             });
         }
-        let force = self.latched != 0;
-        let (drain_c, loss_cj, valve_ev, alarm_ev) = match (self.core.as_mut(), u) {
-            (Some(c), Some(u)) => {
-                if !self.have_ambient {
-                    c.model.set_uniform(u.ambient_c);
-                    self.have_ambient = true;
+        if self.latched != 0 && self.valve.force_open() {
+            self.trace.write(Trace::ValveOpen {
+                step: self.step,
+                drain_c: self.out.drain_c,
+                forced: true,
+            });
+        }
+        match u {
+            Some(u) if self.core.is_some() => {
+                if !self.started {
+                    self.start(u.ambient_c);
                 }
-                // The exchanger ran over this step if the valve was open; under a
-                // latched fault the model takes no cooling credit (conservative: the
-                // exchanger itself may be what failed).
-                c.model.step_n(u, self.valve.is_open() && !force);
-                let d = c.model.drain_c();
-                let th = &c.th;
-                let v = self
-                    .valve
-                    .update_with(d, force, th.open, th.close, self.dwell_steps);
-                let a = alarm_update_with(&mut self.alarm, d, th.alarm, th.clear);
-                // Total loss kW → cJ per 10 ms step (= W), never negative.
-                let cj = c.model.last_total_kw().round_times(1000).max(0) as u32;
-                (d.to_f32(), cj, v, a)
+                self.refresh_out();
+                self.tick(u)
             }
             _ => {
-                let v = self
-                    .valve
-                    .update_with(DRAIN_C_UNKNOWN, true, 0.0, 0.0, self.dwell_steps);
+                // No model (CONFIG): fail-safe outputs, nothing to estimate.
                 self.alarm = true;
-                (DRAIN_C_UNKNOWN, 0, v, None)
+                self.out.drain_c = DRAIN_C_UNKNOWN;
+                self.refresh_out();
+                self.step = self.step.wrapping_add(1);
+                self.out
             }
+        }
+    }
+
+    /// The per-tick part common to both paths: the model's tick accumulation, and
+    /// every `TICKS_PER_STEP` ticks the model step with the protection.
+    #[inline(always)]
+    fn tick(&mut self, u: &ModelInputN<N>) -> Output {
+        let full = match self.core.as_mut() {
+            Some(c) => c.model.tick_n(u),
+            None => false,
         };
+        if full {
+            self.model_step();
+        }
+        self.step = self.step.wrapping_add(1);
+        self.out
+    }
+
+    /// First tick: a cold start takes every node to this tick's ambient; then the
+    /// protection is evaluated once on the initial (or restored) estimate, so that a
+    /// warm restore above the threshold opens the valve at once.
+    #[cold]
+    #[inline(never)]
+    fn start(&mut self, ambient_c: N) {
+        self.started = true;
+        self.settle(self.step);
+        if self.cold {
+            if let Some(c) = self.core.as_mut() {
+                c.model.set_uniform(ambient_c);
+            }
+        }
+        self.protect(0, 0);
+    }
+
+    /// Adds the ticks from `mark` up to (not including) `upto` to the open / credited
+    /// counts in the present valve and fault state. Called before anything changes
+    /// that state, so the counts need no per-tick work: the valve command changes
+    /// only at a model step and on the slow path (forced open), the credit also when
+    /// faults latch or clear.
+    fn settle(&mut self, upto: u32) {
+        let n = upto.wrapping_sub(self.mark);
+        if self.valve.is_open() {
+            self.open_acc = self.open_acc.wrapping_add(n);
+            if self.latched == 0 {
+                // The exchanger runs over these ticks; under a latched fault the model
+                // takes no cooling credit (conservative: the exchanger itself may be
+                // what failed).
+                self.credit_acc = self.credit_acc.wrapping_add(n);
+            }
+        }
+        self.mark = upto;
+    }
+
+    /// Every `TICKS_PER_STEP` ticks: the model step, then the protection.
+    #[inline(never)]
+    fn model_step(&mut self) {
+        // This tick belongs to the model step that ends now, in the state it had.
+        self.settle(self.step.wrapping_add(1));
+        let (open_ticks, credit_ticks) = (self.open_acc, self.credit_acc);
+        self.open_acc = 0;
+        self.credit_acc = 0;
+        let Some(c) = self.core.as_mut() else {
+            return;
+        };
+        c.model.update(credit_ticks);
+        // Mean total loss kW → cJ per 10 ms tick (= W), never negative.
+        let cj = c.model.last_total_kw().round_times(1000).max(0) as u32;
+        // The valid run of the clear rule is `step - valid_since`; keep it from
+        // wrapping (2^30 ticks = 124 days is far above any clear_valid_steps).
+        if self.step.wrapping_sub(self.valid_since) > 1 << 30 {
+            self.valid_since = self.step.wrapping_sub(1 << 30);
+        }
+        self.protect(cj, open_ticks);
+    }
+
+    /// Valve hysteresis and dwell, alarm, LNG budget (`open_ticks` ticks of the model
+    /// step with the valve open, at `cj` centijoules per tick) and the outputs that
+    /// change only here.
+    fn protect(&mut self, cj: u32, open_ticks: u32) {
+        let Some(c) = self.core.as_ref() else {
+            return;
+        };
+        let force = self.latched != 0;
+        let d = c.model.drain_c();
+        let th = &c.th;
+        let valve_ev = self
+            .valve
+            .update_with(d, force, th.open, th.close, self.dwell_model_steps);
+        let alarm_ev = alarm_update_with(&mut self.alarm, d, th.alarm, th.clear);
+        let drain_c = d.to_f32();
         let drain_c = if drain_c.is_finite() {
             drain_c
         } else {
             DRAIN_C_UNKNOWN
         };
+        self.out.drain_c = drain_c;
         if let Some(open) = valve_ev {
             let t = if open {
                 Trace::ValveOpen {
@@ -274,7 +437,8 @@ impl<N: Num> GuardOf<N> {
             };
             self.trace.write(t);
         }
-        self.lng.update_cj(self.valve.is_open(), loss_cj);
+        self.lng.update_cj_ticks(cj, open_ticks);
+        self.last_cj = cj;
         let low = self.lng.is_low();
         if low && !self.lng_low {
             self.trace.write(Trace::LngLow {
@@ -283,16 +447,20 @@ impl<N: Num> GuardOf<N> {
             });
         }
         self.lng_low = low;
-        self.step = self.step.wrapping_add(1);
-        Output {
-            drain_c,
+        self.refresh_out();
+    }
+
+    /// Rebuilds the cached outputs from the present state.
+    fn refresh_out(&mut self) {
+        self.out = Output {
+            drain_c: self.out.drain_c,
             valve_open: self.valve.is_open(),
             alarm: self.alarm,
             derate: self.alarm,
             faults: self.faults(),
             lng_remaining_kg: self.lng.remaining_kg(),
-            lng_seconds_left: self.lng.seconds_left_cj(loss_cj),
-        }
+            lng_seconds_left: self.lng.seconds_left_cj(self.last_cj),
+        };
     }
 
     /// Present fault word (see [`faults`]).
@@ -308,10 +476,12 @@ impl<N: Num> GuardOf<N> {
     /// The thermal estimate is *not* reset: it relaxes from its conservative value.
     /// Returns `true` when the faults were cleared.
     pub fn clear_faults(&mut self) -> bool {
-        if self.missing != 0 || self.valid_run < self.clear_valid_steps {
+        let valid_run = self.step.wrapping_sub(self.valid_since);
+        if self.missing != 0 || valid_run < self.clear_valid_steps {
             return false;
         }
         let bits = (self.latched & !faults::CONFIG) | ((self.bad_ch as u16) << faults::CH_SHIFT);
+        self.settle(self.step);
         self.latched &= faults::CONFIG;
         self.bad_ch = 0;
         if bits != 0 {
@@ -320,11 +490,14 @@ impl<N: Num> GuardOf<N> {
                 bits,
             });
         }
+        self.refresh_out();
         true
     }
 
-    /// Marks an actuator (valve pin) error reported by the board: latches ACTUATOR.
+    /// Marks an actuator (valve pin) error reported by the board: latches ACTUATOR
+    /// and commands the valve open at once (fail-safe).
     pub fn report_actuator_fault(&mut self) {
+        self.settle(self.step);
         if self.latched & faults::ACTUATOR == 0 {
             self.latched |= faults::ACTUATOR;
             self.trace.write(Trace::Fault {
@@ -332,12 +505,21 @@ impl<N: Num> GuardOf<N> {
                 new_bits: faults::ACTUATOR,
             });
         }
+        if self.valve.force_open() {
+            self.trace.write(Trace::ValveOpen {
+                step: self.step,
+                drain_c: self.out.drain_c,
+                forced: true,
+            });
+        }
+        self.refresh_out();
     }
 
     /// Refills the LNG budget (new charge installed).
     pub fn refill_lng(&mut self, cfg: &LngConfig) {
         self.lng = LngBudget::new(cfg);
         self.lng_low = false;
+        self.refresh_out();
     }
 
     /// Thermal-memory record of the present state (sealed with its CRC).
@@ -369,7 +551,7 @@ impl<N: Num> GuardOf<N> {
         self.core.as_ref().map(|c| &c.model)
     }
 
-    /// Steps taken since boot (10 ms each, wraps after 497 days).
+    /// Ticks taken since boot (10 ms each, wraps after 497 days).
     pub fn steps(&self) -> u32 {
         self.step
     }

@@ -21,10 +21,18 @@ pub trait Num: Copy + PartialOrd + core::fmt::Debug {
     type Coef: Copy + core::fmt::Debug;
     /// High-precision state accumulator type.
     type State: Copy + core::fmt::Debug;
+    /// Un-rounded row increment `Σ c v` (floating point: the value type; fixed
+    /// point: the state's Q9.55 in an `i64`).
+    type Dot: Copy + core::fmt::Debug;
     /// Input scale factor type (wire unit → model unit).
     type Scale: Copy + core::fmt::Debug;
+    /// Tick accumulator of a model value (sum over the ticks of one model step
+    /// without overflow: floating point, or a wider integer for fixed point).
+    type Acc: Copy + core::fmt::Debug;
     /// Zero.
     const ZERO: Self;
+    /// Empty tick accumulator.
+    const ACC_ZERO: Self::Acc;
     /// Largest allowed Σ|coefficient| of one discretised row (fixed point: keeps the
     /// `i64` accumulation free of overflow; floating point: unbounded).
     const MAX_ROW_SUM: f64;
@@ -36,6 +44,16 @@ pub trait Num: Copy + PartialOrd + core::fmt::Debug {
     fn scale_from_f64(x: f64) -> Option<Self::Scale>;
     /// Wire value (finite, validated) times scale → model unit. Saturating.
     fn from_f32_scaled(x: f32, s: Self::Scale) -> Self;
+    /// [`Num::from_f32_scaled`] for validation: a non-finite `x` gives a value that
+    /// fails every range check (NaN or ±inf for floating point; for fixed point NaN
+    /// gives the format's minimum, ±inf saturates), so that one combined range test
+    /// catches non-finite samples too (`validate::convert_check`).
+    fn from_sample(x: f32, s: Self::Scale) -> Self;
+    /// `a + x`: adds one tick's value to an accumulator.
+    fn acc(a: Self::Acc, x: Self) -> Self::Acc;
+    /// The mean of [`crate::params::TICKS_PER_STEP`] accumulated ticks, `a / M`
+    /// (saturating for fixed point).
+    fn acc_mean(a: Self::Acc) -> Self;
     /// To `f32` (wire units for outputs).
     fn to_f32(self) -> f32;
     /// To `f64` (tests, diagnostics).
@@ -61,22 +79,23 @@ pub trait Num: Copy + PartialOrd + core::fmt::Debug {
     fn state(x: Self) -> Self::State;
     /// Present value of a state accumulator.
     fn value(s: Self::State) -> Self;
+    /// Un-rounded increment `Σ c_k v_k` of one discretised row.
+    fn dot<const K: usize>(c: &[Self::Coef; K], v: &[Self; K]) -> Self::Dot;
+    /// A [`Num::dot`] increment rounded to the value type.
+    fn dot_value(d: Self::Dot) -> Self;
+    /// `s + d + Σ a_m b_m` with one rounding step into the state.
+    fn apply<const M: usize>(s: Self::State, d: Self::Dot, a: &[Self; M], b: &[Self; M]) -> Self::State;
     /// `s + Σ c_k v_k`: the discretised state update row.
+    #[inline(always)]
     fn accumulate<const K: usize>(
         s: Self::State,
         c: &[Self::Coef; K],
         v: &[Self; K],
-    ) -> Self::State;
+    ) -> Self::State {
+        Self::apply(s, Self::dot(c, v), &[], &[])
+    }
     /// `s + a b` at full accumulator precision.
     fn add_product(s: Self::State, a: Self, b: Self) -> Self::State;
-    /// `s + Σ c_k v_k + Σ a_m b_m` with one rounding step into the state.
-    fn accumulate_plus<const K: usize, const M: usize>(
-        s: Self::State,
-        c: &[Self::Coef; K],
-        v: &[Self; K],
-        a: &[Self; M],
-        b: &[Self; M],
-    ) -> Self::State;
     /// `round(self · k)` as an integer (saturating; NaN → 0).
     fn round_times(self, k: i32) -> i32;
     /// `(floor(x), x - floor(x))` for finite `x >= 0`; `(0, 0)` for negative or NaN
@@ -84,14 +103,29 @@ pub trait Num: Copy + PartialOrd + core::fmt::Debug {
     fn split_floor(self) -> (i32, Self);
 }
 
+/// `1 / TICKS_PER_STEP` in `f64`.
+const INV_TICKS_F64: f64 = 1.0 / crate::params::TICKS_PER_STEP as f64;
+
 impl Num for f64 {
     type Coef = f64;
     type State = f64;
+    type Dot = f64;
     type Scale = f64;
+    type Acc = f64;
     const ZERO: Self = 0.0;
+    const ACC_ZERO: f64 = 0.0;
     const MAX_ROW_SUM: f64 = f64::INFINITY;
     fn from_f64(x: f64) -> Self {
         x
+    }
+    fn from_sample(x: f32, s: f64) -> Self {
+        x as f64 * s
+    }
+    fn acc(a: f64, x: f64) -> f64 {
+        a + x
+    }
+    fn acc_mean(a: f64) -> f64 {
+        a * INV_TICKS_F64
     }
     fn coef_from_f64(x: f64) -> Option<f64> {
         x.is_finite().then_some(x)
@@ -146,17 +180,14 @@ impl Num for f64 {
     fn value(s: f64) -> Self {
         s
     }
-    fn accumulate<const K: usize>(s: f64, c: &[f64; K], v: &[f64; K]) -> f64 {
-        s + c.iter().zip(v.iter()).fold(0.0, |a, (c, v)| a + c * v)
+    fn dot<const K: usize>(c: &[f64; K], v: &[f64; K]) -> f64 {
+        c.iter().zip(v.iter()).fold(0.0, |a, (c, v)| a + c * v)
     }
-    fn accumulate_plus<const K: usize, const M: usize>(
-        s: f64,
-        c: &[f64; K],
-        v: &[f64; K],
-        a: &[f64; M],
-        b: &[f64; M],
-    ) -> f64 {
-        Self::accumulate(s, c, v) + a.iter().zip(b.iter()).fold(0.0, |acc, (a, b)| acc + a * b)
+    fn dot_value(d: f64) -> f64 {
+        d
+    }
+    fn apply<const M: usize>(s: f64, d: f64, a: &[f64; M], b: &[f64; M]) -> f64 {
+        s + d + a.iter().zip(b.iter()).fold(0.0, |acc, (a, b)| acc + a * b)
     }
     fn add_product(s: f64, a: f64, b: f64) -> f64 {
         s + a * b
@@ -211,11 +242,26 @@ fn sqrt_f32(x: f32) -> f32 {
 impl Num for f32 {
     type Coef = f32;
     type State = F32State;
+    type Dot = f32;
     type Scale = f32;
+    type Acc = f32;
     const ZERO: Self = 0.0;
+    const ACC_ZERO: f32 = 0.0;
     const MAX_ROW_SUM: f64 = f64::INFINITY;
     fn from_f64(x: f64) -> Self {
         x as f32
+    }
+    #[inline(always)]
+    fn from_sample(x: f32, s: f32) -> Self {
+        x * s
+    }
+    #[inline(always)]
+    fn acc(a: f32, x: f32) -> f32 {
+        a + x
+    }
+    #[inline(always)]
+    fn acc_mean(a: f32) -> f32 {
+        a * INV_TICKS_F64 as f32
     }
     fn coef_from_f64(x: f64) -> Option<f32> {
         x.is_finite().then_some(x as f32)
@@ -280,20 +326,16 @@ impl Num for f32 {
         s.hi
     }
     #[inline(always)]
-    fn accumulate<const K: usize>(s: F32State, c: &[f32; K], v: &[f32; K]) -> F32State {
-        let d = c.iter().zip(v.iter()).fold(0.0f32, |a, (c, v)| a + c * v);
-        two_sum(s, d)
+    fn dot<const K: usize>(c: &[f32; K], v: &[f32; K]) -> f32 {
+        c.iter().zip(v.iter()).fold(0.0f32, |a, (c, v)| a + c * v)
     }
     #[inline(always)]
-    fn accumulate_plus<const K: usize, const M: usize>(
-        s: F32State,
-        c: &[f32; K],
-        v: &[f32; K],
-        a: &[f32; M],
-        b: &[f32; M],
-    ) -> F32State {
-        let e = a.iter().zip(b.iter()).fold(0.0f32, |acc, (a, b)| acc + a * b);
-        let d = c.iter().zip(v.iter()).fold(e, |acc, (c, v)| acc + c * v);
+    fn dot_value(d: f32) -> f32 {
+        d
+    }
+    #[inline(always)]
+    fn apply<const M: usize>(s: F32State, d: f32, a: &[f32; M], b: &[f32; M]) -> F32State {
+        let d = a.iter().zip(b.iter()).fold(d, |acc, (a, b)| acc + a * b);
         two_sum(s, d)
     }
     #[inline(always)]

@@ -1,10 +1,10 @@
-//! Synthetic input profiles shared by the host tests (wire units, 10 ms steps).
+//! Synthetic input profiles shared by the host tests (wire units, 10 ms ticks).
 #![allow(dead_code)]
 
 use eha_guard::model::ModelInput;
 use eha_guard::Sample;
 
-/// Steps in 600 s at 10 ms.
+/// Ticks in 600 s at 10 ms.
 pub const STEPS_600S: usize = 60_000;
 
 /// Case-1-like: 500 rpm against a needle valve at `dp_bar`, ~30 A, piston still,
@@ -44,7 +44,7 @@ pub fn servo(k: usize) -> Sample {
     }
 }
 
-/// Model input from consecutive samples (position derivative per step).
+/// Model input from consecutive samples (position change per tick).
 pub fn to_input(s: &Sample, prev: Option<&Sample>) -> ModelInput {
     ModelInput {
         current_a: s.current_a,

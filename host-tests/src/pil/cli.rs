@@ -76,7 +76,7 @@ pub fn run(args: &PilArgs) -> Result<()> {
     let mut q = QemuOptions::new(build, &elf);
     q.icount = !args.no_icount;
     q.reply_timeout = Duration::from_secs_f64(args.timeout);
-    let opts = LoopOptions { step_s: eha_guard::params::S_PER_STEP, duration_s: args.duration };
+    let opts = LoopOptions { step_s: eha_guard::params::S_PER_TICK, duration_s: args.duration };
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
     let stem = format!("pil_{}_{}", args.scenario, build.name());
     let csv = args.out.join(format!("{stem}.csv"));

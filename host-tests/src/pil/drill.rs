@@ -1,8 +1,8 @@
 //! The open-loop "drill" input sequence used by the PIL equivalence and
-//! golden-output tests: 600 s at the firmware's 10 ms step (60,000 frames).
+//! golden-output tests: 600 s at the firmware's 10 ms tick (60,000 frames).
 //!
 //! - 0–100 s: hard throttling (140 bar, 60 A, 500 rpm): the predicted drain
-//!   temperature crosses 40 °C and the LNG valve opens (about 19 s with the
+//!   temperature crosses 40 °C and the LNG valve opens (about 22 s with the
 //!   identified parameters);
 //! - from 100 s: 10 bar, 5 A: the prediction falls and the valve closes
 //!   before the first fault at 450 s;
