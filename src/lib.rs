@@ -23,7 +23,6 @@ pub mod num;
 pub mod params;
 pub mod protection;
 pub mod protocol;
-pub mod rom;
 pub mod trace;
 pub mod validate;
 

@@ -1,282 +1,267 @@
-//! SI parameters of the reduced-order thermal model (design side, `f64`).
+//! SI parameters of the reduced-order model (design side, `f64`).
 //!
-//! Everything here is plain SI (J/K, W/K, ohm, m^3/rad, ...) so that an
-//! identification procedure in `host-tests` can set every field from `f64`
-//! values and regenerate [`DEFAULT`] with plain literals. The firmware never
-//! steps with these numbers directly: [`crate::model::Model::new`] turns them
-//! once into discretised coefficients of the firmware's number type.
+//! Everything is plain SI so that the reduction tool in `host-tests`
+//! (`eha_sim::reduce`) can derive every field from the reference rig and
+//! regenerate [`DEFAULT`] with plain literals. The firmware never steps with these
+//! numbers directly: [`crate::model::Model::new`] converts them once into model units
+//! of the firmware's number type and builds the exact-ZOH matrix.
 //!
-//! Node order (fixed, see `docs/contracts.md`): `0 winding, 1 motor housing,
-//! 2 pump housing, 3 loop oil, 4 valve block, 5 drain oil`.
-//! Loss order: `0 copper, 1 iron, 2 leakage, 3 mechanical, 4 throttling`.
+//! Node order (fixed): `0 pump housing, 1 drain (case) oil, 2 loop oil, 3 main
+//! valve block, 4 ball/needle-valve block, 5 actuator body` ([`NODE_PUMP`] ...).
 
-/// Number of thermal states (nodes) of the reduced model.
+/// Number of thermal states of the reduced model.
 pub const N_NODES: usize = 6;
-/// Number of loss inputs (copper, iron, leakage, mechanical, throttling).
-pub const N_LOSSES: usize = 5;
+/// Node index: pump housing (rig measurement Point 3), J/K capacity [`ReducedParams::pump_j_per_k`].
+pub const NODE_PUMP: usize = 0;
+/// Node index: oil in the pump case, which leaves through the drain port (the protected temperature).
+pub const NODE_DRAIN: usize = 1;
+/// Node index: circulating oil of the main-block passages, hoses and accumulator side.
+pub const NODE_LOOP: usize = 2;
+/// Node index: main valve block (Point 4).
+pub const NODE_MAIN_BLOCK: usize = 3;
+/// Node index: ball/needle-valve block (Point 5).
+pub const NODE_BALL_BLOCK: usize = 4;
+/// Node index: actuator body with its chamber oil.
+pub const NODE_ACTUATOR: usize = 5;
+/// Metal nodes that see the air, in the order of the `outer_*` arrays.
+pub const OUTER_NODES: [usize; 4] = [NODE_PUMP, NODE_MAIN_BLOCK, NODE_BALL_BLOCK, NODE_ACTUATOR];
 
-/// Node index: motor winding (copper + stator teeth).
-pub const NODE_WINDING: usize = 0;
-/// Node index: motor housing (measurement Point 1).
-pub const NODE_MOTOR: usize = 1;
-/// Node index: pump housing (measurement Point 3).
-pub const NODE_PUMP: usize = 2;
-/// Node index: circulating (loop) oil.
-pub const NODE_LOOP_OIL: usize = 3;
-/// Node index: valve block metal (Points 4 + 5 lumped).
-pub const NODE_BLOCK: usize = 4;
-/// Node index: drain oil in the pump case (the protected temperature).
-pub const NODE_DRAIN: usize = 5;
+/// Points of every conductance table. Grid `x_j = x_max (j / (N_TABLE - 1))^2`:
+/// uniform in `sqrt(x)`, dense at low flow where the laminar film laws
+/// (Nu ∝ (Re Pr d/L)^(1/3)) are steepest.
+pub const N_TABLE: usize = 32;
 
-/// Sample tick: 10 ms (100 Hz), s. `Guard::step` is called once per tick; inputs are
-/// validated and the losses and exchange drivers accumulated every tick.
+/// Sample interval of the controller (one [`crate::Guard`] tick), s.
 pub const S_PER_TICK: f64 = 0.01;
-/// Ticks per model step (multi-rate step, docs/firmware.md): the thermal model is
-/// advanced once every `TICKS_PER_STEP` ticks with the tick-averaged inputs.
-/// 10 ticks = 100 ms: the fastest thermal time constant of the model (the drain oil,
-/// 296 J/K against ≈ 7 W/K at 60 bar / 500 rpm: ≈ 40 s) is 400 model steps.
+/// Ticks per model step.
 pub const TICKS_PER_STEP: u32 = 10;
-/// Model step: `TICKS_PER_STEP` × [`S_PER_TICK`] = 100 ms, s. Every discretised
-/// coefficient (the exact ZOH matrices, the explicit exchange rates) assumes it.
-pub const S_PER_STEP: f64 = 0.1;
-const _: () = assert!(TICKS_PER_STEP >= 1 && TICKS_PER_STEP <= 64);
-const _: () = assert!(S_PER_STEP == S_PER_TICK * TICKS_PER_STEP as f64);
+/// Model step, s: the thermal state advances every [`TICKS_PER_STEP`] ticks
+/// (100 ms) with the tick-averaged losses and flows. The fastest thermal state (the
+/// case oil, 0.25 kJ/K against ≈ 7 W/K) has a time constant of ≈ 35 s.
+pub const S_PER_STEP: f64 = S_PER_TICK * TICKS_PER_STEP as f64;
 
 /// Reduced-order model parameters, SI units, `f64`.
 ///
-/// Continuous model (contracts.md): `C dT/dt = -(L + diag(g_amb)) T + E p + g_amb T_amb`
-/// with `L` the graph Laplacian of [`ReducedParams::conductance_w_per_k`],
-/// `E` = [`ReducedParams::loss_split`] and the losses `p` of eqs. (1)-(11).
+/// Continuous model (docs/firmware.md): six slow nodes; the pump's port passages
+/// and the ball-valve oil are quasi-steady links of the oil ring (their capacity is
+/// small against the circulating flow); losses of eqs. (1)-(11); conductances of
+/// eqs. (12)-(19) tabulated over flow; the LNG exchanger of eqs. (20)-(22).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ReducedParams {
-    /// Heat capacity of each node, J/K (must be > 0).
-    pub capacity_j_per_k: [f64; N_NODES],
-    /// Symmetric node-to-node conductance, W/K; diagonal ignored. Includes the
-    /// constant drain <-> loop-oil conductance `g_od0` at `[3][5]`/`[5][3]`.
-    pub conductance_w_per_k: [[f64; N_NODES]; N_NODES],
-    /// Conductance of each node to ambient (free convection + radiation), W/K.
-    pub ambient_w_per_k: [f64; N_NODES],
-    /// Share of each loss (column) deposited in each node (row), dimensionless;
-    /// each column sums to 1 so that energy is conserved.
-    pub loss_split: [[f64; N_LOSSES]; N_NODES],
-    /// Number of motor phases `m` in eq. (1).
-    pub phases: f64,
-    /// Phase resistance at 25 degC `R0`, ohm (eq. 1).
-    pub r0_ohm: f64,
-    /// Temperature coefficient of the winding resistance, 1/K (0 = constant R).
-    pub alpha_r_per_k: f64,
-    /// Iron loss, hysteresis-like term: `P = k_fe1 |w|`, W/(rad/s) (eq. 2, f ∝ w).
-    pub k_fe1_w_s_per_rad: f64,
-    /// Iron loss, eddy term: `P = k_fe2 w^2`, W/(rad/s)^2 (eq. 2).
-    pub k_fe2_w_s2_per_rad2: f64,
-    /// Iron loss, excess term: `P = k_fe15 |w|^1.5`, W/(rad/s)^1.5 (eq. 2).
-    pub k_fe15_w_per_rad15: f64,
-    /// Leakage loss coefficient `P_leak = K_leak dp^2 mu_ratio`, W/Pa^2 (eqs. 5-7).
-    pub k_leak_w_per_pa2: f64,
-    /// Viscosity-temperature exponent: `mu_ratio = exp(k_mu (T_drain - T_ref))`, 1/K
-    /// (0 when viscosity is held constant, as in the reference baseline).
-    pub k_mu_per_k: f64,
-    /// Reference temperature of the viscosity ratio, degC.
-    pub t_mu_ref_c: f64,
-    /// Pump mechanical loss coefficient `eta_m` (eq. 8: `P = eta_m D |dp| |w|`), dimensionless.
-    pub eta_m: f64,
+    /// Heat capacity of the pump housing, J/K (Table 2: 20 kg steel).
+    pub pump_j_per_k: f64,
+    /// Heat capacity of the main valve block, J/K.
+    pub main_block_j_per_k: f64,
+    /// Heat capacity of the ball/needle-valve block, J/K.
+    pub ball_block_j_per_k: f64,
+    /// Heat capacity of the actuator body, J/K.
+    pub actuator_j_per_k: f64,
+    /// Oil volume of the pump case (the drain node), m^3.
+    pub case_oil_m3: f64,
+    /// Oil volume of the loop node (main-block passages, hoses, sensor pocket), m^3.
+    pub loop_oil_m3: f64,
+    /// Oil volume of one pump port passage (inlet = outlet), m^3 (quasi-steady link).
+    pub port_oil_m3: f64,
+    /// Oil volume of the ball/needle-valve passage, m^3 (quasi-steady link).
+    pub ball_oil_m3: f64,
+    /// Oil density at 40 degC, kg/m^3.
+    pub rho_kg_per_m3: f64,
+    /// Oil specific heat at 20 degC, J/(kg K).
+    pub cp20_j_per_kg_k: f64,
+    /// Slope of the oil specific heat, J/(kg K^2) (`cp = cp20 + slope (T - 20)`).
+    pub cp_slope_j_per_kg_k2: f64,
     /// Pump displacement per radian, m^3/rad (19 cm^3/rev / 2 pi).
     pub displacement_m3_per_rad: f64,
-    /// Effective ram area of the double-rod cylinder, m^2 (Table 3: 1526.81 mm^2).
+    /// Pump mechanical loss coefficient `eta_m` (eq. 8: `P = eta_m D |dp| |w|`).
+    pub eta_m: f64,
+    /// Share of the mechanical loss heating the high-pressure port oil (the rest
+    /// heats the case oil), dimensionless.
+    pub mech_to_outlet: f64,
+    /// Pump leakage flow conductance of the gaps (eqs. 5-7), m^3/(s Pa), at `t_mu_ref_c`:
+    /// each port leaks `K (p_port - p_case)` into the case.
+    pub k_leak_m3_per_s_pa: f64,
+    /// Case (accumulator) pressure, Pa gauge.
+    pub case_pressure_pa: f64,
+    /// Viscosity-temperature exponent: the leakage conductance scales by
+    /// `exp(k_mu (T_drain - t_mu_ref_c))` (mu falls as T rises), 1/K; 0 holds the
+    /// viscosity at its reference value, as the reference baseline does.
+    pub k_mu_per_k: f64,
+    /// Reference temperature of the leakage conductance, degC.
+    pub t_mu_ref_c: f64,
+    /// Laminar resistance of the throttle path's line (eq. 10, Hagen-Poiseuille),
+    /// Pa s/m^3: line loss `P = R1 q^2 + R2 |q|^3`.
+    pub line_r1_pa_s_per_m3: f64,
+    /// Local-loss resistance of the throttle path's line (eq. 10, sum of xi), Pa s^2/m^6.
+    pub line_r2_pa_s2_per_m6: f64,
+    /// Effective ram area of the cylinder, m^2 (Table 3: 1526.81 mm^2).
     pub ram_area_m2: f64,
-    /// Constant drain <-> loop-oil conductance `g_od0`, W/K (also in the matrix; kept
-    /// here so identification can set it in one place, see [`ReducedParams::with_g_od0`]).
-    pub g_od0_w_per_k: f64,
-    /// Flow-dependent drain <-> loop-oil conductance `g_od1 |dp|`, W/(K Pa)
-    /// (leakage advection, applied as an exact two-node exchange per step).
-    pub g_od1_w_per_k_pa: f64,
-    /// Speed-dependent drain <-> pump-housing conductance `g_pd1 sqrt|w|`,
-    /// W/(K (rad/s)^0.5): forced convection of the case oil by the rotating group
-    /// (eqs. 13-14: laminar Nu ∝ (Re Pr d/L)^(1/3), between that and the turbulent
-    /// Re^0.8 the square root is the cheap middle); it vanishes when the pump stops.
-    /// Added to the constant entry `[2][5]` as an explicit two-node exchange per step.
-    pub g_pd1_w_per_k_sqrt_rad_s: f64,
-    /// Speed-dependent loop-oil <-> valve-block conductance `g_lb1 sqrt|w|`,
-    /// W/(K (rad/s)^0.5): the duct film coefficient grows with the circulating flow
-    /// `D |w|` (eqs. 13-14).
-    pub g_lb1_w_per_k_sqrt_rad_s: f64,
-    /// LNG exchanger conductance at full circulation, `eps C_LNG`, W/K (eqs. 20-22:
-    /// the LNG stream is the smaller capacity rate; see [`ReducedParams::lng_w_per_k`]).
-    pub lng_max_w_per_k: f64,
-    /// LNG exchanger conductance per rad/s at low speed, where the oil stream
-    /// `rho c_p D |w|` is the smaller capacity rate, W/(K rad/s).
-    pub lng_slope_w_s_per_k_rad: f64,
-    /// LNG inlet temperature (Table 6: -162 degC), degC.
+    /// Cross-piston leakage conductance of the actuator, m^3/(s Pa) (eq. 11).
+    pub act_leak_m3_per_s_pa: f64,
+    /// Viscous seal friction of the piston, N s/m (heat `F v` into the actuator body).
+    pub act_friction_n_s_per_m: f64,
+    /// Motor phases `m` (eq. 1; copper loss, for the dissipation total only).
+    pub phases: f64,
+    /// Phase resistance, ohm (eq. 1; constant, as in the reference baseline).
+    pub r_ohm: f64,
+    /// Iron loss, hysteresis term: `k_fe1 |w|`, W s/rad (eq. 2 with f ∝ w).
+    pub k_fe1_w_s_per_rad: f64,
+    /// Iron loss, eddy term: `k_fe2 w^2`, W s^2/rad^2 (eq. 2).
+    pub k_fe2_w_s2_per_rad2: f64,
+    /// Iron loss, excess term: `k_fe15 |w|^1.5`, W (s/rad)^1.5 (eq. 2).
+    pub k_fe15_w_per_rad15: f64,
+    /// Shaft speed at the last point of the case-oil table, rad/s.
+    pub speed_table_max_rad_s: f64,
+    /// Flow at the last point of the flow tables, m^3/s.
+    pub flow_table_max_m3_per_s: f64,
+    /// Case oil <-> pump housing conductance over shaft speed (film of the oil
+    /// stirred by the rotating group, eqs. 12-14), W/K.
+    pub g_case_w_per_k: [f64; N_TABLE],
+    /// One port passage <-> pump housing conductance over circulating flow (eqs. 12-14), W/K.
+    pub g_port_w_per_k: [f64; N_TABLE],
+    /// Loop oil <-> main block over circulating flow: duct film in series with the
+    /// block wall (eqs. 12-14, 18), W/K.
+    pub g_loop_block_w_per_k: [f64; N_TABLE],
+    /// Ball-valve oil <-> ball-valve block over circulating flow (eqs. 12-14, 18), W/K.
+    pub g_ball_block_w_per_k: [f64; N_TABLE],
+    /// LNG exchanger conductance `eps(NTU, C*) C_min` over the oil flow through it
+    /// (eqs. 20-22), W/K; the heat removed is this times `T_loop - lng_inlet_c`.
+    pub g_lng_w_per_k: [f64; N_TABLE],
+    /// LNG inlet temperature (Table 6 context: -162 degC), degC.
     pub lng_inlet_c: f64,
-    /// Temperature rise of the leakage feed over the loop oil per unit `|dp|`, K/Pa:
-    /// the leakage leaves from the high-pressure port, which the mechanical loss has
-    /// heated by `f eta_m |dp| / (rho c_p)` (eq. 8 over the circulating flow).
-    pub feed_rise_k_per_pa: f64,
+    /// Outer surfaces of [`OUTER_NODES`]: free-convection conductance, constant part
+    /// `A c0` of `h = c0 + c1 |dT|^(1/4)` (eqs. 15-16 fitted), W/K.
+    pub outer_w_per_k: [f64; 4],
+    /// Outer surfaces: free-convection part `A c1` of `h = c0 + c1 |dT|^(1/4)`, W/K^1.25.
+    pub outer_quarter_w_per_k125: [f64; 4],
+    /// Outer surfaces: radiation `eps sigma A` (eq. 19, linearised about the mean of
+    /// wall and air: `4 eps sigma A T_m^3 dT`), W/K^4.
+    pub outer_rad_w_per_k4: [f64; 4],
+    /// Jacobian of the model's right-hand side at the nominal operating point
+    /// (500 rpm, 30 bar, nodes at 40 degC, air 20 degC), 1/s: the linear part whose
+    /// zero-order hold is exact (exponential Euler).
+    pub nominal_jacobian_per_s: [[f64; N_NODES]; N_NODES],
 }
 
 impl ReducedParams {
-    /// Conductance of the LNG exchanger while open at shaft speed `w_rad_s`, W/K:
-    /// `min(lng_max, lng_slope |w|)` — eqs. (20)-(22) with the effectiveness held at
-    /// its value for the nominal flows; the heat removed from the loop oil is this
-    /// times `T_loop - lng_inlet_c`.
-    pub fn lng_w_per_k(&self, w_rad_s: f64) -> f64 {
-        let g = self.lng_slope_w_s_per_k_rad * libm::fabs(w_rad_s);
-        if g < self.lng_max_w_per_k {
-            g
-        } else {
-            self.lng_max_w_per_k
-        }
+    /// Oil volumetric heat capacity at `t_c`, J/(m^3 K).
+    pub fn rho_cp(&self, t_c: f64) -> f64 {
+        self.rho_kg_per_m3 * (self.cp20_j_per_kg_k + self.cp_slope_j_per_kg_k2 * (t_c - 20.0))
     }
 
-    /// Returns a copy with `g_od0` written into both the field and the matrix entries.
-    pub const fn with_g_od0(mut self, g_w_per_k: f64) -> Self {
-        self.g_od0_w_per_k = g_w_per_k;
-        self.conductance_w_per_k[NODE_LOOP_OIL][NODE_DRAIN] = g_w_per_k;
-        self.conductance_w_per_k[NODE_DRAIN][NODE_LOOP_OIL] = g_w_per_k;
-        self
-    }
-
-    /// Physical plausibility check: capacities > 0, conductances >= 0 and symmetric,
-    /// split columns sum to 1 within 1e-9, all finite. `true` when usable.
+    /// Physical plausibility: capacities and volumes > 0, conductances and
+    /// coefficients >= 0, everything finite. `true` when usable.
     pub fn is_plausible(&self) -> bool {
-        let caps = self
-            .capacity_j_per_k
-            .iter()
-            .all(|c| c.is_finite() && *c > 0.0);
-        let amb = self
-            .ambient_w_per_k
-            .iter()
-            .all(|g| g.is_finite() && *g >= 0.0);
-        let mut sym = true;
-        for (i, row) in self.conductance_w_per_k.iter().enumerate() {
-            for (j, g) in row.iter().enumerate() {
-                let gt = self.conductance_w_per_k.get(j).and_then(|r| r.get(i));
-                if i != j && (!g.is_finite() || *g < 0.0 || gt != Some(g)) {
-                    sym = false;
-                }
-            }
-        }
-        let mut col_sum = [0.0f64; N_LOSSES];
-        let mut split = true;
-        for row in self.loss_split.iter() {
-            for (s, x) in col_sum.iter_mut().zip(row.iter()) {
-                if !x.is_finite() || *x < 0.0 {
-                    split = false;
-                }
-                *s += x;
-            }
-        }
-        if col_sum.iter().any(|s| (s - 1.0).abs() > 1e-9) {
-            split = false;
-        }
-        let scalars = [
+        let pos = [
+            self.pump_j_per_k,
+            self.main_block_j_per_k,
+            self.ball_block_j_per_k,
+            self.actuator_j_per_k,
+            self.case_oil_m3,
+            self.loop_oil_m3,
+            self.port_oil_m3,
+            self.ball_oil_m3,
+            self.rho_kg_per_m3,
+            self.cp20_j_per_kg_k,
+            self.speed_table_max_rad_s,
+            self.flow_table_max_m3_per_s,
+        ]
+        .iter()
+        .all(|x| x.is_finite() && *x > 0.0);
+        let non_neg = [
+            self.displacement_m3_per_rad,
+            self.eta_m,
+            self.mech_to_outlet,
+            self.k_leak_m3_per_s_pa,
+            self.line_r1_pa_s_per_m3,
+            self.line_r2_pa_s2_per_m6,
+            self.ram_area_m2,
+            self.act_leak_m3_per_s_pa,
+            self.act_friction_n_s_per_m,
             self.phases,
-            self.r0_ohm,
-            self.alpha_r_per_k,
+            self.r_ohm,
             self.k_fe1_w_s_per_rad,
             self.k_fe2_w_s2_per_rad2,
             self.k_fe15_w_per_rad15,
-            self.k_leak_w_per_pa2,
+        ]
+        .iter()
+        .chain(self.g_case_w_per_k.iter())
+        .chain(self.g_port_w_per_k.iter())
+        .chain(self.g_loop_block_w_per_k.iter())
+        .chain(self.g_ball_block_w_per_k.iter())
+        .chain(self.g_lng_w_per_k.iter())
+        .chain(self.outer_w_per_k.iter())
+        .chain(self.outer_quarter_w_per_k125.iter())
+        .chain(self.outer_rad_w_per_k4.iter())
+        .all(|x| x.is_finite() && *x >= 0.0);
+        // The quasi-steady links divide by their conductance at zero flow.
+        let links = self.g_port_w_per_k.first().is_some_and(|g| *g > 0.0)
+            && self.g_ball_block_w_per_k.first().is_some_and(|g| *g > 0.0);
+        let finite = [
+            self.cp_slope_j_per_kg_k2,
+            self.case_pressure_pa,
             self.k_mu_per_k,
             self.t_mu_ref_c,
-            self.eta_m,
-            self.displacement_m3_per_rad,
-            self.ram_area_m2,
-            self.g_od0_w_per_k,
-            self.g_od1_w_per_k_pa,
-            self.g_pd1_w_per_k_sqrt_rad_s,
-            self.g_lb1_w_per_k_sqrt_rad_s,
-            self.lng_max_w_per_k,
-            self.lng_slope_w_s_per_k_rad,
             self.lng_inlet_c,
-            self.feed_rise_k_per_pa,
         ]
         .iter()
+        .chain(self.nominal_jacobian_per_s.iter().flatten())
         .all(|x| x.is_finite());
-        let non_negative = [
-            self.g_od1_w_per_k_pa,
-            self.g_pd1_w_per_k_sqrt_rad_s,
-            self.g_lb1_w_per_k_sqrt_rad_s,
-            self.lng_max_w_per_k,
-            self.lng_slope_w_s_per_k_rad,
-        ]
-        .iter()
-        .all(|x| *x >= 0.0);
-        caps && amb && sym && split && scalars && non_negative
+        let split = self.mech_to_outlet <= 1.0;
+        let cp_pos = self.rho_cp(-60.0) > 0.0 && self.rho_cp(150.0) > 0.0;
+        pos && non_neg && links && finite && split && cp_pos
     }
 }
 
-/// Default parameters, identified from the reference simulation (`eha_sim::identify`,
-/// docs/identification.md): loss coefficients reduced from `Rig::default()`
-/// (R constant, iron eq. 2 with f = p w / 2 pi, K_leak = gap conductance at 40 degC,
-/// eta_m, D, A; LNG exchanger eqs. 20-22 at 300 rpm); capacities, conductances, ambient
-/// conductances, the mechanical and throttling splits, g_od1, g_pd1, g_lb1 and the feed
-/// rise fitted by Levenberg-Marquardt on log-parameters to the drain temperature of the
-/// training runs (Case 1 at 10/30/50 bar, Case 2, random missions [6, 9, 19, 22, 24, 29], and the
-/// drain-thermostat LNG runs of `LNG_TRAINING`).
-/// No conservative bias applied (training under-prediction within budget).
-/// THIS CONSTANT IS REGENERATED BY THE IDENTIFICATION TOOL: keep plain literals.
+/// Default parameters, reduced from the reference rig `Rig::default()` by
+/// `eha_sim::reduce` (docs/reduction.md): nothing is fitted to simulation output.
+/// THIS CONSTANT IS REGENERATED BY `cargo run --release -p eha-sim --example reduce`:
+/// keep plain literals.
 pub const DEFAULT: ReducedParams = ReducedParams {
-    capacity_j_per_k: [3079.8361793868903, 33451.35598778382, 10269.831889029729, 2981.7121267106995, 81624.17558988974, 296.1952580597654],
-    conductance_w_per_k: [
-        [0.0, 15.000505282525731, 0.0, 0.0, 0.0, 0.0],
-        [15.000505282525731, 0.0, 0.004957867005760049, 0.0, 0.0, 0.0],
-        [0.0, 0.004957867005760049, 0.0, 3.3606150367622787, 0.0, 0.26967942292228864],
-        [0.0, 0.0, 3.3606150367622787, 0.0, 8.81131394313296, 0.09952120137410797],
-        [0.0, 0.0, 0.0, 8.81131394313296, 0.0, 0.0],
-        [0.0, 0.0, 0.26967942292228864, 0.09952120137410797, 0.0, 0.0],
-    ],
-    ambient_w_per_k: [0.0, 3.5751339534778723, 7.113408811134203, 0.0, 0.010906509580101392, 0.0],
-    loss_split: [
-        [1.0, 0.0, 0.0, 0.0, 0.0],
-        [0.0, 1.0, 0.0, 0.0, 0.0],
-        [0.0, 0.0, 0.0, 0.0, 0.0],
-        [0.0, 0.0, 0.0, 0.70987551636462, 0.999724656433377],
-        [0.0, 0.0, 0.0, 0.0, 0.00027534356662295423],
-        [0.0, 0.0, 1.0, 0.29012448363538, 0.0],
-    ],
+    pump_j_per_k: 9200.0,
+    main_block_j_per_k: 73600.0,
+    ball_block_j_per_k: 13800.0,
+    actuator_j_per_k: 5520.0,
+    case_oil_m3: 0.00015,
+    loop_oil_m3: 0.0016797960000000001,
+    port_oil_m3: 5e-5,
+    ball_oil_m3: 5e-5,
+    rho_kg_per_m3: 857.83,
+    cp20_j_per_kg_k: 1880.0,
+    cp_slope_j_per_kg_k2: 3.7,
+    displacement_m3_per_rad: 3.023943918746011e-6,
+    eta_m: 0.49826,
+    mech_to_outlet: 0.768027,
+    k_leak_m3_per_s_pa: 3.357993172582738e-13,
+    case_pressure_pa: 500000.0,
+    k_mu_per_k: 0.0,
+    t_mu_ref_c: 40.0,
+    line_r1_pa_s_per_m3: 588776503.3402457,
+    line_r2_pa_s2_per_m6: 1018550987858.2805,
+    ram_area_m2: 0.00152681,
+    act_leak_m3_per_s_pa: 2e-14,
+    act_friction_n_s_per_m: 2000.0,
     phases: 3.0,
-    r0_ohm: 0.074,
-    alpha_r_per_k: 0.0,
+    r_ohm: 0.074,
     k_fe1_w_s_per_rad: 0.37433242615213785,
     k_fe2_w_s2_per_rad2: 0.0015887161595118564,
     k_fe15_w_per_rad15: 0.008414188516295527,
-    k_leak_w_per_pa2: 3.357993172582738e-13,
-    k_mu_per_k: 0.0,
-    t_mu_ref_c: 40.0,
-    eta_m: 0.49826,
-    displacement_m3_per_rad: 3.023943918746011e-6,
-    ram_area_m2: 0.00152681,
-    g_od0_w_per_k: 0.09952120137410797,
-    g_od1_w_per_k_pa: 6.269003909744255e-7,
-    g_pd1_w_per_k_sqrt_rad_s: 0.4380786213812423,
-    g_lb1_w_per_k_sqrt_rad_s: 3.848199452970729,
-    lng_max_w_per_k: 15.08143111783885,
-    lng_slope_w_s_per_k_rad: 5.068734252292159,
+    speed_table_max_rad_s: 628.3185307179587,
+    flow_table_max_m3_per_s: 0.0018999999999999998,
     lng_inlet_c: -162.0,
-    feed_rise_k_per_pa: 5.669537874889348e-10,
+    g_case_w_per_k: [0.23594499397973182, 0.6213927963218584, 0.9989139364854088, 1.3196645759264543, 1.6068240611444087, 1.8710570624957699, 2.118260227808865, 2.352109092209836, 2.575085480308449, 2.788963219460052, 2.995065085987329, 3.194410492029924, 3.387805954547485, 3.5759033806376412, 3.7592391874690665, 3.9382614644135363, 4.113349378848181, 4.28482738272898, 4.452975834361532, 4.61803908731989, 4.780231751043793, 4.939743606484021, 5.096743515589239, 5.251382566660512, 5.7598908388774115, 6.394469812043816, 7.05494996778844, 7.741331306111289, 8.453613827012353, 9.191797530491641, 9.955882416549146, 10.745868485184873],
+    g_port_w_per_k: [0.07560387378374933, 0.2748022522340945, 0.4423833607032144, 0.5836207577780461, 0.7098294089997703, 0.8258773502812233, 0.9344073607794409, 1.0370538264422924, 1.13491575020411, 1.2287766768315487, 1.3192199777537055, 1.4066947438777055, 1.4915560003471056, 1.5740905481755956, 1.654534275980776, 1.7330841630330174, 1.8099068453993519, 1.885144881645827, 1.9589214342603665, 2.0313438327482767, 2.1025063300899194, 2.1724922661956003, 2.241375787971247, 2.392372188132318, 2.6207827146944895, 2.8589128381316486, 3.106762558443794, 3.364331875630926, 3.6316207896930432, 3.908629300630146, 4.195357408442237, 4.4918051131293115],
+    g_loop_block_w_per_k: [8.933381080694256, 12.059373001328881, 16.974119961248537, 21.02187395837909, 24.354251640797205, 27.17183273269746, 29.60728567133343, 31.748473298740084, 33.65604751058917, 35.37358052452336, 36.93344553079983, 38.36037394907429, 39.67370146776373, 40.88884190528057, 42.01828732101678, 43.07230659108939, 44.05944575577042, 44.986894306072564, 45.86075851911261, 46.68626891280987, 47.46794008630137, 50.6635489619979, 55.45903825567321, 59.36716787865576, 62.60457901840651, 65.3234768980779, 67.6338409688754, 69.61705289347995, 71.33457530333573, 72.83365727092144, 74.15118973868097, 75.31637418660927],
+    g_ball_block_w_per_k: [0.44356272462810814, 0.8631598153412554, 1.3386181488960296, 1.7313669593858871, 2.0706471664216943, 2.3723843936675104, 2.6458392031472733, 2.8969376551696735, 3.129750536417811, 3.34722417619623, 3.55157733621289, 3.744533499525995, 3.927465123618757, 4.101487602791317, 4.267522916608381, 4.426344174969737, 4.578607666315402, 4.724876466667409, 4.865638191536064, 5.430558801853497, 6.17866184749917, 6.886534687334913, 7.555008443678394, 8.185289194898846, 8.778846020809585, 9.337321054427978, 9.862458494151882, 10.35604958471944, 10.81989079790601, 11.255752750803566, 11.665357735328644, 12.050364063044562],
+    g_lng_w_per_k: [0.0, 3.3096682228248526, 9.942776739489462, 12.96264658390632, 14.136534000606629, 14.658585305173963, 14.930811085570172, 15.0900443468699, 15.191171939230621, 15.259425100268043, 15.307684378047224, 15.343080548790175, 15.369822002200275, 15.390523783739235, 15.406881138317255, 15.420032612236465, 15.430766148357852, 15.439641273518907, 15.447064292249626, 15.453336078719953, 15.458683321598944, 15.463279465193647, 15.467259058122599, 15.470727780930769, 15.473769579489431, 15.476451821691988, 15.47882908002316, 15.48094594339928, 15.482839133094563, 15.484539112987429, 15.486071327761085, 15.487457164214225],
+    outer_w_per_k: [0.0, 0.21683159140672917, 0.10139433161277256, 0.0],
+    outer_quarter_w_per_k125: [0.2037238720409924, 0.7855458029157932, 0.21064691787299047, 0.2564177663859325],
+    outer_rad_w_per_k4: [4.8198179e-9, 1.735134444e-8, 3.85585432e-9, 5.78378148e-9],
+    nominal_jacobian_per_s: [
+        [-0.0006883357089114851, 0.000301960902861307, 0.0002635093844905335, 0.0, 0.0, 0.0],
+        [0.011110428633751002, -0.018209857897037718, 0.006654548638886093, 0.0, 0.0, 0.0],
+        [0.0008453905418370766, 0.0005997144604308335, -0.015554756086895438, 0.01251455018843467, 0.0011678886077642892, 0.0],
+        [0.0, 0.0, 0.00047876209910518953, -0.0005387935174095207, 0.0, 0.0],
+        [2.1780683253128878e-6, 0.0, 0.00023504275651297073, 0.0, -0.00032020493090926714, 0.0],
+        [0.0, 0.0, 0.0, 0.0, 0.0, -0.00025111188000728236],
+    ],
 };
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn default_is_plausible_and_displacement_matches_table2() {
-        assert!(DEFAULT.is_plausible());
-        // 19 cm^3/rev = 19e-6 m^3 / (2 pi rad); 1e-15 relative is f64 literal rounding.
-        let d = 19e-6 / (2.0 * core::f64::consts::PI);
-        assert!((DEFAULT.displacement_m3_per_rad - d).abs() < 1e-15);
-        assert_eq!(DEFAULT.conductance_w_per_k[3][5], DEFAULT.g_od0_w_per_k);
-    }
-
-    #[test]
-    fn implausible_split_is_rejected() {
-        let mut p = DEFAULT;
-        p.loss_split[0][0] = 0.9; // copper column now sums to 0.9: energy not conserved
-        assert!(!p.is_plausible());
-        let mut q = DEFAULT;
-        q.capacity_j_per_k[5] = 0.0;
-        assert!(!q.is_plausible());
-    }
-}

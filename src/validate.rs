@@ -88,7 +88,6 @@ pub struct LimitsN<N: Num> {
     lo: Channels<N>,
     hi: Channels<N>,
     rate: Channels<N>,
-    p_span: N,
 }
 
 impl<N: Num> LimitsN<N> {
@@ -133,7 +132,6 @@ impl<N: Num> LimitsN<N> {
             lo: [N::ZERO; 6],
             hi: [N::ZERO; 6],
             rate: [N::ZERO; 6],
-            p_span: N::ZERO,
         };
         for ((((o_lo, o_hi), o_rt), (a, b)), (c, (sc, k))) in out
             .lo
@@ -151,7 +149,6 @@ impl<N: Num> LimitsN<N> {
             *o_hi = cv(*b, *sc);
             *o_rt = cv(*c, *sc);
         }
-        out.p_span = cv(l.pressure_bar_max - l.pressure_bar_min, sc.hbar_per_bar);
         Some(out)
     }
 }
@@ -231,14 +228,15 @@ pub fn convert_check<N: Num>(
 }
 
 /// Model inputs of a tick whose sample passed [`convert_check`] with every channel
-/// valid and no channel latched bad: `dp = p_A - p_B`, `dpos = x - x_prev`.
+/// valid and no channel latched bad: the port pressures, `dpos = x - x_prev`.
 #[inline(always)]
 pub fn direct<N: Num>(v: &Channels<N>, prev: &Channels<N>) -> ModelInputN<N> {
     let [i, pa, pb, w, x, amb] = *v;
     let [_, _, _, _, x_prev, _] = *prev;
     ModelInputN {
         current_ha: i,
-        dp_hbar: pa.sub(pb),
+        p_a_hbar: pa,
+        p_b_hbar: pb,
         speed_hrads: w,
         dpos_mm: x.sub(x_prev),
         ambient_c: amb,
@@ -308,9 +306,10 @@ pub fn check<N: Num>(
 
 /// Model inputs for one step after worst-case substitution of the `bad` channels.
 ///
-/// Worst case = maximum heat: current at its maximum; a bad pressure gives the
-/// full pressure span with the sign that makes `dp·w` positive (all pump power
-/// throttled); a bad speed gives the maximum speed with the sign of `dp`; a bad
+/// Worst case = maximum heat: current at its maximum; a bad pressure gives both
+/// ports the full pressure range (one at the maximum, the other at the minimum)
+/// with the sign that makes `dp·w` positive (all pump power throttled, maximum
+/// leakage); a bad speed gives the maximum speed with the sign of `dp`; a bad
 /// position gives zero piston work (`dpos = 0`: nothing leaves as work); a bad
 /// ambient gives the maximum ambient. Valid channels are used as they are.
 /// `prev_pos` is the last valid position (`None` → no derivative, `dpos = 0`).
@@ -323,18 +322,20 @@ pub fn substitute<N: Num>(
 ) -> ModelInputN<N> {
     let [i, pa, pb, w, x, amb] = *v;
     let [_, _, _, _, _, amb_max] = lim.hi;
-    let [i_max, _, _, w_max, _, _] = lim.hi;
+    let [i_max, p_max, _, w_max, _, _] = lim.hi;
+    let [_, p_min, _, _, _, _] = lim.lo;
     let current = if bad & CH_CURRENT != 0 { i_max } else { i };
     let speed_ok = bad & CH_SPEED == 0;
-    let dp = if bad & (CH_P_A | CH_P_B) != 0 {
+    let (pa, pb) = if bad & (CH_P_A | CH_P_B) != 0 {
         if speed_ok && w < N::ZERO {
-            N::ZERO.sub(lim.p_span)
+            (p_min, p_max)
         } else {
-            lim.p_span
+            (p_max, p_min)
         }
     } else {
-        pa.sub(pb)
+        (pa, pb)
     };
+    let dp = pa.sub(pb);
     let speed = if speed_ok {
         w
     } else if dp < N::ZERO {
@@ -349,7 +350,8 @@ pub fn substitute<N: Num>(
     let ambient = if bad & CH_AMBIENT != 0 { amb_max } else { amb };
     ModelInputN {
         current_ha: current,
-        dp_hbar: dp,
+        p_a_hbar: pa,
+        p_b_hbar: pb,
         speed_hrads: speed,
         dpos_mm: dpos,
         ambient_c: ambient,

@@ -350,8 +350,9 @@ fn trace_ring_keeps_newest_32() {
 #[test]
 fn stale_input_integrates_worst_case_loss() {
     // After STALE every channel takes its worst case: copper loss at 340.5 A is
-    // m × 340.5² × R0 × (1 + alpha (T_w − 25)) W, and the drain estimate keeps
-    // rising faster than under the nominal Case-1 input it replaced.
+    // m × 340.5² × R W, throttling and leakage at the full pressure range and speed,
+    // and the drain estimate keeps rising faster than under the nominal Case-1 input
+    // it replaced.
     let cfg = GuardConfig::DEFAULT;
     let mut g = GuardOf::<f64>::new(&cfg, Restore::Cold);
     for _ in 0..100 {
@@ -362,39 +363,30 @@ fn stale_input_integrates_worst_case_loss() {
         g.step_missing();
     }
     // Multi-rate: the model step averages its ticks' losses. Go on to the next model
-    // step boundary, then one whole model step of worst-case ticks only; the copper
-    // loss uses the winding temperature at that step.
+    // step boundary, then one whole model step of worst-case ticks only.
     let mut o0 = g.step_missing();
     while g.model().unwrap().pending_ticks() != 0 {
         o0 = g.step_missing();
     }
-    let t_w = g.model().unwrap().temperatures_c()[0];
     for _ in 0..eha_guard::params::TICKS_PER_STEP {
         o0 = g.step_missing();
     }
     assert_eq!(g.model().unwrap().pending_ticks(), 0);
     let p = g.model().unwrap().last_losses_kw();
-    // R and its temperature coefficient from the configured parameters (the identified
-    // DEFAULT has a constant R, as the reference baseline).
+    // Copper (eq. 1) at 340.5 A with the configured constant R.
     let pp = &cfg.params;
-    let p_cu_expect = pp.phases * 340.5f64.powi(2) * pp.r0_ohm * (1.0 + pp.alpha_r_per_k * (t_w - 25.0)) / 1e3;
-    assert!(
-        (p[0] - p_cu_expect).abs() < 1e-6 * p_cu_expect,
-        "copper {} kW vs {} kW",
-        p[0],
-        p_cu_expect
-    );
-    // Throttling at the full pressure span (355 bar) and 6000 rpm, no piston work.
-    let dp_pa = 355e5;
-    let q = 6000.0 * 2.0 * std::f64::consts::PI / 60.0
-        * eha_guard::params::DEFAULT.displacement_m3_per_rad;
-    let p_throttle = (dp_pa * q / 1e3) - p[2];
-    assert!(
-        (p[4] - p_throttle).abs() < 1e-6 * p_throttle,
-        "throttle {} kW vs {} kW",
-        p[4],
-        p_throttle
-    );
+    let p_cu_expect = pp.phases * 340.5f64.powi(2) * pp.r_ohm / 1e3;
+    assert!((p[0] - p_cu_expect).abs() < 1e-6 * p_cu_expect, "copper {} kW vs {} kW", p[0], p_cu_expect);
+    // Both ports at the ends of the pressure range (A 350, B -5 bar: 355 bar across the
+    // pump) and 6000 rpm, no piston work: everything the pump delivers past its
+    // leakage is throttled, dp (D w - K (p_A - p_case)).
+    let (pa, pb, pc) = (350e5, -5e5, pp.case_pressure_pa);
+    let q = 6000.0 * 2.0 * std::f64::consts::PI / 60.0 * pp.displacement_m3_per_rad - pp.k_leak_m3_per_s_pa * (pa - pc);
+    let p_throttle = (pa - pb) * q / 1e3;
+    assert!((p[4] - p_throttle).abs() < 1e-6 * p_throttle, "throttle {} kW vs {} kW", p[4], p_throttle);
+    // Leakage (eqs. 5-7) of both ports into the case.
+    let p_leak = pp.k_leak_m3_per_s_pa * ((pa - pc).powi(2) + (pb - pc).powi(2)) / 1e3;
+    assert!((p[2] - p_leak).abs() < 1e-6 * p_leak, "leakage {} kW vs {} kW", p[2], p_leak);
     assert!(o0.valve_open && o0.faults & faults::STALE != 0);
     let mut o = o0;
     let mut n = o0;

@@ -16,7 +16,7 @@ pub mod diagnosis;
 pub mod fluid;
 pub mod heat;
 pub mod hydraulics;
-pub mod identify;
+pub mod missions;
 pub mod losses;
 pub mod lsq;
 pub mod measured;

@@ -1,8 +1,7 @@
 //! A least-squares problem defined by its residual function, with a
 //! forward-difference Jacobian (columns evaluated in parallel), for the
-//! `levenberg-marquardt` crate. Shared by the paper calibration
-//! ([`crate::calibrate`]) and the firmware identification
-//! ([`crate::identify`]).
+//! `levenberg-marquardt` crate, used by the paper calibration
+//! ([`crate::calibrate`]).
 
 use levenberg_marquardt::LeastSquaresProblem;
 use nalgebra::{DMatrix, DVector, Dyn, Owned};

@@ -4,7 +4,7 @@
 //! identify the parameters (`identify::TRAIN_SEEDS`).
 //!
 //! Every run is **closed loop**, as on the actuator: the guard (`GuardOf<f64>`,
-//! validation included, identified `eha_guard::params::DEFAULT`) is fed the
+//! validation included, reduced `eha_guard::params::DEFAULT`) is fed the
 //! reference's sensor signals as f32 wire samples every 10 ms and its valve
 //! command drives the reference's LNG exchanger. The guard's model credits the
 //! exchanger's cooling while its own valve is open, so an open-loop comparison
@@ -14,7 +14,7 @@
 use eha_guard::num::{Fx, Num};
 use eha_guard::protection::Valve;
 use eha_guard::{GuardConfig, GuardOf, Restore};
-use eha_sim::identify::{random_mission, stats, ErrorStats, TEST_SEEDS};
+use eha_sim::missions::{random_mission, stats, ErrorStats, TEST_SEEDS};
 use eha_sim::plant::{Control, Plant, Sensors};
 use eha_sim::rig::Rig;
 use eha_sim::scenario::{Mission, Scenario, Schedule};
@@ -157,7 +157,7 @@ fn case2_drain_within_bounds() {
     assert_bounds(&report(&["case2"]));
 }
 
-/// Five random missions never used for identification.
+/// Five random missions (the model is reduced from the rig, fitted to no run).
 #[test]
 fn random_missions_drain_within_bounds() {
     let rows = report(&["random-"]);
@@ -283,7 +283,6 @@ fn thermostat_from_branch(scenario: &Scenario, events: &[(f64, bool)], i: usize)
 /// thermostat on the true drain would have switched from the same plant state and
 /// valve history. Issue: within 2 s.
 #[test]
-#[ignore = "fails: 72 of 80 events within 2 s (multi-rate guard, 100 ms model step); 8 exceed it: early (conservative) openings at slow heating slopes, 3.7/5.1 s (random-1) and 4.9/3.6 s (random-4), and early closings 2.6 s (first LNG cycle at 60 bar, random-1). 0.1-0.2 K of estimate error at 0.03-0.1 K/s slopes; the 2 s bound asks for ~0.05-0.1 K at every crossing"]
 fn valve_switching_times_match_true_drain() {
     let mut cases = scenarios();
     cases.push(("load-then-idle".into(), load_then_idle()));
@@ -330,34 +329,53 @@ fn valve_switching_times_match_true_drain() {
     assert!(failures.is_empty(), "switching time differences > {MAX_SWITCH_S} s:\n{}", failures.join("\n"));
 }
 
-/// The reduced model's LNG conductance (`ReducedParams::lng_w_per_k`, reduced from
-/// the rig by `identify::reduce_losses`) against the reference exchanger of eqs.
-/// (20)-(22) (`cooling::Lng::exchanger_w`) with the oil stream D|w| (no leakage).
-/// The reduction holds the cross-flow effectiveness at its 300 rpm value, the
-/// smallest over the loaded missions' 300-1000 rpm: there the model must never
-/// credit more heat removal than the reference (conservative) and at most 2.5 %
-/// less (the effectiveness rises by ~2 % to 1000 rpm as C* falls from 0.11 to 0.03).
-/// Below 300 rpm it over-credits (≈ +8 % at 100 rpm, +42 % at 30 rpm where the oil
-/// stream becomes the smaller one and the model takes eps = 1): printed, not
-/// asserted; the missions load the pump at 300-700 rpm.
+/// The reduced parameters are the rig's: `DEFAULT` in `src/params.rs` equals what
+/// `eha_sim::reduce` computes from `Rig::default()` now (so a rig change cannot
+/// leave the firmware's constants stale), and the LNG table reproduces the
+/// reference exchanger of eqs. (20)-(22) at its points (to the 1e-12 of the
+/// literals) and between them within 1 % over 100-3000 rpm (linear interpolation
+/// in sqrt(q) of a smooth saturating curve).
 #[test]
-fn lng_conductance_matches_reference_exchanger() {
+fn params_are_the_reduction_of_the_rig() {
     let rig = Rig::default();
-    let p = eha_guard::params::DEFAULT;
-    let rho_cp = rig.oil.rho(40.0, 0.0) * rig.oil.cp(40.0);
-    let rel = |rpm: f64| {
-        let w = rpm * std::f64::consts::PI / 30.0;
-        let t_oil = 45.0;
-        let q_ref = rig.lng.exchanger_w(rho_cp * p.displacement_m3_per_rad * w, t_oil);
-        let q_red = p.lng_w_per_k(w) * (t_oil - p.lng_inlet_c);
-        (q_red - q_ref) / q_ref
+    let p = eha_sim::reduce::reduce(&rig).expect("reduce");
+    let d = eha_guard::params::DEFAULT;
+    let rel = |a: f64, b: f64| (a - b).abs() <= 1e-12 * a.abs().max(b.abs()).max(1e-30);
+    let flat = |q: &eha_guard::params::ReducedParams| {
+        let mut v = vec![
+            q.pump_j_per_k, q.main_block_j_per_k, q.ball_block_j_per_k, q.actuator_j_per_k, q.case_oil_m3, q.loop_oil_m3,
+            q.port_oil_m3, q.ball_oil_m3, q.rho_kg_per_m3, q.cp20_j_per_kg_k, q.cp_slope_j_per_kg_k2, q.displacement_m3_per_rad,
+            q.eta_m, q.mech_to_outlet, q.k_leak_m3_per_s_pa, q.case_pressure_pa, q.k_mu_per_k, q.t_mu_ref_c,
+            q.line_r1_pa_s_per_m3, q.line_r2_pa_s2_per_m6, q.ram_area_m2, q.act_leak_m3_per_s_pa, q.act_friction_n_s_per_m,
+            q.phases, q.r_ohm, q.k_fe1_w_s_per_rad, q.k_fe2_w_s2_per_rad2, q.k_fe15_w_per_rad15, q.speed_table_max_rad_s,
+            q.flow_table_max_m3_per_s, q.lng_inlet_c,
+        ];
+        for t in [&q.g_case_w_per_k, &q.g_port_w_per_k, &q.g_loop_block_w_per_k, &q.g_ball_block_w_per_k, &q.g_lng_w_per_k] {
+            v.extend_from_slice(t);
+        }
+        v.extend_from_slice(&q.outer_w_per_k);
+        v.extend_from_slice(&q.outer_quarter_w_per_k125);
+        v.extend_from_slice(&q.outer_rad_w_per_k4);
+        for r in &q.nominal_jacobian_per_s {
+            v.extend_from_slice(r);
+        }
+        v
     };
-    for rpm in [30.0, 100.0, 200.0] {
-        println!("LNG conductance at {rpm} rpm: reduced - reference = {:+.2} %", 100.0 * rel(rpm));
-    }
-    for rpm in (300..=1000).step_by(50) {
-        let r = rel(rpm as f64);
-        println!("LNG conductance at {rpm} rpm: reduced - reference = {:+.2} %", 100.0 * r);
-        assert!(r <= 1e-9 && r > -0.025, "{rpm} rpm: relative difference {r:+.4}");
+    let (a, b) = (flat(&p), flat(&d));
+    let stale: Vec<usize> = a.iter().zip(&b).enumerate().filter(|(_, (x, y))| !rel(**x, **y)).map(|(i, _)| i).collect();
+    assert!(stale.is_empty(), "src/params.rs DEFAULT differs from reduce(Rig::default()) at fields {stale:?}: run `cargo run --release -p eha-sim --example reduce`");
+    // The LNG table between its points, against eqs. (20)-(22) with the oil stream D|w|.
+    let rho_cp = rig.oil.rho(40.0, 0.0) * rig.oil.cp(40.0);
+    let n1 = (eha_guard::params::N_TABLE - 1) as f64;
+    for rpm in (100..=3000).step_by(25) {
+        let q = rpm as f64 * std::f64::consts::PI / 30.0 * d.displacement_m3_per_rad;
+        let u = (q / d.flow_table_max_m3_per_s).sqrt() * n1;
+        let j = u.floor() as usize;
+        let f = u - j as f64;
+        let g = d.g_lng_w_per_k[j] * (1.0 - f) + d.g_lng_w_per_k[j + 1] * f;
+        let t_oil = 45.0;
+        let q_ref = rig.lng.exchanger_w(rho_cp * q, t_oil);
+        let r = (g * (t_oil - d.lng_inlet_c) - q_ref) / q_ref;
+        assert!(r.abs() < 0.01, "{rpm} rpm: LNG table {:+.3} % off eqs. (20)-(22)", 100.0 * r);
     }
 }

@@ -20,7 +20,7 @@ mod fw {
     use cortex_m::peripheral::{syst::SystClkSource, SYST};
     use cortex_m_rt::{entry, exception, ExceptionFrame};
     use defmt_semihosting as _;
-    use eha_guard::model::{InputScales, Model, ModelInput, ModelInputN};
+    use eha_guard::model::{InputScales, Model, ModelInputN};
     use eha_guard::num::Num;
     use eha_guard::validate::{self, Channels, LimitsN, CH_ALL};
     use eha_guard::{Guard, GuardConfig, Real, Restore, Sample};
@@ -272,14 +272,8 @@ mod fw {
         let mut lng_ticks = 0u32;
         for k in 0..STEPS {
             let s = sample(k, &mut noise);
-            let u = ModelInput {
-                current_a: s.current_a,
-                dp_bar: s.p_a_bar - s.p_b_bar,
-                speed_rpm: s.speed_rpm,
-                dpos_mm: s.position_mm - prev_pos,
-                ambient_c: s.ambient_c,
-                lng_open: last.valve_open,
-            };
+            let dpos_mm = s.position_mm - prev_pos;
+            let lng_open = last.valve_open;
             prev_pos = s.position_mm;
 
             let w0 = WRAPS.load(Ordering::Relaxed);
@@ -316,11 +310,12 @@ mod fw {
 
             // The model alone, in wire units converted as the guard converts them.
             let un = ModelInputN {
-                current_ha: Real::from_f32_scaled(u.current_a, scales.ha_per_a),
-                dp_hbar: Real::from_f32_scaled(u.dp_bar, scales.hbar_per_bar),
-                speed_hrads: Real::from_f32_scaled(u.speed_rpm, scales.hrads_per_rpm),
-                dpos_mm: Real::from_f32_scaled(u.dpos_mm, scales.one),
-                ambient_c: Real::from_f32_scaled(u.ambient_c, scales.one),
+                current_ha: Real::from_f32_scaled(s.current_a, scales.ha_per_a),
+                p_a_hbar: Real::from_f32_scaled(s.p_a_bar, scales.hbar_per_bar),
+                p_b_hbar: Real::from_f32_scaled(s.p_b_bar, scales.hbar_per_bar),
+                speed_hrads: Real::from_f32_scaled(s.speed_rpm, scales.hrads_per_rpm),
+                dpos_mm: Real::from_f32_scaled(dpos_mm, scales.one),
+                ambient_c: Real::from_f32_scaled(s.ambient_c, scales.one),
             };
             let w0 = WRAPS.load(Ordering::Relaxed);
             let t0 = now();
@@ -328,7 +323,7 @@ mod fw {
             if let Some(t) = elapsed(t0, w0) {
                 mt_stats.add(t);
             }
-            lng_ticks += u.lng_open as u32;
+            lng_ticks += lng_open as u32;
             if full {
                 let w0 = WRAPS.load(Ordering::Relaxed);
                 let t0 = now();

@@ -1,7 +1,6 @@
 //! Synthetic input profiles shared by the host tests (wire units, 10 ms ticks).
 #![allow(dead_code)]
 
-use eha_guard::model::ModelInput;
 use eha_guard::Sample;
 
 /// Ticks in 600 s at 10 ms.
@@ -41,17 +40,5 @@ pub fn servo(k: usize) -> Sample {
         speed_rpm: (omega * 60.0 / (2.0 * core::f64::consts::PI)) as f32,
         position_mm: x_mm as f32,
         ambient_c: 26.4,
-    }
-}
-
-/// Model input from consecutive samples (position change per tick).
-pub fn to_input(s: &Sample, prev: Option<&Sample>) -> ModelInput {
-    ModelInput {
-        current_a: s.current_a,
-        dp_bar: s.p_a_bar - s.p_b_bar,
-        speed_rpm: s.speed_rpm,
-        dpos_mm: prev.map(|p| s.position_mm - p.position_mm).unwrap_or(0.0),
-        ambient_c: s.ambient_c,
-        lng_open: false,
     }
 }

@@ -21,14 +21,13 @@
 //! `T(k+1) = T(k) + Phi F(T(k), u(k))`, `Phi = h phi1(h A)` from the matrix
 //! exponential of the nominal Jacobian `A`, built once at init.
 
-pub mod params;
 mod ring;
 pub mod table;
 
 use crate::linalg::expm1m;
 use crate::num::Num;
-pub use params::{
-    RomParams, N_NODES, N_TABLE, NODE_ACTUATOR, NODE_BALL_BLOCK, NODE_DRAIN, NODE_LOOP, NODE_MAIN_BLOCK, NODE_PUMP,
+pub use crate::params::{
+    ReducedParams, N_NODES, N_TABLE, NODE_ACTUATOR, NODE_BALL_BLOCK, NODE_DRAIN, NODE_LOOP, NODE_MAIN_BLOCK, NODE_PUMP,
     OUTER_NODES, S_PER_STEP, S_PER_TICK, TICKS_PER_STEP,
 };
 use ring::{Ring, RingIn};
@@ -50,7 +49,7 @@ const MAX_DELAY_STEPS: i32 = 31;
 
 /// One tick of validated inputs in model units (hA, hbar, hrad/s, mm, degC).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct TickInput<N> {
+pub struct ModelInputN<N> {
     /// Motor phase current, hA (100 A) rms.
     pub current_ha: N,
     /// Port A pressure, hbar gauge.
@@ -101,7 +100,7 @@ impl<N: Num> InputScales<N> {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(any(target_os = "none", feature = "defmt"), derive(defmt::Format))]
 pub enum ConfigError {
-    /// [`RomParams::is_plausible`] failed.
+    /// [`ReducedParams::is_plausible`] failed.
     Implausible,
     /// A discretised coefficient or row sum exceeds the coefficient format.
     CoefficientRange,
@@ -184,6 +183,7 @@ struct Rhs<N> {
     lng_kw: N,
     heat_kw: N,
     outer_kw: N,
+    losses_kw: [N; N_LOSSES],
 }
 
 /// Constants in model units (built once).
@@ -261,7 +261,11 @@ pub struct Model<N: Num> {
     last_lng_kw: N,
     last_heat_kw: N,
     last_outer_kw: N,
+    last_losses_kw: [N; N_LOSSES],
 }
+
+/// Number of loss groups reported by [`Model::last_losses_kw`].
+pub const N_LOSSES: usize = 6;
 
 /// `Phi = h phi1(h A) = integral_0^h exp(A s) ds`, from the exponential of the
 /// augmented matrix `[[A h, I h], [0, 0]]` (upper-right block).
@@ -289,7 +293,7 @@ pub fn etd_matrix(a: &[[f64; N_NODES]; N_NODES], h: f64) -> [[f64; N_NODES]; N_N
 impl<N: Num> Model<N> {
     /// Builds the model once from SI parameters: constants in model units, tables,
     /// and the exact-ZOH matrix (matrix exponential in `f64`). Starts at 0 degC.
-    pub fn new(p: &RomParams) -> Result<Self, ConfigError> {
+    pub fn new(p: &ReducedParams) -> Result<Self, ConfigError> {
         if !p.is_plausible() {
             return Err(ConfigError::Implausible);
         }
@@ -454,6 +458,7 @@ impl<N: Num> Model<N> {
             last_lng_kw: N::ZERO,
             last_heat_kw: N::ZERO,
             last_outer_kw: N::ZERO,
+            last_losses_kw: [N::ZERO; N_LOSSES],
         })
     }
 
@@ -487,7 +492,7 @@ impl<N: Num> Model<N> {
     /// inputs). Returns `true` when [`TICKS_PER_STEP`] ticks are summed: the caller
     /// then calls [`Model::update`].
     #[inline(always)]
-    pub fn accumulate(&mut self, u: &TickInput<N>) -> bool {
+    pub fn tick_n(&mut self, u: &ModelInputN<N>) -> bool {
         let k = &self.k;
         let s = &mut self.sums;
         let dpa = u.p_a_hbar.sub(k.p_case);
@@ -548,6 +553,7 @@ impl<N: Num> Model<N> {
         self.last_lng_kw = r.lng_kw;
         self.last_heat_kw = r.heat_kw;
         self.last_outer_kw = r.outer_kw;
+        self.last_losses_kw = r.losses_kw;
         let [p0, p1, p2, p3, p4, p5] = &self.phi;
         let [s0, s1, s2, s3, s4, s5] = &mut self.temp;
         *s0 = N::accumulate(*s0, p0, &r.rates);
@@ -561,10 +567,10 @@ impl<N: Num> Model<N> {
     /// Right-hand side `dT/dt` (K/s, node order) at temperatures `t` with every tick
     /// at inputs `u`, the ring in steady flow (links stored nothing, no transport lag):
     /// the function whose Jacobian at the nominal point is `A` (reduction tool).
-    pub fn derivative(&self, t: &[N; N_NODES], u: &TickInput<N>, lng_open: bool) -> [N; N_NODES] {
+    pub fn derivative(&self, t: &[N; N_NODES], u: &ModelInputN<N>, lng_open: bool) -> [N; N_NODES] {
         let mut probe = *self;
         probe.sums = Sums::ZERO;
-        let _ = probe.accumulate(u);
+        let _ = probe.tick_n(u);
         let m = probe.sums.scaled(self.k.one);
         let share = if lng_open { self.k.one } else { N::ZERO };
         self.rhs(t, &m, u32::from(lng_open), share, None, N::ZERO).rates
@@ -686,6 +692,7 @@ impl<N: Num> Model<N> {
             lng_kw: ring.q_lng,
             heat_kw,
             outer_kw: o_p.add(o_mb).add(o_bb).add(o_a),
+            losses_kw: [m.copper_kw, iron, leak_kw, mech_kw, m.line_kw.add(m.needle_kw), m.act_kw],
         }
     }
 
@@ -705,8 +712,8 @@ impl<N: Num> Model<N> {
     }
 
     /// Advances one model step with every tick at the same inputs (tests, tools).
-    pub fn step(&mut self, u: &TickInput<N>, lng_open: bool) {
-        while !self.accumulate(u) {}
+    pub fn step(&mut self, u: &ModelInputN<N>, lng_open: bool) {
+        while !self.tick_n(u) {}
         self.update(if lng_open { TICKS_PER_STEP } else { 0 });
     }
 
@@ -749,6 +756,13 @@ impl<N: Num> Model<N> {
     /// throttling, actuator), kW: what heats the six nodes.
     pub fn last_heat_kw(&self) -> N {
         self.last_heat_kw
+    }
+
+    /// Mean losses of the last step, kW: `[copper (eq. 1), iron (eq. 2), leakage
+    /// (eqs. 5-7), mechanical (eq. 8), throttling = line + needle (eqs. 10-11),
+    /// actuator leakage + seal friction]`.
+    pub fn last_losses_kw(&self) -> [N; N_LOSSES] {
+        self.last_losses_kw
     }
 
     /// Heat the outer surfaces gave to the air over the last step (eqs. 15, 16, 19), kW.

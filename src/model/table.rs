@@ -1,7 +1,7 @@
 //! Piecewise-linear tables over `sqrt(x)`: the flow- and speed-dependent
 //! conductances of eqs. (12)-(14) and (20)-(22), sampled once by the reduction tool.
 
-use super::params::N_TABLE;
+use crate::params::N_TABLE;
 use crate::num::Num;
 
 /// Position in a table: index of the left point and the fraction towards the next.
