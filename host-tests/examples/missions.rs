@@ -1,6 +1,6 @@
 //! Prints the random missions of a seed range (speed schedule or servo marker):
 //! `cargo run --release -p eha-sim --example missions -- 1 20`.
-use eha_sim::identify::random_mission;
+use eha_sim::missions::random_mission;
 use eha_sim::scenario::{Circuit, PositionRef};
 
 fn main() {
