@@ -226,17 +226,33 @@ fn two_sum(s: F32State, d: f32) -> F32State {
     }
 }
 
-/// Square root of a non-negative finite `f32` without libm's bit-by-bit routine:
-/// reciprocal square root by the 0x5f375a86 seed and three Newton steps (relative
-/// error < 2e-7, i.e. at f32 rounding; ~15 FPU instructions), times `x`. `sqrt(0) = 0`.
+/// Correctly rounded square root of a non-negative `f32` (IEEE 754 `sqrt`).
+/// On the Cortex-M4F one `vsqrt.f32` instruction; elsewhere libm's `sqrtf`, which is
+/// also correctly rounded, so the host and the target give the same bits (the
+/// processor-in-the-loop equivalence test relies on it).
 #[inline(always)]
 fn sqrt_f32(x: f32) -> f32 {
-    let mut y = f32::from_bits(0x5f37_5a86u32.wrapping_sub(x.to_bits() >> 1));
-    let h = 0.5 * x;
-    y *= 1.5 - h * y * y;
-    y *= 1.5 - h * y * y;
-    y *= 1.5 - h * y * y;
-    x * y
+    #[cfg(all(target_arch = "arm", target_os = "none", target_abi = "eabihf"))]
+    {
+        let mut bits = x.to_bits();
+        // SAFETY: `s15` is declared clobbered; `vsqrt.f32` has no other effect (the FPU
+        // is enabled by cortex-m-rt on eabihf targets).
+        unsafe {
+            core::arch::asm!(
+                "vmov s15, {b}",
+                "vsqrt.f32 s15, s15",
+                "vmov {b}, s15",
+                b = inout(reg) bits,
+                out("s15") _,
+                options(pure, nomem, nostack),
+            );
+        }
+        f32::from_bits(bits)
+    }
+    #[cfg(not(all(target_arch = "arm", target_os = "none", target_abi = "eabihf")))]
+    {
+        libm::sqrtf(x)
+    }
 }
 
 impl Num for f32 {
