@@ -21,8 +21,10 @@ use crate::params::N_NODES;
 
 /// Record magic: "EHAT".
 pub const MAGIC: u32 = 0x4548_4154;
-/// Record layout version.
-pub const VERSION: u16 = 1;
+/// Record layout version. 2: the six temperatures are the reduced model's nodes
+/// (pump housing, case oil, loop oil, main block, ball-valve block, actuator); a
+/// version-1 record (the former identified network's nodes) is treated as corrupt.
+pub const VERSION: u16 = 2;
 /// Plausible stored temperature range, degC (anything else is treated as corrupt).
 pub const PLAUSIBLE_C: (f32, f32) = (-80.0, 250.0);
 

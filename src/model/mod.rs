@@ -44,6 +44,8 @@ const PA_PER_HBAR: f64 = 1e7;
 const L_PER_M3: f64 = 1e3;
 /// kW per W.
 const KW_PER_W: f64 = 1e-3;
+/// Temperature unit of the radiation term's mean wall-air temperature, K.
+const RAD_T_K: f64 = 300.0;
 /// Longest transport delay of the exchanger's effect, model steps (the history is a `u32`).
 const MAX_DELAY_STEPS: i32 = 31;
 
@@ -108,8 +110,8 @@ pub enum ConfigError {
     ConstantRange,
 }
 
-/// Sums over the ticks of the present model step (model units; divided by the tick
-/// count at the step).
+/// Sums over the ticks of the present model step: raw per-tick terms (their
+/// constants are applied at the step by [`Sums::means`]); `ambient` is the last tick's.
 #[derive(Clone, Copy, Debug)]
 struct Sums<N> {
     leak_kw: N,
@@ -150,24 +152,25 @@ impl<N: Num> Sums<N> {
 }
 
 impl<N: Num> Sums<N> {
-    /// Every sum times `f` (the tick means for `f = 1 / ticks`).
+    /// Means of the raw tick sums in physical model units (kW, L/s), `f = 1 / ticks`:
+    /// the per-tick constants are applied here once per step.
     #[inline(always)]
-    fn scaled(&self, f: N) -> Self {
+    fn means(&self, f: N, k: &Consts<N>) -> Self {
         Sums {
-            leak_kw: self.leak_kw.mul(f),
-            mech_kw: self.mech_kw.mul(f),
+            leak_kw: self.leak_kw.mul(f.mul(k.k_lp)),
+            mech_kw: self.mech_kw.mul(f.mul(k.k_mech)),
             line_kw: self.line_kw.mul(f),
-            needle_kw: self.needle_kw.mul(f),
-            act_kw: self.act_kw.mul(f),
-            copper_kw: self.copper_kw.mul(f),
-            leak_lps: self.leak_lps.mul(f),
+            needle_kw: self.needle_kw.mul(f.mul(k.half)),
+            act_kw: self.act_kw.mul(f.mul(k.k_act)),
+            copper_kw: self.copper_kw.mul(f.mul(k.k_cu)),
+            leak_lps: self.leak_lps.mul(f.mul(k.k_lf_half)),
             pump_lps: self.pump_lps.mul(f),
             abs_pump_lps: self.abs_pump_lps.mul(f),
             abs_thr_lps: self.abs_thr_lps.mul(f),
-            abs_act_lps: self.abs_act_lps.mul(f),
+            abs_act_lps: self.abs_act_lps.mul(f.mul(k.k_a)),
             abs_speed: self.abs_speed.mul(f),
             dp: self.dp.mul(f),
-            ambient: self.ambient.mul(f),
+            ambient: self.ambient,
             ticks: self.ticks,
         }
     }
@@ -199,8 +202,10 @@ struct Consts<N> {
     k_dpq: N,     // kW per (hbar L/s)
     r1: N,        // kW per (L/s)^2
     r2: N,        // kW per (L/s)^3
-    k_al: N,      // actuator leakage, kW per hbar^2
-    k_fr: N,      // piston friction, kW per (mm/tick)^2
+    w_dp: N,      // actuator heat weights: act = k_act (w_dp dp^2 + w_dx dx^2), kW
+    w_dx: N,
+    k_act: N,
+    k_lf_half: N, // k_lf / 2
     k_cu: N,      // copper, kW per hA^2
     fe1: N,       // iron, kW per hrad/s
     fe2: N,       // kW per (hrad/s)^2
@@ -229,12 +234,12 @@ struct Consts<N> {
     use_mu: bool,
     ga: [N; 4],   // outer, kW/K
     gb: [N; 4],   // outer, kW/K^1.25
-    gr: [N; 4],   // outer radiation 4 eps sigma A 1e6, kW/(K hK^3)
+    gr: [N; 4],   // outer radiation 4 eps sigma A (300 K)^3, kW/K per (T_m / 300 K)^3
     h: N,         // s
     inv_h: N,     // 1/s
     half: N,
-    hundredth: N,
-    k_offset_hk: N, // 273.15 / 100
+    per_rad_t: N,   // 1 / 300 K
+    rad_offset: N,  // 273.15 / 300
     one: N,
 }
 
@@ -262,6 +267,9 @@ pub struct Model<N: Num> {
     last_heat_kw: N,
     last_outer_kw: N,
     last_losses_kw: [N; N_LOSSES],
+    /// Outer conductances of [`OUTER_NODES`], kW/K, refreshed one per step.
+    outer_g: [N; 4],
+    outer_phase: u8,
 }
 
 /// Number of loss groups reported by [`Model::last_losses_kw`].
@@ -332,7 +340,9 @@ impl<N: Num> Model<N> {
         };
         let ga = outer(&p.outer_w_per_k, KW_PER_W);
         let gb = outer(&p.outer_quarter_w_per_k125, KW_PER_W);
-        let gr = outer(&p.outer_rad_w_per_k4, 4.0 * 1e6 * KW_PER_W);
+        // radiation 4 eps sigma A T_m^3 with T_m in units of 300 K (so the coefficient
+        // keeps its resolution in fixed point)
+        let gr = outer(&p.outer_rad_w_per_k4, 4.0 * RAD_T_K * RAD_T_K * RAD_T_K * KW_PER_W);
         let scalars = [
             p.case_pressure_pa / PA_PER_HBAR,
             kl * PA_PER_HBAR * L_PER_M3,
@@ -365,6 +375,11 @@ impl<N: Num> Model<N> {
             p.k_mu_per_k,
             p.t_mu_ref_c,
         ];
+        // Actuator heat per tick `k_al dp^2 + k_fr dx^2` as `k_act (w_dp dp^2 + w_dx dx^2)`
+        // with the larger coefficient factored out (both weights <= 1).
+        let (k_al, k_fr) = (scalars[9], scalars[10]);
+        let k_act = if k_al > k_fr { k_al } else { k_fr };
+        let act_w = if k_act > 0.0 { (k_al / k_act, k_fr / k_act, k_act) } else { (0.0, 0.0, 0.0) };
         if scalars.iter().chain(ga.iter()).chain(gb.iter()).chain(gr.iter()).chain(inv_c64.iter()).any(|x| !x.is_finite() || libm::fabs(*x) >= 250.0) {
             return Err(ConfigError::ConstantRange);
         }
@@ -393,8 +408,10 @@ impl<N: Num> Model<N> {
             k_dpq: s(6),
             r1: s(7),
             r2: s(8),
-            k_al: s(9),
-            k_fr: s(10),
+            w_dp: f(act_w.0),
+            w_dx: f(act_w.1),
+            k_act: f(act_w.2),
+            k_lf_half: f(scalars[1] * 0.5),
             k_cu: s(11),
             fe1: s(12),
             fe2: s(13),
@@ -426,8 +443,8 @@ impl<N: Num> Model<N> {
             h: f(S_PER_STEP),
             inv_h: f(1.0 / S_PER_STEP),
             half: f(0.5),
-            hundredth: f(0.01),
-            k_offset_hk: f(2.7315),
+            per_rad_t: f(1.0 / RAD_T_K),
+            rad_offset: f(273.15 / RAD_T_K),
             one: f(1.0),
         };
         let tables = [
@@ -459,6 +476,8 @@ impl<N: Num> Model<N> {
             last_heat_kw: N::ZERO,
             last_outer_kw: N::ZERO,
             last_losses_kw: [N::ZERO; N_LOSSES],
+            outer_g: [N::ZERO; 4],
+            outer_phase: 0,
         })
     }
 
@@ -470,6 +489,7 @@ impl<N: Num> Model<N> {
         }
         self.links = [t_c; 3];
         self.ring_rate = N::ZERO;
+        self.outer_g = self.outer_all(&[t_c; N_NODES], t_c);
     }
 
     /// Sets every node's temperature (degC, node order) and the ambient from `f32`
@@ -486,6 +506,7 @@ impl<N: Num> Model<N> {
         let tl = temps_c.get(NODE_LOOP).map_or(self.ambient_c, |t| conv(*t));
         self.links = [tl; 3];
         self.ring_rate = N::ZERO;
+        self.outer_g = self.outer_all(&self.temperatures_c(), self.ambient_c);
     }
 
     /// Accumulates one 10 ms tick (losses of eqs. 5-11 and the flows at this tick's
@@ -495,35 +516,38 @@ impl<N: Num> Model<N> {
     pub fn tick_n(&mut self, u: &ModelInputN<N>) -> bool {
         let k = &self.k;
         let s = &mut self.sums;
+        // Raw per-tick terms; their constants are applied once at the model step
+        // (`Sums::means`).
         let dpa = u.p_a_hbar.sub(k.p_case);
         let dpb = u.p_b_hbar.sub(k.p_case);
         let dp = u.p_a_hbar.sub(u.p_b_hbar);
         let aw = u.speed_hrads.abs();
         // eqs. (5)-(7): each port leaks K (p - p_case) into the case; heat K dp^2.
-        s.leak_kw = s.leak_kw.add(k.k_lp.mul(dpa.mul(dpa).add(dpb.mul(dpb))));
-        s.leak_lps = s.leak_lps.add(k.k_lf.mul(dpa.max0().add(dpb.max0())));
-        // eq. (8): eta_m D |dp| |w|
-        s.mech_kw = s.mech_kw.add(k.k_mech.mul(dp.abs()).mul(aw));
+        s.leak_kw = s.leak_kw.add(dpa.mul(dpa).add(dpb.mul(dpb)));
+        // 2 max(0, x) = x + |x|: the leaking ports' pressure excess (x2)
+        s.leak_lps = s.leak_lps.add(dpa.add(dpa.abs()).add(dpb).add(dpb.abs()));
+        // eq. (8): |dp| |w|
+        s.mech_kw = s.mech_kw.add(dp.abs().mul(aw));
         // pump delivery into A, piston flow, throttled remainder (eqs. 10-11)
         let q_pump = k.k_q.mul(u.speed_hrads).sub(k.k_lf.mul(dpa));
         let q_act = k.k_a.mul(u.dpos_mm);
         let q_thr = q_pump.sub(q_act);
         let aq_thr = q_thr.abs();
         let line = q_thr.mul(q_thr).mul(k.r1.add(k.r2.mul(aq_thr)));
-        let needle = k.k_dpq.mul(dp).mul(q_thr).sub(line).max0();
+        let x = k.k_dpq.mul(dp).mul(q_thr).sub(line);
         s.line_kw = s.line_kw.add(line);
-        s.needle_kw = s.needle_kw.add(needle);
-        // eq. (11) and the piston's viscous seal friction, into the actuator body
-        s.act_kw = s.act_kw.add(k.k_al.mul(dp).mul(dp).add(k.k_fr.mul(u.dpos_mm).mul(u.dpos_mm)));
-        // eq. (1), constant R (dissipation total only)
-        s.copper_kw = s.copper_kw.add(k.k_cu.mul(u.current_ha).mul(u.current_ha));
+        s.needle_kw = s.needle_kw.add(x.add(x.abs())); // 2 max(0, dp q - line)
+        // eq. (11) and the piston's viscous seal friction
+        s.act_kw = s.act_kw.add(k.w_dp.mul(dp).mul(dp).add(k.w_dx.mul(u.dpos_mm).mul(u.dpos_mm)));
+        // eq. (1): I^2 (dissipation total only)
+        s.copper_kw = s.copper_kw.add(u.current_ha.mul(u.current_ha));
         s.pump_lps = s.pump_lps.add(q_pump);
         s.abs_pump_lps = s.abs_pump_lps.add(q_pump.abs());
         s.abs_thr_lps = s.abs_thr_lps.add(aq_thr);
-        s.abs_act_lps = s.abs_act_lps.add(q_act.abs());
+        s.abs_act_lps = s.abs_act_lps.add(u.dpos_mm.abs());
         s.abs_speed = s.abs_speed.add(aw);
         s.dp = s.dp.add(dp);
-        s.ambient = s.ambient.add(u.ambient_c);
+        s.ambient = u.ambient_c;
         s.ticks += 1;
         s.ticks >= TICKS_PER_STEP
     }
@@ -541,12 +565,20 @@ impl<N: Num> Model<N> {
         let inv = k.inv_n.get(ticks as usize).copied().unwrap_or(k.inv_ticks);
         let on = lng_ticks.min(ticks);
         let share = k.inv_n.get(ticks as usize).copied().unwrap_or(k.inv_ticks).mul(k.count.get(on as usize).copied().unwrap_or(k.one));
-        let m = self.sums.scaled(inv);
+        let m = self.sums.means(inv, &self.k);
         self.sums = Sums::ZERO;
         self.ambient_c = m.ambient;
         let t = self.temperatures_c();
         self.lng_hist = (self.lng_hist << 1) | u32::from(2 * on >= ticks && on > 0);
-        let r = self.rhs(&t, &m, self.lng_hist, share, Some(self.links), self.ring_rate);
+        // One outer surface's conductance is refreshed per step (each every 0.4 s; the
+        // metal temperatures move by millikelvin in that time).
+        let i = self.outer_phase as usize % OUTER_NODES.len();
+        if let (Some(g), Some(n)) = (self.outer_g.get_mut(i), OUTER_NODES.get(i)) {
+            let tw = t.get(*n).copied().unwrap_or(m.ambient);
+            *g = Self::outer_conductance_of(&self.k, i, tw, m.ambient);
+        }
+        self.outer_phase = self.outer_phase.wrapping_add(1);
+        let r = self.rhs(&t, &m, self.lng_hist, share, Some(self.links), self.ring_rate, &self.outer_g);
         self.links = r.links;
         self.ring_rate = r.ring_rate;
         self.last_total_kw = r.total_kw;
@@ -571,9 +603,10 @@ impl<N: Num> Model<N> {
         let mut probe = *self;
         probe.sums = Sums::ZERO;
         let _ = probe.tick_n(u);
-        let m = probe.sums.scaled(self.k.one);
+        let m = probe.sums.means(self.k.one, &self.k);
         let share = if lng_open { self.k.one } else { N::ZERO };
-        self.rhs(t, &m, u32::from(lng_open), share, None, N::ZERO).rates
+        let og = self.outer_all(t, m.ambient);
+        self.rhs(t, &m, u32::from(lng_open), share, None, N::ZERO, &og).rates
     }
 
     /// Heat balances of the six nodes for one step (tick means `m`). `hist`: exchanger
@@ -581,7 +614,8 @@ impl<N: Num> Model<N> {
     /// the credited share of this step. `links`: the link temperatures of the last
     /// step (energy they store leaves the loop); `None` for steady flow.
     #[inline(always)]
-    fn rhs(&self, t: &[N; N_NODES], m: &Sums<N>, hist: u32, share: N, links: Option<[N; 3]>, rate: N) -> Rhs<N> {
+    #[allow(clippy::too_many_arguments)]
+    fn rhs(&self, t: &[N; N_NODES], m: &Sums<N>, hist: u32, share: N, links: Option<[N; 3]>, rate: N, outer_g: &[N; 4]) -> Rhs<N> {
         let k = &self.k;
         let amb = m.ambient;
         let [t_p, t_c, t_l, t_mb, t_bb, t_a] = *t;
@@ -595,22 +629,31 @@ impl<N: Num> Model<N> {
         // conductances of eqs. (12)-(14), (20)-(22) at this step's flows
         let at_q = table::locate(aq, k.q_scale, k.one);
         let at_w = table::locate(aw, k.w_scale, k.one);
-        let at_l = table::locate(aq.add(leak_lps), k.q_scale, k.one);
         let g_case = table::value(&self.g_case, &at_w);
         let g_port = table::value(&self.g_port, &at_q);
         let g_loop = table::value(&self.g_loop, &at_q);
         let g_ball = table::value(&self.g_ball, &at_q);
-        let g_lng = table::value(&self.g_lng, &at_l);
+        // (the exchanger's flow is |q_p| plus the leakage, ≈ 1 % more: the table is
+        // read at |q_p|, where the effectiveness is within 0.1 % of it)
+        let g_lng = table::value(&self.g_lng, &at_q);
         // oil capacity rates, kW/K
         let rc_l = k.rc0.add(k.rc1.mul(t_l));
         let m_c = rc_l.mul(aq);
         let m_thr = rc_l.mul(if m.abs_thr_lps < aq { m.abs_thr_lps } else { aq });
         let m_l = rc_l.mul(leak_lps);
         let g_tidal = rc_l.mul(m.abs_act_lps);
-        // transport delay of the exchanger's effect to the high-pressure port
-        let delay = k.v_port.add(k.v_port).mul(rc_l).div_pos(m_c.add(m_l).mul(k.h)).round_times(1);
-        let delay = delay.clamp(0, MAX_DELAY_STEPS);
-        let lng_at_port = (hist >> (delay as u32)) & 1 == 1;
+        // transport delay of the exchanger's effect to the high-pressure port: the
+        // port passages' residence time (C_in + C_out) / (m c_p) in model steps, with
+        // linear interpolation between the credit of the two steps around it
+        let (j, frac) = k.v_port.add(k.v_port).mul(rc_l).div_pos(m_c.add(m_l).mul(k.h)).split_floor();
+        let j = j.clamp(0, MAX_DELAY_STEPS - 1) as u32;
+        let at = |b: u32| (hist >> b) & 1 == 1;
+        let port_share = match (at(j), at(j + 1)) {
+            (true, true) => k.one,
+            (true, false) => k.one.sub(frac),
+            (false, true) => frac,
+            (false, false) => N::ZERO,
+        };
         let q_lng_full = g_lng.mul(t_l.sub(k.lng_in));
         let ring = Ring::solve(&RingIn {
             t_loop: t_l,
@@ -622,7 +665,7 @@ impl<N: Num> Model<N> {
             g_port,
             g_ball,
             q_lng: q_lng_full.mul(share),
-            q_lng_port: if lng_at_port { q_lng_full } else { N::ZERO },
+            q_lng_port: q_lng_full.mul(port_share),
             p_hp: k.f_out.mul(mech_kw),
             p_needle: m.needle_kw,
             c_port: rc_l.mul(k.v_port),
@@ -635,8 +678,8 @@ impl<N: Num> Model<N> {
         // leakage advection case <-> ring at the mean specific heat of the two temperatures
         let m_lk = k.rc0.add(k.rc1.mul(ring.t_feed.add(t_c).mul(k.half))).mul(leak_lps);
         let adv = m_lk.mul(ring.t_feed.sub(t_c));
-        let outer = [self.outer(0, t_p, amb), self.outer(1, t_mb, amb), self.outer(2, t_bb, amb), self.outer(3, t_a, amb)];
-        let [o_p, o_mb, o_bb, o_a] = outer;
+        let [g_op, g_omb, g_obb, g_oa] = *outer_g;
+        let (o_p, o_mb, o_bb, o_a) = (g_op.mul(t_p.sub(amb)), g_omb.mul(t_mb.sub(amb)), g_obb.mul(t_bb.sub(amb)), g_oa.mul(t_a.sub(amb)));
         let q_pump = g_case
             .mul(t_c.sub(t_p))
             .add(g_port.mul(ring.t_in.sub(t_p)))
@@ -696,19 +739,28 @@ impl<N: Num> Model<N> {
         }
     }
 
-    /// Heat from outer surface `i` of [`OUTER_NODES`] to the air, kW: free convection
+    /// Conductance of outer surface `i` of [`OUTER_NODES`] to the air, kW/K: free convection
     /// `(c0 + c1 |dT|^(1/4)) A dT` (eqs. 15-16) plus radiation linearised about the
     /// mean of wall and air, `4 eps sigma A T_m^3 dT` (eq. 19, within 0.1 % here).
+    /// The heat is `g dT` with `g` from [`Model::outer_conductance`].
     #[inline(always)]
-    fn outer(&self, i: usize, t_wall: N, t_air: N) -> N {
-        let k = &self.k;
+    fn outer_conductance_of(k: &Consts<N>, i: usize, t_wall: N, t_air: N) -> N {
         let (Some(ga), Some(gb), Some(gr)) = (k.ga.get(i), k.gb.get(i), k.gr.get(i)) else {
             return N::ZERO;
         };
         let dt = t_wall.sub(t_air);
         let q4 = dt.sqrt_abs().sqrt_abs();
-        let tm = t_air.add(dt.mul(k.half)).mul(k.hundredth).add(k.k_offset_hk);
-        ga.add(gb.mul(q4)).add(gr.mul(tm).mul(tm).mul(tm)).mul(dt)
+        let tm = t_air.add(dt.mul(k.half)).mul(k.per_rad_t).add(k.rad_offset);
+        ga.add(gb.mul(q4)).add(gr.mul(tm).mul(tm).mul(tm))
+    }
+
+    /// Outer conductances of all four surfaces at temperatures `t` in air `amb`, kW/K.
+    fn outer_all(&self, t: &[N; N_NODES], amb: N) -> [N; 4] {
+        let mut g = [N::ZERO; 4];
+        for (i, (o, n)) in g.iter_mut().zip(OUTER_NODES.iter()).enumerate() {
+            *o = Self::outer_conductance_of(&self.k, i, t.get(*n).copied().unwrap_or(amb), amb);
+        }
+        g
     }
 
     /// Advances one model step with every tick at the same inputs (tests, tools).
