@@ -108,7 +108,7 @@ pub const INFEASIBLE_K: f64 = 1e3;
 /// Residual sampling interval, firmware ticks (1 s; a whole number of model steps,
 /// so the residuals compare states right after a model step).
 pub const RESIDUAL_EVERY: usize = 100;
-const _: () = assert!(RESIDUAL_EVERY % TICKS_PER_STEP as usize == 0);
+const _: () = assert!(RESIDUAL_EVERY.is_multiple_of(TICKS_PER_STEP as usize));
 
 /// Reference nodes compared with the reduced nodes (contract order
 /// winding, motor, pump, loop oil, valve block, drain).
