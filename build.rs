@@ -1,13 +1,14 @@
-//! Selects the linker memory map and puts it on the linker search path as
-//! `memory.x` (cortex-m-rt's `link.x` INCLUDEs it). Default (QEMU mps2-an385/an386,
-//! 256 KiB flash at 0, 64 KiB RAM): `boards/mps2/memory.x`. With feature
-//! `board-stm32f4`: `boards/stm32f411/memory.x`. There is deliberately no
-//! `memory.x` in the package root: the linker searches its working directory
-//! (the workspace root) first, which would override the board's map.
+//! Selects the linker memory map: copies the board's map to `OUT_DIR` as
+//! `board-memory.x` and puts `OUT_DIR` on the linker search path; the root
+//! `memory.x` (which cortex-m-rt's `link.x` INCLUDEs, found first in the linker's
+//! working directory, the package root) INCLUDEs it. Default (QEMU
+//! mps2-an385/an386, 256 KiB flash at 0, 64 KiB RAM): `boards/mps2/memory.x`.
+//! With feature `board-stm32f4`: `boards/stm32f411/memory.x`.
 use std::{env, fs, path::PathBuf};
 
 fn main() {
     println!("cargo:rerun-if-changed=build.rs");
+    println!("cargo:rerun-if-changed=memory.x");
     println!("cargo:rerun-if-changed=boards/mps2/memory.x");
     println!("cargo:rerun-if-changed=boards/stm32f411/memory.x");
     let Some(out) = env::var_os("OUT_DIR").map(PathBuf::from) else {
@@ -19,7 +20,7 @@ fn main() {
         "boards/mps2/memory.x"
     };
     if let Ok(bytes) = fs::read(src) {
-        if fs::write(out.join("memory.x"), bytes).is_ok() {
+        if fs::write(out.join("board-memory.x"), bytes).is_ok() {
             println!("cargo:rustc-link-search={}", out.display());
         }
     }
