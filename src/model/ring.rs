@@ -144,3 +144,92 @@ impl<N: Num> Ring<N> {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn base(forward: bool, hp_is_a: bool) -> RingIn<f64> {
+        RingIn {
+            t_loop: 40.0,
+            t_pump: 40.0,
+            t_ball_block: 40.0,
+            m_c: 0.26,
+            m_thr: 0.26,
+            m_l: 0.003,
+            g_port: 0.002,
+            g_ball: 0.002,
+            q_lng: 0.0,
+            q_lng_port: 0.0,
+            p_hp: 0.0,
+            p_needle: 0.0,
+            c_port: 0.085,
+            c_ball: 0.085,
+            rate: 0.0,
+            forward,
+            hp_is_a,
+            one: 1.0,
+        }
+    }
+
+    /// Everything at one temperature, no heat: every link at that temperature, in
+    /// both flow directions and with either port at high pressure.
+    #[test]
+    fn isothermal_ring_stays_isothermal() {
+        for (f, h) in [(true, true), (true, false), (false, true), (false, false)] {
+            let r = Ring::solve(&base(f, h));
+            for t in [r.t_in, r.t_out, r.t_ball, r.t_feed] {
+                assert!((t - 40.0).abs() < 1e-12, "forward {f} hp A {h}: {t}");
+            }
+        }
+    }
+
+    /// A heat input P on the high-pressure port raises the outlet by P / (m + g)
+    /// (m = the capacity rate through it), and the ball passage downstream by the
+    /// same advected amount less what its film passes to the block.
+    #[test]
+    fn heat_input_raises_the_stream_downstream() {
+        let mut x = base(true, true);
+        x.p_hp = 0.3; // kW
+        let r = Ring::solve(&x);
+        let m1 = x.m_c + x.m_l;
+        assert!((r.t_in - 40.0).abs() < 1e-12);
+        assert!((r.t_out - (40.0 + 0.3 / (m1 + x.g_port))).abs() < 1e-12);
+        let expect_ball = (x.m_thr * r.t_out + x.g_ball * 40.0) / (x.m_thr + x.g_ball);
+        assert!((r.t_ball - expect_ball).abs() < 1e-12);
+        assert!((r.t_feed - r.t_out).abs() < 1e-12, "the leakage leaves at the high-pressure (outlet) port");
+    }
+
+    /// The exchanger's heat leaves the loop outflow: the inlet drops by q / (m0 + g);
+    /// while it has not reached the port (`q_lng_port = 0`) the drain feed is the
+    /// outlet as if the exchanger were off.
+    #[test]
+    fn exchanger_cools_the_inlet_and_reaches_the_feed_late() {
+        let mut x = base(true, true);
+        x.q_lng = 3.0;
+        x.q_lng_port = 0.0;
+        let r = Ring::solve(&x);
+        let m0 = x.m_c + x.m_l;
+        assert!((r.t_in - (40.0 - 3.0 / (m0 + x.g_port))).abs() < 1e-12);
+        assert!(r.t_out < 40.0 - 10.0, "outlet {}", r.t_out);
+        assert!((r.t_feed - 40.0).abs() < 1e-9, "feed {}", r.t_feed);
+        x.q_lng_port = 3.0;
+        let r2 = Ring::solve(&x);
+        assert!((r2.t_feed - r2.t_out).abs() < 1e-12);
+    }
+
+    /// With the flow stopped each link relaxes onto its metal plus its heat over the film.
+    #[test]
+    fn stopped_flow_links_sit_on_their_metal() {
+        let mut x = base(true, true);
+        x.m_c = 0.0;
+        x.m_thr = 0.0;
+        x.m_l = 0.0;
+        x.t_pump = 30.0;
+        x.t_ball_block = 25.0;
+        x.p_needle = 0.001;
+        let r = Ring::solve(&x);
+        assert!((r.t_in - 30.0).abs() < 1e-12 && (r.t_out - 30.0).abs() < 1e-12);
+        assert!((r.t_ball - (25.0 + 0.001 / x.g_ball)).abs() < 1e-12);
+    }
+}

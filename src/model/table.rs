@@ -44,3 +44,32 @@ pub fn to_kw<N: Num>(t: &[f64; N_TABLE]) -> [N; N_TABLE] {
     }
     o
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Grid `x_j = x_max (j/31)^2` with `t_j = j`: interpolation in sqrt(x), the
+    /// last point held beyond the range, negative and NaN inputs at the first.
+    #[test]
+    fn locate_and_interpolate() {
+        let mut t = [0.0f64; N_TABLE];
+        for (j, v) in t.iter_mut().enumerate() {
+            *v = j as f64;
+        }
+        let x_max = 4.0;
+        let root_scale = (N_TABLE - 1) as f64 / libm::sqrt(x_max);
+        let at = |x: f64| value(&t, &locate(x, root_scale, 1.0));
+        // exactly on grid point 10 and half way (in sqrt) between 10 and 11
+        let x10 = x_max * (10.0f64 / 31.0).powi(2);
+        let x105 = x_max * (10.5f64 / 31.0).powi(2);
+        assert!((at(x10) - 10.0).abs() < 1e-12);
+        assert!((at(x105) - 10.5).abs() < 1e-12);
+        assert!((at(x_max) - 31.0).abs() < 1e-12);
+        assert_eq!(at(10.0 * x_max), 31.0);
+        assert_eq!(at(0.0), 0.0);
+        assert_eq!(at(f64::NAN), 0.0);
+        // sqrt_abs: a negative input reads the table at |x| (flows are magnitudes)
+        assert!((at(-x10) - 10.0).abs() < 1e-12);
+    }
+}
