@@ -15,7 +15,6 @@
 //! per n ticks with every loss from the mean inputs.
 use eha_guard::{GuardConfig, GuardOf, Restore};
 use eha_sim::heat;
-use eha_sim::missions::random_mission;
 use eha_sim::network::{self, Node, Shape};
 use eha_sim::plant::{Control, Plant, Sensors};
 use eha_sim::rig::Rig;
@@ -248,11 +247,9 @@ fn main() {
     let arg = std::env::args().nth(1).unwrap_or("4".into());
     let every: usize = std::env::args().nth(2).and_then(|s| s.parse().ok()).unwrap_or(100000);
     let flags = std::env::args().nth(3).unwrap_or_default();
-    let sc = match arg.as_str() {
-        "lng" => Scenario::Lng { duration_s: 600.0 },
-        "case2" => Scenario::Case2 { duration_s: 600.0 },
-        a if a.starts_with("c1-") => Scenario::Case1 { needle_bar: a[3..].parse().unwrap(), duration_s: 600.0 },
-        _ => Scenario::Mission(random_mission(arg.parse().unwrap(), 600.0)),
+    let Some(sc) = eha_sim::missions::run_by_name(&arg) else {
+        eprintln!("unknown run {arg:?}: expected lng, case2, c1-<bar> or a random-mission seed");
+        std::process::exit(2);
     };
     let rig = Rig::default();
     let mut plant = Plant::new(&rig, &sc).unwrap();

@@ -2,20 +2,16 @@
 //! with the reference: the model's own 40/38 thermostat (2 s dwell) at model steps.
 use eha_guard::protection::{Valve, ValveConfig};
 use eha_guard::model::{Model, ModelInputN, HA_PER_A, HBAR_PER_BAR, HRADS_PER_RPM};
-use eha_sim::missions::random_mission;
 use eha_sim::network::Node;
 use eha_sim::plant::{Control, Plant, Sensors};
 use eha_sim::reduce::reduce;
 use eha_sim::rig::Rig;
-use eha_sim::scenario::Scenario;
 fn main() {
     let arg = std::env::args().nth(1).unwrap_or("4".into());
     let every: usize = std::env::args().nth(2).and_then(|s| s.parse().ok()).unwrap_or(1000);
-    let sc = match arg.as_str() {
-        "lng" => Scenario::Lng { duration_s: 600.0 },
-        "case2" => Scenario::Case2 { duration_s: 600.0 },
-        a if a.starts_with("c1-") => Scenario::Case1 { needle_bar: a[3..].parse().unwrap(), duration_s: 600.0 },
-        _ => Scenario::Mission(random_mission(arg.parse().unwrap(), 600.0)),
+    let Some(sc) = eha_sim::missions::run_by_name(&arg) else {
+        eprintln!("unknown run {arg:?}: expected lng, case2, c1-<bar> or a random-mission seed");
+        std::process::exit(2);
     };
     let rig = Rig::default();
     let p = reduce(&rig).expect("reduce");

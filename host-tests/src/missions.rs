@@ -119,3 +119,19 @@ pub fn stats(errs: impl Iterator<Item = f64>) -> ErrorStats {
     ErrorStats { max_abs, rms: (ss / n.max(1) as f64).sqrt(), max_under: under, max_over: over }
 }
 
+
+/// A 600 s acceptance run by name, as the study examples take it on the command
+/// line: `lng` (Fig. 15), `case2`, `c1-<bar>` (Case 1 at that needle drop) or a
+/// random-mission seed. `None` for anything else.
+pub fn run_by_name(name: &str) -> Option<crate::scenario::Scenario> {
+    use crate::scenario::Scenario;
+    let d = 600.0;
+    match name {
+        "lng" => Some(Scenario::Lng { duration_s: d }),
+        "case2" => Some(Scenario::Case2 { duration_s: d }),
+        a => match a.strip_prefix("c1-") {
+            Some(bar) => bar.parse().ok().map(|b| Scenario::Case1 { needle_bar: b, duration_s: d }),
+            None => a.parse().ok().map(|s| Scenario::Mission(random_mission(s, d))),
+        },
+    }
+}
