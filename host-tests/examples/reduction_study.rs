@@ -18,7 +18,6 @@ use eha_sim::heat;
 use eha_sim::network::{self, Node, Shape};
 use eha_sim::plant::{Control, Plant, Sensors};
 use eha_sim::rig::Rig;
-use eha_sim::scenario::Scenario;
 use std::f64::consts::PI;
 
 #[derive(Clone, Copy, Debug, Default)]
