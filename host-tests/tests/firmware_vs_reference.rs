@@ -342,27 +342,17 @@ fn params_are_the_reduction_of_the_rig() {
     let d = eha_guard::params::DEFAULT;
     let rel = |a: f64, b: f64| (a - b).abs() <= 1e-12 * a.abs().max(b.abs()).max(1e-30);
     let flat = |q: &eha_guard::params::ReducedParams| {
-        let mut v = vec![
-            q.pump_j_per_k, q.main_block_j_per_k, q.ball_block_j_per_k, q.actuator_j_per_k, q.case_oil_m3, q.loop_oil_m3,
-            q.port_oil_m3, q.ball_oil_m3, q.rho_kg_per_m3, q.cp20_j_per_kg_k, q.cp_slope_j_per_kg_k2, q.displacement_m3_per_rad,
-            q.eta_m, q.mech_to_outlet, q.k_leak_m3_per_s_pa, q.case_pressure_pa, q.k_mu_per_k, q.t_mu_ref_c,
-            q.line_r1_pa_s_per_m3, q.line_r2_pa_s2_per_m6, q.ram_area_m2, q.act_leak_m3_per_s_pa, q.act_friction_n_s_per_m,
-            q.phases, q.r_ohm, q.k_fe1_w_s_per_rad, q.k_fe2_w_s2_per_rad2, q.k_fe15_w_per_rad15, q.speed_table_max_rad_s,
-            q.flow_table_max_m3_per_s, q.lng_inlet_c,
-        ];
-        for t in [&q.g_case_w_per_k, &q.g_port_w_per_k, &q.g_loop_block_w_per_k, &q.g_ball_block_w_per_k, &q.g_lng_w_per_k] {
-            v.extend_from_slice(t);
+        let mut v: Vec<(String, f64)> = eha_sim::reduce::scalar_fields(q).iter().map(|(n, x)| (n.to_string(), *x)).collect();
+        for (n, t) in eha_sim::reduce::array_fields(q) {
+            v.extend(t.iter().enumerate().map(|(i, x)| (format!("{n}[{i}]"), *x)));
         }
-        v.extend_from_slice(&q.outer_w_per_k);
-        v.extend_from_slice(&q.outer_quarter_w_per_k125);
-        v.extend_from_slice(&q.outer_rad_w_per_k4);
-        for r in &q.nominal_jacobian_per_s {
-            v.extend_from_slice(r);
+        for (i, r) in q.nominal_jacobian_per_s.iter().enumerate() {
+            v.extend(r.iter().enumerate().map(|(j, x)| (format!("nominal_jacobian_per_s[{i}][{j}]"), *x)));
         }
         v
     };
     let (a, b) = (flat(&p), flat(&d));
-    let stale: Vec<usize> = a.iter().zip(&b).enumerate().filter(|(_, (x, y))| !rel(**x, **y)).map(|(i, _)| i).collect();
+    let stale: Vec<&str> = a.iter().zip(&b).filter(|((_, x), (_, y))| !rel(*x, *y)).map(|((n, _), _)| n.as_str()).collect();
     assert!(stale.is_empty(), "src/params.rs DEFAULT differs from reduce(Rig::default()) at fields {stale:?}: run `cargo run --release -p eha-sim --example reduce`");
     // The LNG table between its points, against eqs. (20)-(22) with the oil stream D|w|.
     let rho_cp = rig.oil.rho(40.0, 0.0) * rig.oil.cp(40.0);

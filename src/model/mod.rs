@@ -2,7 +2,7 @@
 //! quasi-steady oil ring, losses of eqs. (1)-(11) from the controller's signals,
 //! conductances of eqs. (12)-(19) and the LNG exchanger of eqs. (20)-(22).
 //!
-//! Multi-rate: [`Model::accumulate`] takes one 10 ms tick of inputs and sums its
+//! Multi-rate: [`Model::tick_n`] takes one 10 ms tick of inputs and sums its
 //! losses and flows; every [`TICKS_PER_STEP`] ticks [`Model::update`] advances the
 //! temperatures by one model step of [`S_PER_STEP`] with the tick means.
 //!
@@ -176,6 +176,49 @@ impl<N: Num> Sums<N> {
     }
 }
 
+impl<N: Num> Sums<N> {
+    /// Adds one tick's raw loss and flow terms (see [`Model::tick_n`]); `true` when
+    /// [`TICKS_PER_STEP`] ticks are summed.
+    #[inline(always)]
+    fn add_tick(&mut self, k: &Consts<N>, u: &ModelInputN<N>) -> bool {
+        let s = self;
+        // Raw per-tick terms; their constants are applied once at the model step
+        // (`Sums::means`).
+        let dpa = u.p_a_hbar.sub(k.p_case);
+        let dpb = u.p_b_hbar.sub(k.p_case);
+        let dp = u.p_a_hbar.sub(u.p_b_hbar);
+        let aw = u.speed_hrads.abs();
+        // eqs. (5)-(7): each port leaks K (p - p_case) into the case; heat K dp^2.
+        s.leak_kw = s.leak_kw.add(dpa.mul(dpa).add(dpb.mul(dpb)));
+        // 2 max(0, x) = x + |x|: the leaking ports' pressure excess (x2)
+        s.leak_lps = s.leak_lps.add(dpa.add(dpa.abs()).add(dpb).add(dpb.abs()));
+        // eq. (8): |dp| |w|
+        s.mech_kw = s.mech_kw.add(dp.abs().mul(aw));
+        // pump delivery into A, piston flow, throttled remainder (eqs. 10-11)
+        let q_pump = k.k_q.mul(u.speed_hrads).sub(k.k_lf.mul(dpa));
+        let q_act = k.k_a.mul(u.dpos_mm);
+        let q_thr = q_pump.sub(q_act);
+        let aq_thr = q_thr.abs();
+        let line = q_thr.mul(q_thr).mul(k.r1.add(k.r2.mul(aq_thr)));
+        let x = k.k_dpq.mul(dp).mul(q_thr).sub(line);
+        s.line_kw = s.line_kw.add(line);
+        s.needle_kw = s.needle_kw.add(x.add(x.abs())); // 2 max(0, dp q - line)
+        // eq. (11) and the piston's viscous seal friction
+        s.act_kw = s.act_kw.add(k.w_dp.mul(dp).mul(dp).add(k.w_dx.mul(u.dpos_mm).mul(u.dpos_mm)));
+        // eq. (1): I^2 (dissipation total only)
+        s.copper_kw = s.copper_kw.add(u.current_ha.mul(u.current_ha));
+        s.pump_lps = s.pump_lps.add(q_pump);
+        s.abs_pump_lps = s.abs_pump_lps.add(q_pump.abs());
+        s.abs_thr_lps = s.abs_thr_lps.add(aq_thr);
+        s.abs_act_lps = s.abs_act_lps.add(u.dpos_mm.abs());
+        s.abs_speed = s.abs_speed.add(aw);
+        s.dp = s.dp.add(dp);
+        s.ambient = u.ambient_c;
+        s.ticks += 1;
+        s.ticks >= TICKS_PER_STEP
+    }
+}
+
 /// Result of [`Model::rhs`].
 #[derive(Clone, Copy, Debug)]
 struct Rhs<N> {
@@ -343,48 +386,45 @@ impl<N: Num> Model<N> {
         // radiation 4 eps sigma A T_m^3 with T_m in units of 300 K (so the coefficient
         // keeps its resolution in fixed point)
         let gr = outer(&p.outer_rad_w_per_k4, 4.0 * RAD_T_K * RAD_T_K * RAD_T_K * KW_PER_W);
-        let scalars = [
-            p.case_pressure_pa / PA_PER_HBAR,
-            kl * PA_PER_HBAR * L_PER_M3,
-            kl * PA_PER_HBAR * PA_PER_HBAR * KW_PER_W,
-            p.eta_m * d * PA_PER_HBAR * 100.0 * KW_PER_W,
-            d * 100.0 * L_PER_M3,
-            p.ram_area_m2 * 1e-3 / S_PER_TICK * L_PER_M3,
-            PA_PER_HBAR / L_PER_M3 * KW_PER_W,
-            p.line_r1_pa_s_per_m3 / (L_PER_M3 * L_PER_M3) * KW_PER_W,
-            p.line_r2_pa_s2_per_m6 / (L_PER_M3 * L_PER_M3 * L_PER_M3) * KW_PER_W,
-            p.act_leak_m3_per_s_pa * PA_PER_HBAR * PA_PER_HBAR * KW_PER_W,
-            p.act_friction_n_s_per_m * (1e-3 / S_PER_TICK) * (1e-3 / S_PER_TICK) * KW_PER_W,
-            p.phases * p.r_ohm / (HA_PER_A * HA_PER_A) * KW_PER_W,
-            p.k_fe1_w_s_per_rad * 100.0 * KW_PER_W,
-            p.k_fe2_w_s2_per_rad2 * 1e4 * KW_PER_W,
-            p.k_fe15_w_per_rad15 * 1e3 * KW_PER_W,
-            n1 / libm::sqrt(q_max),
-            n1 / libm::sqrt(w_max),
-            rc0,
-            rc1,
-            // 1/(rc40 + rc1 (T - 40)) ≈ (1/rc40)(1 - (rc1/rc40)(T - 40)) = irc0 - irc1 T
-            (1.0 + 40.0 * rc1 / rho_cp40) / rho_cp40,
-            rc1 / (rho_cp40 * rho_cp40),
-            1.0 / (p.case_oil_m3 * L_PER_M3),
-            1.0 / (p.loop_oil_m3 * L_PER_M3),
-            p.port_oil_m3 * L_PER_M3,
-            p.ball_oil_m3 * L_PER_M3,
-            1.0 / v_ring,
-            p.lng_inlet_c,
-            p.k_mu_per_k,
-            p.t_mu_ref_c,
-        ];
+        // The constants in model units, named once; all are checked against the value
+        // format below before conversion.
+        let p_case = p.case_pressure_pa / PA_PER_HBAR;
+        let k_lf = kl * PA_PER_HBAR * L_PER_M3;
+        let k_lp = kl * PA_PER_HBAR * PA_PER_HBAR * KW_PER_W;
+        let k_mech = p.eta_m * d * PA_PER_HBAR * 100.0 * KW_PER_W;
+        let k_q = d * 100.0 * L_PER_M3;
+        let k_a = p.ram_area_m2 * 1e-3 / S_PER_TICK * L_PER_M3;
+        let k_dpq = PA_PER_HBAR / L_PER_M3 * KW_PER_W;
+        let r1 = p.line_r1_pa_s_per_m3 / (L_PER_M3 * L_PER_M3) * KW_PER_W;
+        let r2 = p.line_r2_pa_s2_per_m6 / (L_PER_M3 * L_PER_M3 * L_PER_M3) * KW_PER_W;
+        let k_al = p.act_leak_m3_per_s_pa * PA_PER_HBAR * PA_PER_HBAR * KW_PER_W;
+        let k_fr = p.act_friction_n_s_per_m * (1e-3 / S_PER_TICK) * (1e-3 / S_PER_TICK) * KW_PER_W;
+        let k_cu = p.phases * p.r_ohm / (HA_PER_A * HA_PER_A) * KW_PER_W;
+        let fe1 = p.k_fe1_w_s_per_rad * 100.0 * KW_PER_W;
+        let fe2 = p.k_fe2_w_s2_per_rad2 * 1e4 * KW_PER_W;
+        let fe15 = p.k_fe15_w_per_rad15 * 1e3 * KW_PER_W;
+        let q_scale = n1 / libm::sqrt(q_max);
+        let w_scale = n1 / libm::sqrt(w_max);
+        // 1/(rc40 + rc1 (T - 40)) ≈ (1/rc40)(1 - (rc1/rc40)(T - 40)) = irc0 - irc1 T
+        let irc0 = (1.0 + 40.0 * rc1 / rho_cp40) / rho_cp40;
+        let irc1 = rc1 / (rho_cp40 * rho_cp40);
+        let inv_v_case = 1.0 / (p.case_oil_m3 * L_PER_M3);
+        let inv_v_loop = 1.0 / (p.loop_oil_m3 * L_PER_M3);
+        let v_port = p.port_oil_m3 * L_PER_M3;
+        let v_ball = p.ball_oil_m3 * L_PER_M3;
+        let inv_v_ring = 1.0 / v_ring;
         // Actuator heat per tick `k_al dp^2 + k_fr dx^2` as `k_act (w_dp dp^2 + w_dx dx^2)`
         // with the larger coefficient factored out (both weights <= 1).
-        let (k_al, k_fr) = (scalars[9], scalars[10]);
         let k_act = if k_al > k_fr { k_al } else { k_fr };
-        let act_w = if k_act > 0.0 { (k_al / k_act, k_fr / k_act, k_act) } else { (0.0, 0.0, 0.0) };
+        let (w_dp, w_dx) = if k_act > 0.0 { (k_al / k_act, k_fr / k_act) } else { (0.0, 0.0) };
+        let scalars = [
+            p_case, k_lf, k_lp, k_mech, k_q, k_a, k_dpq, r1, r2, k_al, k_fr, k_cu, fe1, fe2, fe15, q_scale, w_scale, rc0, rc1,
+            irc0, irc1, inv_v_case, inv_v_loop, v_port, v_ball, inv_v_ring, p.lng_inlet_c, p.k_mu_per_k, p.t_mu_ref_c,
+        ];
         if scalars.iter().chain(ga.iter()).chain(gb.iter()).chain(gr.iter()).chain(inv_c64.iter()).any(|x| !x.is_finite() || libm::fabs(*x) >= 250.0) {
             return Err(ConfigError::ConstantRange);
         }
         let f = N::from_f64;
-        let s = |i: usize| f(scalars.get(i).copied().unwrap_or(0.0));
         let arr4 = |a: &[f64; 4]| [f(a[0]), f(a[1]), f(a[2]), f(a[3])];
         let mut inv_n = [N::ZERO; TICKS_PER_STEP as usize + 1];
         let mut count = [N::ZERO; TICKS_PER_STEP as usize + 1];
@@ -399,43 +439,43 @@ impl<N: Num> Model<N> {
             *o = f(*x);
         }
         let k = Consts {
-            p_case: s(0),
-            k_lf: s(1),
-            k_lp: s(2),
-            k_mech: s(3),
-            k_q: s(4),
-            k_a: s(5),
-            k_dpq: s(6),
-            r1: s(7),
-            r2: s(8),
-            w_dp: f(act_w.0),
-            w_dx: f(act_w.1),
-            k_act: f(act_w.2),
-            k_lf_half: f(scalars[1] * 0.5),
-            k_cu: s(11),
-            fe1: s(12),
-            fe2: s(13),
-            fe15: s(14),
+            p_case: f(p_case),
+            k_lf: f(k_lf),
+            k_lp: f(k_lp),
+            k_mech: f(k_mech),
+            k_q: f(k_q),
+            k_a: f(k_a),
+            k_dpq: f(k_dpq),
+            r1: f(r1),
+            r2: f(r2),
+            w_dp: f(w_dp),
+            w_dx: f(w_dx),
+            k_act: f(k_act),
+            k_lf_half: f(k_lf * 0.5),
+            k_cu: f(k_cu),
+            fe1: f(fe1),
+            fe2: f(fe2),
+            fe15: f(fe15),
             inv_ticks: f(1.0 / TICKS_PER_STEP as f64),
-            q_scale: s(15),
-            w_scale: s(16),
-            rc0: s(17),
-            rc1: s(18),
-            irc0: s(19),
-            irc1: s(20),
-            inv_v_case: s(21),
-            inv_v_loop: s(22),
+            q_scale: f(q_scale),
+            w_scale: f(w_scale),
+            rc0: f(rc0),
+            rc1: f(rc1),
+            irc0: f(irc0),
+            irc1: f(irc1),
+            inv_v_case: f(inv_v_case),
+            inv_v_loop: f(inv_v_loop),
             inv_n,
             count,
-            v_port: s(23),
-            v_ball: s(24),
-            inv_v_ring: s(25),
+            v_port: f(v_port),
+            v_ball: f(v_ball),
+            inv_v_ring: f(inv_v_ring),
             inv_c,
             f_out: f(p.mech_to_outlet),
             f_case: f(1.0 - p.mech_to_outlet),
-            lng_in: s(26),
-            k_mu: s(27),
-            t_mu: s(28),
+            lng_in: f(p.lng_inlet_c),
+            k_mu: f(p.k_mu_per_k),
+            t_mu: f(p.t_mu_ref_c),
             use_mu: p.k_mu_per_k != 0.0,
             ga: arr4(&ga),
             gb: arr4(&gb),
@@ -514,42 +554,7 @@ impl<N: Num> Model<N> {
     /// then calls [`Model::update`].
     #[inline(always)]
     pub fn tick_n(&mut self, u: &ModelInputN<N>) -> bool {
-        let k = &self.k;
-        let s = &mut self.sums;
-        // Raw per-tick terms; their constants are applied once at the model step
-        // (`Sums::means`).
-        let dpa = u.p_a_hbar.sub(k.p_case);
-        let dpb = u.p_b_hbar.sub(k.p_case);
-        let dp = u.p_a_hbar.sub(u.p_b_hbar);
-        let aw = u.speed_hrads.abs();
-        // eqs. (5)-(7): each port leaks K (p - p_case) into the case; heat K dp^2.
-        s.leak_kw = s.leak_kw.add(dpa.mul(dpa).add(dpb.mul(dpb)));
-        // 2 max(0, x) = x + |x|: the leaking ports' pressure excess (x2)
-        s.leak_lps = s.leak_lps.add(dpa.add(dpa.abs()).add(dpb).add(dpb.abs()));
-        // eq. (8): |dp| |w|
-        s.mech_kw = s.mech_kw.add(dp.abs().mul(aw));
-        // pump delivery into A, piston flow, throttled remainder (eqs. 10-11)
-        let q_pump = k.k_q.mul(u.speed_hrads).sub(k.k_lf.mul(dpa));
-        let q_act = k.k_a.mul(u.dpos_mm);
-        let q_thr = q_pump.sub(q_act);
-        let aq_thr = q_thr.abs();
-        let line = q_thr.mul(q_thr).mul(k.r1.add(k.r2.mul(aq_thr)));
-        let x = k.k_dpq.mul(dp).mul(q_thr).sub(line);
-        s.line_kw = s.line_kw.add(line);
-        s.needle_kw = s.needle_kw.add(x.add(x.abs())); // 2 max(0, dp q - line)
-        // eq. (11) and the piston's viscous seal friction
-        s.act_kw = s.act_kw.add(k.w_dp.mul(dp).mul(dp).add(k.w_dx.mul(u.dpos_mm).mul(u.dpos_mm)));
-        // eq. (1): I^2 (dissipation total only)
-        s.copper_kw = s.copper_kw.add(u.current_ha.mul(u.current_ha));
-        s.pump_lps = s.pump_lps.add(q_pump);
-        s.abs_pump_lps = s.abs_pump_lps.add(q_pump.abs());
-        s.abs_thr_lps = s.abs_thr_lps.add(aq_thr);
-        s.abs_act_lps = s.abs_act_lps.add(u.dpos_mm.abs());
-        s.abs_speed = s.abs_speed.add(aw);
-        s.dp = s.dp.add(dp);
-        s.ambient = u.ambient_c;
-        s.ticks += 1;
-        s.ticks >= TICKS_PER_STEP
+        self.sums.add_tick(&self.k, u)
     }
 
     /// One model step of [`S_PER_STEP`] with the means of the accumulated ticks.
@@ -564,7 +569,7 @@ impl<N: Num> Model<N> {
         let k = &self.k;
         let inv = k.inv_n.get(ticks as usize).copied().unwrap_or(k.inv_ticks);
         let on = lng_ticks.min(ticks);
-        let share = k.inv_n.get(ticks as usize).copied().unwrap_or(k.inv_ticks).mul(k.count.get(on as usize).copied().unwrap_or(k.one));
+        let share = inv.mul(k.count.get(on as usize).copied().unwrap_or(k.one));
         let m = self.sums.means(inv, &self.k);
         self.sums = Sums::ZERO;
         self.ambient_c = m.ambient;
@@ -600,10 +605,9 @@ impl<N: Num> Model<N> {
     /// at inputs `u`, the ring in steady flow (links stored nothing, no transport lag):
     /// the function whose Jacobian at the nominal point is `A` (reduction tool).
     pub fn derivative(&self, t: &[N; N_NODES], u: &ModelInputN<N>, lng_open: bool) -> [N; N_NODES] {
-        let mut probe = *self;
-        probe.sums = Sums::ZERO;
-        let _ = probe.tick_n(u);
-        let m = probe.sums.means(self.k.one, &self.k);
+        let mut sums = Sums::ZERO;
+        let _ = sums.add_tick(&self.k, u);
+        let m = sums.means(self.k.one, &self.k);
         let share = if lng_open { self.k.one } else { N::ZERO };
         let og = self.outer_all(t, m.ambient);
         self.rhs(t, &m, u32::from(lng_open), share, None, N::ZERO, &og).rates
@@ -645,7 +649,9 @@ impl<N: Num> Model<N> {
         // transport delay of the exchanger's effect to the high-pressure port: the
         // port passages' residence time (C_in + C_out) / (m c_p) in model steps, with
         // linear interpolation between the credit of the two steps around it
-        let (j, frac) = k.v_port.add(k.v_port).mul(rc_l).div_pos(m_c.add(m_l).mul(k.h)).split_floor();
+        let c_port = rc_l.mul(k.v_port);
+        let c_ball = rc_l.mul(k.v_ball);
+        let (j, frac) = c_port.add(c_port).div_pos(m_c.add(m_l).mul(k.h)).split_floor();
         let j = j.clamp(0, MAX_DELAY_STEPS - 1) as u32;
         let at = |b: u32| (hist >> b) & 1 == 1;
         let port_share = match (at(j), at(j + 1)) {
@@ -668,8 +674,8 @@ impl<N: Num> Model<N> {
             q_lng_port: q_lng_full.mul(port_share),
             p_hp: k.f_out.mul(mech_kw),
             p_needle: m.needle_kw,
-            c_port: rc_l.mul(k.v_port),
-            c_ball: rc_l.mul(k.v_ball),
+            c_port,
+            c_ball,
             rate,
             forward: m.pump_lps >= N::ZERO,
             hp_is_a: m.dp >= N::ZERO,
@@ -699,13 +705,10 @@ impl<N: Num> Model<N> {
             .add(g_tidal.mul(t_a.sub(t_l)));
         // energy kept by the ring: what the links stored since the last step leaves the loop
         let stored = match links {
-            Some([li, lo, lb]) => {
-                let c_port = rc_l.mul(k.v_port);
-                c_port
-                    .mul(ring.t_in.sub(li))
-                    .add(c_port.mul(ring.t_out.sub(lo)))
-                    .add(rc_l.mul(k.v_ball).mul(ring.t_ball.sub(lb)))
-            }
+            Some([li, lo, lb]) => c_port
+                .mul(ring.t_in.sub(li))
+                .add(c_port.mul(ring.t_out.sub(lo)))
+                .add(c_ball.mul(ring.t_ball.sub(lb))),
             None => N::ZERO,
         };
         let inv_rc_l = k.irc0.sub(k.irc1.mul(t_l));

@@ -75,7 +75,6 @@ impl<N: Num> Ring<N> {
     /// Solves the links in flow order (three divisions).
     #[inline(always)]
     pub fn solve(x: &RingIn<N>) -> Self {
-        let m_act = x.m_c.sub(x.m_thr);
         let m0 = x.m_c.add(x.m_l);
         let one_pump = x.g_port.mul(x.t_pump);
         let cr_port = x.c_port.mul(x.rate);
@@ -104,12 +103,11 @@ impl<N: Num> Ring<N> {
             } else {
                 t_in.add(lag.mul(d_in))
             };
-            let _ = m_act;
             Ring { t_in, t_out, t_ball, t_feed, q_lng: x.q_lng }
         } else {
             // loop → {ball passage (m_thr), direct (m_act + m_l)} → outlet (A) → inlet (B) → loop;
             // the exchanger's cooling is taken by the larger of the two branches.
-            let m_direct = m_act.add(x.m_l);
+            let m_direct = x.m_c.sub(x.m_thr).add(x.m_l);
             let on_direct = m_direct >= x.m_thr;
             let (q_d, q_b) = if on_direct { (x.q_lng, N::ZERO) } else { (N::ZERO, x.q_lng) };
             let t_ball = x
