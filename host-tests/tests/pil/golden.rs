@@ -22,7 +22,7 @@ fn f32_drill_matches_golden_output() {
     q.icount = true;
     let run = run_open_loop(&q, &drill::inputs()).unwrap_or_else(|e| panic!("{e:#}"));
     let got = open_loop_transcript(&run, eha_guard::params::S_PER_TICK, 1000);
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/expected/pil_drill_f32.run");
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/pil/expected/pil_drill_f32.run");
     if std::env::var_os("PIL_BLESS").is_some() {
         std::fs::write(&path, &got).unwrap();
         eprintln!("blessed {}", path.display());

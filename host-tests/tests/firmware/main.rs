@@ -1,0 +1,4 @@
+//! The firmware's reduced model (host build of `eha-guard`) in closed loop
+//! with the reference simulation.
+
+mod vs_reference;

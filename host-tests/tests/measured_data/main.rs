@@ -1,0 +1,3 @@
+//! The strict reader and writer of the shared measured-data format.
+
+mod reader;

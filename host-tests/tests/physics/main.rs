@@ -1,0 +1,6 @@
+//! Physics tests of the reference simulation: the paper's published numbers,
+//! energy closure and the stiff solver against analytic solutions.
+
+mod energy;
+mod paper;
+mod solver;

@@ -1,0 +1,10 @@
+//! Processor-in-the-loop tests: the firmware ELF in QEMU against the host
+//! build of the same code and the reference plant (frame protocol, fault
+//! handling, golden transcript, closed loop).
+
+mod equivalence;
+mod faults;
+mod golden;
+mod protocol;
+mod scenarios;
+mod valve_loop;
