@@ -29,6 +29,10 @@ enum Cmd {
     Diagnose(eha_sim::diagnosis::cli::DiagnoseArgs),
     /// Hidden-effect sweep: synthetic runs with one effect each, diagnosed blind.
     DiagnoseSweep(eha_sim::diagnosis::sweep::SweepArgs),
+    /// Firmware budgets: instructions per tick, stack, flash, RAM of every
+    /// image (QEMU -icount), written to out/fw-budget.json and checked
+    /// against .ci/fw-budget.json (fails on > 10 % over a budget).
+    FwBudget(eha_sim::pil::budget::BudgetArgs),
 }
 
 fn main() -> ExitCode {
@@ -39,6 +43,7 @@ fn main() -> ExitCode {
         Cmd::Calibrate(a) => cli::run_calibrate(&a),
         Cmd::Rig => cli::run_rig(),
         Cmd::Pil(a) => eha_sim::pil::cli::run(&a),
+        Cmd::FwBudget(a) => eha_sim::pil::budget::run(&a),
         // Own exit codes: 0 diagnosis made (none included), 2 bad input.
         Cmd::Diagnose(a) => return eha_sim::diagnosis::cli::run(&a),
         Cmd::DiagnoseSweep(a) => return eha_sim::diagnosis::sweep::run(&a),

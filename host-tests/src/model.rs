@@ -115,6 +115,24 @@ impl ReplayDrive {
         }
     }
 
+    /// Piston speed at logged sample `i`, mm/s: the mean of the difference
+    /// quotients of the segments on either side (one side at the ends).
+    fn node_speed(&self, i: usize) -> f64 {
+        let r = &self.inputs;
+        let Some(p) = &r.position_mm else { return 0.0 };
+        let ts = &r.time_s;
+        let q = |j: usize| -> Option<f64> {
+            let (a, b) = (ts.get(j)?, ts.get(j + 1)?);
+            Some((p.get(j + 1)? - p.get(j)?) / (b - a))
+        };
+        match (i.checked_sub(1).and_then(q), q(i)) {
+            (Some(a), Some(b)) => 0.5 * (a + b),
+            (Some(a), None) => a,
+            (None, Some(b)) => b,
+            (None, None) => 0.0,
+        }
+    }
+
     /// Operating point at `t` from the measured inputs.
     pub fn op(&self, rig: &Rig, t: f64) -> OpPoint {
         let (i, f) = self.locate(t);
@@ -122,9 +140,13 @@ impl ReplayDrive {
         let (x, v) = match &r.position_mm {
             Some(p) => {
                 let x = Self::lerp(p, i, f) * 1e-3;
-                let dt = r.time_s.get(i + 1).zip(r.time_s.get(i)).map_or(1.0, |(b, a)| b - a);
-                let v = (p.get(i + 1).zip(p.get(i)).map_or(0.0, |(b, a)| b - a)) * 1e-3 / dt;
-                (x, v)
+                // Piston speed: the logged samples' difference quotients
+                // averaged onto the samples and interpolated linearly, so
+                // that the speed is continuous (a piecewise-constant speed
+                // would make the friction and flow heat jump at every logged
+                // sample and force the solver to stop there).
+                let v = (1.0 - f) * self.node_speed(i) + f * self.node_speed(i + 1);
+                (x, v * 1e-3)
             }
             None => (0.0, 0.0),
         };

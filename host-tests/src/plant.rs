@@ -245,6 +245,7 @@ pub struct Plant {
     y0: Vec<f64>,
     t: f64,
     stats: Stats,
+    rtol: f64,
 }
 
 impl Plant {
@@ -265,7 +266,7 @@ impl Plant {
             Drive::Replay(r) => r.inputs().time_s.first().copied().unwrap_or(0.0),
             Drive::Mission(_) => 0.0,
         };
-        Ok(Self { y0: y.clone(), y, t, model, stats: Stats::default() })
+        Ok(Self { y0: y.clone(), y, t, model, stats: Stats::default(), rtol: RTOL })
     }
 
     /// The model.
@@ -286,6 +287,12 @@ impl Plant {
     /// Set the LNG valve.
     pub fn set_lng_valve(&mut self, open: bool) {
         self.model.lng_open.set(open);
+    }
+
+    /// Relative tolerance of the solver's error control (default [`RTOL`]).
+    /// The diagnosis fits replays with a looser one (`diagnosis::reference`).
+    pub fn set_rtol(&mut self, rtol: f64) {
+        self.rtol = rtol;
     }
 
     /// Snapshot of the current state.
@@ -324,7 +331,7 @@ impl Plant {
         let t_start = self.t;
         let mut problem = OdeBuilder::<NalgebraMat<f64>>::new()
             .t0(t_start)
-            .rtol(RTOL)
+            .rtol(self.rtol)
             .atol(atol())
             .h0(1e-4)
             .rhs_implicit(rhs, jac)
@@ -463,7 +470,12 @@ fn breakpoints(drive: &Drive, t0: f64, t1: f64) -> Vec<f64> {
                 crate::scenario::PositionRef::Sine { .. } => vec![],
             })
             .collect(),
-        Drive::Replay(r) => r.inputs().time_s.clone(),
+        // Replayed inputs are interpolated linearly between the logged
+        // samples: continuous, so the solver steps across the samples with
+        // its own error control instead of restarting at each one (a servo
+        // log at 0.1 s would otherwise force 10 stops per simulated second).
+        // The logged valve command is applied at the control callbacks.
+        Drive::Replay(_) => Vec::new(),
     };
     v.retain(|&b| b > t0 && b < t1);
     v.sort_by(f64::total_cmp);

@@ -154,7 +154,13 @@ impl SimOutput {
 
 /// Run `scenario` on `rig` and sample every channel.
 pub fn simulate(rig: &Rig, scenario: &Scenario, opt: &SimOptions) -> Result<SimOutput, SimError> {
+    simulate_rtol(rig, scenario, opt, crate::plant::RTOL)
+}
+
+/// [`simulate`] with the solver's relative tolerance `rtol`.
+pub fn simulate_rtol(rig: &Rig, scenario: &Scenario, opt: &SimOptions, rtol: f64) -> Result<SimOutput, SimError> {
     let mut plant = Plant::new(rig, scenario)?;
+    plant.set_rtol(rtol);
     let name = match scenario.mission() {
         Some(m) => m.name,
         None => match scenario {

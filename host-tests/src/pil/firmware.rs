@@ -40,12 +40,6 @@ impl Build {
             Build::Fixed => "fixed-point",
         }
     }
-    fn features(self) -> &'static [&'static str] {
-        match self {
-            Build::F32 => &[],
-            Build::Fixed => &["--features", "fixed-point"],
-        }
-    }
 }
 
 impl std::str::FromStr for Build {
@@ -67,14 +61,28 @@ pub fn workspace_root() -> PathBuf {
 /// Build the firmware (release) and return the ELF path. Uses the `cargo`
 /// that runs us (`$CARGO`) when there is one; output goes to the same target
 /// directory as the host build (`$CARGO_TARGET_DIR` or `<workspace>/target`).
+/// When the image was built beforehand (`.ci/run` builds every image before
+/// the tests), this is cargo's up-to-date check, about a second.
 pub fn build_firmware(build: Build) -> Result<PathBuf> {
+    build_bin(build, "eha-fw", &[])
+}
+
+/// Build firmware binary `bin` of the root crate for `build` (release
+/// profile, LTO, the flashed configuration) with the extra cargo `features`
+/// (e.g. `board-stm32f4`), and return the ELF path.
+pub fn build_bin(build: Build, bin: &str, features: &[&str]) -> Result<PathBuf> {
     ensure_target(build)?;
     let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
     let root = workspace_root();
+    let mut feats: Vec<&str> = features.to_vec();
+    if build == Build::Fixed {
+        feats.push("fixed-point");
+    }
+    let feat_args: Vec<String> = if feats.is_empty() { vec![] } else { vec!["--features".into(), feats.join(",")] };
     let mut cmd = Command::new(&cargo);
     cmd.current_dir(&root)
-        .args(["build", "--release", "-p", "eha-guard", "--bin", "eha-fw", "--target", build.target()])
-        .args(build.features())
+        .args(["build", "--release", "-p", "eha-guard", "--bin", bin, "--target", build.target()])
+        .args(&feat_args)
         .args(["--message-format", "json-render-diagnostics"])
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
@@ -84,22 +92,22 @@ pub fn build_firmware(build: Build) -> Result<PathBuf> {
     let out = cmd.output().with_context(|| format!("running {cargo:?} to build the firmware in {}", root.display()))?;
     if !out.status.success() {
         bail!(
-            "firmware build failed ({}): cargo build --release -p eha-guard --bin eha-fw --target {} {} (see the compiler output above)",
+            "firmware build failed ({}): cargo build --release -p eha-guard --bin {bin} --target {} {} (see the compiler output above)",
             out.status,
             build.target(),
-            build.features().join(" ")
+            feat_args.join(" ")
         );
     }
     let stdout = String::from_utf8_lossy(&out.stdout);
     for line in stdout.lines().rev() {
         let Ok(v) = serde_json::from_str::<serde_json::Value>(line) else { continue };
-        if v["reason"] == "compiler-artifact" && v["target"]["name"] == "eha-fw" {
+        if v["reason"] == "compiler-artifact" && v["target"]["name"] == bin {
             if let Some(exe) = v["executable"].as_str() {
                 return Ok(PathBuf::from(exe));
             }
         }
     }
-    bail!("firmware build succeeded but cargo reported no eha-fw executable")
+    bail!("firmware build succeeded but cargo reported no {bin} executable")
 }
 
 /// Make sure the Rust target of `build` is installed (rustup does not add the

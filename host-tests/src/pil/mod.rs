@@ -7,6 +7,7 @@
 //! step. The same loop runs against [`sil::SilTarget`] (the same core code on
 //! the host), which is the bit-for-bit oracle for the firmware's replies.
 
+pub mod budget;
 pub mod defmt_log;
 pub mod drill;
 pub mod firmware;
@@ -21,7 +22,7 @@ use std::time::{Duration, Instant};
 
 use eha_guard::protocol::{Reply, ReplyKind, Request};
 
-pub use firmware::{build_firmware, Build};
+pub use firmware::{build_bin, build_firmware, Build};
 pub use qemu::{PilError, QemuOptions, QemuSession};
 
 /// What the firmware can measure, plus the plant's true drain temperature.

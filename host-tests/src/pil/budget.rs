@@ -1,0 +1,252 @@
+//! Firmware resource budgets: `eha-sim fw-budget` runs the benchmark image
+//! in QEMU under `-icount` (instruction counts, stack painting; see
+//! `src/bin/eha-bench.rs`), reads the flash and static RAM of every image
+//! from its ELF, writes `out/fw-budget.json` and compares each figure with
+//! the committed budgets (`.ci/fw-budget.json`): a figure more than
+//! [`REGRESSION_MARGIN`] above its budget fails.
+//!
+//! Instruction counts under `-icount` are deterministic, so the margin is for
+//! compiler and dependency updates, not for noise.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::Duration;
+
+use anyhow::{bail, Context, Result};
+use object::{Object, ObjectSection, SectionFlags};
+use serde::{Deserialize, Serialize};
+
+use super::firmware::{build_bin, workspace_root, Build};
+
+/// Allowed growth over a committed budget (fraction): 10 %.
+pub const REGRESSION_MARGIN: f64 = 0.10;
+
+/// The measured figures of one firmware image (`None`: not measured for it).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct ImageBudget {
+    /// `Guard::step` instructions per 10 ms tick, mean over the bench run.
+    pub instr_per_tick_mean: Option<f64>,
+    /// `Guard::step` instructions per tick, max (a model-step tick).
+    pub instr_per_tick_max: Option<f64>,
+    /// `Guard::new` instructions (init, once per boot).
+    pub guard_new_instr: Option<f64>,
+    /// Stack high-water mark of boot + init, bytes (stack painting).
+    pub stack_boot_b: Option<f64>,
+    /// Stack high-water mark of the tick loop, bytes.
+    pub stack_tick_b: Option<f64>,
+    /// Flash: `.text` + `.rodata`, bytes.
+    pub flash_b: Option<f64>,
+    /// Static RAM: every allocated writable section (`.data`, `.bss`, no-init), bytes.
+    pub ram_static_b: Option<f64>,
+}
+
+impl ImageBudget {
+    fn fields(&self) -> [(&'static str, Option<f64>); 7] {
+        [
+            ("instr_per_tick_mean", self.instr_per_tick_mean),
+            ("instr_per_tick_max", self.instr_per_tick_max),
+            ("guard_new_instr", self.guard_new_instr),
+            ("stack_boot_b", self.stack_boot_b),
+            ("stack_tick_b", self.stack_tick_b),
+            ("flash_b", self.flash_b),
+            ("ram_static_b", self.ram_static_b),
+        ]
+    }
+}
+
+/// One image the budget covers.
+struct Image {
+    name: &'static str,
+    build: Build,
+    bin: &'static str,
+    features: &'static [&'static str],
+    /// Run in QEMU for instruction counts and stack (the bench images).
+    run: bool,
+}
+
+const IMAGES: [Image; 3] = [
+    Image { name: "bench-f32", build: Build::F32, bin: "eha-bench", features: &[], run: true },
+    Image { name: "bench-fixed", build: Build::Fixed, bin: "eha-bench", features: &[], run: true },
+    Image { name: "stm32f411", build: Build::F32, bin: "eha-stm32f4", features: &["board-stm32f4"], run: false },
+];
+
+/// Flash (`.text` + `.rodata`) and static RAM of an ELF, bytes.
+pub fn elf_sizes(elf: &Path) -> Result<(u64, u64)> {
+    let data = std::fs::read(elf).with_context(|| format!("reading {}", elf.display()))?;
+    let file = object::File::parse(&*data).with_context(|| format!("parsing ELF {}", elf.display()))?;
+    let (mut flash, mut ram) = (0u64, 0u64);
+    for s in file.sections() {
+        let name = s.name().unwrap_or("");
+        let SectionFlags::Elf { sh_flags } = s.flags() else { continue };
+        let alloc = sh_flags & u64::from(object::elf::SHF_ALLOC) != 0;
+        let write = sh_flags & u64::from(object::elf::SHF_WRITE) != 0;
+        if name == ".text" || name == ".rodata" {
+            flash += s.size();
+        } else if alloc && write {
+            ram += s.size();
+        }
+    }
+    Ok((flash, ram))
+}
+
+/// The number after `key` in `line` (e.g. `mean 333.1`).
+fn number_after(line: &str, key: &str) -> Option<f64> {
+    let rest = &line[line.find(key)? + key.len()..];
+    rest.split_whitespace().next()?.trim_end_matches(',').parse().ok()
+}
+
+/// Parse the bench's semihosting report into the run-time figures.
+pub fn parse_bench(text: &str) -> Result<ImageBudget> {
+    if !text.lines().any(|l| l.trim() == "EHA-BENCH-DONE") {
+        bail!("the benchmark did not complete (no EHA-BENCH-DONE marker)");
+    }
+    let mut b = ImageBudget::default();
+    for l in text.lines() {
+        if l.starts_with("Guard::step, every tick:") {
+            b.instr_per_tick_mean = number_after(l, " mean ");
+            b.instr_per_tick_max = number_after(l, " max ");
+        } else if l.starts_with("Guard::new") {
+            b.guard_new_instr = number_after(l, "): ");
+        } else if l.starts_with("stack high-water mark:") {
+            b.stack_boot_b = number_after(l, "boot+init ");
+            b.stack_tick_b = number_after(l, "step loop ");
+        }
+    }
+    for (k, v) in b.fields() {
+        if v.is_none() && !k.ends_with("flash_b") && k != "ram_static_b" {
+            bail!("the benchmark report has no {k}");
+        }
+    }
+    Ok(b)
+}
+
+/// Run a bench ELF in QEMU under `-icount` and return its report (stderr).
+fn run_bench(build: Build, elf: &Path) -> Result<String> {
+    let mut child = Command::new("qemu-system-arm")
+        .args(["-machine", build.machine(), "-cpu", build.cpu(), "-nographic", "-monitor", "none", "-serial", "none"])
+        .args(["-semihosting-config", "enable=on,target=native", "-icount", "shift=10,align=off,sleep=off", "-kernel"])
+        .arg(elf)
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .context("starting qemu-system-arm (apt-get install qemu-system-arm)")?;
+    let mut err = child.stderr.take().context("qemu stderr")?;
+    let reader = std::thread::spawn(move || {
+        let mut s = String::new();
+        let _ = std::io::Read::read_to_string(&mut err, &mut s);
+        s
+    });
+    let deadline = std::time::Instant::now() + Duration::from_secs(120);
+    let status = loop {
+        if let Some(st) = child.try_wait()? {
+            break st;
+        }
+        if std::time::Instant::now() > deadline {
+            let _ = child.kill();
+            bail!("the benchmark {} did not finish within 120 s", elf.display());
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    let text = reader.join().unwrap_or_default();
+    if !status.success() {
+        bail!("the benchmark {} exited with {status}:\n{text}", elf.display());
+    }
+    Ok(text)
+}
+
+/// Measure every image (building it if needed).
+pub fn measure() -> Result<BTreeMap<String, ImageBudget>> {
+    let mut out = BTreeMap::new();
+    for im in &IMAGES {
+        let elf = build_bin(im.build, im.bin, im.features)?;
+        let mut b = if im.run { parse_bench(&run_bench(im.build, &elf)?)? } else { ImageBudget::default() };
+        let (flash, ram) = elf_sizes(&elf)?;
+        b.flash_b = Some(flash as f64);
+        b.ram_static_b = Some(ram as f64);
+        out.insert(im.name.to_string(), b);
+    }
+    Ok(out)
+}
+
+/// Every figure more than [`REGRESSION_MARGIN`] over its budget, and every
+/// budgeted figure that was not measured, as messages; empty: within budget.
+pub fn regressions(measured: &BTreeMap<String, ImageBudget>, budget: &BTreeMap<String, ImageBudget>) -> Vec<String> {
+    let mut v = Vec::new();
+    for (name, want) in budget {
+        let got = measured.get(name);
+        for ((key, limit), (_, value)) in want.fields().into_iter().zip(got.cloned().unwrap_or_default().fields()) {
+            let Some(limit) = limit else { continue };
+            match value {
+                None => v.push(format!("{name}.{key}: budgeted {limit} but not measured")),
+                Some(x) if x > limit * (1.0 + REGRESSION_MARGIN) => v.push(format!(
+                    "{name}.{key}: {x} > budget {limit} + {:.0} %",
+                    100.0 * REGRESSION_MARGIN
+                )),
+                Some(_) => {}
+            }
+        }
+    }
+    v
+}
+
+/// Arguments of `eha-sim fw-budget`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct BudgetArgs {
+    /// Where to write the measured figures.
+    #[arg(long, default_value = "out/fw-budget.json")]
+    pub out: PathBuf,
+    /// The committed budgets to check against (relative to the workspace root).
+    #[arg(long, default_value = ".ci/fw-budget.json")]
+    pub budget: PathBuf,
+}
+
+/// `eha-sim fw-budget`: measure, write, compare; an error lists every regression.
+pub fn run(a: &BudgetArgs) -> Result<()> {
+    let measured = measure()?;
+    if let Some(dir) = a.out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    let json = serde_json::to_string_pretty(&measured)?;
+    std::fs::write(&a.out, &json).with_context(|| format!("writing {}", a.out.display()))?;
+    println!("{json}");
+    println!("wrote {}", a.out.display());
+    let path = if a.budget.is_absolute() { a.budget.clone() } else { workspace_root().join(&a.budget) };
+    let text = std::fs::read_to_string(&path).with_context(|| format!("reading the budgets {}", path.display()))?;
+    let budget: BTreeMap<String, ImageBudget> =
+        serde_json::from_str(&text).with_context(|| format!("parsing the budgets {}", path.display()))?;
+    let r = regressions(&measured, &budget);
+    if !r.is_empty() {
+        bail!("firmware budget exceeded ({}):\n  {}", path.display(), r.join("\n  "));
+    }
+    println!("every figure within {} + {:.0} %", path.display(), 100.0 * REGRESSION_MARGIN);
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_the_bench_report() {
+        let text = "Guard::step, every tick: instructions/step min 243 mean 333.1 max 1157 (n = 5995)\n\
+                    Guard::new (ZOH expm, f64): 3920773 instructions\n\
+                    stack high-water mark: boot+init 13576 bytes, step loop 6288 bytes\nEHA-BENCH-DONE\n";
+        let b = parse_bench(text).expect("parses");
+        assert_eq!(b.instr_per_tick_mean, Some(333.1));
+        assert_eq!(b.instr_per_tick_max, Some(1157.0));
+        assert_eq!(b.guard_new_instr, Some(3920773.0));
+        assert_eq!((b.stack_boot_b, b.stack_tick_b), (Some(13576.0), Some(6288.0)));
+        assert!(parse_bench("Guard::new (ZOH expm, f64): 1 instructions\n").is_err(), "no completion marker");
+    }
+
+    #[test]
+    fn flags_only_growth_beyond_the_margin() {
+        let b = |x: f64| ImageBudget { instr_per_tick_mean: Some(x), ..Default::default() };
+        let budget = BTreeMap::from([("a".to_string(), b(100.0))]);
+        assert!(regressions(&BTreeMap::from([("a".to_string(), b(110.0))]), &budget).is_empty());
+        assert_eq!(regressions(&BTreeMap::from([("a".to_string(), b(110.5))]), &budget).len(), 1);
+        assert_eq!(regressions(&BTreeMap::new(), &budget).len(), 1, "a budgeted image that was not measured fails");
+    }
+}
