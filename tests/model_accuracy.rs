@@ -1,4 +1,4 @@
-//! The reduced-order model (`eha_guard::rom`): its exact-ZOH matrix against the
+//! The reduced-order model (`eha_guard::model`): its exact-ZOH matrix against the
 //! analytic solution, energy closure of the ring bookkeeping, and the f32 /
 //! fixed-point builds against f64 with the error budgets.
 
@@ -125,7 +125,6 @@ fn energy_balance_closes() {
     let p = DEFAULT;
     let mut m = Model::<f64>::new(&p).expect("model");
     m.set_uniform(16.0);
-    let rho_cp = |t: f64| p.rho_cp(t) * 1e-3; // J/(m^3 K) -> kJ/(m^3 K)
     // oil enthalpy per m^3 relative to 0 degC, kJ/m^3 (exact for the linear cp)
     let e_oil = |t: f64| p.rho_kg_per_m3 * ((p.cp20_j_per_kg_k - 20.0 * p.cp_slope_j_per_kg_k2) * t + 0.5 * p.cp_slope_j_per_kg_k2 * t * t) * 1e-3;
     let stored = |m: &Model<f64>| {
@@ -140,7 +139,6 @@ fn energy_balance_closes() {
             + (e_oil(l[0]) + e_oil(l[1])) * p.port_oil_m3
             + e_oil(l[2]) * p.ball_oil_m3
     };
-    let _ = rho_cp;
     let e0 = stored(&m);
     let (mut heat, mut outer, mut lng) = (0.0, 0.0, 0.0);
     let mut prev = 0.0;

@@ -1,7 +1,6 @@
 //! Property tests of the protection layer: no panics / finite outputs for arbitrary
 //! input sequences, same-step fail-safe, valve hysteresis and dwell under noise,
 //! latching and the clear rule, thermal-memory CRC, LNG arithmetic.
-mod common;
 
 use eha_guard::faults;
 use eha_guard::memory::{RecordStatus, Restore, ThermalRecord};
