@@ -34,8 +34,10 @@ pub fn identity<const N: usize>() -> [[f64; N]; N] {
 
 /// `exp(a) - I` by scaling and squaring with a degree-16 Taylor series.
 ///
-/// Returning `exp(a) - I` (not `exp(a)`) keeps the tiny entries of `Ad - I`
-/// (~1e-6 for a 10 ms step) at full relative precision. The argument is scaled
+/// Returning `exp(a) - I` (not `exp(a)`) keeps entries far below 1 at full
+/// relative precision: [`crate::model::etd_matrix`] takes `Phi` from the upper-right
+/// block of the augmented matrix, and the squarings that form it multiply the
+/// small diagonal block `exp(A h 2^-s) - I`, never `I + tiny`. The argument is scaled
 /// by `2^-s` so that `‖a‖∞ 2^-s ≤ 2^-4`; the truncation error is then below
 /// `(1/16)^17 / 17! ≈ 2e-35` relative, far under `f64` rounding. Squaring uses
 /// `E(2x) = 2E(x) + E(x)^2` with `E = exp - I`, which never forms `I + tiny`.

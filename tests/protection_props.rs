@@ -1,12 +1,13 @@
 //! Property tests of the protection layer: no panics / finite outputs for arbitrary
-//! input sequences, same-step fail-safe, valve hysteresis and dwell under noise,
+//! input sequences, the invariants and the unlatched path under mostly valid,
+//! rate-limited input with injected faults, same-step fail-safe, valve hysteresis and dwell under noise,
 //! latching and the clear rule, thermal-memory CRC, LNG arithmetic.
-mod common;
 
 use eha_guard::faults;
 use eha_guard::memory::{RecordStatus, Restore, ThermalRecord};
 use eha_guard::num::Fx;
 use eha_guard::protection::{LngBudget, LngConfig, Valve, ValveConfig};
+use eha_guard::validate::InputLimits;
 use eha_guard::{GuardConfig, GuardOf, Output, Sample};
 use proptest::prelude::*;
 
@@ -19,6 +20,12 @@ fn nominal() -> Sample {
         position_mm: 0.0,
         ambient_c: 16.0,
     }
+}
+
+/// One unit in the last place of `x` (the spacing above |x|): the regression bound
+/// of comparisons that measure exactly 0.
+fn ulp32(x: f32) -> f32 {
+    f32::from_bits(x.abs().to_bits() + 1) - x.abs()
 }
 
 fn finite(o: &Output) -> bool {
@@ -65,6 +72,255 @@ fn run_all<N: eha_guard::num::Num>(seq: &[Option<Sample>]) -> Result<(), TestCas
         }
     }
     Ok(())
+}
+
+/// One channel of [`InputLimits::DEFAULT`] in wire units: range and per-tick rate.
+#[derive(Clone, Copy, Debug)]
+struct Chan {
+    lo: f32,
+    hi: f32,
+    rate: f32,
+}
+
+/// The six channels in `Sample` order (current, p_A, p_B, speed, position, ambient).
+fn channels() -> [Chan; 6] {
+    let l = InputLimits::DEFAULT;
+    let p = Chan { lo: l.pressure_bar_min, hi: l.pressure_bar_max, rate: l.pressure_bar_per_step };
+    [
+        Chan { lo: -l.current_a_max, hi: l.current_a_max, rate: l.current_a_per_step },
+        p,
+        p,
+        Chan { lo: -l.speed_rpm_max, hi: l.speed_rpm_max, rate: l.speed_rpm_per_step },
+        Chan { lo: l.position_mm_min, hi: l.position_mm_max, rate: l.position_mm_per_step },
+        Chan { lo: l.ambient_c_min, hi: l.ambient_c_max, rate: l.ambient_c_per_step },
+    ]
+}
+
+fn to_sample(x: &[f32; 6]) -> Sample {
+    let [current_a, p_a_bar, p_b_bar, speed_rpm, position_mm, ambient_c] = *x;
+    Sample { current_a, p_a_bar, p_b_bar, speed_rpm, position_mm, ambient_c }
+}
+
+/// A fault injected on purpose at one tick of a valid run.
+#[derive(Clone, Copy, Debug)]
+enum Fault {
+    /// This tick's value of channel `ch` is NaN or ±inf (one tick).
+    NonFinite { ch: usize, v: f32 },
+    /// This tick's value of `ch` lies `excess` × the range width outside the range
+    /// (above when `high`), one tick.
+    Range { ch: usize, excess: f32, high: bool },
+    /// `ch` jumps by `factor` × its rate limit towards the middle of its range and
+    /// the run goes on from there (a step change).
+    Rate { ch: usize, factor: f32 },
+    /// `ticks` ticks without a sample (STALE from `stale_steps` = 5 on).
+    Missing { ticks: u32 },
+}
+
+fn fault() -> impl Strategy<Value = Fault> {
+    prop_oneof![
+        (0usize..6, prop_oneof![Just(f32::NAN), Just(f32::INFINITY), Just(f32::NEG_INFINITY)])
+            .prop_map(|(ch, v)| Fault::NonFinite { ch, v }),
+        (0usize..6, 0.02f32..1.0, any::<bool>()).prop_map(|(ch, excess, high)| Fault::Range { ch, excess, high }),
+        (0usize..6, 1.1f32..2.0).prop_map(|(ch, factor)| Fault::Rate { ch, factor }),
+        (1u32..10).prop_map(|ticks| Fault::Missing { ticks }),
+    ]
+}
+
+/// A mostly valid input run: a start inside every range, then piecewise-linear
+/// ramps whose per-tick change is at most 0.9 × the channel's rate limit, reflected
+/// at the range (inset by 0.5 % of its width), so every sample is valid and
+/// rate-limited with a margin that holds in all three number types. On top: in one
+/// case of three, 1-3 faults at chosen ticks; in half of the cases a maintenance
+/// `clear_faults` every `clear_every` ticks.
+#[derive(Clone, Debug)]
+struct Run {
+    start: [f32; 6],
+    /// (ticks, per-channel slope as a fraction of the rate limit, in [-0.9, 0.9]).
+    ramps: Vec<(u32, [f32; 6])>,
+    /// (position in the run as a fraction of its length, fault).
+    faults: Vec<(f64, Fault)>,
+    clear_every: Option<u32>,
+}
+
+fn valid_run() -> impl Strategy<Value = Run> {
+    (
+        proptest::array::uniform6(0.0f32..1.0),
+        proptest::collection::vec((1u32..250, proptest::array::uniform6(-0.9f32..0.9)), 1..8),
+        prop_oneof![2 => Just(vec![]), 1 => proptest::collection::vec((0.0f64..1.0, fault()), 1..4)],
+        proptest::option::weighted(0.5, 100u32..400),
+    )
+        .prop_map(|(u, ramps, faults, clear_every)| {
+            let mut start = [0.0f32; 6];
+            for ((x, c), u) in start.iter_mut().zip(channels()).zip(u) {
+                let m = 0.005 * (c.hi - c.lo);
+                *x = c.lo + m + u * (c.hi - c.lo - 2.0 * m);
+            }
+            Run { start, ramps, faults, clear_every }
+        })
+}
+
+/// What one tick of a [`Run`] feeds the guard.
+#[derive(Clone, Copy, Debug)]
+enum Tick {
+    Sample(Sample),
+    Missing,
+}
+
+/// The ticks of a run, each with the fault injected at it (if any).
+fn expand(run: &Run) -> Vec<(Tick, Option<Fault>)> {
+    let chans = channels();
+    let len: u32 = run.ramps.iter().map(|r| r.0).sum();
+    let mut at: Vec<(usize, Fault)> =
+        run.faults.iter().map(|(f, k)| (((*f * len as f64) as usize).min(len as usize - 1), *k)).collect();
+    at.sort_by_key(|a| a.0);
+    let mut x = run.start;
+    let mut out = Vec::with_capacity(len as usize + 32);
+    let mut k = 0usize;
+    for (n, slope) in &run.ramps {
+        let mut slope = *slope;
+        for _ in 0..*n {
+            let mut injected = None;
+            for (_, f) in at.iter().filter(|a| a.0 == k) {
+                injected = Some(*f);
+            }
+            // Reflecting ramp: |x' - x| <= |slope| rate <= 0.9 rate.
+            for ((x, s), c) in x.iter_mut().zip(slope.iter_mut()).zip(chans) {
+                let m = 0.005 * (c.hi - c.lo);
+                let (lo, hi) = (c.lo + m, c.hi - m);
+                let mut y = *x + *s * c.rate;
+                if y > hi {
+                    y = 2.0 * hi - y;
+                    *s = -*s;
+                } else if y < lo {
+                    y = 2.0 * lo - y;
+                    *s = -*s;
+                }
+                *x = y;
+            }
+            match injected {
+                None => out.push((Tick::Sample(to_sample(&x)), None)),
+                Some(f @ Fault::Missing { ticks }) => {
+                    out.push((Tick::Missing, Some(f)));
+                    out.extend((1..ticks).map(|_| (Tick::Missing, None)));
+                }
+                Some(f @ Fault::Rate { ch, factor }) => {
+                    let c = chans[ch];
+                    let dir = if x[ch] > 0.5 * (c.lo + c.hi) { -1.0 } else { 1.0 };
+                    x[ch] += dir * factor * c.rate;
+                    out.push((Tick::Sample(to_sample(&x)), Some(f)));
+                }
+                Some(f @ Fault::NonFinite { ch, v }) => {
+                    let mut y = x;
+                    y[ch] = v;
+                    out.push((Tick::Sample(to_sample(&y)), Some(f)));
+                }
+                Some(f @ Fault::Range { ch, excess, high }) => {
+                    let c = chans[ch];
+                    let mut y = x;
+                    y[ch] = if high { c.hi + excess * (c.hi - c.lo) } else { c.lo - excess * (c.hi - c.lo) };
+                    out.push((Tick::Sample(to_sample(&y)), Some(f)));
+                }
+            }
+            k += 1;
+        }
+    }
+    out
+}
+
+/// Runs `ticks` through a cold guard in number type `N`, checks the invariants at
+/// every tick and returns (ticks without a latched fault, ticks).
+fn run_valid<N: eha_guard::num::Num>(ticks: &[(Tick, Option<Fault>)], clear_every: Option<u32>) -> Result<(u64, u64), TestCaseError> {
+    let cfg = GuardConfig::DEFAULT;
+    let full = LngBudget::new(&cfg.lng).remaining_kg();
+    let mut g = GuardOf::<N>::new(&cfg, Restore::Cold);
+    let mut unlatched = 0u64;
+    // A latched bit is only allowed after a fault that can latch one (non-finite,
+    // range, a rate jump, a missing burst reaching `stale_steps`) since the last
+    // successful clear: valid, rate-limited input never latches anything.
+    let mut may_latch = false;
+    let mut missing_run = 0u32;
+    for (k, (t, f)) in ticks.iter().enumerate() {
+        if let Some(p) = clear_every {
+            if k > 0 && (k as u32).is_multiple_of(p) && g.clear_faults() {
+                prop_assert_eq!(g.faults() & faults::LATCHED, 0, "cleared at tick {}", k);
+                may_latch = false;
+            }
+        }
+        let o = match t {
+            Tick::Sample(s) => {
+                missing_run = 0;
+                g.step(s)
+            }
+            Tick::Missing => {
+                missing_run += 1;
+                g.step_missing()
+            }
+        };
+        match f {
+            Some(Fault::NonFinite { ch, .. }) | Some(Fault::Range { ch, .. }) => {
+                may_latch = true;
+                let class = if matches!(f, Some(Fault::NonFinite { .. })) { faults::NON_FINITE } else { faults::RANGE };
+                prop_assert!(o.valve_open && o.faults & class != 0, "tick {}: {:?} not latched: {:?}", k, f, o);
+                prop_assert!(o.faults & (1 << (faults::CH_SHIFT as usize + ch)) != 0, "tick {}: channel bit of {:?} missing: {:?}", k, f, o);
+            }
+            Some(Fault::Rate { .. }) => may_latch = true,
+            _ => {}
+        }
+        if missing_run >= cfg.stale_steps {
+            may_latch = true;
+        }
+        prop_assert!(finite(&o), "tick {}: non-finite output {:?}", k, o);
+        prop_assert!(o.lng_remaining_kg >= 0.0 && o.lng_remaining_kg <= full, "tick {}: LNG {}", k, o.lng_remaining_kg);
+        prop_assert_eq!(o.alarm, o.derate, "tick {}: derate must follow the alarm", k);
+        if o.faults & faults::LATCHED != 0 {
+            prop_assert!(o.valve_open, "tick {}: latched fault {:#x} but valve closed", k, o.faults);
+            prop_assert!(may_latch, "tick {}: fault {:#x} latched on valid, rate-limited input", k, o.faults);
+        } else {
+            unlatched += 1;
+        }
+    }
+    Ok((unlatched, ticks.len() as u64))
+}
+
+/// The normal (unlatched) path under mostly valid input, in all three number types:
+/// the invariants at every tick, and at least half of all generated ticks must run
+/// without a latched fault (the fully arbitrary test above reaches that path on
+/// about one sample in 10,000).
+#[test]
+fn valid_inputs_with_injected_faults_keep_invariants() {
+    use std::cell::Cell;
+    const CASES: u32 = 256;
+    // No failure persistence: a runner outside `proptest!` has no source file to
+    // name the regressions file after (proptest would only warn).
+    let config = ProptestConfig { cases: CASES, failure_persistence: None, ..ProptestConfig::default() };
+    let mut runner = proptest::test_runner::TestRunner::new(config);
+    // (unlatched, total) ticks per number type: f32, Fx, f64.
+    let counts = Cell::new([(0u64, 0u64); 3]);
+    let faulty = Cell::new(0u32);
+    let result = runner.run(&valid_run(), |run| {
+        let ticks = expand(&run);
+        let r = [
+            run_valid::<f32>(&ticks, run.clear_every)?,
+            run_valid::<Fx>(&ticks, run.clear_every)?,
+            run_valid::<f64>(&ticks, run.clear_every)?,
+        ];
+        let mut c = counts.get();
+        for (c, r) in c.iter_mut().zip(r) {
+            c.0 += r.0;
+            c.1 += r.1;
+        }
+        counts.set(c);
+        faulty.set(faulty.get() + u32::from(!run.faults.is_empty()));
+        Ok(())
+    });
+    if let Err(e) = result {
+        panic!("{e}");
+    }
+    for (name, (u, n)) in ["f32", "Fx", "f64"].iter().zip(counts.get()) {
+        let share = u as f64 / n as f64;
+        println!("{name}: {u} of {n} ticks without a latched fault ({:.1} %), {} of {CASES} runs with faults", 100.0 * share, faulty.get());
+        assert!(share >= 0.5, "{name}: only {:.1} % of the ticks reach the unlatched path", 100.0 * share);
+    }
 }
 
 proptest! {
@@ -229,6 +485,9 @@ fn boot_rules_cold_warm_corrupt() {
         (o.drain_c - 16.0).abs() < 0.01 && !o.valve_open,
         "cold: {o:?}"
     );
+    // Regression bound: the first tick reports the start estimate itself (no model
+    // step yet): measured exactly 16.0, bound one f32 ulp.
+    assert!((o.drain_c - 16.0).abs() <= ulp32(16.0), "cold: {o:?}");
     // Warm: 45 degC record restored although the ambient is 16 degC → valve opens.
     let rec = ThermalRecord::new(
         [50.0, 45.0, 46.0, 44.0, 30.0, 45.0],
@@ -243,6 +502,8 @@ fn boot_rules_cold_warm_corrupt() {
         (o.drain_c - 45.0).abs() < 0.05 && o.valve_open && o.faults == 0,
         "warm: {o:?}"
     );
+    // Regression bound: the restored drain node itself, measured exactly 45.0.
+    assert!((o.drain_c - 45.0).abs() <= ulp32(45.0), "warm: {o:?}");
     // Snapshot → record → restore round trip keeps every node within 1e-4 K. (The
     // valve state is not in the record: after a reset the valve output restarts
     // closed, so the restored guard's first step takes no exchanger credit, while
@@ -253,6 +514,8 @@ fn boot_rules_cold_warm_corrupt() {
     let snap2 = g2.snapshot();
     for (a, b) in snap.temps_c.iter().zip(snap2.temps_c.iter()) {
         assert!((a - b).abs() < 1e-4, "{a} vs {b}");
+        // Regression bound: the f32 round trip measures exactly 0; one ulp.
+        assert!((a - b).abs() <= ulp32(*a), "{a} vs {b}: regression bound 1 ulp (measured 0)");
     }
     // Corrupt: conservative 60 degC start, valve open, MEMORY_CORRUPT latched, LNG empty.
     let mut bad = rec;
@@ -264,6 +527,8 @@ fn boot_rules_cold_warm_corrupt() {
         (o.drain_c - 60.0).abs() < 0.05 && o.valve_open,
         "corrupt: {o:?}"
     );
+    // Regression bound: the conservative start itself, measured exactly 60.0.
+    assert!((o.drain_c - 60.0).abs() <= ulp32(60.0), "corrupt: {o:?}");
     assert!(o.faults & faults::MEMORY_CORRUPT != 0 && o.lng_remaining_kg == 0.0);
 }
 
@@ -271,19 +536,30 @@ fn boot_rules_cold_warm_corrupt() {
 fn lng_budget_arithmetic() {
     let c = LngConfig::DEFAULT;
     // Eq. (25): 5 L × 430 kg/m^3 = 2.15 kg. Eq. (24): 509e3 + 2.9e3 × 180 = 1.031e6 J/kg.
+    // Spec bounds (the paper's numbers, f32 arithmetic).
     assert!((c.charge_kg() - 2.15).abs() < 1e-6);
     assert!((c.j_per_kg() - 1.031e6).abs() < 0.5);
+    // Regression bounds: both measure exactly 0 (2.5x of 0 is 0): one f32 ulp.
+    assert!((c.charge_kg() - 2.15).abs() <= ulp32(2.15), "charge {} kg", c.charge_kg());
+    assert!((c.j_per_kg() - 1.031e6).abs() <= ulp32(1.031e6), "{} J/kg", c.j_per_kg());
     // Eq. (23): 1.5 kW for 600 s with the valve open uses 9e5 J = 0.8729 kg.
     let mut b = LngBudget::new(&c);
     for _ in 0..60_000 {
         b.update(true, 1500.0);
     }
     let used = 2.15 - b.remaining_kg();
-    assert!((used - 9e5 / 1.031e6).abs() < 1e-5, "used {used} kg");
+    let used_expect = 9e5 / 1.031e6;
+    println!("LNG used {used} kg, expected {used_expect} kg");
+    // Spec bound 1e-5 kg; regression bound one f32 ulp (measured exactly 0).
+    assert!((used - used_expect).abs() < 1e-5, "used {used} kg");
+    assert!((used - used_expect).abs() <= ulp32(used_expect), "used {used} kg: regression bound 1 ulp (measured 0)");
     // Seconds left at 1.5 kW: remaining energy / power.
     let left = b.seconds_left(1500.0);
     let expect = (2.15 * 1.031e6 - 9e5) / 1500.0;
+    println!("seconds left {left} s, expected {expect} s");
+    // Spec bound 0.5 s; regression bound one f32 ulp (measured exactly 0).
     assert!((left - expect as f32).abs() < 0.5, "{left} s vs {expect}");
+    assert!((left - expect as f32).abs() <= ulp32(expect as f32), "{left} s vs {expect}: regression bound 1 ulp (measured 0)");
     // Closed valve uses nothing; LNG-low below 20 % (0.43 kg).
     let r = b.remaining_kg();
     b.update(false, 1500.0);
@@ -376,17 +652,28 @@ fn stale_input_integrates_worst_case_loss() {
     // Copper (eq. 1) at 340.5 A with the configured constant R.
     let pp = &cfg.params;
     let p_cu_expect = pp.phases * 340.5f64.powi(2) * pp.r_ohm / 1e3;
-    assert!((p[0] - p_cu_expect).abs() < 1e-6 * p_cu_expect, "copper {} kW vs {} kW", p[0], p_cu_expect);
+    let e_cu = (p[0] - p_cu_expect).abs() / p_cu_expect;
+    assert!(e_cu < 1e-6, "copper {} kW vs {} kW", p[0], p_cu_expect);
     // Both ports at the ends of the pressure range (A 350, B -5 bar: 355 bar across the
     // pump) and 6000 rpm, no piston work: everything the pump delivers past its
     // leakage is throttled, dp (D w - K (p_A - p_case)).
     let (pa, pb, pc) = (350e5, -5e5, pp.case_pressure_pa);
     let q = 6000.0 * 2.0 * std::f64::consts::PI / 60.0 * pp.displacement_m3_per_rad - pp.k_leak_m3_per_s_pa * (pa - pc);
     let p_throttle = (pa - pb) * q / 1e3;
-    assert!((p[4] - p_throttle).abs() < 1e-6 * p_throttle, "throttle {} kW vs {} kW", p[4], p_throttle);
+    let e_thr = (p[4] - p_throttle).abs() / p_throttle;
+    assert!(e_thr < 1e-6, "throttle {} kW vs {} kW", p[4], p_throttle);
     // Leakage (eqs. 5-7) of both ports into the case.
     let p_leak = pp.k_leak_m3_per_s_pa * ((pa - pc).powi(2) + (pb - pc).powi(2)) / 1e3;
-    assert!((p[2] - p_leak).abs() < 1e-6 * p_leak, "leakage {} kW vs {} kW", p[2], p_leak);
+    let e_leak = (p[2] - p_leak).abs() / p_leak;
+    assert!(e_leak < 1e-6, "leakage {} kW vs {} kW", p[2], p_leak);
+    // The three 1e-6 bounds above are the spec (closed forms of eqs. 1, 5-7 and the
+    // throttling). Regression bound: the measured relative errors are 1.38e-16
+    // (copper), 2.12e-16 (throttle) and 1.39e-16 (leakage), about one f64 ulp: 5e-16
+    // is about 2.4x the largest.
+    println!("worst-case loss relative errors: copper {e_cu:.3e}, throttle {e_thr:.3e}, leakage {e_leak:.3e}");
+    for (name, e) in [("copper", e_cu), ("throttle", e_thr), ("leakage", e_leak)] {
+        assert!(e <= 5e-16, "{name} relative error {e:e}: regression bound 5e-16 (measured <= 2.12e-16)");
+    }
     assert!(o0.valve_open && o0.faults & faults::STALE != 0);
     let mut o = o0;
     let mut n = o0;

@@ -109,7 +109,7 @@ mod fw {
         loop {
             board.wait_tick();
             let out = service(&mut board, &mut guard);
-            if guard.steps() % 100 == 0 {
+            if guard.steps().is_multiple_of(100) {
                 noinit::store(&guard.snapshot());
                 defmt::info!(
                     "drain {} degC valve {} faults {=u16:#x}",

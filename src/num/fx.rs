@@ -8,12 +8,13 @@ use fixed::types::{I2F30, I9F23, I9F55};
 /// resolution 2^-23 ≈ 1.19e-7. Used for temperatures (degC / K), powers (kW),
 /// current (hA), pressure (hbar), speed (hrad/s), position (mm).
 pub type Fx = I9F23;
-/// Fixed-point coefficient of `Ad - I` and `Bd` for the 100 ms model step: Q2.30 in
-/// an `i32` (`I2F30`): range [-2, 2), resolution 2^-30 ≈ 9.3e-10. The largest entry of
-/// the identified model is the drain row's leakage column, `Bd ≈ 1000 h / C_drain ≈
-/// 0.34` per kW at h = 0.1 s: 6× headroom (a drain capacity down to ≈ 50 J/K fits).
-/// The smallest non-zero entries (≈ 1e-8, the 0.005 W/K motor-pump link) are then
-/// resolved to ≈ 5 %, the typical `Ad - I` entries (≥ 1e-5) to < 1e-4 relative.
+/// Fixed-point coefficient of the model step's exact-ZOH matrix `Phi` (seconds,
+/// h = 0.1 s): Q2.30 in an `i32` (`I2F30`): range [-2, 2), resolution 2^-30 ≈
+/// 9.3e-10. The largest entries are the diagonal, ≈ h = 0.1 s: 20× headroom. With
+/// the default parameters the direct couplings (≥ 1e-6 s) are resolved to < 4e-4
+/// relative, the weakest one (≈ 1.1e-8 s, pump → ball-valve block) to ≈ 4 %; the
+/// second-order entries between nodes without a direct link (< 1.3e-9 s) round to
+/// 0 or 1 LSB.
 pub type FxCoef = I2F30;
 /// Fixed-point state accumulator: Q9.55 in an `i64` (`I9F55`): range [-256, 256) K,
 /// resolution 2^-55 ≈ 2.8e-17 K; `coef × value` (Q2.30 × Q9.23 = Q.53) is shifted

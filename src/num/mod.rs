@@ -17,7 +17,7 @@ pub use fx::{Fx, FxCoef, FxScale, FxState};
 /// Arithmetic the model needs from its number type. All methods are total
 /// (no panics): the fixed-point instantiation saturates at its documented range.
 pub trait Num: Copy + PartialOrd + core::fmt::Debug {
-    /// Discretised matrix coefficient type (entries of `Ad - I` and `Bd`).
+    /// Discretised matrix coefficient type (entries of the exact-ZOH matrix `Phi`).
     type Coef: Copy + core::fmt::Debug;
     /// High-precision state accumulator type.
     type State: Copy + core::fmt::Debug;
