@@ -28,3 +28,20 @@ pub mod validate;
 
 pub use guard::{faults, Guard, GuardConfig, GuardOf, Output, Real, Sample};
 pub use memory::{Restore, ThermalRecord};
+
+#[cfg(test)]
+mod build_checks {
+    extern crate std;
+
+    /// The host test profile (`cargo test --profile fast`, Cargo.toml
+    /// `[profile.fast.package.eha-guard]`) builds this crate with overflow
+    /// checks and debug assertions, so an arithmetic overflow anywhere in the
+    /// firmware core fails the host tests instead of wrapping silently. This
+    /// test fails if a profile change drops them.
+    #[test]
+    fn firmware_core_is_tested_with_overflow_checks_and_debug_assertions() {
+        assert!(cfg!(debug_assertions), "debug assertions are off in this test build of eha-guard");
+        let r = std::panic::catch_unwind(|| core::hint::black_box(u8::MAX) + core::hint::black_box(1u8));
+        assert!(r.is_err(), "u8::MAX + 1 did not panic: overflow checks are off in this test build of eha-guard");
+    }
+}

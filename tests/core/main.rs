@@ -1,0 +1,7 @@
+//! Host tests of the firmware core (`eha-guard` built for the host): the
+//! reduced model's accuracy and discretisation, the protection layer's
+//! properties (proptest), and the over-temperature alarm and derate.
+
+mod alarm;
+mod model_accuracy;
+mod protection_props;
