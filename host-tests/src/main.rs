@@ -33,6 +33,9 @@ enum Cmd {
     /// image (QEMU -icount), written to out/fw-budget.json and checked
     /// against .ci/fw-budget.json (fails on > 10 % over a budget).
     FwBudget(eha_sim::pil::budget::BudgetArgs),
+    /// Fault campaign: every sensor, transport, memory and actuator fault in
+    /// closed loop with the reference plant; writes out/faults/faults.json.
+    Faults(eha_sim::faults::FaultsArgs),
 }
 
 fn main() -> ExitCode {
@@ -44,6 +47,7 @@ fn main() -> ExitCode {
         Cmd::Rig => cli::run_rig(),
         Cmd::Pil(a) => eha_sim::pil::cli::run(&a),
         Cmd::FwBudget(a) => eha_sim::pil::budget::run(&a),
+        Cmd::Faults(a) => eha_sim::faults::run(&a),
         // Own exit codes: 0 diagnosis made (none included), 2 bad input.
         Cmd::Diagnose(a) => return eha_sim::diagnosis::cli::run(&a),
         Cmd::DiagnoseSweep(a) => return eha_sim::diagnosis::sweep::run(&a),
