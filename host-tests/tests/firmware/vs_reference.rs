@@ -192,7 +192,7 @@ fn assert_bounds(rows: &[(String, ErrorStats, u16)]) {
     }
 }
 
-/// Case 1 at the paper's four needle-valve pressures (10/30/50 bar trained; these are not).
+/// Case 1 at the paper's four needle-valve pressures.
 #[test]
 fn case1_all_pressures_drain_within_bounds() {
     assert_bounds(&report(&["case1-"]));
