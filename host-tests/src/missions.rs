@@ -1,5 +1,5 @@
 //! Seeded random missions inside the rig's envelope of the paper's cases (the
-//! firmware's acceptance suite, `tests/firmware_vs_reference.rs`) and drain-error
+//! firmware's acceptance suite, `tests/firmware/vs_reference.rs`) and drain-error
 //! statistics.
 
 use crate::scenario::{Circuit, Mission, PositionRef, Schedule, ValveRule};

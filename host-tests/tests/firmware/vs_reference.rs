@@ -1,7 +1,8 @@
 //! Acceptance of the firmware's reduced model (issue 3, "Host tests") against
 //! the full reference simulation: Case 1 at 0/20/40/60 bar, Case 2, the LNG case
-//! and five random missions whose seeds (`identify::TEST_SEEDS`) were not used to
-//! identify the parameters (`identify::TRAIN_SEEDS`).
+//! and five random missions (`missions::TEST_SEEDS`); the reduced model is
+//! computed from the rig (`eha_sim::reduce`), fitted to no run, so every run is
+//! unseen.
 //!
 //! Every run is **closed loop**, as on the actuator: the guard (`GuardOf<f64>`,
 //! validation included, reduced `eha_guard::params::DEFAULT`) is fed the
@@ -9,7 +10,16 @@
 //! command drives the reference's LNG exchanger. The guard's model credits the
 //! exchanger's cooling while its own valve is open, so an open-loop comparison
 //! against a plant whose exchanger does not follow the guard would be meaningless.
-//! Every run is made once (in parallel) and shared by the tests of this file.
+//!
+//! Every closed loop is made once per test binary (in parallel) and shared by the
+//! tests of this file: [`runs`] holds the guard-driven run of every case (the
+//! acceptance runs plus load-then-idle), [`thermostat_first_switch`] the
+//! thermostat-driven loop of every case up to its first switch.
+//!
+//! Bounds: each assertion has the issue's **spec** bound and, where the spec sits
+//! far above what is measured, a **regression** bound at 2–3× the measured value,
+//! so that a change that makes the model several times worse fails even while it
+//! still meets the spec.
 
 use eha_guard::num::{Fx, Num};
 use eha_guard::protection::Valve;
@@ -31,6 +41,33 @@ const GOAL_K: f64 = 0.5;
 const MAX_UNDER_K: f64 = 0.5;
 /// Issue bound on a valve switching time against switching on the true drain, s.
 const MAX_SWITCH_S: f64 = 2.0;
+/// Regression bound on max |drain error| over every run, K: measured worst
+/// 0.070 K (random-1), 2.1×.
+const REG_MAX_ABS_K: f64 = 0.15;
+/// Regression bound on drain under-prediction over every run, K: measured worst
+/// 0.057 K (random-1), 2.6×.
+const REG_MAX_UNDER_K: f64 = 0.15;
+/// Regression bound on |f32 − f64| drain, K: measured 3.81e-6 K (Case 1 60 bar
+/// and LNG), 2.6×. (The fixed-point spec bound, 0.1 K, is itself 2.2× the
+/// measured 4.47e-2 K, so it serves as that type's regression bound too.)
+const REG_F32_K: f64 = 1e-5;
+/// Regression bound on any switching-time difference, s: measured worst 0.54 s
+/// (random-1 event 1, random-2 event 4), 2.2×.
+const REG_SWITCH_S: f64 = 1.2;
+/// Regression bound on a first-opening difference, s: measured worst 0.14 s
+/// (Case 1 40 bar), 2.1×.
+const REG_FIRST_OPEN_S: f64 = 0.3;
+
+/// The acceptance runs (drain-error bounds) followed by load-then-idle (valve
+/// switching only).
+fn cases() -> &'static [(String, Scenario)] {
+    static C: OnceLock<Vec<(String, Scenario)>> = OnceLock::new();
+    C.get_or_init(|| {
+        let mut v = scenarios();
+        v.push(("load-then-idle".into(), load_then_idle()));
+        v
+    })
+}
 
 fn scenarios() -> Vec<(String, Scenario)> {
     let mut v: Vec<(String, Scenario)> = [0.0, 20.0, 40.0, 60.0]
@@ -46,7 +83,7 @@ fn scenarios() -> Vec<(String, Scenario)> {
 }
 
 /// One closed-loop run: the reference plant with its exchanger commanded by the
-/// guard (or, for the comparison runs, by a thermostat on the true drain).
+/// guard.
 struct Run {
     name: String,
     /// Sensor snapshots at `t = k·10 ms`, `k = 0..=n` (valve state included).
@@ -55,18 +92,16 @@ struct Run {
     pred: Vec<f64>,
     /// OR of the guard's fault words over the run.
     faults: u16,
-    /// Valve events (time s, open) of the commanding side.
+    /// Valve events (time s, open) of the guard.
     events: Vec<(f64, bool)>,
 }
 
-/// Runs `scenario` in closed loop; the valve follows the guard (`by_guard`) or the
-/// guard's own hysteresis and dwell applied to the true drain temperature.
-fn closed_loop(name: &str, scenario: &Scenario, by_guard: bool) -> Run {
+/// Runs `scenario` in closed loop, the valve following the guard.
+fn closed_loop(name: &str, scenario: &Scenario) -> Run {
     let rig = Rig::default();
     let mut plant = Plant::new(&rig, scenario).expect("plant");
     let cfg = GuardConfig::DEFAULT;
     let mut guard = GuardOf::<f64>::new(&cfg, Restore::Cold);
-    let mut valve = Valve::new();
     let mut run = Run { name: name.into(), sensors: vec![], pred: vec![], faults: 0, events: vec![] };
     let mut open = false;
     plant
@@ -75,8 +110,7 @@ fn closed_loop(name: &str, scenario: &Scenario, by_guard: bool) -> Run {
             let o = guard.step(&s.sample());
             run.faults |= o.faults;
             run.pred.push(o.drain_c as f64);
-            valve.update(s.t_drain_c as f32, false, &cfg.valve);
-            let want = if by_guard { o.valve_open } else { valve.is_open() };
+            let want = o.valve_open;
             if want != open {
                 run.events.push((s.t, want));
                 open = want;
@@ -88,9 +122,19 @@ fn closed_loop(name: &str, scenario: &Scenario, by_guard: bool) -> Run {
     run
 }
 
+/// The guard-driven run of every case of [`cases`], in its order.
 fn runs() -> &'static [Run] {
     static R: OnceLock<Vec<Run>> = OnceLock::new();
-    R.get_or_init(|| scenarios().par_iter().map(|(n, s)| closed_loop(n, s, true)).collect())
+    R.get_or_init(|| cases().par_iter().map(|(n, s)| closed_loop(n, s)).collect())
+}
+
+/// For every case of [`cases`], in its order: when a thermostat with the guard's
+/// hysteresis and dwell on the **true** drain, commanding the exchanger from
+/// t = 0, first switches (an opening; None: not in the run). This is event 0 of
+/// [`thermostat_from_branch`], shared by both valve tests.
+fn thermostat_first_switch() -> &'static [Option<f64>] {
+    static T: OnceLock<Vec<Option<f64>>> = OnceLock::new();
+    T.get_or_init(|| cases().par_iter().map(|(_, sc)| thermostat_from_branch(sc, &[], 0)).collect())
 }
 
 /// Drain predictions of a guard in number type `N` replaying the sensor stream of
@@ -142,10 +186,13 @@ fn assert_bounds(rows: &[(String, ErrorStats, u16)]) {
         assert!(e.max_abs <= MAX_ABS_K, "{n}: max |error| {:.3} K > {MAX_ABS_K} K", e.max_abs);
         // Issue: under-prediction is the unsafe side, never more than 0.5 K.
         assert!(e.max_under <= MAX_UNDER_K, "{n}: under-prediction {:.3} K > {MAX_UNDER_K} K", e.max_under);
+        // Regression bounds (2-3x the measured worst; the spec bounds above are what the issue demands).
+        assert!(e.max_abs <= REG_MAX_ABS_K, "{n}: max |error| {:.3} K > regression bound {REG_MAX_ABS_K} K", e.max_abs);
+        assert!(e.max_under <= REG_MAX_UNDER_K, "{n}: under-prediction {:.3} K > regression bound {REG_MAX_UNDER_K} K", e.max_under);
     }
 }
 
-/// Case 1 at the paper's four needle-valve pressures (10/30/50 bar trained; these are not).
+/// Case 1 at the paper's four needle-valve pressures.
 #[test]
 fn case1_all_pressures_drain_within_bounds() {
     assert_bounds(&report(&["case1-"]));
@@ -185,9 +232,11 @@ fn number_types_agree_on_a_reference_run() {
         let e32 = d64.iter().zip(&d32).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
         let efx = d64.iter().zip(&dfx).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
         println!("{name}: |f32 - f64| max {e32:.2e} K, |fixed - f64| max {efx:.2e} K");
-        // Issue: f32 within 0.01 K of f64.
+        // Issue (spec): f32 within 0.01 K of f64.
         assert!(e32 <= 0.01, "{name}: f32 {e32} K");
-        // Issue: fixed point within 0.1 K of f64.
+        // Regression: 2.6x the measured 3.81e-6 K.
+        assert!(e32 <= REG_F32_K, "{name}: f32 {e32:.2e} K > regression bound {REG_F32_K:.0e} K");
+        // Issue (spec): fixed point within 0.1 K of f64 (2.2x the measured 4.47e-2 K).
         assert!(efx <= 0.1, "{name}: fixed {efx} K");
     }
 }
@@ -210,18 +259,12 @@ fn load_then_idle() -> Scenario {
 /// while the other does not fails.
 #[test]
 fn valve_first_opening_within_2s() {
-    let mut cases = scenarios();
-    cases.push(("load-then-idle".into(), load_then_idle()));
-    let rows: Vec<_> = cases
-        .par_iter()
-        .map(|(n, sc)| {
-            let (a, b) = rayon::join(|| closed_loop(n, sc, true), || closed_loop(n, sc, false));
-            (n.clone(), a.events, b.events)
-        })
-        .collect();
     let mut failures = vec![];
-    for (n, fw, truth) in &rows {
-        match (fw.first(), truth.first()) {
+    let (guard_runs, first) = (runs(), thermostat_first_switch());
+    for (run, truth) in guard_runs.iter().zip(first) {
+        let n = &run.name;
+        // The thermostat starts closed, so its first switch is an opening.
+        match (run.events.first(), truth.map(|t| (t, true))) {
             (None, None) => println!("{n}: no opening on either side"),
             (Some(f), Some(t)) => {
                 let d = (f.0 - t.0).abs();
@@ -229,6 +272,10 @@ fn valve_first_opening_within_2s() {
                 // Issue: switching within 2 s of switching on the true drain temperature.
                 if !(f.1 && t.1 && d <= MAX_SWITCH_S) {
                     failures.push(format!("{n}: {d:.2} s"));
+                }
+                // Regression: 2.1x the measured worst 0.14 s.
+                if d > REG_FIRST_OPEN_S {
+                    failures.push(format!("{n}: {d:.2} s > regression bound {REG_FIRST_OPEN_S} s"));
                 }
             }
             (f, t) => failures.push(format!("{n}: firmware {f:?}, true drain {t:?}")),
@@ -284,28 +331,20 @@ fn thermostat_from_branch(scenario: &Scenario, events: &[(f64, bool)], i: usize)
 /// valve history. Issue: within 2 s.
 #[test]
 fn valve_switching_times_match_true_drain() {
-    let mut cases = scenarios();
-    cases.push(("load-then-idle".into(), load_then_idle()));
-    let guard_runs: Vec<(String, Scenario, Vec<(f64, bool)>)> = cases
-        .par_iter()
-        .map(|(n, sc)| {
-            let ev = match runs().iter().find(|r| &r.name == n) {
-                Some(r) => r.events.clone(),
-                None => closed_loop(n, sc, true).events,
-            };
-            (n.clone(), sc.clone(), ev)
-        })
-        .collect();
+    // The caches are filled here, outside any rayon job: a worker that blocks on a
+    // `OnceLock` being filled by a parallel iterator can deadlock the pool.
+    let (cases, guard_runs, first) = (cases(), runs(), thermostat_first_switch());
     let jobs: Vec<(usize, usize)> =
-        guard_runs.iter().enumerate().flat_map(|(r, (_, _, ev))| (0..ev.len()).map(move |i| (r, i))).collect();
-    let mut results: Vec<(usize, usize, Option<f64>)> = jobs
-        .par_iter()
-        .map(|&(r, i)| (r, i, thermostat_from_branch(&guard_runs[r].1, &guard_runs[r].2, i)))
-        .collect();
+        guard_runs.iter().enumerate().flat_map(|(r, run)| (1..run.events.len()).map(move |i| (r, i))).collect();
+    // Event 0 branches at t = 0: the shared thermostat loop.
+    let mut results: Vec<(usize, usize, Option<f64>)> =
+        guard_runs.iter().enumerate().filter(|(_, run)| !run.events.is_empty()).map(|(r, _)| (r, 0, first[r])).collect();
+    results.par_extend(jobs.par_iter().map(|&(r, i)| (r, i, thermostat_from_branch(&cases[r].1, &guard_runs[r].events, i))));
     results.sort_by_key(|x| (x.0, x.1));
     let mut worst = 0.0f64;
     let mut failures = vec![];
-    for (r, (n, _, ev)) in guard_runs.iter().enumerate() {
+    for (r, run) in guard_runs.iter().enumerate() {
+        let (n, ev) = (&run.name, &run.events);
         if ev.is_empty() {
             continue;
         }
@@ -320,13 +359,17 @@ fn valve_switching_times_match_true_drain() {
                 if d.abs() > MAX_SWITCH_S {
                     failures.push(format!("{n} event {i} ({}) at {te:.2} s: {d:+.2} s", if open { "open" } else { "close" }));
                 }
+                // Regression: 2.2x the measured worst 0.54 s.
+                if d.abs() > REG_SWITCH_S {
+                    failures.push(format!("{n} event {i} at {te:.2} s: {d:+.2} s > regression bound {REG_SWITCH_S} s"));
+                }
                 format!("{te:.1}{}{d:+.2}", if open { "+" } else { "-" })
             })
             .collect();
         println!("{n}: guard event (time, direction, minus thermostat) {}", diffs.join(" "));
     }
     println!("{} events, worst |difference| {worst:.2} s", results.len());
-    assert!(failures.is_empty(), "switching time differences > {MAX_SWITCH_S} s:\n{}", failures.join("\n"));
+    assert!(failures.is_empty(), "switching time differences:\n{}", failures.join("\n"));
 }
 
 /// The reduced parameters are the rig's: `DEFAULT` in `src/params.rs` equals what

@@ -1,11 +1,29 @@
-//! The paper's published numbers (Liu et al.), each with its tolerance and
-//! the reason for it. One calibrated parameter set (`Rig::default()`) serves
-//! every case; see docs/calibration.md for how it was calibrated.
+//! The paper's published numbers (Liu et al.), each asserted with its
+//! tolerance and the reason for it. One calibrated parameter set
+//! (`Rig::default()`) serves every case (docs/calibration.md).
+//!
+//! Fitted vs predicted: the calibration fits five parameters to five targets
+//! exactly — Table 4's inlet / outlet / drain at 600 s, Table 5's still-air
+//! pump shell 25.38 °C, and the circulating oil passing 40 °C at 110 s (Fig.
+//! 15's valve opening). Two more numbers are set to the paper's outcome: the
+//! ram-air run length (Table 5's 15 m/s coefficient) and the LNG flow (the
+//! smallest round flow that keeps Fig. 15's drain below 50 °C). A test of a
+//! fitted number reproduces the fit; it validates nothing. The predictions
+//! are Table 5's 30 and 50 m/s coefficients, Table 5's shell and drain with
+//! ram air, the still-air coefficient and Case 2's balance time.
+//!
+//! Known misses (the model disagrees with the paper) are asserted as measured,
+//! with a tolerance around the measured value, and say so: they are to be
+//! fixed by the physics, not by widening a tolerance. When the physics moves
+//! one of them, the test fails and must be re-measured (towards the paper's
+//! value, one hopes).
 
+use eha_sim::calibrate::{evaluate, PAPER};
 use eha_sim::cooling::{size, Lng};
 use eha_sim::heat::h_forced_plate;
+use eha_sim::network::{h_outer, masses, Shape, NODES};
 use eha_sim::rig::Rig;
-use eha_sim::scenario::Scenario;
+use eha_sim::scenario::{Scenario, Schedule};
 use eha_sim::sim::{simulate, SimOptions, SimOutput};
 
 fn case1(rig: &Rig, bar: f64) -> SimOutput {
@@ -15,12 +33,17 @@ fn case1(rig: &Rig, bar: f64) -> SimOutput {
 /// Table 4 (600 s, 60 bar): inlet 53.00, outlet 54.17, drain 59.67 °C, each
 /// within ±1.5 K (the issue's tolerance: the paper's own simulation-vs-test
 /// agreement in Fig. 8 is of that order).
+///
+/// **Fitted, reproduces the fit**: these three temperatures are calibration
+/// targets (docs/calibration.md), so passing validates nothing; the fit
+/// itself is held to 0.01 K by [`calibration_targets_are_reproduced`].
+/// Measured: 53.00 / 54.17 / 59.67 °C.
 #[test]
-fn table4_port_temperatures_at_600s_60bar() {
+fn table4_port_temperatures_at_600s_60bar_fitted() {
     let out = case1(&Rig::default(), 60.0);
     for (ch, paper) in [("t_inlet_c", 53.00), ("t_outlet_c", 54.17), ("t_drain_c", 59.67)] {
         let ours = out.last(ch).expect("channel");
-        println!("{ch}: ours {ours:.2} °C, paper {paper:.2} °C");
+        println!("{ch}: ours {ours:.3} °C, paper {paper:.2} °C (fitted)");
         assert!((ours - paper).abs() <= 1.5, "{ch}: {ours:.2} vs {paper:.2}");
     }
     // The paper's ordering: drain hottest, outlet above inlet.
@@ -28,50 +51,151 @@ fn table4_port_temperatures_at_600s_60bar() {
     assert!(g("t_drain_c") > g("t_outlet_c") && g("t_outlet_c") > g("t_inlet_c"));
 }
 
+/// The committed rig still reproduces its calibration (`eha-sim calibrate`,
+/// docs/calibration.md): five targets, five parameters, an exact fit
+/// (residuals < 1e-9 K when it was made). Bound: 0.01 K on the four
+/// temperatures (twice half the paper's last printed digit: anything more
+/// means the physics changed since the fit and `eha-sim calibrate` must be
+/// re-run, together with every number downstream of the rig) and 0.1 s on the
+/// 40 °C crossing (the calibration's 1 s output grid, linearly interpolated).
+/// A regression guard, not a validation.
+#[test]
+fn calibration_targets_are_reproduced() {
+    let m = evaluate(&Rig::default()).expect("case 1 runs");
+    let temps = [
+        ("inlet", m.inlet_c, PAPER.inlet_c),
+        ("outlet", m.outlet_c, PAPER.outlet_c),
+        ("drain", m.drain_c, PAPER.drain_c),
+        ("pump shell", m.pump_shell_c, PAPER.pump_shell_c),
+    ];
+    for (name, ours, target) in temps {
+        println!("{name}: ours {ours:.5} °C, target {target:.2} °C, residual {:+.2e} K", ours - target);
+        assert!((ours - target).abs() <= 0.01, "{name}: residual {:+.4} K: re-run `eha-sim calibrate`", ours - target);
+    }
+    println!("oil passes 40 °C at {:.3} s, target {:.1} s", m.t40_s, PAPER.t40_s);
+    assert!((m.t40_s - PAPER.t40_s).abs() <= 0.1, "40 °C crossing {:.2} s: re-run `eha-sim calibrate`", m.t40_s);
+}
+
 /// Table 5: ram-air coefficients 66.13, 115.13, 173.25 W/(m²·K) at 15, 30,
-/// 50 m/s within 1 % (issue tolerance). The run length is calibrated on the
-/// 15 m/s entry only, so the 30 and 50 m/s entries test the correlation's
-/// v^0.8 law.
+/// 50 m/s within 1 % (issue tolerance).
+///
+/// **15 m/s: fitted, reproduces the fit** (the run length 0.352 m is set so
+/// that this entry comes out). 30 and 50 m/s are predictions of the
+/// correlation's v^0.8 law with the paper's property temperature; the
+/// paper's entries grow exactly so. Measured: 66.13 / 115.14 / 173.26
+/// (+0.00 / +0.01 / +0.01 %).
 #[test]
 fn table5_ram_air_coefficients() {
     let rig = Rig::default();
-    for (v, paper) in [(15.0, 66.13), (30.0, 115.13), (50.0, 173.25)] {
+    for (v, paper, note) in [(15.0, 66.13, "fitted"), (30.0, 115.13, "predicted"), (50.0, 173.25, "predicted")] {
         let h = h_forced_plate(v, rig.outside.ram_run_length_m, rig.outside.ram_property_c);
-        println!("{v} m/s: ours {h:.2}, paper {paper:.2} W/(m²·K)");
+        println!("{v} m/s: ours {h:.3}, paper {paper:.2} W/(m²·K), {:+.3} % ({note})", 100.0 * (h - paper) / paper);
         assert!((h - paper).abs() / paper < 0.01, "{v} m/s: {h}");
     }
 }
 
-/// Table 5: the pump shell and the drain port cool as the air speed rises
-/// (strictly monotonic; the paper reports 25.38 → 23.82 °C and 59.67 →
-/// 58.57 °C from 0 to 50 m/s). Ours are printed beside the paper's.
+/// Table 5: pump shell and drain port at 600 s, 60 bar, with ram air of 0 /
+/// 15 / 30 / 50 m/s over the housings. Paper: shell 25.38 / 24.78 / 24.32 /
+/// 23.82 °C, drain 59.67 / 59.14 / 58.84 / 58.57 °C.
+///
+/// **The 0 m/s row is fitted** (the shell is a calibration target, the drain
+/// is Table 4's); 15–50 m/s are predictions.
+///
+/// Against the paper with Table 4's ±1.5 K the drain passes at every speed
+/// (asserted; measured −0.26 / −0.47 / −0.73 K) and the shell passes at 15 and
+/// 30 m/s but not at 50 m/s (−1.70 K). That tolerance is as large as the whole
+/// effect (the paper's shell falls 1.56 K, its drain 1.10 K from 0 to 50 m/s),
+/// so it cannot tell a right ram-air model from none: what tests the ram air
+/// is the fall from the still-air row.
+///
+/// **Known miss**, to be fixed by the physics issue: the model's fall is about
+/// twice the paper's on the shell and 1.5–1.7 times on the drain (the paper
+/// seems to apply the ram air to a smaller area than the whole housings,
+/// docs/calibration.md). Measured falls (0→15/30/50 m/s): shell 1.45 / 2.36 /
+/// 3.26 K where the paper falls 0.60 / 1.06 / 1.56 K; drain 0.79 / 1.30 /
+/// 1.83 K where the paper falls 0.53 / 0.83 / 1.10 K. Asserted: the measured
+/// falls within ±0.05 K (the runs are deterministic; 0.05 K is 2–6 % of the
+/// falls, so a change of the ram-air physics shows) and a strictly monotonic
+/// fall (the paper's trend, which holds).
 #[test]
-fn table5_pump_shell_and_drain_fall_with_air_speed() {
-    let paper = [(0.0, 25.38, 59.67), (15.0, 24.78, 59.14), (30.0, 24.32, 58.84), (50.0, 23.82, 58.57)];
-    let mut prev: Option<(f64, f64)> = None;
-    for (v, shell_p, drain_p) in paper {
-        let rig = Rig::default();
-        let mut sc = Scenario::Case1 { needle_bar: 60.0, duration_s: 600.0 }.mission().expect("mission");
-        sc.air_speed_mps = eha_sim::scenario::Schedule::constant(v);
-        rig.validate().expect("rig");
-        let out = simulate(&rig, &Scenario::Mission(sc), &SimOptions::default()).expect("runs");
-        let (shell, drain) = (out.last("t_pump_c").unwrap_or(f64::NAN), out.last("t_drain_c").unwrap_or(f64::NAN));
-        println!("{v:>4} m/s: pump shell ours {shell:.2} paper {shell_p:.2}; drain ours {drain:.2} paper {drain_p:.2}");
-        if let Some((s0, d0)) = prev {
-            assert!(shell < s0 && drain < d0, "not cooling at {v} m/s");
+fn table5_pump_shell_and_drain_with_ram_air_known_miss() {
+    // (air speed m/s, paper shell °C, paper drain °C, measured shell fall K, measured drain fall K)
+    let rows = [
+        (0.0, 25.38, 59.67, 0.0, 0.0),
+        (15.0, 24.78, 59.14, 1.45, 0.79),
+        (30.0, 24.32, 58.84, 2.36, 1.30),
+        (50.0, 23.82, 58.57, 3.26, 1.83),
+    ];
+    let runs: Vec<(f64, f64)> = rows
+        .iter()
+        .map(|&(v, ..)| {
+            let mut sc = Scenario::Case1 { needle_bar: 60.0, duration_s: 600.0 }.mission().expect("mission");
+            sc.air_speed_mps = Schedule::constant(v);
+            let out = simulate(&Rig::default(), &Scenario::Mission(sc), &SimOptions::default()).expect("runs");
+            (out.last("t_pump_c").unwrap_or(f64::NAN), out.last("t_drain_c").unwrap_or(f64::NAN))
+        })
+        .collect();
+    let (shell0, drain0) = runs[0];
+    let (paper_shell0, paper_drain0) = (rows[0].1, rows[0].2);
+    let mut failures = vec![];
+    for (i, (&(v, shell_p, drain_p, shell_fall_m, drain_fall_m), &(shell, drain))) in rows.iter().zip(&runs).enumerate() {
+        let (fs, fd) = (shell0 - shell, drain0 - drain);
+        let (fs_p, fd_p) = (paper_shell0 - shell_p, paper_drain0 - drain_p);
+        println!(
+            "{v:>4} m/s: shell ours {shell:.3} paper {shell_p:.2} ({:+.2} K), fall ours {fs:.3} paper {fs_p:.2} K; \
+             drain ours {drain:.3} paper {drain_p:.2} ({:+.2} K), fall ours {fd:.3} paper {fd_p:.2} K",
+            shell - shell_p,
+            drain - drain_p
+        );
+        // Paper tolerance of Table 4 on the drain (holds at every speed).
+        if (drain - drain_p).abs() > 1.5 {
+            failures.push(format!("{v} m/s: drain {drain:.2} vs paper {drain_p:.2} °C beyond ±1.5 K"));
         }
-        prev = Some((shell, drain));
+        // Known miss: the falls as measured (paper's in the message).
+        if (fs - shell_fall_m).abs() > 0.05 {
+            failures.push(format!("{v} m/s: shell fall {fs:.3} K, measured {shell_fall_m} K (paper {fs_p:.2} K): re-measure"));
+        }
+        if (fd - drain_fall_m).abs() > 0.05 {
+            failures.push(format!("{v} m/s: drain fall {fd:.3} K, measured {drain_fall_m} K (paper {fd_p:.2} K): re-measure"));
+        }
+        if i > 0 && !(shell < runs[i - 1].0 && drain < runs[i - 1].1) {
+            failures.push(format!("{v} m/s: not cooler than at the previous speed"));
+        }
     }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
-/// LNG sizing, eqs. (23)–(25) with Table 6: 1.5 kW over a 680 s mission needs
-/// 2.30 L (the paper's "2.3 L"; the mission time is not printed, 680 s is the
-/// one that gives it); the 5 L charge is 2.15 kg. Tolerances: half the last
-/// printed digit.
+/// Table 5's still-air convective coefficient of the pump shell, 1.40
+/// W/(m²·K). Ours is Churchill–Chu free convection (eq. 15) on the 0.12 m
+/// housing at its 600 s, 60 bar wall temperature (25.38 °C, fitted) over 16 °C
+/// air. **Known miss**: measured 3.61 W/(m²·K), 2.6 times the paper's; the
+/// correlation's scatter is ±20 % or so, and no free-convection correlation
+/// gives 1.40 at ΔT ≈ 9.4 K (docs/calibration.md). Asserted: the measured
+/// value within ±2 % (the wall temperature is fitted to 0.01 K, h ∝ ΔT^¼
+/// roughly; 2 % catches a change of the correlation or of the housing).
 #[test]
-fn lng_sizing_reproduces_the_paper() {
+fn table5_still_air_coefficient_known_miss() {
+    let rig = Rig::default();
+    let shell = case1(&rig, 60.0).last("t_pump_c").expect("channel");
+    let h = h_outer(&rig, Shape::Cylinder(rig.pump.diameter_m), shell, 16.0, 0.0);
+    let measured = 3.61;
+    println!("still-air h of the pump shell: ours {h:.3} W/(m²·K) at {shell:.2} °C, paper 1.40 (known miss, measured {measured})");
+    assert!((h - measured).abs() <= 0.02 * measured, "still-air h {h:.3}, measured {measured} (paper 1.40): re-measure");
+}
+
+/// LNG sizing, eqs. (23)–(25) with Table 6. Tolerances: half the last printed
+/// digit.
+///
+/// **2.3 L is fitted, reproduces the choice**: the paper does not print the
+/// mission time; t_m = 680 s is the one that gives 2.3 L at 1.5 kW (measured
+/// 2.30 L). **2.15 kg is arithmetic of the paper's own numbers** (5 L × Table
+/// 6's 430 kg/m³; measured 2.150 kg): it checks our Table 6 density, not a
+/// model.
+#[test]
+fn lng_sizing_reproduces_the_paper_fitted() {
     let lng = Lng::default();
     let s = size(&lng, 1500.0, 680.0, 2.0);
+    println!("1.5 kW, 680 s: {:.3} L (paper 2.3 L, t_m chosen); 5 L: {:.4} kg (paper 2.15 kg)", s.volume_m3 * 1e3, lng.charge_kg());
     assert!((s.volume_m3 * 1e3 - 2.3).abs() < 0.05, "{} L", s.volume_m3 * 1e3);
     assert!((lng.charge_kg() - 2.15).abs() < 0.005, "{} kg", lng.charge_kg());
     // And the inverse: the 5 L charge lasts 1478 s at 1.5 kW.
@@ -81,18 +205,28 @@ fn lng_sizing_reproduces_the_paper() {
 
 /// Fig. 15: with the LNG exchanger the valve opens at about 110 s (±20 s,
 /// the reading of the figure) and the drain port stays below 50 °C.
+///
+/// **Both fitted, reproduce the fit**: the valve follows the circulating oil
+/// at 40 °C, whose 110 s crossing is a calibration target (measured: opens at
+/// 110.1 s, the thermostat sampled every 0.1 s); the LNG flow (3 g/s) was
+/// chosen as the smallest round value that keeps the drain below 50 °C
+/// (measured max 49.97 °C, 0.03 K of margin).
 #[test]
-fn fig15_lng_valve_opens_near_110s_and_drain_stays_below_50c() {
+fn fig15_lng_valve_opens_near_110s_and_drain_stays_below_50c_fitted() {
     let out = simulate(&Rig::default(), &Scenario::Lng { duration_s: 600.0 }, &SimOptions::default()).expect("runs");
     let open = *out.valve_open_times_s.first().expect("valve opened");
     let max_drain = out.max("t_drain_c").unwrap_or(f64::NAN);
-    println!("valve opens at {open:.1} s (paper ≈ 110 s); drain max {max_drain:.2} °C (paper < 50 °C); {} openings", out.valve_open_times_s.len());
+    println!(
+        "valve opens at {open:.1} s (paper ≈ 110 s, fitted); drain max {max_drain:.3} °C (paper < 50 °C, LNG flow chosen); {} openings",
+        out.valve_open_times_s.len()
+    );
     assert!((open - 110.0).abs() <= 20.0);
     assert!(max_drain < 50.0);
 }
 
 /// Node temperatures at 600 s rise monotonically with the needle pressure
-/// (0, 20, 40, 60 bar), as Fig. 8 shows for every measured point.
+/// (0, 20, 40, 60 bar), as Fig. 8 shows for every measured point. (Only 60 bar
+/// is calibrated; 0–40 bar are predictions.)
 #[test]
 fn temperatures_rise_monotonically_with_needle_pressure() {
     let rig = Rig::default();
@@ -104,36 +238,151 @@ fn temperatures_rise_monotonically_with_needle_pressure() {
     }
 }
 
-/// Case 2 reaches a periodic thermal balance (paper, Fig. 12b: "the heat
+/// Period of the Case 2 command (0.2 Hz sine), s.
+const CASE2_PERIOD_S: f64 = 5.0;
+/// Output samples per period (0.1 s output interval).
+const CASE2_PER: usize = 50;
+/// Periods over which a drift is measured (30 s): from one period to the
+/// next a port's period-mean drift scatters by ≈ ±0.2 mK, ±5 % of the 3.4 mK
+/// per period that the 10 % threshold allows, and the threshold ratio falls
+/// so slowly (≈ 0.0003 per period) that one-period drifts move the crossing
+/// by up to 80 s; over six periods the scatter is a sixth.
+const CASE2_WINDOW: usize = 6;
+/// Balance threshold: the oil stores less than 10 % of the power lost into
+/// it, i.e. 90 % of it leaves (the 90 % settling of a first-order lag).
+const CASE2_EPS: f64 = 0.10;
+/// Loss channels that heat oil nodes (model.rs `thermal`: leakage, the
+/// pump's friction split between case and high-pressure port, churning, line
+/// and valve losses into the loop oil, needle throttling into the ball-valve
+/// oil) and those that heat metal (winding, motor, actuator).
+const OIL_LOSSES: [&str; 6] = ["p_leak_w", "p_mech_w", "p_churn_w", "p_line_w", "p_throttle_w", "p_valves_w"];
+const METAL_LOSSES: [&str; 5] = ["p_cu_w", "p_fe_w", "p_bearing_w", "p_act_leak_w", "p_act_friction_w"];
+
+/// Balance time: the centre of the first window from which on every window's
+/// ratio (stored / lost power, `(centre s, ratio)`) is below `eps` in
+/// magnitude, s; None if that never holds to the end of the run.
+fn balance_from(ratios: &[(f64, f64)], eps: f64) -> Option<f64> {
+    (0..ratios.len()).find(|&k| ratios[k..].iter().all(|r| r.1.abs() < eps)).map(|k| ratios[k].0)
+}
+
+/// Case 2 periodic balance against the paper (Fig. 12b: "the heat
 /// dissipation and power loss of the system are in balance after 200 s").
-/// Balance at a port: the period-mean temperature drifts by less than 10 % of
-/// its first-period drift (the transient has decayed to the slow warm-up of the
-/// metal) and the swing repeats from period to period within 10 %. Every port
-/// must reach it within the 600 s run; the times are printed beside the
-/// paper's 200 s.
+///
+/// Balance, defined physically: the circulating oil (every oil node) receives
+/// the losses in `OIL_LOSSES` and hands heat on to the metal; it is in balance
+/// when, over 30 s windows (whole periods, so the swing cancels), the energy
+/// it stores is below 10 % of the power lost into it (90 % leaves) — for this
+/// and every later window. A port or the drain is in balance when its
+/// period-mean temperature rises no faster than that: C_oil·dT̄/dt < 10 % of
+/// the oil's loss power (the lumped view of the paper's model, where one
+/// temperature stands for the oil; for the oil as a whole the two definitions
+/// coincide). The time is the window's centre. The whole rig is far from
+/// balance in 600 s (≈ 4 % of the losses reach ambient at 600 s, the metal
+/// stores the rest; printed), so the paper's statement can only mean the oil.
+///
+/// Paper: ≈ 200 s, read as ±50 s (half a 100 s division of a 600 s axis).
+/// **Known miss**, to be fixed by the physics issue: measured oil 390.0 s,
+/// inlet 382.5 s, outlet 382.5 s, drain 517.5 s — the oil still stores 10–20 %
+/// of its losses from ≈ 175 s to 390 s while the metal it heats warms up
+/// (printed beside: at 20 % the oil is balanced from 175 s, the ports from
+/// 117.5 s, the drain from 347.5 s; at 5 % nothing is within 600 s).
+/// Asserted: each time within ±15 s of the measured (three periods: near the
+/// crossing the ratio falls ≈ 0.001 per 15 s and scatters ≈ ±0.0005 between
+/// windows; 30 s windows of 3–10 periods and a 0.05 s output grid give times
+/// within 5 s of these). The port and drain swing must repeat period to
+/// period within 10 % over the last 100 s (a periodic state, not a drift).
+/// Previous definition (drift below 10 % of the first period's drift) gave
+/// ports 25–30 s, drain 245 s: the first period's drift of a port is its own
+/// fast fill-up, not the oil's heat balance.
 #[test]
-fn case2_reaches_periodic_thermal_balance() {
-    let out = simulate(&Rig::default(), &Scenario::Case2 { duration_s: 600.0 }, &SimOptions { output_interval_s: 0.1, control_interval_s: 0.1 }).expect("runs");
-    let per = 50; // samples per 5 s period of the 0.2 Hz command
-    for ch in ["t_inlet_c", "t_outlet_c", "t_drain_c"] {
-        let periods: Vec<(f64, f64)> = out
-            .get(ch)
-            .expect("channel")
-            .chunks_exact(per)
-            .map(|c| {
-                let mean = c.iter().sum::<f64>() / c.len() as f64;
-                let hi = c.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-                let lo = c.iter().copied().fold(f64::INFINITY, f64::min);
-                (mean, hi - lo)
-            })
-            .collect();
-        let first = periods[1].0 - periods[0].0;
-        assert!(first > 0.0, "{ch} does not warm up");
-        let balanced = |k: usize| {
-            periods[k..].windows(2).all(|w| (w[1].0 - w[0].0).abs() < 0.1 * first && (w[1].1 - w[0].1).abs() <= 0.1 * w[0].1)
-        };
-        let k = (1..periods.len() - 1).find(|&k| balanced(k)).expect("balance reached");
-        println!("{ch}: periodic balance from {} s (paper: ≈ 200 s), swing {:.3} K", k * 5, periods[k].1);
-        assert!(periods[k].1 > 0.0, "{ch}: no periodic swing");
+fn case2_periodic_balance_time_known_miss() {
+    let rig = Rig::default();
+    let out = simulate(&rig, &Scenario::Case2 { duration_s: 600.0 }, &SimOptions { output_interval_s: 0.1, control_interval_s: 0.1 })
+        .expect("runs");
+    let get = |c: &str| out.get(c).unwrap_or_else(|| panic!("channel {c}"));
+    let n_per = (out.time_s.len() - 1) / CASE2_PER;
+    assert!((out.time_s[CASE2_PER] - CASE2_PERIOD_S).abs() < 1e-9, "output grid is not 0.1 s");
+    // Every loss channel is either an oil or a metal one (a new loss channel
+    // must be placed before this test can be trusted).
+    let total = get("p_total_w");
+    let all: Vec<&[f64]> = OIL_LOSSES.iter().chain(&METAL_LOSSES).map(|c| get(c)).collect();
+    for (i, &p) in total.iter().enumerate() {
+        let s: f64 = all.iter().map(|v| v[i]).sum();
+        assert!((s - p).abs() <= 1e-9 * p.abs().max(1.0), "loss channels do not add up to p_total_w at sample {i}");
     }
+    let p_oil: Vec<f64> = (0..total.len()).map(|i| OIL_LOSSES.iter().map(|c| get(c)[i]).sum()).collect();
+    // Oil energy (enthalpy) and capacity from the oil nodes.
+    let m = masses(&rig);
+    let oil_nodes: Vec<(usize, &[f64])> =
+        NODES.iter().enumerate().filter(|(_, n)| n.is_oil()).map(|(i, n)| (i, get(n.channel()))).collect();
+    let e_oil = |s: usize| oil_nodes.iter().map(|&(i, t)| m[i].0 * rig.oil.enthalpy(t[s])).sum::<f64>();
+    let c_oil = |s: usize| oil_nodes.iter().map(|&(i, t)| m[i].0 * rig.oil.cp(t[s])).sum::<f64>();
+    let period_mean = |v: &[f64], k: usize| v[k * CASE2_PER..(k + 1) * CASE2_PER].iter().sum::<f64>() / CASE2_PER as f64;
+    let w = CASE2_WINDOW;
+    let span = w as f64 * CASE2_PERIOD_S;
+    // Window k: periods k..k+w (oil energy at their bounds, centre (k + w/2)·T);
+    // node means of periods k and k+w (centre (k + w/2 + 1/2)·T).
+    let p_in = |k: usize| (k..k + w).map(|j| period_mean(&p_oil, j)).sum::<f64>() / w as f64;
+    let oil: Vec<(f64, f64)> = (0..=n_per - w)
+        .map(|k| ((k as f64 + w as f64 / 2.0) * CASE2_PERIOD_S, (e_oil((k + w) * CASE2_PER) - e_oil(k * CASE2_PER)) / span / p_in(k)))
+        .collect();
+    let node = |ch: &str| -> Vec<(f64, f64)> {
+        let v = get(ch);
+        (0..n_per - w)
+            .map(|k| {
+                let rate = (period_mean(v, k + w) - period_mean(v, k)) / span;
+                ((k as f64 + w as f64 / 2.0 + 0.5) * CASE2_PERIOD_S, c_oil(k * CASE2_PER) * rate / p_in(k))
+            })
+            .collect()
+    };
+    let (amb, loss) = (out.last("e_ambient_j").unwrap_or(0.0), out.last("e_loss_j").unwrap_or(1.0));
+    let (pa, pl) = (
+        (amb - out.at("e_ambient_j", 570.0).unwrap_or(0.0)) / 30.0,
+        (loss - out.at("e_loss_j", 570.0).unwrap_or(0.0)) / 30.0,
+    );
+    println!(
+        "whole rig, 570-600 s: {pl:.1} W lost, {pa:.2} W to ambient ({:.1} %); oil: {:.2} W of it, C_oil {:.0} J/K",
+        100.0 * pa / pl,
+        p_in(n_per - w),
+        c_oil(0)
+    );
+    // (name, measured balance time at CASE2_EPS, s)
+    let cases: [(&str, Vec<(f64, f64)>, f64); 4] = [
+        ("oil (energy)", oil, 390.0),
+        ("t_inlet_c", node("t_inlet_c"), 382.5),
+        ("t_outlet_c", node("t_outlet_c"), 382.5),
+        ("t_drain_c", node("t_drain_c"), 517.5),
+    ];
+    let mut failures = vec![];
+    for (name, ratios, measured) in &cases {
+        let at = |eps| balance_from(ratios, eps).map_or("not in 600 s".to_string(), |t| format!("{t:.1} s"));
+        let t = balance_from(ratios, CASE2_EPS);
+        println!(
+            "{name}: balance (< {:.0} %) from {} (paper ≈ 200 s; measured {measured} s); at 20 %: {}, at 5 %: {}; ratio at 300 s {:.3}, at 550 s {:.3}",
+            100.0 * CASE2_EPS,
+            at(CASE2_EPS),
+            at(0.2),
+            at(0.05),
+            ratios.iter().find(|r| r.0 >= 300.0).map_or(f64::NAN, |r| r.1),
+            ratios.iter().find(|r| r.0 >= 550.0).map_or(f64::NAN, |r| r.1),
+        );
+        match t {
+            Some(t) if (t - measured).abs() <= 15.0 => {}
+            _ => failures.push(format!("{name}: balance at {t:?} s, measured {measured} s (paper ≈ 200 s): re-measure")),
+        }
+    }
+    // Periodic: the swing repeats within 10 % over the last 100 s.
+    for ch in ["t_inlet_c", "t_outlet_c", "t_drain_c"] {
+        let v = get(ch);
+        let swing = |k: usize| {
+            let c = &v[k * CASE2_PER..(k + 1) * CASE2_PER];
+            c.iter().copied().fold(f64::NEG_INFINITY, f64::max) - c.iter().copied().fold(f64::INFINITY, f64::min)
+        };
+        let s: Vec<f64> = (n_per - 20..n_per).map(swing).collect();
+        println!("{ch}: swing over the last 100 s {:.3}–{:.3} K", s.iter().copied().fold(f64::INFINITY, f64::min), s.iter().copied().fold(0.0, f64::max));
+        if !(s[0] > 0.0 && s.windows(2).all(|p| (p[1] - p[0]).abs() <= 0.1 * p[0])) {
+            failures.push(format!("{ch}: swing not periodic in the last 100 s: {s:.4?}"));
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
 }

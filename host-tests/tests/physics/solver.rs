@@ -5,6 +5,16 @@
 
 use eha_sim::plant::integrate;
 
+// The spec bound (1e-6) is what the issue demands; the measured errors are
+// 300-40 000 times smaller, so each test also has a regression bound at 2-3x
+// its measured error (a change of the BDF order/step control or of the
+// Jacobian that costs accuracy shows here first).
+/// Regression bound of the RC node: measured rel. error 3.00e-9, 2.7×.
+const REG_RC: f64 = 8e-9;
+/// Regression bounds of the two-node network: measured rel. errors 4.51e-10
+/// (oil) and 2.67e-11 (metal), 2.2× each.
+const REG_TWO_NODE: [f64; 2] = [1e-9, 6e-11];
+
 /// One RC node heated by P and cooled to ambient through G:
 /// T(t) = T_a + P/G + (T_0 − T_a − P/G)·exp(−G·t/C).
 #[test]
@@ -14,7 +24,11 @@ fn rc_node_matches_exponential() {
     let y = integrate(|_t, x, d| d[0] = (p - g * (x[0] - ta)) / c, &[t0], &[50.0], t_end, 1e-9, 1e-9).expect("solves");
     let exact = ta + p / g + (t0 - ta - p / g) * (-g * t_end / c).exp();
     let rel = (y[0] - exact).abs() / exact;
+    println!("RC node: T = {:.9} °C, exact {exact:.9} °C, rel. error {rel:.2e}", y[0]);
+    // Spec (issue): 1e-6.
     assert!(rel < 1e-6, "T = {} vs {exact} (rel {rel:e})", y[0]);
+    // Regression: 2-3x the measured REG_RC.
+    assert!(rel < REG_RC, "rel. error {rel:.2e} > regression bound {REG_RC:.0e}");
 }
 
 /// Two nodes (oil C1 heated by P, metal C2 to ambient) with a stiff ratio
@@ -48,6 +62,10 @@ fn two_node_network_matches_eigen_solution() {
     for i in 0..2 {
         let exact = xs[i] + k1 * v1[i] * (l1 * t_end).exp() + k2 * v2[i] * (l2 * t_end).exp();
         let rel = (y[i] - exact).abs() / exact.abs();
+        println!("two-node, node {i}: {:.9} K, exact {exact:.9} K, rel. error {rel:.2e}", y[i]);
+        // Spec (issue): 1e-6.
         assert!(rel < 1e-6, "node {i}: {} vs {exact} (rel {rel:e})", y[i]);
+        // Regression: 2-3x the measured.
+        assert!(rel < REG_TWO_NODE[i], "node {i}: rel. error {rel:.2e} > regression bound {:.0e}", REG_TWO_NODE[i]);
     }
 }
