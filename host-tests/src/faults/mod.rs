@@ -1,6 +1,6 @@
 //! Fault campaign (`eha-sim faults`): every fault of [`inject`] applied to
-//! the firmware's guard (host SIL: the f32 `GuardOf`, the same frame
-//! [`Link`] and `step_guard` as the firmware) in closed loop with the
+//! the firmware's guard (host SIL: the f32 `GuardOf` behind the same frame
+//! [`Link`] as the firmware) in closed loop with the
 //! reference plant, during the Fig. 15 LNG case and one random mission.
 //!
 //! Pass rule per fault and scenario: either the guard latches a fault and
@@ -9,9 +9,9 @@
 //! [`MAX_UNDER_K`] and the true drain never exceeds [`MAX_CLOSED_C`] while the
 //! valve is physically closed (both from the fault's start on).
 //!
-//! The controller sends one frame per 10 ms tick; the guard steps on every
-//! accepted frame and on the ticks the sequence numbers say were lost, as
-//! the firmware does. A reset or a power loss restarts the guard from the
+//! The controller sends one frame per 10 ms tick; the guard runs the product
+//! loop: every tick, the newest sample accepted by the frame [`Link`] steps
+//! it, and a tick without one is a missing sample. A reset or a power loss restarts the guard from the
 //! record it would find (warm: its last snapshot; power loss: none today,
 //! there is no non-volatile copy; torn write: a corrupt record). While the
 //! MCU is off the valve is open (normally-open valve, the fail-safe design).
@@ -22,7 +22,7 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 use eha_guard::memory::{Restore, ThermalRecord};
-use eha_guard::protocol::{step_guard, Link, Request};
+use eha_guard::protocol::{Link, Request};
 use eha_guard::{faults as fbits, GuardConfig, GuardOf, Output, Sample};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -88,17 +88,27 @@ impl Mcu {
         Mcu { guard: GuardOf::new(&cfg, restore), link: Link::new() }
     }
 
-    /// Feed one frame's bytes; the newest reply's output, if any.
-    fn push(&mut self, bytes: &[u8]) -> Option<Output> {
-        let Mcu { guard, link, .. } = self;
-        let mut got = None;
-        link.push_bytes(bytes, |r: &Request, gap| (step_guard(guard, r, gap), 0), |rep, _| {
-            if rep.kind == eha_guard::protocol::ReplyKind::Step {
-                got = Some(rep.out);
-            }
-        });
-        got
+    /// One 10 ms tick of the product loop: the bytes received since the
+    /// last tick go through the frame [`Link`]; the newest accepted sample
+    /// steps the guard, and a tick without one is a missing sample.
+    fn tick(&mut self, bytes: &[u8]) -> Output {
+        let Mcu { guard, link } = self;
+        let mut newest: Option<Sample> = None;
+        let last = guard_out(guard);
+        link.push_bytes(bytes, |r: &Request, _gap| {
+            newest = Some(r.sample());
+            (last, 0)
+        }, |_, _| {});
+        match newest {
+            Some(s) => guard.step(&s),
+            None => guard.step_missing(),
+        }
     }
+}
+
+/// The guard's latest output (what the link reports until the tick runs).
+fn guard_out(g: &GuardOf<f32>) -> Output {
+    Output { faults: g.faults(), ..Output::default() }
 }
 
 /// A record whose LNG charge is used up, node temperatures at `ambient_c`.
@@ -194,24 +204,22 @@ pub fn run_one(fault: Fault, scenario_name: &str, scenario: &Scenario) -> Result
             };
             seq = seq.wrapping_add(1);
             if let Some(m) = mcu.as_mut() {
+                let mut wire: Vec<u8> = Vec::new();
                 if send {
-                    let mut wire: Vec<u8> = req.encode().as_slice().to_vec();
-                    if active && fault == Fault::CorruptedFrames && k % 50 == 0 && wire.len() > 4 {
-                        wire[3] ^= 0x10;
+                    let mut frame: Vec<u8> = req.encode().as_slice().to_vec();
+                    if active && fault == Fault::CorruptedFrames && k % 50 == 0 && frame.len() > 4 {
+                        frame[3] ^= 0x10;
                     }
                     if active && fault == Fault::OutOfOrderFrames && k % 40 == 0 {
-                        held = Some(wire);
+                        held = Some(frame);
                     } else {
-                        if let Some(o) = m.push(&wire) {
-                            out = Some(o);
-                        }
+                        wire.extend_from_slice(&frame);
                         if let Some(h) = held.take() {
-                            if let Some(o) = m.push(&h) {
-                                out = Some(o);
-                            }
+                            wire.extend_from_slice(&h);
                         }
                     }
                 }
+                out = Some(m.tick(&wire));
             } else {
                 out = None;
             }
@@ -221,7 +229,10 @@ pub fn run_one(fault: Fault, scenario_name: &str, scenario: &Scenario) -> Result
                 (Some(_), Some(o)) => o.valve_open,
                 (Some(m), None) => m.guard.faults() & fbits::LATCHED != 0,
             };
-            let physical = commanded && !stuck_closed && fault != Fault::LngEmpty;
+            // The valve's real position, and whether it cools: an empty tank
+            // leaves a working valve with nothing to flow through it.
+            let physical = commanded && !stuck_closed;
+            let cooling = physical && fault != Fault::LngEmpty;
             if stuck_closed && commanded && observable_at.is_none() {
                 observable_at = Some(t);
             }
@@ -242,7 +253,7 @@ pub fn run_one(fault: Fault, scenario_name: &str, scenario: &Scenario) -> Result
                 }
             }
             k += 1;
-            Ok(Control { lng_valve: Some(physical), stop: false })
+            Ok(Control { lng_valve: Some(cooling), stop: false })
         })
         .context("closed-loop run")?;
     let max_under_k = if max_under.is_finite() { max_under } else { 0.0 };
