@@ -363,7 +363,7 @@ mod fw {
         let w0 = WRAPS.load(Ordering::Relaxed);
         let t0 = now();
         let rec = guard.snapshot();
-        eha_guard::memory::noinit::store(&rec);
+        eha_guard::memory::slots::noinit::store(0, &rec);
         let save = elapsed(t0, w0).unwrap_or(0);
 
         let build = if cfg!(feature = "fixed-point") {

@@ -35,7 +35,8 @@ mod fw {
     use cortex_m::peripheral::{syst::SystClkSource, SYST};
     use cortex_m_rt::{entry, exception, ExceptionFrame};
     use defmt_semihosting as _;
-    use eha_guard::memory::{noinit, Restore};
+    use eha_guard::memory::slots::{self, noinit, AbWriter};
+    use eha_guard::memory::Restore;
     use eha_guard::protocol::{step_guard, GuardOutput, Link, Reply, ReplyKind, Request};
     use eha_guard::{Guard, GuardConfig};
     use semihosting::io::{Read as _, Write as _};
@@ -78,10 +79,12 @@ mod fw {
             exit(EXIT_OPEN)
         };
 
-        // Thermal memory: a warm reset restores the no-init record, a cold
-        // boot (QEMU starts with zeroed RAM) starts at ambient, a corrupt
-        // record starts conservatively (see `eha_guard::memory`).
-        let restore = Restore::from_record(&noinit::load());
+        // Thermal memory: a warm reset restores the newest valid no-init
+        // record (A/B), a cold boot (QEMU starts with zeroed RAM) starts at
+        // ambient, damaged records start conservatively (`eha_guard::memory`).
+        let (rec_a, rec_b) = noinit::load();
+        let restore = slots::restore_from(&rec_a, &rec_b);
+        let mut records = AbWriter::after_boot(&rec_a, &rec_b);
         let mut guard = Guard::new(&GuardConfig::DEFAULT, restore);
         defmt::info!("eha-fw up: build {=str}, restore {=str}, faults {=u16:#06x}", BUILD, restore_name(&restore), guard.faults());
         let mut last_trace = guard.trace().recent().copied();
@@ -123,7 +126,7 @@ mod fw {
                     let t0 = SYST::get_current();
                     let out = step_guard(&mut guard, req, skipped);
                     let t1 = SYST::get_current();
-                    noinit::store(&guard.snapshot());
+                    records.write(&guard.snapshot(), noinit::store);
                     STEPS.fetch_add(1, core::sync::atomic::Ordering::Relaxed);
                     log_changes(&last, &out);
                     let trace = guard.trace().recent().copied();

@@ -34,7 +34,7 @@ mod fw {
     use cortex_m_rt::{entry, exception, ExceptionFrame};
     use defmt_semihosting as _;
     use eha_guard::board::{service, Board};
-    use eha_guard::memory::{noinit, Restore};
+    use eha_guard::memory::slots::{self, noinit, AbWriter};
     use eha_guard::{Guard, GuardConfig, Sample};
     use stm32f4xx_hal::gpio::{Output, PushPull, PA5};
     use stm32f4xx_hal::timer::SysCounterUs;
@@ -104,13 +104,15 @@ mod fw {
         }
         let mut board = F411 { valve, tick, ms: 0 };
 
-        let restore = Restore::from_record(&noinit::load());
+        let (rec_a, rec_b) = noinit::load();
+        let restore = slots::restore_from(&rec_a, &rec_b);
+        let mut records = AbWriter::after_boot(&rec_a, &rec_b);
         let mut guard = Guard::new(&GuardConfig::DEFAULT, restore);
         loop {
             board.wait_tick();
             let out = service(&mut board, &mut guard);
             if guard.steps().is_multiple_of(100) {
-                noinit::store(&guard.snapshot());
+                records.write(&guard.snapshot(), noinit::store);
                 defmt::info!(
                     "drain {} degC valve {} faults {=u16:#x}",
                     out.drain_c,

@@ -162,6 +162,10 @@ impl<N: Num> GuardOf<N> {
                 g.lng.set_used_cj(r.lng_used_cj);
                 g.latched |= r.faults & faults::LATCHED & !faults::CONFIG;
                 g.bad_ch = ((r.faults >> faults::CH_SHIFT) as u8) & CH_ALL;
+                if r.valve_open() {
+                    // The valve was open: it stays open for at least its dwell.
+                    g.valve.force_open();
+                }
                 RestoreKind::Warm
             }
             Restore::Corrupt => {
@@ -522,7 +526,8 @@ impl<N: Num> GuardOf<N> {
         self.refresh_out();
     }
 
-    /// Thermal-memory record of the present state (sealed with its CRC).
+    /// Thermal-memory record of the present state, valve state included
+    /// (sealed with its CRC; sequence number 0: the writer sets it).
     pub fn snapshot(&self) -> ThermalRecord {
         let mut temps = [0.0f32; N_NODES];
         let mut amb = 0.0;
@@ -539,6 +544,7 @@ impl<N: Num> GuardOf<N> {
             self.faults() & !faults::LNG_LOW,
             self.step,
         )
+        .with_seq(0, self.valve.is_open())
     }
 
     /// The event trace (most recent [`crate::trace::TRACE_LEN`] events).

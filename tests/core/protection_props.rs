@@ -435,7 +435,7 @@ proptest! {
         let mut b = bytes;
         b[bit / 8] ^= 1 << (bit % 8);
         let c = record_from_bytes(&b);
-        // Padding-free layout: bytes 44..48 are `reserved`, 48..52 the CRC; every bit counts.
+        // Padding-free layout: bytes 44..48 are `seq_flags`, 48..52 the CRC; every bit counts.
         prop_assert_eq!(c.classify(), RecordStatus::Corrupt, "flip of bit {} undetected", bit);
     }
 }
@@ -451,7 +451,7 @@ fn record_bytes(r: &ThermalRecord) -> [u8; 52] {
         b[16 + 4 * i..20 + 4 * i].copy_from_slice(&t.to_le_bytes());
     }
     b[40..44].copy_from_slice(&r.ambient_c.to_le_bytes());
-    b[44..48].copy_from_slice(&r.reserved.to_le_bytes());
+    b[44..48].copy_from_slice(&r.seq_flags.to_le_bytes());
     b[48..52].copy_from_slice(&r.crc.to_le_bytes());
     b
 }
@@ -470,7 +470,7 @@ fn record_from_bytes(b: &[u8; 52]) -> ThermalRecord {
         faults: u16::from_le_bytes([b[14], b[15]]),
         temps_c: temps,
         ambient_c: f32::from_bits(u32_at(40)),
-        reserved: u32_at(44),
+        seq_flags: u32_at(44),
         crc: u32_at(48),
     }
 }

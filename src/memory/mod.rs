@@ -1,5 +1,14 @@
-//! Thermal memory: the model state survives a warm or watchdog reset in a
-//! no-init RAM section, guarded by a magic word and a CRC-32.
+//! Thermal memory: the model state survives a warm or watchdog reset in two
+//! no-init RAM records (A/B, [`slots`]: a reset during a write leaves the
+//! other one), and a power loss in non-volatile flash ([`nv`], through
+//! `sequential-storage`), each record guarded by a magic word, a sequence
+//! number and a CRC-32. The record carries the node temperatures, the LNG
+//! energy used (never reset except by the refill command), the latched
+//! faults and the valve state.
+//!
+//! Boot order: the newest valid RAM record (warm reset), else the newest
+//! valid flash record (power loss of unknown length: the saved temperatures,
+//! not cooled — conservative), else a cold start.
 //!
 //! Boot rules (documented behaviour):
 //! * **Cold boot** (power-on: the magic word is absent, i.e. more than 4 bits from it): every node starts at the
@@ -21,10 +30,14 @@ use crate::params::N_NODES;
 
 /// Record magic: "EHAT".
 pub const MAGIC: u32 = 0x4548_4154;
-/// Record layout version. 2: the six temperatures are the reduced model's nodes
-/// (pump housing, case oil, loop oil, main block, ball-valve block, actuator); a
-/// version-1 record (the former identified network's nodes) is treated as corrupt.
-pub const VERSION: u16 = 2;
+/// Record layout version. 3: the former reserved word holds the sequence
+/// number and the valve state ([`ThermalRecord::seq`], [`ThermalRecord::valve_open`]).
+/// 2: the six temperatures are the reduced model's nodes (pump housing, case
+/// oil, loop oil, main block, ball-valve block, actuator). An older record is
+/// treated as corrupt (conservative).
+pub const VERSION: u16 = 3;
+/// Bit of [`ThermalRecord::seq_flags`] that holds the valve state (1 = open).
+pub const FLAG_VALVE_OPEN: u32 = 1 << 31;
 /// Plausible stored temperature range, degC (anything else is treated as corrupt).
 pub const PLAUSIBLE_C: (f32, f32) = (-80.0, 250.0);
 
@@ -46,8 +59,9 @@ pub struct ThermalRecord {
     pub temps_c: [f32; N_NODES],
     /// Ambient the temperatures were referred to, degC.
     pub ambient_c: f32,
-    /// Reserved (zero).
-    pub reserved: u32,
+    /// Sequence number of the write (bits 0–30, wrapping) and the valve
+    /// state ([`FLAG_VALVE_OPEN`]).
+    pub seq_flags: u32,
     /// CRC-32 (IEEE) of all preceding bytes, little endian field order.
     pub crc: u32,
 }
@@ -102,7 +116,7 @@ impl ThermalRecord {
         temps_c: [0.0; N_NODES],
         ambient_c: 0.0,
         step: 0,
-        reserved: 0,
+        seq_flags: 0,
         crc: 0,
     };
 
@@ -117,7 +131,7 @@ impl ThermalRecord {
             c = crc32_update(c, &t.to_bits().to_le_bytes());
         }
         c = crc32_update(c, &self.ambient_c.to_bits().to_le_bytes());
-        c = crc32_update(c, &self.reserved.to_le_bytes());
+        c = crc32_update(c, &self.seq_flags.to_le_bytes());
         !c
     }
 
@@ -137,11 +151,29 @@ impl ThermalRecord {
             temps_c,
             ambient_c,
             step,
-            reserved: 0,
+            seq_flags: 0,
             crc: 0,
         };
         r.crc = r.body_crc();
         r
+    }
+
+    /// The same record with sequence number `seq` (31 bits) and the valve
+    /// state, resealed.
+    pub fn with_seq(mut self, seq: u32, valve_open: bool) -> Self {
+        self.seq_flags = (seq & !FLAG_VALVE_OPEN) | if valve_open { FLAG_VALVE_OPEN } else { 0 };
+        self.crc = self.body_crc();
+        self
+    }
+
+    /// Sequence number of the write (31 bits, wrapping).
+    pub fn seq(&self) -> u32 {
+        self.seq_flags & !FLAG_VALVE_OPEN
+    }
+
+    /// The valve was open when the record was written.
+    pub fn valve_open(&self) -> bool {
+        self.seq_flags & FLAG_VALVE_OPEN != 0
     }
 
     /// Classifies the record per the module's boot rules.
@@ -157,7 +189,7 @@ impl ThermalRecord {
             .iter()
             .chain(core::iter::once(&self.ambient_c))
             .all(|t| t.is_finite() && *t >= lo && *t <= hi);
-        if self.version == VERSION && self.reserved == 0 && self.crc == self.body_crc() && plausible
+        if self.version == VERSION && self.crc == self.body_crc() && plausible
         {
             RecordStatus::Valid
         } else {
@@ -199,30 +231,13 @@ impl Restore {
     }
 }
 
-/// The no-init RAM copy (target only).
-#[cfg(target_os = "none")]
-pub mod noinit {
-    use super::ThermalRecord;
-    use core::mem::MaybeUninit;
+pub mod nv;
+pub mod slots;
 
-    #[link_section = ".uninit.thermal"]
-    static mut RECORD: MaybeUninit<ThermalRecord> = MaybeUninit::uninit();
-
-    /// Reads the record left in no-init RAM (whatever bits are there).
-    pub fn load() -> ThermalRecord {
-        // SAFETY: single-threaded access from the main loop; every bit pattern is a
-        // valid `ThermalRecord` (integers and floats, no padding); volatile so the
-        // compiler makes no assumption about memory it never initialised.
-        unsafe { core::ptr::read_volatile(core::ptr::addr_of!(RECORD).cast::<ThermalRecord>()) }
-    }
-
-    /// Writes the record to no-init RAM.
-    pub fn store(r: &ThermalRecord) {
-        // SAFETY: as in `load`; the static is only touched from the main loop.
-        unsafe {
-            core::ptr::write_volatile(core::ptr::addr_of_mut!(RECORD).cast::<ThermalRecord>(), *r)
-        }
-    }
+/// Whether sequence number `a` is newer than `b` (31-bit wrapping order).
+pub fn seq_newer(a: u32, b: u32) -> bool {
+    let d = a.wrapping_sub(b) & !FLAG_VALVE_OPEN;
+    d != 0 && d < (1 << 30)
 }
 
 #[cfg(test)]
