@@ -234,6 +234,18 @@ impl Restore {
 pub mod nv;
 pub mod slots;
 
+/// The boot rule over both memories: the RAM records' rule
+/// ([`slots::restore_from`]) unless RAM holds nothing (power-on), then the
+/// non-volatile record (a power loss of unknown length: the saved
+/// temperatures, not cooled), else a cold start. A damaged RAM record stays
+/// a conservative start even when flash holds an older valid one.
+pub fn boot_restore(ram: Restore, nv: Option<ThermalRecord>) -> Restore {
+    match (ram, nv) {
+        (Restore::Cold, Some(r)) => Restore::Warm(r),
+        (ram, _) => ram,
+    }
+}
+
 /// Whether sequence number `a` is newer than `b` (31-bit wrapping order).
 pub fn seq_newer(a: u32, b: u32) -> bool {
     let d = a.wrapping_sub(b) & !FLAG_VALVE_OPEN;

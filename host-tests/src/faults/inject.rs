@@ -155,8 +155,8 @@ pub enum Fault {
     OutOfOrderFrames,
     /// The MCU resets (watchdog, brown-out) and restores its thermal record.
     WarmReset,
-    /// Power is lost for 60 s; RAM is gone; the guard boots from what its
-    /// non-volatile record holds (today: nothing, a cold start at ambient).
+    /// Power is lost for 60 s; RAM is gone; the guard boots from its
+    /// non-volatile record.
     PowerLoss,
     /// A reset during the record write: the record reads corrupt at boot.
     TornRecordWrite,

@@ -21,7 +21,9 @@ pub mod inject;
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use eha_guard::memory::{Restore, ThermalRecord};
+use eha_guard::memory::nv::{Blocking, NvPolicy, NvStore, RamFlash};
+use eha_guard::memory::slots::{restore_from, AbWriter};
+use eha_guard::memory::{boot_restore, Restore, ThermalRecord};
 use eha_guard::protocol::{Link, Request};
 use eha_guard::{faults as fbits, GuardConfig, GuardOf, Output, Sample};
 use rayon::prelude::*;
@@ -77,22 +79,64 @@ pub struct FaultResult {
     pub pass: bool,
 }
 
-/// The guard as the MCU runs it: reboots replace it.
+/// The non-volatile memory of the MCU (survives power loss): the firmware's
+/// `NvStore` over a RAM-backed flash, with the firmware's write policy.
+struct Nv {
+    store: NvStore<Blocking<RamFlash<16384>>>,
+    last: Option<ThermalRecord>,
+}
+
+impl Nv {
+    fn new() -> Result<Self> {
+        let store = NvStore::new(Blocking(RamFlash::new()), 0..16384).map_err(|e| anyhow::anyhow!("nv store: {e:?}"))?;
+        Ok(Nv { store, last: None })
+    }
+
+    fn save_if_due(&mut self, rec: &ThermalRecord) {
+        if NvPolicy::DEFAULT.due(self.last.as_ref(), rec) && self.store.save(rec).is_ok() {
+            self.last = Some(*rec);
+        }
+    }
+}
+
+/// The guard as the MCU runs it: reboots replace it; the two no-init RAM
+/// records survive a reset, not a power loss.
 struct Mcu {
     guard: GuardOf<f32>,
     link: Link,
+    slots: [ThermalRecord; 2],
+    writer: AbWriter,
+    last_slot: usize,
 }
 
 impl Mcu {
-    fn boot(cfg: GuardConfig, restore: Restore) -> Self {
-        Mcu { guard: GuardOf::new(&cfg, restore), link: Link::new() }
+    /// Boot with RAM records `slots` (zeros after a power loss) and the
+    /// non-volatile store, by the firmware's boot rule.
+    fn boot(cfg: GuardConfig, slots: [ThermalRecord; 2], nv: &mut Nv, first: Option<Restore>) -> Self {
+        let restore = first.unwrap_or_else(|| boot_restore(restore_from(&slots[0], &slots[1]), nv.store.load()));
+        let writer = AbWriter::after_boot(&slots[0], &slots[1]);
+        Mcu { guard: GuardOf::new(&cfg, restore), link: Link::new(), slots, writer, last_slot: 0 }
+    }
+
+    /// The thermal-memory writes after a tick: both RAM records in turn,
+    /// and flash when the policy says so.
+    fn save(&mut self, nv: &mut Nv) {
+        let rec = self.guard.snapshot();
+        let Mcu { writer, slots, last_slot, .. } = self;
+        writer.write(&rec, |i, r| {
+            if let Some(s) = slots.get_mut(i) {
+                *s = *r;
+                *last_slot = i;
+            }
+        });
+        nv.save_if_due(&rec);
     }
 
     /// One 10 ms tick of the product loop: the bytes received since the
     /// last tick go through the frame [`Link`]; the newest accepted sample
     /// steps the guard, and a tick without one is a missing sample.
     fn tick(&mut self, bytes: &[u8]) -> Output {
-        let Mcu { guard, link } = self;
+        let Mcu { guard, link, .. } = self;
         let mut newest: Option<Sample> = None;
         let last = guard_out(guard);
         link.push_bytes(bytes, |r: &Request, _gap| {
@@ -123,11 +167,12 @@ pub fn run_one(fault: Fault, scenario_name: &str, scenario: &Scenario) -> Result
     let mut plant = Plant::new(&rig, scenario).context("plant")?;
     let cfg = GuardConfig::DEFAULT;
     let first = Sensors::from(&plant.snapshot()).sample();
+    let mut nv = Nv::new()?;
     let restore = match fault {
-        Fault::LngEmpty => Restore::from_record(&lng_empty_record(&cfg, first.ambient_c)),
-        _ => Restore::Cold,
+        Fault::LngEmpty => Some(Restore::from_record(&lng_empty_record(&cfg, first.ambient_c))),
+        _ => None,
     };
-    let mut mcu = Some(Mcu::boot(cfg, restore));
+    let mut mcu = Some(Mcu::boot(cfg, [ThermalRecord::EMPTY; 2], &mut nv, restore));
     let mut rng = Gauss::new(0x5EED ^ fault.name().len() as u64);
     let mut seq: u16 = 0;
     let mut out: Option<Output> = None;
@@ -153,15 +198,19 @@ pub fn run_one(fault: Fault, scenario_name: &str, scenario: &Scenario) -> Result
                 }
                 match fault {
                     Fault::WarmReset => {
-                        let rec = mcu.as_ref().map(|m| m.guard.snapshot());
-                        if let Some(rec) = rec {
-                            mcu = Some(Mcu::boot(cfg, Restore::from_record(&rec)));
+                        if let Some(m) = mcu.take() {
+                            mcu = Some(Mcu::boot(cfg, m.slots, &mut nv, None));
                         }
                     }
                     Fault::TornRecordWrite => {
-                        let mut rec = mcu.as_ref().map_or(ThermalRecord::EMPTY, |m| m.guard.snapshot());
-                        rec.temps_c[0] = f32::from_bits(rec.temps_c[0].to_bits() ^ 0x0040_0000); // half-written word
-                        mcu = Some(Mcu::boot(cfg, Restore::from_record(&rec)));
+                        if let Some(m) = mcu.take() {
+                            // The reset hit the write of the newest record: one word half written.
+                            let mut slots = m.slots;
+                            if let Some(r) = slots.get_mut(m.last_slot) {
+                                r.temps_c[0] = f32::from_bits(r.temps_c[0].to_bits() ^ 0x0040_0000);
+                            }
+                            mcu = Some(Mcu::boot(cfg, slots, &mut nv, None));
+                        }
                     }
                     Fault::PowerLoss => {
                         mcu = None;
@@ -176,8 +225,8 @@ pub fn run_one(fault: Fault, scenario_name: &str, scenario: &Scenario) -> Result
             }
             if let Some(until) = powered_off_until {
                 if t >= until - 1e-9 {
-                    // Power back: no non-volatile record exists today, RAM is lost.
-                    mcu = Some(Mcu::boot(cfg, Restore::Cold));
+                    // Power back: RAM is lost, the non-volatile record remains.
+                    mcu = Some(Mcu::boot(cfg, [ThermalRecord::EMPTY; 2], &mut nv, None));
                     powered_off_until = None;
                     seq = 0;
                 }
@@ -220,6 +269,7 @@ pub fn run_one(fault: Fault, scenario_name: &str, scenario: &Scenario) -> Result
                     }
                 }
                 out = Some(m.tick(&wire));
+                m.save(&mut nv);
             } else {
                 out = None;
             }
