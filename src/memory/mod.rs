@@ -237,11 +237,20 @@ pub mod slots;
 /// The boot rule over both memories: the RAM records' rule
 /// ([`slots::restore_from`]) unless RAM holds nothing (power-on), then the
 /// non-volatile record (a power loss of unknown length: the saved
-/// temperatures, not cooled), else a cold start. A damaged RAM record stays
-/// a conservative start even when flash holds an older valid one.
-pub fn boot_restore(ram: Restore, nv: Option<ThermalRecord>) -> Restore {
+/// temperatures, not cooled, each raised by the write policy's `rise_k`,
+/// the most the estimate can have risen since that record was written, so
+/// the restored state is never colder than the state at power-off), else a
+/// cold start. A damaged RAM record stays a conservative start even when
+/// flash holds an older valid one.
+pub fn boot_restore(ram: Restore, nv: Option<ThermalRecord>, policy: &nv::NvPolicy) -> Restore {
     match (ram, nv) {
-        (Restore::Cold, Some(r)) => Restore::Warm(r),
+        (Restore::Cold, Some(r)) => {
+            let mut hot = r;
+            for t in hot.temps_c.iter_mut() {
+                *t += policy.rise_k;
+            }
+            Restore::Warm(ThermalRecord::new(hot.temps_c, r.ambient_c, r.lng_used_cj, r.faults, r.step).with_seq(r.seq(), r.valve_open()))
+        }
         (ram, _) => ram,
     }
 }

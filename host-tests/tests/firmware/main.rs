@@ -1,4 +1,5 @@
 //! The firmware's reduced model (host build of `eha-guard`) in closed loop
 //! with the reference simulation.
 
+mod nv_wear;
 mod vs_reference;
