@@ -6,6 +6,7 @@
 use super::analysis::{diagnose, DiagnoseOptions};
 use super::reference::ReferenceModel;
 use super::report::write_outputs;
+use super::Simulator;
 use crate::measured::MeasuredRun;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -30,6 +31,49 @@ pub struct DiagnoseArgs {
     /// Model runs allowed per least-squares fit.
     #[arg(long, default_value_t = 80)]
     pub max_sims: usize,
+}
+
+/// The model with a progress bar on the terminal (hidden when stderr is not
+/// one): the stage (baseline calibration, then the candidates' fits) and the
+/// model runs done of the budget (the baseline fit plus two starts per
+/// candidate, each at most `max_sims` runs; fits that converge earlier leave
+/// part of the budget unused, so the time left is an upper bound).
+struct Progress<'a> {
+    inner: &'a dyn Simulator,
+    bar: indicatif::ProgressBar,
+    candidates: std::sync::atomic::AtomicBool,
+}
+
+impl<'a> Progress<'a> {
+    fn new(inner: &'a dyn Simulator, max_sims: usize) -> Self {
+        let fits = 1 + 2 * super::Candidate::EXTENSIONS.len() as u64;
+        let budget = 1 + fits * max_sims as u64;
+        let bar = indicatif::ProgressBar::new(budget);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template("{msg:28} [{bar:30}] {pos}/{len} model runs, {elapsed} elapsed, ≤ {eta} left")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
+                .progress_chars("=> "),
+        );
+        bar.set_message("calibrating the baseline");
+        bar.enable_steady_tick(std::time::Duration::from_millis(200));
+        Progress { inner, bar, candidates: std::sync::atomic::AtomicBool::new(false) }
+    }
+}
+
+impl Simulator for Progress<'_> {
+    fn nuisance(&self) -> Vec<super::ParamSpec> {
+        self.inner.nuisance()
+    }
+    fn extension_params(&self, c: super::Candidate) -> Vec<super::ParamSpec> {
+        self.inner.extension_params(c)
+    }
+    fn simulate(&self, nuisance: &[f64], c: super::Candidate, ext: &[f64]) -> Result<super::SimSeries, String> {
+        if c != super::Candidate::None && !self.candidates.swap(true, std::sync::atomic::Ordering::Relaxed) {
+            self.bar.set_message("fitting 7 candidates × 2 starts");
+        }
+        self.bar.inc(1);
+        self.inner.simulate(nuisance, c, ext)
+    }
 }
 
 /// Runs `diagnose` and prints a one-line verdict; see the module doc for the
@@ -63,7 +107,10 @@ fn run_inner(args: &DiagnoseArgs) -> anyhow::Result<String> {
     let mut o = DiagnoseOptions { train_fraction: args.train_fraction.clamp(0.1, 0.7), ..Default::default() };
     o.fit.max_sims = args.max_sims.max(4);
     let t = std::time::Instant::now();
-    let d = diagnose(&run, &model, &o)?;
+    let progress = Progress::new(&model, o.fit.max_sims);
+    let d = diagnose(&run, &progress, &o);
+    progress.bar.finish_and_clear();
+    let d = d?;
     write_outputs(&d, &run, &args.measured.display().to_string(), &args.out)?;
     Ok(format!(
         "cause: {} | held-out RMSE {:.3} -> {:.3} K | training {:.3} -> {:.3} K | {} model runs, {:.1} s | {}",
