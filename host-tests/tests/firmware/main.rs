@@ -1,5 +1,6 @@
 //! The firmware's reduced model (host build of `eha-guard`) in closed loop
 //! with the reference simulation.
 
+mod faults;
 mod nv_wear;
 mod vs_reference;

@@ -1,0 +1,46 @@
+//! The fault campaign (`eha-sim faults`, `eha_sim::faults`) as a test: every
+//! sensor, transport, memory and actuator fault, each during the Fig. 15 LNG
+//! case and one random mission, in closed loop with the reference plant.
+//!
+//! Pass rule per fault and scenario (issue "No silent protection failure"):
+//! the guard latches a fault and opens the valve within 1 s of the fault
+//! becoming observable, or its drain estimate never under-predicts the true
+//! drain by more than 1 K and the true drain never exceeds 42 °C while the
+//! valve is closed. Faults the design cannot meet are listed in
+//! [`KNOWN_FAILING`] with the reason, not removed: the test fails when a
+//! listed fault starts passing (update the list and the README) or an
+//! unlisted one fails. The table is written to `out/faults/`.
+
+use eha_sim::faults::{campaign, table, write};
+
+/// (fault, scenario, why the design cannot meet the pass rule).
+const KNOWN_FAILING: &[(&str, &str, &str)] = &[];
+
+#[test]
+fn fault_campaign_passes_except_the_listed_design_limits() {
+    let rows = campaign().expect("campaign runs");
+    let md = table(&rows);
+    println!("{md}");
+    let out = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../out/faults");
+    write(&out, &rows).expect("write out/faults");
+    let mut problems = Vec::new();
+    for r in &rows {
+        let listed = KNOWN_FAILING.iter().find(|(f, s, _)| *f == r.fault && *s == r.scenario);
+        match (r.pass, listed) {
+            (true, Some((_, _, why))) => problems.push(format!("{} / {} now passes (listed as failing: {why})", r.fault, r.scenario)),
+            (false, None) => problems.push(format!(
+                "{} / {} fails: detected {} after {:?} s, max under {:.3} K, max true drain with the valve closed {:.2} °C",
+                r.fault, r.scenario, r.detected, r.detect_s, r.max_under_k, r.max_true_drain_closed_c
+            )),
+            _ => {}
+        }
+    }
+    for (f, s, _) in KNOWN_FAILING {
+        if !rows.iter().any(|r| r.fault == *f && r.scenario == *s) {
+            problems.push(format!("{f} / {s} is listed but not in the campaign"));
+        }
+    }
+    let failing = rows.iter().filter(|r| !r.pass).count();
+    println!("{} runs, {failing} failing ({} listed)", rows.len(), KNOWN_FAILING.len());
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
