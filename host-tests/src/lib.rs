@@ -30,3 +30,6 @@ pub mod reduce;
 pub mod rig;
 pub mod scenario;
 pub mod sim;
+
+#[cfg(test)]
+mod reader_props;

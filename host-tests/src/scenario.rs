@@ -259,11 +259,20 @@ pub enum MissionError {
 /// mission whose position reference is the `position_mm` profile.
 pub fn read_mission_csv(path: &Path, valve: ValveRule) -> Result<Mission, MissionError> {
     let p = path.display().to_string();
-    let mut rdr = csv::ReaderBuilder::new()
-        .comment(Some(b'#'))
-        .trim(csv::Trim::All)
-        .from_path(path)
-        .map_err(|e| MissionError::Csv { path: p.clone(), message: e.to_string() })?;
+    let file = std::fs::File::open(path).map_err(|e| MissionError::Csv { path: p.clone(), message: e.to_string() })?;
+    let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    read_mission(file, &p, name, valve)
+}
+
+/// [`read_mission_csv`] on CSV text held in memory: `path` names it in
+/// errors, `name` becomes the mission's name.
+pub fn read_mission_str(text: &str, path: &str, name: &str, valve: ValveRule) -> Result<Mission, MissionError> {
+    read_mission(text.as_bytes(), path, name.to_string(), valve)
+}
+
+fn read_mission<R: std::io::Read>(src: R, path: &str, name: String, valve: ValveRule) -> Result<Mission, MissionError> {
+    let p = path.to_string();
+    let mut rdr = csv::ReaderBuilder::new().comment(Some(b'#')).trim(csv::Trim::All).from_reader(src);
     let (mut speed, mut needle, mut pos, mut amb, mut air) = (vec![], vec![], vec![], vec![], vec![]);
     let mut last_t = f64::NEG_INFINITY;
     for rec in rdr.deserialize::<MissionRow>() {
@@ -285,7 +294,7 @@ pub fn read_mission_csv(path: &Path, valve: ValveRule) -> Result<Mission, Missio
     }
     let circuit = if pos.is_empty() { Circuit::Throttle } else { Circuit::Servo };
     Ok(Mission {
-        name: path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default(),
+        name,
         circuit,
         duration_s: last_t,
         ambient_c: Schedule(amb),
