@@ -191,7 +191,8 @@ impl NvPolicy {
     /// written given the `last` record written (None: nothing yet).
     pub fn due(&self, last: Option<&ThermalRecord>, now: &ThermalRecord) -> bool {
         let Some(last) = last else { return true };
-        let risen = now.temps_c.iter().zip(last.temps_c.iter()).any(|(n, l)| !(*n <= *l + self.rise_k));
+        // An unordered (NaN) estimate counts as risen.
+        let risen = now.temps_c.iter().zip(last.temps_c.iter()).any(|(n, l)| !n.partial_cmp(&(*l + self.rise_k)).is_some_and(|o| o.is_le()));
         risen
             || now.faults != last.faults
             || now.lng_used_cj.saturating_sub(last.lng_used_cj) >= self.lng_step_cj
@@ -261,7 +262,7 @@ impl<const BYTES: usize> blocking::NorFlash for RamFlash<BYTES> {
     const ERASE_SIZE: usize = RAM_FLASH_PAGE;
     fn erase(&mut self, from: u32, to: u32) -> Result<(), RamFlashError> {
         let (f, t) = (from as usize, to as usize);
-        if f % RAM_FLASH_PAGE != 0 || t % RAM_FLASH_PAGE != 0 || t > BYTES || f > t {
+        if !f.is_multiple_of(RAM_FLASH_PAGE) || !t.is_multiple_of(RAM_FLASH_PAGE) || t > BYTES || f > t {
             return Err(RamFlashError);
         }
         self.mem.get_mut(f..t).ok_or(RamFlashError)?.fill(0xFF);
@@ -274,7 +275,7 @@ impl<const BYTES: usize> blocking::NorFlash for RamFlash<BYTES> {
     }
     fn write(&mut self, offset: u32, bytes: &[u8]) -> Result<(), RamFlashError> {
         let o = offset as usize;
-        if o % 4 != 0 || bytes.len() % 4 != 0 {
+        if !o.is_multiple_of(4) || !bytes.len().is_multiple_of(4) {
             return Err(RamFlashError);
         }
         let dst = self.mem.get_mut(o..o + bytes.len()).ok_or(RamFlashError)?;
