@@ -161,8 +161,26 @@ fn lng_empty_record(cfg: &GuardConfig, ambient_c: f32) -> ThermalRecord {
     ThermalRecord::new([ambient_c; eha_guard::params::N_NODES], ambient_c, used_cj, 0, 0)
 }
 
-/// Run one fault in one scenario.
+/// Run one fault in one scenario on the host build of the guard (SIL).
 pub fn run_one(fault: Fault, scenario_name: &str, scenario: &Scenario) -> Result<FaultResult> {
+    run_on(fault, scenario_name, scenario, None)
+}
+
+/// Run one fault in one scenario; with `target` (the firmware in QEMU through
+/// the lockstep PIL, one frame per tick) instead of the host guard. The
+/// lockstep firmware steps per frame, so only the input faults (every tick
+/// still carries one frame) run on a target; they must give the same result
+/// as on the host, bit for bit.
+pub fn run_on(
+    fault: Fault,
+    scenario_name: &str,
+    scenario: &Scenario,
+    mut target: Option<&mut dyn crate::pil::Target>,
+) -> Result<FaultResult> {
+    if target.is_some() && !matches!(fault, Fault::Input(..)) {
+        anyhow::bail!("{}: only input faults run on a lockstep target", fault.name());
+    }
+    let mut target_error: Option<anyhow::Error> = None;
     let rig = Rig::default();
     let mut plant = Plant::new(&rig, scenario).context("plant")?;
     let cfg = GuardConfig::DEFAULT;
@@ -193,9 +211,7 @@ pub fn run_one(fault: Fault, scenario_name: &str, scenario: &Scenario) -> Result
             let active = t >= FAULT_AT_S - 1e-9;
             // Events at the fault's start.
             if active && k == (FAULT_AT_S / TICK_S).round() as u64 {
-                if let Some(m) = mcu.as_ref() {
-                    latched_before = m.guard.faults() & fbits::LATCHED;
-                }
+                latched_before = out.map_or(0, |o| o.faults & fbits::LATCHED);
                 match fault {
                     Fault::WarmReset => {
                         if let Some(m) = mcu.take() {
@@ -268,8 +284,19 @@ pub fn run_one(fault: Fault, scenario_name: &str, scenario: &Scenario) -> Result
                         }
                     }
                 }
-                out = Some(m.tick(&wire));
-                m.save(&mut nv);
+                match target.as_deref_mut() {
+                    Some(t) => match t.exchange(&wire, k) {
+                        Ok(r) => out = Some(r.out),
+                        Err(e) => {
+                            target_error = Some(e.into());
+                            return Ok(Control { lng_valve: None, stop: true });
+                        }
+                    },
+                    None => {
+                        out = Some(m.tick(&wire));
+                        m.save(&mut nv);
+                    }
+                }
             } else {
                 out = None;
             }
@@ -277,7 +304,7 @@ pub fn run_one(fault: Fault, scenario_name: &str, scenario: &Scenario) -> Result
             let commanded = match (&mcu, out) {
                 (None, _) => true,
                 (Some(_), Some(o)) => o.valve_open,
-                (Some(m), None) => m.guard.faults() & fbits::LATCHED != 0,
+                (Some(_), None) => true,
             };
             // The valve's real position, and whether it cools: an empty tank
             // leaves a working valve with nothing to flow through it.
@@ -287,8 +314,8 @@ pub fn run_one(fault: Fault, scenario_name: &str, scenario: &Scenario) -> Result
                 observable_at = Some(t);
             }
             if active {
-                if let (Some(m), Some(o)) = (&mcu, out) {
-                    let new_latch = m.guard.faults() & fbits::LATCHED & !latched_before;
+                if let (Some(_), Some(o)) = (&mcu, out) {
+                    let new_latch = o.faults & fbits::LATCHED & !latched_before;
                     if new_latch != 0 && detect.is_none() && o.valve_open {
                         if let Some(t0) = observable_at {
                             detect = Some((t - t0).max(0.0));
@@ -306,6 +333,9 @@ pub fn run_one(fault: Fault, scenario_name: &str, scenario: &Scenario) -> Result
             Ok(Control { lng_valve: Some(cooling), stop: false })
         })
         .context("closed-loop run")?;
+    if let Some(e) = target_error {
+        return Err(e.context(format!("{} on the target", fault.name())));
+    }
     let max_under_k = if max_under.is_finite() { max_under } else { 0.0 };
     let max_true_drain_closed_c = if max_closed.is_finite() { max_closed } else { f64::NAN };
     let detected = detect.is_some();
