@@ -3,5 +3,6 @@
 //! properties (proptest), and the over-temperature alarm and derate.
 
 mod alarm;
+mod lng_credit;
 mod model_accuracy;
 mod protection_props;
