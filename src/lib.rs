@@ -39,6 +39,8 @@ mod build_checks {
     /// firmware core fails the host tests instead of wrapping silently. This
     /// test fails if a profile change drops them.
     #[test]
+    // The constant is the point: it is what the build profile made it.
+    #[allow(clippy::assertions_on_constants)]
     fn firmware_core_is_tested_with_overflow_checks_and_debug_assertions() {
         assert!(cfg!(debug_assertions), "debug assertions are off in this test build of eha-guard");
         let r = std::panic::catch_unwind(|| core::hint::black_box(u8::MAX) + core::hint::black_box(1u8));
