@@ -6,3 +6,4 @@ mod alarm;
 mod lng_credit;
 mod model_accuracy;
 mod protection_props;
+mod valve;

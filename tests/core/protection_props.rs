@@ -694,35 +694,58 @@ fn stale_input_integrates_worst_case_loss() {
 }
 
 #[test]
-fn guard_dwell_is_two_seconds_at_the_model_step() {
+fn guard_dwell_qualifies_the_closing_at_the_model_step() {
     // The guard decides on temperature once per 100 ms model step and counts the
-    // dwell in model steps: consecutive temperature-driven toggles of the guard's
-    // valve are at least `dwell_steps` ticks (2 s) apart. A narrow band just above
-    // the ambient and alternating load / idle make the estimate cross it often.
+    // dwell in model steps (20 = 2 s). The rule (items 3 and 9 of "No silent
+    // protection failure"; before, the dwell also delayed openings): an opening is
+    // never delayed (estimate above the threshold at a model step => valve open in
+    // that tick); a closing comes only after 20 consecutive model steps below the
+    // closing threshold, so every open period lasts at least 2 s. A narrow band just
+    // above the ambient and alternating load / idle make the estimate cross it often.
     let mut cfg = GuardConfig::DEFAULT;
     cfg.valve.open_c = 16.3;
     cfg.valve.close_c = 16.25;
+    let dwell = cfg.valve.dwell_steps / eha_guard::params::TICKS_PER_STEP;
     let mut g = GuardOf::<f32>::new(&cfg, Restore::Cold);
     let load = nominal();
     let idle = Sample { current_a: 0.0, p_a_bar: 5.0, p_b_bar: 5.0, speed_rpm: 500.0, ..nominal() };
+    let mut below_run = 0u32;
+    let mut was_open = false;
     for k in 0..20_000u32 {
         let o = g.step(if (k / 150) % 2 == 0 { &load } else { &idle });
         assert_eq!(o.faults & faults::LATCHED, 0);
+        let m = g.model().unwrap();
+        if m.pending_ticks() == 0 {
+            let d = m.drain_c();
+            below_run = if d < cfg.valve.close_c { below_run + 1 } else { 0 };
+            if d > cfg.valve.open_c {
+                assert!(o.valve_open, "tick {k}: estimate {d} above {} but the valve is closed", cfg.valve.open_c);
+            }
+            if was_open && !o.valve_open {
+                assert!(below_run >= dwell, "tick {k}: closed after {below_run} model steps below {} (< {dwell})", cfg.valve.close_c);
+            }
+        } else {
+            assert_eq!(o.valve_open, was_open, "tick {k}: the valve changed between model steps");
+        }
+        was_open = o.valve_open;
     }
-    let toggles: Vec<u32> = g
+    let toggles: Vec<(u32, bool)> = g
         .trace()
         .iter()
         .filter_map(|e| match e {
-            eha_guard::trace::Trace::ValveOpen { step, forced: false, .. } => Some(*step),
-            eha_guard::trace::Trace::ValveClose { step, .. } => Some(*step),
+            eha_guard::trace::Trace::ValveOpen { step, forced: false, .. } => Some((*step, true)),
+            eha_guard::trace::Trace::ValveClose { step, .. } => Some((*step, false)),
             _ => None,
         })
         .collect();
     println!("valve toggles at ticks {toggles:?}");
     assert!(toggles.len() >= 6, "the band must be crossed repeatedly: {toggles:?}");
+    // Every open period lasts at least the dwell (2 s = 200 ticks).
     for w in toggles.windows(2) {
-        assert!(w[1] - w[0] >= cfg.valve.dwell_steps, "toggles {} ticks apart < {}", w[1] - w[0], cfg.valve.dwell_steps);
+        if w[0].1 && !w[1].1 {
+            assert!(w[1].0 - w[0].0 >= cfg.valve.dwell_steps, "open for {} ticks < {}", w[1].0 - w[0].0, cfg.valve.dwell_steps);
+        }
     }
     // Decisions fall on model-step ticks (the 10th of each model step).
-    assert!(toggles.iter().all(|t| (t + 1) % eha_guard::params::TICKS_PER_STEP == 0), "{toggles:?}");
+    assert!(toggles.iter().all(|t| (t.0 + 1) % eha_guard::params::TICKS_PER_STEP == 0), "{toggles:?}");
 }
