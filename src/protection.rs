@@ -54,6 +54,11 @@ impl Valve {
         Valve { open: false, below: 0 }
     }
 
+    /// Open (the guard's state from boot until its first sample).
+    pub const fn open() -> Self {
+        Valve { open: true, below: 0 }
+    }
+
     /// `true` when commanded open.
     #[inline(always)]
     pub fn is_open(&self) -> bool {

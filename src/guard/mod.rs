@@ -83,6 +83,7 @@ pub struct GuardOf<N: Num> {
     /// Valve dwell in model steps (the configured ticks, rounded up).
     dwell_model_steps: u32,
     stale_steps: u32,
+    startup_timeout_steps: u32,
     clear_valid_steps: u32,
     latched: u16,
     bad_ch: u8,
@@ -92,8 +93,10 @@ pub struct GuardOf<N: Num> {
     /// Tick index from which every sample was present and valid (the run of valid
     /// samples of the clear rule is `step - valid_since`).
     valid_since: u32,
-    /// `false` until the first tick: a cold start takes that tick's ambient, and the
-    /// protection is evaluated once on the initial (or restored) estimate.
+    /// `false` until the first sample: until then the guard waits (valve open, model
+    /// not started, STALE only after `startup_timeout_steps`). A cold start takes
+    /// the first sample's ambient, and the protection is evaluated once on the
+    /// initial (or restored) estimate.
     started: bool,
     cold: bool,
     /// Tick from which the present valve and credit state hold in this model step.
@@ -129,6 +132,7 @@ impl<N: Num> GuardOf<N> {
             core,
             dwell_model_steps: config.valve.dwell_steps.div_ceil(TICKS_PER_STEP),
             stale_steps: config.stale_steps,
+            startup_timeout_steps: config.startup_timeout_steps,
             clear_valid_steps: config.clear_valid_steps,
             bad_ch: 0,
             prev: [N::ZERO; 6],
@@ -141,7 +145,8 @@ impl<N: Num> GuardOf<N> {
             open_acc: 0,
             credit_acc: 0,
             last_cj: 0,
-            valve: Valve::new(),
+            // Open from boot: the safe state while the guard waits for its first sample.
+            valve: Valve::open(),
             alarm: false,
             lng: LngBudget::new(&config.lng),
             lng_low: false,
@@ -176,8 +181,28 @@ impl<N: Num> GuardOf<N> {
             }
         };
         g.trace.write(Trace::Restore { step: 0, kind });
-        g.refresh_out();
+        g.boot_outputs();
         g
+    }
+
+    /// Outputs before the first sample: the restored estimate (none on a cold boot)
+    /// with the alarm evaluated on it; no model, no alarm and derate on: CONFIG.
+    #[cold]
+    #[inline(never)]
+    fn boot_outputs(&mut self) {
+        match self.core.as_ref() {
+            Some(c) if !self.cold => {
+                let d = c.model.drain_c();
+                let f = d.to_f32();
+                self.out.drain_c = if f.is_finite() { f } else { DRAIN_C_UNKNOWN };
+                if alarm_update_with(&mut self.alarm, d, c.th.alarm, c.th.clear) == Some(true) {
+                    self.trace.write(Trace::Alarm { step: 0, drain_c: self.out.drain_c });
+                }
+            }
+            Some(_) => {}
+            None => self.alarm = true,
+        }
+        self.refresh_out();
     }
 
     /// One 10 ms tick with a new sample. Never panics; any invalid channel latches a
@@ -226,7 +251,7 @@ impl<N: Num> GuardOf<N> {
     fn step_slow(&mut self, s: &Sample) -> Output {
         self.missing = 0;
         let Some(core) = self.core.as_ref() else {
-            return self.slow_tail(None, 0);
+            return self.slow_tail(None, 0, N::ZERO);
         };
         let (v, nonfinite) = validate::convert(s, &core.scales);
         let c = validate::check(&v, nonfinite, &self.prev, self.prev_ok, &core.limits);
@@ -251,15 +276,24 @@ impl<N: Num> GuardOf<N> {
             None
         };
         let u = validate::substitute(&v, self.bad_ch, prev_pos, &core.limits);
+        // A cold start takes this sample's own ambient when it is valid (also when
+        // an earlier STALE makes the model run on the worst case from now on), else
+        // the worst case.
+        let [_, _, _, _, _, amb] = v;
+        let start_amb = if c.bad & validate::CH_AMBIENT == 0 { amb } else { u.ambient_c };
         self.prev = v;
         self.prev_ok = !c.bad & CH_ALL;
-        self.slow_tail(Some(&u), new_bits)
+        self.slow_tail(Some(&u), new_bits, start_amb)
     }
 
     /// One 10 ms tick without a new sample: inputs are held (piston work taken as
     /// zero); after `stale_steps` consecutive misses the STALE fault latches and every
-    /// channel takes its worst case.
+    /// channel takes its worst case. Before the first sample the guard waits instead
+    /// ([`GuardOf::wait_tick`]).
     pub fn step_missing(&mut self) -> Output {
+        if !self.started {
+            return self.wait_tick();
+        }
         self.missing = self.missing.saturating_add(1);
         self.valid_since = self.step.wrapping_add(1);
         self.prev_ok = 0;
@@ -272,13 +306,39 @@ impl<N: Num> GuardOf<N> {
             .core
             .as_ref()
             .map(|c| validate::substitute(&self.prev, self.bad_ch, None, &c.limits));
-        self.slow_tail(u.as_ref(), new_bits)
+        self.slow_tail(u.as_ref(), new_bits, N::ZERO)
+    }
+
+    /// A tick without a sample before the first sample (boot, or samples not yet
+    /// flowing): the model is not started and accumulates nothing, the valve stays
+    /// open; after `startup_timeout_steps` such ticks STALE latches (every channel
+    /// worst case once samples arrive, until a clear).
+    #[cold]
+    #[inline(never)]
+    fn wait_tick(&mut self) -> Output {
+        self.missing = self.missing.saturating_add(1);
+        self.valid_since = self.step.wrapping_add(1);
+        if self.missing >= self.startup_timeout_steps {
+            if self.latched & faults::STALE == 0 {
+                self.trace.write(Trace::Fault {
+                    step: self.step,
+                    new_bits: faults::STALE | ((CH_ALL as u16) << faults::CH_SHIFT),
+                });
+            }
+            self.latched |= faults::STALE;
+            self.bad_ch = CH_ALL;
+        }
+        // The valve is open since boot (nothing closes it before the first sample).
+        self.refresh_out();
+        self.step = self.step.wrapping_add(1);
+        self.mark = self.step;
+        self.out
     }
 
     /// Slow-path tail: latches `new_bits` and opens the valve at once when any fault
-    /// is latched (fail-safe in the same tick), starts the model on the first tick,
-    /// then the common tick.
-    fn slow_tail(&mut self, u: Option<&ModelInputN<N>>, new_bits: u16) -> Output {
+    /// is latched (fail-safe in the same tick), starts the model at the first sample
+    /// (cold: at `start_amb`), then the common tick.
+    fn slow_tail(&mut self, u: Option<&ModelInputN<N>>, new_bits: u16, start_amb: N) -> Output {
         // The valve / credit state may change for this tick: count the ticks before.
         self.settle(self.step);
         let newly = new_bits & !self.latched;
@@ -299,7 +359,7 @@ impl<N: Num> GuardOf<N> {
         match u {
             Some(u) if self.core.is_some() => {
                 if !self.started {
-                    self.start(u.ambient_c);
+                    self.start(start_amb);
                 }
                 self.refresh_out();
                 self.tick(u)
@@ -330,18 +390,31 @@ impl<N: Num> GuardOf<N> {
         self.out
     }
 
-    /// First tick: a cold start takes every node to this tick's ambient; then the
-    /// protection is evaluated once on the initial (or restored) estimate, so that a
-    /// warm restore above the threshold opens the valve at once.
+    /// First sample: a cold start takes every node to `ambient_c`; the valve leaves
+    /// the open start-up state by the hysteresis relay on the initial (or restored)
+    /// estimate (closed only below the closing threshold, with no qualification: the
+    /// opening was not temperature-driven), then the protection is evaluated once.
     #[cold]
     #[inline(never)]
     fn start(&mut self, ambient_c: N) {
         self.started = true;
-        self.settle(self.step);
+        // Nothing of the waiting time is counted: no model ran, no credit, no LNG booked.
+        self.mark = self.step;
+        self.open_acc = 0;
+        self.credit_acc = 0;
+        let Some(c) = self.core.as_mut() else {
+            return;
+        };
         if self.cold {
-            if let Some(c) = self.core.as_mut() {
-                c.model.set_uniform(ambient_c);
-            }
+            c.model.set_uniform(ambient_c);
+        }
+        let d = c.model.drain_c();
+        if self.latched == 0 && d < c.th.close && self.valve.is_open() {
+            self.valve.set(false);
+            self.trace.write(Trace::ValveClose {
+                step: self.step,
+                drain_c: d.to_f32(),
+            });
         }
         self.protect(0, 0);
     }
@@ -461,6 +534,11 @@ impl<N: Num> GuardOf<N> {
             lng_remaining_kg: self.lng.remaining_kg(),
             lng_seconds_left: self.lng.seconds_left_cj(self.last_cj),
         };
+    }
+
+    /// The outputs as the last tick left them (at boot: the waiting state).
+    pub fn output(&self) -> Output {
+        self.out
     }
 
     /// Present fault word (see [`faults`]).

@@ -86,8 +86,13 @@ pub struct GuardConfig {
     pub alarm: AlarmConfig,
     /// LNG heat sink.
     pub lng: LngConfig,
-    /// Consecutive missing samples that make the input stale, steps (5 = 50 ms).
+    /// Consecutive missing samples, once samples have started, that make the input
+    /// stale, 10 ms ticks (5 = 50 ms).
     pub stale_steps: u32,
+    /// Ticks after boot without any sample before the input is declared stale
+    /// (1000 = 10 s). Until the first sample the guard waits: valve open (the safe
+    /// state), model not started, no fault.
+    pub startup_timeout_steps: u32,
     /// Consecutive fully valid samples required before `clear_faults` succeeds, steps.
     pub clear_valid_steps: u32,
 }
@@ -101,6 +106,7 @@ impl GuardConfig {
         alarm: AlarmConfig::DEFAULT,
         lng: LngConfig::DEFAULT,
         stale_steps: 5,
+        startup_timeout_steps: 1000,
         clear_valid_steps: 100,
     };
 }

@@ -6,4 +6,5 @@ mod alarm;
 mod lng_credit;
 mod model_accuracy;
 mod protection_props;
+mod startup;
 mod valve;

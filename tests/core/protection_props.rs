@@ -746,6 +746,8 @@ fn guard_dwell_qualifies_the_closing_at_the_model_step() {
             assert!(w[1].0 - w[0].0 >= cfg.valve.dwell_steps, "open for {} ticks < {}", w[1].0 - w[0].0, cfg.valve.dwell_steps);
         }
     }
-    // Decisions fall on model-step ticks (the 10th of each model step).
-    assert!(toggles.iter().all(|t| (t.0 + 1) % eha_guard::params::TICKS_PER_STEP == 0), "{toggles:?}");
+    // Decisions fall on model-step ticks (the 10th of each model step); the first
+    // event is the start-up state (valve open from boot) ending at the first sample.
+    assert_eq!(toggles[0], (0, false), "{toggles:?}");
+    assert!(toggles[1..].iter().all(|t| (t.0 + 1) % eha_guard::params::TICKS_PER_STEP == 0), "{toggles:?}");
 }
