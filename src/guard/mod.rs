@@ -109,6 +109,9 @@ pub struct GuardOf<N: Num> {
     last_cj: u32,
     valve: Valve,
     alarm: bool,
+    /// The estimate is not trusted (corrupt record at boot, no sample by the start-up
+    /// timeout): alarm and derate held until a successful `clear_faults`.
+    untrusted: bool,
     lng: LngBudget,
     lng_low: bool,
     step: u32,
@@ -148,6 +151,7 @@ impl<N: Num> GuardOf<N> {
             // Open from boot: the safe state while the guard waits for its first sample.
             valve: Valve::open(),
             alarm: false,
+            untrusted: false,
             lng: LngBudget::new(&config.lng),
             lng_low: false,
             step: 0,
@@ -167,6 +171,8 @@ impl<N: Num> GuardOf<N> {
                 g.lng.set_used_cj(r.lng_used_cj);
                 g.latched |= r.faults & faults::LATCHED & !faults::CONFIG;
                 g.bad_ch = ((r.faults >> faults::CH_SHIFT) as u8) & CH_ALL;
+                // Saved before a clear restored trust: still not trusted.
+                g.untrusted = r.faults & faults::UNTRUSTED != 0;
                 RestoreKind::Warm
             }
             Restore::Corrupt => {
@@ -177,6 +183,7 @@ impl<N: Num> GuardOf<N> {
                 g.cold = false;
                 g.lng.set_used_cj(u32::MAX);
                 g.latched |= faults::MEMORY_CORRUPT;
+                g.untrusted = true;
                 RestoreKind::Corrupt
             }
         };
@@ -195,7 +202,13 @@ impl<N: Num> GuardOf<N> {
                 let d = c.model.drain_c();
                 let f = d.to_f32();
                 self.out.drain_c = if f.is_finite() { f } else { DRAIN_C_UNKNOWN };
-                if alarm_update_with(&mut self.alarm, d, c.th.alarm, c.th.clear) == Some(true) {
+                let raised = if self.untrusted {
+                    self.alarm = true;
+                    true
+                } else {
+                    alarm_update_with(&mut self.alarm, d, c.th.alarm, c.th.clear) == Some(true)
+                };
+                if raised {
                     self.trace.write(Trace::Alarm { step: 0, drain_c: self.out.drain_c });
                 }
             }
@@ -327,6 +340,15 @@ impl<N: Num> GuardOf<N> {
             }
             self.latched |= faults::STALE;
             self.bad_ch = CH_ALL;
+            // No estimate and no input: alarm and derate until a clear.
+            self.untrusted = true;
+            if !self.alarm {
+                self.alarm = true;
+                self.trace.write(Trace::Alarm {
+                    step: self.step,
+                    drain_c: self.out.drain_c,
+                });
+            }
         }
         // The valve is open since boot (nothing closes it before the first sample).
         self.refresh_out();
@@ -473,7 +495,12 @@ impl<N: Num> GuardOf<N> {
         let valve_ev = self
             .valve
             .update_with(d, force, th.open, th.close, self.dwell_model_steps);
-        let alarm_ev = alarm_update_with(&mut self.alarm, d, th.alarm, th.clear);
+        let alarm_ev = if self.untrusted {
+            // Held whatever the estimate says (raised at boot or at the timeout).
+            (!core::mem::replace(&mut self.alarm, true)).then_some(true)
+        } else {
+            alarm_update_with(&mut self.alarm, d, th.alarm, th.clear)
+        };
         let drain_c = d.to_f32();
         let drain_c = if drain_c.is_finite() {
             drain_c
@@ -546,13 +573,16 @@ impl<N: Num> GuardOf<N> {
         self.latched
             | ((self.bad_ch as u16) << faults::CH_SHIFT)
             | if self.lng_low { faults::LNG_LOW } else { 0 }
+            | if self.untrusted { faults::UNTRUSTED } else { 0 }
     }
 
     /// **Clear rule.** Latched faults (except CONFIG) clear only through this explicit
     /// call (maintenance / operator command), and only if the last
     /// `clear_valid_steps` samples (1 s by default) were all valid and none is missing.
     /// The thermal estimate is *not* reset: it relaxes from its conservative value.
-    /// Returns `true` when the faults were cleared.
+    /// A successful clear also restores trust in the estimate ([`faults::UNTRUSTED`]:
+    /// after a corrupt record or no sample by the start-up timeout the alarm and
+    /// derate are held until then). Returns `true` when the faults were cleared.
     pub fn clear_faults(&mut self) -> bool {
         let valid_run = self.step.wrapping_sub(self.valid_since);
         if self.missing != 0 || valid_run < self.clear_valid_steps {
@@ -562,6 +592,10 @@ impl<N: Num> GuardOf<N> {
         self.settle(self.step);
         self.latched &= faults::CONFIG;
         self.bad_ch = 0;
+        // The controller accepts the estimate as it is (it is not reset); the alarm
+        // follows it again from the next model step.
+        let bits = bits | if self.untrusted { faults::UNTRUSTED } else { 0 };
+        self.untrusted = false;
         if bits != 0 {
             self.trace.write(Trace::FaultsCleared {
                 step: self.step,

@@ -28,6 +28,11 @@ pub mod faults {
     pub const LNG_LOW: u16 = 1 << 7;
     /// Shift of the latched bad-channel mask inside the fault word.
     pub const CH_SHIFT: u16 = 8;
+    /// The estimate is not trusted (corrupt thermal record at boot, or no sample by
+    /// the start-up timeout): alarm and derate are held until a successful
+    /// [`super::GuardOf::clear_faults`]. Status, not a latched fault; kept in the
+    /// thermal record so a warm reset does not drop it.
+    pub const UNTRUSTED: u16 = 1 << 15;
     /// Bits that latch.
     pub const LATCHED: u16 = 0x7f;
 }

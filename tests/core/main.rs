@@ -7,4 +7,5 @@ mod lng_credit;
 mod model_accuracy;
 mod protection_props;
 mod startup;
+mod untrusted;
 mod valve;
