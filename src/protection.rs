@@ -332,6 +332,11 @@ impl LngBudget {
         }
     }
 
+    /// `true` when nothing is left (the heat absorbed reached the charge's capacity).
+    pub fn is_empty(&self) -> bool {
+        self.used_cj >= self.capacity_cj
+    }
+
     /// `true` when remaining < the low threshold.
     pub fn is_low(&self) -> bool {
         self.capacity_cj.saturating_sub(self.used_cj) < self.low_cj

@@ -102,12 +102,21 @@ pub struct GuardOf<N: Num> {
     /// Tick from which the present valve and credit state hold in this model step.
     mark: u32,
     /// Ticks of this model step before `mark` with the valve commanded open (LNG
-    /// budget), and with the exchanger credited (open, no fault latched).
+    /// budget), and with the exchanger credited (open, no fault latched, LNG left,
+    /// the position feedback, if any, not saying shut).
     open_acc: u32,
     credit_acc: u32,
     /// Mean loss of the last model step, cJ per tick (= W).
     last_cj: u32,
     valve: Valve,
+    /// Last valve position reported by [`GuardOf::valve_feedback`] (None: no feedback).
+    fb: Option<bool>,
+    /// Consecutive reports differing from the command.
+    fb_mismatch: u32,
+    /// Reports differing from the command that latch ACTUATOR.
+    mismatch_steps: u32,
+    /// The LNG budget is used up: no exchanger credit.
+    lng_empty: bool,
     alarm: bool,
     /// The estimate is not trusted (corrupt record at boot, no sample by the start-up
     /// timeout): alarm and derate held until a successful `clear_faults`.
@@ -150,6 +159,10 @@ impl<N: Num> GuardOf<N> {
             last_cj: 0,
             // Open from boot: the safe state while the guard waits for its first sample.
             valve: Valve::open(),
+            fb: None,
+            fb_mismatch: 0,
+            mismatch_steps: config.actuator_mismatch_steps,
+            lng_empty: false,
             alarm: false,
             untrusted: false,
             lng: LngBudget::new(&config.lng),
@@ -188,6 +201,7 @@ impl<N: Num> GuardOf<N> {
             }
         };
         g.trace.write(Trace::Restore { step: 0, kind });
+        g.lng_empty = g.lng.is_empty();
         g.boot_outputs();
         g
     }
@@ -450,10 +464,11 @@ impl<N: Num> GuardOf<N> {
         let n = upto.wrapping_sub(self.mark);
         if self.valve.is_open() {
             self.open_acc = self.open_acc.wrapping_add(n);
-            if self.latched == 0 {
-                // The exchanger runs over these ticks; under a latched fault the model
-                // takes no cooling credit (conservative: the exchanger itself may be
-                // what failed).
+            if self.latched == 0 && !self.lng_empty && self.fb != Some(false) {
+                // The exchanger runs over these ticks. No cooling credit under a
+                // latched fault (conservative: the exchanger itself may be what
+                // failed), with the LNG used up, or while the valve's position
+                // feedback says shut.
                 self.credit_acc = self.credit_acc.wrapping_add(n);
             }
         }
@@ -538,6 +553,8 @@ impl<N: Num> GuardOf<N> {
             self.trace.write(t);
         }
         self.lng.update_cj_ticks(cj, open_ticks);
+        // The credit state of the ticks from here on (`settle` ran for the step's).
+        self.lng_empty = self.lng.is_empty();
         self.last_cj = cj;
         let low = self.lng.is_low();
         if low && !self.lng_low {
@@ -592,6 +609,8 @@ impl<N: Num> GuardOf<N> {
         self.settle(self.step);
         self.latched &= faults::CONFIG;
         self.bad_ch = 0;
+        // A valve still disagreeing with its command latches again after the full time.
+        self.fb_mismatch = 0;
         // The controller accepts the estimate as it is (it is not reset); the alarm
         // follows it again from the next model step.
         let bits = bits | if self.untrusted { faults::UNTRUSTED } else { 0 };
@@ -627,9 +646,35 @@ impl<N: Num> GuardOf<N> {
         self.refresh_out();
     }
 
+    /// Reports the valve position read back from the valve (limit switch or
+    /// position sensor), `true` = open. Optional; when used, call it once per tick,
+    /// before [`GuardOf::step`] / [`GuardOf::step_missing`] (the position holds until
+    /// the next report). The model credits the exchanger only while the report does
+    /// not say shut; `actuator_mismatch_steps` consecutive reports that differ from
+    /// the command latch ACTUATOR (valve forced open, no credit). Without reports the
+    /// command is taken as the position (residual risk: docs/firmware.md).
+    pub fn valve_feedback(&mut self, open: bool) {
+        if self.fb != Some(open) {
+            // The credit may change from this tick on: count the ticks before.
+            self.settle(self.step);
+            self.fb = Some(open);
+        }
+        if open == self.valve.is_open() {
+            self.fb_mismatch = 0;
+            return;
+        }
+        self.fb_mismatch = self.fb_mismatch.saturating_add(1);
+        if self.fb_mismatch >= self.mismatch_steps {
+            self.report_actuator_fault();
+        }
+    }
+
     /// Refills the LNG budget (new charge installed).
     pub fn refill_lng(&mut self, cfg: &LngConfig) {
+        // The credit may change from this tick on: count the ticks before.
+        self.settle(self.step);
         self.lng = LngBudget::new(cfg);
+        self.lng_empty = self.lng.is_empty();
         self.lng_low = false;
         self.refresh_out();
     }

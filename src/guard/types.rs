@@ -100,6 +100,10 @@ pub struct GuardConfig {
     pub startup_timeout_steps: u32,
     /// Consecutive fully valid samples required before `clear_faults` succeeds, steps.
     pub clear_valid_steps: u32,
+    /// Consecutive valve-position reports ([`super::GuardOf::valve_feedback`]) that
+    /// differ from the command before ACTUATOR latches, 10 ms ticks (200 = 2 s: the
+    /// valve's stroke time with margin).
+    pub actuator_mismatch_steps: u32,
 }
 
 impl GuardConfig {
@@ -113,5 +117,6 @@ impl GuardConfig {
         stale_steps: 5,
         startup_timeout_steps: 1000,
         clear_valid_steps: 100,
+        actuator_mismatch_steps: 200,
     };
 }

@@ -32,6 +32,7 @@ pub fn inputs() -> Vec<Request> {
             speed_rpm: 500.0,
             position_mm: 20.0 * (0.05 * t).sin(),
             ambient_c: 16.0,
+            valve_fb: None,
         };
         if k == 50_000 {
             r.current_a = f32::NAN;
