@@ -50,7 +50,7 @@
 //! | 3 | u8 | reject reason ([`RejectReason`] as u8, 0 for step/done) |
 //! | 4 | f32 | predicted drain temperature, °C |
 //! | 8 | u8 | flags: bit0 valve open, bit1 alarm, bit2 derate |
-//! | 9 | u16 | fault word ([`crate::faults`]): bits 0-6 latched RANGE, RATE, NON_FINITE, STALE, MEMORY_CORRUPT, CONFIG, ACTUATOR; bit 7 LNG_LOW (status); bits 8-13 latched bad channels (current, p_A, p_B, speed, position, ambient); bit 15 UNTRUSTED (status) |
+//! | 9 | u16 | fault word ([`crate::faults`]): bits 0-6 latched RANGE, RATE, NON_FINITE, STALE, MEMORY_CORRUPT, CONFIG, ACTUATOR; bit 7 LNG_LOW (status); bits 8-13 latched bad channels (current, p_A, p_B, speed, position, ambient); bit 14 latched SENSOR_DISAGREE; bit 15 UNTRUSTED (status) |
 //! | 11 | f32 | LNG remaining, kg |
 //! | 15 | f32 | LNG seconds left at present dissipation, s |
 //! | 19 | u16 | rejected: CRC |

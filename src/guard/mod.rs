@@ -10,13 +10,18 @@
 mod types;
 pub use types::{faults, GuardConfig, Output, Sample, DRAIN_C_UNKNOWN};
 
+use crate::crosscheck::{CrossCheck, Verdict};
 use crate::memory::{Restore, ThermalRecord};
 use crate::model::{InputScales, Model, ModelInputN};
 use crate::num::Num;
 use crate::params::{N_NODES, TICKS_PER_STEP};
 use crate::protection::{alarm_update_with, LngBudget, LngConfig, Valve};
 use crate::trace::{RestoreKind, Trace, TraceBuf};
-use crate::validate::{self, Channels, LimitsN, CH_ALL, CH_POSITION};
+use crate::validate::{self, Channels, LimitsN, CH_ALL, CH_CURRENT, CH_POSITION, CH_P_A, CH_P_B, CH_SPEED};
+
+/// Channels the sensor cross-check compares: a window with any of them substituted
+/// by its worst case is not evaluated.
+const CROSS_CHANNELS: u8 = CH_CURRENT | CH_P_A | CH_P_B | CH_SPEED;
 
 /// Number type of the firmware build: `f32`, or [`crate::num::Fx`] with `fixed-point`.
 #[cfg(not(feature = "fixed-point"))]
@@ -44,6 +49,8 @@ struct Core<N: Num> {
     scales: InputScales<N>,
     limits: LimitsN<N>,
     th: Thresholds<N>,
+    /// Sensor cross-check; `None` without a torque constant (disabled).
+    cc: Option<CrossCheck<N>>,
 }
 
 impl<N: Num> Core<N> {
@@ -67,11 +74,17 @@ impl<N: Num> Core<N> {
             alarm: f(t[2]),
             clear: f(t[3]),
         };
+        let cc = if config.params.torque_constant_nm_per_a > 0.0 {
+            Some(CrossCheck::new(&config.crosscheck, TICKS_PER_STEP)?)
+        } else {
+            None
+        };
         Some(Core {
             model,
             scales,
             limits,
             th,
+            cc,
         })
     }
 }
@@ -186,6 +199,9 @@ impl<N: Num> GuardOf<N> {
                 g.bad_ch = ((r.faults >> faults::CH_SHIFT) as u8) & CH_ALL;
                 // Saved before a clear restored trust: still not trusted.
                 g.untrusted = r.faults & faults::UNTRUSTED != 0;
+                if let Some(c) = g.core.as_mut() {
+                    c.model.set_loss_max(g.latched & faults::SENSOR_DISAGREE != 0);
+                }
                 RestoreKind::Warm
             }
             Restore::Corrupt => {
@@ -489,12 +505,41 @@ impl<N: Num> GuardOf<N> {
         c.model.update(credit_ticks);
         // Mean total loss kW → cJ per 10 ms tick (= W), never negative.
         let cj = c.model.last_total_kw().round_times(1000).max(0) as u32;
+        if let Some(cc) = c.cc.as_mut() {
+            let (from_p, from_i) = c.model.last_mech_pair_kw();
+            match cc.step(from_p, from_i, self.bad_ch & CROSS_CHANNELS == 0) {
+                Verdict::None => {}
+                // While they disagree (and once latched) the model heats with the
+                // larger of the two losses.
+                Verdict::Window(d) => c.model.set_loss_max(d || self.latched & faults::SENSOR_DISAGREE != 0),
+                Verdict::Latch => {
+                    c.model.set_loss_max(true);
+                    self.latch_disagree();
+                }
+            }
+        }
         // The valid run of the clear rule is `step - valid_since`; keep it from
         // wrapping (2^30 ticks = 124 days is far above any clear_valid_steps).
         if self.step.wrapping_sub(self.valid_since) > 1 << 30 {
             self.valid_since = self.step.wrapping_sub(1 << 30);
         }
         self.protect(cj, open_ticks);
+    }
+
+    /// The current and the pressures / speed have disagreed for `persist_windows`
+    /// windows: SENSOR_DISAGREE latches (the valve opens in `protect`, this same
+    /// tick) and the estimate is not trusted (alarm and derate until a clear).
+    #[cold]
+    #[inline(never)]
+    fn latch_disagree(&mut self) {
+        if self.latched & faults::SENSOR_DISAGREE == 0 {
+            self.latched |= faults::SENSOR_DISAGREE;
+            self.trace.write(Trace::Fault {
+                step: self.step,
+                new_bits: faults::SENSOR_DISAGREE,
+            });
+        }
+        self.untrusted = true;
     }
 
     /// Valve hysteresis and dwell, alarm, LNG budget (`open_ticks` ticks of the model
@@ -609,8 +654,15 @@ impl<N: Num> GuardOf<N> {
         self.settle(self.step);
         self.latched &= faults::CONFIG;
         self.bad_ch = 0;
-        // A valve still disagreeing with its command latches again after the full time.
+        // A valve still disagreeing with its command latches again after the full time;
+        // so do sensors that still disagree.
         self.fb_mismatch = 0;
+        if let Some(c) = self.core.as_mut() {
+            if let Some(cc) = c.cc.as_mut() {
+                cc.restart_count();
+                c.model.set_loss_max(cc.disagrees());
+            }
+        }
         // The controller accepts the estimate as it is (it is not reset); the alarm
         // follows it again from the next model step.
         let bits = bits | if self.untrusted { faults::UNTRUSTED } else { 0 };

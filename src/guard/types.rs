@@ -5,9 +5,10 @@ use crate::params::ReducedParams;
 use crate::protection::{AlarmConfig, LngConfig, ValveConfig};
 use crate::validate::InputLimits;
 
-/// Fault bits of [`Output::faults`]. Bits 0-6 are latched until the clear rule
-/// ([`GuardOf::clear_faults`]); bit 7 is a live status; bits 8-13 name the latched
-/// bad input channels (`validate::CH_*` shifted by [`faults::CH_SHIFT`]).
+/// Fault bits of [`Output::faults`]. Bits 0-6 and 14 are latched until the clear
+/// rule ([`GuardOf::clear_faults`]); bits 7 and 15 are live status; bits 8-13 name
+/// the latched bad input channels (`validate::CH_*` shifted by
+/// [`faults::CH_SHIFT`]). The same word goes on the wire (`crate::protocol`).
 pub mod faults {
     /// An input was outside its plausible range.
     pub const RANGE: u16 = 1 << 0;
@@ -26,6 +27,11 @@ pub mod faults {
     pub const ACTUATOR: u16 = 1 << 6;
     /// LNG remaining below the low threshold (live status, not latched).
     pub const LNG_LOW: u16 = 1 << 7;
+    /// The motor current and the port pressures / speed have disagreed about the
+    /// shaft's loss for `crosscheck.persist_windows` windows in a row (analytic
+    /// redundancy, [`crate::crosscheck`]). Latched: valve open, alarm and derate
+    /// (UNTRUSTED), the model heats with the larger of the two losses.
+    pub const SENSOR_DISAGREE: u16 = 1 << 14;
     /// Shift of the latched bad-channel mask inside the fault word.
     pub const CH_SHIFT: u16 = 8;
     /// The estimate is not trusted (corrupt thermal record at boot, or no sample by
@@ -34,7 +40,7 @@ pub mod faults {
     /// thermal record so a warm reset does not drop it.
     pub const UNTRUSTED: u16 = 1 << 15;
     /// Bits that latch.
-    pub const LATCHED: u16 = 0x7f;
+    pub const LATCHED: u16 = 0x7f | SENSOR_DISAGREE;
 }
 
 /// One input sample, wire units (f32).
@@ -104,6 +110,8 @@ pub struct GuardConfig {
     /// differ from the command before ACTUATOR latches, 10 ms ticks (200 = 2 s: the
     /// valve's stroke time with margin).
     pub actuator_mismatch_steps: u32,
+    /// Sensor cross-check (current against pressures and speed).
+    pub crosscheck: crate::crosscheck::CrossCheckConfig,
 }
 
 impl GuardConfig {
@@ -118,5 +126,6 @@ impl GuardConfig {
         startup_timeout_steps: 1000,
         clear_valid_steps: 100,
         actuator_mismatch_steps: 200,
+        crosscheck: crate::crosscheck::CrossCheckConfig::DEFAULT,
     };
 }

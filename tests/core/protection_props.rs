@@ -11,9 +11,11 @@ use eha_guard::validate::InputLimits;
 use eha_guard::{GuardConfig, GuardOf, Output, Sample};
 use proptest::prelude::*;
 
+/// Case 1 at 60 bar, 500 rpm, the motor current consistent with it (36.2 A; was
+/// 30 A, which the sensor cross-check now reports as SENSOR_DISAGREE).
 fn nominal() -> Sample {
     Sample {
-        current_a: 30.0,
+        current_a: crate::plant::motor_current(65.0, 5.0, 500.0),
         p_a_bar: 65.0,
         p_b_bar: 5.0,
         speed_rpm: 500.0,
@@ -129,7 +131,8 @@ fn fault() -> impl Strategy<Value = Fault> {
 /// A mostly valid input run: a start inside every range, then piecewise-linear
 /// ramps whose per-tick change is at most 0.9 × the channel's rate limit, reflected
 /// at the range (inset by 0.5 % of its width), so every sample is valid and
-/// rate-limited with a margin that holds in all three number types. On top: in one
+/// rate-limited with a margin that holds in all three number types; the current
+/// follows the pressures and the speed (`plant::motor_current`). On top: in one
 /// case of three, 1-3 faults at chosen ticks; in half of the cases a maintenance
 /// `clear_faults` every `clear_every` ticks.
 #[derive(Clone, Debug)]
@@ -197,6 +200,11 @@ fn expand(run: &Run) -> Vec<(Tick, Option<Fault>)> {
                 }
                 *x = y;
             }
+            // The current is not free: a machine with consistent sensors draws the
+            // current of its pressures and speed (else the sensor cross-check rightly
+            // latches SENSOR_DISAGREE). Per tick it changes by at most 197 A (a 270 bar
+            // swing of dp with the speed's sign flipping) against the 200 A rate limit.
+            x[0] = crate::plant::motor_current(x[1], x[2], x[3]);
             match injected {
                 None => out.push((Tick::Sample(to_sample(&x)), None)),
                 Some(f @ Fault::Missing { ticks }) => {

@@ -13,9 +13,9 @@ use eha_guard::num::{Fx, Num};
 use eha_guard::trace::Trace;
 use eha_guard::{faults, GuardConfig, GuardOf, Output, Restore, Sample, ThermalRecord};
 
-/// Pump turning, little load, 20 degC air: the drain estimate falls from 60 degC.
+/// Pump turning, little load (the consistent motor current), 20 degC air.
 fn idle() -> Sample {
-    Sample { current_a: 6.0, p_a_bar: 10.0, p_b_bar: 5.0, speed_rpm: 500.0, position_mm: 0.0, ambient_c: 20.0 }
+    Sample { current_a: crate::plant::motor_current(10.0, 5.0, 500.0), p_a_bar: 10.0, p_b_bar: 5.0, speed_rpm: 500.0, position_mm: 0.0, ambient_c: 20.0 }
 }
 
 fn corrupt_record() -> ThermalRecord {

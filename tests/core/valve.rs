@@ -143,16 +143,7 @@ fn noise_of_half_a_kelvin_at_the_threshold_gives_at_most_one_toggle_per_dwell() 
     assert!(swing_toggles >= 16 * 18, "swing runs toggled only {swing_toggles} times");
 }
 
-/// Motor current consistent with the port pressures and the speed through the
-/// reduced model's loss equation (eq. 8) and the rig's torque constant:
-/// `|D dp + sign(w) eta_m D |dp||/Kt` (the reference's `shaft_torque`, |w| >= 1 rad/s).
-fn consistent_current(p_a: f32, p_b: f32, rpm: f32) -> f32 {
-    let p = eha_guard::params::DEFAULT;
-    let dp = (p_a - p_b) as f64 * 1e5;
-    let d = p.displacement_m3_per_rad;
-    let tau = d * dp + rpm.signum() as f64 * p.eta_m * d * dp.abs();
-    (tau.abs() / 0.75) as f32
-}
+use crate::plant::motor_current as consistent_current;
 
 fn sample(p_a: f32, rpm: f32) -> Sample {
     Sample {
