@@ -56,9 +56,17 @@ fn any_sample() -> impl Strategy<Value = Option<Sample>> {
     ]
 }
 
-fn run_all<N: eha_guard::num::Num>(seq: &[Option<Sample>]) -> Result<(), TestCaseError> {
+/// Runs an arbitrary sequence: samples or missing ticks, each with an optional
+/// valve-position report before it, and now and then a maintenance clear.
+fn run_all<N: eha_guard::num::Num>(seq: &[(Option<Sample>, Option<bool>)]) -> Result<(), TestCaseError> {
     let mut g = GuardOf::<N>::new(&GuardConfig::DEFAULT, Restore::Cold);
-    for s in seq {
+    for (k, (s, fb)) in seq.iter().enumerate() {
+        if let Some(v) = fb {
+            g.valve_feedback(*v);
+        }
+        if k % 97 == 96 {
+            let _ = g.clear_faults();
+        }
         let o = match s {
             Some(s) => g.step(s),
             None => g.step_missing(),
@@ -335,7 +343,7 @@ proptest! {
     #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
 
     #[test]
-    fn arbitrary_inputs_never_panic_and_stay_finite(seq in proptest::collection::vec(any_sample(), 1..300)) {
+    fn arbitrary_inputs_never_panic_and_stay_finite(seq in proptest::collection::vec((any_sample(), proptest::option::of(any::<bool>())), 1..300)) {
         run_all::<f32>(&seq)?;
         run_all::<Fx>(&seq)?;
         run_all::<f64>(&seq)?;
