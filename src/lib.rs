@@ -15,6 +15,7 @@
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing))]
 
 pub mod board;
+pub mod crosscheck;
 pub mod guard;
 pub mod linalg;
 pub mod memory;

@@ -103,6 +103,10 @@ pub struct ReducedParams {
     pub phases: f64,
     /// Phase resistance, ohm (eq. 1; constant, as in the reference baseline).
     pub r_ohm: f64,
+    /// Motor torque constant, N m per A rms: the shaft torque is `Kt |I|`. Used only
+    /// by the sensor cross-check (shaft power `Kt |I| |w|` against the hydraulic
+    /// power and eq. 8); 0 disables the cross-check.
+    pub torque_constant_nm_per_a: f64,
     /// Iron loss, hysteresis term: `k_fe1 |w|`, W s/rad (eq. 2 with f ∝ w).
     pub k_fe1_w_s_per_rad: f64,
     /// Iron loss, eddy term: `k_fe2 w^2`, W s^2/rad^2 (eq. 2).
@@ -179,6 +183,7 @@ impl ReducedParams {
             self.act_friction_n_s_per_m,
             self.phases,
             self.r_ohm,
+            self.torque_constant_nm_per_a,
             self.k_fe1_w_s_per_rad,
             self.k_fe2_w_s2_per_rad2,
             self.k_fe15_w_per_rad15,
@@ -242,6 +247,7 @@ pub const DEFAULT: ReducedParams = ReducedParams {
     act_friction_n_s_per_m: 2000.0,
     phases: 3.0,
     r_ohm: 0.074,
+    torque_constant_nm_per_a: 0.75,
     k_fe1_w_s_per_rad: 0.37433242615213785,
     k_fe2_w_s2_per_rad2: 0.0015887161595118564,
     k_fe15_w_per_rad15: 0.008414188516295527,

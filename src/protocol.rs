@@ -24,7 +24,7 @@
 //! the code is short enough to review in full, and it is tested against the
 //! published check value and against a reference encoder in the unit tests.
 //!
-//! # Request (host → guard), payload 27 bytes
+//! # Request (host → guard), payload 28 bytes
 //! | off | type | field |
 //! |---|---|---|
 //! | 0 | u8 | kind = [`KIND_SAMPLE`] |
@@ -35,6 +35,12 @@
 //! | 15 | f32 | `speed_rpm` |
 //! | 19 | f32 | `position_mm` |
 //! | 23 | f32 | `ambient_c` |
+//! | 27 | u8 | flags: bit0 valve position reported, bit1 valve reported open (only with bit0); bits 2-7 reserved, 0 |
+//!
+//! A frame with a reserved flag bit set, or bit1 without bit0, is rejected
+//! ([`RejectReason::Kind`]). The valve position is the read-back of the LNG valve
+//! ([`crate::GuardOf::valve_feedback`]); without it (bit0 clear) the guard takes
+//! the command as the position.
 //!
 //! # Reply (guard → host), payload 37 bytes
 //! | off | type | field |
@@ -44,7 +50,7 @@
 //! | 3 | u8 | reject reason ([`RejectReason`] as u8, 0 for step/done) |
 //! | 4 | f32 | predicted drain temperature, °C |
 //! | 8 | u8 | flags: bit0 valve open, bit1 alarm, bit2 derate |
-//! | 9 | u16 | fault bits (the guard's latched faults) |
+//! | 9 | u16 | fault word ([`crate::faults`]): bits 0-6 latched RANGE, RATE, NON_FINITE, STALE, MEMORY_CORRUPT, CONFIG, ACTUATOR; bit 7 LNG_LOW (status); bits 8-13 latched bad channels (current, p_A, p_B, speed, position, ambient); bit 14 latched SENSOR_DISAGREE; bit 15 UNTRUSTED (status) |
 //! | 11 | f32 | LNG remaining, kg |
 //! | 15 | f32 | LNG seconds left at present dissipation, s |
 //! | 19 | u16 | rejected: CRC |
@@ -75,6 +81,11 @@
 
 use heapless::Vec;
 
+/// Request flag: the valve position is reported in this frame.
+pub const FLAG_VALVE_FB: u8 = 1 << 0;
+/// Request flag: the reported valve position is open (only with [`FLAG_VALVE_FB`]).
+pub const FLAG_VALVE_FB_OPEN: u8 = 1 << 1;
+
 /// Request kind: one sensor sample, step the guard once.
 pub const KIND_SAMPLE: u8 = 0x01;
 /// Reply kind: the frame was accepted and the guard stepped.
@@ -85,7 +96,7 @@ pub const KIND_REJECT: u8 = 0x82;
 pub const KIND_DONE: u8 = 0x83;
 
 /// Length of a request payload (without CRC).
-pub const REQUEST_LEN: usize = 27;
+pub const REQUEST_LEN: usize = 28;
 /// Length of a reply payload (without CRC).
 pub const REPLY_LEN: usize = 37;
 /// Largest payload + CRC of any frame.
@@ -257,6 +268,8 @@ pub struct Request {
     pub position_mm: f32,
     /// Ambient air temperature, degC.
     pub ambient_c: f32,
+    /// LNG valve position read back (`Some(true)` open), `None` when not reported.
+    pub valve_fb: Option<bool>,
 }
 
 /// What the guard reports after a step: the guard's own [`crate::Output`].
@@ -285,10 +298,14 @@ pub const MAX_MISSED_STEPS: u16 = 100;
 /// binary and the host SIL twin so both run exactly the same code: frames
 /// the sequence numbers say were lost count as missed samples
 /// ([`crate::GuardOf::step_missing`], at most [`MAX_MISSED_STEPS`]), then
-/// the guard steps on the frame's sample.
+/// the frame's valve position, if reported, goes to
+/// [`crate::GuardOf::valve_feedback`] and the guard steps on the frame's sample.
 pub fn step_guard<N: crate::num::Num>(guard: &mut crate::GuardOf<N>, req: &Request, skipped: u16) -> GuardOutput {
     for _ in 0..skipped.min(MAX_MISSED_STEPS) {
         let _ = guard.step_missing();
+    }
+    if let Some(open) = req.valve_fb {
+        guard.valve_feedback(open);
     }
     guard.step(&req.sample())
 }
@@ -428,6 +445,12 @@ impl Request {
         for v in [self.current_a, self.p_a_bar, self.p_b_bar, self.speed_rpm, self.position_mm, self.ambient_c] {
             let _ = p.extend_from_slice(&v.to_le_bytes());
         }
+        let flags = match self.valve_fb {
+            None => 0,
+            Some(false) => FLAG_VALVE_FB,
+            Some(true) => FLAG_VALVE_FB | FLAG_VALVE_FB_OPEN,
+        };
+        let _ = p.push(flags);
         p
     }
 
@@ -440,7 +463,7 @@ impl Request {
         if p.len() != REQUEST_LEN {
             return Err(DecodeError::Length);
         }
-        Ok(Request {
+        let mut q = Request {
             seq: r.u16()?,
             current_a: r.f32()?,
             p_a_bar: r.f32()?,
@@ -448,7 +471,15 @@ impl Request {
             speed_rpm: r.f32()?,
             position_mm: r.f32()?,
             ambient_c: r.f32()?,
-        })
+            valve_fb: None,
+        };
+        q.valve_fb = match r.u8()? {
+            0 => None,
+            FLAG_VALVE_FB => Some(false),
+            f if f == FLAG_VALVE_FB | FLAG_VALVE_FB_OPEN => Some(true),
+            _ => return Err(DecodeError::Kind),
+        };
+        Ok(q)
     }
 
     /// Wire bytes: COBS frame terminated by `0x00` (no leading delimiter).
@@ -721,6 +752,7 @@ mod tests {
             speed_rpm: -1500.0,
             position_mm: 42.0,
             ambient_c: 21.0,
+            valve_fb: None,
         }
     }
 
@@ -776,6 +808,39 @@ mod tests {
             }
         }
         assert_eq!(got, Some(r));
+    }
+
+    #[test]
+    fn request_valve_feedback_flags() {
+        // None / shut / open round-trip through the flags byte (offset 27).
+        for fb in [None, Some(false), Some(true)] {
+            let r = Request { valve_fb: fb, ..req(3) };
+            let p = r.to_payload();
+            assert_eq!(p.len(), REQUEST_LEN);
+            assert_eq!(p[27], match fb { None => 0, Some(false) => 1, Some(true) => 3 });
+            assert_eq!(Request::from_payload(&p), Ok(r));
+        }
+        // Reserved bits, or "open" without "reported", are rejected.
+        for flags in [2u8, 4, 0x80, 0xff, 7] {
+            let mut p = req(3).to_payload();
+            p[27] = flags;
+            assert_eq!(Request::from_payload(&p), Err(DecodeError::Kind), "flags {flags:#x}");
+        }
+    }
+
+    #[test]
+    fn step_guard_passes_the_valve_feedback() {
+        // A cold guard commands the valve shut at 21 degC; 50 frames reporting it
+        // open latch ACTUATOR (GuardConfig::DEFAULT.actuator_mismatch_steps = 50).
+        let mut g = crate::GuardOf::<f32>::new(&crate::GuardConfig::DEFAULT, crate::Restore::Cold);
+        let s = Request { current_a: 0.0, p_a_bar: 5.0, p_b_bar: 5.0, speed_rpm: 500.0, ..req(0) };
+        let o = step_guard(&mut g, &s, 0);
+        assert!(!o.valve_open && o.faults == 0, "{o:?}");
+        let mut o = o;
+        for k in 1..=50u16 {
+            o = step_guard(&mut g, &Request { seq: k, valve_fb: Some(true), ..s }, 0);
+        }
+        assert!(o.valve_open && o.faults & crate::faults::ACTUATOR != 0, "{o:?}");
     }
 
     #[test]

@@ -40,7 +40,7 @@ pub enum Trace {
         /// `true` when a fault forced it, `false` when the temperature did.
         forced: bool,
     },
-    /// LNG valve commanded closed (below the hysteresis band, dwell elapsed).
+    /// LNG valve commanded closed (below the closing threshold for the whole dwell).
     ValveClose {
         /// Step counter.
         step: u32,

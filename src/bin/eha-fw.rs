@@ -90,7 +90,9 @@ mod fw {
         let mut last_trace = guard.trace().recent().copied();
 
         let mut link = Link::new();
-        let mut last = GuardOutput::default();
+        // The outputs at boot (valve open while waiting for the first frame), so the
+        // first frame's changes are logged against them.
+        let mut last = guard.output();
         let mut buf = [0u8; 64];
         loop {
             let n = match stdin.read(&mut buf) {

@@ -10,13 +10,18 @@
 mod types;
 pub use types::{faults, GuardConfig, Output, Sample, DRAIN_C_UNKNOWN};
 
+use crate::crosscheck::{CrossCheck, Verdict};
 use crate::memory::{Restore, ThermalRecord};
 use crate::model::{InputScales, Model, ModelInputN};
 use crate::num::Num;
 use crate::params::{N_NODES, TICKS_PER_STEP};
 use crate::protection::{alarm_update_with, LngBudget, LngConfig, Valve};
 use crate::trace::{RestoreKind, Trace, TraceBuf};
-use crate::validate::{self, Channels, LimitsN, CH_ALL, CH_POSITION};
+use crate::validate::{self, Channels, LimitsN, CH_ALL, CH_CURRENT, CH_POSITION, CH_P_A, CH_P_B, CH_SPEED};
+
+/// Channels the sensor cross-check compares: a window with any of them substituted
+/// by its worst case is not evaluated.
+const CROSS_CHANNELS: u8 = CH_CURRENT | CH_P_A | CH_P_B | CH_SPEED;
 
 /// Number type of the firmware build: `f32`, or [`crate::num::Fx`] with `fixed-point`.
 #[cfg(not(feature = "fixed-point"))]
@@ -44,6 +49,8 @@ struct Core<N: Num> {
     scales: InputScales<N>,
     limits: LimitsN<N>,
     th: Thresholds<N>,
+    /// Sensor cross-check; `None` without a torque constant (disabled).
+    cc: Option<CrossCheck<N>>,
 }
 
 impl<N: Num> Core<N> {
@@ -67,11 +74,17 @@ impl<N: Num> Core<N> {
             alarm: f(t[2]),
             clear: f(t[3]),
         };
+        let cc = if config.params.torque_constant_nm_per_a > 0.0 {
+            Some(CrossCheck::new(&config.crosscheck, TICKS_PER_STEP)?)
+        } else {
+            None
+        };
         Some(Core {
             model,
             scales,
             limits,
             th,
+            cc,
         })
     }
 }
@@ -83,6 +96,7 @@ pub struct GuardOf<N: Num> {
     /// Valve dwell in model steps (the configured ticks, rounded up).
     dwell_model_steps: u32,
     stale_steps: u32,
+    startup_timeout_steps: u32,
     clear_valid_steps: u32,
     latched: u16,
     bad_ch: u8,
@@ -92,20 +106,34 @@ pub struct GuardOf<N: Num> {
     /// Tick index from which every sample was present and valid (the run of valid
     /// samples of the clear rule is `step - valid_since`).
     valid_since: u32,
-    /// `false` until the first tick: a cold start takes that tick's ambient, and the
-    /// protection is evaluated once on the initial (or restored) estimate.
+    /// `false` until the first sample: until then the guard waits (valve open, model
+    /// not started, STALE only after `startup_timeout_steps`). A cold start takes
+    /// the first sample's ambient, and the protection is evaluated once on the
+    /// initial (or restored) estimate.
     started: bool,
     cold: bool,
     /// Tick from which the present valve and credit state hold in this model step.
     mark: u32,
     /// Ticks of this model step before `mark` with the valve commanded open (LNG
-    /// budget), and with the exchanger credited (open, no fault latched).
+    /// budget), and with the exchanger credited (open, no fault latched, LNG left,
+    /// the position feedback, if any, not saying shut).
     open_acc: u32,
     credit_acc: u32,
     /// Mean loss of the last model step, cJ per tick (= W).
     last_cj: u32,
     valve: Valve,
+    /// Last valve position reported by [`GuardOf::valve_feedback`] (None: no feedback).
+    fb: Option<bool>,
+    /// Consecutive reports differing from the command.
+    fb_mismatch: u32,
+    /// Reports differing from the command that latch ACTUATOR.
+    mismatch_steps: u32,
+    /// The LNG budget is used up: no exchanger credit.
+    lng_empty: bool,
     alarm: bool,
+    /// The estimate is not trusted (corrupt record at boot, no sample by the start-up
+    /// timeout): alarm and derate held until a successful `clear_faults`.
+    untrusted: bool,
     lng: LngBudget,
     lng_low: bool,
     step: u32,
@@ -129,6 +157,7 @@ impl<N: Num> GuardOf<N> {
             core,
             dwell_model_steps: config.valve.dwell_steps.div_ceil(TICKS_PER_STEP),
             stale_steps: config.stale_steps,
+            startup_timeout_steps: config.startup_timeout_steps,
             clear_valid_steps: config.clear_valid_steps,
             bad_ch: 0,
             prev: [N::ZERO; 6],
@@ -141,8 +170,14 @@ impl<N: Num> GuardOf<N> {
             open_acc: 0,
             credit_acc: 0,
             last_cj: 0,
-            valve: Valve::new(),
+            // Open from boot: the safe state while the guard waits for its first sample.
+            valve: Valve::open(),
+            fb: None,
+            fb_mismatch: 0,
+            mismatch_steps: config.actuator_mismatch_steps,
+            lng_empty: false,
             alarm: false,
+            untrusted: false,
             lng: LngBudget::new(&config.lng),
             lng_low: false,
             step: 0,
@@ -166,6 +201,11 @@ impl<N: Num> GuardOf<N> {
                     // The valve was open: it stays open for at least its dwell.
                     g.valve.force_open();
                 }
+                // Saved before a clear restored trust: still not trusted.
+                g.untrusted = r.faults & faults::UNTRUSTED != 0;
+                if let Some(c) = g.core.as_mut() {
+                    c.model.set_loss_max(g.latched & faults::SENSOR_DISAGREE != 0);
+                }
                 RestoreKind::Warm
             }
             Restore::Corrupt => {
@@ -176,12 +216,40 @@ impl<N: Num> GuardOf<N> {
                 g.cold = false;
                 g.lng.set_used_cj(u32::MAX);
                 g.latched |= faults::MEMORY_CORRUPT;
+                g.untrusted = true;
                 RestoreKind::Corrupt
             }
         };
         g.trace.write(Trace::Restore { step: 0, kind });
-        g.refresh_out();
+        g.lng_empty = g.lng.is_empty();
+        g.boot_outputs();
         g
+    }
+
+    /// Outputs before the first sample: the restored estimate (none on a cold boot)
+    /// with the alarm evaluated on it; no model, no alarm and derate on: CONFIG.
+    #[cold]
+    #[inline(never)]
+    fn boot_outputs(&mut self) {
+        match self.core.as_ref() {
+            Some(c) if !self.cold => {
+                let d = c.model.drain_c();
+                let f = d.to_f32();
+                self.out.drain_c = if f.is_finite() { f } else { DRAIN_C_UNKNOWN };
+                let raised = if self.untrusted {
+                    self.alarm = true;
+                    true
+                } else {
+                    alarm_update_with(&mut self.alarm, d, c.th.alarm, c.th.clear) == Some(true)
+                };
+                if raised {
+                    self.trace.write(Trace::Alarm { step: 0, drain_c: self.out.drain_c });
+                }
+            }
+            Some(_) => {}
+            None => self.alarm = true,
+        }
+        self.refresh_out();
     }
 
     /// One 10 ms tick with a new sample. Never panics; any invalid channel latches a
@@ -230,7 +298,7 @@ impl<N: Num> GuardOf<N> {
     fn step_slow(&mut self, s: &Sample) -> Output {
         self.missing = 0;
         let Some(core) = self.core.as_ref() else {
-            return self.slow_tail(None, 0);
+            return self.slow_tail(None, 0, N::ZERO);
         };
         let (v, nonfinite) = validate::convert(s, &core.scales);
         let c = validate::check(&v, nonfinite, &self.prev, self.prev_ok, &core.limits);
@@ -255,15 +323,24 @@ impl<N: Num> GuardOf<N> {
             None
         };
         let u = validate::substitute(&v, self.bad_ch, prev_pos, &core.limits);
+        // A cold start takes this sample's own ambient when it is valid (also when
+        // an earlier STALE makes the model run on the worst case from now on), else
+        // the worst case.
+        let [_, _, _, _, _, amb] = v;
+        let start_amb = if c.bad & validate::CH_AMBIENT == 0 { amb } else { u.ambient_c };
         self.prev = v;
         self.prev_ok = !c.bad & CH_ALL;
-        self.slow_tail(Some(&u), new_bits)
+        self.slow_tail(Some(&u), new_bits, start_amb)
     }
 
     /// One 10 ms tick without a new sample: inputs are held (piston work taken as
     /// zero); after `stale_steps` consecutive misses the STALE fault latches and every
-    /// channel takes its worst case.
+    /// channel takes its worst case. Before the first sample the guard waits instead
+    /// ([`GuardOf::wait_tick`]).
     pub fn step_missing(&mut self) -> Output {
+        if !self.started {
+            return self.wait_tick();
+        }
         self.missing = self.missing.saturating_add(1);
         self.valid_since = self.step.wrapping_add(1);
         self.prev_ok = 0;
@@ -276,13 +353,48 @@ impl<N: Num> GuardOf<N> {
             .core
             .as_ref()
             .map(|c| validate::substitute(&self.prev, self.bad_ch, None, &c.limits));
-        self.slow_tail(u.as_ref(), new_bits)
+        self.slow_tail(u.as_ref(), new_bits, N::ZERO)
+    }
+
+    /// A tick without a sample before the first sample (boot, or samples not yet
+    /// flowing): the model is not started and accumulates nothing, the valve stays
+    /// open; after `startup_timeout_steps` such ticks STALE latches (every channel
+    /// worst case once samples arrive, until a clear).
+    #[cold]
+    #[inline(never)]
+    fn wait_tick(&mut self) -> Output {
+        self.missing = self.missing.saturating_add(1);
+        self.valid_since = self.step.wrapping_add(1);
+        if self.missing >= self.startup_timeout_steps {
+            if self.latched & faults::STALE == 0 {
+                self.trace.write(Trace::Fault {
+                    step: self.step,
+                    new_bits: faults::STALE | ((CH_ALL as u16) << faults::CH_SHIFT),
+                });
+            }
+            self.latched |= faults::STALE;
+            self.bad_ch = CH_ALL;
+            // No estimate and no input: alarm and derate until a clear.
+            self.untrusted = true;
+            if !self.alarm {
+                self.alarm = true;
+                self.trace.write(Trace::Alarm {
+                    step: self.step,
+                    drain_c: self.out.drain_c,
+                });
+            }
+        }
+        // The valve is open since boot (nothing closes it before the first sample).
+        self.refresh_out();
+        self.step = self.step.wrapping_add(1);
+        self.mark = self.step;
+        self.out
     }
 
     /// Slow-path tail: latches `new_bits` and opens the valve at once when any fault
-    /// is latched (fail-safe in the same tick), starts the model on the first tick,
-    /// then the common tick.
-    fn slow_tail(&mut self, u: Option<&ModelInputN<N>>, new_bits: u16) -> Output {
+    /// is latched (fail-safe in the same tick), starts the model at the first sample
+    /// (cold: at `start_amb`), then the common tick.
+    fn slow_tail(&mut self, u: Option<&ModelInputN<N>>, new_bits: u16, start_amb: N) -> Output {
         // The valve / credit state may change for this tick: count the ticks before.
         self.settle(self.step);
         let newly = new_bits & !self.latched;
@@ -303,7 +415,7 @@ impl<N: Num> GuardOf<N> {
         match u {
             Some(u) if self.core.is_some() => {
                 if !self.started {
-                    self.start(u.ambient_c);
+                    self.start(start_amb);
                 }
                 self.refresh_out();
                 self.tick(u)
@@ -334,18 +446,31 @@ impl<N: Num> GuardOf<N> {
         self.out
     }
 
-    /// First tick: a cold start takes every node to this tick's ambient; then the
-    /// protection is evaluated once on the initial (or restored) estimate, so that a
-    /// warm restore above the threshold opens the valve at once.
+    /// First sample: a cold start takes every node to `ambient_c`; the valve leaves
+    /// the open start-up state by the hysteresis relay on the initial (or restored)
+    /// estimate (closed only below the closing threshold, with no qualification: the
+    /// opening was not temperature-driven), then the protection is evaluated once.
     #[cold]
     #[inline(never)]
     fn start(&mut self, ambient_c: N) {
         self.started = true;
-        self.settle(self.step);
+        // Nothing of the waiting time is counted: no model ran, no credit, no LNG booked.
+        self.mark = self.step;
+        self.open_acc = 0;
+        self.credit_acc = 0;
+        let Some(c) = self.core.as_mut() else {
+            return;
+        };
         if self.cold {
-            if let Some(c) = self.core.as_mut() {
-                c.model.set_uniform(ambient_c);
-            }
+            c.model.set_uniform(ambient_c);
+        }
+        let d = c.model.drain_c();
+        if self.latched == 0 && d < c.th.close && self.valve.is_open() {
+            self.valve.set(false);
+            self.trace.write(Trace::ValveClose {
+                step: self.step,
+                drain_c: d.to_f32(),
+            });
         }
         self.protect(0, 0);
     }
@@ -359,10 +484,11 @@ impl<N: Num> GuardOf<N> {
         let n = upto.wrapping_sub(self.mark);
         if self.valve.is_open() {
             self.open_acc = self.open_acc.wrapping_add(n);
-            if self.latched == 0 {
-                // The exchanger runs over these ticks; under a latched fault the model
-                // takes no cooling credit (conservative: the exchanger itself may be
-                // what failed).
+            if self.latched == 0 && !self.lng_empty && self.fb != Some(false) {
+                // The exchanger runs over these ticks. No cooling credit under a
+                // latched fault (conservative: the exchanger itself may be what
+                // failed), with the LNG used up, or while the valve's position
+                // feedback says shut.
                 self.credit_acc = self.credit_acc.wrapping_add(n);
             }
         }
@@ -383,12 +509,41 @@ impl<N: Num> GuardOf<N> {
         c.model.update(credit_ticks);
         // Mean total loss kW → cJ per 10 ms tick (= W), never negative.
         let cj = c.model.last_total_kw().round_times(1000).max(0) as u32;
+        if let Some(cc) = c.cc.as_mut() {
+            let (from_p, from_i) = c.model.last_mech_pair_kw();
+            match cc.step(from_p, from_i, self.bad_ch & CROSS_CHANNELS == 0) {
+                Verdict::None => {}
+                // While they disagree (and once latched) the model heats with the
+                // larger of the two losses.
+                Verdict::Window(d) => c.model.set_loss_max(d || self.latched & faults::SENSOR_DISAGREE != 0),
+                Verdict::Latch => {
+                    c.model.set_loss_max(true);
+                    self.latch_disagree();
+                }
+            }
+        }
         // The valid run of the clear rule is `step - valid_since`; keep it from
         // wrapping (2^30 ticks = 124 days is far above any clear_valid_steps).
         if self.step.wrapping_sub(self.valid_since) > 1 << 30 {
             self.valid_since = self.step.wrapping_sub(1 << 30);
         }
         self.protect(cj, open_ticks);
+    }
+
+    /// The current and the pressures / speed have disagreed for `persist_windows`
+    /// windows: SENSOR_DISAGREE latches (the valve opens in `protect`, this same
+    /// tick) and the estimate is not trusted (alarm and derate until a clear).
+    #[cold]
+    #[inline(never)]
+    fn latch_disagree(&mut self) {
+        if self.latched & faults::SENSOR_DISAGREE == 0 {
+            self.latched |= faults::SENSOR_DISAGREE;
+            self.trace.write(Trace::Fault {
+                step: self.step,
+                new_bits: faults::SENSOR_DISAGREE,
+            });
+        }
+        self.untrusted = true;
     }
 
     /// Valve hysteresis and dwell, alarm, LNG budget (`open_ticks` ticks of the model
@@ -404,7 +559,12 @@ impl<N: Num> GuardOf<N> {
         let valve_ev = self
             .valve
             .update_with(d, force, th.open, th.close, self.dwell_model_steps);
-        let alarm_ev = alarm_update_with(&mut self.alarm, d, th.alarm, th.clear);
+        let alarm_ev = if self.untrusted {
+            // Held whatever the estimate says (raised at boot or at the timeout).
+            (!core::mem::replace(&mut self.alarm, true)).then_some(true)
+        } else {
+            alarm_update_with(&mut self.alarm, d, th.alarm, th.clear)
+        };
         let drain_c = d.to_f32();
         let drain_c = if drain_c.is_finite() {
             drain_c
@@ -442,6 +602,8 @@ impl<N: Num> GuardOf<N> {
             self.trace.write(t);
         }
         self.lng.update_cj_ticks(cj, open_ticks);
+        // The credit state of the ticks from here on (`settle` ran for the step's).
+        self.lng_empty = self.lng.is_empty();
         self.last_cj = cj;
         let low = self.lng.is_low();
         if low && !self.lng_low {
@@ -467,18 +629,26 @@ impl<N: Num> GuardOf<N> {
         };
     }
 
+    /// The outputs as the last tick left them (at boot: the waiting state).
+    pub fn output(&self) -> Output {
+        self.out
+    }
+
     /// Present fault word (see [`faults`]).
     pub fn faults(&self) -> u16 {
         self.latched
             | ((self.bad_ch as u16) << faults::CH_SHIFT)
             | if self.lng_low { faults::LNG_LOW } else { 0 }
+            | if self.untrusted { faults::UNTRUSTED } else { 0 }
     }
 
     /// **Clear rule.** Latched faults (except CONFIG) clear only through this explicit
     /// call (maintenance / operator command), and only if the last
     /// `clear_valid_steps` samples (1 s by default) were all valid and none is missing.
     /// The thermal estimate is *not* reset: it relaxes from its conservative value.
-    /// Returns `true` when the faults were cleared.
+    /// A successful clear also restores trust in the estimate ([`faults::UNTRUSTED`]:
+    /// after a corrupt record or no sample by the start-up timeout the alarm and
+    /// derate are held until then). Returns `true` when the faults were cleared.
     pub fn clear_faults(&mut self) -> bool {
         let valid_run = self.step.wrapping_sub(self.valid_since);
         if self.missing != 0 || valid_run < self.clear_valid_steps {
@@ -488,6 +658,19 @@ impl<N: Num> GuardOf<N> {
         self.settle(self.step);
         self.latched &= faults::CONFIG;
         self.bad_ch = 0;
+        // A valve still disagreeing with its command latches again after the full time;
+        // so do sensors that still disagree.
+        self.fb_mismatch = 0;
+        if let Some(c) = self.core.as_mut() {
+            if let Some(cc) = c.cc.as_mut() {
+                cc.restart_count();
+                c.model.set_loss_max(cc.disagrees());
+            }
+        }
+        // The controller accepts the estimate as it is (it is not reset); the alarm
+        // follows it again from the next model step.
+        let bits = bits | if self.untrusted { faults::UNTRUSTED } else { 0 };
+        self.untrusted = false;
         if bits != 0 {
             self.trace.write(Trace::FaultsCleared {
                 step: self.step,
@@ -519,9 +702,35 @@ impl<N: Num> GuardOf<N> {
         self.refresh_out();
     }
 
+    /// Reports the valve position read back from the valve (limit switch or
+    /// position sensor), `true` = open. Optional; when used, call it once per tick,
+    /// before [`GuardOf::step`] / [`GuardOf::step_missing`] (the position holds until
+    /// the next report). The model credits the exchanger only while the report does
+    /// not say shut; `actuator_mismatch_steps` consecutive reports that differ from
+    /// the command latch ACTUATOR (valve forced open, no credit). Without reports the
+    /// command is taken as the position (residual risk: docs/firmware.md).
+    pub fn valve_feedback(&mut self, open: bool) {
+        if self.fb != Some(open) {
+            // The credit may change from this tick on: count the ticks before.
+            self.settle(self.step);
+            self.fb = Some(open);
+        }
+        if open == self.valve.is_open() {
+            self.fb_mismatch = 0;
+            return;
+        }
+        self.fb_mismatch = self.fb_mismatch.saturating_add(1);
+        if self.fb_mismatch >= self.mismatch_steps {
+            self.report_actuator_fault();
+        }
+    }
+
     /// Refills the LNG budget (new charge installed).
     pub fn refill_lng(&mut self, cfg: &LngConfig) {
+        // The credit may change from this tick on: count the ticks before.
+        self.settle(self.step);
         self.lng = LngBudget::new(cfg);
+        self.lng_empty = self.lng.is_empty();
         self.lng_low = false;
         self.refresh_out();
     }

@@ -5,9 +5,10 @@ use crate::params::ReducedParams;
 use crate::protection::{AlarmConfig, LngConfig, ValveConfig};
 use crate::validate::InputLimits;
 
-/// Fault bits of [`Output::faults`]. Bits 0-6 are latched until the clear rule
-/// ([`GuardOf::clear_faults`]); bit 7 is a live status; bits 8-13 name the latched
-/// bad input channels (`validate::CH_*` shifted by [`faults::CH_SHIFT`]).
+/// Fault bits of [`Output::faults`]. Bits 0-6 and 14 are latched until the clear
+/// rule ([`GuardOf::clear_faults`]); bits 7 and 15 are live status; bits 8-13 name
+/// the latched bad input channels (`validate::CH_*` shifted by
+/// [`faults::CH_SHIFT`]). The same word goes on the wire (`crate::protocol`).
 pub mod faults {
     /// An input was outside its plausible range.
     pub const RANGE: u16 = 1 << 0;
@@ -26,10 +27,20 @@ pub mod faults {
     pub const ACTUATOR: u16 = 1 << 6;
     /// LNG remaining below the low threshold (live status, not latched).
     pub const LNG_LOW: u16 = 1 << 7;
+    /// The motor current and the port pressures / speed have disagreed about the
+    /// shaft's loss for `crosscheck.persist_windows` windows in a row (analytic
+    /// redundancy, [`crate::crosscheck`]). Latched: valve open, alarm and derate
+    /// (UNTRUSTED), the model heats with the larger of the two losses.
+    pub const SENSOR_DISAGREE: u16 = 1 << 14;
     /// Shift of the latched bad-channel mask inside the fault word.
     pub const CH_SHIFT: u16 = 8;
+    /// The estimate is not trusted (corrupt thermal record at boot, or no sample by
+    /// the start-up timeout): alarm and derate are held until a successful
+    /// [`super::GuardOf::clear_faults`]. Status, not a latched fault; kept in the
+    /// thermal record so a warm reset does not drop it.
+    pub const UNTRUSTED: u16 = 1 << 15;
     /// Bits that latch.
-    pub const LATCHED: u16 = 0x7f;
+    pub const LATCHED: u16 = 0x7f | SENSOR_DISAGREE;
 }
 
 /// One input sample, wire units (f32).
@@ -86,10 +97,22 @@ pub struct GuardConfig {
     pub alarm: AlarmConfig,
     /// LNG heat sink.
     pub lng: LngConfig,
-    /// Consecutive missing samples that make the input stale, steps (5 = 50 ms).
+    /// Consecutive missing samples, once samples have started, that make the input
+    /// stale, 10 ms ticks (5 = 50 ms).
     pub stale_steps: u32,
+    /// Ticks after boot without any sample before the input is declared stale
+    /// (1000 = 10 s). Until the first sample the guard waits: valve open (the safe
+    /// state), model not started, no fault.
+    pub startup_timeout_steps: u32,
     /// Consecutive fully valid samples required before `clear_faults` succeeds, steps.
     pub clear_valid_steps: u32,
+    /// Consecutive valve-position reports ([`super::GuardOf::valve_feedback`]) that
+    /// differ from the command before ACTUATOR latches, 10 ms ticks (50 = 0.5 s: a
+    /// cryogenic solenoid valve strokes in ≤ 0.1 s; the fault campaign's rule is
+    /// detection within 1 s of the mismatch).
+    pub actuator_mismatch_steps: u32,
+    /// Sensor cross-check (current against pressures and speed).
+    pub crosscheck: crate::crosscheck::CrossCheckConfig,
 }
 
 impl GuardConfig {
@@ -101,6 +124,9 @@ impl GuardConfig {
         alarm: AlarmConfig::DEFAULT,
         lng: LngConfig::DEFAULT,
         stale_steps: 5,
+        startup_timeout_steps: 1000,
         clear_valid_steps: 100,
+        actuator_mismatch_steps: 50,
+        crosscheck: crate::crosscheck::CrossCheckConfig::DEFAULT,
     };
 }

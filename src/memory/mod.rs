@@ -20,8 +20,10 @@
 //!   unknown but the machine may be hot, so every node starts at the over-temperature
 //!   alarm temperature (60 degC, the paper's permissible drain temperature), the
 //!   valve is forced open by the latched `MEMORY_CORRUPT` fault, and the LNG budget
-//!   is taken as empty (unknown use: report the worst case). The estimate then
-//!   relaxes with the model dynamics; the fault clears only by the clear rule.
+//!   is taken as empty (unknown use: report the worst case). The estimate is not
+//!   trusted: alarm and derate are raised at once (the start temperature alone would
+//!   not raise them: the alarm fires above it) and held until the clear rule
+//!   (`faults::UNTRUSTED`); the estimate relaxes with the model dynamics.
 //!
 //! The record type and CRC are plain Rust and host-tested; only the static in the
 //! `.uninit.thermal` section (cortex-m-rt's NOLOAD `.uninit`) is target-only.

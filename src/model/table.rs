@@ -11,6 +11,14 @@ pub struct At<N> {
     frac: N,
 }
 
+impl<N> At<N> {
+    /// `true` below the table's second point (`x < x_max / (N_TABLE - 1)^2`).
+    #[inline(always)]
+    pub fn in_first_interval(&self) -> bool {
+        self.j == 0
+    }
+}
+
 /// Locates `x >= 0` (table unit) on the grid `x_j = x_max (j / (N_TABLE - 1))^2`,
 /// given `root_scale = (N_TABLE - 1) / sqrt(x_max)`: `u = sqrt(x) root_scale`, `j = floor(u)`.
 /// Beyond the last point the value is held at the last point (fraction 1 of the

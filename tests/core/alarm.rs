@@ -93,34 +93,40 @@ fn fixed_point_thresholds_are_exact() {
     assert_eq!(alarm_update_with(&mut a, c58 - lsb, a60, c58), Some(false), "one LSB below clears");
 }
 
-/// Heating load: Case-1-like at higher loss (50 A, 100 bar across the pump, 600 rpm,
-/// ambient 20 degC). From the 56 degC warm start below it lifts the drain by
+/// Heating load: Case-1-like at higher loss (100 bar across the pump, 600 rpm,
+/// ambient 20 degC, the consistent motor current 60.3 A; was 50 A, which the sensor
+/// cross-check now reports). From the 56 degC warm start below it lifts the drain by
 /// ≈ 0.1 K per 100 ms model step (measured, f32), so the estimate passes through the
 /// 58-60 band in several model steps and the first step above 60 is unambiguous;
 /// it stays far inside every input range.
-const LOAD: Sample = Sample {
-    current_a: 50.0,
-    p_a_bar: 105.0,
-    p_b_bar: 5.0,
-    speed_rpm: 600.0,
-    position_mm: 0.0,
-    ambient_c: 20.0,
-};
+fn load() -> Sample {
+    Sample {
+        current_a: crate::plant::motor_current(105.0, 5.0, 600.0),
+        p_a_bar: 105.0,
+        p_b_bar: 5.0,
+        speed_rpm: 600.0,
+        position_mm: 0.0,
+        ambient_c: 20.0,
+    }
+}
 
-/// Cooling: low loss (5 A, 5 bar across the pump) with the pump still turning at
-/// 500 rpm, so the oil circulates through the open LNG exchanger (at 0 rpm the ring
-/// stops and the drain hardly cools).
-const IDLE: Sample = Sample {
-    current_a: 5.0,
-    p_a_bar: 10.0,
-    p_b_bar: 5.0,
-    speed_rpm: 500.0,
-    position_mm: 0.0,
-    ambient_c: 20.0,
-};
+/// Cooling: low loss (5 bar across the pump, the consistent 3.0 A; was 5 A) with the
+/// pump still turning at 500 rpm, so the oil circulates through the open LNG
+/// exchanger (at 0 rpm the ring stops and the drain hardly cools).
+fn idle() -> Sample {
+    Sample {
+        current_a: crate::plant::motor_current(10.0, 5.0, 500.0),
+        p_a_bar: 10.0,
+        p_b_bar: 5.0,
+        speed_rpm: 500.0,
+        position_mm: 0.0,
+        ambient_c: 20.0,
+    }
+}
 
-/// `a` → `b` over 10 ticks: 45 A and 9.5 bar per tick, inside the rate limits
-/// (200 A, 150 bar per tick), so no RATE fault.
+/// `a` → `b` over 10 ticks: 5.7 A and 9.5 bar per tick, inside the rate limits
+/// (200 A, 150 bar per tick), so no RATE fault. The current stays consistent: at a
+/// fixed sign of the speed it is linear in dp.
 fn ramp(a: &Sample, b: &Sample, k: u32) -> Sample {
     let t = (k as f32 / 10.0).min(1.0);
     let f = |x: f32, y: f32| x + (y - x) * t;
@@ -137,7 +143,7 @@ fn ramp(a: &Sample, b: &Sample, k: u32) -> Sample {
 /// Ticks of the alarm and of its clearing, in number type `N`.
 fn alarm_round_trip<N: Num>() -> (u32, u32) {
     let cfg = GuardConfig::DEFAULT;
-    // Warm restore, every node at 56 degC: 4 K below the alarm, so the valid LOAD
+    // Warm restore, every node at 56 degC: 4 K below the alarm, so the valid load
     // reaches it in about 5 s. (From a cold start at 20 degC the same load settles
     // near 50 degC with the exchanger on and never raises the alarm: measured 49.9
     // degC after an hour.) The valve opens at once (56 > 40 degC): the test runs with
@@ -155,8 +161,8 @@ fn alarm_round_trip<N: Num>() -> (u32, u32) {
     // Cap: the clearing comes at tick ≈ 8150 (measured); 20 000 ticks leave 2.5x.
     for k in 0..20_000u32 {
         let s = match cool_from {
-            None => ramp(&IDLE, &LOAD, k),
-            Some(k0) => ramp(&LOAD, &IDLE, k - k0),
+            None => ramp(&idle(), &load(), k),
+            Some(k0) => ramp(&load(), &idle(), k - k0),
         };
         let o = g.step(&s);
         let m = g.model().expect("default parameters build a model");

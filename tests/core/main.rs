@@ -3,5 +3,11 @@
 //! properties (proptest), and the over-temperature alarm and derate.
 
 mod alarm;
+mod crosscheck;
+mod lng_credit;
 mod model_accuracy;
+mod plant;
 mod protection_props;
+mod startup;
+mod untrusted;
+mod valve;

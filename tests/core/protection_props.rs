@@ -11,9 +11,11 @@ use eha_guard::validate::InputLimits;
 use eha_guard::{GuardConfig, GuardOf, Output, Sample};
 use proptest::prelude::*;
 
+/// Case 1 at 60 bar, 500 rpm, the motor current consistent with it (36.2 A; was
+/// 30 A, which the sensor cross-check now reports as SENSOR_DISAGREE).
 fn nominal() -> Sample {
     Sample {
-        current_a: 30.0,
+        current_a: crate::plant::motor_current(65.0, 5.0, 500.0),
         p_a_bar: 65.0,
         p_b_bar: 5.0,
         speed_rpm: 500.0,
@@ -54,9 +56,17 @@ fn any_sample() -> impl Strategy<Value = Option<Sample>> {
     ]
 }
 
-fn run_all<N: eha_guard::num::Num>(seq: &[Option<Sample>]) -> Result<(), TestCaseError> {
+/// Runs an arbitrary sequence: samples or missing ticks, each with an optional
+/// valve-position report before it, and now and then a maintenance clear.
+fn run_all<N: eha_guard::num::Num>(seq: &[(Option<Sample>, Option<bool>)]) -> Result<(), TestCaseError> {
     let mut g = GuardOf::<N>::new(&GuardConfig::DEFAULT, Restore::Cold);
-    for s in seq {
+    for (k, (s, fb)) in seq.iter().enumerate() {
+        if let Some(v) = fb {
+            g.valve_feedback(*v);
+        }
+        if k % 97 == 96 {
+            let _ = g.clear_faults();
+        }
         let o = match s {
             Some(s) => g.step(s),
             None => g.step_missing(),
@@ -129,7 +139,8 @@ fn fault() -> impl Strategy<Value = Fault> {
 /// A mostly valid input run: a start inside every range, then piecewise-linear
 /// ramps whose per-tick change is at most 0.9 × the channel's rate limit, reflected
 /// at the range (inset by 0.5 % of its width), so every sample is valid and
-/// rate-limited with a margin that holds in all three number types. On top: in one
+/// rate-limited with a margin that holds in all three number types; the current
+/// follows the pressures and the speed (`plant::motor_current`). On top: in one
 /// case of three, 1-3 faults at chosen ticks; in half of the cases a maintenance
 /// `clear_faults` every `clear_every` ticks.
 #[derive(Clone, Debug)]
@@ -197,6 +208,11 @@ fn expand(run: &Run) -> Vec<(Tick, Option<Fault>)> {
                 }
                 *x = y;
             }
+            // The current is not free: a machine with consistent sensors draws the
+            // current of its pressures and speed (else the sensor cross-check rightly
+            // latches SENSOR_DISAGREE). Per tick it changes by at most 197 A (a 270 bar
+            // swing of dp with the speed's sign flipping) against the 200 A rate limit.
+            x[0] = crate::plant::motor_current(x[1], x[2], x[3]);
             match injected {
                 None => out.push((Tick::Sample(to_sample(&x)), None)),
                 Some(f @ Fault::Missing { ticks }) => {
@@ -327,7 +343,7 @@ proptest! {
     #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
 
     #[test]
-    fn arbitrary_inputs_never_panic_and_stay_finite(seq in proptest::collection::vec(any_sample(), 1..300)) {
+    fn arbitrary_inputs_never_panic_and_stay_finite(seq in proptest::collection::vec((any_sample(), proptest::option::of(any::<bool>())), 1..300)) {
         run_all::<f32>(&seq)?;
         run_all::<Fx>(&seq)?;
         run_all::<f64>(&seq)?;
@@ -694,35 +710,60 @@ fn stale_input_integrates_worst_case_loss() {
 }
 
 #[test]
-fn guard_dwell_is_two_seconds_at_the_model_step() {
+fn guard_dwell_qualifies_the_closing_at_the_model_step() {
     // The guard decides on temperature once per 100 ms model step and counts the
-    // dwell in model steps: consecutive temperature-driven toggles of the guard's
-    // valve are at least `dwell_steps` ticks (2 s) apart. A narrow band just above
-    // the ambient and alternating load / idle make the estimate cross it often.
+    // dwell in model steps (20 = 2 s). The rule (items 3 and 9 of "No silent
+    // protection failure"; before, the dwell also delayed openings): an opening is
+    // never delayed (estimate above the threshold at a model step => valve open in
+    // that tick); a closing comes only after 20 consecutive model steps below the
+    // closing threshold, so every open period lasts at least 2 s. A narrow band just
+    // above the ambient and alternating load / idle make the estimate cross it often.
     let mut cfg = GuardConfig::DEFAULT;
     cfg.valve.open_c = 16.3;
     cfg.valve.close_c = 16.25;
+    let dwell = cfg.valve.dwell_steps / eha_guard::params::TICKS_PER_STEP;
     let mut g = GuardOf::<f32>::new(&cfg, Restore::Cold);
     let load = nominal();
     let idle = Sample { current_a: 0.0, p_a_bar: 5.0, p_b_bar: 5.0, speed_rpm: 500.0, ..nominal() };
+    let mut below_run = 0u32;
+    let mut was_open = false;
     for k in 0..20_000u32 {
         let o = g.step(if (k / 150) % 2 == 0 { &load } else { &idle });
         assert_eq!(o.faults & faults::LATCHED, 0);
+        let m = g.model().unwrap();
+        if m.pending_ticks() == 0 {
+            let d = m.drain_c();
+            below_run = if d < cfg.valve.close_c { below_run + 1 } else { 0 };
+            if d > cfg.valve.open_c {
+                assert!(o.valve_open, "tick {k}: estimate {d} above {} but the valve is closed", cfg.valve.open_c);
+            }
+            if was_open && !o.valve_open {
+                assert!(below_run >= dwell, "tick {k}: closed after {below_run} model steps below {} (< {dwell})", cfg.valve.close_c);
+            }
+        } else {
+            assert_eq!(o.valve_open, was_open, "tick {k}: the valve changed between model steps");
+        }
+        was_open = o.valve_open;
     }
-    let toggles: Vec<u32> = g
+    let toggles: Vec<(u32, bool)> = g
         .trace()
         .iter()
         .filter_map(|e| match e {
-            eha_guard::trace::Trace::ValveOpen { step, forced: false, .. } => Some(*step),
-            eha_guard::trace::Trace::ValveClose { step, .. } => Some(*step),
+            eha_guard::trace::Trace::ValveOpen { step, forced: false, .. } => Some((*step, true)),
+            eha_guard::trace::Trace::ValveClose { step, .. } => Some((*step, false)),
             _ => None,
         })
         .collect();
     println!("valve toggles at ticks {toggles:?}");
     assert!(toggles.len() >= 6, "the band must be crossed repeatedly: {toggles:?}");
+    // Every open period lasts at least the dwell (2 s = 200 ticks).
     for w in toggles.windows(2) {
-        assert!(w[1] - w[0] >= cfg.valve.dwell_steps, "toggles {} ticks apart < {}", w[1] - w[0], cfg.valve.dwell_steps);
+        if w[0].1 && !w[1].1 {
+            assert!(w[1].0 - w[0].0 >= cfg.valve.dwell_steps, "open for {} ticks < {}", w[1].0 - w[0].0, cfg.valve.dwell_steps);
+        }
     }
-    // Decisions fall on model-step ticks (the 10th of each model step).
-    assert!(toggles.iter().all(|t| (t + 1) % eha_guard::params::TICKS_PER_STEP == 0), "{toggles:?}");
+    // Decisions fall on model-step ticks (the 10th of each model step); the first
+    // event is the start-up state (valve open from boot) ending at the first sample.
+    assert_eq!(toggles[0], (0, false), "{toggles:?}");
+    assert!(toggles[1..].iter().all(|t| (t.0 + 1) % eha_guard::params::TICKS_PER_STEP == 0), "{toggles:?}");
 }

@@ -137,14 +137,19 @@ impl Mcu {
     /// steps the guard, and a tick without one is a missing sample.
     fn tick(&mut self, bytes: &[u8]) -> Output {
         let Mcu { guard, link, .. } = self;
-        let mut newest: Option<Sample> = None;
+        let mut newest: Option<Request> = None;
         let last = guard_out(guard);
         link.push_bytes(bytes, |r: &Request, _gap| {
-            newest = Some(r.sample());
+            newest = Some(*r);
             (last, 0)
         }, |_, _| {});
         match newest {
-            Some(s) => guard.step(&s),
+            Some(r) => {
+                if let Some(open) = r.valve_fb {
+                    guard.valve_feedback(open);
+                }
+                guard.step(&r.sample())
+            }
             None => guard.step_missing(),
         }
     }
@@ -157,7 +162,7 @@ fn guard_out(g: &GuardOf<f32>) -> Output {
 
 /// A record whose LNG charge is used up, node temperatures at `ambient_c`.
 fn lng_empty_record(cfg: &GuardConfig, ambient_c: f32) -> ThermalRecord {
-    let used_cj = (cfg.lng.charge_kg() * cfg.lng.j_per_kg() / 100.0).ceil() as u32;
+    let used_cj = (f64::from(cfg.lng.charge_kg()) * f64::from(cfg.lng.j_per_kg()) * 100.0).ceil() as u32;
     ThermalRecord::new([ambient_c; eha_guard::params::N_NODES], ambient_c, used_cj, 0, 0)
 }
 
@@ -204,6 +209,7 @@ pub fn run_on(
     let mut max_closed = f64::NEG_INFINITY;
     let mut powered_off_until: Option<f64> = None;
     let mut stuck_closed = false;
+    let mut valve_position = false;
     plant
         .run(TICK_S, DURATION_S, |snap| {
             let s = Sensors::from(snap);
@@ -260,6 +266,8 @@ pub fn run_on(
             };
             let req = Request {
                 seq,
+                // The valve's position switch: where the valve really is.
+                valve_fb: Some(valve_position),
                 current_a: sample.current_a,
                 p_a_bar: sample.p_a_bar,
                 p_b_bar: sample.p_b_bar,
@@ -309,6 +317,7 @@ pub fn run_on(
             // The valve's real position, and whether it cools: an empty tank
             // leaves a working valve with nothing to flow through it.
             let physical = commanded && !stuck_closed;
+            valve_position = physical;
             let cooling = physical && fault != Fault::LngEmpty;
             if stuck_closed && commanded && observable_at.is_none() {
                 observable_at = Some(t);

@@ -1,17 +1,33 @@
 //! The open-loop "drill" input sequence used by the PIL equivalence and
 //! golden-output tests: 600 s at the firmware's 10 ms tick (60,000 frames).
 //!
-//! - 0–100 s: hard throttling (140 bar, 60 A, 500 rpm): the predicted drain
-//!   temperature crosses 40 °C and the LNG valve opens (about 22 s with the
-//!   identified parameters);
-//! - from 100 s: 10 bar, 5 A: the prediction falls and the valve closes
-//!   before the first fault at 450 s;
+//! - 0–100 s: hard throttling (140 bar, 500 rpm): the predicted drain
+//!   temperature crosses 40 °C and the LNG valve opens (about 22 s);
+//! - from 100 s: 10 bar: the prediction falls and the valve closes;
+//! - the motor current is the one the reference plant draws at these pressures
+//!   and speed ([`motor_current`]: 84.6 A, then 6.0 A), so the sensor
+//!   cross-check agrees, until
+//! - 300 s: the current sensor reads 30 % low (SENSOR_DISAGREE latches after
+//!   three 2 s windows: valve forced open, alarm and derate held, the model
+//!   heats with the larger loss);
 //! - step 10,000: 3 lost frames (sequence gap, missed steps, below `stale_steps`);
 //! - step 45,000: 10 lost frames (STALE fault latches, fail-safe valve open);
 //! - step 50,000: a NaN current (non-finite fault); step 55,000: 5000 bar (range fault).
-//! The piston moves ±20 mm slowly throughout; ambient 16 °C.
+//! The piston moves ±20 mm slowly throughout; ambient 16 °C. No valve position is
+//! reported.
 
 use eha_guard::protocol::Request;
+
+/// Motor current of the reference plant, A rms: `|D dp + sign(w) eta_m D |dp|| /
+/// Kt` (`eha_sim::hydraulics::shaft_torque` with eq. 8, |w| >= 1 rad/s), with the
+/// firmware's own parameters.
+pub fn motor_current(p_a_bar: f32, p_b_bar: f32, speed_rpm: f32) -> f32 {
+    let p = eha_guard::params::DEFAULT;
+    let d = p.displacement_m3_per_rad;
+    let dp = (p_a_bar - p_b_bar) as f64 * 1e5;
+    let tau = d * dp + (speed_rpm as f64).signum() * p.eta_m * d * dp.abs();
+    (tau.abs() / p.torque_constant_nm_per_a) as f32
+}
 
 /// Number of frames.
 pub const STEPS: u32 = 60_000;
@@ -24,14 +40,16 @@ pub fn inputs() -> Vec<Request> {
         let t = k as f32 * 0.01;
         let hot = t < 100.0;
         let dp = if hot { 140.0 } else { 10.0 };
+        let sensor_gain = if t < 300.0 { 1.0 } else { 0.7 };
         let mut r = Request {
             seq,
-            current_a: if hot { 60.0 } else { 5.0 },
+            current_a: sensor_gain * motor_current(2.0 + dp, 2.0, 500.0),
             p_a_bar: 2.0 + dp,
             p_b_bar: 2.0,
             speed_rpm: 500.0,
             position_mm: 20.0 * (0.05 * t).sin(),
             ambient_c: 16.0,
+            valve_fb: None,
         };
         if k == 50_000 {
             r.current_a = f32::NAN;

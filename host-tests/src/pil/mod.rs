@@ -38,6 +38,9 @@ pub struct PlantSensors {
     pub t_drain_c: f64,
     /// Manifold oil sensor (`t_oil_c` of the measured format), if the plant has it.
     pub t_oil_c: Option<f64>,
+    /// LNG valve position read back (the valve the plant ran during the last step),
+    /// if the plant reports it; sent in the request's flags byte.
+    pub valve_fb: Option<bool>,
 }
 
 impl PlantSensors {
@@ -51,6 +54,7 @@ impl PlantSensors {
             speed_rpm: self.speed_rpm as f32,
             position_mm: self.position_mm as f32,
             ambient_c: self.ambient_c as f32,
+            valve_fb: self.valve_fb,
         }
     }
 }

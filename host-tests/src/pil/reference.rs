@@ -21,6 +21,7 @@ pub fn sensors(snap: &Snapshot) -> PlantSensors {
         ambient_c: op.ambient_c,
         t_drain_c: snap.temp(Node::Case),
         t_oil_c: Some(snap.temp(Node::Sensor)),
+        valve_fb: Some(snap.lng_open),
     }
 }
 

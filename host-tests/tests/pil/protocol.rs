@@ -11,8 +11,8 @@ fn any_f32() -> impl Strategy<Value = f32> {
 }
 
 prop_compose! {
-    fn any_request()(seq in any::<u16>(), v in proptest::array::uniform6(any_f32())) -> Request {
-        Request { seq, current_a: v[0], p_a_bar: v[1], p_b_bar: v[2], speed_rpm: v[3], position_mm: v[4], ambient_c: v[5] }
+    fn any_request()(seq in any::<u16>(), v in proptest::array::uniform6(any_f32()), fb in proptest::option::of(any::<bool>())) -> Request {
+        Request { seq, current_a: v[0], p_a_bar: v[1], p_b_bar: v[2], speed_rpm: v[3], position_mm: v[4], ambient_c: v[5], valve_fb: fb }
     }
 }
 
@@ -64,6 +64,7 @@ proptest! {
         let back = Request::from_payload(got[0].as_ref().unwrap()).unwrap();
         prop_assert_eq!(back.seq, r.seq);
         prop_assert_eq!(bits(&back), bits(&r));
+        prop_assert_eq!(back.valve_fb, r.valve_fb);
     }
 
     #[test]
