@@ -13,8 +13,18 @@
 
 use eha_sim::faults::{campaign, table, write};
 
+const SPEED_UNSEEN: &str = "a speed sensor error is invisible to the torque cross-check: both loss estimates (from the current and from the port pressures) scale with the measured speed, and the pump's heat with the true speed; a second speed source (the motor drive's commutation frequency) would be needed";
+
 /// (fault, scenario, why the design cannot meet the pass rule).
-const KNOWN_FAILING: &[(&str, &str, &str)] = &[];
+const KNOWN_FAILING: &[(&str, &str, &str)] = &[
+    ("speed/stuck-last", "random-1", SPEED_UNSEEN),
+    ("speed/stuck-zero", "lng", SPEED_UNSEEN),
+    ("speed/stuck-zero", "random-1", SPEED_UNSEEN),
+    ("speed/gain-x0.5", "lng", SPEED_UNSEEN),
+    ("speed/gain-x0.5", "random-1", SPEED_UNSEEN),
+    ("speed/drift", "lng", SPEED_UNSEEN),
+    ("speed/drift", "random-1", SPEED_UNSEEN),
+];
 
 #[test]
 fn fault_campaign_passes_except_the_listed_design_limits() {
