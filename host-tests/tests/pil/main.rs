@@ -3,6 +3,7 @@
 //! handling, golden transcript, closed loop).
 
 mod equivalence;
+mod fault_subset;
 mod faults;
 mod golden;
 mod protocol;

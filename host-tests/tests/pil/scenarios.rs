@@ -13,7 +13,7 @@
 //! - accuracy against the reference (issue 3): max |fw − ref drain| ≤ 1.0 K,
 //!   under-prediction ≤ 0.5 K; valve switching within 2 s of switching on the
 //!   reference's true drain temperature (40 °C threshold) for the first
-//!   opening (later events: see `firmware_vs_reference.rs`).
+//!   opening (later events: see `tests/firmware/vs_reference.rs`).
 
 use eha_sim::pil::report::{compare, Summary};
 use eha_sim::pil::sil::{sil_core, SilTarget};
