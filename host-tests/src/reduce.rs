@@ -174,6 +174,7 @@ pub fn reduce_without_jacobian(rig: &Rig) -> ReducedParams {
         outer_quarter_w_per_k125: outer_quarter,
         outer_rad_w_per_k4: outer_rad,
         nominal_jacobian_per_s: [[0.0; N_NODES]; N_NODES],
+        phi_step_s: eha_guard::model::etd_matrix(&[[0.0; N_NODES]; N_NODES], eha_guard::params::S_PER_STEP),
     }
 }
 
@@ -216,6 +217,7 @@ pub fn nominal_jacobian(p: &ReducedParams) -> Option<[[f64; N_NODES]; N_NODES]> 
 pub fn reduce(rig: &Rig) -> Option<ReducedParams> {
     let mut p = reduce_without_jacobian(rig);
     p.nominal_jacobian_per_s = nominal_jacobian(&p)?;
+    p.phi_step_s = eha_guard::model::etd_matrix(&p.nominal_jacobian_per_s, eha_guard::params::S_PER_STEP);
     Model::<f64>::new(&p).ok()?;
     Some(p)
 }
@@ -302,6 +304,11 @@ pub fn render_params_rs(p: &ReducedParams) -> String {
     }
     s.push_str("    nominal_jacobian_per_s: [\n");
     for r in &p.nominal_jacobian_per_s {
+        s.push_str(&format!("        {},\n", row(r)));
+    }
+    s.push_str("    ],\n");
+    s.push_str("    phi_step_s: [\n");
+    for r in &p.phi_step_s {
         s.push_str(&format!("        {},\n", row(r)));
     }
     s.push_str("    ],\n};\n");

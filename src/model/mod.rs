@@ -364,12 +364,13 @@ pub fn etd_matrix(a: &[[f64; N_NODES]; N_NODES], h: f64) -> [[f64; N_NODES]; N_N
 
 impl<N: Num> Model<N> {
     /// Builds the model once from SI parameters: constants in model units, tables,
-    /// and the exact-ZOH matrix (matrix exponential in `f64`). Starts at 0 degC.
+    /// and the exact-ZOH matrix (precomputed on the host: `ReducedParams::phi_step_s`).
+    /// Starts at 0 degC.
     pub fn new(p: &ReducedParams) -> Result<Self, ConfigError> {
         if !p.is_plausible() {
             return Err(ConfigError::Implausible);
         }
-        let phi64 = etd_matrix(&p.nominal_jacobian_per_s, S_PER_STEP);
+        let phi64 = p.phi_step_s;
         let mut phi = [[N::coef_from_f64(0.0).ok_or(ConfigError::CoefficientRange)?; N_NODES]; N_NODES];
         for (pr, dr) in phi.iter_mut().zip(phi64.iter()) {
             if dr.iter().map(|x| libm::fabs(*x)).sum::<f64>() >= N::MAX_ROW_SUM {

@@ -188,3 +188,22 @@ fn energy_balance_closes() {
     // Regression bound, about 2.6x the measured 2.333e-4.
     assert!(closure < 6e-4, "closure {closure:e}: regression bound 6e-4 (measured 2.333e-4)");
 }
+
+/// The exact-ZOH matrix is computed on the host (`eha_sim::reduce`) and
+/// stored with the parameters, so the firmware does no matrix exponential at
+/// boot. It must equal what the firmware computed before from the stored
+/// Jacobian (`etd_matrix`, the same f64 code the target ran): relative error
+/// ≤ 1e-6 per entry (spec), and measured bit-exact (regression: 0).
+#[test]
+fn stored_phi_is_the_zoh_of_the_stored_jacobian() {
+    let p = DEFAULT;
+    let phi = etd_matrix(&p.nominal_jacobian_per_s, S_PER_STEP);
+    let mut worst = 0.0f64;
+    for (a, b) in p.phi_step_s.iter().flatten().zip(phi.iter().flatten()) {
+        let rel = (a - b).abs() / b.abs().max(1e-300);
+        worst = worst.max(if a == b { 0.0 } else { rel });
+    }
+    println!("stored Phi vs etd_matrix: worst relative difference {worst:.2e}");
+    assert!(worst <= 1e-6, "stored Phi differs from the ZOH of the stored Jacobian by {worst:e} (spec 1e-6)");
+    assert_eq!(worst, 0.0, "regression: the stored Phi was bit-exact; regenerate src/params.rs (example reduce)");
+}

@@ -485,6 +485,9 @@ fn params_are_the_reduction_of_the_rig() {
         for (i, r) in q.nominal_jacobian_per_s.iter().enumerate() {
             v.extend(r.iter().enumerate().map(|(j, x)| (format!("nominal_jacobian_per_s[{i}][{j}]"), *x)));
         }
+        for (i, r) in q.phi_step_s.iter().enumerate() {
+            v.extend(r.iter().enumerate().map(|(j, x)| (format!("phi_step_s[{i}][{j}]"), *x)));
+        }
         v
     };
     let (a, b) = (flat(&p), flat(&d));
