@@ -34,11 +34,51 @@ mod fw {
     use cortex_m_rt::{entry, exception, ExceptionFrame};
     use defmt_semihosting as _;
     use eha_guard::board::{service, Board};
+    use eha_guard::memory::nv::{Blocking, NvPolicy, NvStore};
     use eha_guard::memory::slots::{self, noinit, AbWriter};
+    use eha_guard::memory::{boot_restore, ThermalRecord};
     use eha_guard::{Guard, GuardConfig, Sample};
+    use embedded_storage::nor_flash::{ErrorType, NorFlash, ReadNorFlash};
+    use stm32f4xx_hal::flash::{FlashExt, LockedFlash};
     use stm32f4xx_hal::gpio::{Output, PushPull, PA5};
     use stm32f4xx_hal::timer::SysCounterUs;
     use stm32f4xx_hal::{pac, prelude::*, rcc::Config};
+
+    /// Byte range of the non-volatile thermal record, offsets from the start of
+    /// flash: sectors 6-7 (2 x 128 KiB at 0x0804_0000, region `NVREC` of
+    /// `boards/stm32f411/memory.x`; wear budget in docs/firmware.md).
+    const NV_RANGE: core::ops::Range<u32> = 0x4_0000..0x8_0000;
+
+    /// The internal flash, unlocked only for the duration of an erase or a
+    /// write (the HAL's `UnlockedFlash` relocks when dropped).
+    struct Flash(LockedFlash);
+
+    impl ErrorType for Flash {
+        type Error = stm32f4xx_hal::flash::Error;
+    }
+
+    impl ReadNorFlash for Flash {
+        const READ_SIZE: usize = 1;
+        fn read(&mut self, offset: u32, bytes: &mut [u8]) -> Result<(), Self::Error> {
+            ReadNorFlash::read(&mut self.0, offset, bytes)
+        }
+        fn capacity(&self) -> usize {
+            ReadNorFlash::capacity(&self.0)
+        }
+    }
+
+    impl NorFlash for Flash {
+        const WRITE_SIZE: usize = 1;
+        const ERASE_SIZE: usize = 128 * 1024;
+        fn erase(&mut self, from: u32, to: u32) -> Result<(), Self::Error> {
+            // Stalls the CPU for up to 2 s per 128 KiB sector (single bank):
+            // once per ~1 950 record writes.
+            NorFlash::erase(&mut self.0.unlocked(), from, to)
+        }
+        fn write(&mut self, offset: u32, bytes: &[u8]) -> Result<(), Self::Error> {
+            NorFlash::write(&mut self.0.unlocked(), offset, bytes)
+        }
+    }
 
     /// STM32F411 board: PA5 valve output, SysTick 10 ms tick.
     struct F411 {
@@ -104,15 +144,27 @@ mod fw {
         }
         let mut board = F411 { valve, tick, ms: 0 };
 
+        // Thermal memory: the newest valid RAM record (warm reset), else the
+        // flash record (power loss: saved temperatures + 2 K), else cold.
+        let mut nv = NvStore::new(Blocking(Flash(LockedFlash::new(dp.FLASH))), NV_RANGE).ok();
+        let mut last_nv: Option<ThermalRecord> = nv.as_mut().and_then(|n| n.load());
         let (rec_a, rec_b) = noinit::load();
-        let restore = slots::restore_from(&rec_a, &rec_b);
+        let restore = boot_restore(slots::restore_from(&rec_a, &rec_b), last_nv, &NvPolicy::DEFAULT);
         let mut records = AbWriter::after_boot(&rec_a, &rec_b);
         let mut guard = Guard::new(&GuardConfig::DEFAULT, restore);
         loop {
             board.wait_tick();
             let out = service(&mut board, &mut guard);
             if guard.steps().is_multiple_of(100) {
-                records.write(&guard.snapshot(), noinit::store);
+                let rec = guard.snapshot();
+                records.write(&rec, noinit::store);
+                if NvPolicy::DEFAULT.due(last_nv.as_ref(), &rec) {
+                    if let Some(n) = nv.as_mut() {
+                        if n.save(&rec).is_ok() {
+                            last_nv = Some(rec);
+                        }
+                    }
+                }
                 defmt::info!(
                     "drain {} degC valve {} faults {=u16:#x}",
                     out.drain_c,
