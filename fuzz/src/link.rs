@@ -124,6 +124,12 @@ pub fn structured(data: &[u8]) -> Vec<u8> {
             speed_rpm: v(&mut u, 500.0, 500.0),
             position_mm: v(&mut u, 0.0, 10.0),
             ambient_c: v(&mut u, 16.0, 1.0),
+            // The valve-position flags byte: absent, reported shut, reported open.
+            valve_fb: match byte(&mut u) % 3 {
+                0 => None,
+                1 => Some(false),
+                _ => Some(true),
+            },
         };
         let wire = req.encode();
         let corrupt = if sel & 0x10 != 0 { byte(&mut u) % 10 } else { 255 };
