@@ -27,6 +27,7 @@ pub mod pil;
 pub mod plant;
 pub mod plot;
 pub mod reduce;
+pub mod reader_checks;
 pub mod rig;
 pub mod scenario;
 pub mod sim;

@@ -4,9 +4,7 @@
 //! and on arbitrary bytes. Each must give a value or an error, never a panic;
 //! what they accept must also pass the same checks as in the fuzz targets.
 
-use crate::measured::MeasuredRun;
-use crate::rig::Rig;
-use crate::scenario::{read_mission_str, ValveRule};
+use crate::reader_checks::{check_measured, check_mission, check_rig};
 use proptest::prelude::*;
 use proptest::sample::Index;
 use std::path::PathBuf;
@@ -27,46 +25,6 @@ fn corpus(target: &str) -> Vec<Vec<u8>> {
     files.into_iter().map(|f| f.1).collect()
 }
 
-/// The measured-data reader: an accepted run validates and round-trips.
-pub(crate) fn check_measured(data: &[u8]) {
-    let text = String::from_utf8_lossy(data);
-    if let Ok(run) = MeasuredRun::from_str_named("fuzz.csv", &text) {
-        run.validate("fuzz.csv").expect("an accepted run must validate");
-        let mut out = Vec::new();
-        run.write(&mut out).expect("an accepted run must be writable");
-        let text2 = String::from_utf8(out).expect("writer emits UTF-8");
-        let back = MeasuredRun::from_str_named("rt.csv", &text2).expect("written run must read back");
-        assert_eq!(back.time_s, run.time_s);
-        assert_eq!(back.channels, run.channels);
-    }
-}
-
-/// The mission reader: an accepted mission can be evaluated.
-pub(crate) fn check_mission(data: &[u8]) {
-    let text = String::from_utf8_lossy(data);
-    if let Ok(m) = read_mission_str(&text, "fuzz.csv", "fuzz", ValveRule::None) {
-        assert!(!m.ambient_c.0.is_empty());
-        for t in [-1.0, 0.0, 0.5 * m.duration_s, m.duration_s, m.duration_s + 1.0] {
-            let _ = m.ambient_c.at(t);
-            let _ = m.speed_rpm.at(t);
-            let _ = m.needle_bar.at(t);
-            let _ = m.position.at(t);
-            let _ = m.air_speed_mps.at(t);
-        }
-    }
-}
-
-/// The rig loader and the override parser (first line).
-pub(crate) fn check_rig(data: &[u8]) {
-    let text = String::from_utf8_lossy(data);
-    if let Ok(rig) = Rig::from_toml_str(&text, "fuzz.toml") {
-        let back = Rig::from_toml_str(&rig.to_toml(), "rt.toml");
-        assert!(back.is_ok(), "an accepted rig must round-trip: {back:?}");
-    }
-    let first = text.lines().next().unwrap_or("");
-    let mut rig = Rig::default();
-    let _ = rig.set_override(first);
-}
 
 /// Fragments that matter to CSV and TOML parsers and to the value checks.
 const TOKENS: &[&str] = &[

@@ -158,12 +158,8 @@ mod fw {
             if guard.steps().is_multiple_of(100) {
                 let rec = guard.snapshot();
                 records.write(&rec, noinit::store);
-                if NvPolicy::DEFAULT.due(last_nv.as_ref(), &rec) {
-                    if let Some(n) = nv.as_mut() {
-                        if n.save(&rec).is_ok() {
-                            last_nv = Some(rec);
-                        }
-                    }
+                if NvPolicy::DEFAULT.due(last_nv.as_ref(), &rec) && nv.as_mut().is_some_and(|n| n.save(&rec).is_ok()) {
+                    last_nv = Some(rec);
                 }
                 defmt::info!(
                     "drain {} degC valve {} faults {=u16:#x}",

@@ -138,10 +138,10 @@ impl Mcu {
     fn tick(&mut self, bytes: &[u8]) -> Output {
         let Mcu { guard, link, .. } = self;
         let mut newest: Option<Request> = None;
-        let last = guard_out(guard);
+        // The link's replies are not used here: the tick's output is the step's.
         link.push_bytes(bytes, |r: &Request, _gap| {
             newest = Some(*r);
-            (last, 0)
+            (Output::default(), 0)
         }, |_, _| {});
         match newest {
             Some(r) => {
@@ -153,11 +153,6 @@ impl Mcu {
             None => guard.step_missing(),
         }
     }
-}
-
-/// The guard's latest output (what the link reports until the tick runs).
-fn guard_out(g: &GuardOf<f32>) -> Output {
-    Output { faults: g.faults(), ..Output::default() }
 }
 
 /// A record whose LNG charge is used up, node temperatures at `ambient_c`.
