@@ -18,7 +18,8 @@
 //! * `Missing` 1..=8 ticks, `NonFinite` (NaN/±inf in one channel), `Range`
 //!   (one channel outside its range), `Rate` (a step of 1.1–3 × the rate limit
 //!   that persists), `Clear` (explicit attempt, may be refused), `Refill` (LNG),
-//!   `Actuator` (valve pin error), `Reboot` (snapshot → `Restore::from_record`
+//!   `Feedback` (valve read-back: none, following the command, or stuck
+//!   open/closed), `Actuator` (valve pin error), `Reboot` (snapshot → `Restore::from_record`
 //!   → new guard, a warm reset), `Raw` (six arbitrary `f32` for one tick).
 //!
 //! Checked at every tick: no panic (overflow checks and debug assertions are
@@ -99,6 +100,19 @@ struct Run<N: Num> {
     /// Unlatched minus latched ticks so far in this input.
     credit: i64,
     stats: bool,
+    /// Valve-position feedback fed before every tick.
+    fb: Feedback,
+}
+
+/// What the valve read-back reports (set by the `Feedback` operation).
+#[derive(Clone, Copy, PartialEq)]
+enum Feedback {
+    /// No read-back wired (the guard takes the command as the position).
+    None,
+    /// A healthy valve: the read-back follows the last command.
+    Follows,
+    /// A valve stuck in one position.
+    Stuck(bool),
 }
 
 impl<N: Num> Run<N> {
@@ -121,6 +135,14 @@ impl<N: Num> Run<N> {
     }
 
     fn tick(&mut self, s: Option<&Sample>, valid: bool) {
+        match self.fb {
+            Feedback::None => {}
+            Feedback::Follows => {
+                let open = self.g.output().valve_open;
+                self.g.valve_feedback(open);
+            }
+            Feedback::Stuck(open) => self.g.valve_feedback(open),
+        }
         let o = match s {
             Some(s) => self.g.step(s),
             None => self.g.step_missing(),
@@ -145,6 +167,10 @@ impl<N: Num> Run<N> {
     fn clear(&mut self) {
         let before = self.g.faults() & faults::LATCHED;
         if self.g.clear_faults() {
+            // Maintenance that clears the faults also repairs a stuck valve.
+            if matches!(self.fb, Feedback::Stuck(_)) {
+                self.fb = Feedback::Follows;
+            }
             // Only CONFIG survives a successful clear.
             let after = self.g.faults() & faults::LATCHED;
             assert_eq!(after & !faults::CONFIG, 0, "clear_faults returned true but {after:#x} still latched");
@@ -228,7 +254,7 @@ pub fn run<N: Num>(data: &[u8], label: &'static str, cold: &OnceLock<GuardOf<N>>
     } else {
         GuardOf::<N>::new(&cfg, boot)
     };
-    let mut r = Run { g, cfg, full_kg, ticks: 0, credit: 0, stats };
+    let mut r = Run { g, cfg, full_kg, ticks: 0, credit: 0, stats, fb: Feedback::None };
     let ch = channels(&cfg.limits);
     let mut x = [0.0f32; 6];
     for (x, c) in x.iter_mut().zip(ch) {
@@ -289,9 +315,22 @@ pub fn run<N: Num>(data: &[u8], label: &'static str, cold: &OnceLock<GuardOf<N>>
                 r.tick(Some(&to_sample(&x)), false);
             }
             222..=231 => r.clear(),
-            232..=237 => {
+            232..=234 => {
                 let cfg = r.cfg.lng;
                 r.g.refill_lng(&cfg);
+            }
+            235..=237 => {
+                // Valve read-back: none, healthy, or stuck (a stuck valve is a
+                // fault operation: it latches ACTUATOR once it disagrees).
+                r.fb = match byte(&mut u) % 4 {
+                    0 => Feedback::None,
+                    1 => Feedback::Follows,
+                    k if r.credit >= FAULT_CREDIT => {
+                        fault_op(&r);
+                        Feedback::Stuck(k == 3)
+                    }
+                    _ => Feedback::Follows,
+                };
             }
             238..=239 => {
                 fault_op(&r);

@@ -22,17 +22,17 @@ pub fn check_measured(data: &[u8]) {
     }
 }
 
-/// The mission reader: an accepted mission can be evaluated.
+/// The mission reader: an accepted mission can be evaluated and every
+/// value it yields is finite.
 pub fn check_mission(data: &[u8]) {
     let text = String::from_utf8_lossy(data);
     if let Ok(m) = read_mission_str(&text, "fuzz.csv", "fuzz", ValveRule::None) {
         assert!(!m.ambient_c.0.is_empty());
+        assert!(m.duration_s.is_finite());
         for t in [-1.0, 0.0, 0.5 * m.duration_s, m.duration_s, m.duration_s + 1.0] {
-            let _ = m.ambient_c.at(t);
-            let _ = m.speed_rpm.at(t);
-            let _ = m.needle_bar.at(t);
-            let _ = m.position.at(t);
-            let _ = m.air_speed_mps.at(t);
+            let (x, v_x) = m.position.at(t);
+            let v = [m.ambient_c.at(t), m.speed_rpm.at(t), m.needle_bar.at(t), x, v_x, m.air_speed_mps.at(t)];
+            assert!(v.iter().all(|x| x.is_finite()), "accepted mission yields a non-finite value at {t} s: {v:?}");
         }
     }
 }

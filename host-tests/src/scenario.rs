@@ -274,20 +274,43 @@ fn read_mission<R: std::io::Read>(src: R, path: &str, name: String, valve: Valve
     let p = path.to_string();
     let mut rdr = csv::ReaderBuilder::new().comment(Some(b'#')).trim(csv::Trim::All).from_reader(src);
     let (mut speed, mut needle, mut pos, mut amb, mut air) = (vec![], vec![], vec![], vec![], vec![]);
+    let headers = rdr.headers().map_err(|e| MissionError::Csv { path: p.clone(), message: e.to_string() })?.clone();
     let mut last_t = f64::NEG_INFINITY;
-    for rec in rdr.deserialize::<MissionRow>() {
-        let row = rec.map_err(|e| MissionError::Csv { path: p.clone(), message: e.to_string() })?;
-        let line = 0;
-        if !(row.time_s >= last_t) {
-            return Err(MissionError::Invalid { path: p, line, message: format!("time {} not increasing", row.time_s) });
+    for rec in rdr.records() {
+        let rec = rec.map_err(|e| MissionError::Csv { path: p.clone(), message: e.to_string() })?;
+        let line = rec.position().map_or(0, |q| q.line());
+        let row: MissionRow =
+            rec.deserialize(Some(&headers)).map_err(|e| MissionError::Csv { path: p.clone(), message: e.to_string() })?;
+        let bad = |column: &str, v: f64, want: &str| MissionError::Invalid {
+            path: p.clone(),
+            line,
+            message: format!("column `{column}`: {v} is not {want}"),
+        };
+        // Every value must be a finite number in its physical range: a NaN or
+        // an infinity would silently poison the simulation.
+        let check = |column: &str, v: f64, lo: f64, hi: f64| {
+            if v.is_finite() && (lo..=hi).contains(&v) {
+                Ok(v)
+            } else {
+                Err(bad(column, v, &format!("a finite number in [{lo}, {hi}]")))
+            }
+        };
+        let t = check("time_s", row.time_s, 0.0, 1e7)?;
+        if t < last_t {
+            return Err(bad("time_s", t, &format!("at or after the previous row's {last_t} s")));
         }
-        last_t = row.time_s;
-        let t = row.time_s;
-        if let Some(v) = row.speed_rpm { speed.push((t, v)); }
-        if let Some(v) = row.needle_bar { needle.push((t, v)); }
-        if let Some(v) = row.position_mm { pos.push((t, v * 1e-3)); }
-        amb.push((t, row.ambient_c));
-        air.push((t, row.air_speed_mps.unwrap_or(0.0)));
+        last_t = t;
+        if let Some(v) = row.speed_rpm {
+            speed.push((t, check("speed_rpm", v, -1e5, 1e5)?));
+        }
+        if let Some(v) = row.needle_bar {
+            needle.push((t, check("needle_bar", v, 0.0, 1e4)?));
+        }
+        if let Some(v) = row.position_mm {
+            pos.push((t, check("position_mm", v, -1e4, 1e4)? * 1e-3));
+        }
+        amb.push((t, check("ambient_c", row.ambient_c, -100.0, 200.0)?));
+        air.push((t, check("air_speed_mps", row.air_speed_mps.unwrap_or(0.0), 0.0, 1e3)?));
     }
     if amb.is_empty() {
         return Err(MissionError::Invalid { path: p, line: 1, message: "no rows".into() });
@@ -317,5 +340,29 @@ mod tests {
         assert!((s.at(5.0) - 2.0).abs() < 1e-12);
         assert_eq!(s.at(10.0), 5.0);
         assert_eq!(s.at(30.0), 5.0);
+    }
+
+    /// Non-finite or out-of-range values are refused with file, line and
+    /// column; before this check `inf` and `NaN` were accepted silently.
+    #[test]
+    fn mission_rejects_non_finite_values_with_line_and_column() {
+        let head = "time_s,speed_rpm,needle_bar,position_mm,ambient_c,air_speed_mps\n";
+        for (row, col) in [
+            ("1,inf,60,,20,0", "speed_rpm"),
+            ("1,500,NaN,,20,0", "needle_bar"),
+            ("1,500,60,,-inf,0", "ambient_c"),
+            ("nan,500,60,,20,0", "time_s"),
+            ("1,500,60,,20,-3", "air_speed_mps"),
+        ] {
+            let text = format!("{head}0,500,60,,20,0\n{row}\n");
+            let e = read_mission_str(&text, "m.csv", "m", ValveRule::None).unwrap_err().to_string();
+            assert!(e.starts_with("m.csv:3: column `") && e.contains(col), "{row}: {e}");
+        }
+        let e = read_mission_str(&format!("{head}5,500,60,,20,0\n4,500,60,,20,0\n"), "m.csv", "m", ValveRule::None)
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("m.csv:3: column `time_s`"), "{e}");
+        let ok = read_mission_str(&format!("{head}0,500,60,,20,0\n10,500,60,,20,0\n"), "m.csv", "m", ValveRule::None);
+        assert_eq!(ok.map(|m| m.duration_s).ok(), Some(10.0));
     }
 }
