@@ -22,6 +22,7 @@ pub mod memory;
 pub mod model;
 pub mod num;
 pub mod params;
+pub mod product;
 pub mod protection;
 pub mod protocol;
 pub mod trace;

@@ -99,8 +99,11 @@ pub const KIND_DONE: u8 = 0x83;
 pub const REQUEST_LEN: usize = 28;
 /// Length of a reply payload (without CRC).
 pub const REPLY_LEN: usize = 37;
+/// Largest payload of any frame, these and the product frames of
+/// [`crate::product::wire`] (the status reply is the longest).
+pub const MAX_PAYLOAD: usize = 48;
 /// Largest payload + CRC of any frame.
-pub const MAX_RAW: usize = REPLY_LEN + 2;
+pub const MAX_RAW: usize = MAX_PAYLOAD + 2;
 /// Largest COBS-encoded frame without delimiters.
 pub const MAX_ENCODED: usize = MAX_RAW + MAX_RAW / 254 + 1;
 /// Buffer size of an encoded frame with leading and trailing delimiter.
@@ -199,7 +202,7 @@ pub fn cobs_decode<const N: usize>(src: &[u8], out: &mut Vec<u8, N>) -> Option<(
 
 /// Frame `payload`: append the CRC, COBS-encode, surround with delimiters.
 /// `lead` adds the leading `0x00` (used for replies, see the module docs).
-fn frame(payload: &[u8], lead: bool) -> WireFrame {
+pub(crate) fn frame(payload: &[u8], lead: bool) -> WireFrame {
     let mut raw: Vec<u8, MAX_RAW> = Vec::new();
     let mut out = WireFrame::new();
     // Payloads here are fixed-size and fit; the `ok()`s cannot fail, and if

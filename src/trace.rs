@@ -82,6 +82,27 @@ pub enum Trace {
         /// Remaining LNG, kg.
         remaining_kg: f32,
     },
+    /// A tick overran its 10 ms period (product loop, [`crate::product`]).
+    Overrun {
+        /// Step counter.
+        step: u32,
+        /// Timer periods that elapsed during the tick beyond its own.
+        lost_ticks: u16,
+    },
+    /// The MCU came out of a reset ([`crate::product::wire::ResetCause`] code).
+    Reset {
+        /// Step counter.
+        step: u32,
+        /// Reset cause code.
+        cause: u8,
+    },
+    /// A controller command was executed ([`crate::product::wire::Cmd`] code).
+    Command {
+        /// Step counter.
+        step: u32,
+        /// Command code.
+        code: u8,
+    },
 }
 
 /// Ring buffer of the most recent [`TRACE_LEN`] events (oldest dropped when full).

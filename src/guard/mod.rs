@@ -761,6 +761,11 @@ impl<N: Num> GuardOf<N> {
         &self.trace
     }
 
+    /// Appends a board-level event (overrun, reset, command) to the trace.
+    pub fn trace_event(&mut self, t: Trace) {
+        self.trace.write(t);
+    }
+
     /// The model, when the parameters were usable.
     pub fn model(&self) -> Option<&Model<N>> {
         self.core.as_ref().map(|c| &c.model)

@@ -1,0 +1,437 @@
+//! The product application: one loop for every board.
+//!
+//! Each 10 ms tick, one sample flows
+//! transport → validate → estimate → protect → outputs:
+//! 1. **transport**: the bytes the UART received since the last tick are
+//!    deframed; the newest valid sample frame is this tick's sample (none =
+//!    a missing sample), command frames are queued;
+//! 2. **validate, estimate, protect**: [`GuardOf::step`] (or
+//!    [`GuardOf::step_missing`]), preceded by a missing step for every timer
+//!    period an overrun swallowed, so the model's clock keeps up with time;
+//! 3. **outputs**: valve and OK pins, read back (a mismatch latches ACTUATOR
+//!    and opens the valve); the thermal record (A/B no-init RAM, and
+//!    non-volatile memory by [`NvPolicy`]); the tick reply; queued commands;
+//! 4. the watchdog is fed, only now that the tick has completed.
+//!
+//! A board ([`Board`]) supplies the UART bytes, pins, timer, watchdog and
+//! memories; the QEMU `mps2-an386` board and the STM32F411 board differ only
+//! there (`src/bin/eha-mps2/`, `src/bin/eha-stm32f4/`).
+
+pub mod reset;
+pub mod wire;
+
+use crate::memory::nv::NvPolicy;
+use crate::memory::slots::{self, AbWriter};
+use crate::memory::{boot_restore, Restore, ThermalRecord};
+use crate::protocol::{DecodeError, Deframer, Request, MAX_MISSED_STEPS};
+use crate::trace::{RestoreKind, Trace, TraceBuf};
+use crate::{Guard, GuardConfig, Output};
+use heapless::Deque;
+use reset::CauseRecord;
+use wire::{Ack, AckResult, Cmd, Command, Pins, ResetCause, Status, TickReply, TraceReply, KIND_COMMAND};
+
+/// Trace events sent per tick while a dump is in progress (a whole ring at
+/// once would not fit in one tick at the UART's rate).
+pub const TRACE_EVENTS_PER_TICK: usize = 4;
+/// Commands queued per tick; more are rejected (counted as framing).
+pub const COMMAND_QUEUE: usize = 4;
+
+/// What the product loop needs from a board.
+pub trait Board {
+    /// Moves bytes received since the last call into `buf`; never blocks.
+    /// Returns how many were written.
+    fn read_rx(&mut self, buf: &mut [u8]) -> usize;
+    /// Received bytes dropped because the receive buffer was full, since boot.
+    fn rx_dropped(&self) -> u32;
+    /// Sends bytes to the controller (returns when they are queued or sent).
+    fn write_tx(&mut self, bytes: &[u8]);
+    /// Drives the valve and OK pins and returns the levels read back from
+    /// the output register.
+    fn set_pins(&mut self, pins: Pins) -> Pins;
+    /// Restarts the watchdog countdown.
+    fn feed_watchdog(&mut self);
+    /// Timer periods since boot (incremented by the tick interrupt).
+    fn ticks(&self) -> u32;
+    /// Sleeps until [`Board::ticks`] differs from `seen` (race-free against
+    /// the tick interrupt).
+    fn wait_tick(&mut self, seen: u32);
+    /// Stores a thermal record in no-init RAM slot `slot` (0 = A, 1 = B).
+    fn store_record(&mut self, slot: usize, rec: &ThermalRecord);
+    /// Stores the reset-cause record in no-init RAM.
+    fn store_cause(&mut self, rec: &CauseRecord);
+    /// Saves a record to non-volatile memory; `false` when the board has none
+    /// or the write failed. May stall (flash erase): the board keeps its
+    /// watchdog from expiring meanwhile.
+    fn nv_save(&mut self, _rec: &ThermalRecord) -> bool {
+        false
+    }
+    /// A free-running core-clock cycle stamp (0 when not available).
+    fn cycle_stamp(&self) -> u32 {
+        0
+    }
+    /// Cycles elapsed since `stamp` (0 when not available).
+    fn cycles_since(&self, _stamp: u32) -> u32 {
+        0
+    }
+    /// Stack high-water mark since boot, bytes (0 when not measured).
+    fn stack_high_water_b(&self) -> u32 {
+        0
+    }
+}
+
+/// What the board found in its memories at boot.
+#[derive(Clone, Copy, Debug)]
+pub struct BootMemory {
+    /// No-init RAM slot A and B.
+    pub records: (ThermalRecord, ThermalRecord),
+    /// The non-volatile record, if the board has one and it is valid.
+    pub nv: Option<ThermalRecord>,
+    /// The reset-cause record left in no-init RAM.
+    pub cause: CauseRecord,
+    /// The board's hardware reset flag, if it names a cause (e.g. IWDG).
+    pub hw_hint: Option<ResetCause>,
+}
+
+/// Frame and tick counters of the product loop (saturating).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Counters {
+    /// Frames with a CRC mismatch.
+    pub rejected_crc: u16,
+    /// Frames with bad COBS, length, kind, or a full command queue.
+    pub rejected_framing: u16,
+    /// Samples that were duplicates or older than the last accepted one.
+    pub rejected_sequence: u16,
+    /// Samples replaced by a newer one within the same tick.
+    pub superseded: u16,
+    /// Samples accepted.
+    pub accepted: u32,
+    /// Ticks without a new sample.
+    pub missing: u32,
+    /// Timer periods lost to ticks that overran.
+    pub overruns: u32,
+    /// Commands executed.
+    pub commands: u16,
+}
+
+impl Counters {
+    fn rejected(&self) -> u16 {
+        self.rejected_crc.saturating_add(self.rejected_framing).saturating_add(self.rejected_sequence)
+    }
+}
+
+/// The product application state (one per board, lives for the whole run).
+pub struct App {
+    cfg: GuardConfig,
+    guard: Guard,
+    rx: Deframer,
+    last_seq: Option<u16>,
+    sample: Option<Request>,
+    commands: Deque<Command, COMMAND_QUEUE>,
+    counters: Counters,
+    records: AbWriter,
+    nv_policy: NvPolicy,
+    nv_last: Option<ThermalRecord>,
+    tick: u32,
+    restore: RestoreKind,
+    reset_cause: ResetCause,
+    boots: u16,
+    worst_tick_cycles: u32,
+    dump: Option<(u16, TraceBuf, u8)>,
+}
+
+fn restore_kind(r: &Restore) -> RestoreKind {
+    match r {
+        Restore::Cold => RestoreKind::Cold,
+        Restore::Warm(_) => RestoreKind::Warm,
+        Restore::Corrupt => RestoreKind::Corrupt,
+    }
+}
+
+impl App {
+    /// Boots: the reset cause, the thermal state (RAM records, else the
+    /// non-volatile one, see [`boot_restore`]), the guard, and the safe
+    /// outputs of a guard waiting for its first sample (valve open).
+    pub fn boot<B: Board>(board: &mut B, cfg: &GuardConfig, mem: &BootMemory) -> App {
+        let (reset_cause, boots, running) = reset::at_boot(&mem.cause, mem.hw_hint);
+        board.store_cause(&running);
+        let (a, b) = &mem.records;
+        let nv_policy = NvPolicy::DEFAULT;
+        let restore = boot_restore(slots::restore_from(a, b), mem.nv, &nv_policy);
+        let mut guard = Guard::new(cfg, restore);
+        guard.trace_event(Trace::Reset { step: 0, cause: reset_cause as u8 });
+        let out = guard.output();
+        let _ = board.set_pins(Pins::for_outputs(out.valve_open, out.alarm || out.derate));
+        App {
+            cfg: *cfg,
+            guard,
+            rx: Deframer::new(),
+            last_seq: None,
+            sample: None,
+            commands: Deque::new(),
+            counters: Counters::default(),
+            records: AbWriter::after_boot(a, b),
+            nv_policy,
+            nv_last: mem.nv,
+            tick: 0,
+            restore: restore_kind(&restore),
+            reset_cause,
+            boots,
+            worst_tick_cycles: 0,
+            dump: None,
+        }
+    }
+
+    /// Runs the tick loop forever: wait for the timer, run one tick, count
+    /// overruns (a tick still running when the next period began).
+    pub fn run<B: Board>(&mut self, board: &mut B) -> ! {
+        let mut seen = board.ticks();
+        loop {
+            board.wait_tick(seen);
+            let now = board.ticks();
+            // Periods that passed with no tick at all (after an overrun).
+            let lost = now.wrapping_sub(seen).saturating_sub(1);
+            seen = now;
+            self.tick(board, lost);
+            let after = board.ticks();
+            if after != now {
+                self.overrun(after.wrapping_sub(now));
+            }
+        }
+    }
+
+    /// Records an overrun of `periods` timer periods.
+    pub fn overrun(&mut self, periods: u32) {
+        self.counters.overruns = self.counters.overruns.saturating_add(periods);
+        let lost_ticks = u16::try_from(periods).unwrap_or(u16::MAX);
+        self.guard.trace_event(Trace::Overrun { step: self.guard.steps(), lost_ticks });
+    }
+
+    /// One tick. `lost` = timer periods since the previous tick that had no
+    /// tick of their own (each becomes a missing step, at most
+    /// [`MAX_MISSED_STEPS`]).
+    pub fn tick<B: Board>(&mut self, board: &mut B, lost: u32) {
+        let stamp = board.cycle_stamp();
+        self.tick = self.tick.wrapping_add(1).wrapping_add(lost);
+
+        // 1. transport
+        let mut buf = [0u8; 32];
+        loop {
+            let n = board.read_rx(&mut buf);
+            let Some(chunk) = buf.get(..n) else { break };
+            if chunk.is_empty() {
+                break;
+            }
+            for &b in chunk {
+                if let Some(res) = self.rx.push(b) {
+                    self.accept(res);
+                }
+            }
+        }
+
+        // 2. validate, estimate, protect
+        for _ in 0..lost.min(u32::from(MAX_MISSED_STEPS)) {
+            let _ = self.guard.step_missing();
+        }
+        let fresh = self.sample.take();
+        let out = match &fresh {
+            Some(req) => {
+                if let Some(open) = req.valve_fb {
+                    self.guard.valve_feedback(open);
+                }
+                self.guard.step(&req.sample())
+            }
+            None => {
+                self.counters.missing = self.counters.missing.saturating_add(1);
+                self.guard.step_missing()
+            }
+        };
+
+        // 3. outputs
+        let (out, pins) = self.drive(board, out);
+        let rec = self.guard.snapshot();
+        self.records.write(&rec, |slot, r| board.store_record(slot, r));
+        if self.nv_policy.due(self.nv_last.as_ref(), &rec) && board.nv_save(&rec) {
+            self.nv_last = Some(rec);
+        }
+        let reply = TickReply {
+            tick: self.tick,
+            sample_seq: self.last_seq.unwrap_or(0),
+            fresh: fresh.is_some(),
+            out,
+            pins,
+            overruns: u16::try_from(self.counters.overruns).unwrap_or(u16::MAX),
+            rejected: self.counters.rejected(),
+            restore: self.restore,
+            reset_cause: self.reset_cause,
+        };
+        board.write_tx(&reply.encode());
+        while let Some(c) = self.commands.pop_front() {
+            self.execute(board, c);
+        }
+        self.send_trace_chunk(board);
+
+        let cycles = board.cycles_since(stamp);
+        self.worst_tick_cycles = self.worst_tick_cycles.max(cycles);
+        // 4. the tick is complete
+        board.feed_watchdog();
+    }
+
+    /// Writes the pins for `out`; a read-back that differs latches ACTUATOR,
+    /// which opens the valve, and the pins are written again.
+    fn drive<B: Board>(&mut self, board: &mut B, out: Output) -> (Output, Pins) {
+        let want = Pins::for_outputs(out.valve_open, out.alarm || out.derate);
+        let got = board.set_pins(want);
+        if got == want {
+            return (out, got);
+        }
+        self.guard.report_actuator_fault();
+        let out = self.guard.output();
+        let got = board.set_pins(Pins::for_outputs(out.valve_open, out.alarm || out.derate));
+        (out, got)
+    }
+
+    fn reject(&mut self, e: DecodeError) {
+        let c = &mut self.counters;
+        let slot = match e {
+            DecodeError::Crc => &mut c.rejected_crc,
+            _ => &mut c.rejected_framing,
+        };
+        *slot = slot.saturating_add(1);
+    }
+
+    /// One received frame: a sample (sequence rule: newer than the last
+    /// accepted, within half the u16 range) or a command.
+    fn accept(&mut self, res: Result<crate::protocol::Payload, DecodeError>) {
+        let payload = match res {
+            Ok(p) => p,
+            Err(e) => return self.reject(e),
+        };
+        if payload.first() == Some(&KIND_COMMAND) {
+            match Command::from_payload(&payload) {
+                Ok(c) => {
+                    if self.commands.push_back(c).is_err() {
+                        self.reject(DecodeError::Overflow);
+                    }
+                }
+                Err(e) => self.reject(e),
+            }
+            return;
+        }
+        let req = match Request::from_payload(&payload) {
+            Ok(r) => r,
+            Err(e) => return self.reject(e),
+        };
+        if let Some(last) = self.last_seq {
+            let ahead = req.seq.wrapping_sub(last);
+            if ahead == 0 || ahead > 0x8000 {
+                self.counters.rejected_sequence = self.counters.rejected_sequence.saturating_add(1);
+                return;
+            }
+        }
+        self.last_seq = Some(req.seq);
+        self.counters.accepted = self.counters.accepted.saturating_add(1);
+        if self.sample.replace(req).is_some() {
+            self.counters.superseded = self.counters.superseded.saturating_add(1);
+        }
+    }
+
+    fn execute<B: Board>(&mut self, board: &mut B, c: Command) {
+        self.counters.commands = self.counters.commands.saturating_add(1);
+        self.guard.trace_event(Trace::Command { step: self.guard.steps(), code: c.cmd.code() });
+        let ack = |result| Ack { token: c.token, cmd: c.cmd, result };
+        match c.cmd {
+            Cmd::ClearFaults => {
+                let ok = self.guard.clear_faults();
+                board.write_tx(&ack(if ok { AckResult::Done } else { AckResult::Refused }).encode());
+            }
+            Cmd::RefillLng => {
+                let lng = self.cfg.lng;
+                self.guard.refill_lng(&lng);
+                board.write_tx(&ack(AckResult::Done).encode());
+            }
+            Cmd::Status => board.write_tx(&self.status(board, c.token).encode()),
+            Cmd::Trace => self.dump = Some((c.token, self.guard.trace().clone(), 0)),
+            Cmd::InjectHang | Cmd::InjectPanic => self.inject(board, c, ack),
+        }
+    }
+
+    #[cfg(feature = "fault-inject")]
+    fn inject<B: Board>(&mut self, board: &mut B, c: Command, ack: impl Fn(AckResult) -> Ack) {
+        board.write_tx(&ack(AckResult::Done).encode());
+        if c.cmd == Cmd::InjectPanic {
+            // Test builds only: exercises the board's panic path.
+            #[allow(clippy::panic)]
+            {
+                panic!("injected by command");
+            }
+        }
+        // Test builds only: the tick never completes, the watchdog is never fed.
+        loop {
+            core::hint::spin_loop();
+        }
+    }
+
+    #[cfg(not(feature = "fault-inject"))]
+    fn inject<B: Board>(&mut self, board: &mut B, _c: Command, ack: impl Fn(AckResult) -> Ack) {
+        board.write_tx(&ack(AckResult::Refused).encode());
+    }
+
+    fn send_trace_chunk<B: Board>(&mut self, board: &mut B) {
+        let Some((token, buf, next)) = &mut self.dump else { return };
+        let count = u8::try_from(buf.len()).unwrap_or(u8::MAX);
+        for ev in buf.iter().skip(usize::from(*next)).take(TRACE_EVENTS_PER_TICK) {
+            let r = TraceReply { token: *token, index: *next, count, event: wire::encode_trace(ev) };
+            board.write_tx(&r.encode());
+            *next = next.saturating_add(1);
+        }
+        if *next >= count {
+            self.dump = None;
+        }
+    }
+
+    /// The status reply for `token`.
+    pub fn status<B: Board>(&self, board: &B, token: u16) -> Status {
+        let c = &self.counters;
+        Status {
+            token,
+            tick: self.tick,
+            overruns: c.overruns,
+            worst_tick_cycles: self.worst_tick_cycles,
+            stack_high_water_b: u16::try_from(board.stack_high_water_b()).unwrap_or(u16::MAX),
+            reset_cause: self.reset_cause as u8,
+            restore: match self.restore {
+                RestoreKind::Cold => 0,
+                RestoreKind::Warm => 1,
+                RestoreKind::Corrupt => 2,
+            },
+            boots: self.boots,
+            rejected_crc: c.rejected_crc,
+            rejected_framing: c.rejected_framing,
+            rejected_sequence: c.rejected_sequence,
+            superseded: c.superseded,
+            accepted: c.accepted,
+            missing: c.missing,
+            rx_overflow: u16::try_from(board.rx_dropped()).unwrap_or(u16::MAX),
+            commands: c.commands,
+            faults: self.guard.faults(),
+        }
+    }
+
+    /// The guard (read only).
+    pub fn guard(&self) -> &Guard {
+        &self.guard
+    }
+
+    /// The counters so far.
+    pub fn counters(&self) -> Counters {
+        self.counters
+    }
+
+    /// Why this boot happened.
+    pub fn reset_cause(&self) -> ResetCause {
+        self.reset_cause
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,303 @@
+//! The product loop on a simulated board: frames in, pins and replies out.
+
+extern crate std;
+use std::vec::Vec as StdVec;
+
+use super::*;
+use crate::protocol::Deframer;
+use wire::FromGuard;
+
+/// A board in memory: RX bytes queued by the test, TX bytes collected,
+/// pins with an optional stuck valve pin, records kept like no-init RAM.
+struct SimBoard {
+    rx: StdVec<u8>,
+    tx: StdVec<u8>,
+    pins: Pins,
+    stuck_valve_pin: Option<bool>,
+    feeds: u32,
+    ticks: u32,
+    records: [ThermalRecord; 2],
+    cause: CauseRecord,
+}
+
+impl SimBoard {
+    fn new() -> Self {
+        SimBoard {
+            rx: StdVec::new(),
+            tx: StdVec::new(),
+            pins: Pins::default(),
+            stuck_valve_pin: None,
+            feeds: 0,
+            ticks: 0,
+            records: [ThermalRecord::EMPTY; 2],
+            cause: CauseRecord::new(0, 0),
+        }
+    }
+
+    fn mem(&self) -> BootMemory {
+        BootMemory { records: (self.records[0], self.records[1]), nv: None, cause: self.cause, hw_hint: None }
+    }
+
+    /// Everything the guard sent since the last call, decoded.
+    fn replies(&mut self) -> StdVec<FromGuard> {
+        let mut d = Deframer::new();
+        let mut out = StdVec::new();
+        for b in core::mem::take(&mut self.tx) {
+            if let Some(Ok(p)) = d.push(b) {
+                out.push(FromGuard::from_payload(&p).expect("guard frames decode"));
+            }
+        }
+        out
+    }
+}
+
+impl Board for SimBoard {
+    fn read_rx(&mut self, buf: &mut [u8]) -> usize {
+        let n = buf.len().min(self.rx.len());
+        buf[..n].copy_from_slice(&self.rx[..n]);
+        self.rx.drain(..n);
+        n
+    }
+    fn rx_dropped(&self) -> u32 {
+        0
+    }
+    fn write_tx(&mut self, bytes: &[u8]) {
+        self.tx.extend_from_slice(bytes);
+    }
+    fn set_pins(&mut self, pins: Pins) -> Pins {
+        self.pins = pins;
+        if let Some(v) = self.stuck_valve_pin {
+            self.pins.valve_pin = v;
+        }
+        self.pins
+    }
+    fn feed_watchdog(&mut self) {
+        self.feeds += 1;
+    }
+    fn ticks(&self) -> u32 {
+        self.ticks
+    }
+    fn wait_tick(&mut self, _seen: u32) {
+        self.ticks += 1;
+    }
+    fn store_record(&mut self, slot: usize, rec: &ThermalRecord) {
+        self.records[slot & 1] = *rec;
+    }
+    fn store_cause(&mut self, rec: &CauseRecord) {
+        self.cause = *rec;
+    }
+}
+
+fn sample(seq: u16, current_a: f32, p_a_bar: f32) -> Request {
+    Request {
+        seq,
+        current_a,
+        p_a_bar,
+        p_b_bar: 3.0,
+        speed_rpm: 500.0,
+        position_mm: 0.0,
+        ambient_c: 30.0,
+        valve_fb: None,
+    }
+}
+
+fn ticks(r: &[FromGuard]) -> StdVec<TickReply> {
+    r.iter().filter_map(|f| if let FromGuard::Tick(t) = f { Some(*t) } else { None }).collect()
+}
+
+/// Before the first sample the valve pin is at its safe (open) level and the
+/// guard waits without a fault; the watchdog is fed once per completed tick.
+#[test]
+fn waits_with_valve_open_until_the_first_sample() {
+    let mut b = SimBoard::new();
+    let mem = b.mem();
+    let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
+    assert_eq!(b.pins, Pins { valve_pin: false, ok_pin: true }, "boot: valve open (pin low), no alarm");
+    assert_eq!(app.reset_cause(), ResetCause::PowerOn);
+    for _ in 0..20 {
+        app.tick(&mut b, 0);
+    }
+    let t = ticks(&b.replies());
+    assert_eq!(t.len(), 20, "one tick reply per tick");
+    assert!(t.iter().all(|r| !r.fresh && r.out.valve_open && r.out.faults == 0 && !r.pins.valve_pin));
+    assert_eq!(b.feeds, 20);
+}
+
+/// The product loop steps the guard exactly like a bare guard fed the same
+/// samples (bit-identical outputs), one tick reply per tick.
+#[test]
+fn one_sample_per_tick_matches_the_bare_guard() {
+    let mut b = SimBoard::new();
+    let mem = b.mem();
+    let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
+    let mut bare = Guard::new(&GuardConfig::DEFAULT, Restore::Cold);
+    for k in 0..300u16 {
+        let s = sample(k, 20.0 + f32::from(k % 7), 60.0);
+        b.rx.extend_from_slice(&s.encode());
+        app.tick(&mut b, 0);
+        let want = bare.step(&s.sample());
+        let t = ticks(&b.replies());
+        assert_eq!(t.len(), 1);
+        assert!(t[0].fresh && t[0].sample_seq == k);
+        assert!(crate::protocol::GuardOutput::bit_eq(&t[0].out, &want), "tick {k}: {:?} vs {want:?}", t[0].out);
+        assert_eq!(t[0].pins, Pins::for_outputs(want.valve_open, want.alarm));
+    }
+    assert_eq!(app.counters().accepted, 300);
+}
+
+/// Two samples in one tick: the newer one is used, the older counted as
+/// superseded; a tick with none is a missing step; an old sequence number is
+/// rejected.
+#[test]
+fn newest_sample_wins_missing_ticks_count_and_old_frames_are_rejected() {
+    let mut b = SimBoard::new();
+    let mem = b.mem();
+    let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
+    b.rx.extend_from_slice(&sample(1, 10.0, 50.0).encode());
+    b.rx.extend_from_slice(&sample(2, 11.0, 50.0).encode());
+    app.tick(&mut b, 0);
+    app.tick(&mut b, 0);
+    b.rx.extend_from_slice(&sample(2, 11.0, 50.0).encode());
+    app.tick(&mut b, 0);
+    let t = ticks(&b.replies());
+    assert_eq!((t[0].fresh, t[0].sample_seq, t[1].fresh, t[2].fresh), (true, 2, false, false));
+    let c = app.counters();
+    assert_eq!((c.accepted, c.superseded, c.missing, c.rejected_sequence), (2, 1, 2, 1));
+    assert_eq!(t[2].rejected, 1);
+}
+
+/// An overrun that swallowed periods: each lost period becomes a missing
+/// step (the model's clock keeps up), and the overrun is counted and traced.
+#[test]
+fn overrun_periods_become_missing_steps_and_are_counted() {
+    let mut b = SimBoard::new();
+    let mem = b.mem();
+    let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
+    b.rx.extend_from_slice(&sample(1, 10.0, 50.0).encode());
+    app.tick(&mut b, 0);
+    let before = app.guard().steps();
+    app.overrun(2);
+    b.rx.extend_from_slice(&sample(2, 10.0, 50.0).encode());
+    app.tick(&mut b, 2);
+    assert_eq!(app.guard().steps() - before, 3, "two catch-up steps and the tick's own");
+    assert_eq!(app.counters().overruns, 2);
+    assert!(app.guard().trace().iter().any(|e| matches!(e, Trace::Overrun { lost_ticks: 2, .. })));
+    let t = ticks(&b.replies());
+    assert_eq!(t.last().map(|r| r.overruns), Some(2));
+}
+
+/// A valve pin that reads back wrong latches ACTUATOR and opens the valve
+/// in the same tick.
+#[test]
+fn pin_read_back_mismatch_latches_actuator_and_opens_the_valve() {
+    let mut b = SimBoard::new();
+    let mem = b.mem();
+    let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
+    b.rx.extend_from_slice(&sample(1, 10.0, 50.0).encode());
+    app.tick(&mut b, 0);
+    assert!(!ticks(&b.replies())[0].out.valve_open, "cold oil: valve closed");
+    b.stuck_valve_pin = Some(false);
+    b.rx.extend_from_slice(&sample(2, 10.0, 50.0).encode());
+    app.tick(&mut b, 0);
+    let t = ticks(&b.replies());
+    assert!(t[0].out.valve_open && t[0].out.faults & crate::faults::ACTUATOR != 0, "{:?}", t[0]);
+}
+
+/// Commands: status and refill are done at once; clear is refused until the
+/// clear rule holds; a trace dump arrives over several ticks; the test-only
+/// injections are refused in a build without `fault-inject`.
+#[test]
+fn commands_status_refill_clear_trace() {
+    let mut b = SimBoard::new();
+    let mem = b.mem();
+    let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
+    // A non-finite sample latches NON_FINITE.
+    b.rx.extend_from_slice(&sample(1, f32::NAN, 50.0).encode());
+    app.tick(&mut b, 0);
+    let cmd = |token, cmd| Command { token, cmd }.encode();
+    b.rx.extend_from_slice(&cmd(7, Cmd::ClearFaults));
+    b.rx.extend_from_slice(&cmd(8, Cmd::RefillLng));
+    b.rx.extend_from_slice(&cmd(9, Cmd::Status));
+    app.tick(&mut b, 0);
+    let r = b.replies();
+    let acks: StdVec<Ack> = r.iter().filter_map(|f| if let FromGuard::Ack(a) = f { Some(*a) } else { None }).collect();
+    assert_eq!(acks[0], Ack { token: 7, cmd: Cmd::ClearFaults, result: AckResult::Refused });
+    assert_eq!(acks[1], Ack { token: 8, cmd: Cmd::RefillLng, result: AckResult::Done });
+    let st = r.iter().find_map(|f| if let FromGuard::Status(s) = f { Some(*s) } else { None }).expect("status");
+    assert_eq!((st.token, st.tick, st.missing, st.faults & crate::faults::NON_FINITE != 0), (9, 2, 1, true));
+    // 100 valid ticks, then the clear succeeds.
+    for k in 2..110u16 {
+        b.rx.extend_from_slice(&sample(k, 10.0, 50.0).encode());
+        app.tick(&mut b, 0);
+    }
+    b.replies();
+    b.rx.extend_from_slice(&cmd(10, Cmd::ClearFaults));
+    b.rx.extend_from_slice(&cmd(11, Cmd::Trace));
+    b.rx.extend_from_slice(&cmd(12, Cmd::InjectHang));
+    b.rx.extend_from_slice(&sample(110, 10.0, 50.0).encode());
+    app.tick(&mut b, 0);
+    for k in 111..130u16 {
+        b.rx.extend_from_slice(&sample(k, 10.0, 50.0).encode());
+        app.tick(&mut b, 0);
+    }
+    let r = b.replies();
+    assert!(r.contains(&FromGuard::Ack(Ack { token: 10, cmd: Cmd::ClearFaults, result: AckResult::Done })));
+    #[cfg(not(feature = "fault-inject"))]
+    assert!(r.contains(&FromGuard::Ack(Ack { token: 12, cmd: Cmd::InjectHang, result: AckResult::Refused })));
+    let dump: StdVec<TraceReply> = r.iter().filter_map(|f| if let FromGuard::Trace(t) = f { Some(*t) } else { None }).collect();
+    assert!(!dump.is_empty());
+    assert_eq!(dump.len(), usize::from(dump[0].count), "the whole ring arrives");
+    assert!(dump.iter().enumerate().all(|(i, t)| usize::from(t.index) == i && t.token == 11));
+    assert!(dump.iter().any(|t| t.event.tag == 7), "the faults-cleared event is in the dump");
+    assert_eq!(app.guard().faults() & crate::faults::LATCHED, 0);
+}
+
+/// Garbage, bursts and truncated frames: counted as rejected, the tick
+/// still completes with its one reply and the watchdog is still fed.
+#[test]
+fn garbage_is_counted_and_every_tick_completes() {
+    let mut b = SimBoard::new();
+    let mem = b.mem();
+    let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
+    let mut x: u32 = 12345;
+    for k in 0..200u16 {
+        for _ in 0..(k % 97) {
+            x = x.wrapping_mul(1_103_515_245).wrapping_add(12345);
+            b.rx.push((x >> 16) as u8);
+        }
+        if k % 3 == 0 {
+            let f = sample(1000 + k, 10.0, 50.0).encode();
+            b.rx.push(0);
+            b.rx.extend_from_slice(&f);
+        }
+        app.tick(&mut b, 0);
+    }
+    let t = ticks(&b.replies());
+    assert_eq!(t.len(), 200);
+    assert_eq!(b.feeds, 200);
+    let c = app.counters();
+    assert!(c.rejected_crc + c.rejected_framing > 50, "{c:?}");
+    assert!(c.accepted >= 40, "most clean frames after a delimiter get through: {c:?}");
+}
+
+/// A warm reboot restores the thermal state from the A/B records and reads
+/// the recorded reset cause.
+#[test]
+fn warm_reboot_restores_the_estimate_and_the_cause() {
+    let mut b = SimBoard::new();
+    let mem = b.mem();
+    let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
+    for k in 0..500u16 {
+        b.rx.extend_from_slice(&sample(k, 40.0, 150.0).encode());
+        app.tick(&mut b, 0);
+    }
+    let before = app.guard().output().drain_c;
+    b.cause = b.cause.with_cause(ResetCause::Watchdog);
+    let mem = b.mem();
+    let app2 = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
+    assert_eq!(app2.reset_cause(), ResetCause::Watchdog);
+    let after = app2.guard().snapshot().temps_c;
+    let was = app.guard().snapshot().temps_c;
+    assert_eq!(after, was, "every node restored");
+    assert!(before > 30.0);
+}

@@ -1,0 +1,526 @@
+//! Product frames on the controller UART, beside the sample request of
+//! [`crate::protocol`] (same framing: COBS, CRC-16, `0x00` delimiters).
+//!
+//! Controller → guard: sample requests ([`crate::protocol::Request`], kind
+//! `0x01`) at the 10 ms tick rate, and [`Command`] frames (kind `0x10`).
+//! Guard → controller: one [`TickReply`] per tick, an [`Ack`] per command,
+//! a [`Status`] on request, and a trace dump as one [`TraceReply`] per event.
+//! Frame layouts are in `docs/firmware.md` (section "Product protocol");
+//! all fields little-endian, floats as IEEE-754 binary32 bit patterns.
+
+use crate::protocol::{frame, DecodeError, WireFrame, MAX_PAYLOAD};
+use crate::trace::{RestoreKind, Trace};
+use crate::Output;
+use heapless::Vec;
+
+/// Kind byte of a command frame (controller → guard).
+pub const KIND_COMMAND: u8 = 0x10;
+/// Kind byte of a tick reply.
+pub const KIND_TICK: u8 = 0x90;
+/// Kind byte of a command acknowledgement.
+pub const KIND_ACK: u8 = 0x91;
+/// Kind byte of a status reply.
+pub const KIND_STATUS: u8 = 0x92;
+/// Kind byte of a trace-event reply.
+pub const KIND_TRACE: u8 = 0x93;
+
+/// Payload length of a command, bytes.
+pub const COMMAND_LEN: usize = 4;
+/// Payload length of a tick reply, bytes.
+pub const TICK_LEN: usize = 30;
+/// Payload length of an acknowledgement, bytes.
+pub const ACK_LEN: usize = 5;
+/// Payload length of a status reply, bytes.
+pub const STATUS_LEN: usize = 43;
+/// Payload length of a trace-event reply, bytes.
+pub const TRACE_LEN: usize = 16;
+
+/// A controller command.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(any(target_os = "none", feature = "defmt"), derive(defmt::Format))]
+pub enum Cmd {
+    /// Clear latched faults (the guard's clear rule: 100 fully valid ticks in
+    /// a row and no CONFIG fault; refused otherwise).
+    ClearFaults,
+    /// A new LNG charge was installed: the budget is full again.
+    RefillLng,
+    /// Send a [`Status`] reply.
+    Status,
+    /// Send the trace ring, oldest event first, as [`TraceReply`] frames.
+    Trace,
+    /// Test builds only (feature `fault-inject`): stop feeding the watchdog.
+    InjectHang,
+    /// Test builds only (feature `fault-inject`): panic inside the tick.
+    InjectPanic,
+}
+
+impl Cmd {
+    /// Wire code.
+    pub fn code(self) -> u8 {
+        match self {
+            Cmd::ClearFaults => 1,
+            Cmd::RefillLng => 2,
+            Cmd::Status => 3,
+            Cmd::Trace => 4,
+            Cmd::InjectHang => 0xE0,
+            Cmd::InjectPanic => 0xE1,
+        }
+    }
+
+    /// From a wire code.
+    pub fn from_code(c: u8) -> Option<Cmd> {
+        Some(match c {
+            1 => Cmd::ClearFaults,
+            2 => Cmd::RefillLng,
+            3 => Cmd::Status,
+            4 => Cmd::Trace,
+            0xE0 => Cmd::InjectHang,
+            0xE1 => Cmd::InjectPanic,
+            _ => return None,
+        })
+    }
+}
+
+/// A command frame: the command and a token the reply echoes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Command {
+    /// Echoed in the reply so the controller can match it.
+    pub token: u16,
+    /// What to do.
+    pub cmd: Cmd,
+}
+
+/// Outcome of a command, in its [`Ack`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AckResult {
+    /// Done.
+    Done = 0,
+    /// Refused (clear rule not met, or not available in this build).
+    Refused = 1,
+}
+
+/// Acknowledgement of a command.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Ack {
+    /// The command's token.
+    pub token: u16,
+    /// The command.
+    pub cmd: Cmd,
+    /// Its outcome.
+    pub result: AckResult,
+}
+
+/// Output pin levels read back from the port's output register.
+///
+/// Electrical design (README, "Wiring"): both pins are active high for the
+/// *healthy* state, so a pin at its reset level (low) is the safe state.
+/// `valve_pin` high energises a normally-open valve to close it; `ok_pin`
+/// high means "no alarm, no derate".
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Pins {
+    /// Valve pin level: `true` = energised = valve closed.
+    pub valve_pin: bool,
+    /// OK pin level: `true` = no alarm; `false` = alarm/derate.
+    pub ok_pin: bool,
+}
+
+impl Pins {
+    /// The levels that command `valve_open` and `alarm`.
+    pub fn for_outputs(valve_open: bool, alarm: bool) -> Pins {
+        Pins { valve_pin: !valve_open, ok_pin: !alarm }
+    }
+}
+
+/// Why the MCU last reset (kept in no-init RAM across the reset, see
+/// [`super::reset`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(any(target_os = "none", feature = "defmt"), derive(defmt::Format))]
+pub enum ResetCause {
+    /// Power-on (no-init RAM held no cause record).
+    PowerOn = 0,
+    /// The watchdog expired (the tick loop stopped).
+    Watchdog = 1,
+    /// A panic (should not happen: the core has no panicking path).
+    Panic = 2,
+    /// A HardFault or other fault exception.
+    HardFault = 3,
+    /// An unexpected interrupt.
+    Exception = 4,
+    /// A reset without a recorded cause (pin reset, debugger, software).
+    Other = 5,
+}
+
+impl ResetCause {
+    /// From the wire/record code (unknown codes are [`ResetCause::Other`]).
+    pub fn from_code(c: u8) -> ResetCause {
+        match c {
+            0 => ResetCause::PowerOn,
+            1 => ResetCause::Watchdog,
+            2 => ResetCause::Panic,
+            3 => ResetCause::HardFault,
+            4 => ResetCause::Exception,
+            _ => ResetCause::Other,
+        }
+    }
+}
+
+fn restore_code(k: RestoreKind) -> u8 {
+    match k {
+        RestoreKind::Cold => 0,
+        RestoreKind::Warm => 1,
+        RestoreKind::Corrupt => 2,
+    }
+}
+
+/// Restore kind from its wire code.
+pub fn restore_from_code(c: u8) -> Option<RestoreKind> {
+    match c {
+        0 => Some(RestoreKind::Cold),
+        1 => Some(RestoreKind::Warm),
+        2 => Some(RestoreKind::Corrupt),
+        _ => None,
+    }
+}
+
+/// Sent once per tick: the outputs of that tick.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TickReply {
+    /// Tick counter since boot (10 ms ticks).
+    pub tick: u32,
+    /// Sequence number of the newest accepted sample.
+    pub sample_seq: u16,
+    /// `true` when a new sample arrived for this tick; `false` = missing.
+    pub fresh: bool,
+    /// The guard's output of this tick.
+    pub out: Output,
+    /// Pin levels read back after writing them.
+    pub pins: Pins,
+    /// Ticks that overran their period since boot (saturating).
+    pub overruns: u16,
+    /// Frames rejected since boot (all reasons, saturating).
+    pub rejected: u16,
+    /// How this boot's thermal state was initialised.
+    pub restore: RestoreKind,
+    /// Why the MCU last reset.
+    pub reset_cause: ResetCause,
+}
+
+/// Counters and health, on request.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Status {
+    /// The command's token.
+    pub token: u16,
+    /// Tick counter since boot.
+    pub tick: u32,
+    /// Overrun ticks since boot.
+    pub overruns: u32,
+    /// Longest tick, core-clock cycles (0 when the board cannot measure it).
+    pub worst_tick_cycles: u32,
+    /// Stack high-water mark since boot, bytes (0 when not measured).
+    pub stack_high_water_b: u16,
+    /// Why the MCU last reset ([`ResetCause`] code).
+    pub reset_cause: u8,
+    /// Restore kind code (0 cold, 1 warm, 2 corrupt record).
+    pub restore: u8,
+    /// Boots since power-on (from no-init RAM).
+    pub boots: u16,
+    /// Frames rejected for a CRC mismatch.
+    pub rejected_crc: u16,
+    /// Frames rejected for framing (COBS, length, overflow, unknown kind).
+    pub rejected_framing: u16,
+    /// Samples rejected as duplicate or older.
+    pub rejected_sequence: u16,
+    /// Samples that arrived within a tick after another and were replaced by it.
+    pub superseded: u16,
+    /// Samples accepted.
+    pub accepted: u32,
+    /// Ticks without a new sample.
+    pub missing: u32,
+    /// Received bytes lost to a full receive buffer.
+    pub rx_overflow: u16,
+    /// Commands executed.
+    pub commands: u16,
+    /// Fault word now.
+    pub faults: u16,
+}
+
+/// One trace event in a dump.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TraceReply {
+    /// The command's token.
+    pub token: u16,
+    /// Index of this event in the dump (0 = oldest).
+    pub index: u8,
+    /// Events in the dump.
+    pub count: u8,
+    /// The event (see [`encode_trace`]).
+    pub event: TraceWire,
+}
+
+/// A trace event flattened for the wire: tag, tick, a value and an aux word.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TraceWire {
+    /// Event tag: 1 restore, 2 valve open, 3 valve close, 4 alarm, 5 alarm
+    /// clear, 6 fault, 7 faults cleared, 8 LNG low, 9 overrun, 10 reset, 11 command.
+    pub tag: u8,
+    /// Guard tick of the event.
+    pub tick: u32,
+    /// Drain °C (valve/alarm events), LNG kg (LNG low), else 0.
+    pub value: f32,
+    /// Fault bits, restore/reset cause code, forced flag, lost ticks or command code.
+    pub aux: u16,
+}
+
+/// Flattens a trace event for the wire.
+pub fn encode_trace(t: &Trace) -> TraceWire {
+    let w = |tag, tick, value, aux| TraceWire { tag, tick, value, aux };
+    match *t {
+        Trace::Restore { step, kind } => w(1, step, 0.0, u16::from(restore_code(kind))),
+        Trace::ValveOpen { step, drain_c, forced } => w(2, step, drain_c, u16::from(forced)),
+        Trace::ValveClose { step, drain_c } => w(3, step, drain_c, 0),
+        Trace::Alarm { step, drain_c } => w(4, step, drain_c, 0),
+        Trace::AlarmClear { step, drain_c } => w(5, step, drain_c, 0),
+        Trace::Fault { step, new_bits } => w(6, step, 0.0, new_bits),
+        Trace::FaultsCleared { step, bits } => w(7, step, 0.0, bits),
+        Trace::LngLow { step, remaining_kg } => w(8, step, remaining_kg, 0),
+        Trace::Overrun { step, lost_ticks } => w(9, step, 0.0, lost_ticks),
+        Trace::Reset { step, cause } => w(10, step, 0.0, u16::from(cause)),
+        Trace::Command { step, code } => w(11, step, 0.0, u16::from(code)),
+    }
+}
+
+type Buf = Vec<u8, MAX_PAYLOAD>;
+
+fn put(p: &mut Buf, b: &[u8]) {
+    // Payloads are fixed-size and below MAX_PAYLOAD; a failure would give a
+    // short frame the peer rejects, never a panic.
+    let _ = p.extend_from_slice(b);
+}
+
+fn out_fields(p: &mut Buf, o: &Output) {
+    put(p, &o.drain_c.to_le_bytes());
+    put(p, &[crate::protocol::GuardOutput::flags(o)]);
+    put(p, &o.faults.to_le_bytes());
+    put(p, &o.lng_remaining_kg.to_le_bytes());
+    put(p, &o.lng_seconds_left.to_le_bytes());
+}
+
+/// Little-endian reader that never panics.
+struct Rd<'a>(&'a [u8]);
+impl Rd<'_> {
+    fn arr<const K: usize>(&mut self) -> Result<[u8; K], DecodeError> {
+        let (head, tail) = self.0.split_at_checked(K).ok_or(DecodeError::Length)?;
+        self.0 = tail;
+        head.try_into().map_err(|_| DecodeError::Length)
+    }
+    fn u8(&mut self) -> Result<u8, DecodeError> {
+        Ok(u8::from_le_bytes(self.arr()?))
+    }
+    fn u16(&mut self) -> Result<u16, DecodeError> {
+        Ok(u16::from_le_bytes(self.arr()?))
+    }
+    fn u32(&mut self) -> Result<u32, DecodeError> {
+        Ok(u32::from_le_bytes(self.arr()?))
+    }
+    fn f32(&mut self) -> Result<f32, DecodeError> {
+        Ok(f32::from_le_bytes(self.arr()?))
+    }
+    fn out(&mut self) -> Result<Output, DecodeError> {
+        let drain_c = self.f32()?;
+        let flags = self.u8()?;
+        Ok(Output {
+            drain_c,
+            valve_open: flags & 1 != 0,
+            alarm: flags & 2 != 0,
+            derate: flags & 4 != 0,
+            faults: self.u16()?,
+            lng_remaining_kg: self.f32()?,
+            lng_seconds_left: self.f32()?,
+        })
+    }
+}
+
+fn expect(p: &[u8], kind: u8, len: usize) -> Result<Rd<'_>, DecodeError> {
+    match p.first() {
+        Some(&k) if k == kind => {}
+        _ => return Err(DecodeError::Kind),
+    }
+    if p.len() != len {
+        return Err(DecodeError::Length);
+    }
+    Ok(Rd(p.get(1..).unwrap_or(&[])))
+}
+
+impl Command {
+    /// Wire bytes (controller side).
+    pub fn encode(&self) -> WireFrame {
+        let mut p = Buf::new();
+        put(&mut p, &[KIND_COMMAND]);
+        put(&mut p, &self.token.to_le_bytes());
+        put(&mut p, &[self.cmd.code()]);
+        frame(&p, false)
+    }
+
+    /// Parses a payload (CRC checked and stripped).
+    pub fn from_payload(p: &[u8]) -> Result<Command, DecodeError> {
+        let mut r = expect(p, KIND_COMMAND, COMMAND_LEN)?;
+        let token = r.u16()?;
+        let cmd = Cmd::from_code(r.u8()?).ok_or(DecodeError::Kind)?;
+        Ok(Command { token, cmd })
+    }
+}
+
+impl TickReply {
+    /// Wire bytes (leading and trailing delimiter).
+    pub fn encode(&self) -> WireFrame {
+        let mut p = Buf::new();
+        put(&mut p, &[KIND_TICK]);
+        put(&mut p, &self.tick.to_le_bytes());
+        put(&mut p, &self.sample_seq.to_le_bytes());
+        put(&mut p, &[u8::from(self.fresh)]);
+        out_fields(&mut p, &self.out);
+        put(&mut p, &[u8::from(self.pins.valve_pin) | (u8::from(self.pins.ok_pin) << 1)]);
+        put(&mut p, &self.overruns.to_le_bytes());
+        put(&mut p, &self.rejected.to_le_bytes());
+        put(&mut p, &[restore_code(self.restore), self.reset_cause as u8]);
+        frame(&p, true)
+    }
+
+    /// Parses a payload (host side).
+    pub fn from_payload(p: &[u8]) -> Result<TickReply, DecodeError> {
+        let mut r = expect(p, KIND_TICK, TICK_LEN)?;
+        let tick = r.u32()?;
+        let sample_seq = r.u16()?;
+        let fresh = r.u8()? != 0;
+        let out = r.out()?;
+        let pins = r.u8()?;
+        let overruns = r.u16()?;
+        let rejected = r.u16()?;
+        let restore = restore_from_code(r.u8()?).ok_or(DecodeError::Kind)?;
+        let reset_cause = ResetCause::from_code(r.u8()?);
+        let pins = Pins { valve_pin: pins & 1 != 0, ok_pin: pins & 2 != 0 };
+        Ok(TickReply { tick, sample_seq, fresh, out, pins, overruns, rejected, restore, reset_cause })
+    }
+}
+
+impl Ack {
+    /// Wire bytes.
+    pub fn encode(&self) -> WireFrame {
+        let mut p = Buf::new();
+        put(&mut p, &[KIND_ACK]);
+        put(&mut p, &self.token.to_le_bytes());
+        put(&mut p, &[self.cmd.code(), self.result as u8]);
+        frame(&p, true)
+    }
+
+    /// Parses a payload (host side).
+    pub fn from_payload(p: &[u8]) -> Result<Ack, DecodeError> {
+        let mut r = expect(p, KIND_ACK, ACK_LEN)?;
+        let token = r.u16()?;
+        let cmd = Cmd::from_code(r.u8()?).ok_or(DecodeError::Kind)?;
+        let result = match r.u8()? {
+            0 => AckResult::Done,
+            1 => AckResult::Refused,
+            _ => return Err(DecodeError::Kind),
+        };
+        Ok(Ack { token, cmd, result })
+    }
+}
+
+impl Status {
+    /// Wire bytes.
+    pub fn encode(&self) -> WireFrame {
+        let mut p = Buf::new();
+        put(&mut p, &[KIND_STATUS]);
+        put(&mut p, &self.token.to_le_bytes());
+        put(&mut p, &self.tick.to_le_bytes());
+        put(&mut p, &self.overruns.to_le_bytes());
+        put(&mut p, &self.worst_tick_cycles.to_le_bytes());
+        put(&mut p, &self.stack_high_water_b.to_le_bytes());
+        put(&mut p, &[self.reset_cause, self.restore]);
+        for v in [self.boots, self.rejected_crc, self.rejected_framing, self.rejected_sequence, self.superseded] {
+            put(&mut p, &v.to_le_bytes());
+        }
+        put(&mut p, &self.accepted.to_le_bytes());
+        put(&mut p, &self.missing.to_le_bytes());
+        for v in [self.rx_overflow, self.commands, self.faults] {
+            put(&mut p, &v.to_le_bytes());
+        }
+        frame(&p, true)
+    }
+
+    /// Parses a payload (host side).
+    pub fn from_payload(p: &[u8]) -> Result<Status, DecodeError> {
+        let mut r = expect(p, KIND_STATUS, STATUS_LEN)?;
+        Ok(Status {
+            token: r.u16()?,
+            tick: r.u32()?,
+            overruns: r.u32()?,
+            worst_tick_cycles: r.u32()?,
+            stack_high_water_b: r.u16()?,
+            reset_cause: r.u8()?,
+            restore: r.u8()?,
+            boots: r.u16()?,
+            rejected_crc: r.u16()?,
+            rejected_framing: r.u16()?,
+            rejected_sequence: r.u16()?,
+            superseded: r.u16()?,
+            accepted: r.u32()?,
+            missing: r.u32()?,
+            rx_overflow: r.u16()?,
+            commands: r.u16()?,
+            faults: r.u16()?,
+        })
+    }
+}
+
+impl TraceReply {
+    /// Wire bytes.
+    pub fn encode(&self) -> WireFrame {
+        let mut p = Buf::new();
+        put(&mut p, &[KIND_TRACE]);
+        put(&mut p, &self.token.to_le_bytes());
+        put(&mut p, &[self.index, self.count, self.event.tag]);
+        put(&mut p, &self.event.tick.to_le_bytes());
+        put(&mut p, &self.event.value.to_le_bytes());
+        put(&mut p, &self.event.aux.to_le_bytes());
+        frame(&p, true)
+    }
+
+    /// Parses a payload (host side).
+    pub fn from_payload(p: &[u8]) -> Result<TraceReply, DecodeError> {
+        let mut r = expect(p, KIND_TRACE, TRACE_LEN)?;
+        let token = r.u16()?;
+        let index = r.u8()?;
+        let count = r.u8()?;
+        let tag = r.u8()?;
+        let event = TraceWire { tag, tick: r.u32()?, value: r.f32()?, aux: r.u16()? };
+        Ok(TraceReply { token, index, count, event })
+    }
+}
+
+/// Any frame the guard sends, decoded (host side).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FromGuard {
+    /// A tick's outputs.
+    Tick(TickReply),
+    /// A command acknowledgement.
+    Ack(Ack),
+    /// A status reply.
+    Status(Status),
+    /// One trace event.
+    Trace(TraceReply),
+}
+
+impl FromGuard {
+    /// Decodes a guard → controller payload by its kind byte.
+    pub fn from_payload(p: &[u8]) -> Result<FromGuard, DecodeError> {
+        match p.first() {
+            Some(&KIND_TICK) => TickReply::from_payload(p).map(FromGuard::Tick),
+            Some(&KIND_ACK) => Ack::from_payload(p).map(FromGuard::Ack),
+            Some(&KIND_STATUS) => Status::from_payload(p).map(FromGuard::Status),
+            Some(&KIND_TRACE) => TraceReply::from_payload(p).map(FromGuard::Trace),
+            _ => Err(DecodeError::Kind),
+        }
+    }
+}
