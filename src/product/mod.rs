@@ -21,10 +21,11 @@ pub mod reset;
 pub mod wire;
 
 use crate::memory::nv::NvPolicy;
+use crate::protection::LngConfig;
 use crate::memory::slots::{self, AbWriter};
 use crate::memory::{boot_restore, Restore, ThermalRecord};
 use crate::protocol::{DecodeError, Deframer, Request, MAX_MISSED_STEPS};
-use crate::trace::{RestoreKind, Trace, TraceBuf};
+use crate::trace::{RestoreKind, Trace};
 use crate::{Guard, GuardConfig, Output};
 use heapless::Deque;
 use reset::CauseRecord;
@@ -73,8 +74,13 @@ pub trait Board {
     fn cycles_since(&self, _stamp: u32) -> u32 {
         0
     }
-    /// Stack high-water mark since boot, bytes (0 when not measured).
+    /// Stack high-water mark of the tick loop, bytes (0 when not measured).
     fn stack_high_water_b(&self) -> u32 {
+        0
+    }
+    /// Stack used by boot (reset to the end of [`App::boot`]), bytes (0 when
+    /// not measured).
+    fn boot_stack_b(&self) -> u32 {
         0
     }
 }
@@ -121,7 +127,7 @@ impl Counters {
 
 /// The product application state (one per board, lives for the whole run).
 pub struct App {
-    cfg: GuardConfig,
+    lng: LngConfig,
     guard: Guard,
     rx: Deframer,
     last_seq: Option<u16>,
@@ -136,7 +142,8 @@ pub struct App {
     reset_cause: ResetCause,
     boots: u16,
     worst_tick_cycles: u32,
-    dump: Option<(u16, TraceBuf, u8)>,
+    /// Trace dump in progress: token, next index, events in the dump.
+    dump: Option<(u16, u8, u8)>,
 }
 
 fn restore_kind(r: &Restore) -> RestoreKind {
@@ -162,7 +169,7 @@ impl App {
         let out = guard.output();
         let _ = board.set_pins(Pins::for_outputs(out.valve_open, out.alarm || out.derate));
         App {
-            cfg: *cfg,
+            lng: cfg.lng,
             guard,
             rx: Deframer::new(),
             last_seq: None,
@@ -345,12 +352,15 @@ impl App {
                 board.write_tx(&ack(if ok { AckResult::Done } else { AckResult::Refused }).encode());
             }
             Cmd::RefillLng => {
-                let lng = self.cfg.lng;
+                let lng = self.lng;
                 self.guard.refill_lng(&lng);
                 board.write_tx(&ack(AckResult::Done).encode());
             }
             Cmd::Status => board.write_tx(&self.status(board, c.token).encode()),
-            Cmd::Trace => self.dump = Some((c.token, self.guard.trace().clone(), 0)),
+            Cmd::Trace => {
+                let count = u8::try_from(self.guard.trace().len()).unwrap_or(u8::MAX);
+                self.dump = Some((c.token, 0, count));
+            }
             Cmd::InjectHang | Cmd::InjectPanic => self.inject(board, c, ack),
         }
     }
@@ -376,17 +386,20 @@ impl App {
         board.write_tx(&ack(AckResult::Refused).encode());
     }
 
+    /// Sends the next events of a dump. The dump reads the live ring by
+    /// index: the `count` events present when it was asked for, oldest
+    /// first. If the ring is full and new events arrive during the dump
+    /// (four ticks per four events), the indices shift and the dump ends
+    /// with the newest events instead of as many of the oldest.
     fn send_trace_chunk<B: Board>(&mut self, board: &mut B) {
-        let Some((token, buf, next)) = &mut self.dump else { return };
-        let count = u8::try_from(buf.len()).unwrap_or(u8::MAX);
-        for ev in buf.iter().skip(usize::from(*next)).take(TRACE_EVENTS_PER_TICK) {
-            let r = TraceReply { token: *token, index: *next, count, event: wire::encode_trace(ev) };
+        let Some((token, next, count)) = self.dump else { return };
+        let mut index = next;
+        for ev in self.guard.trace().iter().skip(usize::from(next)).take(TRACE_EVENTS_PER_TICK.min(usize::from(count - next.min(count)))) {
+            let r = TraceReply { token, index, count, event: wire::encode_trace(ev) };
             board.write_tx(&r.encode());
-            *next = next.saturating_add(1);
+            index = index.saturating_add(1);
         }
-        if *next >= count {
-            self.dump = None;
-        }
+        self.dump = if index >= count { None } else { Some((token, index, count)) };
     }
 
     /// The status reply for `token`.
@@ -398,6 +411,7 @@ impl App {
             overruns: c.overruns,
             worst_tick_cycles: self.worst_tick_cycles,
             stack_high_water_b: u16::try_from(board.stack_high_water_b()).unwrap_or(u16::MAX),
+            boot_stack_b: u16::try_from(board.boot_stack_b()).unwrap_or(u16::MAX),
             reset_cause: self.reset_cause as u8,
             restore: match self.restore {
                 RestoreKind::Cold => 0,

@@ -301,3 +301,4 @@ fn warm_reboot_restores_the_estimate_and_the_cause() {
     assert_eq!(after, was, "every node restored");
     assert!(before > 30.0);
 }
+

@@ -31,7 +31,7 @@ pub const TICK_LEN: usize = 30;
 /// Payload length of an acknowledgement, bytes.
 pub const ACK_LEN: usize = 5;
 /// Payload length of a status reply, bytes.
-pub const STATUS_LEN: usize = 43;
+pub const STATUS_LEN: usize = 45;
 /// Payload length of a trace-event reply, bytes.
 pub const TRACE_LEN: usize = 16;
 
@@ -216,8 +216,10 @@ pub struct Status {
     pub overruns: u32,
     /// Longest tick, core-clock cycles (0 when the board cannot measure it).
     pub worst_tick_cycles: u32,
-    /// Stack high-water mark since boot, bytes (0 when not measured).
+    /// Stack high-water mark of the tick loop, bytes (0 when not measured).
     pub stack_high_water_b: u16,
+    /// Stack used by boot, bytes (0 when not measured).
+    pub boot_stack_b: u16,
     /// Why the MCU last reset ([`ResetCause`] code).
     pub reset_cause: u8,
     /// Restore kind code (0 cold, 1 warm, 2 corrupt record).
@@ -437,6 +439,7 @@ impl Status {
         put(&mut p, &self.overruns.to_le_bytes());
         put(&mut p, &self.worst_tick_cycles.to_le_bytes());
         put(&mut p, &self.stack_high_water_b.to_le_bytes());
+        put(&mut p, &self.boot_stack_b.to_le_bytes());
         put(&mut p, &[self.reset_cause, self.restore]);
         for v in [self.boots, self.rejected_crc, self.rejected_framing, self.rejected_sequence, self.superseded] {
             put(&mut p, &v.to_le_bytes());
@@ -458,6 +461,7 @@ impl Status {
             overruns: r.u32()?,
             worst_tick_cycles: r.u32()?,
             stack_high_water_b: r.u16()?,
+            boot_stack_b: r.u16()?,
             reset_cause: r.u8()?,
             restore: r.u8()?,
             boots: r.u16()?,

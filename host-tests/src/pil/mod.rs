@@ -12,6 +12,7 @@ pub mod defmt_log;
 pub mod drill;
 pub mod firmware;
 pub mod plot;
+pub mod product;
 pub mod qemu;
 pub mod reference;
 pub mod cli;

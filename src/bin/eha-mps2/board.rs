@@ -1,0 +1,282 @@
+//! QEMU `mps2-an386` board: CMSDK UART0 (controller link), CMSDK timer 0
+//! (10 ms tick), CMSDK APB watchdog, FPGAIO LED register as the two output
+//! pins (QEMU emulates no GPIO block on this machine; the LED register is a
+//! real read/write register that resets to 0, like a GPIO port).
+//!
+//! Pins: LED bit 0 = valve pin (high = energise = close the normally-open
+//! valve), bit 1 = OK pin (high = no alarm). Reset level 0 = valve open,
+//! alarm: the safe state.
+//!
+//! Interrupts (no PAC: cortex-m-rt's default vector table sends every IRQ
+//! to `DefaultHandler`, which dispatches by number): UART0 RX = IRQ 0,
+//! timer 0 = IRQ 8; the watchdog's warning goes to NMI.
+
+use core::cell::RefCell;
+use core::sync::atomic::{AtomicU32, Ordering::Relaxed};
+use cortex_m::interrupt::{self as irq, Mutex};
+use cortex_m::peripheral::{syst::SystClkSource, NVIC, SCB, SYST};
+use cortex_m_rt::{exception, ExceptionFrame};
+use eha_guard::memory::slots::noinit;
+use eha_guard::memory::ThermalRecord;
+use eha_guard::product::reset::{self, CauseRecord};
+use eha_guard::product::wire::{Pins, ResetCause};
+use eha_guard::product::{Board, BootMemory};
+use heapless::Deque;
+
+const SYSCLK_HZ: u32 = 25_000_000;
+/// Tick period: 10 ms of the 25 MHz APB clock.
+const TICK_RELOAD: u32 = SYSCLK_HZ / 100;
+/// Watchdog period: the warning (NMI) after 0.5 s without a feed, the reset
+/// after a second period. Long against the 10 ms tick so that a QEMU process
+/// descheduled by a loaded host does not look like a hang.
+const WDOG_LOAD: u32 = SYSCLK_HZ / 2;
+
+const UART0: usize = 0x4000_4000;
+const TIMER0: usize = 0x4000_0000;
+const WDOG: usize = 0x4000_8000;
+const FPGAIO_LED0: usize = 0x4002_8000;
+const IRQ_UART0_RX: u16 = 0;
+const IRQ_TIMER0: u16 = 8;
+
+fn wr(addr: usize, v: u32) {
+    // SAFETY: MMIO registers of the mps2-an386 memory map (constants above).
+    unsafe { core::ptr::write_volatile(addr as *mut u32, v) }
+}
+
+fn rd(addr: usize) -> u32 {
+    // SAFETY: as in `wr`.
+    unsafe { core::ptr::read_volatile(addr as *const u32) }
+}
+
+#[derive(Clone, Copy)]
+struct Irq(u16);
+// SAFETY: the numbers are device interrupt lines of this machine.
+unsafe impl cortex_m::interrupt::InterruptNumber for Irq {
+    fn number(self) -> u16 {
+        self.0
+    }
+}
+
+static TICKS: AtomicU32 = AtomicU32::new(0);
+static RX_DROPPED: AtomicU32 = AtomicU32::new(0);
+static RX: Mutex<RefCell<Deque<u8, 256>>> = Mutex::new(RefCell::new(Deque::new()));
+
+/// Puts the outputs in their safe state with one register write: valve
+/// pin low (valve open), OK pin low (alarm). Used by the fault handlers.
+fn safe_outputs() {
+    wr(FPGAIO_LED0, 0);
+}
+
+/// Records `cause`, makes the outputs safe and resets the MCU.
+fn fail(cause: ResetCause) -> ! {
+    safe_outputs();
+    reset::noinit::record(cause);
+    SCB::sys_reset()
+}
+
+/// The board's peripherals (all MMIO; the statics above are shared with the
+/// interrupt handlers).
+pub struct Mps2 {
+    syst: SYST,
+    boot_stack_b: u32,
+}
+
+const PAINT: u32 = 0xDEAD_BEEF;
+extern "C" {
+    static _stack_end: u32;
+    static _stack_start: u32;
+}
+
+/// Fills the unused stack below the live frames (from its lowest address
+/// up to 256 bytes below SP) with a pattern.
+#[inline(never)]
+fn paint_stack() {
+    let lo = core::ptr::addr_of!(_stack_end) as usize;
+    let sp = cortex_m::register::msp::read() as usize;
+    let mut p = lo;
+    while p + 256 < sp {
+        // SAFETY: [lo, sp - 256) is unused stack below the live frames.
+        unsafe { core::ptr::write_volatile(p as *mut u32, PAINT) };
+        p += 4;
+    }
+}
+
+/// Bytes of stack ever used since the last paint.
+fn stack_high_water() -> u32 {
+    let lo = core::ptr::addr_of!(_stack_end) as usize;
+    let hi = core::ptr::addr_of!(_stack_start) as usize;
+    let mut p = lo;
+    // SAFETY: reading our own stack region word by word.
+    while p < hi && unsafe { core::ptr::read_volatile(p as *const u32) } == PAINT {
+        p += 4;
+    }
+    (hi - p) as u32
+}
+
+impl Mps2 {
+    /// Safe outputs, stack paint, watchdog armed, and what the memories hold.
+    pub fn init() -> (Mps2, BootMemory) {
+        safe_outputs();
+        paint_stack();
+        let Some(cp) = cortex_m::Peripherals::take() else { fail(ResetCause::Other) };
+        let mut syst = cp.SYST;
+        syst.set_clock_source(SystClkSource::Core);
+        syst.set_reload(0x00FF_FFFF);
+        syst.clear_current();
+        syst.enable_counter();
+        // Watchdog: unlock, load, interrupt (NMI warning) + reset, lock.
+        wr(WDOG + 0xC00, 0x1ACC_E551);
+        wr(WDOG, WDOG_LOAD);
+        wr(WDOG + 0x008, 0b11);
+        wr(WDOG + 0xC00, 0);
+        let (a, b) = noinit::load();
+        let mem = BootMemory { records: (a, b), nv: None, cause: reset::noinit::load(), hw_hint: None };
+        (Mps2 { syst, boot_stack_b: 0 }, mem)
+    }
+
+    /// Called after `App::boot`: the boot stack is measured, then repainted so
+    /// that the status reply reports the tick loop's own high-water mark.
+    pub fn boot_done(&mut self) {
+        self.boot_stack_b = stack_high_water();
+        paint_stack();
+        defmt::info!("boot stack {=u32} B", self.boot_stack_b);
+    }
+}
+
+/// Starts UART0 (RX interrupt) and the tick timer.
+pub fn start(_b: &mut Mps2) {
+    wr(UART0 + 0x010, 16); // BAUDDIV (QEMU needs >= 16; the rate is not modelled)
+    wr(UART0 + 0x008, 0b1011); // TX enable, RX enable, RX interrupt enable
+    wr(TIMER0 + 0x008, TICK_RELOAD); // RELOAD
+    wr(TIMER0 + 0x004, TICK_RELOAD); // VALUE
+    wr(TIMER0, 0b1001); // enable, interrupt enable
+    // SAFETY: the handlers only touch the statics above, through atomics or
+    // a critical section.
+    unsafe {
+        NVIC::unmask(Irq(IRQ_UART0_RX));
+        NVIC::unmask(Irq(IRQ_TIMER0));
+    }
+}
+
+impl Board for Mps2 {
+    fn read_rx(&mut self, buf: &mut [u8]) -> usize {
+        irq::free(|cs| {
+            let mut q = RX.borrow(cs).borrow_mut();
+            let mut n = 0;
+            for slot in buf.iter_mut() {
+                let Some(b) = q.pop_front() else { break };
+                *slot = b;
+                n += 1;
+            }
+            n
+        })
+    }
+
+    fn rx_dropped(&self) -> u32 {
+        RX_DROPPED.load(Relaxed)
+    }
+
+    fn write_tx(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            while rd(UART0 + 0x004) & 1 != 0 {} // TX full
+            wr(UART0, u32::from(b));
+        }
+    }
+
+    fn set_pins(&mut self, pins: Pins) -> Pins {
+        wr(FPGAIO_LED0, u32::from(pins.valve_pin) | (u32::from(pins.ok_pin) << 1));
+        let v = rd(FPGAIO_LED0);
+        Pins { valve_pin: v & 1 != 0, ok_pin: v & 2 != 0 }
+    }
+
+    fn feed_watchdog(&mut self) {
+        wr(WDOG + 0xC00, 0x1ACC_E551);
+        wr(WDOG + 0x00C, 1); // INTCLR: clears the warning and reloads the count
+        wr(WDOG + 0xC00, 0);
+    }
+
+    fn ticks(&self) -> u32 {
+        TICKS.load(Relaxed)
+    }
+
+    fn wait_tick(&mut self, seen: u32) {
+        while TICKS.load(Relaxed) == seen {
+            // WFI with interrupts masked: a tick that fires between the check
+            // and the WFI still wakes it (pending), and runs after `free`.
+            irq::free(|_| {
+                if TICKS.load(Relaxed) == seen {
+                    cortex_m::asm::wfi();
+                }
+            });
+        }
+    }
+
+    fn store_record(&mut self, slot: usize, rec: &ThermalRecord) {
+        noinit::store(slot, rec);
+    }
+
+    fn store_cause(&mut self, rec: &CauseRecord) {
+        reset::noinit::store(rec);
+    }
+
+    fn cycle_stamp(&self) -> u32 {
+        SYST::get_current()
+    }
+
+    fn cycles_since(&self, stamp: u32) -> u32 {
+        let _ = &self.syst;
+        stamp.wrapping_sub(SYST::get_current()) & 0x00FF_FFFF
+    }
+
+    fn stack_high_water_b(&self) -> u32 {
+        stack_high_water()
+    }
+
+    fn boot_stack_b(&self) -> u32 {
+        self.boot_stack_b
+    }
+}
+
+fn uart0_rx() {
+    // Drain the (one-byte) receive buffer, then acknowledge.
+    while rd(UART0 + 0x004) & 2 != 0 {
+        let b = rd(UART0) as u8;
+        irq::free(|cs| {
+            if RX.borrow(cs).borrow_mut().push_back(b).is_err() {
+                RX_DROPPED.fetch_add(1, Relaxed);
+            }
+        });
+    }
+    wr(UART0 + 0x00C, 0b1010); // clear RX and RX-overrun interrupts
+}
+
+fn timer0() {
+    wr(TIMER0 + 0x00C, 1);
+    TICKS.fetch_add(1, Relaxed);
+}
+
+#[exception]
+unsafe fn DefaultHandler(irqn: i16) {
+    match irqn {
+        0 => uart0_rx(),
+        8 => timer0(),
+        _ => fail(ResetCause::Exception),
+    }
+}
+
+/// The watchdog's warning: the tick loop has not completed for a whole
+/// watchdog period.
+#[exception]
+unsafe fn NonMaskableInt() {
+    fail(ResetCause::Watchdog)
+}
+
+#[exception]
+unsafe fn HardFault(_ef: &ExceptionFrame) -> ! {
+    fail(ResetCause::HardFault)
+}
+
+#[panic_handler]
+fn panic(_info: &core::panic::PanicInfo) -> ! {
+    fail(ResetCause::Panic)
+}
