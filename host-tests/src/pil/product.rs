@@ -39,6 +39,30 @@ pub fn product_elf() -> Result<PathBuf> {
     Ok(p)
 }
 
+/// Sends one gdb remote-protocol packet and, if `reply`, waits for `OK`.
+fn gdb_packet(s: &mut UnixStream, body: &str, reply: bool) -> Result<()> {
+    let sum = body.bytes().fold(0u8, u8::wrapping_add);
+    s.write_all(format!("${body}#{sum:02x}").as_bytes())?;
+    if !reply {
+        return Ok(());
+    }
+    s.set_read_timeout(Some(Duration::from_secs(5)))?;
+    let mut got = Vec::new();
+    let mut buf = [0u8; 256];
+    while !got.windows(2).any(|w| w == b"OK") {
+        let n = s.read(&mut buf).context("reading the gdb stub")?;
+        if n == 0 {
+            bail!("gdb stub closed");
+        }
+        got.extend_from_slice(&buf[..n]);
+        if got.starts_with(b"+$E") || got.windows(2).any(|w| w == b"$E") {
+            bail!("gdb stub refused `{}`: {}", &body[..body.len().min(20)], String::from_utf8_lossy(&got));
+        }
+    }
+    s.write_all(b"+")?;
+    Ok(())
+}
+
 /// A frame from the guard with its arrival time.
 #[derive(Clone, Copy, Debug)]
 pub struct Received {
@@ -80,9 +104,18 @@ fn connect(path: &Path, child: &mut Child) -> Result<UnixStream> {
 }
 
 impl ProductSession {
-    /// Starts QEMU with `elf`; `extra` are more QEMU arguments (e.g. a
-    /// `-device loader` that puts a thermal record in no-init RAM).
+    /// Starts QEMU with `elf`; `extra` are more QEMU arguments.
     pub fn spawn(elf: &Path, extra: &[String]) -> Result<Self> {
+        Self::spawn_with_ram(elf, extra, &[])
+    }
+
+    /// Starts QEMU with `elf` and the bytes `ram` written at their addresses
+    /// before the CPU runs (e.g. a thermal record in no-init RAM, as a warm
+    /// reset leaves it). The writes go through QEMU's gdb stub: the CPU starts
+    /// stopped (`-S`), the memory is written, then the CPU continues. (A
+    /// `-device loader` blob there overlaps the ELF's RAM segment, which QEMU
+    /// refuses.)
+    pub fn spawn_with_ram(elf: &Path, extra: &[String], ram: &[(u32, Vec<u8>)]) -> Result<Self> {
         super::qemu::qemu_available()?;
         let dir = std::env::temp_dir().join(format!("eha-product-{}-{:?}", std::process::id(), std::thread::current().id()))
             .with_extension(format!("{}", Instant::now().elapsed().as_nanos()));
@@ -90,7 +123,13 @@ impl ProductSession {
         std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
         let uart = dir.join("uart.sock");
         let mon = dir.join("mon.sock");
+        let gdb = dir.join("gdb.sock");
+        let mut gdb_args: Vec<String> = Vec::new();
+        if !ram.is_empty() {
+            gdb_args = vec!["-S".into(), "-gdb".into(), format!("unix:{},server=on,wait=off", gdb.display())];
+        }
         let mut child = Command::new("qemu-system-arm")
+            .args(&gdb_args)
             .args(["-machine", "mps2-an386", "-cpu", "cortex-m4", "-nographic"])
             .args(["-semihosting-config", "enable=on,target=native"])
             .arg("-chardev")
@@ -114,6 +153,14 @@ impl ProductSession {
         });
         let uart = connect(&uart, &mut child)?;
         let monitor = connect(&mon, &mut child).ok().map(BufReader::new);
+        if !ram.is_empty() {
+            let mut g = connect(&gdb, &mut child)?;
+            for (addr, bytes) in ram {
+                let hex: String = bytes.iter().map(|b| format!("{b:02x}")).collect();
+                gdb_packet(&mut g, &format!("M{addr:x},{:x}:{hex}", bytes.len()), true)?;
+            }
+            gdb_packet(&mut g, "c", false)?;
+        }
         let start = Instant::now();
         let (tx, rx) = mpsc::channel();
         let mut reader = uart.try_clone().context("cloning the UART socket")?;
@@ -309,6 +356,7 @@ pub fn run_closed_loop(
     let mut run = ProductRun::default();
     let mut failure: Option<anyhow::Error> = None;
     let n = (duration_s / 0.01).round() as usize;
+    let debug = std::env::var_os("EHA_DEBUG").is_some();
     let mut on_step = |t_s: f64, sensors: &PlantSensors| -> StepControl {
         let k = run.steps.len();
         if k >= n {
@@ -319,9 +367,13 @@ pub fn run_closed_loop(
             failure = Some(e);
             return StepControl::Stop;
         }
+        let mut waited = 0u32;
         loop {
             match s.next_tick(tick_timeout, &mut run.others) {
                 Ok(Some((at, t))) => {
+                    if debug && run.ticks.len() < 30 {
+                        eprintln!("tick {t:?}");
+                    }
                     run.ticks.push((at, t));
                     if t.fresh && t.sample_seq == request.seq {
                         let step = ProductStep { t_s, sensors: *sensors, request, tick: t };
@@ -335,10 +387,15 @@ pub fn run_closed_loop(
                             }
                         }
                     }
-                    // A tick before this sample arrived (or a missing one):
-                    // resend the sample if the firmware rebooted meanwhile.
-                    if t.tick <= 2 && !t.fresh {
-                        let _ = s.send_sample(&request);
+                    // A tick without this sample: it was lost (garbage
+                    // on the line, a reboot emptied the receive buffer):
+                    // after a few such ticks, or right after a reboot, send
+                    // it again (the same sequence number).
+                    if !t.fresh {
+                        waited += 1;
+                        if t.tick <= 2 || waited % 5 == 0 {
+                            let _ = s.send_sample(&request);
+                        }
                     }
                 }
                 Ok(None) => {
@@ -358,4 +415,118 @@ pub fn run_closed_loop(
     }
     res?;
     Ok(run)
+}
+
+/// A board on the host for [`sil_replay`]: the bytes of each tick, the
+/// pins echoed, records kept in memory.
+struct ReplayBoard {
+    rx: Vec<u8>,
+    tx: Vec<u8>,
+    ticks: u32,
+    records: [eha_guard::ThermalRecord; 2],
+}
+
+impl eha_guard::product::Board for ReplayBoard {
+    fn read_rx(&mut self, buf: &mut [u8]) -> usize {
+        let n = buf.len().min(self.rx.len());
+        buf[..n].copy_from_slice(&self.rx[..n]);
+        self.rx.drain(..n);
+        n
+    }
+    fn rx_dropped(&self) -> u32 {
+        0
+    }
+    fn write_tx(&mut self, bytes: &[u8]) {
+        self.tx.extend_from_slice(bytes);
+    }
+    fn set_pins(&mut self, pins: Pins) -> Pins {
+        pins
+    }
+    fn feed_watchdog(&mut self) {}
+    fn ticks(&self) -> u32 {
+        self.ticks
+    }
+    fn wait_tick(&mut self, _seen: u32) {
+        self.ticks += 1;
+    }
+    fn store_record(&mut self, slot: usize, rec: &eha_guard::ThermalRecord) {
+        self.records[slot & 1] = *rec;
+    }
+    fn store_cause(&mut self, _rec: &eha_guard::product::reset::CauseRecord) {}
+}
+
+/// The host build of the product application (SIL) fed exactly what the
+/// firmware's tick replies say it saw: per tick, the sample it used (by
+/// sequence number) or none, and the periods an overrun swallowed (gaps in
+/// the tick counter). Returns the host's tick replies, one per firmware tick
+/// of the first boot (a reset ends the replay).
+pub fn sil_replay(run: &ProductRun) -> Vec<TickReply> {
+    use eha_guard::product::{App, BootMemory};
+    let by_seq: std::collections::HashMap<u16, Request> = run.steps.iter().map(|p| (p.request.seq, p.request)).collect();
+    let mut b = ReplayBoard { rx: Vec::new(), tx: Vec::new(), ticks: 0, records: [eha_guard::ThermalRecord::EMPTY; 2] };
+    let mem = BootMemory {
+        records: (eha_guard::ThermalRecord::EMPTY, eha_guard::ThermalRecord::EMPTY),
+        nv: None,
+        cause: eha_guard::product::reset::CauseRecord::new(0, 0),
+        hw_hint: None,
+    };
+    let mut app = App::boot(&mut b, &eha_guard::GuardConfig::DEFAULT, &mem);
+    let mut out = Vec::new();
+    let mut last_tick = 0u32;
+    let mut d = Deframer::new();
+    for (_, t) in &run.ticks {
+        if t.tick <= last_tick {
+            break; // the firmware rebooted
+        }
+        let lost = t.tick - last_tick - 1;
+        last_tick = t.tick;
+        if t.fresh {
+            if let Some(r) = by_seq.get(&t.sample_seq) {
+                b.rx.extend_from_slice(&r.encode());
+            }
+        }
+        app.tick(&mut b, lost);
+        for byte in std::mem::take(&mut b.tx) {
+            if let Some(Ok(p)) = d.push(byte) {
+                if let Ok(FromGuard::Tick(r)) = FromGuard::from_payload(&p) {
+                    out.push(r);
+                }
+            }
+        }
+    }
+    out
+}
+
+/// The address of a static in `elf` whose symbol name contains every one of
+/// `parts` (e.g. the no-init thermal record `["noinit", "RECORD_A"]`).
+pub fn symbol_addr(elf: &Path, parts: &[&str]) -> Result<u32> {
+    use object::{Object, ObjectSymbol};
+    let data = std::fs::read(elf).with_context(|| format!("reading {}", elf.display()))?;
+    let file = object::File::parse(&*data).with_context(|| format!("parsing {}", elf.display()))?;
+    for sym in file.symbols() {
+        if let Ok(name) = sym.name() {
+            if parts.iter().all(|p| name.contains(p)) {
+                return u32::try_from(sym.address()).context("symbol address above 4 GiB");
+            }
+        }
+    }
+    bail!("no symbol containing {parts:?} in {}", elf.display())
+}
+
+/// The bytes of a thermal record as the firmware stores it (`#[repr(C)]`,
+/// little endian), for `-device loader` into no-init RAM.
+pub fn record_bytes(r: &eha_guard::ThermalRecord) -> Vec<u8> {
+    let mut b = Vec::with_capacity(52);
+    b.extend_from_slice(&r.lng_used_cj.to_le_bytes());
+    b.extend_from_slice(&r.step.to_le_bytes());
+    b.extend_from_slice(&r.magic.to_le_bytes());
+    b.extend_from_slice(&r.version.to_le_bytes());
+    b.extend_from_slice(&r.faults.to_le_bytes());
+    for t in r.temps_c {
+        b.extend_from_slice(&t.to_le_bytes());
+    }
+    b.extend_from_slice(&r.ambient_c.to_le_bytes());
+    b.extend_from_slice(&r.seq_flags.to_le_bytes());
+    b.extend_from_slice(&r.crc.to_le_bytes());
+    b
 }

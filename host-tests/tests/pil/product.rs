@@ -6,7 +6,7 @@
 //! time), so they are in the slow tier; they run in parallel with each
 //! other (each is a QEMU process that mostly sleeps).
 
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use eha_guard::product::wire::{Cmd, FromGuard, Pins, ResetCause};
 use eha_guard::trace::RestoreKind;
@@ -39,11 +39,18 @@ fn events(v: impl Iterator<Item = bool>) -> Vec<(usize, bool)> {
     out
 }
 
-/// 120 s of the Fig. 15 LNG case in closed loop over the UART: the same
-/// valve events as the semihosting lockstep PIL run of the same plant
-/// (within one tick), and the same drain estimate per sample within f32
-/// rounding when no tick went without its sample. The pins read back in
-/// every tick reply match the outputs.
+/// 120 s of the Fig. 15 LNG case in closed loop over the UART.
+///
+/// - Every tick reply equals, bit for bit, the host build of the same
+///   application fed what that tick saw (its sample, or none): no f32
+///   rounding difference between target and host.
+/// - Against the semihosting lockstep PIL run of the same plant: the same
+///   valve events within one tick. The drain estimate per sample is
+///   bit-identical when every tick got its sample; a tick without its
+///   sample (the host late by more than 10 ms of real time) shifts the
+///   100 ms model step by one tick, so then the difference is bounded by
+///   the largest change of the PIL estimate over one model step.
+/// - The pins read back in every tick reply match the outputs.
 #[test]
 #[ignore = "slow tier: 120 s of real time in QEMU"]
 fn fig15_120s_closed_loop_over_the_uart_matches_the_semihosting_pil() {
@@ -88,12 +95,19 @@ fn fig15_120s_closed_loop_over_the_uart_matches_the_semihosting_pil() {
     for (a, b) in prod_ev.iter().zip(&pil_ev) {
         assert!(a.1 == b.1 && a.0.abs_diff(b.0) <= 1, "valve event product {a:?} vs PIL {b:?}");
     }
+    let sil = eha_sim::pil::product::sil_replay(&run);
+    assert_eq!(sil.len(), run.ticks.len());
+    for (k, ((_, fw), host)) in run.ticks.iter().zip(&sil).enumerate() {
+        assert!(
+            fw.tick == host.tick && fw.fresh == host.fresh && eha_guard::protocol::GuardOutput::bit_eq(&fw.out, &host.out),
+            "tick {k}: firmware {fw:?} != host {host:?}"
+        );
+    }
+    let step_jump = pil.records.windows(11).map(|w| (w[10].reply.out.drain_c - w[0].reply.out.drain_c).abs()).fold(0.0f32, f32::max);
     if missed == 0 {
         assert_eq!(max_diff, 0.0, "every sample got its own tick: the estimate must be bit-identical");
     } else {
-        // A tick without its sample holds the last inputs 10 ms longer: the
-        // difference is the heat of one tick, far below 0.01 K.
-        assert!(max_diff <= 0.01, "{missed} ticks missed their sample; max drain difference {max_diff} K");
+        assert!(max_diff <= step_jump, "{missed} ticks missed their sample; max drain difference {max_diff} K > {step_jump} K");
     }
     assert!(missed * 100 <= run.steps.len(), "more than 1 % of ticks missed their sample: {missed}");
     for p in &run.steps {
@@ -107,4 +121,170 @@ fn fig15_120s_closed_loop_over_the_uart_matches_the_semihosting_pil() {
     assert_eq!(run.steps[0].tick.restore, RestoreKind::Cold);
     let _ = FromGuard::Tick(run.steps[0].tick);
     let _ = Cmd::Status;
+}
+
+/// Pin readings through the QEMU monitor from an injected fault until the
+/// first tick reply after the reboot. Returns (seconds after the command,
+/// pins) and the frames received meanwhile (put back in the backlog).
+fn watch_pins_until_reboot(s: &mut ProductSession, token: u16, cmd: Cmd) -> anyhow::Result<Vec<(f64, Pins)>> {
+    let t0 = Instant::now();
+    s.command(token, cmd)?;
+    let mut log = Vec::new();
+    let mut kept = Vec::new();
+    loop {
+        log.push((t0.elapsed().as_secs_f64(), s.pins()?));
+        if std::env::var_os("EHA_DEBUG").is_some() {
+            eprintln!("watch {:?}", log.last());
+        }
+        if let Some(r) = s.next(Duration::from_millis(5))? {
+            let rebooted = matches!(r.frame, FromGuard::Tick(t) if t.tick <= 2);
+            kept.push(r);
+            if rebooted {
+                break;
+            }
+        }
+        anyhow::ensure!(t0.elapsed() < Duration::from_secs(10), "no reboot within 10 s of {cmd:?}");
+    }
+    s.backlog.extend(kept);
+    Ok(log)
+}
+
+/// What the injected-fault tests check after the reboot.
+fn check_fault_reset(name: &str, cmd: Cmd, at_sample: u16, cause: ResetCause, max_unsafe_s: f64) {
+    let duration_s = f64::from(at_sample) * 0.01 + 5.0;
+    let mut s = session(&[]);
+    let mut pins_log = Vec::new();
+    let mut before = None;
+    let run = run_closed_loop(&mut s, &mut plant(duration_s), duration_s, Duration::from_secs(10), &mut |s, step| {
+        if std::env::var_os("EHA_DEBUG").is_some() && step.request.seq % 100 == 0 {
+            eprintln!("step {}", step.request.seq);
+        }
+        if step.request.seq == at_sample {
+            before = Some(step.tick.out);
+            pins_log = watch_pins_until_reboot(s, 99, cmd)?;
+        }
+        Ok(true)
+    })
+    .unwrap_or_else(|e| panic!("{name}: {e:#}"));
+    let before = before.unwrap_or_else(|| panic!("{name}: the fault was never injected"));
+    let first_safe = pins_log.iter().find(|(_, p)| !p.valve_pin && !p.ok_pin).map(|(t, _)| *t);
+    let after: Vec<_> = run.steps.iter().filter(|p| p.request.seq > at_sample).collect();
+    let first = after.first().unwrap_or_else(|| panic!("{name}: no sample after the reboot"));
+    eprintln!(
+        "{name}: drain before {:.3} C, first after reboot {:.3} C (cause {:?}, restore {:?}); outputs safe {:?} s after the command; {} pin readings",
+        before.drain_c,
+        first.tick.out.drain_c,
+        first.tick.reset_cause,
+        first.tick.restore,
+        first_safe,
+        pins_log.len()
+    );
+    assert_eq!(first.tick.reset_cause, cause, "{name}: reset cause");
+    assert_eq!(first.tick.restore, RestoreKind::Warm, "{name}: warm restore from the no-init record");
+    let t_safe = first_safe.unwrap_or_else(|| panic!("{name}: the pins never reached the safe state: {pins_log:?}"));
+    assert!(t_safe <= max_unsafe_s, "{name}: outputs safe only {t_safe:.3} s after the fault (bound {max_unsafe_s} s)");
+    let k = pins_log.iter().position(|(t, _)| *t >= t_safe).unwrap_or(0);
+    assert!(
+        pins_log[k..].iter().all(|(_, p)| !p.valve_pin),
+        "{name}: the valve left its safe (open) state during the reset: {:?}",
+        &pins_log[k..]
+    );
+    // The plant is held while the MCU resets, so the estimate must continue
+    // from where it was: within 0.1 K (one tick of heating is ~0.002 K).
+    assert!((first.tick.out.drain_c - before.drain_c).abs() <= 0.1, "{name}: estimate jumped {} -> {}", before.drain_c, first.tick.out.drain_c);
+    assert_eq!(run.steps.len(), (duration_s / 0.01).round() as usize, "{name}: the closed loop completed after the reboot");
+}
+
+/// A hang injected after 30 s: the watchdog (0.5 s warning period) resets
+/// the MCU; the outputs are safe within the watchdog period plus margin and
+/// stay safe through the reset; the thermal state is restored warm.
+#[test]
+#[ignore = "slow tier: 35 s of real time in QEMU"]
+fn hang_is_reset_by_the_watchdog_with_safe_outputs_and_warm_restore() {
+    check_fault_reset("hang", Cmd::InjectHang, 3000, ResetCause::Watchdog, 0.5 + 0.3);
+}
+
+/// A panic injected after 5 s: the panic handler makes the outputs safe,
+/// records the cause and resets; warm restore.
+#[test]
+#[ignore = "slow tier: 10 s of real time in QEMU"]
+fn panic_gives_safe_outputs_a_reset_and_warm_restore() {
+    check_fault_reset("panic", Cmd::InjectPanic, 500, ResetCause::Panic, 0.1);
+}
+
+/// Garbage, bursts longer than the receive buffer and truncated frames on
+/// the UART during a closed-loop run: no hang (the loop completes, ticks
+/// keep their 100 Hz, no overrun), the junk is counted as rejected and the
+/// overflowing bytes as dropped, no junk is taken as sample data.
+#[test]
+#[ignore = "slow tier: 10 s of real time in QEMU"]
+fn garbage_and_bursts_on_the_uart_are_rejected_without_a_hang() {
+    use rand::{Rng, SeedableRng};
+    let duration_s = 10.0;
+    let mut s = session(&[]);
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+    let run = run_closed_loop(&mut s, &mut plant(duration_s), duration_s, Duration::from_secs(2), &mut |s, step| {
+        let k = step.request.seq;
+        if k % 50 == 25 {
+            // A burst of random bytes (zeros included), up to 600 long.
+            let n = rng.random_range(1..600);
+            let junk: Vec<u8> = (0..n).map(|_| rng.random()).collect();
+            s.send(&junk)?;
+            s.send(&[0])?;
+        } else if k % 50 == 40 {
+            // A truncated sample frame, then the delimiter.
+            let f = step.request.encode();
+            s.send(&f[..f.len() / 2])?;
+            s.send(&[0])?;
+        }
+        Ok(true)
+    })
+    .unwrap_or_else(|e| panic!("{e:#}"));
+    let mut ticks = Vec::new();
+    let st = s.status(5, &mut ticks).unwrap_or_else(|e| panic!("{e:#}"));
+    let (t_first, _) = run.ticks[0];
+    let (t_last, _) = *run.ticks.last().unwrap();
+    let rate = (run.ticks.len() - 1) as f64 / (t_last - t_first);
+    eprintln!("garbage: {} ticks at {rate:.1} Hz; status {st:?}", run.ticks.len());
+    assert_eq!(run.steps.len(), 1000, "every sample eventually got its tick");
+    assert!(st.rejected_crc + st.rejected_framing >= 20, "20 junk bursts and 20 truncated frames: {st:?}");
+    assert!((90.0..=110.0).contains(&rate), "tick rate {rate} Hz");
+    assert_eq!(st.overruns, 0);
+    // Junk never reaches the guard as data: no range, rate or non-finite
+    // fault. (A sample stuck behind a long burst arrives late; more than
+    // 50 ms late is STALE, which is what STALE is for, so it may latch.)
+    let data_faults = eha_guard::faults::RANGE | eha_guard::faults::RATE | eha_guard::faults::NON_FINITE;
+    assert!(run.steps.iter().all(|p| p.tick.out.faults & data_faults == 0), "junk was taken as sample data");
+    assert!(st.rx_overflow > 0, "bursts longer than the 256-byte receive ring are dropped and counted");
+}
+
+/// The OK (alarm) pin follows the 60 °C alarm: the MCU boots with a warm
+/// thermal record at 61 °C put in no-init RAM (through QEMU's gdb stub), so the
+/// alarm is raised at once; in closed loop with the valve open the
+/// estimate falls, and the alarm clears below 58 °C. In every tick reply
+/// the OK pin read back is the inverse of the alarm.
+#[test]
+#[ignore = "slow tier: real time in QEMU"]
+fn alarm_pin_follows_the_60c_alarm() {
+    let elf = product_elf().unwrap_or_else(|e| panic!("{e:#}"));
+    let addr = eha_sim::pil::product::symbol_addr(&elf, &["noinit", "RECORD_A"]).unwrap_or_else(|e| panic!("{e:#}"));
+    let rec = eha_guard::ThermalRecord::new([61.0; eha_guard::params::N_NODES], 26.0, 0, 0, 1000).with_seq(1, true);
+    let duration_s = 60.0;
+    let mut s = ProductSession::spawn_with_ram(&elf, &[], &[(addr, eha_sim::pil::product::record_bytes(&rec))])
+        .unwrap_or_else(|e| panic!("{e:#}"));
+    let run = run_closed_loop(&mut s, &mut plant(duration_s), duration_s, Duration::from_secs(2), &mut |_, _| Ok(true))
+        .unwrap_or_else(|e| panic!("{e:#}"));
+    let alarm: Vec<bool> = run.ticks.iter().map(|(_, t)| t.out.alarm).collect();
+    let cleared = alarm.iter().position(|a| !a);
+    eprintln!(
+        "alarm: restore {:?}, first drain {:.2} C, alarm clears at tick {cleared:?} (drain then {:?})",
+        run.ticks[0].1.restore,
+        run.ticks[0].1.out.drain_c,
+        cleared.map(|k| run.ticks[k].1.out.drain_c)
+    );
+    assert_eq!(run.ticks[0].1.restore, RestoreKind::Warm);
+    assert!(alarm[0], "61 C restored: alarm from the first tick");
+    for (_, t) in &run.ticks {
+        assert_eq!(t.pins.ok_pin, !t.out.alarm, "tick {}: OK pin {} with alarm {}", t.tick, t.pins.ok_pin, t.out.alarm);
+    }
 }
