@@ -1,0 +1,51 @@
+//! The flashed product image: STM32F411 (Cortex-M4F, e.g. WeAct "Black Pill"
+//! STM32F411CEU6). The same application as the QEMU product image
+//! ([`eha_guard::product`], `src/bin/eha-mps2/`), with this board module
+//! ([`board`]) instead of the QEMU one.
+//!
+//! Build (CI keeps it building and checks that it has no semihosting symbol):
+//! ```text
+//! cargo fw-build-stm32f4
+//! ```
+//! (the memory map `boards/stm32f411/memory.x` is selected by `build.rs` when
+//! the feature `board-stm32f4` is on).
+//!
+//! Flash and run with probe-rs (ST-LINK or any CMSIS-DAP probe on SWD):
+//! ```text
+//! cargo install probe-rs-tools --locked          # once
+//! probe-rs run --chip STM32F411CEUx target/thumbv7em-none-eabihf/release/eha-stm32f4
+//! ```
+//! The defmt log goes over RTT (`defmt-rtt`, non-blocking: a full buffer
+//! drops log frames, it never stalls the tick loop); without a probe the
+//! board runs on its own. Wiring, what the controller must send, and what the
+//! board does on every fault: `docs/firmware.md`, "STM32F411 product image".
+#![cfg_attr(target_os = "none", no_std, no_main)]
+
+#[cfg(not(target_os = "none"))]
+fn main() {}
+
+#[cfg(target_os = "none")]
+mod board;
+
+#[cfg(target_os = "none")]
+mod fw {
+    use super::board::{self, F411};
+    use core::mem::MaybeUninit;
+    use cortex_m_rt::entry;
+    use defmt_rtt as _;
+    use eha_guard::product::App;
+    use eha_guard::GuardConfig;
+
+    #[entry]
+    fn main() -> ! {
+        let (mut b, mem) = F411::init();
+        // The application state lives in .bss, not on the stack.
+        static mut APP: MaybeUninit<App> = MaybeUninit::uninit();
+        // SAFETY: `main` runs once; this is the only reference to APP.
+        let app = unsafe { (*core::ptr::addr_of_mut!(APP)).write(App::boot(&mut b, &GuardConfig::DEFAULT, &mem)) };
+        b.boot_done();
+        defmt::info!("eha-stm32f4 up: reset cause {}, faults {=u16:#06x}", app.reset_cause(), app.guard().faults());
+        board::start(&mut b);
+        app.run(&mut b)
+    }
+}
