@@ -112,7 +112,7 @@ impl ProductSession {
     /// Starts QEMU with `elf` and the bytes `ram` written at their addresses
     /// before the CPU runs (e.g. a thermal record in no-init RAM, as a warm
     /// reset leaves it). The writes go through QEMU's gdb stub: the CPU starts
-    /// stopped (`-S`), the memory is written, then the CPU continues. (A
+    /// stopped (`-S`), the memory is written, then the stub detaches. (A
     /// `-device loader` blob there overlaps the ELF's RAM segment, which QEMU
     /// refuses.)
     pub fn spawn_with_ram(elf: &Path, extra: &[String], ram: &[(u32, Vec<u8>)]) -> Result<Self> {
@@ -159,7 +159,9 @@ impl ProductSession {
                 let hex: String = bytes.iter().map(|b| format!("{b:02x}")).collect();
                 gdb_packet(&mut g, &format!("M{addr:x},{:x}:{hex}", bytes.len()), true)?;
             }
-            gdb_packet(&mut g, "c", false)?;
+            // Detach: the CPU runs, and the stub is out of the way (a stub
+            // that stays attached stops the machine at a later reset).
+            gdb_packet(&mut g, "D", true)?;
         }
         let start = Instant::now();
         let (tx, rx) = mpsc::channel();
@@ -371,7 +373,7 @@ pub fn run_closed_loop(
         loop {
             match s.next_tick(tick_timeout, &mut run.others) {
                 Ok(Some((at, t))) => {
-                    if debug && run.ticks.len() < 30 {
+                    if debug && (run.ticks.len() % 500 == 0 || t.tick <= 2) {
                         eprintln!("tick {t:?}");
                     }
                     run.ticks.push((at, t));

@@ -238,7 +238,11 @@ impl Board for Mps2 {
 }
 
 fn uart0_rx() {
-    // Drain the (one-byte) receive buffer, then acknowledge.
+    // Acknowledge first, then drain the (one-byte) receive buffer: a byte
+    // that arrives after the drain raises the interrupt again. (The other
+    // order loses it: its interrupt is cleared with the buffer full, and the
+    // UART takes no more bytes while the buffer is full.)
+    wr(UART0 + 0x00C, 0b1010); // clear RX and RX-overrun interrupts
     while rd(UART0 + 0x004) & 2 != 0 {
         let b = rd(UART0) as u8;
         irq::free(|cs| {
@@ -247,7 +251,6 @@ fn uart0_rx() {
             }
         });
     }
-    wr(UART0 + 0x00C, 0b1010); // clear RX and RX-overrun interrupts
 }
 
 fn timer0() {
