@@ -54,10 +54,34 @@ struct Core<N: Num> {
 }
 
 impl<N: Num> Core<N> {
-    fn new(config: &GuardConfig) -> Option<Self> {
-        let model = Model::<N>::new(&config.params).ok()?;
-        let scales = InputScales::<N>::new()?;
-        let limits = LimitsN::new(&config.limits, &scales)?;
+    /// Builds the core in place at `dst`; `false` (and an all-zero core, a
+    /// valid value by the [`Num`] contract, never read) when the
+    /// configuration cannot be built.
+    ///
+    /// # Safety
+    /// `dst` must be valid for writes of a `Core<N>`.
+    #[inline(never)]
+    unsafe fn init_in(dst: *mut Self, config: &GuardConfig) -> bool {
+        // SAFETY: `dst` is valid for writes (caller); all-zero bytes are a
+        // valid `Core<N>` (numbers, bools and an Option of numbers; the
+        // `Num` contract covers N and its associated types).
+        unsafe {
+            dst.write_bytes(0, 1);
+            let ok = Model::<N>::init_in(core::ptr::addr_of_mut!((*dst).model), &config.params).is_ok() && Self::init_small(dst, config);
+            if !ok {
+                dst.write_bytes(0, 1);
+            }
+            ok
+        }
+    }
+
+    /// The small fields of the core (everything but the model).
+    ///
+    /// # Safety
+    /// As [`Core::init_in`].
+    unsafe fn init_small(dst: *mut Self, config: &GuardConfig) -> bool {
+        let Some(scales) = InputScales::<N>::new() else { return false };
+        let Some(limits) = LimitsN::new(&config.limits, &scales) else { return false };
         let t = [
             config.valve.open_c,
             config.valve.close_c,
@@ -65,7 +89,7 @@ impl<N: Num> Core<N> {
             config.alarm.clear_c,
         ];
         if t.iter().any(|x| !x.is_finite() || x.abs() >= 250.0) {
-            return None;
+            return false;
         }
         let f = |x: f32| N::from_f64(x as f64);
         let th = Thresholds {
@@ -75,24 +99,29 @@ impl<N: Num> Core<N> {
             clear: f(t[3]),
         };
         let cc = if config.params.torque_constant_nm_per_a > 0.0 {
-            Some(CrossCheck::new(&config.crosscheck, TICKS_PER_STEP)?)
+            let Some(cc) = CrossCheck::new(&config.crosscheck, TICKS_PER_STEP) else { return false };
+            Some(cc)
         } else {
             None
         };
-        Some(Core {
-            model,
-            scales,
-            limits,
-            th,
-            cc,
-        })
+        // SAFETY: `dst` is valid for writes (caller).
+        unsafe {
+            core::ptr::addr_of_mut!((*dst).scales).write(scales);
+            core::ptr::addr_of_mut!((*dst).limits).write(limits);
+            core::ptr::addr_of_mut!((*dst).th).write(th);
+            core::ptr::addr_of_mut!((*dst).cc).write(cc);
+        }
+        true
     }
 }
 
 /// The guard, generic over the model number type (`f64` for host tests).
 #[derive(Clone, Debug)]
 pub struct GuardOf<N: Num> {
-    core: Option<Core<N>>,
+    /// The model and its constants; used only when `core_ok`.
+    core: Core<N>,
+    /// The configuration built into a model (else CONFIG, fail-safe).
+    core_ok: bool,
     /// Valve dwell in model steps (the configured ticks, rounded up).
     dwell_model_steps: u32,
     stale_steps: u32,
@@ -151,10 +180,28 @@ impl<N: Num> GuardOf<N> {
     /// [`crate::memory`]. Never fails: unusable parameters give a CONFIG fault and a
     /// permanently fail-safe guard (valve open, alarm, derate).
     pub fn new(config: &GuardConfig, restore: Restore) -> Self {
-        let core = Core::<N>::new(config);
-        let mut g = GuardOf {
-            latched: if core.is_none() { faults::CONFIG } else { 0 },
-            core,
+        let mut g = core::mem::MaybeUninit::uninit();
+        Self::new_in(&mut g, config, restore);
+        // SAFETY: `new_in` initialised every field.
+        unsafe { g.assume_init() }
+    }
+
+    /// [`GuardOf::new`] written in place into `slot` (the firmware keeps the
+    /// guard in a static: the boot stack holds no copy of it or its model).
+    #[inline(never)]
+    pub fn new_in<'a>(slot: &'a mut core::mem::MaybeUninit<Self>, config: &GuardConfig, restore: Restore) -> &'a mut Self {
+        /// Writes fields of the struct behind a raw pointer.
+        macro_rules! put {
+            ($p:expr, $($f:ident : $v:expr),* $(,)?) => { $( core::ptr::addr_of_mut!((*$p).$f).write($v); )* };
+        }
+        let p = slot.as_mut_ptr();
+        // SAFETY: `p` points to `slot`, valid for writes; `Core::init_in` and
+        // `put!` write every field exactly once before the reference is made.
+        let g = unsafe {
+            let ok = Core::<N>::init_in(core::ptr::addr_of_mut!((*p).core), config);
+            put!(p,
+            core_ok: ok,
+            latched: if ok { 0 } else { faults::CONFIG },
             dwell_model_steps: config.valve.dwell_steps.div_ceil(TICKS_PER_STEP),
             stale_steps: config.stale_steps,
             startup_timeout_steps: config.startup_timeout_steps,
@@ -186,11 +233,13 @@ impl<N: Num> GuardOf<N> {
                 ..Output::default()
             },
             trace: TraceBuf::new(),
+            );
+            &mut *p
         };
         let kind = match restore {
             Restore::Cold => RestoreKind::Cold,
             Restore::Warm(r) => {
-                if let Some(c) = g.core.as_mut() {
+                if let Some(c) = g.core_ok.then_some(&mut g.core) {
                     c.model.set_temperatures(&r.temps_c, r.ambient_c);
                 }
                 g.cold = false;
@@ -203,14 +252,14 @@ impl<N: Num> GuardOf<N> {
                 }
                 // Saved before a clear restored trust: still not trusted.
                 g.untrusted = r.faults & faults::UNTRUSTED != 0;
-                if let Some(c) = g.core.as_mut() {
+                if let Some(c) = g.core_ok.then_some(&mut g.core) {
                     c.model.set_loss_max(g.latched & faults::SENSOR_DISAGREE != 0);
                 }
                 RestoreKind::Warm
             }
             Restore::Corrupt => {
                 let t = config.alarm.alarm_c;
-                if let Some(c) = g.core.as_mut() {
+                if let Some(c) = g.core_ok.then_some(&mut g.core) {
                     c.model.set_temperatures(&[t; N_NODES], t);
                 }
                 g.cold = false;
@@ -231,7 +280,7 @@ impl<N: Num> GuardOf<N> {
     #[cold]
     #[inline(never)]
     fn boot_outputs(&mut self) {
-        match self.core.as_ref() {
+        match self.core_ok.then_some(&self.core) {
             Some(c) if !self.cold => {
                 let d = c.model.drain_c();
                 let f = d.to_f32();
@@ -256,7 +305,7 @@ impl<N: Num> GuardOf<N> {
     /// fault, opens the valve in this same tick and is replaced by its worst case.
     #[inline(never)]
     pub fn step(&mut self, s: &Sample) -> Output {
-        if let Some(core) = self.core.as_ref() {
+        if let Some(core) = self.core_ok.then_some(&self.core) {
             // Fast path: every channel in range and within its rate and every previous
             // value valid (so this is not the first tick). Nothing to latch, the valve
             // is not forced by this tick (an earlier latched fault has already opened
@@ -297,7 +346,7 @@ impl<N: Num> GuardOf<N> {
     #[cold]
     fn step_slow(&mut self, s: &Sample) -> Output {
         self.missing = 0;
-        let Some(core) = self.core.as_ref() else {
+        let Some(core) = self.core_ok.then_some(&self.core) else {
             return self.slow_tail(None, 0, N::ZERO);
         };
         let (v, nonfinite) = validate::convert(s, &core.scales);
@@ -349,10 +398,7 @@ impl<N: Num> GuardOf<N> {
             new_bits |= faults::STALE;
             self.bad_ch = CH_ALL;
         }
-        let u = self
-            .core
-            .as_ref()
-            .map(|c| validate::substitute(&self.prev, self.bad_ch, None, &c.limits));
+        let u = self.core_ok.then(|| validate::substitute(&self.prev, self.bad_ch, None, &self.core.limits));
         self.slow_tail(u.as_ref(), new_bits, N::ZERO)
     }
 
@@ -413,7 +459,7 @@ impl<N: Num> GuardOf<N> {
             });
         }
         match u {
-            Some(u) if self.core.is_some() => {
+            Some(u) if self.core_ok => {
                 if !self.started {
                     self.start(start_amb);
                 }
@@ -435,7 +481,7 @@ impl<N: Num> GuardOf<N> {
     /// every `TICKS_PER_STEP` ticks the model step with the protection.
     #[inline(always)]
     fn tick(&mut self, u: &ModelInputN<N>) -> Output {
-        let full = match self.core.as_mut() {
+        let full = match self.core_ok.then_some(&mut self.core) {
             Some(c) => c.model.tick_n(u),
             None => false,
         };
@@ -458,7 +504,7 @@ impl<N: Num> GuardOf<N> {
         self.mark = self.step;
         self.open_acc = 0;
         self.credit_acc = 0;
-        let Some(c) = self.core.as_mut() else {
+        let Some(c) = self.core_ok.then_some(&mut self.core) else {
             return;
         };
         if self.cold {
@@ -503,7 +549,7 @@ impl<N: Num> GuardOf<N> {
         let (open_ticks, credit_ticks) = (self.open_acc, self.credit_acc);
         self.open_acc = 0;
         self.credit_acc = 0;
-        let Some(c) = self.core.as_mut() else {
+        let Some(c) = self.core_ok.then_some(&mut self.core) else {
             return;
         };
         c.model.update(credit_ticks);
@@ -550,7 +596,7 @@ impl<N: Num> GuardOf<N> {
     /// step with the valve open, at `cj` centijoules per tick) and the outputs that
     /// change only here.
     fn protect(&mut self, cj: u32, open_ticks: u32) {
-        let Some(c) = self.core.as_ref() else {
+        let Some(c) = self.core_ok.then_some(&self.core) else {
             return;
         };
         let force = self.latched != 0;
@@ -661,7 +707,7 @@ impl<N: Num> GuardOf<N> {
         // A valve still disagreeing with its command latches again after the full time;
         // so do sensors that still disagree.
         self.fb_mismatch = 0;
-        if let Some(c) = self.core.as_mut() {
+        if let Some(c) = self.core_ok.then_some(&mut self.core) {
             if let Some(cc) = c.cc.as_mut() {
                 cc.restart_count();
                 c.model.set_loss_max(cc.disagrees());
@@ -740,7 +786,7 @@ impl<N: Num> GuardOf<N> {
     pub fn snapshot(&self) -> ThermalRecord {
         let mut temps = [0.0f32; N_NODES];
         let mut amb = 0.0;
-        if let Some(c) = self.core.as_ref() {
+        if let Some(c) = self.core_ok.then_some(&self.core) {
             for (o, t) in temps.iter_mut().zip(c.model.temperatures_c().iter()) {
                 *o = t.to_f32();
             }
@@ -768,7 +814,7 @@ impl<N: Num> GuardOf<N> {
 
     /// The model, when the parameters were usable.
     pub fn model(&self) -> Option<&Model<N>> {
-        self.core.as_ref().map(|c| &c.model)
+        self.core_ok.then_some(&self.core).map(|c| &c.model)
     }
 
     /// Ticks taken since boot (10 ms each, wraps after 497 days).

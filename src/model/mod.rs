@@ -367,6 +367,19 @@ impl<N: Num> Model<N> {
     /// and the exact-ZOH matrix (precomputed on the host: `ReducedParams::phi_step_s`).
     /// Starts at 0 degC.
     pub fn new(p: &ReducedParams) -> Result<Self, ConfigError> {
+        let mut m = core::mem::MaybeUninit::<Self>::uninit();
+        // SAFETY: `init_in` writes the whole value when it returns Ok.
+        unsafe { Self::init_in(m.as_mut_ptr(), p).map(|()| m.assume_init()) }
+    }
+
+    /// [`Model::new`] written in place at `dst` (the firmware builds its state
+    /// in a static, so the boot stack holds no copy of the model). On `Err`
+    /// nothing is written.
+    ///
+    /// # Safety
+    /// `dst` must be valid for writes of a `Model<N>`.
+    #[inline(never)]
+    pub unsafe fn init_in(dst: *mut Self, p: &ReducedParams) -> Result<(), ConfigError> {
         if !p.is_plausible() {
             return Err(ConfigError::Implausible);
         }
@@ -523,7 +536,8 @@ impl<N: Num> Model<N> {
         if tables.iter().any(|t| t.iter().any(|g| g * KW_PER_W >= 250.0)) {
             return Err(ConfigError::ConstantRange);
         }
-        Ok(Model {
+        // SAFETY: the caller guarantees `dst` is valid for writes.
+        unsafe { dst.write(Model {
             temp: [N::state(N::ZERO); N_NODES],
             links: [N::ZERO; 3],
             ring_rate: N::ZERO,
@@ -546,7 +560,8 @@ impl<N: Num> Model<N> {
             loss_max: false,
             outer_g: [N::ZERO; 4],
             outer_phase: 0,
-        })
+        }) };
+        Ok(())
     }
 
     /// Sets every node, the ring links and the ambient to `t_c` (degC): cold start.

@@ -104,7 +104,8 @@ fn isqrt_u32(n: u32) -> u32 {
     }
 }
 
-impl Num for Fx {
+// SAFETY: the fixed-point types are plain integers: zero bits are 0.
+unsafe impl Num for Fx {
     type Coef = FxCoef;
     type State = FxState;
     type Dot = i64;

@@ -16,7 +16,13 @@ pub use fx::{Fx, FxCoef, FxScale, FxState};
 
 /// Arithmetic the model needs from its number type. All methods are total
 /// (no panics): the fixed-point instantiation saturates at its documented range.
-pub trait Num: Copy + PartialOrd + core::fmt::Debug {
+///
+/// # Safety
+/// The all-zero bit pattern must be a valid value of `Self` and of its
+/// associated types (`Coef`, `State`, `Scale`): the guard's core is built in
+/// place over zeroed memory (`GuardOf::new_in`). True for `f32`, `f64` and
+/// the fixed-point types here (plain numbers).
+pub unsafe trait Num: Copy + PartialOrd + core::fmt::Debug {
     /// Discretised matrix coefficient type (entries of the exact-ZOH matrix `Phi`).
     type Coef: Copy + core::fmt::Debug;
     /// High-precision state accumulator type.
@@ -106,7 +112,8 @@ pub trait Num: Copy + PartialOrd + core::fmt::Debug {
 /// `1 / TICKS_PER_STEP` in `f64`.
 const INV_TICKS_F64: f64 = 1.0 / crate::params::TICKS_PER_STEP as f64;
 
-impl Num for f64 {
+// SAFETY: zero bits are 0.0 for f64 and its associated types (f64).
+unsafe impl Num for f64 {
     type Coef = f64;
     type State = f64;
     type Dot = f64;
@@ -255,7 +262,8 @@ fn sqrt_f32(x: f32) -> f32 {
     }
 }
 
-impl Num for f32 {
+// SAFETY: zero bits are 0.0 / an all-zero F32State (plain f32 fields).
+unsafe impl Num for f32 {
     type Coef = f32;
     type State = F32State;
     type Dot = f32;

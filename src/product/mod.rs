@@ -159,33 +159,47 @@ impl App {
     /// non-volatile one, see [`boot_restore`]), the guard, and the safe
     /// outputs of a guard waiting for its first sample (valve open).
     pub fn boot<B: Board>(board: &mut B, cfg: &GuardConfig, mem: &BootMemory) -> App {
+        let mut slot = core::mem::MaybeUninit::uninit();
+        Self::boot_into(&mut slot, board, cfg, mem);
+        // SAFETY: `boot_into` initialised every field.
+        unsafe { slot.assume_init() }
+    }
+
+    /// [`App::boot`] into `slot` (a static on the target): each field is
+    /// written in place, so the boot stack holds no copy of the whole state.
+    #[inline(never)]
+    pub fn boot_into<'a, B: Board>(slot: &'a mut core::mem::MaybeUninit<App>, board: &mut B, cfg: &GuardConfig, mem: &BootMemory) -> &'a mut App {
         let (reset_cause, boots, running) = reset::at_boot(&mem.cause, mem.hw_hint);
         board.store_cause(&running);
         let (a, b) = &mem.records;
         let nv_policy = NvPolicy::DEFAULT;
         let restore = boot_restore(slots::restore_from(a, b), mem.nv, &nv_policy);
-        let mut guard = Guard::new(cfg, restore);
-        guard.trace_event(Trace::Reset { step: 0, cause: reset_cause as u8 });
-        let out = guard.output();
+        let p = slot.as_mut_ptr();
+        // SAFETY: `p` points to `slot`, valid for writes; every field is written
+        // exactly once below before the reference is created.
+        let app = unsafe {
+            Guard::new_in(&mut *core::ptr::addr_of_mut!((*p).guard).cast::<core::mem::MaybeUninit<Guard>>(), cfg, restore);
+            core::ptr::addr_of_mut!((*p).lng).write(cfg.lng);
+            core::ptr::addr_of_mut!((*p).rx).write(Deframer::new());
+            core::ptr::addr_of_mut!((*p).last_seq).write(None);
+            core::ptr::addr_of_mut!((*p).sample).write(None);
+            core::ptr::addr_of_mut!((*p).commands).write(Deque::new());
+            core::ptr::addr_of_mut!((*p).counters).write(Counters::default());
+            core::ptr::addr_of_mut!((*p).records).write(AbWriter::after_boot(a, b));
+            core::ptr::addr_of_mut!((*p).nv_policy).write(nv_policy);
+            core::ptr::addr_of_mut!((*p).nv_last).write(mem.nv);
+            core::ptr::addr_of_mut!((*p).tick).write(0);
+            core::ptr::addr_of_mut!((*p).restore).write(restore_kind(&restore));
+            core::ptr::addr_of_mut!((*p).reset_cause).write(reset_cause);
+            core::ptr::addr_of_mut!((*p).boots).write(boots);
+            core::ptr::addr_of_mut!((*p).worst_tick_cycles).write(0);
+            core::ptr::addr_of_mut!((*p).dump).write(None);
+            &mut *p
+        };
+        app.guard.trace_event(Trace::Reset { step: 0, cause: reset_cause as u8 });
+        let out = app.guard.output();
         let _ = board.set_pins(Pins::for_outputs(out.valve_open, out.alarm || out.derate));
-        App {
-            lng: cfg.lng,
-            guard,
-            rx: Deframer::new(),
-            last_seq: None,
-            sample: None,
-            commands: Deque::new(),
-            counters: Counters::default(),
-            records: AbWriter::after_boot(a, b),
-            nv_policy,
-            nv_last: mem.nv,
-            tick: 0,
-            restore: restore_kind(&restore),
-            reset_cause,
-            boots,
-            worst_tick_cycles: 0,
-            dump: None,
-        }
+        app
     }
 
     /// Runs the tick loop forever: wait for the timer, run one tick, count

@@ -36,7 +36,7 @@ mod fw {
         // The application state lives in .bss, not on the stack.
         static mut APP: MaybeUninit<App> = MaybeUninit::uninit();
         // SAFETY: `main` runs once; this is the only reference to APP.
-        let app = unsafe { (*core::ptr::addr_of_mut!(APP)).write(App::boot(&mut b, &GuardConfig::DEFAULT, &mem)) };
+        let app = App::boot_into(unsafe { &mut *core::ptr::addr_of_mut!(APP) }, &mut b, &GuardConfig::DEFAULT, &mem);
         b.boot_done();
         defmt::info!("eha-mps2 up: reset cause {}, faults {=u16:#06x}", app.reset_cause(), app.guard().faults());
         board::start(&mut b);
