@@ -61,15 +61,45 @@ struct Image {
     build: Build,
     bin: &'static str,
     features: &'static [&'static str],
-    /// Run in QEMU for instruction counts and stack (the bench images).
-    run: bool,
+    /// How the image is run in QEMU, if at all.
+    run: Run,
 }
 
-const IMAGES: [Image; 3] = [
-    Image { name: "bench-f32", build: Build::F32, bin: "eha-bench", features: &[], run: true },
-    Image { name: "bench-fixed", build: Build::Fixed, bin: "eha-bench", features: &[], run: true },
-    Image { name: "stm32f411", build: Build::F32, bin: "eha-stm32f4", features: &["board-stm32f4"], run: false },
+/// How an image's run-time figures are measured.
+#[derive(Clone, Copy, PartialEq)]
+enum Run {
+    /// Not run (flash and static RAM only).
+    No,
+    /// The bench image under `-icount`: instructions and stack.
+    Bench,
+    /// The product image over its UART in real time: boot and tick-loop stack
+    /// from its status reply.
+    Product,
+}
+
+const IMAGES: [Image; 4] = [
+    Image { name: "bench-f32", build: Build::F32, bin: "eha-bench", features: &[], run: Run::Bench },
+    Image { name: "bench-fixed", build: Build::Fixed, bin: "eha-bench", features: &[], run: Run::Bench },
+    Image { name: "product-mps2", build: Build::F32, bin: "eha-mps2", features: &["fault-inject"], run: Run::Product },
+    Image { name: "stm32f411", build: Build::F32, bin: "eha-stm32f4", features: &["board-stm32f4"], run: Run::No },
 ];
+
+/// Boot and tick-loop stack of the product image: 3 s of the drill's
+/// samples (valid, faulty, lost) paced by its tick replies, then its status.
+fn run_product(elf: &Path) -> Result<ImageBudget> {
+    let mut s = super::product::ProductSession::spawn(elf, &[])?;
+    let mut others = Vec::new();
+    for r in super::drill::inputs().iter().take(300) {
+        s.send_sample(r)?;
+        s.next_tick(Duration::from_secs(2), &mut others)?.context("no tick reply from the product image")?;
+    }
+    let st = s.status(1, &mut Vec::new())?;
+    Ok(ImageBudget {
+        stack_boot_b: Some(f64::from(st.boot_stack_b)),
+        stack_tick_b: Some(f64::from(st.stack_high_water_b)),
+        ..Default::default()
+    })
+}
 
 /// Flash (`.text` + `.rodata`) and static RAM of an ELF, bytes.
 pub fn elf_sizes(elf: &Path) -> Result<(u64, u64)> {
@@ -161,7 +191,11 @@ pub fn measure() -> Result<BTreeMap<String, ImageBudget>> {
     let mut out = BTreeMap::new();
     for im in &IMAGES {
         let elf = build_bin(im.build, im.bin, im.features)?;
-        let mut b = if im.run { parse_bench(&run_bench(im.build, &elf)?)? } else { ImageBudget::default() };
+        let mut b = match im.run {
+            Run::Bench => parse_bench(&run_bench(im.build, &elf)?)?,
+            Run::Product => run_product(&elf)?,
+            Run::No => ImageBudget::default(),
+        };
         let (flash, ram) = elf_sizes(&elf)?;
         b.flash_b = Some(flash as f64);
         b.ram_static_b = Some(ram as f64);

@@ -44,12 +44,12 @@ fn events(v: impl Iterator<Item = bool>) -> Vec<(usize, bool)> {
 /// - Every tick reply equals, bit for bit, the host build of the same
 ///   application fed what that tick saw (its sample, or none): no f32
 ///   rounding difference between target and host.
-/// - Against the semihosting lockstep PIL run of the same plant: the same
-///   valve events within one tick. The drain estimate per sample is
-///   bit-identical when every tick got its sample; a tick without its
-///   sample (the host late by more than 10 ms of real time) shifts the
-///   100 ms model step by one tick, so then the difference is bounded by
-///   the largest change of the PIL estimate over one model step.
+/// - Against the semihosting lockstep PIL run of the same plant, in guard
+///   time (ticks since the first sample): the same valve events within one
+///   tick, and the same drain estimate, bit-identical when every tick got
+///   its sample (a tick without one, when the host is more than 10 ms late,
+///   holds the last inputs: then within 0.01 K). At most 1 % of ticks may
+///   miss their sample.
 /// - The pins read back in every tick reply match the outputs.
 #[test]
 #[ignore = "slow tier: 120 s of real time in QEMU"]
@@ -69,16 +69,19 @@ fn fig15_120s_closed_loop_over_the_uart_matches_the_semihosting_pil() {
     let pil = run_pil(&mut plant(duration_s), &q, &LoopOptions { step_s: 0.01, duration_s })
         .unwrap_or_else(|f| panic!("{f}"));
 
-    let prod_ev = events(run.steps.iter().map(|p| p.tick.out.valve_open));
-    let pil_ev = events(pil.records.iter().map(|r| r.reply.out.valve_open));
     // Ticks after the first sample that had no sample of their own.
     let first = run.ticks.iter().position(|(_, t)| t.fresh).unwrap_or(0);
-    let missed = run.ticks[first..].iter().filter(|(_, t)| !t.fresh).count();
-    let max_diff = run
-        .steps
+    let guard_ticks: Vec<_> = run.ticks[first..].iter().map(|(_, t)| *t).collect();
+    let missed = guard_ticks.iter().filter(|t| !t.fresh).count();
+    // In guard time (ticks since its first sample): a tick without its
+    // sample is still a tick of the guard's clock (the harness pauses the
+    // plant while the host is late; the guard's clock does not pause).
+    let prod_ev = events(guard_ticks.iter().map(|t| t.out.valve_open));
+    let pil_ev = events(pil.records.iter().map(|r| r.reply.out.valve_open));
+    let max_diff = guard_ticks
         .iter()
         .zip(&pil.records)
-        .map(|(p, r)| (p.tick.out.drain_c - r.reply.out.drain_c).abs())
+        .map(|(t, r)| (t.out.drain_c - r.reply.out.drain_c).abs())
         .fold(0.0f32, f32::max);
     eprintln!(
         "product: {} samples, {} ticks, {missed} missed after the first sample; valve events product {prod_ev:?} pil {pil_ev:?}; \
@@ -103,11 +106,12 @@ fn fig15_120s_closed_loop_over_the_uart_matches_the_semihosting_pil() {
             "tick {k}: firmware {fw:?} != host {host:?}"
         );
     }
-    let step_jump = pil.records.windows(11).map(|w| (w[10].reply.out.drain_c - w[0].reply.out.drain_c).abs()).fold(0.0f32, f32::max);
     if missed == 0 {
         assert_eq!(max_diff, 0.0, "every sample got its own tick: the estimate must be bit-identical");
     } else {
-        assert!(max_diff <= step_jump, "{missed} ticks missed their sample; max drain difference {max_diff} K > {step_jump} K");
+        // A missed tick holds the previous sample's inputs for 10 ms (Fig. 15
+        // is a constant operating point): far below 0.01 K of drain.
+        assert!(max_diff <= 0.01, "{missed} ticks missed their sample; max drain difference {max_diff} K in guard time");
     }
     assert!(missed * 100 <= run.steps.len(), "more than 1 % of ticks missed their sample: {missed}");
     for p in &run.steps {
