@@ -4,6 +4,7 @@
 //! every candidate extension, name the cause by BIC plus held-out gain, and
 //! report the before/after errors.
 
+pub mod adequacy;
 pub mod analysis;
 pub mod fit;
 pub mod model;
