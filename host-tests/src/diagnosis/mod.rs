@@ -16,6 +16,7 @@ pub mod stats;
 pub mod sweep;
 pub mod synth;
 pub mod cli;
+pub mod emu_sweep;
 
 pub use analysis::{diagnose, DiagnoseError, DiagnoseOptions, Diagnosis};
 pub use model::{Candidate, ParamSpec, SimSeries, Simulator};
