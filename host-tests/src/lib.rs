@@ -13,6 +13,7 @@ pub mod calibrate;
 pub mod cli;
 pub mod cooling;
 pub mod diagnosis;
+pub mod emulator;
 pub mod faults;
 pub mod fluid;
 pub mod heat;

@@ -29,6 +29,9 @@ enum Cmd {
     Diagnose(eha_sim::diagnosis::cli::DiagnoseArgs),
     /// Hidden-effect sweep: synthetic runs with one effect each, diagnosed blind.
     DiagnoseSweep(eha_sim::diagnosis::sweep::SweepArgs),
+    /// Emulator sweep: logs of the independent rig emulator with one hidden
+    /// effect each (or none), diagnosed blind; writes a Markdown/JSON table.
+    EmulatorSweep(eha_sim::diagnosis::emu_sweep::EmuSweepArgs),
     /// Firmware budgets: instructions per tick, stack, flash, RAM of every
     /// image (QEMU -icount), written to out/fw-budget.json and checked
     /// against .ci/fw-budget.json (fails on > 10 % over a budget).
@@ -51,6 +54,7 @@ fn main() -> ExitCode {
         // Own exit codes: 0 diagnosis made (none included), 2 bad input.
         Cmd::Diagnose(a) => return eha_sim::diagnosis::cli::run(&a),
         Cmd::DiagnoseSweep(a) => return eha_sim::diagnosis::sweep::run(&a),
+        Cmd::EmulatorSweep(a) => return eha_sim::diagnosis::emu_sweep::run(&a),
     };
     match res {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,6 +1,6 @@
 //! The `diagnose` subcommand: `eha-sim diagnose <measured.csv> [--rig
 //! rig.toml] [--set key=value]... [--out DIR]`. Exit 0 when a diagnosis was
-//! made (`none` included), 2 on bad input (file, rig, or a baseline that
+//! made (`none` and `unexplained` included), 2 on bad input (file, rig, or a baseline that
 //! cannot run on the inputs).
 
 use super::analysis::{diagnose, DiagnoseOptions};
@@ -114,7 +114,7 @@ fn run_inner(args: &DiagnoseArgs) -> anyhow::Result<String> {
     write_outputs(&d, &run, &args.measured.display().to_string(), &args.out)?;
     Ok(format!(
         "cause: {} | held-out RMSE {:.3} -> {:.3} K | training {:.3} -> {:.3} K | {} model runs, {:.1} s | {}",
-        d.cause.name(),
+        d.answer(),
         d.before.heldout_rmse_k,
         d.after.heldout_rmse_k,
         d.before.train_rmse_k,

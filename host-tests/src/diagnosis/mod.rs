@@ -4,6 +4,7 @@
 //! every candidate extension, name the cause by BIC plus held-out gain, and
 //! report the before/after errors.
 
+pub mod adequacy;
 pub mod analysis;
 pub mod fit;
 pub mod model;
@@ -15,6 +16,7 @@ pub mod stats;
 pub mod sweep;
 pub mod synth;
 pub mod cli;
+pub mod emu_sweep;
 
 pub use analysis::{diagnose, DiagnoseError, DiagnoseOptions, Diagnosis};
 pub use model::{Candidate, ParamSpec, SimSeries, Simulator};

@@ -22,7 +22,9 @@ pub struct RankingJson {
 /// when `cause` is `none`).
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize, PartialEq)]
 pub struct DiagnosisJson {
-    /// Named cause (candidate name or `none`).
+    /// Named cause: a candidate name, `none` (the calibrated model explains
+    /// the data to the noise level) or `unexplained` (it does not, and no
+    /// candidate does).
     pub cause: String,
     /// Fitted parameters of the cause, name → value (units in report.md).
     pub parameters: std::collections::BTreeMap<String, f64>,
@@ -36,13 +38,43 @@ pub struct DiagnosisJson {
     pub heldout_rmse_after_k: f64,
     /// Every candidate and `none`, best BIC first.
     pub ranking: Vec<RankingJson>,
+    /// Present only when `cause` is `unexplained`: what misfits and what
+    /// to check (issue 17).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub unexplained: Option<UnexplainedJson>,
+}
+
+/// One misfitting channel in `diagnosis.json`.
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize, PartialEq)]
+pub struct MisfitJson {
+    /// Channel name.
+    pub channel: String,
+    /// Held-out RMSE of the calibrated baseline, K.
+    pub heldout_rmse_k: f64,
+    /// Mean residual (simulated − measured), K.
+    pub bias_k: f64,
+    /// Noise σ estimated from the samples, K.
+    pub noise_k: f64,
+    /// Regressors the residual correlates with most: name → peak ρ.
+    pub correlates_with: std::collections::BTreeMap<String, f64>,
+}
+
+/// The evidence behind an `unexplained` answer.
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize, PartialEq)]
+pub struct UnexplainedJson {
+    /// Channels whose held-out error is far above their noise.
+    pub misfit_channels: Vec<MisfitJson>,
+    /// Calibrated parameters on a bound: name → value.
+    pub parameters_at_bounds: std::collections::BTreeMap<String, f64>,
+    /// What to check or measure.
+    pub check: Vec<String>,
 }
 
 impl DiagnosisJson {
     /// The JSON verdict of `d`.
     pub fn from_diagnosis(d: &Diagnosis) -> Self {
         DiagnosisJson {
-            cause: d.cause.name().into(),
+            cause: d.answer().into(),
             parameters: d.params.iter().map(|(n, v, _)| (n.clone(), *v)).collect(),
             rmse_before_k: d.before.train_rmse_k,
             rmse_after_k: d.after.train_rmse_k,
@@ -53,6 +85,23 @@ impl DiagnosisJson {
                 .iter()
                 .map(|r| RankingJson { cause: r.cause.clone(), bic: r.bic, heldout_rmse_k: r.heldout_rmse_k })
                 .collect(),
+            unexplained: d.unexplained.then(|| UnexplainedJson {
+                misfit_channels: d
+                    .adequacy
+                    .channels
+                    .iter()
+                    .filter(|c| c.misfit)
+                    .map(|c| MisfitJson {
+                        channel: c.channel.clone(),
+                        heldout_rmse_k: c.heldout_rmse_k,
+                        bias_k: c.bias_k,
+                        noise_k: c.noise_k,
+                        correlates_with: c.regressors.iter().map(|(n, r, _)| (n.clone(), *r)).collect(),
+                    })
+                    .collect(),
+                parameters_at_bounds: d.adequacy.at_bounds.iter().map(|b| (b.name.clone(), b.value)).collect(),
+                check: d.adequacy.advice.clone(),
+            }),
         }
     }
 }
@@ -75,15 +124,50 @@ fn metrics_table(s: &mut String, title: &str, m: &Metrics) {
     }
 }
 
+/// The calibrated baseline's fit per channel against its noise floor and
+/// rise, and (for `unexplained`) what to check.
+fn adequacy_section(s: &mut String, d: &Diagnosis) {
+    let a = &d.adequacy;
+    if d.unexplained {
+        let _ = writeln!(
+            s,
+            "\nNo candidate qualifies, and the calibrated baseline does not explain the data to the noise level: \
+             the model is missing something that is not among the candidates, or the rig file is wrong by more than the calibration can take up."
+        );
+    }
+    let _ = writeln!(s, "\n## Calibrated baseline against the noise floor\n");
+    let _ = writeln!(s, "| channel | held-out RMSE (K) | noise σ (K) | ratio | RMS rise (K) | bias (K) | misfit | correlates with (peak ρ) |");
+    let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---|---|");
+    for c in &a.channels {
+        let r: Vec<String> = c.regressors.iter().map(|(n, rho, lag)| format!("{n} {rho:+.2} @{lag:.0}s")).collect();
+        let _ = writeln!(
+            s,
+            "| `{}` | {:.3} | {:.3} | {:.1} | {:.2} | {:+.3} | {} | {} |",
+            c.channel, c.heldout_rmse_k, c.noise_k, c.heldout_rmse_k / c.noise_k, c.rise_k, c.bias_k,
+            if c.misfit { "yes" } else { "no" }, r.join(", ")
+        );
+    }
+    for b in &a.at_bounds {
+        let _ = writeln!(s, "\n- calibrated `{}` = {:.4} is on its {} bound", b.name, b.value, b.bound);
+    }
+    if d.unexplained && !a.advice.is_empty() {
+        let _ = writeln!(s, "\n**What to check or measure**\n");
+        for x in &a.advice {
+            let _ = writeln!(s, "- {x}");
+        }
+    }
+}
+
 /// The Markdown report of `d` for the measured file `source`; `pngs` are
 /// the plot file names (relative to the report) to embed.
 pub fn report_markdown(d: &Diagnosis, source: &str, pngs: &[String]) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "# Diagnosis of `{source}`\n");
-    let _ = writeln!(s, "**Cause: `{}`**", d.cause.name());
+    let _ = writeln!(s, "**Cause: `{}`**", d.answer());
     for (n, v, u) in &d.params {
         let _ = writeln!(s, "- fitted `{n}` = {} {u}", num(*v));
     }
+    adequacy_section(&mut s, d);
     let _ = writeln!(
         s,
         "\nTraining window: before {:.2} s; held-out window: from {:.2} s (last ≥ 30 % of the run). \
@@ -131,7 +215,7 @@ pub fn report_markdown(d: &Diagnosis, source: &str, pngs: &[String]) -> String {
             .map(|r| {
                 d.xcorr
                     .iter()
-                    .find(|x| &x.channel == &ch && &x.regressor == r)
+                    .find(|x| x.channel == ch && &x.regressor == r)
                     .map(|x| format!("{:+.2} @{:.0}s ({:+.2})", x.peak_rho, x.peak_lag_s, x.rho0))
                     .unwrap_or_default()
             })

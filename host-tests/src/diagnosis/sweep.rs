@@ -18,6 +18,8 @@ pub struct CaseResult {
     pub case: SynthCase,
     /// The cause the diagnosis named.
     pub named: Candidate,
+    /// The answer: the named cause, `none` or `unexplained`.
+    pub answer: &'static str,
     /// Hidden magnitude.
     pub magnitude: f64,
     /// Channel the hidden effect changes most (truth side), its imprint, K.
@@ -34,6 +36,8 @@ pub struct CaseResult {
     pub sims: usize,
     /// The diagnosis ranking (every candidate's evidence), best BIC first.
     pub ranking: Vec<super::analysis::RankEntry>,
+    /// The calibrated baseline against the noise floor, per channel.
+    pub adequacy: Vec<super::adequacy::ChannelFit>,
 }
 
 impl CaseResult {
@@ -70,18 +74,34 @@ impl CaseResult {
                 p.join(" ")
             );
         }
+        let a: Vec<String> = self
+            .adequacy
+            .iter()
+            .map(|c| {
+                format!(
+                    "{}={:.3} K ({:.1}σ, {:.0} % of rise {:.1} K){}",
+                    c.channel.trim_start_matches("t_").trim_end_matches("_c"),
+                    c.heldout_rmse_k,
+                    c.heldout_rmse_k / c.noise_k,
+                    100.0 * c.heldout_rmse_k / c.rise_k.max(1e-9),
+                    c.rise_k,
+                    if c.misfit { " MISFIT" } else { "" }
+                )
+            })
+            .collect();
+        s += &format!("    calibrated baseline: {}\n", a.join(", "));
         s
     }
 
     /// One-line summary.
     pub fn line(&self) -> String {
         format!(
-            "hidden {:<31} {:?}/{:?} seed {:>3}: named {:<31} affected {:<14} gain {:>6} held-out {:.3}->{:.3} K  {:.0} s, {} runs",
+            "hidden {:<31} {:?}/{:?} seed {:>3}: answer {:<31} affected {:<14} gain {:>6} held-out {:.3}->{:.3} K  {:.0} s, {} runs",
             self.case.hidden.name(),
             self.case.scenario,
             self.case.mismatch,
             self.case.seed,
-            self.named.name(),
+            self.answer,
             self.affected.as_ref().map_or("-".into(), |a| format!("{} ({:.2} K)", a.0, a.1)),
             self.affected_gain().map_or("-".into(), |g| format!("{:.0} %", 100.0 * g)),
             self.pooled_heldout_k.0,
@@ -105,6 +125,7 @@ pub fn run_case(case: SynthCase, o: &DiagnoseOptions) -> Result<CaseResult, Stri
     Ok(CaseResult {
         case,
         named: d.cause,
+        answer: d.answer(),
         magnitude: truth.magnitude,
         affected,
         affected_heldout_k,
@@ -113,6 +134,7 @@ pub fn run_case(case: SynthCase, o: &DiagnoseOptions) -> Result<CaseResult, Stri
         seconds: t.elapsed().as_secs_f64(),
         sims: d.sims,
         ranking: d.ranking,
+        adequacy: d.adequacy.channels,
     })
 }
 
@@ -168,7 +190,7 @@ pub fn run(a: &SweepArgs) -> ExitCode {
         match r {
             Ok(r) => {
                 n += 1;
-                let hit = r.named == r.case.hidden;
+                let hit = r.answer == r.case.hidden.name();
                 ok += hit as usize;
                 println!("{} {}", if hit { "OK  " } else { "MISS" }, r.line());
             }
@@ -181,10 +203,11 @@ pub fn run(a: &SweepArgs) -> ExitCode {
         if mine.is_empty() {
             continue;
         }
-        let hits = mine.iter().filter(|r| r.named == hidden).count();
+        let hits = mine.iter().filter(|r| r.answer == hidden.name()).count();
         let gain_ok = mine
             .iter()
-            .filter(|r| r.named == hidden && (hidden == Candidate::None || r.affected_gain().is_some_and(|g| g >= 0.5)))
+            
+            .filter(|r| r.answer == hidden.name() && (hidden == Candidate::None || r.affected_gain().is_some_and(|g| g >= 0.5)))
             .count();
         println!("  {:<31} named {hits}/{}  (named with >= 50 % held-out gain: {gain_ok})", hidden.name(), mine.len());
     }

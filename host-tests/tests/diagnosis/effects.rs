@@ -56,7 +56,7 @@ fn check(cases: &[SynthCase]) {
     let mut failures = Vec::new();
     for r in results {
         let r = r.expect("case must generate and diagnose");
-        if r.named != r.case.hidden {
+        if r.answer != r.case.hidden.name() {
             failures.push(format!("wrong cause: {}", r.line()));
         } else if r.case.hidden != Candidate::None {
             let g = r.affected_gain().expect("affected channel measured");
@@ -81,9 +81,8 @@ fn check_miss(cases: &[(SynthCase, &str, Option<f64>)]) {
     for (r, expected, max_gain) in results {
         let r = r.expect("case must generate and diagnose");
         eprintln!("{} magnitude {:.4}\n{}", r.line(), r.magnitude, r.detail());
-        let expected = Candidate::from_name(expected).expect("candidate name");
-        if r.named != expected {
-            failures.push(format!("measured outcome changed (was {}): {}", expected.name(), r.line()));
+        if r.answer != expected {
+            failures.push(format!("measured outcome changed (was {expected}): {}", r.line()));
         } else if let (Some(bound), Some(g)) = (max_gain, r.affected_gain()) {
             if g >= bound {
                 failures.push(format!("measured miss now gains {:.0} % (was < {:.0} %): {}", 100.0 * g, 100.0 * bound, r.line()));

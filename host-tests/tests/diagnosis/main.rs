@@ -1,8 +1,10 @@
 //! Diagnosis tests: statistics, replay of measured inputs, the command line,
 //! and the hidden-effect cases (fast tier: one case per candidate and the
-//! `none` guards; slow tier, `--ignored`: the rest).
+//! `none` guards; slow tier, `--ignored`: the rest), and the same on logs
+//! of the independent rig emulator (`emulator.rs`).
 
 mod cli;
 mod effects;
+mod emulator;
 mod replay;
 mod stats;

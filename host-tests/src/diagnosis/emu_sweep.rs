@@ -1,0 +1,233 @@
+//! Diagnosis on logs of the independent rig emulator ([`crate::emulator`]):
+//! generate, diagnose blind with the rig file as baseline, score. Used by
+//! the tests (a small subset) and by `eha-sim emulator-sweep`, which writes
+//! the whole table (`emulator-sweep.md`, `emulator-sweep.json`).
+
+use super::analysis::{diagnose, DiagnoseOptions};
+use super::model::Candidate;
+use super::reference::ReferenceModel;
+use crate::emulator::missions::EmuScenario;
+use crate::emulator::{generate, EmuCase};
+use crate::rig::Rig;
+use rayon::prelude::*;
+use std::fmt::Write as _;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Outcome of one emulated log.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct EmuResult {
+    /// The case.
+    pub case: EmuCase,
+    /// Hidden magnitude.
+    pub magnitude: f64,
+    /// The answer (candidate name, `none` or `unexplained`).
+    pub answer: String,
+    /// Channel the hidden effect changes most and its imprint, K.
+    pub affected: Option<(String, f64)>,
+    /// Held-out RMSE on the affected channel, calibrated baseline → answer, K.
+    pub affected_heldout_k: Option<(f64, f64)>,
+    /// Pooled held-out RMSE: nominal baseline, calibrated baseline, answer, K.
+    pub pooled_heldout_k: [f64; 3],
+    /// Calibrated baseline per channel: (channel, held-out RMSE K, RMSE /
+    /// noise σ, RMSE / RMS rise above ambient, misfit).
+    pub channels: Vec<(String, f64, f64, f64, bool)>,
+    /// Calibrated nuisance parameters on a bound.
+    pub at_bounds: Vec<String>,
+    /// Best candidate by BIC other than `none`: name, ΔBIC, best-channel
+    /// held-out gain, whether it qualified.
+    pub best_candidate: Option<(String, f64, f64, bool)>,
+    /// Wall time of the diagnosis, s.
+    pub seconds: f64,
+}
+
+impl EmuResult {
+    /// Relative held-out RMSE reduction on the affected channel.
+    pub fn affected_gain(&self) -> Option<f64> {
+        self.affected_heldout_k.map(|(b, a)| 1.0 - a / b)
+    }
+
+    /// Whether the answer is the hidden effect.
+    pub fn hit(&self) -> bool {
+        self.answer == self.case.hidden.name()
+    }
+}
+
+/// Generates and diagnoses `case` with the rig file as baseline.
+pub fn run_emu_case(case: EmuCase, o: &DiagnoseOptions) -> Result<EmuResult, String> {
+    let (run, truth) = generate(&case)?;
+    let t = std::time::Instant::now();
+    let model = ReferenceModel::new(Rig::default(), &run).map_err(|e| e.to_string())?;
+    let d = diagnose(&run, &model, o).map_err(|e| e.to_string())?;
+    let affected = truth.affected.map(|(c, v)| (c.name().to_string(), v));
+    let affected_heldout_k =
+        affected.as_ref().and_then(|(c, _)| Some((d.before.channel(c)?.heldout_rmse_k, d.after.channel(c)?.heldout_rmse_k)));
+    let best = d.ranking.iter().find(|r| r.cause != "none").map(|r| (r.cause.clone(), r.delta_bic, r.heldout_gain, r.qualifies));
+    Ok(EmuResult {
+        case,
+        magnitude: truth.magnitude,
+        answer: d.answer().into(),
+        affected,
+        affected_heldout_k,
+        pooled_heldout_k: [d.nominal.heldout_rmse_k, d.before.heldout_rmse_k, d.after.heldout_rmse_k],
+        channels: d
+            .adequacy
+            .channels
+            .iter()
+            .map(|c| (c.channel.clone(), c.heldout_rmse_k, c.heldout_rmse_k / c.noise_k, c.heldout_rmse_k / c.rise_k.max(1e-9), c.misfit))
+            .collect(),
+        at_bounds: d.adequacy.at_bounds.iter().map(|b| format!("{} {}", b.name, b.bound)).collect(),
+        best_candidate: best,
+        seconds: t.elapsed().as_secs_f64(),
+    })
+}
+
+/// The default case set: two scenarios per candidate (each chosen to excite
+/// it) and four without a hidden effect; seeds `base + k`.
+pub fn default_cases(duration_s: f64, base: u64) -> Vec<EmuCase> {
+    use EmuScenario::*;
+    let list: [(&str, EmuScenario); 18] = [
+        ("winding-resistance-temperature", PressureSpeedSteps),
+        ("winding-resistance-temperature", LoadCycles),
+        ("viscosity-temperature", LoadCycles),
+        ("viscosity-temperature", PressureSpeedSteps),
+        ("sensor-lag", ConstantThrottle),
+        ("sensor-lag", SpeedSteps),
+        ("coulomb-friction", ServoHoldMove),
+        ("coulomb-friction", ServoHoldMove),
+        ("churning-loss", SpeedSteps),
+        ("churning-loss", PressureSpeedSteps),
+        ("motor-pump-conduction", ConstantThrottle),
+        ("motor-pump-conduction", LoadCycles),
+        ("forced-convection", ConstantThrottle),
+        ("forced-convection", AirSteps),
+        ("none", ConstantThrottle),
+        ("none", LoadCycles),
+        ("none", SpeedSteps),
+        ("none", ServoHoldMove),
+    ];
+    list.iter()
+        .enumerate()
+        .map(|(k, (h, s))| EmuCase {
+            hidden: Candidate::from_name(h).unwrap_or(Candidate::None),
+            scenario: *s,
+            seed: base + k as u64,
+            duration_s,
+        })
+        .collect()
+}
+
+/// One Markdown table row of `r`.
+pub fn table_row(r: &EmuResult) -> String {
+    let ch: Vec<String> = r
+        .channels
+        .iter()
+        .map(|(c, v, q, f, m)| {
+            let b = if *m { "**" } else { "" };
+            format!("{b}{} {v:.2} ({q:.0}σ, {:.0} %){b}", c.trim_start_matches("t_").trim_end_matches("_c"), 100.0 * f)
+        })
+        .collect();
+    format!(
+        "| {:?} ({}) | {} | {} | {} | {} | {} | {:.2} / {:.2} → {:.2} | {} | {} | {:.0} |",
+        r.case.scenario,
+        r.case.seed,
+        r.case.hidden.name(),
+        if r.case.hidden == Candidate::None { "–".to_string() } else { format!("{:.3e}", r.magnitude) },
+        r.answer,
+        r.affected.as_ref().map_or("–".into(), |(c, v)| format!("{c} ({v:.2} K)")),
+        r.affected_heldout_k.map_or("–".into(), |(b, a)| format!("{b:.2} → {a:.2} ({:.0} %)", 100.0 * (1.0 - a / b))),
+        r.pooled_heldout_k[0],
+        r.pooled_heldout_k[1],
+        r.pooled_heldout_k[2],
+        ch.join(", "),
+        if r.at_bounds.is_empty() { "–".into() } else { r.at_bounds.join(", ") },
+        r.seconds
+    )
+}
+
+/// Arguments of `emulator-sweep`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct EmuSweepArgs {
+    /// Log duration, s.
+    #[arg(long, default_value_t = 1200.0)]
+    pub duration: f64,
+    /// Repetitions of the case set (seeds 1700 + 100·k + case index).
+    #[arg(long, default_value_t = 1)]
+    pub seeds: u64,
+    /// Leave out the servo cases (slow replays, and with them coulomb-friction).
+    #[arg(long)]
+    pub no_servo: bool,
+    /// Output directory for emulator-sweep.md and emulator-sweep.json.
+    #[arg(long, default_value = "emulator-sweep-out")]
+    pub out: PathBuf,
+    /// Also write every generated log to OUT/logs/ (measured-data format).
+    #[arg(long)]
+    pub logs: bool,
+}
+
+/// Runs the emulator sweep; exit 0 always unless the outputs cannot be
+/// written (it is a measurement, not a test).
+pub fn run(a: &EmuSweepArgs) -> ExitCode {
+    let cases: Vec<EmuCase> = (0..a.seeds)
+        .flat_map(|k| default_cases(a.duration, 1700 + 100 * k))
+        .filter(|c| !(a.no_servo && c.scenario.is_servo()))
+        .collect();
+    let bar = indicatif::ProgressBar::new(cases.len() as u64);
+    let res: Vec<Result<EmuResult, String>> = cases
+        .par_iter()
+        .map(|c| {
+            if a.logs {
+                if let Ok((run, _)) = generate(c) {
+                    let dir = a.out.join("logs");
+                    let _ = std::fs::create_dir_all(&dir);
+                    let _ = run.write_file(dir.join(format!("{}-{:?}-{}.csv", c.hidden.name(), c.scenario, c.seed)));
+                }
+            }
+            let r = run_emu_case(*c, &DiagnoseOptions::default());
+            bar.inc(1);
+            r
+        })
+        .collect();
+    bar.finish_and_clear();
+    let mut md = String::from(
+        "| scenario (seed) | hidden | magnitude | answer | affected channel (imprint) | its held-out RMSE before → after (K) | pooled held-out RMSE nominal / calibrated → after (K) | calibrated held-out per channel, K (× noise σ, % of rise; **misfit**) | nuisance on a bound | s |\n|---|---|---|---|---|---|---|---|---|---:|\n",
+    );
+    let ok: Vec<&EmuResult> = res.iter().flatten().collect();
+    for r in &ok {
+        md += &table_row(r);
+        md.push('\n');
+    }
+    for e in res.iter().filter_map(|r| r.as_ref().err()) {
+        let _ = writeln!(md, "\nerror: {e}");
+    }
+    let with = ok.iter().filter(|r| r.case.hidden != Candidate::None).count();
+    let hits = ok.iter().filter(|r| r.case.hidden != Candidate::None && r.hit()).count();
+    let gain = ok.iter().filter(|r| r.case.hidden != Candidate::None && r.hit() && r.affected_gain().is_some_and(|g| g >= 0.5)).count();
+    let count = |s: &str| ok.iter().filter(|r| r.answer == s).count();
+    let nones: Vec<&&EmuResult> = ok.iter().filter(|r| r.case.hidden == Candidate::None).collect();
+    let false_disc = nones.iter().filter(|r| r.answer != "none" && r.answer != "unexplained").count();
+    let _ = writeln!(
+        md,
+        "\nHidden effect named in {hits} of {with} (with ≥ 50 % held-out gain on the affected channel: {gain}); \
+         `none` cases: {} none, {} unexplained, {false_disc} false discoveries of {}; answers overall: {} unexplained, {} none.",
+        nones.iter().filter(|r| r.answer == "none").count(),
+        nones.iter().filter(|r| r.answer == "unexplained").count(),
+        nones.len(),
+        count("unexplained"),
+        count("none"),
+    );
+    print!("{md}");
+    let write = || -> std::io::Result<()> {
+        std::fs::create_dir_all(&a.out)?;
+        std::fs::write(a.out.join("emulator-sweep.md"), &md)?;
+        let j = serde_json::to_string_pretty(&ok).map_err(std::io::Error::other)?;
+        std::fs::write(a.out.join("emulator-sweep.json"), j + "\n")
+    };
+    match write() {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+    }
+}

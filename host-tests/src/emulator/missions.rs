@@ -1,0 +1,176 @@
+//! Operating profiles of the emulated rig: what the operator does (shaft
+//! speed and needle setting on the throttle circuit, the position command on
+//! the servo circuit, the ram-air fan), drawn from a seed. The families are
+//! those of the paper (Case 1 throttle runs, Case 2 servo runs) and of the
+//! diagnosis tests (speed and load steps, hold/manoeuvre servo duty).
+
+use rand::Rng;
+
+/// Operating scenario of an emulated log.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum EmuScenario {
+    /// Case 1: constant 500 rpm, needle set for 20, 40 or 60 bar.
+    ConstantThrottle,
+    /// One speed (800–1200 rpm), needle alternating between 10–30 and
+    /// 70–100 bar every 120–240 s.
+    LoadCycles,
+    /// Speed steps 1000–2000 rpm every 100–250 s at 5–25 bar.
+    SpeedSteps,
+    /// Needle drop 70–100 bar, speed steps 500–1200 rpm every 120–240 s.
+    PressureSpeedSteps,
+    /// Case 1 at 40–60 bar with logged ram air alternating 0 / 10–25 m/s
+    /// every 150–300 s.
+    AirSteps,
+    /// Servo: segments of 120–240 s alternating between holding 25–40 mm
+    /// against the spring and manoeuvring (15–25 mm triangles, half-period
+    /// 1.0–1.6 s) about the centre. Logged at 0.1 s.
+    ServoHoldMove,
+}
+
+impl EmuScenario {
+    /// Whether the servo circuit is used (piston moving, position logged).
+    pub fn is_servo(self) -> bool {
+        self == EmuScenario::ServoHoldMove
+    }
+
+    /// Whether the ram air is logged.
+    pub fn logs_air(self) -> bool {
+        self == EmuScenario::AirSteps
+    }
+
+    /// Logger interval, s: 0.1 s for servo runs (the format's interval for
+    /// moving runs), 2 s otherwise.
+    pub fn log_interval_s(self) -> f64 {
+        if self.is_servo() { 0.1 } else { 2.0 }
+    }
+}
+
+/// A drawn operating profile.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EmuMission {
+    /// Scenario.
+    pub scenario: EmuScenario,
+    /// Duration, s.
+    pub duration_s: f64,
+    /// Ambient: mean °C, drift amplitude K, drift phase rad (period 2400 s:
+    /// the laboratory air conditioning).
+    pub ambient: [f64; 3],
+    /// Shaft speed steps (start time s, rpm) for the throttle circuit.
+    pub speed: Vec<(f64, f64)>,
+    /// Needle target drop steps (start time s, bar): the needle opening is
+    /// set for this drop at the step's nominal pump flow.
+    pub dp_bar: Vec<(f64, f64)>,
+    /// Position command, piecewise linear (time s, m), servo circuit.
+    pub x_ref: Vec<(f64, f64)>,
+    /// Logged ram-air steps (start time s, m/s).
+    pub air: Vec<(f64, f64)>,
+}
+
+/// Value of a step schedule at `t` with a 2 s linear ramp after each step
+/// (the drive and the operator do not step instantly).
+pub fn step_at(s: &[(f64, f64)], t: f64) -> f64 {
+    let i = s.partition_point(|p| p.0 <= t);
+    if i == 0 {
+        return s.first().map_or(0.0, |p| p.1);
+    }
+    let (t0, v) = s[i - 1];
+    let prev = if i >= 2 { s[i - 2].1 } else { v };
+    let f = ((t - t0) / 2.0).clamp(0.0, 1.0);
+    prev + (v - prev) * f
+}
+
+/// Value of a piecewise-linear profile at `t` (held at the ends).
+pub fn linear_at(s: &[(f64, f64)], t: f64) -> f64 {
+    let i = s.partition_point(|p| p.0 <= t);
+    match (i.checked_sub(1).and_then(|j| s.get(j)), s.get(i)) {
+        (Some(a), Some(b)) if b.0 > a.0 => a.1 + (b.1 - a.1) * (t - a.0) / (b.0 - a.0),
+        (Some(a), _) => a.1,
+        (None, Some(b)) => b.1,
+        (None, None) => 0.0,
+    }
+}
+
+/// Steps every `lo..hi` s until `d`, values from `value`.
+fn steps(rng: &mut impl Rng, d: f64, lo: f64, hi: f64, mut value: impl FnMut(&mut dyn FnMut(f64, f64) -> f64, usize) -> f64) -> Vec<(f64, f64)> {
+    let (mut out, mut t) = (Vec::new(), 0.0);
+    while t < d {
+        let v = value(&mut |a, b| rng.random_range(a..b), out.len());
+        out.push((t, v));
+        t += rng.random_range(lo..hi);
+    }
+    out
+}
+
+/// Draws the profile of `scenario` for `duration_s` seconds.
+pub fn draw(scenario: EmuScenario, duration_s: f64, rng: &mut impl Rng) -> EmuMission {
+    let d = duration_s;
+    let ambient = [rng.random_range(15.0..27.0), rng.random_range(0.2..0.8), rng.random_range(0.0..std::f64::consts::TAU)];
+    let mut m = EmuMission { scenario, duration_s, ambient, speed: vec![(0.0, 500.0)], dp_bar: vec![(0.0, 60.0)], x_ref: vec![], air: vec![(0.0, 0.0)] };
+    match scenario {
+        EmuScenario::ConstantThrottle => m.dp_bar = vec![(0.0, [20.0, 40.0, 60.0][rng.random_range(0..3)])],
+        EmuScenario::LoadCycles => {
+            m.speed = vec![(0.0, rng.random_range(800.0..1200.0))];
+            let high0 = rng.random_bool(0.5);
+            m.dp_bar = steps(rng, d, 120.0, 240.0, |r, k| if (k % 2 == 0) == high0 { r(70.0, 100.0) } else { r(10.0, 30.0) });
+        }
+        EmuScenario::SpeedSteps => {
+            m.speed = steps(rng, d, 100.0, 250.0, |r, _| r(1000.0, 2000.0));
+            m.dp_bar = vec![(0.0, rng.random_range(5.0..25.0))];
+        }
+        EmuScenario::PressureSpeedSteps => {
+            m.speed = steps(rng, d, 120.0, 240.0, |r, _| r(500.0, 1200.0));
+            m.dp_bar = vec![(0.0, rng.random_range(70.0..100.0))];
+        }
+        EmuScenario::AirSteps => {
+            m.dp_bar = vec![(0.0, rng.random_range(40.0..60.0))];
+            let on0 = rng.random_bool(0.5);
+            m.air = steps(rng, d, 150.0, 300.0, |r, k| if (k % 2 == 0) == on0 { r(10.0, 25.0) } else { 0.0 });
+        }
+        EmuScenario::ServoHoldMove => {
+            let (mut pts, mut t, mut hold) = (vec![(0.0, 0.0)], 0.0, rng.random_bool(0.5));
+            while t < d {
+                let t_seg = (t + rng.random_range(120.0..240.0)).min(d + 10.0);
+                if hold {
+                    let x = rng.random_range(0.025..0.040) * if rng.random_bool(0.5) { 1.0 } else { -1.0 };
+                    pts.extend([(t + 2.0, x), (t_seg - 2.0, x), (t_seg, 0.0)]);
+                    t = t_seg;
+                } else {
+                    while t < t_seg {
+                        let (a, h) = (rng.random_range(0.015..0.025), rng.random_range(1.0..1.6));
+                        pts.extend([(t + 0.5 * h, a), (t + 1.5 * h, -a), (t + 2.0 * h, 0.0)]);
+                        t += 2.0 * h;
+                    }
+                }
+                hold = !hold;
+            }
+            m.x_ref = pts;
+            m.speed = vec![(0.0, 0.0)];
+            m.dp_bar = vec![(0.0, 0.0)];
+        }
+    }
+    m
+}
+
+impl EmuMission {
+    /// Ambient air temperature at `t`, °C.
+    pub fn ambient_c(&self, t: f64) -> f64 {
+        let [a, amp, ph] = self.ambient;
+        a + amp * (2.0 * std::f64::consts::PI * t / 2400.0 + ph).sin()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn schedules_ramp_and_interpolate() {
+        let s = [(0.0, 10.0), (100.0, 20.0)];
+        assert_eq!(step_at(&s, 50.0), 10.0);
+        assert!((step_at(&s, 101.0) - 15.0).abs() < 1e-12);
+        assert_eq!(step_at(&s, 200.0), 20.0);
+        let p = [(0.0, 0.0), (2.0, 4.0)];
+        assert!((linear_at(&p, 1.0) - 2.0).abs() < 1e-12);
+        assert_eq!(linear_at(&p, 5.0), 4.0);
+    }
+}

@@ -1,0 +1,389 @@
+//! The emulated machine: a quasi-static hydraulic operating point (the
+//! hydraulics settle in milliseconds, the temperatures in minutes), the
+//! losses of eqs. (1)–(11) placed in a 14-node thermal network of its own,
+//! the sensors as first-order states, integrated by Heun's method with a
+//! step bounded by the network's fastest time constant.
+
+use super::missions::{linear_at, step_at, EmuMission};
+use super::params::EmuParams;
+use super::props::{self, oil_cp, oil_nu, oil_rho};
+use crate::diagnosis::Candidate;
+use std::f64::consts::PI;
+
+/// Thermal nodes of the emulator (the reference model has 12 others).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(usize)]
+pub enum N {
+    /// Stator: copper and laminations together.
+    Stator,
+    /// Motor housing (Point 1).
+    MotorCase,
+    /// Pump barrel housing (most of Point 3).
+    Barrel,
+    /// Pump port end cap, bolted to the manifold plate.
+    EndCap,
+    /// Case (drain) oil.
+    CaseOil,
+    /// Oil in the two port passages.
+    PortOil,
+    /// Manifold plate: the part of the main block the pump is bolted to.
+    Manifold,
+    /// Oil circulating in the manifold, block passages and accumulator.
+    LoopOil,
+    /// Main valve block (Point 4).
+    Block,
+    /// Ball/needle-valve block (Point 5).
+    Ball,
+    /// Oil in the ball/needle-valve block.
+    BallOil,
+    /// Cylinder barrel.
+    Cylinder,
+    /// Oil in the cylinder chambers.
+    CylOil,
+    /// Dead-end sensor pocket (only coupled with hidden `sensor-lag`).
+    Pocket,
+}
+
+/// Number of nodes.
+pub const NN: usize = 14;
+/// State: node temperatures, five sensor states, piston position.
+pub const NS: usize = NN + 6;
+
+/// Heat flows and conductance sums being assembled, per node.
+struct Acc {
+    q: [f64; NN],
+    g: [f64; NN],
+}
+
+impl Acc {
+    /// Symmetric exchange `g` (W/K) between `a` and `b`.
+    fn link(&mut self, y: &[f64], a: N, b: N, g: f64) {
+        let w = g * (y[a as usize] - y[b as usize]);
+        self.q[a as usize] -= w;
+        self.q[b as usize] += w;
+        self.g[a as usize] += g;
+        self.g[b as usize] += g;
+    }
+
+    /// Stream of capacity rate `g` (ṁ·c, W/K) from `from` into the
+    /// well-mixed node `to`, which sends the same flow on (upwind).
+    fn flow(&mut self, y: &[f64], from: N, to: N, g: f64) {
+        self.q[to as usize] += g * (y[from as usize] - y[to as usize]);
+        self.g[to as usize] += g;
+    }
+}
+
+/// The hidden effect switched on in the emulated machine, with its
+/// magnitude in the unit of the diagnosis candidate's parameter.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Hidden {
+    /// Which effect (`Candidate::None` for none).
+    pub effect: Candidate,
+    /// Magnitude (α 1/K, τ s, N, W/(rad/s)^2.5, W/K, m/s; 1 for viscosity).
+    pub magnitude: f64,
+}
+
+/// Operating point and the heat sources at one instant.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Op {
+    /// Shaft speed, rad/s.
+    pub omega: f64,
+    /// Motor current, A rms.
+    pub current_a: f64,
+    /// Port pressures, Pa gauge.
+    pub p_a: f64,
+    /// Port B, Pa gauge.
+    pub p_b: f64,
+    /// Piston speed, m/s.
+    pub v: f64,
+    /// Pump leakage flow to the case, m³/s.
+    pub q_leak: f64,
+    /// Flow through the throttle path, m³/s.
+    pub q_path: f64,
+    /// Air speed over the housings (logged ram air + hidden draught), m/s.
+    pub air: f64,
+}
+
+/// Emulated machine running one mission.
+pub struct Plant<'a> {
+    /// Parameters.
+    pub p: &'a EmuParams,
+    /// Mission.
+    pub m: &'a EmuMission,
+    /// Hidden effect.
+    pub h: Hidden,
+}
+
+impl Plant<'_> {
+    fn mag(&self, c: Candidate) -> Option<f64> {
+        (self.h.effect == c).then_some(self.h.magnitude)
+    }
+
+    /// Kinematic viscosity in use at `t_c`: the 40 °C value unless the
+    /// hidden effect is `viscosity-temperature`.
+    fn nu(&self, t_c: f64) -> f64 {
+        if self.h.effect == Candidate::ViscosityTemperature { oil_nu(t_c) } else { oil_nu(40.0) }
+    }
+
+    /// Leakage conductance of eqs. (5)–(7) with the emulator's own pump
+    /// geometry (9 pistons of 9.5 mm, seal 22 mm, eccentricity 0.4;
+    /// slipper r2/r1 = 1.6; port plate φ = π, r = 21 mm, L = 5.5 mm),
+    /// common gap `gap_m`, m³/(s·Pa).
+    fn k_leak(&self, mu: f64) -> f64 {
+        let d3 = self.p.gap_m.powi(3);
+        let piston = 9.0 * PI * 0.0095 * d3 * (1.0 + 1.5 * 0.16) / (12.0 * mu * 0.022);
+        let slipper = 9.0 * PI * d3 / (6.0 * mu * 1.6f64.ln());
+        let port = PI * 0.021 * d3 / (12.0 * mu * 0.0055);
+        piston + slipper + port
+    }
+
+    /// Iron loss, eq. (2), W.
+    fn iron_w(&self, omega: f64) -> f64 {
+        let f = self.p.pole_pairs * omega.abs() / (2.0 * PI);
+        let b = self.p.b_peak_t;
+        let [kh, kc, ke] = self.p.iron_k;
+        kh * f * b * b + kc * f * f * b * b + ke * f.powf(1.5) * b.powf(1.5)
+    }
+
+    /// Operating point at `t` with temperatures `y` and piston position `x`.
+    pub fn op(&self, t: f64, y: &[f64], x: f64) -> Op {
+        let p = self.p;
+        let mu_case = self.nu(y[N::CaseOil as usize]) * oil_rho(y[N::CaseOil as usize]);
+        let kl = self.k_leak(mu_case);
+        let air = step_at(&self.m.air, t) + self.mag(Candidate::ForcedConvection).unwrap_or(0.0);
+        let d_rad = p.displacement_m3 / (2.0 * PI);
+        let churn = |w: f64| self.mag(Candidate::ChurningLoss).map_or(0.0, |k| k * w.abs().powf(1.5) * w.signum());
+        if self.m.scenario.is_servo() {
+            let v = p.pos_gain * (linear_at(&self.m.x_ref, t) - x);
+            let fc = self.mag(Candidate::CoulombFriction).map_or(0.0, |f| f * (v / 1e-3).tanh());
+            // Spring, spring damping, seal friction; the 13.5 kg load's
+            // inertia (< 30 N here) is left out.
+            let force = 245e3 * x + 15e3 * v + p.seal_viscous * v + fc;
+            let dp = force / 1526.81e-6;
+            let q_leak = kl * dp.abs();
+            let q = 1526.81e-6 * v + p.act_leak * dp + q_leak * dp.signum();
+            let omega = q / d_rad;
+            let torque = d_rad * dp + p.eta_m * d_rad * dp.abs() * omega.signum() + churn(omega);
+            let drag = self.iron_w(omega) / omega.abs().max(1.0);
+            let (pa, pb) = (p.boost_pa + dp.max(0.0), p.boost_pa + (-dp).max(0.0));
+            Op { omega, current_a: (torque.abs() + drag) / p.kt_nm_per_a, p_a: pa, p_b: pb, v, q_leak, q_path: 0.0, air }
+        } else {
+            let omega = step_at(&self.m.speed, t) * PI / 30.0;
+            // Needle opening set for the target drop at the nominal flow
+            // (first guess without leakage), then the actual drop.
+            let q_nom = d_rad * omega;
+            let target = step_at(&self.m.dp_bar, t).max(0.5) * 1e5;
+            let rho = oil_rho(y[N::BallOil as usize]);
+            let area = q_nom / (p.needle_cd * (2.0 * target / rho).sqrt());
+            let mut q_path = q_nom;
+            let mut dp = target;
+            for _ in 0..3 {
+                q_path = (q_nom - kl * dp).max(0.0);
+                dp = 0.5 * rho * (q_path / (p.needle_cd * area)).powi(2) + self.hose_dp(q_path, y[N::LoopOil as usize]);
+            }
+            let torque = d_rad * dp * (1.0 + p.eta_m) + churn(omega);
+            let drag = self.iron_w(omega) / omega.abs().max(1.0);
+            Op {
+                omega,
+                current_a: (torque + drag) / p.kt_nm_per_a,
+                p_a: p.boost_pa + dp,
+                p_b: p.boost_pa,
+                v: 0.0,
+                q_leak: kl * dp,
+                q_path,
+                air,
+            }
+        }
+    }
+
+    /// Pressure drop of the throttle hoses, eq. (10): Darcy friction
+    /// (64/Re laminar, Blasius turbulent) plus local losses, Pa.
+    fn hose_dp(&self, q: f64, t_c: f64) -> f64 {
+        let [l, d, xi] = self.p.hose;
+        let vel = q / (PI * d * d / 4.0);
+        let re = (vel * d / self.nu(t_c)).max(1.0);
+        let lambda = if re < 2300.0 { 64.0 / re } else { 0.3164 * re.powf(-0.25) };
+        (lambda * l / d + xi) * 0.5 * oil_rho(t_c) * vel * vel
+    }
+
+    /// Heat lost by a surface `s` = (area, height, diameter) at `t_w` to
+    /// ambient `t_a` with air speed `air`: sides (80 %, Churchill–Chu
+    /// vertical), top and bottom faces (10 % each, McAdams), each mixed
+    /// with Churchill–Bernstein cross flow, plus radiation, W.
+    fn outer_w(&self, s: [f64; 3], t_w: f64, t_a: f64, air: f64) -> f64 {
+        let [a, hgt, d] = s;
+        let forced = if air > 0.0 { props::h_cross_flow(air, d, 0.5 * (t_w + t_a)) } else { 0.0 };
+        let side = props::h_mixed(props::h_free_vertical(t_w, t_a, hgt), forced);
+        let top = props::h_mixed(props::h_free_horizontal(t_w, t_a, d, true), forced);
+        let bot = props::h_mixed(props::h_free_horizontal(t_w, t_a, d, false), forced);
+        (0.8 * side + 0.1 * top + 0.1 * bot) * a * (t_w - t_a) + props::radiation_w(self.p.emissivity, a, t_w, t_a)
+    }
+
+    /// Heat capacities of the nodes at temperatures `y`, J/K.
+    pub fn capacities(&self, y: &[f64]) -> [f64; NN] {
+        let p = self.p;
+        let oil = |v: f64, i: N| v * oil_rho(y[i as usize]) * oil_cp(y[i as usize]);
+        [
+            p.c_stator,
+            p.c_motor_case,
+            p.c_pump[0],
+            p.c_pump[1],
+            oil(p.v_case, N::CaseOil),
+            oil(p.v_port, N::PortOil),
+            p.c_manifold,
+            oil(p.v_loop, N::LoopOil),
+            p.c_block,
+            p.c_ball,
+            oil(p.v_ball, N::BallOil),
+            p.cyl[0],
+            oil(p.cyl[1], N::CylOil),
+            oil(p.pocket[0], N::Pocket),
+        ]
+    }
+
+    /// Right-hand side: fills `dy` and returns the largest ΣG/C (1/s) of
+    /// the thermal nodes, which bounds the explicit step.
+    pub fn rhs(&self, t: f64, y: &[f64], dy: &mut [f64]) -> f64 {
+        let p = self.p;
+        let x = y[NS - 1];
+        let o = self.op(t, y, x);
+        let amb = self.m.ambient_c(t);
+        let tn = |n: N| y[n as usize];
+        let mut acc = Acc { q: [0.0; NN], g: [0.0; NN] };
+        // Sources, eqs. (1)–(11).
+        let alpha = self.mag(Candidate::WindingResistanceTemperature).unwrap_or(0.0);
+        let r = p.r25_ohm * (1.0 + alpha * (tn(N::Stator) - 25.0));
+        acc.q[N::Stator as usize] += 3.0 * o.current_a * o.current_a * r + self.iron_w(o.omega);
+        let dp = o.p_a - o.p_b;
+        let d_rad = p.displacement_m3 / (2.0 * PI);
+        let mech = p.eta_m * d_rad * dp.abs() * o.omega.abs();
+        let [ms_oil, ms_case, ms_metal] = p.mech_split;
+        acc.q[N::PortOil as usize] += ms_oil * mech;
+        acc.q[N::EndCap as usize] += ms_metal * mech;
+        let churn = self.mag(Candidate::ChurningLoss).map_or(0.0, |k| k * o.omega.abs().powf(2.5));
+        acc.q[N::CaseOil as usize] += ms_case * mech + o.q_leak * (o.p_a.max(o.p_b) - p.boost_pa) + churn;
+        if self.m.scenario.is_servo() {
+            let coul = self.mag(Candidate::CoulombFriction).map_or(0.0, |f| f * (o.v / 1e-3).tanh() * o.v);
+            acc.q[N::Cylinder as usize] += p.seal_viscous * o.v * o.v + coul;
+            acc.q[N::CylOil as usize] += p.act_leak * dp * dp;
+        } else {
+            let hose = self.hose_dp(o.q_path, tn(N::LoopOil)) * o.q_path;
+            acc.q[N::LoopOil as usize] += hose;
+            acc.q[N::BallOil as usize] += (dp * o.q_path - hose).max(0.0);
+        }
+        // Conduction and films.
+        acc.link(y, N::Stator, N::MotorCase, p.g_stator_case);
+        if let Some(g) = self.mag(Candidate::MotorPumpConduction) {
+            acc.link(y, N::MotorCase, N::Barrel, g);
+        }
+        acc.link(y, N::Barrel, N::EndCap, p.g_barrel_end);
+        acc.link(y, N::EndCap, N::Manifold, p.g_end_manifold);
+        acc.link(y, N::Manifold, N::Block, p.g_manifold_block);
+        acc.link(y, N::Ball, N::Block, p.g_ball_block);
+        let nu_case = self.nu(tn(N::CaseOil));
+        for (wall, a) in [(N::Barrel, p.a_case[0]), (N::EndCap, p.a_case[1])] {
+            acc.link(y, N::CaseOil, wall, props::case_film(o.omega, p.r_rotor, a, nu_case, tn(N::CaseOil)));
+        }
+        let q_geo = d_rad * o.omega.abs();
+        let duct = |dct: [f64; 3], flow: f64, n: N| props::duct_film(flow.max(1e-7), dct[0], dct[1], dct[2], self.nu(tn(n)), tn(n));
+        acc.link(y, N::PortOil, N::EndCap, duct(p.port_duct, q_geo, N::PortOil));
+        acc.link(y, N::LoopOil, N::Manifold, duct(p.plate_duct, q_geo, N::LoopOil));
+        acc.link(y, N::LoopOil, N::Block, duct(p.block_duct, q_geo, N::LoopOil));
+        let q_ball = if self.m.scenario.is_servo() { 0.0 } else { o.q_path };
+        acc.link(y, N::BallOil, N::Ball, duct(p.ball_duct, q_ball, N::BallOil));
+        let q_cyl = 1526.81e-6 * o.v.abs();
+        acc.link(y, N::CylOil, N::Cylinder, duct([0.063, 0.1, p.cyl[2]], q_cyl, N::CylOil));
+        // Sensor pocket: dead end with `sensor-lag`, otherwise a small
+        // well-stirred volume following the loop (never read then).
+        let c_pocket = p.pocket[0] * oil_rho(tn(N::Pocket)) * oil_cp(tn(N::Pocket));
+        match self.mag(Candidate::SensorLag) {
+            Some(tau) => {
+                acc.link(y, N::LoopOil, N::Pocket, c_pocket / tau);
+                acc.link(y, N::Manifold, N::Pocket, p.pocket[1]);
+            }
+            None => acc.link(y, N::LoopOil, N::Pocket, c_pocket / 5.0),
+        }
+        // Advection (upwind, mass-balanced rings) and tidal mixing.
+        let rho_cp = |n: N| oil_rho(tn(n)) * oil_cp(tn(n));
+        acc.flow(y, N::PortOil, N::CaseOil, o.q_leak * rho_cp(N::PortOil));
+        acc.flow(y, N::CaseOil, N::LoopOil, o.q_leak * rho_cp(N::CaseOil));
+        if self.m.scenario.is_servo() {
+            acc.flow(y, N::LoopOil, N::PortOil, o.q_leak * rho_cp(N::LoopOil));
+            // Oil swinging between pump, manifold and chambers.
+            let g_pump = q_geo * rho_cp(N::PortOil);
+            acc.link(y, N::PortOil, N::LoopOil, g_pump);
+            acc.link(y, N::LoopOil, N::CylOil, 0.5 * q_cyl * rho_cp(N::LoopOil));
+        } else {
+            acc.flow(y, N::LoopOil, N::PortOil, (o.q_path + o.q_leak) * rho_cp(N::LoopOil));
+            acc.flow(y, N::PortOil, N::BallOil, o.q_path * rho_cp(N::PortOil));
+            acc.flow(y, N::BallOil, N::LoopOil, o.q_path * rho_cp(N::BallOil));
+        }
+        // Outer surfaces.
+        let outer = [N::MotorCase, N::Barrel, N::EndCap, N::Manifold, N::Block, N::Ball, N::Cylinder];
+        for (k, n) in outer.iter().enumerate() {
+            let w = self.outer_w(p.surfaces[k], tn(*n), amb, o.air);
+            acc.q[*n as usize] -= w;
+            acc.g[*n as usize] += (w / (tn(*n) - amb)).abs().min(50.0);
+        }
+        let c = self.capacities(y);
+        let mut rate: f64 = 0.0;
+        for i in 0..NN {
+            dy[i] = acc.q[i] / c[i];
+            rate = rate.max(acc.g[i] / c[i]);
+        }
+        // Sensors: Point 1, Point 3 (barrel/end-cap mix), Point 4,
+        // Point 5 (surface probes read a little towards ambient) and the
+        // manifold oil (thermowell in the flow, or the dead-end pocket).
+        let surf = |t: f64| t - p.probe_ambient_frac * (t - amb);
+        let w = p.pump_probe_barrel;
+        let oil_target = if self.h.effect == Candidate::SensorLag { tn(N::Pocket) } else { tn(N::LoopOil) };
+        let targets = [
+            surf(tn(N::MotorCase)),
+            surf(w * tn(N::Barrel) + (1.0 - w) * tn(N::EndCap)),
+            surf(tn(N::Block)),
+            surf(tn(N::Ball)),
+            oil_target,
+        ];
+        for k in 0..5 {
+            dy[NN + k] = (targets[k] - y[NN + k]) / p.sensor_tau[k];
+        }
+        dy[NS - 1] = o.v;
+        rate
+    }
+
+    /// Initial state: everything at the initial ambient (paper assumption
+    /// 1), piston centred.
+    pub fn initial(&self) -> Vec<f64> {
+        let mut y = vec![self.m.ambient_c(0.0); NS];
+        y[NS - 1] = 0.0;
+        y
+    }
+
+    /// Integrates to the end of the mission and returns the state at every
+    /// `dt_out` (t = 0 included), with the operating point there.
+    pub fn run(&self, dt_out: f64) -> Vec<(f64, Vec<f64>, Op)> {
+        let mut y = self.initial();
+        let n_out = (self.m.duration_s / dt_out).round() as usize;
+        let dt_ctrl = if self.m.scenario.is_servo() { 0.01 } else { 0.5 };
+        let (mut k1, mut k2, mut ys) = (vec![0.0; NS], vec![0.0; NS], vec![0.0; NS]);
+        let mut t = 0.0;
+        let mut out = Vec::with_capacity(n_out + 1);
+        for k in 0..=n_out {
+            let t_out = k as f64 * dt_out;
+            while t < t_out - 1e-9 {
+                let rate = self.rhs(t, &y, &mut k1);
+                let dt = (0.8 / rate.max(1e-9)).min(dt_ctrl).min(t_out - t);
+                for i in 0..NS {
+                    ys[i] = y[i] + dt * k1[i];
+                }
+                self.rhs(t + dt, &ys, &mut k2);
+                for i in 0..NS {
+                    y[i] += 0.5 * dt * (k1[i] + k2[i]);
+                }
+                t += dt;
+            }
+            out.push((t_out, y.clone(), self.op(t_out, &y, y[NS - 1])));
+        }
+        out
+    }
+}
