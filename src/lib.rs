@@ -9,12 +9,13 @@
 //!
 //! Module map: [`params`] (SI parameters) → [`model`] (discretised model, generic
 //! over [`num::Num`]: `f64`, `f32`, fixed point) → [`validate`], [`protection`],
-//! [`trace`], [`memory`] → [`guard`] (`Guard::new`, `Guard::step`) → [`board`].
+//! [`trace`], [`memory`] → [`guard`] (`Guard::new`, `Guard::step`) → [`product`]
+//! (the board-agnostic product loop; boards in `src/bin/eha-mps2/` and
+//! `src/bin/eha-stm32f4/`).
 #![no_std]
 #![warn(missing_docs)]
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing))]
 
-pub mod board;
 pub mod crosscheck;
 pub mod guard;
 pub mod linalg;

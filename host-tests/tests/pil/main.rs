@@ -6,7 +6,6 @@ mod equivalence;
 mod fault_subset;
 mod faults;
 mod golden;
-mod product;
 mod protocol;
 mod scenarios;
 mod valve_loop;
