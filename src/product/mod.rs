@@ -36,6 +36,10 @@ use wire::{Ack, AckResult, Cmd, Command, Pins, ResetCause, Status, TickReply, Tr
 pub const TRACE_EVENTS_PER_TICK: usize = 4;
 /// Commands queued per tick; more are rejected (counted as framing).
 pub const COMMAND_QUEUE: usize = 4;
+/// Ticks to wait after a failed non-volatile save before the next attempt
+/// (60 s): a dead or worn flash must not cost an erase attempt, which can
+/// stall the MCU for seconds, on every tick.
+pub const NV_RETRY_TICKS: u32 = 6000;
 
 /// What the product loop needs from a board.
 pub trait Board {
@@ -117,6 +121,9 @@ pub struct Counters {
     pub overruns: u32,
     /// Commands executed.
     pub commands: u16,
+    /// Non-volatile saves that failed (each followed by [`NV_RETRY_TICKS`]
+    /// without an attempt).
+    pub nv_failures: u16,
 }
 
 impl Counters {
@@ -137,6 +144,8 @@ pub struct App {
     records: AbWriter,
     nv_policy: NvPolicy,
     nv_last: Option<ThermalRecord>,
+    /// No non-volatile save attempt before this tick (after a failure).
+    nv_retry_at: u32,
     tick: u32,
     restore: RestoreKind,
     reset_cause: ResetCause,
@@ -188,6 +197,7 @@ impl App {
             core::ptr::addr_of_mut!((*p).records).write(AbWriter::after_boot(a, b));
             core::ptr::addr_of_mut!((*p).nv_policy).write(nv_policy);
             core::ptr::addr_of_mut!((*p).nv_last).write(mem.nv);
+            core::ptr::addr_of_mut!((*p).nv_retry_at).write(0);
             core::ptr::addr_of_mut!((*p).tick).write(0);
             core::ptr::addr_of_mut!((*p).restore).write(restore_kind(&restore));
             core::ptr::addr_of_mut!((*p).reset_cause).write(reset_cause);
@@ -271,8 +281,13 @@ impl App {
         let (out, pins) = self.drive(board, out);
         let rec = self.guard.snapshot();
         self.records.write(&rec, |slot, r| board.store_record(slot, r));
-        if self.nv_policy.due(self.nv_last.as_ref(), &rec) && board.nv_save(&rec) {
-            self.nv_last = Some(rec);
+        if self.tick >= self.nv_retry_at && self.nv_policy.due(self.nv_last.as_ref(), &rec) {
+            if board.nv_save(&rec) {
+                self.nv_last = Some(rec);
+            } else {
+                self.counters.nv_failures = self.counters.nv_failures.saturating_add(1);
+                self.nv_retry_at = self.tick.saturating_add(NV_RETRY_TICKS);
+            }
         }
         let reply = TickReply {
             tick: self.tick,
@@ -441,6 +456,7 @@ impl App {
             missing: c.missing,
             rx_overflow: u16::try_from(board.rx_dropped()).unwrap_or(u16::MAX),
             commands: c.commands,
+            nv_failures: c.nv_failures,
             faults: self.guard.faults(),
         }
     }

@@ -18,6 +18,9 @@ struct SimBoard {
     ticks: u32,
     records: [ThermalRecord; 2],
     cause: CauseRecord,
+    /// `Some(ok)`: the board has a non-volatile store whose saves return `ok`.
+    nv: Option<bool>,
+    nv_calls: u32,
 }
 
 impl SimBoard {
@@ -31,6 +34,8 @@ impl SimBoard {
             ticks: 0,
             records: [ThermalRecord::EMPTY; 2],
             cause: CauseRecord::new(0, 0),
+            nv: None,
+            nv_calls: 0,
         }
     }
 
@@ -85,6 +90,10 @@ impl Board for SimBoard {
     }
     fn store_cause(&mut self, rec: &CauseRecord) {
         self.cause = *rec;
+    }
+    fn nv_save(&mut self, _rec: &ThermalRecord) -> bool {
+        self.nv_calls += 1;
+        self.nv.unwrap_or(false)
     }
 }
 
@@ -302,3 +311,31 @@ fn warm_reboot_restores_the_estimate_and_the_cause() {
     assert!(before > 30.0);
 }
 
+
+/// A failing non-volatile store is tried once per [`NV_RETRY_TICKS`], not on
+/// every tick (an erase attempt can stall the MCU for seconds); a working
+/// one is written by the policy (first record at once, then on a 2 K rise).
+#[test]
+fn failing_nv_store_is_retried_once_a_minute_not_every_tick() {
+    let mut b = SimBoard::new();
+    b.nv = Some(false);
+    let mem = b.mem();
+    let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
+    for k in 0..12_000u32 {
+        b.rx.extend_from_slice(&sample((k & 0xFFFF) as u16, 30.0, 150.0).encode());
+        app.tick(&mut b, 0);
+    }
+    b.replies();
+    assert_eq!(b.nv_calls, 2, "ticks 1 and 6001 of 12 000");
+    assert_eq!(app.counters().nv_failures, 2);
+    let mut ok = SimBoard::new();
+    ok.nv = Some(true);
+    let mem = ok.mem();
+    let mut app = App::boot(&mut ok, &GuardConfig::DEFAULT, &mem);
+    for k in 0..50u32 {
+        ok.rx.extend_from_slice(&sample(k as u16, 30.0, 150.0).encode());
+        app.tick(&mut ok, 0);
+    }
+    // The estimate rises ~0.7 K in these 0.5 s, no fault: nothing due after the first.
+    assert_eq!(ok.nv_calls, 1, "one record at the start; the next on a 2 K rise");
+}

@@ -31,7 +31,7 @@ pub const TICK_LEN: usize = 30;
 /// Payload length of an acknowledgement, bytes.
 pub const ACK_LEN: usize = 5;
 /// Payload length of a status reply, bytes.
-pub const STATUS_LEN: usize = 45;
+pub const STATUS_LEN: usize = 47;
 /// Payload length of a trace-event reply, bytes.
 pub const TRACE_LEN: usize = 16;
 
@@ -242,6 +242,8 @@ pub struct Status {
     pub rx_overflow: u16,
     /// Commands executed.
     pub commands: u16,
+    /// Non-volatile record saves that failed.
+    pub nv_failures: u16,
     /// Fault word now.
     pub faults: u16,
 }
@@ -446,7 +448,7 @@ impl Status {
         }
         put(&mut p, &self.accepted.to_le_bytes());
         put(&mut p, &self.missing.to_le_bytes());
-        for v in [self.rx_overflow, self.commands, self.faults] {
+        for v in [self.rx_overflow, self.commands, self.nv_failures, self.faults] {
             put(&mut p, &v.to_le_bytes());
         }
         frame(&p, true)
@@ -473,6 +475,7 @@ impl Status {
             missing: r.u32()?,
             rx_overflow: r.u16()?,
             commands: r.u16()?,
+            nv_failures: r.u16()?,
             faults: r.u16()?,
         })
     }
