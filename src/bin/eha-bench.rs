@@ -205,6 +205,52 @@ mod fw {
         g.step(s)
     }
 
+    /// A board in memory for timing the product loop: the sample frame is
+    /// put in the receive buffer before the tick (the UART interrupt's
+    /// per-byte work is not counted), replies are counted and dropped.
+    struct BenchBoard {
+        rx: heapless::Deque<u8, 128>,
+        tx_bytes: u32,
+        ticks: u32,
+    }
+
+    impl eha_guard::product::Board for BenchBoard {
+        fn read_rx(&mut self, buf: &mut [u8]) -> usize {
+            let mut n = 0;
+            for slot in buf.iter_mut() {
+                let Some(b) = self.rx.pop_front() else { break };
+                *slot = b;
+                n += 1;
+            }
+            n
+        }
+        fn rx_dropped(&self) -> u32 {
+            0
+        }
+        fn write_tx(&mut self, bytes: &[u8]) {
+            self.tx_bytes = self.tx_bytes.wrapping_add(core::hint::black_box(bytes).len() as u32);
+        }
+        fn set_pins(&mut self, pins: eha_guard::product::wire::Pins) -> eha_guard::product::wire::Pins {
+            pins
+        }
+        fn feed_watchdog(&mut self) {}
+        fn ticks(&self) -> u32 {
+            self.ticks
+        }
+        fn wait_tick(&mut self, _seen: u32) {
+            self.ticks += 1;
+        }
+        fn store_record(&mut self, slot: usize, rec: &eha_guard::ThermalRecord) {
+            eha_guard::memory::slots::noinit::store(slot, rec);
+        }
+        fn store_cause(&mut self, _rec: &eha_guard::product::reset::CauseRecord) {}
+    }
+
+    #[inline(never)]
+    fn app_tick(app: &mut eha_guard::product::App, b: &mut BenchBoard) {
+        app.tick(b, 0);
+    }
+
     #[inline(always)]
     fn now() -> u32 {
         SYST::get_current()
@@ -370,6 +416,45 @@ mod fw {
             last = core::hint::black_box(out);
         }
 
+        // The product loop per tick (src/product): deframe the 32-byte sample
+        // frame, Guard::step, pins, A/B record, NV policy check, tick reply
+        // (COBS + CRC), watchdog; the same samples as above, from a cold boot.
+        static mut APP: core::mem::MaybeUninit<eha_guard::product::App> = core::mem::MaybeUninit::uninit();
+        let mut board = BenchBoard { rx: heapless::Deque::new(), tx_bytes: 0, ticks: 0 };
+        let mem = eha_guard::product::BootMemory {
+            records: (eha_guard::ThermalRecord::EMPTY, eha_guard::ThermalRecord::EMPTY),
+            nv: None,
+            cause: eha_guard::product::reset::CauseRecord::new(0, 0),
+            hw_hint: None,
+        };
+        // SAFETY: the only reference to APP, taken once.
+        let app = eha_guard::product::App::boot_into(unsafe { &mut *core::ptr::addr_of_mut!(APP) }, &mut board, &GuardConfig::DEFAULT, &mem);
+        let mut a_stats = Stats::new();
+        let mut noise_a = 1u32;
+        for k in 0..STEPS {
+            let s = sample(k, &mut noise_a);
+            let req = eha_guard::protocol::Request {
+                seq: (k & 0xFFFF) as u16,
+                current_a: s.current_a,
+                p_a_bar: s.p_a_bar,
+                p_b_bar: s.p_b_bar,
+                speed_rpm: s.speed_rpm,
+                position_mm: s.position_mm,
+                ambient_c: s.ambient_c,
+                valve_fb: None,
+            };
+            for &b in req.encode().iter() {
+                let _ = board.rx.push_back(b);
+            }
+            let w0 = WRAPS.load(Ordering::Relaxed);
+            let t0 = now();
+            app_tick(app, &mut board);
+            if let Some(t) = elapsed(t0, w0) {
+                a_stats.add(t);
+            }
+        }
+        core::hint::black_box(board.tx_bytes);
+
         // Thermal-memory save (snapshot + CRC + no-init write).
         let w0 = WRAPS.load(Ordering::Relaxed);
         let t0 = now();
@@ -403,6 +488,10 @@ mod fw {
         );
         ft_stats.report("  fault latched, ticks without a model step", ovh);
         fm_stats.report("  fault latched, ticks with the model step", ovh);
+        a_stats.report(
+            "App::tick (product loop: 32-byte frame in, Guard::step, pins, A/B record, tick reply; UART interrupt not counted), every tick",
+            ovh,
+        );
         mt_stats.report("Model::tick_n (tick accumulation)", ovh);
         mu_stats.report("Model::update (model step)", ovh);
         v_stats.report(

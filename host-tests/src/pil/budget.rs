@@ -151,6 +151,13 @@ pub fn parse_bench(text: &str) -> Result<ImageBudget> {
     Ok(b)
 }
 
+/// The product loop's cost per tick (`App::tick`, mean and max
+/// instructions) from a bench report, if it has the line.
+pub fn parse_app_tick(text: &str) -> Option<(f64, f64)> {
+    let l = text.lines().find(|l| l.starts_with("App::tick"))?;
+    Some((number_after(l, " mean ")?, number_after(l, " max ")?))
+}
+
 /// Run a bench ELF in QEMU under `-icount` and return its report (stderr).
 fn run_bench(build: Build, elf: &Path) -> Result<String> {
     let mut child = Command::new("qemu-system-arm")
@@ -189,11 +196,25 @@ fn run_bench(build: Build, elf: &Path) -> Result<String> {
 /// Measure every image (building it if needed).
 pub fn measure() -> Result<BTreeMap<String, ImageBudget>> {
     let mut out = BTreeMap::new();
+    // The product loop's instructions per tick come from the f32 bench image
+    // (same application code, timed under -icount on an in-memory board).
+    let mut app_tick = None;
     for im in &IMAGES {
         let elf = build_bin(im.build, im.bin, im.features)?;
         let mut b = match im.run {
-            Run::Bench => parse_bench(&run_bench(im.build, &elf)?)?,
-            Run::Product => run_product(&elf)?,
+            Run::Bench => {
+                let text = run_bench(im.build, &elf)?;
+                if im.build == Build::F32 {
+                    app_tick = parse_app_tick(&text);
+                }
+                parse_bench(&text)?
+            }
+            Run::Product => {
+                let mut b = run_product(&elf)?;
+                let (mean, max) = app_tick.context("the f32 bench report has no App::tick line")?;
+                (b.instr_per_tick_mean, b.instr_per_tick_max) = (Some(mean), Some(max));
+                b
+            }
             Run::No => ImageBudget::default(),
         };
         let (flash, ram) = elf_sizes(&elf)?;
