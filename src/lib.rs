@@ -26,6 +26,8 @@ pub mod params;
 pub mod product;
 pub mod protection;
 pub mod protocol;
+#[cfg(target_os = "none")]
+pub mod stack;
 pub mod trace;
 pub mod validate;
 

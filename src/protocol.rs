@@ -417,24 +417,25 @@ impl core::fmt::Display for DecodeError {
     }
 }
 
-/// Little-endian field reader that never panics.
-struct Rd<'a>(&'a [u8]);
+/// Little-endian field reader that never panics (also used by
+/// [`crate::product::wire`]).
+pub(crate) struct Rd<'a>(pub(crate) &'a [u8]);
 impl Rd<'_> {
     fn arr<const K: usize>(&mut self) -> Result<[u8; K], DecodeError> {
         let (head, tail) = self.0.split_at_checked(K).ok_or(DecodeError::Length)?;
         self.0 = tail;
         head.try_into().map_err(|_| DecodeError::Length)
     }
-    fn u8(&mut self) -> Result<u8, DecodeError> {
+    pub(crate) fn u8(&mut self) -> Result<u8, DecodeError> {
         Ok(u8::from_le_bytes(self.arr()?))
     }
-    fn u16(&mut self) -> Result<u16, DecodeError> {
+    pub(crate) fn u16(&mut self) -> Result<u16, DecodeError> {
         Ok(u16::from_le_bytes(self.arr()?))
     }
-    fn u32(&mut self) -> Result<u32, DecodeError> {
+    pub(crate) fn u32(&mut self) -> Result<u32, DecodeError> {
         Ok(u32::from_le_bytes(self.arr()?))
     }
-    fn f32(&mut self) -> Result<f32, DecodeError> {
+    pub(crate) fn f32(&mut self) -> Result<f32, DecodeError> {
         Ok(f32::from_le_bytes(self.arr()?))
     }
 }

@@ -27,13 +27,8 @@ mod fw {
     use semihosting::eprintln;
 
     const STEPS: u32 = 6000;
-    const PAINT: u32 = 0xDEAD_BEEF;
     static WRAPS: AtomicU32 = AtomicU32::new(0);
 
-    extern "C" {
-        static _stack_end: u32;
-        static _stack_start: u32;
-    }
 
     #[exception]
     fn SysTick() {
@@ -55,30 +50,6 @@ mod fw {
         semihosting::process::exit(101)
     }
 
-    /// Fills the unused stack (from its lowest address up to 256 bytes below SP).
-    #[inline(never)]
-    fn paint_stack() {
-        let lo = core::ptr::addr_of!(_stack_end) as usize;
-        let sp = cortex_m::register::msp::read() as usize;
-        let mut p = lo;
-        while p + 256 < sp {
-            // SAFETY: [lo, sp - 256) is unused stack below the live frames.
-            unsafe { core::ptr::write_volatile(p as *mut u32, PAINT) };
-            p += 4;
-        }
-    }
-
-    /// Bytes of stack ever used: top minus the lowest overwritten paint word.
-    fn stack_high_water() -> u32 {
-        let lo = core::ptr::addr_of!(_stack_end) as usize;
-        let hi = core::ptr::addr_of!(_stack_start) as usize;
-        let mut p = lo;
-        // SAFETY: reading our own stack region word by word.
-        while p < hi && unsafe { core::ptr::read_volatile(p as *const u32) } == PAINT {
-            p += 4;
-        }
-        (hi - p) as u32
-    }
 
     /// Deterministic input: 0-30 s Case 1 (60 bar, 500 rpm, 30 A) with small noise,
     /// 30-60 s sinusoidal servo (20 mm, 0.2 Hz) against the Table 3 spring.
@@ -268,7 +239,7 @@ mod fw {
 
     #[entry]
     fn main() -> ! {
-        paint_stack();
+        eha_guard::stack::paint();
         let Some(mut p) = cortex_m::Peripherals::take() else {
             semihosting::process::exit(104)
         };
@@ -307,8 +278,8 @@ mod fw {
 
         // Stack used by boot + init (f64 matrix exponential), then repaint to measure
         // the step loop alone (its figure includes main's own frame).
-        let init_stack = stack_high_water();
-        paint_stack();
+        let init_stack = eha_guard::stack::high_water();
+        eha_guard::stack::paint();
         let Some(limits) = LimitsN::<Real>::new(&GuardConfig::DEFAULT.limits, &scales) else {
             semihosting::process::exit(107)
         };
@@ -513,7 +484,7 @@ mod fw {
         eprintln!(
             "stack high-water mark: boot+init {} bytes, step loop {} bytes",
             init_stack,
-            stack_high_water()
+            eha_guard::stack::high_water()
         );
         let dc = (last.drain_c * 1000.0) as i32;
         eprintln!(

@@ -8,7 +8,7 @@
 //! Frame layouts are in `docs/firmware.md` (section "Product protocol");
 //! all fields little-endian, floats as IEEE-754 binary32 bit patterns.
 
-use crate::protocol::{frame, DecodeError, WireFrame, MAX_PAYLOAD};
+use crate::protocol::{frame, DecodeError, Rd, WireFrame, MAX_PAYLOAD};
 use crate::trace::{RestoreKind, Trace};
 use crate::Output;
 use heapless::Vec;
@@ -309,26 +309,8 @@ fn out_fields(p: &mut Buf, o: &Output) {
     put(p, &o.lng_seconds_left.to_le_bytes());
 }
 
-/// Little-endian reader that never panics.
-struct Rd<'a>(&'a [u8]);
 impl Rd<'_> {
-    fn arr<const K: usize>(&mut self) -> Result<[u8; K], DecodeError> {
-        let (head, tail) = self.0.split_at_checked(K).ok_or(DecodeError::Length)?;
-        self.0 = tail;
-        head.try_into().map_err(|_| DecodeError::Length)
-    }
-    fn u8(&mut self) -> Result<u8, DecodeError> {
-        Ok(u8::from_le_bytes(self.arr()?))
-    }
-    fn u16(&mut self) -> Result<u16, DecodeError> {
-        Ok(u16::from_le_bytes(self.arr()?))
-    }
-    fn u32(&mut self) -> Result<u32, DecodeError> {
-        Ok(u32::from_le_bytes(self.arr()?))
-    }
-    fn f32(&mut self) -> Result<f32, DecodeError> {
-        Ok(f32::from_le_bytes(self.arr()?))
-    }
+    /// The output fields of a reply (drain, flags, faults, LNG kg and s).
     fn out(&mut self) -> Result<Output, DecodeError> {
         let drain_c = self.f32()?;
         let flags = self.u8()?;

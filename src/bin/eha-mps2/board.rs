@@ -81,43 +81,12 @@ pub struct Mps2 {
     boot_stack_b: u32,
 }
 
-const PAINT: u32 = 0xDEAD_BEEF;
-extern "C" {
-    static _stack_end: u32;
-    static _stack_start: u32;
-}
-
-/// Fills the unused stack below the live frames (from its lowest address
-/// up to 256 bytes below SP) with a pattern.
-#[inline(never)]
-fn paint_stack() {
-    let lo = core::ptr::addr_of!(_stack_end) as usize;
-    let sp = cortex_m::register::msp::read() as usize;
-    let mut p = lo;
-    while p + 256 < sp {
-        // SAFETY: [lo, sp - 256) is unused stack below the live frames.
-        unsafe { core::ptr::write_volatile(p as *mut u32, PAINT) };
-        p += 4;
-    }
-}
-
-/// Bytes of stack ever used since the last paint.
-fn stack_high_water() -> u32 {
-    let lo = core::ptr::addr_of!(_stack_end) as usize;
-    let hi = core::ptr::addr_of!(_stack_start) as usize;
-    let mut p = lo;
-    // SAFETY: reading our own stack region word by word.
-    while p < hi && unsafe { core::ptr::read_volatile(p as *const u32) } == PAINT {
-        p += 4;
-    }
-    (hi - p) as u32
-}
 
 impl Mps2 {
     /// Safe outputs, stack paint, watchdog armed, and what the memories hold.
     pub fn init() -> (Mps2, BootMemory) {
         safe_outputs();
-        paint_stack();
+        eha_guard::stack::paint();
         let Some(cp) = cortex_m::Peripherals::take() else { fail(ResetCause::Other) };
         let mut syst = cp.SYST;
         syst.set_clock_source(SystClkSource::Core);
@@ -137,8 +106,8 @@ impl Mps2 {
     /// Called after `App::boot`: the boot stack is measured, then repainted so
     /// that the status reply reports the tick loop's own high-water mark.
     pub fn boot_done(&mut self) {
-        self.boot_stack_b = stack_high_water();
-        paint_stack();
+        self.boot_stack_b = eha_guard::stack::high_water();
+        eha_guard::stack::paint();
         defmt::info!("boot stack {=u32} B", self.boot_stack_b);
     }
 }
@@ -229,7 +198,7 @@ impl Board for Mps2 {
     }
 
     fn stack_high_water_b(&self) -> u32 {
-        stack_high_water()
+        eha_guard::stack::high_water()
     }
 
     fn boot_stack_b(&self) -> u32 {

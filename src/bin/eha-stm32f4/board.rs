@@ -166,37 +166,6 @@ impl NorFlash for Flash {
     }
 }
 
-const PAINT: u32 = 0xDEAD_BEEF;
-extern "C" {
-    static _stack_end: u32;
-    static _stack_start: u32;
-}
-
-/// Fills the unused stack below the live frames (from its lowest address
-/// up to 256 bytes below SP) with a pattern.
-#[inline(never)]
-fn paint_stack() {
-    let lo = core::ptr::addr_of!(_stack_end) as usize;
-    let sp = cortex_m::register::msp::read() as usize;
-    let mut p = lo;
-    while p + 256 < sp {
-        // SAFETY: [lo, sp - 256) is unused stack below the live frames.
-        unsafe { core::ptr::write_volatile(p as *mut u32, PAINT) };
-        p += 4;
-    }
-}
-
-/// Bytes of stack ever used since the last paint.
-fn stack_high_water() -> u32 {
-    let lo = core::ptr::addr_of!(_stack_end) as usize;
-    let hi = core::ptr::addr_of!(_stack_start) as usize;
-    let mut p = lo;
-    // SAFETY: reading our own stack region word by word.
-    while p < hi && unsafe { core::ptr::read_volatile(p as *const u32) } == PAINT {
-        p += 4;
-    }
-    (hi - p) as u32
-}
 
 /// The board's peripherals (the statics above are shared with the
 /// interrupt handlers).
@@ -236,7 +205,7 @@ impl F411 {
         let gpioa = dp.GPIOA.split(&mut rcc);
         let valve = gpioa.pa5.into_push_pull_output_in_state(PinState::Low);
         let ok = gpioa.pa6.into_push_pull_output_in_state(PinState::Low);
-        paint_stack();
+        eha_guard::stack::paint();
         // 2. Watchdog (LSI, independent of the clock tree below): a boot that
         // hangs, e.g. on a crystal that never starts, is reset.
         // With a probe attached, the IWDG stops while the core is halted, and
@@ -277,8 +246,8 @@ impl F411 {
     /// Called after `App::boot`: the boot stack is measured, then repainted so
     /// that the status reply reports the tick loop's own high-water mark.
     pub fn boot_done(&mut self) {
-        self.boot_stack_b = stack_high_water();
-        paint_stack();
+        self.boot_stack_b = eha_guard::stack::high_water();
+        eha_guard::stack::paint();
         defmt::info!("boot stack {=u32} B", self.boot_stack_b);
     }
 }
@@ -393,7 +362,7 @@ impl Board for F411 {
     }
 
     fn stack_high_water_b(&self) -> u32 {
-        stack_high_water()
+        eha_guard::stack::high_water()
     }
 
     fn boot_stack_b(&self) -> u32 {

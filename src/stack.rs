@@ -1,0 +1,37 @@
+//! Stack painting (target only): fill the unused stack with a pattern, later
+//! find the lowest overwritten word. Used by the product boards (boot and
+//! tick-loop high-water marks in the status reply) and the benchmark.
+
+const PAINT: u32 = 0xDEAD_BEEF;
+
+extern "C" {
+    // cortex-m-rt's linker script: lowest and highest address of the stack.
+    static _stack_end: u32;
+    static _stack_start: u32;
+}
+
+/// Fills the unused stack below the live frames (from its lowest address
+/// up to 256 bytes below SP) with a pattern.
+#[inline(never)]
+pub fn paint() {
+    let lo = core::ptr::addr_of!(_stack_end) as usize;
+    let sp = cortex_m::register::msp::read() as usize;
+    let mut p = lo;
+    while p + 256 < sp {
+        // SAFETY: [lo, sp - 256) is unused stack below the live frames.
+        unsafe { core::ptr::write_volatile(p as *mut u32, PAINT) };
+        p += 4;
+    }
+}
+
+/// Bytes of stack ever used since the last [`paint`].
+pub fn high_water() -> u32 {
+    let lo = core::ptr::addr_of!(_stack_end) as usize;
+    let hi = core::ptr::addr_of!(_stack_start) as usize;
+    let mut p = lo;
+    // SAFETY: reading our own stack region word by word.
+    while p < hi && unsafe { core::ptr::read_volatile(p as *const u32) } == PAINT {
+        p += 4;
+    }
+    (hi - p) as u32
+}
