@@ -88,9 +88,9 @@ fn events(v: impl Iterator<Item = bool>) -> Vec<(usize, bool)> {
 /// - Against the semihosting lockstep PIL run of the same plant, in guard
 ///   time (ticks since the first sample): the same valve events within one
 ///   tick, and the same drain estimate: bit-identical when every tick got
-///   its sample; a tick whose sample came late (the host more than 10 ms
-///   late in real time) holds the last inputs, which at Fig. 15's constant
-///   operating point moves the estimate by far less than 0.01 K. At most
+///   its sample; after a tick whose sample came late (the host more than
+///   10 ms late in real time) within the PIL estimate's largest change over
+///   (late ticks + 1) model steps (see the assertion). At most
 ///   1 % of ticks may miss their sample or overrun: in QEMU both come from
 ///   the host descheduling the emulator, not from the firmware (its tick
 ///   costs ~1 200 instructions, see the bench).
@@ -151,7 +151,15 @@ fn fig15_120s_closed_loop_over_the_uart_matches_the_semihosting_pil() {
     if missed == 0 {
         assert_eq!(max_diff, 0.0, "every tick got its sample: the estimate must be bit-identical to the PIL's");
     } else {
-        assert!(max_diff <= 0.01, "{missed} ticks missed their sample; max drain difference {max_diff} K in guard time");
+        // Each tick without its sample shifts the later samples by one tick
+        // against guard time, which can move a valve event (and its LNG
+        // credit) by a tick: the difference is bounded by the PIL estimate's
+        // largest change over (missed + 1) model steps of 10 ticks. (A fixed
+        // 0.01 K, the earlier bound, was measured exceeded: 0.0159 K with 3
+        // late samples, the closing moved by one tick.)
+        let w = 10 * (missed + 1);
+        let bound = pil.records.windows(w + 1).map(|r| (r[w].reply.out.drain_c - r[0].reply.out.drain_c).abs()).fold(0.0f32, f32::max);
+        assert!(max_diff <= bound, "{missed} ticks missed their sample; max drain difference {max_diff} K > {bound} K in guard time");
     }
     assert!(missed * 100 <= run.steps.len(), "more than 1 % of ticks missed their sample: {missed}");
     for p in &run.steps {
