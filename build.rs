@@ -19,6 +19,12 @@ fn main() {
     } else {
         "boards/mps2/memory.x"
     };
+    // cortex-m-rt's `device` feature INCLUDEs `device.x` (PROVIDEs of the
+    // device's handler names). The STM32 PAC ships one; the mps2 vectors
+    // (`src/vectors.rs`) name only `DefaultHandler`, so theirs is empty.
+    if env::var_os("CARGO_FEATURE_BOARD_STM32F4").is_none() {
+        let _ = fs::write(out.join("device.x"), "/* mps2: every IRQ vector is DefaultHandler (src/vectors.rs) */\n");
+    }
     if let Ok(bytes) = fs::read(src) {
         if fs::write(out.join("board-memory.x"), bytes).is_ok() {
             println!("cargo:rustc-link-search={}", out.display());

@@ -76,14 +76,14 @@ impl<N: Num> CrossCheck<N> {
     /// window is empty.
     pub fn new(cfg: &CrossCheckConfig, ticks_per_step: u32) -> Option<Self> {
         let steps = cfg.window_steps.div_ceil(ticks_per_step.max(1));
-        let b = cfg.bound_w as f64 * 1e-3;
+        let b = cfg.bound_w * 1e-3;
         if steps == 0 || !b.is_finite() || !(0.0..250.0).contains(&b) {
             return None;
         }
         Some(CrossCheck {
             steps,
-            inv: N::from_f64(1.0 / steps as f64),
-            bound: N::from_f64(b),
+            inv: N::from_exact(1.0 / steps as f32, 1.0 / steps as f64),
+            bound: N::from_exact(b, cfg.bound_w as f64 * 1e-3),
             persist: cfg.persist_windows,
             n: 0,
             acc: N::ZERO,

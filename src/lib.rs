@@ -17,12 +17,14 @@
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing))]
 
 pub mod crosscheck;
+mod default_consts;
 pub mod guard;
 pub mod linalg;
 pub mod memory;
 pub mod model;
 pub mod num;
 pub mod params;
+pub mod params_block;
 pub mod product;
 pub mod protection;
 pub mod protocol;
@@ -30,6 +32,8 @@ pub mod protocol;
 pub mod stack;
 pub mod trace;
 pub mod validate;
+#[cfg(all(target_os = "none", not(feature = "board-stm32f4")))]
+mod vectors;
 
 pub use guard::{faults, Guard, GuardConfig, GuardOf, Output, Real, Sample};
 pub use memory::{Restore, ThermalRecord};

@@ -9,6 +9,8 @@
 //! Node order (fixed): `0 pump housing, 1 drain (case) oil, 2 loop oil, 3 main
 //! valve block, 4 ball/needle-valve block, 5 actuator body` ([`NODE_PUMP`] ...).
 
+pub use crate::default_consts::DEFAULT_CONSTS;
+
 /// Number of thermal states of the reduced model.
 pub const N_NODES: usize = 6;
 /// Node index: pump housing (rig measurement Point 3), J/K capacity [`ReducedParams::pump_j_per_k`].

@@ -251,13 +251,15 @@ pub struct LngBudget {
 impl LngBudget {
     /// Full charge per `cfg`.
     pub fn new(cfg: &LngConfig) -> Self {
-        let j_per_kg = cfg.j_per_kg() as f64;
-        let cap_cj = cfg.charge_kg() as f64 * j_per_kg * 100.0;
+        // (f32: the charge in centijoules to 7 digits, the budget's own accuracy
+        // is that of eq. 23's latent heat)
+        let j_per_kg = cfg.j_per_kg();
+        let cap_cj = cfg.charge_kg() * j_per_kg * 100.0;
         LngBudget {
             used_cj: 0,
             capacity_cj: cap_cj as u32,
-            low_cj: (cap_cj * cfg.low_fraction as f64) as u32,
-            kg_per_cj: (0.01 / j_per_kg) as f32,
+            low_cj: (cap_cj * cfg.low_fraction) as u32,
+            kg_per_cj: 1.0 / (j_per_kg * 100.0),
         }
     }
 

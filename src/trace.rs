@@ -103,6 +103,15 @@ pub enum Trace {
         /// Command code.
         code: u8,
     },
+    /// Where this boot's model constants come from
+    /// ([`crate::params_block::ParamSource::code`]: 0 compiled-in default,
+    /// 1 parameter block, 2.. invalid block).
+    Params {
+        /// Step counter.
+        step: u32,
+        /// Source code.
+        source: u8,
+    },
 }
 
 /// Ring buffer of the most recent [`TRACE_LEN`] events (oldest dropped when full).

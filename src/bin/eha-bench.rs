@@ -268,7 +268,7 @@ mod fw {
         let wraps = WRAPS.load(Ordering::Relaxed) - w0;
         let init_ticks = wraps as u64 * 0x0100_0000 + (t0.wrapping_sub(t1) & 0x00FF_FFFF) as u64;
 
-        let Ok(mut model) = Model::<Real>::new(&eha_guard::params::DEFAULT) else {
+        let Ok(mut model) = Model::<Real>::from_consts(&eha_guard::params::DEFAULT_CONSTS) else {
             semihosting::process::exit(105)
         };
         let Some(scales) = InputScales::<Real>::new() else {
@@ -474,7 +474,7 @@ mod fw {
             ovh,
         );
         eprintln!(
-            "Guard::new (ZOH expm, f64): {} instructions",
+            "Guard::new (constants, checks, stability): {} instructions",
             init_ticks * 10 / 256
         );
         eprintln!(

@@ -67,7 +67,7 @@ impl<N: Num> Core<N> {
         // `Num` contract covers N and its associated types).
         unsafe {
             dst.write_bytes(0, 1);
-            let ok = Model::<N>::init_in(core::ptr::addr_of_mut!((*dst).model), &config.params).is_ok() && Self::init_small(dst, config);
+            let ok = Model::<N>::init_in(core::ptr::addr_of_mut!((*dst).model), config.model).is_ok() && Self::init_small(dst, config);
             if !ok {
                 dst.write_bytes(0, 1);
             }
@@ -91,14 +91,14 @@ impl<N: Num> Core<N> {
         if t.iter().any(|x| !x.is_finite() || x.abs() >= 250.0) {
             return false;
         }
-        let f = |x: f32| N::from_f64(x as f64);
+        let f = |x: f32| N::from_exact(x, x as f64);
         let th = Thresholds {
             open: f(t[0]),
             close: f(t[1]),
             alarm: f(t[2]),
             clear: f(t[3]),
         };
-        let cc = if config.params.torque_constant_nm_per_a > 0.0 {
+        let cc = if config.model.k_sh > 0.0 {
             let Some(cc) = CrossCheck::new(&config.crosscheck, TICKS_PER_STEP) else { return false };
             Some(cc)
         } else {
@@ -810,6 +810,15 @@ impl<N: Num> GuardOf<N> {
     /// Appends a board-level event (overrun, reset, command) to the trace.
     pub fn trace_event(&mut self, t: Trace) {
         self.trace.write(t);
+    }
+
+    /// Refuses the configuration after boot (an invalid parameter block):
+    /// CONFIG latches and the model is disabled, as for constants the model
+    /// rejects at init: valve open, alarm, drain reported as
+    /// [`DRAIN_C_UNKNOWN`]. CONFIG is never cleared.
+    pub fn refuse_config(&mut self) {
+        self.core_ok = false;
+        self.latched |= faults::CONFIG;
     }
 
     /// The model, when the parameters were usable.

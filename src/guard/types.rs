@@ -1,7 +1,7 @@
 //! Interface types of the guard (docs/contracts.md): the wire-unit [`Sample`] and
 //! [`Output`], the fault word, and [`GuardConfig`].
 
-use crate::params::ReducedParams;
+use crate::model::ModelConsts;
 use crate::protection::{AlarmConfig, LngConfig, ValveConfig};
 use crate::validate::InputLimits;
 
@@ -86,9 +86,12 @@ pub const DRAIN_C_UNKNOWN: f32 = 1.0e6;
 
 /// Everything configurable, SI/wire units.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct GuardConfig {
-    /// Reduced-model parameters.
-    pub params: ReducedParams,
+pub struct GuardConfig<'a> {
+    /// Reduced-model constants in model units, `f32` words: the compiled-in
+    /// [`crate::params::DEFAULT_CONSTS`] or a parameter block
+    /// ([`crate::params_block`]); from SI parameters on the host with
+    /// `model::consts::derive(&p)?.to_f32()`.
+    pub model: &'a ModelConsts<f32>,
     /// Input ranges and rates.
     pub limits: InputLimits,
     /// LNG valve thresholds and dwell.
@@ -115,10 +118,10 @@ pub struct GuardConfig {
     pub crosscheck: crate::crosscheck::CrossCheckConfig,
 }
 
-impl GuardConfig {
-    /// Defaults: [`crate::params::DEFAULT`], Tables 2/3/6 limits, 40/38 degC valve, 60 degC alarm.
-    pub const DEFAULT: GuardConfig = GuardConfig {
-        params: crate::params::DEFAULT,
+impl GuardConfig<'static> {
+    /// Defaults: [`crate::params::DEFAULT_CONSTS`] (the paper rig), Tables 2/3/6 limits, 40/38 degC valve, 60 degC alarm.
+    pub const DEFAULT: GuardConfig<'static> = GuardConfig {
+        model: &crate::params::DEFAULT_CONSTS,
         limits: InputLimits::DEFAULT,
         valve: ValveConfig::DEFAULT,
         alarm: AlarmConfig::DEFAULT,

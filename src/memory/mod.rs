@@ -92,6 +92,7 @@ const CRC_NIBBLE: [u32; 16] = {
 };
 
 /// CRC-32 (IEEE 802.3, as zlib's `crc32`) update over `data`.
+#[inline(never)]
 pub fn crc32_update(mut crc: u32, data: &[u8]) -> u32 {
     for b in data {
         crc ^= *b as u32;

@@ -21,11 +21,14 @@
 //! `T(k+1) = T(k) + Phi F(T(k), u(k))`, `Phi = h phi1(h A)` from the matrix
 //! exponential of the nominal Jacobian `A`, built once at init.
 
+pub mod consts;
 mod ring;
+mod stability;
 pub mod table;
 
 use crate::linalg::expm1m;
 use crate::num::Num;
+pub use consts::{ModelConsts, Word};
 pub use crate::params::{
     ReducedParams, N_NODES, N_TABLE, NODE_ACTUATOR, NODE_BALL_BLOCK, NODE_DRAIN, NODE_LOOP, NODE_MAIN_BLOCK, NODE_PUMP,
     OUTER_NODES, S_PER_STEP, S_PER_TICK, TICKS_PER_STEP,
@@ -108,6 +111,10 @@ pub enum ConfigError {
     CoefficientRange,
     /// A constant exceeds the value format.
     ConstantRange,
+    /// The discretised model amplifies a temperature deviation
+    /// ([`Model::check_stability`]), or its `Phi` does not belong to its own
+    /// Jacobian.
+    Unstable,
 }
 
 /// Sums over the ticks of the present model step: raw per-tick terms (their
@@ -336,6 +343,31 @@ pub struct Model<N: Num> {
     outer_phase: u8,
 }
 
+/// `1/n` for partial model steps of `n` ticks (`[0]` = 0), f64 and rounded to f32.
+/// (Evaluated at compile time: an index out of range would fail the build.)
+const INV_N_F64: [f64; TICKS_PER_STEP as usize + 1] = inv_n_f64();
+#[allow(clippy::indexing_slicing)]
+const INV_N_F32: [f32; TICKS_PER_STEP as usize + 1] = {
+    let mut o = [0.0f32; TICKS_PER_STEP as usize + 1];
+    let mut j = 0;
+    while j < o.len() {
+        o[j] = INV_N_F64[j] as f32;
+        j += 1;
+    }
+    o
+};
+
+#[allow(clippy::indexing_slicing)]
+const fn inv_n_f64() -> [f64; TICKS_PER_STEP as usize + 1] {
+    let mut o = [0.0f64; TICKS_PER_STEP as usize + 1];
+    let mut j = 1;
+    while j < o.len() {
+        o[j] = 1.0 / j as f64;
+        j += 1;
+    }
+    o
+}
+
 /// Number of loss groups reported by [`Model::last_losses_kw`].
 pub const N_LOSSES: usize = 6;
 
@@ -363,179 +395,125 @@ pub fn etd_matrix(a: &[[f64; N_NODES]; N_NODES], h: f64) -> [[f64; N_NODES]; N_N
 }
 
 impl<N: Num> Model<N> {
-    /// Builds the model once from SI parameters: constants in model units, tables,
-    /// and the exact-ZOH matrix (precomputed on the host: `ReducedParams::phi_step_s`).
-    /// Starts at 0 degC.
+    /// Builds the model from SI parameters (host: [`consts::derive`] in `f64`,
+    /// then [`Model::from_consts`]). Starts at 0 degC.
     pub fn new(p: &ReducedParams) -> Result<Self, ConfigError> {
-        let mut m = core::mem::MaybeUninit::<Self>::uninit();
-        // SAFETY: `init_in` writes the whole value when it returns Ok.
-        unsafe { Self::init_in(m.as_mut_ptr(), p).map(|()| m.assume_init()) }
+        Self::from_consts(&consts::derive(p)?)
     }
 
-    /// [`Model::new`] written in place at `dst` (the firmware builds its state
-    /// in a static, so the boot stack holds no copy of the model). On `Err`
-    /// nothing is written.
+    /// Builds the model from its constants in model units (`f64` or `f32` words).
+    /// Starts at 0 degC.
+    pub fn from_consts<S: Word>(c: &ModelConsts<S>) -> Result<Self, ConfigError> {
+        let mut m = core::mem::MaybeUninit::<Self>::uninit();
+        // SAFETY: `init_in` writes the whole value when it returns Ok.
+        unsafe { Self::init_in(m.as_mut_ptr(), c).map(|()| m.assume_init()) }
+    }
+
+    /// [`Model::from_consts`] written in place at `dst` (the firmware builds its
+    /// state in a static, so the boot stack holds no copy of the model). Checks
+    /// the values ([`ModelConsts::check_values`]), the number format and the
+    /// stability of the discretisation ([`Model::check_stability`]). On `Err`,
+    /// `dst` may be partly written and must not be used.
     ///
     /// # Safety
     /// `dst` must be valid for writes of a `Model<N>`.
     #[inline(never)]
-    pub unsafe fn init_in(dst: *mut Self, p: &ReducedParams) -> Result<(), ConfigError> {
-        if !p.is_plausible() {
-            return Err(ConfigError::Implausible);
-        }
-        let phi64 = p.phi_step_s;
-        let mut phi = [[N::coef_from_f64(0.0).ok_or(ConfigError::CoefficientRange)?; N_NODES]; N_NODES];
-        for (pr, dr) in phi.iter_mut().zip(phi64.iter()) {
-            if dr.iter().map(|x| libm::fabs(*x)).sum::<f64>() >= N::MAX_ROW_SUM {
+    pub unsafe fn init_in<S: Word>(dst: *mut Self, c: &ModelConsts<S>) -> Result<(), ConfigError> {
+        // SAFETY: as this function's.
+        unsafe { Self::init_values_in(dst, c)? };
+        let phi_s = c.phi.map(|r| r.map(Word::to_f32));
+        // SAFETY: written by `init_values_in`.
+        unsafe { (*dst).check_stability(&phi_s) }
+    }
+
+    /// The model of `c` without the stability check of `Phi`: for the
+    /// reduction tool, which needs the model's Jacobian before `Phi` exists.
+    pub fn for_linearisation<S: Word>(c: &ModelConsts<S>) -> Result<Self, ConfigError> {
+        let mut m = core::mem::MaybeUninit::<Self>::uninit();
+        // SAFETY: `init_values_in` writes the whole value when it returns Ok.
+        unsafe { Self::init_values_in(m.as_mut_ptr(), c).map(|()| m.assume_init()) }
+    }
+
+    /// [`Model::init_in`] without the stability check.
+    ///
+    /// # Safety
+    /// `dst` must be valid for writes of a `Model<N>`.
+    unsafe fn init_values_in<S: Word>(dst: *mut Self, c: &ModelConsts<S>) -> Result<(), ConfigError> {
+        c.check_values()?;
+        let max_row = N::MAX_ROW_SUM as f32;
+        let mut phi = [[N::coef_from_f32(0.0).ok_or(ConfigError::CoefficientRange)?; N_NODES]; N_NODES];
+        for (pr, dr) in phi.iter_mut().zip(c.phi.iter()) {
+            if dr.iter().map(|x| x.to_f32().abs()).sum::<f32>() >= max_row {
                 return Err(ConfigError::CoefficientRange);
             }
-            for (c, x) in pr.iter_mut().zip(dr.iter()) {
-                *c = N::coef_from_f64(*x).ok_or(ConfigError::CoefficientRange)?;
+            for (o, x) in pr.iter_mut().zip(dr.iter()) {
+                *o = x.to_coef::<N>().ok_or(ConfigError::CoefficientRange)?;
             }
         }
-        let d = p.displacement_m3_per_rad;
-        let kl = p.k_leak_m3_per_s_pa;
-        let rho_cp40 = p.rho_cp(40.0) * 1e-6; // kJ/(L K)
-        let rc1 = p.rho_kg_per_m3 * p.cp_slope_j_per_kg_k2 * 1e-6;
-        let rc0 = p.rho_cp(0.0) * 1e-6;
-        let q_max = p.flow_table_max_m3_per_s * L_PER_M3;
-        let w_max = p.speed_table_max_rad_s * 0.01;
-        let n1 = (N_TABLE - 1) as f64;
-        let v_ring = (p.loop_oil_m3 + 2.0 * p.port_oil_m3 + p.ball_oil_m3) * L_PER_M3;
-        let caps_kj = [p.pump_j_per_k, 0.0, 0.0, p.main_block_j_per_k, p.ball_block_j_per_k, p.actuator_j_per_k];
-        let mut inv_c64 = [0.0; N_NODES];
-        for (o, c) in inv_c64.iter_mut().zip(caps_kj.iter()) {
-            if *c > 0.0 {
-                *o = 1e3 / c;
-            }
-        }
-        let outer = |a: &[f64; 4], s: f64| {
-            let mut o = [0.0; 4];
-            for (o, x) in o.iter_mut().zip(a.iter()) {
-                *o = x * s;
-            }
-            o
-        };
-        let ga = outer(&p.outer_w_per_k, KW_PER_W);
-        let gb = outer(&p.outer_quarter_w_per_k125, KW_PER_W);
-        // radiation 4 eps sigma A T_m^3 with T_m in units of 300 K (so the coefficient
-        // keeps its resolution in fixed point)
-        let gr = outer(&p.outer_rad_w_per_k4, 4.0 * RAD_T_K * RAD_T_K * RAD_T_K * KW_PER_W);
-        // The constants in model units, named once; all are checked against the value
-        // format below before conversion.
-        let p_case = p.case_pressure_pa / PA_PER_HBAR;
-        let k_lf = kl * PA_PER_HBAR * L_PER_M3;
-        let k_lp = kl * PA_PER_HBAR * PA_PER_HBAR * KW_PER_W;
-        let k_mech = p.eta_m * d * PA_PER_HBAR * 100.0 * KW_PER_W;
-        let k_q = d * 100.0 * L_PER_M3;
-        let k_a = p.ram_area_m2 * 1e-3 / S_PER_TICK * L_PER_M3;
-        let k_dpq = PA_PER_HBAR / L_PER_M3 * KW_PER_W;
-        let r1 = p.line_r1_pa_s_per_m3 / (L_PER_M3 * L_PER_M3) * KW_PER_W;
-        let r2 = p.line_r2_pa_s2_per_m6 / (L_PER_M3 * L_PER_M3 * L_PER_M3) * KW_PER_W;
-        let k_al = p.act_leak_m3_per_s_pa * PA_PER_HBAR * PA_PER_HBAR * KW_PER_W;
-        let k_fr = p.act_friction_n_s_per_m * (1e-3 / S_PER_TICK) * (1e-3 / S_PER_TICK) * KW_PER_W;
-        let k_cu = p.phases * p.r_ohm / (HA_PER_A * HA_PER_A) * KW_PER_W;
-        let k_sh = p.torque_constant_nm_per_a / HA_PER_A * 100.0 * KW_PER_W;
-        let k_hyd = d * PA_PER_HBAR * 100.0 * KW_PER_W;
-        let fe1 = p.k_fe1_w_s_per_rad * 100.0 * KW_PER_W;
-        let fe2 = p.k_fe2_w_s2_per_rad2 * 1e4 * KW_PER_W;
-        let fe15 = p.k_fe15_w_per_rad15 * 1e3 * KW_PER_W;
-        let q_scale = n1 / libm::sqrt(q_max);
-        let w_scale = n1 / libm::sqrt(w_max);
-        // 1/(rc40 + rc1 (T - 40)) ≈ (1/rc40)(1 - (rc1/rc40)(T - 40)) = irc0 - irc1 T
-        let irc0 = (1.0 + 40.0 * rc1 / rho_cp40) / rho_cp40;
-        let irc1 = rc1 / (rho_cp40 * rho_cp40);
-        let inv_v_case = 1.0 / (p.case_oil_m3 * L_PER_M3);
-        let inv_v_loop = 1.0 / (p.loop_oil_m3 * L_PER_M3);
-        let v_port = p.port_oil_m3 * L_PER_M3;
-        let v_ball = p.ball_oil_m3 * L_PER_M3;
-        let inv_v_ring = 1.0 / v_ring;
-        // Actuator heat per tick `k_al dp^2 + k_fr dx^2` as `k_act (w_dp dp^2 + w_dx dx^2)`
-        // with the larger coefficient factored out (both weights <= 1).
-        let k_act = if k_al > k_fr { k_al } else { k_fr };
-        let (w_dp, w_dx) = if k_act > 0.0 { (k_al / k_act, k_fr / k_act) } else { (0.0, 0.0) };
-        let scalars = [
-            p_case, k_lf, k_lp, k_mech, k_q, k_a, k_dpq, r1, r2, k_al, k_fr, k_cu, k_sh, k_hyd, fe1, fe2, fe15, q_scale, w_scale, rc0, rc1,
-            irc0, irc1, inv_v_case, inv_v_loop, v_port, v_ball, inv_v_ring, p.lng_inlet_c, p.k_mu_per_k, p.t_mu_ref_c,
-        ];
-        if scalars.iter().chain(ga.iter()).chain(gb.iter()).chain(gr.iter()).chain(inv_c64.iter()).any(|x| !x.is_finite() || libm::fabs(*x) >= 250.0) {
-            return Err(ConfigError::ConstantRange);
-        }
-        let f = N::from_f64;
-        let arr4 = |a: &[f64; 4]| [f(a[0]), f(a[1]), f(a[2]), f(a[3])];
+        let f = |x: S| x.to_n::<N>();
         let mut inv_n = [N::ZERO; TICKS_PER_STEP as usize + 1];
         let mut count = [N::ZERO; TICKS_PER_STEP as usize + 1];
-        for (j, (o, c)) in inv_n.iter_mut().zip(count.iter_mut()).enumerate() {
-            if j > 0 {
-                *o = f(1.0 / j as f64);
-            }
-            *c = f(j as f64);
+        for (j, ((o, n), (x32, x64))) in inv_n.iter_mut().zip(count.iter_mut()).zip(INV_N_F32.iter().zip(INV_N_F64.iter())).enumerate() {
+            *o = N::from_exact(*x32, *x64);
+            *n = N::from_exact(j as f32, j as f64);
         }
-        let mut inv_c = [N::ZERO; N_NODES];
-        for (o, x) in inv_c.iter_mut().zip(inv_c64.iter()) {
-            *o = f(*x);
+        // a constant in both precisions, rounded at compile time
+        macro_rules! exact {
+            ($x:expr) => {
+                N::from_exact(($x) as f32, $x)
+            };
         }
         let k = Consts {
-            p_case: f(p_case),
-            k_lf: f(k_lf),
-            k_lp: f(k_lp),
-            k_mech: f(k_mech),
-            k_q: f(k_q),
-            k_a: f(k_a),
-            k_dpq: f(k_dpq),
-            r1: f(r1),
-            r2: f(r2),
-            w_dp: f(w_dp),
-            w_dx: f(w_dx),
-            k_act: f(k_act),
-            k_lf_half: f(k_lf * 0.5),
-            k_cu: f(k_cu),
-            k_sh: f(k_sh),
-            k_hyd: f(k_hyd),
-            fe1: f(fe1),
-            fe2: f(fe2),
-            fe15: f(fe15),
-            inv_ticks: f(1.0 / TICKS_PER_STEP as f64),
-            q_scale: f(q_scale),
-            w_scale: f(w_scale),
-            rc0: f(rc0),
-            rc1: f(rc1),
-            irc0: f(irc0),
-            irc1: f(irc1),
-            inv_v_case: f(inv_v_case),
-            inv_v_loop: f(inv_v_loop),
+            p_case: f(c.p_case),
+            k_lf: f(c.k_lf),
+            k_lp: f(c.k_lp),
+            k_mech: f(c.k_mech),
+            k_q: f(c.k_q),
+            k_a: f(c.k_a),
+            k_dpq: f(c.k_dpq),
+            r1: f(c.r1),
+            r2: f(c.r2),
+            w_dp: f(c.w_dp),
+            w_dx: f(c.w_dx),
+            k_act: f(c.k_act),
+            k_lf_half: f(c.k_lf_half),
+            k_cu: f(c.k_cu),
+            k_sh: f(c.k_sh),
+            k_hyd: f(c.k_hyd),
+            fe1: f(c.fe1),
+            fe2: f(c.fe2),
+            fe15: f(c.fe15),
+            inv_ticks: exact!(1.0 / TICKS_PER_STEP as f64),
+            q_scale: f(c.q_scale),
+            w_scale: f(c.w_scale),
+            rc0: f(c.rc0),
+            rc1: f(c.rc1),
+            irc0: f(c.irc0),
+            irc1: f(c.irc1),
+            inv_v_case: f(c.inv_v_case),
+            inv_v_loop: f(c.inv_v_loop),
             inv_n,
             count,
-            v_port: f(v_port),
-            v_ball: f(v_ball),
-            inv_v_ring: f(inv_v_ring),
-            inv_c,
-            f_out: f(p.mech_to_outlet),
-            f_case: f(1.0 - p.mech_to_outlet),
-            lng_in: f(p.lng_inlet_c),
-            k_mu: f(p.k_mu_per_k),
-            t_mu: f(p.t_mu_ref_c),
-            use_mu: p.k_mu_per_k != 0.0,
-            ga: arr4(&ga),
-            gb: arr4(&gb),
-            gr: arr4(&gr),
-            h: f(S_PER_STEP),
-            inv_h: f(1.0 / S_PER_STEP),
-            half: f(0.5),
-            per_rad_t: f(1.0 / RAD_T_K),
-            rad_offset: f(273.15 / RAD_T_K),
-            one: f(1.0),
+            v_port: f(c.v_port),
+            v_ball: f(c.v_ball),
+            inv_v_ring: f(c.inv_v_ring),
+            inv_c: c.inv_c.map(f),
+            f_out: f(c.f_out),
+            f_case: f(c.f_case),
+            lng_in: f(c.lng_in),
+            k_mu: f(c.k_mu),
+            t_mu: f(c.t_mu),
+            use_mu: c.k_mu.to_f32() != 0.0,
+            ga: c.ga.map(f),
+            gb: c.gb.map(f),
+            gr: c.gr.map(f),
+            h: exact!(S_PER_STEP),
+            inv_h: exact!(1.0 / S_PER_STEP),
+            half: exact!(0.5),
+            per_rad_t: exact!(1.0 / RAD_T_K),
+            rad_offset: exact!(273.15 / RAD_T_K),
+            one: exact!(1.0),
         };
-        let tables = [
-            &p.g_case_w_per_k,
-            &p.g_port_w_per_k,
-            &p.g_loop_block_w_per_k,
-            &p.g_ball_block_w_per_k,
-            &p.g_lng_w_per_k,
-        ];
-        if tables.iter().any(|t| t.iter().any(|g| g * KW_PER_W >= 250.0)) {
-            return Err(ConfigError::ConstantRange);
-        }
         // SAFETY: the caller guarantees `dst` is valid for writes.
         unsafe { dst.write(Model {
             temp: [N::state(N::ZERO); N_NODES],
@@ -546,11 +524,11 @@ impl<N: Num> Model<N> {
             sums: Sums::ZERO,
             phi,
             k,
-            g_case: table::to_kw(&p.g_case_w_per_k),
-            g_port: table::to_kw(&p.g_port_w_per_k),
-            g_loop: table::to_kw(&p.g_loop_block_w_per_k),
-            g_ball: table::to_kw(&p.g_ball_block_w_per_k),
-            g_lng: table::to_kw(&p.g_lng_w_per_k),
+            g_case: c.g_case.map(f),
+            g_port: c.g_port.map(f),
+            g_loop: c.g_loop.map(f),
+            g_ball: c.g_ball.map(f),
+            g_lng: c.g_lng.map(f),
             last_total_kw: N::ZERO,
             last_lng_kw: N::ZERO,
             last_heat_kw: N::ZERO,
@@ -652,6 +630,7 @@ impl<N: Num> Model<N> {
     /// Right-hand side `dT/dt` (K/s, node order) at temperatures `t` with every tick
     /// at inputs `u`, the ring in steady flow (links stored nothing, no transport lag):
     /// the function whose Jacobian at the nominal point is `A` (reduction tool).
+    #[inline(never)]
     pub fn derivative(&self, t: &[N; N_NODES], u: &ModelInputN<N>, lng_open: bool) -> [N; N_NODES] {
         let mut sums = Sums::ZERO;
         let _ = sums.add_tick(&self.k, u);
@@ -665,7 +644,9 @@ impl<N: Num> Model<N> {
     /// credit of the past steps (bit 0 = this step, for the transport delay), `share`:
     /// the credited share of this step. `links`: the link temperatures of the last
     /// step (energy they store leaves the loop); `None` for steady flow.
-    #[inline(always)]
+    // Not inlined: one copy serves the model step and the init's stability
+    // check ([`Model::derivative`]); the call costs a few instructions per step.
+    #[inline(never)]
     #[allow(clippy::too_many_arguments)]
     fn rhs(&self, t: &[N; N_NODES], m: &Sums<N>, hist: u32, share: N, links: Option<[N; 3]>, rate: N, outer_g: &[N; 4]) -> Rhs<N> {
         let k = &self.k;

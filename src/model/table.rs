@@ -44,15 +44,6 @@ pub fn value<N: Num>(table: &[N; N_TABLE], at: &At<N>) -> N {
     }
 }
 
-/// Converts an SI table (`f64`, W/K) to the number type in kW/K.
-pub fn to_kw<N: Num>(t: &[f64; N_TABLE]) -> [N; N_TABLE] {
-    let mut o = [N::ZERO; N_TABLE];
-    for (o, x) in o.iter_mut().zip(t.iter()) {
-        *o = N::from_f64(x * 1e-3);
-    }
-    o
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

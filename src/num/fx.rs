@@ -128,6 +128,21 @@ unsafe impl Num for Fx {
     fn coef_from_f64(x: f64) -> Option<FxCoef> {
         FxCoef::checked_from_num(x)
     }
+    fn from_f32(x: f32) -> Self {
+        Fx::checked_from_num(x).unwrap_or(if x > 0.0 {
+            Fx::MAX
+        } else if x < 0.0 {
+            Fx::MIN
+        } else {
+            Fx::ZERO
+        })
+    }
+    fn from_exact(_x32: f32, x64: f64) -> Self {
+        Self::from_f64(x64)
+    }
+    fn coef_from_f32(x: f32) -> Option<FxCoef> {
+        FxCoef::checked_from_num(x)
+    }
     fn scale_from_f64(x: f64) -> Option<FxScale> {
         FxScale::checked_from_num(x)
     }

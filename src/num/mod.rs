@@ -46,6 +46,14 @@ pub unsafe trait Num: Copy + PartialOrd + core::fmt::Debug {
     fn from_f64(x: f64) -> Self;
     /// Coefficient conversion at init; `None` when `x` is outside the coefficient range.
     fn coef_from_f64(x: f64) -> Option<Self::Coef>;
+    /// Conversion of a parameter-block word (saturating for fixed point; no `f64`).
+    fn from_f32(x: f32) -> Self;
+    /// A constant of the model's structure given in both precisions (`x32` is
+    /// `x64` rounded): each type takes the one it can hold without `f64`
+    /// arithmetic on an FPU-single target (`f32` takes `x32`).
+    fn from_exact(x32: f32, x64: f64) -> Self;
+    /// Coefficient conversion of a parameter-block word; `None` outside the range.
+    fn coef_from_f32(x: f32) -> Option<Self::Coef>;
     /// Scale conversion at init; `None` when outside the scale range.
     fn scale_from_f64(x: f64) -> Option<Self::Scale>;
     /// Wire value (finite, validated) times scale → model unit. Saturating.
@@ -136,6 +144,15 @@ unsafe impl Num for f64 {
     }
     fn coef_from_f64(x: f64) -> Option<f64> {
         x.is_finite().then_some(x)
+    }
+    fn from_f32(x: f32) -> Self {
+        x as f64
+    }
+    fn from_exact(_x32: f32, x64: f64) -> Self {
+        x64
+    }
+    fn coef_from_f32(x: f32) -> Option<f64> {
+        x.is_finite().then_some(x as f64)
     }
     fn scale_from_f64(x: f64) -> Option<f64> {
         x.is_finite().then_some(x)
@@ -289,6 +306,18 @@ unsafe impl Num for f32 {
     }
     fn coef_from_f64(x: f64) -> Option<f32> {
         x.is_finite().then_some(x as f32)
+    }
+    #[inline(always)]
+    fn from_f32(x: f32) -> Self {
+        x
+    }
+    #[inline(always)]
+    fn from_exact(x32: f32, _x64: f64) -> Self {
+        x32
+    }
+    #[inline(always)]
+    fn coef_from_f32(x: f32) -> Option<f32> {
+        x.is_finite().then_some(x)
     }
     fn scale_from_f64(x: f64) -> Option<f32> {
         x.is_finite().then_some(x as f32)

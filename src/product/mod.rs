@@ -26,6 +26,7 @@ use crate::memory::slots::{self, AbWriter};
 use crate::memory::{boot_restore, Restore, ThermalRecord};
 use crate::protocol::{DecodeError, Deframer, Request, MAX_MISSED_STEPS};
 use crate::trace::{RestoreKind, Trace};
+use crate::params_block::{self, ParamSource, BLOCK_LEN};
 use crate::{Guard, GuardConfig, Output};
 use heapless::Deque;
 use reset::CauseRecord;
@@ -86,6 +87,11 @@ pub trait Board {
     /// not measured).
     fn boot_stack_b(&self) -> u32 {
         0
+    }
+    /// The parameter-block region of the flash (`PARAMS` in the board's
+    /// `memory.x`), `None` when the board has none ([`crate::params_block`]).
+    fn param_block(&self) -> Option<&'static [u8; BLOCK_LEN]> {
+        None
     }
 }
 
@@ -153,6 +159,8 @@ pub struct App {
     worst_tick_cycles: u32,
     /// Trace dump in progress: token, next index, events in the dump.
     dump: Option<(u16, u8, u8)>,
+    /// Where the model constants of this boot come from.
+    params: ParamSource,
 }
 
 fn restore_kind(r: &Restore) -> RestoreKind {
@@ -183,11 +191,20 @@ impl App {
         let (a, b) = &mem.records;
         let nv_policy = NvPolicy::DEFAULT;
         let restore = boot_restore(slots::restore_from(a, b), mem.nv, &nv_policy);
+        // The model constants: a valid parameter block, else `cfg`'s own (the
+        // compiled-in paper rig on the boards: NOT_COMMISSIONED); an invalid
+        // block refuses the configuration (CONFIG, fail-safe).
+        let (model, params) = match board.param_block().map(params_block::view) {
+            None | Some(Ok(None)) => (cfg.model, ParamSource::Default),
+            Some(Ok(Some(c))) => (c, ParamSource::Block),
+            Some(Err(e)) => (cfg.model, ParamSource::Invalid(e)),
+        };
+        let cfg = GuardConfig { model, ..*cfg };
         let p = slot.as_mut_ptr();
         // SAFETY: `p` points to `slot`, valid for writes; every field is written
         // exactly once below before the reference is created.
         let app = unsafe {
-            Guard::new_in(&mut *core::ptr::addr_of_mut!((*p).guard).cast::<core::mem::MaybeUninit<Guard>>(), cfg, restore);
+            Guard::new_in(&mut *core::ptr::addr_of_mut!((*p).guard).cast::<core::mem::MaybeUninit<Guard>>(), &cfg, restore);
             core::ptr::addr_of_mut!((*p).lng).write(cfg.lng);
             core::ptr::addr_of_mut!((*p).rx).write(Deframer::new());
             core::ptr::addr_of_mut!((*p).last_seq).write(None);
@@ -204,9 +221,14 @@ impl App {
             core::ptr::addr_of_mut!((*p).boots).write(boots);
             core::ptr::addr_of_mut!((*p).worst_tick_cycles).write(0);
             core::ptr::addr_of_mut!((*p).dump).write(None);
+            core::ptr::addr_of_mut!((*p).params).write(params);
             &mut *p
         };
+        if let ParamSource::Invalid(_) = params {
+            app.guard.refuse_config();
+        }
         app.guard.trace_event(Trace::Reset { step: 0, cause: reset_cause as u8 });
+        app.guard.trace_event(Trace::Params { step: 0, source: params.code() });
         let out = app.guard.output();
         let _ = board.set_pins(Pins::for_outputs(out.valve_open, out.alarm || out.derate));
         app
@@ -293,6 +315,7 @@ impl App {
             tick: self.tick,
             sample_seq: self.last_seq.unwrap_or(0),
             fresh: fresh.is_some(),
+            not_commissioned: self.params == ParamSource::Default,
             out,
             pins,
             overruns: u16::try_from(self.counters.overruns).unwrap_or(u16::MAX),
@@ -326,6 +349,8 @@ impl App {
         (out, got)
     }
 
+    // cold path, kept out of the tick loop's code (flash)
+    #[inline(never)]
     fn reject(&mut self, e: DecodeError) {
         let c = &mut self.counters;
         let slot = match e {
@@ -371,6 +396,8 @@ impl App {
         }
     }
 
+    // cold path, kept out of the tick loop's code (flash)
+    #[inline(never)]
     fn execute<B: Board>(&mut self, board: &mut B, c: Command) {
         self.counters.commands = self.counters.commands.saturating_add(1);
         self.guard.trace_event(Trace::Command { step: self.guard.steps(), code: c.cmd.code() });
@@ -420,6 +447,8 @@ impl App {
     /// first. If the ring is full and new events arrive during the dump
     /// (four ticks per four events), the indices shift and the dump ends
     /// with the newest events instead of as many of the oldest.
+    // cold path, kept out of the tick loop's code (flash)
+    #[inline(never)]
     fn send_trace_chunk<B: Board>(&mut self, board: &mut B) {
         let Some((token, next, count)) = self.dump else { return };
         let mut index = next;
@@ -432,6 +461,8 @@ impl App {
     }
 
     /// The status reply for `token`.
+    // cold path, kept out of the tick loop's code (flash)
+    #[inline(never)]
     pub fn status<B: Board>(&self, board: &B, token: u16) -> Status {
         let c = &self.counters;
         Status {
@@ -471,7 +502,12 @@ impl App {
         self.counters
     }
 
-    /// Why this boot happened.
+    /// Where this boot's model constants come from.
+    pub fn params(&self) -> ParamSource {
+        self.params
+    }
+
+    /// Why the MCU last reset.
     pub fn reset_cause(&self) -> ResetCause {
         self.reset_cause
     }

@@ -21,6 +21,8 @@ struct SimBoard {
     /// `Some(ok)`: the board has a non-volatile store whose saves return `ok`.
     nv: Option<bool>,
     nv_calls: u32,
+    /// The flash's parameter-block region (`None`: the board has none).
+    block: Option<&'static [u8; BLOCK_LEN]>,
 }
 
 impl SimBoard {
@@ -36,6 +38,7 @@ impl SimBoard {
             cause: CauseRecord::new(0, 0),
             nv: None,
             nv_calls: 0,
+            block: None,
         }
     }
 
@@ -94,6 +97,9 @@ impl Board for SimBoard {
     fn nv_save(&mut self, _rec: &ThermalRecord) -> bool {
         self.nv_calls += 1;
         self.nv.unwrap_or(false)
+    }
+    fn param_block(&self) -> Option<&'static [u8; BLOCK_LEN]> {
+        self.block
     }
 }
 
@@ -338,4 +344,105 @@ fn failing_nv_store_is_retried_once_a_minute_not_every_tick() {
     }
     // The estimate rises ~0.7 K in these 0.5 s, no fault: nothing due after the first.
     assert_eq!(ok.nv_calls, 1, "one record at the start; the next on a 2 K rise");
+}
+
+
+/// Flash storage of a parameter block for a test (4-byte aligned, leaked: it
+/// lives as long as the flash it stands for).
+fn flash_block(bytes: [u8; BLOCK_LEN]) -> &'static [u8; BLOCK_LEN] {
+    #[repr(C, align(4))]
+    struct Aligned([u8; BLOCK_LEN]);
+    &std::boxed::Box::leak(std::boxed::Box::new(Aligned(bytes))).0
+}
+
+/// Another EHA's constants: the pump's mechanical loss 1.5× the paper rig's
+/// (eq. 8; Phi does not depend on it, so the block stays consistent).
+fn other_rig() -> crate::model::ModelConsts<f32> {
+    crate::model::ModelConsts { k_mech: crate::params::DEFAULT_CONSTS.k_mech * 1.5, ..crate::params::DEFAULT_CONSTS }
+}
+
+/// No block (erased flash, or a board without the region): the compiled-in
+/// paper rig runs, every tick reply says NOT_COMMISSIONED, the trace says why.
+#[test]
+fn without_a_block_the_default_runs_and_every_reply_says_not_commissioned() {
+    for block in [None, Some(flash_block([0xFF; BLOCK_LEN]))] {
+        let mut b = SimBoard::new();
+        b.block = block;
+        let mem = b.mem();
+        let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
+        assert_eq!(app.params(), ParamSource::Default);
+        for k in 0..30u16 {
+            b.rx.extend_from_slice(&sample(k, 20.0, 60.0).encode());
+            app.tick(&mut b, 0);
+        }
+        let t = ticks(&b.replies());
+        assert!(t.iter().all(|r| r.not_commissioned && r.out.faults == 0), "{t:?}");
+        assert!(app.guard().trace().iter().any(|e| matches!(e, Trace::Params { source: 0, .. })));
+    }
+}
+
+/// A valid block for another rig: the guard predicts with that rig's
+/// constants, bit-identical to a bare guard built from them, higher than the
+/// paper rig's (1.5× the pump's friction heat), and the replies say
+/// commissioned.
+#[test]
+fn a_valid_block_runs_its_own_rig() {
+    let other = other_rig();
+    let mut b = SimBoard::new();
+    b.block = Some(flash_block(params_block::encode(&other, "other-eha")));
+    let mem = b.mem();
+    let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
+    assert_eq!(app.params(), ParamSource::Block);
+    let mut bare = Guard::new(&GuardConfig { model: &other, ..GuardConfig::DEFAULT }, Restore::Cold);
+    let mut paper = Guard::new(&GuardConfig::DEFAULT, Restore::Cold);
+    let (mut last, mut last_paper) = (0.0, 0.0);
+    for k in 0..3000u16 {
+        let s = sample(k, 30.0, 60.0);
+        b.rx.extend_from_slice(&s.encode());
+        app.tick(&mut b, 0);
+        let want = bare.step(&s.sample());
+        last_paper = paper.step(&s.sample()).drain_c;
+        let t = ticks(&b.replies());
+        assert!(!t[0].not_commissioned);
+        assert!(crate::protocol::GuardOutput::bit_eq(&t[0].out, &want), "tick {k}: {:?} vs {want:?}", t[0].out);
+        last = want.drain_c;
+    }
+    // 30 s at 60 bar, 500 rpm: the other rig's drain runs warmer (more friction heat)
+    assert!(last > last_paper + 0.01, "other rig {last} degC vs paper rig {last_paper} degC");
+    assert!(app.guard().trace().iter().any(|e| matches!(e, Trace::Params { source: 1, .. })));
+}
+
+/// A block that fails its checks (a flipped bit: CRC; or constants whose Phi
+/// belongs to another rig: stability) latches CONFIG and opens the valve from
+/// the first tick, and CONFIG cannot be cleared.
+#[test]
+fn an_invalid_block_latches_config_and_opens_the_valve() {
+    let mut torn = params_block::encode(&other_rig(), "torn");
+    torn[500] ^= 0x10;
+    let mut wrong_phi = other_rig();
+    for g in wrong_phi.g_loop.iter_mut() {
+        *g *= 1.5;
+    }
+    for (name, bytes, source) in [
+        ("torn", torn, ParamSource::Invalid(params_block::BlockError::Crc)),
+        ("phi of another rig", params_block::encode(&wrong_phi, "bad-phi"), ParamSource::Block),
+    ] {
+        let mut b = SimBoard::new();
+        b.block = Some(flash_block(bytes));
+        let mem = b.mem();
+        let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
+        assert_eq!(app.params(), source, "{name}");
+        assert!(!b.pins.valve_pin, "{name}: valve open (pin low) from boot");
+        for k in 0..50u16 {
+            b.rx.extend_from_slice(&sample(k, 20.0, 60.0).encode());
+            app.tick(&mut b, 0);
+        }
+        b.rx.extend_from_slice(&Command { token: 7, cmd: Cmd::ClearFaults }.encode());
+        app.tick(&mut b, 0);
+        let t = ticks(&b.replies());
+        assert!(
+            t.iter().all(|r| r.out.faults & crate::guard::faults::CONFIG != 0 && r.out.valve_open && !r.pins.valve_pin && r.out.alarm),
+            "{name}: {t:?}"
+        );
+    }
 }

@@ -191,6 +191,10 @@ pub struct TickReply {
     pub sample_seq: u16,
     /// `true` when a new sample arrived for this tick; `false` = missing.
     pub fresh: bool,
+    /// NOT_COMMISSIONED: the model runs the compiled-in paper-rig constants
+    /// (no parameter block in flash), not this machine's
+    /// ([`crate::params_block`]). Bit 1 of the `fresh` byte.
+    pub not_commissioned: bool,
     /// The guard's output of this tick.
     pub out: Output,
     /// Pin levels read back after writing them.
@@ -290,6 +294,7 @@ pub fn encode_trace(t: &Trace) -> TraceWire {
         Trace::Overrun { step, lost_ticks } => w(9, step, 0.0, lost_ticks),
         Trace::Reset { step, cause } => w(10, step, 0.0, u16::from(cause)),
         Trace::Command { step, code } => w(11, step, 0.0, u16::from(code)),
+        Trace::Params { step, source } => w(12, step, 0.0, u16::from(source)),
     }
 }
 
@@ -363,7 +368,7 @@ impl TickReply {
         put(&mut p, &[KIND_TICK]);
         put(&mut p, &self.tick.to_le_bytes());
         put(&mut p, &self.sample_seq.to_le_bytes());
-        put(&mut p, &[u8::from(self.fresh)]);
+        put(&mut p, &[u8::from(self.fresh) | (u8::from(self.not_commissioned) << 1)]);
         out_fields(&mut p, &self.out);
         put(&mut p, &[u8::from(self.pins.valve_pin) | (u8::from(self.pins.ok_pin) << 1)]);
         put(&mut p, &self.overruns.to_le_bytes());
@@ -377,7 +382,8 @@ impl TickReply {
         let mut r = expect(p, KIND_TICK, TICK_LEN)?;
         let tick = r.u32()?;
         let sample_seq = r.u16()?;
-        let fresh = r.u8()? != 0;
+        let fresh_byte = r.u8()?;
+        let (fresh, not_commissioned) = (fresh_byte & 1 != 0, fresh_byte & 2 != 0);
         let out = r.out()?;
         let pins = r.u8()?;
         let overruns = r.u16()?;
@@ -385,7 +391,7 @@ impl TickReply {
         let restore = restore_from_code(r.u8()?).ok_or(DecodeError::Kind)?;
         let reset_cause = ResetCause::from_code(r.u8()?);
         let pins = Pins { valve_pin: pins & 1 != 0, ok_pin: pins & 2 != 0 };
-        Ok(TickReply { tick, sample_seq, fresh, out, pins, overruns, rejected, restore, reset_cause })
+        Ok(TickReply { tick, sample_seq, fresh, not_commissioned, out, pins, overruns, rejected, restore, reset_cause })
     }
 }
 

@@ -133,7 +133,8 @@ fn while_disagreeing_the_model_heats_with_the_larger_loss() {
     cfg.valve.open_c = 200.0;
     cfg.valve.close_c = 198.0;
     let mut g = GuardOf::<f32>::new(&cfg, Restore::Cold);
-    cfg.params.torque_constant_nm_per_a = 0.0;
+    let off_model = eha_guard::model::ModelConsts { k_sh: 0.0, ..eha_guard::params::DEFAULT_CONSTS };
+    cfg.model = &off_model;
     let mut off = GuardOf::<f32>::new(&cfg, Restore::Cold);
     let mut first_max = None;
     for k in 0..6000u32 {
@@ -168,7 +169,8 @@ fn blind_at_zero_speed() {
 #[test]
 fn disabled_without_a_torque_constant() {
     let mut cfg = GuardConfig::DEFAULT;
-    cfg.params.torque_constant_nm_per_a = 0.0;
+    let off_model = eha_guard::model::ModelConsts { k_sh: 0.0, ..eha_guard::params::DEFAULT_CONSTS };
+    cfg.model = &off_model;
     let mut g = GuardOf::<f32>::new(&cfg, Restore::Cold);
     let out = run(&mut g, 1000, |_| Sample { current_a: 5.0, ..sample(65.0, 5.0, 500.0) });
     assert_eq!(out.last().unwrap().faults, 0);

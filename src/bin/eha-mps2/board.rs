@@ -7,7 +7,7 @@
 //! valve), bit 1 = OK pin (high = no alarm). Reset level 0 = valve open,
 //! alarm: the safe state.
 //!
-//! Interrupts (no PAC: cortex-m-rt's default vector table sends every IRQ
+//! Interrupts (no PAC: the vector table of `src/vectors.rs` sends every IRQ
 //! to `DefaultHandler`, which dispatches by number): UART0 RX = IRQ 0,
 //! timer 0 = IRQ 8; the watchdog's warning goes to NMI.
 
@@ -203,6 +203,10 @@ impl Board for Mps2 {
 
     fn boot_stack_b(&self) -> u32 {
         self.boot_stack_b
+    }
+
+    fn param_block(&self) -> Option<&'static [u8; eha_guard::params_block::BLOCK_LEN]> {
+        Some(eha_guard::params_block::flash_region())
     }
 }
 

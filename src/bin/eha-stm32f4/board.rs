@@ -368,6 +368,10 @@ impl Board for F411 {
     fn boot_stack_b(&self) -> u32 {
         self.boot_stack_b
     }
+
+    fn param_block(&self) -> Option<&'static [u8; eha_guard::params_block::BLOCK_LEN]> {
+        Some(eha_guard::params_block::flash_region())
+    }
 }
 
 /// USART1: RXNE or ORE (RXNEIE enables both). Reading SR then DR clears

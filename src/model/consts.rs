@@ -1,0 +1,463 @@
+//! The model's constants in model units (kW, L/s, hbar, hrad/s, degC): what the
+//! firmware needs to run the reduced model, derived once from the SI
+//! [`ReducedParams`] on the host ([`derive`], `f64`) and carried to the target as
+//! `f32` (the compiled-in [`crate::params::DEFAULT_CONSTS`] or a parameter block
+//! in flash, [`crate::params_block`]). The target does no `f64` arithmetic and no
+//! matrix exponential: it converts these values into its number type and checks them.
+
+use super::{ConfigError, HA_PER_A, KW_PER_W, L_PER_M3, PA_PER_HBAR, RAD_T_K};
+use crate::num::Num;
+use crate::params::{ReducedParams, N_NODES, N_TABLE, S_PER_TICK};
+
+/// Constants of the reduced model in model units, scalar type `S` (`f64` on the
+/// host, `f32` in a parameter block). Field order is the block's word order.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
+pub struct ModelConsts<S> {
+    /// Case pressure, hbar.
+    pub p_case: S,
+    /// Pump leakage flow per port, L/s per hbar (eqs. 5-7).
+    pub k_lf: S,
+    /// Half of [`Self::k_lf`] (the case receives the mean of both ports' leakage).
+    pub k_lf_half: S,
+    /// Pump leakage heat, kW per hbar^2 (eqs. 5-7).
+    pub k_lp: S,
+    /// Pump mechanical loss, kW per (hbar hrad/s) (eq. 8).
+    pub k_mech: S,
+    /// Pump flow, L/s per hrad/s.
+    pub k_q: S,
+    /// Piston flow, L/s per (mm per tick).
+    pub k_a: S,
+    /// Throttling power, kW per (hbar L/s).
+    pub k_dpq: S,
+    /// Line loss, kW per (L/s)^2 (eq. 10, laminar part).
+    pub r1: S,
+    /// Line loss, kW per (L/s)^3 (eq. 10, local losses).
+    pub r2: S,
+    /// Actuator heat weight of `dp^2` (eq. 11), of [`Self::k_act`] (≤ 1).
+    pub w_dp: S,
+    /// Actuator heat weight of `dx^2` (seal friction), of [`Self::k_act`] (≤ 1).
+    pub w_dx: S,
+    /// Actuator heat scale, kW: `k_act (w_dp dp^2 + w_dx dx^2)` per tick.
+    pub k_act: S,
+    /// Copper loss, kW per hA^2 (eq. 1).
+    pub k_cu: S,
+    /// Shaft power from the current, kW per (hA hrad/s) (cross-check); 0 disables it.
+    pub k_sh: S,
+    /// Hydraulic power of the displacement, kW per (hbar hrad/s) (cross-check).
+    pub k_hyd: S,
+    /// Iron loss, hysteresis, kW per hrad/s (eq. 2).
+    pub fe1: S,
+    /// Iron loss, eddy, kW per (hrad/s)^2 (eq. 2).
+    pub fe2: S,
+    /// Iron loss, excess, kW per (hrad/s)^1.5 (eq. 2).
+    pub fe15: S,
+    /// Flow-table index scale `(N_TABLE - 1) / sqrt(q_max)`, per sqrt(L/s).
+    pub q_scale: S,
+    /// Speed-table index scale `(N_TABLE - 1) / sqrt(w_max)`, per sqrt(hrad/s).
+    pub w_scale: S,
+    /// Oil `rho c_p` at 0 degC, kJ/(L K).
+    pub rc0: S,
+    /// Slope of `rho c_p`, kJ/(L K^2).
+    pub rc1: S,
+    /// `1/(rho c_p)` linearised about 40 degC, `irc0 - irc1 T`: constant part, L K/kJ.
+    pub irc0: S,
+    /// `1/(rho c_p)` linearised about 40 degC: slope, L/kJ.
+    pub irc1: S,
+    /// 1 / case oil volume, 1/L.
+    pub inv_v_case: S,
+    /// 1 / loop oil volume, 1/L.
+    pub inv_v_loop: S,
+    /// One port passage's oil volume, L.
+    pub v_port: S,
+    /// Ball-valve passage oil volume, L.
+    pub v_ball: S,
+    /// 1 / ring oil volume, 1/L.
+    pub inv_v_ring: S,
+    /// Share of the mechanical loss into the delivered oil.
+    pub f_out: S,
+    /// `1 - f_out`: share into the case oil.
+    pub f_case: S,
+    /// LNG inlet temperature, degC (eqs. 20-22).
+    pub lng_in: S,
+    /// Viscosity exponent of the leakage, 1/K (0: off).
+    pub k_mu: S,
+    /// Reference temperature of the leakage conductance, degC.
+    pub t_mu: S,
+    /// 1 / capacity of the metal nodes, K/kJ (oil nodes 0).
+    pub inv_c: [S; N_NODES],
+    /// Outer surfaces, constant conductance, kW/K (eqs. 15-16).
+    pub ga: [S; 4],
+    /// Outer surfaces, `|dT|^(1/4)` conductance, kW/K^1.25.
+    pub gb: [S; 4],
+    /// Outer surfaces, radiation `4 eps sigma A (300 K)^3`, kW/K (eq. 19).
+    pub gr: [S; 4],
+    /// Case oil <-> pump housing over `sqrt` speed grid, kW/K.
+    pub g_case: [S; N_TABLE],
+    /// Port passage <-> pump housing over flow, kW/K.
+    pub g_port: [S; N_TABLE],
+    /// Loop oil <-> main block over flow, kW/K.
+    pub g_loop: [S; N_TABLE],
+    /// Ball-valve oil <-> its block over flow, kW/K.
+    pub g_ball: [S; N_TABLE],
+    /// LNG exchanger `eps C_min` over flow, kW/K (eqs. 20-22).
+    pub g_lng: [S; N_TABLE],
+    /// Exact-ZOH matrix `Phi = h phi1(h A)` of the model step, s.
+    pub phi: [[S; N_NODES]; N_NODES],
+}
+
+mod sealed {
+    pub trait Sealed {}
+    impl Sealed for f32 {}
+    impl Sealed for f64 {}
+}
+
+/// A word of [`ModelConsts`]: `f64` (host design) or `f32` (parameter block).
+/// Sealed: [`ModelConsts::as_words`] relies on these two being the only ones.
+pub trait Word: Copy + sealed::Sealed {
+    /// To the model's number type (saturating for fixed point).
+    fn to_n<N: Num>(self) -> N;
+    /// To a discretised-matrix coefficient; `None` outside the coefficient range.
+    fn to_coef<N: Num>(self) -> Option<N::Coef>;
+    /// To `f32` (checks).
+    fn to_f32(self) -> f32;
+}
+
+impl Word for f32 {
+    #[inline(always)]
+    fn to_n<N: Num>(self) -> N {
+        N::from_f32(self)
+    }
+    #[inline(always)]
+    fn to_coef<N: Num>(self) -> Option<N::Coef> {
+        N::coef_from_f32(self)
+    }
+    #[inline(always)]
+    fn to_f32(self) -> f32 {
+        self
+    }
+}
+
+impl Word for f64 {
+    fn to_n<N: Num>(self) -> N {
+        N::from_f64(self)
+    }
+    fn to_coef<N: Num>(self) -> Option<N::Coef> {
+        N::coef_from_f64(self)
+    }
+    fn to_f32(self) -> f32 {
+        self as f32
+    }
+}
+
+/// Scalar words at the head of a [`ModelConsts`] (`p_case` .. `t_mu`).
+pub const N_SCALARS: usize = 35;
+/// Number of words in a [`ModelConsts`].
+pub const N_WORDS: usize = N_SCALARS + N_NODES + 12 + 5 * N_TABLE + N_NODES * N_NODES;
+
+// Every field is a word: no padding, no other data.
+const _: () = assert!(core::mem::size_of::<ModelConsts<f32>>() == 4 * N_WORDS);
+const _: () = assert!(core::mem::size_of::<ModelConsts<f64>>() == 8 * N_WORDS);
+
+/// Largest magnitude of any constant (fixed-point value range, with margin).
+pub const MAX_ABS: f32 = 250.0;
+
+impl<S: Copy> ModelConsts<S> {
+    /// Applies `f` to every word, in word order (the only listing of the fields).
+    pub fn map<T: Copy>(&self, mut f: impl FnMut(S) -> T) -> ModelConsts<T> {
+        let c = self;
+        ModelConsts {
+            p_case: f(c.p_case),
+            k_lf: f(c.k_lf),
+            k_lf_half: f(c.k_lf_half),
+            k_lp: f(c.k_lp),
+            k_mech: f(c.k_mech),
+            k_q: f(c.k_q),
+            k_a: f(c.k_a),
+            k_dpq: f(c.k_dpq),
+            r1: f(c.r1),
+            r2: f(c.r2),
+            w_dp: f(c.w_dp),
+            w_dx: f(c.w_dx),
+            k_act: f(c.k_act),
+            k_cu: f(c.k_cu),
+            k_sh: f(c.k_sh),
+            k_hyd: f(c.k_hyd),
+            fe1: f(c.fe1),
+            fe2: f(c.fe2),
+            fe15: f(c.fe15),
+            q_scale: f(c.q_scale),
+            w_scale: f(c.w_scale),
+            rc0: f(c.rc0),
+            rc1: f(c.rc1),
+            irc0: f(c.irc0),
+            irc1: f(c.irc1),
+            inv_v_case: f(c.inv_v_case),
+            inv_v_loop: f(c.inv_v_loop),
+            v_port: f(c.v_port),
+            v_ball: f(c.v_ball),
+            inv_v_ring: f(c.inv_v_ring),
+            f_out: f(c.f_out),
+            f_case: f(c.f_case),
+            lng_in: f(c.lng_in),
+            k_mu: f(c.k_mu),
+            t_mu: f(c.t_mu),
+            inv_c: c.inv_c.map(&mut f),
+            ga: c.ga.map(&mut f),
+            gb: c.gb.map(&mut f),
+            gr: c.gr.map(&mut f),
+            g_case: c.g_case.map(&mut f),
+            g_port: c.g_port.map(&mut f),
+            g_loop: c.g_loop.map(&mut f),
+            g_ball: c.g_ball.map(&mut f),
+            g_lng: c.g_lng.map(&mut f),
+            phi: c.phi.map(|r| r.map(&mut f)),
+        }
+    }
+
+    /// Calls `f` on every word in word order.
+    pub fn for_each(&self, f: impl FnMut(S)) {
+        let _ = self.map(f);
+    }
+
+    /// Builds the constants from words in word order (`next` is called
+    /// [`N_WORDS`] times).
+    pub fn from_words(mut next: impl FnMut() -> S) -> Self {
+        ModelConsts::<()>::UNIT.map(|()| next())
+    }
+}
+
+impl ModelConsts<()> {
+    /// The field skeleton (for [`ModelConsts::from_words`]).
+    const UNIT: Self = ModelConsts {
+        p_case: (),
+        k_lf: (),
+        k_lf_half: (),
+        k_lp: (),
+        k_mech: (),
+        k_q: (),
+        k_a: (),
+        k_dpq: (),
+        r1: (),
+        r2: (),
+        w_dp: (),
+        w_dx: (),
+        k_act: (),
+        k_cu: (),
+        k_sh: (),
+        k_hyd: (),
+        fe1: (),
+        fe2: (),
+        fe15: (),
+        q_scale: (),
+        w_scale: (),
+        rc0: (),
+        rc1: (),
+        irc0: (),
+        irc1: (),
+        inv_v_case: (),
+        inv_v_loop: (),
+        v_port: (),
+        v_ball: (),
+        inv_v_ring: (),
+        f_out: (),
+        f_case: (),
+        lng_in: (),
+        k_mu: (),
+        t_mu: (),
+        inv_c: [(); N_NODES],
+        ga: [(); 4],
+        gb: [(); 4],
+        gr: [(); 4],
+        g_case: [(); N_TABLE],
+        g_port: [(); N_TABLE],
+        g_loop: [(); N_TABLE],
+        g_ball: [(); N_TABLE],
+        g_lng: [(); N_TABLE],
+        phi: [[(); N_NODES]; N_NODES],
+    };
+}
+
+impl ModelConsts<f64> {
+    /// The `f32` words of a parameter block (round to nearest).
+    pub fn to_f32(&self) -> ModelConsts<f32> {
+        self.map(|x| x as f32)
+    }
+}
+
+impl<S: Word> ModelConsts<S> {
+    /// The words in field order, in place.
+    pub fn as_words(&self) -> &[S; N_WORDS] {
+        // SAFETY: `ModelConsts<S>` is `repr(C)` with only `S` fields and arrays
+        // of `S` (`S` is `f32` or `f64`, the only `Word`s): no padding, size
+        // `N_WORDS` words (asserted above), alignment that of `S`.
+        unsafe { &*(self as *const Self).cast::<[S; N_WORDS]>() }
+    }
+
+    /// Value checks that need no model: every word finite and below
+    /// [`MAX_ABS`]; capacities, volumes, conductances, tables, loss coefficients
+    /// and shares non-negative; shares ≤ 1; the links' zero-flow conductances and
+    /// the table scales positive. The stability of the discretisation is checked
+    /// by [`crate::model::Model::check_stability`].
+    pub fn check_values(&self) -> Result<(), ConfigError> {
+        let finite = self.as_words().iter().all(|x| {
+            let x = x.to_f32();
+            x.is_finite() && x.abs() < MAX_ABS
+        });
+        if !finite {
+            return Err(ConfigError::ConstantRange);
+        }
+        let c = self;
+        let w = |x: S| x.to_f32();
+        let scalars_non_neg = [
+            c.k_lf, c.k_lf_half, c.k_lp, c.k_mech, c.k_q, c.k_a, c.k_dpq, c.r1, c.r2, c.w_dp, c.w_dx, c.k_act, c.k_cu, c.k_sh, c.k_hyd,
+            c.fe1, c.fe2, c.fe15, c.inv_v_case, c.inv_v_loop, c.v_port, c.v_ball, c.inv_v_ring, c.f_out, c.f_case,
+        ];
+        // inv_c, outer conductances and the tables: every word between the
+        // scalars and Phi (a rolled loop: init code, flash)
+        let arrays = self.as_words().get(core::hint::black_box(N_SCALARS)..N_WORDS - N_NODES * N_NODES).unwrap_or(&[]);
+        let non_neg = scalars_non_neg.iter().all(|x| w(*x) >= 0.0) && arrays.iter().all(|x| w(*x) >= 0.0);
+        let pos = [c.q_scale, c.w_scale, c.inv_v_case, c.inv_v_loop, c.v_port, c.v_ball, c.inv_v_ring, c.g_port[0], c.g_ball[0]]
+            .iter()
+            .all(|x| w(*x) > 0.0);
+        let shares = w(c.w_dp) <= 1.0 && w(c.w_dx) <= 1.0 && w(c.f_out) <= 1.0 && w(c.f_case) <= 1.0;
+        // rho c_p stays positive over the oil's range (-60..150 degC)
+        let rc = w(c.rc0) + w(c.rc1) * -60.0 > 0.0 && w(c.rc0) + w(c.rc1) * 150.0 > 0.0;
+        if non_neg && pos && shares && rc {
+            Ok(())
+        } else {
+            Err(ConfigError::Implausible)
+        }
+    }
+}
+
+/// Derives the model constants from SI parameters (host side, `f64`): the unit
+/// conversions of eqs. (1)-(22) into model units. `Err` if the parameters are
+/// implausible or a constant leaves the value format.
+pub fn derive(p: &ReducedParams) -> Result<ModelConsts<f64>, ConfigError> {
+    if !p.is_plausible() {
+        return Err(ConfigError::Implausible);
+    }
+    let d = p.displacement_m3_per_rad;
+    let kl = p.k_leak_m3_per_s_pa;
+    let rho_cp40 = p.rho_cp(40.0) * 1e-6; // kJ/(L K)
+    let rc1 = p.rho_kg_per_m3 * p.cp_slope_j_per_kg_k2 * 1e-6;
+    let rc0 = p.rho_cp(0.0) * 1e-6;
+    let q_max = p.flow_table_max_m3_per_s * L_PER_M3;
+    let w_max = p.speed_table_max_rad_s * 0.01;
+    let n1 = (N_TABLE - 1) as f64;
+    let v_ring = (p.loop_oil_m3 + 2.0 * p.port_oil_m3 + p.ball_oil_m3) * L_PER_M3;
+    let caps_kj = [p.pump_j_per_k, 0.0, 0.0, p.main_block_j_per_k, p.ball_block_j_per_k, p.actuator_j_per_k];
+    let inv_c = caps_kj.map(|c| if c > 0.0 { 1e3 / c } else { 0.0 });
+    let k_lf = kl * PA_PER_HBAR * L_PER_M3;
+    let k_al = p.act_leak_m3_per_s_pa * PA_PER_HBAR * PA_PER_HBAR * KW_PER_W;
+    let k_fr = p.act_friction_n_s_per_m * (1e-3 / S_PER_TICK) * (1e-3 / S_PER_TICK) * KW_PER_W;
+    // Actuator heat per tick `k_al dp^2 + k_fr dx^2` as `k_act (w_dp dp^2 + w_dx dx^2)`
+    // with the larger coefficient factored out (both weights <= 1).
+    let k_act = if k_al > k_fr { k_al } else { k_fr };
+    let (w_dp, w_dx) = if k_act > 0.0 { (k_al / k_act, k_fr / k_act) } else { (0.0, 0.0) };
+    // 1/(rc40 + rc1 (T - 40)) ≈ (1/rc40)(1 - (rc1/rc40)(T - 40)) = irc0 - irc1 T
+    let irc0 = (1.0 + 40.0 * rc1 / rho_cp40) / rho_cp40;
+    let irc1 = rc1 / (rho_cp40 * rho_cp40);
+    let kw = |t: &[f64; N_TABLE]| t.map(|g| g * KW_PER_W);
+    let c = ModelConsts {
+        p_case: p.case_pressure_pa / PA_PER_HBAR,
+        k_lf,
+        k_lf_half: k_lf * 0.5,
+        k_lp: kl * PA_PER_HBAR * PA_PER_HBAR * KW_PER_W,
+        k_mech: p.eta_m * d * PA_PER_HBAR * 100.0 * KW_PER_W,
+        k_q: d * 100.0 * L_PER_M3,
+        k_a: p.ram_area_m2 * 1e-3 / S_PER_TICK * L_PER_M3,
+        k_dpq: PA_PER_HBAR / L_PER_M3 * KW_PER_W,
+        r1: p.line_r1_pa_s_per_m3 / (L_PER_M3 * L_PER_M3) * KW_PER_W,
+        r2: p.line_r2_pa_s2_per_m6 / (L_PER_M3 * L_PER_M3 * L_PER_M3) * KW_PER_W,
+        w_dp,
+        w_dx,
+        k_act,
+        k_cu: p.phases * p.r_ohm / (HA_PER_A * HA_PER_A) * KW_PER_W,
+        k_sh: p.torque_constant_nm_per_a / HA_PER_A * 100.0 * KW_PER_W,
+        k_hyd: d * PA_PER_HBAR * 100.0 * KW_PER_W,
+        fe1: p.k_fe1_w_s_per_rad * 100.0 * KW_PER_W,
+        fe2: p.k_fe2_w_s2_per_rad2 * 1e4 * KW_PER_W,
+        fe15: p.k_fe15_w_per_rad15 * 1e3 * KW_PER_W,
+        q_scale: n1 / libm::sqrt(q_max),
+        w_scale: n1 / libm::sqrt(w_max),
+        rc0,
+        rc1,
+        irc0,
+        irc1,
+        inv_v_case: 1.0 / (p.case_oil_m3 * L_PER_M3),
+        inv_v_loop: 1.0 / (p.loop_oil_m3 * L_PER_M3),
+        v_port: p.port_oil_m3 * L_PER_M3,
+        v_ball: p.ball_oil_m3 * L_PER_M3,
+        inv_v_ring: 1.0 / v_ring,
+        f_out: p.mech_to_outlet,
+        f_case: 1.0 - p.mech_to_outlet,
+        lng_in: p.lng_inlet_c,
+        k_mu: p.k_mu_per_k,
+        t_mu: p.t_mu_ref_c,
+        inv_c,
+        ga: p.outer_w_per_k.map(|x| x * KW_PER_W),
+        gb: p.outer_quarter_w_per_k125.map(|x| x * KW_PER_W),
+        // radiation 4 eps sigma A T_m^3 with T_m in units of 300 K (so the
+        // coefficient keeps its resolution in fixed point)
+        gr: p.outer_rad_w_per_k4.map(|x| x * (4.0 * RAD_T_K * RAD_T_K * RAD_T_K * KW_PER_W)),
+        g_case: kw(&p.g_case_w_per_k),
+        g_port: kw(&p.g_port_w_per_k),
+        g_loop: kw(&p.g_loop_block_w_per_k),
+        g_ball: kw(&p.g_ball_block_w_per_k),
+        g_lng: kw(&p.g_lng_w_per_k),
+        phi: p.phi_step_s,
+    };
+    let mut ok = true;
+    c.for_each(|x| ok &= x.is_finite() && libm::fabs(x) < MAX_ABS as f64);
+    if ok {
+        Ok(c)
+    } else {
+        Err(ConfigError::ConstantRange)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    extern crate std;
+    use crate::params::{DEFAULT, DEFAULT_CONSTS};
+
+    /// `src/default_consts.rs` is `derive(&DEFAULT)` rounded to f32, bit for bit
+    /// (regenerate with `cargo run --release -p eha-sim --example reduce -- --consts-only`).
+    #[test]
+    fn default_consts_are_derived_from_default() {
+        let d = derive(&DEFAULT).unwrap().to_f32();
+        let (mut a, mut b) = (std::vec::Vec::new(), std::vec::Vec::new());
+        d.for_each(|x| a.push(x.to_bits()));
+        DEFAULT_CONSTS.for_each(|x| b.push(x.to_bits()));
+        assert_eq!(a.len(), N_WORDS);
+        assert_eq!(a, b);
+    }
+
+    /// Words round-trip in order through `for_each` / `from_words`.
+    #[test]
+    fn words_round_trip() {
+        let mut w = std::vec::Vec::new();
+        DEFAULT_CONSTS.for_each(|x| w.push(x));
+        let mut it = w.iter();
+        let back = ModelConsts::from_words(|| it.next().copied().unwrap_or(f32::NAN));
+        assert_eq!(back, DEFAULT_CONSTS);
+    }
+
+    /// Implausible words are refused by the value check.
+    #[test]
+    fn bad_words_are_refused() {
+        let mut c = DEFAULT_CONSTS;
+        c.g_case[3] = -0.1;
+        assert_eq!(c.check_values(), Err(ConfigError::Implausible));
+        let mut c = DEFAULT_CONSTS;
+        c.k_mech = f32::NAN;
+        assert_eq!(c.check_values(), Err(ConfigError::ConstantRange));
+        let mut c = DEFAULT_CONSTS;
+        c.rc1 = 300.0;
+        assert_eq!(c.check_values(), Err(ConfigError::ConstantRange));
+        assert_eq!(DEFAULT_CONSTS.check_values(), Ok(()));
+    }
+}
