@@ -24,6 +24,7 @@ pub mod lsq;
 pub mod measured;
 pub mod model;
 pub mod network;
+pub mod params_block;
 pub mod pil;
 pub mod plant;
 pub mod plot;

@@ -39,6 +39,9 @@ enum Cmd {
     /// Fault campaign: every sensor, transport, memory and actuator fault in
     /// closed loop with the reference plant; writes out/faults/faults.json.
     Faults(eha_sim::faults::FaultsArgs),
+    /// Firmware parameter blocks (firmware-params.bin): write one from a rig
+    /// file, or run the firmware's boot checks on one.
+    ParamsBlock(eha_sim::params_block::ParamsBlockArgs),
 }
 
 fn main() -> ExitCode {
@@ -51,6 +54,7 @@ fn main() -> ExitCode {
         Cmd::Pil(a) => eha_sim::pil::cli::run(&a),
         Cmd::FwBudget(a) => eha_sim::pil::budget::run(&a),
         Cmd::Faults(a) => eha_sim::faults::run(&a),
+        Cmd::ParamsBlock(a) => eha_sim::params_block::run(&a),
         // Own exit codes: 0 diagnosis made (none included), 2 bad input.
         Cmd::Diagnose(a) => return eha_sim::diagnosis::cli::run(&a),
         Cmd::DiagnoseSweep(a) => return eha_sim::diagnosis::sweep::run(&a),

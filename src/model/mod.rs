@@ -23,7 +23,7 @@
 
 pub mod consts;
 mod ring;
-mod stability;
+pub mod stability;
 pub mod table;
 
 use crate::linalg::expm1m;

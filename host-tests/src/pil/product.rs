@@ -426,6 +426,7 @@ struct ReplayBoard {
     tx: Vec<u8>,
     ticks: u32,
     records: [eha_guard::ThermalRecord; 2],
+    block: Option<&'static [u8; eha_guard::params_block::BLOCK_LEN]>,
 }
 
 impl eha_guard::product::Board for ReplayBoard {
@@ -455,6 +456,9 @@ impl eha_guard::product::Board for ReplayBoard {
         self.records[slot & 1] = *rec;
     }
     fn store_cause(&mut self, _rec: &eha_guard::product::reset::CauseRecord) {}
+    fn param_block(&self) -> Option<&'static [u8; eha_guard::params_block::BLOCK_LEN]> {
+        self.block
+    }
 }
 
 /// The host build of the product application (SIL) fed exactly what the
@@ -463,9 +467,19 @@ impl eha_guard::product::Board for ReplayBoard {
 /// the tick counter). Returns the host's tick replies, one per firmware tick
 /// of the first boot (a reset ends the replay).
 pub fn sil_replay(run: &ProductRun) -> Vec<TickReply> {
+    sil_replay_with_block(run, None)
+}
+
+/// [`sil_replay`] on a board whose flash holds the parameter block `block`
+/// (as the firmware's PARAMS region). The block is leaked: it stands for
+/// flash, which lives as long as the program.
+pub fn sil_replay_with_block(run: &ProductRun, block: Option<&[u8; eha_guard::params_block::BLOCK_LEN]>) -> Vec<TickReply> {
     use eha_guard::product::{App, BootMemory};
+    #[repr(C, align(4))]
+    struct Aligned([u8; eha_guard::params_block::BLOCK_LEN]);
+    let block = block.map(|b| &Box::leak(Box::new(Aligned(*b))).0);
     let by_seq: std::collections::HashMap<u16, Request> = run.steps.iter().map(|p| (p.request.seq, p.request)).collect();
-    let mut b = ReplayBoard { rx: Vec::new(), tx: Vec::new(), ticks: 0, records: [eha_guard::ThermalRecord::EMPTY; 2] };
+    let mut b = ReplayBoard { rx: Vec::new(), tx: Vec::new(), ticks: 0, records: [eha_guard::ThermalRecord::EMPTY; 2], block };
     let mem = BootMemory {
         records: (eha_guard::ThermalRecord::EMPTY, eha_guard::ThermalRecord::EMPTY),
         nv: None,

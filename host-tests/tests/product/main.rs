@@ -9,15 +9,17 @@
 //! test binary of their own so that no other test competes with them for
 //! the CPU (a host that answers late costs samples in real time). One
 //! scenario alone: `EHA_PRODUCT=hang cargo test --profile fast -p eha-sim
-//! --test product -- --ignored` (names: fig15, hang, panic, garbage, alarm).
+//! --test product -- --ignored` (names: fig15, hang, panic, garbage, alarm,
+//! params).
 
 /// The scenarios, by name.
-const SCENARIOS: [(&str, fn()); 5] = [
+const SCENARIOS: [(&str, fn()); 6] = [
     ("fig15", fig15_120s_closed_loop_over_the_uart_matches_the_semihosting_pil),
     ("hang", hang_is_reset_by_the_watchdog_with_safe_outputs_and_warm_restore),
     ("panic", panic_gives_safe_outputs_a_reset_and_warm_restore),
     ("garbage", garbage_and_bursts_on_the_uart_are_rejected_without_a_hang),
     ("alarm", alarm_pin_follows_the_60c_alarm),
+    ("params", parameter_block_in_flash_runs_its_rig_and_an_invalid_one_is_refused),
 ];
 
 /// Every product scenario in QEMU, concurrently; fails with the names and
@@ -342,4 +344,70 @@ fn alarm_pin_follows_the_60c_alarm() {
     for (_, t) in &run.ticks {
         assert_eq!(t.pins.ok_pin, !t.out.alarm, "tick {}: OK pin {} with alarm {}", t.tick, t.pins.ok_pin, t.out.alarm);
     }
+}
+
+
+/// Writes `block` to a file for QEMU's generic loader and returns the QEMU
+/// arguments that put it at the mps2 PARAMS region (boards/mps2/memory.x).
+fn loader_args(name: &str, block: &[u8]) -> Vec<String> {
+    let path = std::env::temp_dir().join(format!("eha-params-{}-{name}.bin", std::process::id()));
+    std::fs::write(&path, block).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    vec!["-device".into(), format!("loader,file={},addr=0x3F000", path.display())]
+}
+
+/// A parameter block for another EHA loaded into the product image's flash:
+/// the firmware predicts for that rig, bit-identical to the host build of the
+/// same application with the same block, and not for the paper rig; the
+/// replies say commissioned. An invalid block (one flipped bit) latches
+/// CONFIG with the valve open from the first tick.
+fn parameter_block_in_flash_runs_its_rig_and_an_invalid_one_is_refused() {
+    // Another EHA: 30 % more pump friction (eta_m), a 30 % lighter pump
+    // housing, a 30 % better case-oil film; Phi recomputed for it.
+    let mut other = eha_guard::params::DEFAULT;
+    other.eta_m *= 1.3;
+    other.pump_j_per_k *= 0.7;
+    for g in other.g_case_w_per_k.iter_mut() {
+        *g *= 1.3;
+    }
+    let other = eha_sim::params_block::rediscretise(&other).expect("other rig");
+    let block = eha_sim::params_block::block_for(&other, "other-eha").unwrap_or_else(|e| panic!("{e:#}"));
+    let duration_s = 30.0;
+    let mut s = session(&loader_args("other", &block));
+    let run = run_closed_loop(&mut s, &mut plant(duration_s), duration_s, Duration::from_secs(2), &mut |_, _| Ok(true))
+        .unwrap_or_else(|e| panic!("{e:#}"));
+    drop(s);
+    let with_block = eha_sim::pil::product::sil_replay_with_block(&run, Some(&block));
+    let paper = eha_sim::pil::product::sil_replay(&run);
+    assert_eq!(with_block.len(), run.ticks.len());
+    for (k, ((_, fw), host)) in run.ticks.iter().zip(&with_block).enumerate() {
+        assert!(!fw.not_commissioned, "tick {k}: the block is in flash");
+        assert!(
+            fw.tick == host.tick && eha_guard::protocol::GuardOutput::bit_eq(&fw.out, &host.out),
+            "tick {k}: firmware {fw:?} != host with the block {host:?}"
+        );
+    }
+    // After 30 s of Case-1-like load the two rigs' drain estimates differ by
+    // more than f32 noise: the firmware did not run the paper rig.
+    let (fw_last, paper_last) = (run.ticks.last().map(|t| t.1.out.drain_c), paper.last().map(|t| t.out.drain_c));
+    let (Some(a), Some(b)) = (fw_last, paper_last) else { panic!("no ticks") };
+    eprintln!("params: other rig drain {a:.4} degC, paper rig {b:.4} degC after {duration_s} s");
+    assert!((a - b).abs() > 0.01, "other rig {a} vs paper rig {b}");
+
+    let mut torn = block;
+    torn[600] ^= 0x04;
+    let mut s = session(&loader_args("torn", &torn));
+    let mut others = Vec::new();
+    let mut seen = Vec::new();
+    for seq in 0..20u16 {
+        s.send_sample(&eha_sim::pil::PlantSensors::default().request(seq)).unwrap_or_else(|e| panic!("{e:#}"));
+        if let Some((_, t)) = s.next_tick(Duration::from_secs(2), &mut others).unwrap_or_else(|e| panic!("{e:#}")) {
+            seen.push(t);
+        }
+    }
+    let pins = s.pins().unwrap_or_else(|e| panic!("{e:#}"));
+    assert!(!seen.is_empty());
+    for t in &seen {
+        assert!(t.out.faults & eha_guard::guard::faults::CONFIG != 0 && t.out.valve_open && !t.pins.valve_pin, "torn block: {t:?}");
+    }
+    assert!(!pins.valve_pin && !pins.ok_pin, "torn block: valve open and alarm on the pins, read {pins:?}");
 }
