@@ -120,11 +120,12 @@ impl<N: Num> LimitsN<N> {
             l.ambient_c_per_step,
         ];
         let s = sc.per_channel();
-        let s64 = [
-            crate::model::HA_PER_A,
-            crate::model::HBAR_PER_BAR,
-            crate::model::HBAR_PER_BAR,
-            crate::model::HRADS_PER_RPM,
+        // (the f64 unit constants rounded at compile time: no f64 on the target)
+        const S32: [f32; 6] = [
+            crate::model::HA_PER_A as f32,
+            crate::model::HBAR_PER_BAR as f32,
+            crate::model::HBAR_PER_BAR as f32,
+            crate::model::HRADS_PER_RPM as f32,
             1.0,
             1.0,
         ];
@@ -139,9 +140,9 @@ impl<N: Num> LimitsN<N> {
             .zip(out.hi.iter_mut())
             .zip(out.rate.iter_mut())
             .zip(lo.iter().zip(hi.iter()))
-            .zip(rt.iter().zip(s.iter().zip(s64.iter())))
+            .zip(rt.iter().zip(s.iter().zip(S32.iter())))
         {
-            let k = *k as f32;
+            let k = *k;
             if !(ok(a * k) && ok(b * k) && ok(c * k) && a <= b && *c >= 0.0) {
                 return None;
             }

@@ -289,6 +289,9 @@ unsafe impl Num for f32 {
     const ZERO: Self = 0.0;
     const ACC_ZERO: f32 = 0.0;
     const MAX_ROW_SUM: f64 = f64::INFINITY;
+    // (inlined: called with compile-time constants, so the conversion folds
+    // and no f64 soft-float routine is linked)
+    #[inline(always)]
     fn from_f64(x: f64) -> Self {
         x as f32
     }
@@ -304,6 +307,7 @@ unsafe impl Num for f32 {
     fn acc_mean(a: f32) -> f32 {
         a * INV_TICKS_F64 as f32
     }
+    #[inline(always)]
     fn coef_from_f64(x: f64) -> Option<f32> {
         x.is_finite().then_some(x as f32)
     }
@@ -319,6 +323,7 @@ unsafe impl Num for f32 {
     fn coef_from_f32(x: f32) -> Option<f32> {
         x.is_finite().then_some(x)
     }
+    #[inline(always)]
     fn scale_from_f64(x: f64) -> Option<f32> {
         x.is_finite().then_some(x as f32)
     }
