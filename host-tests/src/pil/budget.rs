@@ -286,6 +286,35 @@ pub fn regressions(measured: &BTreeMap<String, ImageBudget>, budget: &BTreeMap<S
     v
 }
 
+/// The product image's absolute budgets (issue 14): `Guard::step` ≤ 400
+/// instructions per tick on the mean, `Guard::new` ≤ 100 k, boot stack ≤ 4 KiB,
+/// tick-loop stack ≤ 2 KiB, flash (`.text` + `.rodata`) ≤ 32 KiB.
+pub const PRODUCT_LIMITS: [(&str, f64); 5] = [
+    ("instr_per_tick_mean", 400.0),
+    ("guard_new_instr", 100_000.0),
+    ("stack_boot_b", 4096.0),
+    ("stack_tick_b", 2048.0),
+    ("flash_b", 32768.0),
+];
+
+/// Every [`PRODUCT_LIMITS`] figure of `product-mps2` that is over its limit
+/// or missing, as messages.
+pub fn over_product_limits(measured: &BTreeMap<String, ImageBudget>) -> Vec<String> {
+    let got = measured.get("product-mps2").cloned().unwrap_or_default();
+    let fields = got.fields();
+    PRODUCT_LIMITS
+        .iter()
+        .filter_map(|(key, limit)| {
+            let value = fields.iter().find(|(k, _)| k == key).and_then(|(_, v)| *v);
+            match value {
+                Some(x) if x <= *limit => None,
+                Some(x) => Some(format!("product-mps2.{key}: {x} > the product limit {limit}")),
+                None => Some(format!("product-mps2.{key}: not measured (product limit {limit})")),
+            }
+        })
+        .collect()
+}
+
 /// Arguments of `eha-sim fw-budget`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct BudgetArgs {
@@ -311,11 +340,16 @@ pub fn run(a: &BudgetArgs) -> Result<()> {
     let text = std::fs::read_to_string(&path).with_context(|| format!("reading the budgets {}", path.display()))?;
     let budget: BTreeMap<String, ImageBudget> =
         serde_json::from_str(&text).with_context(|| format!("parsing the budgets {}", path.display()))?;
-    let r = regressions(&measured, &budget);
+    let mut r = over_product_limits(&measured);
+    r.extend(regressions(&measured, &budget));
     if !r.is_empty() {
         bail!("firmware budget exceeded ({}):\n  {}", path.display(), r.join("\n  "));
     }
-    println!("every figure within {} + {:.0} %", path.display(), 100.0 * REGRESSION_MARGIN);
+    println!(
+        "every figure within {} + {:.0} %, and the product image within its limits (400 instr/tick, 100 k init, 4/2 KiB stack, 32 KiB flash)",
+        path.display(),
+        100.0 * REGRESSION_MARGIN
+    );
     Ok(())
 }
 
@@ -343,5 +377,23 @@ mod tests {
         assert!(regressions(&BTreeMap::from([("a".to_string(), b(110.0))]), &budget).is_empty());
         assert_eq!(regressions(&BTreeMap::from([("a".to_string(), b(110.5))]), &budget).len(), 1);
         assert_eq!(regressions(&BTreeMap::new(), &budget).len(), 1, "a budgeted image that was not measured fails");
+    }
+
+    /// The product image's absolute limits: the committed figures pass, one
+    /// byte over 32 KiB of flash fails, a missing figure fails.
+    #[test]
+    fn product_limits_are_absolute() {
+        let ok = ImageBudget {
+            instr_per_tick_mean: Some(355.9),
+            guard_new_instr: Some(61_765.0),
+            stack_boot_b: Some(3056.0),
+            stack_tick_b: Some(1240.0),
+            flash_b: Some(31_132.0),
+            ..Default::default()
+        };
+        let m = |b: ImageBudget| BTreeMap::from([("product-mps2".to_string(), b)]);
+        assert!(over_product_limits(&m(ok.clone())).is_empty());
+        assert_eq!(over_product_limits(&m(ImageBudget { flash_b: Some(32_769.0), ..ok.clone() })).len(), 1);
+        assert_eq!(over_product_limits(&m(ImageBudget { stack_boot_b: None, ..ok })).len(), 1);
     }
 }
