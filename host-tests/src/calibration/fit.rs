@@ -167,6 +167,15 @@ pub fn calibrate(base: &Rig, logs: &[CalLog], o: &CalOptions) -> Result<Calibrat
             _ => None,
         })
         .collect();
+    // 1b. One operating point in every log: losses that differ only in how
+    // they scale with speed and pressure are a single constant heat there;
+    // `pump_friction` stands for the pump's, the others are held.
+    if super::ident::all_one_point(logs) {
+        for name in ["leak_gap", "iron_loss", "winding_r", "needle_split"] {
+            let k = super::set::index(name).expect("calibration parameter");
+            held[k].get_or_insert_with(|| format!("every log has one operating point; would need: {}", PARAMS[k].excitation));
+        }
+    }
     // 2. Screening at the rig file: hold what the data do not identify.
     let cand: Vec<usize> = (0..PARAMS.len()).filter(|&k| held[k].is_none()).collect();
     let (r0, j0) = jacobian_ln(base, logs, &ones, &cand, sigma, &runs)

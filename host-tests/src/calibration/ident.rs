@@ -73,6 +73,22 @@ pub fn spread(run: &crate::measured::MeasuredRun, f: impl Fn(usize) -> Option<f6
 /// Spread below which an input counts as held at one value.
 pub const ONE_POINT_SPREAD: f64 = 0.2;
 
+/// Whether a log holds speed, pressure drop and current each within
+/// [`ONE_POINT_SPREAD`] of one value.
+pub fn one_point(run: &crate::measured::MeasuredRun) -> bool {
+    let col = |c: Channel| run.get(c).map(|v| v.to_vec()).unwrap_or_default();
+    let (sp, pa, pb, cur) = (col(Channel::SpeedRpm), col(Channel::PABar), col(Channel::PBBar), col(Channel::CurrentA));
+    let s_speed = spread(run, |i| sp.get(i).copied().flatten());
+    let s_dp = spread(run, |i| Some((pa.get(i).copied().flatten()? - pb.get(i).copied().flatten()?).abs()));
+    let s_cur = spread(run, |i| cur.get(i).copied().flatten());
+    s_speed.max(s_dp).max(s_cur) < ONE_POINT_SPREAD
+}
+
+/// Whether every log has one operating point ([`one_point`]).
+pub fn all_one_point(logs: &[CalLog]) -> bool {
+    !logs.is_empty() && logs.iter().all(|l| one_point(&l.run))
+}
+
 /// Warnings for logs whose shaft speed, pressure drop and current all stay
 /// within [`ONE_POINT_SPREAD`] of one value (one operating point), and when
 /// no log has any such excitation.
