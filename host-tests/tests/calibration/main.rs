@@ -2,5 +2,6 @@
 //! data of the reference, a truth written independently (the rig
 //! emulator), and the one-operating-point warning.
 
+mod commission;
 mod emulator;
 mod recovery;
