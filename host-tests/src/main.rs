@@ -39,6 +39,10 @@ enum Cmd {
     /// Fault campaign: every sensor, transport, memory and actuator fault in
     /// closed loop with the reference plant; writes out/faults/faults.json.
     Faults(eha_sim::faults::FaultsArgs),
+    /// Commissioning: calibrate the reference model to your rig's logs,
+    /// validate on held-out logs, reduce to firmware parameters and check
+    /// them (rig.toml, params.rs, report.md, PNGs).
+    Commission(eha_sim::calibration::cli::CommissionArgs),
 }
 
 fn main() -> ExitCode {
@@ -55,6 +59,8 @@ fn main() -> ExitCode {
         Cmd::Diagnose(a) => return eha_sim::diagnosis::cli::run(&a),
         Cmd::DiagnoseSweep(a) => return eha_sim::diagnosis::sweep::run(&a),
         Cmd::EmulatorSweep(a) => return eha_sim::diagnosis::emu_sweep::run(&a),
+        // Own exit codes: 0 commissioned, 1 reduced-model check failed, 2 bad input.
+        Cmd::Commission(a) => return eha_sim::calibration::cli::run(&a),
     };
     match res {
         Ok(()) => ExitCode::SUCCESS,

@@ -10,6 +10,7 @@
 //!   pairs) and the one-operating-point warning;
 //! - [`synthetic`]: logs generated from a rig (tests and examples).
 
+pub mod cli;
 pub mod commission;
 pub mod fit;
 pub mod ident;

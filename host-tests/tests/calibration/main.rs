@@ -2,6 +2,7 @@
 //! data of the reference, a truth written independently (the rig
 //! emulator), and the one-operating-point warning.
 
+mod cli;
 mod commission;
 mod emulator;
 mod recovery;
