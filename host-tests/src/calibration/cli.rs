@@ -106,8 +106,6 @@ fn load(args: &CommissionArgs) -> anyhow::Result<Inputs> {
 }
 
 fn headline(c: &Commissioning) -> String {
-    let n = c.cal.rig.clone();
-    let _ = n;
     let h: Vec<String> = c
         .reduced
         .iter()

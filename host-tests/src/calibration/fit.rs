@@ -208,14 +208,12 @@ pub fn calibrate(base: &Rig, logs: &[CalLog], o: &CalOptions) -> Result<Calibrat
         }
         let th = theta_of(z);
         let mut r = data_residuals(base, logs, &th, sigma, &runs)?;
-        let chi2: f64 = r.iter().map(|x| x * x).sum();
         r.extend(free.iter().map(|&k| th[k].ln() / PARAMS[k].prior_sigma_ln));
         let mut b = best.lock().ok()?;
         let total: f64 = r.iter().map(|x| x * x).sum();
         if total < b.0 {
             *b = (total, th);
         }
-        let _ = chi2;
         Some(DVector::from_vec(r))
     };
     if !free.is_empty() {
