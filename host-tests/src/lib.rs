@@ -10,6 +10,7 @@
 //! [`scenario`] (paper cases, missions, replay), [`sim`] (runs and outputs).
 
 pub mod calibrate;
+pub mod calibration;
 pub mod cli;
 pub mod cooling;
 pub mod diagnosis;

@@ -42,6 +42,11 @@ enum Cmd {
     /// Firmware parameter blocks (firmware-params.bin): write one from a rig
     /// file, or run the firmware's boot checks on one.
     ParamsBlock(eha_sim::params_block::ParamsBlockArgs),
+    /// Commissioning: calibrate the reference model to your rig's logs,
+    /// validate on held-out logs, reduce to firmware parameters and check
+    /// them (rig.toml, params.rs, firmware-params.bin, report.md, PNGs);
+    /// `--check firmware-params.bin` runs the firmware's boot checks.
+    Commission(eha_sim::calibration::cli::CommissionArgs),
 }
 
 fn main() -> ExitCode {
@@ -59,6 +64,8 @@ fn main() -> ExitCode {
         Cmd::Diagnose(a) => return eha_sim::diagnosis::cli::run(&a),
         Cmd::DiagnoseSweep(a) => return eha_sim::diagnosis::sweep::run(&a),
         Cmd::EmulatorSweep(a) => return eha_sim::diagnosis::emu_sweep::run(&a),
+        // Own exit codes: 0 commissioned, 1 reduced-model check failed, 2 bad input.
+        Cmd::Commission(a) => return eha_sim::calibration::cli::run(&a),
     };
     match res {
         Ok(()) => ExitCode::SUCCESS,

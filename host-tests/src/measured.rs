@@ -42,10 +42,15 @@ pub enum Channel {
     LngValve,
     /// `air_speed_mps`: ram-air speed over the housings, m/s.
     AirSpeedMps,
+    /// `t_drain_c`: pump drain-port (case) oil temperature, °C — optional
+    /// bench thermocouple for commissioning (not in [`Channel::ALL`], which
+    /// the fault campaign and the generators iterate; see [`Channel::FORMAT`]).
+    TDrainC,
 }
 
 impl Channel {
-    /// Every channel in the column order the writer uses.
+    /// Every channel the fault campaign and the generators know (the format's
+    /// columns without the bench-only `t_drain_c`), in the writer's order.
     pub const ALL: [Channel; 13] = [
         Channel::SpeedRpm,
         Channel::CurrentA,
@@ -60,6 +65,25 @@ impl Channel {
         Channel::TOilC,
         Channel::LngValve,
         Channel::AirSpeedMps,
+    ];
+
+    /// Every column of the format other than `time_s`: [`Channel::ALL`] plus
+    /// the bench-only `t_drain_c`, in the writer's column order.
+    pub const FORMAT: [Channel; 14] = [
+        Channel::SpeedRpm,
+        Channel::CurrentA,
+        Channel::PABar,
+        Channel::PBBar,
+        Channel::AmbientC,
+        Channel::PositionMm,
+        Channel::TMotorC,
+        Channel::TPumpC,
+        Channel::TBlockC,
+        Channel::TBallvalveC,
+        Channel::TOilC,
+        Channel::LngValve,
+        Channel::AirSpeedMps,
+        Channel::TDrainC,
     ];
 
     /// The measured temperature channels (Points 1, 3, 4, 5 and the manifold
@@ -88,12 +112,13 @@ impl Channel {
             Channel::TOilC => "t_oil_c",
             Channel::LngValve => "lng_valve",
             Channel::AirSpeedMps => "air_speed_mps",
+            Channel::TDrainC => "t_drain_c",
         }
     }
 
     /// The channel whose column name is `name` (exact match), if any.
     pub fn from_name(name: &str) -> Option<Channel> {
-        Channel::ALL.into_iter().find(|c| c.name() == name)
+        Channel::FORMAT.into_iter().find(|c| c.name() == name)
     }
 
     /// Unit as printed in the format's table.
@@ -388,7 +413,7 @@ impl MeasuredRun {
     }
 
     /// Writes the run in the measured-data format: metadata, header
-    /// (`time_s` then the present channels in [`Channel::ALL`] order), rows
+    /// (`time_s` then the present channels in [`Channel::FORMAT`] order), rows
     /// with shortest round-trip decimal numbers, empty cells for `None`.
     pub fn write<W: Write>(&self, w: W) -> Result<(), MeasuredError> {
         self.validate("<output>")?;
@@ -402,7 +427,7 @@ impl MeasuredRun {
             }
         }
         let mut cw = csv::WriterBuilder::new().terminator(csv::Terminator::Any(b'\n')).from_writer(w);
-        let cols: Vec<Channel> = Channel::ALL.into_iter().filter(|c| self.channels.contains_key(c)).collect();
+        let cols: Vec<Channel> = Channel::FORMAT.into_iter().filter(|c| self.channels.contains_key(c)).collect();
         let csv_err = |e: csv::Error| MeasuredError::Csv { file: "<output>".into(), line: 0, message: e.to_string() };
         let mut header = vec!["time_s".to_string()];
         header.extend(cols.iter().map(|c| c.name().to_string()));

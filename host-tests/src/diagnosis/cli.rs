@@ -67,6 +67,15 @@ impl Simulator for Progress<'_> {
     fn extension_params(&self, c: super::Candidate) -> Vec<super::ParamSpec> {
         self.inner.extension_params(c)
     }
+    fn physical_set(&self) -> Option<Box<dyn Simulator + '_>> {
+        // The escalated diagnosis runs without the progress bar's counts.
+        self.inner.physical_set()
+    }
+
+    fn nuisance_set_name(&self) -> &'static str {
+        self.inner.nuisance_set_name()
+    }
+
     fn simulate(&self, nuisance: &[f64], c: super::Candidate, ext: &[f64]) -> Result<super::SimSeries, String> {
         if c != super::Candidate::None && !self.candidates.swap(true, std::sync::atomic::Ordering::Relaxed) {
             self.bar.set_message("fitting 7 candidates × 2 starts");

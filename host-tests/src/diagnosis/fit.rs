@@ -15,6 +15,10 @@ use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
 use nalgebra::{storage::Owned, DMatrix, DVector, Dyn};
 use rayon::prelude::*;
 
+/// Data σ, K, against which the prior rows of [`ParamSpec::prior_sigma_ln`]
+/// are weighed (the calibration's default, `CalOptions::sigma_data_k`).
+pub const PRIOR_DATA_SIGMA_K: f64 = 0.2;
+
 /// One residual point: channel and row index into the measured run.
 pub type Point = (Channel, usize);
 
@@ -92,7 +96,12 @@ impl Problem<'_> {
         }
         let v = self.values(x);
         let s = self.sim.simulate(&v[..self.n_nuis], self.cand, &v[self.n_nuis..]).ok()?;
-        let r = residuals_at(self.run, &s, self.points)?;
+        let mut r = residuals_at(self.run, &s, self.points)?;
+        for (v, sp) in v.iter().zip(&self.specs) {
+            if let Some(sig) = sp.prior_sigma_ln {
+                r.push(PRIOR_DATA_SIGMA_K * (v / sp.start).ln() / sig);
+            }
+        }
         r.iter().all(|x| x.is_finite()).then(|| (DVector::from_vec(r), s))
     }
 }
@@ -187,6 +196,9 @@ pub fn fit(
         .zip(&specs)
         .map(|(v, s)| to_internal(*v, s).clamp(-1.5, 1.5))
         .collect();
+    // A budget of at least ~6 Jacobians: the calibration set has up to 18
+    // parameters (80 runs were enough for the former 4 multipliers).
+    let opts = FitOptions { max_sims: opts.max_sims.max(6 * (specs.len() + 1)), ..opts };
     let mut p = Problem {
         sim,
         run,
@@ -207,8 +219,10 @@ pub fn fit(
         .with_xtol(1e-4)
         .with_patience(opts.max_sims.max(1))
         .minimize(p);
-    let (rss, x, series) = p.best.clone()?;
+    let (_, x, series) = p.best.clone()?;
     let v = p.values(&x);
+    // The data part only (BIC and RMSEs compare fits on the data).
+    let rss = residuals_at(run, &series, points)?.iter().map(|e| e * e).sum();
     Some(FitResult {
         candidate: cand,
         nuisance: v[..n_nuis].to_vec(),

@@ -79,12 +79,22 @@ pub struct ParamSpec {
     pub lo: f64,
     /// Upper bound.
     pub hi: f64,
+    /// Prior towards `start`: standard deviation of ln(value/start). With a
+    /// prior the fit adds the row σ_d·ln(value/start)/σ to its residuals
+    /// (σ_d = [`super::fit::PRIOR_DATA_SIGMA_K`]); `None` = no prior.
+    pub prior_sigma_ln: Option<f64>,
 }
 
 impl ParamSpec {
     /// A parameter spec with `start` inside `[lo, hi]`, all > 0.
     pub fn new(name: &str, unit: &str, start: f64, lo: f64, hi: f64) -> Self {
-        ParamSpec { name: name.into(), unit: unit.into(), start, lo, hi }
+        ParamSpec { name: name.into(), unit: unit.into(), start, lo, hi, prior_sigma_ln: None }
+    }
+
+    /// The same spec with a prior of width `sigma_ln` (in ln) towards `start`.
+    pub fn with_prior(mut self, sigma_ln: f64) -> Self {
+        self.prior_sigma_ln = Some(sigma_ln);
+        self
     }
 }
 
@@ -109,4 +119,15 @@ pub trait Simulator: Sync {
     /// Runs the model with candidate `c` switched on, returning the series
     /// at the measured times, or a message when the model fails.
     fn simulate(&self, nuisance: &[f64], c: Candidate, ext: &[f64]) -> Result<SimSeries, String>;
+    /// The same model with the per-node physical calibration set
+    /// (`eha_sim::calibration`) as its nuisance set, to which the diagnosis
+    /// escalates when the calibrated baseline misfits; `None` when the model
+    /// has none or already uses it.
+    fn physical_set(&self) -> Option<Box<dyn Simulator + '_>> {
+        None
+    }
+    /// Name of the nuisance set in reports (`global` or `physical`).
+    fn nuisance_set_name(&self) -> &'static str {
+        "global"
+    }
 }

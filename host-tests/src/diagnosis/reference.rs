@@ -1,8 +1,11 @@
 //! The reference simulation (`eha_sim::sim`) as a [`Simulator`]: replay of
-//! the measured inputs, the rig's four nuisance multipliers as the
-//! calibrated set, and one parameter per candidate extension.
+//! the measured inputs, two nuisance sets (the rig's four global
+//! multipliers first; the physical calibration set of
+//! [`crate::calibration`] when the diagnosis escalates), and one parameter
+//! per candidate extension.
 
 use super::model::{Candidate, ParamSpec, SimSeries, Simulator};
+use crate::calibration::{self, set::Needs};
 use crate::measured::{Channel, MeasuredRun};
 use crate::rig::Rig;
 use crate::scenario::{ReplayInputs, Scenario};
@@ -44,14 +47,18 @@ pub fn replay_inputs(run: &MeasuredRun, name: &str) -> Result<ReplayInputs, Refe
 
 /// The reference model driven by one measured run.
 ///
-/// Nuisance set (calibrated on every fit, log-space, within a factor 2 of
-/// the rig file — the prior a thermal engineer has on a new rig):
+/// Global nuisance set (the first tier; log-space, within a factor 2 of
+/// the rig file):
 /// `outer_scale` (free convection + radiation conductances), `inner_scale`
 /// (oil-to-metal conductances), `metal_capacity_scale`,
 /// `oil_capacity_scale` (see `eha_sim::rig::Nuisance`). A richer set (per
 /// component capacities, 6 parameters) was tried and rejected: it absorbs
 /// the effects themselves (forced convection, viscosity and churning were
-/// then no longer identified).
+/// then no longer identified). The physical set ([`nuisance_set`], bounds
+/// and priors of [`crate::calibration::PARAMS`]) is the second tier, used
+/// when the global baseline misfits ([`Simulator::physical_set`]); it
+/// absorbs churning, forced convection and motor–pump conduction on the
+/// synthetic cases, hence not from the start.
 ///
 /// Candidate parameters (ranges are the physically plausible ones):
 /// `alpha_per_k` 1e-4…1e-2 1/K (copper 3.9e-3; a fit at the upper bound
@@ -63,6 +70,12 @@ pub fn replay_inputs(run: &MeasuredRun, name: &str) -> Result<ReplayInputs, Refe
 /// 0.01…50 W/K, `air_speed_mps` 0.2…40 m/s.
 pub struct ReferenceModel {
     rig: Rig,
+    /// Indices into [`crate::calibration::PARAMS`] of the physical set for
+    /// this run ([`nuisance_set`]).
+    free: Vec<usize>,
+    /// Whether the nuisance set is the physical set (else the four global
+    /// multipliers).
+    physical: bool,
     scenario: Scenario,
     times: Vec<f64>,
     opts: SimOptions,
@@ -80,7 +93,8 @@ impl ReferenceModel {
         // far below the 0.1 K sensor noise.
         let dt = (span / 400.0).clamp(0.5, 5.0);
         let opts = SimOptions { output_interval_s: dt, control_interval_s: dt };
-        let m = ReferenceModel { rig, scenario: Scenario::Replay(inputs), times: run.time_s.clone(), opts };
+        let free = nuisance_set(run);
+        let m = ReferenceModel { rig, free, physical: false, scenario: Scenario::Replay(inputs), times: run.time_s.clone(), opts };
         let n: Vec<f64> = m.nuisance().iter().map(|p| p.start).collect();
         m.simulate(&n, Candidate::None, &[]).map_err(ReferenceError::Model)?;
         Ok(m)
@@ -88,11 +102,20 @@ impl ReferenceModel {
 
     /// The rig with nuisance values `nuis` and candidate `c` at `ext`.
     pub fn rig_for(&self, nuis: &[f64], c: Candidate, ext: &[f64]) -> Rig {
-        let mut r = self.rig.clone();
-        r.nuisance.outer_scale = nuis[0];
-        r.nuisance.inner_scale = nuis[1];
-        r.nuisance.metal_capacity_scale = nuis[2];
-        r.nuisance.oil_capacity_scale = nuis[3];
+        let mut r = if self.physical {
+            let mut theta = calibration::set::nominal();
+            for (&k, &v) in self.free.iter().zip(nuis) {
+                theta[k] = v;
+            }
+            calibration::apply(&self.rig, &theta)
+        } else {
+            let mut r = self.rig.clone();
+            r.nuisance.outer_scale = nuis[0];
+            r.nuisance.inner_scale = nuis[1];
+            r.nuisance.metal_capacity_scale = nuis[2];
+            r.nuisance.oil_capacity_scale = nuis[3];
+            r
+        };
         let e = &mut r.ext;
         let x = ext.first().copied();
         match c {
@@ -109,6 +132,29 @@ impl ReferenceModel {
     }
 }
 
+/// The calibration parameters (indices into [`calibration::PARAMS`]) the
+/// diagnosis calibrates on `run`: those whose sensor is among the
+/// diagnosis's channels ([`Channel::TEMPERATURES`], logged), without the
+/// loss coefficients that only speed and pressure steps separate when the
+/// run has one operating point (the calibration's rule), and without the
+/// needle split on servo runs (no throttling).
+pub fn nuisance_set(run: &MeasuredRun) -> Vec<usize> {
+    let logged = |ch: Channel| Channel::TEMPERATURES.contains(&ch) && run.get(ch).is_some_and(|v| v.iter().any(Option::is_some));
+    let one_point = calibration::ident::one_point(run);
+    let servo = run.get(Channel::PositionMm).is_some();
+    calibration::PARAMS
+        .iter()
+        .enumerate()
+        .filter(|(_, d)| match d.needs {
+            Needs::Sensor(ch) => logged(ch),
+            Needs::Nothing => true,
+        })
+        .filter(|(_, d)| !(one_point && ["leak_gap", "iron_loss", "winding_r", "needle_split"].contains(&d.name)))
+        .filter(|(_, d)| !(servo && d.name == "needle_split"))
+        .map(|(k, _)| k)
+        .collect()
+}
+
 /// Relative tolerance of the solver in the diagnosis replays. Measured
 /// against 1e-7 on 1200 s synthetic logs: max temperature error 1.4e-2 K on
 /// a servo log at 0.1 s (15.6 k steps; 1.6e-3 K and 28 k steps at the
@@ -123,14 +169,40 @@ const INTERNALS: [&str; 5] = ["t_winding_c", "t_drain_c", "t_motor_c", "t_pump_c
 
 impl Simulator for ReferenceModel {
     fn nuisance(&self) -> Vec<ParamSpec> {
-        let n = &self.rig.nuisance;
-        let p = |name: &str, v: f64| ParamSpec::new(name, "1", v, v / 2.0, v * 2.0);
-        vec![
-            p("outer_scale", n.outer_scale),
-            p("inner_scale", n.inner_scale),
-            p("metal_capacity_scale", n.metal_capacity_scale),
-            p("oil_capacity_scale", n.oil_capacity_scale),
-        ]
+        if !self.physical {
+            let n = &self.rig.nuisance;
+            let p = |name: &str, v: f64| ParamSpec::new(name, "1", v, v / 2.0, v * 2.0);
+            return vec![
+                p("outer_scale", n.outer_scale),
+                p("inner_scale", n.inner_scale),
+                p("metal_capacity_scale", n.metal_capacity_scale),
+                p("oil_capacity_scale", n.oil_capacity_scale),
+            ];
+        }
+        self.free
+            .iter()
+            .map(|&k| {
+                let d = &calibration::PARAMS[k];
+                ParamSpec::new(d.name, "1", 1.0, d.lo, d.hi).with_prior(d.prior_sigma_ln)
+            })
+            .collect()
+    }
+
+    fn physical_set(&self) -> Option<Box<dyn Simulator + '_>> {
+        (!self.physical).then(|| {
+            Box::new(ReferenceModel {
+                rig: self.rig.clone(),
+                free: self.free.clone(),
+                physical: true,
+                scenario: self.scenario.clone(),
+                times: self.times.clone(),
+                opts: self.opts,
+            }) as Box<dyn Simulator>
+        })
+    }
+
+    fn nuisance_set_name(&self) -> &'static str {
+        if self.physical { "physical" } else { "global" }
     }
 
     fn extension_params(&self, c: Candidate) -> Vec<ParamSpec> {

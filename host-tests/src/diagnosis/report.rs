@@ -192,7 +192,7 @@ pub fn report_markdown(d: &Diagnosis, source: &str, pngs: &[String]) -> String {
     metrics_table(&mut s, "Baseline at nominal parameters", &d.nominal);
     metrics_table(&mut s, "Calibrated baseline (before)", &d.before);
     metrics_table(&mut s, &format!("With `{}` (after)", d.cause.name()), &d.after);
-    let _ = writeln!(s, "\n## Calibrated nuisance parameters\n\n| parameter | before | after | unit |\n|---|---:|---:|---|");
+    let _ = writeln!(s, "\n## Calibrated nuisance parameters (set: {})\n\n| parameter | before | after | unit |\n|---|---:|---:|---|", d.nuisance_set);
     for ((n, b, u), (_, a, _)) in d.nuisance_before.iter().zip(&d.nuisance_after) {
         let _ = writeln!(s, "| `{n}` | {b:.4} | {a:.4} | {u} |");
     }

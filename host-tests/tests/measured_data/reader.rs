@@ -148,3 +148,25 @@ fn round_trip_is_lossless() {
     bad.channels.get_mut(&Channel::TOilC).unwrap()[0] = Some(f64::NAN);
     assert!(bad.write(Vec::new()).is_err());
 }
+
+/// The optional bench column `t_drain_c` (issue 18): read as
+/// `Channel::TDrainC`, range-checked like every temperature (−60…250 °C,
+/// error naming file, line and column) and written back in the format's
+/// column order.
+#[test]
+fn reads_and_writes_optional_drain_column() {
+    let text = "time_s,speed_rpm,current_a,p_a_bar,p_b_bar,ambient_c,t_oil_c,t_drain_c\n\
+                0.0,500,12.5,60,1,16,20.0,21.5\n\
+                1.0,500,12.5,60,1,16,20.1,\n";
+    let run = MeasuredRun::from_str_named("bench.csv", text).expect("drain column accepted");
+    assert_eq!(run.get(Channel::TDrainC).expect("drain"), &[Some(21.5), None]);
+    assert!(run.notes.is_empty(), "not an unknown column: {:?}", run.notes);
+    let mut out = Vec::new();
+    run.write(&mut out).expect("write");
+    let back = MeasuredRun::from_str_named("back.csv", std::str::from_utf8(&out).expect("utf8")).expect("read back");
+    assert_eq!(back.get(Channel::TDrainC), run.get(Channel::TDrainC));
+    let bad = text.replace("21.5", "300");
+    let e = MeasuredRun::from_str_named("bench.csv", &bad).expect_err("out of range");
+    let msg = e.to_string();
+    assert!(msg.contains("bench.csv:2") && msg.contains("t_drain_c"), "{msg}");
+}

@@ -1,0 +1,167 @@
+//! Commissioning (issue 18): calibrate the reference model to a team's
+//! training logs, validate on held-out logs, reduce the commissioned rig to
+//! firmware parameters and check the reduced model against the
+//! commissioned reference, and against the measured drain temperature when
+//! the logs carry `t_drain_c`.
+
+use super::fit::{calibrate, CalError, CalOptions, Calibration};
+use super::log::{channel_errors, CalLog, ChannelError};
+use crate::diagnosis::reference::replay_inputs;
+use crate::measured::Channel;
+use crate::plant::{Control, Plant, Sensors};
+use crate::reduce::reduce;
+use crate::rig::Rig;
+use crate::scenario::Scenario;
+use eha_guard::model::{Model, ModelInputN, ReducedParams, HA_PER_A, HBAR_PER_BAR, HRADS_PER_RPM};
+
+/// Bound of the reduced model against the commissioned reference on every
+/// log's inputs, drain max |e|, K (issue 18).
+pub const REDUCED_BOUND_K: f64 = 0.2;
+
+/// The reduced model (firmware parameters `p`, f64) on one log's inputs.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct ReducedCheck {
+    /// Log name.
+    pub log: String,
+    /// Max |reduced − reference| drain, K (reference = the rig it was reduced from).
+    pub vs_reference_max_k: f64,
+    /// Largest under-prediction of the reference drain (reference − reduced), K.
+    pub vs_reference_under_k: f64,
+    /// Max |reduced − measured| drain, K, when the log has `t_drain_c`.
+    pub vs_measured_max_k: Option<f64>,
+    /// Largest under-prediction of the measured drain (measured − reduced), K.
+    pub vs_measured_under_k: Option<f64>,
+    /// RMSE against the measured drain, K.
+    pub vs_measured_rmse_k: Option<f64>,
+}
+
+/// Runs the reference on `rig` replaying `log`'s inputs at the firmware's
+/// 10 ms tick and feeds the same signals to the reduced model `p` exactly as
+/// the guard does (tick accumulation, 100 ms model step; the logged LNG
+/// valve, if any, is the exchanger command). Errors compare the reduced
+/// drain estimate with the reference's case-oil node and with the measured
+/// `t_drain_c` (interpolated to the tick; only where samples exist).
+pub fn check_reduced(rig: &Rig, p: &ReducedParams, log: &CalLog) -> Result<ReducedCheck, String> {
+    let inputs = replay_inputs(&log.run, &log.name).map_err(|e| e.to_string())?;
+    let t_end = log.run.time_s[log.run.len() - 1];
+    let mut plant = Plant::new(rig, &Scenario::Replay(inputs)).map_err(|e| e.to_string())?;
+    let mut m = Model::<f64>::new(p).map_err(|e| format!("reduced model rejects the parameters: {e:?}"))?;
+    let (mut k, mut prev_x, mut max_ref, mut under_ref) = (0usize, 0.0, 0.0f64, 0.0f64);
+    let (mut max_meas, mut under, mut ss, mut n) = (0.0f64, 0.0f64, 0.0, 0usize);
+    let has_drain = log.has(Channel::TDrainC);
+    let mut open = false;
+    plant
+        .run(0.01, t_end, |snap| {
+            let s = Sensors::from(snap);
+            if k == 0 {
+                m.set_uniform(s.ambient_c);
+                prev_x = s.position_mm;
+            }
+            let est = m.drain_c();
+            max_ref = max_ref.max((est - s.t_drain_c).abs());
+            under_ref = under_ref.max(s.t_drain_c - est);
+            if has_drain && k > 0 {
+                if let Some(meas) = log.run.value_at(Channel::TDrainC, s.t) {
+                    let e = est - meas;
+                    max_meas = max_meas.max(e.abs());
+                    under = under.max(-e);
+                    ss += e * e;
+                    n += 1;
+                }
+            }
+            let u = ModelInputN {
+                current_ha: s.current_a * HA_PER_A,
+                p_a_hbar: s.p_a_bar * HBAR_PER_BAR,
+                p_b_hbar: s.p_b_bar * HBAR_PER_BAR,
+                speed_hrads: s.speed_rpm * HRADS_PER_RPM,
+                dpos_mm: s.position_mm - prev_x,
+                ambient_c: s.ambient_c,
+            };
+            prev_x = s.position_mm;
+            if m.tick_n(&u) {
+                m.update(if open { 10 } else { 0 });
+            }
+            open = log.run.value_at(Channel::LngValve, s.t).is_some_and(|v| v >= 0.5);
+            k += 1;
+            Ok(Control { lng_valve: Some(open), stop: false })
+        })
+        .map_err(|e| e.to_string())?;
+    let meas = |x: f64| has_drain.then_some(x);
+    Ok(ReducedCheck {
+        log: log.name.clone(),
+        vs_reference_max_k: max_ref,
+        vs_reference_under_k: under_ref,
+        vs_measured_max_k: meas(max_meas),
+        vs_measured_under_k: meas(under),
+        vs_measured_rmse_k: meas((ss / n.max(1) as f64).sqrt()),
+    })
+}
+
+/// Errors of the reference on one held-out log, before and after commissioning.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct HoldoutScore {
+    /// Log name.
+    pub log: String,
+    /// Per channel with the rig as given.
+    pub as_given: Vec<ChannelError>,
+    /// Per channel with the commissioned rig.
+    pub commissioned: Vec<ChannelError>,
+}
+
+/// Everything commissioning produces.
+#[derive(Debug, Clone)]
+pub struct Commissioning {
+    /// The calibration (commissioned rig inside).
+    pub cal: Calibration,
+    /// Held-out scores of the reference.
+    pub holdout: Vec<HoldoutScore>,
+    /// Firmware parameters reduced from the commissioned rig.
+    pub params: ReducedParams,
+    /// Reduced model vs the commissioned reference on every log (training
+    /// then held-out).
+    pub reduced: Vec<ReducedCheck>,
+    /// The paper-default firmware parameters (the compiled-in `DEFAULT`) on
+    /// the held-out logs, for comparison.
+    pub default_on_holdout: Vec<ReducedCheck>,
+    /// Whether every reduced check is within [`REDUCED_BOUND_K`].
+    pub reduced_ok: bool,
+}
+
+/// Errors of commissioning.
+#[derive(Debug, thiserror::Error)]
+pub enum CommissionError {
+    /// The calibration failed.
+    #[error(transparent)]
+    Cal(#[from] CalError),
+    /// The commissioned rig cannot be reduced to firmware parameters.
+    #[error("the commissioned rig gives firmware parameters the firmware model rejects")]
+    Reduce,
+    /// A model run failed.
+    #[error("{0}")]
+    Run(String),
+}
+
+/// Commissions `base` on `train`, validates on `holdout`.
+pub fn commission(base: &Rig, train: &[CalLog], holdout: &[CalLog], o: &CalOptions) -> Result<Commissioning, CommissionError> {
+    let cal = calibrate(base, train, o)?;
+    let mut scores = Vec::new();
+    for l in holdout {
+        let a = l.simulate(base).map_err(CommissionError::Run)?;
+        let b = l.simulate(&cal.rig).map_err(CommissionError::Run)?;
+        scores.push(HoldoutScore { log: l.name.clone(), as_given: channel_errors(l, &a), commissioned: channel_errors(l, &b) });
+    }
+    let params = reduce(&cal.rig).ok_or(CommissionError::Reduce)?;
+    let reduced: Vec<ReducedCheck> = train
+        .iter()
+        .chain(holdout)
+        .map(|l| check_reduced(&cal.rig, &params, l))
+        .collect::<Result<_, _>>()
+        .map_err(CommissionError::Run)?;
+    let default_on_holdout = holdout
+        .iter()
+        .map(|l| check_reduced(&cal.rig, &eha_guard::params::DEFAULT, l))
+        .collect::<Result<_, _>>()
+        .map_err(CommissionError::Run)?;
+    let reduced_ok = reduced.iter().all(|r| r.vs_reference_max_k <= REDUCED_BOUND_K);
+    Ok(Commissioning { cal, holdout: scores, params, reduced, default_on_holdout, reduced_ok })
+}

@@ -1,0 +1,269 @@
+//! Joint least-squares fit of the calibration set to several logs:
+//! identifiability screening at the rig file, Levenberg–Marquardt on the
+//! identifiable parameters with prior rows towards the rig file, and the
+//! identifiability report at the optimum.
+//!
+//! Objective: Σ_logs Σ_points ((sim − meas)/σ_d)² + Σ_k (ln θ_k / σ_k)²,
+//! σ_d = [`CalOptions::sigma_data_k`] (sensor noise plus model structure),
+//! σ_k the prior width of [`super::set::PARAMS`]. Bounds: the MINUIT
+//! transform ln θ = ln lo + (ln hi − ln lo)(1 + sin z)/2, as in the
+//! diagnosis fits.
+
+use super::ident::{excitation_warnings, identifiability, Identifiability};
+use super::log::CalLog;
+use super::set::{apply, Needs, PARAMS};
+use crate::lsq::FdProblem;
+use crate::rig::Rig;
+use levenberg_marquardt::LevenbergMarquardt;
+use nalgebra::{DMatrix, DVector};
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
+
+/// Settings of a calibration.
+#[derive(Debug, Clone, Copy)]
+pub struct CalOptions {
+    /// Data σ, K: residuals are divided by it. 0.2 K = the 0.1 K sensor
+    /// noise plus as much again for model structure the set cannot remove.
+    pub sigma_data_k: f64,
+    /// Fit points per channel and log.
+    pub points_per_channel: usize,
+    /// Budget of residual evaluations of the LM fit (Jacobian columns
+    /// included; one evaluation runs the model once per log).
+    pub max_evals: usize,
+    /// A parameter is held at its rig value when the data reduce its prior
+    /// standard deviation by less than this factor (posterior/prior sd >
+    /// `hold_ratio`): the logs cannot identify it.
+    pub hold_ratio: f64,
+    /// |correlation| at or above which a pair is reported.
+    pub corr_threshold: f64,
+}
+
+impl Default for CalOptions {
+    fn default() -> Self {
+        CalOptions { sigma_data_k: 0.2, points_per_channel: 120, max_evals: 600, hold_ratio: 0.7, corr_threshold: 0.9 }
+    }
+}
+
+/// Status of one parameter after calibration.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub enum Status {
+    /// Fitted.
+    Fitted,
+    /// Held at the rig value: the reason.
+    Held(String),
+}
+
+/// One parameter's outcome.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct ParamResult {
+    /// Parameter name ([`super::set::PARAMS`]).
+    pub name: String,
+    /// Multiplier on the rig file.
+    pub value: f64,
+    /// Approximate 95 % interval of the multiplier (linearised, prior
+    /// included, inflated by the reduced χ² when above 1); the value itself
+    /// for held parameters.
+    pub interval95: (f64, f64),
+    /// Whether it ended within 1 % (in ln) of a bound.
+    pub at_bound: bool,
+    /// Fitted or held (with the reason and the excitation that would identify it).
+    pub status: Status,
+}
+
+/// Outcome of a calibration.
+#[derive(Debug, Clone)]
+pub struct Calibration {
+    /// Multipliers for every [`PARAMS`] entry (1 = held at the rig file).
+    pub theta: Vec<f64>,
+    /// Per parameter.
+    pub params: Vec<ParamResult>,
+    /// The calibrated rig.
+    pub rig: Rig,
+    /// Data part of the objective (Σ (r/σ_d)²) at the rig file and at the end.
+    pub chi2_before_after: (f64, f64),
+    /// Number of data points.
+    pub n_points: usize,
+    /// Model runs spent (one per log per evaluation).
+    pub model_runs: usize,
+    /// Identifiability at the optimum (fitted parameters).
+    pub ident: Identifiability,
+    /// Warnings: logs with one operating point, parameters nothing identifies.
+    pub warnings: Vec<String>,
+}
+
+/// Errors of a calibration.
+#[derive(Debug, thiserror::Error)]
+pub enum CalError {
+    /// No log given.
+    #[error("no training log")]
+    NoLogs,
+    /// The model does not run on a log with the rig as given.
+    #[error("reference model fails on {0}: {1}")]
+    Model(String, String),
+}
+
+fn to_ln(z: f64, d: &super::set::ParamDef) -> f64 {
+    d.lo.ln() + (d.hi / d.lo).ln() * 0.5 * (1.0 + z.sin())
+}
+
+fn to_z(ln: f64, d: &super::set::ParamDef) -> f64 {
+    let u = ((ln - d.lo.ln()) / (d.hi / d.lo).ln()).clamp(0.0, 1.0);
+    (2.0 * u - 1.0).asin().clamp(-1.5, 1.5)
+}
+
+/// Scaled data residuals of every log at full multiplier vector `theta`.
+fn data_residuals(base: &Rig, logs: &[CalLog], theta: &[f64], sigma: f64, runs: &AtomicUsize) -> Option<Vec<f64>> {
+    let rig = apply(base, theta);
+    let parts: Option<Vec<Vec<f64>>> = logs
+        .par_iter()
+        .map(|l| {
+            runs.fetch_add(1, Ordering::Relaxed);
+            let s = l.simulate(&rig).ok()?;
+            let r = l.residuals(&s);
+            r.iter().all(|x| x.is_finite()).then(|| r.into_iter().map(|x| x / sigma).collect())
+        })
+        .collect();
+    Some(parts?.concat())
+}
+
+/// Jacobian of the scaled data residuals with respect to ln θ of the
+/// parameters `idx`, at `theta` (forward differences of 0.05 in ln θ,
+/// stepping inwards from an upper bound).
+pub(crate) fn jacobian_ln(base: &Rig, logs: &[CalLog], theta: &[f64], idx: &[usize], sigma: f64, runs: &AtomicUsize) -> Option<(DVector<f64>, DMatrix<f64>)> {
+    let r0 = DVector::from_vec(data_residuals(base, logs, theta, sigma, runs)?);
+    let cols: Option<Vec<DVector<f64>>> = idx
+        .par_iter()
+        .map(|&k| {
+            let d = &PARAMS[k];
+            let h = if (theta[k].ln() + 0.05) > d.hi.ln() { -0.05 } else { 0.05 };
+            let mut th = theta.to_vec();
+            th[k] = (theta[k].ln() + h).exp();
+            let r = DVector::from_vec(data_residuals(base, logs, &th, sigma, runs)?);
+            Some((r - &r0) / h)
+        })
+        .collect();
+    Some((r0.clone(), DMatrix::from_columns(&cols?)))
+}
+
+/// Calibrates the set on `logs` starting from (and regularised towards) `base`.
+pub fn calibrate(base: &Rig, logs: &[CalLog], o: &CalOptions) -> Result<Calibration, CalError> {
+    if logs.is_empty() {
+        return Err(CalError::NoLogs);
+    }
+    let runs = AtomicUsize::new(0);
+    let sigma = o.sigma_data_k;
+    let ones = super::set::nominal();
+    for l in logs {
+        l.simulate(base).map_err(|e| CalError::Model(l.name.clone(), e))?;
+    }
+    // 1. Which parameters have the sensor they need in at least one log.
+    let mut held: Vec<Option<String>> = PARAMS
+        .iter()
+        .map(|d| match d.needs {
+            Needs::Sensor(ch) if !logs.iter().any(|l| l.has(ch)) => {
+                Some(format!("no log carries `{}`; would need: {}", ch.name(), d.excitation))
+            }
+            _ => None,
+        })
+        .collect();
+    // 1b. One operating point in every log: losses that differ only in how
+    // they scale with speed and pressure are a single constant heat there;
+    // `pump_friction` stands for the pump's, the others are held.
+    if super::ident::all_one_point(logs) {
+        for name in ["leak_gap", "iron_loss", "winding_r", "needle_split"] {
+            let k = super::set::index(name).expect("calibration parameter");
+            held[k].get_or_insert_with(|| format!("every log has one operating point; would need: {}", PARAMS[k].excitation));
+        }
+    }
+    // 2. Screening at the rig file: hold what the data do not identify.
+    let cand: Vec<usize> = (0..PARAMS.len()).filter(|&k| held[k].is_none()).collect();
+    let (r0, j0) = jacobian_ln(base, logs, &ones, &cand, sigma, &runs)
+        .ok_or_else(|| CalError::Model("a perturbed rig".into(), "model failed in the screening Jacobian".into()))?;
+    let chi2_before = r0.norm_squared();
+    let pre = identifiability(&j0, &cand, &ones, 1.0, o.corr_threshold);
+    for (j, &k) in cand.iter().enumerate() {
+        if pre.posterior_over_prior[j] > o.hold_ratio {
+            held[k] = Some(format!(
+                "the logs reduce its prior uncertainty only to {:.0} %; would need: {}",
+                100.0 * pre.posterior_over_prior[j],
+                PARAMS[k].excitation
+            ));
+        }
+    }
+    let free: Vec<usize> = (0..PARAMS.len()).filter(|&k| held[k].is_none()).collect();
+    // 3. LM on the free parameters (internal z), data rows + prior rows.
+    let best: Mutex<(f64, Vec<f64>)> = Mutex::new((f64::INFINITY, ones.clone()));
+    let theta_of = |z: &[f64]| -> Vec<f64> {
+        let mut th = ones.clone();
+        for (j, &k) in free.iter().enumerate() {
+            th[k] = to_ln(z[j], &PARAMS[k]).exp();
+        }
+        th
+    };
+    let budget = o.max_evals * logs.len();
+    let residual = |z: &[f64]| -> Option<DVector<f64>> {
+        if runs.load(Ordering::Relaxed) > budget + (cand.len() + 1) * logs.len() {
+            return None;
+        }
+        let th = theta_of(z);
+        let mut r = data_residuals(base, logs, &th, sigma, &runs)?;
+        r.extend(free.iter().map(|&k| th[k].ln() / PARAMS[k].prior_sigma_ln));
+        let mut b = best.lock().ok()?;
+        let total: f64 = r.iter().map(|x| x * x).sum();
+        if total < b.0 {
+            *b = (total, th);
+        }
+        Some(DVector::from_vec(r))
+    };
+    if !free.is_empty() {
+        let z0 = DVector::from_vec(free.iter().map(|&k| to_z(0.0, &PARAMS[k])).collect());
+        let p = FdProblem::new(&residual, z0, 0.02);
+        let _ = LevenbergMarquardt::new().with_ftol(1e-6).with_xtol(1e-5).with_patience((o.max_evals / (free.len() + 1)).max(2)).minimize(p);
+    }
+    let theta = best.into_inner().map(|b| b.1).unwrap_or(ones.clone());
+    // 4. Identifiability at the optimum.
+    let (r1, j1) = jacobian_ln(base, logs, &theta, &free, sigma, &runs)
+        .ok_or_else(|| CalError::Model("the calibrated rig".into(), "model failed in the final Jacobian".into()))?;
+    let chi2_after = r1.norm_squared();
+    let n = r1.len();
+    let s2 = (chi2_after / (n.saturating_sub(free.len()).max(1)) as f64).max(1.0);
+    let ident = identifiability(&j1, &free, &theta, s2, o.corr_threshold);
+    let params = PARAMS
+        .iter()
+        .enumerate()
+        .map(|(k, d)| {
+            let ln = theta[k].ln();
+            let at_bound = (ln - d.lo.ln()).abs() < 0.01 || (d.hi.ln() - ln).abs() < 0.01;
+            match &held[k] {
+                Some(why) => ParamResult { name: d.name.into(), value: 1.0, interval95: (1.0, 1.0), at_bound: false, status: Status::Held(why.clone()) },
+                None => {
+                    let j = free.iter().position(|&f| f == k).unwrap_or(0);
+                    let sd = ident.sd_ln[j];
+                    ParamResult {
+                        name: d.name.into(),
+                        value: theta[k],
+                        interval95: ((ln - 1.96 * sd).exp(), (ln + 1.96 * sd).exp()),
+                        at_bound,
+                        status: Status::Fitted,
+                    }
+                }
+            }
+        })
+        .collect();
+    let mut warnings = excitation_warnings(logs);
+    let unident: Vec<&str> = (0..PARAMS.len()).filter(|&k| held[k].is_some()).map(|k| PARAMS[k].name).collect();
+    if !warnings.is_empty() && !unident.is_empty() {
+        warnings.push(format!("held at the rig file (not identifiable from these logs): {}", unident.join(", ")));
+    }
+    Ok(Calibration {
+        rig: apply(base, &theta),
+        theta,
+        params,
+        chi2_before_after: (chi2_before, chi2_after),
+        n_points: n,
+        model_runs: runs.load(Ordering::Relaxed),
+        ident,
+        warnings,
+    })
+}

@@ -1,0 +1,122 @@
+//! Identifiability of the calibration set from the scaled Jacobian
+//! (residuals / σ_d with respect to ln θ): singular values, linearised
+//! posterior standard deviations with the prior, strongly correlated pairs;
+//! and the excitation check of each log (one operating point).
+
+use super::log::CalLog;
+use super::set::PARAMS;
+use crate::measured::Channel;
+use nalgebra::{DMatrix, DVector};
+
+/// Identifiability of the parameters `idx` at one point.
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
+pub struct Identifiability {
+    /// Parameter names, in column order.
+    pub names: Vec<String>,
+    /// Singular values of the scaled data Jacobian, largest first.
+    pub singular_values: Vec<f64>,
+    /// Posterior standard deviation of ln θ (prior included, times √s²).
+    pub sd_ln: Vec<f64>,
+    /// Posterior over prior standard deviation, without the s² inflation:
+    /// near 1 = the data add nothing to the prior.
+    pub posterior_over_prior: Vec<f64>,
+    /// Pairs with |posterior correlation| ≥ the threshold: (a, b, ρ).
+    pub correlated: Vec<(String, String, f64)>,
+}
+
+/// Identifiability from the scaled data Jacobian `j` (columns = `idx`,
+/// derivatives in ln θ), the prior widths of [`PARAMS`], residual variance
+/// factor `s2` (≥ 1) and the correlation threshold.
+pub fn identifiability(j: &DMatrix<f64>, idx: &[usize], _theta: &[f64], s2: f64, corr_threshold: f64) -> Identifiability {
+    let p = idx.len();
+    let names: Vec<String> = idx.iter().map(|&k| PARAMS[k].name.to_string()).collect();
+    if p == 0 {
+        return Identifiability { names, ..Default::default() };
+    }
+    let mut sv: Vec<f64> = j.clone().svd(false, false).singular_values.iter().copied().collect();
+    sv.sort_by(|a, b| b.total_cmp(a));
+    let prior = DVector::from_iterator(p, idx.iter().map(|&k| PARAMS[k].prior_sigma_ln));
+    let mut h = j.transpose() * j;
+    for i in 0..p {
+        h[(i, i)] += 1.0 / (prior[i] * prior[i]);
+    }
+    let c = h.clone().try_inverse().unwrap_or_else(|| DMatrix::from_diagonal(&prior.map(|s| s * s)));
+    let sd0: Vec<f64> = (0..p).map(|i| c[(i, i)].max(0.0).sqrt()).collect();
+    let posterior_over_prior = (0..p).map(|i| sd0[i] / prior[i]).collect();
+    let sd_ln = sd0.iter().map(|s| s * s2.sqrt()).collect();
+    let mut correlated = Vec::new();
+    for a in 0..p {
+        for b in a + 1..p {
+            let rho = c[(a, b)] / (sd0[a] * sd0[b]).max(1e-300);
+            if rho.abs() >= corr_threshold {
+                correlated.push((names[a].clone(), names[b].clone(), rho));
+            }
+        }
+    }
+    Identifiability { names, singular_values: sv, sd_ln, posterior_over_prior, correlated }
+}
+
+/// Relative spread (5th–95th percentile over the 95th percentile of |x|) of
+/// an input column; 0 for a constant or absent column.
+pub fn spread(run: &crate::measured::MeasuredRun, f: impl Fn(usize) -> Option<f64>) -> f64 {
+    let mut v: Vec<f64> = (0..run.len()).filter_map(f).collect();
+    if v.len() < 3 {
+        return 0.0;
+    }
+    v.sort_by(f64::total_cmp);
+    let q = |p: f64| v[((v.len() - 1) as f64 * p).round() as usize];
+    let (lo, hi) = (q(0.05), q(0.95));
+    let top = lo.abs().max(hi.abs());
+    if top <= 1e-9 { 0.0 } else { (hi - lo) / top }
+}
+
+/// Spread below which an input counts as held at one value.
+pub const ONE_POINT_SPREAD: f64 = 0.2;
+
+/// Whether a log holds speed, pressure drop and current each within
+/// [`ONE_POINT_SPREAD`] of one value.
+pub fn one_point(run: &crate::measured::MeasuredRun) -> bool {
+    let col = |c: Channel| run.get(c).map(|v| v.to_vec()).unwrap_or_default();
+    let (sp, pa, pb, cur) = (col(Channel::SpeedRpm), col(Channel::PABar), col(Channel::PBBar), col(Channel::CurrentA));
+    let s_speed = spread(run, |i| sp.get(i).copied().flatten());
+    let s_dp = spread(run, |i| Some((pa.get(i).copied().flatten()? - pb.get(i).copied().flatten()?).abs()));
+    let s_cur = spread(run, |i| cur.get(i).copied().flatten());
+    s_speed.max(s_dp).max(s_cur) < ONE_POINT_SPREAD
+}
+
+/// Whether every log has one operating point ([`one_point`]).
+pub fn all_one_point(logs: &[CalLog]) -> bool {
+    !logs.is_empty() && logs.iter().all(|l| one_point(&l.run))
+}
+
+/// Warnings for logs whose shaft speed, pressure drop and current all stay
+/// within [`ONE_POINT_SPREAD`] of one value (one operating point), and when
+/// no log has any such excitation.
+pub fn excitation_warnings(logs: &[CalLog]) -> Vec<String> {
+    let mut w = Vec::new();
+    let mut all_flat = true;
+    for l in logs {
+        let r = &l.run;
+        let col = |c: Channel| r.get(c).map(|v| v.to_vec()).unwrap_or_default();
+        let (sp, pa, pb, cur) = (col(Channel::SpeedRpm), col(Channel::PABar), col(Channel::PBBar), col(Channel::CurrentA));
+        let s_speed = spread(r, |i| sp.get(i).copied().flatten());
+        let s_dp = spread(r, |i| Some((pa.get(i).copied().flatten()? - pb.get(i).copied().flatten()?).abs()));
+        let s_cur = spread(r, |i| cur.get(i).copied().flatten());
+        if s_speed.max(s_dp).max(s_cur) < ONE_POINT_SPREAD {
+            w.push(format!(
+                "WARNING: log `{}` has one operating point (speed, pressure drop and current each vary by < {:.0} %: {:.0} / {:.0} / {:.0} %): losses that scale differently with speed and pressure cannot be told apart",
+                l.name,
+                100.0 * ONE_POINT_SPREAD,
+                100.0 * s_speed,
+                100.0 * s_dp,
+                100.0 * s_cur
+            ));
+        } else {
+            all_flat = false;
+        }
+    }
+    if all_flat && !logs.is_empty() {
+        w.push("WARNING: no training log has more than one operating point: the loss coefficients (pump friction, leakage, iron loss, winding resistance) are not separable; run speed steps and pressure steps (docs/commissioning.md)".into());
+    }
+    w
+}

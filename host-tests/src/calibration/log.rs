@@ -1,0 +1,118 @@
+//! One measured log prepared for calibration: the replay scenario of its
+//! inputs, the channels it can be scored on (the five temperatures plus
+//! `t_drain_c` when logged) and the thinned fit points.
+
+use crate::diagnosis::reference::{replay_inputs, REPLAY_RTOL};
+use crate::measured::{Channel, MeasuredRun};
+use crate::rig::Rig;
+use crate::scenario::Scenario;
+use crate::sim::{simulate_rtol, SimOptions};
+use std::collections::BTreeMap;
+
+/// Simulated channels at a log's sample times, °C.
+pub type Series = BTreeMap<Channel, Vec<f64>>;
+
+/// A log ready to be replayed by the reference model.
+#[derive(Debug, Clone)]
+pub struct CalLog {
+    /// Name (file name) used in reports.
+    pub name: String,
+    /// The measured data.
+    pub run: MeasuredRun,
+    /// Channels with at least one sample: the temperatures and `t_drain_c`.
+    pub channels: Vec<Channel>,
+    /// Fit points: (channel, row), uniformly thinned per channel.
+    pub points: Vec<(Channel, usize)>,
+    scenario: Scenario,
+    opts: SimOptions,
+}
+
+/// The channels a log can be scored on: [`Channel::TEMPERATURES`] and
+/// `t_drain_c`, those with at least one sample.
+pub fn scored_channels(run: &MeasuredRun) -> Vec<Channel> {
+    Channel::TEMPERATURES
+        .into_iter()
+        .chain([Channel::TDrainC])
+        .filter(|&c| run.get(c).is_some_and(|v| v.iter().any(Option::is_some)))
+        .collect()
+}
+
+impl CalLog {
+    /// Prepares `run` (named `name`) with at most `points_per_channel` fit
+    /// points per channel. Errors when an input column is empty.
+    pub fn new(name: &str, run: MeasuredRun, points_per_channel: usize) -> Result<Self, String> {
+        let inputs = replay_inputs(&run, name).map_err(|e| format!("{name}: {e}"))?;
+        let span = run.time_s[run.len() - 1] - run.time_s[0];
+        // Output every ~1/400 of the run (as the diagnosis replay does).
+        let dt = (span / 400.0).clamp(0.5, 5.0);
+        let opts = SimOptions { output_interval_s: dt, control_interval_s: dt };
+        let channels = scored_channels(&run);
+        let mut points = Vec::new();
+        for &ch in &channels {
+            let rows: Vec<usize> = (0..run.len()).filter(|&i| run.get(ch).is_some_and(|v| v[i].is_some())).collect();
+            let step = (rows.len() as f64 / points_per_channel.max(1) as f64).max(1.0);
+            let mut k = 0.0;
+            while (k as usize) < rows.len() {
+                points.push((ch, rows[k as usize]));
+                k += step;
+            }
+        }
+        Ok(CalLog { name: name.into(), run, channels, points, scenario: Scenario::Replay(inputs), opts })
+    }
+
+    /// The reference model on `rig` driven by this log's inputs: every
+    /// scored channel at every sample time.
+    pub fn simulate(&self, rig: &Rig) -> Result<Series, String> {
+        let out = simulate_rtol(rig, &self.scenario, &self.opts, REPLAY_RTOL).map_err(|e| e.to_string())?;
+        let mut s = Series::new();
+        for &ch in &self.channels {
+            let v: Option<Vec<f64>> = self.run.time_s.iter().map(|&t| out.at(ch.name(), t)).collect();
+            s.insert(ch, v.ok_or_else(|| format!("model has no channel {}", ch.name()))?);
+        }
+        Ok(s)
+    }
+
+    /// Residuals (simulated − measured, K) at the fit points.
+    pub fn residuals(&self, s: &Series) -> Vec<f64> {
+        self.points
+            .iter()
+            .map(|&(ch, i)| s[&ch][i] - self.run.get(ch).and_then(|v| v[i]).unwrap_or(f64::NAN))
+            .collect()
+    }
+
+    /// Whether the log carries channel `ch`.
+    pub fn has(&self, ch: Channel) -> bool {
+        self.channels.contains(&ch)
+    }
+}
+
+/// Error of one channel over a whole log, K.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct ChannelError {
+    /// Channel name.
+    pub channel: String,
+    /// RMSE over every sample, K.
+    pub rmse_k: f64,
+    /// Largest |simulated − measured|, K.
+    pub max_abs_k: f64,
+    /// Largest under-prediction (measured − simulated, ≥ 0), K.
+    pub max_under_k: f64,
+}
+
+/// Per-channel errors of series `s` against log `log` (every sample).
+pub fn channel_errors(log: &CalLog, s: &Series) -> Vec<ChannelError> {
+    log.channels
+        .iter()
+        .map(|&ch| {
+            let m = log.run.get(ch).unwrap_or(&[]);
+            let e: Vec<f64> = m.iter().zip(&s[&ch]).filter_map(|(m, p)| m.map(|m| p - m)).collect();
+            let n = e.len().max(1) as f64;
+            ChannelError {
+                channel: ch.name().into(),
+                rmse_k: (e.iter().map(|x| x * x).sum::<f64>() / n).sqrt(),
+                max_abs_k: e.iter().fold(0.0f64, |a, x| a.max(x.abs())),
+                max_under_k: e.iter().fold(0.0f64, |a, x| a.max(-x)),
+            }
+        })
+        .collect()
+}

@@ -1,0 +1,23 @@
+//! Physical calibration of the reference model to a user's logs (issues 17
+//! and 18): one implementation used by `diagnose` (nuisance set) and by
+//! `commission` (the commissioned rig).
+//!
+//! - [`set`]: the declared parameters, their physical bounds, priors and
+//!   the single table mapping them onto rig fields;
+//! - [`log`]: a measured log prepared for replay and scoring;
+//! - [`fit`]: joint fit over several logs with prior rows;
+//! - [`ident`]: identifiability (singular values, intervals, correlated
+//!   pairs) and the one-operating-point warning;
+//! - [`synthetic`]: logs generated from a rig (tests and examples).
+
+pub mod cli;
+pub mod commission;
+pub mod fit;
+pub mod ident;
+pub mod log;
+pub mod set;
+pub mod synthetic;
+
+pub use fit::{calibrate, CalError, CalOptions, Calibration, ParamResult, Status};
+pub use log::{channel_errors, CalLog, ChannelError};
+pub use set::{apply, ParamDef, PARAMS};

@@ -1,0 +1,164 @@
+//! Commissioning an EHA that is not the paper's (issue 18 §4): a synthetic
+//! other rig (1.5× displacement, other masses and areas in its rig file;
+//! the true machine with films 30 % off and per-node deviations no global
+//! multiplier represents), logs with noise, quantisation and dropouts and a
+//! drain thermocouple; two training missions, one held-out mission of
+//! another kind.
+
+use eha_sim::calibration::commission::{check_reduced, commission};
+use eha_sim::calibration::synthetic::{log, mission, other_rig_file, other_rig_truth, Kind};
+use eha_sim::calibration::{CalLog, CalOptions};
+
+fn cal_log(kind: Kind, seed: u64) -> CalLog {
+    CalLog::new(&format!("{kind:?}-{seed}"), log(&other_rig_truth(), &mission(kind, 1800.0, seed), 2.0, seed, true).expect("log"), 120).expect("cal log")
+}
+
+/// Measured (one run, ~6 s): reference held-out drain RMSE 6.98 → 0.19 K
+/// (max 12.5 → 1.08 K against the noisy thermocouple); the reduced model
+/// with the commissioned parameters against the machine's true drain on the
+/// held-out mission: max |e| 0.257 K, under-prediction 0.037 K; the paper
+/// default parameters: max |e| 18.2 K, all of it under-prediction. The
+/// reduced-vs-commissioned-reference check is 0.197 / 0.336 / 0.174 K on the
+/// three logs: the speed-steps log (1500 rpm) exceeds the 0.2 K bound, so
+/// `commission` refuses these logs (asserted below as measured).
+#[test]
+fn other_rig_commissioned_firmware_meets_drain_bounds_on_held_out_mission() {
+    let t0 = std::time::Instant::now();
+    let train = [cal_log(Kind::PressureSteps, 31), cal_log(Kind::SpeedSteps, 32)];
+    let hold = [cal_log(Kind::SoakThenMixed, 33)];
+    let c = commission(&other_rig_file(), &train, &hold, &CalOptions::default()).expect("commissioning");
+    eprintln!("{:.1} s, {} model runs", t0.elapsed().as_secs_f64(), c.cal.model_runs);
+    for p in &c.cal.params {
+        eprintln!("{:18} {:6.3} [{:6.3}, {:6.3}] {:?}", p.name, p.value, p.interval95.0, p.interval95.1, p.status);
+    }
+    for s in &c.holdout {
+        for (a, b) in s.as_given.iter().zip(&s.commissioned) {
+            eprintln!("{} {:14} RMSE {:.3} -> {:.3}, max {:.3} -> {:.3}", s.log, a.channel, a.rmse_k, b.rmse_k, a.max_abs_k, b.max_abs_k);
+        }
+    }
+    for r in &c.reduced {
+        eprintln!("reduced {:22} vs ref max {:.3} | vs measured max {:?} under {:?} rmse {:?}", r.log, r.vs_reference_max_k, r.vs_measured_max_k, r.vs_measured_under_k, r.vs_measured_rmse_k);
+    }
+    for r in &c.default_on_holdout {
+        eprintln!("paper default {:22} vs measured max {:?} under {:?}", r.log, r.vs_measured_max_k, r.vs_measured_under_k);
+    }
+    assert!(!c.reduced_ok, "measured: the speed-steps log exceeds the 0.2 K reduced-model bound");
+    let worst = c.reduced.iter().map(|r| r.vs_reference_max_k).fold(0.0, f64::max);
+    assert!((0.25..0.45).contains(&worst), "worst reduced-vs-reference {worst:.3} K (measured 0.336)");
+    // Against the true (noise-free) drain of the machine: the reduced model
+    // with the commissioned parameters vs the truth rig replaying the
+    // held-out inputs (`vs_reference` of a check on the truth rig).
+    let truth = other_rig_truth();
+    let fw = check_reduced(&truth, &c.params, &hold[0]).expect("commissioned firmware on the truth");
+    let paper = check_reduced(&truth, &eha_guard::params::DEFAULT, &hold[0]).expect("paper firmware on the truth");
+    eprintln!(
+        "held-out true drain: commissioned max |e| {:.3} K, under {:.3} K; paper default max |e| {:.3} K, under {:.3} K",
+        fw.vs_reference_max_k, fw.vs_reference_under_k, paper.vs_reference_max_k, paper.vs_reference_under_k
+    );
+    eprintln!("held-out measured drain: commissioned under {:?}, paper default under {:?}", fw.vs_measured_under_k, paper.vs_measured_under_k);
+    // Issue 18 §4 bounds on the held-out mission: max |e| ≤ 1.0 K against
+    // the true drain.
+    assert!(fw.vs_reference_max_k <= 1.0, "commissioned firmware max |e| {:.3} K", fw.vs_reference_max_k);
+    assert!(fw.vs_reference_under_k <= 0.5, "commissioned firmware under-predicts by {:.3} K", fw.vs_reference_under_k);
+    // The paper-default firmware is far off on this machine (the reason to
+    // commission): > 5 K.
+    assert!(paper.vs_reference_max_k > 5.0, "paper default {:.3} K", paper.vs_reference_max_k);
+}
+
+/// Issue 18 §4 in closed loop, through the flash block: the commissioned
+/// parameters written as `firmware-params.bin`, read back in place as the
+/// firmware reads its PARAMS region, run the f32 guard against the true
+/// machine on the held-out mission (30 min; the guard's valve acts on the
+/// plant). Issue bounds: drain max |e| ≤ 1.0 K, under-prediction ≤ 0.5 K
+/// against the true drain; the paper-default image on the same loop is
+/// reported beside it. What is met and what is a measured miss is asserted
+/// below (the cross-check and the uncommissioned LNG exchanger).
+#[test]
+#[ignore = "slow tier: commissioning (~6 s) and three 30-minute closed loops"]
+fn commissioned_block_in_closed_loop_on_the_held_out_mission() {
+    use eha_guard::protocol::step_guard;
+    use eha_guard::{GuardConfig, GuardOf, Restore};
+    use eha_sim::pil::sil::SilTarget;
+    use eha_sim::pil::{run_closed_loop, LoopOptions};
+    use eha_sim::plant::Plant;
+    use eha_sim::scenario::Scenario;
+
+    let train = [cal_log(Kind::PressureSteps, 31), cal_log(Kind::SpeedSteps, 32)];
+    let hold = [cal_log(Kind::SoakThenMixed, 33)];
+    let c = commission(&other_rig_file(), &train, &hold, &CalOptions::default()).expect("commissioning");
+    let block = eha_sim::params_block::block_for(&c.params, "other-eha").expect("a block the firmware accepts");
+    #[repr(C, align(4))]
+    struct Flash([u8; eha_guard::params_block::BLOCK_LEN]);
+    let flash = Flash(block);
+    let consts = eha_guard::params_block::view(&flash.0).expect("valid block").expect("present block");
+    // Per run: max |e| and under-prediction over the whole mission and while
+    // the guard's LNG budget lasts (after that the guard takes no cooling
+    // credit by design, while this plant's tank never runs dry: the estimate
+    // then reads high, on the safe side), ticks with the valve open, and the
+    // first fault.
+    struct Loop {
+        max: f64,
+        under: f64,
+        max_lng: f64,
+        under_lng: f64,
+        before_open: f64,
+        open: usize,
+        n: usize,
+        fault: Option<(f64, u16)>,
+    }
+    let run = |cfg: &GuardConfig| {
+        let mut guard = GuardOf::<f32>::new(cfg, Restore::Cold);
+        assert_eq!(guard.faults(), 0, "configuration accepted");
+        let mut sil = SilTarget::new(move |r: &eha_guard::protocol::Request, gap| step_guard(&mut guard, r, gap));
+        let m = mission(Kind::SoakThenMixed, 1800.0, 33);
+        let mut plant = Plant::new(&other_rig_truth(), &Scenario::Mission(m)).expect("plant");
+        let opts = LoopOptions { step_s: eha_guard::params::S_PER_TICK, duration_s: 1800.0 };
+        let rec = run_closed_loop(&mut plant, &mut sil, &opts).unwrap_or_else(|f| panic!("{:#}", f.error));
+        let e = |r: &eha_sim::pil::StepRecord| f64::from(r.reply.out.drain_c) - r.sensors.t_drain_c;
+        let lng = |r: &&eha_sim::pil::StepRecord| r.reply.out.lng_remaining_kg > 0.0;
+        Loop {
+            max: rec.iter().map(|r| e(r).abs()).fold(0.0, f64::max),
+            under: rec.iter().map(|r| -e(r)).fold(0.0, f64::max),
+            max_lng: rec.iter().filter(lng).map(|r| e(r).abs()).fold(0.0, f64::max),
+            under_lng: rec.iter().filter(lng).map(|r| -e(r)).fold(0.0, f64::max),
+            before_open: rec.iter().take_while(|r| !r.reply.out.valve_open).map(|r| e(r).abs()).fold(0.0, f64::max),
+            open: rec.iter().filter(|r| r.reply.out.valve_open).count(),
+            n: rec.len(),
+            fault: rec.iter().find(|r| r.reply.out.faults != 0).map(|r| (r.t_s, r.reply.out.faults)),
+        }
+    };
+    let fw = run(&GuardConfig { model: consts, ..GuardConfig::DEFAULT });
+    // The same block with the sensor cross-check off (its shaft-power term
+    // zero): the thermal prediction alone.
+    let no_cc = eha_guard::model::ModelConsts { k_sh: 0.0, ..*consts };
+    let th = run(&GuardConfig { model: &no_cc, ..GuardConfig::DEFAULT });
+    let paper = run(&GuardConfig::DEFAULT);
+    for (name, l) in [("commissioned block", &fw), ("block, cross-check off", &th), ("paper default", &paper)] {
+        eprintln!(
+            "{name}: max |e| {:.3} K, under {:.3} K; before the valve opens {:.3} K; while LNG lasts max |e| {:.3} K, under {:.3} K; valve open {} of {} ticks; first fault {:?}",
+            l.max, l.under, l.before_open, l.max_lng, l.under_lng, l.open, l.n, l.fault
+        );
+    }
+    // The thermal prediction from the block: never under-predicts by more than
+    // 0.5 K over the whole mission (issue bound), meets max |e| ≤ 1.0 K until
+    // the valve first opens (0.20 K measured), but not with the LNG
+    // exchanger running: measured miss, 2.116 K over-prediction while the
+    // budget lasts. The training logs have no LNG runs, so the exchanger is
+    // the paper rig's (not commissioned) and under-credits this machine's
+    // cooling (the error is over-prediction: safe side). The band is the
+    // measured value ±25 %.
+    assert!(th.under <= 0.5, "commissioned block, cross-check off: under-prediction {:.3} K > 0.5 K", th.under);
+    assert!(th.before_open <= 1.0, "commissioned block, cross-check off, valve closed: max |e| {:.3} K > 1.0 K", th.before_open);
+    assert!((1.59..2.65).contains(&th.max_lng), "measured miss: max |e| with LNG {:.3} K (was 2.116 K)", th.max_lng);
+    // Measured miss: with the cross-check on, the guard latches
+    // SENSOR_DISAGREE within the first second on this machine (the
+    // calibration fits temperatures only; the cross-check's electrical
+    // balance, Kt |I| w against D dp w + eta_m D |dp| w, is not commissioned
+    // and the fitted eta_m does not close it). The guard then holds the valve
+    // open and takes the larger loss estimate: conservative, far from the drain.
+    let (t_fault, bits) = fw.fault.expect("measured: the cross-check latches");
+    assert!(t_fault <= 1.5 && bits & eha_guard::guard::faults::SENSOR_DISAGREE != 0, "first fault {:?}", fw.fault);
+    assert!(fw.under <= 0.5, "commissioned block: under-prediction {:.3} K > 0.5 K", fw.under);
+    // The paper-default image on this machine: the reason to commission.
+    assert!(paper.max_lng > 5.0, "paper default: max |e| {:.3} K", paper.max_lng);
+}

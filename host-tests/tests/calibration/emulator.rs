@@ -1,0 +1,63 @@
+//! Calibration against a truth not written with the reference: the rig
+//! emulator (`eha_sim::emulator`, 14 nodes, other correlations and
+//! parameters), nominal machine, nothing hidden. Two training logs of
+//! different kinds, one held-out log of a third kind.
+
+use eha_sim::calibration::{calibrate, channel_errors, CalLog, CalOptions};
+use eha_sim::diagnosis::Candidate;
+use eha_sim::emulator::missions::{draw, EmuScenario};
+use eha_sim::emulator::params::EmuParams;
+use eha_sim::emulator::plant::{Hidden, Plant};
+use eha_sim::emulator::logger;
+use eha_sim::rig::Rig;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+
+fn emu_log(p: &EmuParams, s: EmuScenario, seed: u64) -> CalLog {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let m = draw(s, 1200.0, &mut rng);
+    let trace = Plant { p, m: &m, h: Hidden { effect: Candidate::None, magnitude: 0.0 } }.run(s.log_interval_s());
+    let run = logger::log(&trace, |t| m.ambient_c(t), None, false, &mut rng);
+    CalLog::new(&format!("{s:?}-{seed}"), run, 120).expect("cal log")
+}
+
+fn pooled(e: &[eha_sim::calibration::ChannelError]) -> f64 {
+    (e.iter().map(|c| c.rmse_k * c.rmse_k).sum::<f64>() / e.len() as f64).sqrt()
+}
+
+/// Measured (one run, ~7 s, 578 model runs): pooled held-out RMSE 9.90 →
+/// 0.42 K (t_oil_c 18.9 → 0.78 K, the other channels 1.1–9.2 → 0.21–0.38
+/// K); `film_case` 5.40 where the emulator's case-oil wetted area is ×5.3
+/// (with another film correlation), `pump_friction` 0.695 where its η_m is
+/// ×0.72; `cap_case_oil` held (no drain sensor). Not every multiplier maps
+/// one to one (the main-block mass is ×0.78 in the emulator, fitted 1.15,
+/// its manifold plate and pump→block path are missing in the reference).
+#[test]
+fn emulator_machine_held_out_error_falls() {
+    let p = EmuParams::default();
+    let train = [emu_log(&p, EmuScenario::LoadCycles, 41), emu_log(&p, EmuScenario::SpeedSteps, 42)];
+    let hold = emu_log(&p, EmuScenario::PressureSpeedSteps, 43);
+    let base = Rig::default();
+    let c = calibrate(&base, &train, &CalOptions::default()).expect("calibration");
+    for q in &c.params {
+        eprintln!("{:18} {:6.3} {:?}{}", q.name, q.value, q.status, if q.at_bound { " (bound)" } else { "" });
+    }
+    let before = channel_errors(&hold, &hold.simulate(&base).expect("sim"));
+    let after = channel_errors(&hold, &hold.simulate(&c.rig).expect("sim"));
+    for (b, a) in before.iter().zip(&after) {
+        eprintln!("{:14} held-out RMSE {:.3} -> {:.3} K", a.channel, b.rmse_k, a.rmse_k);
+    }
+    eprintln!("pooled {:.3} -> {:.3} K, {} runs", pooled(&before), pooled(&after), c.model_runs);
+    // Held out, every channel better and pooled ≤ 0.6 K (measured 0.42 K;
+    // the rest is the emulator's structure the reference lacks).
+    assert!(pooled(&after) <= 0.6, "pooled held-out {:.3} K", pooled(&after));
+    for (b, a) in before.iter().zip(&after) {
+        assert!(a.rmse_k < b.rmse_k, "{} got worse", a.channel);
+    }
+    let v = |n: &str| c.params.iter().find(|q| q.name == n).expect(n).value;
+    // The two deviations that map one to one, within the ranges the
+    // emulator's own structure allows: case film ×5.3 (another correlation:
+    // > 2), η_m ×0.72 (0.5–1.0).
+    assert!(v("film_case") > 2.0, "film_case {:.3}", v("film_case"));
+    assert!((0.5..1.0).contains(&v("pump_friction")), "pump_friction {:.3}", v("pump_friction"));
+}

@@ -1,0 +1,8 @@
+//! Calibration set (issue 17 item 1, issue 18): recovery on synthetic
+//! data of the reference, a truth written independently (the rig
+//! emulator), and the one-operating-point warning.
+
+mod cli;
+mod commission;
+mod emulator;
+mod recovery;
