@@ -94,7 +94,7 @@ fn f32_raw(u: &mut Unstructured<'_>) -> f32 {
 /// One guard under test plus the bookkeeping of the checks.
 struct Run<N: Num> {
     g: GuardOf<N>,
-    cfg: GuardConfig,
+    cfg: GuardConfig<'static>,
     full_kg: f32,
     ticks: u32,
     /// Unlatched minus latched ticks so far in this input.
@@ -181,7 +181,7 @@ impl<N: Num> Run<N> {
     }
 }
 
-fn config(u: &mut Unstructured<'_>, variant: u8) -> GuardConfig {
+fn config(u: &mut Unstructured<'_>, variant: u8) -> GuardConfig<'static> {
     let mut cfg = GuardConfig::DEFAULT;
     if variant & 3 == 3 {
         cfg.stale_steps = 1 + u32::from(byte(u) % 20);
