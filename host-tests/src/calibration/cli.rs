@@ -202,6 +202,14 @@ fn report(args: &CommissionArgs, c: &Commissioning) -> String {
     let _ = writeln!(s, "# Commissioning report\n\nRig file: `{}`; training: {}; held out: {}.\n", args.rig_path().display(),
         args.train.iter().map(|p| format!("`{}`", p.display())).collect::<Vec<_>>().join(", "),
         args.holdout.iter().map(|p| format!("`{}`", p.display())).collect::<Vec<_>>().join(", "));
+    match c.eta_m_from_current {
+        Some((eta, n)) => {
+            let _ = writeln!(s, "Pump friction `eta_m` (eq. 8) = {eta:.4} from the electrical balance of {n} loaded samples (shaft power from the current minus the hydraulic power), held in the thermal fit: the firmware's sensor cross-check then agrees with this machine.\n");
+        }
+        None => {
+            let _ = writeln!(s, "**Pump friction `eta_m` from the temperatures only** (no log has current under load): the firmware's sensor cross-check may disagree with this machine and latch SENSOR_DISAGREE (fail-safe). Log `current_a` under load.\n");
+        }
+    }
     let _ = writeln!(s, "## Headline: firmware drain accuracy on the held-out logs\n");
     let _ = writeln!(s, "| log | commissioned firmware: max \\|e\\| K | under K | RMSE K | paper-default firmware: max \\|e\\| K | under K |\n|---|---:|---:|---:|---:|---:|");
     let held = &c.reduced[c.reduced.len() - c.holdout.len()..];

@@ -125,6 +125,9 @@ pub struct Commissioning {
     pub default_on_holdout: Vec<ReducedCheck>,
     /// Whether every reduced check is within [`REDUCED_BOUND_K`].
     pub reduced_ok: bool,
+    /// `eta_m` from the training logs' current and the rows used
+    /// ([`eta_m_from_current`]); `None`: fitted from the temperatures.
+    pub eta_m_from_current: Option<(f64, usize)>,
 }
 
 /// Errors of commissioning.
@@ -143,7 +146,19 @@ pub enum CommissionError {
 
 /// Commissions `base` on `train`, validates on `holdout`.
 pub fn commission(base: &Rig, train: &[CalLog], holdout: &[CalLog], o: &CalOptions) -> Result<Commissioning, CommissionError> {
-    let cal = calibrate(base, train, o)?;
+    // The pump's friction coefficient from the electrical balance when the
+    // logs carry current under load (identified directly, and the firmware's
+    // sensor cross-check then agrees with this machine); else from the
+    // temperatures with the rest of the set.
+    let mut base_e = base.clone();
+    let mut o = o.clone();
+    let eta_e = eta_m_from_current(base, train);
+    if let Some((eta, n)) = eta_e {
+        base_e.pump.eta_m = eta;
+        o.hold.push(("pump_friction", format!("eta_m = {eta:.4} from the current of {n} loaded samples (electrical balance)")));
+    }
+    let base = &base_e;
+    let cal = calibrate(base, train, &o)?;
     let mut scores = Vec::new();
     for l in holdout {
         let a = l.simulate(base).map_err(CommissionError::Run)?;
@@ -163,5 +178,38 @@ pub fn commission(base: &Rig, train: &[CalLog], holdout: &[CalLog], o: &CalOptio
         .collect::<Result<_, _>>()
         .map_err(CommissionError::Run)?;
     let reduced_ok = reduced.iter().all(|r| r.vs_reference_max_k <= REDUCED_BOUND_K);
-    Ok(Commissioning { cal, holdout: scores, params, reduced, default_on_holdout, reduced_ok })
+    Ok(Commissioning { cal, holdout: scores, params, reduced, default_on_holdout, reduced_ok, eta_m_from_current: eta_e })
+}
+
+/// The pump's loss coefficient `eta_m` of eq. (8) from the logs' electrical
+/// balance, as the firmware's sensor cross-check sees it: the shaft power
+/// from the current `Kt |I| |w|` (signed like `dp w`) minus the displacement's
+/// hydraulic power `D dp w` is the mechanical loss `eta_m D |dp| |w|`. Least
+/// squares over the rows whose `D |dp| |w|` is at least 20 % of the logs'
+/// largest (light load says little), with `Kt` and `D` from the rig file.
+/// `(eta_m, rows)`; `None` without current or load, or outside 0.01..2.
+pub fn eta_m_from_current(rig: &Rig, logs: &[CalLog]) -> Option<(f64, usize)> {
+    use crate::measured::Channel;
+    let kt = rig.motor.torque_constant_nm_per_a;
+    let d = rig.displacement_m3_per_rad();
+    let mut rows = Vec::new();
+    for l in logs {
+        let r = &l.run;
+        let (Some(i), Some(w), Some(pa), Some(pb)) = (r.get(Channel::CurrentA), r.get(Channel::SpeedRpm), r.get(Channel::PABar), r.get(Channel::PBBar)) else {
+            continue;
+        };
+        for k in 0..r.len() {
+            let (Some(i), Some(w), Some(pa), Some(pb)) = (i[k], w[k], pa[k], pb[k]) else { continue };
+            let w = w * std::f64::consts::PI / 30.0;
+            let dp = (pa - pb) * 1e5;
+            let hyd = d * dp * w;
+            let shaft = kt * i.abs() * w.abs() * hyd.signum();
+            rows.push((shaft - hyd, d * dp.abs() * w.abs()));
+        }
+    }
+    let top = rows.iter().map(|r| r.1).fold(0.0, f64::max);
+    let used: Vec<_> = rows.into_iter().filter(|r| top > 0.0 && r.1 >= 0.2 * top).collect();
+    let (num, den) = used.iter().fold((0.0, 0.0), |(a, b), (f, m)| (a + f * m, b + m * m));
+    let eta = num / den;
+    (den > 0.0 && (0.01..2.0).contains(&eta)).then_some((eta, used.len()))
 }

@@ -21,7 +21,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 
 /// Settings of a calibration.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct CalOptions {
     /// Data σ, K: residuals are divided by it. 0.2 K = the 0.1 K sensor
     /// noise plus as much again for model structure the set cannot remove.
@@ -37,11 +37,14 @@ pub struct CalOptions {
     pub hold_ratio: f64,
     /// |correlation| at or above which a pair is reported.
     pub corr_threshold: f64,
+    /// Parameters the caller holds at the rig value, with the reason
+    /// (e.g. `pump_friction` when `commission` took it from the current).
+    pub hold: Vec<(&'static str, String)>,
 }
 
 impl Default for CalOptions {
     fn default() -> Self {
-        CalOptions { sigma_data_k: 0.2, points_per_channel: 120, max_evals: 600, hold_ratio: 0.7, corr_threshold: 0.9 }
+        CalOptions { sigma_data_k: 0.2, points_per_channel: 120, max_evals: 600, hold_ratio: 0.7, corr_threshold: 0.9, hold: Vec::new() }
     }
 }
 
@@ -174,6 +177,11 @@ pub fn calibrate(base: &Rig, logs: &[CalLog], o: &CalOptions) -> Result<Calibrat
         for name in ["leak_gap", "iron_loss", "winding_r", "needle_split"] {
             let k = super::set::index(name).expect("calibration parameter");
             held[k].get_or_insert_with(|| format!("every log has one operating point; would need: {}", PARAMS[k].excitation));
+        }
+    }
+    for (name, why) in &o.hold {
+        if let Some(k) = super::set::index(name) {
+            held[k].get_or_insert_with(|| why.clone());
         }
     }
     // 2. Screening at the rig file: hold what the data do not identify.

@@ -13,14 +13,15 @@ fn cal_log(kind: Kind, seed: u64) -> CalLog {
     CalLog::new(&format!("{kind:?}-{seed}"), log(&other_rig_truth(), &mission(kind, 1800.0, seed), 2.0, seed, true).expect("log"), 120).expect("cal log")
 }
 
-/// Measured (one run, ~6 s): reference held-out drain RMSE 6.98 → 0.19 K
-/// (max 12.5 → 1.08 K against the noisy thermocouple); the reduced model
-/// with the commissioned parameters against the machine's true drain on the
-/// held-out mission: max |e| 0.257 K, under-prediction 0.037 K; the paper
-/// default parameters: max |e| 18.2 K, all of it under-prediction. The
-/// reduced-vs-commissioned-reference check is 0.197 / 0.336 / 0.174 K on the
-/// three logs: the speed-steps log (1500 rpm) exceeds the 0.2 K bound, so
-/// `commission` refuses these logs (asserted below as measured).
+/// Measured (one run, ~5 s; eta_m from the current, 0.3736 from 1 355
+/// loaded samples): the reduced model with the commissioned parameters
+/// against the machine's true drain on the held-out mission: max |e|
+/// 0.225 K, under-prediction 0.038 K (was 0.257 / 0.037 K with eta_m from
+/// the temperatures); the paper default parameters: max |e| 18.2 K, all of
+/// it under-prediction. The reduced-vs-commissioned-reference check is
+/// 0.194 / 0.332 / 0.171 K on the three logs: the speed-steps log (1500
+/// rpm) exceeds the 0.2 K bound, so `commission` refuses these logs
+/// (asserted below as measured).
 #[test]
 fn other_rig_commissioned_firmware_meets_drain_bounds_on_held_out_mission() {
     let t0 = std::time::Instant::now();
@@ -44,7 +45,7 @@ fn other_rig_commissioned_firmware_meets_drain_bounds_on_held_out_mission() {
     }
     assert!(!c.reduced_ok, "measured: the speed-steps log exceeds the 0.2 K reduced-model bound");
     let worst = c.reduced.iter().map(|r| r.vs_reference_max_k).fold(0.0, f64::max);
-    assert!((0.25..0.45).contains(&worst), "worst reduced-vs-reference {worst:.3} K (measured 0.336)");
+    assert!((0.25..0.45).contains(&worst), "worst reduced-vs-reference {worst:.3} K (measured 0.332)");
     // Against the true (noise-free) drain of the machine: the reduced model
     // with the commissioned parameters vs the truth rig replaying the
     // held-out inputs (`vs_reference` of a check on the truth rig).
@@ -71,8 +72,7 @@ fn other_rig_commissioned_firmware_meets_drain_bounds_on_held_out_mission() {
 /// machine on the held-out mission (30 min; the guard's valve acts on the
 /// plant). Issue bounds: drain max |e| ≤ 1.0 K, under-prediction ≤ 0.5 K
 /// against the true drain; the paper-default image on the same loop is
-/// reported beside it. What is met and what is a measured miss is asserted
-/// below (the cross-check and the uncommissioned LNG exchanger).
+/// reported beside it.
 #[test]
 #[ignore = "slow tier: commissioning (~6 s) and three 30-minute closed loops"]
 fn commissioned_block_in_closed_loop_on_the_held_out_mission() {
@@ -128,37 +128,33 @@ fn commissioned_block_in_closed_loop_on_the_held_out_mission() {
         }
     };
     let fw = run(&GuardConfig { model: consts, ..GuardConfig::DEFAULT });
-    // The same block with the sensor cross-check off (its shaft-power term
-    // zero): the thermal prediction alone.
-    let no_cc = eha_guard::model::ModelConsts { k_sh: 0.0, ..*consts };
-    let th = run(&GuardConfig { model: &no_cc, ..GuardConfig::DEFAULT });
     let paper = run(&GuardConfig::DEFAULT);
-    for (name, l) in [("commissioned block", &fw), ("block, cross-check off", &th), ("paper default", &paper)] {
+    for (name, l) in [("commissioned block", &fw), ("paper default", &paper)] {
         eprintln!(
             "{name}: max |e| {:.3} K, under {:.3} K; before the valve opens {:.3} K; while LNG lasts max |e| {:.3} K, under {:.3} K; valve open {} of {} ticks; first fault {:?}",
             l.max, l.under, l.before_open, l.max_lng, l.under_lng, l.open, l.n, l.fault
         );
     }
-    // The thermal prediction from the block: never under-predicts by more than
-    // 0.5 K over the whole mission (issue bound), meets max |e| ≤ 1.0 K until
-    // the valve first opens (0.20 K measured), but not with the LNG
-    // exchanger running: measured miss, 2.116 K over-prediction while the
-    // budget lasts. The training logs have no LNG runs, so the exchanger is
-    // the paper rig's (not commissioned) and under-credits this machine's
-    // cooling (the error is over-prediction: safe side). The band is the
-    // measured value ±25 %.
-    assert!(th.under <= 0.5, "commissioned block, cross-check off: under-prediction {:.3} K > 0.5 K", th.under);
-    assert!(th.before_open <= 1.0, "commissioned block, cross-check off, valve closed: max |e| {:.3} K > 1.0 K", th.before_open);
-    assert!((1.59..2.65).contains(&th.max_lng), "measured miss: max |e| with LNG {:.3} K (was 2.116 K)", th.max_lng);
-    // Measured miss: with the cross-check on, the guard latches
-    // SENSOR_DISAGREE within the first second on this machine (the
-    // calibration fits temperatures only; the cross-check's electrical
-    // balance, Kt |I| w against D dp w + eta_m D |dp| w, is not commissioned
-    // and the fitted eta_m does not close it). The guard then holds the valve
-    // open and takes the larger loss estimate: conservative, far from the drain.
-    let (t_fault, bits) = fw.fault.expect("measured: the cross-check latches");
-    assert!(t_fault <= 1.5 && bits & eha_guard::guard::faults::SENSOR_DISAGREE != 0, "first fault {:?}", fw.fault);
+    eprintln!("eta_m from the current: {:?}", c.eta_m_from_current);
+    // Issue 18 §4 bounds, met with the block as flashed (cross-check on):
+    // max |e| ≤ 1.0 K while the guard's cooling model holds (measured
+    // 0.342 K; 0.172 K until the valve first opens), under-prediction ≤ 0.5 K
+    // over the whole mission (measured 0.342 K). After the guard's LNG budget
+    // is spent it takes no cooling credit (this plant's tank never runs dry):
+    // the estimate then reads high, the safe side (measured 14.8 K).
+    assert!(fw.max_lng <= 1.0, "commissioned block: max |e| {:.3} K > 1.0 K", fw.max_lng);
     assert!(fw.under <= 0.5, "commissioned block: under-prediction {:.3} K > 0.5 K", fw.under);
-    // The paper-default image on this machine: the reason to commission.
+    // The electrical balance is commissioned (eta_m from the current), so the
+    // sensor cross-check agrees with this machine: the only fault is LNG_LOW.
+    assert!(
+        fw.fault.is_none_or(|(_, bits)| bits & eha_guard::guard::faults::SENSOR_DISAGREE == 0),
+        "cross-check fault with the commissioned block: {:?}",
+        fw.fault
+    );
+    // The paper-default image on this machine: its cross-check sees the wrong
+    // machine within a second (SENSOR_DISAGREE, fail-safe), so it never
+    // under-predicts here, but its estimate is useless: the reason to commission.
+    let (t_fault, bits) = paper.fault.expect("measured: the paper default's cross-check latches");
+    assert!(t_fault <= 1.5 && bits & eha_guard::guard::faults::SENSOR_DISAGREE != 0, "first fault {:?}", paper.fault);
     assert!(paper.max_lng > 5.0, "paper default: max |e| {:.3} K", paper.max_lng);
 }
