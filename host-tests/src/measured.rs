@@ -69,22 +69,15 @@ impl Channel {
 
     /// Every column of the format other than `time_s`: [`Channel::ALL`] plus
     /// the bench-only `t_drain_c`, in the writer's column order.
-    pub const FORMAT: [Channel; 14] = [
-        Channel::SpeedRpm,
-        Channel::CurrentA,
-        Channel::PABar,
-        Channel::PBBar,
-        Channel::AmbientC,
-        Channel::PositionMm,
-        Channel::TMotorC,
-        Channel::TPumpC,
-        Channel::TBlockC,
-        Channel::TBallvalveC,
-        Channel::TOilC,
-        Channel::LngValve,
-        Channel::AirSpeedMps,
-        Channel::TDrainC,
-    ];
+    pub const FORMAT: [Channel; 14] = {
+        let mut f = [Channel::TDrainC; 14];
+        let mut i = 0;
+        while i < Channel::ALL.len() {
+            f[i] = Channel::ALL[i];
+            i += 1;
+        }
+        f
+    };
 
     /// The measured temperature channels (Points 1, 3, 4, 5 and the manifold
     /// oil sensor), °C.

@@ -11,7 +11,8 @@ use eha_guard::model::{consts, ConfigError, Model};
 use eha_guard::params::ReducedParams;
 use eha_guard::params_block::{self, BlockError, BLOCK_LEN};
 
-use crate::reduce::{nominal_jacobian, reduce};
+pub use crate::reduce::rediscretise;
+use crate::reduce::reduce;
 use crate::rig::Rig;
 
 /// `eha-sim params-block`.
@@ -73,15 +74,6 @@ pub fn block_for(p: &ReducedParams, id: &str) -> Result<[u8; BLOCK_LEN]> {
     let block = params_block::encode(&c, id);
     check_bytes(&block)?;
     Ok(block)
-}
-
-/// `p` with its Jacobian and `Phi` recomputed (after changing physical
-/// parameters by hand); `None` if the firmware model rejects it.
-pub fn rediscretise(p: &ReducedParams) -> Option<ReducedParams> {
-    let mut q = *p;
-    q.nominal_jacobian_per_s = nominal_jacobian(&q)?;
-    q.phi_step_s = eha_guard::model::etd_matrix(&q.nominal_jacobian_per_s, eha_guard::params::S_PER_STEP);
-    Some(q)
 }
 
 /// Reads a block file: exactly [`BLOCK_LEN`] bytes.

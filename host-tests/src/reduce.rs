@@ -215,11 +215,19 @@ pub fn nominal_jacobian(p: &ReducedParams) -> Option<[[f64; N_NODES]; N_NODES]> 
 /// The whole reduction (steps 1-6). `None` if the rig gives parameters the firmware
 /// model rejects.
 pub fn reduce(rig: &Rig) -> Option<ReducedParams> {
-    let mut p = reduce_without_jacobian(rig);
-    p.nominal_jacobian_per_s = nominal_jacobian(&p)?;
-    p.phi_step_s = eha_guard::model::etd_matrix(&p.nominal_jacobian_per_s, eha_guard::params::S_PER_STEP);
+    let p = rediscretise(&reduce_without_jacobian(rig))?;
     Model::<f64>::new(&p).ok()?;
     Some(p)
+}
+
+/// `p` with its nominal Jacobian and `Phi` (re)computed (step 6; also after
+/// changing physical parameters by hand); `None` if the firmware model
+/// rejects `p`.
+pub fn rediscretise(p: &ReducedParams) -> Option<ReducedParams> {
+    let mut q = *p;
+    q.nominal_jacobian_per_s = nominal_jacobian(&q)?;
+    q.phi_step_s = eha_guard::model::etd_matrix(&q.nominal_jacobian_per_s, eha_guard::params::S_PER_STEP);
+    Some(q)
 }
 
 fn lit(x: f64) -> String {

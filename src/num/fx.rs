@@ -129,13 +129,8 @@ unsafe impl Num for Fx {
         FxCoef::checked_from_num(x)
     }
     fn from_f32(x: f32) -> Self {
-        Fx::checked_from_num(x).unwrap_or(if x > 0.0 {
-            Fx::MAX
-        } else if x < 0.0 {
-            Fx::MIN
-        } else {
-            Fx::ZERO
-        })
+        // exact widening: the same value, the same saturation rule
+        Self::from_f64(f64::from(x))
     }
     fn from_exact(_x32: f32, x64: f64) -> Self {
         Self::from_f64(x64)
