@@ -152,6 +152,17 @@ pub struct ReducedParams {
     /// 12x12 matrix exponential), so that the firmware does no matrix
     /// exponential at boot.
     pub phi_step_s: [[f64; N_NODES]; N_NODES],
+    /// Cooling at rest (pump stopped, no power): decay rate `r_i` of the bound
+    /// `T_i(t) - T_air <= c v_i e^(-r_i t)` on the model's temperatures, 1/s,
+    /// node order: a Collatz–Wielandt bound of the rest Jacobian per group of
+    /// coupled nodes (outer convection at its linear part, radiation at its
+    /// tangent: the slowest cooling), computed on the host by
+    /// `eha_sim::reduce::rest_cooling`; all 0 = no cooling bound (a restore
+    /// after a power loss keeps the saved temperatures).
+    pub rest_rate_per_s: [f64; N_NODES],
+    /// The bound's mode shape `v` (node order, positive, max 1 in each group
+    /// of coupled nodes): the Perron vector of each group.
+    pub rest_mode: [f64; N_NODES],
 }
 
 impl ReducedParams {
@@ -220,9 +231,11 @@ impl ReducedParams {
         .chain(self.nominal_jacobian_per_s.iter().flatten())
         .chain(self.phi_step_s.iter().flatten())
         .all(|x| x.is_finite());
+        let rest = self.rest_rate_per_s.iter().all(|r| r.is_finite() && *r >= 0.0)
+            && self.rest_mode.iter().all(|v| v.is_finite() && (0.0..=1.0).contains(v));
         let split = self.mech_to_outlet <= 1.0;
         let cp_pos = self.rho_cp(-60.0) > 0.0 && self.rho_cp(150.0) > 0.0;
-        pos && non_neg && links && finite && split && cp_pos
+        pos && non_neg && links && finite && split && cp_pos && rest
     }
 }
 
@@ -245,11 +258,11 @@ pub const DEFAULT: ReducedParams = ReducedParams {
     displacement_m3_per_rad: 3.023943918746011e-6,
     eta_m: 0.49826,
     mech_to_outlet: 0.768027,
-    k_leak_m3_per_s_pa: 3.357993172582738e-13,
+    k_leak_m3_per_s_pa: 3.3579931725827373e-13,
     case_pressure_pa: 500000.0,
     k_mu_per_k: 0.0,
     t_mu_ref_c: 40.0,
-    line_r1_pa_s_per_m3: 588776503.3402457,
+    line_r1_pa_s_per_m3: 588776503.3402456,
     line_r2_pa_s2_per_m6: 1018550987858.2805,
     ram_area_m2: 0.00152681,
     act_leak_m3_per_s_pa: 2e-14,
@@ -287,4 +300,6 @@ pub const DEFAULT: ReducedParams = ReducedParams {
         [1.0923085523082414e-8, 2.3582895253361937e-11, 1.1745922478786992e-6, 4.900413227034233e-10, 0.09999839903816597, 0.0],
         [0.0, 0.0, 0.0, 0.0, 0.0, 0.09999874445110943],
     ],
+    rest_rate_per_s: [2.4152711784546283e-5, 2.4152711784546283e-5, 1.3608994549955179e-5, 1.3608994549955179e-5, 2.1664745628787115e-5, 5.177148895001672e-5],
+    rest_mode: [0.9433341364526963, 1.0, 1.0, 0.9916256868071123, 1.0, 1.0],
 };

@@ -17,6 +17,9 @@ pub enum RestoreKind {
     /// A record was present but failed its magic/CRC/plausibility check:
     /// conservative start (every node at the alarm temperature, valve open).
     Corrupt,
+    /// Power loss: the non-volatile record was restored (raised by the write
+    /// policy's margin; cooled over the off-time where a clock measured it).
+    PowerLoss,
 }
 
 /// One protection event. `step` is the guard's step counter (10 ms ticks) at the event;

@@ -161,6 +161,7 @@ mod fw {
             Restore::Cold => "cold",
             Restore::Warm(_) => "warm",
             Restore::Corrupt => "corrupt record",
+            Restore::PowerLoss(_) => "power loss (non-volatile record)",
         }
     }
 

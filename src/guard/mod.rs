@@ -141,6 +141,9 @@ pub struct GuardOf<N: Num> {
     /// initial (or restored) estimate.
     started: bool,
     cold: bool,
+    /// Restored from the non-volatile record after a power loss: the first
+    /// sample's ambient, if warmer than the saved one, raises every node.
+    after_power_loss: bool,
     /// Tick from which the present valve and credit state hold in this model step.
     mark: u32,
     /// Ticks of this model step before `mark` with the valve commanded open (LNG
@@ -213,6 +216,7 @@ impl<N: Num> GuardOf<N> {
             valid_since: 0,
             started: false,
             cold: true,
+            after_power_loss: false,
             mark: 0,
             open_acc: 0,
             credit_acc: 0,
@@ -238,7 +242,8 @@ impl<N: Num> GuardOf<N> {
         };
         let kind = match restore {
             Restore::Cold => RestoreKind::Cold,
-            Restore::Warm(r) => {
+            Restore::Warm(r) | Restore::PowerLoss(r) => {
+                g.after_power_loss = matches!(restore, Restore::PowerLoss(_));
                 if let Some(c) = g.core_ok.then_some(&mut g.core) {
                     c.model.set_temperatures(&r.temps_c, r.ambient_c);
                 }
@@ -255,7 +260,11 @@ impl<N: Num> GuardOf<N> {
                 if let Some(c) = g.core_ok.then_some(&mut g.core) {
                     c.model.set_loss_max(g.latched & faults::SENSOR_DISAGREE != 0);
                 }
-                RestoreKind::Warm
+                if g.after_power_loss {
+                    RestoreKind::PowerLoss
+                } else {
+                    RestoreKind::Warm
+                }
             }
             Restore::Corrupt => {
                 let t = config.alarm.alarm_c;
@@ -509,6 +518,15 @@ impl<N: Num> GuardOf<N> {
         };
         if self.cold {
             c.model.set_uniform(ambient_c);
+        } else if self.after_power_loss {
+            // The air may have been warmer during the off-time than at the save:
+            // every node is raised by the first sample's excess over the saved
+            // ambient (the cooling bound assumes the larger of the two).
+            let rise = ambient_c.sub(c.model.ambient_c());
+            if rise > N::ZERO {
+                let t = c.model.temperatures_c().map(|x| x.add(rise).to_f32());
+                c.model.set_temperatures(&t, ambient_c.to_f32());
+            }
         }
         let d = c.model.drain_c();
         if self.latched == 0 && d < c.th.close && self.valve.is_open() {

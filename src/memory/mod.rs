@@ -7,8 +7,9 @@
 //! faults and the valve state.
 //!
 //! Boot order: the newest valid RAM record (warm reset), else the newest
-//! valid flash record (power loss of unknown length: the saved temperatures,
-//! not cooled — conservative), else a cold start.
+//! valid flash record (power loss: the saved temperatures, cooled over the
+//! off-time only where a real-time clock measured it, [`boot_restore`]),
+//! else a cold start.
 //!
 //! Boot rules (documented behaviour):
 //! * **Cold boot** (power-on: the magic word is absent, i.e. more than 4 bits from it): every node starts at the
@@ -32,18 +33,21 @@ use crate::params::N_NODES;
 
 /// Record magic: "EHAT".
 pub const MAGIC: u32 = 0x4548_4154;
-/// Record layout version. 3: the former reserved word holds the sequence
+/// Record layout version. 4: the RTC time of the write ([`ThermalRecord::rtc_s`]).
+/// 3: the former reserved word holds the sequence
 /// number and the valve state ([`ThermalRecord::seq`], [`ThermalRecord::valve_open`]).
 /// 2: the six temperatures are the reduced model's nodes (pump housing, case
 /// oil, loop oil, main block, ball-valve block, actuator). An older record is
 /// treated as corrupt (conservative).
-pub const VERSION: u16 = 3;
+pub const VERSION: u16 = 4;
+/// [`ThermalRecord::rtc_s`] of a board without a real-time clock.
+pub const RTC_NONE: u32 = u32::MAX;
 /// Bit of [`ThermalRecord::seq_flags`] that holds the valve state (1 = open).
 pub const FLAG_VALVE_OPEN: u32 = 1 << 31;
 /// Plausible stored temperature range, degC (anything else is treated as corrupt).
 pub const PLAUSIBLE_C: (f32, f32) = (-80.0, 250.0);
 
-/// Persistent thermal record, 52 bytes, no implicit padding.
+/// Persistent thermal record, 56 bytes, no implicit padding.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C)]
 pub struct ThermalRecord {
@@ -64,6 +68,9 @@ pub struct ThermalRecord {
     /// Sequence number of the write (bits 0–30, wrapping) and the valve
     /// state ([`FLAG_VALVE_OPEN`]).
     pub seq_flags: u32,
+    /// Seconds of the board's battery-backed real-time clock at the write
+    /// ([`RTC_NONE`]: no clock), for the cooling over the off-time.
+    pub rtc_s: u32,
     /// CRC-32 (IEEE) of all preceding bytes, little endian field order.
     pub crc: u32,
 }
@@ -120,6 +127,7 @@ impl ThermalRecord {
         ambient_c: 0.0,
         step: 0,
         seq_flags: 0,
+        rtc_s: RTC_NONE,
         crc: 0,
     };
 
@@ -135,6 +143,7 @@ impl ThermalRecord {
         }
         c = crc32_update(c, &self.ambient_c.to_bits().to_le_bytes());
         c = crc32_update(c, &self.seq_flags.to_le_bytes());
+        c = crc32_update(c, &self.rtc_s.to_le_bytes());
         !c
     }
 
@@ -155,10 +164,19 @@ impl ThermalRecord {
             ambient_c,
             step,
             seq_flags: 0,
+            rtc_s: RTC_NONE,
             crc: 0,
         };
         r.crc = r.body_crc();
         r
+    }
+
+    /// The same record stamped with the real-time clock `rtc_s` (seconds;
+    /// `None`: no clock), resealed.
+    pub fn with_rtc(mut self, rtc_s: Option<u32>) -> Self {
+        self.rtc_s = rtc_s.unwrap_or(RTC_NONE);
+        self.crc = self.body_crc();
+        self
     }
 
     /// The same record with sequence number `seq` (31 bits) and the valve
@@ -219,6 +237,11 @@ pub enum Restore {
     Cold,
     /// Warm reset with a valid record.
     Warm(ThermalRecord),
+    /// Power loss: the non-volatile record, raised by the write policy's
+    /// `rise_k` and cooled over the off-time where a clock measured it
+    /// ([`boot_restore`]). The guard raises every node by the ambient's rise
+    /// at its first sample.
+    PowerLoss(ThermalRecord),
     /// A corrupt record was found: conservative start (see module docs).
     Corrupt,
 }
@@ -234,25 +257,40 @@ impl Restore {
     }
 }
 
+pub mod cooling;
 pub mod nv;
 pub mod slots;
 
 /// The boot rule over both memories: the RAM records' rule
 /// ([`slots::restore_from`]) unless RAM holds nothing (power-on), then the
-/// non-volatile record (a power loss of unknown length: the saved
-/// temperatures, not cooled, each raised by the write policy's `rise_k`,
-/// the most the estimate can have risen since that record was written, so
-/// the restored state is never colder than the state at power-off), else a
-/// cold start. A damaged RAM record stays a conservative start even when
-/// flash holds an older valid one.
-pub fn boot_restore(ram: Restore, nv: Option<ThermalRecord>, policy: &nv::NvPolicy) -> Restore {
+/// non-volatile record (a power loss), else a cold start. A damaged RAM
+/// record stays a conservative start even when flash holds an older valid one.
+///
+/// After a power loss every node is first raised by the write policy's
+/// `rise_k` (the most the estimate can have risen since that record was
+/// written, so the state is never colder than at power-off). Then, when the
+/// record and the board both have a clock reading (`now_rtc_s`) and the clock
+/// has not gone back, the state is cooled by the model's bound at rest
+/// ([`cooling::RestCooling`]) over the off-time minus the policy's longest
+/// write interval (the machine may have run that long after the write);
+/// without a clock or a bound, the saved temperatures stand (power loss of
+/// unknown length: conservative).
+pub fn boot_restore(ram: Restore, nv: Option<ThermalRecord>, policy: &nv::NvPolicy, cool: Option<&cooling::RestCooling>, now_rtc_s: Option<u32>) -> Restore {
     match (ram, nv) {
         (Restore::Cold, Some(r)) => {
-            let mut hot = r;
-            for t in hot.temps_c.iter_mut() {
+            let mut hot = r.temps_c;
+            for t in hot.iter_mut() {
                 *t += policy.rise_k;
             }
-            Restore::Warm(ThermalRecord::new(hot.temps_c, r.ambient_c, r.lng_used_cj, r.faults, r.step).with_seq(r.seq(), r.valve_open()))
+            let run_s = policy.max_interval_steps / 100;
+            let off_s = match (now_rtc_s, r.rtc_s) {
+                (Some(now), saved) if saved != RTC_NONE && now >= saved => Some((now - saved).saturating_sub(run_s)).filter(|s| *s > 0),
+                _ => None,
+            };
+            if let (Some(b), Some(off)) = (cool, off_s) {
+                hot = b.cool(&hot, r.ambient_c, off);
+            }
+            Restore::PowerLoss(ThermalRecord::new(hot, r.ambient_c, r.lng_used_cj, r.faults, r.step).with_seq(r.seq(), r.valve_open()).with_rtc(Some(r.rtc_s)))
         }
         (ram, _) => ram,
     }
@@ -276,7 +314,7 @@ mod tests {
 
     #[test]
     fn record_has_no_padding() {
-        // 4 + 4 + 4 + 2 + 2 + 6*4 + 4 + 4 + 4 = 52 bytes of fields.
-        assert_eq!(core::mem::size_of::<ThermalRecord>(), 52);
+        // 4 + 4 + 4 + 2 + 2 + 6*4 + 4 + 4 + 4 + 4 = 56 bytes of fields.
+        assert_eq!(core::mem::size_of::<ThermalRecord>(), 56);
     }
 }

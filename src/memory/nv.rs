@@ -36,7 +36,7 @@ use crate::params::N_NODES;
 /// Map key of the thermal record.
 pub const RECORD_KEY: u8 = 1;
 /// Serialized record size, bytes.
-pub const RECORD_BYTES: usize = 52;
+pub const RECORD_BYTES: usize = 56;
 /// Scratch buffer: key + record, rounded up to the largest flash word (32 B).
 const BUF_BYTES: usize = 96;
 
@@ -81,11 +81,11 @@ impl<F: blocking::NorFlash> nf::NorFlash for Blocking<F> {
     }
 }
 
-/// The record as a map value: its 52 bytes, little endian, field order.
+/// The record as a map value: its 56 bytes, little endian, field order.
 impl<'a> Value<'a> for ThermalRecord {
     fn serialize_into(&self, buffer: &mut [u8]) -> Result<usize, SerializationError> {
         let out = buffer.get_mut(..RECORD_BYTES).ok_or(SerializationError::BufferTooSmall)?;
-        let mut words = [0u32; 13];
+        let mut words = [0u32; 14];
         words[0] = self.lng_used_cj;
         words[1] = self.step;
         words[2] = self.magic;
@@ -95,7 +95,8 @@ impl<'a> Value<'a> for ThermalRecord {
         }
         words[10] = self.ambient_c.to_bits();
         words[11] = self.seq_flags;
-        words[12] = self.crc;
+        words[12] = self.rtc_s;
+        words[13] = self.crc;
         for (chunk, w) in out.chunks_exact_mut(4).zip(words.iter()) {
             chunk.copy_from_slice(&w.to_le_bytes());
         }
@@ -104,7 +105,7 @@ impl<'a> Value<'a> for ThermalRecord {
 
     fn deserialize_from(buffer: &'a [u8]) -> Result<(Self, usize), SerializationError> {
         let b = buffer.get(..RECORD_BYTES).ok_or(SerializationError::InvalidFormat)?;
-        let mut w = [0u32; 13];
+        let mut w = [0u32; 14];
         for (x, chunk) in w.iter_mut().zip(b.chunks_exact(4)) {
             let mut a = [0u8; 4];
             a.copy_from_slice(chunk);
@@ -123,7 +124,8 @@ impl<'a> Value<'a> for ThermalRecord {
             temps_c,
             ambient_c: f32::from_bits(w[10]),
             seq_flags: w[11],
-            crc: w[12],
+            rtc_s: w[12],
+            crc: w[13],
         };
         Ok((r, RECORD_BYTES))
     }

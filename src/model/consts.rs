@@ -102,6 +102,12 @@ pub struct ModelConsts<S> {
     pub g_ball: [S; N_TABLE],
     /// LNG exchanger `eps C_min` over flow, kW/K (eqs. 20-22).
     pub g_lng: [S; N_TABLE],
+    /// Cooling at rest: decay rate of each node's bound on its excess over
+    /// the air, 1/s (all 0: no bound; [`ReducedParams::rest_rate_per_s`]).
+    pub rest_rate: [S; N_NODES],
+    /// Cooling at rest: the bound's mode shape, node order, in (0, 1]
+    /// ([`ReducedParams::rest_mode`]).
+    pub rest_mode: [S; N_NODES],
     /// Exact-ZOH matrix `Phi = h phi1(h A)` of the model step, s.
     pub phi: [[S; N_NODES]; N_NODES],
 }
@@ -153,7 +159,7 @@ impl Word for f64 {
 /// Scalar words at the head of a [`ModelConsts`] (`p_case` .. `t_mu`).
 pub const N_SCALARS: usize = 35;
 /// Number of words in a [`ModelConsts`].
-pub const N_WORDS: usize = N_SCALARS + N_NODES + 12 + 5 * N_TABLE + N_NODES * N_NODES;
+pub const N_WORDS: usize = N_SCALARS + N_NODES + 12 + 5 * N_TABLE + 2 * N_NODES + N_NODES * N_NODES;
 
 // Every field is a word: no padding, no other data.
 const _: () = assert!(core::mem::size_of::<ModelConsts<f32>>() == 4 * N_WORDS);
@@ -211,6 +217,8 @@ impl<S: Copy> ModelConsts<S> {
             g_loop: c.g_loop.map(&mut f),
             g_ball: c.g_ball.map(&mut f),
             g_lng: c.g_lng.map(&mut f),
+            rest_rate: c.rest_rate.map(&mut f),
+            rest_mode: c.rest_mode.map(&mut f),
             phi: c.phi.map(|r| r.map(&mut f)),
         }
     }
@@ -274,6 +282,8 @@ impl ModelConsts<()> {
         g_loop: [(); N_TABLE],
         g_ball: [(); N_TABLE],
         g_lng: [(); N_TABLE],
+        rest_rate: [(); N_NODES],
+        rest_mode: [(); N_NODES],
         phi: [[(); N_NODES]; N_NODES],
     };
 }
@@ -296,7 +306,7 @@ impl<S: Word> ModelConsts<S> {
 
     /// Value checks that need no model: every word finite and below
     /// [`MAX_ABS`]; capacities, volumes, conductances, tables, loss coefficients
-    /// and shares non-negative; shares ≤ 1; the links' zero-flow conductances and
+    /// and shares non-negative; shares and the rest mode ≤ 1; the links' zero-flow conductances and
     /// the table scales positive. The stability of the discretisation is checked
     /// by [`crate::model::Model::check_stability`].
     pub fn check_values(&self) -> Result<(), ConfigError> {
@@ -321,9 +331,10 @@ impl<S: Word> ModelConsts<S> {
             .iter()
             .all(|x| w(*x) > 0.0);
         let shares = w(c.w_dp) <= 1.0 && w(c.w_dx) <= 1.0 && w(c.f_out) <= 1.0 && w(c.f_case) <= 1.0;
+        let mode = c.rest_mode.iter().all(|v| w(*v) <= 1.0);
         // rho c_p stays positive over the oil's range (-60..150 degC)
         let rc = w(c.rc0) + w(c.rc1) * -60.0 > 0.0 && w(c.rc0) + w(c.rc1) * 150.0 > 0.0;
-        if non_neg && pos && shares && rc {
+        if non_neg && pos && shares && mode && rc {
             Ok(())
         } else {
             Err(ConfigError::Implausible)
@@ -407,6 +418,8 @@ pub fn derive(p: &ReducedParams) -> Result<ModelConsts<f64>, ConfigError> {
         g_loop: kw(&p.g_loop_block_w_per_k),
         g_ball: kw(&p.g_ball_block_w_per_k),
         g_lng: kw(&p.g_lng_w_per_k),
+        rest_rate: p.rest_rate_per_s,
+        rest_mode: p.rest_mode,
         phi: p.phi_step_s,
     };
     let mut ok = true;

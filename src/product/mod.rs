@@ -23,6 +23,7 @@ pub mod wire;
 use crate::memory::nv::NvPolicy;
 use crate::protection::LngConfig;
 use crate::memory::slots::{self, AbWriter};
+use crate::memory::cooling::RestCooling;
 use crate::memory::{boot_restore, Restore, ThermalRecord};
 use crate::protocol::{DecodeError, Deframer, Request, MAX_MISSED_STEPS};
 use crate::trace::{RestoreKind, Trace};
@@ -70,6 +71,14 @@ pub trait Board {
     /// watchdog from expiring meanwhile.
     fn nv_save(&mut self, _rec: &ThermalRecord) -> bool {
         false
+    }
+    /// Seconds of a battery-backed real-time clock that keeps running while
+    /// the board is unpowered (`None`: the board has none, or it lost its
+    /// time). Read at boot and at each non-volatile save: the off-time of a
+    /// power loss, over which the restored state is cooled
+    /// ([`crate::memory::boot_restore`]).
+    fn rtc_s(&mut self) -> Option<u32> {
+        None
     }
     /// A free-running core-clock cycle stamp (0 when not available).
     fn cycle_stamp(&self) -> u32 {
@@ -168,6 +177,7 @@ fn restore_kind(r: &Restore) -> RestoreKind {
         Restore::Cold => RestoreKind::Cold,
         Restore::Warm(_) => RestoreKind::Warm,
         Restore::Corrupt => RestoreKind::Corrupt,
+        Restore::PowerLoss(_) => RestoreKind::PowerLoss,
     }
 }
 
@@ -189,8 +199,6 @@ impl App {
         let (reset_cause, boots, running) = reset::at_boot(&mem.cause, mem.hw_hint);
         board.store_cause(&running);
         let (a, b) = &mem.records;
-        let nv_policy = NvPolicy::DEFAULT;
-        let restore = boot_restore(slots::restore_from(a, b), mem.nv, &nv_policy);
         // The model constants: a valid parameter block, else `cfg`'s own (the
         // compiled-in paper rig on the boards: NOT_COMMISSIONED); an invalid
         // block refuses the configuration (CONFIG, fail-safe).
@@ -199,6 +207,14 @@ impl App {
             Some(Ok(Some(c))) => (c, ParamSource::Block),
             Some(Err(e)) => (cfg.model, ParamSource::Invalid(e)),
         };
+        let nv_policy = NvPolicy::DEFAULT;
+        // The cooling bound at rest of the model in use (none under CONFIG).
+        let cool = match params {
+            ParamSource::Invalid(_) => None,
+            _ => RestCooling::from_consts(model),
+        };
+        let now_s = if mem.nv.is_some() { board.rtc_s() } else { None };
+        let restore = boot_restore(slots::restore_from(a, b), mem.nv, &nv_policy, cool.as_ref(), now_s);
         let cfg = GuardConfig { model, ..*cfg };
         let p = slot.as_mut_ptr();
         // SAFETY: `p` points to `slot`, valid for writes; every field is written
@@ -304,6 +320,7 @@ impl App {
         let rec = self.guard.snapshot();
         self.records.write(&rec, |slot, r| board.store_record(slot, r));
         if self.tick >= self.nv_retry_at && self.nv_policy.due(self.nv_last.as_ref(), &rec) {
+            let rec = rec.with_rtc(board.rtc_s());
             if board.nv_save(&rec) {
                 self.nv_last = Some(rec);
             } else {
@@ -473,11 +490,7 @@ impl App {
             stack_high_water_b: u16::try_from(board.stack_high_water_b()).unwrap_or(u16::MAX),
             boot_stack_b: u16::try_from(board.boot_stack_b()).unwrap_or(u16::MAX),
             reset_cause: self.reset_cause as u8,
-            restore: match self.restore {
-                RestoreKind::Cold => 0,
-                RestoreKind::Warm => 1,
-                RestoreKind::Corrupt => 2,
-            },
+            restore: wire::restore_code(self.restore),
             boots: self.boots,
             rejected_crc: c.rejected_crc,
             rejected_framing: c.rejected_framing,

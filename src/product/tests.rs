@@ -23,6 +23,10 @@ struct SimBoard {
     nv_calls: u32,
     /// The flash's parameter-block region (`None`: the board has none).
     block: Option<&'static [u8; BLOCK_LEN]>,
+    /// The real-time clock's reading, s (`None`: no clock).
+    rtc: Option<u32>,
+    /// The last record handed to `nv_save`.
+    nv_saved: Option<ThermalRecord>,
 }
 
 impl SimBoard {
@@ -39,6 +43,8 @@ impl SimBoard {
             nv: None,
             nv_calls: 0,
             block: None,
+            rtc: None,
+            nv_saved: None,
         }
     }
 
@@ -94,9 +100,13 @@ impl Board for SimBoard {
     fn store_cause(&mut self, rec: &CauseRecord) {
         self.cause = *rec;
     }
-    fn nv_save(&mut self, _rec: &ThermalRecord) -> bool {
+    fn nv_save(&mut self, rec: &ThermalRecord) -> bool {
         self.nv_calls += 1;
+        self.nv_saved = Some(*rec);
         self.nv.unwrap_or(false)
+    }
+    fn rtc_s(&mut self) -> Option<u32> {
+        self.rtc
     }
     fn param_block(&self) -> Option<&'static [u8; BLOCK_LEN]> {
         self.block
@@ -445,4 +455,47 @@ fn an_invalid_block_latches_config_and_opens_the_valve() {
             "{name}: {t:?}"
         );
     }
+}
+
+/// Power loss on a board with a real-time clock (issue 15 §5): the
+/// non-volatile record carries the clock reading; after 24 h off the restore
+/// is cooled by the model's rest bound (never below the air), on a board
+/// without a clock it stays at the saved temperatures plus the write
+/// policy's 2 K; a first sample with a warmer ambient than the saved one
+/// raises every node by the difference.
+#[test]
+fn power_loss_restore_is_cooled_over_the_clocks_off_time() {
+    // the save carries the clock
+    let mut b = SimBoard::new();
+    b.nv = Some(true);
+    b.rtc = Some(5_000);
+    let mem = b.mem();
+    let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
+    b.rx.extend_from_slice(&sample(1, 10.0, 40.0).encode());
+    app.tick(&mut b, 0);
+    assert_eq!(b.nv_saved.map(|r| r.rtc_s), Some(5_000), "the first save is stamped");
+
+    let hot = ThermalRecord::new([55.0, 60.0, 50.0, 45.0, 40.0, 30.0], 20.0, 0, 0, 100).with_rtc(Some(5_000));
+    let boot_after = |rtc: Option<u32>, ambient_c: f32| {
+        let mut b = SimBoard::new();
+        b.rtc = rtc;
+        let mem = BootMemory { nv: Some(hot), ..b.mem() };
+        let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
+        let mut s = sample(1, 0.0, 3.0);
+        s.speed_rpm = 0.0;
+        s.ambient_c = ambient_c;
+        b.rx.extend_from_slice(&s.encode());
+        app.tick(&mut b, 0);
+        let t = ticks(&b.replies());
+        let last = *t.last().expect("a tick reply");
+        (last.restore, last.out.drain_c)
+    };
+    let (kind, uncooled) = boot_after(None, 20.0);
+    assert_eq!(kind, RestoreKind::PowerLoss);
+    assert!((uncooled - 62.0).abs() < 0.05, "no clock: saved + 2 K, got {uncooled}");
+    let (_, day) = boot_after(Some(5_000 + 86_400), 20.0);
+    // pump group bound: 11.5 h; 23.5 h counted (the 30-minute write interval off)
+    assert!(day > 20.0 && day < 35.0, "24 h off: {day}");
+    let (_, warmer) = boot_after(Some(5_000 + 86_400), 25.0);
+    assert!((warmer - day - 5.0).abs() < 0.05, "a 5 K warmer first ambient raises the drain by 5 K: {day} -> {warmer}");
 }

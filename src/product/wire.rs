@@ -164,11 +164,13 @@ impl ResetCause {
     }
 }
 
-fn restore_code(k: RestoreKind) -> u8 {
+/// Wire code of a restore kind (tick reply and status).
+pub(crate) fn restore_code(k: RestoreKind) -> u8 {
     match k {
         RestoreKind::Cold => 0,
         RestoreKind::Warm => 1,
         RestoreKind::Corrupt => 2,
+        RestoreKind::PowerLoss => 3,
     }
 }
 
@@ -178,6 +180,7 @@ pub fn restore_from_code(c: u8) -> Option<RestoreKind> {
         0 => Some(RestoreKind::Cold),
         1 => Some(RestoreKind::Warm),
         2 => Some(RestoreKind::Corrupt),
+        3 => Some(RestoreKind::PowerLoss),
         _ => None,
     }
 }

@@ -443,7 +443,7 @@ proptest! {
     #[test]
     fn record_roundtrip_and_single_bit_corruption(
         temps in proptest::array::uniform6(-40.0f32..200.0), amb in -40.0f32..80.0,
-        used in any::<u32>(), faults_w in any::<u16>(), step in any::<u32>(), bit in 0usize..(52 * 8),
+        used in any::<u32>(), faults_w in any::<u16>(), step in any::<u32>(), bit in 0usize..(56 * 8),
     ) {
         let r = ThermalRecord::new(temps, amb, used, faults_w, step);
         prop_assert_eq!(r.classify(), RecordStatus::Valid);
@@ -451,13 +451,13 @@ proptest! {
         let mut b = bytes;
         b[bit / 8] ^= 1 << (bit % 8);
         let c = record_from_bytes(&b);
-        // Padding-free layout: bytes 44..48 are `seq_flags`, 48..52 the CRC; every bit counts.
+        // Padding-free layout: bytes 44..48 are `seq_flags`, 48..52 the RTC stamp, 52..56 the CRC; every bit counts.
         prop_assert_eq!(c.classify(), RecordStatus::Corrupt, "flip of bit {} undetected", bit);
     }
 }
 
-fn record_bytes(r: &ThermalRecord) -> [u8; 52] {
-    let mut b = [0u8; 52];
+fn record_bytes(r: &ThermalRecord) -> [u8; 56] {
+    let mut b = [0u8; 56];
     b[0..4].copy_from_slice(&r.lng_used_cj.to_le_bytes());
     b[4..8].copy_from_slice(&r.step.to_le_bytes());
     b[8..12].copy_from_slice(&r.magic.to_le_bytes());
@@ -468,11 +468,12 @@ fn record_bytes(r: &ThermalRecord) -> [u8; 52] {
     }
     b[40..44].copy_from_slice(&r.ambient_c.to_le_bytes());
     b[44..48].copy_from_slice(&r.seq_flags.to_le_bytes());
-    b[48..52].copy_from_slice(&r.crc.to_le_bytes());
+    b[48..52].copy_from_slice(&r.rtc_s.to_le_bytes());
+    b[52..56].copy_from_slice(&r.crc.to_le_bytes());
     b
 }
 
-fn record_from_bytes(b: &[u8; 52]) -> ThermalRecord {
+fn record_from_bytes(b: &[u8; 56]) -> ThermalRecord {
     let u32_at = |i: usize| u32::from_le_bytes(b[i..i + 4].try_into().unwrap());
     let mut temps = [0.0f32; 6];
     for (i, t) in temps.iter_mut().enumerate() {
@@ -487,7 +488,8 @@ fn record_from_bytes(b: &[u8; 52]) -> ThermalRecord {
         temps_c: temps,
         ambient_c: f32::from_bits(u32_at(40)),
         seq_flags: u32_at(44),
-        crc: u32_at(48),
+        rtc_s: u32_at(48),
+        crc: u32_at(52),
     }
 }
 

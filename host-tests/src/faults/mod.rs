@@ -113,7 +113,7 @@ impl Mcu {
     /// Boot with RAM records `slots` (zeros after a power loss) and the
     /// non-volatile store, by the firmware's boot rule.
     fn boot(cfg: GuardConfig, slots: [ThermalRecord; 2], nv: &mut Nv, first: Option<Restore>) -> Self {
-        let restore = first.unwrap_or_else(|| boot_restore(restore_from(&slots[0], &slots[1]), nv.store.load(), &NvPolicy::DEFAULT));
+        let restore = first.unwrap_or_else(|| boot_restore(restore_from(&slots[0], &slots[1]), nv.store.load(), &NvPolicy::DEFAULT, None, None));
         let writer = AbWriter::after_boot(&slots[0], &slots[1]);
         Mcu { guard: GuardOf::new(&cfg, restore), link: Link::new(), slots, writer, last_slot: 0 }
     }

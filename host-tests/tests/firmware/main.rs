@@ -3,4 +3,5 @@
 
 mod faults;
 mod nv_wear;
+mod rest_cooling;
 mod vs_reference;
