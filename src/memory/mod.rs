@@ -47,6 +47,9 @@ pub const FLAG_VALVE_OPEN: u32 = 1 << 31;
 /// Plausible stored temperature range, degC (anything else is treated as corrupt).
 pub const PLAUSIBLE_C: (f32, f32) = (-80.0, 250.0);
 
+/// Size of a [`ThermalRecord`] and of its byte form, bytes.
+pub const RECORD_BYTES: usize = 56;
+
 /// Persistent thermal record, 56 bytes, no implicit padding.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C)]
@@ -187,6 +190,54 @@ impl ThermalRecord {
         self
     }
 
+    /// The record's bytes: every field little-endian in field order (the
+    /// form stored in flash and in no-init RAM on a little-endian target).
+    pub fn to_le_bytes(&self) -> [u8; RECORD_BYTES] {
+        let mut words = [0u32; RECORD_BYTES / 4];
+        words[0] = self.lng_used_cj;
+        words[1] = self.step;
+        words[2] = self.magic;
+        words[3] = u32::from(self.version) | (u32::from(self.faults) << 16);
+        for (w, t) in words[4..4 + N_NODES].iter_mut().zip(self.temps_c.iter()) {
+            *w = t.to_bits();
+        }
+        words[10] = self.ambient_c.to_bits();
+        words[11] = self.seq_flags;
+        words[12] = self.rtc_s;
+        words[13] = self.crc;
+        let mut out = [0u8; RECORD_BYTES];
+        for (chunk, w) in out.chunks_exact_mut(4).zip(words.iter()) {
+            chunk.copy_from_slice(&w.to_le_bytes());
+        }
+        out
+    }
+
+    /// The record of [`Self::to_le_bytes`] bytes (not checked: see [`Self::classify`]).
+    pub fn from_le_bytes(b: &[u8; RECORD_BYTES]) -> Self {
+        let mut w = [0u32; RECORD_BYTES / 4];
+        for (x, chunk) in w.iter_mut().zip(b.chunks_exact(4)) {
+            let mut a = [0u8; 4];
+            a.copy_from_slice(chunk);
+            *x = u32::from_le_bytes(a);
+        }
+        let mut temps_c = [0.0f32; N_NODES];
+        for (t, x) in temps_c.iter_mut().zip(w[4..4 + N_NODES].iter()) {
+            *t = f32::from_bits(*x);
+        }
+        ThermalRecord {
+            lng_used_cj: w[0],
+            step: w[1],
+            magic: w[2],
+            version: (w[3] & 0xFFFF) as u16,
+            faults: (w[3] >> 16) as u16,
+            temps_c,
+            ambient_c: f32::from_bits(w[10]),
+            seq_flags: w[11],
+            rtc_s: w[12],
+            crc: w[13],
+        }
+    }
+
     /// Sequence number of the write (31 bits, wrapping).
     pub fn seq(&self) -> u32 {
         self.seq_flags & !FLAG_VALVE_OPEN
@@ -315,6 +366,6 @@ mod tests {
     #[test]
     fn record_has_no_padding() {
         // 4 + 4 + 4 + 2 + 2 + 6*4 + 4 + 4 + 4 + 4 = 56 bytes of fields.
-        assert_eq!(core::mem::size_of::<ThermalRecord>(), 56);
+        assert_eq!(core::mem::size_of::<ThermalRecord>(), RECORD_BYTES);
     }
 }

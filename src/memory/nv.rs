@@ -31,12 +31,11 @@ use sequential_storage::cache::{Cache, Uncached};
 use sequential_storage::map::{MapConfig, MapStorage, SerializationError, Value};
 
 use super::{RecordStatus, ThermalRecord};
-use crate::params::N_NODES;
 
 /// Map key of the thermal record.
 pub const RECORD_KEY: u8 = 1;
 /// Serialized record size, bytes.
-pub const RECORD_BYTES: usize = 56;
+pub use super::RECORD_BYTES;
 /// Scratch buffer: key + record, rounded up to the largest flash word (32 B).
 const BUF_BYTES: usize = 96;
 
@@ -81,53 +80,20 @@ impl<F: blocking::NorFlash> nf::NorFlash for Blocking<F> {
     }
 }
 
-/// The record as a map value: its 56 bytes, little endian, field order.
+/// The record as a map value: its [`RECORD_BYTES`] bytes
+/// ([`ThermalRecord::to_le_bytes`]).
 impl<'a> Value<'a> for ThermalRecord {
     fn serialize_into(&self, buffer: &mut [u8]) -> Result<usize, SerializationError> {
         let out = buffer.get_mut(..RECORD_BYTES).ok_or(SerializationError::BufferTooSmall)?;
-        let mut words = [0u32; 14];
-        words[0] = self.lng_used_cj;
-        words[1] = self.step;
-        words[2] = self.magic;
-        words[3] = u32::from(self.version) | (u32::from(self.faults) << 16);
-        for (w, t) in words[4..4 + N_NODES].iter_mut().zip(self.temps_c.iter()) {
-            *w = t.to_bits();
-        }
-        words[10] = self.ambient_c.to_bits();
-        words[11] = self.seq_flags;
-        words[12] = self.rtc_s;
-        words[13] = self.crc;
-        for (chunk, w) in out.chunks_exact_mut(4).zip(words.iter()) {
-            chunk.copy_from_slice(&w.to_le_bytes());
-        }
+        out.copy_from_slice(&self.to_le_bytes());
         Ok(RECORD_BYTES)
     }
 
     fn deserialize_from(buffer: &'a [u8]) -> Result<(Self, usize), SerializationError> {
         let b = buffer.get(..RECORD_BYTES).ok_or(SerializationError::InvalidFormat)?;
-        let mut w = [0u32; 14];
-        for (x, chunk) in w.iter_mut().zip(b.chunks_exact(4)) {
-            let mut a = [0u8; 4];
-            a.copy_from_slice(chunk);
-            *x = u32::from_le_bytes(a);
-        }
-        let mut temps_c = [0.0f32; N_NODES];
-        for (t, x) in temps_c.iter_mut().zip(w[4..4 + N_NODES].iter()) {
-            *t = f32::from_bits(*x);
-        }
-        let r = ThermalRecord {
-            lng_used_cj: w[0],
-            step: w[1],
-            magic: w[2],
-            version: (w[3] & 0xFFFF) as u16,
-            faults: (w[3] >> 16) as u16,
-            temps_c,
-            ambient_c: f32::from_bits(w[10]),
-            seq_flags: w[11],
-            rtc_s: w[12],
-            crc: w[13],
-        };
-        Ok((r, RECORD_BYTES))
+        let mut a = [0u8; RECORD_BYTES];
+        a.copy_from_slice(b);
+        Ok((ThermalRecord::from_le_bytes(&a), RECORD_BYTES))
     }
 }
 
@@ -295,7 +261,7 @@ mod tests {
     type Flash = Blocking<RamFlash<8192>>;
 
     fn rec(t: f32, step: u32) -> ThermalRecord {
-        ThermalRecord::new([t; N_NODES], 20.0, 1234, 0, step).with_seq(step, t > 40.0)
+        ThermalRecord::new([t; crate::params::N_NODES], 20.0, 1234, 0, step).with_seq(step, t > 40.0)
     }
 
     #[test]

@@ -457,40 +457,11 @@ proptest! {
 }
 
 fn record_bytes(r: &ThermalRecord) -> [u8; 56] {
-    let mut b = [0u8; 56];
-    b[0..4].copy_from_slice(&r.lng_used_cj.to_le_bytes());
-    b[4..8].copy_from_slice(&r.step.to_le_bytes());
-    b[8..12].copy_from_slice(&r.magic.to_le_bytes());
-    b[12..14].copy_from_slice(&r.version.to_le_bytes());
-    b[14..16].copy_from_slice(&r.faults.to_le_bytes());
-    for (i, t) in r.temps_c.iter().enumerate() {
-        b[16 + 4 * i..20 + 4 * i].copy_from_slice(&t.to_le_bytes());
-    }
-    b[40..44].copy_from_slice(&r.ambient_c.to_le_bytes());
-    b[44..48].copy_from_slice(&r.seq_flags.to_le_bytes());
-    b[48..52].copy_from_slice(&r.rtc_s.to_le_bytes());
-    b[52..56].copy_from_slice(&r.crc.to_le_bytes());
-    b
+    r.to_le_bytes()
 }
 
 fn record_from_bytes(b: &[u8; 56]) -> ThermalRecord {
-    let u32_at = |i: usize| u32::from_le_bytes(b[i..i + 4].try_into().unwrap());
-    let mut temps = [0.0f32; 6];
-    for (i, t) in temps.iter_mut().enumerate() {
-        *t = f32::from_bits(u32_at(16 + 4 * i));
-    }
-    ThermalRecord {
-        lng_used_cj: u32_at(0),
-        step: u32_at(4),
-        magic: u32_at(8),
-        version: u16::from_le_bytes([b[12], b[13]]),
-        faults: u16::from_le_bytes([b[14], b[15]]),
-        temps_c: temps,
-        ambient_c: f32::from_bits(u32_at(40)),
-        seq_flags: u32_at(44),
-        rtc_s: u32_at(48),
-        crc: u32_at(52),
-    }
+    ThermalRecord::from_le_bytes(b)
 }
 
 #[test]

@@ -532,17 +532,5 @@ pub fn symbol_addr(elf: &Path, parts: &[&str]) -> Result<u32> {
 /// The bytes of a thermal record as the firmware stores it (`#[repr(C)]`,
 /// little endian), for `-device loader` into no-init RAM.
 pub fn record_bytes(r: &eha_guard::ThermalRecord) -> Vec<u8> {
-    let mut b = Vec::with_capacity(52);
-    b.extend_from_slice(&r.lng_used_cj.to_le_bytes());
-    b.extend_from_slice(&r.step.to_le_bytes());
-    b.extend_from_slice(&r.magic.to_le_bytes());
-    b.extend_from_slice(&r.version.to_le_bytes());
-    b.extend_from_slice(&r.faults.to_le_bytes());
-    for t in r.temps_c {
-        b.extend_from_slice(&t.to_le_bytes());
-    }
-    b.extend_from_slice(&r.ambient_c.to_le_bytes());
-    b.extend_from_slice(&r.seq_flags.to_le_bytes());
-    b.extend_from_slice(&r.crc.to_le_bytes());
-    b
+    r.to_le_bytes().to_vec()
 }
