@@ -3,7 +3,7 @@
 //! matrix included), with a header and a CRC, flashed into its own region (the
 //! `PARAMS` region of the board's `memory.x`) and read at boot.
 //!
-//! Layout (little-endian, [`BLOCK_LEN`] = 1072 bytes):
+//! Layout (little-endian, [`BLOCK_LEN`] = 1064 bytes):
 //!
 //! | offset | size | field |
 //! |---|---|---|
@@ -29,9 +29,10 @@ use crate::model::ModelConsts;
 pub const BLOCK_LEN: usize = WORDS_AT + 4 * N_WORDS + 4;
 /// `"EHAP"` little-endian.
 pub const MAGIC: u32 = u32::from_le_bytes(*b"EHAP");
-/// Format version of this firmware. 2: the rest-cooling words
-/// (`rest_rate`, `rest_mode`; 261 words, 1072 bytes). A version-1 block is refused.
-pub const VERSION: u16 = 2;
+/// Format version of this firmware. 3: without `irc0`/`irc1` (the oil
+/// capacity's inverse is exact; 259 words, 1064 bytes). 2: the rest-cooling
+/// words (`rest_rate`, `rest_mode`). Older blocks are refused.
+pub const VERSION: u16 = 3;
 /// Offset of the rig id.
 const ID_AT: usize = 8;
 /// Length of the rig id, bytes.
@@ -216,7 +217,7 @@ mod tests {
     #[test]
     fn version_and_words_are_checked_before_the_crc() {
         let mut b = Aligned(encode(&DEFAULT_CONSTS, "x"));
-        b.0[4] = 1; // a version-1 block (before the rest-cooling words)
+        b.0[4] = 2; // a version-2 block (with irc0/irc1)
         assert_eq!(view(&b.0), Err(BlockError::Version));
         let mut b = Aligned(encode(&DEFAULT_CONSTS, "x"));
         b.0[6] ^= 1;

@@ -60,10 +60,6 @@ pub struct ModelConsts<S> {
     pub rc0: S,
     /// Slope of `rho c_p`, kJ/(L K^2).
     pub rc1: S,
-    /// `1/(rho c_p)` linearised about 40 degC, `irc0 - irc1 T`: constant part, L K/kJ.
-    pub irc0: S,
-    /// `1/(rho c_p)` linearised about 40 degC: slope, L/kJ.
-    pub irc1: S,
     /// 1 / case oil volume, 1/L.
     pub inv_v_case: S,
     /// 1 / loop oil volume, 1/L.
@@ -157,7 +153,7 @@ impl Word for f64 {
 }
 
 /// Scalar words at the head of a [`ModelConsts`] (`p_case` .. `t_mu`).
-pub const N_SCALARS: usize = 35;
+pub const N_SCALARS: usize = 33;
 /// Number of words in a [`ModelConsts`].
 pub const N_WORDS: usize = N_SCALARS + N_NODES + 12 + 5 * N_TABLE + 2 * N_NODES + N_NODES * N_NODES;
 
@@ -196,8 +192,6 @@ impl<S: Copy> ModelConsts<S> {
             w_scale: f(c.w_scale),
             rc0: f(c.rc0),
             rc1: f(c.rc1),
-            irc0: f(c.irc0),
-            irc1: f(c.irc1),
             inv_v_case: f(c.inv_v_case),
             inv_v_loop: f(c.inv_v_loop),
             v_port: f(c.v_port),
@@ -261,8 +255,6 @@ impl ModelConsts<()> {
         w_scale: (),
         rc0: (),
         rc1: (),
-        irc0: (),
-        irc1: (),
         inv_v_case: (),
         inv_v_loop: (),
         v_port: (),
@@ -351,7 +343,6 @@ pub fn derive(p: &ReducedParams) -> Result<ModelConsts<f64>, ConfigError> {
     }
     let d = p.displacement_m3_per_rad;
     let kl = p.k_leak_m3_per_s_pa;
-    let rho_cp40 = p.rho_cp(40.0) * 1e-6; // kJ/(L K)
     let rc1 = p.rho_kg_per_m3 * p.cp_slope_j_per_kg_k2 * 1e-6;
     let rc0 = p.rho_cp(0.0) * 1e-6;
     let q_max = p.flow_table_max_m3_per_s * L_PER_M3;
@@ -367,9 +358,6 @@ pub fn derive(p: &ReducedParams) -> Result<ModelConsts<f64>, ConfigError> {
     // with the larger coefficient factored out (both weights <= 1).
     let k_act = if k_al > k_fr { k_al } else { k_fr };
     let (w_dp, w_dx) = if k_act > 0.0 { (k_al / k_act, k_fr / k_act) } else { (0.0, 0.0) };
-    // 1/(rc40 + rc1 (T - 40)) ≈ (1/rc40)(1 - (rc1/rc40)(T - 40)) = irc0 - irc1 T
-    let irc0 = (1.0 + 40.0 * rc1 / rho_cp40) / rho_cp40;
-    let irc1 = rc1 / (rho_cp40 * rho_cp40);
     let kw = |t: &[f64; N_TABLE]| t.map(|g| g * KW_PER_W);
     let c = ModelConsts {
         p_case: p.case_pressure_pa / PA_PER_HBAR,
@@ -395,8 +383,6 @@ pub fn derive(p: &ReducedParams) -> Result<ModelConsts<f64>, ConfigError> {
         w_scale: n1 / libm::sqrt(w_max),
         rc0,
         rc1,
-        irc0,
-        irc1,
         inv_v_case: 1.0 / (p.case_oil_m3 * L_PER_M3),
         inv_v_loop: 1.0 / (p.loop_oil_m3 * L_PER_M3),
         v_port: p.port_oil_m3 * L_PER_M3,

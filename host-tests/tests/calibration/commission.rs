@@ -14,14 +14,11 @@ fn cal_log(kind: Kind, seed: u64) -> CalLog {
 }
 
 /// Measured (one run, ~5 s; eta_m from the current, 0.3736 from 1 355
-/// loaded samples): the reduced model with the commissioned parameters
-/// against the machine's true drain on the held-out mission: max |e|
-/// 0.225 K, under-prediction 0.038 K (was 0.257 / 0.037 K with eta_m from
-/// the temperatures); the paper default parameters: max |e| 18.2 K, all of
-/// it under-prediction. The reduced-vs-commissioned-reference check is
-/// 0.194 / 0.332 / 0.171 K on the three logs: the speed-steps log (1500
-/// rpm) exceeds the 0.2 K bound, so `commission` refuses these logs
-/// (asserted below as measured).
+/// loaded samples): see the eprintln and docs/commissioning.md. The
+/// reduced-vs-commissioned-reference check is 0.114 / 0.065 / 0.117 K on the
+/// three logs (issue bound 0.2 K; it was 0.194 / 0.332 / 0.171 K while the
+/// firmware linearised the oil's `1/(rho c_p)` about 40 °C, which missed on
+/// the speed-steps log's 142 °C excursion).
 #[test]
 fn other_rig_commissioned_firmware_meets_drain_bounds_on_held_out_mission() {
     let t0 = std::time::Instant::now();
@@ -43,9 +40,10 @@ fn other_rig_commissioned_firmware_meets_drain_bounds_on_held_out_mission() {
     for r in &c.default_on_holdout {
         eprintln!("paper default {:22} vs measured max {:?} under {:?}", r.log, r.vs_measured_max_k, r.vs_measured_under_k);
     }
-    assert!(!c.reduced_ok, "measured: the speed-steps log exceeds the 0.2 K reduced-model bound");
+    // Issue 18: the reduced model within 0.2 K of the commissioned reference
+    // on every log's inputs (measured worst 0.117 K).
     let worst = c.reduced.iter().map(|r| r.vs_reference_max_k).fold(0.0, f64::max);
-    assert!((0.25..0.45).contains(&worst), "worst reduced-vs-reference {worst:.3} K (measured 0.332)");
+    assert!(c.reduced_ok && worst <= eha_sim::calibration::commission::REDUCED_BOUND_K, "worst reduced-vs-reference {worst:.3} K");
     // Against the true (noise-free) drain of the machine: the reduced model
     // with the commissioned parameters vs the truth rig replaying the
     // held-out inputs (`vs_reference` of a check on the truth rig).
