@@ -17,6 +17,7 @@
 //! memories; the QEMU `mps2-an386` board and the STM32F411 board differ only
 //! there (`src/bin/eha-mps2/`, `src/bin/eha-stm32f4/`).
 
+pub mod clock;
 pub mod reset;
 pub mod wire;
 

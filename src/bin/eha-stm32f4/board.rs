@@ -1,6 +1,7 @@
 //! STM32F411 board (through `stm32f4xx-hal` 0.23): USART1 (controller link,
 //! RX by interrupt), TIM2 (10 ms tick interrupt), IWDG, PA5/PA6 outputs, the
-//! non-volatile thermal record in flash sectors 6-7, DWT cycle stamps.
+//! non-volatile thermal record in flash sectors 6-7, the backup-domain RTC
+//! (`rtc.rs`: the off-time of a power loss), DWT cycle stamps.
 //!
 //! Pins (wiring and the valve the board needs: `docs/firmware.md`, "STM32F411
 //! product image"):
@@ -178,6 +179,8 @@ pub struct F411 {
     nv: Option<NvStore<Blocking<Flash>>>,
     nv_errors: u32,
     boot_stack_b: u32,
+    /// The backup-domain calendar (off-time of a power loss).
+    rtc: crate::rtc::Rtc,
 }
 
 /// The hardware's hint from RCC_CSR (read before it is cleared).
@@ -239,7 +242,10 @@ impl F411 {
             nv.is_some(),
             nv_rec.is_some()
         );
-        let board = F411 { valve, ok, tx, rx, tick, nv, nv_errors: 0, boot_stack_b: 0 };
+        // The RTC: started here (the LSE crystal needs up to ~2 s; never waited for).
+        let mut rtc = crate::rtc::Rtc::new();
+        let _ = rtc.seconds();
+        let board = F411 { valve, ok, tx, rx, tick, nv, nv_errors: 0, boot_stack_b: 0, rtc };
         (board, mem)
     }
 
@@ -371,6 +377,9 @@ impl Board for F411 {
 
     fn param_block(&self) -> Option<&'static [u8; eha_guard::params_block::BLOCK_LEN]> {
         Some(eha_guard::params_block::flash_region())
+    }
+    fn rtc_s(&mut self) -> Option<u32> {
+        self.rtc.seconds()
     }
 }
 

@@ -28,6 +28,9 @@ fn main() {}
 mod board;
 
 #[cfg(target_os = "none")]
+mod rtc;
+
+#[cfg(target_os = "none")]
 mod fw {
     use super::board::{self, F411};
     use core::mem::MaybeUninit;
