@@ -1,7 +1,7 @@
 //! Scratch: the firmware's reduced-order model (`eha_guard::rom`, f64) in closed loop
 //! with the reference: the model's own 40/38 thermostat (2 s dwell) at model steps.
 use eha_guard::protection::{Valve, ValveConfig};
-use eha_guard::model::{Model, ModelInputN, HA_PER_A, HBAR_PER_BAR, HRADS_PER_RPM};
+use eha_guard::model::{Model, ModelInputN};
 use eha_sim::network::Node;
 use eha_sim::plant::{Control, Plant, Sensors};
 use eha_sim::reduce::reduce;
@@ -44,14 +44,7 @@ fn main() {
                 s.t, valve.is_open() as u8, s.t_drain_c, e, t[0] - snap.temp(Node::Pump), t[2] - snap.temp(Node::Loop), t[3] - snap.temp(Node::MainBlock),
                 t[4] - snap.temp(Node::BallBlock), t[5] - snap.temp(Node::Actuator), l[0] - snap.temp(Node::Inlet), l[1] - snap.temp(Node::Outlet), l[2] - snap.temp(Node::BallOil));
         }
-        let u = ModelInputN {
-            current_ha: s.current_a * HA_PER_A,
-            p_a_hbar: s.p_a_bar * HBAR_PER_BAR,
-            p_b_hbar: s.p_b_bar * HBAR_PER_BAR,
-            speed_hrads: s.speed_rpm * HRADS_PER_RPM,
-            dpos_mm: s.position_mm - prev_x,
-            ambient_c: s.ambient_c,
-        };
+        let u = ModelInputN::from_wire_f64(s.current_a, s.p_a_bar, s.p_b_bar, s.speed_rpm, s.position_mm - prev_x, s.ambient_c);
         prev_x = s.position_mm;
         if m.tick_n(&u) {
             let was = valve.is_open();

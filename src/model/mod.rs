@@ -69,6 +69,23 @@ pub struct ModelInputN<N> {
     pub ambient_c: N,
 }
 
+impl<N: Num> ModelInputN<N> {
+    /// One tick's inputs from wire units (A, bar, rpm, mm of piston travel in
+    /// this tick, degC) given as `f64`: host tools and tests. The firmware
+    /// scales its `f32` samples in its own number type ([`InputScales`]).
+    pub fn from_wire_f64(current_a: f64, p_a_bar: f64, p_b_bar: f64, speed_rpm: f64, dpos_mm: f64, ambient_c: f64) -> Self {
+        let f = N::from_f64;
+        ModelInputN {
+            current_ha: f(current_a * HA_PER_A),
+            p_a_hbar: f(p_a_bar * HBAR_PER_BAR),
+            p_b_hbar: f(p_b_bar * HBAR_PER_BAR),
+            speed_hrads: f(speed_rpm * HRADS_PER_RPM),
+            dpos_mm: f(dpos_mm),
+            ambient_c: f(ambient_c),
+        }
+    }
+}
+
 /// Wire → model unit scales in the number type (built once).
 #[derive(Clone, Copy, Debug)]
 pub struct InputScales<N: Num> {

@@ -4,7 +4,7 @@
 
 use eha_guard::num::{Fx, Num};
 use eha_guard::params::DEFAULT;
-use eha_guard::model::{etd_matrix, Model, ModelInputN, HA_PER_A, HBAR_PER_BAR, HRADS_PER_RPM, N_NODES, S_PER_STEP};
+use eha_guard::model::{etd_matrix, Model, ModelInputN, N_NODES, S_PER_STEP};
 
 /// One tick of wire-unit inputs: current A, port pressures bar, speed rpm, piston
 /// position mm, ambient degC.
@@ -37,15 +37,7 @@ fn mission(k: usize) -> Wire {
 }
 
 fn tick<N: Num>(w: &Wire, prev_mm: f64) -> ModelInputN<N> {
-    let f = N::from_f64;
-    ModelInputN {
-        current_ha: f(w.current_a * HA_PER_A),
-        p_a_hbar: f(w.p_a_bar * HBAR_PER_BAR),
-        p_b_hbar: f(w.p_b_bar * HBAR_PER_BAR),
-        speed_hrads: f(w.speed_rpm * HRADS_PER_RPM),
-        dpos_mm: f(w.position_mm - prev_mm),
-        ambient_c: f(w.ambient_c),
-    }
+    ModelInputN::from_wire_f64(w.current_a, w.p_a_bar, w.p_b_bar, w.speed_rpm, w.position_mm - prev_mm, w.ambient_c)
 }
 
 /// Drain temperature after every model step of the mission in number type `N`; the

@@ -12,7 +12,7 @@ use crate::plant::{Control, Plant, Sensors};
 use crate::reduce::reduce;
 use crate::rig::Rig;
 use crate::scenario::Scenario;
-use eha_guard::model::{Model, ModelInputN, ReducedParams, HA_PER_A, HBAR_PER_BAR, HRADS_PER_RPM};
+use eha_guard::model::{Model, ModelInputN, ReducedParams};
 
 /// Bound of the reduced model against the commissioned reference on every
 /// log's inputs, drain max |e|, K (issue 18).
@@ -69,14 +69,7 @@ pub fn check_reduced(rig: &Rig, p: &ReducedParams, log: &CalLog) -> Result<Reduc
                     n += 1;
                 }
             }
-            let u = ModelInputN {
-                current_ha: s.current_a * HA_PER_A,
-                p_a_hbar: s.p_a_bar * HBAR_PER_BAR,
-                p_b_hbar: s.p_b_bar * HBAR_PER_BAR,
-                speed_hrads: s.speed_rpm * HRADS_PER_RPM,
-                dpos_mm: s.position_mm - prev_x,
-                ambient_c: s.ambient_c,
-            };
+            let u = ModelInputN::from_wire_f64(s.current_a, s.p_a_bar, s.p_b_bar, s.speed_rpm, s.position_mm - prev_x, s.ambient_c);
             prev_x = s.position_mm;
             if m.tick_n(&u) {
                 m.update(if open { 10 } else { 0 });
