@@ -35,7 +35,7 @@ pub mod validate;
 #[cfg(all(target_os = "none", not(feature = "board-stm32f4")))]
 mod vectors;
 
-pub use guard::{faults, Guard, GuardConfig, GuardOf, Output, Real, Sample};
+pub use guard::{faults, Faults, Guard, GuardConfig, GuardOf, Output, Real, Sample};
 pub use memory::{Restore, ThermalRecord};
 
 #[cfg(test)]

@@ -507,7 +507,7 @@ impl Reply {
         let _ = p.push(reason);
         let _ = p.extend_from_slice(&self.out.drain_c.to_le_bytes());
         let _ = p.push(self.out.flags());
-        let _ = p.extend_from_slice(&self.out.faults.to_le_bytes());
+        let _ = p.extend_from_slice(&self.out.faults.bits().to_le_bytes());
         let _ = p.extend_from_slice(&self.out.lng_remaining_kg.to_le_bytes());
         let _ = p.extend_from_slice(&self.out.lng_seconds_left.to_le_bytes());
         let _ = p.extend_from_slice(&c.rejected_crc.to_le_bytes());
@@ -537,7 +537,7 @@ impl Reply {
         };
         let drain_c = r.f32()?;
         let flags = r.u8()?;
-        let faults = r.u16()?;
+        let faults = crate::faults::Faults::from_bits(r.u16()?);
         let lng_remaining_kg = r.f32()?;
         let lng_seconds_left = r.f32()?;
         let counters = Counters {
@@ -663,7 +663,7 @@ impl Link {
                 valve_open: false,
                 alarm: false,
                 derate: false,
-                faults: 0,
+                faults: crate::faults::Faults::NONE,
                 lng_remaining_kg: 0.0,
                 lng_seconds_left: 0.0,
             },
@@ -839,12 +839,12 @@ mod tests {
         let mut g = crate::GuardOf::<f32>::new(&crate::GuardConfig::DEFAULT, crate::Restore::Cold);
         let s = Request { current_a: 0.0, p_a_bar: 5.0, p_b_bar: 5.0, speed_rpm: 500.0, ..req(0) };
         let o = step_guard(&mut g, &s, 0);
-        assert!(!o.valve_open && o.faults == 0, "{o:?}");
+        assert!(!o.valve_open && o.faults.is_empty(), "{o:?}");
         let mut o = o;
         for k in 1..=50u16 {
             o = step_guard(&mut g, &Request { seq: k, valve_fb: Some(true), ..s }, 0);
         }
-        assert!(o.valve_open && o.faults & crate::faults::ACTUATOR != 0, "{o:?}");
+        assert!(o.valve_open && o.faults.contains(crate::faults::ACTUATOR), "{o:?}");
     }
 
     #[test]
@@ -857,7 +857,7 @@ mod tests {
                 valve_open: true,
                 alarm: false,
                 derate: true,
-                faults: 0xA5A5,
+                faults: crate::faults::Faults::from_bits(0xA5A5),
                 lng_remaining_kg: 2.0,
                 lng_seconds_left: f32::INFINITY,
             },

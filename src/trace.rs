@@ -68,15 +68,15 @@ pub enum Trace {
     Fault {
         /// Step counter.
         step: u32,
-        /// Bits newly set this step.
-        new_bits: u16,
+        /// Faults newly set this step (with the latched channels).
+        new_bits: crate::faults::Faults,
     },
     /// Latched faults cleared by the explicit clear rule.
     FaultsCleared {
         /// Step counter.
         step: u32,
-        /// Bits that were cleared.
-        bits: u16,
+        /// Faults that were cleared.
+        bits: crate::faults::Faults,
     },
     /// LNG remaining fell below the low threshold.
     LngLow {

@@ -121,7 +121,7 @@ impl<N: Num> Run<N> {
             o.drain_c.is_finite() && o.lng_remaining_kg.is_finite() && o.lng_seconds_left.is_finite(),
             "{what}: non-finite output {o:?}"
         );
-        if o.faults & faults::LATCHED != 0 {
+        if o.faults.intersects(faults::LATCHED) {
             assert!(o.valve_open, "{what}: latched fault {:#x} but valve closed: {o:?}", o.faults);
         }
         assert_eq!(o.alarm, o.derate, "{what}: derate must follow the alarm: {o:?}");
@@ -149,10 +149,10 @@ impl<N: Num> Run<N> {
         };
         self.check(&o, "tick");
         self.ticks += 1;
-        self.credit += if o.faults & faults::LATCHED == 0 { 1 } else { -1 };
+        self.credit += if !o.faults.intersects(faults::LATCHED) { 1 } else { -1 };
         if self.stats {
             stats::TICKS.fetch_add(1, Relaxed);
-            if o.faults & faults::LATCHED == 0 {
+            if !o.faults.intersects(faults::LATCHED) {
                 stats::UNLATCHED.fetch_add(1, Relaxed);
             }
             if valid {
@@ -173,8 +173,8 @@ impl<N: Num> Run<N> {
             }
             // Only CONFIG survives a successful clear.
             let after = self.g.faults() & faults::LATCHED;
-            assert_eq!(after & !faults::CONFIG, 0, "clear_faults returned true but {after:#x} still latched");
-            if self.stats && before & !faults::CONFIG != 0 {
+            assert!((after & !faults::CONFIG).is_empty(), "clear_faults returned true but {after:#x} still latched");
+            if self.stats && !(before & !faults::CONFIG).is_empty() {
                 stats::CLEARS.fetch_add(1, Relaxed);
             }
         }
@@ -211,7 +211,7 @@ fn restore(u: &mut Unstructured<'_>, variant: u8) -> Restore {
             }
             let amb = -20.0 + 0.25 * f32::from(byte(u));
             let used = u.arbitrary::<u32>().unwrap_or(0);
-            let fb = u.arbitrary::<u16>().unwrap_or(0) & (faults::LATCHED | 0x3f00);
+            let fb = u.arbitrary::<u16>().unwrap_or(0) & (faults::LATCHED | eha_guard::Faults::channels(0x3F)).bits();
             let fb = if byte(u) & 1 == 0 { 0 } else { fb };
             Restore::from_record(&ThermalRecord::new(temps, amb, used, fb, 0))
         }
@@ -336,7 +336,7 @@ pub fn run<N: Num>(data: &[u8], label: &'static str, cold: &OnceLock<GuardOf<N>>
                 fault_op(&r);
                 r.g.report_actuator_fault();
                 let f = r.g.faults();
-                assert!(f & faults::ACTUATOR != 0, "actuator fault not latched: {f:#x}");
+                assert!(f.intersects(faults::ACTUATOR), "actuator fault not latched: {f:#x}");
             }
             240..=245 => {
                 // Warm reset: the snapshot goes through the boot rule.
@@ -385,7 +385,7 @@ fn ramp<N: Num>(r: &mut Run<N>, x: &mut [f32; 6], slope: &mut [f32; 6], ch: &[Ch
         }
         r.tick(Some(&to_sample(x)), true);
     }
-    if r.g.faults() & faults::LATCHED != 0 {
+    if r.g.faults().intersects(faults::LATCHED) {
         r.clear();
     }
 }

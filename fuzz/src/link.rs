@@ -47,7 +47,7 @@ fn check_output(o: &Output, full_kg: f32) {
         o.drain_c.is_finite() && o.lng_remaining_kg.is_finite() && o.lng_seconds_left.is_finite(),
         "non-finite output {o:?}"
     );
-    if o.faults & faults::LATCHED != 0 {
+    if o.faults.intersects(faults::LATCHED) {
         assert!(o.valve_open, "latched fault {:#x} but valve closed: {o:?}", o.faults);
     }
     assert!(o.lng_remaining_kg >= 0.0 && o.lng_remaining_kg <= full_kg, "LNG out of range: {o:?}");

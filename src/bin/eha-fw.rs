@@ -86,7 +86,7 @@ mod fw {
         let restore = slots::restore_from(&rec_a, &rec_b);
         let mut records = AbWriter::after_boot(&rec_a, &rec_b);
         let mut guard = Guard::new(&GuardConfig::DEFAULT, restore);
-        defmt::info!("eha-fw up: build {=str}, restore {=str}, faults {=u16:#06x}", BUILD, restore_name(&restore), guard.faults());
+        defmt::info!("eha-fw up: build {=str}, restore {=str}, faults {=u16:#06x}", BUILD, restore_name(&restore), guard.faults().bits());
         let mut last_trace = guard.trace().recent().copied();
 
         let mut link = Link::new();
@@ -173,7 +173,7 @@ mod fw {
             defmt::warn!("over-temperature alarm {=bool} at drain {=f32} C", out.alarm, out.drain_c);
         }
         if prev.faults != out.faults {
-            defmt::error!("faults {=u16:#06x} -> {=u16:#06x}", prev.faults, out.faults);
+            defmt::error!("faults {=u16:#06x} -> {=u16:#06x}", prev.faults.bits(), out.faults.bits());
         }
     }
 

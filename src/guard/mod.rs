@@ -8,7 +8,9 @@
 //! valve/alarm hysteresis, dwell, LNG budget and trace run on the new estimate.
 
 mod types;
-pub use types::{faults, GuardConfig, Output, Sample, DRAIN_C_UNKNOWN};
+pub mod faults;
+pub use faults::Faults;
+pub use types::{GuardConfig, Output, Sample, DRAIN_C_UNKNOWN};
 
 use crate::crosscheck::{CrossCheck, Verdict};
 use crate::memory::{Restore, ThermalRecord};
@@ -127,7 +129,7 @@ pub struct GuardOf<N: Num> {
     stale_steps: u32,
     startup_timeout_steps: u32,
     clear_valid_steps: u32,
-    latched: u16,
+    latched: Faults,
     bad_ch: u8,
     prev: Channels<N>,
     prev_ok: u8,
@@ -204,7 +206,7 @@ impl<N: Num> GuardOf<N> {
             let ok = Core::<N>::init_in(core::ptr::addr_of_mut!((*p).core), config);
             put!(p,
             core_ok: ok,
-            latched: if ok { 0 } else { faults::CONFIG },
+            latched: if ok { Faults::NONE } else { faults::CONFIG },
             dwell_model_steps: config.valve.dwell_steps.div_ceil(TICKS_PER_STEP),
             stale_steps: config.stale_steps,
             startup_timeout_steps: config.startup_timeout_steps,
@@ -249,16 +251,17 @@ impl<N: Num> GuardOf<N> {
                 }
                 g.cold = false;
                 g.lng.set_used_cj(r.lng_used_cj);
-                g.latched |= r.faults & faults::LATCHED & !faults::CONFIG;
-                g.bad_ch = ((r.faults >> faults::CH_SHIFT) as u8) & CH_ALL;
+                let saved = Faults::from_bits(r.faults);
+                g.latched |= saved & faults::LATCHED & !faults::CONFIG;
+                g.bad_ch = saved.channel_mask() & CH_ALL;
                 if r.valve_open() {
                     // The valve was open: it stays open for at least its dwell.
                     g.valve.force_open();
                 }
                 // Saved before a clear restored trust: still not trusted.
-                g.untrusted = r.faults & faults::UNTRUSTED != 0;
+                g.untrusted = saved.contains(faults::UNTRUSTED);
                 if let Some(c) = g.core_ok.then_some(&mut g.core) {
-                    c.model.set_loss_max(g.latched & faults::SENSOR_DISAGREE != 0);
+                    c.model.set_loss_max(g.latched.contains(faults::SENSOR_DISAGREE));
                 }
                 if g.after_power_loss {
                     RestoreKind::PowerLoss
@@ -356,11 +359,11 @@ impl<N: Num> GuardOf<N> {
     fn step_slow(&mut self, s: &Sample) -> Output {
         self.missing = 0;
         let Some(core) = self.core_ok.then_some(&self.core) else {
-            return self.slow_tail(None, 0, N::ZERO);
+            return self.slow_tail(None, Faults::NONE, N::ZERO);
         };
         let (v, nonfinite) = validate::convert(s, &core.scales);
         let c = validate::check(&v, nonfinite, &self.prev, self.prev_ok, &core.limits);
-        let mut new_bits = 0u16;
+        let mut new_bits = Faults::NONE;
         if c.range {
             new_bits |= faults::RANGE;
         }
@@ -402,7 +405,7 @@ impl<N: Num> GuardOf<N> {
         self.missing = self.missing.saturating_add(1);
         self.valid_since = self.step.wrapping_add(1);
         self.prev_ok = 0;
-        let mut new_bits = 0;
+        let mut new_bits = Faults::NONE;
         if self.missing >= self.stale_steps {
             new_bits |= faults::STALE;
             self.bad_ch = CH_ALL;
@@ -421,10 +424,10 @@ impl<N: Num> GuardOf<N> {
         self.missing = self.missing.saturating_add(1);
         self.valid_since = self.step.wrapping_add(1);
         if self.missing >= self.startup_timeout_steps {
-            if self.latched & faults::STALE == 0 {
+            if !self.latched.contains(faults::STALE) {
                 self.trace.write(Trace::Fault {
                     step: self.step,
-                    new_bits: faults::STALE | ((CH_ALL as u16) << faults::CH_SHIFT),
+                    new_bits: faults::STALE | Faults::channels(CH_ALL),
                 });
             }
             self.latched |= faults::STALE;
@@ -449,18 +452,18 @@ impl<N: Num> GuardOf<N> {
     /// Slow-path tail: latches `new_bits` and opens the valve at once when any fault
     /// is latched (fail-safe in the same tick), starts the model at the first sample
     /// (cold: at `start_amb`), then the common tick.
-    fn slow_tail(&mut self, u: Option<&ModelInputN<N>>, new_bits: u16, start_amb: N) -> Output {
+    fn slow_tail(&mut self, u: Option<&ModelInputN<N>>, new_bits: Faults, start_amb: N) -> Output {
         // The valve / credit state may change for this tick: count the ticks before.
         self.settle(self.step);
         let newly = new_bits & !self.latched;
         self.latched |= new_bits;
-        if newly != 0 {
+        if !newly.is_empty() {
             self.trace.write(Trace::Fault {
                 step: self.step,
-                new_bits: newly | ((self.bad_ch as u16) << faults::CH_SHIFT),
+                new_bits: newly | Faults::channels(self.bad_ch),
             });
         }
-        if self.latched != 0 && self.valve.force_open() {
+        if !self.latched.is_empty() && self.valve.force_open() {
             self.trace.write(Trace::ValveOpen {
                 step: self.step,
                 drain_c: self.out.drain_c,
@@ -529,7 +532,7 @@ impl<N: Num> GuardOf<N> {
             }
         }
         let d = c.model.drain_c();
-        if self.latched == 0 && d < c.th.close && self.valve.is_open() {
+        if self.latched.is_empty() && d < c.th.close && self.valve.is_open() {
             self.valve.set(false);
             self.trace.write(Trace::ValveClose {
                 step: self.step,
@@ -548,7 +551,7 @@ impl<N: Num> GuardOf<N> {
         let n = upto.wrapping_sub(self.mark);
         if self.valve.is_open() {
             self.open_acc = self.open_acc.wrapping_add(n);
-            if self.latched == 0 && !self.lng_empty && self.fb != Some(false) {
+            if self.latched.is_empty() && !self.lng_empty && self.fb != Some(false) {
                 // The exchanger runs over these ticks. No cooling credit under a
                 // latched fault (conservative: the exchanger itself may be what
                 // failed), with the LNG used up, or while the valve's position
@@ -579,7 +582,7 @@ impl<N: Num> GuardOf<N> {
                 Verdict::None => {}
                 // While they disagree (and once latched) the model heats with the
                 // larger of the two losses.
-                Verdict::Window(d) => c.model.set_loss_max(d || self.latched & faults::SENSOR_DISAGREE != 0),
+                Verdict::Window(d) => c.model.set_loss_max(d || self.latched.contains(faults::SENSOR_DISAGREE)),
                 Verdict::Latch => {
                     c.model.set_loss_max(true);
                     self.latch_disagree();
@@ -600,7 +603,7 @@ impl<N: Num> GuardOf<N> {
     #[cold]
     #[inline(never)]
     fn latch_disagree(&mut self) {
-        if self.latched & faults::SENSOR_DISAGREE == 0 {
+        if !self.latched.contains(faults::SENSOR_DISAGREE) {
             self.latched |= faults::SENSOR_DISAGREE;
             self.trace.write(Trace::Fault {
                 step: self.step,
@@ -617,7 +620,7 @@ impl<N: Num> GuardOf<N> {
         let Some(c) = self.core_ok.then_some(&self.core) else {
             return;
         };
-        let force = self.latched != 0;
+        let force = !self.latched.is_empty();
         let d = c.model.drain_c();
         let th = &c.th;
         let valve_ev = self
@@ -698,12 +701,12 @@ impl<N: Num> GuardOf<N> {
         self.out
     }
 
-    /// Present fault word (see [`faults`]).
-    pub fn faults(&self) -> u16 {
+    /// Present faults (see [`faults`]).
+    pub fn faults(&self) -> Faults {
         self.latched
-            | ((self.bad_ch as u16) << faults::CH_SHIFT)
-            | if self.lng_low { faults::LNG_LOW } else { 0 }
-            | if self.untrusted { faults::UNTRUSTED } else { 0 }
+            | Faults::channels(self.bad_ch)
+            | Faults::when(self.lng_low, faults::LNG_LOW)
+            | Faults::when(self.untrusted, faults::UNTRUSTED)
     }
 
     /// **Clear rule.** Latched faults (except CONFIG) clear only through this explicit
@@ -718,7 +721,7 @@ impl<N: Num> GuardOf<N> {
         if self.missing != 0 || valid_run < self.clear_valid_steps {
             return false;
         }
-        let bits = (self.latched & !faults::CONFIG) | ((self.bad_ch as u16) << faults::CH_SHIFT);
+        let bits = (self.latched & !faults::CONFIG) | Faults::channels(self.bad_ch);
         self.settle(self.step);
         self.latched &= faults::CONFIG;
         self.bad_ch = 0;
@@ -733,9 +736,9 @@ impl<N: Num> GuardOf<N> {
         }
         // The controller accepts the estimate as it is (it is not reset); the alarm
         // follows it again from the next model step.
-        let bits = bits | if self.untrusted { faults::UNTRUSTED } else { 0 };
+        let bits = bits | Faults::when(self.untrusted, faults::UNTRUSTED);
         self.untrusted = false;
-        if bits != 0 {
+        if !bits.is_empty() {
             self.trace.write(Trace::FaultsCleared {
                 step: self.step,
                 bits,
@@ -749,7 +752,7 @@ impl<N: Num> GuardOf<N> {
     /// and commands the valve open at once (fail-safe).
     pub fn report_actuator_fault(&mut self) {
         self.settle(self.step);
-        if self.latched & faults::ACTUATOR == 0 {
+        if !self.latched.contains(faults::ACTUATOR) {
             self.latched |= faults::ACTUATOR;
             self.trace.write(Trace::Fault {
                 step: self.step,
@@ -814,7 +817,7 @@ impl<N: Num> GuardOf<N> {
             temps,
             amb,
             self.lng.used_cj(),
-            self.faults() & !faults::LNG_LOW,
+            (self.faults() & !faults::LNG_LOW).bits(),
             self.step,
         )
         .with_seq(0, self.valve.is_open())

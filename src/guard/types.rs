@@ -5,44 +5,6 @@ use crate::model::ModelConsts;
 use crate::protection::{AlarmConfig, LngConfig, ValveConfig};
 use crate::validate::InputLimits;
 
-/// Fault bits of [`Output::faults`]. Bits 0-6 and 14 are latched until the clear
-/// rule ([`GuardOf::clear_faults`]); bits 7 and 15 are live status; bits 8-13 name
-/// the latched bad input channels (`validate::CH_*` shifted by
-/// [`faults::CH_SHIFT`]). The same word goes on the wire (`crate::protocol`).
-pub mod faults {
-    /// An input was outside its plausible range.
-    pub const RANGE: u16 = 1 << 0;
-    /// An input changed faster than its rate limit.
-    pub const RATE: u16 = 1 << 1;
-    /// An input was NaN or infinite.
-    pub const NON_FINITE: u16 = 1 << 2;
-    /// No new sample for `stale_steps` consecutive steps.
-    pub const STALE: u16 = 1 << 3;
-    /// The thermal-memory record was corrupt at boot.
-    pub const MEMORY_CORRUPT: u16 = 1 << 4;
-    /// The parameters could not be built into a model (model disabled, fail-safe).
-    /// Not clearable at run time: needs valid parameters and a restart.
-    pub const CONFIG: u16 = 1 << 5;
-    /// The valve output pin reported an error (set by the board layer).
-    pub const ACTUATOR: u16 = 1 << 6;
-    /// LNG remaining below the low threshold (live status, not latched).
-    pub const LNG_LOW: u16 = 1 << 7;
-    /// The motor current and the port pressures / speed have disagreed about the
-    /// shaft's loss for `crosscheck.persist_windows` windows in a row (analytic
-    /// redundancy, [`crate::crosscheck`]). Latched: valve open, alarm and derate
-    /// (UNTRUSTED), the model heats with the larger of the two losses.
-    pub const SENSOR_DISAGREE: u16 = 1 << 14;
-    /// Shift of the latched bad-channel mask inside the fault word.
-    pub const CH_SHIFT: u16 = 8;
-    /// The estimate is not trusted (corrupt thermal record at boot, or no sample by
-    /// the start-up timeout): alarm and derate are held until a successful
-    /// [`super::GuardOf::clear_faults`]. Status, not a latched fault; kept in the
-    /// thermal record so a warm reset does not drop it.
-    pub const UNTRUSTED: u16 = 1 << 15;
-    /// Bits that latch.
-    pub const LATCHED: u16 = 0x7f | SENSOR_DISAGREE;
-}
-
 /// One input sample, wire units (f32).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[cfg_attr(any(target_os = "none", feature = "defmt"), derive(defmt::Format))]
@@ -73,8 +35,8 @@ pub struct Output {
     pub alarm: bool,
     /// Derate request to the actuator controller (= alarm).
     pub derate: bool,
-    /// Fault word, see [`faults`].
-    pub faults: u16,
+    /// The faults ([`crate::faults`]; on the wire as their 16-bit word).
+    pub faults: crate::faults::Faults,
     /// LNG remaining, kg.
     pub lng_remaining_kg: f32,
     /// Seconds of LNG cooling left at the present dissipation, s.

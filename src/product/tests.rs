@@ -144,7 +144,7 @@ fn waits_with_valve_open_until_the_first_sample() {
     }
     let t = ticks(&b.replies());
     assert_eq!(t.len(), 20, "one tick reply per tick");
-    assert!(t.iter().all(|r| !r.fresh && r.out.valve_open && r.out.faults == 0 && !r.pins.valve_pin));
+    assert!(t.iter().all(|r| !r.fresh && r.out.valve_open && r.out.faults.is_empty() && !r.pins.valve_pin));
     assert_eq!(b.feeds, 20);
 }
 
@@ -225,7 +225,7 @@ fn pin_read_back_mismatch_latches_actuator_and_opens_the_valve() {
     b.rx.extend_from_slice(&sample(2, 10.0, 50.0).encode());
     app.tick(&mut b, 0);
     let t = ticks(&b.replies());
-    assert!(t[0].out.valve_open && t[0].out.faults & crate::faults::ACTUATOR != 0, "{:?}", t[0]);
+    assert!(t[0].out.valve_open && t[0].out.faults.intersects(crate::faults::ACTUATOR), "{:?}", t[0]);
 }
 
 /// Commands: status and refill are done at once; clear is refused until the
@@ -249,7 +249,7 @@ fn commands_status_refill_clear_trace() {
     assert_eq!(acks[0], Ack { token: 7, cmd: Cmd::ClearFaults, result: AckResult::Refused });
     assert_eq!(acks[1], Ack { token: 8, cmd: Cmd::RefillLng, result: AckResult::Done });
     let st = r.iter().find_map(|f| if let FromGuard::Status(s) = f { Some(*s) } else { None }).expect("status");
-    assert_eq!((st.token, st.tick, st.missing, st.faults & crate::faults::NON_FINITE != 0), (9, 2, 1, true));
+    assert_eq!((st.token, st.tick, st.missing, st.faults.intersects(crate::faults::NON_FINITE)), (9, 2, 1, true));
     // 100 valid ticks, then the clear succeeds.
     for k in 2..110u16 {
         b.rx.extend_from_slice(&sample(k, 10.0, 50.0).encode());
@@ -274,7 +274,7 @@ fn commands_status_refill_clear_trace() {
     assert_eq!(dump.len(), usize::from(dump[0].count), "the whole ring arrives");
     assert!(dump.iter().enumerate().all(|(i, t)| usize::from(t.index) == i && t.token == 11));
     assert!(dump.iter().any(|t| t.event.tag == 7), "the faults-cleared event is in the dump");
-    assert_eq!(app.guard().faults() & crate::faults::LATCHED, 0);
+    assert!(!app.guard().faults().intersects(crate::faults::LATCHED));
 }
 
 /// Garbage, bursts and truncated frames: counted as rejected, the tick
@@ -386,7 +386,7 @@ fn without_a_block_the_default_runs_and_every_reply_says_not_commissioned() {
             app.tick(&mut b, 0);
         }
         let t = ticks(&b.replies());
-        assert!(t.iter().all(|r| r.not_commissioned && r.out.faults == 0), "{t:?}");
+        assert!(t.iter().all(|r| r.not_commissioned && r.out.faults.is_empty()), "{t:?}");
         assert!(app.guard().trace().iter().any(|e| matches!(e, Trace::Params { source: 0, .. })));
     }
 }
@@ -451,7 +451,7 @@ fn an_invalid_block_latches_config_and_opens_the_valve() {
         app.tick(&mut b, 0);
         let t = ticks(&b.replies());
         assert!(
-            t.iter().all(|r| r.out.faults & crate::guard::faults::CONFIG != 0 && r.out.valve_open && !r.pins.valve_pin && r.out.alarm),
+            t.iter().all(|r| r.out.faults.intersects(crate::guard::faults::CONFIG) && r.out.valve_open && !r.pins.valve_pin && r.out.alarm),
             "{name}: {t:?}"
         );
     }

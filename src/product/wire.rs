@@ -251,8 +251,8 @@ pub struct Status {
     pub commands: u16,
     /// Non-volatile record saves that failed.
     pub nv_failures: u16,
-    /// Fault word now.
-    pub faults: u16,
+    /// Faults now.
+    pub faults: crate::faults::Faults,
 }
 
 /// One trace event in a dump.
@@ -291,8 +291,8 @@ pub fn encode_trace(t: &Trace) -> TraceWire {
         Trace::ValveClose { step, drain_c } => w(3, step, drain_c, 0),
         Trace::Alarm { step, drain_c } => w(4, step, drain_c, 0),
         Trace::AlarmClear { step, drain_c } => w(5, step, drain_c, 0),
-        Trace::Fault { step, new_bits } => w(6, step, 0.0, new_bits),
-        Trace::FaultsCleared { step, bits } => w(7, step, 0.0, bits),
+        Trace::Fault { step, new_bits } => w(6, step, 0.0, new_bits.bits()),
+        Trace::FaultsCleared { step, bits } => w(7, step, 0.0, bits.bits()),
         Trace::LngLow { step, remaining_kg } => w(8, step, remaining_kg, 0),
         Trace::Overrun { step, lost_ticks } => w(9, step, 0.0, lost_ticks),
         Trace::Reset { step, cause } => w(10, step, 0.0, u16::from(cause)),
@@ -312,7 +312,7 @@ fn put(p: &mut Buf, b: &[u8]) {
 fn out_fields(p: &mut Buf, o: &Output) {
     put(p, &o.drain_c.to_le_bytes());
     put(p, &[crate::protocol::GuardOutput::flags(o)]);
-    put(p, &o.faults.to_le_bytes());
+    put(p, &o.faults.bits().to_le_bytes());
     put(p, &o.lng_remaining_kg.to_le_bytes());
     put(p, &o.lng_seconds_left.to_le_bytes());
 }
@@ -327,7 +327,7 @@ impl Rd<'_> {
             valve_open: flags & 1 != 0,
             alarm: flags & 2 != 0,
             derate: flags & 4 != 0,
-            faults: self.u16()?,
+            faults: crate::faults::Faults::from_bits(self.u16()?),
             lng_remaining_kg: self.f32()?,
             lng_seconds_left: self.f32()?,
         })
@@ -439,7 +439,7 @@ impl Status {
         }
         put(&mut p, &self.accepted.to_le_bytes());
         put(&mut p, &self.missing.to_le_bytes());
-        for v in [self.rx_overflow, self.commands, self.nv_failures, self.faults] {
+        for v in [self.rx_overflow, self.commands, self.nv_failures, self.faults.bits()] {
             put(&mut p, &v.to_le_bytes());
         }
         frame(&p, true)
@@ -467,7 +467,7 @@ impl Status {
             rx_overflow: r.u16()?,
             commands: r.u16()?,
             nv_failures: r.u16()?,
-            faults: r.u16()?,
+            faults: crate::faults::Faults::from_bits(r.u16()?),
         })
     }
 }

@@ -54,7 +54,7 @@ fn consistent_sensors_never_disagree() {
         let (mut sp, mut si, mut n) = (0.0f64, 0.0f64, 0u32);
         for k in 0..60_000u32 {
             let o = g.step(&mission(k));
-            assert_eq!(o.faults & faults::LATCHED, 0, "{name} tick {k}: {o:?}");
+            assert!(!o.faults.intersects(faults::LATCHED), "{name} tick {k}: {o:?}");
             let m = g.model().unwrap();
             if m.pending_ticks() == 0 {
                 let (lp, li) = m.last_mech_pair_kw();
@@ -81,7 +81,7 @@ fn run(g: &mut GuardOf<f32>, ticks: u32, s: impl Fn(u32) -> Sample) -> Vec<Outpu
 }
 
 fn latched_at(out: &[Output]) -> Option<usize> {
-    out.iter().position(|o| o.faults & faults::SENSOR_DISAGREE != 0)
+    out.iter().position(|o| o.faults.intersects(faults::SENSOR_DISAGREE))
 }
 
 #[test]
@@ -95,9 +95,9 @@ fn current_sensor_reading_30_percent_low_at_load_latches_after_the_persist_windo
     let k = latched_at(&out).expect("SENSOR_DISAGREE must latch");
     assert_eq!(k as u32, GuardConfig::DEFAULT.crosscheck.persist_windows * window() - 1);
     let o = out[k];
-    assert!(o.valve_open && o.alarm && o.derate && o.faults & faults::UNTRUSTED != 0, "{o:?}");
-    assert!(out[k..].iter().all(|o| o.faults & faults::SENSOR_DISAGREE != 0 && o.valve_open && o.alarm));
-    assert!(g.trace().iter().any(|e| matches!(e, Trace::Fault { step, new_bits } if *step == k as u32 && new_bits & faults::SENSOR_DISAGREE != 0)));
+    assert!(o.valve_open && o.alarm && o.derate && o.faults.intersects(faults::UNTRUSTED), "{o:?}");
+    assert!(out[k..].iter().all(|o| o.faults.intersects(faults::SENSOR_DISAGREE) && o.valve_open && o.alarm));
+    assert!(g.trace().iter().any(|e| matches!(e, Trace::Fault { step, new_bits } if *step == k as u32 && new_bits.intersects(faults::SENSOR_DISAGREE))));
 }
 
 #[test]
@@ -173,7 +173,7 @@ fn disabled_without_a_torque_constant() {
     cfg.model = &off_model;
     let mut g = GuardOf::<f32>::new(&cfg, Restore::Cold);
     let out = run(&mut g, 1000, |_| Sample { current_a: 5.0, ..sample(65.0, 5.0, 500.0) });
-    assert_eq!(out.last().unwrap().faults, 0);
+    assert_eq!(out.last().unwrap().faults, eha_guard::Faults::NONE);
 }
 
 #[test]
@@ -185,8 +185,8 @@ fn clear_after_the_sensors_agree_again() {
         let f = if k < 1000 { 0.7 } else { 1.0 };
         Sample { current_a: f * current(65.0, 5.0, 500.0), ..sample(65.0, 5.0, 500.0) }
     });
-    assert!(out[2999].faults & faults::SENSOR_DISAGREE != 0);
+    assert!(out[2999].faults.intersects(faults::SENSOR_DISAGREE));
     assert!(g.clear_faults());
     let out = run(&mut g, 3000, |_| sample(65.0, 5.0, 500.0));
-    assert!(out.iter().all(|o| o.faults & faults::LATCHED == 0 && o.faults & faults::UNTRUSTED == 0));
+    assert!(out.iter().all(|o| !o.faults.intersects(faults::LATCHED) && !o.faults.intersects(faults::UNTRUSTED)));
 }

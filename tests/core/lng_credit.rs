@@ -174,7 +174,7 @@ fn valve_reported_shut_while_commanded_open_gets_no_credit_and_latches_actuator_
         if let Some(c) = credit_kw(&g) {
             assert_eq!(c, 0.0, "tick {k}: {c} kW credited with the valve reported shut");
         }
-        if o.faults & faults::ACTUATOR != 0 && latched_at.is_none() {
+        if o.faults.intersects(faults::ACTUATOR) && latched_at.is_none() {
             latched_at = Some(k);
         }
     }
@@ -190,10 +190,10 @@ fn valve_reported_open_while_commanded_shut_latches_actuator_and_forces_it_open(
     // the valve is commanded open (fail-safe), which then matches the feedback.
     let mut g = GuardOf::<f32>::new(&GuardConfig::DEFAULT, Restore::Cold);
     let out = with_feedback(&mut g, 400, |k, _| (k > 0).then_some(true));
-    let k = out.iter().position(|o| o.faults & faults::ACTUATOR != 0).expect("ACTUATOR must latch");
+    let k = out.iter().position(|o| o.faults.intersects(faults::ACTUATOR)).expect("ACTUATOR must latch");
     assert_eq!(k, 50, "latched at tick {k}");
     assert!(out[..50].iter().all(|o| !o.valve_open));
-    assert!(out[50..].iter().all(|o| o.valve_open && o.faults & faults::ACTUATOR != 0));
+    assert!(out[50..].iter().all(|o| o.valve_open && o.faults.intersects(faults::ACTUATOR)));
 }
 
 #[test]
@@ -213,7 +213,7 @@ fn matching_feedback_raises_nothing_and_leaves_the_estimate_unchanged() {
     let empty = oa.iter().position(|o| o.lng_remaining_kg == 0.0).map(|k| k as f64 * 0.01);
     println!("{events} valve events; LNG used up at {empty:?} s; max |estimate with feedback - without| {worst:.2e} K");
     assert!(events >= 4, "the valve must cycle: {events} events");
-    assert!(oa.iter().all(|o| o.faults & faults::LATCHED == 0));
+    assert!(oa.iter().all(|o| !o.faults.intersects(faults::LATCHED)));
     assert!(worst < 0.01, "{worst} K");
 }
 
@@ -222,5 +222,5 @@ fn mismatch_time_is_configurable() {
     let cfg = GuardConfig { actuator_mismatch_steps: 50, ..GuardConfig::DEFAULT };
     let mut g = GuardOf::<f32>::new(&cfg, Restore::Cold);
     let out = with_feedback(&mut g, 100, |k, _| (k > 0).then_some(true));
-    assert_eq!(out.iter().position(|o| o.faults & faults::ACTUATOR != 0), Some(50));
+    assert_eq!(out.iter().position(|o| o.faults.intersects(faults::ACTUATOR)), Some(50));
 }

@@ -73,7 +73,7 @@ fn run_all<N: eha_guard::num::Num>(seq: &[(Option<Sample>, Option<bool>)]) -> Re
         };
         prop_assert!(finite(&o), "non-finite output {:?}", o);
         prop_assert!(o.lng_remaining_kg >= 0.0 && o.lng_remaining_kg <= 2.1501);
-        if o.faults & faults::LATCHED != 0 {
+        if o.faults.intersects(faults::LATCHED) {
             prop_assert!(
                 o.valve_open,
                 "latched fault {:#x} but valve closed",
@@ -258,7 +258,7 @@ fn run_valid<N: eha_guard::num::Num>(ticks: &[(Tick, Option<Fault>)], clear_ever
     for (k, (t, f)) in ticks.iter().enumerate() {
         if let Some(p) = clear_every {
             if k > 0 && (k as u32).is_multiple_of(p) && g.clear_faults() {
-                prop_assert_eq!(g.faults() & faults::LATCHED, 0, "cleared at tick {}", k);
+                prop_assert!(!g.faults().intersects(faults::LATCHED), "cleared at tick {}", k);
                 may_latch = false;
             }
         }
@@ -276,8 +276,8 @@ fn run_valid<N: eha_guard::num::Num>(ticks: &[(Tick, Option<Fault>)], clear_ever
             Some(Fault::NonFinite { ch, .. }) | Some(Fault::Range { ch, .. }) => {
                 may_latch = true;
                 let class = if matches!(f, Some(Fault::NonFinite { .. })) { faults::NON_FINITE } else { faults::RANGE };
-                prop_assert!(o.valve_open && o.faults & class != 0, "tick {}: {:?} not latched: {:?}", k, f, o);
-                prop_assert!(o.faults & (1 << (faults::CH_SHIFT as usize + ch)) != 0, "tick {}: channel bit of {:?} missing: {:?}", k, f, o);
+                prop_assert!(o.valve_open && o.faults.intersects(class), "tick {}: {:?} not latched: {:?}", k, f, o);
+                prop_assert!(o.faults.channel_mask() & (1 << ch) != 0, "tick {}: channel bit of {:?} missing: {:?}", k, f, o);
             }
             Some(Fault::Rate { .. }) => may_latch = true,
             _ => {}
@@ -288,7 +288,7 @@ fn run_valid<N: eha_guard::num::Num>(ticks: &[(Tick, Option<Fault>)], clear_ever
         prop_assert!(finite(&o), "tick {}: non-finite output {:?}", k, o);
         prop_assert!(o.lng_remaining_kg >= 0.0 && o.lng_remaining_kg <= full, "tick {}: LNG {}", k, o.lng_remaining_kg);
         prop_assert_eq!(o.alarm, o.derate, "tick {}: derate must follow the alarm", k);
-        if o.faults & faults::LATCHED != 0 {
+        if o.faults.intersects(faults::LATCHED) {
             prop_assert!(o.valve_open, "tick {}: latched fault {:#x} but valve closed", k, o.faults);
             prop_assert!(may_latch, "tick {}: fault {:#x} latched on valid, rate-limited input", k, o.faults);
         } else {
@@ -357,7 +357,7 @@ proptest! {
         let mut g = GuardOf::<f32>::new(&GuardConfig::DEFAULT, Restore::Cold);
         for _ in 0..warm {
             let o = g.step(&nominal());
-            prop_assert!(!o.valve_open && o.faults == 0, "nominal must be quiet: {:?}", o);
+            prop_assert!(!o.valve_open && o.faults.is_empty(), "nominal must be quiet: {:?}", o);
         }
         let mut s = nominal();
         match ch {
@@ -367,8 +367,8 @@ proptest! {
         let o = g.step(&s);
         prop_assert!(o.valve_open, "valve must open in the faulting step");
         let class = if bad.is_finite() { faults::RANGE } else { faults::NON_FINITE };
-        prop_assert!(o.faults & class != 0, "fault bits {:#x}", o.faults);
-        prop_assert!(o.faults & (1 << (faults::CH_SHIFT as usize + ch)) != 0, "channel bit missing {:#x}", o.faults);
+        prop_assert!(o.faults.intersects(class), "fault bits {:#x}", o.faults);
+        prop_assert!(o.faults.channel_mask() & (1 << ch) != 0, "channel bit missing {:#x}", o.faults);
     }
 
     #[test]
@@ -381,9 +381,9 @@ proptest! {
         for k in 1..=cfg.stale_steps {
             let o = g.step_missing();
             if k < cfg.stale_steps {
-                prop_assert!(!o.valve_open && o.faults & faults::STALE == 0, "not stale yet at {}", k);
+                prop_assert!(!o.valve_open && !o.faults.intersects(faults::STALE), "not stale yet at {}", k);
             } else {
-                prop_assert!(o.valve_open && o.faults & faults::STALE != 0, "stale at {} must open: {:?}", k, o);
+                prop_assert!(o.valve_open && o.faults.intersects(faults::STALE), "stale at {} must open: {:?}", k, o);
             }
         }
     }
@@ -432,12 +432,12 @@ proptest! {
         g.step(&s);
         for _ in 0..valid_after {
             let o = g.step(&nominal());
-            prop_assert!(o.valve_open && o.faults & faults::NON_FINITE != 0, "fault must stay latched");
+            prop_assert!(o.valve_open && o.faults.intersects(faults::NON_FINITE), "fault must stay latched");
         }
         let cleared = g.clear_faults();
         prop_assert_eq!(cleared, valid_after >= cfg.clear_valid_steps, "clear rule: {} valid steps", valid_after);
         let o = g.step(&nominal());
-        prop_assert_eq!(o.faults & faults::LATCHED == 0, cleared);
+        prop_assert_eq!(!o.faults.intersects(faults::LATCHED), cleared);
     }
 
     #[test]
@@ -488,7 +488,7 @@ fn boot_rules_cold_warm_corrupt() {
     let mut g = GuardOf::<f32>::new(&cfg, Restore::from_record(&rec));
     let o = g.step(&nominal());
     assert!(
-        (o.drain_c - 45.0).abs() < 0.05 && o.valve_open && o.faults == 0,
+        (o.drain_c - 45.0).abs() < 0.05 && o.valve_open && o.faults.is_empty(),
         "warm: {o:?}"
     );
     // Regression bound: the restored drain node itself, measured exactly 45.0.
@@ -518,7 +518,7 @@ fn boot_rules_cold_warm_corrupt() {
     );
     // Regression bound: the conservative start itself, measured exactly 60.0.
     assert!((o.drain_c - 60.0).abs() <= ulp32(60.0), "corrupt: {o:?}");
-    assert!(o.faults & faults::MEMORY_CORRUPT != 0 && o.lng_remaining_kg == 0.0);
+    assert!(o.faults.intersects(faults::MEMORY_CORRUPT) && o.lng_remaining_kg == 0.0);
 }
 
 #[test]
@@ -587,7 +587,7 @@ fn case1_60bar_opens_valve_by_temperature() {
             opened = Some(k);
         }
     }
-    assert_eq!(o.faults & faults::LATCHED, 0);
+    assert!(!o.faults.intersects(faults::LATCHED));
     let k = opened.expect("60 bar for an hour must open the valve");
     assert!(o.lng_remaining_kg < 2.15, "LNG used while open");
     let ev = g
@@ -608,7 +608,7 @@ fn trace_ring_keeps_newest_32() {
     for k in 0..40u32 {
         t.write(eha_guard::trace::Trace::Fault {
             step: k,
-            new_bits: 1,
+            new_bits: eha_guard::Faults::from_bits(1),
         });
     }
     assert_eq!(t.len(), eha_guard::trace::TRACE_LEN);
@@ -675,7 +675,7 @@ fn stale_input_integrates_worst_case_loss() {
     for (name, e) in [("copper", e_cu), ("throttle", e_thr), ("leakage", e_leak)] {
         assert!(e <= 2.0 * f32::EPSILON as f64 / 2.0 + 1e-15, "{name} relative error {e:e}: bound 2 f32 roundings (1.19e-7)");
     }
-    assert!(o0.valve_open && o0.faults & faults::STALE != 0);
+    assert!(o0.valve_open && o0.faults.intersects(faults::STALE));
     let mut o = o0;
     let mut n = o0;
     for _ in 0..500 {
@@ -714,7 +714,7 @@ fn guard_dwell_qualifies_the_closing_at_the_model_step() {
     let mut was_open = false;
     for k in 0..20_000u32 {
         let o = g.step(if (k / 150) % 2 == 0 { &load } else { &idle });
-        assert_eq!(o.faults & faults::LATCHED, 0);
+        assert!(!o.faults.intersects(faults::LATCHED));
         let m = g.model().unwrap();
         if m.pending_ticks() == 0 {
             let d = m.drain_c();

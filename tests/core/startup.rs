@@ -32,12 +32,12 @@ fn missing_tick_at_boot_does_not_start_the_model_at_0_degc() {
     fn run<N: Num>() -> f32 {
         let mut g = GuardOf::<N>::new(&GuardConfig::DEFAULT, Restore::Cold);
         let o = g.step_missing();
-        assert!(o.valve_open && o.faults == 0, "waiting: {o:?}");
+        assert!(o.valve_open && o.faults.is_empty(), "waiting: {o:?}");
         let mut o = o;
         for _ in 0..12 {
             o = g.step(&idle30());
         }
-        assert_eq!(o.faults, 0, "{o:?}");
+        assert_eq!(o.faults, eha_guard::Faults::NONE, "{o:?}");
         assert!(!o.valve_open, "{o:?}");
         o.drain_c
     }
@@ -58,17 +58,17 @@ fn guard_waits_for_the_first_sample_valve_open_no_stale() {
     let cfg = GuardConfig::DEFAULT;
     let mut g = GuardOf::<f32>::new(&cfg, Restore::Cold);
     let o0 = g.output();
-    assert!(o0.valve_open && o0.faults == 0 && !o0.alarm, "at boot: {o0:?}");
+    assert!(o0.valve_open && o0.faults.is_empty() && !o0.alarm, "at boot: {o0:?}");
     for k in 0..300 {
         let o = g.step_missing();
         assert!(o.valve_open, "tick {k}: valve must be open while waiting: {o:?}");
-        assert_eq!(o.faults, 0, "tick {k}: no fault while waiting: {o:?}");
+        assert_eq!(o.faults, eha_guard::Faults::NONE, "tick {k}: no fault while waiting: {o:?}");
         assert!(!o.alarm, "tick {k}: {o:?}");
         assert_eq!(o.drain_c, eha_guard::guard::DRAIN_C_UNKNOWN, "tick {k}: no estimate before the first sample");
         assert_eq!(g.model().unwrap().pending_ticks(), 0, "tick {k}: the model accumulated a tick while waiting");
     }
     let o = g.step(&idle30());
-    assert_eq!(o.faults, 0, "{o:?}");
+    assert_eq!(o.faults, eha_guard::Faults::NONE, "{o:?}");
     assert!(!o.valve_open, "the valve closes at the first sample of a cold start: {o:?}");
     assert_eq!(o.drain_c, 30.0, "cold start at the first sample's ambient");
     // The closing is in the trace at the first sample's tick.
@@ -76,11 +76,11 @@ fn guard_waits_for_the_first_sample_valve_open_no_stale() {
     // A clear needs no maintenance: nothing latched. And samples that then stop are
     // STALE after stale_steps, as before.
     for _ in 0..100 {
-        assert_eq!(g.step(&idle30()).faults, 0);
+        assert_eq!(g.step(&idle30()).faults, eha_guard::Faults::NONE);
     }
     for k in 1..=cfg.stale_steps {
         let o = g.step_missing();
-        assert_eq!(o.faults & faults::STALE != 0, k == cfg.stale_steps, "missing {k}: {o:?}");
+        assert_eq!(o.faults.intersects(faults::STALE), k == cfg.stale_steps, "missing {k}: {o:?}");
     }
 }
 
@@ -94,12 +94,12 @@ fn stale_after_the_startup_timeout_without_any_sample() {
     for k in 0..cfg.startup_timeout_steps {
         let o = g.step_missing();
         assert!(o.valve_open, "tick {k}: {o:?}");
-        let stale = o.faults & faults::STALE != 0;
+        let stale = o.faults.intersects(faults::STALE);
         assert_eq!(stale, k + 1 == cfg.startup_timeout_steps, "tick {k}: {o:?}");
     }
-    assert!(g.trace().iter().any(|e| matches!(e, Trace::Fault { step: 999, new_bits } if new_bits & faults::STALE != 0)));
+    assert!(g.trace().iter().any(|e| matches!(e, Trace::Fault { step: 999, new_bits } if new_bits.intersects(faults::STALE))));
     let o = g.step(&idle30());
-    assert!(o.valve_open && o.faults & faults::STALE != 0, "{o:?}");
+    assert!(o.valve_open && o.faults.intersects(faults::STALE), "{o:?}");
     // The model starts at the sample's own (valid) ambient, not at the worst case
     // that STALE substitutes from then on.
     assert_eq!(o.drain_c, 30.0, "{o:?}");
@@ -108,7 +108,7 @@ fn stale_after_the_startup_timeout_without_any_sample() {
     let mut g = GuardOf::<f32>::new(&cfg2, Restore::Cold);
     for k in 0..50u32 {
         let o = g.step_missing();
-        assert_eq!(o.faults & faults::STALE != 0, k == 49, "tick {k}: {o:?}");
+        assert_eq!(o.faults.intersects(faults::STALE), k == 49, "tick {k}: {o:?}");
     }
 }
 
@@ -123,12 +123,12 @@ fn warm_restore_waits_and_starts_from_the_record() {
     let mut g = GuardOf::<f32>::new(&GuardConfig::DEFAULT, Restore::from_record(&rec));
     for k in 0..200 {
         let o = g.step_missing();
-        assert!(o.valve_open && o.faults == 0, "tick {k}: {o:?}");
+        assert!(o.valve_open && o.faults.is_empty(), "tick {k}: {o:?}");
         assert_eq!(o.drain_c, 45.0, "tick {k}: the restored estimate");
     }
     let o = g.step(&idle30());
-    assert!(o.valve_open && o.faults == 0, "{o:?}");
+    assert!(o.valve_open && o.faults.is_empty(), "{o:?}");
     assert_eq!(o.drain_c, 45.0, "{o:?}");
     let snap = g.snapshot();
-    assert_eq!(snap.faults & faults::STALE, 0, "no STALE in the saved record");
+    assert!(!eha_guard::Faults::from_bits(snap.faults).intersects(faults::STALE), "no STALE in the saved record");
 }

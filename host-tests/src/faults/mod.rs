@@ -197,7 +197,7 @@ pub fn run_on(
     let mut frozen: Option<f32> = None;
     let mut held: Option<Vec<u8>> = None; // out-of-order: a frame held back
     let mut k: u64 = 0;
-    let mut latched_before: u16 = 0;
+    let mut latched_before = eha_guard::Faults::NONE;
     let mut observable_at: Option<f64> = None;
     let mut detect: Option<f64> = None;
     let mut max_under = f64::NEG_INFINITY;
@@ -212,7 +212,7 @@ pub fn run_on(
             let active = t >= FAULT_AT_S - 1e-9;
             // Events at the fault's start.
             if active && k == (FAULT_AT_S / TICK_S).round() as u64 {
-                latched_before = out.map_or(0, |o| o.faults & fbits::LATCHED);
+                latched_before = out.map_or(eha_guard::Faults::NONE, |o| o.faults & fbits::LATCHED);
                 match fault {
                     Fault::WarmReset => {
                         if let Some(m) = mcu.take() {
@@ -320,7 +320,7 @@ pub fn run_on(
             if active {
                 if let (Some(_), Some(o)) = (&mcu, out) {
                     let new_latch = o.faults & fbits::LATCHED & !latched_before;
-                    if new_latch != 0 && detect.is_none() && o.valve_open {
+                    if !new_latch.is_empty() && detect.is_none() && o.valve_open {
                         if let Some(t0) = observable_at {
                             detect = Some((t - t0).max(0.0));
                         }

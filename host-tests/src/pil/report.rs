@@ -233,7 +233,7 @@ pub fn write_csv(path: &Path, records: &[StepRecord], meta: &[(&str, String)]) -
                 o.drain_c,
                 u8::from(o.alarm),
                 u8::from(o.derate),
-                o.faults,
+                o.faults.bits(),
                 o.lng_remaining_kg,
                 // The format forbids non-finite values: an infinite "seconds
                 // left" (no dissipation) is written as an empty cell.

@@ -73,7 +73,7 @@ fn restore_after_a_measured_off_time_is_cooled_and_never_below_the_reference() {
     drop(sil);
     let last = rec.last().expect("steps");
     let saved = guard.snapshot().with_rtc(Some(T0_S));
-    assert_eq!(guard.faults(), 0, "a clean hot run");
+    assert!(guard.faults().is_empty(), "a clean hot run");
     let ref_at_save = last.sensors.t_drain_c;
     eprintln!("save: estimate {:.2} degC, reference {:.2} degC", saved.temps_c[1], ref_at_save);
 

@@ -99,7 +99,7 @@ struct Run {
     /// Guard drain prediction after sample `k` (compared with the truth at `k+1`), °C.
     pred: Vec<f64>,
     /// OR of the guard's fault words over the run.
-    faults: u16,
+    faults: eha_guard::Faults,
     /// Valve events (time s, open) of the guard.
     events: Vec<(f64, bool)>,
     /// The guard's two estimates of the shaft's loss at every model step (from the
@@ -113,7 +113,7 @@ fn closed_loop(name: &str, scenario: &Scenario) -> Run {
     let mut plant = Plant::new(&rig, scenario).expect("plant");
     let cfg = GuardConfig::DEFAULT;
     let mut guard = GuardOf::<f64>::new(&cfg, Restore::Cold);
-    let mut run = Run { name: name.into(), sensors: vec![], pred: vec![], faults: 0, events: vec![], mech_pairs: vec![] };
+    let mut run = Run { name: name.into(), sensors: vec![], pred: vec![], faults: eha_guard::Faults::NONE, events: vec![], mech_pairs: vec![] };
     let mut open = false;
     plant
         .run(0.01, scenario.duration_s(), |snap| {
@@ -156,11 +156,11 @@ fn thermostat_first_switch() -> &'static [Option<f64>] {
 /// a run (element k: after sample k), and the fault word at the end. The guard
 /// credits cooling by its own valve; on the f64 guard's run that is the valve
 /// the plant had (up to the f64 guard's own switching steps).
-fn guard_drain<N: Num>(run: &Run) -> (Vec<f64>, u16) {
+fn guard_drain<N: Num>(run: &Run) -> (Vec<f64>, eha_guard::Faults) {
     let mut g = GuardOf::<N>::new(&GuardConfig::DEFAULT, Restore::Cold);
     let n = run.sensors.len() - 1;
     let mut out = Vec::with_capacity(n);
-    let mut faults = 0;
+    let mut faults = eha_guard::Faults::NONE;
     for s in &run.sensors[..n] {
         let o = g.step(&s.sample());
         faults |= o.faults;
@@ -173,7 +173,7 @@ fn drain_stats(run: &Run) -> ErrorStats {
     stats(run.pred.iter().zip(run.sensors.iter().skip(1)).map(|(p, s)| p - s.t_drain_c))
 }
 
-fn report(names: &[&str]) -> Vec<(String, ErrorStats, u16)> {
+fn report(names: &[&str]) -> Vec<(String, ErrorStats, eha_guard::Faults)> {
     let rows: Vec<_> = runs()
         .iter()
         .filter(|r| names.iter().any(|n| r.name.starts_with(n)))
@@ -192,11 +192,11 @@ fn report(names: &[&str]) -> Vec<(String, ErrorStats, u16)> {
     rows
 }
 
-fn assert_bounds(rows: &[(String, ErrorStats, u16)]) {
+fn assert_bounds(rows: &[(String, ErrorStats, eha_guard::Faults)]) {
     for (n, e, f) in rows {
         // No fault on clean reference signals (validation, SENSOR_DISAGREE, ...):
         // otherwise the estimate is the fail-safe one, not the model's.
-        assert_eq!(*f & faults::LATCHED, 0, "{n}: guard faulted on reference signals");
+        assert!(!f.intersects(faults::LATCHED), "{n}: guard faulted on reference signals");
         // Issue: max |drain error| <= 1.0 K.
         assert!(e.max_abs <= MAX_ABS_K, "{n}: max |error| {:.3} K > {MAX_ABS_K} K", e.max_abs);
         // Issue: under-prediction is the unsafe side, never more than 0.5 K.
@@ -253,7 +253,7 @@ fn sensor_cross_check_margin_on_the_acceptance_runs() {
             .fold(0.0, f64::max);
         let peak = r.mech_pairs.iter().map(|(p, _)| *p).fold(0.0, f64::max);
         println!("{:>14}: largest window disagreement {w:.4} W (bound {} W, margin {:.0}x); peak mechanical loss {peak:.0} W", r.name, cfg.bound_w, cfg.bound_w as f64 / w.max(1e-9));
-        assert_eq!(r.faults & faults::SENSOR_DISAGREE, 0, "{}", r.name);
+        assert!(!r.faults.intersects(faults::SENSOR_DISAGREE), "{}", r.name);
         worst = worst.max(w);
     }
     println!("worst {worst:.4} W");

@@ -29,7 +29,7 @@ prop_compose! {
         Reply {
             kind,
             seq,
-            out: GuardOutput { drain_c: drain, valve_open: flags & 1 != 0, alarm: flags & 2 != 0, derate: flags & 4 != 0, faults, lng_remaining_kg: kg, lng_seconds_left: secs },
+            out: GuardOutput { drain_c: drain, valve_open: flags & 1 != 0, alarm: flags & 2 != 0, derate: flags & 4 != 0, faults: eha_guard::Faults::from_bits(faults), lng_remaining_kg: kg, lng_seconds_left: secs },
             counters: Counters { rejected_crc: c[0], rejected_framing: c[1], rejected_sequence: c[2], skipped: c[3], accepted: acc },
             step_ticks: ticks,
         }

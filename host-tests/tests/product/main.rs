@@ -310,7 +310,7 @@ fn garbage_and_bursts_on_the_uart_are_rejected_without_a_hang() {
     // fault. (A sample stuck behind a long burst arrives late; more than
     // 50 ms late is STALE, which is what STALE is for, so it may latch.)
     let data_faults = eha_guard::faults::RANGE | eha_guard::faults::RATE | eha_guard::faults::NON_FINITE;
-    assert!(run.steps.iter().all(|p| p.tick.out.faults & data_faults == 0), "junk was taken as sample data");
+    assert!(run.steps.iter().all(|p| !p.tick.out.faults.intersects(data_faults)), "junk was taken as sample data");
     assert!(st.rx_overflow > 0, "bursts longer than the 256-byte receive ring are dropped and counted");
 }
 
@@ -407,7 +407,7 @@ fn parameter_block_in_flash_runs_its_rig_and_an_invalid_one_is_refused() {
     let pins = s.pins().unwrap_or_else(|e| panic!("{e:#}"));
     assert!(!seen.is_empty());
     for t in &seen {
-        assert!(t.out.faults & eha_guard::guard::faults::CONFIG != 0 && t.out.valve_open && !t.pins.valve_pin, "torn block: {t:?}");
+        assert!(t.out.faults.intersects(eha_guard::guard::faults::CONFIG) && t.out.valve_open && !t.pins.valve_pin, "torn block: {t:?}");
     }
     assert!(!pins.valve_pin && !pins.ok_pin, "torn block: valve open and alarm on the pins, read {pins:?}");
 }

@@ -1,0 +1,196 @@
+//! The fault word as a typed set ([`Faults`]) and its named members
+//! (`faults::RANGE`, …). Bits 0-6 and 14 latch until the clear rule
+//! ([`super::GuardOf::clear_faults`]); bits 7 and 15 are live status; bits
+//! 8-13 name the latched bad input channels (`validate::CH_*` shifted by
+//! [`CH_SHIFT`]). The same 16 bits go on the wire ([`Faults::bits`],
+//! `crate::protocol`) and into the thermal record.
+
+use core::ops::{BitAnd, BitAndAssign, BitOr, BitOrAssign, Not};
+
+/// A set of guard faults (the 16-bit fault word).
+#[derive(Clone, Copy, Default, PartialEq, Eq)]
+pub struct Faults(u16);
+
+/// In the defmt log: the word in hex, as on the wire.
+#[cfg(any(target_os = "none", feature = "defmt"))]
+impl defmt::Format for Faults {
+    fn format(&self, f: defmt::Formatter) {
+        defmt::write!(f, "{=u16:#06x}", self.0)
+    }
+}
+
+impl Faults {
+    /// No fault.
+    pub const NONE: Faults = Faults(0);
+
+    /// The word's bits (wire and record form).
+    pub const fn bits(self) -> u16 {
+        self.0
+    }
+
+    /// The set of a fault word (every bit has a meaning; none is dropped).
+    pub const fn from_bits(bits: u16) -> Faults {
+        Faults(bits)
+    }
+
+    /// The latched bad-channel mask `ch` (`validate::CH_*`) as fault bits.
+    pub const fn channels(ch: u8) -> Faults {
+        Faults(((ch & 0x3F) as u16) << CH_SHIFT)
+    }
+
+    /// The bad-channel mask in this set (`validate::CH_*`).
+    pub const fn channel_mask(self) -> u8 {
+        ((self.0 >> CH_SHIFT) & 0x3F) as u8
+    }
+
+    /// No fault in the set.
+    pub const fn is_empty(self) -> bool {
+        self.0 == 0
+    }
+
+    /// Every member of `other` is in the set.
+    pub const fn contains(self, other: Faults) -> bool {
+        self.0 & other.0 == other.0
+    }
+
+    /// Some member of `other` is in the set.
+    pub const fn intersects(self, other: Faults) -> bool {
+        self.0 & other.0 != 0
+    }
+
+    /// `other` if `on`, else no fault.
+    pub const fn when(on: bool, other: Faults) -> Faults {
+        if on {
+            other
+        } else {
+            Faults::NONE
+        }
+    }
+}
+
+impl BitOr for Faults {
+    type Output = Faults;
+    fn bitor(self, o: Faults) -> Faults {
+        Faults(self.0 | o.0)
+    }
+}
+
+impl BitOrAssign for Faults {
+    fn bitor_assign(&mut self, o: Faults) {
+        self.0 |= o.0;
+    }
+}
+
+impl BitAnd for Faults {
+    type Output = Faults;
+    fn bitand(self, o: Faults) -> Faults {
+        Faults(self.0 & o.0)
+    }
+}
+
+impl BitAndAssign for Faults {
+    fn bitand_assign(&mut self, o: Faults) {
+        self.0 &= o.0;
+    }
+}
+
+impl Not for Faults {
+    type Output = Faults;
+    fn not(self) -> Faults {
+        Faults(!self.0)
+    }
+}
+
+impl core::fmt::LowerHex for Faults {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        core::fmt::LowerHex::fmt(&self.0, f)
+    }
+}
+
+/// Names of the single-bit members, for `Debug`.
+const NAMES: [(Faults, &str); 10] = [
+    (RANGE, "RANGE"),
+    (RATE, "RATE"),
+    (NON_FINITE, "NON_FINITE"),
+    (STALE, "STALE"),
+    (MEMORY_CORRUPT, "MEMORY_CORRUPT"),
+    (CONFIG, "CONFIG"),
+    (ACTUATOR, "ACTUATOR"),
+    (LNG_LOW, "LNG_LOW"),
+    (SENSOR_DISAGREE, "SENSOR_DISAGREE"),
+    (UNTRUSTED, "UNTRUSTED"),
+];
+
+impl core::fmt::Debug for Faults {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(f, "Faults(")?;
+        let mut first = true;
+        for (bit, name) in NAMES.iter() {
+            if self.contains(*bit) {
+                write!(f, "{}{name}", if first { "" } else { " | " })?;
+                first = false;
+            }
+        }
+        if self.channel_mask() != 0 {
+            write!(f, "{}channels {:#08b}", if first { "" } else { " | " }, self.channel_mask())?;
+            first = false;
+        }
+        if first {
+            write!(f, "none")?;
+        }
+        write!(f, ")")
+    }
+}
+
+/// An input was outside its plausible range.
+pub const RANGE: Faults = Faults(1 << 0);
+/// An input changed faster than its rate limit.
+pub const RATE: Faults = Faults(1 << 1);
+/// An input was NaN or infinite.
+pub const NON_FINITE: Faults = Faults(1 << 2);
+/// No new sample for `stale_steps` consecutive steps.
+pub const STALE: Faults = Faults(1 << 3);
+/// The thermal-memory record was corrupt at boot.
+pub const MEMORY_CORRUPT: Faults = Faults(1 << 4);
+/// The parameters could not be built into a model (model disabled, fail-safe).
+/// Not clearable at run time: needs valid parameters and a restart.
+pub const CONFIG: Faults = Faults(1 << 5);
+/// The valve output pin reported an error, or its position feedback
+/// disagreed with the command (set by the board layer / the guard).
+pub const ACTUATOR: Faults = Faults(1 << 6);
+/// LNG remaining below the low threshold (live status, not latched).
+pub const LNG_LOW: Faults = Faults(1 << 7);
+/// The motor current and the port pressures / speed have disagreed about the
+/// shaft's loss for `crosscheck.persist_windows` windows in a row (analytic
+/// redundancy, [`crate::crosscheck`]). Latched: valve open, alarm and derate
+/// (UNTRUSTED), the model heats with the larger of the two losses.
+pub const SENSOR_DISAGREE: Faults = Faults(1 << 14);
+/// Shift of the latched bad-channel mask inside the fault word.
+pub const CH_SHIFT: u16 = 8;
+/// The estimate is not trusted (corrupt thermal record at boot, or no sample by
+/// the start-up timeout): alarm and derate are held until a successful
+/// [`super::GuardOf::clear_faults`]. Status, not a latched fault; kept in the
+/// thermal record so a warm reset does not drop it.
+pub const UNTRUSTED: Faults = Faults(1 << 15);
+/// Bits that latch.
+pub const LATCHED: Faults = Faults(0x7f | (1 << 14));
+/// Bits that latch or are status, besides the channels: every named member.
+pub const ALL_NAMED: Faults = Faults(0x7f | (1 << 7) | (1 << 14) | (1 << 15));
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    extern crate std;
+
+    #[test]
+    fn set_operations_and_names() {
+        let f = STALE | Faults::channels(0b101) | UNTRUSTED;
+        assert!(f.contains(STALE) && f.intersects(UNTRUSTED | RANGE) && !f.contains(STALE | RANGE));
+        assert_eq!(f.channel_mask(), 0b101);
+        assert_eq!(Faults::from_bits(f.bits()), f);
+        assert_eq!((f & !UNTRUSTED) & UNTRUSTED, Faults::NONE);
+        assert_eq!(std::format!("{:?}", f), "Faults(STALE | UNTRUSTED | channels 0b000101)");
+        assert_eq!(std::format!("{:?}", Faults::NONE), "Faults(none)");
+        assert_eq!(ALL_NAMED.bits() & Faults::channels(0x3F).bits(), 0);
+    }
+}
