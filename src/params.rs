@@ -74,11 +74,24 @@ pub struct ReducedParams {
     pub cp_slope_j_per_kg_k2: f64,
     /// Pump displacement per radian, m^3/rad (19 cm^3/rev / 2 pi).
     pub displacement_m3_per_rad: f64,
-    /// Pump mechanical loss coefficient `eta_m` (eq. 8: `P = eta_m D |dp| |w|`).
+    /// Pump friction, pressure term `eta_m` (eq. 8: `P = eta_m D |dp| |w|`).
     pub eta_m: f64,
-    /// Share of the mechanical loss heating the high-pressure port oil (the rest
-    /// heats the case oil), dimensionless.
+    /// Pump friction, no-load torque `T0` of the extended eq. (8), N m: heat
+    /// `T0 |w|` into the pump housing (bearings, shaft seal).
+    pub no_load_torque_nm: f64,
+    /// Pump friction, viscous term of the extended eq. (8) at the 40 degC
+    /// viscosity, W per (rad/s)^2: heat `C_v mu D w^2`, split like the pressure term.
+    pub viscous_w_s2_per_rad2: f64,
+    /// Share of the pump's viscous and pressure friction heating the delivered
+    /// (high-pressure port) oil (sliding-pair rule of the reference), dimensionless.
     pub mech_to_outlet: f64,
+    /// Share of the pump's viscous and pressure friction heating the case oil; the
+    /// rest, `1 - mech_to_outlet - mech_to_case`, heats the pump housing.
+    pub mech_to_case: f64,
+    /// Oil volumetric expansion coefficient alpha, 1/K: the pump's compression
+    /// warms the delivered oil by `alpha T dp / (rho c_p)` and every throttling
+    /// releases `(1 - alpha T) dp q` as heat (enthalpy h(T, p), T absolute).
+    pub expansion_per_k: f64,
     /// Pump leakage flow conductance of the gaps (eqs. 5-7), m^3/(s Pa), at `t_mu_ref_c`:
     /// each port leaks `K (p_port - p_case)` into the case.
     pub k_leak_m3_per_s_pa: f64,
@@ -193,7 +206,11 @@ impl ReducedParams {
         let non_neg = [
             self.displacement_m3_per_rad,
             self.eta_m,
+            self.no_load_torque_nm,
+            self.viscous_w_s2_per_rad2,
             self.mech_to_outlet,
+            self.mech_to_case,
+            self.expansion_per_k,
             self.k_leak_m3_per_s_pa,
             self.line_r1_pa_s_per_m3,
             self.line_r2_pa_s2_per_m6,
@@ -233,7 +250,7 @@ impl ReducedParams {
         .all(|x| x.is_finite());
         let rest = self.rest_rate_per_s.iter().all(|r| r.is_finite() && *r >= 0.0)
             && self.rest_mode.iter().all(|v| v.is_finite() && (0.0..=1.0).contains(v));
-        let split = self.mech_to_outlet <= 1.0;
+        let split = self.mech_to_outlet + self.mech_to_case <= 1.0;
         let cp_pos = self.rho_cp(-60.0) > 0.0 && self.rho_cp(150.0) > 0.0;
         pos && non_neg && links && finite && split && cp_pos && rest
     }
@@ -257,7 +274,11 @@ pub const DEFAULT: ReducedParams = ReducedParams {
     cp_slope_j_per_kg_k2: 3.7,
     displacement_m3_per_rad: 3.023943918746011e-6,
     eta_m: 0.49826,
+    no_load_torque_nm: 0.0,
+    viscous_w_s2_per_rad2: 0.0,
     mech_to_outlet: 0.768027,
+    mech_to_case: 0.231973,
+    expansion_per_k: 0.0,
     k_leak_m3_per_s_pa: 3.3579931725827373e-13,
     case_pressure_pa: 500000.0,
     k_mu_per_k: 0.0,

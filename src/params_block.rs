@@ -3,7 +3,7 @@
 //! matrix included), with a header and a CRC, flashed into its own region (the
 //! `PARAMS` region of the board's `memory.x`) and read at boot.
 //!
-//! Layout (little-endian, [`BLOCK_LEN`] = 1064 bytes):
+//! Layout (little-endian, [`BLOCK_LEN`] = 1080 bytes):
 //!
 //! | offset | size | field |
 //! |---|---|---|
@@ -29,10 +29,12 @@ use crate::model::ModelConsts;
 pub const BLOCK_LEN: usize = WORDS_AT + 4 * N_WORDS + 4;
 /// `"EHAP"` little-endian.
 pub const MAGIC: u32 = u32::from_le_bytes(*b"EHAP");
-/// Format version of this firmware. 3: without `irc0`/`irc1` (the oil
+/// Format version of this firmware. 4: the pump's no-load and viscous
+/// friction and the oil's expansion coefficient (`k_m0`, `k_mv`, `alpha`,
+/// `alpha_t0`; 263 words, 1080 bytes). 3: without `irc0`/`irc1` (the oil
 /// capacity's inverse is exact; 259 words, 1064 bytes). 2: the rest-cooling
 /// words (`rest_rate`, `rest_mode`). Older blocks are refused.
-pub const VERSION: u16 = 3;
+pub const VERSION: u16 = 4;
 /// Offset of the rig id.
 const ID_AT: usize = 8;
 /// Length of the rig id, bytes.

@@ -1,7 +1,7 @@
 //! Command-line subcommands of the reference simulation: `simulate`,
 //! `size-lng`, `sweep`, `calibrate` and `rig`.
 
-use crate::calibrate::{calibrate, PAPER};
+use crate::calibrate::{calibrate, PAPER, PARAMS};
 use crate::cooling::size;
 use crate::rig::Rig;
 use crate::scenario::{read_mission_csv, Scenario, ValveRule};
@@ -293,9 +293,15 @@ pub fn run_calibrate(a: &CalibrateArgs) -> Result<()> {
     println!("target  {:?}", PAPER);
     println!("before  {:?}", c.before);
     println!("after   {:?}", c.after);
-    for (n, v) in &c.values {
-        println!("  {n} = {v:.6e}");
+    println!("stage 1 (Table 4 and the 110 s opening, residuals / sigma {:?}):", crate::calibrate::SIGMA);
+    for ((n, v), (lo, hi)) in c.values.iter().zip(&c.ident.intervals) {
+        println!("  {n} = {v:.6e}   (95 % approx. {lo:.4e} .. {hi:.4e})");
     }
+    println!("  singular values of the scaled Jacobian: {:?}", c.ident.singular_values);
+    for (n, row) in PARAMS.iter().zip(&c.ident.correlation) {
+        println!("  correlation {n}: {:?}", row.iter().map(|x| (x * 1000.0).round() / 1000.0).collect::<Vec<_>>());
+    }
+    println!("stage 2 (Table 5 shell at {} m/s): outside.pump_ram_exposure = {:.6}", crate::calibrate::RAM_FIT_MPS, c.pump_ram_exposure);
     Ok(())
 }
 

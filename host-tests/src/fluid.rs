@@ -115,6 +115,23 @@ impl Oil {
         self.cp20_j_per_kg_k * d + 0.5 * self.cp_slope_j_per_kg_k2 * d * d
     }
 
+    /// Specific enthalpy at `t_c` °C and gauge pressure `p_pa`, J/kg, relative
+    /// to 20 °C and 0 bar: h = ∫c_p dT + (1 − α·T)·p/ρ (T absolute, ρ at 40 °C
+    /// and 0 bar). The pressure term is the first-order one of
+    /// dh = c_p dT + v(1 − αT) dp, so a reversible compression by Δp raises the
+    /// temperature by αTΔp/(ρc_p) and an isenthalpic throttling by
+    /// (1 − αT)Δp/(ρc_p): the two add up to the Δp/(ρc_p) of the whole
+    /// hydraulic energy turned into heat.
+    pub fn enthalpy_tp(&self, t_c: f64, p_pa: f64) -> f64 {
+        self.enthalpy(t_c) + (1.0 - self.expansion_per_k * (t_c + KELVIN_OFFSET)) * p_pa / self.rho(40.0, 0.0)
+    }
+
+    /// Temperature rise of a reversible (isentropic) compression by `dp_pa`
+    /// from `t_c`, K: αTΔp/(ρc_p) (the leading term of (∂T/∂p)_s).
+    pub fn isentropic_rise_k(&self, t_c: f64, dp_pa: f64) -> f64 {
+        self.expansion_per_k * (t_c + KELVIN_OFFSET) * dp_pa / (self.rho(40.0, 0.0) * self.cp(t_c))
+    }
+
     /// Thermal conductivity at `t_c`, W/(m·K).
     pub fn k(&self, t_c: f64) -> f64 {
         self.k0_w_per_m_k + self.k_slope_w_per_m_k2 * t_c
@@ -184,6 +201,29 @@ mod tests {
         assert!((a.nu - 1.516e-5).abs() / 1.516e-5 < 0.02, "nu {}", a.nu);
         assert!((a.k - 0.0257).abs() / 0.0257 < 0.02, "k {}", a.k);
         assert!((a.pr - 0.71).abs() / 0.71 < 0.02, "pr {}", a.pr);
+    }
+
+    /// The pressure term of h(T, p): at constant h a drop of Δp warms the oil
+    /// by (1 − αT)Δp/(ρc_p), and a
+    /// reversible compression of 58 bar at 40 °C warms it by αTΔp/(ρc_p) =
+    /// 6.5e-4·313.15·5.8e6/(857.8·1954) = 0.704 K (hand value, 1e-3 K).
+    #[test]
+    fn pressure_term_gives_throttling_and_compression() {
+        let oil = Oil::default();
+        let (t, dp) = (40.0, 58e5);
+        let rise = oil.isentropic_rise_k(t, dp);
+        let hand = 6.5e-4 * 313.15 * 5.8e6 / (oil.rho(40.0, 0.0) * oil.cp(40.0));
+        assert!((rise - hand).abs() < 1e-9 && (rise - 0.704).abs() < 1e-3, "{rise}");
+        // Throttle: find T2 with h(T2, 0) = h(t, dp) by bisection.
+        let h1 = oil.enthalpy_tp(t, dp);
+        let (mut lo, mut hi) = (t, t + 10.0);
+        for _ in 0..100 {
+            let mid = 0.5 * (lo + hi);
+            if oil.enthalpy_tp(mid, 0.0) < h1 { lo = mid } else { hi = mid }
+        }
+        let want = (1.0 - 6.5e-4 * 313.15) * dp / (oil.rho(40.0, 0.0) * oil.cp(t));
+        // 0.5 %: c_p(t) against its mean over the 2.75 K rise (0.26 %)
+        assert!(((lo - t) - want).abs() / want < 5e-3, "{} vs {want}", lo - t);
     }
 
     /// Enthalpy is the integral of cp: its finite difference equals cp to 1e-6.

@@ -29,15 +29,16 @@ pub fn nu_laminar(re: f64, pr: f64, d_over_l: f64) -> f64 {
     (3.66f64.powi(3) + 0.7f64.powi(3) + g.max(0.0).powi(3)).cbrt()
 }
 
-/// Turbulent mean Nusselt number in a tube, eq. (14), Gnielinski (1976):
-/// Nu = (ξ/8)(Re − 1000)Pr / (1 + 12.7·√(ξ/8)·(Pr^(2/3) − 1)) · [1 + (d/L)^(2/3)],
-/// ξ = (1.8·log10 Re − 1.5)⁻².
+/// Turbulent mean Nusselt number in a tube, eq. (14), Gnielinski (1976) with
+/// Filonenko's friction factor ξ = (1.82·log10 Re − 1.64)⁻², as the paper
+/// prints it: Nu = (ξ/8)(Re − 1000)Pr / (1 + 12.7·√(ξ/8)·(Pr^(2/3) − 1)) ·
+/// [1 + (d/L)^(2/3)].
 ///
-/// The paper prints Pr^(1/3) in the denominator and the Filonenko factor
-/// (1.82·log Re − 1.64)⁻² with the division by 8 misplaced; this is the
-/// published Gnielinski form.
+/// The paper's only departure from the published form is Pr^(1/3) in the
+/// denominator (a misprint: Gnielinski's is Pr^(2/3)); its ξ/8 is the same
+/// as here. The (Pr/Pr_w)^0.11 factor is taken as 1, as in eq. (13).
 pub fn nu_turbulent(re: f64, pr: f64, d_over_l: f64) -> f64 {
-    let xi = (1.8 * re.log10() - 1.5).powi(-2);
+    let xi = (1.82 * re.log10() - 1.64).powi(-2);
     let num = xi / 8.0 * (re - 1000.0) * pr;
     let den = 1.0 + 12.7 * (xi / 8.0).sqrt() * (pr.powf(2.0 / 3.0) - 1.0);
     num / den * (1.0 + d_over_l.powf(2.0 / 3.0))
@@ -54,6 +55,23 @@ pub fn nu_tube(re: f64, pr: f64, d_over_l: f64) -> f64 {
     } else {
         let gamma = (re - 2300.0) / (1e4 - 2300.0);
         (1.0 - gamma) * nu_laminar(2300.0, pr, d_over_l) + gamma * nu_turbulent(1e4, pr, d_over_l)
+    }
+}
+
+/// Mean Nusselt number Nu = h·2e/k of the oil film between a rotating inner
+/// cylinder and a fixed outer one (Taylor–Couette flow, no axial flow), by
+/// Becker & Kaye (1962) as compiled by Fénot et al. (Int. J. Thermal Sci. 50,
+/// 2011): Nu = 2 below the Taylor instability (Ta < 1700, conduction across
+/// the gap), 0.128·Ta^0.367 up to 10⁴, 0.409·Ta^0.241 above (continuous at
+/// both joins). `ta` is the Taylor number ω²·R_m·e³/ν² (geometric factor 1:
+/// gap small against the radius).
+pub fn nu_taylor_couette(ta: f64) -> f64 {
+    if ta < 1700.0 {
+        2.0
+    } else if ta < 1e4 {
+        (0.128 * ta.powf(0.367)).max(2.0)
+    } else {
+        0.409 * ta.powf(0.241)
     }
 }
 
@@ -146,6 +164,16 @@ pub fn series(g1: f64, g2: f64) -> f64 {
 
 #[cfg(test)]
 mod tests {
+    /// Becker & Kaye's three pieces join: 2 at Ta = 1700 (0.128·1700^0.367 =
+    /// 1.96, held at 2) and 3.77 at 10⁴ from both sides (to 0.5 %: the
+    /// published coefficients are rounded to three figures).
+    #[test]
+    fn taylor_couette_pieces_join() {
+        assert_eq!(super::nu_taylor_couette(1000.0), 2.0);
+        let (a, b) = (super::nu_taylor_couette(1e4 - 1e-6), super::nu_taylor_couette(1e4));
+        assert!((a - b).abs() / b < 5e-3 && (b - 3.77).abs() < 0.01, "{a} {b}");
+    }
+
     use super::*;
 
     /// Fully developed laminar limit: long tube, Nu → 3.66 (Graetz), to 1 %.
@@ -156,12 +184,13 @@ mod tests {
     }
 
     /// Gnielinski at Re = 1e5, Pr = 0.7, long tube equals the published
-    /// formula evaluated by hand (to round-off) and lies within the ±25 %
-    /// uncertainty band of Dittus–Boelter (199.4; Gnielinski gives 176.3).
+    /// formula with Filonenko's friction factor evaluated by hand (to
+    /// round-off) and lies within the ±25 % uncertainty band of Dittus–Boelter
+    /// (199.4).
     #[test]
     fn gnielinski_matches_textbook() {
         let nu = nu_turbulent(1e5, 0.7, 0.0);
-        let xi = (1.8f64 * 5.0 - 1.5).powi(-2);
+        let xi = (1.82f64 * 5.0 - 1.64).powi(-2);
         let expect = xi / 8.0 * 99_000.0 * 0.7 / (1.0 + 12.7 * (xi / 8.0).sqrt() * (0.7f64.powf(2.0 / 3.0) - 1.0));
         assert!((nu - expect).abs() < 1e-9);
         let db = 0.023 * 1e5f64.powf(0.8) * 0.7f64.powf(0.4);

@@ -177,8 +177,8 @@ pub fn shaft_torque(rig: &Rig, op: &OpPoint, friction_w: f64) -> f64 {
 }
 
 /// Speed command of the drive, rad/s: the mission's speed in Case 1; in
-/// Case 2 the position loop ω = (A·ẋ_ref + A·K_p·(x_ref − x))/D with a smooth
-/// speed limit.
+/// Case 2 the position loop ω = (A·ẋ_ref + A·K_p·(x_ref − x))/D; both through
+/// the smooth [`speed_limit`].
 pub fn speed_command(rig: &Rig, m: &Mission, t: f64, x: f64) -> f64 {
     let wmax = rig.motor.max_speed_rpm * 2.0 * PI / 60.0;
     let raw = match m.circuit {
@@ -189,7 +189,21 @@ pub fn speed_command(rig: &Rig, m: &Mission, t: f64, x: f64) -> f64 {
             (a * vr + a * rig.actuator.position_gain_per_s * (xr - x)) / rig.displacement_m3_per_rad()
         }
     };
-    wmax * (raw / wmax).tanh()
+    speed_limit(raw, wmax)
+}
+
+/// Smooth speed limit: the identity up to 80 % of `wmax` (no nominal
+/// operating point is touched), then a tanh knee that tends to `wmax`;
+/// continuous with its first derivative, odd in `raw`, rad/s.
+pub fn speed_limit(raw: f64, wmax: f64) -> f64 {
+    let knee = 0.8 * wmax;
+    let a = raw.abs();
+    if a <= knee {
+        raw
+    } else {
+        let span = wmax - knee;
+        raw.signum() * (knee + span * ((a - knee) / span).tanh())
+    }
 }
 
 /// Derivatives of the hydraulic states (`y` = full state, `dy` = its

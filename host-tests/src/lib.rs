@@ -15,6 +15,7 @@ pub mod cli;
 pub mod cooling;
 pub mod diagnosis;
 pub mod emulator;
+pub mod equilibrium;
 pub mod faults;
 pub mod fluid;
 pub mod heat;

@@ -104,9 +104,39 @@ pub fn leakage_w(conductance: f64, dp_pa: f64) -> f64 {
 }
 
 /// Pump mechanical (friction) loss, eq. (8): P_m = η_m·M_p·ω, W, with the
-/// load torque M_p = D·|Δp| (D in m³/rad).
+/// load torque M_p = D·|Δp| (D in m³/rad): the pressure term of
+/// [`PumpFriction`].
 pub fn pump_mechanical_w(eta_m: f64, displacement_m3_per_rad: f64, dp_pa: f64, omega: f64) -> f64 {
     eta_m * displacement_m3_per_rad * dp_pa.abs() * omega.abs()
+}
+
+/// The pump's friction heat by term of eq. (8) extended with the no-load and
+/// viscous torques (Wilson's loss-torque model):
+/// T = T₀ + C_v·μ·D·|ω| + η_m·D·|Δp|, heat T·|ω|, W.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct PumpFriction {
+    /// No-load term T₀·|ω|, W.
+    pub no_load_w: f64,
+    /// Viscous term C_v·μ·D·ω², W.
+    pub viscous_w: f64,
+    /// Pressure term η_m·D·|Δp|·|ω| (eq. 8), W.
+    pub pressure_w: f64,
+}
+
+impl PumpFriction {
+    /// The three terms at speed `omega` (rad/s), pressure difference `dp_pa`
+    /// and film viscosity `mu` (Pa·s), for no-load torque `t0_nm`, viscous
+    /// coefficient `cv`, pressure coefficient `eta_m` and displacement `d`
+    /// (m³/rad).
+    pub fn new(t0_nm: f64, cv: f64, eta_m: f64, d: f64, mu: f64, dp_pa: f64, omega: f64) -> Self {
+        let w = omega.abs();
+        Self { no_load_w: t0_nm * w, viscous_w: cv * mu * d * w * w, pressure_w: pump_mechanical_w(eta_m, d, dp_pa, omega) }
+    }
+
+    /// Total friction heat, W.
+    pub fn total_w(&self) -> f64 {
+        self.no_load_w + self.viscous_w + self.pressure_w
+    }
 }
 
 /// Churning loss of the rotating group (extension `churning-loss`):

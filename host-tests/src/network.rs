@@ -110,6 +110,19 @@ pub fn duct_conductance(rig: &Rig, q_m3_per_s: f64, d: f64, len: f64, area_scale
     h * std::f64::consts::PI * d * len * area_scale * rig.nuisance.inner_scale
 }
 
+/// Case-oil film between the pump case and the oil the rotating cylinder
+/// barrel drags round (Taylor–Couette flow in the radial gap), W/K:
+/// h = Nu·k/(2e) with Nu from [`heat::nu_taylor_couette`] at the barrel's
+/// speed `omega` (rad/s, either sign), on the case's real inner area.
+/// `t_oil` °C and `nu` m²/s are the case oil's.
+pub fn case_film_w_per_k(rig: &Rig, omega: f64, t_oil: f64, nu: f64) -> f64 {
+    let p = &rig.pump;
+    let e = p.case_gap_m;
+    let r_mean = p.rotor_radius_m + 0.5 * e;
+    let ta = omega * omega * r_mean * e.powi(3) / (nu * nu);
+    heat::nu_taylor_couette(ta) * rig.oil.k(t_oil) / (2.0 * e) * p.case_inner_area_m2 * rig.nuisance.inner_scale
+}
+
 /// Outer surfaces exchanging heat with ambient.
 #[derive(Debug, Clone, Copy)]
 pub enum Shape {
@@ -119,16 +132,29 @@ pub enum Shape {
     Cube(f64),
 }
 
-/// The metal nodes that see the air: node, area m², shape.
-pub fn surfaces(rig: &Rig) -> [(Node, f64, Shape); 5] {
+/// The metal nodes that see the air: node, area m², shape, and the share of
+/// the area the ram air reaches (1 but for the pump housing, see
+/// [`crate::rig::Outside::pump_ram_exposure`]).
+pub fn surfaces(rig: &Rig) -> [(Node, f64, Shape, f64); 5] {
     let side = |a: f64| (a / 6.0).sqrt();
     [
-        (Node::Motor, rig.motor.area_m2, Shape::Cylinder(rig.motor.diameter_m)),
-        (Node::Pump, rig.pump.area_m2, Shape::Cylinder(rig.pump.diameter_m)),
-        (Node::MainBlock, rig.blocks.main_area_m2, Shape::Cube(side(rig.blocks.main_area_m2))),
-        (Node::BallBlock, rig.blocks.ball_area_m2, Shape::Cube(side(rig.blocks.ball_area_m2))),
-        (Node::Actuator, rig.actuator.area_m2, Shape::Cylinder(rig.actuator.diameter_m)),
+        (Node::Motor, rig.motor.area_m2, Shape::Cylinder(rig.motor.diameter_m), 1.0),
+        (Node::Pump, rig.pump.area_m2, Shape::Cylinder(rig.pump.diameter_m), rig.outside.pump_ram_exposure),
+        (Node::MainBlock, rig.blocks.main_area_m2, Shape::Cube(side(rig.blocks.main_area_m2)), 1.0),
+        (Node::BallBlock, rig.blocks.ball_area_m2, Shape::Cube(side(rig.blocks.ball_area_m2)), 1.0),
+        (Node::Actuator, rig.actuator.area_m2, Shape::Cylinder(rig.actuator.diameter_m), 1.0),
     ]
+}
+
+/// Heat flow from a surface of which the share `ram_share` of `area` sees
+/// the ram air at `air_mps` and the rest only free convection, plus
+/// radiation from all of it, W.
+pub fn q_outer_exposed(rig: &Rig, area: f64, shape: Shape, t_wall: f64, t_air: f64, air_mps: f64, ram_share: f64) -> f64 {
+    if air_mps > 0.0 && ram_share < 1.0 {
+        ram_share * q_outer(rig, area, shape, t_wall, t_air, air_mps) + (1.0 - ram_share) * q_outer(rig, area, shape, t_wall, t_air, 0.0)
+    } else {
+        q_outer(rig, area, shape, t_wall, t_air, air_mps)
+    }
 }
 
 /// Convective coefficient of an outer surface: free convection (eq. 15 or

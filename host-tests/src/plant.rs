@@ -274,6 +274,11 @@ impl Plant {
         &self.model
     }
 
+    /// The full state vector (hydraulics, node temperatures, energy integrals).
+    pub fn state(&self) -> &[f64] {
+        &self.y
+    }
+
     /// Current time, s.
     pub fn time_s(&self) -> f64 {
         self.t

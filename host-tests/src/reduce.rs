@@ -92,11 +92,7 @@ pub fn reduce_without_jacobian(rig: &Rig) -> ReducedParams {
     let w_max = TABLE_MAX_RPM * PI / 30.0;
     let q_max = d * w_max;
     let duct = |q: f64, dd: f64, len: f64, scale: f64| network::duct_conductance(rig, q, dd, len, scale, FILM_PROPERTY_C, nu);
-    let case_area = PI * p.case_gap_m * p.case_gap_m * 10.0;
-    let g_case = table(w_max, |w| {
-        let q_rot = w * p.rotor_radius_m * PI * 0.25 * p.case_gap_m * p.case_gap_m;
-        duct(q_rot, p.case_gap_m, p.case_gap_m * 10.0, 1.0) / case_area * p.case_wetted_m2
-    });
+    let g_case = table(w_max, |w| network::case_film_w_per_k(rig, w, FILM_PROPERTY_C, nu));
     let g_port = table(q_max, |q| duct(q, p.port_d_m, p.port_len_m, p.port_area_scale));
     let g_loop = table(q_max, |q| network::block_path(rig, duct(q, b.loop_d_m, b.loop_len_m, b.loop_area_scale), b.main_area_m2));
     let g_ball = table(q_max, |q| network::block_path(rig, duct(q, b.ball_d_m, b.ball_len_m, 1.0), b.ball_area_m2));
@@ -146,7 +142,11 @@ pub fn reduce_without_jacobian(rig: &Rig) -> ReducedParams {
         cp_slope_j_per_kg_k2: oil.cp_slope_j_per_kg_k2,
         displacement_m3_per_rad: d,
         eta_m: p.eta_m,
-        mech_to_outlet: p.mech_to_outlet,
+        no_load_torque_nm: p.no_load_torque_nm,
+        viscous_w_s2_per_rad2: p.viscous_torque_coeff * oil.mu_pa_s(40.0) * d,
+        mech_to_outlet: p.friction_pairs.shares().0,
+        mech_to_case: p.friction_pairs.shares().1,
+        expansion_per_k: oil.expansion_per_k,
         k_leak_m3_per_s_pa: p.gaps.conductance(oil.mu_pa_s(40.0)),
         case_pressure_pa: rig.hydraulics.accumulator_pa,
         k_mu_per_k: k_mu,
@@ -360,7 +360,7 @@ fn row(r: &[f64]) -> String {
 
 /// The scalar fields of `p` by name, in `DEFAULT`'s order (the renderer writes
 /// them; the acceptance test compares them with the reduction).
-pub fn scalar_fields(p: &ReducedParams) -> [(&'static str, f64); 32] {
+pub fn scalar_fields(p: &ReducedParams) -> [(&'static str, f64); 36] {
     [
         ("pump_j_per_k", p.pump_j_per_k),
         ("main_block_j_per_k", p.main_block_j_per_k),
@@ -375,7 +375,11 @@ pub fn scalar_fields(p: &ReducedParams) -> [(&'static str, f64); 32] {
         ("cp_slope_j_per_kg_k2", p.cp_slope_j_per_kg_k2),
         ("displacement_m3_per_rad", p.displacement_m3_per_rad),
         ("eta_m", p.eta_m),
+        ("no_load_torque_nm", p.no_load_torque_nm),
+        ("viscous_w_s2_per_rad2", p.viscous_w_s2_per_rad2),
         ("mech_to_outlet", p.mech_to_outlet),
+        ("mech_to_case", p.mech_to_case),
+        ("expansion_per_k", p.expansion_per_k),
         ("k_leak_m3_per_s_pa", p.k_leak_m3_per_s_pa),
         ("case_pressure_pa", p.case_pressure_pa),
         ("k_mu_per_k", p.k_mu_per_k),

@@ -72,8 +72,17 @@ pub struct ModelConsts<S> {
     pub inv_v_ring: S,
     /// Share of the mechanical loss into the delivered oil.
     pub f_out: S,
-    /// `1 - f_out`: share into the case oil.
+    /// Share of the pump friction's viscous and pressure terms into the case
+    /// oil; `1 - f_out - f_case` heats the pump housing.
     pub f_case: S,
+    /// Pump no-load friction, kW per hrad/s (extended eq. 8), into the pump housing.
+    pub k_m0: S,
+    /// Pump viscous friction, kW per (hrad/s)^2 (extended eq. 8), split `f_out`/`f_case`.
+    pub k_mv: S,
+    /// Oil expansion coefficient alpha, 1/K (compression and throttling, h(T, p)).
+    pub alpha: S,
+    /// `alpha * 273.15`: `alpha T` with T in kelvin is `alpha_t0 + alpha t_degC`.
+    pub alpha_t0: S,
     /// LNG inlet temperature, degC (eqs. 20-22).
     pub lng_in: S,
     /// Viscosity exponent of the leakage, 1/K (0: off).
@@ -153,7 +162,7 @@ impl Word for f64 {
 }
 
 /// Scalar words at the head of a [`ModelConsts`] (`p_case` .. `t_mu`).
-pub const N_SCALARS: usize = 33;
+pub const N_SCALARS: usize = 37;
 /// Number of words in a [`ModelConsts`].
 pub const N_WORDS: usize = N_SCALARS + N_NODES + 12 + 5 * N_TABLE + 2 * N_NODES + N_NODES * N_NODES;
 
@@ -199,6 +208,10 @@ impl<S: Copy> ModelConsts<S> {
             inv_v_ring: f(c.inv_v_ring),
             f_out: f(c.f_out),
             f_case: f(c.f_case),
+            k_m0: f(c.k_m0),
+            k_mv: f(c.k_mv),
+            alpha: f(c.alpha),
+            alpha_t0: f(c.alpha_t0),
             lng_in: f(c.lng_in),
             k_mu: f(c.k_mu),
             t_mu: f(c.t_mu),
@@ -262,6 +275,10 @@ impl ModelConsts<()> {
         inv_v_ring: (),
         f_out: (),
         f_case: (),
+        k_m0: (),
+        k_mv: (),
+        alpha: (),
+        alpha_t0: (),
         lng_in: (),
         k_mu: (),
         t_mu: (),
@@ -314,6 +331,7 @@ impl<S: Word> ModelConsts<S> {
         let scalars_non_neg = [
             c.k_lf, c.k_lf_half, c.k_lp, c.k_mech, c.k_q, c.k_a, c.k_dpq, c.r1, c.r2, c.w_dp, c.w_dx, c.k_act, c.k_cu, c.k_sh, c.k_hyd,
             c.fe1, c.fe2, c.fe15, c.inv_v_case, c.inv_v_loop, c.v_port, c.v_ball, c.inv_v_ring, c.f_out, c.f_case,
+            c.k_m0, c.k_mv, c.alpha, c.alpha_t0,
         ];
         // inv_c, outer conductances and the tables: every word between the
         // scalars and Phi (a rolled loop: init code, flash)
@@ -322,7 +340,7 @@ impl<S: Word> ModelConsts<S> {
         let pos = [c.q_scale, c.w_scale, c.inv_v_case, c.inv_v_loop, c.v_port, c.v_ball, c.inv_v_ring, c.g_port[0], c.g_ball[0]]
             .iter()
             .all(|x| w(*x) > 0.0);
-        let shares = w(c.w_dp) <= 1.0 && w(c.w_dx) <= 1.0 && w(c.f_out) <= 1.0 && w(c.f_case) <= 1.0;
+        let shares = w(c.w_dp) <= 1.0 && w(c.w_dx) <= 1.0 && w(c.f_out) + w(c.f_case) <= 1.0;
         let mode = c.rest_mode.iter().all(|v| w(*v) <= 1.0);
         // rho c_p stays positive over the oil's range (-60..150 degC)
         let rc = w(c.rc0) + w(c.rc1) * -60.0 > 0.0 && w(c.rc0) + w(c.rc1) * 150.0 > 0.0;
@@ -389,7 +407,11 @@ pub fn derive(p: &ReducedParams) -> Result<ModelConsts<f64>, ConfigError> {
         v_ball: p.ball_oil_m3 * L_PER_M3,
         inv_v_ring: 1.0 / v_ring,
         f_out: p.mech_to_outlet,
-        f_case: 1.0 - p.mech_to_outlet,
+        f_case: p.mech_to_case,
+        k_m0: p.no_load_torque_nm * 100.0 * KW_PER_W,
+        k_mv: p.viscous_w_s2_per_rad2 * 1e4 * KW_PER_W,
+        alpha: p.expansion_per_k,
+        alpha_t0: p.expansion_per_k * 273.15,
         lng_in: p.lng_inlet_c,
         k_mu: p.k_mu_per_k,
         t_mu: p.t_mu_ref_c,

@@ -308,7 +308,11 @@ struct Consts<N> {
     inv_v_ring: N, // 1 / (V_loop + 2 V_port + V_ball), 1/L
     inv_c: [N; N_NODES], // 1/C of the metal nodes, K/kJ (oil nodes unused)
     f_out: N,
-    f_case: N,    // 1 - f_out
+    f_case: N,    // the rest, 1 - f_out - f_case, heats the pump housing
+    k_m0: N,      // pump no-load friction, kW per hrad/s (pump housing)
+    k_mv: N,      // pump viscous friction, kW per (hrad/s)^2 (split f_out/f_case)
+    alpha: N,     // oil expansion, 1/K
+    alpha_t0: N,  // alpha 273.15
     lng_in: N,    // degC
     k_mu: N,
     t_mu: N,
@@ -513,6 +517,10 @@ impl<N: Num> Model<N> {
             inv_c: c.inv_c.map(f),
             f_out: f(c.f_out),
             f_case: f(c.f_case),
+            k_m0: f(c.k_m0),
+            k_mv: f(c.k_mv),
+            alpha: f(c.alpha),
+            alpha_t0: f(c.alpha_t0),
             lng_in: f(c.lng_in),
             k_mu: f(c.k_mu),
             t_mu: f(c.t_mu),
@@ -606,9 +614,13 @@ impl<N: Num> Model<N> {
         let share = inv.mul(k.count.get(on as usize).copied().unwrap_or(k.one));
         let mut m = self.sums.means(inv, &self.k);
         let from_current = m.shaft_kw.sub(m.hyd_kw);
-        self.last_mech_pair_kw = (m.mech_kw, from_current);
-        if self.loss_max && from_current > m.mech_kw {
-            m.mech_kw = from_current;
+        // the model's whole pump friction: pressure term plus no-load and viscous
+        let aw = m.abs_speed;
+        let speed_kw = aw.mul(k.k_m0.add(k.k_mv.mul(aw)));
+        let model_kw = m.mech_kw.add(speed_kw);
+        self.last_mech_pair_kw = (model_kw, from_current);
+        if self.loss_max && from_current > model_kw {
+            m.mech_kw = from_current.sub(speed_kw);
         }
         self.sums = Sums::ZERO;
         self.ambient_c = m.ambient;
@@ -669,9 +681,25 @@ impl<N: Num> Model<N> {
         let mu = if k.use_mu { k.k_mu.mul(t_c.sub(k.t_mu)).exp() } else { k.one };
         let leak_kw = m.leak_kw.mul(mu);
         let leak_lps = m.leak_lps.mul(mu);
-        let mech_kw = m.mech_kw;
         let aq = m.abs_pump_lps;
         let aw = m.abs_speed;
+        // pump friction (extended eq. 8): no-load term into the housing; the
+        // viscous and pressure terms split between delivered oil, case oil and
+        // housing (sliding-pair rule)
+        let m0_kw = k.k_m0.mul(aw);
+        let split_kw = m.mech_kw.add(k.k_mv.mul(aw).mul(aw));
+        let mech_kw = split_kw.add(m0_kw);
+        let metal_kw = m0_kw.add(k.one.sub(k.f_out).sub(k.f_case).mul(split_kw));
+        // oil enthalpy h(T, p): alpha T (absolute) at the loop and case oil; the
+        // pump's compression warms the delivered oil by alpha T dp q, every
+        // throttling releases (1 - alpha T) dp q, the actuator's work leaves
+        // alpha T dp q of cooling in the loop
+        let at_l = k.alpha_t0.add(k.alpha.mul(t_l));
+        let at_c = k.alpha_t0.add(k.alpha.mul(t_c));
+        let thr_l = k.one.sub(at_l);
+        let needle_kw = thr_l.mul(m.needle_kw);
+        let line_kw = thr_l.mul(m.line_kw);
+        let expand_kw = at_l.mul(m.hyd_kw.sub(leak_kw).sub(m.line_kw).sub(m.needle_kw));
         // conductances of eqs. (12)-(14), (20)-(22) at this step's flows
         let at_q = table::locate(aq, k.q_scale, k.one);
         let at_w = table::locate(aw, k.w_scale, k.one);
@@ -732,8 +760,8 @@ impl<N: Num> Model<N> {
             g_ball,
             q_lng: q_lng_full.mul(share),
             q_lng_port: q_lng_full.mul(port_share),
-            p_hp: k.f_out.mul(mech_kw),
-            p_needle: m.needle_kw,
+            p_hp: k.f_out.mul(split_kw).add(at_l.mul(m.hyd_kw)),
+            p_needle: needle_kw,
             c_port,
             c_ball,
             rate,
@@ -746,16 +774,23 @@ impl<N: Num> Model<N> {
         let adv = m_lk.mul(ring.t_feed.sub(t_c));
         let [g_op, g_omb, g_obb, g_oa] = *outer_g;
         let (o_p, o_mb, o_bb, o_a) = (g_op.mul(t_p.sub(amb)), g_omb.mul(t_mb.sub(amb)), g_obb.mul(t_bb.sub(amb)), g_oa.mul(t_a.sub(amb)));
-        let q_pump = g_case
-            .mul(t_c.sub(t_p))
+        let q_pump = metal_kw
+            .add(g_case.mul(t_c.sub(t_p)))
             .add(g_port.mul(ring.t_in.sub(t_p)))
             .add(g_port.mul(ring.t_out.sub(t_p)))
             .sub(o_p);
-        let q_case = leak_kw.add(k.f_case.mul(mech_kw)).add(g_case.mul(t_p.sub(t_c))).add(adv);
-        let q_ring = m
-            .line_kw
-            .add(m.needle_kw)
-            .add(k.f_out.mul(mech_kw))
+        let q_case = k
+            .one
+            .sub(at_c)
+            .mul(leak_kw)
+            .add(k.f_case.mul(split_kw))
+            .add(g_case.mul(t_p.sub(t_c)))
+            .add(adv);
+        let q_ring = line_kw
+            .add(needle_kw)
+            .add(k.f_out.mul(split_kw))
+            .add(at_l.mul(m.hyd_kw))
+            .sub(expand_kw)
             .add(g_port.mul(t_p.sub(ring.t_in)))
             .add(g_port.mul(t_p.sub(ring.t_out)))
             .add(g_ball.mul(t_bb.sub(ring.t_ball)))

@@ -104,7 +104,7 @@ pub const PARAMS: [ParamDef; 19] = [
     ParamDef {
         name: "film_ball",
         what: "oil-to-metal film, ball-valve oil ↔ ball block",
-        fields: "nuisance.inner_scale (×θ) with blocks.loop_area_scale, pump.port_area_scale, pump.case_wetted_m2 (÷θ, so only the ball film changes)",
+        fields: "nuisance.inner_scale (×θ) with blocks.loop_area_scale, pump.port_area_scale, pump.case_inner_area_m2 (÷θ, so only the ball film changes)",
         lo: 0.2, hi: 5.0, prior_sigma_ln: 0.7,
         why: "ball-block passage geometry assumed",
         needs: Needs::Sensor(Channel::TBallvalveC),
@@ -113,7 +113,7 @@ pub const PARAMS: [ParamDef; 19] = [
     ParamDef {
         name: "film_case",
         what: "case-oil film on the pump housing (rotating group)",
-        fields: "pump.case_wetted_m2",
+        fields: "pump.case_inner_area_m2",
         lo: 0.1, hi: 10.0, prior_sigma_ln: 1.0,
         why: "the case flow is a rotating-cylinder flow the duct correlation only approximates; wetted area calibrated on one rig",
         needs: Needs::Sensor(Channel::TPumpC),
@@ -243,9 +243,9 @@ pub fn apply(base: &Rig, theta: &[f64]) -> Rig {
                 r.nuisance.inner_scale *= t;
                 r.blocks.loop_area_scale /= t;
                 r.pump.port_area_scale /= t;
-                r.pump.case_wetted_m2 /= t;
+                r.pump.case_inner_area_m2 /= t;
             }
-            "film_case" => r.pump.case_wetted_m2 *= t,
+            "film_case" => r.pump.case_inner_area_m2 *= t,
             "cap_motor" => {
                 let w = r.motor.winding_mass_kg;
                 r.motor.mass_kg = w + t * (r.motor.mass_kg - w);
@@ -305,7 +305,7 @@ mod tests {
         let r = apply(&rig, &th);
         let rel = |a: f64, b: f64| ((a - b) / b).abs();
         assert!(rel(r.nuisance.inner_scale * r.blocks.loop_area_scale, rig.blocks.loop_area_scale) < 1e-12);
-        assert!(rel(r.nuisance.inner_scale * r.pump.case_wetted_m2, rig.pump.case_wetted_m2) < 1e-12);
+        assert!(rel(r.nuisance.inner_scale * r.pump.case_inner_area_m2, rig.pump.case_inner_area_m2) < 1e-12);
         assert!(rel(r.nuisance.inner_scale * r.pump.port_area_scale, rig.pump.port_area_scale) < 1e-12);
     }
 }

@@ -168,7 +168,7 @@ pub fn other_rig_truth() -> Rig {
     let mut r = other_rig_file();
     r.blocks.loop_area_scale *= 0.7;
     r.pump.port_area_scale *= 1.3;
-    r.pump.case_wetted_m2 *= 1.3;
+    r.pump.case_inner_area_m2 *= 1.3;
     r.motor.area_m2 *= 0.8;
     r.pump.area_m2 *= 1.35;
     r.blocks.main_area_m2 *= 0.75;

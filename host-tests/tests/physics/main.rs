@@ -3,4 +3,5 @@
 
 mod energy;
 mod paper;
+mod pump_energy;
 mod solver;

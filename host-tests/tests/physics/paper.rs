@@ -2,15 +2,17 @@
 //! tolerance and the reason for it. One calibrated parameter set
 //! (`Rig::default()`) serves every case (docs/calibration.md).
 //!
-//! Fitted vs predicted: the calibration fits five parameters to five targets
-//! exactly — Table 4's inlet / outlet / drain at 600 s, Table 5's still-air
-//! pump shell 25.38 °C, and the circulating oil passing 40 °C at 110 s (Fig.
-//! 15's valve opening). Two more numbers are set to the paper's outcome: the
-//! ram-air run length (Table 5's 15 m/s coefficient) and the LNG flow (the
-//! smallest round flow that keeps Fig. 15's drain below 50 °C). A test of a
-//! fitted number reproduces the fit; it validates nothing. The predictions
-//! are Table 5's 30 and 50 m/s coefficients, Table 5's shell and drain with
-//! ram air, the still-air coefficient and Case 2's balance time.
+//! Fitted vs predicted (docs/calibration.md): three parameters are fitted by
+//! least squares to four numbers — Table 4's inlet / outlet / drain at 600 s
+//! and the circulating oil passing 40 °C at 110 s (Fig. 15's valve opening);
+//! one more, the pump housing's ram-air share, to Table 5's shell at 30 m/s.
+//! Two numbers are set to the paper's outcome: the ram-air run length
+//! (Table 5's 15 m/s coefficient) and the LNG flow (the smallest round flow
+//! that keeps Fig. 15's drain below 50 °C). A test of a fitted number
+//! reproduces the fit; it validates nothing. The predictions: the pump shell
+//! in still air, the other Table 5 temperatures (`pump_energy.rs`), Table 5's
+//! 30 and 50 m/s coefficients, the still-air coefficient, Case 2's balance
+//! time.
 //!
 //! Known misses (the model disagrees with the paper) are asserted as measured,
 //! with a tolerance around the measured value, and say so: they are to be
@@ -23,7 +25,7 @@ use eha_sim::cooling::{size, Lng};
 use eha_sim::heat::h_forced_plate;
 use eha_sim::network::{h_outer, masses, Shape, NODES};
 use eha_sim::rig::Rig;
-use eha_sim::scenario::{Scenario, Schedule};
+use eha_sim::scenario::Scenario;
 use eha_sim::sim::{simulate, SimOptions, SimOutput};
 
 fn case1(rig: &Rig, bar: f64) -> SimOutput {
@@ -31,20 +33,21 @@ fn case1(rig: &Rig, bar: f64) -> SimOutput {
 }
 
 /// Table 4 (600 s, 60 bar): inlet 53.00, outlet 54.17, drain 59.67 °C, each
-/// within ±1.5 K (the issue's tolerance: the paper's own simulation-vs-test
-/// agreement in Fig. 8 is of that order).
+/// within ±0.5 K (issue 16's bound: a tenth of the paper's own
+/// simulation-vs-test scatter in Fig. 8, and twice the 0.25 K reading
+/// uncertainty the fit assumes).
 ///
 /// **Fitted, reproduces the fit**: these three temperatures are calibration
-/// targets (docs/calibration.md), so passing validates nothing; the fit
-/// itself is held to 0.01 K by [`calibration_targets_are_reproduced`].
-/// Measured: 53.00 / 54.17 / 59.67 °C.
+/// targets (four targets, three parameters, least squares), so passing
+/// validates little; what it shows is that three physical parameters can
+/// meet four numbers at once. Measured: 52.97 / 54.20 / 59.67 °C.
 #[test]
 fn table4_port_temperatures_at_600s_60bar_fitted() {
     let out = case1(&Rig::default(), 60.0);
     for (ch, paper) in [("t_inlet_c", 53.00), ("t_outlet_c", 54.17), ("t_drain_c", 59.67)] {
         let ours = out.last(ch).expect("channel");
         println!("{ch}: ours {ours:.3} °C, paper {paper:.2} °C (fitted)");
-        assert!((ours - paper).abs() <= 1.5, "{ch}: {ours:.2} vs {paper:.2}");
+        assert!((ours - paper).abs() <= 0.5, "{ch}: {ours:.2} vs {paper:.2}");
     }
     // The paper's ordering: drain hottest, outlet above inlet.
     let g = |c| out.last(c).unwrap_or(f64::NAN);
@@ -52,28 +55,39 @@ fn table4_port_temperatures_at_600s_60bar_fitted() {
 }
 
 /// The committed rig still reproduces its calibration (`eha-sim calibrate`,
-/// docs/calibration.md): five targets, five parameters, an exact fit
-/// (residuals < 1e-9 K when it was made). Bound: 0.01 K on the four
-/// temperatures (twice half the paper's last printed digit: anything more
-/// means the physics changed since the fit and `eha-sim calibrate` must be
-/// re-run, together with every number downstream of the rig) and 0.1 s on the
-/// 40 °C crossing (the calibration's 1 s output grid, linearly interpolated).
-/// A regression guard, not a validation.
+/// docs/calibration.md): the least-squares residuals as measured when the
+/// fit was made (inlet −0.026, outlet +0.028, drain −0.002 K; 40 °C crossing
+/// 109.99 s), each within 0.01 K (0.1 s): anything more means the physics
+/// changed since the fit and `eha-sim calibrate` must be re-run, together
+/// with every number downstream of the rig. A regression guard, not a
+/// validation.
 #[test]
 fn calibration_targets_are_reproduced() {
     let m = evaluate(&Rig::default()).expect("case 1 runs");
     let temps = [
-        ("inlet", m.inlet_c, PAPER.inlet_c),
-        ("outlet", m.outlet_c, PAPER.outlet_c),
-        ("drain", m.drain_c, PAPER.drain_c),
-        ("pump shell", m.pump_shell_c, PAPER.pump_shell_c),
+        ("inlet", m.inlet_c, PAPER.inlet_c, -0.026),
+        ("outlet", m.outlet_c, PAPER.outlet_c, 0.028),
+        ("drain", m.drain_c, PAPER.drain_c, -0.002),
     ];
-    for (name, ours, target) in temps {
-        println!("{name}: ours {ours:.5} °C, target {target:.2} °C, residual {:+.2e} K", ours - target);
-        assert!((ours - target).abs() <= 0.01, "{name}: residual {:+.4} K: re-run `eha-sim calibrate`", ours - target);
+    for (name, ours, target, residual) in temps {
+        println!("{name}: ours {ours:.5} °C, target {target:.2} °C, residual {:+.4} K (at the fit {residual:+.3})", ours - target);
+        assert!((ours - target - residual).abs() <= 0.01, "{name}: residual {:+.4} K: re-run `eha-sim calibrate`", ours - target);
     }
     println!("oil passes 40 °C at {:.3} s, target {:.1} s", m.t40_s, PAPER.t40_s);
-    assert!((m.t40_s - PAPER.t40_s).abs() <= 0.1, "40 °C crossing {:.2} s: re-run `eha-sim calibrate`", m.t40_s);
+    assert!((m.t40_s - 109.99).abs() <= 0.1, "40 °C crossing {:.2} s: re-run `eha-sim calibrate`", m.t40_s);
+}
+
+/// Table 5's pump shell in still air at 600 s, 60 bar: paper 25.38 °C.
+/// **Predicted** (no parameter is fitted to it). **Known miss**: measured
+/// 26.82 °C, +1.44 K: with the sliding-pair rule (docs/calibration.md) the
+/// housing receives the bearings' and about a quarter of the films' friction
+/// heat; with all film heat into the oil the shell came out 3.4 K too cold
+/// (22.0 °C). Asserted as measured (±0.05 K: a deterministic run).
+#[test]
+fn still_air_pump_shell_predicted_known_miss() {
+    let m = evaluate(&Rig::default()).expect("case 1 runs");
+    println!("pump shell {:.3} °C, paper 25.38 (predicted, {:+.2} K)", m.pump_shell_c, m.pump_shell_c - 25.38);
+    assert!((m.pump_shell_c - 26.82).abs() <= 0.05, "shell {:.3}: re-measure", m.pump_shell_c);
 }
 
 /// Table 5: ram-air coefficients 66.13, 115.13, 173.25 W/(m²·K) at 15, 30,
@@ -94,81 +108,10 @@ fn table5_ram_air_coefficients() {
     }
 }
 
-/// Table 5: pump shell and drain port at 600 s, 60 bar, with ram air of 0 /
-/// 15 / 30 / 50 m/s over the housings. Paper: shell 25.38 / 24.78 / 24.32 /
-/// 23.82 °C, drain 59.67 / 59.14 / 58.84 / 58.57 °C.
-///
-/// **The 0 m/s row is fitted** (the shell is a calibration target, the drain
-/// is Table 4's); 15–50 m/s are predictions.
-///
-/// Against the paper with Table 4's ±1.5 K the drain passes at every speed
-/// (asserted; measured −0.26 / −0.47 / −0.73 K) and the shell passes at 15 and
-/// 30 m/s but not at 50 m/s (−1.70 K). That tolerance is as large as the whole
-/// effect (the paper's shell falls 1.56 K, its drain 1.10 K from 0 to 50 m/s),
-/// so it cannot tell a right ram-air model from none: what tests the ram air
-/// is the fall from the still-air row.
-///
-/// **Known miss**, to be fixed by the physics issue: the model's fall is about
-/// twice the paper's on the shell and 1.5–1.7 times on the drain (the paper
-/// seems to apply the ram air to a smaller area than the whole housings,
-/// docs/calibration.md). Measured falls (0→15/30/50 m/s): shell 1.45 / 2.36 /
-/// 3.26 K where the paper falls 0.60 / 1.06 / 1.56 K; drain 0.79 / 1.30 /
-/// 1.83 K where the paper falls 0.53 / 0.83 / 1.10 K. Asserted: the measured
-/// falls within ±0.05 K (the runs are deterministic; 0.05 K is 2–6 % of the
-/// falls, so a change of the ram-air physics shows) and a strictly monotonic
-/// fall (the paper's trend, which holds).
-#[test]
-fn table5_pump_shell_and_drain_with_ram_air_known_miss() {
-    // (air speed m/s, paper shell °C, paper drain °C, measured shell fall K, measured drain fall K)
-    let rows = [
-        (0.0, 25.38, 59.67, 0.0, 0.0),
-        (15.0, 24.78, 59.14, 1.45, 0.79),
-        (30.0, 24.32, 58.84, 2.36, 1.30),
-        (50.0, 23.82, 58.57, 3.26, 1.83),
-    ];
-    let runs: Vec<(f64, f64)> = rows
-        .iter()
-        .map(|&(v, ..)| {
-            let mut sc = Scenario::Case1 { needle_bar: 60.0, duration_s: 600.0 }.mission().expect("mission");
-            sc.air_speed_mps = Schedule::constant(v);
-            let out = simulate(&Rig::default(), &Scenario::Mission(sc), &SimOptions::default()).expect("runs");
-            (out.last("t_pump_c").unwrap_or(f64::NAN), out.last("t_drain_c").unwrap_or(f64::NAN))
-        })
-        .collect();
-    let (shell0, drain0) = runs[0];
-    let (paper_shell0, paper_drain0) = (rows[0].1, rows[0].2);
-    let mut failures = vec![];
-    for (i, (&(v, shell_p, drain_p, shell_fall_m, drain_fall_m), &(shell, drain))) in rows.iter().zip(&runs).enumerate() {
-        let (fs, fd) = (shell0 - shell, drain0 - drain);
-        let (fs_p, fd_p) = (paper_shell0 - shell_p, paper_drain0 - drain_p);
-        println!(
-            "{v:>4} m/s: shell ours {shell:.3} paper {shell_p:.2} ({:+.2} K), fall ours {fs:.3} paper {fs_p:.2} K; \
-             drain ours {drain:.3} paper {drain_p:.2} ({:+.2} K), fall ours {fd:.3} paper {fd_p:.2} K",
-            shell - shell_p,
-            drain - drain_p
-        );
-        // Paper tolerance of Table 4 on the drain (holds at every speed).
-        if (drain - drain_p).abs() > 1.5 {
-            failures.push(format!("{v} m/s: drain {drain:.2} vs paper {drain_p:.2} °C beyond ±1.5 K"));
-        }
-        // Known miss: the falls as measured (paper's in the message).
-        if (fs - shell_fall_m).abs() > 0.05 {
-            failures.push(format!("{v} m/s: shell fall {fs:.3} K, measured {shell_fall_m} K (paper {fs_p:.2} K): re-measure"));
-        }
-        if (fd - drain_fall_m).abs() > 0.05 {
-            failures.push(format!("{v} m/s: drain fall {fd:.3} K, measured {drain_fall_m} K (paper {fd_p:.2} K): re-measure"));
-        }
-        if i > 0 && !(shell < runs[i - 1].0 && drain < runs[i - 1].1) {
-            failures.push(format!("{v} m/s: not cooler than at the previous speed"));
-        }
-    }
-    assert!(failures.is_empty(), "{}", failures.join("\n"));
-}
-
 /// Table 5's still-air convective coefficient of the pump shell, 1.40
 /// W/(m²·K). Ours is Churchill–Chu free convection (eq. 15) on the 0.12 m
-/// housing at its 600 s, 60 bar wall temperature (25.38 °C, fitted) over 16 °C
-/// air. **Known miss**: measured 3.61 W/(m²·K), 2.6 times the paper's; the
+/// housing at its 600 s, 60 bar wall temperature (predicted) over 16 °C
+/// air. **Known miss**: measured 3.75 W/(m²·K) at the predicted 26.82 °C shell, 2.7 times the paper's; the
 /// correlation's scatter is ±20 % or so, and no free-convection correlation
 /// gives 1.40 at ΔT ≈ 9.4 K (docs/calibration.md). Asserted: the measured
 /// value within ±2 % (the wall temperature is fitted to 0.01 K, h ∝ ΔT^¼
@@ -178,7 +121,7 @@ fn table5_still_air_coefficient_known_miss() {
     let rig = Rig::default();
     let shell = case1(&rig, 60.0).last("t_pump_c").expect("channel");
     let h = h_outer(&rig, Shape::Cylinder(rig.pump.diameter_m), shell, 16.0, 0.0);
-    let measured = 3.61;
+    let measured = 3.75;
     println!("still-air h of the pump shell: ours {h:.3} W/(m²·K) at {shell:.2} °C, paper 1.40 (known miss, measured {measured})");
     assert!((h - measured).abs() <= 0.02 * measured, "still-air h {h:.3}, measured {measured} (paper 1.40): re-measure");
 }
@@ -281,11 +224,12 @@ fn balance_from(ratios: &[(f64, f64)], eps: f64) -> Option<f64> {
 /// stores the rest; printed), so the paper's statement can only mean the oil.
 ///
 /// Paper: ≈ 200 s, read as ±50 s (half a 100 s division of a 600 s axis).
-/// **Known miss**, to be fixed by the physics issue: measured oil 390.0 s,
-/// inlet 382.5 s, outlet 382.5 s, drain 517.5 s — the oil still stores 10–20 %
-/// of its losses from ≈ 175 s to 390 s while the metal it heats warms up
-/// (printed beside: at 20 % the oil is balanced from 175 s, the ports from
-/// 117.5 s, the drain from 347.5 s; at 5 % nothing is within 600 s).
+/// **Known miss**: measured oil 305.0 s, inlet 212.5 s, outlet 212.5 s, drain
+/// not within 600 s (issue 16's pump energy balance moved them from 390 /
+/// 382.5 / 382.5 / 517.5 s: part of the pump's friction now heats the housing
+/// directly, and the "oil losses" below still count the whole of eq. 8 as
+/// oil heat, so the oil ratio is an upper bound). Printed beside: the 20 %
+/// and 5 % crossings.
 /// Asserted: each time within ±15 s of the measured (three periods: near the
 /// crossing the ratio falls ≈ 0.001 per 15 s and scatters ≈ ±0.0005 between
 /// windows; 30 s windows of 3–10 periods and a 0.05 s output grid give times
@@ -347,18 +291,18 @@ fn case2_periodic_balance_time_known_miss() {
         c_oil(0)
     );
     // (name, measured balance time at CASE2_EPS, s)
-    let cases: [(&str, Vec<(f64, f64)>, f64); 4] = [
-        ("oil (energy)", oil, 390.0),
-        ("t_inlet_c", node("t_inlet_c"), 382.5),
-        ("t_outlet_c", node("t_outlet_c"), 382.5),
-        ("t_drain_c", node("t_drain_c"), 517.5),
+    let cases: [(&str, Vec<(f64, f64)>, Option<f64>); 4] = [
+        ("oil (energy)", oil, Some(305.0)),
+        ("t_inlet_c", node("t_inlet_c"), Some(212.5)),
+        ("t_outlet_c", node("t_outlet_c"), Some(212.5)),
+        ("t_drain_c", node("t_drain_c"), None),
     ];
     let mut failures = vec![];
     for (name, ratios, measured) in &cases {
         let at = |eps| balance_from(ratios, eps).map_or("not in 600 s".to_string(), |t| format!("{t:.1} s"));
         let t = balance_from(ratios, CASE2_EPS);
         println!(
-            "{name}: balance (< {:.0} %) from {} (paper ≈ 200 s; measured {measured} s); at 20 %: {}, at 5 %: {}; ratio at 300 s {:.3}, at 550 s {:.3}",
+            "{name}: balance (< {:.0} %) from {} (paper ≈ 200 s; measured {measured:?} s); at 20 %: {}, at 5 %: {}; ratio at 300 s {:.3}, at 550 s {:.3}",
             100.0 * CASE2_EPS,
             at(CASE2_EPS),
             at(0.2),
@@ -366,9 +310,10 @@ fn case2_periodic_balance_time_known_miss() {
             ratios.iter().find(|r| r.0 >= 300.0).map_or(f64::NAN, |r| r.1),
             ratios.iter().find(|r| r.0 >= 550.0).map_or(f64::NAN, |r| r.1),
         );
-        match t {
-            Some(t) if (t - measured).abs() <= 15.0 => {}
-            _ => failures.push(format!("{name}: balance at {t:?} s, measured {measured} s (paper ≈ 200 s): re-measure")),
+        match (t, measured) {
+            (Some(t), Some(m)) if (t - m).abs() <= 15.0 => {}
+            (None, None) => {}
+            _ => failures.push(format!("{name}: balance at {t:?} s, measured {measured:?} s (paper ≈ 200 s): re-measure")),
         }
     }
     // Periodic: the swing repeats within 10 % over the last 100 s.
