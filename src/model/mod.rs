@@ -154,6 +154,8 @@ struct Sums<N> {
     abs_thr_lps: N,
     abs_act_lps: N,
     abs_speed: N,
+    /// `w^2` (the pump's viscous friction, extended eq. 8).
+    sq_speed: N,
     dp: N,
     ambient: N,
     ticks: u32,
@@ -175,6 +177,7 @@ impl<N: Num> Sums<N> {
         abs_thr_lps: N::ZERO,
         abs_act_lps: N::ZERO,
         abs_speed: N::ZERO,
+        sq_speed: N::ZERO,
         dp: N::ZERO,
         ambient: N::ZERO,
         ticks: 0,
@@ -201,6 +204,7 @@ impl<N: Num> Sums<N> {
             abs_thr_lps: self.abs_thr_lps.mul(f),
             abs_act_lps: self.abs_act_lps.mul(f.mul(k.k_a)),
             abs_speed: self.abs_speed.mul(f),
+            sq_speed: self.sq_speed.mul(f),
             dp: self.dp.mul(f),
             ambient: self.ambient,
             ticks: self.ticks,
@@ -250,6 +254,7 @@ impl<N: Num> Sums<N> {
         s.abs_thr_lps = s.abs_thr_lps.add(aq_thr);
         s.abs_act_lps = s.abs_act_lps.add(u.dpos_mm.abs());
         s.abs_speed = s.abs_speed.add(aw);
+        s.sq_speed = s.sq_speed.add(aw.mul(aw));
         s.dp = s.dp.add(dp);
         s.ambient = u.ambient_c;
         s.ticks += 1;
@@ -616,7 +621,7 @@ impl<N: Num> Model<N> {
         let from_current = m.shaft_kw.sub(m.hyd_kw);
         // the model's whole pump friction: pressure term plus no-load and viscous
         let aw = m.abs_speed;
-        let speed_kw = aw.mul(k.k_m0.add(k.k_mv.mul(aw)));
+        let speed_kw = aw.mul(k.k_m0).add(k.k_mv.mul(m.sq_speed));
         let model_kw = m.mech_kw.add(speed_kw);
         self.last_mech_pair_kw = (model_kw, from_current);
         if self.loss_max && from_current > model_kw {
@@ -687,7 +692,7 @@ impl<N: Num> Model<N> {
         // viscous and pressure terms split between delivered oil, case oil and
         // housing (sliding-pair rule)
         let m0_kw = k.k_m0.mul(aw);
-        let split_kw = m.mech_kw.add(k.k_mv.mul(aw).mul(aw));
+        let split_kw = m.mech_kw.add(k.k_mv.mul(m.sq_speed));
         let mech_kw = split_kw.add(m0_kw);
         let metal_kw = m0_kw.add(k.one.sub(k.f_out).sub(k.f_case).mul(split_kw));
         // oil enthalpy h(T, p): alpha T (absolute) at the loop and case oil; the
