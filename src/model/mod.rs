@@ -154,8 +154,10 @@ struct Sums<N> {
     abs_thr_lps: N,
     abs_act_lps: N,
     abs_speed: N,
-    /// `w^2` (the pump's viscous friction, extended eq. 8).
-    sq_speed: N,
+    /// The pump's viscous friction `k_mv w^2`, kW (extended eq. 8; its constant is
+    /// applied per tick: `w^2` summed over a step would leave the fixed-point range
+    /// at 6000 rpm).
+    visc_kw: N,
     dp: N,
     ambient: N,
     ticks: u32,
@@ -177,7 +179,7 @@ impl<N: Num> Sums<N> {
         abs_thr_lps: N::ZERO,
         abs_act_lps: N::ZERO,
         abs_speed: N::ZERO,
-        sq_speed: N::ZERO,
+        visc_kw: N::ZERO,
         dp: N::ZERO,
         ambient: N::ZERO,
         ticks: 0,
@@ -204,7 +206,7 @@ impl<N: Num> Sums<N> {
             abs_thr_lps: self.abs_thr_lps.mul(f),
             abs_act_lps: self.abs_act_lps.mul(f.mul(k.k_a)),
             abs_speed: self.abs_speed.mul(f),
-            sq_speed: self.sq_speed.mul(f),
+            visc_kw: self.visc_kw.mul(f),
             dp: self.dp.mul(f),
             ambient: self.ambient,
             ticks: self.ticks,
@@ -243,18 +245,23 @@ impl<N: Num> Sums<N> {
         s.act_kw = s.act_kw.add(k.w_dp.mul(dp).mul(dp).add(k.w_dx.mul(u.dpos_mm).mul(u.dpos_mm)));
         // eq. (1): I^2 (dissipation total only)
         s.copper_kw = s.copper_kw.add(u.current_ha.mul(u.current_ha));
-        // Cross-check terms: shaft power Kt |I| |w| with the sign of the hydraulic
-        // power (motoring +, the load driving the pump -), and the hydraulic power
-        // D dp w; their difference is the shaft's loss (eq. 8 in the model).
+        // Cross-check terms: shaft power Kt |I| w with the sign of the shaft torque
+        // the model expects, D dp + sign(w) T_f (the current's sign is not
+        // measured; at low pressure the friction torque T_f of the extended eq. 8
+        // can outweigh D dp, and a load driving the pump then still needs a
+        // driving torque), and the hydraulic power D dp w; their difference is the
+        // shaft's loss (eq. 8 in the model).
         let iw = u.current_ha.abs().mul(u.speed_hrads);
-        s.shaft_kw = s.shaft_kw.add(if dp < N::ZERO { N::ZERO.sub(iw) } else { iw });
+        let t_f = k.k_mech.mul(dp.abs()).add(k.k_m0).add(k.k_mv.mul(aw));
+        let t_shaft = k.k_hyd.mul(dp).add(if u.speed_hrads < N::ZERO { N::ZERO.sub(t_f) } else { t_f });
+        s.shaft_kw = s.shaft_kw.add(if t_shaft < N::ZERO { N::ZERO.sub(iw) } else { iw });
         s.hyd_kw = s.hyd_kw.add(dp.mul(u.speed_hrads));
         s.pump_lps = s.pump_lps.add(q_pump);
         s.abs_pump_lps = s.abs_pump_lps.add(q_pump.abs());
         s.abs_thr_lps = s.abs_thr_lps.add(aq_thr);
         s.abs_act_lps = s.abs_act_lps.add(u.dpos_mm.abs());
         s.abs_speed = s.abs_speed.add(aw);
-        s.sq_speed = s.sq_speed.add(aw.mul(aw));
+        s.visc_kw = s.visc_kw.add(k.k_mv.mul(aw).mul(aw));
         s.dp = s.dp.add(dp);
         s.ambient = u.ambient_c;
         s.ticks += 1;
@@ -621,7 +628,7 @@ impl<N: Num> Model<N> {
         let from_current = m.shaft_kw.sub(m.hyd_kw);
         // the model's whole pump friction: pressure term plus no-load and viscous
         let aw = m.abs_speed;
-        let speed_kw = aw.mul(k.k_m0).add(k.k_mv.mul(m.sq_speed));
+        let speed_kw = aw.mul(k.k_m0).add(m.visc_kw);
         let model_kw = m.mech_kw.add(speed_kw);
         self.last_mech_pair_kw = (model_kw, from_current);
         if self.loss_max && from_current > model_kw {
@@ -692,7 +699,7 @@ impl<N: Num> Model<N> {
         // viscous and pressure terms split between delivered oil, case oil and
         // housing (sliding-pair rule)
         let m0_kw = k.k_m0.mul(aw);
-        let split_kw = m.mech_kw.add(k.k_mv.mul(m.sq_speed));
+        let split_kw = m.mech_kw.add(m.visc_kw);
         let mech_kw = split_kw.add(m0_kw);
         let metal_kw = m0_kw.add(k.one.sub(k.f_out).sub(k.f_case).mul(split_kw));
         // oil enthalpy h(T, p): alpha T (absolute) at the loop and case oil; the

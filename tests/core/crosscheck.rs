@@ -144,7 +144,9 @@ fn while_disagreeing_the_model_heats_with_the_larger_loss() {
         if m.pending_ticks() == 0 && k > window() {
             let (lp, li) = m.last_mech_pair_kw();
             assert!(li > lp + 0.1, "tick {k}: {lp} {li}");
-            assert_eq!(m.last_losses_kw()[3], li, "tick {k}: the model must heat with the larger loss");
+            // to f32 rounding: the model splits the loss back into its friction terms
+            let heat = m.last_losses_kw()[3];
+            assert!((heat - li).abs() <= 1e-6 * li.abs(), "tick {k}: the model must heat with the larger loss ({heat} vs {li})");
             first_max.get_or_insert(k);
         }
     }
@@ -190,3 +192,4 @@ fn clear_after_the_sensors_agree_again() {
     let out = run(&mut g, 3000, |_| sample(65.0, 5.0, 500.0));
     assert!(out.iter().all(|o| !o.faults.intersects(faults::LATCHED) && !o.faults.intersects(faults::UNTRUSTED)));
 }
+

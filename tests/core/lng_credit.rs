@@ -77,7 +77,7 @@ use eha_guard::{faults, GuardConfig, GuardOf, Output, Restore, Sample, ThermalRe
 /// Case 1 at 60 bar, 500 rpm, with the motor current of the loss model (1.5
 /// hydraulic torque / 0.75 N m/A); 20 degC air.
 fn load() -> Sample {
-    Sample { current_a: 36.2, p_a_bar: 65.0, p_b_bar: 5.0, speed_rpm: 500.0, position_mm: 0.0, ambient_c: 20.0 }
+    Sample { current_a: crate::plant::motor_current(65.0, 5.0, 500.0), p_a_bar: 65.0, p_b_bar: 5.0, speed_rpm: 500.0, position_mm: 0.0, ambient_c: 20.0 }
 }
 
 /// Warm restore at 45 degC (the valve opens at the first sample), `used_cj` of the

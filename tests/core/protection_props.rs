@@ -709,7 +709,7 @@ fn guard_dwell_qualifies_the_closing_at_the_model_step() {
     let dwell = cfg.valve.dwell_steps / eha_guard::params::TICKS_PER_STEP;
     let mut g = GuardOf::<f32>::new(&cfg, Restore::Cold);
     let load = nominal();
-    let idle = Sample { current_a: 0.0, p_a_bar: 5.0, p_b_bar: 5.0, speed_rpm: 500.0, ..nominal() };
+    let idle = Sample { current_a: crate::plant::motor_current(5.0, 5.0, 500.0), p_a_bar: 5.0, p_b_bar: 5.0, speed_rpm: 500.0, ..nominal() };
     let mut below_run = 0u32;
     let mut was_open = false;
     for k in 0..20_000u32 {

@@ -12,7 +12,7 @@ use eha_guard::{faults, GuardConfig, GuardOf, Restore, Sample, ThermalRecord};
 /// Pump turning with no load at 30 degC ambient (nothing heats measurably in a few
 /// ticks: the drain moves by < 1e-4 K per model step here).
 fn idle30() -> Sample {
-    Sample { current_a: 0.0, p_a_bar: 5.0, p_b_bar: 5.0, speed_rpm: 500.0, position_mm: 0.0, ambient_c: 30.0 }
+    Sample { current_a: crate::plant::motor_current(5.0, 5.0, 500.0), p_a_bar: 5.0, p_b_bar: 5.0, speed_rpm: 500.0, position_mm: 0.0, ambient_c: 30.0 }
 }
 
 #[test]
