@@ -3,7 +3,7 @@
 //! matrix included), with a header and a CRC, flashed into its own region (the
 //! `PARAMS` region of the board's `memory.x`) and read at boot.
 //!
-//! Layout (little-endian, [`BLOCK_LEN`] = 1080 bytes):
+//! Layout (little-endian, [`BLOCK_LEN`] = 1084 bytes):
 //!
 //! | offset | size | field |
 //! |---|---|---|
@@ -31,7 +31,7 @@ pub const BLOCK_LEN: usize = WORDS_AT + 4 * N_WORDS + 4;
 pub const MAGIC: u32 = u32::from_le_bytes(*b"EHAP");
 /// Format version of this firmware. 4: the pump's no-load and viscous
 /// friction and the oil's expansion coefficient (`k_m0`, `k_mv`, `alpha`,
-/// `alpha_t0`; 263 words, 1080 bytes). 3: without `irc0`/`irc1` (the oil
+/// `alpha_t0`, `g_case_slope`; 264 words, 1084 bytes). 3: without `irc0`/`irc1` (the oil
 /// capacity's inverse is exact; 259 words, 1064 bytes). 2: the rest-cooling
 /// words (`rest_rate`, `rest_mode`). Older blocks are refused.
 pub const VERSION: u16 = 4;

@@ -440,17 +440,26 @@ impl Model {
             (Circuit::Servo, true) => &[Node::Loop, Node::Inlet, Node::Outlet],
             (Circuit::Servo, false) => &[Node::Loop, Node::Outlet, Node::Inlet],
         };
+        // Node pressures. Throttle circuit, forward: outlet (p_a) → ball-valve oil
+        // (needle drop) → loop (line drop) → inlet (p_b); reverse: inlet (p_b) →
+        // loop (line drop) → ball-valve oil (needle drop) → outlet (p_a). Servo: the
+        // loop at the pump's suction pressure (the actuator does the work between).
         let p_suction = if forward { op.p_b } else { op.p_a };
         let line_dp = match op.circuit {
-            Circuit::Throttle if forward => hydraulics::path_dp(rig, op.q_path, self.nu(tc(Node::BallOil)), None).0.max(0.0),
-            _ => 0.0,
+            Circuit::Throttle => hydraulics::path_dp(rig, op.q_path.abs(), self.nu(tc(Node::BallOil)), None).0.max(0.0),
+            Circuit::Servo => 0.0,
+        };
+        let (p_loop, p_ball) = match (op.circuit, forward) {
+            (Circuit::Throttle, true) => (op.p_b, op.p_b + line_dp),
+            (Circuit::Throttle, false) => (op.p_b - line_dp, op.p_a),
+            (Circuit::Servo, _) => (p_suction, p_suction),
         };
         let pres = |n: Node| match n {
             Node::Inlet => op.p_b,
             Node::Outlet => op.p_a,
-            Node::BallOil => p_suction + line_dp,
+            Node::BallOil => p_ball,
             Node::Case => op.p_case,
-            _ => p_suction,
+            _ => p_loop,
         };
         let h = |n: Node| oil.enthalpy_tp(tc(n), pres(n));
         let hp_pos = ring.iter().position(|&n| n == hp).unwrap_or(0);

@@ -33,8 +33,7 @@ use std::f64::consts::PI;
 
 /// Shaft speed of the last table point, rpm (the guard's speed range limit).
 pub const TABLE_MAX_RPM: f64 = 6000.0;
-/// Oil temperature at which the film correlations are evaluated, °C.
-pub const FILM_PROPERTY_C: f64 = 40.0;
+pub use eha_guard::params::FILM_PROPERTY_C;
 /// Air temperature of the free-convection fit, °C.
 pub const FIT_AIR_C: f64 = 20.0;
 
@@ -93,6 +92,10 @@ pub fn reduce_without_jacobian(rig: &Rig) -> ReducedParams {
     let q_max = d * w_max;
     let duct = |q: f64, dd: f64, len: f64, scale: f64| network::duct_conductance(rig, q, dd, len, scale, FILM_PROPERTY_C, nu);
     let g_case = table(w_max, |w| network::case_film_w_per_k(rig, w, FILM_PROPERTY_C, nu));
+    // d ln G_case / dT at the film temperature (central difference at 500 rpm)
+    let w_nom = 500.0 * PI / 30.0;
+    let gc = |t: f64| network::case_film_w_per_k(rig, w_nom, t, nu);
+    let case_film_slope = (gc(FILM_PROPERTY_C + 1.0) - gc(FILM_PROPERTY_C - 1.0)) / (2.0 * gc(FILM_PROPERTY_C));
     let g_port = table(q_max, |q| duct(q, p.port_d_m, p.port_len_m, p.port_area_scale));
     let g_loop = table(q_max, |q| network::block_path(rig, duct(q, b.loop_d_m, b.loop_len_m, b.loop_area_scale), b.main_area_m2));
     let g_ball = table(q_max, |q| network::block_path(rig, duct(q, b.ball_d_m, b.ball_len_m, 1.0), b.ball_area_m2));
@@ -117,6 +120,9 @@ pub fn reduce_without_jacobian(rig: &Rig) -> ReducedParams {
         outer_quarter[i] = c1 * area * os;
         outer_rad[i] = heat::SIGMA_W_PER_M2_K4 * rig.outside.emissivity * area * os;
     }
+    // the main block's bench mounting (to a bench at the air temperature) is a
+    // constant conductance like free convection's c0 term
+    outer_w_per_k[1] += b.mount_w_per_k;
     let line = &rig.hydraulics.path;
     let la = line.area_m2();
     let fe = &m.iron;
@@ -146,6 +152,7 @@ pub fn reduce_without_jacobian(rig: &Rig) -> ReducedParams {
         viscous_w_s2_per_rad2: p.viscous_torque_coeff * oil.mu_pa_s(40.0) * d,
         mech_to_outlet: p.friction_pairs.shares().0,
         mech_to_case: p.friction_pairs.shares().1,
+        case_film_slope_per_k: case_film_slope,
         expansion_per_k: oil.expansion_per_k,
         k_leak_m3_per_s_pa: p.gaps.conductance(oil.mu_pa_s(40.0)),
         case_pressure_pa: rig.hydraulics.accumulator_pa,
@@ -360,7 +367,7 @@ fn row(r: &[f64]) -> String {
 
 /// The scalar fields of `p` by name, in `DEFAULT`'s order (the renderer writes
 /// them; the acceptance test compares them with the reduction).
-pub fn scalar_fields(p: &ReducedParams) -> [(&'static str, f64); 36] {
+pub fn scalar_fields(p: &ReducedParams) -> [(&'static str, f64); 37] {
     [
         ("pump_j_per_k", p.pump_j_per_k),
         ("main_block_j_per_k", p.main_block_j_per_k),
@@ -379,6 +386,7 @@ pub fn scalar_fields(p: &ReducedParams) -> [(&'static str, f64); 36] {
         ("viscous_w_s2_per_rad2", p.viscous_w_s2_per_rad2),
         ("mech_to_outlet", p.mech_to_outlet),
         ("mech_to_case", p.mech_to_case),
+        ("case_film_slope_per_k", p.case_film_slope_per_k),
         ("expansion_per_k", p.expansion_per_k),
         ("k_leak_m3_per_s_pa", p.k_leak_m3_per_s_pa),
         ("case_pressure_pa", p.case_pressure_pa),

@@ -81,6 +81,9 @@ pub struct ModelConsts<S> {
     pub k_mv: S,
     /// Oil expansion coefficient alpha, 1/K (compression and throttling, h(T, p)).
     pub alpha: S,
+    /// Relative slope of the case film conductance with the case-oil temperature,
+    /// 1/K, about `FILM_PROPERTY_C` (may be negative).
+    pub g_case_slope: S,
     /// `alpha * 273.15`: `alpha T` with T in kelvin is `alpha_t0 + alpha t_degC`.
     pub alpha_t0: S,
     /// LNG inlet temperature, degC (eqs. 20-22).
@@ -162,7 +165,7 @@ impl Word for f64 {
 }
 
 /// Scalar words at the head of a [`ModelConsts`] (`p_case` .. `t_mu`).
-pub const N_SCALARS: usize = 37;
+pub const N_SCALARS: usize = 38;
 /// Number of words in a [`ModelConsts`].
 pub const N_WORDS: usize = N_SCALARS + N_NODES + 12 + 5 * N_TABLE + 2 * N_NODES + N_NODES * N_NODES;
 
@@ -211,6 +214,7 @@ impl<S: Copy> ModelConsts<S> {
             k_m0: f(c.k_m0),
             k_mv: f(c.k_mv),
             alpha: f(c.alpha),
+            g_case_slope: f(c.g_case_slope),
             alpha_t0: f(c.alpha_t0),
             lng_in: f(c.lng_in),
             k_mu: f(c.k_mu),
@@ -278,6 +282,7 @@ impl ModelConsts<()> {
         k_m0: (),
         k_mv: (),
         alpha: (),
+        g_case_slope: (),
         alpha_t0: (),
         lng_in: (),
         k_mu: (),
@@ -411,6 +416,7 @@ pub fn derive(p: &ReducedParams) -> Result<ModelConsts<f64>, ConfigError> {
         k_m0: p.no_load_torque_nm * 100.0 * KW_PER_W,
         k_mv: p.viscous_w_s2_per_rad2 * 1e4 * KW_PER_W,
         alpha: p.expansion_per_k,
+        g_case_slope: p.case_film_slope_per_k,
         alpha_t0: p.expansion_per_k * 273.15,
         lng_in: p.lng_inlet_c,
         k_mu: p.k_mu_per_k,

@@ -324,6 +324,8 @@ struct Consts<N> {
     k_m0: N,      // pump no-load friction, kW per hrad/s (pump housing)
     k_mv: N,      // pump viscous friction, kW per (hrad/s)^2 (split f_out/f_case)
     alpha: N,     // oil expansion, 1/K
+    g_case_slope: N, // relative slope of the case film with the case-oil temperature, 1/K
+    t_film: N,    // FILM_PROPERTY_C, degC
     alpha_t0: N,  // alpha 273.15
     lng_in: N,    // degC
     k_mu: N,
@@ -532,6 +534,8 @@ impl<N: Num> Model<N> {
             k_m0: f(c.k_m0),
             k_mv: f(c.k_mv),
             alpha: f(c.alpha),
+            g_case_slope: f(c.g_case_slope),
+            t_film: exact!(crate::params::FILM_PROPERTY_C),
             alpha_t0: f(c.alpha_t0),
             lng_in: f(c.lng_in),
             k_mu: f(c.k_mu),
@@ -715,7 +719,7 @@ impl<N: Num> Model<N> {
         // conductances of eqs. (12)-(14), (20)-(22) at this step's flows
         let at_q = table::locate(aq, k.q_scale, k.one);
         let at_w = table::locate(aw, k.w_scale, k.one);
-        let g_case = table::value(&self.g_case, &at_w);
+        let g_case = table::value(&self.g_case, &at_w).mul(k.one.add(k.g_case_slope.mul(t_c.sub(k.t_film))));
         let g_port = table::value(&self.g_port, &at_q);
         let g_loop = table::value(&self.g_loop, &at_q);
         let g_ball = table::value(&self.g_ball, &at_q);

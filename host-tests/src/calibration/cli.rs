@@ -97,7 +97,7 @@ pub fn run(args: &CommissionArgs) -> ExitCode {
                 eprintln!("{w}");
             }
             println!("{} | {:.1} s | {}", headline(&c), t.elapsed().as_secs_f64(), args.out.join("report.md").display());
-            if c.reduced_ok {
+            if c.flashable() {
                 ExitCode::SUCCESS
             } else {
                 eprintln!("error: {}", reduced_failure(&c));
@@ -143,6 +143,9 @@ fn headline(c: &Commissioning) -> String {
 }
 
 fn reduced_failure(c: &Commissioning) -> String {
+    if !c.excitation_ok {
+        return "no training log has more than one operating point: the pump friction, leakage, iron loss and winding resistance are not separable and the firmware would extrapolate them to other speeds and pressures; params.rs is written but must not be flashed (run speed steps and pressure steps, docs/commissioning.md)".into();
+    }
     let bad: Vec<String> = c
         .reduced
         .iter()
@@ -164,7 +167,7 @@ fn write_outputs(args: &CommissionArgs, base: &Rig, hold: &[CalLog], c: &Commiss
     // commissioned machine (else the report says why and nothing flashable is
     // written).
     let bin = args.out.join("firmware-params.bin");
-    if c.reduced_ok {
+    if c.flashable() {
         let id = args.rig_path().file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
         std::fs::write(&bin, crate::params_block::block_for(&c.params, &id)?)?;
     } else if bin.exists() {
@@ -229,7 +232,7 @@ fn report(args: &CommissionArgs, c: &Commissioning) -> String {
     for r in &c.reduced {
         let _ = writeln!(s, "| {} | {:.3} | {} |", r.log, r.vs_reference_max_k, if r.vs_reference_max_k <= REDUCED_BOUND_K { "ok" } else { "**exceeds**" });
     }
-    if !c.reduced_ok {
+    if !c.flashable() {
         let _ = writeln!(s, "\n**FAILED:** {}\n", reduced_failure(c));
     }
     let _ = writeln!(s, "\n## Held-out validation of the reference model\n\n| log | channel | RMSE as given K | RMSE commissioned K | max as given K | max commissioned K |\n|---|---|---:|---:|---:|---:|");

@@ -118,9 +118,23 @@ pub struct Commissioning {
     pub default_on_holdout: Vec<ReducedCheck>,
     /// Whether every reduced check is within [`REDUCED_BOUND_K`].
     pub reduced_ok: bool,
+    /// Whether some training log has more than one operating point (else the
+    /// loss coefficients are not separable and the block is not flashable).
+    pub excitation_ok: bool,
     /// `eta_m` from the training logs' current and the rows used
     /// ([`eta_m_from_current`]); `None`: fitted from the temperatures.
     pub eta_m_from_current: Option<(f64, usize)>,
+}
+
+impl Commissioning {
+    /// Whether the firmware parameter block may be flashed: the reduced model
+    /// holds every log and the training logs separate the loss coefficients.
+    /// Measured (issue 16): commissioned from one operating point, the other
+    /// EHA's firmware under-predicted a held-out high-pressure mission by
+    /// 1.8 K with every reduced check passing.
+    pub fn flashable(&self) -> bool {
+        self.reduced_ok && self.excitation_ok
+    }
 }
 
 /// Errors of commissioning.
@@ -171,20 +185,25 @@ pub fn commission(base: &Rig, train: &[CalLog], holdout: &[CalLog], o: &CalOptio
         .collect::<Result<_, _>>()
         .map_err(CommissionError::Run)?;
     let reduced_ok = reduced.iter().all(|r| r.vs_reference_max_k <= REDUCED_BOUND_K);
-    Ok(Commissioning { cal, holdout: scores, params, reduced, default_on_holdout, reduced_ok, eta_m_from_current: eta_e })
+    let excitation_ok = !cal.warnings.iter().any(|w| w.starts_with(crate::calibration::ident::NO_EXCITATION));
+    Ok(Commissioning { cal, holdout: scores, params, reduced, default_on_holdout, reduced_ok, excitation_ok, eta_m_from_current: eta_e })
 }
 
 /// The pump's loss coefficient `eta_m` of eq. (8) from the logs' electrical
 /// balance, as the firmware's sensor cross-check sees it: the shaft power
-/// from the current `Kt |I| |w|` (signed like `dp w`) minus the displacement's
-/// hydraulic power `D dp w` is the mechanical loss `eta_m D |dp| |w|`. Least
-/// squares over the rows whose `D |dp| |w|` is at least 20 % of the logs'
-/// largest (light load says little), with `Kt` and `D` from the rig file.
+/// from the current `Kt |I| |w|` (signed like the shaft torque) minus the
+/// displacement's hydraulic power `D dp w` is the friction `T0 |w| + C_v mu D
+/// w^2 + eta_m D |dp| |w|` (extended eq. 8). With `T0` and `C_v` held at the
+/// rig file, `eta_m` by least squares over the rows whose `D |dp| |w|` is at
+/// least 20 % of the logs' largest (light load says little), with `Kt` and `D`
+/// from the rig file.
 /// `(eta_m, rows)`; `None` without current or load, or outside 0.01..2.
 pub fn eta_m_from_current(rig: &Rig, logs: &[CalLog]) -> Option<(f64, usize)> {
     use crate::measured::Channel;
     let kt = rig.motor.torque_constant_nm_per_a;
     let d = rig.displacement_m3_per_rad();
+    let p = &rig.pump;
+    let mu = rig.oil.mu_pa_s(40.0);
     let mut rows = Vec::new();
     for l in logs {
         let r = &l.run;
@@ -196,8 +215,12 @@ pub fn eta_m_from_current(rig: &Rig, logs: &[CalLog]) -> Option<(f64, usize)> {
             let w = w * std::f64::consts::PI / 30.0;
             let dp = (pa - pb) * 1e5;
             let hyd = d * dp * w;
-            let shaft = kt * i.abs() * w.abs() * hyd.signum();
-            rows.push((shaft - hyd, d * dp.abs() * w.abs()));
+            let speed_w = p.no_load_torque_nm * w.abs() + p.viscous_torque_coeff * mu * d * w * w;
+            let pressure_w = d * dp.abs() * w.abs();
+            // torque sign: D dp + sign(w) T_f with the rig file's friction
+            let sign = (hyd + speed_w + p.eta_m * pressure_w).signum();
+            let shaft = kt * i.abs() * w.abs() * sign;
+            rows.push((shaft - hyd - speed_w, pressure_w));
         }
     }
     let top = rows.iter().map(|r| r.1).fold(0.0, f64::max);

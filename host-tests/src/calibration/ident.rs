@@ -3,6 +3,10 @@
 //! posterior standard deviations with the prior, strongly correlated pairs;
 //! and the excitation check of each log (one operating point).
 
+/// Start of the warning that no training log has more than one operating
+/// point; `commission` refuses to write a flashable block then.
+pub const NO_EXCITATION: &str = "WARNING: no training log has more than one operating point";
+
 use super::log::CalLog;
 use super::set::PARAMS;
 use crate::measured::Channel;
@@ -116,7 +120,7 @@ pub fn excitation_warnings(logs: &[CalLog]) -> Vec<String> {
         }
     }
     if all_flat && !logs.is_empty() {
-        w.push("WARNING: no training log has more than one operating point: the loss coefficients (pump friction, leakage, iron loss, winding resistance) are not separable; run speed steps and pressure steps (docs/commissioning.md)".into());
+        w.push(format!("{NO_EXCITATION}: the loss coefficients (pump friction, leakage, iron loss, winding resistance) are not separable; run speed steps and pressure steps (docs/commissioning.md)"));
     }
     w
 }

@@ -5,10 +5,9 @@
 //! Every parameter is a multiplier θ on rig-file values (θ = 1 is the rig
 //! as given), fitted in ln θ. **The mapping "parameter → rig fields" lives
 //! only in [`apply`]** (and is listed in [`PARAMS`]' `fields` text), so
-//! that a change of the reference physics remaps one table. Known pending
-//! remap: `pump_friction` acts on `pump.eta_m` (eq. 8) today; when the pump
-//! loss torque becomes T0 + C_v·μ·ω + C_p·Δp it must act on those
-//! coefficients instead.
+//! that a change of the reference physics remaps one table. `pump_friction`
+//! scales the whole loss torque of the extended eq. (8), T₀ + C_v·μ·D·ω +
+//! η_m·D·Δp (its shape from the rig file).
 
 use crate::measured::Channel;
 use crate::rig::Rig;
@@ -175,10 +174,10 @@ pub const PARAMS: [ParamDef; 19] = [
     },
     ParamDef {
         name: "pump_friction",
-        what: "pump mechanical loss coefficient η_m of eq. (8) (REMAP: becomes T0 + C_v·μ·ω + C_p·Δp)",
-        fields: "pump.eta_m",
+        what: "pump friction torque of the extended eq. (8), T0 + C_v·μ·D·ω + η_m·D·Δp, as a whole",
+        fields: "pump.no_load_torque_nm, pump.viscous_torque_coeff, pump.eta_m",
         lo: 0.1, hi: 2.0, prior_sigma_ln: 0.5,
-        why: "η_m in 0.05–1.0 (the rig file's 0.50 is calibrated on one rig)",
+        why: "hydro-mechanical efficiency 70–95 % (the rig file's η_m 0.28 is calibrated on one rig)",
         needs: Needs::Nothing,
         excitation: "pressure steps at constant speed and speed steps at constant pressure (separates it from leakage)",
     },
@@ -256,7 +255,11 @@ pub fn apply(base: &Rig, theta: &[f64]) -> Rig {
             "cap_loop_oil" => r.blocks.loop_oil_m3 *= t,
             "cap_case_oil" => r.pump.case_oil_m3 *= t,
             // REMAP at merge: the new pump loss torque T0 + C_v·μ·ω + C_p·Δp.
-            "pump_friction" => r.pump.eta_m *= t,
+            "pump_friction" => {
+                r.pump.eta_m *= t;
+                r.pump.no_load_torque_nm *= t;
+                r.pump.viscous_torque_coeff *= t;
+            }
             "leak_gap" => {
                 r.pump.gaps.piston_gap_m *= t;
                 r.pump.gaps.slipper_gap_m *= t;

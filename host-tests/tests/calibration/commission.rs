@@ -163,10 +163,13 @@ fn commissioned_block_in_closed_loop_on_the_held_out_mission() {
 /// the result is refused by `commission` (reduced model off the commissioned
 /// reference by more than 0.2 K) or conservative on the held-out mission of
 /// another kind (the reduced model under-predicts the true drain by ≤ 0.5 K).
-/// Measured: accepted (worst reduced vs reference 0.176 K), held-out true
-/// drain max |e| 0.948 K, under-prediction 0.281 K: conservative within the
-/// 0.5 K bound (eta_m still comes from the current, which one operating
-/// point identifies; leak gap, iron loss, winding R and needle split held).
+/// Measured: every reduced check passes (worst 0.096 K) but `commission`
+/// refuses the block for the excitation (`Commissioning::flashable`); the
+/// refused parameters would under-predict the held-out true drain by 1.81 K
+/// (eta_m comes exactly from the current, 0.2074; the leak gaps, ×1.15 on
+/// this machine, are held at the rig file and one operating point cannot
+/// tell leakage from the films). Before issue 16's pump energy balance the
+/// same parameters under-predicted by 0.28 K and were accepted.
 #[test]
 fn low_excitation_commissioning_warns_and_is_refused_or_conservative() {
     let train = [cal_log(Kind::Constant { rpm: 500.0, bar: 40.0 }, 41)];
@@ -184,10 +187,13 @@ fn low_excitation_commissioning_warns_and_is_refused_or_conservative() {
     let worst = c.reduced.iter().map(|r| r.vs_reference_max_k).fold(0.0, f64::max);
     eprintln!(
         "one operating point: commission {} (worst reduced vs reference {worst:.3} K); held-out true drain max |e| {:.3} K, under {:.3} K; eta_m from current {:?}",
-        if c.reduced_ok { "accepts" } else { "refuses" },
+        if c.flashable() { "accepts" } else { "refuses" },
         fw.vs_reference_max_k,
         fw.vs_reference_under_k,
         c.eta_m_from_current
     );
-    assert!(!c.reduced_ok || fw.vs_reference_under_k <= 0.5, "accepted and under-predicts by {:.3} K", fw.vs_reference_under_k);
+    assert!(!c.flashable() || fw.vs_reference_under_k <= 0.5, "accepted and under-predicts by {:.3} K", fw.vs_reference_under_k);
+    // Measured since issue 16: the reduced checks pass (0.096 K) but the block is
+    // refused for the excitation; flashed anyway it would under-predict by 1.8 K.
+    assert!(!c.flashable() && c.reduced_ok, "measured: refused for the excitation alone");
 }
