@@ -18,14 +18,17 @@
 
 use eha_guard::protocol::Request;
 
-/// Motor current of the reference plant, A rms: `|D dp + sign(w) eta_m D |dp|| /
-/// Kt` (`eha_sim::hydraulics::shaft_torque` with eq. 8, |w| >= 1 rad/s), with the
+/// Motor current of the reference plant, A rms: `|D dp + sign(w) T_f| / Kt` with
+/// the friction torque of the extended eq. (8), `T_f = T0 + C_v mu D |w| + eta_m D
+/// |dp|` (`eha_sim::hydraulics::shaft_torque`, |w| >= 1 rad/s), with the
 /// firmware's own parameters.
 pub fn motor_current(p_a_bar: f32, p_b_bar: f32, speed_rpm: f32) -> f32 {
     let p = eha_guard::params::DEFAULT;
     let d = p.displacement_m3_per_rad;
     let dp = (p_a_bar - p_b_bar) as f64 * 1e5;
-    let tau = d * dp + (speed_rpm as f64).signum() * p.eta_m * d * dp.abs();
+    let w = (speed_rpm as f64 * std::f64::consts::PI / 30.0).abs();
+    let t_f = p.no_load_torque_nm + p.viscous_w_s2_per_rad2 * w + p.eta_m * d * dp.abs();
+    let tau = d * dp + (speed_rpm as f64).signum() * t_f;
     (tau.abs() / p.torque_constant_nm_per_a) as f32
 }
 
