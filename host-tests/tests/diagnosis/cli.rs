@@ -40,7 +40,9 @@ const HIDDEN_TAU_S: f64 = 213.590;
 /// cells the stored file lacks. Only what the random draws decide is
 /// compared (the τ, the kept rows, the empty cells); the temperatures follow
 /// the physics, which may change after the example was frozen (they were
-/// identical to the last digit when this test was written).
+/// identical to the last digit when this test was written). `EXAMPLE_BLESS=1`
+/// re-freezes the example from the generator (done after issue 16's pump
+/// energy balance).
 #[test]
 fn worked_example_is_the_generators_seed_5() {
     let case = SynthCase {
@@ -54,6 +56,10 @@ fn worked_example_is_the_generators_seed_5() {
     let (run, truth) = generate(&case).expect("generates");
     println!("seed 5: hidden sensor_tau_s {:.4} s", truth.magnitude);
     assert!((truth.magnitude - HIDDEN_TAU_S).abs() < 1e-3, "hidden τ {} s", truth.magnitude);
+    if std::env::var_os("EXAMPLE_BLESS").is_some() {
+        // re-freeze the example after a change of the reference physics
+        run.write_file(example()).expect("example writes");
+    }
     let stored = MeasuredRun::read_file(example()).expect("example reads");
     assert_eq!(run.time_s, stored.time_s, "kept rows differ: the example is not seed 5's run");
     assert_eq!(run.channels.keys().collect::<Vec<_>>(), stored.channels.keys().collect::<Vec<_>>());
@@ -69,7 +75,8 @@ fn worked_example_is_the_generators_seed_5() {
 /// within 15 % of the hidden value: the nuisance set it is fitted with
 /// (conductances and capacities the generator moved by 10–20 %) trades off
 /// against τ, so the magnitude is indicative, not exact (docs/diagnosis.md).
-/// Measured: 227.43 s, +6.5 % (149 s, −30 %, before the two-start fits).
+/// Measured: 234.85 s, +10.0 % (re-frozen after issue 16; 227.43 s, +6.5 %,
+/// before it; 149 s, −30 %, before the two-start fits).
 #[test]
 fn worked_example_is_diagnosed_as_sensor_lag() {
     let dir = std::env::temp_dir().join(format!("diag-ex-{}", std::process::id()));
