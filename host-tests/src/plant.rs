@@ -29,6 +29,15 @@ pub enum SimError {
     /// The step callback asked to stop with an error.
     #[error("{0}")]
     Callback(String),
+    /// The solver needed more steps than the run's budget
+    /// ([`Plant::set_step_limit`]).
+    #[error("step budget of {steps} solver steps exhausted at t = {t:.3} s")]
+    StepBudget {
+        /// The budget.
+        steps: u64,
+        /// Time reached, s.
+        t: f64,
+    },
 }
 
 /// Newton convergence failures allowed over one run (see [`Plant::run`]).
@@ -246,6 +255,7 @@ pub struct Plant {
     t: f64,
     stats: Stats,
     rtol: f64,
+    step_limit: Option<u64>,
 }
 
 impl Plant {
@@ -266,7 +276,7 @@ impl Plant {
             Drive::Replay(r) => r.inputs().time_s.first().copied().unwrap_or(0.0),
             Drive::Mission(_) => 0.0,
         };
-        Ok(Self { y0: y.clone(), y, t, model, stats: Stats::default(), rtol: RTOL })
+        Ok(Self { y0: y.clone(), y, t, model, stats: Stats::default(), rtol: RTOL, step_limit: None })
     }
 
     /// The model.
@@ -298,6 +308,14 @@ impl Plant {
     /// The diagnosis fits replays with a looser one (`diagnosis::reference`).
     pub fn set_rtol(&mut self, rtol: f64) {
         self.rtol = rtol;
+    }
+
+    /// Fails a [`Plant::run`] with [`SimError::StepBudget`] once the solver has
+    /// taken more than `steps` steps in it (`None`: no limit). The diagnosis
+    /// uses it so that one pathological candidate run (the stiff solver
+    /// crawling at ~10 ms steps) cannot stall a fit.
+    pub fn set_step_limit(&mut self, steps: Option<u64>) {
+        self.step_limit = steps;
     }
 
     /// Snapshot of the current state.
@@ -365,6 +383,11 @@ impl Plant {
         let mut y_buf = vec![0.0; N_STATE];
         'outer: while !ctl.stop && snap.t < t_end - 1e-9 {
             let here = solver.state().t;
+            if let Some(limit) = self.step_limit {
+                if solver.get_statistics().number_of_steps as u64 > limit {
+                    return Err(SimError::StepBudget { steps: limit, t: here });
+                }
+            }
             let reason = solver.step().map_err(err(here))?;
             let t_now = solver.state().t;
             // Callbacks at the segment ends inside this step, by interpolation.

@@ -159,8 +159,15 @@ pub fn simulate(rig: &Rig, scenario: &Scenario, opt: &SimOptions) -> Result<SimO
 
 /// [`simulate`] with the solver's relative tolerance `rtol`.
 pub fn simulate_rtol(rig: &Rig, scenario: &Scenario, opt: &SimOptions, rtol: f64) -> Result<SimOutput, SimError> {
+    simulate_budget(rig, scenario, opt, rtol, None)
+}
+
+/// [`simulate_rtol`] that fails with [`SimError::StepBudget`] after
+/// `step_limit` solver steps ([`Plant::set_step_limit`]).
+pub fn simulate_budget(rig: &Rig, scenario: &Scenario, opt: &SimOptions, rtol: f64, step_limit: Option<u64>) -> Result<SimOutput, SimError> {
     let mut plant = Plant::new(rig, scenario)?;
     plant.set_rtol(rtol);
+    plant.set_step_limit(step_limit);
     let name = match scenario.mission() {
         Some(m) => m.name,
         None => match scenario {

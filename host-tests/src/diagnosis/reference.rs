@@ -9,7 +9,7 @@ use crate::calibration::{self, set::Needs};
 use crate::measured::{Channel, MeasuredRun};
 use crate::rig::Rig;
 use crate::scenario::{ReplayInputs, Scenario};
-use crate::sim::{simulate_rtol, SimOptions};
+use crate::sim::{simulate_budget, SimOptions};
 
 /// Errors building the replay model from a measured run.
 #[derive(Debug, thiserror::Error)]
@@ -100,6 +100,15 @@ impl ReferenceModel {
         Ok(m)
     }
 
+    /// Solver-step budget of one replay of this log ([`REPLAY_STEPS_PER_S`]).
+    fn step_budget(&self) -> u64 {
+        let span = match (self.times.first(), self.times.last()) {
+            (Some(a), Some(b)) => (b - a).max(0.0),
+            _ => 0.0,
+        };
+        (REPLAY_STEPS_PER_S * span).max(10_000.0) as u64
+    }
+
     /// The rig with nuisance values `nuis` and candidate `c` at `ext`.
     pub fn rig_for(&self, nuis: &[f64], c: Candidate, ext: &[f64]) -> Rig {
         let mut r = if self.physical {
@@ -164,6 +173,13 @@ pub fn nuisance_set(run: &MeasuredRun) -> Vec<usize> {
 /// space, far above this integration error.
 pub const REPLAY_RTOL: f64 = 1e-5;
 
+/// Solver-step budget of one replay, per second of log: a replay normally
+/// takes a few hundred steps for 20 minutes; a candidate run that makes the
+/// stiff solver crawl (measured: 58–96 thousand steps in 1.2–1.8 s for a
+/// `viscosity-temperature` fit of a load-cycle log, stalling its case for
+/// 266 s) fails instead, and the fit treats it as a failed evaluation.
+pub const REPLAY_STEPS_PER_S: f64 = 20.0;
+
 /// Internal series kept for the regressors.
 const INTERNALS: [&str; 5] = ["t_winding_c", "t_drain_c", "t_motor_c", "t_pump_c", "t_loop_oil_c"];
 
@@ -219,7 +235,7 @@ impl Simulator for ReferenceModel {
 
     fn simulate(&self, nuisance: &[f64], c: Candidate, ext: &[f64]) -> Result<SimSeries, String> {
         let rig = self.rig_for(nuisance, c, ext);
-        let out = simulate_rtol(&rig, &self.scenario, &self.opts, REPLAY_RTOL).map_err(|e| e.to_string())?;
+        let out = simulate_budget(&rig, &self.scenario, &self.opts, REPLAY_RTOL, Some(self.step_budget())).map_err(|e| e.to_string())?;
         let mut s = SimSeries::default();
         let sample = |name: &str| -> Option<Vec<f64>> { self.times.iter().map(|&t| out.at(name, t)).collect() };
         for ch in Channel::TEMPERATURES {
