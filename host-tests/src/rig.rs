@@ -86,7 +86,8 @@ pub struct Motor {
 pub struct Pump {
     /// Displacement, cm³/rev (Table 2: 19).
     pub displacement_cm3: f64,
-    /// Leakage gaps of eqs. (5)–(7) (assumed; the film thickness calibrated).
+    /// Leakage gaps of eqs. (5)–(7) (assumed: 12 µm films of a 19 cm³/rev
+    /// nine-piston pump; none of them is fitted).
     pub gaps: PumpGaps,
     /// Pressure-proportional friction coefficient of eq. (8), C_p = η_m: the
     /// friction torque's load term is η_m·D·|Δp| (calibrated).
