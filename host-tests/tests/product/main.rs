@@ -315,14 +315,16 @@ fn garbage_and_bursts_on_the_uart_are_rejected_without_a_hang() {
 }
 
 /// The OK (alarm) pin follows the 60 °C alarm: the MCU boots with a warm
-/// thermal record at 59 °C put in no-init RAM (through QEMU's gdb stub), as
+/// thermal record at 59.8 °C put in no-init RAM (through QEMU's gdb stub), as
 /// after a reset on a hot machine; in closed loop at 60 bar the estimate
-/// rises through 60 °C and the alarm is raised. In every tick reply the OK
+/// rises through 60 °C and the alarm is raised (measured after issue 16: from
+/// 59 °C the estimate peaked at 59.32 °C after 6 s with the exchanger on,
+/// then fell; from 59.8 °C it crosses 60 °C on the way up). In every tick reply the OK
 /// pin read back is the inverse of the alarm, before and after the edge.
 fn alarm_pin_follows_the_60c_alarm() {
     let elf = product_elf().unwrap_or_else(|e| panic!("{e:#}"));
     let addr = eha_sim::pil::product::symbol_addr(&elf, &["noinit", "RECORD_A"]).unwrap_or_else(|e| panic!("{e:#}"));
-    let rec = eha_guard::ThermalRecord::new([59.0; eha_guard::params::N_NODES], 26.0, 0, 0, 1000).with_seq(1, true);
+    let rec = eha_guard::ThermalRecord::new([59.8; eha_guard::params::N_NODES], 26.0, 0, 0, 1000).with_seq(1, true);
     let duration_s = 20.0;
     let mut s = ProductSession::spawn_with_ram(&elf, &[], &[(addr, eha_sim::pil::product::record_bytes(&rec))])
         .unwrap_or_else(|e| panic!("{e:#}"));
@@ -337,7 +339,7 @@ fn alarm_pin_follows_the_60c_alarm() {
         raised.map(|k| run.ticks[k].1.out.drain_c)
     );
     assert_eq!(run.ticks[0].1.restore, RestoreKind::Warm);
-    assert!(!alarm[0], "59 C restored: no alarm at first");
+    assert!(!alarm[0], "59.8 C restored: no alarm at first");
     let k = raised.unwrap_or_else(|| panic!("the estimate never rose above 60 C"));
     assert!(run.ticks[k].1.out.drain_c > 60.0, "alarm raised above 60 C");
     assert!(alarm[k..].iter().all(|a| *a), "no chatter: the alarm clears only below 58 C");
