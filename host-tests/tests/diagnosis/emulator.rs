@@ -99,10 +99,12 @@ fn slow_emulator_viscosity_is_named() {
 /// 16, 3.21 K before the physical set): the emulator, written from the
 /// paper, has no compression heat and no no-load or viscous pump friction,
 /// which the reference now has, and at 70–100 bar that structural difference
-/// shows (asserted as measured, ≤ 0.9 K); the hidden forced convection (7.9 m/s) on a Case 1 log (seed
-/// 1712) is named, but with a 1 % gain on t_pump_c (0.09 K: the calibration
-/// set has already taken the imprint up) — the measured shortfall, asserted
-/// as a gain < 50 %.
+/// shows (asserted as measured, ≤ 0.9 K); the hidden forced convection
+/// (7.9 m/s) on a Case 1 log (seed 1712) is answered `none` since issue 16
+/// (before: named with a 1 % gain on t_pump_c): the calibrated baseline
+/// fits every channel to 1–2σ (pooled held-out 0.12 K, t_pump_c 0.13 K),
+/// the ram-air share of the pump housing and `h_out_pump` having taken the
+/// imprint up — a miss, not a false discovery, asserted as measured.
 #[test]
 #[ignore = "slow tier: emulator cases, measured shortfall"]
 fn slow_emulator_former_unexplained_answers() {
@@ -110,6 +112,6 @@ fn slow_emulator_former_unexplained_answers() {
     assert_eq!(a.answer, "none");
     assert!(a.pooled_heldout_k[1] <= 0.9, "pooled {:.2} K (measured 0.86)", a.pooled_heldout_k[1]);
     let b = run(case("forced-convection", ConstantThrottle, 1712));
-    assert_eq!(b.answer, "forced-convection", "measured outcome changed");
-    assert!(b.affected_gain().expect("affected") < 0.5, "measured shortfall changed");
+    assert_eq!(b.answer, "none", "measured outcome changed");
+    assert!(b.pooled_heldout_k[1] <= 0.2, "pooled {:.2} K (measured 0.12)", b.pooled_heldout_k[1]);
 }
