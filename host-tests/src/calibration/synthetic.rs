@@ -29,6 +29,11 @@ pub enum Kind {
     PressureSteps,
     /// Speed steps 300–1500 rpm every 150–300 s at a 6 bar needle.
     SpeedSteps,
+    /// Needle steps between 20 and 40 bar every 150–300 s at 700 rpm with
+    /// the LNG exchanger in the circuit, its valve on the bench thermostat
+    /// at the drain thermocouple (the exchanger's heat in the logs; the
+    /// `lng_valve` column is logged).
+    CoolingSteps,
     /// A high-pressure soak (needle 36–40 bar, 600 rpm) for 60 % of the
     /// run, then random speed (300–1200 rpm) / needle (3–10 bar) segments
     /// of 90–180 s and a stop for the last 120 s (the held-out kind).
@@ -70,6 +75,10 @@ pub fn mission(kind: Kind, duration_s: f64, seed: u64) -> Mission {
             let (sp, _) = seg((300.0, 6.0), (1500.0, 6.1), &mut rng);
             (sp, vec![(0.0, 6.0)])
         }
+        Kind::CoolingSteps => {
+            let (_, nb) = seg((700.0, 20.0), (700.1, 40.0), &mut rng);
+            (vec![(0.0, 700.0)], nb)
+        }
         Kind::SoakThenMixed => {
             let soak = 0.6 * duration_s;
             let (mut sp, mut nb) = (vec![(0.0, 600.0)], vec![(0.0, rng.random_range(36.0..40.0))]);
@@ -92,13 +101,14 @@ pub fn mission(kind: Kind, duration_s: f64, seed: u64) -> Mission {
         needle_bar: steps(&needle),
         position: PositionRef::Profile(Schedule::constant(0.0)),
         air_speed_mps: Schedule::constant(0.0),
-        valve: ValveRule::None,
+        valve: if kind == Kind::CoolingSteps { ValveRule::Drain } else { ValveRule::None },
     }
 }
 
 /// Noise-free model outputs and the noisy log of `rig` flying `m`, sampled
 /// every `sample_s` (seeded noise, quantisation and dropouts); with a
-/// `t_drain_c` column when `drain`.
+/// `t_drain_c` column when `drain`, and the `lng_valve` command when the
+/// mission has an LNG exchanger.
 pub fn log(rig: &Rig, m: &Mission, sample_s: f64, seed: u64, drain: bool) -> Result<MeasuredRun, String> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0xCA11);
     let opts = SimOptions { output_interval_s: sample_s, control_interval_s: sample_s.min(0.5) };
@@ -120,7 +130,8 @@ pub fn log(rig: &Rig, m: &Mission, sample_s: f64, seed: u64, drain: bool) -> Res
         Channel::TOilC,
         Channel::TDrainC,
     ];
-    for ch in chans {
+    let lng = m.valve != ValveRule::None;
+    for ch in chans.into_iter().chain(lng.then_some(Channel::LngValve)) {
         if ch == Channel::TDrainC && !drain {
             continue;
         }

@@ -2,10 +2,10 @@
 //! other rig (1.5× displacement, other masses and areas in its rig file;
 //! the true machine with films 30 % off and per-node deviations no global
 //! multiplier represents), logs with noise, quantisation and dropouts and a
-//! drain thermocouple; two training missions, one held-out mission of
-//! another kind.
+//! drain thermocouple; three training missions (one with the LNG valve on
+//! the bench thermostat), one held-out mission of another kind.
 
-use eha_sim::calibration::commission::{check_reduced, commission};
+use eha_sim::calibration::commission::{check_reduced, commission, NO_COOLING};
 use eha_sim::calibration::synthetic::{log, mission, other_rig_file, other_rig_truth, Kind};
 use eha_sim::calibration::{CalLog, CalOptions};
 
@@ -13,16 +13,14 @@ fn cal_log(kind: Kind, seed: u64) -> CalLog {
     CalLog::new(&format!("{kind:?}-{seed}"), log(&other_rig_truth(), &mission(kind, 1800.0, seed), 2.0, seed, true).expect("log"), 120).expect("cal log")
 }
 
-/// Measured (one run, ~5 s; eta_m from the current, 0.3736 from 1 355
-/// loaded samples): see the eprintln and docs/commissioning.md. The
-/// reduced-vs-commissioned-reference check is 0.114 / 0.065 / 0.117 K on the
-/// three logs (issue bound 0.2 K; it was 0.194 / 0.332 / 0.171 K while the
-/// firmware linearised the oil's `1/(rho c_p)` about 40 °C, which missed on
-/// the speed-steps log's 142 °C excursion).
+/// Three training logs (pressure steps, speed steps, and needle steps with
+/// the LNG valve on the bench thermostat), a soak-then-mixed held-out log.
+/// Measured numbers: the eprintln and docs/commissioning.md (which also
+/// records the earlier reduced-model misses this test caught).
 #[test]
 fn other_rig_commissioned_firmware_meets_drain_bounds_on_held_out_mission() {
     let t0 = std::time::Instant::now();
-    let train = [cal_log(Kind::PressureSteps, 31), cal_log(Kind::SpeedSteps, 32)];
+    let train = [cal_log(Kind::PressureSteps, 31), cal_log(Kind::SpeedSteps, 32), cal_log(Kind::CoolingSteps, 34)];
     let hold = [cal_log(Kind::SoakThenMixed, 33)];
     let c = commission(&other_rig_file(), &train, &hold, &CalOptions::default()).expect("commissioning");
     eprintln!("{:.1} s, {} model runs", t0.elapsed().as_secs_f64(), c.cal.model_runs);
@@ -40,6 +38,8 @@ fn other_rig_commissioned_firmware_meets_drain_bounds_on_held_out_mission() {
     for r in &c.default_on_holdout {
         eprintln!("paper default {:22} vs measured max {:?} under {:?}", r.log, r.vs_measured_max_k, r.vs_measured_under_k);
     }
+    // The cooling run is in the training set: no warning about the exchanger.
+    assert!(!c.cal.warnings.iter().any(|w| w.starts_with(NO_COOLING)), "{:?}", c.cal.warnings);
     // Issue 18: the reduced model within 0.2 K of the commissioned reference
     // on every log's inputs (measured worst 0.117 K).
     let worst = c.reduced.iter().map(|r| r.vs_reference_max_k).fold(0.0, f64::max);
@@ -72,7 +72,6 @@ fn other_rig_commissioned_firmware_meets_drain_bounds_on_held_out_mission() {
 /// against the true drain; the paper-default image on the same loop is
 /// reported beside it.
 #[test]
-#[ignore = "slow tier: commissioning (~6 s) and three 30-minute closed loops"]
 fn commissioned_block_in_closed_loop_on_the_held_out_mission() {
     use eha_guard::protocol::step_guard;
     use eha_guard::{GuardConfig, GuardOf, Restore};
@@ -81,7 +80,7 @@ fn commissioned_block_in_closed_loop_on_the_held_out_mission() {
     use eha_sim::plant::Plant;
     use eha_sim::scenario::Scenario;
 
-    let train = [cal_log(Kind::PressureSteps, 31), cal_log(Kind::SpeedSteps, 32)];
+    let train = [cal_log(Kind::PressureSteps, 31), cal_log(Kind::SpeedSteps, 32), cal_log(Kind::CoolingSteps, 34)];
     let hold = [cal_log(Kind::SoakThenMixed, 33)];
     let c = commission(&other_rig_file(), &train, &hold, &CalOptions::default()).expect("commissioning");
     let block = eha_sim::params_block::block_for(&c.params, "other-eha").expect("a block the firmware accepts");
@@ -135,18 +134,17 @@ fn commissioned_block_in_closed_loop_on_the_held_out_mission() {
     }
     eprintln!("eta_m from the current: {:?}", c.eta_m_from_current);
     // Issue 18 §4 bounds with the block as flashed (cross-check on): max |e|
-    // ≤ 1.0 K while the guard's cooling model holds — met (measured 0.667 K;
-    // 0.196 K until the valve first opens). Under-prediction ≤ 0.5 K over the
-    // whole mission — **a measured miss since issue 16's pump energy balance**:
-    // 0.667 K (was 0.342 K). The reduced model still follows the commissioned
-    // reference (≤ 0.144 K on every log); the commissioned reference itself
-    // misses the true machine's held-out drain by up to 0.68 K open loop (was
-    // 0.303 K), drifting low over the mission's mixed second half. Asserted as
-    // measured (≤ 0.7 K) so that a fix or a further regression shows. After
-    // the guard's LNG budget is spent it takes no cooling credit (this plant's
-    // tank never runs dry): the estimate then reads high, the safe side.
+    // ≤ 1.0 K while the guard's cooling model holds, under-prediction ≤ 0.5 K
+    // over the whole mission (measured 0.179 / 0.179 K). The third training
+    // log (valve on the bench thermostat) is what holds the bound: trained
+    // without it, the commissioned reference matched the true machine open
+    // loop but the exchanger's cycling exposed ball-block and port-film values
+    // the throttle logs could not tell apart, and the loop under-predicted by
+    // 0.667 K. After the guard's LNG budget is spent it takes no cooling credit
+    // (this plant's tank never runs dry): the estimate then reads high, the
+    // safe side.
     assert!(fw.max_lng <= 1.0, "commissioned block: max |e| {:.3} K > 1.0 K", fw.max_lng);
-    assert!(fw.under <= 0.7, "commissioned block: under-prediction {:.3} K > the measured 0.667 K (+0.03)", fw.under);
+    assert!(fw.under <= 0.5, "commissioned block: under-prediction {:.3} K > 0.5 K", fw.under);
     // The electrical balance is commissioned (eta_m from the current), so the
     // sensor cross-check agrees with this machine: the only fault is LNG_LOW.
     assert!(
@@ -184,6 +182,7 @@ fn low_excitation_commissioning_warns_and_is_refused_or_conservative() {
         eprintln!("{w}");
     }
     assert!(c.cal.warnings.iter().any(|w| w.contains("one operating point")), "no low-excitation warning: {:?}", c.cal.warnings);
+    assert!(c.cal.warnings.iter().any(|w| w.starts_with(NO_COOLING)), "no warning that the LNG valve never opens: {:?}", c.cal.warnings);
     let listed = c.cal.warnings.iter().find(|w| w.contains("held at the rig file")).expect("held list in the warnings");
     for name in ["iron_loss", "leak_gap"] {
         assert!(listed.contains(name), "{name} not named in the warning: {listed}");
