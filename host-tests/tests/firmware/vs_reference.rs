@@ -152,17 +152,9 @@ fn thermostat_first_switch() -> &'static [Option<f64>] {
     T.get_or_init(|| cases().par_iter().map(|(_, sc)| thermostat_from_branch(sc, &[], 0).map(|(t, _)| t)).collect())
 }
 
-/// Drain predictions of a guard in number type `N` replaying the sensor stream of
-/// a run (element k: after sample k), and the fault word at the end. The guard
-/// credits cooling by its own valve; on the f64 guard's run that is the valve
-/// the plant had (up to the f64 guard's own switching steps).
-fn guard_drain<N: Num>(run: &Run) -> (Vec<f64>, eha_guard::Faults) {
-    let (d, _, f) = guard_drain_valve::<N>(run);
-    (d, f)
-}
-
-/// The guard of number type `N` on a run's sensor signals: drain estimate,
-/// its own valve command (which sets its exchanger credit) per tick, faults.
+/// The guard of number type `N` on a run's sensor signals: drain estimate
+/// (element k: after sample k), its own valve command (which sets its
+/// exchanger credit) per tick, faults at the end.
 fn guard_drain_valve<N: Num>(run: &Run) -> (Vec<f64>, Vec<bool>, eha_guard::Faults) {
     let mut g = GuardOf::<N>::new(&GuardConfig::DEFAULT, Restore::Cold);
     let n = run.sensors.len() - 1;

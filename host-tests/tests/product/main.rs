@@ -311,7 +311,26 @@ fn garbage_and_bursts_on_the_uart_are_rejected_without_a_hang() {
     // 50 ms late is STALE, which is what STALE is for, so it may latch.)
     let data_faults = eha_guard::faults::RANGE | eha_guard::faults::RATE | eha_guard::faults::NON_FINITE;
     assert!(run.steps.iter().all(|p| !p.tick.out.faults.intersects(data_faults)), "junk was taken as sample data");
-    assert!(st.rx_overflow > 0, "bursts longer than the 256-byte receive ring are dropped and counted");
+    // The ring overflows only when QEMU hands the guest more than 256 bytes
+    // within one 10 ms tick, which depends on how fast its I/O thread runs
+    // on a loaded host (one CI run on a slow machine saw no overflow from
+    // the 600-byte bursts above). So after the loop, 4 KiB bursts until the
+    // drop counter moves, at most 10: the assertion is that bytes beyond the
+    // ring are dropped and counted, and that the firmware still answers.
+    let mut overflow = st.rx_overflow;
+    let mut sent = 0usize;
+    for token in 6..16 {
+        if overflow > 0 {
+            break;
+        }
+        let junk: Vec<u8> = (0..4096).map(|_| rng.random_range(1..=255)).collect();
+        s.send(&junk).unwrap_or_else(|e| panic!("{e:#}"));
+        s.send(&[0]).unwrap_or_else(|e| panic!("{e:#}"));
+        sent += junk.len() + 1;
+        overflow = s.status(token, &mut ticks).unwrap_or_else(|e| panic!("{e:#}")).rx_overflow;
+    }
+    eprintln!("garbage: rx_overflow {overflow} (extra junk sent after the loop: {sent} B)");
+    assert!(overflow > 0, "bursts longer than the 256-byte receive ring are dropped and counted ({sent} B of extra junk sent)");
 }
 
 /// The OK (alarm) pin follows the 60 °C alarm: the MCU boots with a warm
