@@ -115,3 +115,21 @@ fn slow_emulator_former_unexplained_answers() {
     assert_eq!(b.answer, "none", "measured outcome changed");
     assert!(b.pooled_heldout_k[1] <= 0.2, "pooled {:.2} K (measured 0.12)", b.pooled_heldout_k[1]);
 }
+
+/// A measured false discovery (emulator sweep, session 12, after issue 16):
+/// the speed-step `none` log (seed 1716) is answered
+/// `motor-pump-conduction`. The calibrated baseline already fits it to
+/// 0.23 K pooled held-out; the conduction path takes that to 0.18 K (22 %,
+/// just over the 20 % pooled rule) by standing in for what differs between
+/// the emulator's pump (split housing, pump → block metal path) and the
+/// reference's. Asserted as measured so that a fix shows here.
+#[test]
+#[ignore = "slow tier: emulator case, measured false discovery"]
+fn slow_emulator_measured_false_discovery_speed_steps() {
+    let r = run(case("none", SpeedSteps, 1716));
+    assert_eq!(r.answer, "motor-pump-conduction", "measured outcome changed");
+    let [_, calibrated, after] = r.pooled_heldout_k;
+    assert!(calibrated <= 0.3, "calibrated pooled held-out {calibrated:.2} K (measured 0.23)");
+    let gain = 1.0 - after / calibrated;
+    assert!((0.2..0.3).contains(&gain), "pooled held-out gain {:.0} % (measured 22 %)", 100.0 * gain);
+}
