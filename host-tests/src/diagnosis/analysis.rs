@@ -33,6 +33,17 @@ pub const MISFIT_RISE_FRACTION: f64 = 0.3;
 /// with the existing cases in view: the structure-mismatch `none` runs
 /// reach 2.69 K (t_ballvalve_c, seed 86).
 pub const MISFIT_ABS_K: f64 = 3.0;
+/// Default [`DiagnoseOptions::physical_misfit_rise_fraction`]: 10 %. The
+/// 30 % and 3 K clauses above excuse structure the four global multipliers
+/// cannot represent (per-node capacities, per-housing transfer). Once the
+/// diagnosis has escalated to the physical calibration set, which has
+/// those, that excuse is gone; what the set still leaves is reported.
+pub const PHYSICAL_MISFIT_RISE_FRACTION: f64 = 0.1;
+/// Default [`DiagnoseOptions::physical_misfit_abs_k`]: 1 K, the firmware's
+/// drain accuracy bound on a commissioned machine (issue 18: max error
+/// ≤ 1 K): a model that misses a held-out channel by more than that after
+/// the full physical calibration is not good enough to judge by.
+pub const PHYSICAL_MISFIT_ABS_K: f64 = 1.0;
 
 /// Settings of one diagnosis.
 #[derive(Debug, Clone, Copy)]
@@ -81,6 +92,12 @@ pub struct DiagnoseOptions {
     /// Held-out RMSE, K, above which a channel (past the noise test)
     /// misfits whatever its rise.
     pub misfit_abs_k: f64,
+    /// [`DiagnoseOptions::misfit_rise_fraction`] once the diagnosis has
+    /// escalated to the physical calibration set.
+    pub physical_misfit_rise_fraction: f64,
+    /// [`DiagnoseOptions::misfit_abs_k`] once the diagnosis has escalated
+    /// to the physical calibration set, K.
+    pub physical_misfit_abs_k: f64,
 }
 
 impl Default for DiagnoseOptions {
@@ -99,6 +116,8 @@ impl Default for DiagnoseOptions {
             misfit_noise_factor: MISFIT_NOISE_FACTOR,
             misfit_rise_fraction: MISFIT_RISE_FRACTION,
             misfit_abs_k: MISFIT_ABS_K,
+            physical_misfit_rise_fraction: PHYSICAL_MISFIT_RISE_FRACTION,
+            physical_misfit_abs_k: PHYSICAL_MISFIT_ABS_K,
         }
     }
 }
@@ -358,7 +377,12 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
     let base = fit(sim, run, &pts, Candidate::None, &nominal_v, None, o.fit)
         .ok_or_else(|| DiagnoseError::Baseline("no valid residuals at the nominal parameters".into()))?;
     let m_before = metrics(run, &base.series, split, o.ljung_box_lags);
-    let rule = MisfitRule { noise_factor: o.misfit_noise_factor, rise_fraction: o.misfit_rise_fraction, abs_k: o.misfit_abs_k };
+    // `escalate` is false only in the physical tier (called from below).
+    let rule = if escalate {
+        MisfitRule { noise_factor: o.misfit_noise_factor, rise_fraction: o.misfit_rise_fraction, abs_k: o.misfit_abs_k }
+    } else {
+        MisfitRule { noise_factor: o.misfit_noise_factor, rise_fraction: o.physical_misfit_rise_fraction, abs_k: o.physical_misfit_abs_k }
+    };
     if escalate {
         let xc = cross_correlations(run, &base.series, o.max_lag_s);
         if assess(run, split, &m_before, &xc, (&nuis_specs, &base.nuisance), rule).misfits {

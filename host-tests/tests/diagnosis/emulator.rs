@@ -93,13 +93,15 @@ fn slow_emulator_viscosity_is_named() {
     assert_named(&run(case("viscosity-temperature", LoadCycles, 1702)));
 }
 
-/// Measured outcomes after the escalation to the physical set, both
-/// formerly `unexplained`: the load-cycle `none` log (seed 1715) is `none`
-/// with a pooled calibrated held-out RMSE of 0.86 K (0.35 K before issue
-/// 16, 3.21 K before the physical set): the emulator, written from the
-/// paper, has no compression heat and no no-load or viscous pump friction,
-/// which the reference now has, and at 70–100 bar that structural difference
-/// shows (asserted as measured, ≤ 0.9 K); the hidden forced convection
+/// Measured outcomes after the escalation to the physical set: the
+/// load-cycle `none` log (seed 1715) is `unexplained` (no discovery) with a
+/// pooled calibrated held-out RMSE of 0.86 K (0.35 K before issue 16,
+/// 3.21 K before the physical set) and t_pump_c 1.49 K, t_oil_c 1.05 K
+/// held out, over the physical tier's 1 K misfit bound (session 12; `none`
+/// under the 3 K bound before): the emulator, written from the paper, has
+/// no compression heat and no no-load or viscous pump friction, which the
+/// reference now has, and at 70–100 bar that structural difference shows
+/// (asserted as measured, ≤ 0.9 K pooled); the hidden forced convection
 /// (7.9 m/s) on a Case 1 log (seed 1712) is answered `none` since issue 16
 /// (before: named with a 1 % gain on t_pump_c): the calibrated baseline
 /// fits every channel to 1–2σ (pooled held-out 0.12 K, t_pump_c 0.13 K),
@@ -109,8 +111,10 @@ fn slow_emulator_viscosity_is_named() {
 #[ignore = "slow tier: emulator cases, measured shortfall"]
 fn slow_emulator_former_unexplained_answers() {
     let a = run(case("none", LoadCycles, 1715));
-    assert_eq!(a.answer, "none");
+    assert_eq!(a.answer, "unexplained", "measured outcome changed");
     assert!(a.pooled_heldout_k[1] <= 0.9, "pooled {:.2} K (measured 0.86)", a.pooled_heldout_k[1]);
+    let misfit: Vec<&str> = a.channels.iter().filter(|c| c.4).map(|c| c.0.as_str()).collect();
+    assert_eq!(misfit, ["t_pump_c", "t_oil_c"], "misfitting channels (measured 1.49 and 1.05 K held out)");
     let b = run(case("forced-convection", ConstantThrottle, 1712));
     assert_eq!(b.answer, "none", "measured outcome changed");
     assert!(b.pooled_heldout_k[1] <= 0.2, "pooled {:.2} K (measured 0.12)", b.pooled_heldout_k[1]);
