@@ -10,12 +10,12 @@ use super::stats::{bias, bic, cross_correlation, ljung_box, max_abs, rmse, Ljung
 use crate::measured::{Channel, MeasuredRun};
 use rayon::prelude::*;
 
-/// Default [`DiagnoseOptions::misfit_noise_factor`]: 5σ. The calibrated
+/// Noise factor of the default [`DiagnoseOptions::misfit`] (both tiers): 5σ. The calibrated
 /// baseline of the synthetic runs whose only mismatch is the four nuisance
 /// multipliers sits at 0.9–2.1σ on every channel (measured on the
 /// fast-tier `none` cases).
 pub const MISFIT_NOISE_FACTOR: f64 = 5.0;
-/// Default [`DiagnoseOptions::misfit_rise_fraction`]: 30 % of the RMS rise
+/// Rise fraction of the default [`DiagnoseOptions::misfit`]: 30 % of the RMS rise
 /// above ambient. Set with the existing cases in view, not derived: the
 /// synthetic `none` runs with per-node capacities and the winding
 /// conductance off the rig file (`Mismatch::Structure`, which the tests
@@ -27,19 +27,19 @@ pub const MISFIT_NOISE_FACTOR: f64 = 5.0;
 /// second clause is looser than the noise level and is what keeps the
 /// structure-mismatch cases `none`.
 pub const MISFIT_RISE_FRACTION: f64 = 0.3;
-/// Default [`DiagnoseOptions::misfit_abs_k`]: 3 K. Without it a 4.7 K
+/// Absolute bound of the default [`DiagnoseOptions::misfit`]: 3 K. Without it a 4.7 K
 /// held-out misfit of t_block_c (24 % of a 19 K rise, emulator log with
 /// hidden motor–pump conduction, seed 1711) was answered `none`. Also set
 /// with the existing cases in view: the structure-mismatch `none` runs
 /// reach 2.69 K (t_ballvalve_c, seed 86).
 pub const MISFIT_ABS_K: f64 = 3.0;
-/// Default [`DiagnoseOptions::physical_misfit_rise_fraction`]: 10 %. The
+/// Rise fraction of the default [`DiagnoseOptions::physical_misfit`]: 10 %. The
 /// 30 % and 3 K clauses above excuse structure the four global multipliers
 /// cannot represent (per-node capacities, per-housing transfer). Once the
 /// diagnosis has escalated to the physical calibration set, which has
 /// those, that excuse is gone; what the set still leaves is reported.
 pub const PHYSICAL_MISFIT_RISE_FRACTION: f64 = 0.1;
-/// Default [`DiagnoseOptions::physical_misfit_abs_k`]: 1 K, the firmware's
+/// Absolute bound of the default [`DiagnoseOptions::physical_misfit`]: 1 K, the firmware's
 /// drain accuracy bound on a commissioned machine (issue 18: max error
 /// ≤ 1 K): a model that misses a held-out channel by more than that after
 /// the full physical calibration is not good enough to judge by.
@@ -81,23 +81,14 @@ pub struct DiagnoseOptions {
     pub max_lag_s: f64,
     /// Lags of the Ljung–Box test.
     pub ljung_box_lags: usize,
-    /// A channel of the calibrated baseline misfits when its held-out RMSE
-    /// exceeds this many times its noise σ (estimated from the samples)…
-    pub misfit_noise_factor: f64,
-    /// …and this fraction of its RMS rise above ambient on the held-out
-    /// window or [`DiagnoseOptions::misfit_abs_k`]. With no candidate
-    /// qualifying and a channel misfitting, the answer is `unexplained`
-    /// instead of `none` (see [`super::adequacy`]).
-    pub misfit_rise_fraction: f64,
-    /// Held-out RMSE, K, above which a channel (past the noise test)
-    /// misfits whatever its rise.
-    pub misfit_abs_k: f64,
-    /// [`DiagnoseOptions::misfit_rise_fraction`] once the diagnosis has
-    /// escalated to the physical calibration set.
-    pub physical_misfit_rise_fraction: f64,
-    /// [`DiagnoseOptions::misfit_abs_k`] once the diagnosis has escalated
-    /// to the physical calibration set, K.
-    pub physical_misfit_abs_k: f64,
+    /// When a channel of the calibrated baseline (global nuisance set)
+    /// misfits: it decides the escalation to the physical set and, with no
+    /// candidate qualifying, `unexplained` instead of `none` (see
+    /// [`super::adequacy`]).
+    pub misfit: MisfitRule,
+    /// The same once the diagnosis has escalated to the physical
+    /// calibration set.
+    pub physical_misfit: MisfitRule,
 }
 
 impl Default for DiagnoseOptions {
@@ -113,11 +104,12 @@ impl Default for DiagnoseOptions {
             min_pooled_gain: 0.2,
             max_lag_s: 120.0,
             ljung_box_lags: 20,
-            misfit_noise_factor: MISFIT_NOISE_FACTOR,
-            misfit_rise_fraction: MISFIT_RISE_FRACTION,
-            misfit_abs_k: MISFIT_ABS_K,
-            physical_misfit_rise_fraction: PHYSICAL_MISFIT_RISE_FRACTION,
-            physical_misfit_abs_k: PHYSICAL_MISFIT_ABS_K,
+            misfit: MisfitRule { noise_factor: MISFIT_NOISE_FACTOR, rise_fraction: MISFIT_RISE_FRACTION, abs_k: MISFIT_ABS_K },
+            physical_misfit: MisfitRule {
+                noise_factor: MISFIT_NOISE_FACTOR,
+                rise_fraction: PHYSICAL_MISFIT_RISE_FRACTION,
+                abs_k: PHYSICAL_MISFIT_ABS_K,
+            },
         }
     }
 }
@@ -378,11 +370,7 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
         .ok_or_else(|| DiagnoseError::Baseline("no valid residuals at the nominal parameters".into()))?;
     let m_before = metrics(run, &base.series, split, o.ljung_box_lags);
     // `escalate` is false only in the physical tier (called from below).
-    let rule = if escalate {
-        MisfitRule { noise_factor: o.misfit_noise_factor, rise_fraction: o.misfit_rise_fraction, abs_k: o.misfit_abs_k }
-    } else {
-        MisfitRule { noise_factor: o.misfit_noise_factor, rise_fraction: o.physical_misfit_rise_fraction, abs_k: o.physical_misfit_abs_k }
-    };
+    let rule = if escalate { o.misfit } else { o.physical_misfit };
     if escalate {
         let xc = cross_correlations(run, &base.series, o.max_lag_s);
         if assess(run, split, &m_before, &xc, (&nuis_specs, &base.nuisance), rule).misfits {
