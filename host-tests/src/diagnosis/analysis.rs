@@ -349,6 +349,13 @@ fn named(specs: &[super::model::ParamSpec], v: &[f64]) -> Vec<(String, f64, Stri
 /// synthetic cases it absorbed churning, forced convection and motor–pump
 /// conduction (fast tier: each answered `none`, calibrated held-out
 /// 0.16–0.19 K), where the global set leaves them to be named.
+///
+/// Two escalations: early, when the global baseline misfits by
+/// [`DiagnoseOptions::misfit`]; late, when no candidate qualifies and the
+/// global baseline misfits by the strict [`DiagnoseOptions::physical_misfit`]
+/// (so `none` always means "within the strict rule"). In each tier the
+/// baseline is refitted from the best candidate fits' nuisance values and
+/// the better of the two is the one candidates are judged against.
 pub fn diagnose(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions) -> Result<Diagnosis, DiagnoseError> {
     diagnose_tier(run, sim, o, true)
 }
@@ -412,6 +419,24 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
             }
         })
         .collect();
+    // The baseline again, from the nuisance values of the two candidate
+    // fits with the least residual: a candidate fitted from other starts
+    // may have found a better basin of the nuisance set, and its gain
+    // would then be the basin's, not the effect's. The better baseline is
+    // kept, so a candidate is judged against the best baseline any start found.
+    let mut by_rss: Vec<&FitResult> = fits.iter().flatten().collect();
+    by_rss.sort_by(|a, b| a.rss.total_cmp(&b.rss));
+    let restarts: Vec<FitResult> = by_rss
+        .iter()
+        .take(2)
+        .map(|f| f.nuisance.clone())
+        .collect::<Vec<_>>()
+        .par_iter()
+        .filter_map(|v| fit(sim, run, &pts, Candidate::None, v, None, o.fit))
+        .collect();
+    extra_sims += restarts.iter().map(|f| f.sims).sum::<usize>();
+    let base = restarts.into_iter().fold(base, |b, r| if r.rss < b.rss { r } else { b });
+    let m_before = metrics(run, &base.series, split, o.ljung_box_lags);
     let n = pts.len();
     let bic_none = bic(base.rss, n, nuis_specs.len());
     let mut ranking = vec![RankEntry {
@@ -472,6 +497,21 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
         None => (Candidate::None, base.clone(), m_before.clone()),
     };
     let xcorr = cross_correlations(run, &base.series, o.max_lag_s);
+    // Late escalation: nothing qualifies with the global set and its
+    // baseline passes the loose rule, but not the strict one (a channel off
+    // by 5σ and 10 % of its rise or 1 K). `none` would then claim more than
+    // the global set shows, so the diagnosis is made again with the
+    // physical set, whose answer (named, `none` to the strict rule, or
+    // `unexplained`) stands. Only after the candidates: escalating before
+    // them lets the physical set absorb effects the global set leaves to be
+    // named (see [`diagnose`]).
+    if escalate && winner.is_none() && assess(run, split, &m_before, &xcorr, (&nuis_specs, &base.nuisance), o.physical_misfit).misfits {
+        if let Some(p) = sim.physical_set() {
+            let mut d = diagnose_tier(run, &*p, o, false)?;
+            d.sims += sims;
+            return Ok(d);
+        }
+    }
     let m_nominal = metrics(run, &nominal, split, o.ljung_box_lags);
     let adequacy = assess(run, split, &m_before, &xcorr, (&nuis_specs, &base.nuisance), rule);
     Ok(Diagnosis {

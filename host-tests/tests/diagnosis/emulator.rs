@@ -6,10 +6,10 @@
 //! `eha-sim emulator-sweep` (table in docs/diagnosis.md), so a test fails
 //! when the outcome changes either way; misses are asserted as misses.
 //!
-//! Fast tier: a `none` Case 1 log, `unexplained` with the global
-//! multipliers, `none` after the escalation to the physical calibration set
-//! (~30 s); slow tier (`--ignored`): three named effects and two formerly
-//! `unexplained` logs.
+//! Fast tier: a `none` Case 1 log answered `none` (~10 s); slow tier
+//! (`--ignored`): two named effects, a measured churning miss, two formerly
+//! `unexplained` logs, the former false discovery (now `none`) and a
+//! misfit that is no longer answered `none`.
 //! Each case is one 1200 s throttle log at 2 s, 6–20 s to diagnose.
 
 use eha_sim::diagnosis::emu_sweep::{run_emu_case, EmuResult};
@@ -69,19 +69,24 @@ fn slow_emulator_sensor_lag_is_named() {
     assert_named(&run(case("sensor-lag", ConstantThrottle, 1704)));
 }
 
-/// Churning (4.8e-4 W/(rad/s)^2.5) in speed steps (seed 1708): named.
-/// **Measured miss since issue 16**: t_pump_c held out 0.39 → 0.20 K, a
-/// 49 % gain, just under the 50 % bar (was 2.74 → 0.14 K, 95 %): the
-/// calibrated baseline already fits the pump to 0.39 K, its viscous pump
-/// friction (C_v·μ·D·ω², scaled by `pump_friction`) taking up most of the
-/// ω^2.5 loss. Asserted: named, gain in [0.4, 0.5).
+/// Churning (4.8e-4 W/(rad/s)^2.5) in speed steps (seed 1708). **Measured
+/// miss since the baseline restart (session 13)**: answered `none`. The
+/// baseline refitted from the best candidates' nuisance values fits
+/// t_pump_c to 0.32 K held out (0.39 K from the single start), its viscous
+/// pump friction (C_v·μ·D·ω², scaled by `pump_friction`) taking up most of
+/// the ω^2.5 loss; churning then gains 37 % there (ΔBIC 56), under the
+/// 50 % bar (49 % against the single-start baseline before; 95 % before
+/// issue 16). Asserted: `none`, the best candidate is churning and does not
+/// qualify, t_pump_c calibrated ≤ 0.35 K held out (measured 0.316 K).
 #[test]
-#[ignore = "slow tier: emulator case"]
-fn slow_emulator_churning_is_named_measured_gain() {
+#[ignore = "slow tier: emulator case, measured miss"]
+fn slow_emulator_churning_measured_miss() {
     let r = run(case("churning-loss", SpeedSteps, 1708));
-    assert!(r.hit(), "answer {} for hidden churning-loss", r.answer);
-    let g = r.affected_gain().expect("affected channel");
-    assert!((0.4..0.5).contains(&g), "held-out gain {:.0} % (measured 49 %)", 100.0 * g);
+    assert_eq!(r.answer, "none", "measured outcome changed");
+    let (name, _, _, qualifies) = r.best_candidate.clone().expect("a best candidate");
+    assert!(name == "churning-loss" && !qualifies, "best candidate {name} (measured churning-loss, not qualifying)");
+    let (before, _) = r.affected_heldout_k.expect("affected channel");
+    assert!(before <= 0.35, "t_pump_c calibrated held-out {before:.3} K (measured 0.316)");
 }
 
 /// Viscosity in load cycles (seed 1702): named with t_oil_c held out
@@ -95,13 +100,13 @@ fn slow_emulator_viscosity_is_named() {
 
 /// Measured outcomes after the escalation to the physical set: the
 /// load-cycle `none` log (seed 1715) is `unexplained` (no discovery) with a
-/// pooled calibrated held-out RMSE of 0.86 K (0.35 K before issue 16,
-/// 3.21 K before the physical set) and t_pump_c 1.49 K, t_oil_c 1.05 K
-/// held out, over the physical tier's 1 K misfit bound (session 12; `none`
-/// under the 3 K bound before): the emulator, written from the paper, has
+/// pooled calibrated held-out RMSE of 0.73 K (0.86 K before the baseline
+/// restart of session 13, 0.35 K before issue 16, 3.21 K before the
+/// physical set) and t_pump_c 1.16 K held out, over the physical tier's
+/// 1 K misfit bound (t_oil_c, 1.05 K before the restart, now under it): the emulator, written from the paper, has
 /// no compression heat and no no-load or viscous pump friction, which the
 /// reference now has, and at 70–100 bar that structural difference shows
-/// (asserted as measured, ≤ 0.9 K pooled); the hidden forced convection
+/// (asserted as measured, ≤ 0.8 K pooled); the hidden forced convection
 /// (7.9 m/s) on a Case 1 log (seed 1712) is answered `none` since issue 16
 /// (before: named with a 1 % gain on t_pump_c): the calibrated baseline
 /// fits every channel to 1–2σ (pooled held-out 0.12 K, t_pump_c 0.13 K),
@@ -112,28 +117,47 @@ fn slow_emulator_viscosity_is_named() {
 fn slow_emulator_former_unexplained_answers() {
     let a = run(case("none", LoadCycles, 1715));
     assert_eq!(a.answer, "unexplained", "measured outcome changed");
-    assert!(a.pooled_heldout_k[1] <= 0.9, "pooled {:.2} K (measured 0.86)", a.pooled_heldout_k[1]);
+    assert!(a.pooled_heldout_k[1] <= 0.8, "pooled {:.2} K (measured 0.73)", a.pooled_heldout_k[1]);
     let misfit: Vec<&str> = a.channels.iter().filter(|c| c.4).map(|c| c.0.as_str()).collect();
-    assert_eq!(misfit, ["t_pump_c", "t_oil_c"], "misfitting channels (measured 1.49 and 1.05 K held out)");
+    assert_eq!(misfit, ["t_pump_c"], "misfitting channels (measured t_pump_c 1.16 K held out)");
     let b = run(case("forced-convection", ConstantThrottle, 1712));
     assert_eq!(b.answer, "none", "measured outcome changed");
     assert!(b.pooled_heldout_k[1] <= 0.2, "pooled {:.2} K (measured 0.12)", b.pooled_heldout_k[1]);
 }
 
-/// A measured false discovery (emulator sweep, session 12, after issue 16):
-/// the speed-step `none` log (seed 1716) is answered
-/// `motor-pump-conduction`. The calibrated baseline already fits it to
-/// 0.23 K pooled held-out; the conduction path takes that to 0.18 K (22 %,
-/// just over the 20 % pooled rule) by standing in for what differs between
-/// the emulator's pump (split housing, pump → block metal path) and the
-/// reference's. Asserted as measured so that a fix shows here.
+/// The speed-step `none` log (seed 1716): no discovery. In session 12 it
+/// was answered `motor-pump-conduction` (pooled held-out 0.23 → 0.18 K,
+/// 22 %, just over the 20 % pooled rule): the single-start baseline sat in
+/// a worse basin of the physical set than the conduction fit. Refitted
+/// from the best candidates' nuisance values (session 13) the baseline
+/// fits to 0.21 K pooled held-out and conduction no longer qualifies
+/// (measured ΔBIC 16). Asserted: `none`, calibrated pooled ≤ 0.25 K (the
+/// noise is 0.1 K; measured 0.213 K), the best candidate not qualifying.
 #[test]
-#[ignore = "slow tier: emulator case, measured false discovery"]
-fn slow_emulator_measured_false_discovery_speed_steps() {
+#[ignore = "slow tier: emulator case, former false discovery"]
+fn slow_emulator_speed_steps_none_log_is_no_discovery() {
     let r = run(case("none", SpeedSteps, 1716));
-    assert_eq!(r.answer, "motor-pump-conduction", "measured outcome changed");
-    let [_, calibrated, after] = r.pooled_heldout_k;
-    assert!(calibrated <= 0.3, "calibrated pooled held-out {calibrated:.2} K (measured 0.23)");
-    let gain = 1.0 - after / calibrated;
-    assert!((0.2..0.3).contains(&gain), "pooled held-out gain {:.0} % (measured 22 %)", 100.0 * gain);
+    assert_eq!(r.answer, "none", "measured outcome changed");
+    let calibrated = r.pooled_heldout_k[1];
+    assert!(calibrated <= 0.25, "calibrated pooled held-out {calibrated:.3} K (measured 0.213)");
+    assert!(r.best_candidate.as_ref().is_none_or(|b| !b.3), "best candidate qualifies: {:?}", r.best_candidate);
+}
+
+/// Motor–pump conduction (5.3 W/K) in load cycles (seed 1711): `none`
+/// before session 13 next to a 2.66 K held-out misfit of t_pump_c, because
+/// the global baseline passed the loose rule (30 % of the rise or 3 K) and
+/// the diagnosis never escalated. With the late escalation (nothing named
+/// and the strict rule failing: 5σ and 10 % of the rise or 1 K) the
+/// physical set takes t_pump_c to 0.67 K held out, no candidate qualifies
+/// and t_oil_c still misfits by 1.10 K: `unexplained`, with that channel
+/// named. Still a miss of the hidden cause (measured), but no longer
+/// `none` next to a misfit.
+#[test]
+#[ignore = "slow tier: emulator case, measured miss"]
+fn slow_emulator_misfit_is_not_answered_none() {
+    let r = run(case("motor-pump-conduction", LoadCycles, 1711));
+    assert_eq!(r.answer, "unexplained", "measured outcome changed");
+    let misfit: Vec<(&str, f64)> = r.channels.iter().filter(|c| c.4).map(|c| (c.0.as_str(), c.1)).collect();
+    assert_eq!(misfit.len(), 1, "misfitting channels {misfit:?} (measured t_oil_c 1.10 K)");
+    assert!(misfit[0].0 == "t_oil_c" && misfit[0].1 > 1.0, "misfit {misfit:?} (measured t_oil_c 1.10 K)");
 }
