@@ -3,38 +3,33 @@
 //! Electro-Hydrostatic Actuator": the oracle for the `eha-guard` firmware and
 //! a desk tool for thermal engineers.
 //!
-//! Module per physical concern: [`fluid`] (oil, air), [`losses`] (eqs. 1–11),
-//! [`heat`] (eqs. 12–19), [`network`] (nodes, capacities, conductances),
-//! [`hydraulics`] (pump, valves, cylinder, position loop), [`cooling`] (LNG,
-//! eqs. 20–25), [`model`] (the right-hand side), [`plant`] (the stiff solver),
-//! [`scenario`] (paper cases, missions, replay), [`sim`] (runs and outputs).
+//! Layers, one folder each:
+//! - [`physics`]: the paper's equations (losses, heat transfer, fluid,
+//!   hydraulics, cooling) and the rig's parameters;
+//! - [`simulation`]: the model's right-hand side, the stiff solver, the
+//!   paper's cases and missions;
+//! - [`calibration`]: fitting the model to the paper ([`calibration::paper`])
+//!   or to a user's logs, identifiability, commissioning;
+//! - [`diagnosis`]: what the model gets wrong on a log, the cause, the gain;
+//!   [`emulator`]: the independent truth model of its tests;
+//! - [`tools`]: the measured-data format, command line, plots, firmware
+//!   parameters; [`pil`] and [`faults`]: the firmware in QEMU against the
+//!   plant.
+//!
+//! The modules are also re-exported at the crate root under their short
+//! names (`eha_sim::rig`, `eha_sim::sim`, ...), the paths the tests,
+//! examples and benchmarks use.
 
-pub mod calibrate;
 pub mod calibration;
-pub mod cli;
-pub mod cooling;
 pub mod diagnosis;
 pub mod emulator;
-pub mod equilibrium;
 pub mod faults;
-pub mod fluid;
-pub mod heat;
-pub mod hydraulics;
-pub mod missions;
-pub mod losses;
-pub mod lsq;
-pub mod measured;
-pub mod model;
-pub mod network;
-pub mod params_block;
+pub mod physics;
 pub mod pil;
-pub mod plant;
-pub mod plot;
-pub mod reduce;
-pub mod reader_checks;
-pub mod rig;
-pub mod scenario;
-pub mod sim;
+pub mod simulation;
+pub mod tools;
 
-#[cfg(test)]
-mod reader_props;
+pub use calibration::{lsq, paper as calibrate};
+pub use physics::{cooling, fluid, heat, hydraulics, losses, network, rig};
+pub use simulation::{equilibrium, missions, model, plant, scenario, sim};
+pub use tools::{cli, measured, params_block, plot, reader_checks, reduce};

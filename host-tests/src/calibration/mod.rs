@@ -8,13 +8,17 @@
 //! - [`fit`]: joint fit over several logs with prior rows;
 //! - [`ident`]: identifiability (singular values, intervals, correlated
 //!   pairs) and the one-operating-point warning;
-//! - [`synthetic`]: logs generated from a rig (tests and examples).
+//! - [`synthetic`]: logs generated from a rig (tests and examples);
+//! - [`paper`]: the reference's own calibration to the paper's Table 4,
+//!   Table 5 and Fig. 15 (`eha-sim calibrate`), with [`lsq`].
 
 pub mod cli;
 pub mod commission;
 pub mod fit;
 pub mod ident;
 pub mod log;
+pub mod lsq;
+pub mod paper;
 pub mod set;
 pub mod synthetic;
 

@@ -353,9 +353,9 @@ fn named(specs: &[super::model::ParamSpec], v: &[f64]) -> Vec<(String, f64, Stri
 /// Two escalations: early, when the global baseline misfits by
 /// [`DiagnoseOptions::misfit`]; late, when no candidate qualifies and the
 /// global baseline misfits by the strict [`DiagnoseOptions::physical_misfit`]
-/// (so `none` always means "within the strict rule"). In each tier the
-/// baseline is refitted from the best candidate fits' nuisance values and
-/// the better of the two is the one candidates are judged against.
+/// (so `none` always means "within the strict rule"). In each tier,
+/// when a candidate qualifies, the baseline is refitted from the best candidate
+/// fits' nuisance values and the better baseline is the one candidates are judged against.
 pub fn diagnose(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions) -> Result<Diagnosis, DiagnoseError> {
     diagnose_tier(run, sim, o, true)
 }
@@ -419,77 +419,31 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
             }
         })
         .collect();
-    // The baseline again, from the nuisance values of the two candidate
-    // fits with the least residual: a candidate fitted from other starts
-    // may have found a better basin of the nuisance set, and its gain
-    // would then be the basin's, not the effect's. The better baseline is
-    // kept, so a candidate is judged against the best baseline any start found.
-    let mut by_rss: Vec<&FitResult> = fits.iter().flatten().collect();
-    by_rss.sort_by(|a, b| a.rss.total_cmp(&b.rss));
-    let restarts: Vec<FitResult> = by_rss
-        .iter()
-        .take(2)
-        .map(|f| f.nuisance.clone())
-        .collect::<Vec<_>>()
-        .par_iter()
-        .filter_map(|v| fit(sim, run, &pts, Candidate::None, v, None, o.fit))
-        .collect();
-    extra_sims += restarts.iter().map(|f| f.sims).sum::<usize>();
-    let base = restarts.into_iter().fold(base, |b, r| if r.rss < b.rss { r } else { b });
-    let m_before = metrics(run, &base.series, split, o.ljung_box_lags);
     let n = pts.len();
-    let bic_none = bic(base.rss, n, nuis_specs.len());
-    let mut ranking = vec![RankEntry {
-        cause: "none".into(),
-        bic: bic_none,
-        heldout_rmse_k: m_before.heldout_rmse_k,
-        train_rmse_k: m_before.train_rmse_k,
-        delta_bic: 0.0,
-        heldout_gain: 0.0,
-        gain_channel: String::new(),
-        channel_heldout_k: m_before.channels.iter().map(|c| (c.channel.clone(), c.heldout_rmse_k)).collect(),
-        params: vec![],
-        qualifies: false,
-        note: String::new(),
-    }];
-    let sims = 1 + base.sims + extra_sims;
-    let mut done: Vec<(FitResult, Metrics)> = Vec::new();
-    for f in fits.into_iter().flatten() {
-        let m = metrics(run, &f.series, split, o.ljung_box_lags);
-        let k = nuis_specs.len() + f.ext.len();
-        let b = bic(f.rss, n, k);
-        let (mut gain, mut gain_k, mut gch) = (f64::NEG_INFINITY, 0.0, String::new());
-        for cb in &m_before.channels {
-            let Some(ca) = m.channel(&cb.channel) else { continue };
-            if cb.heldout_rmse_k >= o.gain_floor_k {
-                let g = 1.0 - ca.heldout_rmse_k / cb.heldout_rmse_k;
-                if g > gain {
-                    (gain, gain_k, gch) = (g, cb.heldout_rmse_k - ca.heldout_rmse_k, cb.channel.clone());
-                }
-            }
+    let fits: Vec<FitResult> = fits.into_iter().flatten().collect();
+    let base_sims = base.sims;
+    let (mut base, mut m_before) = (base, m_before);
+    let (mut ranking, mut done) = rank(run, sim, o, split, n, &base, &m_before, &fits);
+    // A candidate qualifies: refit the baseline from the nuisance values of
+    // the two candidate fits with the least residual. A candidate fitted
+    // from other starts may have found a better basin of the nuisance set,
+    // and its gain would then be the basin's, not the effect's; the better
+    // baseline (training residual) is the one candidates are judged
+    // against. Only then: with nothing qualifying, it would only cost time.
+    if ranking.iter().any(|r| r.qualifies) {
+        let mut by_rss: Vec<&FitResult> = fits.iter().collect();
+        by_rss.sort_by(|a, b| a.rss.total_cmp(&b.rss));
+        let starts: Vec<Vec<f64>> = by_rss.iter().take(2).map(|f| f.nuisance.clone()).collect();
+        let restarts: Vec<FitResult> =
+            starts.par_iter().filter_map(|v| fit(sim, run, &pts, Candidate::None, v, None, o.fit)).collect();
+        extra_sims += restarts.iter().map(|f| f.sims).sum::<usize>();
+        if let Some(better) = restarts.into_iter().filter(|r| r.rss < base.rss).min_by(|a, b| a.rss.total_cmp(&b.rss)) {
+            base = better;
+            m_before = metrics(run, &base.series, split, o.ljung_box_lags);
+            (ranking, done) = rank(run, sim, o, split, n, &base, &m_before, &fits);
         }
-        let gain = if gain.is_finite() { gain } else { 0.0 };
-        let ident = identifiable(f.candidate, run, split);
-        let pooled_ok = m.heldout_rmse_k <= (1.0 - o.min_pooled_gain) * m_before.heldout_rmse_k;
-        ranking.push(RankEntry {
-            cause: f.candidate.name().into(),
-            bic: b,
-            heldout_rmse_k: m.heldout_rmse_k,
-            train_rmse_k: m.train_rmse_k,
-            delta_bic: bic_none - b,
-            heldout_gain: gain,
-            gain_channel: gch,
-            channel_heldout_k: m.channels.iter().map(|c| (c.channel.clone(), c.heldout_rmse_k)).collect(),
-            params: named(&sim.extension_params(f.candidate), &f.ext),
-            qualifies: ident.is_ok()
-                && bic_none - b >= o.min_delta_bic
-                && gain >= o.min_heldout_gain
-                && gain_k >= o.min_gain_k
-                && pooled_ok,
-            note: ident.err().unwrap_or_default().into(),
-        });
-        done.push((f, m));
     }
+    let sims = 1 + base_sims + extra_sims;
     ranking.sort_by(|a, b| a.bic.total_cmp(&b.bic));
     let winner = ranking.iter().find(|r| r.qualifies).and_then(|r| Candidate::from_name(&r.cause));
     let (cause, after_fit, m_after) = match winner.and_then(|w| done.iter().find(|(f, _)| f.candidate == w)) {
@@ -531,6 +485,75 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
         series: [nominal, base.series.clone(), after_fit.series],
         sims,
     })
+}
+
+/// The ranking of `fits` against the baseline `base` (metrics `m_before`):
+/// BIC, held-out gains and whether each candidate qualifies, unsorted,
+/// with each fit's metrics.
+#[allow(clippy::too_many_arguments)]
+fn rank(
+    run: &MeasuredRun,
+    sim: &dyn Simulator,
+    o: &DiagnoseOptions,
+    split: f64,
+    n: usize,
+    base: &FitResult,
+    m_before: &Metrics,
+    fits: &[FitResult],
+) -> (Vec<RankEntry>, Vec<(FitResult, Metrics)>) {
+    let nuis_len = sim.nuisance().len();
+    let bic_none = bic(base.rss, n, nuis_len);
+    let mut ranking = vec![RankEntry {
+        cause: "none".into(),
+        bic: bic_none,
+        heldout_rmse_k: m_before.heldout_rmse_k,
+        train_rmse_k: m_before.train_rmse_k,
+        delta_bic: 0.0,
+        heldout_gain: 0.0,
+        gain_channel: String::new(),
+        channel_heldout_k: m_before.channels.iter().map(|c| (c.channel.clone(), c.heldout_rmse_k)).collect(),
+        params: vec![],
+        qualifies: false,
+        note: String::new(),
+    }];
+    let mut done: Vec<(FitResult, Metrics)> = Vec::new();
+    for f in fits {
+        let m = metrics(run, &f.series, split, o.ljung_box_lags);
+        let k = nuis_len + f.ext.len();
+        let b = bic(f.rss, n, k);
+        let (mut gain, mut gain_k, mut gch) = (f64::NEG_INFINITY, 0.0, String::new());
+        for cb in &m_before.channels {
+            let Some(ca) = m.channel(&cb.channel) else { continue };
+            if cb.heldout_rmse_k >= o.gain_floor_k {
+                let g = 1.0 - ca.heldout_rmse_k / cb.heldout_rmse_k;
+                if g > gain {
+                    (gain, gain_k, gch) = (g, cb.heldout_rmse_k - ca.heldout_rmse_k, cb.channel.clone());
+                }
+            }
+        }
+        let gain = if gain.is_finite() { gain } else { 0.0 };
+        let ident = identifiable(f.candidate, run, split);
+        let pooled_ok = m.heldout_rmse_k <= (1.0 - o.min_pooled_gain) * m_before.heldout_rmse_k;
+        ranking.push(RankEntry {
+            cause: f.candidate.name().into(),
+            bic: b,
+            heldout_rmse_k: m.heldout_rmse_k,
+            train_rmse_k: m.train_rmse_k,
+            delta_bic: bic_none - b,
+            heldout_gain: gain,
+            gain_channel: gch,
+            channel_heldout_k: m.channels.iter().map(|c| (c.channel.clone(), c.heldout_rmse_k)).collect(),
+            params: named(&sim.extension_params(f.candidate), &f.ext),
+            qualifies: ident.is_ok()
+                && bic_none - b >= o.min_delta_bic
+                && gain >= o.min_heldout_gain
+                && gain_k >= o.min_gain_k
+                && pooled_ok,
+            note: ident.err().unwrap_or_default().into(),
+        });
+        done.push((f.clone(), m));
+    }
+    (ranking, done)
 }
 
 /// Cross-correlation of every channel's calibrated-baseline residual with

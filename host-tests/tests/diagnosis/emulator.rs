@@ -71,7 +71,8 @@ fn slow_emulator_sensor_lag_is_named() {
 
 /// Churning (4.8e-4 W/(rad/s)^2.5) in speed steps (seed 1708). **Measured
 /// miss since the baseline restart (session 13)**: answered `none`. The
-/// baseline refitted from the best candidates' nuisance values fits
+/// churning fit qualified against the first baseline; the baseline then
+/// refitted from the best candidates' nuisance values fits
 /// t_pump_c to 0.32 K held out (0.39 K from the single start), its viscous
 /// pump friction (C_v·μ·D·ω², scaled by `pump_friction`) taking up most of
 /// the ω^2.5 loss; churning then gains 37 % there (ΔBIC 56), under the
@@ -100,13 +101,13 @@ fn slow_emulator_viscosity_is_named() {
 
 /// Measured outcomes after the escalation to the physical set: the
 /// load-cycle `none` log (seed 1715) is `unexplained` (no discovery) with a
-/// pooled calibrated held-out RMSE of 0.73 K (0.86 K before the baseline
-/// restart of session 13, 0.35 K before issue 16, 3.21 K before the
-/// physical set) and t_pump_c 1.16 K held out, over the physical tier's
-/// 1 K misfit bound (t_oil_c, 1.05 K before the restart, now under it): the emulator, written from the paper, has
+/// pooled calibrated held-out RMSE of 0.86 K (0.35 K before issue 16,
+/// 3.21 K before the physical set) and t_pump_c 1.49 K, t_oil_c 1.05 K
+/// held out, over the physical tier's 1 K misfit bound (session 12; `none`
+/// under the 3 K bound before): the emulator, written from the paper, has
 /// no compression heat and no no-load or viscous pump friction, which the
 /// reference now has, and at 70–100 bar that structural difference shows
-/// (asserted as measured, ≤ 0.8 K pooled); the hidden forced convection
+/// (asserted as measured, ≤ 0.9 K pooled); the hidden forced convection
 /// (7.9 m/s) on a Case 1 log (seed 1712) is answered `none` since issue 16
 /// (before: named with a 1 % gain on t_pump_c): the calibrated baseline
 /// fits every channel to 1–2σ (pooled held-out 0.12 K, t_pump_c 0.13 K),
@@ -117,9 +118,9 @@ fn slow_emulator_viscosity_is_named() {
 fn slow_emulator_former_unexplained_answers() {
     let a = run(case("none", LoadCycles, 1715));
     assert_eq!(a.answer, "unexplained", "measured outcome changed");
-    assert!(a.pooled_heldout_k[1] <= 0.8, "pooled {:.2} K (measured 0.73)", a.pooled_heldout_k[1]);
+    assert!(a.pooled_heldout_k[1] <= 0.9, "pooled {:.2} K (measured 0.86)", a.pooled_heldout_k[1]);
     let misfit: Vec<&str> = a.channels.iter().filter(|c| c.4).map(|c| c.0.as_str()).collect();
-    assert_eq!(misfit, ["t_pump_c"], "misfitting channels (measured t_pump_c 1.16 K held out)");
+    assert_eq!(misfit, ["t_pump_c", "t_oil_c"], "misfitting channels (measured 1.49 and 1.05 K held out)");
     let b = run(case("forced-convection", ConstantThrottle, 1712));
     assert_eq!(b.answer, "none", "measured outcome changed");
     assert!(b.pooled_heldout_k[1] <= 0.2, "pooled {:.2} K (measured 0.12)", b.pooled_heldout_k[1]);
@@ -129,7 +130,8 @@ fn slow_emulator_former_unexplained_answers() {
 /// was answered `motor-pump-conduction` (pooled held-out 0.23 → 0.18 K,
 /// 22 %, just over the 20 % pooled rule): the single-start baseline sat in
 /// a worse basin of the physical set than the conduction fit. Refitted
-/// from the best candidates' nuisance values (session 13) the baseline
+/// from the best candidates' nuisance values once a candidate qualifies
+/// (session 13) the baseline
 /// fits to 0.21 K pooled held-out and conduction no longer qualifies
 /// (measured ΔBIC 16). Asserted: `none`, calibrated pooled ≤ 0.25 K (the
 /// noise is 0.1 K; measured 0.213 K), the best candidate not qualifying.
@@ -148,8 +150,8 @@ fn slow_emulator_speed_steps_none_log_is_no_discovery() {
 /// the global baseline passed the loose rule (30 % of the rise or 3 K) and
 /// the diagnosis never escalated. With the late escalation (nothing named
 /// and the strict rule failing: 5σ and 10 % of the rise or 1 K) the
-/// physical set takes t_pump_c to 0.67 K held out, no candidate qualifies
-/// and t_oil_c still misfits by 1.10 K: `unexplained`, with that channel
+/// physical set takes t_pump_c to 0.71 K held out, no candidate qualifies
+/// and t_oil_c still misfits by 1.29 K: `unexplained`, with that channel
 /// named. Still a miss of the hidden cause (measured), but no longer
 /// `none` next to a misfit.
 #[test]
@@ -158,6 +160,6 @@ fn slow_emulator_misfit_is_not_answered_none() {
     let r = run(case("motor-pump-conduction", LoadCycles, 1711));
     assert_eq!(r.answer, "unexplained", "measured outcome changed");
     let misfit: Vec<(&str, f64)> = r.channels.iter().filter(|c| c.4).map(|c| (c.0.as_str(), c.1)).collect();
-    assert_eq!(misfit.len(), 1, "misfitting channels {misfit:?} (measured t_oil_c 1.10 K)");
-    assert!(misfit[0].0 == "t_oil_c" && misfit[0].1 > 1.0, "misfit {misfit:?} (measured t_oil_c 1.10 K)");
+    assert_eq!(misfit.len(), 1, "misfitting channels {misfit:?} (measured t_oil_c 1.29 K)");
+    assert!(misfit[0].0 == "t_oil_c" && misfit[0].1 > 1.0, "misfit {misfit:?} (measured t_oil_c 1.29 K)");
 }
