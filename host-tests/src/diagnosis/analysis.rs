@@ -376,16 +376,12 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
     let base = fit(sim, run, &pts, Candidate::None, &nominal_v, None, o.fit)
         .ok_or_else(|| DiagnoseError::Baseline("no valid residuals at the nominal parameters".into()))?;
     let m_before = metrics(run, &base.series, split, o.ljung_box_lags);
+    let xcorr = cross_correlations(run, &base.series, o.max_lag_s);
     // `escalate` is false only in the physical tier (called from below).
     let rule = if escalate { o.misfit } else { o.physical_misfit };
-    if escalate {
-        let xc = cross_correlations(run, &base.series, o.max_lag_s);
-        if assess(run, split, &m_before, &xc, (&nuis_specs, &base.nuisance), rule).misfits {
-            if let Some(p) = sim.physical_set() {
-                let mut d = diagnose_tier(run, &*p, o, false)?;
-                d.sims += 1 + base.sims;
-                return Ok(d);
-            }
+    if escalate && assess(run, split, &m_before, &xcorr, (&nuis_specs, &base.nuisance), rule).misfits {
+        if let Some(d) = in_physical_tier(run, sim, o, 1 + base.sims) {
+            return d;
         }
     }
     // Every candidate is fitted jointly with the nuisance set from two
@@ -422,8 +418,8 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
     let n = pts.len();
     let fits: Vec<FitResult> = fits.into_iter().flatten().collect();
     let base_sims = base.sims;
-    let (mut base, mut m_before) = (base, m_before);
-    let (mut ranking, mut done) = rank(run, sim, o, split, n, &base, &m_before, &fits);
+    let (mut base, mut m_before, mut xcorr) = (base, m_before, xcorr);
+    let (mut ranking, mut fit_metrics) = rank(run, sim, o, split, n, &base, &m_before, &fits);
     // A candidate qualifies: refit the baseline from the nuisance values of
     // the two candidate fits with the least residual. A candidate fitted
     // from other starts may have found a better basin of the nuisance set,
@@ -440,17 +436,17 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
         if let Some(better) = restarts.into_iter().filter(|r| r.rss < base.rss).min_by(|a, b| a.rss.total_cmp(&b.rss)) {
             base = better;
             m_before = metrics(run, &base.series, split, o.ljung_box_lags);
-            (ranking, done) = rank(run, sim, o, split, n, &base, &m_before, &fits);
+            xcorr = cross_correlations(run, &base.series, o.max_lag_s);
+            (ranking, fit_metrics) = rank(run, sim, o, split, n, &base, &m_before, &fits);
         }
     }
     let sims = 1 + base_sims + extra_sims;
     ranking.sort_by(|a, b| a.bic.total_cmp(&b.bic));
     let winner = ranking.iter().find(|r| r.qualifies).and_then(|r| Candidate::from_name(&r.cause));
-    let (cause, after_fit, m_after) = match winner.and_then(|w| done.iter().find(|(f, _)| f.candidate == w)) {
+    let (cause, after_fit, m_after) = match winner.and_then(|w| fits.iter().zip(&fit_metrics).find(|(f, _)| f.candidate == w)) {
         Some((f, m)) => (f.candidate, f.clone(), m.clone()),
         None => (Candidate::None, base.clone(), m_before.clone()),
     };
-    let xcorr = cross_correlations(run, &base.series, o.max_lag_s);
     // Late escalation: nothing qualifies with the global set and its
     // baseline passes the loose rule, but not the strict one (a channel off
     // by 5σ and 10 % of its rise or 1 K). `none` would then claim more than
@@ -460,10 +456,8 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
     // them lets the physical set absorb effects the global set leaves to be
     // named (see [`diagnose`]).
     if escalate && winner.is_none() && assess(run, split, &m_before, &xcorr, (&nuis_specs, &base.nuisance), o.physical_misfit).misfits {
-        if let Some(p) = sim.physical_set() {
-            let mut d = diagnose_tier(run, &*p, o, false)?;
-            d.sims += sims;
-            return Ok(d);
+        if let Some(d) = in_physical_tier(run, sim, o, sims) {
+            return d;
         }
     }
     let m_nominal = metrics(run, &nominal, split, o.ljung_box_lags);
@@ -487,9 +481,20 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
     })
 }
 
+/// The diagnosis made again with `sim`'s physical calibration set, its model
+/// runs counting the `spent` ones of the global tier; `None` when the model
+/// has no physical set.
+fn in_physical_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, spent: usize) -> Option<Result<Diagnosis, DiagnoseError>> {
+    let p = sim.physical_set()?;
+    Some(diagnose_tier(run, &*p, o, false).map(|mut d| {
+        d.sims += spent;
+        d
+    }))
+}
+
 /// The ranking of `fits` against the baseline `base` (metrics `m_before`):
-/// BIC, held-out gains and whether each candidate qualifies, unsorted,
-/// with each fit's metrics.
+/// BIC, held-out gains and whether each candidate qualifies, unsorted;
+/// and each fit's metrics, in the order of `fits`.
 #[allow(clippy::too_many_arguments)]
 fn rank(
     run: &MeasuredRun,
@@ -500,7 +505,7 @@ fn rank(
     base: &FitResult,
     m_before: &Metrics,
     fits: &[FitResult],
-) -> (Vec<RankEntry>, Vec<(FitResult, Metrics)>) {
+) -> (Vec<RankEntry>, Vec<Metrics>) {
     let nuis_len = sim.nuisance().len();
     let bic_none = bic(base.rss, n, nuis_len);
     let mut ranking = vec![RankEntry {
@@ -516,7 +521,7 @@ fn rank(
         qualifies: false,
         note: String::new(),
     }];
-    let mut done: Vec<(FitResult, Metrics)> = Vec::new();
+    let mut fit_metrics = Vec::with_capacity(fits.len());
     for f in fits {
         let m = metrics(run, &f.series, split, o.ljung_box_lags);
         let k = nuis_len + f.ext.len();
@@ -551,9 +556,9 @@ fn rank(
                 && pooled_ok,
             note: ident.err().unwrap_or_default().into(),
         });
-        done.push((f.clone(), m));
+        fit_metrics.push(m);
     }
-    (ranking, done)
+    (ranking, fit_metrics)
 }
 
 /// Cross-correlation of every channel's calibrated-baseline residual with

@@ -30,6 +30,11 @@ fn run(c: EmuCase) -> EmuResult {
     r
 }
 
+/// The channels the calibrated baseline misfits, with their held-out RMSE, K.
+fn misfits(r: &EmuResult) -> Vec<(&str, f64)> {
+    r.channels.iter().filter(|c| c.4).map(|c| (c.0.as_str(), c.1)).collect()
+}
+
 /// A named effect: the answer is the hidden cause and the affected
 /// channel's held-out RMSE falls by ≥ 50 % (issue 5's bar).
 fn assert_named(r: &EmuResult) {
@@ -119,7 +124,7 @@ fn slow_emulator_former_unexplained_answers() {
     let a = run(case("none", LoadCycles, 1715));
     assert_eq!(a.answer, "unexplained", "measured outcome changed");
     assert!(a.pooled_heldout_k[1] <= 0.9, "pooled {:.2} K (measured 0.86)", a.pooled_heldout_k[1]);
-    let misfit: Vec<&str> = a.channels.iter().filter(|c| c.4).map(|c| c.0.as_str()).collect();
+    let misfit: Vec<&str> = misfits(&a).iter().map(|m| m.0).collect();
     assert_eq!(misfit, ["t_pump_c", "t_oil_c"], "misfitting channels (measured 1.49 and 1.05 K held out)");
     let b = run(case("forced-convection", ConstantThrottle, 1712));
     assert_eq!(b.answer, "none", "measured outcome changed");
@@ -159,7 +164,7 @@ fn slow_emulator_speed_steps_none_log_is_no_discovery() {
 fn slow_emulator_misfit_is_not_answered_none() {
     let r = run(case("motor-pump-conduction", LoadCycles, 1711));
     assert_eq!(r.answer, "unexplained", "measured outcome changed");
-    let misfit: Vec<(&str, f64)> = r.channels.iter().filter(|c| c.4).map(|c| (c.0.as_str(), c.1)).collect();
+    let misfit = misfits(&r);
     assert_eq!(misfit.len(), 1, "misfitting channels {misfit:?} (measured t_oil_c 1.29 K)");
     assert!(misfit[0].0 == "t_oil_c" && misfit[0].1 > 1.0, "misfit {misfit:?} (measured t_oil_c 1.29 K)");
 }
