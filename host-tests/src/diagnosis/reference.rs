@@ -237,7 +237,7 @@ impl Simulator for ReferenceModel {
         let rig = self.rig_for(nuisance, c, ext);
         let out = simulate_budget(&rig, &self.scenario, &self.opts, REPLAY_RTOL, Some(self.step_budget())).map_err(|e| e.to_string())?;
         let mut s = SimSeries::default();
-        let sample = |name: &str| -> Option<Vec<f64>> { self.times.iter().map(|&t| out.at(name, t)).collect() };
+        let sample = |name: &str| out.sample(name, &self.times);
         for ch in Channel::TEMPERATURES {
             if let Some(v) = sample(ch.name()) {
                 s.channels.insert(ch, v);

@@ -85,12 +85,16 @@ impl Losses {
 #[derive(Debug, Clone)]
 pub struct ReplayDrive {
     inputs: ReplayInputs,
+    /// Segment of the last [`ReplayDrive::locate`]: the solver asks for
+    /// times close to each other, so the next is usually this one or the
+    /// one after (checked, else a binary search).
+    hint: Cell<usize>,
 }
 
 impl ReplayDrive {
     /// Wrap replay inputs.
     pub fn new(inputs: ReplayInputs) -> Self {
-        Self { inputs }
+        Self { inputs, hint: Cell::new(0) }
     }
 
     /// The inputs.
@@ -105,7 +109,18 @@ impl ReplayDrive {
         if n < 2 {
             return (0, 0.0);
         }
-        let i = ts.partition_point(|&x| x <= t).clamp(1, n - 1) - 1;
+        // Segment i holds t when ts[i] <= t < ts[i+1]; the first also takes
+        // earlier times and the last later ones (the binary search's clamp).
+        let holds = |i: usize| i + 1 < n && (i == 0 || ts[i] <= t) && (i + 2 == n || t < ts[i + 1]);
+        let h = self.hint.get();
+        let i = if holds(h) {
+            h
+        } else if holds(h + 1) {
+            h + 1
+        } else {
+            ts.partition_point(|&x| x <= t).clamp(1, n - 1) - 1
+        };
+        self.hint.set(i);
         let (a, b) = (ts[i], ts[i + 1]);
         (i, ((t - a) / (b - a)).clamp(0.0, 1.0))
     }
@@ -525,6 +540,21 @@ impl Model {
         dy[E_LNG] = q_lng;
     }
 
+    /// The states no derivative of [`Model::rhs`] depends on: the energy
+    /// integrals always, and in a replay the hydraulic states too (the
+    /// operating point is imposed from the log). Their Jacobian columns are
+    /// zero.
+    pub fn inert_states(&self) -> [bool; N_STATE] {
+        let mut inert = [false; N_STATE];
+        for e in [E_LOSS, E_AMB, E_LNG] {
+            inert[e] = true;
+        }
+        if matches!(self.drive, Drive::Replay(_)) {
+            inert[..ix::N].iter_mut().for_each(|i| *i = true);
+        }
+        inert
+    }
+
     /// Energy stored in the nodes relative to the state `y0`, J.
     pub fn stored_energy(&self, y0: &[f64], y: &[f64]) -> f64 {
         let oil = &self.rig.oil;
@@ -548,6 +578,42 @@ impl Model {
         match &self.drive {
             Drive::Mission(m) => m.valve,
             Drive::Replay(_) => ValveRule::External,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The segment hint of `locate` changes only the search, not the
+    /// answer: for times ascending, descending, jumping and outside the log,
+    /// the same (segment, fraction) as a fresh binary search.
+    #[test]
+    fn locate_with_a_hint_equals_the_binary_search() {
+        let time_s = vec![0.0, 0.1, 0.2, 0.5, 0.6, 2.0];
+        let n = time_s.len();
+        let z = vec![0.0; n];
+        let inputs = ReplayInputs {
+            name: "t".into(),
+            time_s: time_s.clone(),
+            speed_rpm: z.clone(),
+            current_a: z.clone(),
+            p_a_bar: z.clone(),
+            p_b_bar: z.clone(),
+            ambient_c: z,
+            position_mm: None,
+            air_speed_mps: None,
+            lng_valve: None,
+        };
+        let d = ReplayDrive::new(inputs);
+        let fresh = |t: f64| {
+            let i = time_s.partition_point(|&x| x <= t).clamp(1, n - 1) - 1;
+            (i, ((t - time_s[i]) / (time_s[i + 1] - time_s[i])).clamp(0.0, 1.0))
+        };
+        let ts = [-1.0, 0.0, 0.05, 0.1, 0.1, 0.15, 0.2, 0.55, 0.6, 1.9, 2.0, 3.0, 0.3, 0.0, 0.19, 2.5, 0.6, 0.59];
+        for t in ts {
+            assert_eq!(d.locate(t), fresh(t), "t = {t}");
         }
     }
 }

