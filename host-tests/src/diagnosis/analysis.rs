@@ -567,16 +567,21 @@ fn cross_correlations(run: &MeasuredRun, base: &SimSeries, max_lag_s: f64) -> Ve
     let regs = regressors(run, base);
     let dt = (run.time_s[run.len() - 1] - run.time_s[0]) / (run.len() - 1) as f64;
     let max_lag = ((max_lag_s / dt).round() as usize).min(run.len() / 3);
-    let mut out = Vec::new();
-    for ch in Channel::TEMPERATURES {
-        let Some(m) = run.get(ch) else { continue };
-        let Some(y) = base.channels.get(&ch) else { continue };
-        let r: Vec<Option<f64>> = m.iter().zip(y).map(|(m, y)| m.map(|m| y - m)).collect();
-        for (name, u) in &regs {
-            let cc = cross_correlation(&r, u, max_lag);
+    let residuals: Vec<(Channel, Vec<Option<f64>>)> = Channel::TEMPERATURES
+        .into_iter()
+        .filter_map(|ch| {
+            let (m, y) = (run.get(ch)?, base.channels.get(&ch)?);
+            Some((ch, m.iter().zip(y).map(|(m, y)| m.map(|m| y - m)).collect()))
+        })
+        .collect();
+    let pairs: Vec<(&(Channel, Vec<Option<f64>>), &(String, Vec<f64>))> =
+        residuals.iter().flat_map(|r| regs.iter().map(move |g| (r, g))).collect();
+    pairs
+        .par_iter()
+        .map(|((ch, r), (name, u))| {
+            let cc = cross_correlation(r, u, max_lag);
             let (k, peak) = cc.iter().enumerate().fold((0, 0.0f64), |b, (k, v)| if v.abs() > b.1.abs() { (k, *v) } else { b });
-            out.push(XCorr { channel: ch.name().into(), regressor: name.clone(), rho0: cc[0], peak_rho: peak, peak_lag_s: k as f64 * dt });
-        }
-    }
-    out
+            XCorr { channel: ch.name().into(), regressor: name.clone(), rho0: cc[0], peak_rho: peak, peak_lag_s: k as f64 * dt }
+        })
+        .collect()
 }
