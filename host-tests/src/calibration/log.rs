@@ -66,7 +66,7 @@ impl CalLog {
         let out = simulate_rtol(rig, &self.scenario, &self.opts, REPLAY_RTOL).map_err(|e| e.to_string())?;
         let mut s = Series::new();
         for &ch in &self.channels {
-            let v: Option<Vec<f64>> = self.run.time_s.iter().map(|&t| out.at(ch.name(), t)).collect();
+            let v = out.sample(ch.name(), &self.run.time_s);
             s.insert(ch, v.ok_or_else(|| format!("model has no channel {}", ch.name()))?);
         }
         Ok(s)
