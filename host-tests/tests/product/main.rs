@@ -4,8 +4,8 @@
 //!
 //! These run in real time (10 ms ticks of QEMU's virtual clock = wall
 //! time), so they are in the slow tier, as one test that runs the five
-//! scenarios at once, each in its own thread with its own QEMU (they mostly
-//! sleep): the slow tier waits ~125 s for them, not the sum. They are a
+//! short scenarios at once, each in its own thread with its own QEMU (they
+//! mostly sleep), then the 120 s closed loop alone: ~165 s. They are a
 //! test binary of their own so that no other test competes with them for
 //! the CPU (a host that answers late costs samples in real time). One
 //! scenario alone: `EHA_PRODUCT=hang cargo test --profile fast -p eha-sim
@@ -22,20 +22,28 @@ const SCENARIOS: [(&str, fn()); 6] = [
     ("params", parameter_block_in_flash_runs_its_rig_and_an_invalid_one_is_refused),
 ];
 
-/// Every product scenario in QEMU, concurrently; fails with the names and
-/// messages of the scenarios that failed.
+/// Every product scenario in QEMU; fails with the names and messages of the
+/// scenarios that failed. The short scenarios run concurrently, then the
+/// 120 s closed loop alone: beside the other five (a 40 KiB UART burst,
+/// reboots) its host harness missed 118 of 12 000 ticks on an idle 2-core
+/// machine, alone 17 (session 14; the bound is 1 %).
 #[test]
-#[ignore = "slow tier: ~125 s of real time in QEMU"]
+#[ignore = "slow tier: ~165 s of real time in QEMU"]
 fn product_image_in_qemu_over_the_uart() {
     require_qemu();
     product_elf().unwrap_or_else(|e| panic!("building eha-mps2: {e:#}"));
     let only = std::env::var("EHA_PRODUCT").ok();
-    let failed: Vec<String> = std::thread::scope(|sc| {
-        let handles: Vec<_> = SCENARIOS
-            .iter()
-            .filter(|(name, _)| only.as_deref().is_none_or(|o| o == *name))
-            .map(|(name, f)| (*name, sc.spawn(*f)))
-            .collect();
+    let selected = |name: &str| only.as_deref().is_none_or(|o| o == name);
+    let mut failed = run_concurrently(SCENARIOS.iter().filter(|(n, _)| *n != "fig15" && selected(n)));
+    failed.extend(run_concurrently(SCENARIOS.iter().filter(|(n, _)| *n == "fig15" && selected(n))));
+    assert!(failed.is_empty(), "product scenarios failed:\n{}", failed.join("\n"));
+}
+
+/// Runs `scenarios`, each in its own thread, and returns "name: message"
+/// of each that panicked.
+fn run_concurrently<'a>(scenarios: impl Iterator<Item = &'a (&'a str, fn())>) -> Vec<String> {
+    std::thread::scope(|sc| {
+        let handles: Vec<_> = scenarios.map(|(name, f)| (*name, sc.spawn(*f))).collect();
         handles
             .into_iter()
             .filter_map(|(name, h)| {
@@ -45,8 +53,7 @@ fn product_image_in_qemu_over_the_uart() {
                 })
             })
             .collect()
-    });
-    assert!(failed.is_empty(), "product scenarios failed:\n{}", failed.join("\n"));
+    })
 }
 
 use std::time::{Duration, Instant};
