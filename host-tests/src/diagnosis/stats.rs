@@ -140,7 +140,7 @@ pub fn cross_correlation(r: &[Option<f64>], u: &[f64], max_lag: usize) -> Vec<f6
     // The pairs of each lag are walked in place (a 30-minute log at 0.1 s
     // has 1200 lags of 18 k pairs per channel and regressor; collecting
     // them cost more than the diagnosis's model runs).
-    (0..=max_lag).map(|lag| pearson_of(|| (lag..r.len()).filter_map(move |i| Some((r[i]?, u[i.checked_sub(lag)?]))))).collect()
+    (0..=max_lag).map(|lag| pearson_of(|| (lag..r.len()).filter_map(move |i| Some((r[i]?, u[i - lag]))))).collect()
 }
 
 /// Pearson correlation of the pairs, 0 when either side is constant.

@@ -118,13 +118,7 @@ impl SimOutput {
     /// Value of a channel interpolated at `t`.
     pub fn at(&self, name: &str, t: f64) -> Option<f64> {
         let v = self.get(name)?;
-        let i = self.time_s.partition_point(|&x| x <= t);
-        match (i.checked_sub(1).and_then(|j| self.time_s.get(j).zip(v.get(j))), self.time_s.get(i).zip(v.get(i))) {
-            (Some((ta, a)), Some((tb, b))) => Some(a + (b - a) * (t - ta) / (tb - ta)),
-            (Some((_, a)), None) => Some(*a),
-            (None, Some((_, b))) => Some(*b),
-            (None, None) => None,
-        }
+        interpolate(&self.time_s, v, self.time_s.partition_point(|&x| x <= t), t)
     }
 
     /// Channel `name` interpolated at every time of `times` (ascending), as
@@ -134,26 +128,21 @@ impl SimOutput {
     pub fn sample(&self, name: &str, times: &[f64]) -> Option<Vec<f64>> {
         let v = self.get(name)?;
         let ts = &self.time_s;
-        if ts.is_empty() || v.len() != ts.len() {
-            return times.iter().map(|&t| self.at(name, t)).collect();
-        }
+        // i = the number of output times <= t, as `at`'s binary search gives.
         let mut i = 0;
-        let mut out = Vec::with_capacity(times.len());
-        for &t in times {
-            if i > 0 && ts[i - 1] > t {
-                // Not ascending: start the walk again.
-                i = 0;
-            }
-            while i < ts.len() && ts[i] <= t {
-                i += 1;
-            }
-            out.push(match (i.checked_sub(1), i < ts.len()) {
-                (Some(j), true) => v[j] + (v[i] - v[j]) * (t - ts[j]) / (ts[i] - ts[j]),
-                (Some(j), false) => v[j],
-                (None, _) => v[0],
-            });
-        }
-        Some(out)
+        times
+            .iter()
+            .map(|&t| {
+                if i > 0 && ts[i - 1] > t {
+                    // Not ascending: start the walk again.
+                    i = 0;
+                }
+                while i < ts.len() && ts[i] <= t {
+                    i += 1;
+                }
+                interpolate(ts, v, i, t)
+            })
+            .collect()
     }
 
     /// Write the run as CSV: the shared measured-data columns first (so any
@@ -178,6 +167,17 @@ impl SimOutput {
         }
         w.flush()?;
         Ok(())
+    }
+}
+
+/// Linear interpolation of `v` (sampled at `ts`) at `t`, where `i` is the
+/// number of `ts` at or before `t`; held at the ends.
+fn interpolate(ts: &[f64], v: &[f64], i: usize, t: f64) -> Option<f64> {
+    match (i.checked_sub(1).and_then(|j| ts.get(j).zip(v.get(j))), ts.get(i).zip(v.get(i))) {
+        (Some((ta, a)), Some((tb, b))) => Some(a + (b - a) * (t - ta) / (tb - ta)),
+        (Some((_, a)), None) => Some(*a),
+        (None, Some((_, b))) => Some(*b),
+        (None, None) => None,
     }
 }
 
