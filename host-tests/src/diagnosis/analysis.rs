@@ -4,6 +4,7 @@
 
 use super::adequacy::{assess, Adequacy, MisfitRule};
 use super::fit::{fit, FitOptions, FitResult, Point};
+use super::identify::{identifiable, HOUSING_OUTER_PREFIX};
 use super::model::{Candidate, SimSeries, Simulator};
 use super::regressors::regressors;
 use super::stats::{bias, bic, cross_correlation, ljung_box, max_abs, rmse, LjungBox};
@@ -176,49 +177,6 @@ pub struct RankEntry {
     /// Why the candidate cannot be named in this run whatever its fit
     /// (empty when it can): see [`identifiable`].
     pub note: String,
-}
-
-/// Whether the run carries the excitation that tells candidate `c` apart
-/// from an error in the nuisance physics; `Err(reason)` when it does not.
-///
-/// - `coulomb-friction` acts only through piston motion: without a moving
-///   `position_mm` it is identically zero.
-/// - `churning-loss` (∝ ω^2.5) at one shaft speed is a constant heat in
-///   the pump case, which a 20-minute run cannot tell from a pump capacity
-///   or conductance that differs from the rig file (measured: with per-node
-///   capacities off the baseline, a constant-speed run without churning
-///   was explained by a 100 W "churning" loss, 40 % pooled held-out gain).
-///   It needs the shaft speed on the training window to span at least 20 %
-///   of its maximum (5th to 95th percentile).
-pub fn identifiable(c: Candidate, run: &MeasuredRun, split: f64) -> Result<(), &'static str> {
-    let train = |ch: Channel| -> Vec<f64> {
-        run.get(ch).map_or(vec![], |v| {
-            v.iter().zip(&run.time_s).filter(|(_, t)| **t < split).filter_map(|(x, _)| *x).collect()
-        })
-    };
-    // 5th and 95th percentiles: the spin-up sample at t = 0 is not a
-    // speed change.
-    let span = |v: &[f64]| -> (f64, f64) {
-        if v.is_empty() {
-            return (0.0, 0.0);
-        }
-        let mut s = v.to_vec();
-        s.sort_by(f64::total_cmp);
-        let q = |p: f64| s[((s.len() - 1) as f64 * p).round() as usize];
-        (q(0.05), q(0.95))
-    };
-    match c {
-        Candidate::CoulombFriction => {
-            let (lo, hi) = span(&train(Channel::PositionMm));
-            if hi - lo > 1.0 { Ok(()) } else { Err("no piston motion logged") }
-        }
-        Candidate::ChurningLoss => {
-            let n: Vec<f64> = train(Channel::SpeedRpm).iter().map(|x| x.abs()).collect();
-            let (lo, hi) = span(&n);
-            if hi > 0.0 && hi - lo >= 0.2 * hi { Ok(()) } else { Err("shaft speed constant: churning not separable") }
-        }
-        _ => Ok(()),
-    }
 }
 
 /// Peak cross-correlation of one channel's residual with one regressor.
@@ -506,7 +464,9 @@ fn rank(
     m_before: &Metrics,
     fits: &[FitResult],
 ) -> (Vec<RankEntry>, Vec<Metrics>) {
-    let nuis_len = sim.nuisance().len();
+    let nuisance = sim.nuisance();
+    let nuis_len = nuisance.len();
+    let housing_outer_calibrated = nuisance.iter().any(|p| p.name.starts_with(HOUSING_OUTER_PREFIX));
     let bic_none = bic(base.rss, n, nuis_len);
     let mut ranking = vec![RankEntry {
         cause: "none".into(),
@@ -537,7 +497,7 @@ fn rank(
             }
         }
         let gain = if gain.is_finite() { gain } else { 0.0 };
-        let ident = identifiable(f.candidate, run, split);
+        let ident = identifiable(f.candidate, run, split, housing_outer_calibrated);
         let pooled_ok = m.heldout_rmse_k <= (1.0 - o.min_pooled_gain) * m_before.heldout_rmse_k;
         ranking.push(RankEntry {
             cause: f.candidate.name().into(),

@@ -7,6 +7,7 @@
 pub mod adequacy;
 pub mod analysis;
 pub mod fit;
+pub mod identify;
 pub mod model;
 pub mod plot;
 pub mod regressors;
