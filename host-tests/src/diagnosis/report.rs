@@ -1,7 +1,7 @@
 //! Writing a diagnosis: `diagnosis.json` (the machine-readable verdict with
 //! exactly the keys of issue 5) and `report.md` (the evidence, with PNGs).
 
-use super::analysis::{Diagnosis, Metrics};
+use super::analysis::{Diagnosis, Metrics, RankEntry};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -186,6 +186,21 @@ pub fn report_markdown(d: &Diagnosis, source: &str, pngs: &[String]) -> String {
             r.cause, r.bic, r.delta_bic, r.train_rmse_k, r.heldout_rmse_k, 100.0 * r.heldout_gain, r.gain_channel,
             if r.qualifies { "yes".to_string() } else if r.note.is_empty() { "no".to_string() } else { format!("no ({})", r.note) },
             p.join(", ")
+        );
+    }
+    let qualifying: Vec<&RankEntry> = d.ranking.iter().filter(|r| r.qualifies).collect();
+    if qualifying.len() > 1 {
+        let others: Vec<String> = qualifying
+            .iter()
+            .filter(|r| r.cause != d.cause.name())
+            .map(|r| format!("`{}` (held-out {:.3} K, ΔBIC {:.1})", r.cause, r.heldout_rmse_k, r.delta_bic))
+            .collect();
+        let _ = writeln!(
+            s,
+            "\n**More than one candidate qualifies.** Named: the one with the lowest held-out error; also qualifying: {}. \
+             This log does not separate them well: a run that excites where they differ (air-speed steps for \
+             forced convection, motor-only heating for conduction, speed steps for churning) would.",
+            others.join(", ")
         );
     }
     let _ = writeln!(s, "\n## Errors per channel\n");
