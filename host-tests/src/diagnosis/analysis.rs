@@ -543,14 +543,15 @@ fn cross_correlations(run: &MeasuredRun, base: &SimSeries, max_lag_s: f64) -> Ve
     let regs = regressors(run, base);
     let dt = (run.time_s[run.len() - 1] - run.time_s[0]) / (run.len() - 1) as f64;
     let max_lag = ((max_lag_s / dt).round() as usize).min(run.len() / 3);
-    let residuals: Vec<(Channel, Vec<Option<f64>>)> = Channel::TEMPERATURES
+    type Residual = (Channel, Vec<Option<f64>>);
+    let residuals: Vec<Residual> = Channel::TEMPERATURES
         .into_iter()
         .filter_map(|ch| {
             let (m, y) = (run.get(ch)?, base.channels.get(&ch)?);
             Some((ch, m.iter().zip(y).map(|(m, y)| m.map(|m| y - m)).collect()))
         })
         .collect();
-    let pairs: Vec<(&(Channel, Vec<Option<f64>>), &(String, Vec<f64>))> =
+    let pairs: Vec<(&Residual, &(String, Vec<f64>))> =
         residuals.iter().flat_map(|r| regs.iter().map(move |g| (r, g))).collect();
     pairs
         .par_iter()
