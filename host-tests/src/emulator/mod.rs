@@ -15,7 +15,11 @@
 //! - **Loss placement**: 20 % of the eq. (8) mechanical loss heats the port
 //!   plate metal directly (the reference: all into oil); iron loss drag is
 //!   in the logged current; the throttle hoses' eq. (10) loss heats the
-//!   loop oil, the needle's the ball-block oil.
+//!   loop oil, the needle's the ball-block oil. In the throttle runs the
+//!   oil obeys the first law: the pressure work's α·T share (α from the
+//!   emulator's own density law) heats the delivered oil on compression,
+//!   the needle, hoses and leakage get the (1 − α·T) rest (session 15;
+//!   before, the expansions took it all, as the paper's eqs. do).
 //! - **Correlations** ([`props`]): Churchill–Chu vertical + McAdams faces
 //!   for free convection, Churchill–Bernstein for the air flow, Churchill's
 //!   Nu³ mixing; Hausen/Gnielinski duct films; a rotating-cylinder film for

@@ -35,6 +35,12 @@ pub fn oil_rho(t_c: f64) -> f64 {
     RHO15 / (1.0 + BETA_OIL * (t_c - 15.0))
 }
 
+/// Volumetric thermal expansion coefficient α = −(1/ρ)·dρ/dT of the
+/// density law [`oil_rho`], 1/K.
+pub fn oil_alpha(t_c: f64) -> f64 {
+    BETA_OIL / (1.0 + BETA_OIL * (t_c - 15.0))
+}
+
 /// Oil specific heat by Cragoe, c = (1.684 + 0.00339·T[°C]) / √s kJ/(kg·K),
 /// s the specific gravity at 15 °C; J/(kg·K).
 pub fn oil_cp(t_c: f64) -> f64 {

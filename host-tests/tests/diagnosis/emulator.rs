@@ -67,7 +67,9 @@ fn emulator_none_case1_log_is_none() {
 
 /// Dead-end oil sensor (τ 203 s hidden) on a Case 1 log (seed 1704):
 /// named, t_oil_c held out 0.60 → 0.24 K (61 %) measured with the physical
-/// set (1.40 → 0.10 K, 93 %, with the global multipliers).
+/// set (1.40 → 0.10 K, 93 %, with the global multipliers); 0.53 → 0.25 K
+/// (52 %, just over the bar) since the emulator's compression heat
+/// (session 15).
 #[test]
 #[ignore = "slow tier: emulator case"]
 fn slow_emulator_sensor_lag_is_named() {
@@ -75,7 +77,8 @@ fn slow_emulator_sensor_lag_is_named() {
 }
 
 /// Motor–pump conduction (4.0 W/K) on a Case 1 log (seed 1710): named,
-/// t_pump_c held out 0.70 → 0.26 K (63 %, measured), in the global tier.
+/// t_pump_c held out 0.70 → 0.26 K (63 %, measured; 0.70 → 0.31 K, 56 %,
+/// with the emulator's compression heat), in the global tier.
 /// Forced convection qualifies too, with the lower BIC (ΔBIC 208 against
 /// 172) but the higher pooled held-out error (0.297 against 0.272 K): until
 /// session 15 the lower BIC was named, a wrong answer; the qualifying
@@ -102,7 +105,8 @@ fn slow_emulator_conduction_is_named_over_a_qualifying_forced_convection() {
 /// 50 % bar (49 % against the single-start baseline before; 95 % before
 /// issue 16). Since the replay tolerances (session 14) the best candidate
 /// is sensor lag, not churning (measured; churning was best by ΔBIC 56),
-/// and t_pump_c calibrates to 0.34 K. Asserted: `none`, the best candidate
+/// and t_pump_c calibrates to 0.34 K (0.30 K with the emulator's
+/// compression heat, session 15). Asserted: `none`, the best candidate
 /// does not qualify, t_pump_c calibrated ≤ 0.35 K held out.
 #[test]
 #[ignore = "slow tier: emulator case, measured miss"]
@@ -112,12 +116,13 @@ fn slow_emulator_churning_measured_miss() {
     let (name, _, _, qualifies) = r.best_candidate.clone().expect("a best candidate");
     assert!(!qualifies, "best candidate {name} qualifies (measured: sensor-lag, not qualifying)");
     let (before, _) = r.affected_heldout_k.expect("affected channel");
-    assert!(before <= 0.35, "t_pump_c calibrated held-out {before:.3} K (measured 0.34)");
+    assert!(before <= 0.35, "t_pump_c calibrated held-out {before:.3} K (measured 0.30)");
 }
 
 /// Viscosity in load cycles (seed 1702): named with t_oil_c held out
 /// 7.48 → 1.30 K (83 %) measured with the physical set (46 %, under the
-/// 50 % bar, with the global multipliers).
+/// 50 % bar, with the global multipliers); 5.82 → 1.68 K (71 %) since the
+/// emulator's compression heat (session 15).
 #[test]
 #[ignore = "slow tier: emulator case"]
 fn slow_emulator_viscosity_is_named() {
@@ -130,12 +135,15 @@ fn slow_emulator_viscosity_is_named() {
 /// 3.21 K before the physical set) and t_pump_c 1.49 K, t_oil_c 1.05 K
 /// held out, over the physical tier's 1 K misfit bound (session 12; `none`
 /// under the 3 K bound before): the emulator, written from the paper, has
-/// no compression heat and no no-load or viscous pump friction, which the
-/// reference now has, and at 70–100 bar that structural difference shows
-/// (asserted as measured, ≤ 0.9 K pooled); the hidden forced convection
+/// no no-load or viscous pump friction, which the reference now has, and
+/// at 70–100 bar that structural difference shows (asserted as measured,
+/// ≤ 0.9 K pooled). With compression heat added to the emulator (session
+/// 15; the other suspected cause) it stays `unexplained`: pooled 0.75 K,
+/// t_pump_c 1.08 K, t_oil_c 1.05 K. The hidden forced convection
 /// (7.9 m/s) on a Case 1 log (seed 1712) is answered `none` since issue 16
 /// (before: named with a 1 % gain on t_pump_c): the calibrated baseline
-/// fits every channel to 1–2σ (pooled held-out 0.12 K, t_pump_c 0.13 K),
+/// fits every channel to 1–3σ (pooled held-out 0.12 K, t_pump_c 0.13 K;
+/// 0.16 and 0.13 K with the emulator's compression heat),
 /// the ram-air share of the pump housing and `h_out_pump` having taken the
 /// imprint up — a miss, not a false discovery, asserted as measured.
 #[test]
@@ -143,12 +151,12 @@ fn slow_emulator_viscosity_is_named() {
 fn slow_emulator_former_unexplained_answers() {
     let a = run(case("none", LoadCycles, 1715));
     assert_eq!(a.answer, "unexplained", "measured outcome changed");
-    assert!(a.pooled_heldout_k[1] <= 0.9, "pooled {:.2} K (measured 0.86)", a.pooled_heldout_k[1]);
+    assert!(a.pooled_heldout_k[1] <= 0.9, "pooled {:.2} K (measured 0.75)", a.pooled_heldout_k[1]);
     let misfit: Vec<&str> = misfits(&a).iter().map(|m| m.0).collect();
-    assert_eq!(misfit, ["t_pump_c", "t_oil_c"], "misfitting channels (measured 1.49 and 1.05 K held out)");
+    assert_eq!(misfit, ["t_pump_c", "t_oil_c"], "misfitting channels (measured 1.08 and 1.05 K held out)");
     let b = run(case("forced-convection", ConstantThrottle, 1712));
     assert_eq!(b.answer, "none", "measured outcome changed");
-    assert!(b.pooled_heldout_k[1] <= 0.2, "pooled {:.2} K (measured 0.12)", b.pooled_heldout_k[1]);
+    assert!(b.pooled_heldout_k[1] <= 0.2, "pooled {:.2} K (measured 0.16)", b.pooled_heldout_k[1]);
 }
 
 /// The speed-step `none` log (seed 1716): no discovery. In session 12 it
@@ -159,14 +167,14 @@ fn slow_emulator_former_unexplained_answers() {
 /// (session 13) the baseline
 /// fits to 0.21 K pooled held-out and conduction no longer qualifies
 /// (measured ΔBIC 16). Asserted: `none`, calibrated pooled ≤ 0.25 K (the
-/// noise is 0.1 K; measured 0.213 K), the best candidate not qualifying.
+/// noise is 0.1 K; measured 0.213 K; 0.22 K with the emulator's compression heat), the best candidate not qualifying.
 #[test]
 #[ignore = "slow tier: emulator case, former false discovery"]
 fn slow_emulator_speed_steps_none_log_is_no_discovery() {
     let r = run(case("none", SpeedSteps, 1716));
     assert_eq!(r.answer, "none", "measured outcome changed");
     let calibrated = r.pooled_heldout_k[1];
-    assert!(calibrated <= 0.25, "calibrated pooled held-out {calibrated:.3} K (measured 0.213)");
+    assert!(calibrated <= 0.25, "calibrated pooled held-out {calibrated:.3} K (measured 0.22)");
     assert!(r.best_candidate.as_ref().is_none_or(|b| !b.3), "best candidate qualifies: {:?}", r.best_candidate);
 }
 
@@ -179,7 +187,8 @@ fn slow_emulator_speed_steps_none_log_is_no_discovery() {
 /// and t_oil_c still misfits by 1.29 K: `unexplained`, with that channel
 /// named. Still a miss of the hidden cause (measured), but no longer
 /// `none` next to a misfit. Since the replay tolerances (session 14) the
-/// physical set leaves t_motor_c at 0.69 K (8σ) too: both are reported.
+/// physical set left t_motor_c at 0.69 K (8σ) too; since the emulator's
+/// compression heat (session 15) only t_oil_c misfits (1.20 K measured).
 #[test]
 #[ignore = "slow tier: emulator case, measured miss"]
 fn slow_emulator_misfit_is_not_answered_none() {
@@ -187,6 +196,6 @@ fn slow_emulator_misfit_is_not_answered_none() {
     assert_eq!(r.answer, "unexplained", "measured outcome changed");
     let misfit = misfits(&r);
     let names: Vec<&str> = misfit.iter().map(|m| m.0).collect();
-    assert_eq!(names, ["t_motor_c", "t_oil_c"], "misfitting channels {misfit:?} (measured t_motor_c 0.69, t_oil_c 1.25 K)");
-    assert!(misfit[1].1 > 1.0, "misfit {misfit:?} (measured t_oil_c 1.25 K)");
+    assert_eq!(names, ["t_oil_c"], "misfitting channels {misfit:?} (measured t_oil_c 1.20 K)");
+    assert!(misfit[0].1 > 1.0, "misfit {misfit:?} (measured t_oil_c 1.20 K)");
 }
