@@ -261,22 +261,18 @@ impl Plant<'_> {
         acc.q[N::PortOil as usize] += ms_oil * mech;
         acc.q[N::EndCap as usize] += ms_metal * mech;
         let churn = self.mag(Candidate::ChurningLoss).map_or(0.0, |k| k * o.omega.abs().powf(2.5));
-        // Leakage throttles from the delivery pressure to the case: in the
-        // throttle runs its α·T share was already taken as compression heat
-        // of the delivered flow (below).
-        let leak_share = if self.m.scenario.is_servo() { 1.0 } else { 1.0 - props::oil_alpha(tn(N::PortOil)) * (tn(N::PortOil) + 273.15) };
-        acc.q[N::CaseOil as usize] += ms_case * mech + leak_share * o.q_leak * (o.p_a.max(o.p_b) - p.boost_pa) + churn;
+        // First law for the oil in the throttle runs: the pump's pressure
+        // work on the delivered flow heats it by α·T per unit of work
+        // (compression); the leakage, the needle and the hoses return the
+        // rest, (1 − α·T), on expansion. One α·T (at the port oil) for all
+        // four keeps the total at Δp·Q. Servo runs: all on expansion.
+        let at = if self.m.scenario.is_servo() { 0.0 } else { props::oil_alpha(tn(N::PortOil)) * (tn(N::PortOil) + 273.15) };
+        acc.q[N::CaseOil as usize] += ms_case * mech + (1.0 - at) * o.q_leak * (o.p_a.max(o.p_b) - p.boost_pa) + churn;
         if self.m.scenario.is_servo() {
             let coul = self.mag(Candidate::CoulombFriction).map_or(0.0, |f| f * (o.v / 1e-3).tanh() * o.v);
             acc.q[N::Cylinder as usize] += p.seal_viscous * o.v * o.v + coul;
             acc.q[N::CylOil as usize] += p.act_leak * dp * dp;
         } else {
-            // First law for the oil: the pump's pressure work on the
-            // delivered flow heats it by α·T per unit of work (compression),
-            // the throttle, the hoses and the leakage return the rest,
-            // (1 − α·T), on expansion. One α·T (at the port oil) for all
-            // four keeps the total at Δp·Q.
-            let at = props::oil_alpha(tn(N::PortOil)) * (tn(N::PortOil) + 273.15);
             let hose = self.hose_dp(o.q_path, tn(N::LoopOil)) * o.q_path;
             acc.q[N::PortOil as usize] += at * dp * (o.q_path + o.q_leak);
             acc.q[N::LoopOil as usize] += (1.0 - at) * hose;
