@@ -42,10 +42,22 @@ pub struct ParamDef {
     pub needs: Needs,
     /// The excitation that identifies it (shown when it is held).
     pub excitation: &'static str,
+    /// Fit stage ([`Stage`]).
+    pub stage: Stage,
+}
+
+/// When a parameter joins the fit: the thermal network first, the sensor
+/// responses on top of it (`calibration::calibrate`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Stage {
+    /// Heat paths, capacities and losses.
+    Thermal,
+    /// A sensor's own response time.
+    SensorResponse,
 }
 
 /// The calibration set, in fit order.
-pub const PARAMS: [ParamDef; 19] = [
+pub const PARAMS: [ParamDef; 20] = [
     ParamDef {
         name: "h_out_motor",
         what: "outer heat transfer of the motor housing (free convection + radiation)",
@@ -54,6 +66,7 @@ pub const PARAMS: [ParamDef; 19] = [
         why: "still-air h of painted housings is 3–15 W/(m²·K) against the correlation's 6–9; exposed area 50–100 % of Table 2's",
         needs: Needs::Sensor(Channel::TMotorC),
         excitation: "a long soak (> 20 min) with the motor loaded, then a cool-down with the shaft stopped",
+        stage: Stage::Thermal,
     },
     ParamDef {
         name: "h_out_pump",
@@ -63,6 +76,7 @@ pub const PARAMS: [ParamDef; 19] = [
         why: "as h_out_motor; the pump's mounting can shield or add area",
         needs: Needs::Sensor(Channel::TPumpC),
         excitation: "a soak to near steady state and a cool-down at 0 rpm",
+        stage: Stage::Thermal,
     },
     ParamDef {
         name: "h_out_main_block",
@@ -72,6 +86,7 @@ pub const PARAMS: [ParamDef; 19] = [
         why: "Table 2 gives 0.44 m² for both blocks; the split and the exposed fraction are assumed",
         needs: Needs::Sensor(Channel::TBlockC),
         excitation: "a long soak (the main block's time constant is hours) and a cool-down",
+        stage: Stage::Thermal,
     },
     ParamDef {
         name: "h_out_ball_block",
@@ -81,6 +96,7 @@ pub const PARAMS: [ParamDef; 19] = [
         why: "split of Table 2's block area assumed",
         needs: Needs::Sensor(Channel::TBallvalveC),
         excitation: "throttling through the needle for > 20 min, then a cool-down",
+        stage: Stage::Thermal,
     },
     ParamDef {
         name: "film_loop",
@@ -90,6 +106,7 @@ pub const PARAMS: [ParamDef; 19] = [
         why: "duct correlations scatter ±30 %; the wetted area of drilled passages is unknown within a factor 3",
         needs: Needs::Sensor(Channel::TBlockC),
         excitation: "flow steps (shaft speed) while the oil is tens of kelvin above the block",
+        stage: Stage::Thermal,
     },
     ParamDef {
         name: "film_port",
@@ -99,6 +116,7 @@ pub const PARAMS: [ParamDef; 19] = [
         why: "port geometry assumed",
         needs: Needs::Sensor(Channel::TPumpC),
         excitation: "speed steps at a constant pressure drop",
+        stage: Stage::Thermal,
     },
     ParamDef {
         name: "film_ball",
@@ -108,6 +126,7 @@ pub const PARAMS: [ParamDef; 19] = [
         why: "ball-block passage geometry assumed",
         needs: Needs::Sensor(Channel::TBallvalveC),
         excitation: "needle throttling at several flows",
+        stage: Stage::Thermal,
     },
     ParamDef {
         name: "film_case",
@@ -117,6 +136,7 @@ pub const PARAMS: [ParamDef; 19] = [
         why: "the case flow is a rotating-cylinder flow the duct correlation only approximates; wetted area calibrated on one rig",
         needs: Needs::Sensor(Channel::TPumpC),
         excitation: "speed steps with a drain thermocouple (t_drain_c) or a pump-surface sensor",
+        stage: Stage::Thermal,
     },
     ParamDef {
         name: "cap_motor",
@@ -126,6 +146,7 @@ pub const PARAMS: [ParamDef; 19] = [
         why: "Table 2 gives the total mass; the part that follows the surface sensor within minutes is 50–100 %",
         needs: Needs::Sensor(Channel::TMotorC),
         excitation: "load steps: the motor's heating rate right after a current step",
+        stage: Stage::Thermal,
     },
     ParamDef {
         name: "cap_pump",
@@ -135,6 +156,7 @@ pub const PARAMS: [ParamDef; 19] = [
         why: "Table 2 mass; participating fraction and cp (steel/aluminium) uncertain",
         needs: Needs::Sensor(Channel::TPumpC),
         excitation: "pressure or speed steps: the pump's heating rate after a step",
+        stage: Stage::Thermal,
     },
     ParamDef {
         name: "cap_main_block",
@@ -144,6 +166,7 @@ pub const PARAMS: [ParamDef; 19] = [
         why: "split of Table 2's 190 kg assumed",
         needs: Needs::Sensor(Channel::TBlockC),
         excitation: "a load step held for > 20 min",
+        stage: Stage::Thermal,
     },
     ParamDef {
         name: "cap_ball_block",
@@ -153,6 +176,7 @@ pub const PARAMS: [ParamDef; 19] = [
         why: "split of Table 2's 190 kg assumed",
         needs: Needs::Sensor(Channel::TBallvalveC),
         excitation: "needle pressure steps",
+        stage: Stage::Thermal,
     },
     ParamDef {
         name: "cap_loop_oil",
@@ -162,6 +186,7 @@ pub const PARAMS: [ParamDef; 19] = [
         why: "hose lengths and accumulator volume differ between rigs",
         needs: Needs::Sensor(Channel::TOilC),
         excitation: "load steps: the oil sensor's rate right after a step",
+        stage: Stage::Thermal,
     },
     ParamDef {
         name: "cap_case_oil",
@@ -171,6 +196,17 @@ pub const PARAMS: [ParamDef; 19] = [
         why: "pump design; not in the paper",
         needs: Needs::Sensor(Channel::TDrainC),
         excitation: "a drain thermocouple (t_drain_c) and pressure steps",
+        stage: Stage::Thermal,
+    },
+    ParamDef {
+        name: "probe_oil",
+        what: "response time of the manifold oil probe in the flowing oil (thermowell, sheath)",
+        fields: "blocks.sensor_tau_s",
+        lo: 0.25, hi: 5.0, prior_sigma_ln: 1.0,
+        why: "sheathed probes in thermowells in flowing oil answer in 1–20 s (t63); the rig file's 2 s is assumed. Longer lags belong to a dead-end pocket (candidate sensor-lag)",
+        needs: Needs::Sensor(Channel::TOilC),
+        excitation: "load or speed steps: the oil channel's delay right after a step",
+        stage: Stage::SensorResponse,
     },
     ParamDef {
         name: "pump_friction",
@@ -180,6 +216,7 @@ pub const PARAMS: [ParamDef; 19] = [
         why: "hydro-mechanical efficiency 70–95 % (the rig file's η_m 0.28 is calibrated on one rig)",
         needs: Needs::Nothing,
         excitation: "pressure steps at constant speed and speed steps at constant pressure (separates it from leakage)",
+        stage: Stage::Thermal,
     },
     ParamDef {
         name: "leak_gap",
@@ -189,6 +226,7 @@ pub const PARAMS: [ParamDef; 19] = [
         why: "gaps of 4–30 µm for the rig file's 12 µm",
         needs: Needs::Nothing,
         excitation: "pressure steps at a low speed (leakage heat ∝ Δp² does not scale with ω)",
+        stage: Stage::Thermal,
     },
     ParamDef {
         name: "winding_r",
@@ -198,6 +236,7 @@ pub const PARAMS: [ParamDef; 19] = [
         why: "Table 2 gives 0.074 Ω; cables, connectors and the measurement temperature move it by tens of %",
         needs: Needs::Nothing,
         excitation: "current steps (pressure steps) with the motor sensor logged; or measure R with a 4-wire meter",
+        stage: Stage::Thermal,
     },
     ParamDef {
         name: "iron_loss",
@@ -207,6 +246,7 @@ pub const PARAMS: [ParamDef; 19] = [
         why: "Bertotti coefficients of electrical steels span an order of magnitude; not in the paper",
         needs: Needs::Nothing,
         excitation: "speed steps at a low pressure drop (iron loss follows ω, copper loss the current)",
+        stage: Stage::Thermal,
     },
     ParamDef {
         name: "needle_split",
@@ -216,6 +256,7 @@ pub const PARAMS: [ParamDef; 19] = [
         why: "hose lengths and fittings of the throttle path are assumed",
         needs: Needs::Sensor(Channel::TBallvalveC),
         excitation: "needle throttling at several flows (line loss ∝ q², needle heat = the rest)",
+        stage: Stage::Thermal,
     },
 ];
 
@@ -254,6 +295,7 @@ pub fn apply(base: &Rig, theta: &[f64]) -> Rig {
             "cap_ball_block" => r.blocks.ball_mass_kg *= t,
             "cap_loop_oil" => r.blocks.loop_oil_m3 *= t,
             "cap_case_oil" => r.pump.case_oil_m3 *= t,
+            "probe_oil" => r.blocks.sensor_tau_s *= t,
             // REMAP at merge: the new pump loss torque T0 + C_v·μ·ω + C_p·Δp.
             "pump_friction" => {
                 r.pump.eta_m *= t;

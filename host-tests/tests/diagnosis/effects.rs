@@ -109,7 +109,9 @@ use SynthScenario::{
 /// error control of before; with both tolerances ten times tighter it is
 /// answered `none`: this case's gain is within what the integration error
 /// moves (docs/diagnosis.md, "Replay tolerances"). The named sensor lags
-/// with ≥ 50 % are seed 32 (slow tier) and the worked example (seed 5).
+/// with ≥ 50 % are the worked example (seed 5) and the emulator's 1704 and
+/// 1705; seed 32 (slow tier) gains 29 % since the probe response time.
+/// Since then (session 16) this case gains −38 % on t_oil_c.
 #[test]
 fn hidden_sensor_lag_is_named_measured_low_gain() {
     check_miss(&[(case("sensor-lag", Case1Pressure, Nuisance, 31), "sensor-lag", Some(0.5))]);
@@ -189,7 +191,6 @@ fn no_hidden_effect_gives_none_when_structure_differs() {
 #[ignore = "slow tier: second scenario per candidate"]
 fn slow_second_scenario_per_candidate_is_named() {
     check(&[
-        case("sensor-lag", ThrottleSteps, Structure, 32),
         case("winding-resistance-temperature", ThrottleSteps, Structure, 12),
         case("viscosity-temperature", LoadCycles, Structure, 22),
         case("viscosity-temperature", PressureSpeedSteps, Nuisance, 25),
@@ -200,6 +201,12 @@ fn slow_second_scenario_per_candidate_is_named() {
     // logged ram-air steps (seed 71) is named, t_pump_c held out
     // 0.274 → 0.176 K pooled, 41 % on t_pump_c (77 % before), under the bar.
     check_miss(&[(case("forced-convection", AirSteps, Nuisance, 71), "forced-convection", Some(0.5))]);
+    // Measured since the oil probe's response time joined the physical set
+    // (session 16): the 185 s dead-end pocket (seed 32) is named (ΔBIC 1500,
+    // pooled held out 0.32 → 0.19 K), but the calibrated baseline's probe
+    // (up to 10 s) already takes up part of the lag: t_oil_c gains 29 %
+    // (68 % against the baseline without a probe), under the bar.
+    check_miss(&[(case("sensor-lag", ThrottleSteps, Structure, 32), "sensor-lag", Some(0.5))]);
 }
 
 /// Measured miss since issue 16's pump energy balance: the motor → pump

@@ -8,8 +8,8 @@
 //!
 //! Fast tier: a `none` Case 1 log answered `none` (~10 s); slow tier
 //! (`--ignored`): three named effects, a measured churning miss, two formerly
-//! `unexplained` logs, the former false discovery (now `none`) and a
-//! misfit that is no longer answered `none`.
+//! `unexplained` logs, the former false discovery (now `none`) and the
+//! conduction that the physical set absorbs.
 //! Each case is one 1200 s throttle log at 2 s, 6–20 s to diagnose.
 
 use eha_sim::diagnosis::emu_sweep::{run_emu_case, EmuResult};
@@ -106,8 +106,11 @@ fn slow_emulator_conduction_is_named_over_a_qualifying_forced_convection() {
 /// issue 16). Since the replay tolerances (session 14) the best candidate
 /// is sensor lag, not churning (measured; churning was best by ΔBIC 56),
 /// and t_pump_c calibrates to 0.34 K (0.30 K with the emulator's
-/// compression heat, session 15). Asserted: `none`, the best candidate
-/// does not qualify, t_pump_c calibrated ≤ 0.35 K held out.
+/// compression heat, session 15; 0.36 K since the oil probe's response
+/// time joined the physical set, session 16). Asserted: `none`, the best
+/// candidate does not qualify, t_pump_c calibrated ≤ 0.4 K held out (4σ of
+/// the 0.1 K noise: the 8.7 K churning imprint is absorbed, not missed by a
+/// misfit).
 #[test]
 #[ignore = "slow tier: emulator case, measured miss"]
 fn slow_emulator_churning_measured_miss() {
@@ -116,7 +119,7 @@ fn slow_emulator_churning_measured_miss() {
     let (name, _, _, qualifies) = r.best_candidate.clone().expect("a best candidate");
     assert!(!qualifies, "best candidate {name} qualifies (measured: sensor-lag, not qualifying)");
     let (before, _) = r.affected_heldout_k.expect("affected channel");
-    assert!(before <= 0.35, "t_pump_c calibrated held-out {before:.3} K (measured 0.30)");
+    assert!(before <= 0.4, "t_pump_c calibrated held-out {before:.3} K (measured 0.36)");
 }
 
 /// Viscosity in load cycles (seed 1702): named with t_oil_c held out
@@ -129,34 +132,30 @@ fn slow_emulator_viscosity_is_named() {
     assert_named(&run(case("viscosity-temperature", LoadCycles, 1702)));
 }
 
-/// Measured outcomes after the escalation to the physical set: the
-/// load-cycle `none` log (seed 1715) is `unexplained` (no discovery) with a
-/// pooled calibrated held-out RMSE of 0.86 K (0.35 K before issue 16,
-/// 3.21 K before the physical set) and t_pump_c 1.49 K, t_oil_c 1.05 K
-/// held out, over the physical tier's 1 K misfit bound (session 12; `none`
-/// under the 3 K bound before): the emulator, written from the paper, has
-/// no no-load or viscous pump friction, which the reference now has, and
-/// at 70–100 bar that structural difference shows (asserted as measured,
-/// ≤ 0.9 K pooled). With compression heat added to the emulator (session
-/// 15; the other suspected cause) it stays `unexplained`: pooled 0.75 K,
-/// t_pump_c 1.08 K, t_oil_c 1.05 K. The hidden forced convection
-/// (7.9 m/s) on a Case 1 log (seed 1712) is answered `none` since issue 16
-/// (before: named with a 1 % gain on t_pump_c): the calibrated baseline
-/// fits every channel to 1–3σ (pooled held-out 0.12 K, t_pump_c 0.13 K;
-/// 0.16 and 0.13 K with the emulator's compression heat),
+/// Measured outcomes of two formerly `unexplained` logs. The load-cycle
+/// `none` log (seed 1715) was `unexplained` from session 12 to 15 (pooled
+/// calibrated held-out 0.75–0.86 K, t_pump_c 1.08–1.49 K and t_oil_c
+/// 1.05 K over the physical tier's 1 K misfit bound); neither the
+/// emulator's compression heat (session 15) nor its missing no-load
+/// friction was the cause: the emulator's oil thermowell answers in 6 s,
+/// the reference's probe in 2 s. With the probe's response time in the
+/// physical set (session 16) it is `none`: pooled 0.42 K, no channel
+/// misfits (asserted ≤ 0.5 K: 5σ of the 0.1 K noise). The hidden forced
+/// convection (7.9 m/s) on a Case 1 log (seed 1712) is answered `none`
+/// since issue 16 (before: named with a 1 % gain on t_pump_c): the
+/// calibrated baseline fits every channel to 1–3σ (pooled held-out 0.15 K),
 /// the ram-air share of the pump housing and `h_out_pump` having taken the
 /// imprint up — a miss, not a false discovery, asserted as measured.
 #[test]
 #[ignore = "slow tier: emulator cases, measured shortfall"]
 fn slow_emulator_former_unexplained_answers() {
     let a = run(case("none", LoadCycles, 1715));
-    assert_eq!(a.answer, "unexplained", "measured outcome changed");
-    assert!(a.pooled_heldout_k[1] <= 0.9, "pooled {:.2} K (measured 0.75)", a.pooled_heldout_k[1]);
-    let misfit: Vec<&str> = misfits(&a).iter().map(|m| m.0).collect();
-    assert_eq!(misfit, ["t_pump_c", "t_oil_c"], "misfitting channels (measured 1.08 and 1.05 K held out)");
+    assert_eq!(a.answer, "none", "measured outcome changed");
+    assert!(a.pooled_heldout_k[1] <= 0.5, "pooled {:.2} K (measured 0.42)", a.pooled_heldout_k[1]);
+    assert!(misfits(&a).is_empty(), "misfitting channels {:?} (measured none)", misfits(&a));
     let b = run(case("forced-convection", ConstantThrottle, 1712));
     assert_eq!(b.answer, "none", "measured outcome changed");
-    assert!(b.pooled_heldout_k[1] <= 0.2, "pooled {:.2} K (measured 0.16)", b.pooled_heldout_k[1]);
+    assert!(b.pooled_heldout_k[1] <= 0.2, "pooled {:.2} K (measured 0.15)", b.pooled_heldout_k[1]);
 }
 
 /// The speed-step `none` log (seed 1716): no discovery. In session 12 it
@@ -181,21 +180,21 @@ fn slow_emulator_speed_steps_none_log_is_no_discovery() {
 /// Motor–pump conduction (5.3 W/K) in load cycles (seed 1711): `none`
 /// before session 13 next to a 2.66 K held-out misfit of t_pump_c, because
 /// the global baseline passed the loose rule (30 % of the rise or 3 K) and
-/// the diagnosis never escalated. With the late escalation (nothing named
-/// and the strict rule failing: 5σ and 10 % of the rise or 1 K) the
-/// physical set takes t_pump_c to 0.71 K held out, no candidate qualifies
-/// and t_oil_c still misfits by 1.29 K: `unexplained`, with that channel
-/// named. Still a miss of the hidden cause (measured), but no longer
-/// `none` next to a misfit. Since the replay tolerances (session 14) the
-/// physical set left t_motor_c at 0.69 K (8σ) too; since the emulator's
-/// compression heat (session 15) only t_oil_c misfits (1.20 K measured).
+/// the diagnosis never escalated. With the late escalation (session 13) the
+/// physical set took t_pump_c to 0.5–0.7 K held out, no candidate
+/// qualified and t_oil_c still misfit by 1.2–1.3 K: `unexplained`. That
+/// oil misfit was the emulator's 6 s oil thermowell: with the probe's
+/// response time in the physical set (session 16) no channel misfits
+/// (pooled 0.57 K, t_oil_c 0.78 K, t_pump_c 0.52 K held out) and the
+/// answer is `none`. A miss of the hidden cause, measured: the per-housing
+/// outer transfer and films absorb the 5.95 K conduction imprint to 4σ on
+/// t_pump_c, and conduction does not qualify. Not `none` next to a misfit:
+/// asserted that no channel misfits and pooled ≤ 0.65 K.
 #[test]
 #[ignore = "slow tier: emulator case, measured miss"]
-fn slow_emulator_misfit_is_not_answered_none() {
+fn slow_emulator_conduction_in_load_cycles_is_absorbed() {
     let r = run(case("motor-pump-conduction", LoadCycles, 1711));
-    assert_eq!(r.answer, "unexplained", "measured outcome changed");
-    let misfit = misfits(&r);
-    let names: Vec<&str> = misfit.iter().map(|m| m.0).collect();
-    assert_eq!(names, ["t_oil_c"], "misfitting channels {misfit:?} (measured t_oil_c 1.20 K)");
-    assert!(misfit[0].1 > 1.0, "misfit {misfit:?} (measured t_oil_c 1.20 K)");
+    assert_eq!(r.answer, "none", "measured outcome changed");
+    assert!(misfits(&r).is_empty(), "misfitting channels {:?} (measured none)", misfits(&r));
+    assert!(r.pooled_heldout_k[1] <= 0.65, "pooled {:.2} K (measured 0.57)", r.pooled_heldout_k[1]);
 }
