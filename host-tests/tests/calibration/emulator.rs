@@ -26,7 +26,8 @@ fn pooled(e: &[eha_sim::calibration::ChannelError]) -> f64 {
 }
 
 /// Measured (one run, ~7 s, 1212 model runs; session 15, the emulator with
-/// compression heat): pooled held-out RMSE 8.08 → 0.41 K (t_oil_c 16.1 →
+/// compression heat; session 16 with the probe fitted and the staged fit:
+/// 1282 runs, 0.41 K): pooled held-out RMSE 8.08 → 0.41 K (t_oil_c 16.1 →
 /// 0.44 K, the other channels 1.1–7.0 → 0.24–0.54 K); `film_case` 9.82
 /// where the emulator's case-oil wetted area is ×5.3 (with another film
 /// correlation); `pump_friction` 0.101 with `leak_gap`
@@ -39,7 +40,11 @@ fn emulator_machine_held_out_error_falls() {
     let train = [emu_log(&p, EmuScenario::LoadCycles, 41), emu_log(&p, EmuScenario::SpeedSteps, 42)];
     let hold = emu_log(&p, EmuScenario::PressureSpeedSteps, 43);
     let base = Rig::default();
-    let c = calibrate(&base, &train, &CalOptions::default()).expect("calibration");
+    // The emulator's oil probe lags (a 6 s thermowell against the rig
+    // file's 2 s): its response time is fitted too (`--fit-oil-probe`),
+    // which exercises the staged fit (thermal network first).
+    let o = CalOptions { hold: Vec::new(), ..CalOptions::default() };
+    let c = calibrate(&base, &train, &o).expect("calibration");
     for q in &c.params {
         eprintln!("{:18} {:6.3} {:?}{}", q.name, q.value, q.status, if q.at_bound { " (bound)" } else { "" });
     }
@@ -69,4 +74,9 @@ fn emulator_machine_held_out_error_falls() {
     let k = eha_sim::calibration::set::index("leak_gap").expect("leak_gap");
     eprintln!("pump_friction {:.3}, leak_gap {:.3} at bound {}", v("pump_friction"), v("leak_gap"), c.params[k].at_bound);
     assert!((v("pump_friction") / 0.105).ln().abs() <= 0.3, "pump_friction {:.3}", v("pump_friction"));
+    // The probe is fitted, not held; its value is not asserted: measured
+    // 1.09–1.15 (2.2–2.3 s, nondeterministic in the last digits) where the
+    // emulator's is 6 s — the 2 s-sampled logs see the lag only on steps.
+    let p = c.params.iter().find(|q| q.name == "probe_oil").expect("probe_oil");
+    assert_eq!(p.status, eha_sim::calibration::Status::Fitted, "probe_oil fitted");
 }
