@@ -35,6 +35,15 @@ pub const HOUSING_OUTER_PREFIX: &str = "h_out_";
 ///   hidden forced convection (seed 1712) gained 1 % (docs/diagnosis.md).
 ///   Under the four global multipliers (one outer scale for every housing)
 ///   the stream's per-housing pattern can still tell it apart.
+/// - `motor-pump-conduction` under the same set on a run with one operating
+///   point (`calibration::ident::one_point`): the path cools the pump and
+///   warms the motor by a nearly constant heat, which the per-housing outer
+///   transfer, films and capacities carry like the stream above; the two
+///   candidates then explain each other (session 16: a hidden forced
+///   convection on a constant-throttle log, seed 1812, was named
+///   conduction with 73 % on t_pump_c; seed 1710 the mirror image under
+///   the global set). Speed or pressure steps change the pump's heat and
+///   the path's share with it.
 pub fn identifiable(c: Candidate, run: &MeasuredRun, split: f64, housing_outer_calibrated: bool) -> Result<(), &'static str> {
     let train = |ch: Channel| -> Vec<f64> {
         run.get(ch).map_or(vec![], |v| {
@@ -70,6 +79,9 @@ pub fn identifiable(c: Candidate, run: &MeasuredRun, split: f64, housing_outer_c
                 Err("air speed constant: an unlogged air stream is a housing outer-transfer error")
             }
         }
+        Candidate::MotorPumpConduction if housing_outer_calibrated && crate::calibration::ident::one_point(run) => {
+            Err("one operating point: a motor–pump path is a change of both housings' heat paths")
+        }
         _ => Ok(()),
     }
 }
@@ -86,12 +98,13 @@ mod tests {
         r
     }
 
-    /// Forced convection at a constant logged air speed is a housing
-    /// outer-transfer error once the nuisance set calibrates each housing
-    /// (the physical set), identifiable under the global multipliers and
-    /// whenever the logged air speed steps on the training window.
+    /// Forced convection at a constant logged air speed, and motor–pump
+    /// conduction at one operating point, are housing heat-path errors once
+    /// the nuisance set calibrates each housing (the physical set);
+    /// identifiable under the global multipliers, and with air steps (on
+    /// the training window) or speed steps respectively.
     #[test]
-    fn forced_convection_needs_air_steps_under_per_housing_calibration() {
+    fn housing_path_candidates_need_excitation_under_per_housing_calibration() {
         let still = run(|_| 0.0, 500.0);
         let constant = run(|_| 30.0, 500.0);
         let steps = run(|k| if k < 30 { 0.0 } else { 30.0 }, 500.0);
@@ -103,6 +116,18 @@ mod tests {
         // The step lies in the held-out window only: not on the training window.
         assert!(identifiable(fc, &late_steps, 70.0, true).is_err());
         assert!(identifiable(fc, &still, 70.0, false).is_ok());
+        // Conduction: not at one operating point under the per-housing set;
+        // under the global multipliers, or with speed steps, it is.
+        let one_point = run(|_| 0.0, 500.0);
+        let speed_steps = {
+            let mut r = run(|_| 0.0, 500.0);
+            r.set(Channel::SpeedRpm, (0..100).map(|k| Some(if k < 50 { 300.0 } else { 900.0 })).collect());
+            r
+        };
+        let mpc = Candidate::MotorPumpConduction;
+        assert!(identifiable(mpc, &one_point, 70.0, true).is_err());
+        assert!(identifiable(mpc, &one_point, 70.0, false).is_ok());
+        assert!(identifiable(mpc, &speed_steps, 70.0, true).is_ok());
         // The other candidates do not depend on the nuisance set.
         assert!(identifiable(Candidate::ChurningLoss, &steps, 70.0, true).is_err());
         assert!(identifiable(Candidate::SensorLag, &still, 70.0, true).is_ok());
