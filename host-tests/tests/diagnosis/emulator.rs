@@ -198,3 +198,19 @@ fn slow_emulator_conduction_in_load_cycles_is_absorbed() {
     assert!(misfits(&r).is_empty(), "misfitting channels {:?} (measured none)", misfits(&r));
     assert!(r.pooled_heldout_k[1] <= 0.65, "pooled {:.2} K (measured 0.57)", r.pooled_heldout_k[1]);
 }
+
+/// Forced convection (7.3 m/s) hidden in a constant-throttle log of the
+/// second seed set (seed 1812): answered `motor-pump-conduction` with 73 %
+/// on t_pump_c once the oil probe joined the physical set (session 16), a
+/// wrong cause, because both candidates add a heat path out of the pump
+/// housing and the log has one operating point. With conduction not
+/// identifiable there under the per-housing set (`diagnosis::identify`)
+/// the answer is `none` (measured; pooled calibrated held-out 0.33 K).
+/// Asserted: `none`, no qualifying candidate.
+#[test]
+#[ignore = "slow tier: emulator case, former wrong cause"]
+fn slow_emulator_forced_convection_at_one_point_is_not_named_conduction() {
+    let r = run(case("forced-convection", ConstantThrottle, 1812));
+    assert_eq!(r.answer, "none", "measured outcome changed");
+    assert!(r.best_candidate.as_ref().is_none_or(|b| !b.3), "best candidate qualifies: {:?}", r.best_candidate);
+}
