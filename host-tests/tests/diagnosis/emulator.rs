@@ -8,8 +8,9 @@
 //!
 //! Fast tier: a `none` Case 1 log answered `none` (~10 s); slow tier
 //! (`--ignored`): three named effects, a measured churning miss, two formerly
-//! `unexplained` logs, the former false discovery (now `none`) and the
-//! conduction that the physical set absorbs.
+//! `unexplained` logs, the former false discovery (now `none`), the
+//! conduction that the physical set absorbs and a former wrong cause at
+//! one operating point (now `none`).
 //! Each case is one 1200 s throttle log at 2 s, 6–20 s to diagnose.
 
 use eha_sim::diagnosis::emu_sweep::{run_emu_case, EmuResult};
