@@ -220,7 +220,9 @@ pub fn calibrate(base: &Rig, logs: &[CalLog], o: &CalOptions) -> Result<Calibrat
     let free: Vec<usize> = (0..PARAMS.len()).filter(|&k| held[k].is_none()).collect();
     // 3. LM on the free parameters (internal z), data rows + prior rows.
     let best: Mutex<(f64, Vec<f64>)> = Mutex::new((f64::INFINITY, ones.clone()));
-    let budget = o.max_evals * logs.len();
+    // LM's evaluation budget, counted in its sequential calls
+    // (`FdProblem::with_budget`) so that the fit is reproducible.
+    let evals = std::sync::Arc::new(AtomicUsize::new(0));
     // One LM run on the parameters `list` (the others held at `th0`), from
     // `th0`; every evaluation updates `best`. Returns whether it gained > 1 %.
     let lm_run = |list: &[usize], th0: &[f64]| -> bool {
@@ -233,9 +235,6 @@ pub fn calibrate(base: &Rig, logs: &[CalLog], o: &CalOptions) -> Result<Calibrat
             th
         };
         let residual = |z: &[f64]| -> Option<DVector<f64>> {
-            if runs.load(Ordering::Relaxed) > budget + (cand.len() + 1) * logs.len() {
-                return None;
-            }
             let th = theta_of(z);
             let mut r = data_residuals(base, logs, &th, sigma, &runs)?;
             r.extend(free.iter().map(|&k| th[k].ln() / PARAMS[k].prior_sigma_ln));
@@ -248,7 +247,7 @@ pub fn calibrate(base: &Rig, logs: &[CalLog], o: &CalOptions) -> Result<Calibrat
         };
         let z0 = DVector::from_vec(list.iter().map(|&k| to_z(th0[k].ln(), &PARAMS[k])).collect());
         let patience = (o.max_evals / (list.len() + 1)).max(2);
-        let _ = LevenbergMarquardt::new().with_ftol(1e-6).with_xtol(1e-5).with_patience(patience).minimize(FdProblem::new(&residual, z0, 0.02));
+        let _ = LevenbergMarquardt::new().with_ftol(1e-6).with_xtol(1e-5).with_patience(patience).minimize(FdProblem::new(&residual, z0, 0.02).with_budget(evals.clone(), o.max_evals));
         let after = best.lock().map(|b| b.0).unwrap_or(f64::INFINITY);
         after < 0.99 * before
     };
@@ -267,7 +266,7 @@ pub fn calibrate(base: &Rig, logs: &[CalLog], o: &CalOptions) -> Result<Calibrat
             Ok(b) => b.1.clone(),
             Err(_) => break,
         };
-        if free.is_empty() || !lm_run(&free, &th0) || runs.load(Ordering::Relaxed) > budget {
+        if free.is_empty() || !lm_run(&free, &th0) || evals.load(Ordering::Relaxed) >= o.max_evals {
             break;
         }
     }

@@ -6,6 +6,8 @@
 use levenberg_marquardt::LeastSquaresProblem;
 use nalgebra::{DMatrix, DVector, Dyn, Owned};
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Arc;
 
 /// Residual function `r(x)` (None when the model cannot be evaluated there)
 /// at parameters `x`, with the forward-difference step `step` in x's units.
@@ -13,6 +15,7 @@ pub struct FdProblem<F> {
     residual: F,
     x: DVector<f64>,
     step: f64,
+    budget: Option<(Arc<AtomicUsize>, usize)>,
 }
 
 impl<F> FdProblem<F>
@@ -21,7 +24,26 @@ where
 {
     /// A problem starting at `x0`.
     pub fn new(residual: F, x0: DVector<f64>, step: f64) -> Self {
-        Self { residual, x: x0, step }
+        Self { residual, x: x0, step, budget: None }
+    }
+
+    /// The same problem with an evaluation budget: `used` counts residual
+    /// evaluations (a Jacobian counts one per column), shared between
+    /// problems; past `max` the problem reports no residuals, which stops
+    /// the minimiser. Counted in the minimiser's sequential calls, before a
+    /// Jacobian's parallel columns run, so where a fit stops does not
+    /// depend on thread timing.
+    pub fn with_budget(mut self, used: Arc<AtomicUsize>, max: usize) -> Self {
+        self.budget = Some((used, max));
+        self
+    }
+
+    /// Takes `n` evaluations from the budget; false when it is spent.
+    fn take(&self, n: usize) -> bool {
+        match &self.budget {
+            None => true,
+            Some((used, max)) => used.fetch_add(n, Ordering::Relaxed) + n <= *max,
+        }
     }
 
     /// The current parameters.
@@ -47,10 +69,16 @@ where
     }
 
     fn residuals(&self) -> Option<DVector<f64>> {
+        if !self.take(1) {
+            return None;
+        }
         (self.residual)(self.x.as_slice())
     }
 
     fn jacobian(&self) -> Option<DMatrix<f64>> {
+        if !self.take(self.x.len() + 1) {
+            return None;
+        }
         let r0 = (self.residual)(self.x.as_slice())?;
         let cols: Option<Vec<DVector<f64>>> = (0..self.x.len())
             .into_par_iter()
