@@ -261,12 +261,10 @@ pub fn calibrate(base: &Rig, logs: &[CalLog], o: &CalOptions) -> Result<Calibrat
     if !thermal.is_empty() && thermal.len() < free.len() {
         lm_run(&thermal, &ones);
     }
-    for _ in 0..MAX_LM_STARTS {
-        let th0 = match best.lock() {
-            Ok(b) => b.1.clone(),
-            Err(_) => break,
-        };
-        if free.is_empty() || !lm_run(&free, &th0) || evals.load(Ordering::Relaxed) >= o.max_evals {
+    let starts = if free.is_empty() { 0 } else { MAX_LM_STARTS };
+    for _ in 0..starts {
+        let Ok(th0) = best.lock().map(|b| b.1.clone()) else { break };
+        if !lm_run(&free, &th0) || evals.load(Ordering::Relaxed) >= o.max_evals {
             break;
         }
     }
