@@ -53,6 +53,16 @@ fn assert_none_without_misfit(r: &EmuResult, max_k: f64, measured_k: f64) {
     assert!(r.pooled_heldout_k[1] <= max_k, "pooled {:.2} K (measured {measured_k})", r.pooled_heldout_k[1]);
 }
 
+/// The hidden effect's own candidate, as the diagnosis fitted it, gains
+/// less than `max` on the affected channel (`measured` quoted): the miss is
+/// the calibration set absorbing the effect, not a rule failing a fit that
+/// would meet the 50 % bar.
+fn assert_oracle_under(r: &EmuResult, max: f64, measured: &str) {
+    let h = r.hidden_fit.as_ref().expect("hidden candidate fitted");
+    let g = h.affected_gain().expect("affected channel");
+    assert!(g < max, "hidden candidate's own gain {:.0} % (measured {measured})", 100.0 * g);
+}
+
 /// The best candidate by BIC, if any, does not qualify.
 fn assert_no_qualifying_candidate(r: &EmuResult) {
     assert!(r.best_candidate.as_ref().is_none_or(|b| !b.3), "best candidate qualifies: {:?}", r.best_candidate);
@@ -106,6 +116,9 @@ fn slow_emulator_sensor_lag_is_named() {
 fn slow_emulator_conduction_is_named_over_a_qualifying_forced_convection() {
     let r = run(case("motor-pump-conduction", ConstantThrottle, 1710));
     assert_named(&r);
+    // The oracle row is the named fit itself.
+    let h = r.hidden_fit.as_ref().expect("hidden candidate fitted");
+    assert!(h.qualifies && h.affected_gain() == r.affected_gain(), "oracle {h:?}");
     let (name, _, _, qualifies) = r.best_candidate.clone().expect("a best candidate");
     assert!(name == "forced-convection" && qualifies, "best by BIC {name} (qualifies {qualifies}); measured: forced-convection, qualifying");
 }
@@ -135,6 +148,9 @@ fn slow_emulator_churning_measured_miss() {
     assert!(!qualifies, "best candidate {name} qualifies (measured: sensor-lag, not qualifying)");
     let (before, _) = r.affected_heldout_k.expect("affected channel");
     assert!(before <= 0.4, "t_pump_c calibrated held-out {before:.3} K (measured 0.36)");
+    // Churning's own fit (session 17): −4 % on t_pump_c at the default fit
+    // budget, −6 % at 2.4× (docs/diagnosis.md, "Why the misses are missed").
+    assert_oracle_under(&r, 0.3, "−4 %");
 }
 
 /// Viscosity in load cycles (seed 1702): named with t_oil_c held out
@@ -205,7 +221,12 @@ fn slow_emulator_speed_steps_none_log_is_no_discovery() {
 #[test]
 #[ignore = "slow tier: emulator case, measured miss"]
 fn slow_emulator_conduction_in_load_cycles_is_absorbed() {
-    assert_none_without_misfit(&run(case("motor-pump-conduction", LoadCycles, 1711)), 0.65, 0.57);
+    let r = run(case("motor-pump-conduction", LoadCycles, 1711));
+    assert_none_without_misfit(&r, 0.65, 0.57);
+    // Conduction's own fit: −2 % on t_pump_c at the default fit budget;
+    // 28 % at 2.4× (ΔBIC 154, 5.46 W/K against the hidden 5.30), still
+    // under the 50 % bar (session 17).
+    assert_oracle_under(&r, 0.5, "−2 %");
 }
 
 /// Forced convection (7.3 m/s) hidden in a constant-throttle log of the
