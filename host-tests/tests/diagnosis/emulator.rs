@@ -149,7 +149,8 @@ fn slow_emulator_churning_measured_miss() {
     let (before, _) = r.affected_heldout_k.expect("affected channel");
     assert!(before <= 0.4, "t_pump_c calibrated held-out {before:.3} K (measured 0.36)");
     // Churning's own fit (session 17): −4 % on t_pump_c at the default fit
-    // budget, −6 % at 2.4× (docs/diagnosis.md, "Why the misses are missed").
+    // budget, −6 % with 13 Jacobians instead of 6 (docs/diagnosis.md, "Why
+    // the misses are missed").
     assert_oracle_under(&r, 0.3, "−4 %");
 }
 
@@ -224,7 +225,8 @@ fn slow_emulator_conduction_in_load_cycles_is_absorbed() {
     let r = run(case("motor-pump-conduction", LoadCycles, 1711));
     assert_none_without_misfit(&r, 0.65, 0.57);
     // Conduction's own fit: −2 % on t_pump_c at the default fit budget;
-    // 28 % at 2.4× (ΔBIC 154, 5.46 W/K against the hidden 5.30), still
+    // 28 % with 13 Jacobians instead of 6 (ΔBIC 154, 5.46 W/K against the
+    // hidden 5.30), still
     // under the 50 % bar (session 17).
     assert_oracle_under(&r, 0.5, "−2 %");
 }
