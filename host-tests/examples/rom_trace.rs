@@ -31,7 +31,7 @@ fn main() {
         }
         let e = m.drain_c() - s.t_drain_c;
         max_e = max_e.max(e.abs());
-        if k % every == 0 {
+        if k.is_multiple_of(every) {
             let t = m.temperatures_c();
             let l = m.links_c();
             let rho = rig.oil.rho(40.0, 0.0);

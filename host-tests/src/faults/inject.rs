@@ -223,7 +223,7 @@ impl Gauss {
     }
 
     /// One standard normal draw.
-    pub fn next(&mut self) -> f64 {
+    pub fn normal(&mut self) -> f64 {
         let u1 = self.uniform().max(1e-300);
         let u2 = self.uniform();
         (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
@@ -251,7 +251,7 @@ pub fn corrupt_sample(s: &mut Sample, c: Channel, f: InputFault, dt_s: f64, froz
                 v * (1.0 - k)
             }
         }
-        InputFault::Noise => v + (0.05 * f64::from(fs) * rng.next()) as f32,
+        InputFault::Noise => v + (0.05 * f64::from(fs) * rng.normal()) as f32,
         InputFault::NaN => f32::NAN,
         InputFault::OutOfRange => 1.5 * fs,
     };

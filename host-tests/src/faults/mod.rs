@@ -275,10 +275,10 @@ pub fn run_on(
                 let mut wire: Vec<u8> = Vec::new();
                 if send {
                     let mut frame: Vec<u8> = req.encode().as_slice().to_vec();
-                    if active && fault == Fault::CorruptedFrames && k % 50 == 0 && frame.len() > 4 {
+                    if active && fault == Fault::CorruptedFrames && k.is_multiple_of(50) && frame.len() > 4 {
                         frame[3] ^= 0x10;
                     }
-                    if active && fault == Fault::OutOfOrderFrames && k % 40 == 0 {
+                    if active && fault == Fault::OutOfOrderFrames && k.is_multiple_of(40) {
                         held = Some(frame);
                     } else {
                         wire.extend_from_slice(&frame);
@@ -344,7 +344,7 @@ pub fn run_on(
     let max_true_drain_closed_c = if max_closed.is_finite() { max_closed } else { f64::NAN };
     let detected = detect.is_some();
     let pass = detect.is_some_and(|d| d <= DETECT_S)
-        || (max_under_k <= MAX_UNDER_K && !(max_true_drain_closed_c > MAX_CLOSED_C));
+        || (max_under_k <= MAX_UNDER_K && (max_true_drain_closed_c.is_nan() || max_true_drain_closed_c <= MAX_CLOSED_C));
     Ok(FaultResult {
         fault: fault.name(),
         scenario: scenario_name.into(),

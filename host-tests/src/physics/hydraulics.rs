@@ -208,6 +208,7 @@ pub fn speed_limit(raw: f64, wmax: f64) -> f64 {
 
 /// Derivatives of the hydraulic states (`y` = full state, `dy` = its
 /// derivative), given the operating point `op` and flows `f`.
+#[allow(clippy::too_many_arguments)] // the ODE right-hand side: each argument is a distinct input
 pub fn derivatives(rig: &Rig, m: &Mission, t: f64, y: &[f64], op: &OpPoint, f: &Flows, nu: f64, dy: &mut [f64]) {
     let act = &rig.actuator;
     let beta = rig.hydraulics.bulk_modulus_pa;

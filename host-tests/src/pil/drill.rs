@@ -13,6 +13,7 @@
 //! - step 10,000: 3 lost frames (sequence gap, missed steps, below `stale_steps`);
 //! - step 45,000: 10 lost frames (STALE fault latches, fail-safe valve open);
 //! - step 50,000: a NaN current (non-finite fault); step 55,000: 5000 bar (range fault).
+//!
 //! The piston moves ±20 mm slowly throughout; ambient 16 °C. No valve position is
 //! reported.
 

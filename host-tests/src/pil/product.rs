@@ -395,7 +395,7 @@ pub fn run_closed_loop(
                     // it again (the same sequence number).
                     if !t.fresh {
                         waited += 1;
-                        if t.tick <= 2 || waited % 5 == 0 {
+                        if t.tick <= 2 || waited.is_multiple_of(5) {
                             let _ = s.send_sample(&request);
                         }
                     }

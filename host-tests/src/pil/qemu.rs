@@ -109,7 +109,9 @@ pub fn ensure_qemu() -> Result<String, PilError> {
     let ok = |args: &[&str]| {
         Command::new("apt-get").args(args).env("DEBIAN_FRONTEND", "noninteractive").stdin(Stdio::null()).status().is_ok_and(|s| s.success())
     };
-    if !ok(&["install", "-y", "qemu-system-arm"]) && !(ok(&["update"]) && ok(&["install", "-y", "qemu-system-arm"])) {
+    // Install; if that fails, refresh the package lists and install again.
+    let installed = ok(&["install", "-y", "qemu-system-arm"]) || (ok(&["update"]) && ok(&["install", "-y", "qemu-system-arm"]));
+    if !installed {
         return Err(PilError::QemuMissing);
     }
     qemu_available()
@@ -243,13 +245,13 @@ impl QemuSession {
             }
             match self.deframer.push(b) {
                 None => {}
-                Some(Ok(p)) => match Reply::from_payload(&p) {
-                    Ok(r) => {
+                Some(Ok(p)) => {
+                    // A payload that is not a reply stays as text.
+                    if let Ok(r) = Reply::from_payload(&p) {
                         self.junk_drop_frame(&p);
                         self.pending.push_back(r);
                     }
-                    Err(_) => {} // keep as text
-                },
+                }
                 Some(Err(_)) => {} // not a frame: keep as text
             }
             if b == 0 {

@@ -30,11 +30,15 @@ impl<F: FnMut(&Request, u16) -> GuardOutput> Target for SilTarget<F> {
     }
 }
 
+/// One firmware tick on the host: the request and the sequence gap in,
+/// the guard's outputs out.
+pub type GuardCore = Box<dyn FnMut(&Request, u16) -> GuardOutput>;
+
 /// The firmware's core for `build`, on the host: the same `GuardOf<N>` with
 /// the same number type, configuration and boot rule (cold: QEMU starts
 /// with zeroed RAM, which reads as an absent thermal record) and the same
 /// [`eha_guard::protocol::step_guard`].
-pub fn sil_core(build: super::Build) -> Box<dyn FnMut(&Request, u16) -> GuardOutput> {
+pub fn sil_core(build: super::Build) -> GuardCore {
     use eha_guard::{GuardConfig, GuardOf, Restore};
     match build {
         super::Build::F32 => {

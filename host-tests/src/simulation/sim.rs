@@ -228,7 +228,7 @@ fn run_plant(mut plant: Plant, scenario: &Scenario, opt: &SimOptions, rtol: f64,
     let rule = plant.valve_rule();
     plant.run(dt, t_end, |s| {
         let cmd = rule.command(s);
-        if k % every == 0 || s.t >= t_end - 1e-9 {
+        if k.is_multiple_of(every) || s.t >= t_end - 1e-9 {
             let ch = channels(s);
             if out.columns.is_empty() {
                 out.columns = ch.iter().map(|(n, _)| (n.to_string(), Vec::new())).collect();

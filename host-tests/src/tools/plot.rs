@@ -47,7 +47,7 @@ pub fn lines(path: &Path, title: &str, panels: &[Panel]) -> Result<()> {
             y0 = y0.min(p.1);
             y1 = y1.max(p.1);
         }
-        if !(x0 < x1) {
+        if x0.is_nan() || x1.is_nan() || x0 >= x1 {
             continue;
         }
         let pad = ((y1 - y0) * 0.05).max(0.5);

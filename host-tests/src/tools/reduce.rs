@@ -291,9 +291,9 @@ fn coupled_groups(jacs: &[[[f64; N_NODES]; N_NODES]]) -> [usize; N_NODES] {
         let mut stack = vec![start];
         group[start] = start;
         while let Some(i) = stack.pop() {
-            for k in 0..N_NODES {
-                if group[k] == usize::MAX && linked(i, k) {
-                    group[k] = start;
+            for (k, g) in group.iter_mut().enumerate() {
+                if *g == usize::MAX && linked(i, k) {
+                    *g = start;
                     stack.push(k);
                 }
             }

@@ -292,7 +292,8 @@ fn case2_periodic_balance_time_known_miss() {
         c_oil(0)
     );
     // (name, measured balance time at CASE2_EPS, s)
-    let cases: [(&str, Vec<(f64, f64)>, Option<f64>); 4] = [
+    type Series = Vec<(f64, f64)>;
+    let cases: [(&str, Series, Option<f64>); 4] = [
         ("oil (energy)", oil, Some(305.0)),
         ("t_inlet_c", node("t_inlet_c"), Some(212.5)),
         ("t_outlet_c", node("t_outlet_c"), Some(212.5)),

@@ -17,7 +17,7 @@ use eha_sim::scenario::Scenario;
 
 /// `open_c`: the guard's valve threshold; `None`: no guard, the valve held shut.
 fn closed_loop(open_c: Option<f32>) -> (Vec<StepRecord>, Plant) {
-    let mut core: Box<dyn FnMut(&eha_guard::protocol::Request, u16) -> eha_guard::Output> = match open_c {
+    let mut core: eha_sim::pil::sil::GuardCore = match open_c {
         Some(open_c) => {
             let mut cfg = GuardConfig::DEFAULT;
             cfg.valve.open_c = open_c;
