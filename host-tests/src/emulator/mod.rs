@@ -92,11 +92,28 @@ pub struct EmuTruth {
 
 /// Generates the log of `c`.
 pub fn generate(c: &EmuCase) -> Result<(MeasuredRun, EmuTruth), String> {
+    generate_on(c, None)
+}
+
+/// The log of case `c` flown by another case's machine: `machine` is that
+/// case's parameters and hidden magnitude (its [`EmuTruth`]); the mission,
+/// noise and dropouts are `c`'s. Two logs of one machine in two scenarios,
+/// as a test campaign would take them.
+pub fn generate_on_machine(c: &EmuCase, machine: &EmuTruth) -> Result<(MeasuredRun, EmuTruth), String> {
+    generate_on(c, Some((&machine.params, machine.magnitude)))
+}
+
+fn generate_on(c: &EmuCase, machine: Option<(&params::EmuParams, f64)>) -> Result<(MeasuredRun, EmuTruth), String> {
     let mut rng = ChaCha8Rng::seed_from_u64(c.seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ 0x17);
     let m = missions::draw(c.scenario, c.duration_s, &mut rng);
     let p = params::EmuParams::draw(&mut rng);
     let (lo, hi) = magnitude_range(c.hidden);
     let magnitude = if hi > lo { rng.random_range(lo..hi) } else { lo };
+    // The draws above keep the noise stream the same either way.
+    let (p, magnitude) = match machine {
+        Some((q, mag)) => (q.clone(), mag),
+        None => (p, magnitude),
+    };
     let dt = c.scenario.log_interval_s();
     let plant = Plant { p: &p, m: &m, h: Hidden { effect: c.hidden, magnitude } };
     let trace = plant.run(dt);
