@@ -283,7 +283,7 @@ fn metrics(run: &MeasuredRun, s: &SimSeries, split: f64, lb_lags: usize) -> Metr
 
 /// Training fit points: present temperature samples before `split`, thinned
 /// uniformly to at most `per_channel` per channel.
-fn fit_points(run: &MeasuredRun, split: f64, per_channel: usize) -> Vec<Point> {
+pub(crate) fn fit_points(run: &MeasuredRun, split: f64, per_channel: usize) -> Vec<Point> {
     let mut pts = Vec::new();
     for ch in Channel::TEMPERATURES {
         let Some(m) = run.get(ch) else { continue };
@@ -452,6 +452,14 @@ fn fit_from(sim: &dyn Simulator, run: &MeasuredRun, pts: &[Point], c: Candidate,
     fit(sim, run, pts, c, &base.nuisance, Some(&off), o.fit)
 }
 
+/// Whether candidate `c` can be named on `run` (training window before
+/// `split`) with `sim`'s nuisance set ([`identifiable`]; the per-housing
+/// rules apply when the set calibrates a housing's outer transfer).
+pub(crate) fn identifiable_here(c: Candidate, run: &MeasuredRun, split: f64, sim: &dyn Simulator) -> Result<(), &'static str> {
+    let housing_outer_calibrated = sim.nuisance().iter().any(|p| p.name.starts_with(HOUSING_OUTER_PREFIX));
+    identifiable(c, run, split, housing_outer_calibrated)
+}
+
 /// The named cause among the qualifying entries of `ranking` (sorted by
 /// BIC): the one with the lowest pooled held-out RMSE, BIC breaking ties;
 /// `None` when nothing qualifies. Not the lowest BIC: the residuals of these
@@ -493,9 +501,7 @@ fn rank(
     m_before: &Metrics,
     fits: &[FitResult],
 ) -> (Vec<RankEntry>, Vec<Metrics>) {
-    let nuisance = sim.nuisance();
-    let nuis_len = nuisance.len();
-    let housing_outer_calibrated = nuisance.iter().any(|p| p.name.starts_with(HOUSING_OUTER_PREFIX));
+    let nuis_len = sim.nuisance().len();
     let bic_none = bic(base.rss, n, nuis_len);
     let mut ranking = vec![RankEntry {
         cause: "none".into(),
@@ -526,7 +532,7 @@ fn rank(
             }
         }
         let gain = if gain.is_finite() { gain } else { 0.0 };
-        let ident = identifiable(f.candidate, run, split, housing_outer_calibrated);
+        let ident = identifiable_here(f.candidate, run, split, sim);
         let pooled_ok = m.heldout_rmse_k <= (1.0 - o.min_pooled_gain) * m_before.heldout_rmse_k;
         ranking.push(RankEntry {
             cause: f.candidate.name().into(),

@@ -31,6 +31,11 @@ pub struct DiagnoseArgs {
     /// Model runs allowed per least-squares fit.
     #[arg(long, default_value_t = 80)]
     pub max_sims: usize,
+    /// Also report what this log could show: each candidate's imprint at its
+    /// typical magnitude and how much of it the calibration takes up
+    /// (report.md section, detectability.json; one more fit per candidate).
+    #[arg(long)]
+    pub detectability: bool,
 }
 
 /// The model with a progress bar on the terminal (hidden when stderr is not
@@ -121,6 +126,21 @@ fn run_inner(args: &DiagnoseArgs) -> anyhow::Result<String> {
     progress.bar.finish_and_clear();
     let d = d?;
     write_outputs(&d, &run, &args.measured.display().to_string(), &args.out)?;
+    if args.detectability {
+        // Around the calibrated values of the tier whose answer stands.
+        let physical = model.physical_set();
+        let sim: &dyn Simulator = match (&physical, d.nuisance_set.as_str()) {
+            (Some(p), "physical") => &**p,
+            _ => &model,
+        };
+        let values: Vec<f64> = d.nuisance_before.iter().map(|(_, v, _)| *v).collect();
+        let rows = super::detect::detectability(&run, sim, &values, d.split_time_s, &o);
+        let report = args.out.join("report.md");
+        let mut md = std::fs::read_to_string(&report)?;
+        md += &super::detect::markdown(&rows);
+        std::fs::write(&report, md)?;
+        std::fs::write(args.out.join("detectability.json"), serde_json::to_string_pretty(&rows)? + "\n")?;
+    }
     Ok(format!(
         "cause: {} | held-out RMSE {:.3} -> {:.3} K | training {:.3} -> {:.3} K | {} model runs, {:.1} s | {}",
         d.answer(),

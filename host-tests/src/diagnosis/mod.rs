@@ -6,6 +6,7 @@
 
 pub mod adequacy;
 pub mod analysis;
+pub mod detect;
 pub mod fit;
 pub mod identify;
 pub mod model;

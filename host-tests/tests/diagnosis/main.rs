@@ -4,6 +4,7 @@
 //! of the independent rig emulator (`emulator.rs`).
 
 mod cli;
+mod detect;
 mod effects;
 mod emulator;
 mod replay;

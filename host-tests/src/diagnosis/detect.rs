@@ -1,0 +1,143 @@
+//! What a log could have shown (`diagnose --detectability`): for each
+//! candidate at its typical magnitude and at 4× and 16× it (within its
+//! bounds), the imprint it would leave on the
+//! logged channels and how much of that imprint the calibration set takes
+//! up. The calibrated model plus the candidate is simulated over the log's
+//! own inputs (noise-free), the baseline is refitted to that output on the
+//! training window, and what it cannot follow on the held-out window is the
+//! imprint "left". With sensor noise σ on that channel, the best held-out
+//! gain any diagnosis could show there is 1 − σ/√(σ² + left²) (the baseline
+//! misses by √(σ² + left²), the right candidate by σ): 50 % needs
+//! left ≥ √3·σ. This assumes the model's own structure; a rig that differs
+//! in structure adds its own misfit on top (docs/diagnosis.md, "Why the
+//! misses are missed").
+
+use super::adequacy::noise_sigma;
+use super::analysis::{fit_points, identifiable_here, DiagnoseOptions};
+use super::fit::fit;
+use super::model::{Candidate, SimSeries, Simulator};
+use crate::measured::{Channel, MeasuredRun};
+use rayon::prelude::*;
+use std::fmt::Write as _;
+
+/// One candidate's detectability on one log.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Detectability {
+    /// Candidate name.
+    pub candidate: String,
+    /// Magnitude injected: (parameter, value, unit); empty for structural
+    /// candidates (temperature-dependent viscosity).
+    pub magnitude: Vec<(String, f64, String)>,
+    /// Channel with the largest held-out imprint and that imprint (RMS of
+    /// the candidate's change), K.
+    pub imprint_k: (String, f64),
+    /// On the same channel: the imprint left once the baseline is
+    /// recalibrated to the output with the candidate (held-out RMS), K.
+    pub left_k: f64,
+    /// That channel's sensor noise σ, K (from the log's second differences).
+    pub noise_k: f64,
+    /// Best held-out gain a diagnosis could show on that channel,
+    /// 1 − σ/√(σ² + left²).
+    pub best_gain: f64,
+    /// Why the candidate cannot be named on this log whatever its fit
+    /// (empty when it can; `diagnosis::identify`).
+    pub note: String,
+}
+
+/// Multiples of a candidate's typical magnitude that are injected.
+pub const MULTIPLES: [f64; 3] = [1.0, 4.0, 16.0];
+
+/// RMS over the rows at or after `split` where `run` has `ch`, of a − b.
+fn heldout_rms(run: &MeasuredRun, ch: Channel, a: &SimSeries, b: &SimSeries, split: f64) -> Option<f64> {
+    let (m, ya, yb) = (run.get(ch)?, a.channels.get(&ch)?, b.channels.get(&ch)?);
+    let d: Vec<f64> = (0..run.len()).filter(|&i| run.time_s[i] >= split && m[i].is_some()).map(|i| (ya[i] - yb[i]).powi(2)).collect();
+    (!d.is_empty()).then(|| (d.iter().sum::<f64>() / d.len() as f64).sqrt())
+}
+
+/// The detectability of every candidate on `run`, around the calibrated
+/// nuisance values `nuisance` of `sim` (the tier whose answer stands),
+/// with the diagnosis's training/held-out split at `split` s. Candidates
+/// whose injected run fails are left out.
+pub fn detectability(run: &MeasuredRun, sim: &dyn Simulator, nuisance: &[f64], split: f64, o: &DiagnoseOptions) -> Vec<Detectability> {
+    let Ok(base) = sim.simulate(nuisance, Candidate::None, &[]) else { return vec![] };
+    let pts = fit_points(run, split, o.points_per_channel);
+    // (candidate, index into MULTIPLES): a structural candidate has one form
+    // only; a multiple is left out once the previous one sat on the bound.
+    let jobs: Vec<(Candidate, usize)> = Candidate::EXTENSIONS
+        .iter()
+        .flat_map(|&c| {
+            let specs = sim.extension_params(c);
+            (0..MULTIPLES.len())
+                .filter(|&j| if specs.is_empty() { j == 0 } else { j == 0 || specs.iter().any(|s| MULTIPLES[j - 1] * s.start < s.hi) })
+                .map(move |j| (c, j))
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    let train_rss = |a: &SimSeries, b: &MeasuredRun| -> Option<f64> {
+        super::fit::residuals_at(b, a, &pts).map(|r| r.iter().map(|e| e * e).sum())
+    };
+    jobs.par_iter()
+        .filter_map(|&(c, j)| {
+            let specs = sim.extension_params(c);
+            let ext: Vec<f64> = specs.iter().map(|s| (MULTIPLES[j] * s.start).min(s.hi)).collect();
+            let with = sim.simulate(nuisance, c, &ext).ok()?;
+            // The log as the model with the candidate would have written it,
+            // noise-free, with the log's own missing samples.
+            let mut syn = run.clone();
+            for ch in Channel::TEMPERATURES {
+                let (Some(m), Some(y)) = (run.get(ch), with.channels.get(&ch)) else { continue };
+                let v = m.iter().zip(y).map(|(m, y)| m.map(|_| *y)).collect();
+                syn.set(ch, v);
+            }
+            let (ch, imprint) = Channel::TEMPERATURES
+                .into_iter()
+                .filter_map(|ch| Some((ch, heldout_rms(run, ch, &with, &base, split)?)))
+                .max_by(|a, b| a.1.total_cmp(&b.1))?;
+            // The fit starts a hair off any bound (`diagnosis::fit`), so the
+            // calibrated point itself stays a contender: the better of the
+            // two on the training window.
+            let refit = fit(sim, &syn, &pts, Candidate::None, nuisance, None, o.fit)?;
+            let best = if train_rss(&refit.series, &syn)? < train_rss(&base, &syn)? { &refit.series } else { &base };
+            let left = heldout_rms(run, ch, best, &with, split)?;
+            let noise = run.get(ch).and_then(noise_sigma).unwrap_or(0.1).max(0.02);
+            Some(Detectability {
+                candidate: c.name().into(),
+                magnitude: specs.iter().zip(&ext).map(|(s, v)| (s.name.clone(), *v, s.unit.clone())).collect(),
+                imprint_k: (ch.name().into(), imprint),
+                left_k: left,
+                noise_k: noise,
+                best_gain: 1.0 - noise / (noise * noise + left * left).sqrt(),
+                note: identifiable_here(c, run, split, sim).err().unwrap_or_default().into(),
+            })
+        })
+        .collect()
+}
+
+/// The Markdown section of `report.md`.
+pub fn markdown(rows: &[Detectability]) -> String {
+    let mut s = String::from(
+        "\n## What this log could show (detectability)\n\n\
+         Each candidate at its typical magnitude, injected into the calibrated model over this log's inputs \
+         (noise-free); the baseline recalibrated to that output; what it cannot follow on the held-out window \
+         is the imprint left. Best gain = 1 − σ/√(σ² + left²): the most any diagnosis could show on that \
+         channel if the model's structure were right (50 % needs left ≥ 1.73 σ).\n\n\
+         | candidate | magnitude | imprint (K, channel) | left after calibration (K) | noise σ (K) | best held-out gain | identifiable here |\n\
+         |---|---|---|---:|---:|---:|---|\n",
+    );
+    for r in rows {
+        let mag: Vec<String> = r.magnitude.iter().map(|(n, v, u)| format!("{n}={v:.3e} {u}")).collect();
+        let _ = writeln!(
+            s,
+            "| `{}` | {} | {:.3} ({}) | {:.3} | {:.3} | {:.0} % | {} |",
+            r.candidate,
+            if mag.is_empty() { "–".into() } else { mag.join(", ") },
+            r.imprint_k.1,
+            r.imprint_k.0,
+            r.left_k,
+            r.noise_k,
+            100.0 * r.best_gain,
+            if r.note.is_empty() { "yes".to_string() } else { format!("no ({})", r.note) },
+        );
+    }
+    s
+}
