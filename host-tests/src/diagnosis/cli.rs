@@ -127,14 +127,7 @@ fn run_inner(args: &DiagnoseArgs) -> anyhow::Result<String> {
     let d = d?;
     write_outputs(&d, &run, &args.measured.display().to_string(), &args.out)?;
     if args.detectability {
-        // Around the calibrated values of the tier whose answer stands.
-        let physical = model.physical_set();
-        let sim: &dyn Simulator = match (&physical, d.nuisance_set.as_str()) {
-            (Some(p), "physical") => &**p,
-            _ => &model,
-        };
-        let values: Vec<f64> = d.nuisance_before.iter().map(|(_, v, _)| *v).collect();
-        let rows = super::detect::detectability(&run, sim, &values, d.split_time_s, &o);
+        let rows = super::detect::with_answer_tier(&model, &d, |sim, values| super::detect::detectability(&run, sim, values, d.split_time_s, &o));
         let report = args.out.join("report.md");
         let mut md = std::fs::read_to_string(&report)?;
         md += &super::detect::markdown(&rows);

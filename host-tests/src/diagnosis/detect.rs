@@ -13,7 +13,7 @@
 //! misses are missed").
 
 use super::adequacy::noise_sigma;
-use super::analysis::{fit_points, identifiable_here, DiagnoseOptions};
+use super::analysis::{fit_points, identifiable_here, DiagnoseOptions, Diagnosis};
 use super::fit::fit;
 use super::model::{Candidate, SimSeries, Simulator};
 use crate::measured::{Channel, MeasuredRun};
@@ -59,8 +59,6 @@ fn heldout_rms(run: &MeasuredRun, ch: Channel, a: &SimSeries, b: &SimSeries, spl
 /// with the diagnosis's training/held-out split at `split` s. Candidates
 /// whose injected run fails are left out.
 pub fn detectability(run: &MeasuredRun, sim: &dyn Simulator, nuisance: &[f64], split: f64, o: &DiagnoseOptions) -> Vec<Detectability> {
-    let Ok(base) = sim.simulate(nuisance, Candidate::None, &[]) else { return vec![] };
-    let pts = fit_points(run, split, o.points_per_channel);
     // (candidate, index into MULTIPLES): a structural candidate has one form
     // only; a multiple is left out once the previous one sat on the bound.
     let jobs: Vec<(Candidate, usize)> = Candidate::EXTENSIONS
@@ -73,44 +71,71 @@ pub fn detectability(run: &MeasuredRun, sim: &dyn Simulator, nuisance: &[f64], s
                 .collect::<Vec<_>>()
         })
         .collect();
+    jobs.par_iter()
+        .filter_map(|&(c, j)| {
+            let ext: Vec<f64> = sim.extension_params(c).iter().map(|s| (MULTIPLES[j] * s.start).min(s.hi)).collect();
+            detect_one(run, sim, nuisance, split, o, c, &ext)
+        })
+        .collect()
+}
+
+/// Runs `f` with the simulator of the tier whose answer stands in `d`
+/// (`model` or its physical set) and that tier's calibrated values.
+pub fn with_answer_tier<R>(model: &dyn Simulator, d: &Diagnosis, f: impl FnOnce(&dyn Simulator, &[f64]) -> R) -> R {
+    let physical = model.physical_set();
+    let sim: &dyn Simulator = match (&physical, d.nuisance_set.as_str()) {
+        (Some(p), "physical") => &**p,
+        _ => model,
+    };
+    let values: Vec<f64> = d.nuisance_before.iter().map(|(_, v, _)| *v).collect();
+    f(sim, &values)
+}
+
+/// The detectability of candidate `c` at parameters `ext` (one fit);
+/// `None` when a run fails.
+pub fn detect_one(
+    run: &MeasuredRun,
+    sim: &dyn Simulator,
+    nuisance: &[f64],
+    split: f64,
+    o: &DiagnoseOptions,
+    c: Candidate,
+    ext: &[f64],
+) -> Option<Detectability> {
+    let base = sim.simulate(nuisance, Candidate::None, &[]).ok()?;
+    let pts = fit_points(run, split, o.points_per_channel);
     let train_rss = |a: &SimSeries, b: &MeasuredRun| -> Option<f64> {
         super::fit::residuals_at(b, a, &pts).map(|r| r.iter().map(|e| e * e).sum())
     };
-    jobs.par_iter()
-        .filter_map(|&(c, j)| {
-            let specs = sim.extension_params(c);
-            let ext: Vec<f64> = specs.iter().map(|s| (MULTIPLES[j] * s.start).min(s.hi)).collect();
-            let with = sim.simulate(nuisance, c, &ext).ok()?;
-            // The log as the model with the candidate would have written it,
-            // noise-free, with the log's own missing samples.
-            let mut syn = run.clone();
-            for ch in Channel::TEMPERATURES {
-                let (Some(m), Some(y)) = (run.get(ch), with.channels.get(&ch)) else { continue };
-                let v = m.iter().zip(y).map(|(m, y)| m.map(|_| *y)).collect();
-                syn.set(ch, v);
-            }
-            let (ch, imprint) = Channel::TEMPERATURES
-                .into_iter()
-                .filter_map(|ch| Some((ch, heldout_rms(run, ch, &with, &base, split)?)))
-                .max_by(|a, b| a.1.total_cmp(&b.1))?;
-            // The fit starts a hair off any bound (`diagnosis::fit`), so the
-            // calibrated point itself stays a contender: the better of the
-            // two on the training window.
-            let refit = fit(sim, &syn, &pts, Candidate::None, nuisance, None, o.fit)?;
-            let best = if train_rss(&refit.series, &syn)? < train_rss(&base, &syn)? { &refit.series } else { &base };
-            let left = heldout_rms(run, ch, best, &with, split)?;
-            let noise = run.get(ch).and_then(noise_sigma).unwrap_or(0.1).max(0.02);
-            Some(Detectability {
-                candidate: c.name().into(),
-                magnitude: specs.iter().zip(&ext).map(|(s, v)| (s.name.clone(), *v, s.unit.clone())).collect(),
-                imprint_k: (ch.name().into(), imprint),
-                left_k: left,
-                noise_k: noise,
-                best_gain: 1.0 - noise / (noise * noise + left * left).sqrt(),
-                note: identifiable_here(c, run, split, sim).err().unwrap_or_default().into(),
-            })
-        })
-        .collect()
+    let with = sim.simulate(nuisance, c, ext).ok()?;
+    // The log as the model with the candidate would have written it,
+    // noise-free, with the log's own missing samples.
+    let mut syn = run.clone();
+    for ch in Channel::TEMPERATURES {
+        let (Some(m), Some(y)) = (run.get(ch), with.channels.get(&ch)) else { continue };
+        let v = m.iter().zip(y).map(|(m, y)| m.map(|_| *y)).collect();
+        syn.set(ch, v);
+    }
+    let (ch, imprint) = Channel::TEMPERATURES
+        .into_iter()
+        .filter_map(|ch| Some((ch, heldout_rms(run, ch, &with, &base, split)?)))
+        .max_by(|a, b| a.1.total_cmp(&b.1))?;
+    // The fit starts a hair off any bound (`diagnosis::fit`), so the
+    // calibrated point itself stays a contender: the better of the two on
+    // the training window.
+    let refit = fit(sim, &syn, &pts, Candidate::None, nuisance, None, o.fit)?;
+    let best = if train_rss(&refit.series, &syn)? < train_rss(&base, &syn)? { &refit.series } else { &base };
+    let left = heldout_rms(run, ch, best, &with, split)?;
+    let noise = run.get(ch).and_then(noise_sigma).unwrap_or(0.1).max(0.02);
+    Some(Detectability {
+        candidate: c.name().into(),
+        magnitude: sim.extension_params(c).iter().zip(ext).map(|(s, v)| (s.name.clone(), *v, s.unit.clone())).collect(),
+        imprint_k: (ch.name().into(), imprint),
+        left_k: left,
+        noise_k: noise,
+        best_gain: 1.0 - noise / (noise * noise + left * left).sqrt(),
+        note: identifiable_here(c, run, split, sim).err().unwrap_or_default().into(),
+    })
 }
 
 /// The Markdown section of `report.md`.
