@@ -376,8 +376,13 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
     // from other starts may have found a better basin of the nuisance set,
     // and its gain would then be the basin's, not the effect's; the better
     // baseline (training residual) is the one candidates are judged
-    // against. Only then: with nothing qualifying, it would only cost time.
-    if ranking.iter().any(|r| r.qualifies) {
+    // against. In the global tier only then (restarting every global
+    // baseline turned the servo `none` log 1717 `unexplained`, session 13);
+    // in the physical tier always: whether a candidate first qualifies there
+    // is itself path-dependent (a semantically neutral refactor moved
+    // emulator log 1708 across it, and its baseline from 0.38 to 0.41 K held
+    // out; session 17), and the baseline should not depend on it.
+    if ranking.iter().any(|r| r.qualifies) || !escalate {
         let mut by_rss: Vec<&FitResult> = fits.iter().collect();
         by_rss.sort_by(|a, b| a.rss.total_cmp(&b.rss));
         let starts: Vec<Vec<f64>> = by_rss.iter().take(2).map(|f| f.nuisance.clone()).collect();

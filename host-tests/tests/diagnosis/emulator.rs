@@ -135,7 +135,8 @@ fn slow_emulator_conduction_is_named_over_a_qualifying_forced_convection() {
 /// is sensor lag, not churning (measured; churning was best by ΔBIC 56),
 /// and t_pump_c calibrates to 0.34 K (0.30 K with the emulator's
 /// compression heat, session 15; 0.36 K since the oil probe's response
-/// time joined the physical set, session 16). Asserted: `none`, the best
+/// time joined the physical set, session 16; 0.32 K since the physical
+/// tier always restarts its baseline, session 17). Asserted: `none`, the best
 /// candidate does not qualify, t_pump_c calibrated ≤ 0.4 K held out (4σ of
 /// the 0.1 K noise: the 8.7 K churning imprint is absorbed, not missed by a
 /// misfit).
@@ -148,10 +149,10 @@ fn slow_emulator_churning_measured_miss() {
     assert!(!qualifies, "best candidate {name} qualifies (measured: sensor-lag, not qualifying)");
     let (before, _) = r.affected_heldout_k.expect("affected channel");
     assert!(before <= 0.4, "t_pump_c calibrated held-out {before:.3} K (measured 0.36)");
-    // Churning's own fit (session 17): −4 % on t_pump_c at the default fit
+    // Churning's own fit (session 17): −3 % on t_pump_c at the default fit
     // budget, −6 % with 13 Jacobians instead of 6 (docs/diagnosis.md, "Why
     // the misses are missed").
-    assert_oracle_under(&r, 0.3, "−4 %");
+    assert_oracle_under(&r, 0.3, "−3 %");
 }
 
 /// Viscosity in load cycles (seed 1702): named with t_oil_c held out
