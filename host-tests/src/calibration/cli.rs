@@ -93,7 +93,7 @@ pub fn run(args: &CommissionArgs) -> ExitCode {
     let t = std::time::Instant::now();
     let mut o = CalOptions { sigma_data_k: args.sigma_data_k, points_per_channel: args.points_per_channel, max_evals: args.max_evals, ..Default::default() };
     if args.fit_oil_probe {
-        o.hold.retain(|(name, _)| *name != "probe_oil");
+        o.hold.retain(|(name, _)| *name != super::set::PROBE_OIL);
     }
     let res = commission(&inputs.0, &inputs.1, &inputs.2, &o).map_err(anyhow::Error::from).and_then(|c| {
         write_outputs(args, &inputs.0, &inputs.2, &c)?;

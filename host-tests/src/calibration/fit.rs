@@ -11,7 +11,7 @@
 
 use super::ident::{excitation_warnings, identifiability, Identifiability};
 use super::log::CalLog;
-use super::set::{apply, Needs, Stage, PARAMS};
+use super::set::{apply, Needs, Stage, PARAMS, PROBE_OIL};
 use crate::lsq::FdProblem;
 use crate::rig::Rig;
 use levenberg_marquardt::LevenbergMarquardt;
@@ -51,7 +51,7 @@ impl Default for CalOptions {
             max_evals: 600,
             hold_ratio: 0.7,
             corr_threshold: 0.9,
-            hold: vec![("probe_oil", PROBE_HELD.into())],
+            hold: vec![(PROBE_OIL, PROBE_HELD.into())],
         }
     }
 }

@@ -56,6 +56,10 @@ pub enum Stage {
     SensorResponse,
 }
 
+/// Name of the oil probe's response-time parameter (held by default in
+/// `commission`, freed by `--fit-oil-probe`).
+pub const PROBE_OIL: &str = "probe_oil";
+
 /// The calibration set, in fit order.
 pub const PARAMS: [ParamDef; 20] = [
     ParamDef {
@@ -199,7 +203,7 @@ pub const PARAMS: [ParamDef; 20] = [
         stage: Stage::Thermal,
     },
     ParamDef {
-        name: "probe_oil",
+        name: PROBE_OIL,
         what: "response time of the manifold oil probe in the flowing oil (thermowell, sheath)",
         fields: "blocks.sensor_tau_s",
         lo: 0.25, hi: 5.0, prior_sigma_ln: 1.0,
@@ -295,8 +299,9 @@ pub fn apply(base: &Rig, theta: &[f64]) -> Rig {
             "cap_ball_block" => r.blocks.ball_mass_kg *= t,
             "cap_loop_oil" => r.blocks.loop_oil_m3 *= t,
             "cap_case_oil" => r.pump.case_oil_m3 *= t,
-            "probe_oil" => r.blocks.sensor_tau_s *= t,
-            // REMAP at merge: the new pump loss torque T0 + C_v·μ·ω + C_p·Δp.
+            PROBE_OIL => r.blocks.sensor_tau_s *= t,
+            // Every term of the pump loss torque T0 + C_v·μ·ω + C_p·Δp
+            // (extended eq. 8) scales together.
             "pump_friction" => {
                 r.pump.eta_m *= t;
                 r.pump.no_load_torque_nm *= t;

@@ -125,7 +125,10 @@ fn run_inner(args: &DiagnoseArgs) -> anyhow::Result<String> {
     let d = diagnose(&run, &progress, &o);
     progress.bar.finish_and_clear();
     let d = d?;
+    // The diagnosis's own time (the detectability pass comes after).
+    let secs = t.elapsed().as_secs_f64();
     write_outputs(&d, &run, &args.measured.display().to_string(), &args.out)?;
+    let mut detect_line = None;
     if args.detectability {
         let rows = super::detect::with_answer_tier(&model, &d, |sim, values| super::detect::detectability(&run, sim, values, d.split_time_s, &o));
         let report = args.out.join("report.md");
@@ -133,8 +136,9 @@ fn run_inner(args: &DiagnoseArgs) -> anyhow::Result<String> {
         md += &super::detect::markdown(&rows);
         std::fs::write(&report, md)?;
         std::fs::write(args.out.join("detectability.json"), serde_json::to_string_pretty(&rows)? + "\n")?;
+        detect_line = Some(super::detect::summary(&rows));
     }
-    Ok(format!(
+    let verdict = format!(
         "cause: {} | held-out RMSE {:.3} -> {:.3} K | training {:.3} -> {:.3} K | {} model runs, {:.1} s | {}",
         d.answer(),
         d.before.heldout_rmse_k,
@@ -142,7 +146,11 @@ fn run_inner(args: &DiagnoseArgs) -> anyhow::Result<String> {
         d.before.train_rmse_k,
         d.after.train_rmse_k,
         d.sims,
-        t.elapsed().as_secs_f64(),
+        secs,
         args.out.join("report.md").display()
-    ))
+    );
+    Ok(match detect_line {
+        Some(l) => format!("{verdict}\n{l}"),
+        None => verdict,
+    })
 }

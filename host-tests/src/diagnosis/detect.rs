@@ -10,7 +10,10 @@
 //! misses by √(σ² + left²), the right candidate by σ): 50 % needs
 //! left ≥ √3·σ. This assumes the model's own structure; a rig that differs
 //! in structure adds its own misfit on top (docs/diagnosis.md, "Why the
-//! misses are missed").
+//! misses are missed"). The recalibration is a local fit from the
+//! calibrated point: a fit that absorbs more would leave less, so "left" and
+//! the best gain are upper bounds (a low value is certain, a high one
+//! optimistic), and they need not grow with the magnitude.
 
 use super::adequacy::noise_sigma;
 use super::analysis::{fit_points, identifiable_here, DiagnoseOptions, Diagnosis};
@@ -138,6 +141,33 @@ pub fn detect_one(
     })
 }
 
+/// One line: per candidate, the smallest magnitude tried whose best gain
+/// reaches 50 % (and whether the log lets it be named at all), or that
+/// none does.
+pub fn summary(rows: &[Detectability]) -> String {
+    let mut shown = Vec::new();
+    let mut hidden = Vec::new();
+    for c in Candidate::EXTENSIONS {
+        let mine: Vec<&Detectability> = rows.iter().filter(|r| r.candidate == c.name()).collect();
+        if mine.is_empty() {
+            continue;
+        }
+        match mine.iter().find(|r| r.best_gain >= 0.5) {
+            Some(r) => {
+                let mag = r.magnitude.first().map_or(String::new(), |(_, v, u)| format!(" from {v:.3e} {u}"));
+                let ident = if r.note.is_empty() { "" } else { ", not identifiable here" };
+                shown.push(format!("{}{mag}{ident}", c.name()));
+            }
+            None => hidden.push(c.name().to_string()),
+        }
+    }
+    format!(
+        "could show on this log (best gain ≥ 50 %, an upper bound): {}; not at any magnitude tried: {}",
+        if shown.is_empty() { "nothing".to_string() } else { shown.join(", ") },
+        if hidden.is_empty() { "–".to_string() } else { hidden.join(", ") }
+    )
+}
+
 /// The Markdown section of `report.md`.
 pub fn markdown(rows: &[Detectability]) -> String {
     let mut s = String::from(
@@ -164,5 +194,6 @@ pub fn markdown(rows: &[Detectability]) -> String {
             if r.note.is_empty() { "yes".to_string() } else { format!("no ({})", r.note) },
         );
     }
+    let _ = writeln!(s, "\n{}.", summary(rows));
     s
 }

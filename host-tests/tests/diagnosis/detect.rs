@@ -32,8 +32,8 @@ fn find<'a>(rows: &'a [Detectability], c: &str, k: usize) -> &'a Detectability {
 ///   its imprint is zero (< 1e-9 K) and it is marked not identifiable.
 /// - A 2-minute oil-probe lag (4× the typical 30 s) on the warm-up cannot
 ///   be taken up by the capacities and films: best gain ≥ 50 % (measured
-///   76 % here; 90 % and 87 % around the calibrated baselines of emulator
-///   logs 1704 and 1708).
+///   76 % here; 90 % around the calibrated baselines of emulator logs
+///   1704 and 1708).
 /// - The imprint grows with the magnitude: forced convection at 3, 12 and
 ///   40 m/s leaves a growing imprint on the logged channels.
 /// - The best gain is 1 − σ/√(σ² + left²) of the row's own numbers.
