@@ -130,11 +130,10 @@ fn run_inner(args: &DiagnoseArgs) -> anyhow::Result<String> {
     write_outputs(&d, &run, &args.measured.display().to_string(), &args.out)?;
     let mut detect_line = None;
     if args.detectability {
-        let rows = super::detect::with_answer_tier(&model, &d, |sim, values| super::detect::detectability(&run, sim, values, d.split_time_s, &o));
-        let report = args.out.join("report.md");
-        let mut md = std::fs::read_to_string(&report)?;
-        md += &super::detect::markdown(&rows);
-        std::fs::write(&report, md)?;
+        let rows = super::detect::with_answer_tier(&model, &d, |a| super::detect::detectability(&run, a, &o));
+        // A section appended to the report just written.
+        use std::io::Write as _;
+        std::fs::OpenOptions::new().append(true).open(args.out.join("report.md"))?.write_all(super::detect::markdown(&rows).as_bytes())?;
         std::fs::write(args.out.join("detectability.json"), serde_json::to_string_pretty(&rows)? + "\n")?;
         detect_line = Some(super::detect::summary(&rows));
     }

@@ -17,7 +17,7 @@
 
 use super::adequacy::noise_sigma;
 use super::analysis::{fit_points, identifiable_here, DiagnoseOptions, Diagnosis};
-use super::fit::fit;
+use super::fit::{fit, residuals_at, Point};
 use super::model::{Candidate, SimSeries, Simulator};
 use crate::measured::{Channel, MeasuredRun};
 use rayon::prelude::*;
@@ -57,60 +57,68 @@ fn heldout_rms(run: &MeasuredRun, ch: Channel, a: &SimSeries, b: &SimSeries, spl
     (!d.is_empty()).then(|| (d.iter().sum::<f64>() / d.len() as f64).sqrt())
 }
 
-/// The detectability of every candidate on `run`, around the calibrated
-/// nuisance values `nuisance` of `sim` (the tier whose answer stands),
-/// with the diagnosis's training/held-out split at `split` s. Candidates
-/// whose injected run fails are left out.
-pub fn detectability(run: &MeasuredRun, sim: &dyn Simulator, nuisance: &[f64], split: f64, o: &DiagnoseOptions) -> Vec<Detectability> {
-    // (candidate, index into MULTIPLES): a structural candidate has one form
-    // only; a multiple is left out once the previous one sat on the bound.
-    let jobs: Vec<(Candidate, usize)> = Candidate::EXTENSIONS
-        .iter()
-        .flat_map(|&c| {
-            let specs = sim.extension_params(c);
-            (0..MULTIPLES.len())
-                .filter(|&j| if specs.is_empty() { j == 0 } else { j == 0 || specs.iter().any(|s| MULTIPLES[j - 1] * s.start < s.hi) })
-                .map(move |j| (c, j))
-                .collect::<Vec<_>>()
-        })
-        .collect();
-    jobs.par_iter()
-        .filter_map(|&(c, j)| {
-            let ext: Vec<f64> = sim.extension_params(c).iter().map(|s| (MULTIPLES[j] * s.start).min(s.hi)).collect();
-            detect_one(run, sim, nuisance, split, o, c, &ext)
-        })
-        .collect()
+/// The calibrated point the injections start from: the simulator of a tier,
+/// its calibrated nuisance values, the baseline series there and the
+/// training/held-out split.
+pub struct Around<'a> {
+    /// Simulator of the tier (the reference model or its physical set).
+    pub sim: &'a dyn Simulator,
+    /// Calibrated nuisance values, in `sim.nuisance()` order.
+    pub nuisance: &'a [f64],
+    /// The baseline's series at those values.
+    pub base: &'a SimSeries,
+    /// Start of the held-out window, s.
+    pub split: f64,
 }
 
-/// Runs `f` with the simulator of the tier whose answer stands in `d`
-/// (`model` or its physical set) and that tier's calibrated values.
-pub fn with_answer_tier<R>(model: &dyn Simulator, d: &Diagnosis, f: impl FnOnce(&dyn Simulator, &[f64]) -> R) -> R {
+/// Runs `f` around the calibrated point of the tier whose answer stands in
+/// `d` (`model` or its physical set; the baseline series is the
+/// diagnosis's own, not simulated again).
+pub fn with_answer_tier<R>(model: &dyn Simulator, d: &Diagnosis, f: impl FnOnce(&Around) -> R) -> R {
     let physical = model.physical_set();
     let sim: &dyn Simulator = match (&physical, d.nuisance_set.as_str()) {
         (Some(p), "physical") => &**p,
         _ => model,
     };
     let values: Vec<f64> = d.nuisance_before.iter().map(|(_, v, _)| *v).collect();
-    f(sim, &values)
+    f(&Around { sim, nuisance: &values, base: &d.series[1], split: d.split_time_s })
 }
 
-/// The detectability of candidate `c` at parameters `ext` (one fit);
-/// `None` when a run fails.
-pub fn detect_one(
-    run: &MeasuredRun,
-    sim: &dyn Simulator,
-    nuisance: &[f64],
-    split: f64,
-    o: &DiagnoseOptions,
-    c: Candidate,
-    ext: &[f64],
-) -> Option<Detectability> {
-    let base = sim.simulate(nuisance, Candidate::None, &[]).ok()?;
-    let pts = fit_points(run, split, o.points_per_channel);
-    let train_rss = |a: &SimSeries, b: &MeasuredRun| -> Option<f64> {
-        super::fit::residuals_at(b, a, &pts).map(|r| r.iter().map(|e| e * e).sum())
-    };
-    let with = sim.simulate(nuisance, c, ext).ok()?;
+/// The detectability of every candidate on `run` around `a`. Candidates
+/// whose injected run fails are left out.
+pub fn detectability(run: &MeasuredRun, a: &Around, o: &DiagnoseOptions) -> Vec<Detectability> {
+    // (candidate, index into MULTIPLES): a structural candidate has one form
+    // only; a multiple is left out once the previous one sat on the bound.
+    let jobs: Vec<(Candidate, usize)> = Candidate::EXTENSIONS
+        .iter()
+        .flat_map(|&c| {
+            let specs = a.sim.extension_params(c);
+            (0..MULTIPLES.len())
+                .filter(|&j| if specs.is_empty() { j == 0 } else { j == 0 || specs.iter().any(|s| MULTIPLES[j - 1] * s.start < s.hi) })
+                .map(move |j| (c, j))
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    let pts = fit_points(run, a.split, o.points_per_channel);
+    jobs.par_iter()
+        .filter_map(|&(c, j)| {
+            let ext: Vec<f64> = a.sim.extension_params(c).iter().map(|s| (MULTIPLES[j] * s.start).min(s.hi)).collect();
+            inject(run, a, &pts, o, c, &ext)
+        })
+        .collect()
+}
+
+/// The detectability of candidate `c` at parameters `ext` around `a` (one
+/// fit); `None` when a run fails.
+pub fn detect_one(run: &MeasuredRun, a: &Around, o: &DiagnoseOptions, c: Candidate, ext: &[f64]) -> Option<Detectability> {
+    inject(run, a, &fit_points(run, a.split, o.points_per_channel), o, c, ext)
+}
+
+/// [`detect_one`] with the training points `pts` given.
+fn inject(run: &MeasuredRun, a: &Around, pts: &[Point], o: &DiagnoseOptions, c: Candidate, ext: &[f64]) -> Option<Detectability> {
+    let (sim, base, split) = (a.sim, a.base, a.split);
+    let train_rss = |s: &SimSeries, m: &MeasuredRun| -> Option<f64> { residuals_at(m, s, pts).map(|r| r.iter().map(|e| e * e).sum()) };
+    let with = sim.simulate(a.nuisance, c, ext).ok()?;
     // The log as the model with the candidate would have written it,
     // noise-free, with the log's own missing samples.
     let mut syn = run.clone();
@@ -121,13 +129,13 @@ pub fn detect_one(
     }
     let (ch, imprint) = Channel::TEMPERATURES
         .into_iter()
-        .filter_map(|ch| Some((ch, heldout_rms(run, ch, &with, &base, split)?)))
-        .max_by(|a, b| a.1.total_cmp(&b.1))?;
+        .filter_map(|ch| Some((ch, heldout_rms(run, ch, &with, base, split)?)))
+        .max_by(|x, y| x.1.total_cmp(&y.1))?;
     // The fit starts a hair off any bound (`diagnosis::fit`), so the
     // calibrated point itself stays a contender: the better of the two on
     // the training window.
-    let refit = fit(sim, &syn, &pts, Candidate::None, nuisance, None, o.fit)?;
-    let best = if train_rss(&refit.series, &syn)? < train_rss(&base, &syn)? { &refit.series } else { &base };
+    let refit = fit(sim, &syn, pts, Candidate::None, a.nuisance, None, o.fit)?;
+    let best = if train_rss(&refit.series, &syn)? < train_rss(base, &syn)? { &refit.series } else { base };
     let left = heldout_rms(run, ch, best, &with, split)?;
     let noise = run.get(ch).and_then(noise_sigma).unwrap_or(0.1).max(0.02);
     Some(Detectability {

@@ -111,9 +111,9 @@ pub fn run_emu_case(case: EmuCase, o: &DiagnoseOptions) -> Result<EmuResult, Str
     });
     let hidden_detect = (case.hidden != Candidate::None)
         .then(|| {
-            super::detect::with_answer_tier(&model, &d, |sim, values| {
-                let ext: Vec<f64> = sim.extension_params(case.hidden).iter().map(|_| truth.magnitude).collect();
-                super::detect::detect_one(&run, sim, values, d.split_time_s, o, case.hidden, &ext)
+            super::detect::with_answer_tier(&model, &d, |a| {
+                let ext: Vec<f64> = a.sim.extension_params(case.hidden).iter().map(|_| truth.magnitude).collect();
+                super::detect::detect_one(&run, a, o, case.hidden, &ext)
             })
         })
         .flatten();
@@ -227,7 +227,7 @@ pub fn oracle_row(r: &EmuResult) -> Option<String> {
         r.case.hidden.name(),
         r.answer,
         h.delta_bic,
-        h.affected_heldout_k.map_or("–".into(), |(b, a)| format!("{b:.2} → {a:.2} ({:.0} %)", 100.0 * (1.0 - a / b))),
+        h.affected_heldout_k.zip(h.affected_gain()).map_or("–".into(), |((b, a), g)| format!("{b:.2} → {a:.2} ({:.0} %)", 100.0 * g)),
         h.pooled_heldout_k.0,
         h.pooled_heldout_k.1,
         if h.qualifies { "yes".to_string() } else if h.note.is_empty() { "no".into() } else { format!("no ({})", h.note) },

@@ -2,7 +2,7 @@
 //! could show, on a Case 1 log of the independent rig emulator (seed 1714,
 //! nothing hidden), around the rig file's values of the physical set.
 
-use eha_sim::diagnosis::detect::{detectability, Detectability};
+use eha_sim::diagnosis::detect::{detectability, Around, Detectability};
 use eha_sim::diagnosis::reference::ReferenceModel;
 use eha_sim::diagnosis::{Candidate, DiagnoseOptions, Simulator};
 use eha_sim::emulator::missions::EmuScenario::ConstantThrottle;
@@ -15,8 +15,10 @@ fn rows() -> Vec<Detectability> {
     let model = ReferenceModel::new(Rig::default(), &run).expect("model");
     let physical = model.physical_set().expect("physical set");
     let nominal: Vec<f64> = physical.nuisance().iter().map(|p| p.start).collect();
+    let base = physical.simulate(&nominal, Candidate::None, &[]).expect("baseline");
     let split = run.time_s[0] + 0.7 * (run.time_s[run.len() - 1] - run.time_s[0]);
-    let rows = detectability(&run, &*physical, &nominal, split, &DiagnoseOptions::default());
+    let around = Around { sim: &*physical, nuisance: &nominal, base: &base, split };
+    let rows = detectability(&run, &around, &DiagnoseOptions::default());
     for r in &rows {
         eprintln!("{} {:?}: imprint {:.3} K on {}, left {:.3} K, σ {:.3}, best gain {:.0} % {}", r.candidate, r.magnitude.first().map(|m| m.1), r.imprint_k.1, r.imprint_k.0, r.left_k, r.noise_k, 100.0 * r.best_gain, r.note);
     }
