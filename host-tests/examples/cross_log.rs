@@ -7,41 +7,26 @@
 //! `cargo run --profile fast -p eha-sim --example cross_log` (~25 s on two
 //! cores); prints one Markdown row per pair.
 
-use eha_sim::diagnosis::fit::{fit, FitOptions, Point};
+use eha_sim::diagnosis::analysis::{fit_from, fit_points};
+use eha_sim::diagnosis::fit::{fit, FitOptions};
+use eha_sim::diagnosis::stats::rmse;
 use eha_sim::diagnosis::model::{SimSeries, Simulator};
 use eha_sim::diagnosis::reference::ReferenceModel;
-use eha_sim::diagnosis::Candidate;
+use eha_sim::diagnosis::{Candidate, DiagnoseOptions};
 use eha_sim::emulator::missions::EmuScenario::{self, *};
 use eha_sim::emulator::{generate, generate_on_machine, EmuCase};
 use eha_sim::measured::{Channel, MeasuredRun};
 use eha_sim::rig::Rig;
 use rayon::prelude::*;
 
-fn points(run: &MeasuredRun, per: usize) -> Vec<Point> {
-    let mut pts = Vec::new();
-    for ch in Channel::TEMPERATURES {
-        let Some(m) = run.get(ch) else { continue };
-        let rows: Vec<usize> = (0..run.len()).filter(|&i| m[i].is_some()).collect();
-        let step = rows.len().div_ceil(per).max(1);
-        pts.extend(rows.iter().step_by(step).map(|&i| (ch, i)));
-    }
-    pts
-}
-
-fn rmse(run: &MeasuredRun, s: &SimSeries, ch: Channel) -> f64 {
-    let (Some(m), Some(y)) = (run.get(ch), s.channels.get(&ch)) else { return f64::NAN };
-    let d: Vec<f64> = m.iter().zip(y).filter_map(|(m, y)| m.map(|m| (y - m).powi(2))).collect();
-    (d.iter().sum::<f64>() / d.len() as f64).sqrt()
-}
-
-fn pooled(run: &MeasuredRun, s: &SimSeries) -> f64 {
-    let mut d = vec![];
-    for ch in Channel::TEMPERATURES {
-        if let (Some(m), Some(y)) = (run.get(ch), s.channels.get(&ch)) {
-            d.extend(m.iter().zip(y).filter_map(|(m, y)| m.map(|m| (y - m).powi(2))));
-        }
-    }
-    (d.iter().sum::<f64>() / d.len() as f64).sqrt()
+/// RMS of the measured-minus-simulated residuals of `channels` in `run`, K.
+fn rmse_over(run: &MeasuredRun, s: &SimSeries, channels: &[Channel]) -> f64 {
+    let r: Vec<Option<f64>> = channels
+        .iter()
+        .filter_map(|&ch| Some(run.get(ch)?.iter().zip(s.channels.get(&ch)?).map(|(m, y)| m.map(|m| y - m))))
+        .flatten()
+        .collect();
+    rmse(&r).unwrap_or(f64::NAN)
 }
 
 fn main() {
@@ -57,6 +42,7 @@ fn main() {
     ];
     // 13 Jacobians of the 19-parameter physical set: converged fits.
     let opts = FitOptions { max_sims: 260, ..FitOptions::default() };
+    let dopts = DiagnoseOptions { fit: opts, ..DiagnoseOptions::default() };
     let rows: Vec<String> = pairs
         .par_iter()
         .map(|&(h, a, b, seed)| {
@@ -69,11 +55,11 @@ fn main() {
             let mb = ReferenceModel::new(Rig::default(), &rb).expect("emulator case");
             let sa = ma.physical_set().expect("emulator case");
             let sb = mb.physical_set().expect("emulator case");
-            let pts = points(&ra, 150);
+            // The whole of log A trains (no held-out window).
+            let pts = fit_points(&ra, f64::INFINITY, 150);
             let nom: Vec<f64> = sa.nuisance().iter().map(|p| p.start).collect();
             let base = fit(&*sa, &ra, &pts, Candidate::None, &nom, None, opts).expect("emulator case");
-            let off: Vec<f64> = sa.extension_params(hid).iter().map(|s| s.lo * (s.hi / s.lo).powf(0.1)).collect();
-            let c1 = fit(&*sa, &ra, &pts, hid, &base.nuisance, Some(&off), opts);
+            let c1 = fit_from(&*sa, &ra, &pts, hid, &base, &dopts);
             let c2 = fit(&*sa, &ra, &pts, hid, &nom, None, opts);
             let cand = [c1, c2].into_iter().flatten().min_by(|x, y| x.rss.total_cmp(&y.rss)).expect("emulator case");
             // Map A's calibrated values onto B's set by name (B's extra ones at the rig file).
@@ -84,8 +70,8 @@ fn main() {
             let yb0 = sb.simulate(&to_b(&base.nuisance), Candidate::None, &[]).expect("emulator case");
             let yb1 = sb.simulate(&to_b(&cand.nuisance), hid, &cand.ext).expect("emulator case");
             let ch = tb.affected.map(|x| x.0).expect("emulator case");
-            let (e0, e1) = (rmse(&rb, &yb0, ch), rmse(&rb, &yb1, ch));
-            let (p0, p1) = (pooled(&rb, &yb0), pooled(&rb, &yb1));
+            let (e0, e1) = (rmse_over(&rb, &yb0, &[ch]), rmse_over(&rb, &yb1, &[ch]));
+            let (p0, p1) = (rmse_over(&rb, &yb0, &Channel::TEMPERATURES), rmse_over(&rb, &yb1, &Channel::TEMPERATURES));
             format!(
                 "| {h} | {a:?} → {b:?} ({seed}) | train rss {:.1} → {:.1} | ext {:?} (truth {:.3e}) | {} {:.2} → {:.2} ({:.0} %) | pooled {:.2} → {:.2} ({:.0} %) |",
                 base.rss,

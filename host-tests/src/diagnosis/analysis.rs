@@ -283,7 +283,7 @@ fn metrics(run: &MeasuredRun, s: &SimSeries, split: f64, lb_lags: usize) -> Metr
 
 /// Training fit points: present temperature samples before `split`, thinned
 /// uniformly to at most `per_channel` per channel.
-pub(crate) fn fit_points(run: &MeasuredRun, split: f64, per_channel: usize) -> Vec<Point> {
+pub fn fit_points(run: &MeasuredRun, split: f64, per_channel: usize) -> Vec<Point> {
     let mut pts = Vec::new();
     for ch in Channel::TEMPERATURES {
         let Some(m) = run.get(ch) else { continue };
@@ -452,7 +452,7 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
 /// Candidate `c` fitted jointly with the nuisance set from the baseline
 /// `base`, with `c`'s parameters nearly off (a tenth of their log range
 /// above the lower bound).
-fn fit_from(sim: &dyn Simulator, run: &MeasuredRun, pts: &[Point], c: Candidate, base: &FitResult, o: &DiagnoseOptions) -> Option<FitResult> {
+pub fn fit_from(sim: &dyn Simulator, run: &MeasuredRun, pts: &[Point], c: Candidate, base: &FitResult, o: &DiagnoseOptions) -> Option<FitResult> {
     let off: Vec<f64> = sim.extension_params(c).iter().map(|s| s.lo * (s.hi / s.lo).powf(0.1)).collect();
     fit(sim, run, pts, c, &base.nuisance, Some(&off), o.fit)
 }
