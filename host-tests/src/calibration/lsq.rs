@@ -7,7 +7,7 @@ use levenberg_marquardt::LeastSquaresProblem;
 use nalgebra::{DMatrix, DVector, Dyn, Owned};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
 /// Residual function `r(x)` (None when the model cannot be evaluated there)
 /// at parameters `x`, with the forward-difference step `step` in x's units.
@@ -16,6 +16,10 @@ pub struct FdProblem<F> {
     x: DVector<f64>,
     step: f64,
     budget: Option<(Arc<AtomicUsize>, usize)>,
+    /// The last residual evaluated and where: the minimiser asks for the
+    /// Jacobian at the point whose residual it just took, so the
+    /// forward difference reuses it instead of running the model again.
+    last: Mutex<Option<(DVector<f64>, DVector<f64>)>>,
 }
 
 impl<F> FdProblem<F>
@@ -24,7 +28,7 @@ where
 {
     /// A problem starting at `x0`.
     pub fn new(residual: F, x0: DVector<f64>, step: f64) -> Self {
-        Self { residual, x: x0, step, budget: None }
+        Self { residual, x: x0, step, budget: None, last: Mutex::new(None) }
     }
 
     /// The same problem with an evaluation budget: `used` counts residual
@@ -50,6 +54,20 @@ where
     pub fn x(&self) -> &DVector<f64> {
         &self.x
     }
+
+    /// The residual at the current parameters, from the cache when the
+    /// last evaluation was there (the residual function is deterministic).
+    fn residual_here(&self) -> Option<DVector<f64>> {
+        let mut last = self.last.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((x, r)) = last.as_ref() {
+            if *x == self.x {
+                return Some(r.clone());
+            }
+        }
+        let r = (self.residual)(self.x.as_slice())?;
+        *last = Some((self.x.clone(), r.clone()));
+        Some(r)
+    }
 }
 
 impl<F> LeastSquaresProblem<f64, Dyn, Dyn> for FdProblem<F>
@@ -72,14 +90,16 @@ where
         if !self.take(1) {
             return None;
         }
-        (self.residual)(self.x.as_slice())
+        self.residual_here()
     }
 
     fn jacobian(&self) -> Option<DMatrix<f64>> {
+        // The budget counts r0 whether or not it is cached, so that where a
+        // fit stops (and so its result) does not depend on the cache.
         if !self.take(self.x.len() + 1) {
             return None;
         }
-        let r0 = (self.residual)(self.x.as_slice())?;
+        let r0 = self.residual_here()?;
         let cols: Option<Vec<DVector<f64>>> = (0..self.x.len())
             .into_par_iter()
             .map(|k| {
