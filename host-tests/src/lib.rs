@@ -20,6 +20,8 @@
 //! names (`eha_sim::rig`, `eha_sim::sim`, ...), the paths the tests,
 //! examples and benchmarks use.
 
+#![warn(missing_docs)]
+
 pub mod calibration;
 pub mod diagnosis;
 pub mod emulator;

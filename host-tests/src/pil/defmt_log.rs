@@ -9,7 +9,9 @@ use anyhow::{anyhow, Context, Result};
 pub struct LogLine {
     /// The defmt timestamp: the firmware's accepted-step count at the time.
     pub step: Option<u64>,
+    /// Log level as defmt prints it (`INFO`, `WARN`, ...).
     pub level: String,
+    /// The formatted message.
     pub message: String,
 }
 

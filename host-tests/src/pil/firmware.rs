@@ -16,24 +16,28 @@ pub enum Build {
 }
 
 impl Build {
+    /// Rust target triple of the build.
     pub fn target(self) -> &'static str {
         match self {
             Build::F32 => "thumbv7em-none-eabihf",
             Build::Fixed => "thumbv7m-none-eabi",
         }
     }
+    /// QEMU machine that emulates the build's board.
     pub fn machine(self) -> &'static str {
         match self {
             Build::F32 => "mps2-an386",
             Build::Fixed => "mps2-an385",
         }
     }
+    /// QEMU CPU of that machine.
     pub fn cpu(self) -> &'static str {
         match self {
             Build::F32 => "cortex-m4",
             Build::Fixed => "cortex-m3",
         }
     }
+    /// Name of the build in reports.
     pub fn name(self) -> &'static str {
         match self {
             Build::F32 => "f32",

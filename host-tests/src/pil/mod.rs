@@ -29,11 +29,17 @@ pub use qemu::{PilError, QemuOptions, QemuSession};
 /// What the firmware can measure, plus the plant's true drain temperature.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PlantSensors {
+    /// Motor current, A rms.
     pub current_a: f64,
+    /// Port A pressure, bar gauge.
     pub p_a_bar: f64,
+    /// Port B pressure, bar gauge.
     pub p_b_bar: f64,
+    /// Motor speed, rpm.
     pub speed_rpm: f64,
+    /// Piston position, mm.
     pub position_mm: f64,
+    /// Ambient air temperature, °C.
     pub ambient_c: f64,
     /// True drain-port oil temperature (not sent to the firmware).
     pub t_drain_c: f64,
@@ -74,6 +80,8 @@ pub enum StepControl {
 /// `on_step(t_s, sensors)` at `t0, t0 + dt, …` up to `t_end` and applies the
 /// returned valve command during the following step.
 pub trait PlantModel {
+    /// Runs from the plant's start to `t_end_s`, calling `on_step` every
+    /// `dt_s` s of plant time; stops early when it returns [`StepControl::Stop`].
     fn run(
         &mut self,
         dt_s: f64,
@@ -100,8 +108,11 @@ impl Target for QemuSession {
 pub struct StepRecord {
     /// Plant time at which the sample was taken, s.
     pub t_s: f64,
+    /// What the plant measured then (and its true drain temperature).
     pub sensors: PlantSensors,
+    /// The frame sent to the firmware.
     pub request: Request,
+    /// The firmware's reply to it.
     pub reply: Reply,
 }
 
@@ -115,6 +126,7 @@ pub struct LoopOptions {
 }
 
 impl LoopOptions {
+    /// Number of firmware steps in the run.
     pub fn steps(&self) -> u64 {
         (self.duration_s / self.step_s).round() as u64
     }
@@ -123,7 +135,9 @@ impl LoopOptions {
 /// A closed-loop run that stopped early: the records up to the failure are kept.
 #[derive(Debug)]
 pub struct LoopFailure {
+    /// The steps completed before the failure.
     pub records: Vec<StepRecord>,
+    /// What failed.
     pub error: anyhow::Error,
 }
 
@@ -188,11 +202,18 @@ pub fn replay(records: &[StepRecord], target: &mut dyn Target) -> Result<Vec<Rep
 /// Result of a full PIL session.
 #[derive(Debug)]
 pub struct PilRun {
+    /// Which firmware build ran.
     pub build: Build,
+    /// Every lockstep step.
     pub records: Vec<StepRecord>,
+    /// The completion marker (a `Done` reply with the final counters).
     pub done: Reply,
+    /// The firmware's decoded defmt log.
     pub log: Vec<defmt_log::LogLine>,
+    /// Wall-clock time of the session.
     pub wall: Duration,
+    /// Whether QEMU counted instructions (`-icount`): the replies' tick
+    /// counts are then instruction counts.
     pub icount: bool,
 }
 
@@ -229,8 +250,11 @@ pub fn run_pil(plant: &mut dyn PlantModel, qemu: &QemuOptions, opts: &LoopOption
 /// A failed PIL session with everything that was recorded before the failure.
 #[derive(Debug)]
 pub struct PilFailure {
+    /// The steps completed before the failure.
     pub records: Vec<StepRecord>,
+    /// The defmt log decoded up to the failure.
     pub log: Vec<defmt_log::LogLine>,
+    /// What failed.
     pub error: anyhow::Error,
 }
 
@@ -274,11 +298,17 @@ pub fn firmware_for_tests(build: Build) -> std::path::PathBuf {
 /// An open-loop firmware session: fixed frames in, replies out.
 #[derive(Debug)]
 pub struct OpenLoopRun {
+    /// Which firmware build ran.
     pub build: Build,
+    /// One reply per request, in order.
     pub replies: Vec<Reply>,
+    /// The completion marker (a `Done` reply with the final counters).
     pub done: Reply,
+    /// The firmware's decoded defmt log.
     pub log: Vec<defmt_log::LogLine>,
+    /// Wall-clock time of the session.
     pub wall: Duration,
+    /// Whether QEMU counted instructions (`-icount`).
     pub icount: bool,
 }
 

@@ -34,18 +34,51 @@ pub fn exit_meaning(code: i32) -> &'static str {
 /// Why a PIL session failed. Every variant says what happened in words.
 #[derive(Debug, thiserror::Error)]
 pub enum PilError {
+    /// `qemu-system-arm` is not installed.
     #[error("qemu-system-arm was not found on PATH: install it (`apt-get install -y qemu-system-arm`; .ci/run does this). QEMU tests cannot run without it")]
     QemuMissing,
+    /// QEMU could not be started.
     #[error("could not start QEMU: {0}")]
     Spawn(std::io::Error),
+    /// No reply within the timeout (QEMU still running, then killed).
     #[error("firmware stopped answering: no reply within {waited:?} at step {step} (QEMU still running; killed). QEMU stderr text: {text:?}")]
-    Timeout { step: u64, waited: Duration, text: String },
+    Timeout {
+        /// Step whose reply was awaited.
+        step: u64,
+        /// How long the harness waited.
+        waited: Duration,
+        /// QEMU's stderr text.
+        text: String,
+    },
+    /// The firmware exited before the run ended.
     #[error("firmware exited abnormally at step {step}: exit code {code:?} ({meaning}). QEMU stderr text: {text:?}")]
-    Exited { step: u64, code: Option<i32>, meaning: &'static str, text: String },
+    Exited {
+        /// Step at which it exited.
+        step: u64,
+        /// Exit code (semihosting exit or QEMU's own).
+        code: Option<i32>,
+        /// What the code means.
+        meaning: &'static str,
+        /// QEMU's stderr text.
+        text: String,
+    },
+    /// The firmware exited without its `Done` reply.
     #[error("firmware exited without the completion marker (exit status {status}); the run is not trustworthy. QEMU stderr text: {text:?}")]
-    NoCompletionMarker { status: String, text: String },
+    NoCompletionMarker {
+        /// QEMU's exit status.
+        status: String,
+        /// QEMU's stderr text.
+        text: String,
+    },
+    /// A reply frame that does not decode or does not answer the request.
     #[error("protocol error at step {step}: {what}")]
-    Protocol { step: u64, what: String },
+    Protocol {
+        /// Step of the bad reply.
+        step: u64,
+        /// What was wrong.
+        what: String,
+    },
+    /// Reading from or writing to QEMU failed.
     #[error("I/O error talking to QEMU: {0}")]
     Io(#[from] std::io::Error),
 }
@@ -53,11 +86,14 @@ pub enum PilError {
 /// Options of one QEMU session.
 #[derive(Clone, Debug)]
 pub struct QemuOptions {
+    /// Firmware build (selects machine and CPU by default).
     pub build: Build,
+    /// The firmware ELF to run.
     pub elf: PathBuf,
     /// QEMU machine and CPU (default: the build's; the tests override them
     /// to run M4F code on a Cortex-M3 and provoke a HardFault).
     pub machine: String,
+    /// QEMU CPU (see `machine`).
     pub cpu: String,
     /// How long to wait for one reply before declaring the firmware dead.
     pub reply_timeout: Duration,
@@ -70,6 +106,7 @@ pub struct QemuOptions {
 }
 
 impl QemuOptions {
+    /// The build's machine and CPU, a 5 s reply timeout, `-icount` on.
     pub fn new(build: Build, elf: &Path) -> Self {
         Self {
             build,
@@ -122,6 +159,7 @@ pub fn ensure_qemu() -> Result<String, PilError> {
 pub struct SessionEnd {
     /// The completion marker (a `Done` reply with the final counters).
     pub done: Reply,
+    /// QEMU's exit status.
     pub status: ExitStatus,
     /// Raw defmt bytes from stdout.
     pub defmt: Vec<u8>,
@@ -144,6 +182,7 @@ pub struct QemuSession {
 }
 
 impl QemuSession {
+    /// The `qemu-system-arm` command line for `opts` (stdio not yet set).
     pub fn command(opts: &QemuOptions) -> Command {
         let mut cmd = Command::new("qemu-system-arm");
         cmd.args(["-machine", &opts.machine, "-cpu", &opts.cpu])
@@ -156,6 +195,7 @@ impl QemuSession {
         cmd
     }
 
+    /// Starts QEMU with the firmware, replies read on a background thread.
     pub fn spawn(opts: &QemuOptions) -> Result<Self, PilError> {
         qemu_available()?;
         let mut child = Self::command(opts)

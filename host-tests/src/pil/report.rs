@@ -13,7 +13,9 @@ use super::{PilRun, StepRecord};
 /// Numbers that describe one run.
 #[derive(Clone, Debug)]
 pub struct Summary {
+    /// Number of lockstep steps.
     pub steps: usize,
+    /// Plant time covered, s.
     pub plant_time_s: f64,
     /// (plant time, open?) at every valve command change.
     pub valve_events: Vec<(f64, bool)>,
@@ -21,15 +23,21 @@ pub struct Summary {
     pub max_abs_err_k: f64,
     /// max (reference − firmware), K (under-prediction; ≤ 0 means never under)
     pub max_under_k: f64,
+    /// LNG used over the run as the firmware counts it, kg.
     pub lng_used_kg: f64,
+    /// LNG left at the end as the firmware counts it, kg.
     pub lng_remaining_kg: f64,
     /// Instructions per step (mean, max) when measured with `-icount`.
     pub instructions: Option<(f64, f64)>,
+    /// Highest reference drain temperature, °C.
     pub peak_ref_c: f64,
+    /// Highest firmware drain estimate, °C.
     pub peak_fw_c: f64,
 }
 
 impl Summary {
+    /// The summary of `records`; `icount` says whether their tick counts
+    /// are instruction counts.
     pub fn of(records: &[StepRecord], icount: bool) -> Self {
         let mut valve_events = Vec::new();
         let mut prev = false;
@@ -158,17 +166,24 @@ pub fn transcript(run: &PilRun, every_s: f64) -> String {
 /// Per-step comparison of two reply streams (firmware vs SIL).
 #[derive(Clone, Debug, Default)]
 pub struct Comparison {
+    /// Steps compared (the shorter stream's length).
     pub steps: usize,
     /// Steps whose replies are bit-identical (all outputs, counters and seq; ticks ignored).
     pub identical: usize,
+    /// Index of the first step that is not bit-identical.
     pub first_difference: Option<usize>,
+    /// Largest drain-estimate difference, K.
     pub max_drain_diff_k: f64,
+    /// Largest LNG-remaining difference, kg.
     pub max_lng_diff_kg: f64,
+    /// Largest relative difference of the LNG time left (∞ when only one
+    /// side is finite).
     pub max_seconds_left_rel: f64,
     /// Steps whose valve/alarm/derate/faults differ.
     pub flag_mismatches: usize,
 }
 
+/// Compares the firmware's replies with the SIL's, step by step.
 pub fn compare(fw: &[Reply], sil: &[Reply]) -> Comparison {
     let mut c = Comparison { steps: fw.len().min(sil.len()), ..Default::default() };
     for (k, (a, b)) in fw.iter().zip(sil).enumerate() {

@@ -12,10 +12,12 @@ pub struct SilTarget<F> {
 }
 
 impl<F: FnMut(&Request, u16) -> GuardOutput> SilTarget<F> {
+    /// A fresh link around the core step `core`.
     pub fn new(core: F) -> Self {
         Self { link: Link::new(), core }
     }
 
+    /// The frame handler (its counters).
     pub fn link(&self) -> &Link {
         &self.link
     }
