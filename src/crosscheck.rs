@@ -21,7 +21,7 @@ use crate::num::Num;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CrossCheckConfig {
     /// Window of means, 10 ms ticks, counted in model steps (rounded up): 50 = 0.5 s.
-    pub window_steps: u32,
+    pub window_ticks: u32,
     /// Consecutive disagreeing windows that latch SENSOR_DISAGREE (2 = 1 s); 0 never
     /// latches (the larger loss is still used while the estimates disagree).
     pub persist_windows: u32,
@@ -34,7 +34,7 @@ impl CrossCheckConfig {
     /// 0.5 s windows, latched after 2 in a row (1 s: the fault campaign's
     /// detection rule), 5 W.
     pub const DEFAULT: CrossCheckConfig = CrossCheckConfig {
-        window_steps: 50,
+        window_ticks: 50,
         persist_windows: 2,
         bound_w: 5.0,
     };
@@ -75,7 +75,7 @@ impl<N: Num> CrossCheck<N> {
     /// `None` when the bound or the window does not fit the number type, or the
     /// window is empty.
     pub fn new(cfg: &CrossCheckConfig, ticks_per_step: u32) -> Option<Self> {
-        let steps = cfg.window_steps.div_ceil(ticks_per_step.max(1));
+        let steps = cfg.window_ticks.div_ceil(ticks_per_step.max(1));
         let b = cfg.bound_w * 1e-3;
         if steps == 0 || !b.is_finite() || !(0.0..250.0).contains(&b) {
             return None;

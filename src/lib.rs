@@ -9,7 +9,7 @@
 //!
 //! Module map: [`params`] (SI parameters) → [`model`] (discretised model, generic
 //! over [`num::Num`]: `f64`, `f32`, fixed point) → [`validate`], [`protection`],
-//! [`trace`], [`memory`] → [`guard`] (`Guard::new`, `Guard::step`) → [`product`]
+//! [`trace`], [`memory`] → [`guard`] (`Guard::new`, `Guard::tick`) → [`product`]
 //! (the board-agnostic product loop; boards in `src/bin/eha-mps2/` and
 //! `src/bin/eha-stm32f4/`).
 #![no_std]

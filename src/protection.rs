@@ -13,12 +13,12 @@ pub struct ValveConfig {
     /// issue specifies.
     pub close_c: f32,
     /// Dwell, 10 ms ticks (200 = 2 s): the valve closes only after the estimate has
-    /// been below `close_c` at every decision of the last `dwell_steps` (which is
+    /// been below `close_c` at every decision of the last `dwell_ticks` (which is
     /// also the minimum open time, counted from any opening, forced or not). It
     /// never delays an opening. The guard decides on temperature once per model step
-    /// and counts the dwell in model steps (`dwell_steps / TICKS_PER_STEP`, rounded
+    /// and counts the dwell in model steps (`dwell_ticks / TICKS_PER_STEP`, rounded
     /// up: 20 steps of 100 ms).
-    pub dwell_steps: u32,
+    pub dwell_ticks: u32,
 }
 
 impl ValveConfig {
@@ -26,7 +26,7 @@ impl ValveConfig {
     pub const DEFAULT: ValveConfig = ValveConfig {
         open_c: 40.0,
         close_c: 38.0,
-        dwell_steps: 200,
+        dwell_ticks: 200,
     };
 }
 
@@ -88,7 +88,7 @@ impl Valve {
     /// One decision (the dwell counts calls: 10 ms ticks here, model steps in the
     /// guard). `force_open` (faults, non-finite estimate) opens at once and holds it
     /// open. Otherwise: open at once when `drain_c > open_c`; close when `drain_c <
-    /// close_c` at this and the `dwell_steps - 1` decisions before it (at least one).
+    /// close_c` at this and the `dwell_ticks - 1` decisions before it (at least one).
     /// A NaN temperature keeps it open / opens it. Returns `Some(new_state)` when the
     /// command changed.
     pub fn update(&mut self, drain_c: f32, force_open: bool, cfg: &ValveConfig) -> Option<bool> {
@@ -97,7 +97,7 @@ impl Valve {
             force_open,
             cfg.open_c,
             cfg.close_c,
-            cfg.dwell_steps,
+            cfg.dwell_ticks,
         )
     }
 
@@ -110,7 +110,7 @@ impl Valve {
         force_open: bool,
         open_above: T,
         close_below: T,
-        dwell_steps: u32,
+        dwell_ticks: u32,
     ) -> Option<bool> {
         if force_open || drain.partial_cmp(&drain).is_none() {
             return self.force_open().then_some(true);
@@ -124,7 +124,7 @@ impl Valve {
         }
         if drain < close_below {
             self.below = self.below.saturating_add(1);
-            if self.below >= dwell_steps {
+            if self.below >= dwell_ticks {
                 self.set(false);
                 return Some(false);
             }

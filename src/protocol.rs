@@ -1,5 +1,5 @@
 //! Wire protocol between the host (or the actuator controller) and the
-//! thermal guard: one request frame per firmware step, one reply frame back.
+//! thermal guard: one request frame per 10 ms tick, one reply frame back.
 //!
 //! The same bytes travel over semihosting stdin/stderr in QEMU and over a UART
 //! on a real board; nothing here knows the transport. The firmware feeds
@@ -45,9 +45,9 @@
 //! # Reply (guard → host), payload 37 bytes
 //! | off | type | field |
 //! |---|---|---|
-//! | 0 | u8 | kind: [`KIND_STEP`], [`KIND_REJECT`] or [`KIND_DONE`] |
+//! | 0 | u8 | kind: [`KIND_TICK`], [`KIND_REJECT`] or [`KIND_DONE`] |
 //! | 1 | u16 | sequence number (see [`ReplyKind`]) |
-//! | 3 | u8 | reject reason ([`RejectReason`] as u8, 0 for step/done) |
+//! | 3 | u8 | reject reason ([`RejectReason`] as u8, 0 for tick/done) |
 //! | 4 | f32 | predicted drain temperature, °C |
 //! | 8 | u8 | flags: bit0 valve open, bit1 alarm, bit2 derate |
 //! | 9 | u16 | fault word ([`crate::faults`]): bits 0-6 latched RANGE, RATE, NON_FINITE, STALE, MEMORY_CORRUPT, CONFIG, ACTUATOR; bit 7 LNG_LOW (status); bits 8-13 latched bad channels (current, p_A, p_B, speed, position, ambient); bit 14 latched SENSOR_DISAGREE; bit 15 UNTRUSTED (status) |
@@ -58,7 +58,7 @@
 //! | 23 | u16 | rejected: sequence (duplicate or older than the last accepted) |
 //! | 25 | u16 | frames skipped (sum of sequence gaps of accepted frames) |
 //! | 27 | u32 | accepted frames |
-//! | 31 | u32 | cost of the step in core-clock ticks (0 when not measured) |
+//! | 31 | u32 | cost of the tick in core-clock cycles (0 when not measured) |
 //! | 35 | u16 | reserved, 0 |
 //!
 //! All multi-byte fields are little-endian; floats are IEEE-754 binary32 bit
@@ -73,10 +73,10 @@
 //! it.
 //!
 //! # Rejections
-//! Every non-empty frame gets exactly one reply: a [`KIND_STEP`] reply when it
-//! was accepted and the guard stepped, otherwise a [`KIND_REJECT`] reply that
+//! Every non-empty frame gets exactly one reply: a [`KIND_TICK`] reply when it
+//! was accepted and the guard ticked, otherwise a [`KIND_REJECT`] reply that
 //! carries the reason, the counters and the *last* output unchanged. The
-//! guard never steps on a rejected frame. This keeps a lockstep host from
+//! guard never ticks on a rejected frame. This keeps a lockstep host from
 //! waiting forever on a frame that was damaged on the way.
 
 use heapless::Vec;
@@ -86,10 +86,10 @@ pub const FLAG_VALVE_FB: u8 = 1 << 0;
 /// Request flag: the reported valve position is open (only with [`FLAG_VALVE_FB`]).
 pub const FLAG_VALVE_FB_OPEN: u8 = 1 << 1;
 
-/// Request kind: one sensor sample, step the guard once.
+/// Request kind: one sensor sample, one guard tick.
 pub const KIND_SAMPLE: u8 = 0x01;
-/// Reply kind: the frame was accepted and the guard stepped.
-pub const KIND_STEP: u8 = 0x81;
+/// Reply kind: the frame was accepted and the guard ticked.
+pub const KIND_TICK: u8 = 0x81;
 /// Reply kind: the frame was rejected (reason in byte 3); outputs are the last ones.
 pub const KIND_REJECT: u8 = 0x82;
 /// Reply kind: completion marker, end of input reached; outputs are the last ones.
@@ -138,7 +138,7 @@ pub fn crc16(data: &[u8]) -> u16 {
     let mut crc: u16 = 0xFFFF;
     for &b in data {
         let idx = usize::from(((crc >> 8) as u8) ^ b);
-        // `idx` < 256 by construction; `get` keeps the step path free of
+        // `idx` < 256 by construction; `get` keeps the tick path free of
         // panicking indexing.
         crc = (crc << 8) ^ CRC_TABLE.get(idx).copied().unwrap_or(0);
     }
@@ -254,7 +254,7 @@ impl RejectReason {
     }
 }
 
-/// One sensor sample for one guard step (the wire form of the guard's `Sample`).
+/// One sensor sample for one guard tick (the wire form of the guard's `Sample`).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Request {
     /// Sequence number (wrapping).
@@ -275,7 +275,7 @@ pub struct Request {
     pub valve_fb: Option<bool>,
 }
 
-/// What the guard reports after a step: the guard's own [`crate::Output`].
+/// What the guard reports after a tick: the guard's own [`crate::Output`].
 pub type GuardOutput = crate::Output;
 
 impl Request {
@@ -292,25 +292,25 @@ impl Request {
     }
 }
 
-/// Most missed steps replayed into the guard for one sequence gap. After
-/// `stale_steps` (5) misses the STALE fault has latched and the guard runs on
+/// Most missed ticks replayed into the guard for one sequence gap. After
+/// `stale_ticks` (5) misses the STALE fault has latched and the guard runs on
 /// worst-case inputs; a longer gap would only spend time, so it is capped.
-pub const MAX_MISSED_STEPS: u16 = 100;
+pub const MAX_MISSED_TICKS: u16 = 100;
 
-/// The firmware's core step for one accepted frame, shared by the firmware
+/// The firmware's core tick for one accepted frame, shared by the firmware
 /// binary and the host SIL twin so both run exactly the same code: frames
 /// the sequence numbers say were lost count as missed samples
-/// ([`crate::GuardOf::step_missing`], at most [`MAX_MISSED_STEPS`]), then
+/// ([`crate::GuardOf::tick_missing`], at most [`MAX_MISSED_TICKS`]), then
 /// the frame's valve position, if reported, goes to
-/// [`crate::GuardOf::valve_feedback`] and the guard steps on the frame's sample.
-pub fn step_guard<N: crate::num::Num>(guard: &mut crate::GuardOf<N>, req: &Request, skipped: u16) -> GuardOutput {
-    for _ in 0..skipped.min(MAX_MISSED_STEPS) {
-        let _ = guard.step_missing();
+/// [`crate::GuardOf::valve_feedback`] and the guard ticks on the frame's sample.
+pub fn tick_guard<N: crate::num::Num>(guard: &mut crate::GuardOf<N>, req: &Request, skipped: u16) -> GuardOutput {
+    for _ in 0..skipped.min(MAX_MISSED_TICKS) {
+        let _ = guard.tick_missing();
     }
     if let Some(open) = req.valve_fb {
         guard.valve_feedback(open);
     }
-    guard.step(&req.sample())
+    guard.tick(&req.sample())
 }
 
 impl GuardOutput {
@@ -340,7 +340,7 @@ pub struct Counters {
     pub rejected_sequence: u16,
     /// Sequence numbers skipped by accepted frames (lost frames).
     pub skipped: u16,
-    /// Accepted frames (guard steps).
+    /// Accepted frames (guard ticks).
     pub accepted: u32,
 }
 
@@ -354,8 +354,8 @@ impl Counters {
 /// Kind of reply.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ReplyKind {
-    /// Accepted; `seq` is the request's sequence number; the guard stepped.
-    Step,
+    /// Accepted; `seq` is the request's sequence number; the guard ticked.
+    Tick,
     /// Rejected; `seq` is the offending frame's number when it could be read,
     /// else the last accepted one.
     Reject(RejectReason),
@@ -366,7 +366,7 @@ pub enum ReplyKind {
 /// A reply frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Reply {
-    /// Step, reject or done.
+    /// Tick, reject or done.
     pub kind: ReplyKind,
     /// Sequence number (see [`ReplyKind`]).
     pub seq: u16,
@@ -374,8 +374,8 @@ pub struct Reply {
     pub out: GuardOutput,
     /// Counters after this frame.
     pub counters: Counters,
-    /// Core-clock ticks spent in the guard step (0 when not measured).
-    pub step_ticks: u32,
+    /// Core-clock cycles spent in the guard tick (0 when not measured).
+    pub tick_cycles: u32,
 }
 
 /// Errors of the host-side decoders.
@@ -496,7 +496,7 @@ impl Reply {
     /// Payload bytes (without CRC).
     pub fn to_payload(&self) -> Vec<u8, REPLY_LEN> {
         let (kind, reason) = match self.kind {
-            ReplyKind::Step => (KIND_STEP, 0u8),
+            ReplyKind::Tick => (KIND_TICK, 0u8),
             ReplyKind::Reject(r) => (KIND_REJECT, r as u8),
             ReplyKind::Done => (KIND_DONE, 0u8),
         };
@@ -515,7 +515,7 @@ impl Reply {
         let _ = p.extend_from_slice(&c.rejected_sequence.to_le_bytes());
         let _ = p.extend_from_slice(&c.skipped.to_le_bytes());
         let _ = p.extend_from_slice(&c.accepted.to_le_bytes());
-        let _ = p.extend_from_slice(&self.step_ticks.to_le_bytes());
+        let _ = p.extend_from_slice(&self.tick_cycles.to_le_bytes());
         let _ = p.extend_from_slice(&0u16.to_le_bytes());
         p
     }
@@ -530,7 +530,7 @@ impl Reply {
         let seq = r.u16()?;
         let reason = r.u8()?;
         let kind = match kind_b {
-            KIND_STEP => ReplyKind::Step,
+            KIND_TICK => ReplyKind::Tick,
             KIND_DONE => ReplyKind::Done,
             KIND_REJECT => ReplyKind::Reject(RejectReason::from_u8(reason).ok_or(DecodeError::Kind)?),
             _ => return Err(DecodeError::Kind),
@@ -547,7 +547,7 @@ impl Reply {
             skipped: r.u16()?,
             accepted: r.u32()?,
         };
-        let step_ticks = r.u32()?;
+        let tick_cycles = r.u32()?;
         Ok(Reply {
             kind,
             seq,
@@ -561,7 +561,7 @@ impl Reply {
                 lng_seconds_left,
             },
             counters,
-            step_ticks,
+            tick_cycles,
         })
     }
 
@@ -631,7 +631,7 @@ impl Deframer {
 // ------------------------------------------------------------------ link
 
 /// The guard's end of the link: deframes requests, enforces the sequence
-/// rule, counts rejections, steps the guard on accepted frames and produces
+/// rule, counts rejections, ticks the guard on accepted frames and produces
 /// exactly one reply per non-empty frame. Transport independent.
 #[derive(Debug, Default)]
 pub struct Link {
@@ -685,22 +685,22 @@ impl Link {
         self.rx.pending()
     }
 
-    /// Feed received bytes. For each complete frame, `step` is called when it
-    /// is accepted (it returns the guard output and the step's cost in ticks)
+    /// Feed received bytes. For each complete frame, `tick` is called when it
+    /// is accepted (it returns the guard output and the tick's cost in core-clock cycles)
     /// and `send` gets the encoded reply. Never panics, never blocks.
-    pub fn push_bytes<S, W>(&mut self, bytes: &[u8], mut step: S, mut send: W)
+    pub fn push_bytes<S, W>(&mut self, bytes: &[u8], mut tick: S, mut send: W)
     where
         S: FnMut(&Request, u16) -> (GuardOutput, u32),
         W: FnMut(&Reply, &[u8]),
     {
         for &b in bytes {
             let Some(res) = self.rx.push(b) else { continue };
-            let reply = self.handle(res, &mut step);
+            let reply = self.handle(res, &mut tick);
             send(&reply, &reply.encode());
         }
     }
 
-    fn handle<S>(&mut self, res: Result<Payload, DecodeError>, step: &mut S) -> Reply
+    fn handle<S>(&mut self, res: Result<Payload, DecodeError>, tick: &mut S) -> Reply
     where
         S: FnMut(&Request, u16) -> (GuardOutput, u32),
     {
@@ -727,13 +727,13 @@ impl Link {
         }
         self.last_seq = Some(req.seq);
         self.counters.accepted = self.counters.accepted.saturating_add(1);
-        let (out, ticks) = step(&req, gap);
+        let (out, cycles) = tick(&req, gap);
         self.last_out = out;
-        self.reply(ReplyKind::Step, req.seq, ticks)
+        self.reply(ReplyKind::Tick, req.seq, cycles)
     }
 
-    fn reply(&self, kind: ReplyKind, seq: u16, step_ticks: u32) -> Reply {
-        Reply { kind, seq, out: self.last_out, counters: self.counters, step_ticks }
+    fn reply(&self, kind: ReplyKind, seq: u16, tick_cycles: u32) -> Reply {
+        Reply { kind, seq, out: self.last_out, counters: self.counters, tick_cycles }
     }
 
     /// The completion marker: sent once at end of input.
@@ -833,16 +833,16 @@ mod tests {
     }
 
     #[test]
-    fn step_guard_passes_the_valve_feedback() {
+    fn tick_guard_passes_the_valve_feedback() {
         // A cold guard commands the valve shut at 21 degC; 50 frames reporting it
-        // open latch ACTUATOR (GuardConfig::DEFAULT.actuator_mismatch_steps = 50).
+        // open latch ACTUATOR (GuardConfig::DEFAULT.actuator_mismatch_ticks = 50).
         let mut g = crate::GuardOf::<f32>::new(&crate::GuardConfig::DEFAULT, crate::Restore::Cold);
         let s = Request { current_a: 0.0, p_a_bar: 5.0, p_b_bar: 5.0, speed_rpm: 500.0, ..req(0) };
-        let o = step_guard(&mut g, &s, 0);
+        let o = tick_guard(&mut g, &s, 0);
         assert!(!o.valve_open && o.faults.is_empty(), "{o:?}");
         let mut o = o;
         for k in 1..=50u16 {
-            o = step_guard(&mut g, &Request { seq: k, valve_fb: Some(true), ..s }, 0);
+            o = tick_guard(&mut g, &Request { seq: k, valve_fb: Some(true), ..s }, 0);
         }
         assert!(o.valve_open && o.faults.contains(crate::faults::ACTUATOR), "{o:?}");
     }
@@ -862,7 +862,7 @@ mod tests {
                 lng_seconds_left: f32::INFINITY,
             },
             counters: Counters { rejected_crc: 1, rejected_framing: 2, rejected_sequence: 3, skipped: 4, accepted: 5 },
-            step_ticks: 1234,
+            tick_cycles: 1234,
         };
         let wire = rep.encode();
         assert_eq!(wire.first(), Some(&0));
@@ -885,28 +885,28 @@ mod tests {
     #[test]
     fn sequence_rules() {
         let mut l = Link::new();
-        assert_eq!(run(&mut l, &req(10).encode())[0].kind, ReplyKind::Step);
+        assert_eq!(run(&mut l, &req(10).encode())[0].kind, ReplyKind::Tick);
         // duplicate
         assert_eq!(run(&mut l, &req(10).encode())[0].kind, ReplyKind::Reject(RejectReason::Sequence));
         // older
         assert_eq!(run(&mut l, &req(9).encode())[0].kind, ReplyKind::Reject(RejectReason::Sequence));
         // next
         let r = run(&mut l, &req(11).encode());
-        assert_eq!((r[0].kind, r[0].seq, r[0].out.drain_c), (ReplyKind::Step, 11, 11.0));
+        assert_eq!((r[0].kind, r[0].seq, r[0].out.drain_c), (ReplyKind::Tick, 11, 11.0));
         // gap of 2 is accepted and counted
         let r = run(&mut l, &req(14).encode());
-        assert_eq!(r[0].kind, ReplyKind::Step);
+        assert_eq!(r[0].kind, ReplyKind::Tick);
         assert_eq!(r[0].counters.skipped, 2);
         assert_eq!(r[0].counters.rejected_sequence, 2);
         assert_eq!(r[0].counters.accepted, 3);
         // wrap-around
         let mut l = Link::new();
         run(&mut l, &req(65535).encode());
-        assert_eq!(run(&mut l, &req(0).encode())[0].kind, ReplyKind::Step);
+        assert_eq!(run(&mut l, &req(0).encode())[0].kind, ReplyKind::Tick);
     }
 
     #[test]
-    fn rejected_frame_does_not_step_and_keeps_last_output() {
+    fn rejected_frame_does_not_tick_and_keeps_last_output() {
         let mut l = Link::new();
         run(&mut l, &req(1).encode());
         let mut bad = req(2).encode();
@@ -919,7 +919,7 @@ mod tests {
         assert_eq!(replies[0].out.drain_c, 1.0);
         assert_eq!(replies[0].seq, 1);
         // the link recovers on the next good frame
-        assert_eq!(run(&mut l, &req(2).encode())[0].kind, ReplyKind::Step);
+        assert_eq!(run(&mut l, &req(2).encode())[0].kind, ReplyKind::Tick);
     }
 
     #[test]
@@ -948,7 +948,7 @@ mod tests {
         let r = run(&mut l, &bytes);
         assert_eq!(r.len(), 2);
         assert_eq!(r[0].kind, ReplyKind::Reject(RejectReason::Overflow));
-        assert_eq!(r[1].kind, ReplyKind::Step);
+        assert_eq!(r[1].kind, ReplyKind::Tick);
     }
 
     #[test]

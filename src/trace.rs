@@ -22,22 +22,22 @@ pub enum RestoreKind {
     PowerLoss,
 }
 
-/// One protection event. `step` is the guard's step counter (10 ms ticks) at the event;
+/// One protection event. `tick` is the guard's tick counter (10 ms) at the event;
 /// temperatures are the predicted drain temperature in degC.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(any(target_os = "none", feature = "defmt"), derive(defmt::Format))]
 pub enum Trace {
     /// Thermal state initialised (cold / warm / corrupt record).
     Restore {
-        /// Step counter.
-        step: u32,
+        /// Tick counter (10 ms).
+        tick: u32,
         /// Kind of start.
         kind: RestoreKind,
     },
     /// LNG valve commanded open (threshold crossed or forced by a fault).
     ValveOpen {
-        /// Step counter.
-        step: u32,
+        /// Tick counter (10 ms).
+        tick: u32,
         /// Predicted drain temperature, degC.
         drain_c: f32,
         /// `true` when a fault forced it, `false` when the temperature did.
@@ -45,64 +45,64 @@ pub enum Trace {
     },
     /// LNG valve commanded closed (below the closing threshold for the whole dwell).
     ValveClose {
-        /// Step counter.
-        step: u32,
+        /// Tick counter (10 ms).
+        tick: u32,
         /// Predicted drain temperature, degC.
         drain_c: f32,
     },
     /// Over-temperature alarm raised (drain > alarm threshold): derate requested.
     Alarm {
-        /// Step counter.
-        step: u32,
+        /// Tick counter (10 ms).
+        tick: u32,
         /// Predicted drain temperature, degC.
         drain_c: f32,
     },
     /// Over-temperature alarm cleared (drain below alarm threshold - hysteresis).
     AlarmClear {
-        /// Step counter.
-        step: u32,
+        /// Tick counter (10 ms).
+        tick: u32,
         /// Predicted drain temperature, degC.
         drain_c: f32,
     },
     /// New fault bits latched (see [`crate::guard::faults`]).
     Fault {
-        /// Step counter.
-        step: u32,
-        /// Faults newly set this step (with the latched channels).
+        /// Tick counter (10 ms).
+        tick: u32,
+        /// Faults newly set this tick (with the latched channels).
         new_bits: crate::faults::Faults,
     },
     /// Latched faults cleared by the explicit clear rule.
     FaultsCleared {
-        /// Step counter.
-        step: u32,
+        /// Tick counter (10 ms).
+        tick: u32,
         /// Faults that were cleared.
         bits: crate::faults::Faults,
     },
     /// LNG remaining fell below the low threshold.
     LngLow {
-        /// Step counter.
-        step: u32,
+        /// Tick counter (10 ms).
+        tick: u32,
         /// Remaining LNG, kg.
         remaining_kg: f32,
     },
     /// A tick overran its 10 ms period (product loop, [`crate::product`]).
     Overrun {
-        /// Step counter.
-        step: u32,
+        /// Tick counter (10 ms).
+        tick: u32,
         /// Timer periods that elapsed during the tick beyond its own.
         lost_ticks: u16,
     },
     /// The MCU came out of a reset ([`crate::product::wire::ResetCause`] code).
     Reset {
-        /// Step counter.
-        step: u32,
+        /// Tick counter (10 ms).
+        tick: u32,
         /// Reset cause code.
         cause: u8,
     },
     /// A controller command was executed ([`crate::product::wire::Cmd`] code).
     Command {
-        /// Step counter.
-        step: u32,
+        /// Tick counter (10 ms).
+        tick: u32,
         /// Command code.
         code: u8,
     },
@@ -110,8 +110,8 @@ pub enum Trace {
     /// ([`crate::params_block::ParamSource::code`]: 0 compiled-in default,
     /// 1 parameter block, 2.. invalid block).
     Params {
-        /// Step counter.
-        step: u32,
+        /// Tick counter (10 ms).
+        tick: u32,
         /// Source code.
         source: u8,
     },
@@ -120,7 +120,7 @@ pub enum Trace {
 /// Ring buffer of the most recent [`TRACE_LEN`] events (oldest dropped when full).
 ///
 /// Built on `heapless::Deque`, whose accessors are unchecked internally, so that the
-/// step path has no bounds-check panic (`HistoryBuf::write` indexes with a check).
+/// tick path has no bounds-check panic (`HistoryBuf::write` indexes with a check).
 #[derive(Clone, Debug, Default)]
 pub struct TraceBuf {
     q: Deque<Trace, TRACE_LEN>,

@@ -47,15 +47,15 @@ pub struct InputLimits {
     /// Max ambient, degC. Also the worst-case ambient substitute.
     pub ambient_c_max: f32,
     /// Max |change| of current per tick, A.
-    pub current_a_per_step: f32,
+    pub current_a_per_tick: f32,
     /// Max |change| of a port pressure per tick, bar.
-    pub pressure_bar_per_step: f32,
+    pub pressure_bar_per_tick: f32,
     /// Max |change| of speed per tick, rpm.
-    pub speed_rpm_per_step: f32,
+    pub speed_rpm_per_tick: f32,
     /// Max |change| of position per tick, mm (0.5 m/s piston speed).
-    pub position_mm_per_step: f32,
+    pub position_mm_per_tick: f32,
     /// Max |change| of ambient per tick, K.
-    pub ambient_c_per_step: f32,
+    pub ambient_c_per_tick: f32,
 }
 
 impl InputLimits {
@@ -70,11 +70,11 @@ impl InputLimits {
         position_mm_max: 55.0,
         ambient_c_min: -60.0,
         ambient_c_max: 85.0,
-        current_a_per_step: 200.0,
-        pressure_bar_per_step: 150.0,
-        speed_rpm_per_step: 3000.0,
-        position_mm_per_step: 5.0,
-        ambient_c_per_step: 1.0,
+        current_a_per_tick: 200.0,
+        pressure_bar_per_tick: 150.0,
+        speed_rpm_per_tick: 3000.0,
+        position_mm_per_tick: 5.0,
+        ambient_c_per_tick: 1.0,
     };
 }
 
@@ -112,12 +112,12 @@ impl<N: Num> LimitsN<N> {
             l.ambient_c_max,
         ];
         let rt = [
-            l.current_a_per_step,
-            l.pressure_bar_per_step,
-            l.pressure_bar_per_step,
-            l.speed_rpm_per_step,
-            l.position_mm_per_step,
-            l.ambient_c_per_step,
+            l.current_a_per_tick,
+            l.pressure_bar_per_tick,
+            l.pressure_bar_per_tick,
+            l.speed_rpm_per_tick,
+            l.position_mm_per_tick,
+            l.ambient_c_per_tick,
         ];
         let s = sc.per_channel();
         // (the f64 unit constants rounded at compile time: no f64 on the target)
@@ -305,7 +305,7 @@ pub fn check<N: Num>(
     c
 }
 
-/// Model inputs for one step after worst-case substitution of the `bad` channels.
+/// Model inputs for one tick after worst-case substitution of the `bad` channels.
 ///
 /// Worst case = maximum heat: current at its maximum; a bad pressure gives both
 /// ports the full pressure range (one at the maximum, the other at the minimum)

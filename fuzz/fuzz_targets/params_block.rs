@@ -39,7 +39,7 @@ fuzz_target!(|data: &[u8]| {
     let refused = g.faults().intersects(faults::CONFIG);
     let s = Sample { current_a: 40.0, p_a_bar: 60.0, p_b_bar: 5.0, speed_rpm: 500.0, position_mm: 0.0, ambient_c: 25.0 };
     for _ in 0..50 {
-        let o = g.step(&s);
+        let o = g.tick(&s);
         if refused {
             assert!(o.valve_open && o.faults.intersects(faults::CONFIG), "refused block: {o:?}");
         } else {

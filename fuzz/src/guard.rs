@@ -42,7 +42,7 @@ pub const MAX_TICKS: u32 = 400;
 
 /// A fault operation runs only when the input has had at least this many more
 /// unlatched than latched ticks so far; otherwise it becomes a short valid
-/// ramp. A latched fault costs at least `clear_valid_steps` (100) latched
+/// ramp. A latched fault costs at least `clear_valid_ticks` (100) latched
 /// ticks before the maintenance clear succeeds, so this keeps at least about
 /// half of all ticks on the unlatched path (see the `EHA_FUZZ_STATS` report).
 pub const FAULT_CREDIT: i64 = 100;
@@ -55,14 +55,14 @@ struct Chan {
 }
 
 fn channels(l: &InputLimits) -> [Chan; 6] {
-    let p = Chan { lo: l.pressure_bar_min, hi: l.pressure_bar_max, rate: l.pressure_bar_per_step };
+    let p = Chan { lo: l.pressure_bar_min, hi: l.pressure_bar_max, rate: l.pressure_bar_per_tick };
     [
-        Chan { lo: -l.current_a_max, hi: l.current_a_max, rate: l.current_a_per_step },
+        Chan { lo: -l.current_a_max, hi: l.current_a_max, rate: l.current_a_per_tick },
         p,
         p,
-        Chan { lo: -l.speed_rpm_max, hi: l.speed_rpm_max, rate: l.speed_rpm_per_step },
-        Chan { lo: l.position_mm_min, hi: l.position_mm_max, rate: l.position_mm_per_step },
-        Chan { lo: l.ambient_c_min, hi: l.ambient_c_max, rate: l.ambient_c_per_step },
+        Chan { lo: -l.speed_rpm_max, hi: l.speed_rpm_max, rate: l.speed_rpm_per_tick },
+        Chan { lo: l.position_mm_min, hi: l.position_mm_max, rate: l.position_mm_per_tick },
+        Chan { lo: l.ambient_c_min, hi: l.ambient_c_max, rate: l.ambient_c_per_tick },
     ]
 }
 
@@ -144,8 +144,8 @@ impl<N: Num> Run<N> {
             Feedback::Stuck(open) => self.g.valve_feedback(open),
         }
         let o = match s {
-            Some(s) => self.g.step(s),
-            None => self.g.step_missing(),
+            Some(s) => self.g.tick(s),
+            None => self.g.tick_missing(),
         };
         self.check(&o, "tick");
         self.ticks += 1;
@@ -184,9 +184,9 @@ impl<N: Num> Run<N> {
 fn config(u: &mut Unstructured<'_>, variant: u8) -> GuardConfig<'static> {
     let mut cfg = GuardConfig::DEFAULT;
     if variant & 3 == 3 {
-        cfg.stale_steps = 1 + u32::from(byte(u) % 20);
-        cfg.clear_valid_steps = u32::from(byte(u)) * 2;
-        cfg.valve.dwell_steps = u32::from(byte(u)) * 4;
+        cfg.stale_ticks = 1 + u32::from(byte(u) % 20);
+        cfg.clear_valid_ticks = u32::from(byte(u)) * 2;
+        cfg.valve.dwell_ticks = u32::from(byte(u)) * 4;
         cfg.valve.open_c = 20.0 + 0.25 * f32::from(byte(u));
         cfg.valve.close_c = cfg.valve.open_c - 0.02 * f32::from(byte(u));
         cfg.alarm.alarm_c = 20.0 + 0.25 * f32::from(byte(u));
@@ -361,7 +361,7 @@ pub fn run<N: Num>(data: &[u8], label: &'static str, cold: &OnceLock<GuardOf<N>>
 }
 
 /// Operations that can latch a fault (the missing burst only from
-/// `stale_steps` on, but it is counted as one).
+/// `stale_ticks` on, but it is counted as one).
 fn is_fault_op(sel: u8) -> bool {
     matches!(sel, 192..=221 | 238..=239 | 246..=255)
 }

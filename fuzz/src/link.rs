@@ -1,5 +1,5 @@
 //! Protocol fuzzing: `Link::push_bytes` (deframer, COBS, CRC, sequence rule,
-//! counters) driving a real f32 guard through `protocol::step_guard`, and the
+//! counters) driving a real f32 guard through `protocol::tick_guard`, and the
 //! request/reply decoders on the raw input.
 //!
 //! Input: byte 0 is the mode. Even: the rest is the byte stream as it is
@@ -15,7 +15,7 @@
 //!
 //! Checked: no panic; exactly one reply per non-empty frame; every reply's
 //! wire bytes deframe to one CRC-valid payload that decodes to the same reply;
-//! counters: accepted = guard steps, accepted + rejected = replies, skipped =
+//! counters: accepted = guard ticks, accepted + rejected = replies, skipped =
 //! the saturated sum of the gaps handed to the step; guard outputs finite, a
 //! latched fault implies the valve open; `Request::from_payload` ok ⇒
 //! `to_payload` gives the same bytes; `Reply::from_payload` ok ⇒ its
@@ -25,7 +25,7 @@
 use eha_guard::faults;
 use eha_guard::protection::LngBudget;
 use eha_guard::protocol::{
-    cobs_decode, cobs_encode, crc16, step_guard, Deframer, Link, RejectReason, Reply, ReplyKind, Request,
+    cobs_decode, cobs_encode, crc16, tick_guard, Deframer, Link, RejectReason, Reply, ReplyKind, Request,
     KIND_SAMPLE, REQUEST_LEN,
 };
 use eha_guard::{Guard, GuardConfig, Output, Restore};
@@ -39,7 +39,7 @@ static TEMPLATE: OnceLock<Guard> = OnceLock::new();
 const MAX_STREAM: usize = 8192;
 
 fn same(a: &Reply, b: &Reply) -> bool {
-    a.kind == b.kind && a.seq == b.seq && a.counters == b.counters && a.step_ticks == b.step_ticks && a.out.bit_eq(&b.out)
+    a.kind == b.kind && a.seq == b.seq && a.counters == b.counters && a.tick_cycles == b.tick_cycles && a.out.bit_eq(&b.out)
 }
 
 fn check_output(o: &Output, full_kg: f32) {
@@ -160,11 +160,11 @@ pub fn structured(data: &[u8]) -> Vec<u8> {
             5 => {
                 // A reply where a request is expected (kind mismatch, CRC good).
                 let rep = Reply {
-                    kind: ReplyKind::Step,
+                    kind: ReplyKind::Tick,
                     seq,
                     out: Output::default(),
                     counters: Default::default(),
-                    step_ticks: 0,
+                    tick_cycles: 0,
                 };
                 out.extend_from_slice(&rep.encode());
             }
@@ -212,17 +212,17 @@ fn drive(stream: &[u8], chunk: usize) -> Vec<Reply> {
     let mut g = template.clone();
     let mut link = Link::new();
     let mut replies = Vec::new();
-    let mut steps = 0u32;
+    let mut ticks = 0u32;
     let mut gaps = 0u64;
     for part in stream.chunks(chunk.max(1)) {
         link.push_bytes(
             part,
             |req, skipped| {
-                steps += 1;
+                ticks += 1;
                 gaps += u64::from(skipped);
-                let o = step_guard(&mut g, req, skipped);
+                let o = tick_guard(&mut g, req, skipped);
                 check_output(&o, full_kg);
-                (o, steps)
+                (o, ticks)
             },
             |rep, wire| {
                 assert_eq!(wire.first(), Some(&0), "reply must start with a delimiter");
@@ -252,8 +252,8 @@ fn drive(stream: &[u8], chunk: usize) -> Vec<Reply> {
     assert_eq!(replies.len(), frames, "replies vs non-empty frames");
     assert_eq!(link.pending(), len > 0);
     let c = link.counters();
-    assert_eq!(c.accepted, steps, "accepted vs guard steps");
-    assert_eq!(replies.iter().filter(|r| r.kind == ReplyKind::Step).count(), steps as usize);
+    assert_eq!(c.accepted, ticks, "accepted vs guard ticks");
+    assert_eq!(replies.iter().filter(|r| r.kind == ReplyKind::Tick).count(), ticks as usize);
     if replies.len() < usize::from(u16::MAX) {
         assert_eq!(c.accepted as usize + c.rejected() as usize, replies.len(), "counters: {c:?}");
     }

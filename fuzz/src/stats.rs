@@ -9,7 +9,7 @@ use std::sync::Once;
 
 /// Executions (inputs run).
 pub static EXECS: AtomicU64 = AtomicU64::new(0);
-/// Guard ticks (`step` + `step_missing`) over all executions.
+/// Guard ticks (`step` + `tick_missing`) over all executions.
 pub static TICKS: AtomicU64 = AtomicU64::new(0);
 /// Ticks whose output had no bit of `faults::LATCHED` set.
 pub static UNLATCHED: AtomicU64 = AtomicU64::new(0);

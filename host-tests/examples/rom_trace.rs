@@ -17,7 +17,7 @@ fn main() {
     let p = reduce(&rig).expect("reduce");
     let mut m = Model::<f64>::new(&p).expect("model");
     let mut plant = Plant::new(&rig, &sc).unwrap();
-    let cfg = ValveConfig { dwell_steps: 20, ..ValveConfig::DEFAULT };
+    let cfg = ValveConfig { dwell_ticks: 20, ..ValveConfig::DEFAULT };
     let mut valve = Valve::new();
     let mut k = 0usize;
     let mut prev_x = 0.0;

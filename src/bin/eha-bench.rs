@@ -1,4 +1,4 @@
-//! Benchmark firmware: instructions per `Guard::step` (per 10 ms tick, split into
+//! Benchmark firmware: instructions per `Guard::tick` (per 10 ms tick, split into
 //! ticks with and without the 100 ms model step), `Model::tick_n` and
 //! `Model::update` in QEMU, stack high-water mark, init cost. Run with `cargo fw-bench` (M4F, f32) or
 //! `cargo fw-bench-m3` (M3, fixed point); see `docs/firmware-numbers.md`.
@@ -122,7 +122,7 @@ mod fw {
             let i = |t: u64| (t.saturating_sub(overhead as u64) * 10) / 256;
             let mean10 = (self.sum.saturating_sub(overhead as u64 * n) * 100) / (256 * n);
             eprintln!(
-                "{}: instructions/step min {} mean {}.{} max {} (n = {})",
+                "{}: instructions/tick min {} mean {}.{} max {} (n = {})",
                 name,
                 i(self.min as u64),
                 mean10 / 10,
@@ -147,7 +147,7 @@ mod fw {
 
     /// Validation alone, fast path: convert + combined range/rate check + inputs.
     #[inline(never)]
-    fn validate_step(
+    fn validate_tick(
         s: &Sample,
         prev: &Channels<Real>,
         sc: &InputScales<Real>,
@@ -172,8 +172,8 @@ mod fw {
     }
 
     #[inline(never)]
-    fn guard_step(g: &mut Guard, s: &Sample) -> eha_guard::Output {
-        g.step(s)
+    fn guard_tick(g: &mut Guard, s: &Sample) -> eha_guard::Output {
+        g.tick(s)
     }
 
     /// A board in memory for timing the product loop: the sample frame is
@@ -277,14 +277,14 @@ mod fw {
         model.set_temperatures(&[16.0; 6], 16.0);
 
         // Stack used by boot + init (f64 matrix exponential), then repaint to measure
-        // the step loop alone (its figure includes main's own frame).
+        // the tick loop alone (its figure includes main's own frame).
         let init_stack = eha_guard::stack::high_water();
         eha_guard::stack::paint();
         let Some(limits) = LimitsN::<Real>::new(&GuardConfig::DEFAULT.limits, &scales) else {
             semihosting::process::exit(107)
         };
         let mut prev_ch: Channels<Real> = validate::convert(&sample(0, &mut 1), &scales).0;
-        // Guard::step over all ticks, over the ticks without a model step, and over
+        // Guard::tick over all ticks, over the ticks without a model step, and over
         // the ticks that end a model step (every TICKS_PER_STEP-th).
         let mut g_stats = Stats::new();
         let mut gt_stats = Stats::new();
@@ -306,7 +306,7 @@ mod fw {
 
             let w0 = WRAPS.load(Ordering::Relaxed);
             let t0 = now();
-            let out = guard_step(&mut guard, core::hint::black_box(&s));
+            let out = guard_tick(&mut guard, core::hint::black_box(&s));
             if let Some(t) = elapsed(t0, w0) {
                 g_stats.add(t);
                 if guard.model().map_or(0, |m| m.pending_ticks()) == 0 {
@@ -322,7 +322,7 @@ mod fw {
 
             let w0 = WRAPS.load(Ordering::Relaxed);
             let t0 = now();
-            let vu = validate_step(core::hint::black_box(&s), &prev_ch, &scales, &limits);
+            let vu = validate_tick(core::hint::black_box(&s), &prev_ch, &scales, &limits);
             if let Some(t) = elapsed(t0, w0) {
                 v_stats.add(t);
             }
@@ -375,7 +375,7 @@ mod fw {
             }
             let w0 = WRAPS.load(Ordering::Relaxed);
             let t0 = now();
-            let out = guard_step(&mut guard, core::hint::black_box(&s));
+            let out = guard_tick(&mut guard, core::hint::black_box(&s));
             if let Some(t) = elapsed(t0, w0) {
                 f_stats.add(t);
                 if guard.model().map_or(0, |m| m.pending_ticks()) == 0 {
@@ -388,7 +388,7 @@ mod fw {
         }
 
         // The product loop per tick (src/product): deframe the 32-byte sample
-        // frame, Guard::step, pins, A/B record, NV policy check, tick reply
+        // frame, Guard::tick, pins, A/B record, NV policy check, tick reply
         // (COBS + CRC), watchdog; the same samples as above, from a cold boot.
         static mut APP: core::mem::MaybeUninit<eha_guard::product::App> = core::mem::MaybeUninit::uninit();
         let mut board = BenchBoard { rx: heapless::Deque::new(), tx_bytes: 0, ticks: 0 };
@@ -450,17 +450,17 @@ mod fw {
             "model step: every {} ticks of 10 ms",
             eha_guard::params::TICKS_PER_STEP
         );
-        g_stats.report("Guard::step, every tick", ovh);
-        gt_stats.report("Guard::step, ticks without a model step", ovh);
-        gm_stats.report("Guard::step, ticks with the model step", ovh);
+        g_stats.report("Guard::tick, every tick", ovh);
+        gt_stats.report("Guard::tick, ticks without a model step", ovh);
+        gm_stats.report("Guard::tick, ticks with the model step", ovh);
         f_stats.report(
-            "Guard::step, fault latched (NaN current then worst case), every tick",
+            "Guard::tick, fault latched (NaN current then worst case), every tick",
             ovh,
         );
         ft_stats.report("  fault latched, ticks without a model step", ovh);
         fm_stats.report("  fault latched, ticks with the model step", ovh);
         a_stats.report(
-            "App::tick (product loop: 32-byte frame in, Guard::step, pins, A/B record, tick reply; UART interrupt not counted), every tick",
+            "App::tick (product loop: 32-byte frame in, Guard::tick, pins, A/B record, tick reply; UART interrupt not counted), every tick",
             ovh,
         );
         mt_stats.report("Model::tick_n (tick accumulation)", ovh);
@@ -482,7 +482,7 @@ mod fw {
             (save.saturating_sub(ovh) as u64 * 10) / 256
         );
         eprintln!(
-            "stack high-water mark: boot+init {} bytes, step loop {} bytes",
+            "stack high-water mark: boot+init {} bytes, tick loop {} bytes",
             init_stack,
             eha_guard::stack::high_water()
         );

@@ -37,7 +37,7 @@ mod fw {
     use defmt_semihosting as _;
     use eha_guard::memory::slots::{self, noinit, AbWriter};
     use eha_guard::memory::Restore;
-    use eha_guard::protocol::{step_guard, GuardOutput, Link, Reply, ReplyKind, Request};
+    use eha_guard::protocol::{tick_guard, GuardOutput, Link, Reply, ReplyKind, Request};
     use eha_guard::{Guard, GuardConfig};
     use semihosting::io::{Read as _, Write as _};
     use semihosting::process::exit;
@@ -55,10 +55,10 @@ mod fw {
     const BUILD: &str = "f32";
 
     defmt::timestamp!("{=u32}", {
-        // Step counter as the log timestamp: plant time = stamp × step period.
-        STEPS.load(core::sync::atomic::Ordering::Relaxed)
+        // Tick counter as the log timestamp: plant time = stamp × 10 ms.
+        TICKS.load(core::sync::atomic::Ordering::Relaxed)
     });
-    static STEPS: core::sync::atomic::AtomicU32 = core::sync::atomic::AtomicU32::new(0);
+    static TICKS: core::sync::atomic::AtomicU32 = core::sync::atomic::AtomicU32::new(0);
 
     /// SysTick ticks elapsed between two readings of the 24-bit down counter.
     fn ticks_between(start: u32, end: u32) -> u32 {
@@ -126,10 +126,10 @@ mod fw {
                 chunk,
                 |req: &Request, skipped: u16| {
                     let t0 = SYST::get_current();
-                    let out = step_guard(&mut guard, req, skipped);
+                    let out = tick_guard(&mut guard, req, skipped);
                     let t1 = SYST::get_current();
                     records.write(&guard.snapshot(), noinit::store);
-                    STEPS.fetch_add(1, core::sync::atomic::Ordering::Relaxed);
+                    TICKS.fetch_add(1, core::sync::atomic::Ordering::Relaxed);
                     log_changes(&last, &out);
                     let trace = guard.trace().recent().copied();
                     if trace != last_trace {

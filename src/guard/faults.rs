@@ -148,7 +148,7 @@ pub const RANGE: Faults = Faults(1 << 0);
 pub const RATE: Faults = Faults(1 << 1);
 /// An input was NaN or infinite.
 pub const NON_FINITE: Faults = Faults(1 << 2);
-/// No new sample for `stale_steps` consecutive steps.
+/// No new sample for `stale_ticks` consecutive ticks.
 pub const STALE: Faults = Faults(1 << 3);
 /// The thermal-memory record was corrupt at boot.
 pub const MEMORY_CORRUPT: Faults = Faults(1 << 4);

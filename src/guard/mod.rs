@@ -44,7 +44,7 @@ struct Thresholds<N> {
     clear: N,
 }
 
-/// Everything the step needs that exists only with usable parameters.
+/// Everything the tick needs that exists only with usable parameters.
 #[derive(Clone, Copy, Debug)]
 struct Core<N: Num> {
     model: Model<N>,
@@ -126,19 +126,19 @@ pub struct GuardOf<N: Num> {
     core_ok: bool,
     /// Valve dwell in model steps (the configured ticks, rounded up).
     dwell_model_steps: u32,
-    stale_steps: u32,
-    startup_timeout_steps: u32,
-    clear_valid_steps: u32,
+    stale_ticks: u32,
+    startup_timeout_ticks: u32,
+    clear_valid_ticks: u32,
     latched: Faults,
     bad_ch: u8,
     prev: Channels<N>,
     prev_ok: u8,
     missing: u32,
     /// Tick index from which every sample was present and valid (the run of valid
-    /// samples of the clear rule is `step - valid_since`).
+    /// samples of the clear rule is `tick - valid_since`).
     valid_since: u32,
     /// `false` until the first sample: until then the guard waits (valve open, model
-    /// not started, STALE only after `startup_timeout_steps`). A cold start takes
+    /// not started, STALE only after `startup_timeout_ticks`). A cold start takes
     /// the first sample's ambient, and the protection is evaluated once on the
     /// initial (or restored) estimate.
     started: bool,
@@ -161,7 +161,7 @@ pub struct GuardOf<N: Num> {
     /// Consecutive reports differing from the command.
     fb_mismatch: u32,
     /// Reports differing from the command that latch ACTUATOR.
-    mismatch_steps: u32,
+    mismatch_ticks: u32,
     /// The LNG budget is used up: no exchanger credit.
     lng_empty: bool,
     alarm: bool,
@@ -170,7 +170,7 @@ pub struct GuardOf<N: Num> {
     untrusted: bool,
     lng: LngBudget,
     lng_low: bool,
-    step: u32,
+    tick: u32,
     /// The outputs, refreshed whenever one of them changes (fault latching, the
     /// fail-safe opening, a model step, clear/refill): a tick on the fast path
     /// returns them as they are.
@@ -207,10 +207,10 @@ impl<N: Num> GuardOf<N> {
             put!(p,
             core_ok: ok,
             latched: if ok { Faults::NONE } else { faults::CONFIG },
-            dwell_model_steps: config.valve.dwell_steps.div_ceil(TICKS_PER_STEP),
-            stale_steps: config.stale_steps,
-            startup_timeout_steps: config.startup_timeout_steps,
-            clear_valid_steps: config.clear_valid_steps,
+            dwell_model_steps: config.valve.dwell_ticks.div_ceil(TICKS_PER_STEP),
+            stale_ticks: config.stale_ticks,
+            startup_timeout_ticks: config.startup_timeout_ticks,
+            clear_valid_ticks: config.clear_valid_ticks,
             bad_ch: 0,
             prev: [N::ZERO; 6],
             prev_ok: 0,
@@ -227,13 +227,13 @@ impl<N: Num> GuardOf<N> {
             valve: Valve::open(),
             fb: None,
             fb_mismatch: 0,
-            mismatch_steps: config.actuator_mismatch_steps,
+            mismatch_ticks: config.actuator_mismatch_ticks,
             lng_empty: false,
             alarm: false,
             untrusted: false,
             lng: LngBudget::new(&config.lng),
             lng_low: false,
-            step: 0,
+            tick: 0,
             out: Output {
                 drain_c: DRAIN_C_UNKNOWN,
                 ..Output::default()
@@ -281,7 +281,7 @@ impl<N: Num> GuardOf<N> {
                 RestoreKind::Corrupt
             }
         };
-        g.trace.write(Trace::Restore { step: 0, kind });
+        g.trace.write(Trace::Restore { tick: 0, kind });
         g.lng_empty = g.lng.is_empty();
         g.boot_outputs();
         g
@@ -304,7 +304,7 @@ impl<N: Num> GuardOf<N> {
                     alarm_update_with(&mut self.alarm, d, c.th.alarm, c.th.clear) == Some(true)
                 };
                 if raised {
-                    self.trace.write(Trace::Alarm { step: 0, drain_c: self.out.drain_c });
+                    self.trace.write(Trace::Alarm { tick: 0, drain_c: self.out.drain_c });
                 }
             }
             Some(_) => {}
@@ -316,14 +316,14 @@ impl<N: Num> GuardOf<N> {
     /// One 10 ms tick with a new sample. Never panics; any invalid channel latches a
     /// fault, opens the valve in this same tick and is replaced by its worst case.
     #[inline(never)]
-    pub fn step(&mut self, s: &Sample) -> Output {
+    pub fn tick(&mut self, s: &Sample) -> Output {
         if let Some(core) = self.core_ok.then_some(&self.core) {
             // Fast path: every channel in range and within its rate and every previous
             // value valid (so this is not the first tick). Nothing to latch, the valve
             // is not forced by this tick (an earlier latched fault has already opened
             // it), the outputs only change at a model step. Channels latched bad by an
             // earlier fault still take their worst case. Anything else is classified
-            // by `step_slow`.
+            // by `tick_slow`.
             let (v, ok) = validate::convert_check(s, &self.prev, &core.scales, &core.limits);
             if ok & (self.prev_ok == CH_ALL) {
                 // `missing` is 0 here: a missing tick clears `prev_ok`.
@@ -333,10 +333,10 @@ impl<N: Num> GuardOf<N> {
                     Self::substitute_latched(&v, &self.prev, self.bad_ch, &core.limits)
                 };
                 self.prev = v;
-                return self.tick(&u);
+                return self.advance(&u);
             }
         }
-        self.step_slow(s)
+        self.tick_slow(s)
     }
 
     /// Fast-path inputs while channels are latched bad: their worst cases.
@@ -352,11 +352,11 @@ impl<N: Num> GuardOf<N> {
         validate::substitute(v, bad_ch, Some(prev_pos), limits)
     }
 
-    /// [`GuardOf::step`] off the fast path: classifies the sample (distinct fault and
+    /// [`GuardOf::tick`] off the fast path: classifies the sample (distinct fault and
     /// channel bits), substitutes worst cases, latches and forces the valve open.
     #[inline(never)]
     #[cold]
-    fn step_slow(&mut self, s: &Sample) -> Output {
+    fn tick_slow(&mut self, s: &Sample) -> Output {
         self.missing = 0;
         let Some(core) = self.core_ok.then_some(&self.core) else {
             return self.slow_tail(None, Faults::NONE, N::ZERO);
@@ -375,7 +375,7 @@ impl<N: Num> GuardOf<N> {
         }
         self.bad_ch |= c.bad;
         if c.bad != 0 {
-            self.valid_since = self.step.wrapping_add(1);
+            self.valid_since = self.tick.wrapping_add(1);
         }
         let [_, _, _, _, prev_pos, _] = self.prev;
         let prev_pos = if self.prev_ok & CH_POSITION != 0 {
@@ -395,18 +395,18 @@ impl<N: Num> GuardOf<N> {
     }
 
     /// One 10 ms tick without a new sample: inputs are held (piston work taken as
-    /// zero); after `stale_steps` consecutive misses the STALE fault latches and every
+    /// zero); after `stale_ticks` consecutive misses the STALE fault latches and every
     /// channel takes its worst case. Before the first sample the guard waits instead
     /// ([`GuardOf::wait_tick`]).
-    pub fn step_missing(&mut self) -> Output {
+    pub fn tick_missing(&mut self) -> Output {
         if !self.started {
             return self.wait_tick();
         }
         self.missing = self.missing.saturating_add(1);
-        self.valid_since = self.step.wrapping_add(1);
+        self.valid_since = self.tick.wrapping_add(1);
         self.prev_ok = 0;
         let mut new_bits = Faults::NONE;
-        if self.missing >= self.stale_steps {
+        if self.missing >= self.stale_ticks {
             new_bits |= faults::STALE;
             self.bad_ch = CH_ALL;
         }
@@ -416,17 +416,17 @@ impl<N: Num> GuardOf<N> {
 
     /// A tick without a sample before the first sample (boot, or samples not yet
     /// flowing): the model is not started and accumulates nothing, the valve stays
-    /// open; after `startup_timeout_steps` such ticks STALE latches (every channel
+    /// open; after `startup_timeout_ticks` such ticks STALE latches (every channel
     /// worst case once samples arrive, until a clear).
     #[cold]
     #[inline(never)]
     fn wait_tick(&mut self) -> Output {
         self.missing = self.missing.saturating_add(1);
-        self.valid_since = self.step.wrapping_add(1);
-        if self.missing >= self.startup_timeout_steps {
+        self.valid_since = self.tick.wrapping_add(1);
+        if self.missing >= self.startup_timeout_ticks {
             if !self.latched.contains(faults::STALE) {
                 self.trace.write(Trace::Fault {
-                    step: self.step,
+                    tick: self.tick,
                     new_bits: faults::STALE | Faults::channels(CH_ALL),
                 });
             }
@@ -437,15 +437,15 @@ impl<N: Num> GuardOf<N> {
             if !self.alarm {
                 self.alarm = true;
                 self.trace.write(Trace::Alarm {
-                    step: self.step,
+                    tick: self.tick,
                     drain_c: self.out.drain_c,
                 });
             }
         }
         // The valve is open since boot (nothing closes it before the first sample).
         self.refresh_out();
-        self.step = self.step.wrapping_add(1);
-        self.mark = self.step;
+        self.tick = self.tick.wrapping_add(1);
+        self.mark = self.tick;
         self.out
     }
 
@@ -454,18 +454,18 @@ impl<N: Num> GuardOf<N> {
     /// (cold: at `start_amb`), then the common tick.
     fn slow_tail(&mut self, u: Option<&ModelInputN<N>>, new_bits: Faults, start_amb: N) -> Output {
         // The valve / credit state may change for this tick: count the ticks before.
-        self.settle(self.step);
+        self.settle(self.tick);
         let newly = new_bits & !self.latched;
         self.latched |= new_bits;
         if !newly.is_empty() {
             self.trace.write(Trace::Fault {
-                step: self.step,
+                tick: self.tick,
                 new_bits: newly | Faults::channels(self.bad_ch),
             });
         }
         if !self.latched.is_empty() && self.valve.force_open() {
             self.trace.write(Trace::ValveOpen {
-                step: self.step,
+                tick: self.tick,
                 drain_c: self.out.drain_c,
                 forced: true,
             });
@@ -476,14 +476,14 @@ impl<N: Num> GuardOf<N> {
                     self.start(start_amb);
                 }
                 self.refresh_out();
-                self.tick(u)
+                self.advance(u)
             }
             _ => {
                 // No model (CONFIG): fail-safe outputs, nothing to estimate.
                 self.alarm = true;
                 self.out.drain_c = DRAIN_C_UNKNOWN;
                 self.refresh_out();
-                self.step = self.step.wrapping_add(1);
+                self.tick = self.tick.wrapping_add(1);
                 self.out
             }
         }
@@ -492,7 +492,7 @@ impl<N: Num> GuardOf<N> {
     /// The per-tick part common to both paths: the model's tick accumulation, and
     /// every `TICKS_PER_STEP` ticks the model step with the protection.
     #[inline(always)]
-    fn tick(&mut self, u: &ModelInputN<N>) -> Output {
+    fn advance(&mut self, u: &ModelInputN<N>) -> Output {
         let full = match self.core_ok.then_some(&mut self.core) {
             Some(c) => c.model.tick_n(u),
             None => false,
@@ -500,7 +500,7 @@ impl<N: Num> GuardOf<N> {
         if full {
             self.model_step();
         }
-        self.step = self.step.wrapping_add(1);
+        self.tick = self.tick.wrapping_add(1);
         self.out
     }
 
@@ -513,7 +513,7 @@ impl<N: Num> GuardOf<N> {
     fn start(&mut self, ambient_c: N) {
         self.started = true;
         // Nothing of the waiting time is counted: no model ran, no credit, no LNG booked.
-        self.mark = self.step;
+        self.mark = self.tick;
         self.open_acc = 0;
         self.credit_acc = 0;
         let Some(c) = self.core_ok.then_some(&mut self.core) else {
@@ -535,7 +535,7 @@ impl<N: Num> GuardOf<N> {
         if self.latched.is_empty() && d < c.th.close && self.valve.is_open() {
             self.valve.set(false);
             self.trace.write(Trace::ValveClose {
-                step: self.step,
+                tick: self.tick,
                 drain_c: d.to_f32(),
             });
         }
@@ -566,7 +566,7 @@ impl<N: Num> GuardOf<N> {
     #[inline(never)]
     fn model_step(&mut self) {
         // This tick belongs to the model step that ends now, in the state it had.
-        self.settle(self.step.wrapping_add(1));
+        self.settle(self.tick.wrapping_add(1));
         let (open_ticks, credit_ticks) = (self.open_acc, self.credit_acc);
         self.open_acc = 0;
         self.credit_acc = 0;
@@ -589,10 +589,10 @@ impl<N: Num> GuardOf<N> {
                 }
             }
         }
-        // The valid run of the clear rule is `step - valid_since`; keep it from
-        // wrapping (2^30 ticks = 124 days is far above any clear_valid_steps).
-        if self.step.wrapping_sub(self.valid_since) > 1 << 30 {
-            self.valid_since = self.step.wrapping_sub(1 << 30);
+        // The valid run of the clear rule is `tick - valid_since`; keep it from
+        // wrapping (2^30 ticks = 124 days is far above any clear_valid_ticks).
+        if self.tick.wrapping_sub(self.valid_since) > 1 << 30 {
+            self.valid_since = self.tick.wrapping_sub(1 << 30);
         }
         self.protect(cj, open_ticks);
     }
@@ -606,7 +606,7 @@ impl<N: Num> GuardOf<N> {
         if !self.latched.contains(faults::SENSOR_DISAGREE) {
             self.latched |= faults::SENSOR_DISAGREE;
             self.trace.write(Trace::Fault {
-                step: self.step,
+                tick: self.tick,
                 new_bits: faults::SENSOR_DISAGREE,
             });
         }
@@ -642,13 +642,13 @@ impl<N: Num> GuardOf<N> {
         if let Some(open) = valve_ev {
             let t = if open {
                 Trace::ValveOpen {
-                    step: self.step,
+                    tick: self.tick,
                     drain_c,
                     forced: force,
                 }
             } else {
                 Trace::ValveClose {
-                    step: self.step,
+                    tick: self.tick,
                     drain_c,
                 }
             };
@@ -657,12 +657,12 @@ impl<N: Num> GuardOf<N> {
         if let Some(a) = alarm_ev {
             let t = if a {
                 Trace::Alarm {
-                    step: self.step,
+                    tick: self.tick,
                     drain_c,
                 }
             } else {
                 Trace::AlarmClear {
-                    step: self.step,
+                    tick: self.tick,
                     drain_c,
                 }
             };
@@ -675,7 +675,7 @@ impl<N: Num> GuardOf<N> {
         let low = self.lng.is_low();
         if low && !self.lng_low {
             self.trace.write(Trace::LngLow {
-                step: self.step,
+                tick: self.tick,
                 remaining_kg: self.lng.remaining_kg(),
             });
         }
@@ -711,18 +711,18 @@ impl<N: Num> GuardOf<N> {
 
     /// **Clear rule.** Latched faults (except CONFIG) clear only through this explicit
     /// call (maintenance / operator command), and only if the last
-    /// `clear_valid_steps` samples (1 s by default) were all valid and none is missing.
+    /// `clear_valid_ticks` samples (1 s by default) were all valid and none is missing.
     /// The thermal estimate is *not* reset: it relaxes from its conservative value.
     /// A successful clear also restores trust in the estimate ([`faults::UNTRUSTED`]:
     /// after a corrupt record or no sample by the start-up timeout the alarm and
     /// derate are held until then). Returns `true` when the faults were cleared.
     pub fn clear_faults(&mut self) -> bool {
-        let valid_run = self.step.wrapping_sub(self.valid_since);
-        if self.missing != 0 || valid_run < self.clear_valid_steps {
+        let valid_run = self.tick.wrapping_sub(self.valid_since);
+        if self.missing != 0 || valid_run < self.clear_valid_ticks {
             return false;
         }
         let bits = (self.latched & !faults::CONFIG) | Faults::channels(self.bad_ch);
-        self.settle(self.step);
+        self.settle(self.tick);
         self.latched &= faults::CONFIG;
         self.bad_ch = 0;
         // A valve still disagreeing with its command latches again after the full time;
@@ -740,7 +740,7 @@ impl<N: Num> GuardOf<N> {
         self.untrusted = false;
         if !bits.is_empty() {
             self.trace.write(Trace::FaultsCleared {
-                step: self.step,
+                tick: self.tick,
                 bits,
             });
         }
@@ -751,17 +751,17 @@ impl<N: Num> GuardOf<N> {
     /// Marks an actuator (valve pin) error reported by the board: latches ACTUATOR
     /// and commands the valve open at once (fail-safe).
     pub fn report_actuator_fault(&mut self) {
-        self.settle(self.step);
+        self.settle(self.tick);
         if !self.latched.contains(faults::ACTUATOR) {
             self.latched |= faults::ACTUATOR;
             self.trace.write(Trace::Fault {
-                step: self.step,
+                tick: self.tick,
                 new_bits: faults::ACTUATOR,
             });
         }
         if self.valve.force_open() {
             self.trace.write(Trace::ValveOpen {
-                step: self.step,
+                tick: self.tick,
                 drain_c: self.out.drain_c,
                 forced: true,
             });
@@ -771,15 +771,15 @@ impl<N: Num> GuardOf<N> {
 
     /// Reports the valve position read back from the valve (limit switch or
     /// position sensor), `true` = open. Optional; when used, call it once per tick,
-    /// before [`GuardOf::step`] / [`GuardOf::step_missing`] (the position holds until
+    /// before [`GuardOf::tick`] / [`GuardOf::tick_missing`] (the position holds until
     /// the next report). The model credits the exchanger only while the report does
-    /// not say shut; `actuator_mismatch_steps` consecutive reports that differ from
+    /// not say shut; `actuator_mismatch_ticks` consecutive reports that differ from
     /// the command latch ACTUATOR (valve forced open, no credit). Without reports the
     /// command is taken as the position (residual risk: docs/firmware.md).
     pub fn valve_feedback(&mut self, open: bool) {
         if self.fb != Some(open) {
             // The credit may change from this tick on: count the ticks before.
-            self.settle(self.step);
+            self.settle(self.tick);
             self.fb = Some(open);
         }
         if open == self.valve.is_open() {
@@ -787,7 +787,7 @@ impl<N: Num> GuardOf<N> {
             return;
         }
         self.fb_mismatch = self.fb_mismatch.saturating_add(1);
-        if self.fb_mismatch >= self.mismatch_steps {
+        if self.fb_mismatch >= self.mismatch_ticks {
             self.report_actuator_fault();
         }
     }
@@ -795,7 +795,7 @@ impl<N: Num> GuardOf<N> {
     /// Refills the LNG budget (new charge installed).
     pub fn refill_lng(&mut self, cfg: &LngConfig) {
         // The credit may change from this tick on: count the ticks before.
-        self.settle(self.step);
+        self.settle(self.tick);
         self.lng = LngBudget::new(cfg);
         self.lng_empty = self.lng.is_empty();
         self.lng_low = false;
@@ -818,7 +818,7 @@ impl<N: Num> GuardOf<N> {
             amb,
             self.lng.used_cj(),
             (self.faults() & !faults::LNG_LOW).bits(),
-            self.step,
+            self.tick,
         )
         .with_seq(0, self.valve.is_open())
     }
@@ -848,7 +848,7 @@ impl<N: Num> GuardOf<N> {
     }
 
     /// Ticks taken since boot (10 ms each, wraps after 497 days).
-    pub fn steps(&self) -> u32 {
-        self.step
+    pub fn ticks(&self) -> u32 {
+        self.tick
     }
 }

@@ -23,7 +23,7 @@ pub struct Sample {
     pub ambient_c: f32,
 }
 
-/// One step's result, wire units. Always finite.
+/// One tick's result, wire units. Always finite.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[cfg_attr(any(target_os = "none", feature = "defmt"), derive(defmt::Format))]
 pub struct Output {
@@ -64,18 +64,18 @@ pub struct GuardConfig<'a> {
     pub lng: LngConfig,
     /// Consecutive missing samples, once samples have started, that make the input
     /// stale, 10 ms ticks (5 = 50 ms).
-    pub stale_steps: u32,
+    pub stale_ticks: u32,
     /// Ticks after boot without any sample before the input is declared stale
     /// (1000 = 10 s). Until the first sample the guard waits: valve open (the safe
     /// state), model not started, no fault.
-    pub startup_timeout_steps: u32,
-    /// Consecutive fully valid samples required before `clear_faults` succeeds, steps.
-    pub clear_valid_steps: u32,
+    pub startup_timeout_ticks: u32,
+    /// Consecutive fully valid samples required before `clear_faults` succeeds, 10 ms ticks.
+    pub clear_valid_ticks: u32,
     /// Consecutive valve-position reports ([`super::GuardOf::valve_feedback`]) that
     /// differ from the command before ACTUATOR latches, 10 ms ticks (50 = 0.5 s: a
     /// cryogenic solenoid valve strokes in ≤ 0.1 s; the fault campaign's rule is
     /// detection within 1 s of the mismatch).
-    pub actuator_mismatch_steps: u32,
+    pub actuator_mismatch_ticks: u32,
     /// Sensor cross-check (current against pressures and speed).
     pub crosscheck: crate::crosscheck::CrossCheckConfig,
 }
@@ -88,10 +88,10 @@ impl GuardConfig<'static> {
         valve: ValveConfig::DEFAULT,
         alarm: AlarmConfig::DEFAULT,
         lng: LngConfig::DEFAULT,
-        stale_steps: 5,
-        startup_timeout_steps: 1000,
-        clear_valid_steps: 100,
-        actuator_mismatch_steps: 50,
+        stale_ticks: 5,
+        startup_timeout_ticks: 1000,
+        clear_valid_ticks: 100,
+        actuator_mismatch_ticks: 50,
         crosscheck: crate::crosscheck::CrossCheckConfig::DEFAULT,
     };
 }

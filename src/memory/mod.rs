@@ -56,8 +56,8 @@ pub const RECORD_BYTES: usize = 56;
 pub struct ThermalRecord {
     /// LNG heat-sink energy used, cJ (0.01 J).
     pub lng_used_cj: u32,
-    /// Guard step counter at save time.
-    pub step: u32,
+    /// Guard tick counter (10 ms) at save time.
+    pub tick: u32,
     /// [`MAGIC`] when written by this firmware.
     pub magic: u32,
     /// [`VERSION`].
@@ -128,7 +128,7 @@ impl ThermalRecord {
         faults: 0,
         temps_c: [0.0; N_NODES],
         ambient_c: 0.0,
-        step: 0,
+        tick: 0,
         seq_flags: 0,
         rtc_s: RTC_NONE,
         crc: 0,
@@ -137,7 +137,7 @@ impl ThermalRecord {
     fn body_crc(&self) -> u32 {
         let mut c = 0xFFFF_FFFF;
         c = crc32_update(c, &self.lng_used_cj.to_le_bytes());
-        c = crc32_update(c, &self.step.to_le_bytes());
+        c = crc32_update(c, &self.tick.to_le_bytes());
         c = crc32_update(c, &self.magic.to_le_bytes());
         c = crc32_update(c, &self.version.to_le_bytes());
         c = crc32_update(c, &self.faults.to_le_bytes());
@@ -156,7 +156,7 @@ impl ThermalRecord {
         ambient_c: f32,
         lng_used_cj: u32,
         faults: u16,
-        step: u32,
+        tick: u32,
     ) -> Self {
         let mut r = ThermalRecord {
             lng_used_cj,
@@ -165,7 +165,7 @@ impl ThermalRecord {
             faults,
             temps_c,
             ambient_c,
-            step,
+            tick,
             seq_flags: 0,
             rtc_s: RTC_NONE,
             crc: 0,
@@ -195,7 +195,7 @@ impl ThermalRecord {
     pub fn to_le_bytes(&self) -> [u8; RECORD_BYTES] {
         let mut words = [0u32; RECORD_BYTES / 4];
         words[0] = self.lng_used_cj;
-        words[1] = self.step;
+        words[1] = self.tick;
         words[2] = self.magic;
         words[3] = u32::from(self.version) | (u32::from(self.faults) << 16);
         for (w, t) in words[4..4 + N_NODES].iter_mut().zip(self.temps_c.iter()) {
@@ -226,7 +226,7 @@ impl ThermalRecord {
         }
         ThermalRecord {
             lng_used_cj: w[0],
-            step: w[1],
+            tick: w[1],
             magic: w[2],
             version: (w[3] & 0xFFFF) as u16,
             faults: (w[3] >> 16) as u16,
@@ -333,7 +333,7 @@ pub fn boot_restore(ram: Restore, nv: Option<ThermalRecord>, policy: &nv::NvPoli
             for t in hot.iter_mut() {
                 *t += policy.rise_k;
             }
-            let run_s = policy.max_interval_steps / 100;
+            let run_s = policy.max_interval_ticks / 100;
             let off_s = match (now_rtc_s, r.rtc_s) {
                 (Some(now), saved) if saved != RTC_NONE && now >= saved => Some((now - saved).saturating_sub(run_s)).filter(|s| *s > 0),
                 _ => None,
@@ -341,7 +341,7 @@ pub fn boot_restore(ram: Restore, nv: Option<ThermalRecord>, policy: &nv::NvPoli
             if let (Some(b), Some(off)) = (cool, off_s) {
                 hot = b.cool(&hot, r.ambient_c, off);
             }
-            Restore::PowerLoss(ThermalRecord::new(hot, r.ambient_c, r.lng_used_cj, r.faults, r.step).with_seq(r.seq(), r.valve_open()).with_rtc(Some(r.rtc_s)))
+            Restore::PowerLoss(ThermalRecord::new(hot, r.ambient_c, r.lng_used_cj, r.faults, r.tick).with_seq(r.seq(), r.valve_open()).with_rtc(Some(r.rtc_s)))
         }
         (ram, _) => ram,
     }

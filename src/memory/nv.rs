@@ -13,9 +13,9 @@
 //! power loss adds `rise_k` to every node, so it is never colder than the
 //! state at power-off: `super::boot_restore`), when the latched faults
 //! change, when the LNG used has grown
-//! by [`NvPolicy::lng_step_cj`] (so the budget never forgets more than that
+//! by [`NvPolicy::lng_rise_cj`] (so the budget never forgets more than that
 //! across a power loss), and at the latest every
-//! [`NvPolicy::max_interval_steps`]. Cooling alone needs no write: a restored
+//! [`NvPolicy::max_interval_ticks`]. Cooling alone needs no write: a restored
 //! record that is warmer than the machine is on the safe side. The flash-wear
 //! budget for 10 years is worked out in docs/firmware.md from the write rate
 //! that `host-tests/tests/firmware/nv_wear.rs` measures on the paper's missions.
@@ -144,16 +144,16 @@ pub struct NvPolicy {
     /// A node's estimate this much above its last written value forces a write, K.
     pub rise_k: f32,
     /// LNG used this much above the last written value forces a write, cJ.
-    pub lng_step_cj: u32,
+    pub lng_rise_cj: u32,
     /// A write at least this often, guard ticks (10 ms).
-    pub max_interval_steps: u32,
+    pub max_interval_ticks: u32,
 }
 
 impl NvPolicy {
     /// 2 K, 20 kJ of LNG (0.9 % of the 5 L charge), 30 minutes. The valve
     /// state rides along in every record but triggers no write: after a
     /// power loss the guard decides it anew from the restored temperatures.
-    pub const DEFAULT: NvPolicy = NvPolicy { rise_k: 2.0, lng_step_cj: 11_000_000, max_interval_steps: 180_000 };
+    pub const DEFAULT: NvPolicy = NvPolicy { rise_k: 2.0, lng_rise_cj: 11_000_000, max_interval_ticks: 180_000 };
 
     /// Whether `now` (the guard's snapshot, valve state in it) must be
     /// written given the `last` record written (None: nothing yet).
@@ -163,8 +163,8 @@ impl NvPolicy {
         let risen = now.temps_c.iter().zip(last.temps_c.iter()).any(|(n, l)| !n.partial_cmp(&(*l + self.rise_k)).is_some_and(|o| o.is_le()));
         risen
             || now.faults != last.faults
-            || now.lng_used_cj.saturating_sub(last.lng_used_cj) >= self.lng_step_cj
-            || now.step.wrapping_sub(last.step) >= self.max_interval_steps
+            || now.lng_used_cj.saturating_sub(last.lng_used_cj) >= self.lng_rise_cj
+            || now.tick.wrapping_sub(last.tick) >= self.max_interval_ticks
     }
 }
 
@@ -260,8 +260,8 @@ mod tests {
 
     type Flash = Blocking<RamFlash<8192>>;
 
-    fn rec(t: f32, step: u32) -> ThermalRecord {
-        ThermalRecord::new([t; crate::params::N_NODES], 20.0, 1234, 0, step).with_seq(step, t > 40.0)
+    fn rec(t: f32, tick: u32) -> ThermalRecord {
+        ThermalRecord::new([t; crate::params::N_NODES], 20.0, 1234, 0, tick).with_seq(tick, t > 40.0)
     }
 
     #[test]
@@ -272,7 +272,7 @@ mod tests {
             nv.save(&rec(20.0 + k as f32 * 0.05, k)).expect("save");
         }
         let r = nv.load().expect("record");
-        assert_eq!((r.step, r.temps_c[0], r.valve_open()), (499, 20.0 + 499.0 * 0.05, true));
+        assert_eq!((r.tick, r.temps_c[0], r.valve_open()), (499, 20.0 + 499.0 * 0.05, true));
         // A power loss: a new store over the same flash reads the same record.
         let flash = nv.into_flash();
         let erases: u32 = flash.0.erase_counts().iter().sum();
@@ -301,7 +301,7 @@ mod tests {
         assert!(p.due(Some(&last), &faulted), "faults change");
         assert!(p.due(Some(&last), &rec(30.0, 180_000)), "30 minutes");
         let mut more_lng = rec(30.0, 100);
-        more_lng.lng_used_cj += p.lng_step_cj;
+        more_lng.lng_used_cj += p.lng_rise_cj;
         assert!(p.due(Some(&last), &more_lng), "LNG used grew by 20 kJ");
         let mut nan = rec(30.0, 100);
         nan.temps_c[1] = f32::NAN;

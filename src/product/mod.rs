@@ -5,8 +5,8 @@
 //! 1. **transport**: the bytes the UART received since the last tick are
 //!    deframed; the newest valid sample frame is this tick's sample (none =
 //!    a missing sample), command frames are queued;
-//! 2. **validate, estimate, protect**: [`GuardOf::step`] (or
-//!    [`GuardOf::step_missing`]), preceded by a missing step for every timer
+//! 2. **validate, estimate, protect**: [`GuardOf::tick`] (or
+//!    [`GuardOf::tick_missing`]), preceded by a missing tick for every timer
 //!    period an overrun swallowed, so the model's clock keeps up with time;
 //! 3. **outputs**: valve and OK pins, read back (a mismatch latches ACTUATOR
 //!    and opens the valve); the thermal record (A/B no-init RAM, and
@@ -26,7 +26,7 @@ use crate::protection::LngConfig;
 use crate::memory::slots::{self, AbWriter};
 use crate::memory::cooling::RestCooling;
 use crate::memory::{boot_restore, Restore, ThermalRecord};
-use crate::protocol::{DecodeError, Deframer, Request, MAX_MISSED_STEPS};
+use crate::protocol::{DecodeError, Deframer, Request, MAX_MISSED_TICKS};
 use crate::trace::{RestoreKind, Trace};
 use crate::params_block::{self, ParamSource, BLOCK_LEN};
 use crate::{Guard, GuardConfig, Output};
@@ -244,8 +244,8 @@ impl App {
         if let ParamSource::Invalid(_) = params {
             app.guard.refuse_config();
         }
-        app.guard.trace_event(Trace::Reset { step: 0, cause: reset_cause as u8 });
-        app.guard.trace_event(Trace::Params { step: 0, source: params.code() });
+        app.guard.trace_event(Trace::Reset { tick: 0, cause: reset_cause as u8 });
+        app.guard.trace_event(Trace::Params { tick: 0, source: params.code() });
         let out = app.guard.output();
         let _ = board.set_pins(Pins::for_outputs(out.valve_open, out.alarm || out.derate));
         app
@@ -273,12 +273,12 @@ impl App {
     pub fn overrun(&mut self, periods: u32) {
         self.counters.overruns = self.counters.overruns.saturating_add(periods);
         let lost_ticks = u16::try_from(periods).unwrap_or(u16::MAX);
-        self.guard.trace_event(Trace::Overrun { step: self.guard.steps(), lost_ticks });
+        self.guard.trace_event(Trace::Overrun { tick: self.guard.ticks(), lost_ticks });
     }
 
     /// One tick. `lost` = timer periods since the previous tick that had no
-    /// tick of their own (each becomes a missing step, at most
-    /// [`MAX_MISSED_STEPS`]).
+    /// tick of their own (each becomes a missing tick, at most
+    /// [`MAX_MISSED_TICKS`]).
     pub fn tick<B: Board>(&mut self, board: &mut B, lost: u32) {
         let stamp = board.cycle_stamp();
         self.tick = self.tick.wrapping_add(1).wrapping_add(lost);
@@ -299,8 +299,8 @@ impl App {
         }
 
         // 2. validate, estimate, protect
-        for _ in 0..lost.min(u32::from(MAX_MISSED_STEPS)) {
-            let _ = self.guard.step_missing();
+        for _ in 0..lost.min(u32::from(MAX_MISSED_TICKS)) {
+            let _ = self.guard.tick_missing();
         }
         let fresh = self.sample.take();
         let out = match &fresh {
@@ -308,11 +308,11 @@ impl App {
                 if let Some(open) = req.valve_fb {
                     self.guard.valve_feedback(open);
                 }
-                self.guard.step(&req.sample())
+                self.guard.tick(&req.sample())
             }
             None => {
                 self.counters.missing = self.counters.missing.saturating_add(1);
-                self.guard.step_missing()
+                self.guard.tick_missing()
             }
         };
 
@@ -418,7 +418,7 @@ impl App {
     #[inline(never)]
     fn execute<B: Board>(&mut self, board: &mut B, c: Command) {
         self.counters.commands = self.counters.commands.saturating_add(1);
-        self.guard.trace_event(Trace::Command { step: self.guard.steps(), code: c.cmd.code() });
+        self.guard.trace_event(Trace::Command { tick: self.guard.ticks(), code: c.cmd.code() });
         let ack = |result| Ack { token: c.token, cmd: c.cmd, result };
         match c.cmd {
             Cmd::ClearFaults => {

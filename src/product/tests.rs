@@ -148,7 +148,7 @@ fn waits_with_valve_open_until_the_first_sample() {
     assert_eq!(b.feeds, 20);
 }
 
-/// The product loop steps the guard exactly like a bare guard fed the same
+/// The product loop ticks the guard exactly like a bare guard fed the same
 /// samples (bit-identical outputs), one tick reply per tick.
 #[test]
 fn one_sample_per_tick_matches_the_bare_guard() {
@@ -160,7 +160,7 @@ fn one_sample_per_tick_matches_the_bare_guard() {
         let s = sample(k, 20.0 + f32::from(k % 7), 60.0);
         b.rx.extend_from_slice(&s.encode());
         app.tick(&mut b, 0);
-        let want = bare.step(&s.sample());
+        let want = bare.tick(&s.sample());
         let t = ticks(&b.replies());
         assert_eq!(t.len(), 1);
         assert!(t[0].fresh && t[0].sample_seq == k);
@@ -171,7 +171,7 @@ fn one_sample_per_tick_matches_the_bare_guard() {
 }
 
 /// Two samples in one tick: the newer one is used, the older counted as
-/// superseded; a tick with none is a missing step; an old sequence number is
+/// superseded; a tick with none is a missing tick; an old sequence number is
 /// rejected.
 #[test]
 fn newest_sample_wins_missing_ticks_count_and_old_frames_are_rejected() {
@@ -192,19 +192,19 @@ fn newest_sample_wins_missing_ticks_count_and_old_frames_are_rejected() {
 }
 
 /// An overrun that swallowed periods: each lost period becomes a missing
-/// step (the model's clock keeps up), and the overrun is counted and traced.
+/// tick (the model's clock keeps up), and the overrun is counted and traced.
 #[test]
-fn overrun_periods_become_missing_steps_and_are_counted() {
+fn overrun_periods_become_missing_ticks_and_are_counted() {
     let mut b = SimBoard::new();
     let mem = b.mem();
     let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
     b.rx.extend_from_slice(&sample(1, 10.0, 50.0).encode());
     app.tick(&mut b, 0);
-    let before = app.guard().steps();
+    let before = app.guard().ticks();
     app.overrun(2);
     b.rx.extend_from_slice(&sample(2, 10.0, 50.0).encode());
     app.tick(&mut b, 2);
-    assert_eq!(app.guard().steps() - before, 3, "two catch-up steps and the tick's own");
+    assert_eq!(app.guard().ticks() - before, 3, "two catch-up ticks and the tick's own");
     assert_eq!(app.counters().overruns, 2);
     assert!(app.guard().trace().iter().any(|e| matches!(e, Trace::Overrun { lost_ticks: 2, .. })));
     let t = ticks(&b.replies());
@@ -410,8 +410,8 @@ fn a_valid_block_runs_its_own_rig() {
         let s = sample(k, 30.0, 60.0);
         b.rx.extend_from_slice(&s.encode());
         app.tick(&mut b, 0);
-        let want = bare.step(&s.sample());
-        last_paper = paper.step(&s.sample()).drain_c;
+        let want = bare.tick(&s.sample());
+        last_paper = paper.tick(&s.sample()).drain_c;
         let t = ticks(&b.replies());
         assert!(!t[0].not_commissioned);
         assert!(crate::protocol::GuardOutput::bit_eq(&t[0].out, &want), "tick {k}: {:?} vs {want:?}", t[0].out);

@@ -286,18 +286,18 @@ pub struct TraceWire {
 pub fn encode_trace(t: &Trace) -> TraceWire {
     let w = |tag, tick, value, aux| TraceWire { tag, tick, value, aux };
     match *t {
-        Trace::Restore { step, kind } => w(1, step, 0.0, u16::from(restore_code(kind))),
-        Trace::ValveOpen { step, drain_c, forced } => w(2, step, drain_c, u16::from(forced)),
-        Trace::ValveClose { step, drain_c } => w(3, step, drain_c, 0),
-        Trace::Alarm { step, drain_c } => w(4, step, drain_c, 0),
-        Trace::AlarmClear { step, drain_c } => w(5, step, drain_c, 0),
-        Trace::Fault { step, new_bits } => w(6, step, 0.0, new_bits.bits()),
-        Trace::FaultsCleared { step, bits } => w(7, step, 0.0, bits.bits()),
-        Trace::LngLow { step, remaining_kg } => w(8, step, remaining_kg, 0),
-        Trace::Overrun { step, lost_ticks } => w(9, step, 0.0, lost_ticks),
-        Trace::Reset { step, cause } => w(10, step, 0.0, u16::from(cause)),
-        Trace::Command { step, code } => w(11, step, 0.0, u16::from(code)),
-        Trace::Params { step, source } => w(12, step, 0.0, u16::from(source)),
+        Trace::Restore { tick, kind } => w(1, tick, 0.0, u16::from(restore_code(kind))),
+        Trace::ValveOpen { tick, drain_c, forced } => w(2, tick, drain_c, u16::from(forced)),
+        Trace::ValveClose { tick, drain_c } => w(3, tick, drain_c, 0),
+        Trace::Alarm { tick, drain_c } => w(4, tick, drain_c, 0),
+        Trace::AlarmClear { tick, drain_c } => w(5, tick, drain_c, 0),
+        Trace::Fault { tick, new_bits } => w(6, tick, 0.0, new_bits.bits()),
+        Trace::FaultsCleared { tick, bits } => w(7, tick, 0.0, bits.bits()),
+        Trace::LngLow { tick, remaining_kg } => w(8, tick, remaining_kg, 0),
+        Trace::Overrun { tick, lost_ticks } => w(9, tick, 0.0, lost_ticks),
+        Trace::Reset { tick, cause } => w(10, tick, 0.0, u16::from(cause)),
+        Trace::Command { tick, code } => w(11, tick, 0.0, u16::from(code)),
+        Trace::Params { tick, source } => w(12, tick, 0.0, u16::from(source)),
     }
 }
 

@@ -165,7 +165,7 @@ fn alarm_round_trip<N: Num>() -> (u32, u32) {
             None => ramp(&idle(), &load(), k),
             Some(k0) => ramp(&load(), &idle(), k - k0),
         };
-        let o = g.step(&s);
+        let o = g.tick(&s);
         let m = g.model().expect("default parameters build a model");
         let d = m.drain_c();
         let model_step = m.pending_ticks() == 0;
@@ -213,8 +213,8 @@ fn alarm_round_trip<N: Num>() -> (u32, u32) {
     assert!(band_off >= 3 && band_on >= 3, "band steps: {band_off} off, {band_on} on");
     // The trace has one Alarm event at the raising tick and one AlarmClear at the
     // clearing tick.
-    let alarms: Vec<u32> = g.trace().iter().filter_map(|e| if let Trace::Alarm { step, .. } = e { Some(*step) } else { None }).collect();
-    let clears: Vec<u32> = g.trace().iter().filter_map(|e| if let Trace::AlarmClear { step, .. } = e { Some(*step) } else { None }).collect();
+    let alarms: Vec<u32> = g.trace().iter().filter_map(|e| if let Trace::Alarm { tick, .. } = e { Some(*tick) } else { None }).collect();
+    let clears: Vec<u32> = g.trace().iter().filter_map(|e| if let Trace::AlarmClear { tick, .. } = e { Some(*tick) } else { None }).collect();
     assert_eq!((alarms, clears), (vec![up], vec![down]));
     (up, down)
 }

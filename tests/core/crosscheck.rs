@@ -20,7 +20,7 @@ fn sample(p_a: f32, p_b: f32, rpm: f32) -> Sample {
 
 /// Ticks of the window (2 s) and of the latch (3 windows).
 fn window() -> u32 {
-    GuardConfig::DEFAULT.crosscheck.window_steps
+    GuardConfig::DEFAULT.crosscheck.window_ticks
 }
 
 /// A 10-minute mission with consistent sensors: Case 1 at 60 bar, a servo-like
@@ -53,7 +53,7 @@ fn consistent_sensors_never_disagree() {
         let mut worst = 0.0f64;
         let (mut sp, mut si, mut n) = (0.0f64, 0.0f64, 0u32);
         for k in 0..60_000u32 {
-            let o = g.step(&mission(k));
+            let o = g.tick(&mission(k));
             assert!(!o.faults.intersects(faults::LATCHED), "{name} tick {k}: {o:?}");
             let m = g.model().unwrap();
             if m.pending_ticks() == 0 {
@@ -77,7 +77,7 @@ fn consistent_sensors_never_disagree() {
 
 /// Runs `ticks` of `s(k)` and returns the outputs.
 fn run(g: &mut GuardOf<f32>, ticks: u32, s: impl Fn(u32) -> Sample) -> Vec<Output> {
-    (0..ticks).map(|k| g.step(&s(k))).collect()
+    (0..ticks).map(|k| g.tick(&s(k))).collect()
 }
 
 fn latched_at(out: &[Output]) -> Option<usize> {
@@ -97,7 +97,7 @@ fn current_sensor_reading_30_percent_low_at_load_latches_after_the_persist_windo
     let o = out[k];
     assert!(o.valve_open && o.alarm && o.derate && o.faults.intersects(faults::UNTRUSTED), "{o:?}");
     assert!(out[k..].iter().all(|o| o.faults.intersects(faults::SENSOR_DISAGREE) && o.valve_open && o.alarm));
-    assert!(g.trace().iter().any(|e| matches!(e, Trace::Fault { step, new_bits } if *step == k as u32 && new_bits.intersects(faults::SENSOR_DISAGREE))));
+    assert!(g.trace().iter().any(|e| matches!(e, Trace::Fault { tick, new_bits } if *tick == k as u32 && new_bits.intersects(faults::SENSOR_DISAGREE))));
 }
 
 #[test]
@@ -138,8 +138,8 @@ fn while_disagreeing_the_model_heats_with_the_larger_loss() {
     let mut off = GuardOf::<f32>::new(&cfg, Restore::Cold);
     let mut first_max = None;
     for k in 0..6000u32 {
-        g.step(&s(k));
-        off.step(&s(k));
+        g.tick(&s(k));
+        off.tick(&s(k));
         let m = g.model().unwrap();
         if m.pending_ticks() == 0 && k > window() {
             let (lp, li) = m.last_mech_pair_kw();

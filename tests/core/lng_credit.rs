@@ -106,7 +106,7 @@ fn no_credit_while_the_lng_budget_is_empty() {
     let mut empty_since = None;
     let mut first_credit = None;
     for k in 0..3000u32 {
-        let o = g.step(&load());
+        let o = g.tick(&load());
         assert!(o.valve_open, "tick {k}: {o:?}");
         if let Some(c) = credit_kw(&g) {
             first_credit.get_or_insert(c);
@@ -128,14 +128,14 @@ fn no_credit_while_the_lng_budget_is_empty() {
     let mut g = warm45(&GuardConfig::DEFAULT, u32::MAX);
     assert!(LngBudget::new(&LngConfig::DEFAULT).remaining_j() < u32::MAX as f32 * 0.01);
     for k in 0..500u32 {
-        g.step(&load());
+        g.tick(&load());
         if let Some(c) = credit_kw(&g) {
             assert_eq!(c, 0.0, "tick {k}: credited with the LNG used up");
         }
     }
     g.refill_lng(&LngConfig::DEFAULT);
     for _ in 0..10 {
-        g.step(&load());
+        g.tick(&load());
     }
     assert!(credit_kw(&g).unwrap() > 1.0);
 }
@@ -149,7 +149,7 @@ fn with_feedback(g: &mut GuardOf<f32>, ticks: u32, fb: impl Fn(u32, bool) -> Opt
         if let Some(v) = fb(k, commanded) {
             g.valve_feedback(v);
         }
-        let o = g.step(&load());
+        let o = g.tick(&load());
         commanded = o.valve_open;
         out.push(o);
     }
@@ -159,17 +159,17 @@ fn with_feedback(g: &mut GuardOf<f32>, ticks: u32, fb: impl Fn(u32, bool) -> Opt
 #[test]
 fn valve_reported_shut_while_commanded_open_gets_no_credit_and_latches_actuator_after_the_mismatch_time() {
     // Commanded open (45 degC), the position feedback says shut (a valve stuck shut).
-    // No credit from the first report on; after 0.5 s (actuator_mismatch_steps = 50
+    // No credit from the first report on; after 0.5 s (actuator_mismatch_ticks = 50
     // reports) ACTUATOR latches, the valve stays commanded open. Before: the credit
     // stayed ("tick 9: 3.1571724 kW credited with the valve reported shut") and
     // nothing latched.
     let cfg = GuardConfig::DEFAULT;
-    assert_eq!(cfg.actuator_mismatch_steps, 50);
+    assert_eq!(cfg.actuator_mismatch_ticks, 50);
     let mut g = warm45(&cfg, 0);
     let mut latched_at = None;
     for k in 0..400u32 {
         g.valve_feedback(false);
-        let o = g.step(&load());
+        let o = g.tick(&load());
         assert!(o.valve_open, "tick {k}: {o:?}");
         if let Some(c) = credit_kw(&g) {
             assert_eq!(c, 0.0, "tick {k}: {c} kW credited with the valve reported shut");
@@ -180,7 +180,7 @@ fn valve_reported_shut_while_commanded_open_gets_no_credit_and_latches_actuator_
     }
     // Reports at ticks 0..: the 50th mismatching one is at tick 49.
     assert_eq!(latched_at, Some(49));
-    assert!(g.trace().iter().any(|e| matches!(e, Trace::Fault { step: 49, new_bits } if *new_bits == faults::ACTUATOR)));
+    assert!(g.trace().iter().any(|e| matches!(e, Trace::Fault { tick: 49, new_bits } if *new_bits == faults::ACTUATOR)));
 }
 
 #[test]
@@ -219,7 +219,7 @@ fn matching_feedback_raises_nothing_and_leaves_the_estimate_unchanged() {
 
 #[test]
 fn mismatch_time_is_configurable() {
-    let cfg = GuardConfig { actuator_mismatch_steps: 50, ..GuardConfig::DEFAULT };
+    let cfg = GuardConfig { actuator_mismatch_ticks: 50, ..GuardConfig::DEFAULT };
     let mut g = GuardOf::<f32>::new(&cfg, Restore::Cold);
     let out = with_feedback(&mut g, 100, |k, _| (k > 0).then_some(true));
     assert_eq!(out.iter().position(|o| o.faults.intersects(faults::ACTUATOR)), Some(50));

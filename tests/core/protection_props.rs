@@ -68,8 +68,8 @@ fn run_all<N: eha_guard::num::Num>(seq: &[(Option<Sample>, Option<bool>)]) -> Re
             let _ = g.clear_faults();
         }
         let o = match s {
-            Some(s) => g.step(s),
-            None => g.step_missing(),
+            Some(s) => g.tick(s),
+            None => g.tick_missing(),
         };
         prop_assert!(finite(&o), "non-finite output {:?}", o);
         prop_assert!(o.lng_remaining_kg >= 0.0 && o.lng_remaining_kg <= 2.1501);
@@ -95,14 +95,14 @@ struct Chan {
 /// The six channels in `Sample` order (current, p_A, p_B, speed, position, ambient).
 fn channels() -> [Chan; 6] {
     let l = InputLimits::DEFAULT;
-    let p = Chan { lo: l.pressure_bar_min, hi: l.pressure_bar_max, rate: l.pressure_bar_per_step };
+    let p = Chan { lo: l.pressure_bar_min, hi: l.pressure_bar_max, rate: l.pressure_bar_per_tick };
     [
-        Chan { lo: -l.current_a_max, hi: l.current_a_max, rate: l.current_a_per_step },
+        Chan { lo: -l.current_a_max, hi: l.current_a_max, rate: l.current_a_per_tick },
         p,
         p,
-        Chan { lo: -l.speed_rpm_max, hi: l.speed_rpm_max, rate: l.speed_rpm_per_step },
-        Chan { lo: l.position_mm_min, hi: l.position_mm_max, rate: l.position_mm_per_step },
-        Chan { lo: l.ambient_c_min, hi: l.ambient_c_max, rate: l.ambient_c_per_step },
+        Chan { lo: -l.speed_rpm_max, hi: l.speed_rpm_max, rate: l.speed_rpm_per_tick },
+        Chan { lo: l.position_mm_min, hi: l.position_mm_max, rate: l.position_mm_per_tick },
+        Chan { lo: l.ambient_c_min, hi: l.ambient_c_max, rate: l.ambient_c_per_tick },
     ]
 }
 
@@ -122,7 +122,7 @@ enum Fault {
     /// `ch` jumps by `factor` × its rate limit towards the middle of its range and
     /// the run goes on from there (a step change).
     Rate { ch: usize, factor: f32 },
-    /// `ticks` ticks without a sample (STALE from `stale_steps` = 5 on).
+    /// `ticks` ticks without a sample (STALE from `stale_ticks` = 5 on).
     Missing { ticks: u32 },
 }
 
@@ -251,7 +251,7 @@ fn run_valid<N: eha_guard::num::Num>(ticks: &[(Tick, Option<Fault>)], clear_ever
     let mut g = GuardOf::<N>::new(&cfg, Restore::Cold);
     let mut unlatched = 0u64;
     // A latched bit is only allowed after a fault that can latch one (non-finite,
-    // range, a rate jump, a missing burst reaching `stale_steps`) since the last
+    // range, a rate jump, a missing burst reaching `stale_ticks`) since the last
     // successful clear: valid, rate-limited input never latches anything.
     let mut may_latch = false;
     let mut missing_run = 0u32;
@@ -265,11 +265,11 @@ fn run_valid<N: eha_guard::num::Num>(ticks: &[(Tick, Option<Fault>)], clear_ever
         let o = match t {
             Tick::Sample(s) => {
                 missing_run = 0;
-                g.step(s)
+                g.tick(s)
             }
             Tick::Missing => {
                 missing_run += 1;
-                g.step_missing()
+                g.tick_missing()
             }
         };
         match f {
@@ -282,7 +282,7 @@ fn run_valid<N: eha_guard::num::Num>(ticks: &[(Tick, Option<Fault>)], clear_ever
             Some(Fault::Rate { .. }) => may_latch = true,
             _ => {}
         }
-        if missing_run >= cfg.stale_steps {
+        if missing_run >= cfg.stale_ticks {
             may_latch = true;
         }
         prop_assert!(finite(&o), "tick {}: non-finite output {:?}", k, o);
@@ -356,7 +356,7 @@ proptest! {
     ) {
         let mut g = GuardOf::<f32>::new(&GuardConfig::DEFAULT, Restore::Cold);
         for _ in 0..warm {
-            let o = g.step(&nominal());
+            let o = g.tick(&nominal());
             prop_assert!(!o.valve_open && o.faults.is_empty(), "nominal must be quiet: {:?}", o);
         }
         let mut s = nominal();
@@ -364,7 +364,7 @@ proptest! {
             0 => s.current_a = bad, 1 => s.p_a_bar = bad, 2 => s.p_b_bar = bad,
             3 => s.speed_rpm = bad, 4 => s.position_mm = bad, _ => s.ambient_c = bad,
         }
-        let o = g.step(&s);
+        let o = g.tick(&s);
         prop_assert!(o.valve_open, "valve must open in the faulting step");
         let class = if bad.is_finite() { faults::RANGE } else { faults::NON_FINITE };
         prop_assert!(o.faults.intersects(class), "fault bits {:#x}", o.faults);
@@ -376,11 +376,11 @@ proptest! {
         let cfg = GuardConfig::DEFAULT;
         let mut g = GuardOf::<f32>::new(&cfg, Restore::Cold);
         for _ in 0..warm {
-            g.step(&nominal());
+            g.tick(&nominal());
         }
-        for k in 1..=cfg.stale_steps {
-            let o = g.step_missing();
-            if k < cfg.stale_steps {
+        for k in 1..=cfg.stale_ticks {
+            let o = g.tick_missing();
+            if k < cfg.stale_ticks {
                 prop_assert!(!o.valve_open && !o.faults.intersects(faults::STALE), "not stale yet at {}", k);
             } else {
                 prop_assert!(o.valve_open && o.faults.intersects(faults::STALE), "stale at {} must open: {:?}", k, o);
@@ -404,14 +404,14 @@ proptest! {
             }
         }
         for w in toggles.windows(2) {
-            prop_assert!(w[1] - w[0] >= cfg.dwell_steps as usize, "toggles {} steps apart < dwell {}", w[1] - w[0], cfg.dwell_steps);
+            prop_assert!(w[1] - w[0] >= cfg.dwell_ticks as usize, "toggles {} steps apart < dwell {}", w[1] - w[0], cfg.dwell_ticks);
         }
     }
 
     #[test]
     fn hysteresis_band(ts in proptest::collection::vec(30.0f32..50.0, 1..2000)) {
         // With the dwell at zero the valve state must be exactly the hysteresis relay.
-        let cfg = ValveConfig { dwell_steps: 0, ..ValveConfig::DEFAULT };
+        let cfg = ValveConfig { dwell_ticks: 0, ..ValveConfig::DEFAULT };
         let mut v = Valve::new();
         let mut open = false;
         for t in ts {
@@ -426,17 +426,17 @@ proptest! {
     fn faults_latch_until_explicit_clear(valid_after in 0u32..250) {
         let cfg = GuardConfig::DEFAULT;
         let mut g = GuardOf::<f32>::new(&cfg, Restore::Cold);
-        g.step(&nominal());
+        g.tick(&nominal());
         let mut s = nominal();
         s.p_a_bar = f32::NAN;
-        g.step(&s);
+        g.tick(&s);
         for _ in 0..valid_after {
-            let o = g.step(&nominal());
+            let o = g.tick(&nominal());
             prop_assert!(o.valve_open && o.faults.intersects(faults::NON_FINITE), "fault must stay latched");
         }
         let cleared = g.clear_faults();
-        prop_assert_eq!(cleared, valid_after >= cfg.clear_valid_steps, "clear rule: {} valid steps", valid_after);
-        let o = g.step(&nominal());
+        prop_assert_eq!(cleared, valid_after >= cfg.clear_valid_ticks, "clear rule: {} valid steps", valid_after);
+        let o = g.tick(&nominal());
         prop_assert_eq!(!o.faults.intersects(faults::LATCHED), cleared);
     }
 
@@ -469,7 +469,7 @@ fn boot_rules_cold_warm_corrupt() {
     let cfg = GuardConfig::DEFAULT;
     // Cold: starts at the first ambient sample (16 degC), valve closed.
     let mut g = GuardOf::<f32>::new(&cfg, Restore::from_record(&ThermalRecord::EMPTY));
-    let o = g.step(&nominal());
+    let o = g.tick(&nominal());
     assert!(
         (o.drain_c - 16.0).abs() < 0.01 && !o.valve_open,
         "cold: {o:?}"
@@ -486,7 +486,7 @@ fn boot_rules_cold_warm_corrupt() {
         123,
     );
     let mut g = GuardOf::<f32>::new(&cfg, Restore::from_record(&rec));
-    let o = g.step(&nominal());
+    let o = g.tick(&nominal());
     assert!(
         (o.drain_c - 45.0).abs() < 0.05 && o.valve_open && o.faults.is_empty(),
         "warm: {o:?}"
@@ -511,7 +511,7 @@ fn boot_rules_cold_warm_corrupt() {
     bad.temps_c[5] = 20.0;
     assert_eq!(bad.classify(), RecordStatus::Corrupt);
     let mut g = GuardOf::<f32>::new(&cfg, Restore::from_record(&bad));
-    let o = g.step(&nominal());
+    let o = g.tick(&nominal());
     assert!(
         (o.drain_c - 60.0).abs() < 0.05 && o.valve_open,
         "corrupt: {o:?}"
@@ -582,7 +582,7 @@ fn case1_60bar_opens_valve_by_temperature() {
     let mut opened = None;
     let mut o = Output::default();
     for k in 0..360_000 {
-        o = g.step(&nominal());
+        o = g.tick(&nominal());
         if o.valve_open && opened.is_none() {
             opened = Some(k);
         }
@@ -607,7 +607,7 @@ fn trace_ring_keeps_newest_32() {
     let mut t = eha_guard::trace::TraceBuf::new();
     for k in 0..40u32 {
         t.write(eha_guard::trace::Trace::Fault {
-            step: k,
+            tick: k,
             new_bits: eha_guard::Faults::from_bits(1),
         });
     }
@@ -615,7 +615,7 @@ fn trace_ring_keeps_newest_32() {
     let steps: Vec<u32> = t
         .iter()
         .map(|e| match e {
-            eha_guard::trace::Trace::Fault { step, .. } => *step,
+            eha_guard::trace::Trace::Fault { tick, .. } => *tick,
             _ => u32::MAX,
         })
         .collect();
@@ -631,20 +631,20 @@ fn stale_input_integrates_worst_case_loss() {
     let cfg = GuardConfig::DEFAULT;
     let mut g = GuardOf::<f64>::new(&cfg, Restore::Cold);
     for _ in 0..100 {
-        g.step(&nominal());
+        g.tick(&nominal());
     }
     let mut nominal_g = g.clone();
-    for _ in 0..cfg.stale_steps {
-        g.step_missing();
+    for _ in 0..cfg.stale_ticks {
+        g.tick_missing();
     }
     // Multi-rate: the model step averages its ticks' losses. Go on to the next model
     // step boundary, then one whole model step of worst-case ticks only.
-    let mut o0 = g.step_missing();
+    let mut o0 = g.tick_missing();
     while g.model().unwrap().pending_ticks() != 0 {
-        o0 = g.step_missing();
+        o0 = g.tick_missing();
     }
     for _ in 0..eha_guard::params::TICKS_PER_STEP {
-        o0 = g.step_missing();
+        o0 = g.tick_missing();
     }
     assert_eq!(g.model().unwrap().pending_ticks(), 0);
     let p = g.model().unwrap().last_losses_kw();
@@ -679,8 +679,8 @@ fn stale_input_integrates_worst_case_loss() {
     let mut o = o0;
     let mut n = o0;
     for _ in 0..500 {
-        o = g.step_missing();
-        n = nominal_g.step(&nominal());
+        o = g.tick_missing();
+        n = nominal_g.tick(&nominal());
     }
     println!(
         "5 s after STALE: fail-safe drain {:.4} degC, nominal {:.4} degC (from {:.4})",
@@ -706,14 +706,14 @@ fn guard_dwell_qualifies_the_closing_at_the_model_step() {
     let mut cfg = GuardConfig::DEFAULT;
     cfg.valve.open_c = 16.3;
     cfg.valve.close_c = 16.25;
-    let dwell = cfg.valve.dwell_steps / eha_guard::params::TICKS_PER_STEP;
+    let dwell = cfg.valve.dwell_ticks / eha_guard::params::TICKS_PER_STEP;
     let mut g = GuardOf::<f32>::new(&cfg, Restore::Cold);
     let load = nominal();
     let idle = Sample { current_a: crate::plant::motor_current(5.0, 5.0, 500.0), p_a_bar: 5.0, p_b_bar: 5.0, speed_rpm: 500.0, ..nominal() };
     let mut below_run = 0u32;
     let mut was_open = false;
     for k in 0..20_000u32 {
-        let o = g.step(if (k / 150) % 2 == 0 { &load } else { &idle });
+        let o = g.tick(if (k / 150) % 2 == 0 { &load } else { &idle });
         assert!(!o.faults.intersects(faults::LATCHED));
         let m = g.model().unwrap();
         if m.pending_ticks() == 0 {
@@ -734,8 +734,8 @@ fn guard_dwell_qualifies_the_closing_at_the_model_step() {
         .trace()
         .iter()
         .filter_map(|e| match e {
-            eha_guard::trace::Trace::ValveOpen { step, forced: false, .. } => Some((*step, true)),
-            eha_guard::trace::Trace::ValveClose { step, .. } => Some((*step, false)),
+            eha_guard::trace::Trace::ValveOpen { tick, forced: false, .. } => Some((*tick, true)),
+            eha_guard::trace::Trace::ValveClose { tick, .. } => Some((*tick, false)),
             _ => None,
         })
         .collect();
@@ -744,7 +744,7 @@ fn guard_dwell_qualifies_the_closing_at_the_model_step() {
     // Every open period lasts at least the dwell (2 s = 200 ticks).
     for w in toggles.windows(2) {
         if w[0].1 && !w[1].1 {
-            assert!(w[1].0 - w[0].0 >= cfg.valve.dwell_steps, "open for {} ticks < {}", w[1].0 - w[0].0, cfg.valve.dwell_steps);
+            assert!(w[1].0 - w[0].0 >= cfg.valve.dwell_ticks, "open for {} ticks < {}", w[1].0 - w[0].0, cfg.valve.dwell_ticks);
         }
     }
     // Decisions fall on model-step ticks (the 10th of each model step); the first

@@ -1,8 +1,8 @@
 //! Start-up (issue "No silent protection failure", item 1): until the first sample
 //! the guard waits — valve open (the safe state), model not started, no STALE —
-//! and declares STALE only after `GuardConfig::startup_timeout_steps` (10 s by
+//! and declares STALE only after `GuardConfig::startup_timeout_ticks` (10 s by
 //! default) without any sample, or after samples have started and then stopped
-//! (`stale_steps`, 50 ms). The model starts from the first sample's ambient (cold
+//! (`stale_ticks`, 50 ms). The model starts from the first sample's ambient (cold
 //! boot) or from the restored thermal record (warm reset).
 
 use eha_guard::num::{Fx, Num};
@@ -18,8 +18,8 @@ fn idle30() -> Sample {
 #[test]
 fn default_startup_timeout_is_10_s() {
     // 1000 ticks of 10 ms.
-    assert_eq!(GuardConfig::DEFAULT.startup_timeout_steps, 1000);
-    assert_eq!(GuardConfig::DEFAULT.stale_steps, 5);
+    assert_eq!(GuardConfig::DEFAULT.startup_timeout_ticks, 1000);
+    assert_eq!(GuardConfig::DEFAULT.stale_ticks, 5);
 }
 
 #[test]
@@ -31,11 +31,11 @@ fn missing_tick_at_boot_does_not_start_the_model_at_0_degc() {
     // one model step of idle moves the drain by < 1e-4 K (measured 0 to 3e-5 K).
     fn run<N: Num>() -> f32 {
         let mut g = GuardOf::<N>::new(&GuardConfig::DEFAULT, Restore::Cold);
-        let o = g.step_missing();
+        let o = g.tick_missing();
         assert!(o.valve_open && o.faults.is_empty(), "waiting: {o:?}");
         let mut o = o;
         for _ in 0..12 {
-            o = g.step(&idle30());
+            o = g.tick(&idle30());
         }
         assert_eq!(o.faults, eha_guard::Faults::NONE, "{o:?}");
         assert!(!o.valve_open, "{o:?}");
@@ -49,7 +49,7 @@ fn missing_tick_at_boot_does_not_start_the_model_at_0_degc() {
 
 #[test]
 fn guard_waits_for_the_first_sample_valve_open_no_stale() {
-    // Samples start 3 s after boot (300 ticks > stale_steps = 5, < the 10 s startup
+    // Samples start 3 s after boot (300 ticks > stale_ticks = 5, < the 10 s startup
     // timeout). Before: STALE latched at the 5th tick and stayed for the power
     // cycle. Now: 300 ticks of waiting (valve open, no fault, no estimate), then the
     // model starts at the first sample's ambient and the valve closes at once (30
@@ -60,27 +60,27 @@ fn guard_waits_for_the_first_sample_valve_open_no_stale() {
     let o0 = g.output();
     assert!(o0.valve_open && o0.faults.is_empty() && !o0.alarm, "at boot: {o0:?}");
     for k in 0..300 {
-        let o = g.step_missing();
+        let o = g.tick_missing();
         assert!(o.valve_open, "tick {k}: valve must be open while waiting: {o:?}");
         assert_eq!(o.faults, eha_guard::Faults::NONE, "tick {k}: no fault while waiting: {o:?}");
         assert!(!o.alarm, "tick {k}: {o:?}");
         assert_eq!(o.drain_c, eha_guard::guard::DRAIN_C_UNKNOWN, "tick {k}: no estimate before the first sample");
         assert_eq!(g.model().unwrap().pending_ticks(), 0, "tick {k}: the model accumulated a tick while waiting");
     }
-    let o = g.step(&idle30());
+    let o = g.tick(&idle30());
     assert_eq!(o.faults, eha_guard::Faults::NONE, "{o:?}");
     assert!(!o.valve_open, "the valve closes at the first sample of a cold start: {o:?}");
     assert_eq!(o.drain_c, 30.0, "cold start at the first sample's ambient");
     // The closing is in the trace at the first sample's tick.
-    assert!(g.trace().iter().any(|e| matches!(e, Trace::ValveClose { step: 300, .. })), "{:?}", g.trace().iter().collect::<Vec<_>>());
+    assert!(g.trace().iter().any(|e| matches!(e, Trace::ValveClose { tick: 300, .. })), "{:?}", g.trace().iter().collect::<Vec<_>>());
     // A clear needs no maintenance: nothing latched. And samples that then stop are
-    // STALE after stale_steps, as before.
+    // STALE after stale_ticks, as before.
     for _ in 0..100 {
-        assert_eq!(g.step(&idle30()).faults, eha_guard::Faults::NONE);
+        assert_eq!(g.tick(&idle30()).faults, eha_guard::Faults::NONE);
     }
-    for k in 1..=cfg.stale_steps {
-        let o = g.step_missing();
-        assert_eq!(o.faults.intersects(faults::STALE), k == cfg.stale_steps, "missing {k}: {o:?}");
+    for k in 1..=cfg.stale_ticks {
+        let o = g.tick_missing();
+        assert_eq!(o.faults.intersects(faults::STALE), k == cfg.stale_ticks, "missing {k}: {o:?}");
     }
 }
 
@@ -91,23 +91,23 @@ fn stale_after_the_startup_timeout_without_any_sample() {
     // model at their ambient, with STALE's worst-case inputs until a clear.
     let cfg = GuardConfig::DEFAULT;
     let mut g = GuardOf::<f32>::new(&cfg, Restore::Cold);
-    for k in 0..cfg.startup_timeout_steps {
-        let o = g.step_missing();
+    for k in 0..cfg.startup_timeout_ticks {
+        let o = g.tick_missing();
         assert!(o.valve_open, "tick {k}: {o:?}");
         let stale = o.faults.intersects(faults::STALE);
-        assert_eq!(stale, k + 1 == cfg.startup_timeout_steps, "tick {k}: {o:?}");
+        assert_eq!(stale, k + 1 == cfg.startup_timeout_ticks, "tick {k}: {o:?}");
     }
-    assert!(g.trace().iter().any(|e| matches!(e, Trace::Fault { step: 999, new_bits } if new_bits.intersects(faults::STALE))));
-    let o = g.step(&idle30());
+    assert!(g.trace().iter().any(|e| matches!(e, Trace::Fault { tick: 999, new_bits } if new_bits.intersects(faults::STALE))));
+    let o = g.tick(&idle30());
     assert!(o.valve_open && o.faults.intersects(faults::STALE), "{o:?}");
     // The model starts at the sample's own (valid) ambient, not at the worst case
     // that STALE substitutes from then on.
     assert_eq!(o.drain_c, 30.0, "{o:?}");
     // A shorter configured timeout is honoured.
-    let cfg2 = GuardConfig { startup_timeout_steps: 50, ..GuardConfig::DEFAULT };
+    let cfg2 = GuardConfig { startup_timeout_ticks: 50, ..GuardConfig::DEFAULT };
     let mut g = GuardOf::<f32>::new(&cfg2, Restore::Cold);
     for k in 0..50u32 {
-        let o = g.step_missing();
+        let o = g.tick_missing();
         assert_eq!(o.faults.intersects(faults::STALE), k == 49, "tick {k}: {o:?}");
     }
 }
@@ -122,11 +122,11 @@ fn warm_restore_waits_and_starts_from_the_record() {
     let rec = ThermalRecord::new([50.0, 45.0, 46.0, 44.0, 30.0, 45.0], 20.0, 0, 0, 123);
     let mut g = GuardOf::<f32>::new(&GuardConfig::DEFAULT, Restore::from_record(&rec));
     for k in 0..200 {
-        let o = g.step_missing();
+        let o = g.tick_missing();
         assert!(o.valve_open && o.faults.is_empty(), "tick {k}: {o:?}");
         assert_eq!(o.drain_c, 45.0, "tick {k}: the restored estimate");
     }
-    let o = g.step(&idle30());
+    let o = g.tick(&idle30());
     assert!(o.valve_open && o.faults.is_empty(), "{o:?}");
     assert_eq!(o.drain_c, 45.0, "{o:?}");
     let snap = g.snapshot();

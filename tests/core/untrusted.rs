@@ -44,14 +44,14 @@ fn corrupt_record_raises_alarm_and_derate_until_a_clear() {
         let o = g.output();
         assert!(held(&o) && o.valve_open && o.faults.intersects(faults::MEMORY_CORRUPT), "at boot: {o:?}");
         assert!(!trusted.output().alarm, "60.0 degC is not above the alarm threshold");
-        assert!(g.trace().iter().any(|e| matches!(e, Trace::Alarm { step: 0, .. })));
+        assert!(g.trace().iter().any(|e| matches!(e, Trace::Alarm { tick: 0, .. })));
         // 10 minutes of light load: held at every tick, whatever the estimate does.
         let mut o = o;
         let mut trusted_off = 0;
         for k in 0..60_000 {
-            o = g.step(&idle());
+            o = g.tick(&idle());
             assert!(held(&o), "tick {k}: {o:?}");
-            trusted_off += u32::from(!trusted.step(&idle()).alarm);
+            trusted_off += u32::from(!trusted.tick(&idle()).alarm);
         }
         println!("{name}: estimate {} degC after 10 min; the trusted twin's alarm was off for {trusted_off} ticks", o.drain_c);
         // The controller clear (1 s of valid samples behind it) restores trust; with a
@@ -65,7 +65,7 @@ fn corrupt_record_raises_alarm_and_derate_until_a_clear() {
         let th = N::from_f64(cfg.alarm.clear_c as f64);
         let mut cleared = false;
         for k in 0..60_000u32 {
-            let o = g.step(&idle());
+            let o = g.tick(&idle());
             let m = g.model().unwrap();
             if m.pending_ticks() == 0 {
                 // The relay on the estimate (it was on at the clear: off only below 58).
@@ -89,11 +89,11 @@ fn corrupt_record_raises_alarm_and_derate_until_a_clear() {
 fn a_rejected_clear_keeps_the_alarm() {
     let mut g = GuardOf::<f32>::new(&GuardConfig::DEFAULT, Restore::from_record(&corrupt_record()));
     for _ in 0..50 {
-        g.step(&idle());
+        g.tick(&idle());
     }
-    // 50 valid samples < clear_valid_steps (100): the clear is refused.
+    // 50 valid samples < clear_valid_ticks (100): the clear is refused.
     assert!(!g.clear_faults());
-    assert!(held(&g.step(&idle())));
+    assert!(held(&g.tick(&idle())));
 }
 
 #[test]
@@ -102,12 +102,12 @@ fn no_sample_by_the_startup_timeout_raises_alarm_and_derate() {
     // start-up timeout and stay after samples arrive, until a clear.
     let cfg = GuardConfig::DEFAULT;
     let mut g = GuardOf::<f32>::new(&cfg, Restore::Cold);
-    for k in 0..cfg.startup_timeout_steps {
-        let o = g.step_missing();
-        assert_eq!(held(&o), k + 1 == cfg.startup_timeout_steps, "tick {k}: {o:?}");
+    for k in 0..cfg.startup_timeout_ticks {
+        let o = g.tick_missing();
+        assert_eq!(held(&o), k + 1 == cfg.startup_timeout_ticks, "tick {k}: {o:?}");
     }
     for k in 0..200 {
-        let o = g.step(&idle());
+        let o = g.tick(&idle());
         assert!(held(&o) && o.faults.intersects(faults::STALE), "tick {k}: {o:?}");
     }
     assert!(g.clear_faults());
@@ -120,13 +120,13 @@ fn untrusted_survives_a_warm_reset() {
     // before the clear does not turn the relaxed 60 degC start into a trusted one.
     let mut g = GuardOf::<f32>::new(&GuardConfig::DEFAULT, Restore::from_record(&corrupt_record()));
     for _ in 0..1000 {
-        g.step(&idle());
+        g.tick(&idle());
     }
     let rec = g.snapshot();
     assert_eq!(rec.classify(), RecordStatus::Valid);
     let mut g2 = GuardOf::<f32>::new(&GuardConfig::DEFAULT, Restore::from_record(&rec));
     assert!(held(&g2.output()), "{:?}", g2.output());
-    assert!(held(&g2.step(&idle())));
+    assert!(held(&g2.tick(&idle())));
     // A normal warm record is trusted.
     let rec = ThermalRecord::new([30.0; 6], 20.0, 0, 0, 1);
     let g3 = GuardOf::<f32>::new(&GuardConfig::DEFAULT, Restore::from_record(&rec));

@@ -16,7 +16,7 @@ use eha_guard::{faults, GuardConfig, GuardOf, Restore, Sample, ThermalRecord};
 /// The guard's decision cadence: one decision per 100 ms model step, the dwell in
 /// model steps (200 ticks of 10 ms = 20 model steps).
 fn guard_dwell() -> u32 {
-    GuardConfig::DEFAULT.valve.dwell_steps.div_ceil(TICKS_PER_STEP)
+    GuardConfig::DEFAULT.valve.dwell_ticks.div_ceil(TICKS_PER_STEP)
 }
 
 /// One decision of the guard's valve at the guard's cadence; `Some(open)` on a change.
@@ -182,7 +182,7 @@ fn guard_opens_at_the_first_model_step_above_40_also_right_after_a_closing() {
                     sample(10.0 + 330.0 * f, 500.0 + 2000.0 * f)
                 }
             };
-            let o = g.step(&s);
+            let o = g.tick(&s);
             assert!(!o.faults.intersects(faults::LATCHED), "tick {k}: {o:?}");
             let d = g.model().unwrap().drain_c();
             if d > open_c {
@@ -198,18 +198,18 @@ fn guard_opens_at_the_first_model_step_above_40_also_right_after_a_closing() {
         }
         let (c, r) = (closed_at.expect("idle must close the valve"), reopened_at.expect("the load must reopen it"));
         // The trace holds the temperature-driven opening at the reopening tick.
-        assert!(g.trace().iter().any(|e| matches!(e, Trace::ValveOpen { step, forced: false, .. } if *step == r)));
+        assert!(g.trace().iter().any(|e| matches!(e, Trace::ValveOpen { tick, forced: false, .. } if *tick == r)));
         (c, r)
     }
     for (name, (c, r)) in [("f32", run::<f32>()), ("Fx", run::<eha_guard::num::Fx>()), ("f64", run::<f64>())] {
         println!("{name}: closed at tick {c}, reopened at tick {r} ({} ms later)", (r - c) * 10);
         // The scenario must really test an opening inside the old dwell: reopened less
         // than 2 s after the closing.
-        assert!(r - c < GuardConfig::DEFAULT.valve.dwell_steps, "{name}: reopened {} ticks after the closing", r - c);
+        assert!(r - c < GuardConfig::DEFAULT.valve.dwell_ticks, "{name}: reopened {} ticks after the closing", r - c);
     }
 }
 
 #[test]
 fn valve_config_default_is_40_38_and_2_s() {
-    assert_eq!(ValveConfig::DEFAULT, ValveConfig { open_c: 40.0, close_c: 38.0, dwell_steps: 200 });
+    assert_eq!(ValveConfig::DEFAULT, ValveConfig { open_c: 40.0, close_c: 38.0, dwell_ticks: 200 });
 }

@@ -148,9 +148,9 @@ impl Mcu {
                 if let Some(open) = r.valve_fb {
                     guard.valve_feedback(open);
                 }
-                guard.step(&r.sample())
+                guard.tick(&r.sample())
             }
-            None => guard.step_missing(),
+            None => guard.tick_missing(),
         }
     }
 }
@@ -168,7 +168,7 @@ pub fn run_one(fault: Fault, scenario_name: &str, scenario: &Scenario) -> Result
 
 /// Run one fault in one scenario; with `target` (the firmware in QEMU through
 /// the lockstep PIL, one frame per tick) instead of the host guard. The
-/// lockstep firmware steps per frame, so only the input faults (every tick
+/// lockstep firmware ticks once per frame, so only the input faults (every tick
 /// still carries one frame) run on a target; they must give the same result
 /// as on the host, bit for bit.
 pub fn run_on(

@@ -25,9 +25,9 @@ pub const REGRESSION_MARGIN: f64 = 0.10;
 /// The measured figures of one firmware image (`None`: not measured for it).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct ImageBudget {
-    /// `Guard::step` instructions per 10 ms tick, mean over the bench run.
+    /// `Guard::tick` instructions per 10 ms tick, mean over the bench run.
     pub instr_per_tick_mean: Option<f64>,
-    /// `Guard::step` instructions per tick, max (a model-step tick).
+    /// `Guard::tick` instructions per tick, max (a model-step tick).
     pub instr_per_tick_max: Option<f64>,
     /// `Guard::new` instructions (init, once per boot).
     pub guard_new_instr: Option<f64>,
@@ -164,14 +164,14 @@ pub fn parse_bench(text: &str) -> Result<ImageBudget> {
     }
     let mut b = ImageBudget::default();
     for l in text.lines() {
-        if l.starts_with("Guard::step, every tick:") {
+        if l.starts_with("Guard::tick, every tick:") {
             b.instr_per_tick_mean = number_after(l, " mean ");
             b.instr_per_tick_max = number_after(l, " max ");
         } else if l.starts_with("Guard::new") {
             b.guard_new_instr = number_after(l, "): ");
         } else if l.starts_with("stack high-water mark:") {
             b.stack_boot_b = number_after(l, "boot+init ");
-            b.stack_tick_b = number_after(l, "step loop ");
+            b.stack_tick_b = number_after(l, "tick loop ");
         }
     }
     for (k, v) in b.fields() {
@@ -230,7 +230,7 @@ pub fn measure() -> Result<BTreeMap<String, ImageBudget>> {
     let mut out = BTreeMap::new();
     // The product image's instructions per tick come from the f32 bench image
     // (same profile, same guard and application code, timed under -icount on
-    // an in-memory board): `Guard::step` (the estimator, as for the bench
+    // an in-memory board): `Guard::tick` (the estimator, as for the bench
     // images), `App::tick` (the whole loop) and `Guard::new`.
     let mut app_tick = None;
     let mut bench_f32 = ImageBudget::default();
@@ -286,7 +286,7 @@ pub fn regressions(measured: &BTreeMap<String, ImageBudget>, budget: &BTreeMap<S
     v
 }
 
-/// The product image's absolute budgets (issue 14): `Guard::step` ≤ 400
+/// The product image's absolute budgets (issue 14): `Guard::tick` ≤ 400
 /// instructions per tick on the mean, `Guard::new` ≤ 100 k, boot stack ≤ 4 KiB,
 /// tick-loop stack ≤ 2 KiB, flash (`.text` + `.rodata`) ≤ 32 KiB.
 pub const PRODUCT_LIMITS: [(&str, f64); 5] = [
@@ -359,9 +359,9 @@ mod tests {
 
     #[test]
     fn parses_the_bench_report() {
-        let text = "Guard::step, every tick: instructions/step min 243 mean 333.1 max 1157 (n = 5995)\n\
+        let text = "Guard::tick, every tick: instructions/tick min 243 mean 333.1 max 1157 (n = 5995)\n\
                     Guard::new (constants, checks, stability): 3920773 instructions\n\
-                    stack high-water mark: boot+init 13576 bytes, step loop 6288 bytes\nEHA-BENCH-DONE\n";
+                    stack high-water mark: boot+init 13576 bytes, tick loop 6288 bytes\nEHA-BENCH-DONE\n";
         let b = parse_bench(text).expect("parses");
         assert_eq!(b.instr_per_tick_mean, Some(333.1));
         assert_eq!(b.instr_per_tick_max, Some(1157.0));

@@ -76,7 +76,7 @@ pub fn run(args: &PilArgs) -> Result<()> {
     let mut q = QemuOptions::new(build, &elf);
     q.icount = !args.no_icount;
     q.reply_timeout = Duration::from_secs_f64(args.timeout);
-    let opts = LoopOptions { step_s: eha_guard::params::S_PER_TICK, duration_s: args.duration };
+    let opts = LoopOptions { tick_s: eha_guard::params::S_PER_TICK, duration_s: args.duration };
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
     let stem = format!("pil_{}_{}", args.scenario, build.name());
     let csv = args.out.join(format!("{stem}.csv"));
@@ -93,8 +93,8 @@ pub fn run(args: &PilArgs) -> Result<()> {
         args.duration,
         args.scenario,
         build.machine(),
-        opts.steps(),
-        opts.step_s
+        opts.ticks(),
+        opts.tick_s
     );
     let run = match run_pil(&mut plant, &q, &opts) {
         Ok(r) => r,
@@ -107,7 +107,7 @@ pub fn run(args: &PilArgs) -> Result<()> {
         }
     };
     let s = Summary::of(&run.records, run.icount);
-    report::write_csv(&csv, &run.records, &meta(format!("PIL {} firmware in QEMU {}, step {} s", build.name(), build.machine(), opts.step_s)))?;
+    report::write_csv(&csv, &run.records, &meta(format!("PIL {} firmware in QEMU {}, tick {} s", build.name(), build.machine(), opts.tick_s)))?;
     report::write_log(&log_path, &run.log)?;
     let transcript = args.out.join(format!("{stem}.run"));
     std::fs::write(&transcript, report::transcript(&run, args.table_every)).with_context(|| format!("writing {}", transcript.display()))?;
@@ -121,7 +121,7 @@ pub fn run(args: &PilArgs) -> Result<()> {
         let c = report::compare(&fw, &sil_replies);
         println!(
             "firmware vs host SIL : {}/{} replies bit-identical, max drain diff {:.2e} K, flag mismatches {}",
-            c.identical, c.steps, c.max_drain_diff_k, c.flag_mismatches
+            c.identical, c.ticks, c.max_drain_diff_k, c.flag_mismatches
         );
     }
     println!("results             : {}, {}, {}", csv.display(), log_path.display(), transcript.display());

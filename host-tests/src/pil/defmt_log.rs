@@ -7,8 +7,8 @@ use anyhow::{anyhow, Context, Result};
 /// One decoded log line.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LogLine {
-    /// The defmt timestamp: the firmware's accepted-step count at the time.
-    pub step: Option<u64>,
+    /// The defmt timestamp: the firmware's tick count at the time.
+    pub tick: Option<u64>,
     /// Log level as defmt prints it (`INFO`, `WARN`, ...).
     pub level: String,
     /// The formatted message.
@@ -17,8 +17,8 @@ pub struct LogLine {
 
 impl std::fmt::Display for LogLine {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self.step {
-            Some(s) => write!(f, "step {s:>6} {:<5} {}", self.level, self.message),
+        match self.tick {
+            Some(s) => write!(f, "tick {s:>6} {:<5} {}", self.level, self.message),
             None => write!(f, "{:<5} {}", self.level, self.message),
         }
     }
@@ -37,9 +37,9 @@ pub fn decode(elf: &Path, bytes: &[u8]) -> Result<Vec<LogLine>> {
     loop {
         match dec.decode() {
             Ok(frame) => {
-                let step = frame.display_timestamp().and_then(|t| t.to_string().trim().parse::<u64>().ok());
+                let tick = frame.display_timestamp().and_then(|t| t.to_string().trim().parse::<u64>().ok());
                 lines.push(LogLine {
-                    step,
+                    tick,
                     level: frame.level().map_or("PRINT".to_string(), |l| l.as_str().to_uppercase()),
                     message: frame.display_message().to_string(),
                 });
@@ -47,7 +47,7 @@ pub fn decode(elf: &Path, bytes: &[u8]) -> Result<Vec<LogLine>> {
             Err(defmt_decoder::DecodeError::UnexpectedEof) => break,
             Err(defmt_decoder::DecodeError::Malformed) => {
                 lines.push(LogLine {
-                    step: None,
+                    tick: None,
                     level: "ERROR".into(),
                     message: "malformed defmt frame in the log stream (bytes lost)".into(),
                 });

@@ -10,7 +10,7 @@
 //! - 300 s: the current sensor reads 30 % low (SENSOR_DISAGREE latches after
 //!   three 2 s windows: valve forced open, alarm and derate held, the model
 //!   heats with the larger loss);
-//! - step 10,000: 3 lost frames (sequence gap, missed steps, below `stale_steps`);
+//! - step 10,000: 3 lost frames (sequence gap, missed steps, below `stale_ticks`);
 //! - step 45,000: 10 lost frames (STALE fault latches, fail-safe valve open);
 //! - step 50,000: a NaN current (non-finite fault); step 55,000: 5000 bar (range fault).
 //!

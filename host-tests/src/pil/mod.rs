@@ -1,10 +1,10 @@
 //! Processor-in-the-loop (PIL): the real firmware binary in QEMU, in
 //! closed loop and lockstep with the reference plant on the host.
 //!
-//! Per step: the plant's sensor values become one request frame
+//! Per tick: the plant's sensor values become one request frame
 //! ([`eha_guard::protocol`]), the firmware answers with one reply frame, the
 //! reply's valve command drives the plant's LNG valve, the plant advances one
-//! step. The same loop runs against [`sil::SilTarget`] (the same core code on
+//! tick. The same loop runs against [`sil::SilTarget`] (the same core code on
 //! the host), which is the bit-for-bit oracle for the firmware's replies.
 
 pub mod budget;
@@ -45,7 +45,7 @@ pub struct PlantSensors {
     pub t_drain_c: f64,
     /// Manifold oil sensor (`t_oil_c` of the measured format), if the plant has it.
     pub t_oil_c: Option<f64>,
-    /// LNG valve position read back (the valve the plant ran during the last step),
+    /// LNG valve position read back (the valve the plant ran during the last tick),
     /// if the plant reports it; sent in the request's flags byte.
     pub valve_fb: Option<bool>,
 }
@@ -66,19 +66,19 @@ impl PlantSensors {
     }
 }
 
-/// What the loop tells the plant after one step.
+/// What the loop tells the plant after one tick.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum StepControl {
-    /// Keep going with this LNG valve command during the next step.
+    /// Keep going with this LNG valve command during the next tick.
     Valve(bool),
     /// Stop now (the run ended or failed).
     Stop,
 }
 
 /// A plant that can run in lockstep with the firmware. The plant owns the
-/// time loop (a stiff solver keeps its state across steps): it calls
+/// time loop (a stiff solver keeps its state across its own steps): it calls
 /// `on_step(t_s, sensors)` at `t0, t0 + dt, …` up to `t_end` and applies the
-/// returned valve command during the following step.
+/// returned valve command during the following tick.
 pub trait PlantModel {
     /// Runs from the plant's start to `t_end_s`, calling `on_step` every
     /// `dt_s` s of plant time; stops early when it returns [`StepControl::Stop`].
@@ -93,19 +93,19 @@ pub trait PlantModel {
 /// The thing that answers request frames: the firmware in QEMU or the SIL core.
 pub trait Target {
     /// Send one encoded frame, return the reply to it.
-    fn exchange(&mut self, wire: &[u8], step: u64) -> Result<Reply, PilError>;
+    fn exchange(&mut self, wire: &[u8], tick: u64) -> Result<Reply, PilError>;
 }
 
 impl Target for QemuSession {
-    fn exchange(&mut self, wire: &[u8], step: u64) -> Result<Reply, PilError> {
+    fn exchange(&mut self, wire: &[u8], tick: u64) -> Result<Reply, PilError> {
         self.send(wire)?;
-        self.recv(step)
+        self.recv(tick)
     }
 }
 
-/// One lockstep step.
+/// One lockstep tick.
 #[derive(Clone, Copy, Debug)]
-pub struct StepRecord {
+pub struct TickRecord {
     /// Plant time at which the sample was taken, s.
     pub t_s: f64,
     /// What the plant measured then (and its true drain temperature).
@@ -119,36 +119,36 @@ pub struct StepRecord {
 /// Closed-loop run options.
 #[derive(Clone, Copy, Debug)]
 pub struct LoopOptions {
-    /// Firmware step period, s (the plant advances this much per frame).
-    pub step_s: f64,
+    /// Firmware tick period, s (the plant advances this much per frame).
+    pub tick_s: f64,
     /// Plant time to run, s.
     pub duration_s: f64,
 }
 
 impl LoopOptions {
-    /// Number of firmware steps in the run.
-    pub fn steps(&self) -> u64 {
-        (self.duration_s / self.step_s).round() as u64
+    /// Number of firmware ticks in the run.
+    pub fn ticks(&self) -> u64 {
+        (self.duration_s / self.tick_s).round() as u64
     }
 }
 
 /// A closed-loop run that stopped early: the records up to the failure are kept.
 #[derive(Debug)]
 pub struct LoopFailure {
-    /// The steps completed before the failure.
-    pub records: Vec<StepRecord>,
+    /// The ticks completed before the failure.
+    pub records: Vec<TickRecord>,
     /// What failed.
     pub error: anyhow::Error,
 }
 
-/// Run plant and target in lockstep for `opts.steps()` firmware steps. On
+/// Run plant and target in lockstep for `opts.ticks()` firmware ticks. On
 /// failure the records so far are returned with the error.
 pub fn run_closed_loop(
     plant: &mut dyn PlantModel,
     target: &mut dyn Target,
     opts: &LoopOptions,
-) -> Result<Vec<StepRecord>, LoopFailure> {
-    let n = opts.steps();
+) -> Result<Vec<TickRecord>, LoopFailure> {
+    let n = opts.ticks();
     let mut records = Vec::with_capacity(n as usize);
     let mut failure: Option<anyhow::Error> = None;
     let mut on_step = |t_s: f64, sensors: &PlantSensors| -> StepControl {
@@ -164,21 +164,21 @@ pub fn run_closed_loop(
                 return StepControl::Stop;
             }
         };
-        if reply.kind != ReplyKind::Step || reply.seq != request.seq {
-            let what = format!("expected a step reply to seq {}, got {:?} for seq {}", request.seq, reply.kind, reply.seq);
-            failure = Some(PilError::Protocol { step: k, what }.into());
+        if reply.kind != ReplyKind::Tick || reply.seq != request.seq {
+            let what = format!("expected a tick reply to seq {}, got {:?} for seq {}", request.seq, reply.kind, reply.seq);
+            failure = Some(PilError::Protocol { tick: k, what }.into());
             return StepControl::Stop;
         }
-        records.push(StepRecord { t_s, sensors: *sensors, request, reply });
+        records.push(TickRecord { t_s, sensors: *sensors, request, reply });
         if records.len() as u64 >= n {
             StepControl::Stop
         } else {
             StepControl::Valve(reply.out.valve_open)
         }
     };
-    // One extra step of plant time so the plant offers all n samples.
-    let t_end = opts.duration_s + opts.step_s;
-    let res = plant.run(opts.step_s, t_end, &mut on_step);
+    // One extra tick of plant time so the plant offers all n samples.
+    let t_end = opts.duration_s + opts.tick_s;
+    let res = plant.run(opts.tick_s, t_end, &mut on_step);
     if let Some(error) = failure {
         return Err(LoopFailure { records, error });
     }
@@ -187,7 +187,7 @@ pub fn run_closed_loop(
         return Err(LoopFailure { records, error: e.context(format!("plant failed after t = {t} s")) });
     }
     if (records.len() as u64) < n {
-        let error = anyhow::anyhow!("plant stopped after {} of {n} steps", records.len());
+        let error = anyhow::anyhow!("plant stopped after {} of {n} ticks", records.len());
         return Err(LoopFailure { records, error });
     }
     Ok(records)
@@ -195,7 +195,7 @@ pub fn run_closed_loop(
 
 /// Replay the exact request frames of a run through another target (SIL) and
 /// return its replies.
-pub fn replay(records: &[StepRecord], target: &mut dyn Target) -> Result<Vec<Reply>, PilError> {
+pub fn replay(records: &[TickRecord], target: &mut dyn Target) -> Result<Vec<Reply>, PilError> {
     records.iter().enumerate().map(|(k, r)| target.exchange(&r.request.encode(), k as u64)).collect()
 }
 
@@ -204,8 +204,8 @@ pub fn replay(records: &[StepRecord], target: &mut dyn Target) -> Result<Vec<Rep
 pub struct PilRun {
     /// Which firmware build ran.
     pub build: Build,
-    /// Every lockstep step.
-    pub records: Vec<StepRecord>,
+    /// Every lockstep tick.
+    pub records: Vec<TickRecord>,
     /// The completion marker (a `Done` reply with the final counters).
     pub done: Reply,
     /// The firmware's decoded defmt log.
@@ -218,21 +218,21 @@ pub struct PilRun {
 }
 
 /// Run one PIL session: spawn QEMU, lockstep loop, completion marker, defmt log.
-/// On failure, whatever was recorded (steps, defmt log) is in the error's
+/// On failure, whatever was recorded (ticks, defmt log) is in the error's
 /// `LoopFailure` and was not thrown away.
 pub fn run_pil(plant: &mut dyn PlantModel, qemu: &QemuOptions, opts: &LoopOptions) -> Result<PilRun, Box<PilFailure>> {
     let start = Instant::now();
     let mut session = QemuSession::spawn(qemu).map_err(|e| PilFailure::new(Vec::new(), Vec::new(), e.into()))?;
     match run_closed_loop(plant, &mut session, opts) {
         Ok(records) => {
-            let steps = records.len() as u64;
-            match session.finish(steps) {
+            let ticks = records.len() as u64;
+            match session.finish(ticks) {
                 Ok(end) => {
                     let log = defmt_log::decode(&qemu.elf, &end.defmt)
                         .map_err(|e| PilFailure::new(records.clone(), Vec::new(), e.context("decoding the defmt log")))?;
-                    if end.done.counters.accepted != steps as u32 {
-                        let what = format!("firmware accepted {} frames, host sent {steps}", end.done.counters.accepted);
-                        return Err(PilFailure::new(records, log, PilError::Protocol { step: steps, what }.into()));
+                    if end.done.counters.accepted != ticks as u32 {
+                        let what = format!("firmware accepted {} frames, host sent {ticks}", end.done.counters.accepted);
+                        return Err(PilFailure::new(records, log, PilError::Protocol { tick: ticks, what }.into()));
                     }
                     Ok(PilRun { build: qemu.build, records, done: end.done, log, wall: start.elapsed(), icount: qemu.icount })
                 }
@@ -250,8 +250,8 @@ pub fn run_pil(plant: &mut dyn PlantModel, qemu: &QemuOptions, opts: &LoopOption
 /// A failed PIL session with everything that was recorded before the failure.
 #[derive(Debug)]
 pub struct PilFailure {
-    /// The steps completed before the failure.
-    pub records: Vec<StepRecord>,
+    /// The ticks completed before the failure.
+    pub records: Vec<TickRecord>,
     /// The defmt log decoded up to the failure.
     pub log: Vec<defmt_log::LogLine>,
     /// What failed.
@@ -259,14 +259,14 @@ pub struct PilFailure {
 }
 
 impl PilFailure {
-    fn new(records: Vec<StepRecord>, log: Vec<defmt_log::LogLine>, error: anyhow::Error) -> Box<Self> {
+    fn new(records: Vec<TickRecord>, log: Vec<defmt_log::LogLine>, error: anyhow::Error) -> Box<Self> {
         Box::new(Self { records, log, error })
     }
 }
 
 impl std::fmt::Display for PilFailure {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "PIL run failed after {} steps: {:#}", self.records.len(), self.error)
+        write!(f, "PIL run failed after {} ticks: {:#}", self.records.len(), self.error)
     }
 }
 

@@ -8,12 +8,12 @@ use std::path::{Path, PathBuf};
 use anyhow::{anyhow, Result};
 use plotters::prelude::*;
 
-use super::StepRecord;
+use super::TickRecord;
 
 use crate::plot::font;
 
 /// Write the plot to `path` (PNG). Returns its path.
-pub fn plot_if_available(records: &[StepRecord], path: &Path) -> Result<Option<PathBuf>> {
+pub fn plot_if_available(records: &[TickRecord], path: &Path) -> Result<Option<PathBuf>> {
     if records.len() < 2 {
         return Ok(None);
     }
@@ -67,7 +67,7 @@ pub fn plot_if_available(records: &[StepRecord], path: &Path) -> Result<Option<P
         .map_err(|e| err(&e))?;
     v.configure_mesh().x_desc("time, s").y_desc("LNG valve").y_labels(2).draw().map_err(|e| err(&e))?;
     // Step plot of the valve command: exact change points only.
-    let valve = |r: &StepRecord| if r.reply.out.valve_open { 1.0 } else { 0.0 };
+    let valve = |r: &TickRecord| if r.reply.out.valve_open { 1.0 } else { 0.0 };
     let mut steps = Vec::new();
     let mut prev = records.first().map_or(0.0, valve);
     steps.push((0.0, prev));

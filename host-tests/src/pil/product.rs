@@ -319,7 +319,7 @@ impl Drop for ProductSession {
 
 /// One plant sample and the tick that used it.
 #[derive(Clone, Copy, Debug)]
-pub struct ProductStep {
+pub struct ProductSample {
     /// Plant time of the sample, s.
     pub t_s: f64,
     /// The sensors (true drain included).
@@ -334,7 +334,7 @@ pub struct ProductStep {
 #[derive(Debug, Default)]
 pub struct ProductRun {
     /// One entry per plant sample.
-    pub steps: Vec<ProductStep>,
+    pub samples: Vec<ProductSample>,
     /// Every tick reply, in order, with its arrival time (s).
     pub ticks: Vec<(f64, TickReply)>,
     /// Other frames received.
@@ -343,7 +343,7 @@ pub struct ProductRun {
 
 /// Hook called after each plant sample's tick: may send commands; returns
 /// `false` to stop the run.
-pub type Hook<'a> = dyn FnMut(&mut ProductSession, &ProductStep) -> Result<bool> + 'a;
+pub type Hook<'a> = dyn FnMut(&mut ProductSession, &ProductSample) -> Result<bool> + 'a;
 
 /// Runs `plant` in closed loop with the product image: each plant sample is
 /// sent, the tick that consumed it gives the valve command for the plant's
@@ -360,7 +360,7 @@ pub fn run_closed_loop(
     let n = (duration_s / 0.01).round() as usize;
     let debug = std::env::var_os("EHA_DEBUG").is_some();
     let mut on_step = |t_s: f64, sensors: &PlantSensors| -> StepControl {
-        let k = run.steps.len();
+        let k = run.samples.len();
         if k >= n {
             return StepControl::Stop;
         }
@@ -378,9 +378,9 @@ pub fn run_closed_loop(
                     }
                     run.ticks.push((at, t));
                     if t.fresh && t.sample_seq == request.seq {
-                        let step = ProductStep { t_s, sensors: *sensors, request, tick: t };
-                        run.steps.push(step);
-                        match hook(s, &step) {
+                        let sample = ProductSample { t_s, sensors: *sensors, request, tick: t };
+                        run.samples.push(sample);
+                        match hook(s, &sample) {
                             Ok(true) => return StepControl::Valve(t.out.valve_open),
                             Ok(false) => return StepControl::Stop,
                             Err(e) => {
@@ -478,7 +478,7 @@ pub fn sil_replay_with_block(run: &ProductRun, block: Option<&[u8; eha_guard::pa
     #[repr(C, align(4))]
     struct Aligned([u8; eha_guard::params_block::BLOCK_LEN]);
     let block = block.map(|b| &Box::leak(Box::new(Aligned(*b))).0);
-    let by_seq: std::collections::HashMap<u16, Request> = run.steps.iter().map(|p| (p.request.seq, p.request)).collect();
+    let by_seq: std::collections::HashMap<u16, Request> = run.samples.iter().map(|p| (p.request.seq, p.request)).collect();
     let mut b = ReplayBoard { rx: Vec::new(), tx: Vec::new(), ticks: 0, records: [eha_guard::ThermalRecord::EMPTY; 2], block };
     let mem = BootMemory {
         records: (eha_guard::ThermalRecord::EMPTY, eha_guard::ThermalRecord::EMPTY),

@@ -41,20 +41,20 @@ pub enum PilError {
     #[error("could not start QEMU: {0}")]
     Spawn(std::io::Error),
     /// No reply within the timeout (QEMU still running, then killed).
-    #[error("firmware stopped answering: no reply within {waited:?} at step {step} (QEMU still running; killed). QEMU stderr text: {text:?}")]
+    #[error("firmware stopped answering: no reply within {waited:?} at tick {tick} (QEMU still running; killed). QEMU stderr text: {text:?}")]
     Timeout {
         /// Step whose reply was awaited.
-        step: u64,
+        tick: u64,
         /// How long the harness waited.
         waited: Duration,
         /// QEMU's stderr text.
         text: String,
     },
     /// The firmware exited before the run ended.
-    #[error("firmware exited abnormally at step {step}: exit code {code:?} ({meaning}). QEMU stderr text: {text:?}")]
+    #[error("firmware exited abnormally at tick {tick}: exit code {code:?} ({meaning}). QEMU stderr text: {text:?}")]
     Exited {
         /// Step at which it exited.
-        step: u64,
+        tick: u64,
         /// Exit code (semihosting exit or QEMU's own).
         code: Option<i32>,
         /// What the code means.
@@ -71,10 +71,10 @@ pub enum PilError {
         text: String,
     },
     /// A reply frame that does not decode or does not answer the request.
-    #[error("protocol error at step {step}: {what}")]
+    #[error("protocol error at tick {tick}: {what}")]
     Protocol {
         /// Step of the bad reply.
-        step: u64,
+        tick: u64,
         /// What was wrong.
         what: String,
     },
@@ -253,14 +253,14 @@ impl QemuSession {
     }
 
     /// Receive the next reply frame, waiting at most the reply timeout.
-    pub fn recv(&mut self, step: u64) -> Result<Reply, PilError> {
+    pub fn recv(&mut self, tick: u64) -> Result<Reply, PilError> {
         let deadline = Instant::now() + self.reply_timeout;
         loop {
             if let Some(r) = self.pending.pop_front() {
                 return Ok(r);
             }
             if self.eof {
-                return Err(self.exited(step));
+                return Err(self.exited(tick));
             }
             let now = Instant::now();
             let wait = deadline.saturating_duration_since(now);
@@ -269,7 +269,7 @@ impl QemuSession {
                 Err(RecvTimeoutError::Timeout) => {
                     let _ = self.child.kill();
                     let _ = self.child.wait();
-                    return Err(PilError::Timeout { step, waited: self.reply_timeout, text: self.text() });
+                    return Err(PilError::Timeout { tick, waited: self.reply_timeout, text: self.text() });
                 }
                 Err(RecvTimeoutError::Disconnected) => self.eof = true,
             }
@@ -313,18 +313,18 @@ impl QemuSession {
     }
 
     /// The process ended (replies channel closed): say how.
-    fn exited(&mut self, step: u64) -> PilError {
+    fn exited(&mut self, tick: u64) -> PilError {
         let status = wait_timeout(&mut self.child, Duration::from_secs(5));
         let code = status.and_then(|s| s.code());
-        PilError::Exited { step, code, meaning: code.map_or("killed by a signal or did not exit", exit_meaning), text: self.text() }
+        PilError::Exited { tick, code, meaning: code.map_or("killed by a signal or did not exit", exit_meaning), text: self.text() }
     }
 
     /// Close stdin (end of input), collect the completion marker and wait
     /// for a clean exit. Any other ending is an error.
-    pub fn finish(mut self, step: u64) -> Result<SessionEnd, PilError> {
+    pub fn finish(mut self, tick: u64) -> Result<SessionEnd, PilError> {
         drop(self.stdin.take());
         let done = loop {
-            match self.recv(step) {
+            match self.recv(tick) {
                 Ok(r) if r.kind == eha_guard::protocol::ReplyKind::Done => break Some(r),
                 Ok(_) => continue, // a late reply (e.g. to trailing garbage)
                 Err(PilError::Exited { code: Some(0), .. }) => break None,
@@ -336,7 +336,7 @@ impl QemuSession {
             None => {
                 let _ = self.child.kill();
                 let _ = self.child.wait();
-                return Err(PilError::Timeout { step, waited: self.reply_timeout, text: self.text() });
+                return Err(PilError::Timeout { tick, waited: self.reply_timeout, text: self.text() });
             }
         };
         let defmt = self.stdout_thread.take().and_then(|h| h.join().ok()).unwrap_or_default();
@@ -345,7 +345,7 @@ impl QemuSession {
             (Some(done), Some(0)) => Ok(SessionEnd { done, status, defmt, text }),
             (None, _) => Err(PilError::NoCompletionMarker { status: status.to_string(), text }),
             (Some(_), code) => Err(PilError::Exited {
-                step,
+                tick,
                 code,
                 meaning: code.map_or("killed by a signal", exit_meaning),
                 text,

@@ -8,13 +8,13 @@ use anyhow::{Context, Result};
 use eha_guard::protocol::Reply;
 
 use super::qemu::TICKS_PER_INSTRUCTION;
-use super::{PilRun, StepRecord};
+use super::{PilRun, TickRecord};
 
 /// Numbers that describe one run.
 #[derive(Clone, Debug)]
 pub struct Summary {
     /// Number of lockstep steps.
-    pub steps: usize,
+    pub ticks: usize,
     /// Plant time covered, s.
     pub plant_time_s: f64,
     /// (plant time, open?) at every valve command change.
@@ -38,7 +38,7 @@ pub struct Summary {
 impl Summary {
     /// The summary of `records`; `icount` says whether their tick counts
     /// are instruction counts.
-    pub fn of(records: &[StepRecord], icount: bool) -> Self {
+    pub fn of(records: &[TickRecord], icount: bool) -> Self {
         let mut valve_events = Vec::new();
         let mut prev = false;
         let (mut max_abs, mut max_under) = (0.0f64, f64::NEG_INFINITY);
@@ -55,7 +55,7 @@ impl Summary {
                 valve_events.push((r.t_s, r.reply.out.valve_open));
                 prev = r.reply.out.valve_open;
             }
-            let instr = f64::from(r.reply.step_ticks) / TICKS_PER_INSTRUCTION;
+            let instr = f64::from(r.reply.tick_cycles) / TICKS_PER_INSTRUCTION;
             tsum += instr;
             tmax = tmax.max(instr);
         }
@@ -63,7 +63,7 @@ impl Summary {
         let last = records.last().map_or(0.0, |r| f64::from(r.reply.out.lng_remaining_kg));
         let n = records.len();
         Summary {
-            steps: n,
+            ticks: n,
             plant_time_s: match (records.first(), records.get(1), records.last()) {
                 (Some(a), Some(b), Some(z)) => z.t_s + (b.t_s - a.t_s),
                 _ => 0.0,
@@ -81,7 +81,7 @@ impl Summary {
 }
 
 /// Compact table: every `every_s` of plant time, plus every valve change.
-pub fn table(records: &[StepRecord], every_s: f64) -> String {
+pub fn table(records: &[TickRecord], every_s: f64) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "{:>8} {:>10} {:>10} {:>8} {:>5} {:>6}", "time_s", "ref_drain", "fw_drain", "err_K", "valve", "faults");
     let mut next = 0.0;
@@ -115,7 +115,7 @@ pub fn summary_text(run: &PilRun, s: &Summary) -> String {
     let mut t = String::new();
     let c = run.done.counters;
     let _ = writeln!(t, "firmware build      : {} ({} in QEMU)", run.build.name(), run.build.machine());
-    let _ = writeln!(t, "steps               : {} ({:.1} s of plant time)", s.steps, s.plant_time_s);
+    let _ = writeln!(t, "ticks               : {} ({:.1} s of plant time)", s.ticks, s.plant_time_s);
     let _ = writeln!(t, "frames              : accepted {}, rejected crc {} framing {} sequence {}, skipped {}", c.accepted, c.rejected_crc, c.rejected_framing, c.rejected_sequence, c.skipped);
     let ev: Vec<String> = s.valve_events.iter().map(|(t, o)| format!("{} at {t:.1} s", if *o { "open" } else { "close" })).collect();
     let _ = writeln!(t, "LNG valve events    : {}", if ev.is_empty() { "none".into() } else { ev.join(", ") });
@@ -130,13 +130,13 @@ pub fn summary_text(run: &PilRun, s: &Summary) -> String {
     let _ = writeln!(t, "max |fw − ref|      : {:.3} K (max under-prediction {:.3} K)", s.max_abs_err_k, s.max_under_k);
     match s.instructions {
         Some((mean, max)) => {
-            let _ = writeln!(t, "instructions / step : mean {mean:.0}, max {max:.0} (QEMU -icount, SysTick around Guard::step)");
+            let _ = writeln!(t, "instructions / step : mean {mean:.0}, max {max:.0} (QEMU -icount, SysTick around Guard::tick)");
         }
         None => {
             let _ = writeln!(t, "instructions / step : not measured (run without -icount)");
         }
     }
-    let _ = writeln!(t, "wall time           : {:.2} s ({:.0} steps/s)", run.wall.as_secs_f64(), s.steps as f64 / run.wall.as_secs_f64().max(1e-9));
+    let _ = writeln!(t, "wall time           : {:.2} s ({:.0} ticks/s)", run.wall.as_secs_f64(), s.ticks as f64 / run.wall.as_secs_f64().max(1e-9));
     t
 }
 
@@ -146,7 +146,7 @@ pub fn transcript(run: &PilRun, every_s: f64) -> String {
     let mut t = String::new();
     let c = run.done.counters;
     let _ = writeln!(t, "build {} machine {}", run.build.name(), run.build.machine());
-    let _ = writeln!(t, "steps {} accepted {} rejected {} skipped {}", s.steps, c.accepted, c.rejected(), c.skipped);
+    let _ = writeln!(t, "ticks {} accepted {} rejected {} skipped {}", s.ticks, c.accepted, c.rejected(), c.skipped);
     t.push_str(&table(&run.records, every_s));
     for (tm, open) in &s.valve_events {
         let _ = writeln!(t, "valve {} at {tm:.1} s", if *open { "open" } else { "close" });
@@ -167,7 +167,7 @@ pub fn transcript(run: &PilRun, every_s: f64) -> String {
 #[derive(Clone, Debug, Default)]
 pub struct Comparison {
     /// Steps compared (the shorter stream's length).
-    pub steps: usize,
+    pub ticks: usize,
     /// Steps whose replies are bit-identical (all outputs, counters and seq; ticks ignored).
     pub identical: usize,
     /// Index of the first step that is not bit-identical.
@@ -185,7 +185,7 @@ pub struct Comparison {
 
 /// Compares the firmware's replies with the SIL's, step by step.
 pub fn compare(fw: &[Reply], sil: &[Reply]) -> Comparison {
-    let mut c = Comparison { steps: fw.len().min(sil.len()), ..Default::default() };
+    let mut c = Comparison { ticks: fw.len().min(sil.len()), ..Default::default() };
     for (k, (a, b)) in fw.iter().zip(sil).enumerate() {
         let same = a.kind == b.kind && a.seq == b.seq && a.counters == b.counters && a.out.bit_eq(&b.out);
         if same {
@@ -216,7 +216,7 @@ fn fmt_opt(v: Option<f64>) -> String {
 /// with extra columns: `t_drain_ref_c` (plant truth), `fw_*` (firmware reply).
 /// Written to a temporary file and renamed, so a failure never leaves a
 /// half-written file under the final name.
-pub fn write_csv(path: &Path, records: &[StepRecord], meta: &[(&str, String)]) -> Result<()> {
+pub fn write_csv(path: &Path, records: &[TickRecord], meta: &[(&str, String)]) -> Result<()> {
     let tmp = path.with_extension("csv.tmp");
     {
         let f = std::fs::File::create(&tmp).with_context(|| format!("creating {}", tmp.display()))?;
@@ -253,7 +253,7 @@ pub fn write_csv(path: &Path, records: &[StepRecord], meta: &[(&str, String)]) -
                 // The format forbids non-finite values: an infinite "seconds
                 // left" (no dissipation) is written as an empty cell.
                 if o.lng_seconds_left.is_finite() { o.lng_seconds_left.to_string() } else { String::new() },
-                r.reply.step_ticks,
+                r.reply.tick_cycles,
                 r.reply.seq,
             )?;
         }
@@ -277,7 +277,7 @@ pub fn write_log(path: &Path, log: &[super::defmt_log::LogLine]) -> Result<()> {
 /// the decoded defmt log. No instruction counts: a compiler update must not
 /// force a re-bless; they are checked by the firmware benchmark
 /// (`eha-sim fw-budget`) against committed budgets with a regression margin.
-pub fn open_loop_transcript(run: &super::OpenLoopRun, step_s: f64, every: usize) -> String {
+pub fn open_loop_transcript(run: &super::OpenLoopRun, tick_s: f64, every: usize) -> String {
     let mut t = String::new();
     let _ = writeln!(t, "build {} machine {} frames {}", run.build.name(), run.build.machine(), run.replies.len());
     let _ = writeln!(t, "{:>8} {:>6} {:>12} {:>5} {:>5} {:>6} {:>8}", "time_s", "seq", "fw_drain_c", "valve", "alarm", "faults", "lng_kg");
@@ -288,7 +288,7 @@ pub fn open_loop_transcript(run: &super::OpenLoopRun, step_s: f64, every: usize)
             let _ = writeln!(
                 t,
                 "{:>8.2} {:>6} {:>12.4} {:>5} {:>5} {:>#6x} {:>8.4}{}",
-                k as f64 * step_s,
+                k as f64 * tick_s,
                 r.seq,
                 r.out.drain_c,
                 u8::from(r.out.valve_open),

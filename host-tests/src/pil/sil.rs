@@ -24,11 +24,11 @@ impl<F: FnMut(&Request, u16) -> GuardOutput> SilTarget<F> {
 }
 
 impl<F: FnMut(&Request, u16) -> GuardOutput> Target for SilTarget<F> {
-    fn exchange(&mut self, wire: &[u8], step: u64) -> Result<Reply, PilError> {
+    fn exchange(&mut self, wire: &[u8], tick: u64) -> Result<Reply, PilError> {
         let Self { link, core } = self;
         let mut got = None;
         link.push_bytes(wire, |r, gap| (core(r, gap), 0), |rep, _| got = Some(*rep));
-        got.ok_or_else(|| PilError::Protocol { step, what: "SIL link produced no reply to a frame".into() })
+        got.ok_or_else(|| PilError::Protocol { tick, what: "SIL link produced no reply to a frame".into() })
     }
 }
 
@@ -39,17 +39,17 @@ pub type GuardCore = Box<dyn FnMut(&Request, u16) -> GuardOutput>;
 /// The firmware's core for `build`, on the host: the same `GuardOf<N>` with
 /// the same number type, configuration and boot rule (cold: QEMU starts
 /// with zeroed RAM, which reads as an absent thermal record) and the same
-/// [`eha_guard::protocol::step_guard`].
+/// [`eha_guard::protocol::tick_guard`].
 pub fn sil_core(build: super::Build) -> GuardCore {
     use eha_guard::{GuardConfig, GuardOf, Restore};
     match build {
         super::Build::F32 => {
             let mut g = GuardOf::<f32>::new(&GuardConfig::DEFAULT, Restore::Cold);
-            Box::new(move |r, gap| eha_guard::protocol::step_guard(&mut g, r, gap))
+            Box::new(move |r, gap| eha_guard::protocol::tick_guard(&mut g, r, gap))
         }
         super::Build::Fixed => {
             let mut g = GuardOf::<eha_guard::num::Fx>::new(&GuardConfig::DEFAULT, Restore::Cold);
-            Box::new(move |r, gap| eha_guard::protocol::step_guard(&mut g, r, gap))
+            Box::new(move |r, gap| eha_guard::protocol::tick_guard(&mut g, r, gap))
         }
     }
 }

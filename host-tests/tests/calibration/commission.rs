@@ -73,7 +73,7 @@ fn other_rig_commissioned_firmware_meets_drain_bounds_on_held_out_mission() {
 /// reported beside it.
 #[test]
 fn commissioned_block_in_closed_loop_on_the_held_out_mission() {
-    use eha_guard::protocol::step_guard;
+    use eha_guard::protocol::tick_guard;
     use eha_guard::{GuardConfig, GuardOf, Restore};
     use eha_sim::pil::sil::SilTarget;
     use eha_sim::pil::{run_closed_loop, LoopOptions};
@@ -106,13 +106,13 @@ fn commissioned_block_in_closed_loop_on_the_held_out_mission() {
     let run = |cfg: &GuardConfig| {
         let mut guard = GuardOf::<f32>::new(cfg, Restore::Cold);
         assert!(guard.faults().is_empty(), "configuration accepted");
-        let mut sil = SilTarget::new(move |r: &eha_guard::protocol::Request, gap| step_guard(&mut guard, r, gap));
+        let mut sil = SilTarget::new(move |r: &eha_guard::protocol::Request, gap| tick_guard(&mut guard, r, gap));
         let m = mission(Kind::SoakThenMixed, 1800.0, 33);
         let mut plant = Plant::new(&other_rig_truth(), &Scenario::Mission(m)).expect("plant");
-        let opts = LoopOptions { step_s: eha_guard::params::S_PER_TICK, duration_s: 1800.0 };
+        let opts = LoopOptions { tick_s: eha_guard::params::S_PER_TICK, duration_s: 1800.0 };
         let rec = run_closed_loop(&mut plant, &mut sil, &opts).unwrap_or_else(|f| panic!("{:#}", f.error));
-        let e = |r: &eha_sim::pil::StepRecord| f64::from(r.reply.out.drain_c) - r.sensors.t_drain_c;
-        let lng = |r: &&eha_sim::pil::StepRecord| r.reply.out.lng_remaining_kg > 0.0;
+        let e = |r: &eha_sim::pil::TickRecord| f64::from(r.reply.out.drain_c) - r.sensors.t_drain_c;
+        let lng = |r: &&eha_sim::pil::TickRecord| r.reply.out.lng_remaining_kg > 0.0;
         Loop {
             max: rec.iter().map(|r| e(r).abs()).fold(0.0, f64::max),
             under: rec.iter().map(|r| -e(r)).fold(0.0, f64::max),

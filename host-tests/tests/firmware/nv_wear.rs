@@ -42,7 +42,7 @@ fn run(scenario: &Scenario) -> (u64, f64) {
     let mut writes = 0u64;
     plant
         .run(0.01, scenario.duration_s(), |snap| {
-            let o = guard.step(&Sensors::from(snap).sample());
+            let o = guard.tick(&Sensors::from(snap).sample());
             let rec = guard.snapshot();
             if NvPolicy::DEFAULT.due(last.as_ref(), &rec) {
                 last = Some(rec);

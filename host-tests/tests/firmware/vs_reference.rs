@@ -118,7 +118,7 @@ fn closed_loop(name: &str, scenario: &Scenario) -> Run {
     plant
         .run(0.01, scenario.duration_s(), |snap| {
             let s = Sensors::from(snap);
-            let o = guard.step(&s.sample());
+            let o = guard.tick(&s.sample());
             run.faults |= o.faults;
             run.pred.push(o.drain_c as f64);
             if let Some(m) = guard.model().filter(|m| m.pending_ticks() == 0) {
@@ -161,7 +161,7 @@ fn guard_drain_valve<N: Num>(run: &Run) -> (Vec<f64>, Vec<bool>, eha_guard::Faul
     let (mut out, mut valve) = (Vec::with_capacity(n), Vec::with_capacity(n));
     let mut faults = eha_guard::Faults::NONE;
     for s in &run.sensors[..n] {
-        let o = g.step(&s.sample());
+        let o = g.tick(&s.sample());
         faults |= o.faults;
         out.push(o.drain_c as f64);
         valve.push(o.valve_open);
@@ -247,7 +247,7 @@ fn lng_case_drain_within_bounds() {
 #[test]
 fn sensor_cross_check_margin_on_the_acceptance_runs() {
     let cfg = GuardConfig::DEFAULT.crosscheck;
-    let steps = cfg.window_steps.div_ceil(eha_guard::params::TICKS_PER_STEP) as usize;
+    let steps = cfg.window_ticks.div_ceil(eha_guard::params::TICKS_PER_STEP) as usize;
     let mut worst = 0.0f64;
     for r in runs() {
         let w = r

@@ -51,7 +51,7 @@ fn check(build: Build) {
     let (fw, secs) = run_qemu(build, &reqs);
     let mut sil = SilTarget::new(sil_core(build));
     let host: Vec<Reply> = reqs.iter().enumerate().map(|(k, r)| sil.exchange(&r.encode(), k as u64).unwrap()).collect();
-    assert!(fw.iter().all(|r| r.kind == ReplyKind::Step));
+    assert!(fw.iter().all(|r| r.kind == ReplyKind::Tick));
     let c = compare(&fw, &host);
     let valve_steps = fw.iter().filter(|r| r.out.valve_open).count();
     let faults = fw.last().map_or(eha_guard::Faults::NONE, |r| r.out.faults);
@@ -62,7 +62,7 @@ fn check(build: Build) {
         secs,
         fw.len() as f64 / secs,
         c.identical,
-        c.steps,
+        c.ticks,
         c.max_drain_diff_k,
         valve_steps,
         faults,
@@ -72,8 +72,8 @@ fn check(build: Build) {
     let first_open = fw.iter().position(|r| r.out.valve_open);
     let drains: Vec<String> = fw.iter().step_by(5000).map(|r| format!("{:.2}", r.out.drain_c)).collect();
     eprintln!("  first fault at step {first_fault:?}, first valve open at {first_open:?}, drain every 50 s: {}", drains.join(" "));
-    assert_eq!(c.steps, STEPS as usize);
-    assert_eq!(c.identical, c.steps, "first difference at step {:?}: fw {:?} vs sil {:?}", c.first_difference, c.first_difference.map(|k| fw[k]), c.first_difference.map(|k| host[k]));
+    assert_eq!(c.ticks, STEPS as usize);
+    assert_eq!(c.identical, c.ticks, "first difference at step {:?}: fw {:?} vs sil {:?}", c.first_difference, c.first_difference.map(|k| fw[k]), c.first_difference.map(|k| host[k]));
     // The sequence exercised what it is meant to: faults were raised and the valve opened.
     assert!(!faults.is_empty(), "the injected bad samples must have latched a fault");
     // ... and, before any fault, the valve opened on temperature and closed again.

@@ -3,7 +3,7 @@
 //! guard: input faults on the three channels that carry the pump's heat
 //! (current reading low, a port pressure stuck at zero, a non-finite speed)
 //! and the speed fault the design cannot see, each during the Fig. 15 LNG case.
-//! Every tick carries one frame, so the firmware steps exactly as the host
+//! Every tick carries one frame, so the firmware ticks exactly as the host
 //! SIL does: each result must equal the host campaign's, field for field
 //! (the guard's replies are bit-identical, `pil::equivalence`), including its
 //! pass/fail verdict.

@@ -56,7 +56,7 @@ fn corrupted_truncated_out_of_order_and_garbage_frames_are_rejected_and_counted(
     let mut seq = 0u16;
 
     let r = exchange(&mut s, &sample(seq).encode(), 0);
-    assert_eq!((r[0].kind, r[0].seq), (ReplyKind::Step, 0));
+    assert_eq!((r[0].kind, r[0].seq), (ReplyKind::Tick, 0));
 
     // Every single-bit corruption of the next frame (terminator included; a
     // trailing 0x00 resyncs in case the flip removed or added a delimiter).
@@ -75,7 +75,7 @@ fn corrupted_truncated_out_of_order_and_garbage_frames_are_rejected_and_counted(
     // The uncorrupted frame with the same sequence number is accepted: no
     // corrupted copy stepped the guard.
     let r = exchange(&mut s, &good, 1000);
-    assert_eq!((r[0].kind, r[0].seq), (ReplyKind::Step, seq));
+    assert_eq!((r[0].kind, r[0].seq), (ReplyKind::Tick, seq));
     assert_eq!(r[0].counters.rejected(), expected_rejects);
 
     // Truncation at every length.
@@ -90,7 +90,7 @@ fn corrupted_truncated_out_of_order_and_garbage_frames_are_rejected_and_counted(
         expected_rejects += 1;
     }
     let r = exchange(&mut s, &good, 3000);
-    assert_eq!(r[0].kind, ReplyKind::Step);
+    assert_eq!(r[0].kind, ReplyKind::Tick);
 
     // Out of order: a duplicate and an older frame.
     for old in [seq, seq - 1] {
@@ -113,7 +113,7 @@ fn corrupted_truncated_out_of_order_and_garbage_frames_are_rejected_and_counted(
     expected_rejects += replies.len() as u32;
     seq += 1;
     let r = exchange(&mut s, &sample(seq).encode(), 6000);
-    assert_eq!(r[0].kind, ReplyKind::Step);
+    assert_eq!(r[0].kind, ReplyKind::Tick);
     assert_eq!(r[0].counters.rejected(), expected_rejects, "every bad frame counted exactly once");
     assert_eq!(r[0].counters.accepted, 4);
 
@@ -143,7 +143,7 @@ fn firmware_that_never_answers_is_a_timeout_not_a_pass() {
     let t0 = Instant::now();
     s.send(&sample(0).encode()).unwrap();
     match s.recv(0) {
-        Err(PilError::Timeout { step: 0, .. }) => {}
+        Err(PilError::Timeout { tick: 0, .. }) => {}
         other => panic!("expected a timeout, got {other:?}"),
     }
     // Reported within the timeout plus slack, not hanging.

@@ -6,7 +6,7 @@
 //! alarm or faults (4 decimals), the final counters and the decoded defmt
 //! log; no instruction counts (those are checked against budgets by
 //! `eha-sim fw-budget`, so a compiler update does not force a re-bless). After an intended change of the firmware,
-//! regenerate with `PIL_BLESS=1 cargo test -p eha-sim --test pil_golden`
+//! regenerate with `PIL_BLESS=1 cargo test --profile fast -p eha-sim --test pil golden`
 //! and review the diff in git.
 
 use std::path::PathBuf;

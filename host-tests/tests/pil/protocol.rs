@@ -22,7 +22,7 @@ prop_compose! {
         kg in any_f32(), secs in any_f32(), c in proptest::array::uniform4(any::<u16>()), acc in any::<u32>(), ticks in any::<u32>(),
     ) -> Reply {
         let kind = match kind {
-            0 => ReplyKind::Step,
+            0 => ReplyKind::Tick,
             1 => ReplyKind::Done,
             r => ReplyKind::Reject(RejectReason::from_u8(r - 1).unwrap_or(RejectReason::Crc)),
         };
@@ -31,7 +31,7 @@ prop_compose! {
             seq,
             out: GuardOutput { drain_c: drain, valve_open: flags & 1 != 0, alarm: flags & 2 != 0, derate: flags & 4 != 0, faults: eha_guard::Faults::from_bits(faults), lng_remaining_kg: kg, lng_seconds_left: secs },
             counters: Counters { rejected_crc: c[0], rejected_framing: c[1], rejected_sequence: c[2], skipped: c[3], accepted: acc },
-            step_ticks: ticks,
+            tick_cycles: ticks,
         }
     }
 }
@@ -76,7 +76,7 @@ proptest! {
         prop_assert_eq!(back.kind, r.kind);
         prop_assert!(back.out.bit_eq(&r.out));
         prop_assert_eq!(back.counters, r.counters);
-        prop_assert_eq!((back.seq, back.step_ticks), (r.seq, r.step_ticks));
+        prop_assert_eq!((back.seq, back.tick_cycles), (r.seq, r.tick_cycles));
     }
 
     /// Every single-bit corruption of a request is rejected: never accepted,
@@ -121,7 +121,7 @@ proptest! {
             let rep = link_replies(&mut link, &r.encode());
             let newer = last.is_none_or(|l| { let d = s.wrapping_sub(l); d != 0 && d <= 0x8000 });
             if newer {
-                prop_assert_eq!(rep[0].kind, ReplyKind::Step, "frame {}", i);
+                prop_assert_eq!(rep[0].kind, ReplyKind::Tick, "frame {}", i);
                 last = Some(*s);
             } else {
                 prop_assert_eq!(rep[0].kind, ReplyKind::Reject(RejectReason::Sequence), "frame {}", i);
@@ -141,7 +141,7 @@ proptest! {
         let mut tail = vec![0u8];
         tail.extend_from_slice(&Request { seq: next, ..Request::default() }.encode());
         let rep = link_replies(&mut link, &tail);
-        prop_assert_eq!(rep.last().map(|r| r.kind), Some(ReplyKind::Step));
+        prop_assert_eq!(rep.last().map(|r| r.kind), Some(ReplyKind::Tick));
     }
 
     #[test]

@@ -30,9 +30,9 @@ fn run(scenario: Scenario, duration_s: f64) -> PilRun {
     let mut q = QemuOptions::new(Build::F32, &elf);
     q.icount = false;
     let mut plant = Plant::new(&Rig::default(), &scenario).unwrap_or_else(|e| panic!("plant: {e}"));
-    let opts = LoopOptions { step_s: eha_guard::params::S_PER_TICK, duration_s };
+    let opts = LoopOptions { tick_s: eha_guard::params::S_PER_TICK, duration_s };
     let run = run_pil(&mut plant, &q, &opts).unwrap_or_else(|f| panic!("{f}"));
-    assert_eq!(run.records.len() as u64, opts.steps());
+    assert_eq!(run.records.len() as u64, opts.ticks());
     assert_eq!(run.done.counters.accepted as usize, run.records.len());
     assert_eq!(run.done.counters.rejected(), 0);
     run
@@ -43,7 +43,7 @@ fn check_sil(run: &PilRun) {
     let host = replay(&run.records, &mut sil).unwrap();
     let fw: Vec<_> = run.records.iter().map(|r| r.reply).collect();
     let c = compare(&fw, &host);
-    assert_eq!(c.identical, c.steps, "firmware differs from SIL first at step {:?}", c.first_difference);
+    assert_eq!(c.identical, c.ticks, "firmware differs from SIL first at step {:?}", c.first_difference);
 }
 
 /// First time the reference's true drain temperature reaches `c`.
@@ -55,7 +55,7 @@ fn report(name: &str, run: &PilRun) -> Summary {
     let s = Summary::of(&run.records, false);
     eprintln!(
         "{name}: {} steps in {:.2} s wall; valve events {:?}; max |fw-ref| {:.3} K; max under {:.3} K; LNG used {:.4} kg; ref crossing 40 C at {:?} s",
-        s.steps,
+        s.ticks,
         run.wall.as_secs_f64(),
         s.valve_events,
         s.max_abs_err_k,

@@ -7,16 +7,16 @@
 //! account: the plant used LNG (eq. 24) only while commanded, and its true
 //! drain temperature ends lower than in the same run with the valve held shut.
 
-use eha_guard::protocol::step_guard;
+use eha_guard::protocol::tick_guard;
 use eha_guard::{GuardConfig, GuardOf, Restore};
 use eha_sim::pil::sil::SilTarget;
-use eha_sim::pil::{run_closed_loop, LoopOptions, StepRecord};
+use eha_sim::pil::{run_closed_loop, LoopOptions, TickRecord};
 use eha_sim::plant::Plant;
 use eha_sim::rig::Rig;
 use eha_sim::scenario::Scenario;
 
 /// `open_c`: the guard's valve threshold; `None`: no guard, the valve held shut.
-fn closed_loop(open_c: Option<f32>) -> (Vec<StepRecord>, Plant) {
+fn closed_loop(open_c: Option<f32>) -> (Vec<TickRecord>, Plant) {
     let mut core: eha_sim::pil::sil::GuardCore = match open_c {
         Some(open_c) => {
             let mut cfg = GuardConfig::DEFAULT;
@@ -24,14 +24,14 @@ fn closed_loop(open_c: Option<f32>) -> (Vec<StepRecord>, Plant) {
             cfg.valve.close_c = open_c - 2.0;
             let mut guard = GuardOf::<f32>::new(&cfg, Restore::Cold);
             assert!(guard.faults().is_empty(), "configuration accepted");
-            Box::new(move |r, gap| step_guard(&mut guard, r, gap))
+            Box::new(move |r, gap| tick_guard(&mut guard, r, gap))
         }
         None => Box::new(|_, _| eha_guard::Output::default()),
     };
     let mut sil = SilTarget::new(move |r: &eha_guard::protocol::Request, gap| core(r, gap));
     let duration_s = 120.0;
     let mut plant = Plant::new(&Rig::default(), &Scenario::Lng { duration_s }).unwrap();
-    let opts = LoopOptions { step_s: eha_guard::params::S_PER_TICK, duration_s };
+    let opts = LoopOptions { tick_s: eha_guard::params::S_PER_TICK, duration_s };
     let records = run_closed_loop(&mut plant, &mut sil, &opts).unwrap_or_else(|f| panic!("{:#}", f.error));
     (records, plant)
 }

@@ -106,7 +106,7 @@ fn events(v: impl Iterator<Item = bool>) -> Vec<(usize, bool)> {
 ///   ~1 200 instructions, see the bench).
 /// - The pins read back in every tick reply match the outputs.
 ///
-/// A host stall of `stale_steps` (5) ticks or more in a row is a real
+/// A host stall of `stale_ticks` (5) ticks or more in a row is a real
 /// controller-silent event for the firmware: the run then checks the
 /// fail-safe instead (STALE latched no earlier than the 5th missed tick,
 /// valve open from then on) and is repeated once for the comparison; a
@@ -144,12 +144,12 @@ fn fig15_attempt() -> Result<(), String> {
 
     // The longest run of consecutive missed ticks: (first index, length).
     let (gap_at, gap_len) = longest_miss_run(&guard_ticks);
-    let stale_steps = eha_guard::guard::GuardConfig::DEFAULT.stale_steps as usize;
-    if gap_len >= stale_steps {
+    let stale_ticks = eha_guard::guard::GuardConfig::DEFAULT.stale_ticks as usize;
+    if gap_len >= stale_ticks {
         let wall_ms = 1e3 * (run.ticks[first + gap_at + gap_len - 1].0 - run.ticks[(first + gap_at).saturating_sub(1)].0);
         let stale = eha_guard::guard::faults::STALE;
         let latched = guard_ticks.iter().position(|t| t.out.faults.contains(stale)).unwrap_or(guard_ticks.len());
-        assert!(latched >= gap_at + stale_steps - 1, "STALE at guard tick {latched}, before the {stale_steps}th miss of the stall at {gap_at}");
+        assert!(latched >= gap_at + stale_ticks - 1, "STALE at guard tick {latched}, before the {stale_ticks}th miss of the stall at {gap_at}");
         assert!(
             guard_ticks[gap_at + gap_len - 1..].iter().all(|t| t.out.faults.contains(stale) && t.out.valve_open),
             "after {gap_len} missed ticks from guard tick {gap_at} the guard must hold STALE with the valve open"
@@ -158,12 +158,12 @@ fn fig15_attempt() -> Result<(), String> {
             "fig15: host stall of {gap_len} ticks ({wall_ms:.0} ms between replies) at guard tick {gap_at}, {missed} ticks missed in all"
         ));
     }
-    assert_eq!(run.steps.len(), 12_000);
+    assert_eq!(run.samples.len(), 12_000);
 
     let elf = firmware_for_tests(Build::F32);
     let mut q = QemuOptions::new(Build::F32, &elf);
     q.icount = false;
-    let pil = run_pil(&mut plant(duration_s), &q, &LoopOptions { step_s: 0.01, duration_s })
+    let pil = run_pil(&mut plant(duration_s), &q, &LoopOptions { tick_s: 0.01, duration_s })
         .unwrap_or_else(|f| panic!("{f}"));
 
     // In guard time (ticks since its first sample): a tick without its
@@ -179,7 +179,7 @@ fn fig15_attempt() -> Result<(), String> {
     eprintln!(
         "product: {} samples, {} ticks, {missed} missed after the first sample; valve events product {prod_ev:?} pil {pil_ev:?}; \
          max |drain diff| {max_diff:.3e} K; overruns {}; worst tick {} cycles; stack boot {} B tick {} B",
-        run.steps.len(),
+        run.samples.len(),
         run.ticks.len(),
         st.overruns,
         st.worst_tick_cycles,
@@ -206,17 +206,17 @@ fn fig15_attempt() -> Result<(), String> {
     }
     // A late sample is a delay, never a loss: each of the 12 000 samples
     // was used by exactly one tick (checked above: every sample got its
-    // fresh reply, with fewer than `stale_steps` missed ticks in a row, so
+    // fresh reply, with fewer than `stale_ticks` missed ticks in a row, so
     // none needed resending), and none was overwritten unused. How many come
     // late is the host's real-time quality, not the firmware's: the emulated
     // UART takes one byte per QEMU main-loop pass, and on a 2-core VM most
     // misses have the sample sent ~9 ms before the tick that lacked it
     // (docs/firmware.md); the count is printed, not asserted.
     assert_eq!(st.superseded, 0, "a sample was overwritten before a tick used it");
-    for p in &run.steps {
+    for p in &run.samples {
         assert_eq!(p.tick.pins, Pins::for_outputs(p.tick.out.valve_open, p.tick.out.alarm), "pins at sample {}", p.request.seq);
     }
-    assert!(st.overruns as usize * 100 <= run.steps.len(), "more than 1 % of ticks overran: {}", st.overruns);
+    assert!(st.overruns as usize * 100 <= run.samples.len(), "more than 1 % of ticks overran: {}", st.overruns);
     // A clean link garbles nothing; a sample the harness sent again after it
     // came late (every 5 ticks without it) may arrive twice: the duplicate is
     // rejected by the sequence rule.
@@ -224,9 +224,9 @@ fn fig15_attempt() -> Result<(), String> {
     assert!(usize::from(st.rejected_sequence) <= missed, "{} duplicates for {missed} late samples", st.rejected_sequence);
     assert!(st.boot_stack_b > 0 && st.boot_stack_b <= 4096, "boot stack {} B > 4 KiB", st.boot_stack_b);
     assert!(st.stack_high_water_b > 0 && st.stack_high_water_b <= 2048, "tick stack {} B > 2 KiB", st.stack_high_water_b);
-    assert_eq!(run.steps[0].tick.reset_cause, ResetCause::PowerOn);
-    assert_eq!(run.steps[0].tick.restore, RestoreKind::Cold);
-    let _ = FromGuard::Tick(run.steps[0].tick);
+    assert_eq!(run.samples[0].tick.reset_cause, ResetCause::PowerOn);
+    assert_eq!(run.samples[0].tick.restore, RestoreKind::Cold);
+    let _ = FromGuard::Tick(run.samples[0].tick);
     let _ = Cmd::Status;
     Ok(())
 }
@@ -294,14 +294,14 @@ fn check_fault_reset(name: &str, cmd: Cmd, at_sample: u16, cause: ResetCause, ma
         // its controller-silent fail-safe (valve open, estimate at the hot
         // side) when the fault hit, which is not the case under test.
         assert!(before.valve_open, "{name}: STALE without the valve open: {before:?}");
-        return Err(format!("{name}: STALE latched before the injection (host stall), {} steps", run.steps.len()));
+        return Err(format!("{name}: STALE latched before the injection (host stall), {} steps", run.samples.len()));
     }
     // Safe for the pump = the valve pin low (valve open). The OK pin is low
     // only from the handler to the reboot's boot (microseconds of emulated
     // time, usually between two monitor readings); after the warm boot it
     // shows the restored estimate's alarm state.
     let first_safe = pins_log.iter().find(|(_, p)| !p.valve_pin).map(|(t, _)| *t);
-    let after: Vec<_> = run.steps.iter().filter(|p| p.request.seq > at_sample).collect();
+    let after: Vec<_> = run.samples.iter().filter(|p| p.request.seq > at_sample).collect();
     let first = after.first().unwrap_or_else(|| panic!("{name}: no sample after the reboot"));
     eprintln!(
         "{name}: drain before {:.3} C, first after reboot {:.3} C (cause {:?}, restore {:?}); outputs safe {:?} s after the command; {} pin readings",
@@ -325,7 +325,7 @@ fn check_fault_reset(name: &str, cmd: Cmd, at_sample: u16, cause: ResetCause, ma
     // The plant is held while the MCU resets, so the estimate must continue
     // from where it was: within 0.1 K (one tick of heating is ~0.002 K).
     assert!((first.tick.out.drain_c - before.drain_c).abs() <= 0.1, "{name}: estimate jumped {} -> {}", before.drain_c, first.tick.out.drain_c);
-    assert_eq!(run.steps.len(), (duration_s / 0.01).round() as usize, "{name}: the closed loop completed after the reboot");
+    assert_eq!(run.samples.len(), (duration_s / 0.01).round() as usize, "{name}: the closed loop completed after the reboot");
     Ok(())
 }
 
@@ -392,7 +392,7 @@ fn garbage_and_bursts_on_the_uart_are_rejected_without_a_hang() {
     let (t_last, _) = *run.ticks.last().unwrap();
     let rate = (run.ticks.len() - 1) as f64 / (t_last - t_first);
     eprintln!("garbage: {} ticks at {rate:.1} Hz; status {st:?}", run.ticks.len());
-    assert_eq!(run.steps.len(), 1000, "every sample eventually got its tick");
+    assert_eq!(run.samples.len(), 1000, "every sample eventually got its tick");
     assert!(st.rejected_crc + st.rejected_framing >= 20, "20 junk bursts and 20 truncated frames: {st:?}");
     assert!((90.0..=110.0).contains(&rate), "tick rate {rate} Hz");
     assert!(st.overruns * 100 <= 1000, "more than 1 % of ticks overran (host descheduling QEMU): {}", st.overruns);
@@ -400,7 +400,7 @@ fn garbage_and_bursts_on_the_uart_are_rejected_without_a_hang() {
     // fault. (A sample stuck behind a long burst arrives late; more than
     // 50 ms late is STALE, which is what STALE is for, so it may latch.)
     let data_faults = eha_guard::faults::RANGE | eha_guard::faults::RATE | eha_guard::faults::NON_FINITE;
-    assert!(run.steps.iter().all(|p| !p.tick.out.faults.intersects(data_faults)), "junk was taken as sample data");
+    assert!(run.samples.iter().all(|p| !p.tick.out.faults.intersects(data_faults)), "junk was taken as sample data");
     // A frame longer than any valid frame (4 KiB of non-zero bytes, then the
     // delimiter) is dropped by the frame decoder and counted once as a
     // framing reject; the firmware still answers. Whether bytes are also
@@ -466,7 +466,7 @@ fn alarm_attempt() -> Result<(), String> {
     Ok(())
 }
 
-/// The first tick whose output carries STALE (the guard saw `stale_steps`
+/// The first tick whose output carries STALE (the guard saw `stale_ticks`
 /// ticks in a row without a sample), with its fail-safe checked: valve
 /// open from there on.
 fn stale_tick(run: &eha_sim::pil::product::ProductRun) -> Option<u32> {
