@@ -10,7 +10,7 @@
 //! valve is physically closed (both from the fault's start on).
 //!
 //! The controller sends one frame per 10 ms tick; the guard runs the product
-//! loop: every tick, the newest sample accepted by the frame [`Link`] steps
+//! loop: every tick, the newest sample accepted by the frame [`Link`] ticks
 //! it, and a tick without one is a missing sample. A reset or a power loss restarts the guard from the
 //! record it would find (warm: its last snapshot; power loss: none today,
 //! there is no non-volatile copy; torn write: a corrupt record). While the
@@ -134,11 +134,11 @@ impl Mcu {
 
     /// One 10 ms tick of the product loop: the bytes received since the
     /// last tick go through the frame [`Link`]; the newest accepted sample
-    /// steps the guard, and a tick without one is a missing sample.
+    /// ticks the guard, and a tick without one is a missing sample.
     fn tick(&mut self, bytes: &[u8]) -> Output {
         let Mcu { guard, link, .. } = self;
         let mut newest: Option<Request> = None;
-        // The link's replies are not used here: the tick's output is the step's.
+        // The link's replies are not used here: the tick's output is the guard's.
         link.push_bytes(bytes, |r: &Request, _gap| {
             newest = Some(*r);
             (Output::default(), 0)

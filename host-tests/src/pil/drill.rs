@@ -10,9 +10,9 @@
 //! - 300 s: the current sensor reads 30 % low (SENSOR_DISAGREE latches after
 //!   three 2 s windows: valve forced open, alarm and derate held, the model
 //!   heats with the larger loss);
-//! - step 10,000: 3 lost frames (sequence gap, missed steps, below `stale_ticks`);
-//! - step 45,000: 10 lost frames (STALE fault latches, fail-safe valve open);
-//! - step 50,000: a NaN current (non-finite fault); step 55,000: 5000 bar (range fault).
+//! - tick 10,000: 3 lost frames (sequence gap, missed ticks, below `stale_ticks`);
+//! - tick 45,000: 10 lost frames (STALE fault latches, fail-safe valve open);
+//! - tick 50,000: a NaN current (non-finite fault); tick 55,000: 5000 bar (range fault).
 //!
 //! The piston moves ±20 mm slowly throughout; ambient 16 °C. No valve position is
 //! reported.

@@ -13,7 +13,7 @@ use super::{PilRun, TickRecord};
 /// Numbers that describe one run.
 #[derive(Clone, Debug)]
 pub struct Summary {
-    /// Number of lockstep steps.
+    /// Number of lockstep ticks.
     pub ticks: usize,
     /// Plant time covered, s.
     pub plant_time_s: f64,
@@ -27,7 +27,7 @@ pub struct Summary {
     pub lng_used_kg: f64,
     /// LNG left at the end as the firmware counts it, kg.
     pub lng_remaining_kg: f64,
-    /// Instructions per step (mean, max) when measured with `-icount`.
+    /// Instructions per tick (mean, max) when measured with `-icount`.
     pub instructions: Option<(f64, f64)>,
     /// Highest reference drain temperature, °C.
     pub peak_ref_c: f64,
@@ -130,10 +130,10 @@ pub fn summary_text(run: &PilRun, s: &Summary) -> String {
     let _ = writeln!(t, "max |fw − ref|      : {:.3} K (max under-prediction {:.3} K)", s.max_abs_err_k, s.max_under_k);
     match s.instructions {
         Some((mean, max)) => {
-            let _ = writeln!(t, "instructions / step : mean {mean:.0}, max {max:.0} (QEMU -icount, SysTick around Guard::tick)");
+            let _ = writeln!(t, "instructions / tick : mean {mean:.0}, max {max:.0} (QEMU -icount, SysTick around Guard::tick)");
         }
         None => {
-            let _ = writeln!(t, "instructions / step : not measured (run without -icount)");
+            let _ = writeln!(t, "instructions / tick : not measured (run without -icount)");
         }
     }
     let _ = writeln!(t, "wall time           : {:.2} s ({:.0} ticks/s)", run.wall.as_secs_f64(), s.ticks as f64 / run.wall.as_secs_f64().max(1e-9));
@@ -154,7 +154,7 @@ pub fn transcript(run: &PilRun, every_s: f64) -> String {
     let _ = writeln!(t, "lng used {:.4} kg", s.lng_used_kg);
     let _ = writeln!(t, "max abs err {:.3} K", s.max_abs_err_k);
     if let Some((mean, max)) = s.instructions {
-        let _ = writeln!(t, "instructions per step mean {mean:.0} max {max:.0}");
+        let _ = writeln!(t, "instructions per tick mean {mean:.0} max {max:.0}");
     }
     t.push_str("defmt log:\n");
     for l in &run.log {
@@ -163,14 +163,14 @@ pub fn transcript(run: &PilRun, every_s: f64) -> String {
     t
 }
 
-/// Per-step comparison of two reply streams (firmware vs SIL).
+/// Per-tick comparison of two reply streams (firmware vs SIL).
 #[derive(Clone, Debug, Default)]
 pub struct Comparison {
     /// Steps compared (the shorter stream's length).
     pub ticks: usize,
     /// Steps whose replies are bit-identical (all outputs, counters and seq; ticks ignored).
     pub identical: usize,
-    /// Index of the first step that is not bit-identical.
+    /// Index of the first tick that is not bit-identical.
     pub first_difference: Option<usize>,
     /// Largest drain-estimate difference, K.
     pub max_drain_diff_k: f64,
@@ -183,7 +183,7 @@ pub struct Comparison {
     pub flag_mismatches: usize,
 }
 
-/// Compares the firmware's replies with the SIL's, step by step.
+/// Compares the firmware's replies with the SIL's, tick by tick.
 pub fn compare(fw: &[Reply], sil: &[Reply]) -> Comparison {
     let mut c = Comparison { ticks: fw.len().min(sil.len()), ..Default::default() };
     for (k, (a, b)) in fw.iter().zip(sil).enumerate() {
@@ -273,7 +273,7 @@ pub fn write_log(path: &Path, log: &[super::defmt_log::LogLine]) -> Result<()> {
 }
 
 /// Deterministic transcript of an open-loop run (golden output): a row every
-/// `every` steps and at every change of valve/alarm/faults, the counters and
+/// `every` ticks and at every change of valve/alarm/faults, the counters and
 /// the decoded defmt log. No instruction counts: a compiler update must not
 /// force a re-bless; they are checked by the firmware benchmark
 /// (`eha-sim fw-budget`) against committed budgets with a regression margin.
