@@ -137,7 +137,7 @@ pub const PARAMS: [ParamDef; 20] = [
         what: "case-oil film on the pump housing (rotating group)",
         fields: "pump.case_inner_area_m2",
         lo: 0.1, hi: 10.0, prior_sigma_ln: 1.0,
-        why: "the case flow is a rotating-cylinder flow the duct correlation only approximates; wetted area calibrated on one rig",
+        why: "the reference takes the case flow as laminar Taylor–Couette flow (Nu = 2 below the instability, a lower bound: slippers, pistons and the leakage jets churn a real case) on an assumed inner area",
         needs: Needs::Sensor(Channel::TPumpC),
         excitation: "speed steps with a drain thermocouple (t_drain_c) or a pump-surface sensor",
         stage: Stage::Thermal,
