@@ -227,7 +227,7 @@ pub fn write_csv(path: &Path, records: &[TickRecord], meta: &[(&str, String)]) -
         writeln!(
             w,
             "time_s,speed_rpm,current_a,p_a_bar,p_b_bar,ambient_c,position_mm,t_oil_c,lng_valve,\
-             t_drain_ref_c,fw_drain_c,fw_alarm,fw_derate,fw_faults,fw_lng_remaining_kg,fw_lng_seconds_left,fw_step_ticks,fw_seq"
+             t_drain_ref_c,fw_drain_c,fw_alarm,fw_derate,fw_faults,fw_lng_remaining_kg,fw_lng_seconds_left,fw_tick_cycles,fw_seq"
         )?;
         for r in records {
             let s = &r.sensors;
