@@ -1,0 +1,163 @@
+//! What the controller may ask of the guard between ticks: outputs, faults
+//! and their clear rule, actuator and valve reports, LNG refill, the
+//! thermal record and the trace.
+
+use super::*;
+
+impl<N: Num> GuardOf<N> {
+    /// The outputs as the last tick left them (at boot: the waiting state).
+    pub fn output(&self) -> Output {
+        self.out
+    }
+
+    /// Present faults (see [`faults`]).
+    pub fn faults(&self) -> Faults {
+        self.latched
+            | Faults::channels(self.bad_ch)
+            | Faults::when(self.lng_low, faults::LNG_LOW)
+            | Faults::when(self.untrusted, faults::UNTRUSTED)
+    }
+
+    /// **Clear rule.** Latched faults (except CONFIG) clear only through this explicit
+    /// call (maintenance / operator command), and only if the last
+    /// `clear_valid_ticks` samples (1 s by default) were all valid and none is missing.
+    /// The thermal estimate is *not* reset: it relaxes from its conservative value.
+    /// A successful clear also restores trust in the estimate ([`faults::UNTRUSTED`]:
+    /// after a corrupt record or no sample by the start-up timeout the alarm and
+    /// derate are held until then). Returns `true` when the faults were cleared.
+    pub fn clear_faults(&mut self) -> bool {
+        let valid_run = self.tick.wrapping_sub(self.valid_since);
+        if self.missing != 0 || valid_run < self.clear_valid_ticks {
+            return false;
+        }
+        let bits = (self.latched & !faults::CONFIG) | Faults::channels(self.bad_ch);
+        self.settle(self.tick);
+        self.latched &= faults::CONFIG;
+        self.bad_ch = 0;
+        // A valve still disagreeing with its command latches again after the full time;
+        // so do sensors that still disagree.
+        self.fb_mismatch = 0;
+        if let Some(c) = self.core_ok.then_some(&mut self.core) {
+            if let Some(cc) = c.cc.as_mut() {
+                cc.restart_count();
+                c.model.set_loss_max(cc.disagrees());
+            }
+        }
+        // The controller accepts the estimate as it is (it is not reset); the alarm
+        // follows it again from the next model step.
+        let bits = bits | Faults::when(self.untrusted, faults::UNTRUSTED);
+        self.untrusted = false;
+        if !bits.is_empty() {
+            self.trace.write(Trace::FaultsCleared {
+                tick: self.tick,
+                bits,
+            });
+        }
+        self.refresh_out();
+        true
+    }
+
+    /// Marks an actuator (valve pin) error reported by the board: latches ACTUATOR
+    /// and commands the valve open at once (fail-safe).
+    pub fn report_actuator_fault(&mut self) {
+        self.settle(self.tick);
+        if !self.latched.contains(faults::ACTUATOR) {
+            self.latched |= faults::ACTUATOR;
+            self.trace.write(Trace::Fault {
+                tick: self.tick,
+                new_bits: faults::ACTUATOR,
+            });
+        }
+        if self.valve.force_open() {
+            self.trace.write(Trace::ValveOpen {
+                tick: self.tick,
+                drain_c: self.out.drain_c,
+                forced: true,
+            });
+        }
+        self.refresh_out();
+    }
+
+    /// Reports the valve position read back from the valve (limit switch or
+    /// position sensor), `true` = open. Optional; when used, call it once per tick,
+    /// before [`GuardOf::tick`] / [`GuardOf::tick_missing`] (the position holds until
+    /// the next report). The model credits the exchanger only while the report does
+    /// not say shut; `actuator_mismatch_ticks` consecutive reports that differ from
+    /// the command latch ACTUATOR (valve forced open, no credit). Without reports the
+    /// command is taken as the position (residual risk: docs/firmware.md).
+    pub fn valve_feedback(&mut self, open: bool) {
+        if self.fb != Some(open) {
+            // The credit may change from this tick on: count the ticks before.
+            self.settle(self.tick);
+            self.fb = Some(open);
+        }
+        if open == self.valve.is_open() {
+            self.fb_mismatch = 0;
+            return;
+        }
+        self.fb_mismatch = self.fb_mismatch.saturating_add(1);
+        if self.fb_mismatch >= self.mismatch_ticks {
+            self.report_actuator_fault();
+        }
+    }
+
+    /// Refills the LNG budget (new charge installed).
+    pub fn refill_lng(&mut self, cfg: &LngConfig) {
+        // The credit may change from this tick on: count the ticks before.
+        self.settle(self.tick);
+        self.lng = LngBudget::new(cfg);
+        self.lng_empty = self.lng.is_empty();
+        self.lng_low = false;
+        self.refresh_out();
+    }
+
+    /// Thermal-memory record of the present state, valve state included
+    /// (sealed with its CRC; sequence number 0: the writer sets it).
+    pub fn snapshot(&self) -> ThermalRecord {
+        let mut temps = [0.0f32; N_NODES];
+        let mut amb = 0.0;
+        if let Some(c) = self.core_ok.then_some(&self.core) {
+            for (o, t) in temps.iter_mut().zip(c.model.temperatures_c().iter()) {
+                *o = t.to_f32();
+            }
+            amb = c.model.ambient_c().to_f32();
+        }
+        ThermalRecord::new(
+            temps,
+            amb,
+            self.lng.used_cj(),
+            (self.faults() & !faults::LNG_LOW).bits(),
+            self.tick,
+        )
+        .with_seq(0, self.valve.is_open())
+    }
+
+    /// The event trace (most recent [`crate::trace::TRACE_LEN`] events).
+    pub fn trace(&self) -> &TraceBuf {
+        &self.trace
+    }
+
+    /// Appends a board-level event (overrun, reset, command) to the trace.
+    pub fn trace_event(&mut self, t: Trace) {
+        self.trace.write(t);
+    }
+
+    /// Refuses the configuration after boot (an invalid parameter block):
+    /// CONFIG latches and the model is disabled, as for constants the model
+    /// rejects at init: valve open, alarm, drain reported as
+    /// [`DRAIN_C_UNKNOWN`]. CONFIG is never cleared.
+    pub fn refuse_config(&mut self) {
+        self.core_ok = false;
+        self.latched |= faults::CONFIG;
+    }
+
+    /// The model, when the parameters were usable.
+    pub fn model(&self) -> Option<&Model<N>> {
+        self.core_ok.then_some(&self.core).map(|c| &c.model)
+    }
+
+    /// Ticks taken since boot (10 ms each, wraps after 497 days).
+    pub fn ticks(&self) -> u32 {
+        self.tick
+    }
+}

@@ -1,0 +1,199 @@
+//! The 10 ms tick: a sample (or its absence) is validated, substituted by its
+//! worst case where it is bad, and accumulated into the model's tick; every
+//! [`crate::params::TICKS_PER_STEP`] ticks it hands over to the model step
+//! (`step.rs`).
+
+use super::*;
+
+impl<N: Num> GuardOf<N> {
+    /// One 10 ms tick with a new sample. Never panics; any invalid channel latches a
+    /// fault, opens the valve in this same tick and is replaced by its worst case.
+    #[inline(never)]
+    pub fn tick(&mut self, s: &Sample) -> Output {
+        if let Some(core) = self.core_ok.then_some(&self.core) {
+            // Fast path: every channel in range and within its rate and every previous
+            // value valid (so this is not the first tick). Nothing to latch, the valve
+            // is not forced by this tick (an earlier latched fault has already opened
+            // it), the outputs only change at a model step. Channels latched bad by an
+            // earlier fault still take their worst case. Anything else is classified
+            // by `tick_slow`.
+            let (v, ok) = validate::convert_check(s, &self.prev, &core.scales, &core.limits);
+            if ok & (self.prev_ok == CH_ALL) {
+                // `missing` is 0 here: a missing tick clears `prev_ok`.
+                let u = if self.bad_ch == 0 {
+                    validate::direct(&v, &self.prev)
+                } else {
+                    Self::substitute_latched(&v, &self.prev, self.bad_ch, &core.limits)
+                };
+                self.prev = v;
+                return self.advance(&u);
+            }
+        }
+        self.tick_slow(s)
+    }
+
+    /// Fast-path inputs while channels are latched bad: their worst cases.
+    #[inline(never)]
+    #[cold]
+    fn substitute_latched(
+        v: &Channels<N>,
+        prev: &Channels<N>,
+        bad_ch: u8,
+        limits: &LimitsN<N>,
+    ) -> ModelInputN<N> {
+        let [_, _, _, _, prev_pos, _] = *prev;
+        validate::substitute(v, bad_ch, Some(prev_pos), limits)
+    }
+
+    /// [`GuardOf::tick`] off the fast path: classifies the sample (distinct fault and
+    /// channel bits), substitutes worst cases, latches and forces the valve open.
+    #[inline(never)]
+    #[cold]
+    fn tick_slow(&mut self, s: &Sample) -> Output {
+        self.missing = 0;
+        let Some(core) = self.core_ok.then_some(&self.core) else {
+            return self.slow_tail(None, Faults::NONE, N::ZERO);
+        };
+        let (v, nonfinite) = validate::convert(s, &core.scales);
+        let c = validate::check(&v, nonfinite, &self.prev, self.prev_ok, &core.limits);
+        let mut new_bits = Faults::NONE;
+        if c.range {
+            new_bits |= faults::RANGE;
+        }
+        if c.rate {
+            new_bits |= faults::RATE;
+        }
+        if c.non_finite {
+            new_bits |= faults::NON_FINITE;
+        }
+        self.bad_ch |= c.bad;
+        if c.bad != 0 {
+            self.valid_since = self.tick.wrapping_add(1);
+        }
+        let [_, _, _, _, prev_pos, _] = self.prev;
+        let prev_pos = if self.prev_ok & CH_POSITION != 0 {
+            Some(prev_pos)
+        } else {
+            None
+        };
+        let u = validate::substitute(&v, self.bad_ch, prev_pos, &core.limits);
+        // A cold start takes this sample's own ambient when it is valid (also when
+        // an earlier STALE makes the model run on the worst case from now on), else
+        // the worst case.
+        let [_, _, _, _, _, amb] = v;
+        let start_amb = if c.bad & validate::CH_AMBIENT == 0 { amb } else { u.ambient_c };
+        self.prev = v;
+        self.prev_ok = !c.bad & CH_ALL;
+        self.slow_tail(Some(&u), new_bits, start_amb)
+    }
+
+    /// One 10 ms tick without a new sample: inputs are held (piston work taken as
+    /// zero); after `stale_ticks` consecutive misses the STALE fault latches and every
+    /// channel takes its worst case. Before the first sample the guard waits instead
+    /// ([`GuardOf::wait_tick`]).
+    pub fn tick_missing(&mut self) -> Output {
+        if !self.started {
+            return self.wait_tick();
+        }
+        self.missing = self.missing.saturating_add(1);
+        self.valid_since = self.tick.wrapping_add(1);
+        self.prev_ok = 0;
+        let mut new_bits = Faults::NONE;
+        if self.missing >= self.stale_ticks {
+            new_bits |= faults::STALE;
+            self.bad_ch = CH_ALL;
+        }
+        let u = self.core_ok.then(|| validate::substitute(&self.prev, self.bad_ch, None, &self.core.limits));
+        self.slow_tail(u.as_ref(), new_bits, N::ZERO)
+    }
+
+    /// A tick without a sample before the first sample (boot, or samples not yet
+    /// flowing): the model is not started and accumulates nothing, the valve stays
+    /// open; after `startup_timeout_ticks` such ticks STALE latches (every channel
+    /// worst case once samples arrive, until a clear).
+    #[cold]
+    #[inline(never)]
+    fn wait_tick(&mut self) -> Output {
+        self.missing = self.missing.saturating_add(1);
+        self.valid_since = self.tick.wrapping_add(1);
+        if self.missing >= self.startup_timeout_ticks {
+            if !self.latched.contains(faults::STALE) {
+                self.trace.write(Trace::Fault {
+                    tick: self.tick,
+                    new_bits: faults::STALE | Faults::channels(CH_ALL),
+                });
+            }
+            self.latched |= faults::STALE;
+            self.bad_ch = CH_ALL;
+            // No estimate and no input: alarm and derate until a clear.
+            self.untrusted = true;
+            if !self.alarm {
+                self.alarm = true;
+                self.trace.write(Trace::Alarm {
+                    tick: self.tick,
+                    drain_c: self.out.drain_c,
+                });
+            }
+        }
+        // The valve is open since boot (nothing closes it before the first sample).
+        self.refresh_out();
+        self.tick = self.tick.wrapping_add(1);
+        self.mark = self.tick;
+        self.out
+    }
+
+    /// Slow-path tail: latches `new_bits` and opens the valve at once when any fault
+    /// is latched (fail-safe in the same tick), starts the model at the first sample
+    /// (cold: at `start_amb`), then the common tick.
+    fn slow_tail(&mut self, u: Option<&ModelInputN<N>>, new_bits: Faults, start_amb: N) -> Output {
+        // The valve / credit state may change for this tick: count the ticks before.
+        self.settle(self.tick);
+        let newly = new_bits & !self.latched;
+        self.latched |= new_bits;
+        if !newly.is_empty() {
+            self.trace.write(Trace::Fault {
+                tick: self.tick,
+                new_bits: newly | Faults::channels(self.bad_ch),
+            });
+        }
+        if !self.latched.is_empty() && self.valve.force_open() {
+            self.trace.write(Trace::ValveOpen {
+                tick: self.tick,
+                drain_c: self.out.drain_c,
+                forced: true,
+            });
+        }
+        match u {
+            Some(u) if self.core_ok => {
+                if !self.started {
+                    self.start(start_amb);
+                }
+                self.refresh_out();
+                self.advance(u)
+            }
+            _ => {
+                // No model (CONFIG): fail-safe outputs, nothing to estimate.
+                self.alarm = true;
+                self.out.drain_c = DRAIN_C_UNKNOWN;
+                self.refresh_out();
+                self.tick = self.tick.wrapping_add(1);
+                self.out
+            }
+        }
+    }
+
+    /// The per-tick part common to both paths: the model's tick accumulation, and
+    /// every `TICKS_PER_STEP` ticks the model step with the protection.
+    #[inline(always)]
+    fn advance(&mut self, u: &ModelInputN<N>) -> Output {
+        let full = match self.core_ok.then_some(&mut self.core) {
+            Some(c) => c.model.tick_n(u),
+            None => false,
+        };
+        if full {
+            self.model_step();
+        }
+        self.tick = self.tick.wrapping_add(1);
+        self.out
+    }
+}
