@@ -90,7 +90,7 @@ impl<N: Num> GuardOf<N> {
     /// One 10 ms tick without a new sample: inputs are held (piston work taken as
     /// zero); after `stale_ticks` consecutive misses the STALE fault latches and every
     /// channel takes its worst case. Before the first sample the guard waits instead
-    /// ([`GuardOf::wait_tick`]).
+    /// (`wait_tick`).
     pub fn tick_missing(&mut self) -> Output {
         if !self.started {
             return self.wait_tick();

@@ -1,6 +1,6 @@
 //! The model's constants in model units (kW, L/s, hbar, hrad/s, degC): what the
 //! firmware needs to run the reduced model, derived once from the SI
-//! [`ReducedParams`] on the host ([`derive`], `f64`) and carried to the target as
+//! [`ReducedParams`] on the host ([`derive()`], `f64`) and carried to the target as
 //! `f32` (the compiled-in [`crate::params::DEFAULT_CONSTS`] or a parameter block
 //! in flash, [`crate::params_block`]). The target does no `f64` arithmetic and no
 //! matrix exponential: it converts these values into its number type and checks them.

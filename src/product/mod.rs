@@ -5,8 +5,8 @@
 //! 1. **transport**: the bytes the UART received since the last tick are
 //!    deframed; the newest valid sample frame is this tick's sample (none =
 //!    a missing sample), command frames are queued;
-//! 2. **validate, estimate, protect**: [`GuardOf::tick`] (or
-//!    [`GuardOf::tick_missing`]), preceded by a missing tick for every timer
+//! 2. **validate, estimate, protect**: [`crate::GuardOf::tick`] (or
+//!    [`crate::GuardOf::tick_missing`]), preceded by a missing tick for every timer
 //!    period an overrun swallowed, so the model's clock keeps up with time;
 //! 3. **outputs**: valve and OK pins, read back (a mismatch latches ACTUATOR
 //!    and opens the valve); the thermal record (A/B no-init RAM, and

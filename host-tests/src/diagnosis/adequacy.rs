@@ -11,7 +11,7 @@ use crate::measured::{Channel, MeasuredRun};
 
 /// Noise standard deviation of a sampled channel, K, from its second
 /// differences (a slowly varying signal plus white noise of σ gives
-/// differences y[i+1] − 2y[i] + y[i−1] of variance 6σ²), robustly:
+/// differences y\[i+1\] − 2y\[i\] + y\[i−1\] of variance 6σ²), robustly:
 /// 1.4826·MAD/√6 over consecutive present samples. `None` with < 10 triples.
 pub fn noise_sigma(v: &[Option<f64>]) -> Option<f64> {
     let mut d: Vec<f64> = v.windows(3).filter_map(|w| Some(w[2]? - 2.0 * w[1]? + w[0]?)).collect();

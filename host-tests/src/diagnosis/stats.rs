@@ -134,7 +134,7 @@ fn gamma_q(a: f64, x: f64) -> f64 {
 }
 
 /// Normalised cross-correlation of residual `r` with regressor `u` at lags
-/// `0..=max_lag` (u leading r by `lag` samples): corr(r[i], u[i−lag]) over
+/// `0..=max_lag` (u leading r by `lag` samples): corr(r\[i\], u\[i−lag\]) over
 /// the pairs where both are present, each series mean-removed.
 pub fn cross_correlation(r: &[Option<f64>], u: &[f64], max_lag: usize) -> Vec<f64> {
     // The pairs of each lag are walked in place (a 30-minute log at 0.1 s

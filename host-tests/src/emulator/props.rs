@@ -53,7 +53,7 @@ pub fn oil_k(t_c: f64) -> f64 {
 }
 
 /// Kinematic viscosity of the emulator oil, m²/s: Walther line
-/// log10 log10(ν+0.7) = A − B·log10 T[K] through 46.0 cSt at 40 °C and
+/// log10 log10(ν+0.7) = A − B·log10 T\[K\] through 46.0 cSt at 40 °C and
 /// 6.7 cSt at 100 °C.
 pub fn oil_nu(t_c: f64) -> f64 {
     let w = |nu: f64| (nu + 0.7f64).log10().log10();

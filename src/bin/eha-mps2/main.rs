@@ -1,6 +1,6 @@
 //! The product image on QEMU `mps2-an386` (Cortex-M4F): the same
 //! application as the flashed STM32F411 image ([`eha_guard::product`]), with
-//! this board module ([`board`]) instead of the STM32 one.
+//! this board module (`board`) instead of the STM32 one.
 //!
 //! Run by hand (the controller side is a unix socket on the emulated UART0):
 //! ```text
