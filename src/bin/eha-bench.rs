@@ -26,7 +26,8 @@ mod fw {
     use eha_guard::{Guard, GuardConfig, Real, Restore, Sample};
     use semihosting::eprintln;
 
-    const STEPS: u32 = 6000;
+    /// Ticks of the bench run (60 s of 10 ms ticks).
+    const TICKS: u32 = 6000;
     static WRAPS: AtomicU32 = AtomicU32::new(0);
 
 
@@ -66,7 +67,7 @@ mod fw {
     fn sample(k: u32, noise: &mut u32) -> Sample {
         *noise = noise.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
         let n = ((*noise >> 9) as f32 / 8_388_608.0 - 0.5) * 0.2;
-        if k < STEPS / 2 {
+        if k < TICKS / 2 {
             Sample {
                 current_a: motor_current(65.0 + n, 5.0, 500.0 + n),
                 p_a_bar: 65.0 + n,
@@ -298,7 +299,7 @@ mod fw {
         let mut last = eha_guard::Output::default();
         let mut opened_at = None;
         let mut lng_ticks = 0u32;
-        for k in 0..STEPS {
+        for k in 0..TICKS {
             let s = sample(k, &mut noise);
             let dpos_mm = s.position_mm - prev_pos;
             let lng_open = last.valve_open;
@@ -369,7 +370,7 @@ mod fw {
         let mut ft_stats = Stats::new();
         let mut fm_stats = Stats::new();
         for k in 0..201u32 {
-            let mut s = sample(STEPS / 2 - 1, &mut noise);
+            let mut s = sample(TICKS / 2 - 1, &mut noise);
             if k == 0 {
                 s.current_a = f32::NAN;
             }
@@ -402,7 +403,7 @@ mod fw {
         let app = eha_guard::product::App::boot_into(unsafe { &mut *core::ptr::addr_of_mut!(APP) }, &mut board, &GuardConfig::DEFAULT, &mem);
         let mut a_stats = Stats::new();
         let mut noise_a = 1u32;
-        for k in 0..STEPS {
+        for k in 0..TICKS {
             let s = sample(k, &mut noise_a);
             let req = eha_guard::protocol::Request {
                 seq: (k & 0xFFFF) as u16,
@@ -488,7 +489,7 @@ mod fw {
         );
         let dc = (last.drain_c * 1000.0) as i32;
         eprintln!(
-            "final drain {}.{:03} degC, valve {}, faults {:#06x}, model drain {} mK, first open step {:?}",
+            "final drain {}.{:03} degC, valve {}, faults {:#06x}, model drain {} mK, first open tick {:?}",
             dc / 1000, (dc % 1000).abs(), last.valve_open, last.faults,
             (model.drain_c().to_f32() * 1000.0) as i32, opened_at
         );
