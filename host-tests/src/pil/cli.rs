@@ -89,7 +89,7 @@ pub fn run(args: &PilArgs) -> Result<()> {
         ]
     };
     eprintln!(
-        "running {} s of the {} scenario in lockstep with the firmware in {qemu_version} {} ({} steps of {} s) ...",
+        "running {} s of the {} scenario in lockstep with the firmware in {qemu_version} {} ({} ticks of {} s) ...",
         args.duration,
         args.scenario,
         build.machine(),

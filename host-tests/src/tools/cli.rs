@@ -135,7 +135,7 @@ pub fn run_simulate(a: &SimulateArgs) -> Result<()> {
     let out = simulate(&rig, &sc, &SimOptions { output_interval_s: a.output_interval_s, control_interval_s: 0.1 })?;
     let wall = t.elapsed();
     let csv = write_run(&out, &rig, &a.out)?;
-    println!("{}: {:.0} s simulated in {:.1} ms ({} rhs evaluations, {} steps)", out.name, sc.duration_s(), wall.as_secs_f64() * 1e3, out.stats.rhs_evals, out.stats.steps);
+    println!("{}: {:.0} s simulated in {:.1} ms ({} rhs evaluations, {} solver steps)", out.name, sc.duration_s(), wall.as_secs_f64() * 1e3, out.stats.rhs_evals, out.stats.steps);
     for ch in ["t_inlet_c", "t_outlet_c", "t_drain_c", "t_pump_c", "t_motor_c", "t_block_c", "t_ballvalve_c", "t_oil_c"] {
         println!("  {ch:<14} final {:7.2} °C   max {:7.2} °C", out.last(ch).unwrap_or(f64::NAN), out.max(ch).unwrap_or(f64::NAN));
     }
