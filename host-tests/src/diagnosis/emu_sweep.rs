@@ -173,6 +173,44 @@ pub fn default_cases(duration_s: f64, base: u64) -> Vec<EmuCase> {
         .collect()
 }
 
+/// The identification-run case set: every throttle-circuit candidate hidden
+/// in two [`EmuScenario::IdentRun`] logs (speed, load and ram air stepped
+/// independently), Coulomb friction in two servo logs (only piston motion
+/// shows it), and four logs with nothing hidden (three identification
+/// runs, one servo run); seeds `base + index`.
+pub fn ident_cases(duration_s: f64, base: u64) -> Vec<EmuCase> {
+    use EmuScenario::*;
+    let list: [(&str, EmuScenario); 18] = [
+        ("winding-resistance-temperature", IdentRun),
+        ("winding-resistance-temperature", IdentRun),
+        ("viscosity-temperature", IdentRun),
+        ("viscosity-temperature", IdentRun),
+        ("sensor-lag", IdentRun),
+        ("sensor-lag", IdentRun),
+        ("coulomb-friction", ServoHoldMove),
+        ("coulomb-friction", ServoHoldMove),
+        ("churning-loss", IdentRun),
+        ("churning-loss", IdentRun),
+        ("motor-pump-conduction", IdentRun),
+        ("motor-pump-conduction", IdentRun),
+        ("forced-convection", IdentRun),
+        ("forced-convection", IdentRun),
+        ("none", IdentRun),
+        ("none", IdentRun),
+        ("none", IdentRun),
+        ("none", ServoHoldMove),
+    ];
+    list.iter()
+        .enumerate()
+        .map(|(k, (h, s))| EmuCase {
+            hidden: Candidate::from_name(h).unwrap_or(Candidate::None),
+            scenario: *s,
+            seed: base + k as u64,
+            duration_s,
+        })
+        .collect()
+}
+
 /// One Markdown table row of `r`.
 pub fn table_row(r: &EmuResult) -> String {
     let ch: Vec<String> = r
@@ -245,6 +283,14 @@ pub struct EmuSweepArgs {
     /// Repetitions of the case set (seeds 1700 + 100·k + case index).
     #[arg(long, default_value_t = 1)]
     pub seeds: u64,
+    /// Case set: `original` (each candidate in two of the diagnosis
+    /// tests' operating families) or `ident` (identification runs, see
+    /// [`ident_cases`]).
+    #[arg(long, default_value = "original")]
+    pub cases: String,
+    /// Run only the cases with these seeds (comma-separated).
+    #[arg(long, value_delimiter = ',')]
+    pub only: Vec<u64>,
     /// Leave out the servo cases (slow replays, and with them coulomb-friction).
     #[arg(long)]
     pub no_servo: bool,
@@ -260,8 +306,12 @@ pub struct EmuSweepArgs {
 /// written (it is a measurement, not a test).
 pub fn run(a: &EmuSweepArgs) -> ExitCode {
     let cases: Vec<EmuCase> = (0..a.seeds)
-        .flat_map(|k| default_cases(a.duration, 1700 + 100 * k))
+        .flat_map(|k| match a.cases.as_str() {
+            "ident" => ident_cases(a.duration, 2700 + 100 * k),
+            _ => default_cases(a.duration, 1700 + 100 * k),
+        })
         .filter(|c| !(a.no_servo && c.scenario.is_servo()))
+        .filter(|c| a.only.is_empty() || a.only.contains(&c.seed))
         .collect();
     let bar = indicatif::ProgressBar::new(cases.len() as u64);
     let res: Vec<Result<EmuResult, String>> = cases

@@ -25,6 +25,11 @@ pub enum EmuScenario {
     /// against the spring and manoeuvring (15–25 mm triangles, half-period
     /// 1.0–1.6 s) about the centre. Logged at 0.1 s.
     ServoHoldMove,
+    /// An identification run, as a thermal engineer designs one to
+    /// commission a machine: shaft speed (500–2000 rpm), needle drop
+    /// (10–100 bar) and logged ram air (0 or 5–25 m/s) each stepped on its
+    /// own schedule (every 60–240 s), so that no two inputs move together.
+    IdentRun,
 }
 
 impl EmuScenario {
@@ -35,7 +40,7 @@ impl EmuScenario {
 
     /// Whether the ram air is logged.
     pub fn logs_air(self) -> bool {
-        self == EmuScenario::AirSteps
+        matches!(self, EmuScenario::AirSteps | EmuScenario::IdentRun)
     }
 
     /// Logger interval, s: 0.1 s for servo runs (the format's interval for
@@ -126,6 +131,11 @@ pub fn draw(scenario: EmuScenario, duration_s: f64, rng: &mut impl Rng) -> EmuMi
             let on0 = rng.random_bool(0.5);
             m.air = steps(rng, d, 150.0, 300.0, |r, k| if (k % 2 == 0) == on0 { r(10.0, 25.0) } else { 0.0 });
         }
+        EmuScenario::IdentRun => {
+            m.speed = steps(rng, d, 60.0, 240.0, |r, _| r(500.0, 2000.0));
+            m.dp_bar = steps(rng, d, 60.0, 240.0, |r, _| r(10.0, 100.0));
+            m.air = steps(rng, d, 60.0, 240.0, |r, _| if r(0.0, 1.0) < 0.35 { 0.0 } else { r(5.0, 25.0) });
+        }
         EmuScenario::ServoHoldMove => {
             let (mut pts, mut t, mut hold) = (vec![(0.0, 0.0)], 0.0, rng.random_bool(0.5));
             while t < d {
@@ -172,5 +182,20 @@ mod tests {
         let p = [(0.0, 0.0), (2.0, 4.0)];
         assert!((linear_at(&p, 1.0) - 2.0).abs() < 1e-12);
         assert_eq!(linear_at(&p, 5.0), 4.0);
+    }
+
+    /// An identification run steps speed, load and logged air on three
+    /// schedules of their own (no shared step time), within their ranges.
+    #[test]
+    fn identification_run_moves_inputs_independently() {
+        use rand::SeedableRng;
+        let m = draw(EmuScenario::IdentRun, 1800.0, &mut rand_chacha::ChaCha8Rng::seed_from_u64(3));
+        assert!(m.speed.len() >= 8 && m.dp_bar.len() >= 8 && m.air.len() >= 8);
+        assert!(m.speed.iter().all(|s| (500.0..2000.0).contains(&s.1)));
+        assert!(m.dp_bar.iter().all(|s| (10.0..100.0).contains(&s.1)));
+        assert!(m.air.iter().any(|s| s.1 == 0.0) && m.air.iter().any(|s| s.1 >= 5.0));
+        let shared = m.speed[1..].iter().filter(|s| m.dp_bar.iter().chain(&m.air).any(|o| o.0 == s.0)).count();
+        assert_eq!(shared, 0, "a speed step coincides with another input's step");
+        assert!(EmuScenario::IdentRun.logs_air() && !EmuScenario::IdentRun.is_servo());
     }
 }
