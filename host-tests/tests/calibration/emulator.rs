@@ -1,7 +1,8 @@
 //! Calibration against a truth not written with the reference: the rig
 //! emulator (`eha_sim::emulator`, 14 nodes, other correlations and
 //! parameters), nominal machine, nothing hidden. Two training logs of
-//! different kinds, one held-out log of a third kind.
+//! different kinds, one held-out log of a third kind; and (slow tier) which
+//! kind of training log carries a calibration across regimes.
 
 use eha_sim::calibration::{calibrate, channel_errors, CalLog, CalOptions};
 use eha_sim::diagnosis::Candidate;
@@ -13,11 +14,15 @@ use eha_sim::rig::Rig;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
+/// A 1200 s log of the nominal emulator in scenario `s` (nothing hidden),
+/// the ram air logged where the scenario has it.
 fn emu_log(p: &EmuParams, s: EmuScenario, seed: u64) -> CalLog {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let m = draw(s, 1200.0, &mut rng);
     let trace = Plant { p, m: &m, h: Hidden { effect: Candidate::None, magnitude: 0.0 } }.run(s.log_interval_s());
-    let run = logger::log(&trace, |t| m.ambient_c(t), None, false, &mut rng);
+    let air = |t: f64| eha_sim::emulator::missions::step_at(&m.air, t);
+    let ram: Option<&dyn Fn(f64) -> f64> = if s.logs_air() { Some(&air) } else { None };
+    let run = logger::log(&trace, |t| m.ambient_c(t), ram, false, &mut rng);
     CalLog::new(&format!("{s:?}-{seed}"), run, 120).expect("cal log")
 }
 
@@ -79,4 +84,38 @@ fn emulator_machine_held_out_error_falls() {
     // emulator's is 6 s — the 2 s-sampled logs see the lag only on steps.
     let p = c.params.iter().find(|q| q.name == "probe_oil").expect("probe_oil");
     assert_eq!(p.status, eha_sim::calibration::Status::Fitted, "probe_oil fitted");
+}
+
+/// Which logs to commission with (session 19). The same emulated machine
+/// calibrated on two logs of the operating families (load cycles, speed
+/// steps) or on two identification runs (speed, load and ram air stepped
+/// independently, `EmuScenario::IdentRun`), each checked on a held-out log
+/// of either kind. Measured (one run each, ~1200 model runs, ~8 s):
+/// families → pressure-speed steps 0.41 K pooled but → identification run
+/// 1.47 K (t_ballvalve_c 2.18 K, t_block_c 1.71 K); identification runs →
+/// 0.54 K and 0.53 K. The families' calibration absorbs structure into
+/// values that hold only for their own excitation; the identification runs
+/// pin the same set across regimes. Tolerances: the identification-run
+/// calibration within 0.75 K pooled on both held-out logs (the
+/// emulator's structure floor, ~0.5 K, plus margin), the families'
+/// calibration at least 1.1 K off on the identification run (a miss more
+/// than twice the floor: the finding itself).
+#[test]
+#[ignore = "slow tier: two calibrations on emulator logs"]
+fn slow_identification_runs_commission_across_regimes() {
+    let p = EmuParams::default();
+    let base = Rig::default();
+    let o = CalOptions { hold: Vec::new(), ..CalOptions::default() };
+    let holds = [emu_log(&p, EmuScenario::PressureSpeedSteps, 43), emu_log(&p, EmuScenario::IdentRun, 46)];
+    let held = |c: &eha_sim::calibration::Calibration| -> Vec<f64> {
+        holds.iter().map(|l| pooled(&channel_errors(l, &l.simulate(&c.rig).expect("sim")))).collect()
+    };
+    let fam = calibrate(&base, &[emu_log(&p, EmuScenario::LoadCycles, 41), emu_log(&p, EmuScenario::SpeedSteps, 42)], &o)
+        .expect("calibration on families");
+    let ident = calibrate(&base, &[emu_log(&p, EmuScenario::IdentRun, 44), emu_log(&p, EmuScenario::IdentRun, 45)], &o)
+        .expect("calibration on identification runs");
+    let (f, i) = (held(&fam), held(&ident));
+    eprintln!("held out (pressure-speed steps, identification run): families {f:.3?} K, identification runs {i:.3?} K");
+    assert!(i.iter().all(|&e| e <= 0.75), "identification-run calibration held out {i:.3?} K (measured 0.54, 0.53)");
+    assert!(f[1] >= 1.1, "families' calibration on the identification run {:.3} K (measured 1.47)", f[1]);
 }
