@@ -5,7 +5,7 @@ use std::vec::Vec as StdVec;
 
 use super::*;
 use crate::protocol::Deframer;
-use wire::FromGuard;
+use wire::{Ack, AckResult, Cmd, FromGuard, TraceReply};
 
 /// A board in memory: RX bytes queued by the test, TX bytes collected,
 /// pins with an optional stuck valve pin, records kept like no-init RAM.
