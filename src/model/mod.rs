@@ -23,6 +23,7 @@
 
 pub mod consts;
 mod init;
+mod input;
 mod rhs;
 mod ring;
 pub mod stability;
@@ -36,14 +37,10 @@ pub use crate::params::{
     ReducedParams, N_NODES, N_TABLE, NODE_ACTUATOR, NODE_BALL_BLOCK, NODE_DRAIN, NODE_LOOP, NODE_MAIN_BLOCK, NODE_PUMP,
     OUTER_NODES, S_PER_STEP, S_PER_TICK, TICKS_PER_STEP,
 };
+pub use input::{InputScales, ModelInputN, HA_PER_A, HBAR_PER_BAR, HRADS_PER_RPM};
 use ring::{Ring, RingIn};
+use sums::Sums;
 
-/// Wire → model unit: A → hA.
-pub const HA_PER_A: f64 = 0.01;
-/// Wire → model unit: bar → hbar (10 MPa).
-pub const HBAR_PER_BAR: f64 = 0.01;
-/// Wire → model unit: rpm → hrad/s (100 rad/s).
-pub const HRADS_PER_RPM: f64 = 2.0 * core::f64::consts::PI / 60.0 / 100.0;
 /// Pa per hbar.
 const PA_PER_HBAR: f64 = 1e7;
 /// L per m^3.
@@ -54,72 +51,6 @@ const KW_PER_W: f64 = 1e-3;
 const RAD_T_K: f64 = 300.0;
 /// Longest transport delay of the exchanger's effect, model steps (the history is a `u32`).
 const MAX_DELAY_STEPS: i32 = 31;
-
-/// One tick of validated inputs in model units (hA, hbar, hrad/s, mm, degC).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ModelInputN<N> {
-    /// Motor phase current, hA (100 A) rms.
-    pub current_ha: N,
-    /// Port A pressure, hbar gauge.
-    pub p_a_hbar: N,
-    /// Port B pressure, hbar gauge.
-    pub p_b_hbar: N,
-    /// Shaft speed, hrad/s (signed; positive delivers into port A).
-    pub speed_hrads: N,
-    /// Piston position change over this tick, mm (signed).
-    pub dpos_mm: N,
-    /// Ambient air temperature, degC.
-    pub ambient_c: N,
-}
-
-impl<N: Num> ModelInputN<N> {
-    /// One tick's inputs from wire units (A, bar, rpm, mm of piston travel in
-    /// this tick, degC) given as `f64`: host tools and tests. The firmware
-    /// scales its `f32` samples in its own number type ([`InputScales`]).
-    pub fn from_wire_f64(current_a: f64, p_a_bar: f64, p_b_bar: f64, speed_rpm: f64, dpos_mm: f64, ambient_c: f64) -> Self {
-        let f = N::from_f64;
-        ModelInputN {
-            current_ha: f(current_a * HA_PER_A),
-            p_a_hbar: f(p_a_bar * HBAR_PER_BAR),
-            p_b_hbar: f(p_b_bar * HBAR_PER_BAR),
-            speed_hrads: f(speed_rpm * HRADS_PER_RPM),
-            dpos_mm: f(dpos_mm),
-            ambient_c: f(ambient_c),
-        }
-    }
-}
-
-/// Wire → model unit scales in the number type (built once).
-#[derive(Clone, Copy, Debug)]
-pub struct InputScales<N: Num> {
-    /// A → hA.
-    pub ha_per_a: N::Scale,
-    /// bar → hbar.
-    pub hbar_per_bar: N::Scale,
-    /// rpm → hrad/s.
-    pub hrads_per_rpm: N::Scale,
-    /// Unity (mm, degC).
-    pub one: N::Scale,
-}
-
-impl<N: Num> InputScales<N> {
-    /// The scale of each sample channel, in channel order `[current, p_A, p_B,
-    /// speed, position, ambient]` (`validate::CH_*`).
-    #[inline(always)]
-    pub fn per_channel(&self) -> [N::Scale; 6] {
-        [self.ha_per_a, self.hbar_per_bar, self.hbar_per_bar, self.hrads_per_rpm, self.one, self.one]
-    }
-
-    /// Builds the scales; `None` only if the number type cannot hold them.
-    pub fn new() -> Option<Self> {
-        Some(InputScales {
-            ha_per_a: N::scale_from_f64(HA_PER_A)?,
-            hbar_per_bar: N::scale_from_f64(HBAR_PER_BAR)?,
-            hrads_per_rpm: N::scale_from_f64(HRADS_PER_RPM)?,
-            one: N::scale_from_f64(1.0)?,
-        })
-    }
-}
 
 /// Why a parameter set cannot be turned into a model of the chosen number type.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -135,48 +66,6 @@ pub enum ConfigError {
     /// ([`Model::check_stability`]), or its `Phi` does not belong to its own
     /// Jacobian.
     Unstable,
-}
-
-/// Sums over the ticks of the present model step: raw per-tick terms (their
-/// constants are applied at the step by [`Sums::means`]); `ambient` is the last tick's.
-#[derive(Clone, Copy, Debug)]
-struct Sums<N> {
-    leak_kw: N,
-    mech_kw: N,
-    line_kw: N,
-    needle_kw: N,
-    act_kw: N,
-    copper_kw: N,
-    /// `sign(dp w) |I| |w|` (shaft power from the current, cross-check).
-    shaft_kw: N,
-    /// `dp w` (hydraulic power of the displacement, cross-check).
-    hyd_kw: N,
-    leak_lps: N,
-    pump_lps: N,
-    abs_pump_lps: N,
-    abs_thr_lps: N,
-    abs_act_lps: N,
-    abs_speed: N,
-    /// The pump's viscous friction `k_mv w^2`, kW (extended eq. 8; its constant is
-    /// applied per tick: `w^2` summed over a step would leave the fixed-point range
-    /// at 6000 rpm).
-    visc_kw: N,
-    dp: N,
-    ambient: N,
-    ticks: u32,
-}
-
-/// Result of [`Model::rhs`].
-#[derive(Clone, Copy, Debug)]
-struct Rhs<N> {
-    rates: [N; N_NODES],
-    links: [N; 3],
-    ring_rate: N,
-    total_kw: N,
-    lng_kw: N,
-    heat_kw: N,
-    outer_kw: N,
-    losses_kw: [N; N_LOSSES],
 }
 
 /// Constants in model units (built once).

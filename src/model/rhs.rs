@@ -3,6 +3,19 @@
 
 use super::*;
 
+/// Result of [`Model::rhs`].
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Rhs<N> {
+    pub(super) rates: [N; N_NODES],
+    pub(super) links: [N; 3],
+    pub(super) ring_rate: N,
+    pub(super) total_kw: N,
+    pub(super) lng_kw: N,
+    pub(super) heat_kw: N,
+    pub(super) outer_kw: N,
+    pub(super) losses_kw: [N; N_LOSSES],
+}
+
 impl<N: Num> Model<N> {
     /// Heat balances of the six nodes for one step (tick means `m`). `hist`: exchanger
     /// credit of the past steps (bit 0 = this step, for the transport delay), `share`:

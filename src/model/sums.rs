@@ -3,6 +3,35 @@
 
 use super::*;
 
+/// Sums over the ticks of the present model step: raw per-tick terms (their
+/// constants are applied at the step by [`Sums::means`]); `ambient` is the last tick's.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Sums<N> {
+    pub(super) leak_kw: N,
+    pub(super) mech_kw: N,
+    pub(super) line_kw: N,
+    pub(super) needle_kw: N,
+    pub(super) act_kw: N,
+    pub(super) copper_kw: N,
+    /// `sign(dp w) |I| |w|` (shaft power from the current, cross-check).
+    pub(super) shaft_kw: N,
+    /// `dp w` (hydraulic power of the displacement, cross-check).
+    pub(super) hyd_kw: N,
+    pub(super) leak_lps: N,
+    pub(super) pump_lps: N,
+    pub(super) abs_pump_lps: N,
+    pub(super) abs_thr_lps: N,
+    pub(super) abs_act_lps: N,
+    pub(super) abs_speed: N,
+    /// The pump's viscous friction `k_mv w^2`, kW (extended eq. 8; its constant is
+    /// applied per tick: `w^2` summed over a step would leave the fixed-point range
+    /// at 6000 rpm).
+    pub(super) visc_kw: N,
+    pub(super) dp: N,
+    pub(super) ambient: N,
+    pub(super) ticks: u32,
+}
+
 impl<N: Num> Sums<N> {
     pub(super) const ZERO: Self = Sums {
         leak_kw: N::ZERO,
