@@ -162,15 +162,7 @@ pub fn default_cases(duration_s: f64, base: u64) -> Vec<EmuCase> {
         ("none", SpeedSteps),
         ("none", ServoHoldMove),
     ];
-    list.iter()
-        .enumerate()
-        .map(|(k, (h, s))| EmuCase {
-            hidden: Candidate::from_name(h).unwrap_or(Candidate::None),
-            scenario: *s,
-            seed: base + k as u64,
-            duration_s,
-        })
-        .collect()
+    cases_from(&list, duration_s, base)
 }
 
 /// The identification-run case set: every throttle-circuit candidate hidden
@@ -200,6 +192,11 @@ pub fn ident_cases(duration_s: f64, base: u64) -> Vec<EmuCase> {
         ("none", IdentRun),
         ("none", ServoHoldMove),
     ];
+    cases_from(&list, duration_s, base)
+}
+
+/// The cases of `list` (hidden candidate name, scenario), seeds `base + index`.
+fn cases_from(list: &[(&str, EmuScenario)], duration_s: f64, base: u64) -> Vec<EmuCase> {
     list.iter()
         .enumerate()
         .map(|(k, (h, s))| EmuCase {
