@@ -186,6 +186,14 @@ pub fn commission(base: &Rig, train: &[CalLog], holdout: &[CalLog], o: &CalOptio
             "{NO_COOLING} (no `lng_valve` column that is both 0 and 1): the exchanger's cooling credit in the firmware is not checked against this machine; run a loaded mission with the valve cycling (docs/commissioning.md)"
         ));
     }
+    if !train.iter().any(|l| super::ident::independent_speed_and_load(&l.run)) {
+        cal.warnings.push(format!(
+            "{} (none has shaft speed and pressure drop each spreading by >= {:.0} % with |correlation| < {}): one-at-a-time missions let the calibration absorb the machine's structure into values that hold only for them; add an identification run (docs/commissioning.md)",
+            super::ident::NO_JOINT_EXCITATION,
+            100.0 * super::ident::ONE_POINT_SPREAD,
+            super::ident::JOINT_MAX_CORRELATION
+        ));
+    }
     let mut scores = Vec::new();
     for l in holdout {
         let a = l.simulate(base).map_err(CommissionError::Run)?;

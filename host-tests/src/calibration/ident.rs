@@ -7,6 +7,12 @@
 /// point; `commission` refuses to write a flashable block then.
 pub const NO_EXCITATION: &str = "WARNING: no training log has more than one operating point";
 
+/// Start of the warning that no training log moves shaft speed and load
+/// independently (`commission`): the calibration then rests on one-at-a-time
+/// excitations, which let the set absorb structure into values that hold
+/// only for them (docs/commissioning.md, "Why the identification run").
+pub const NO_JOINT_EXCITATION: &str = "WARNING: no training log moves shaft speed and load independently";
+
 use super::log::CalLog;
 use super::set::PARAMS;
 use crate::measured::Channel;
@@ -123,4 +129,34 @@ pub fn excitation_warnings(logs: &[CalLog]) -> Vec<String> {
         w.push(format!("{NO_EXCITATION}: the loss coefficients (pump friction, leakage, iron loss, winding resistance) are not separable; run speed steps and pressure steps (docs/commissioning.md)"));
     }
     w
+}
+
+/// |Correlation| of shaft speed and pressure drop above which they count as
+/// moving together (a speed step at one needle setting moves the pressure
+/// drop with the square of the flow).
+pub const JOINT_MAX_CORRELATION: f64 = 0.7;
+
+/// Spreads of |speed| and |Δp| ([`spread`]) and their Pearson correlation
+/// over the rows where both are logged.
+pub fn speed_load_excitation(run: &crate::measured::MeasuredRun) -> (f64, f64, f64) {
+    let col = |c: Channel| run.get(c).map(|v| v.to_vec()).unwrap_or_default();
+    let (sp, pa, pb) = (col(Channel::SpeedRpm), col(Channel::PABar), col(Channel::PBBar));
+    let speed = |i: usize| sp.get(i).copied().flatten().map(f64::abs);
+    let dp = |i: usize| Some((pa.get(i).copied().flatten()? - pb.get(i).copied().flatten()?).abs());
+    let pairs: Vec<(f64, f64)> = (0..run.len()).filter_map(|i| Some((speed(i)?, dp(i)?))).collect();
+    let n = pairs.len().max(1) as f64;
+    let (mx, my) = pairs.iter().fold((0.0, 0.0), |a, p| (a.0 + p.0 / n, a.1 + p.1 / n));
+    let (sxy, sxx, syy) = pairs.iter().fold((0.0, 0.0, 0.0), |a, p| {
+        let (dx, dy) = (p.0 - mx, p.1 - my);
+        (a.0 + dx * dy, a.1 + dx * dx, a.2 + dy * dy)
+    });
+    let rho = if sxx > 0.0 && syy > 0.0 { sxy / (sxx * syy).sqrt() } else { 1.0 };
+    (spread(run, speed), spread(run, dp), rho)
+}
+
+/// Whether a log moves shaft speed and pressure drop independently: each
+/// spreads by at least [`ONE_POINT_SPREAD`] and |ρ| < [`JOINT_MAX_CORRELATION`].
+pub fn independent_speed_and_load(run: &crate::measured::MeasuredRun) -> bool {
+    let (s_speed, s_dp, rho) = speed_load_excitation(run);
+    s_speed >= ONE_POINT_SPREAD && s_dp >= ONE_POINT_SPREAD && rho.abs() < JOINT_MAX_CORRELATION
 }

@@ -183,6 +183,8 @@ fn low_excitation_commissioning_warns_and_is_refused_or_conservative() {
     }
     assert!(c.cal.warnings.iter().any(|w| w.contains("one operating point")), "no low-excitation warning: {:?}", c.cal.warnings);
     assert!(c.cal.warnings.iter().any(|w| w.starts_with(NO_COOLING)), "no warning that the LNG valve never opens: {:?}", c.cal.warnings);
+    let joint = eha_sim::calibration::ident::NO_JOINT_EXCITATION;
+    assert!(c.cal.warnings.iter().any(|w| w.starts_with(joint)), "no warning that speed and load never move independently: {:?}", c.cal.warnings);
     let listed = c.cal.warnings.iter().find(|w| w.contains("held at the rig file")).expect("held list in the warnings");
     for name in ["iron_loss", "leak_gap"] {
         assert!(listed.contains(name), "{name} not named in the warning: {listed}");

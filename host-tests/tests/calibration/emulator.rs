@@ -119,3 +119,26 @@ fn slow_identification_runs_commission_across_regimes() {
     assert!(i.iter().all(|&e| e <= 0.75), "identification-run calibration held out {i:.3?} K (measured 0.54, 0.53)");
     assert!(f[1] >= 1.1, "families' calibration on the identification run {:.3} K (measured 1.47)", f[1]);
 }
+
+/// The identification run is recognised as moving speed and load
+/// independently, the operating families are not (spreads and correlation
+/// printed; `commission` warns with `NO_JOINT_EXCITATION` when no training
+/// log does).
+#[test]
+fn identification_runs_are_recognised_as_joint_excitation() {
+    use eha_sim::calibration::ident::{independent_speed_and_load, speed_load_excitation};
+    let p = EmuParams::default();
+    for (s, seed, want) in [
+        (EmuScenario::IdentRun, 44, true),
+        (EmuScenario::IdentRun, 45, true),
+        (EmuScenario::LoadCycles, 41, false),
+        (EmuScenario::SpeedSteps, 42, false),
+        (EmuScenario::PressureSpeedSteps, 43, false),
+        (EmuScenario::ConstantThrottle, 47, false),
+    ] {
+        let l = emu_log(&p, s, seed);
+        let (a, b, rho) = speed_load_excitation(&l.run);
+        eprintln!("{s:?}: speed spread {a:.2}, Δp spread {b:.2}, ρ {rho:.2}");
+        assert_eq!(independent_speed_and_load(&l.run), want, "{s:?}");
+    }
+}
