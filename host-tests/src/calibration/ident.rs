@@ -83,14 +83,41 @@ pub fn spread(run: &crate::measured::MeasuredRun, f: impl Fn(usize) -> Option<f6
 /// Spread below which an input counts as held at one value.
 pub const ONE_POINT_SPREAD: f64 = 0.2;
 
+/// A log's operating inputs, row by row: speed (rpm, signed), |Δp| (bar)
+/// and current (A), `None` where a cell is empty.
+struct Inputs {
+    speed: Vec<Option<f64>>,
+    pa: Vec<Option<f64>>,
+    pb: Vec<Option<f64>>,
+    current: Vec<Option<f64>>,
+}
+
+impl Inputs {
+    fn of(run: &crate::measured::MeasuredRun) -> Self {
+        let col = |c: Channel| run.get(c).map(|v| v.to_vec()).unwrap_or_default();
+        Inputs { speed: col(Channel::SpeedRpm), pa: col(Channel::PABar), pb: col(Channel::PBBar), current: col(Channel::CurrentA) }
+    }
+    fn speed(&self, i: usize) -> Option<f64> {
+        self.speed.get(i).copied().flatten()
+    }
+    fn dp(&self, i: usize) -> Option<f64> {
+        Some((self.pa.get(i).copied().flatten()? - self.pb.get(i).copied().flatten()?).abs())
+    }
+    fn current(&self, i: usize) -> Option<f64> {
+        self.current.get(i).copied().flatten()
+    }
+}
+
+/// Spreads ([`spread`]) of speed, pressure drop and current of a log.
+fn spreads(run: &crate::measured::MeasuredRun) -> (f64, f64, f64) {
+    let x = Inputs::of(run);
+    (spread(run, |i| x.speed(i)), spread(run, |i| x.dp(i)), spread(run, |i| x.current(i)))
+}
+
 /// Whether a log holds speed, pressure drop and current each within
 /// [`ONE_POINT_SPREAD`] of one value.
 pub fn one_point(run: &crate::measured::MeasuredRun) -> bool {
-    let col = |c: Channel| run.get(c).map(|v| v.to_vec()).unwrap_or_default();
-    let (sp, pa, pb, cur) = (col(Channel::SpeedRpm), col(Channel::PABar), col(Channel::PBBar), col(Channel::CurrentA));
-    let s_speed = spread(run, |i| sp.get(i).copied().flatten());
-    let s_dp = spread(run, |i| Some((pa.get(i).copied().flatten()? - pb.get(i).copied().flatten()?).abs()));
-    let s_cur = spread(run, |i| cur.get(i).copied().flatten());
+    let (s_speed, s_dp, s_cur) = spreads(run);
     s_speed.max(s_dp).max(s_cur) < ONE_POINT_SPREAD
 }
 
@@ -106,12 +133,7 @@ pub fn excitation_warnings(logs: &[CalLog]) -> Vec<String> {
     let mut w = Vec::new();
     let mut all_flat = true;
     for l in logs {
-        let r = &l.run;
-        let col = |c: Channel| r.get(c).map(|v| v.to_vec()).unwrap_or_default();
-        let (sp, pa, pb, cur) = (col(Channel::SpeedRpm), col(Channel::PABar), col(Channel::PBBar), col(Channel::CurrentA));
-        let s_speed = spread(r, |i| sp.get(i).copied().flatten());
-        let s_dp = spread(r, |i| Some((pa.get(i).copied().flatten()? - pb.get(i).copied().flatten()?).abs()));
-        let s_cur = spread(r, |i| cur.get(i).copied().flatten());
+        let (s_speed, s_dp, s_cur) = spreads(&l.run);
         if s_speed.max(s_dp).max(s_cur) < ONE_POINT_SPREAD {
             w.push(format!(
                 "WARNING: log `{}` has one operating point (speed, pressure drop and current each vary by < {:.0} %: {:.0} / {:.0} / {:.0} %): losses that scale differently with speed and pressure cannot be told apart",
@@ -139,11 +161,8 @@ pub const JOINT_MAX_CORRELATION: f64 = 0.7;
 /// Spreads of |speed| and |Δp| ([`spread`]) and their Pearson correlation
 /// over the rows where both are logged.
 pub fn speed_load_excitation(run: &crate::measured::MeasuredRun) -> (f64, f64, f64) {
-    let col = |c: Channel| run.get(c).map(|v| v.to_vec()).unwrap_or_default();
-    let (sp, pa, pb) = (col(Channel::SpeedRpm), col(Channel::PABar), col(Channel::PBBar));
-    let speed = |i: usize| sp.get(i).copied().flatten().map(f64::abs);
-    let dp = |i: usize| Some((pa.get(i).copied().flatten()? - pb.get(i).copied().flatten()?).abs());
-    let pairs: Vec<(f64, f64)> = (0..run.len()).filter_map(|i| Some((speed(i)?, dp(i)?))).collect();
+    let x = Inputs::of(run);
+    let pairs: Vec<(f64, f64)> = (0..run.len()).filter_map(|i| Some((x.speed(i)?.abs(), x.dp(i)?))).collect();
     let n = pairs.len().max(1) as f64;
     let (mx, my) = pairs.iter().fold((0.0, 0.0), |a, p| (a.0 + p.0 / n, a.1 + p.1 / n));
     let (sxy, sxx, syy) = pairs.iter().fold((0.0, 0.0, 0.0), |a, p| {
@@ -151,7 +170,7 @@ pub fn speed_load_excitation(run: &crate::measured::MeasuredRun) -> (f64, f64, f
         (a.0 + dx * dy, a.1 + dx * dx, a.2 + dy * dy)
     });
     let rho = if sxx > 0.0 && syy > 0.0 { sxy / (sxx * syy).sqrt() } else { 1.0 };
-    (spread(run, speed), spread(run, dp), rho)
+    (spread(run, |i| x.speed(i).map(f64::abs)), spread(run, |i| x.dp(i)), rho)
 }
 
 /// Whether a log moves shaft speed and pressure drop independently: each

@@ -271,6 +271,16 @@ pub fn oracle_row(r: &EmuResult) -> Option<String> {
     ))
 }
 
+/// Which emulator case set `emulator-sweep` runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum CaseSet {
+    /// Each candidate in two of the diagnosis tests' operating families
+    /// ([`default_cases`], seeds 1700 + 100·k + index).
+    Original,
+    /// Identification runs ([`ident_cases`], seeds 2700 + 100·k + index).
+    Ident,
+}
+
 /// Arguments of `emulator-sweep`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct EmuSweepArgs {
@@ -280,11 +290,9 @@ pub struct EmuSweepArgs {
     /// Repetitions of the case set (seeds 1700 + 100·k + case index).
     #[arg(long, default_value_t = 1)]
     pub seeds: u64,
-    /// Case set: `original` (each candidate in two of the diagnosis
-    /// tests' operating families) or `ident` (identification runs, see
-    /// [`ident_cases`]).
-    #[arg(long, default_value = "original")]
-    pub cases: String,
+    /// Case set.
+    #[arg(long, value_enum, default_value_t = CaseSet::Original)]
+    pub cases: CaseSet,
     /// Run only the cases with these seeds (comma-separated).
     #[arg(long, value_delimiter = ',')]
     pub only: Vec<u64>,
@@ -303,9 +311,9 @@ pub struct EmuSweepArgs {
 /// written (it is a measurement, not a test).
 pub fn run(a: &EmuSweepArgs) -> ExitCode {
     let cases: Vec<EmuCase> = (0..a.seeds)
-        .flat_map(|k| match a.cases.as_str() {
-            "ident" => ident_cases(a.duration, 2700 + 100 * k),
-            _ => default_cases(a.duration, 1700 + 100 * k),
+        .flat_map(|k| match a.cases {
+            CaseSet::Ident => ident_cases(a.duration, 2700 + 100 * k),
+            CaseSet::Original => default_cases(a.duration, 1700 + 100 * k),
         })
         .filter(|c| !(a.no_servo && c.scenario.is_servo()))
         .filter(|c| a.only.is_empty() || a.only.contains(&c.seed))

@@ -139,11 +139,18 @@ fn generate_on(c: &EmuCase, machine: Option<(&params::EmuParams, f64)>) -> Resul
             })
             .max_by(|a, b| a.1.total_cmp(&b.1))
     };
-    let air = |t: f64| step_at(&m.air, t);
-    let ram: Option<&dyn Fn(f64) -> f64> = if c.scenario.logs_air() { Some(&air) } else { None };
-    let run = logger::log(&trace, |t| m.ambient_c(t), ram, c.scenario.is_servo(), &mut rng);
+    let run = log_mission(&trace, &m, &mut rng);
     run.validate("emulator").map_err(|e| e.to_string())?;
     Ok((run, EmuTruth { magnitude, params: p, affected }))
+}
+
+/// The logged run of an emulated `trace` flown on mission `m`: the
+/// mission's ambient, its ram air where the scenario logs it, the servo
+/// columns on servo runs, the sensors' noise and dropouts from `rng`.
+pub fn log_mission(trace: &[logger::Row], m: &missions::EmuMission, rng: &mut impl Rng) -> MeasuredRun {
+    let air = |t: f64| step_at(&m.air, t);
+    let ram: Option<&dyn Fn(f64) -> f64> = if m.scenario.logs_air() { Some(&air) } else { None };
+    logger::log(trace, |t| m.ambient_c(t), ram, m.scenario.is_servo(), rng)
 }
 
 #[cfg(test)]

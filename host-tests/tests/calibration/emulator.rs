@@ -9,7 +9,6 @@ use eha_sim::diagnosis::Candidate;
 use eha_sim::emulator::missions::{draw, EmuScenario};
 use eha_sim::emulator::params::EmuParams;
 use eha_sim::emulator::plant::{Hidden, Plant};
-use eha_sim::emulator::logger;
 use eha_sim::rig::Rig;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -20,9 +19,7 @@ fn emu_log(p: &EmuParams, s: EmuScenario, seed: u64) -> CalLog {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let m = draw(s, 1200.0, &mut rng);
     let trace = Plant { p, m: &m, h: Hidden { effect: Candidate::None, magnitude: 0.0 } }.run(s.log_interval_s());
-    let air = |t: f64| eha_sim::emulator::missions::step_at(&m.air, t);
-    let ram: Option<&dyn Fn(f64) -> f64> = if s.logs_air() { Some(&air) } else { None };
-    let run = logger::log(&trace, |t| m.ambient_c(t), ram, false, &mut rng);
+    let run = eha_sim::emulator::log_mission(&trace, &m, &mut rng);
     CalLog::new(&format!("{s:?}-{seed}"), run, 120).expect("cal log")
 }
 

@@ -253,7 +253,8 @@ fn slow_emulator_forced_convection_at_one_point_is_not_named_conduction() {
 /// design): the emulator's structure shows and the answer is `unexplained`,
 /// not `none` and not a false discovery. Measured (session 19): the
 /// physical set fits the training window to 0.30 K pooled and misses the
-/// held-out window by 1.63 K, t_block_c by 2.41 K (27σ); the residuals of
+/// held-out window by 1.59–1.63 K, t_block_c by 2.39–2.41 K (27σ; the
+/// digits move between builds on the same log, docs/diagnosis.md); the residuals of
 /// the block follow the motor–pump temperature difference (ρ 0.90) and the
 /// report sends the user to the pump's mounting on the block and a flange
 /// path — the emulator's bolted pump end cap ↔ manifold plate, a metal path
@@ -269,10 +270,10 @@ fn slow_emulator_identification_run_none_is_unexplained() {
     let j = DiagnosisJson::from_diagnosis(&d);
     eprintln!("cause {} training {:.3} K held-out {:.3} K", j.cause, d.before.train_rmse_k, d.before.heldout_rmse_k);
     assert_eq!(j.cause, "unexplained", "measured outcome changed");
-    assert!(d.before.heldout_rmse_k >= 1.2, "pooled held-out {:.3} K (measured 1.63)", d.before.heldout_rmse_k);
+    assert!(d.before.heldout_rmse_k >= 1.2, "pooled held-out {:.3} K (measured 1.59–1.63)", d.before.heldout_rmse_k);
     assert!(d.before.train_rmse_k <= 0.45, "pooled training {:.3} K (measured 0.30)", d.before.train_rmse_k);
     let block = d.adequacy.channels.iter().find(|c| c.channel == "t_block_c").expect("t_block_c");
-    assert!(block.misfit && block.heldout_rmse_k >= 1.5, "t_block_c {:.3} K (measured 2.41)", block.heldout_rmse_k);
+    assert!(block.misfit && block.heldout_rmse_k >= 1.5, "t_block_c {:.3} K (measured 2.39–2.41)", block.heldout_rmse_k);
     let check = j.unexplained.expect("unexplained section").check.join("\n");
     assert!(check.contains("mounting") && check.contains("flange"), "advice:\n{check}");
 }
