@@ -212,7 +212,7 @@ fn fmt_opt(v: Option<f64>) -> String {
     v.map_or(String::new(), |x| format!("{x}"))
 }
 
-/// Write the run as a measured-data CSV (`shared/measured-data-format.md`)
+/// Write the run as a measured-data CSV (`docs/measured-data-format.md`)
 /// with extra columns: `t_drain_ref_c` (plant truth), `fw_*` (firmware reply).
 /// Written to a temporary file and renamed, so a failure never leaves a
 /// half-written file under the final name.

@@ -1,5 +1,5 @@
 //! Strict reader and writer of the measured-data format
-//! (`shared/measured-data-format.md`): one rig run per file, `# key: value`
+//! (`docs/measured-data-format.md`): one rig run per file, `# key: value`
 //! metadata lines, one CSV header row, one row per sample.
 //!
 //! Reading never fills, drops or clamps data: an empty cell is a missing

@@ -1,5 +1,5 @@
 //! The strict measured-data reader: every rejection rule of
-//! `shared/measured-data-format.md` and a lossless write/read round trip.
+//! `docs/measured-data-format.md` and a lossless write/read round trip.
 
 use eha_sim::measured::{Channel, MeasuredError, MeasuredRun};
 
