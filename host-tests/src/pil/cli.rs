@@ -47,6 +47,11 @@ pub struct PilArgs {
     /// Skip the SIL replay comparison.
     #[arg(long)]
     pub no_sil: bool,
+    /// Software in the loop only: the firmware's own code on the host (the
+    /// same core and frames as in QEMU) in closed loop with the plant; no
+    /// emulator. Writes `sil_<scenario>_<build>.csv`.
+    #[arg(long, conflicts_with_all = ["elf", "no_icount", "no_sil"])]
+    pub sil: bool,
 }
 
 /// Parse the scenario name.
@@ -62,6 +67,9 @@ pub fn scenario(name: &str, duration_s: f64, needle_bar: f64) -> Result<Scenario
 /// Run the PIL demo and print its summary.
 pub fn run(args: &PilArgs) -> Result<()> {
     let build: Build = args.build.parse()?;
+    if args.sil {
+        return run_sil(args, build);
+    }
     let qemu_version = super::qemu::ensure_qemu()?;
     let scen = scenario(&args.scenario, args.duration, args.needle_bar)?;
     let elf = match &args.elf {
@@ -128,5 +136,27 @@ pub fn run(args: &PilArgs) -> Result<()> {
     if let Some(png) = super::plot::plot_if_available(&run.records, &args.out.join(format!("{stem}.png")))? {
         println!("plot                : {}", png.display());
     }
+    Ok(())
+}
+
+/// `pil --sil`: the closed loop with the host SIL core.
+fn run_sil(args: &PilArgs, build: Build) -> Result<()> {
+    let scen = scenario(&args.scenario, args.duration, args.needle_bar)?;
+    let mut plant = Plant::new(&Rig::default(), &scen).map_err(|e| anyhow::anyhow!("reference plant: {e}"))?;
+    let opts = LoopOptions { tick_s: eha_guard::params::S_PER_TICK, duration_s: args.duration };
+    std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
+    let csv = args.out.join(format!("sil_{}_{}.csv", args.scenario, build.name()));
+    let mut target = SilTarget::new(sil_core(build));
+    let meta = |note: String| vec![("rig", "reference plant eha_sim (Rig::default)".to_string()), ("case", args.scenario.clone()), ("note", note)];
+    let records = match super::run_closed_loop(&mut plant, &mut target, &opts) {
+        Ok(r) => r,
+        Err(fail) => {
+            let _ = report::write_csv(&csv, &fail.records, &meta(format!("FAILED SIL run ({build:?}): {:#}", fail.error)));
+            bail!("{:#}\n(partial results: {})", fail.error, csv.display());
+        }
+    };
+    report::write_csv(&csv, &records, &meta(format!("SIL {} firmware core on the host, tick {} s", build.name(), opts.tick_s)))?;
+    println!("{}", report::table(&records, args.table_every));
+    println!("results             : {}", csv.display());
     Ok(())
 }

@@ -354,6 +354,16 @@ impl Plant {
         self.stats
     }
 
+    /// The mission that drives the plant (`None` for a replay), for callers
+    /// that set its inputs between runs: the FMU holds each communication
+    /// step's inputs as constant schedules.
+    pub fn mission_mut(&mut self) -> Option<&mut crate::scenario::Mission> {
+        match &mut self.model.drive {
+            Drive::Mission(m) => Some(m),
+            Drive::Replay(_) => None,
+        }
+    }
+
     /// Set the LNG valve.
     pub fn set_lng_valve(&mut self, open: bool) {
         self.model.lng_open.set(open);

@@ -89,6 +89,9 @@ pub struct SimulateArgs {
     /// Output sample interval, s.
     #[arg(long, default_value_t = 1.0)]
     pub output_interval_s: f64,
+    /// Relative tolerance of the solver's error control.
+    #[arg(long, default_value_t = crate::plant::RTOL)]
+    pub rtol: f64,
     /// Output directory.
     #[arg(long, default_value = "out")]
     pub out: PathBuf,
@@ -132,7 +135,10 @@ pub fn run_simulate(a: &SimulateArgs) -> Result<()> {
     let rig = a.rig.load()?;
     let sc = scenario_of(a)?;
     let t = std::time::Instant::now();
-    let out = simulate(&rig, &sc, &SimOptions { output_interval_s: a.output_interval_s, control_interval_s: 0.1 })?;
+    if !(a.rtol > 0.0 && a.rtol < 1.0) {
+        anyhow::bail!("--rtol {} must lie in (0, 1)", a.rtol);
+    }
+    let out = crate::sim::simulate_rtol(&rig, &sc, &SimOptions { output_interval_s: a.output_interval_s, control_interval_s: 0.1 }, a.rtol)?;
     let wall = t.elapsed();
     let csv = write_run(&out, &rig, &a.out)?;
     println!("{}: {:.0} s simulated in {:.1} ms ({} rhs evaluations, {} solver steps)", out.name, sc.duration_s(), wall.as_secs_f64() * 1e3, out.stats.rhs_evals, out.stats.steps);
