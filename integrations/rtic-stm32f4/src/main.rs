@@ -179,7 +179,7 @@ mod app {
 
         // Motor encoder on TIM4 (PB6/PB7).
         let encoder = Qei::new(dp.TIM4, (gpiob.pb6, gpiob.pb7), &mut rcc);
-        let last_count = encoder.count() as u16;
+        let last_count = encoder.count();
 
         // The independent watchdog: a hung task stops feeding it.
         let mut wdt = IndependentWatchdog::new(dp.IWDG);
@@ -202,7 +202,7 @@ mod app {
     fn tick(mut cx: tick::Context) {
         let l = cx.local;
         l.timer.clear_all_flags();
-        let count = l.encoder.count() as u16;
+        let count = l.encoder.count();
         let counts = count.wrapping_sub(*l.last_count) as i16;
         *l.last_count = count;
         let raw = cx.shared.latest.lock(|x| x.take());
