@@ -8,7 +8,7 @@ use super::model::{Candidate, ParamSpec, SimSeries, Simulator};
 use crate::calibration::{self, set::Needs};
 use crate::measured::{Channel, MeasuredRun};
 use crate::rig::Rig;
-use crate::scenario::{ReplayInputs, Scenario};
+use crate::scenario::{Circuit, ReplayInputs, Scenario};
 use crate::sim::{simulate_budget, SimOptions};
 
 /// Errors building the replay model from a measured run.
@@ -20,6 +20,57 @@ pub enum ReferenceError {
     /// The rig does not validate or the baseline does not run.
     #[error("reference model: {0}")]
     Model(String),
+    /// The hydraulic circuit is stated wrongly or cannot be told.
+    #[error("{0}")]
+    Circuit(String),
+}
+
+/// Piston travel (max − min of `position_mm`) at or below which a log is a
+/// throttle run (the cylinder isolated; encoder noise and creep), mm.
+pub const THROTTLE_MAX_TRAVEL_MM: f64 = 0.5;
+/// Piston travel at or above which a log is a servo run, mm.
+pub const SERVO_MIN_TRAVEL_MM: f64 = 2.0;
+
+/// The hydraulic circuit of `run`: the `# circuit: throttle|servo` metadata
+/// line when there is one (checked against the data), else inferred from the
+/// piston: no `position_mm` column, or a travel of at most
+/// [`THROTTLE_MAX_TRAVEL_MM`], is the throttle circuit; a travel of at least
+/// [`SERVO_MIN_TRAVEL_MM`] the servo circuit; in between the log is
+/// ambiguous and refused with the line to add.
+pub fn circuit_of(run: &MeasuredRun) -> Result<Circuit, ReferenceError> {
+    let travel = run.get(Channel::PositionMm).map(|p| {
+        let (lo, hi) = p.iter().flatten().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &x| (lo.min(x), hi.max(x)));
+        if hi >= lo {
+            hi - lo
+        } else {
+            0.0
+        }
+    });
+    let stated = run.metadata.iter().enumerate().find(|(_, m)| m.key == "circuit");
+    match stated {
+        Some((i, m)) => {
+            let line = i + 1;
+            match (m.value.trim(), travel) {
+                ("throttle", Some(t)) if t > THROTTLE_MAX_TRAVEL_MM => Err(ReferenceError::Circuit(format!(
+                    "line {line}: `# circuit: throttle`, but position_mm travels {t:.2} mm (the throttle circuit isolates the cylinder: at most {THROTTLE_MAX_TRAVEL_MM} mm)"
+                ))),
+                ("throttle", _) => Ok(Circuit::Throttle),
+                ("servo", None) => Err(ReferenceError::Circuit(format!(
+                    "line {line}: `# circuit: servo`, but the log has no position_mm column (a servo replay is driven by the piston position)"
+                ))),
+                ("servo", Some(_)) => Ok(Circuit::Servo),
+                (other, _) => Err(ReferenceError::Circuit(format!("line {line}: `# circuit: {other}`: expected `throttle` or `servo`"))),
+            }
+        }
+        None => match travel {
+            None => Ok(Circuit::Throttle),
+            Some(t) if t <= THROTTLE_MAX_TRAVEL_MM => Ok(Circuit::Throttle),
+            Some(t) if t >= SERVO_MIN_TRAVEL_MM => Ok(Circuit::Servo),
+            Some(t) => Err(ReferenceError::Circuit(format!(
+                "position_mm travels {t:.2} mm: neither a stationary piston (throttle circuit, <= {THROTTLE_MAX_TRAVEL_MM} mm) nor a servo run (>= {SERVO_MIN_TRAVEL_MM} mm); state the circuit with a metadata line `# circuit: throttle` or `# circuit: servo` before the header"
+            ))),
+        },
+    }
 }
 
 /// Replay inputs from the input columns of `run`: gaps bridged by linear
@@ -31,8 +82,10 @@ pub fn replay_inputs(run: &MeasuredRun, name: &str) -> Result<ReplayInputs, Refe
         run.time_s.iter().map(|&t| run.value_at(ch, t)).collect()
     };
     let req = |ch: Channel| col(ch).ok_or(ReferenceError::EmptyInput(ch.name()));
+    let circuit = circuit_of(run)?;
     Ok(ReplayInputs {
         name: name.into(),
+        circuit,
         time_s: run.time_s.clone(),
         speed_rpm: req(Channel::SpeedRpm)?,
         current_a: req(Channel::CurrentA)?,

@@ -155,8 +155,11 @@ impl ReplayDrive {
     pub fn op(&self, rig: &Rig, t: f64) -> OpPoint {
         let (i, f) = self.locate(t);
         let r = &self.inputs;
-        let (x, v) = match &r.position_mm {
-            Some(p) => {
+        let circuit = r.circuit;
+        // The piston moves only in the servo circuit (in the throttle circuit
+        // the cylinder is isolated; a logged position is its rest position).
+        let (x, v) = match (&r.position_mm, circuit) {
+            (Some(p), Circuit::Servo) => {
                 let x = Self::lerp(p, i, f) * 1e-3;
                 // Piston speed: the logged samples' difference quotients
                 // averaged onto the samples and interpolated linearly, so
@@ -166,12 +169,11 @@ impl ReplayDrive {
                 let v = (1.0 - f) * self.node_speed(i) + f * self.node_speed(i + 1);
                 (x, v * 1e-3)
             }
-            None => (0.0, 0.0),
+            _ => (0.0, 0.0),
         };
         let omega = Self::lerp(&r.speed_rpm, i, f) * 2.0 * PI / 60.0;
         let p_a = Self::lerp(&r.p_a_bar, i, f) * 1e5;
         let p_b = Self::lerp(&r.p_b_bar, i, f) * 1e5;
-        let circuit = if r.position_mm.is_some() { Circuit::Servo } else { Circuit::Throttle };
         let logged_air = r.air_speed_mps.as_ref().map_or(0.0, |a| Self::lerp(a, i, f));
         let mut op = OpPoint {
             omega,
@@ -596,6 +598,7 @@ mod tests {
         let z = vec![0.0; n];
         let inputs = ReplayInputs {
             name: "t".into(),
+            circuit: Circuit::Throttle,
             time_s: time_s.clone(),
             speed_rpm: z.clone(),
             current_a: z.clone(),

@@ -128,6 +128,10 @@ pub struct Mission {
 pub struct ReplayInputs {
     /// Name used in outputs.
     pub name: String,
+    /// Hydraulic circuit of the run: stated in the log (`# circuit:`) or
+    /// inferred from the piston's travel (`diagnosis::reference::circuit_of`),
+    /// never from which columns the file has.
+    pub circuit: Circuit,
     /// Sample times, s (strictly increasing).
     pub time_s: Vec<f64>,
     /// Motor speed, rpm.
@@ -140,7 +144,7 @@ pub struct ReplayInputs {
     pub p_b_bar: Vec<f64>,
     /// Ambient, °C.
     pub ambient_c: Vec<f64>,
-    /// Piston position, mm (absent: throttle circuit, cylinder isolated).
+    /// Piston position, mm (absent: not logged; the servo circuit needs it).
     pub position_mm: Option<Vec<f64>>,
     /// Logged ram-air speed, m/s (absent: still air).
     pub air_speed_mps: Option<Vec<f64>>,

@@ -76,3 +76,68 @@ fn replay_tolerances_keep_the_logged_channels_within_a_fifth_of_the_noise() {
         assert!(w <= 0.02, "{scenario:?}: replay differs from the tight solution by {w:.4} K");
     }
 }
+
+/// The circuit of a replay comes from the log's `# circuit:` line or the
+/// piston's travel, never from whether a `position_mm` column exists: a
+/// throttle log that also logs its stationary piston (12.3 mm ± 0.05 mm of
+/// encoder noise) replays exactly as the same log without the column. Before
+/// the rule, that log was replayed as a servo circuit and the temperatures
+/// moved by kelvins.
+#[test]
+fn a_logged_stationary_piston_does_not_change_the_circuit() {
+    use eha_sim::diagnosis::reference::replay_inputs;
+    use eha_sim::scenario::{Circuit, Scenario};
+    use eha_sim::sim::{simulate_budget, SimOptions};
+    let c = SynthCase { hidden: Candidate::None, scenario: SynthScenario::ThrottleSteps, mismatch: Mismatch::Nuisance, seed: 7, duration_s: 600.0, sample_s: 2.0 };
+    let (plain, _) = generate(&c).expect("generate");
+    assert!(plain.get(Channel::PositionMm).is_none(), "the synthetic throttle log has no position column");
+    let mut with_piston = plain.clone();
+    let noise = |i: usize| 0.05 * ((i as f64) * 0.7).sin();
+    with_piston.set(Channel::PositionMm, (0..plain.len()).map(|i| Some(12.3 + noise(i))).collect());
+    let a = replay_inputs(&plain, "plain").expect("inputs");
+    let b = replay_inputs(&with_piston, "piston").expect("inputs");
+    assert_eq!((a.circuit, b.circuit), (Circuit::Throttle, Circuit::Throttle));
+    let opts = SimOptions { output_interval_s: 10.0, control_interval_s: 10.0 };
+    let rig = eha_sim::rig::Rig::default();
+    let ya = simulate_budget(&rig, &Scenario::Replay(a), &opts, 1e-6, None).expect("replay");
+    let yb = simulate_budget(&rig, &Scenario::Replay(b), &opts, 1e-6, None).expect("replay");
+    for ch in Channel::TEMPERATURES {
+        let (x, y) = (ya.get(ch.name()).expect("channel"), yb.get(ch.name()).expect("channel"));
+        let d = x.iter().zip(y).map(|(p, q)| (p - q).abs()).fold(0.0, f64::max);
+        assert_eq!(d, 0.0, "{ch}: the position column moved the replay by {d} K");
+    }
+}
+
+/// Every other case of the rule: a stated circuit (and a contradiction of
+/// it, with its line), a moving piston, and the ambiguous travel between
+/// 0.5 and 2 mm, refused with the line to add.
+#[test]
+fn the_circuit_is_stated_or_inferred_and_an_ambiguous_log_is_refused() {
+    use eha_sim::diagnosis::reference::circuit_of;
+    use eha_sim::measured::MeasuredRun;
+    use eha_sim::scenario::Circuit;
+    let run = |travel: Option<f64>, meta: Option<&str>| {
+        let mut r = MeasuredRun::new((0..50).map(|i| i as f64).collect());
+        r.push_meta("rig", "bench 3");
+        if let Some(m) = meta {
+            r.push_meta("circuit", m);
+        }
+        if let Some(t) = travel {
+            r.set(Channel::PositionMm, (0..50).map(|i| Some(t * (i as f64 / 49.0))).collect());
+        }
+        r
+    };
+    assert_eq!(circuit_of(&run(None, None)).expect("no column"), Circuit::Throttle);
+    assert_eq!(circuit_of(&run(Some(0.4), None)).expect("stationary"), Circuit::Throttle);
+    assert_eq!(circuit_of(&run(Some(20.0), None)).expect("moving"), Circuit::Servo);
+    assert_eq!(circuit_of(&run(Some(0.1), Some("servo"))).expect("stated"), Circuit::Servo);
+    assert_eq!(circuit_of(&run(Some(0.1), Some(" throttle "))).expect("stated"), Circuit::Throttle);
+    let e = circuit_of(&run(Some(1.0), None)).expect_err("ambiguous").to_string();
+    assert!(e.contains("1.00 mm") && e.contains("# circuit: throttle"), "{e}");
+    let e = circuit_of(&run(Some(20.0), Some("throttle"))).expect_err("contradiction").to_string();
+    assert!(e.starts_with("line 2:") && e.contains("20.00 mm"), "{e}");
+    let e = circuit_of(&run(None, Some("servo"))).expect_err("servo without position").to_string();
+    assert!(e.contains("no position_mm column"), "{e}");
+    let e = circuit_of(&run(None, Some("hydrostatic"))).expect_err("unknown").to_string();
+    assert!(e.contains("expected `throttle` or `servo`"), "{e}");
+}
