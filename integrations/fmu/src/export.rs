@@ -356,6 +356,23 @@ fn type_err(want: &str, got: &Value) -> String {
     format!("the variable is not a {want} (it is {got:?})")
 }
 
+/// Shared body of the numeric getters: `pick` takes the value of the
+/// wanted type out of a [`Value`].
+///
+/// # Safety
+/// FMI contract: arrays of `n` elements.
+unsafe fn get_typed<T>(c: Component, call: &str, want: &str, vr: *const ValueReference, n: usize, value: *mut T, pick: impl Fn(&Value) -> Option<T>) -> Status {
+    // SAFETY: caller contract.
+    let Some(out) = (unsafe { slice_mut(value, n) }) else { return Status::Error };
+    // SAFETY: caller contract.
+    unsafe {
+        get_values(c, call, vr, n, |_, i, v| {
+            out[i] = pick(&v).ok_or_else(|| type_err(want, &v))?;
+            Ok(())
+        })
+    }
+}
+
 /// `fmi2GetReal`.
 ///
 /// # Safety
@@ -363,17 +380,7 @@ fn type_err(want: &str, got: &Value) -> String {
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetReal(c: Component, vr: *const ValueReference, n: usize, value: *mut f64) -> Status {
     // SAFETY: caller contract.
-    let Some(out) = (unsafe { slice_mut(value, n) }) else { return Status::Error };
-    // SAFETY: caller contract.
-    unsafe {
-        get_values(c, "fmi2GetReal", vr, n, |_, i, v| match v {
-            Value::Real(x) => {
-                out[i] = x;
-                Ok(())
-            }
-            o => Err(type_err("Real", &o)),
-        })
-    }
+    unsafe { get_typed(c, "fmi2GetReal", "Real", vr, n, value, |v| if let Value::Real(x) = v { Some(*x) } else { None }) }
 }
 
 /// `fmi2GetInteger`.
@@ -383,17 +390,7 @@ pub unsafe extern "C" fn fmi2GetReal(c: Component, vr: *const ValueReference, n:
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetInteger(c: Component, vr: *const ValueReference, n: usize, value: *mut Integer) -> Status {
     // SAFETY: caller contract.
-    let Some(out) = (unsafe { slice_mut(value, n) }) else { return Status::Error };
-    // SAFETY: caller contract.
-    unsafe {
-        get_values(c, "fmi2GetInteger", vr, n, |_, i, v| match v {
-            Value::Integer(x) => {
-                out[i] = x;
-                Ok(())
-            }
-            o => Err(type_err("Integer", &o)),
-        })
-    }
+    unsafe { get_typed(c, "fmi2GetInteger", "Integer", vr, n, value, |v| if let Value::Integer(x) = v { Some(*x) } else { None }) }
 }
 
 /// `fmi2GetBoolean`.
@@ -403,17 +400,7 @@ pub unsafe extern "C" fn fmi2GetInteger(c: Component, vr: *const ValueReference,
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetBoolean(c: Component, vr: *const ValueReference, n: usize, value: *mut Boolean) -> Status {
     // SAFETY: caller contract.
-    let Some(out) = (unsafe { slice_mut(value, n) }) else { return Status::Error };
-    // SAFETY: caller contract.
-    unsafe {
-        get_values(c, "fmi2GetBoolean", vr, n, |_, i, v| match v {
-            Value::Boolean(x) => {
-                out[i] = Boolean::from(x);
-                Ok(())
-            }
-            o => Err(type_err("Boolean", &o)),
-        })
-    }
+    unsafe { get_typed(c, "fmi2GetBoolean", "Boolean", vr, n, value, |v| if let Value::Boolean(x) = v { Some(Boolean::from(*x)) } else { None }) }
 }
 
 /// `fmi2GetString`: the strings stay valid until the next fmi2GetString.

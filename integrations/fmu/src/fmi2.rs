@@ -134,6 +134,23 @@ pub struct Var {
     pub description: &'static str,
 }
 
+impl Var {
+    /// A `Real` input with its start value.
+    pub const fn real_input(vr: ValueReference, name: &'static str, unit: &'static str, start: f64, description: &'static str) -> Self {
+        Self { vr, name, causality: Causality::Input, ty: VarType::Real { unit, start: Some(start) }, description }
+    }
+
+    /// A `Real` output.
+    pub const fn real_output(vr: ValueReference, name: &'static str, unit: &'static str, description: &'static str) -> Self {
+        Self { vr, name, causality: Causality::Output, ty: VarType::Real { unit, start: None }, description }
+    }
+
+    /// A variable of any other kind.
+    pub const fn new(vr: ValueReference, name: &'static str, causality: Causality, ty: VarType, description: &'static str) -> Self {
+        Self { vr, name, causality, ty, description }
+    }
+}
+
 /// A value crossing the interface.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Value {

@@ -29,52 +29,25 @@ mod vr {
     pub const PARAMS: u32 = 20;
 }
 
-const fn real_in(vr: u32, name: &'static str, unit: &'static str, start: f64, description: &'static str) -> Var {
-    Var { vr, name, causality: Causality::Input, ty: VarType::Real { unit, start: Some(start) }, description }
-}
-
-const fn real_out(vr: u32, name: &'static str, unit: &'static str, description: &'static str) -> Var {
-    Var { vr, name, causality: Causality::Output, ty: VarType::Real { unit, start: None }, description }
-}
-
-const fn bool_out(vr: u32, name: &'static str, description: &'static str) -> Var {
-    Var { vr, name, causality: Causality::Output, ty: VarType::Boolean { start: None }, description }
-}
+/// Boolean outputs have no start value.
+const BOOL_OUT: VarType = VarType::Boolean { start: None };
 
 static VARS: [Var; 15] = [
-    real_in(vr::CURRENT, "current_a", "A", 0.0, "Motor phase current (RMS)"),
-    real_in(vr::P_A, "p_a_bar", "bar", 0.0, "Pump port A pressure (gauge)"),
-    real_in(vr::P_B, "p_b_bar", "bar", 0.0, "Pump port B pressure (gauge)"),
-    real_in(vr::SPEED, "speed_rpm", "rpm", 0.0, "Motor = pump shaft speed, signed by direction"),
-    real_in(vr::POSITION, "position_mm", "mm", 0.0, "Piston position from the linear encoder"),
-    real_in(vr::AMBIENT, "ambient_c", "degC", 20.0, "Ambient air temperature near the actuator"),
-    Var {
-        vr: vr::VALVE_FB,
-        name: "valve_feedback",
-        causality: Causality::Input,
-        ty: VarType::Integer { start: Some(-1) },
-        description: "LNG valve position switch: -1 = not wired, 0 = shut, 1 = open",
-    },
-    real_out(vr::DRAIN, "drain_c", "degC", "Estimated pump drain-port oil temperature (1e6 when the model is refused: CONFIG fault)"),
-    bool_out(vr::VALVE, "valve_open", "LNG cooling valve command (true = open)"),
-    bool_out(vr::ALARM, "alarm", "Over-temperature alarm (drain above 60 degC, cleared below 58 degC) or untrusted estimate"),
-    bool_out(vr::DERATE, "derate", "Derate request to the actuator controller"),
-    Var {
-        vr: vr::FAULTS,
-        name: "faults",
-        causality: Causality::Output,
-        ty: VarType::Integer { start: None },
-        description: "Latched fault word (eha_guard::faults, docs/firmware.md)",
-    },
-    real_out(vr::LNG_KG, "lng_remaining_kg", "kg", "LNG remaining in the tank model"),
-    real_out(vr::LNG_S, "lng_seconds_left", "s", "Seconds of LNG cooling left at the present dissipation"),
-    Var {
-        vr: vr::PARAMS,
-        name: "params_file",
-        causality: Causality::Parameter,
-        ty: VarType::String { start: "" },
-        description: "Firmware parameter block file (eha-sim params-block / commission); empty = the compiled-in paper rig",
-    },
+    Var::real_input(vr::CURRENT, "current_a", "A", 0.0, "Motor phase current (RMS)"),
+    Var::real_input(vr::P_A, "p_a_bar", "bar", 0.0, "Pump port A pressure (gauge)"),
+    Var::real_input(vr::P_B, "p_b_bar", "bar", 0.0, "Pump port B pressure (gauge)"),
+    Var::real_input(vr::SPEED, "speed_rpm", "rpm", 0.0, "Motor = pump shaft speed, signed by direction"),
+    Var::real_input(vr::POSITION, "position_mm", "mm", 0.0, "Piston position from the linear encoder"),
+    Var::real_input(vr::AMBIENT, "ambient_c", "degC", 20.0, "Ambient air temperature near the actuator"),
+    Var::new(vr::VALVE_FB, "valve_feedback", Causality::Input, VarType::Integer { start: Some(-1) }, "LNG valve position switch: -1 = not wired, 0 = shut, 1 = open"),
+    Var::real_output(vr::DRAIN, "drain_c", "degC", "Estimated pump drain-port oil temperature (1e6 when the model is refused: CONFIG fault)"),
+    Var::new(vr::VALVE, "valve_open", Causality::Output, BOOL_OUT, "LNG cooling valve command (true = open)"),
+    Var::new(vr::ALARM, "alarm", Causality::Output, BOOL_OUT, "Over-temperature alarm (drain above 60 degC, cleared below 58 degC) or untrusted estimate"),
+    Var::new(vr::DERATE, "derate", Causality::Output, BOOL_OUT, "Derate request to the actuator controller"),
+    Var::new(vr::FAULTS, "faults", Causality::Output, VarType::Integer { start: None }, "Latched fault word (eha_guard::faults, docs/firmware.md)"),
+    Var::real_output(vr::LNG_KG, "lng_remaining_kg", "kg", "LNG remaining in the tank model"),
+    Var::real_output(vr::LNG_S, "lng_seconds_left", "s", "Seconds of LNG cooling left at the present dissipation"),
+    Var::new(vr::PARAMS, "params_file", Causality::Parameter, VarType::String { start: "" }, "Firmware parameter block file (eha-sim params-block / commission); empty = the compiled-in paper rig"),
 ];
 
 /// The guard FMU's state.

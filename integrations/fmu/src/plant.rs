@@ -79,60 +79,30 @@ fn describe(name: &str) -> &'static str {
 fn vars() -> &'static [Var] {
     static VARS: OnceLock<Vec<Var>> = OnceLock::new();
     VARS.get_or_init(|| {
-        let real_in = |vr, name, unit, start, description| Var {
-            vr,
-            name,
-            causality: Causality::Input,
-            ty: VarType::Real { unit, start: Some(start) },
-            description,
-        };
+        let real_in = Var::real_input;
         let mut v = vec![
             real_in(vr::SPEED, "cmd_speed_rpm", "rpm", 500.0, "Motor speed command (throttle circuit)"),
             real_in(vr::NEEDLE, "cmd_needle_bar", "bar", 0.0, "Needle-valve setting: its pressure drop at the 500 rpm reference flow (throttle circuit)"),
             real_in(vr::POSITION, "cmd_position_mm", "mm", 0.0, "Piston position reference (servo circuit)"),
             real_in(vr::AMBIENT, "in_ambient_c", "degC", 16.0, "Ambient air temperature (also the initial temperature of every node)"),
             real_in(vr::AIR, "in_air_speed_mps", "m/s", 0.0, "Ram-air speed over the housings"),
-            Var {
-                vr: vr::LNG,
-                name: "cmd_lng_valve",
-                causality: Causality::Input,
-                ty: VarType::Boolean { start: Some(false) },
-                description: "LNG cooling valve command (true = open)",
-            },
-            Var {
-                vr: vr::RIG,
-                name: "rig_file",
-                causality: Causality::Parameter,
-                ty: VarType::String { start: "" },
-                description: "Rig file (TOML, eha-sim rig format); empty = the paper rig (Liu et al., Tables 2-3)",
-            },
-            Var {
-                vr: vr::CIRCUIT,
-                name: "circuit",
-                causality: Causality::Parameter,
-                ty: VarType::Integer { start: Some(0) },
-                description: "Hydraulic circuit: 0 = throttle (paper Case 1), 1 = servo (Case 2)",
-            },
-            Var {
-                vr: vr::RTOL,
-                name: "rtol",
-                causality: Causality::Parameter,
-                ty: VarType::Real { unit: "1", start: Some(eha_sim::plant::RTOL) },
-                description: "Relative tolerance of the BDF error control (fmi2SetupExperiment's tolerance overrides it when defined)",
-            },
+            Var::new(vr::LNG, "cmd_lng_valve", Causality::Input, VarType::Boolean { start: Some(false) }, "LNG cooling valve command (true = open)"),
+            Var::new(vr::RIG, "rig_file", Causality::Parameter, VarType::String { start: "" }, "Rig file (TOML, eha-sim rig format); empty = the paper rig (Liu et al., Tables 2-3)"),
+            Var::new(vr::CIRCUIT, "circuit", Causality::Parameter, VarType::Integer { start: Some(0) }, "Hydraulic circuit: 0 = throttle (paper Case 1), 1 = servo (Case 2)"),
+            Var::new(
+                vr::RTOL,
+                "rtol",
+                Causality::Parameter,
+                VarType::Real { unit: "1", start: Some(eha_sim::plant::RTOL) },
+                "Relative tolerance of the BDF error control (fmi2SetupExperiment's tolerance overrides it when defined)",
+            ),
         ];
         let probe = Plant::new(&Rig::default(), &Scenario::Mission(mission(Circuit::Throttle, &Inputs::default())))
             .map(|p| p.snapshot())
             .ok();
         if let Some(s) = probe {
             for (i, (name, _)) in channels(&s).into_iter().enumerate() {
-                v.push(Var {
-                    vr: FIRST_OUTPUT + i as u32,
-                    name,
-                    causality: Causality::Output,
-                    ty: VarType::Real { unit: unit_of(name).unwrap_or("1"), start: None },
-                    description: describe(name),
-                });
+                v.push(Var::real_output(FIRST_OUTPUT + i as u32, name, unit_of(name).unwrap_or("1"), describe(name)));
             }
         }
         v
