@@ -114,6 +114,13 @@ impl<N: Num> GuardOf<N> {
     /// Thermal-memory record of the present state, valve state included
     /// (sealed with its CRC; sequence number 0: the writer sets it).
     pub fn snapshot(&self) -> ThermalRecord {
+        let r = self.snapshot_unsealed();
+        r.with_seq(r.seq(), r.valve_open())
+    }
+
+    /// [`GuardOf::snapshot`] without its CRC, for a writer that seals it
+    /// ([`crate::memory::slots::AbWriter::write`]): one CRC per record.
+    pub fn snapshot_unsealed(&self) -> ThermalRecord {
         let mut temps = [0.0f32; N_NODES];
         let mut amb = 0.0;
         if let Some(c) = self.core_ok.then_some(&self.core) {
@@ -122,14 +129,16 @@ impl<N: Num> GuardOf<N> {
             }
             amb = c.model.ambient_c().to_f32();
         }
-        ThermalRecord::new(
-            temps,
-            amb,
-            self.lng.used_cj(),
-            (self.faults() & !faults::LNG_LOW).bits(),
-            self.tick,
-        )
-        .with_seq(0, self.valve.is_open())
+        let mut r = ThermalRecord::unsealed(temps, amb, self.lng.used_cj(), (self.faults() & !faults::LNG_LOW).bits(), self.tick);
+        r.seq_flags = if self.valve.is_open() { crate::memory::FLAG_VALVE_OPEN } else { 0 };
+        r
+    }
+
+    /// Counts every change of the outputs or of the state the thermal record
+    /// holds (model step, fault latched or cleared, valve, LNG refill): a
+    /// record written at one value of it is still current while it holds.
+    pub fn epoch(&self) -> u32 {
+        self.epoch
     }
 
     /// The event trace (most recent [`crate::trace::TRACE_LEN`] events).

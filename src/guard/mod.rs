@@ -178,6 +178,8 @@ pub struct GuardOf<N: Num> {
     /// fail-safe opening, a model step, clear/refill): a tick on the fast path
     /// returns them as they are.
     out: Output,
+    /// Changes of the outputs and of the recorded state ([`GuardOf::epoch`]).
+    epoch: u32,
     trace: TraceBuf,
 }
 
@@ -241,6 +243,7 @@ impl<N: Num> GuardOf<N> {
                 drain_c: DRAIN_C_UNKNOWN,
                 ..Output::default()
             },
+            epoch: 0,
             trace: TraceBuf::new(),
             );
             &mut *p

@@ -186,6 +186,7 @@ impl<N: Num> GuardOf<N> {
 
     /// Rebuilds the cached outputs from the present state.
     pub(super) fn refresh_out(&mut self) {
+        self.epoch = self.epoch.wrapping_add(1);
         self.out = Output {
             drain_c: self.out.drain_c,
             valve_open: self.valve.is_open(),

@@ -162,7 +162,21 @@ impl ThermalRecord {
         faults: u16,
         tick: u32,
     ) -> Self {
-        let mut r = ThermalRecord {
+        let mut r = Self::unsealed(temps_c, ambient_c, lng_used_cj, faults, tick);
+        r.crc = r.body_crc();
+        r
+    }
+
+    /// [`ThermalRecord::new`] without its CRC (0): for a writer that seals it
+    /// itself ([`ThermalRecord::with_seq`]), so the CRC is taken once.
+    pub fn unsealed(
+        temps_c: [f32; N_NODES],
+        ambient_c: f32,
+        lng_used_cj: u32,
+        faults: u16,
+        tick: u32,
+    ) -> Self {
+        ThermalRecord {
             lng_used_cj,
             magic: MAGIC,
             version: VERSION,
@@ -173,9 +187,7 @@ impl ThermalRecord {
             seq_flags: 0,
             rtc_s: RTC_NONE,
             crc: 0,
-        };
-        r.crc = r.body_crc();
-        r
+        }
     }
 
     /// The same record stamped with the real-time clock `rtc_s` (seconds;

@@ -175,6 +175,10 @@ impl NvPolicy {
 pub struct RamFlash<const BYTES: usize> {
     mem: [u8; BYTES],
     erases: [u32; 64],
+    /// Every read fails (a dead flash or bus: fault injection).
+    pub fail_reads: bool,
+    /// Every write and erase fails (a worn or locked flash: fault injection).
+    pub fail_writes: bool,
 }
 
 /// Erase page of [`RamFlash`], bytes.
@@ -183,7 +187,7 @@ pub const RAM_FLASH_PAGE: usize = 1024;
 impl<const BYTES: usize> RamFlash<BYTES> {
     /// An erased flash (all ones).
     pub fn new() -> Self {
-        RamFlash { mem: [0xFF; BYTES], erases: [0; 64] }
+        RamFlash { mem: [0xFF; BYTES], erases: [0; 64], fail_reads: false, fail_writes: false }
     }
 
     /// Erase count of each page (the first `BYTES / 1024`).
@@ -215,6 +219,9 @@ impl<const BYTES: usize> blocking::ErrorType for RamFlash<BYTES> {
 impl<const BYTES: usize> blocking::ReadNorFlash for RamFlash<BYTES> {
     const READ_SIZE: usize = 1;
     fn read(&mut self, offset: u32, bytes: &mut [u8]) -> Result<(), RamFlashError> {
+        if self.fail_reads {
+            return Err(RamFlashError);
+        }
         let o = offset as usize;
         let src = self.mem.get(o..o + bytes.len()).ok_or(RamFlashError)?;
         bytes.copy_from_slice(src);
@@ -229,6 +236,9 @@ impl<const BYTES: usize> blocking::NorFlash for RamFlash<BYTES> {
     const WRITE_SIZE: usize = 4;
     const ERASE_SIZE: usize = RAM_FLASH_PAGE;
     fn erase(&mut self, from: u32, to: u32) -> Result<(), RamFlashError> {
+        if self.fail_writes {
+            return Err(RamFlashError);
+        }
         let (f, t) = (from as usize, to as usize);
         if !f.is_multiple_of(RAM_FLASH_PAGE) || !t.is_multiple_of(RAM_FLASH_PAGE) || t > BYTES || f > t {
             return Err(RamFlashError);
@@ -242,6 +252,9 @@ impl<const BYTES: usize> blocking::NorFlash for RamFlash<BYTES> {
         Ok(())
     }
     fn write(&mut self, offset: u32, bytes: &[u8]) -> Result<(), RamFlashError> {
+        if self.fail_writes {
+            return Err(RamFlashError);
+        }
         let o = offset as usize;
         if !o.is_multiple_of(4) || !bytes.len().is_multiple_of(4) {
             return Err(RamFlashError);

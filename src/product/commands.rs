@@ -3,11 +3,32 @@
 //! executed and acknowledged, trace dumps and the status reply.
 
 use super::wire::{self, Ack, AckResult, Cmd, Command, Status, TraceReply, KIND_COMMAND};
-use super::{App, Board, TRACE_EVENTS_PER_TICK};
+use super::{AppOf, Board, TRACE_EVENTS_PER_TICK};
+use crate::num::Num;
 use crate::protocol::{DecodeError, Request};
 use crate::trace::Trace;
 
-impl App {
+/// A received frame, parsed: a sample or a command.
+pub(super) enum Incoming {
+    /// A sample request.
+    Sample(Request),
+    /// A command.
+    Command(Command),
+}
+
+impl Incoming {
+    /// The frame a CRC-checked payload holds (by its kind byte).
+    #[inline(always)]
+    pub(super) fn parse(res: Result<&[u8], DecodeError>) -> Result<Incoming, DecodeError> {
+        let payload = res?;
+        if payload.first() == Some(&KIND_COMMAND) {
+            return Command::from_payload(payload).map(Incoming::Command);
+        }
+        Request::from_payload(payload).map(Incoming::Sample)
+    }
+}
+
+impl<N: Num> AppOf<N> {
     // cold path, kept out of the tick loop's code (flash)
     #[inline(never)]
     pub(super) fn reject(&mut self, e: DecodeError) {
@@ -21,24 +42,15 @@ impl App {
 
     /// One received frame: a sample (sequence rule: newer than the last
     /// accepted, within half the u16 range) or a command.
-    pub(super) fn accept(&mut self, res: Result<crate::protocol::Payload, DecodeError>) {
-        let payload = match res {
-            Ok(p) => p,
-            Err(e) => return self.reject(e),
-        };
-        if payload.first() == Some(&KIND_COMMAND) {
-            match Command::from_payload(&payload) {
-                Ok(c) => {
-                    if self.commands.push_back(c).is_err() {
-                        self.reject(DecodeError::Overflow);
-                    }
+    pub(super) fn accept(&mut self, frame: Result<Incoming, DecodeError>) {
+        let req = match frame {
+            Ok(Incoming::Sample(r)) => r,
+            Ok(Incoming::Command(c)) => {
+                if self.commands.push_back(c).is_err() {
+                    self.reject(DecodeError::Overflow);
                 }
-                Err(e) => self.reject(e),
+                return;
             }
-            return;
-        }
-        let req = match Request::from_payload(&payload) {
-            Ok(r) => r,
             Err(e) => return self.reject(e),
         };
         if let Some(last) = self.last_seq {

@@ -19,6 +19,7 @@
 
 pub mod clock;
 mod commands;
+pub mod mem_board;
 pub mod reset;
 pub mod wire;
 
@@ -27,10 +28,11 @@ use crate::protection::LngConfig;
 use crate::memory::slots::{self, AbWriter};
 use crate::memory::cooling::RestCooling;
 use crate::memory::{boot_restore, Restore, ThermalRecord};
-use crate::protocol::{Deframer, Request, MAX_MISSED_TICKS};
+use crate::num::Num;
+use crate::protocol::{Deframer, Request};
 use crate::trace::{RestoreKind, Trace};
 use crate::params_block::{self, ParamSource, BLOCK_LEN};
-use crate::{Guard, GuardConfig, Output};
+use crate::{GuardConfig, GuardOf, Output, Real};
 use heapless::Deque;
 use reset::CauseRecord;
 use wire::{Command, Pins, ResetCause, TickReply};
@@ -40,6 +42,10 @@ use wire::{Command, Pins, ResetCause, TickReply};
 pub const TRACE_EVENTS_PER_TICK: usize = 4;
 /// Commands queued per tick; more are rejected (counted as framing).
 pub const COMMAND_QUEUE: usize = 4;
+/// Most timer periods one tick catches up as missing ticks (after an
+/// overrun). After `stale_ticks` (5) misses STALE has latched and the guard
+/// runs on worst-case inputs; a longer gap would only spend time.
+pub const MAX_MISSED_TICKS: u32 = 100;
 /// Ticks to wait after a failed non-volatile save before the next attempt
 /// (60 s): a dead or worn flash must not cost an erase attempt, which can
 /// stall the MCU for seconds, on every tick.
@@ -149,20 +155,31 @@ impl Counters {
     }
 }
 
-/// The product application state (one per board, lives for the whole run).
-pub struct App {
+/// The product application of the firmware build's number type.
+pub type App = AppOf<Real>;
+
+/// The product application state (one per board, lives for the whole run),
+/// generic over the guard's number type (the boards run [`App`]; the host
+/// runs the fixed-point build's too, as the twin of the M3 PIL image).
+#[derive(Clone)]
+pub struct AppOf<N: Num> {
     lng: LngConfig,
-    guard: Guard,
+    guard: GuardOf<N>,
     rx: Deframer,
     last_seq: Option<u16>,
     sample: Option<Request>,
     commands: Deque<Command, COMMAND_QUEUE>,
     counters: Counters,
     records: AbWriter,
+    /// The guard's [`GuardOf::epoch`] when the A/B record was last written
+    /// (the record is rewritten only when the state it holds changed).
+    record_epoch: Option<u32>,
     nv_policy: NvPolicy,
     nv_last: Option<ThermalRecord>,
-    /// No non-volatile save attempt before this tick (after a failure).
-    nv_retry_at: u32,
+    /// Tick of the last failed non-volatile save: no attempt for
+    /// [`NV_RETRY_TICKS`] after it (compared by wrapping difference, so the
+    /// 497-day wrap of the tick counter does not stop the saves).
+    nv_failed_at: Option<u32>,
     tick: u32,
     restore: RestoreKind,
     reset_cause: ResetCause,
@@ -183,11 +200,11 @@ fn restore_kind(r: &Restore) -> RestoreKind {
     }
 }
 
-impl App {
+impl<N: Num> AppOf<N> {
     /// Boots: the reset cause, the thermal state (RAM records, else the
     /// non-volatile one, see [`boot_restore`]), the guard, and the safe
     /// outputs of a guard waiting for its first sample (valve open).
-    pub fn boot<B: Board>(board: &mut B, cfg: &GuardConfig, mem: &BootMemory) -> App {
+    pub fn boot<B: Board>(board: &mut B, cfg: &GuardConfig, mem: &BootMemory) -> Self {
         let mut slot = core::mem::MaybeUninit::uninit();
         Self::boot_into(&mut slot, board, cfg, mem);
         // SAFETY: `boot_into` initialised every field.
@@ -197,7 +214,7 @@ impl App {
     /// [`App::boot`] into `slot` (a static on the target): each field is
     /// written in place, so the boot stack holds no copy of the whole state.
     #[inline(never)]
-    pub fn boot_into<'a, B: Board>(slot: &'a mut core::mem::MaybeUninit<App>, board: &mut B, cfg: &GuardConfig, mem: &BootMemory) -> &'a mut App {
+    pub fn boot_into<'a, B: Board>(slot: &'a mut core::mem::MaybeUninit<Self>, board: &mut B, cfg: &GuardConfig, mem: &BootMemory) -> &'a mut Self {
         let (reset_cause, boots, running) = reset::at_boot(&mem.cause, mem.hw_hint);
         board.store_cause(&running);
         let (a, b) = &mem.records;
@@ -222,7 +239,7 @@ impl App {
         // SAFETY: `p` points to `slot`, valid for writes; every field is written
         // exactly once below before the reference is created.
         let app = unsafe {
-            Guard::new_in(&mut *core::ptr::addr_of_mut!((*p).guard).cast::<core::mem::MaybeUninit<Guard>>(), &cfg, restore);
+            GuardOf::<N>::new_in(&mut *core::ptr::addr_of_mut!((*p).guard).cast::<core::mem::MaybeUninit<GuardOf<N>>>(), &cfg, restore);
             core::ptr::addr_of_mut!((*p).lng).write(cfg.lng);
             core::ptr::addr_of_mut!((*p).rx).write(Deframer::new());
             core::ptr::addr_of_mut!((*p).last_seq).write(None);
@@ -232,7 +249,8 @@ impl App {
             core::ptr::addr_of_mut!((*p).records).write(AbWriter::after_boot(a, b));
             core::ptr::addr_of_mut!((*p).nv_policy).write(nv_policy);
             core::ptr::addr_of_mut!((*p).nv_last).write(mem.nv);
-            core::ptr::addr_of_mut!((*p).nv_retry_at).write(0);
+            core::ptr::addr_of_mut!((*p).record_epoch).write(None);
+            core::ptr::addr_of_mut!((*p).nv_failed_at).write(None);
             core::ptr::addr_of_mut!((*p).tick).write(0);
             core::ptr::addr_of_mut!((*p).restore).write(restore_kind(&restore));
             core::ptr::addr_of_mut!((*p).reset_cause).write(reset_cause);
@@ -285,22 +303,26 @@ impl App {
         self.tick = self.tick.wrapping_add(1).wrapping_add(lost);
 
         // 1. transport
-        let mut buf = [0u8; 32];
+        let mut buf = [0u8; 64];
         loop {
             let n = board.read_rx(&mut buf);
             let Some(chunk) = buf.get(..n) else { break };
             if chunk.is_empty() {
                 break;
             }
-            for &b in chunk {
-                if let Some(res) = self.rx.push(b) {
-                    self.accept(res);
+            let mut rest = chunk;
+            while !rest.is_empty() {
+                let (n, res) = self.rx.feed(rest);
+                if let Some(res) = res {
+                    let frame = commands::Incoming::parse(res);
+                    self.accept(frame);
                 }
+                rest = rest.get(n..).unwrap_or(&[]);
             }
         }
 
         // 2. validate, estimate, protect
-        for _ in 0..lost.min(u32::from(MAX_MISSED_TICKS)) {
+        for _ in 0..lost.min(MAX_MISSED_TICKS) {
             let _ = self.guard.tick_missing();
         }
         let fresh = self.sample.take();
@@ -319,16 +341,8 @@ impl App {
 
         // 3. outputs
         let (out, pins) = self.drive(board, out);
-        let rec = self.guard.snapshot();
-        self.records.write(&rec, |slot, r| board.store_record(slot, r));
-        if self.tick >= self.nv_retry_at && self.nv_policy.due(self.nv_last.as_ref(), &rec) {
-            let rec = rec.with_rtc(board.rtc_s());
-            if board.nv_save(&rec) {
-                self.nv_last = Some(rec);
-            } else {
-                self.counters.nv_failures = self.counters.nv_failures.saturating_add(1);
-                self.nv_retry_at = self.tick.saturating_add(NV_RETRY_TICKS);
-            }
+        if self.record_epoch != Some(self.guard.epoch()) {
+            self.save(board);
         }
         let reply = TickReply {
             tick: self.tick,
@@ -354,6 +368,27 @@ impl App {
         board.feed_watchdog();
     }
 
+    /// The thermal record, written when the state it holds has changed
+    /// (a model step, a fault, the valve, a clear or refill: between those
+    /// only its tick count would differ): the next A/B slot, and the
+    /// non-volatile store when its policy says so.
+    #[inline(never)]
+    fn save<B: Board>(&mut self, board: &mut B) {
+        self.record_epoch = Some(self.guard.epoch());
+        let rec = self.records.write(&self.guard.snapshot_unsealed(), |slot, r| board.store_record(slot, r));
+        let retry = self.nv_failed_at.is_none_or(|t| self.tick.wrapping_sub(t) >= NV_RETRY_TICKS);
+        if retry && self.nv_policy.due(self.nv_last.as_ref(), &rec) {
+            let rec = rec.with_rtc(board.rtc_s());
+            if board.nv_save(&rec) {
+                self.nv_last = Some(rec);
+                self.nv_failed_at = None;
+            } else {
+                self.counters.nv_failures = self.counters.nv_failures.saturating_add(1);
+                self.nv_failed_at = Some(self.tick);
+            }
+        }
+    }
+
     /// Writes the pins for `out`; a read-back that differs latches ACTUATOR,
     /// which opens the valve, and the pins are written again.
     fn drive<B: Board>(&mut self, board: &mut B, out: Output) -> (Output, Pins) {
@@ -369,7 +404,7 @@ impl App {
     }
 
     /// The guard (read only).
-    pub fn guard(&self) -> &Guard {
+    pub fn guard(&self) -> &GuardOf<N> {
         &self.guard
     }
 

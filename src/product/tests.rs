@@ -7,110 +7,24 @@ use super::*;
 use crate::protocol::Deframer;
 use wire::{Ack, AckResult, Cmd, FromGuard, TraceReply};
 
-/// A board in memory: RX bytes queued by the test, TX bytes collected,
-/// pins with an optional stuck valve pin, records kept like no-init RAM.
-struct SimBoard {
-    rx: StdVec<u8>,
-    tx: StdVec<u8>,
-    pins: Pins,
-    stuck_valve_pin: Option<bool>,
-    feeds: u32,
-    ticks: u32,
-    records: [ThermalRecord; 2],
-    cause: CauseRecord,
-    /// `Some(ok)`: the board has a non-volatile store whose saves return `ok`.
-    nv: Option<bool>,
-    nv_calls: u32,
-    /// The flash's parameter-block region (`None`: the board has none).
-    block: Option<&'static [u8; BLOCK_LEN]>,
-    /// The real-time clock's reading, s (`None`: no clock).
-    rtc: Option<u32>,
-    /// The last record handed to `nv_save`.
-    nv_saved: Option<ThermalRecord>,
+use crate::Guard;
+use mem_board::MemBoard;
+
+/// Everything the guard sent since the last call, decoded.
+fn replies(b: &mut MemBoard) -> StdVec<FromGuard> {
+    let mut d = Deframer::new();
+    let mut out = StdVec::new();
+    for &x in b.take_tx().iter() {
+        if let Some(Ok(p)) = d.push(x) {
+            out.push(FromGuard::from_payload(p).expect("guard frames decode"));
+        }
+    }
+    out
 }
 
-impl SimBoard {
-    fn new() -> Self {
-        SimBoard {
-            rx: StdVec::new(),
-            tx: StdVec::new(),
-            pins: Pins::default(),
-            stuck_valve_pin: None,
-            feeds: 0,
-            ticks: 0,
-            records: [ThermalRecord::EMPTY; 2],
-            cause: CauseRecord::new(0, 0),
-            nv: None,
-            nv_calls: 0,
-            block: None,
-            rtc: None,
-            nv_saved: None,
-        }
-    }
-
-    fn mem(&self) -> BootMemory {
-        BootMemory { records: (self.records[0], self.records[1]), nv: None, cause: self.cause, hw_hint: None }
-    }
-
-    /// Everything the guard sent since the last call, decoded.
-    fn replies(&mut self) -> StdVec<FromGuard> {
-        let mut d = Deframer::new();
-        let mut out = StdVec::new();
-        for b in core::mem::take(&mut self.tx) {
-            if let Some(Ok(p)) = d.push(b) {
-                out.push(FromGuard::from_payload(&p).expect("guard frames decode"));
-            }
-        }
-        out
-    }
-}
-
-impl Board for SimBoard {
-    fn read_rx(&mut self, buf: &mut [u8]) -> usize {
-        let n = buf.len().min(self.rx.len());
-        buf[..n].copy_from_slice(&self.rx[..n]);
-        self.rx.drain(..n);
-        n
-    }
-    fn rx_dropped(&self) -> u32 {
-        0
-    }
-    fn write_tx(&mut self, bytes: &[u8]) {
-        self.tx.extend_from_slice(bytes);
-    }
-    fn set_pins(&mut self, pins: Pins) -> Pins {
-        self.pins = pins;
-        if let Some(v) = self.stuck_valve_pin {
-            self.pins.valve_pin = v;
-        }
-        self.pins
-    }
-    fn feed_watchdog(&mut self) {
-        self.feeds += 1;
-    }
-    fn ticks(&self) -> u32 {
-        self.ticks
-    }
-    fn wait_tick(&mut self, _seen: u32) {
-        self.ticks += 1;
-    }
-    fn store_record(&mut self, slot: usize, rec: &ThermalRecord) {
-        self.records[slot & 1] = *rec;
-    }
-    fn store_cause(&mut self, rec: &CauseRecord) {
-        self.cause = *rec;
-    }
-    fn nv_save(&mut self, rec: &ThermalRecord) -> bool {
-        self.nv_calls += 1;
-        self.nv_saved = Some(*rec);
-        self.nv.unwrap_or(false)
-    }
-    fn rtc_s(&mut self) -> Option<u32> {
-        self.rtc
-    }
-    fn param_block(&self) -> Option<&'static [u8; BLOCK_LEN]> {
-        self.block
-    }
+/// A powered-on board (boxed: it holds a 16 KiB flash).
+fn board() -> std::boxed::Box<MemBoard> {
+    std::boxed::Box::new(MemBoard::new())
 }
 
 fn sample(seq: u16, current_a: f32, p_a_bar: f32) -> Request {
@@ -134,15 +48,15 @@ fn ticks(r: &[FromGuard]) -> StdVec<TickReply> {
 /// guard waits without a fault; the watchdog is fed once per completed tick.
 #[test]
 fn waits_with_valve_open_until_the_first_sample() {
-    let mut b = SimBoard::new();
-    let mem = b.mem();
-    let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
+    let mut b = board();
+    let mem = b.boot_memory();
+    let mut app = App::boot(&mut *b, &GuardConfig::DEFAULT, &mem);
     assert_eq!(b.pins, Pins { valve_pin: false, ok_pin: true }, "boot: valve open (pin low), no alarm");
     assert_eq!(app.reset_cause(), ResetCause::PowerOn);
     for _ in 0..20 {
-        app.tick(&mut b, 0);
+        app.tick(&mut *b, 0);
     }
-    let t = ticks(&b.replies());
+    let t = ticks(&replies(&mut b));
     assert_eq!(t.len(), 20, "one tick reply per tick");
     assert!(t.iter().all(|r| !r.fresh && r.out.valve_open && r.out.faults.is_empty() && !r.pins.valve_pin));
     assert_eq!(b.feeds, 20);
@@ -152,16 +66,16 @@ fn waits_with_valve_open_until_the_first_sample() {
 /// samples (bit-identical outputs), one tick reply per tick.
 #[test]
 fn one_sample_per_tick_matches_the_bare_guard() {
-    let mut b = SimBoard::new();
-    let mem = b.mem();
-    let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
+    let mut b = board();
+    let mem = b.boot_memory();
+    let mut app = App::boot(&mut *b, &GuardConfig::DEFAULT, &mem);
     let mut bare = Guard::new(&GuardConfig::DEFAULT, Restore::Cold);
     for k in 0..300u16 {
         let s = sample(k, 20.0 + f32::from(k % 7), 60.0);
-        b.rx.extend_from_slice(&s.encode());
-        app.tick(&mut b, 0);
+        b.push_rx(&s.encode());
+        app.tick(&mut *b, 0);
         let want = bare.tick(&s.sample());
-        let t = ticks(&b.replies());
+        let t = ticks(&replies(&mut b));
         assert_eq!(t.len(), 1);
         assert!(t[0].fresh && t[0].sample_seq == k);
         assert!(crate::protocol::GuardOutput::bit_eq(&t[0].out, &want), "tick {k}: {:?} vs {want:?}", t[0].out);
@@ -175,16 +89,16 @@ fn one_sample_per_tick_matches_the_bare_guard() {
 /// rejected.
 #[test]
 fn newest_sample_wins_missing_ticks_count_and_old_frames_are_rejected() {
-    let mut b = SimBoard::new();
-    let mem = b.mem();
-    let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
-    b.rx.extend_from_slice(&sample(1, 10.0, 50.0).encode());
-    b.rx.extend_from_slice(&sample(2, 11.0, 50.0).encode());
-    app.tick(&mut b, 0);
-    app.tick(&mut b, 0);
-    b.rx.extend_from_slice(&sample(2, 11.0, 50.0).encode());
-    app.tick(&mut b, 0);
-    let t = ticks(&b.replies());
+    let mut b = board();
+    let mem = b.boot_memory();
+    let mut app = App::boot(&mut *b, &GuardConfig::DEFAULT, &mem);
+    b.push_rx(&sample(1, 10.0, 50.0).encode());
+    b.push_rx(&sample(2, 11.0, 50.0).encode());
+    app.tick(&mut *b, 0);
+    app.tick(&mut *b, 0);
+    b.push_rx(&sample(2, 11.0, 50.0).encode());
+    app.tick(&mut *b, 0);
+    let t = ticks(&replies(&mut b));
     assert_eq!((t[0].fresh, t[0].sample_seq, t[1].fresh, t[2].fresh), (true, 2, false, false));
     let c = app.counters();
     assert_eq!((c.accepted, c.superseded, c.missing, c.rejected_sequence), (2, 1, 2, 1));
@@ -195,19 +109,19 @@ fn newest_sample_wins_missing_ticks_count_and_old_frames_are_rejected() {
 /// tick (the model's clock keeps up), and the overrun is counted and traced.
 #[test]
 fn overrun_periods_become_missing_ticks_and_are_counted() {
-    let mut b = SimBoard::new();
-    let mem = b.mem();
-    let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
-    b.rx.extend_from_slice(&sample(1, 10.0, 50.0).encode());
-    app.tick(&mut b, 0);
+    let mut b = board();
+    let mem = b.boot_memory();
+    let mut app = App::boot(&mut *b, &GuardConfig::DEFAULT, &mem);
+    b.push_rx(&sample(1, 10.0, 50.0).encode());
+    app.tick(&mut *b, 0);
     let before = app.guard().ticks();
     app.overrun(2);
-    b.rx.extend_from_slice(&sample(2, 10.0, 50.0).encode());
-    app.tick(&mut b, 2);
+    b.push_rx(&sample(2, 10.0, 50.0).encode());
+    app.tick(&mut *b, 2);
     assert_eq!(app.guard().ticks() - before, 3, "two catch-up ticks and the tick's own");
     assert_eq!(app.counters().overruns, 2);
     assert!(app.guard().trace().iter().any(|e| matches!(e, Trace::Overrun { lost_ticks: 2, .. })));
-    let t = ticks(&b.replies());
+    let t = ticks(&replies(&mut b));
     assert_eq!(t.last().map(|r| r.overruns), Some(2));
 }
 
@@ -215,16 +129,16 @@ fn overrun_periods_become_missing_ticks_and_are_counted() {
 /// in the same tick.
 #[test]
 fn pin_read_back_mismatch_latches_actuator_and_opens_the_valve() {
-    let mut b = SimBoard::new();
-    let mem = b.mem();
-    let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
-    b.rx.extend_from_slice(&sample(1, 10.0, 50.0).encode());
-    app.tick(&mut b, 0);
-    assert!(!ticks(&b.replies())[0].out.valve_open, "cold oil: valve closed");
+    let mut b = board();
+    let mem = b.boot_memory();
+    let mut app = App::boot(&mut *b, &GuardConfig::DEFAULT, &mem);
+    b.push_rx(&sample(1, 10.0, 50.0).encode());
+    app.tick(&mut *b, 0);
+    assert!(!ticks(&replies(&mut b))[0].out.valve_open, "cold oil: valve closed");
     b.stuck_valve_pin = Some(false);
-    b.rx.extend_from_slice(&sample(2, 10.0, 50.0).encode());
-    app.tick(&mut b, 0);
-    let t = ticks(&b.replies());
+    b.push_rx(&sample(2, 10.0, 50.0).encode());
+    app.tick(&mut *b, 0);
+    let t = ticks(&replies(&mut b));
     assert!(t[0].out.valve_open && t[0].out.faults.intersects(crate::faults::ACTUATOR), "{:?}", t[0]);
 }
 
@@ -233,18 +147,18 @@ fn pin_read_back_mismatch_latches_actuator_and_opens_the_valve() {
 /// injections are refused in a build without `fault-inject`.
 #[test]
 fn commands_status_refill_clear_trace() {
-    let mut b = SimBoard::new();
-    let mem = b.mem();
-    let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
+    let mut b = board();
+    let mem = b.boot_memory();
+    let mut app = App::boot(&mut *b, &GuardConfig::DEFAULT, &mem);
     // A non-finite sample latches NON_FINITE.
-    b.rx.extend_from_slice(&sample(1, f32::NAN, 50.0).encode());
-    app.tick(&mut b, 0);
+    b.push_rx(&sample(1, f32::NAN, 50.0).encode());
+    app.tick(&mut *b, 0);
     let cmd = |token, cmd| Command { token, cmd }.encode();
-    b.rx.extend_from_slice(&cmd(7, Cmd::ClearFaults));
-    b.rx.extend_from_slice(&cmd(8, Cmd::RefillLng));
-    b.rx.extend_from_slice(&cmd(9, Cmd::Status));
-    app.tick(&mut b, 0);
-    let r = b.replies();
+    b.push_rx(&cmd(7, Cmd::ClearFaults));
+    b.push_rx(&cmd(8, Cmd::RefillLng));
+    b.push_rx(&cmd(9, Cmd::Status));
+    app.tick(&mut *b, 0);
+    let r = replies(&mut b);
     let acks: StdVec<Ack> = r.iter().filter_map(|f| if let FromGuard::Ack(a) = f { Some(*a) } else { None }).collect();
     assert_eq!(acks[0], Ack { token: 7, cmd: Cmd::ClearFaults, result: AckResult::Refused });
     assert_eq!(acks[1], Ack { token: 8, cmd: Cmd::RefillLng, result: AckResult::Done });
@@ -252,20 +166,20 @@ fn commands_status_refill_clear_trace() {
     assert_eq!((st.token, st.tick, st.missing, st.faults.intersects(crate::faults::NON_FINITE)), (9, 2, 1, true));
     // 100 valid ticks, then the clear succeeds.
     for k in 2..110u16 {
-        b.rx.extend_from_slice(&sample(k, 10.0, 50.0).encode());
-        app.tick(&mut b, 0);
+        b.push_rx(&sample(k, 10.0, 50.0).encode());
+        app.tick(&mut *b, 0);
     }
-    b.replies();
-    b.rx.extend_from_slice(&cmd(10, Cmd::ClearFaults));
-    b.rx.extend_from_slice(&cmd(11, Cmd::Trace));
-    b.rx.extend_from_slice(&cmd(12, Cmd::InjectHang));
-    b.rx.extend_from_slice(&sample(110, 10.0, 50.0).encode());
-    app.tick(&mut b, 0);
+    replies(&mut b);
+    b.push_rx(&cmd(10, Cmd::ClearFaults));
+    b.push_rx(&cmd(11, Cmd::Trace));
+    b.push_rx(&cmd(12, Cmd::InjectHang));
+    b.push_rx(&sample(110, 10.0, 50.0).encode());
+    app.tick(&mut *b, 0);
     for k in 111..130u16 {
-        b.rx.extend_from_slice(&sample(k, 10.0, 50.0).encode());
-        app.tick(&mut b, 0);
+        b.push_rx(&sample(k, 10.0, 50.0).encode());
+        app.tick(&mut *b, 0);
     }
-    let r = b.replies();
+    let r = replies(&mut b);
     assert!(r.contains(&FromGuard::Ack(Ack { token: 10, cmd: Cmd::ClearFaults, result: AckResult::Done })));
     #[cfg(not(feature = "fault-inject"))]
     assert!(r.contains(&FromGuard::Ack(Ack { token: 12, cmd: Cmd::InjectHang, result: AckResult::Refused })));
@@ -281,23 +195,23 @@ fn commands_status_refill_clear_trace() {
 /// still completes with its one reply and the watchdog is still fed.
 #[test]
 fn garbage_is_counted_and_every_tick_completes() {
-    let mut b = SimBoard::new();
-    let mem = b.mem();
-    let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
+    let mut b = board();
+    let mem = b.boot_memory();
+    let mut app = App::boot(&mut *b, &GuardConfig::DEFAULT, &mem);
     let mut x: u32 = 12345;
     for k in 0..200u16 {
         for _ in 0..(k % 97) {
             x = x.wrapping_mul(1_103_515_245).wrapping_add(12345);
-            b.rx.push((x >> 16) as u8);
+            b.push_rx(&[(x >> 16) as u8]);
         }
         if k % 3 == 0 {
             let f = sample(1000 + k, 10.0, 50.0).encode();
-            b.rx.push(0);
-            b.rx.extend_from_slice(&f);
+            b.push_rx(&[0]);
+            b.push_rx(&f);
         }
-        app.tick(&mut b, 0);
+        app.tick(&mut *b, 0);
     }
-    let t = ticks(&b.replies());
+    let t = ticks(&replies(&mut b));
     assert_eq!(t.len(), 200);
     assert_eq!(b.feeds, 200);
     let c = app.counters();
@@ -309,17 +223,17 @@ fn garbage_is_counted_and_every_tick_completes() {
 /// the recorded reset cause.
 #[test]
 fn warm_reboot_restores_the_estimate_and_the_cause() {
-    let mut b = SimBoard::new();
-    let mem = b.mem();
-    let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
+    let mut b = board();
+    let mem = b.boot_memory();
+    let mut app = App::boot(&mut *b, &GuardConfig::DEFAULT, &mem);
     for k in 0..500u16 {
-        b.rx.extend_from_slice(&sample(k, 40.0, 150.0).encode());
-        app.tick(&mut b, 0);
+        b.push_rx(&sample(k, 40.0, 150.0).encode());
+        app.tick(&mut *b, 0);
     }
     let before = app.guard().output().drain_c;
     b.cause = b.cause.with_cause(ResetCause::Watchdog);
-    let mem = b.mem();
-    let app2 = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
+    let mem = b.boot_memory();
+    let app2 = App::boot(&mut *b, &GuardConfig::DEFAULT, &mem);
     assert_eq!(app2.reset_cause(), ResetCause::Watchdog);
     let after = app2.guard().snapshot().temps_c;
     let was = app.guard().snapshot().temps_c;
@@ -333,24 +247,23 @@ fn warm_reboot_restores_the_estimate_and_the_cause() {
 /// one is written by the policy (first record at once, then on a 2 K rise).
 #[test]
 fn failing_nv_store_is_retried_once_a_minute_not_every_tick() {
-    let mut b = SimBoard::new();
-    b.nv = Some(false);
-    let mem = b.mem();
-    let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
+    let mut b = std::boxed::Box::new(MemBoard::new().with_nv());
+    b.set_flash_faults(false, true);
+    let mem = b.boot_memory();
+    let mut app = App::boot(&mut *b, &GuardConfig::DEFAULT, &mem);
     for k in 0..12_000u32 {
-        b.rx.extend_from_slice(&sample((k & 0xFFFF) as u16, 30.0, 150.0).encode());
-        app.tick(&mut b, 0);
+        b.push_rx(&sample((k & 0xFFFF) as u16, 30.0, 150.0).encode());
+        app.tick(&mut *b, 0);
     }
-    b.replies();
+    replies(&mut b);
     assert_eq!(b.nv_calls, 2, "ticks 1 and 6001 of 12 000");
     assert_eq!(app.counters().nv_failures, 2);
-    let mut ok = SimBoard::new();
-    ok.nv = Some(true);
-    let mem = ok.mem();
-    let mut app = App::boot(&mut ok, &GuardConfig::DEFAULT, &mem);
+    let mut ok = std::boxed::Box::new(MemBoard::new().with_nv());
+    let mem = ok.boot_memory();
+    let mut app = App::boot(&mut *ok, &GuardConfig::DEFAULT, &mem);
     for k in 0..50u32 {
-        ok.rx.extend_from_slice(&sample(k as u16, 30.0, 150.0).encode());
-        app.tick(&mut ok, 0);
+        ok.push_rx(&sample(k as u16, 30.0, 150.0).encode());
+        app.tick(&mut *ok, 0);
     }
     // The estimate rises ~0.7 K in these 0.5 s, no fault: nothing due after the first.
     assert_eq!(ok.nv_calls, 1, "one record at the start; the next on a 2 K rise");
@@ -376,16 +289,16 @@ fn other_rig() -> crate::model::ModelConsts<f32> {
 #[test]
 fn without_a_block_the_default_runs_and_every_reply_says_not_commissioned() {
     for block in [None, Some(flash_block([0xFF; BLOCK_LEN]))] {
-        let mut b = SimBoard::new();
+        let mut b = board();
         b.block = block;
-        let mem = b.mem();
-        let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
+        let mem = b.boot_memory();
+        let mut app = App::boot(&mut *b, &GuardConfig::DEFAULT, &mem);
         assert_eq!(app.params(), ParamSource::Default);
         for k in 0..30u16 {
-            b.rx.extend_from_slice(&sample(k, 20.0, 60.0).encode());
-            app.tick(&mut b, 0);
+            b.push_rx(&sample(k, 20.0, 60.0).encode());
+            app.tick(&mut *b, 0);
         }
-        let t = ticks(&b.replies());
+        let t = ticks(&replies(&mut b));
         assert!(t.iter().all(|r| r.not_commissioned && r.out.faults.is_empty()), "{t:?}");
         assert!(app.guard().trace().iter().any(|e| matches!(e, Trace::Params { source: 0, .. })));
     }
@@ -398,21 +311,21 @@ fn without_a_block_the_default_runs_and_every_reply_says_not_commissioned() {
 #[test]
 fn a_valid_block_runs_its_own_rig() {
     let other = other_rig();
-    let mut b = SimBoard::new();
+    let mut b = board();
     b.block = Some(flash_block(params_block::encode(&other, "other-eha")));
-    let mem = b.mem();
-    let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
+    let mem = b.boot_memory();
+    let mut app = App::boot(&mut *b, &GuardConfig::DEFAULT, &mem);
     assert_eq!(app.params(), ParamSource::Block);
     let mut bare = Guard::new(&GuardConfig { model: &other, ..GuardConfig::DEFAULT }, Restore::Cold);
     let mut paper = Guard::new(&GuardConfig::DEFAULT, Restore::Cold);
     let (mut last, mut last_paper) = (0.0, 0.0);
     for k in 0..3000u16 {
         let s = sample(k, 30.0, 60.0);
-        b.rx.extend_from_slice(&s.encode());
-        app.tick(&mut b, 0);
+        b.push_rx(&s.encode());
+        app.tick(&mut *b, 0);
         let want = bare.tick(&s.sample());
         last_paper = paper.tick(&s.sample()).drain_c;
-        let t = ticks(&b.replies());
+        let t = ticks(&replies(&mut b));
         assert!(!t[0].not_commissioned);
         assert!(crate::protocol::GuardOutput::bit_eq(&t[0].out, &want), "tick {k}: {:?} vs {want:?}", t[0].out);
         last = want.drain_c;
@@ -437,19 +350,19 @@ fn an_invalid_block_latches_config_and_opens_the_valve() {
         ("torn", torn, ParamSource::Invalid(params_block::BlockError::Crc)),
         ("phi of another rig", params_block::encode(&wrong_phi, "bad-phi"), ParamSource::Block),
     ] {
-        let mut b = SimBoard::new();
+        let mut b = board();
         b.block = Some(flash_block(bytes));
-        let mem = b.mem();
-        let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
+        let mem = b.boot_memory();
+        let mut app = App::boot(&mut *b, &GuardConfig::DEFAULT, &mem);
         assert_eq!(app.params(), source, "{name}");
         assert!(!b.pins.valve_pin, "{name}: valve open (pin low) from boot");
         for k in 0..50u16 {
-            b.rx.extend_from_slice(&sample(k, 20.0, 60.0).encode());
-            app.tick(&mut b, 0);
+            b.push_rx(&sample(k, 20.0, 60.0).encode());
+            app.tick(&mut *b, 0);
         }
-        b.rx.extend_from_slice(&Command { token: 7, cmd: Cmd::ClearFaults }.encode());
-        app.tick(&mut b, 0);
-        let t = ticks(&b.replies());
+        b.push_rx(&Command { token: 7, cmd: Cmd::ClearFaults }.encode());
+        app.tick(&mut *b, 0);
+        let t = ticks(&replies(&mut b));
         assert!(
             t.iter().all(|r| r.out.faults.intersects(crate::guard::faults::CONFIG) && r.out.valve_open && !r.pins.valve_pin && r.out.alarm),
             "{name}: {t:?}"
@@ -466,27 +379,26 @@ fn an_invalid_block_latches_config_and_opens_the_valve() {
 #[test]
 fn power_loss_restore_is_cooled_over_the_clocks_off_time() {
     // the save carries the clock
-    let mut b = SimBoard::new();
-    b.nv = Some(true);
+    let mut b = std::boxed::Box::new(MemBoard::new().with_nv());
     b.rtc = Some(5_000);
-    let mem = b.mem();
-    let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
-    b.rx.extend_from_slice(&sample(1, 10.0, 40.0).encode());
-    app.tick(&mut b, 0);
+    let mem = b.boot_memory();
+    let mut app = App::boot(&mut *b, &GuardConfig::DEFAULT, &mem);
+    b.push_rx(&sample(1, 10.0, 40.0).encode());
+    app.tick(&mut *b, 0);
     assert_eq!(b.nv_saved.map(|r| r.rtc_s), Some(5_000), "the first save is stamped");
 
     let hot = ThermalRecord::new([55.0, 60.0, 50.0, 45.0, 40.0, 30.0], 20.0, 0, 0, 100).with_rtc(Some(5_000));
     let boot_after = |rtc: Option<u32>, ambient_c: f32| {
-        let mut b = SimBoard::new();
+        let mut b = board();
         b.rtc = rtc;
-        let mem = BootMemory { nv: Some(hot), ..b.mem() };
-        let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
+        let mem = BootMemory { nv: Some(hot), ..b.boot_memory() };
+        let mut app = App::boot(&mut *b, &GuardConfig::DEFAULT, &mem);
         let mut s = sample(1, 0.0, 3.0);
         s.speed_rpm = 0.0;
         s.ambient_c = ambient_c;
-        b.rx.extend_from_slice(&s.encode());
-        app.tick(&mut b, 0);
-        let t = ticks(&b.replies());
+        b.push_rx(&s.encode());
+        app.tick(&mut *b, 0);
+        let t = ticks(&replies(&mut b));
         let last = *t.last().expect("a tick reply");
         (last.restore, last.out.drain_c)
     };

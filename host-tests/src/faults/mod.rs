@@ -1,7 +1,8 @@
 //! Fault campaign (`eha-sim faults`): every fault of [`inject`] applied to
-//! the firmware's guard (host SIL: the f32 `GuardOf` behind the same frame
-//! [`Link`] as the firmware) in closed loop with the
-//! reference plant, during the Fig. 15 LNG case and one random mission.
+//! the product application (the f32 [`eha_guard::product::App`] on the
+//! shared in-memory board, the host twin of the flashed image; the faults
+//! that need no reboot also on the PIL image in QEMU) in closed loop with
+//! the reference plant, during the Fig. 15 LNG case and one random mission.
 //!
 //! Pass rule per fault and scenario: either the guard latches a fault and
 //! opens the valve within [`DETECT_S`] of the fault becoming observable, or
@@ -9,11 +10,11 @@
 //! [`MAX_UNDER_K`] and the true drain never exceeds [`MAX_CLOSED_C`] while the
 //! valve is physically closed (both from the fault's start on).
 //!
-//! The controller sends one frame per 10 ms tick; the guard runs the product
-//! loop: every tick, the newest sample accepted by the frame [`Link`] ticks
-//! it, and a tick without one is a missing sample. A reset or a power loss restarts the guard from the
-//! record it would find (warm: its last snapshot; power loss: none today,
-//! there is no non-volatile copy; torn write: a corrupt record). While the
+//! The controller sends one frame per 10 ms tick; the application takes the
+//! newest valid sample of the tick, and a tick without one is a missing
+//! sample. A reset or a power loss boots the application again on the same
+//! board, from what its memories keep (warm: the no-init records; power
+//! loss: the non-volatile record; torn write: a damaged record). While the
 //! MCU is off the valve is open (normally-open valve, the fail-safe design).
 
 pub mod inject;
@@ -21,15 +22,16 @@ pub mod inject;
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use eha_guard::memory::nv::{Blocking, NvPolicy, NvStore, RamFlash};
-use eha_guard::memory::slots::{restore_from, AbWriter};
-use eha_guard::memory::{boot_restore, Restore, ThermalRecord};
-use eha_guard::protocol::{Link, Request};
-use eha_guard::{faults as fbits, GuardConfig, GuardOf, Output, Sample};
+use eha_guard::memory::ThermalRecord;
+use eha_guard::product::mem_board::MemBoard;
+use eha_guard::protocol::Request;
+use eha_guard::{faults as fbits, GuardConfig, Output, Sample};
 use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::missions::random_mission;
+use crate::pil::sil::AppTarget;
+use crate::pil::Target;
 use crate::plant::{Control, Plant, Sensors};
 use crate::rig::Rig;
 use crate::scenario::Scenario;
@@ -79,86 +81,37 @@ pub struct FaultResult {
     pub pass: bool,
 }
 
-/// The non-volatile memory of the MCU (survives power loss): the firmware's
-/// `NvStore` over a RAM-backed flash, with the firmware's write policy.
-struct Nv {
-    store: NvStore<Blocking<RamFlash<16384>>>,
-    last: Option<ThermalRecord>,
-}
-
-impl Nv {
-    fn new() -> Result<Self> {
-        let store = NvStore::new(Blocking(RamFlash::new()), 0..16384).map_err(|e| anyhow::anyhow!("nv store: {e:?}"))?;
-        Ok(Nv { store, last: None })
-    }
-
-    fn save_if_due(&mut self, rec: &ThermalRecord) {
-        if NvPolicy::DEFAULT.due(self.last.as_ref(), rec) && self.store.save(rec).is_ok() {
-            self.last = Some(*rec);
-        }
-    }
-}
-
-/// The guard as the MCU runs it: reboots replace it; the two no-init RAM
-/// records survive a reset, not a power loss.
+/// The MCU: the application on its board; a reboot boots it again on the
+/// same board.
 struct Mcu {
-    guard: GuardOf<f32>,
-    link: Link,
-    slots: [ThermalRecord; 2],
-    writer: AbWriter,
-    last_slot: usize,
+    app: AppTarget<f32>,
 }
 
 impl Mcu {
-    /// Boot with RAM records `slots` (zeros after a power loss) and the
-    /// non-volatile store, by the firmware's boot rule.
-    fn boot(cfg: GuardConfig, slots: [ThermalRecord; 2], nv: &mut Nv, first: Option<Restore>) -> Self {
-        let restore = first.unwrap_or_else(|| boot_restore(restore_from(&slots[0], &slots[1]), nv.store.load(), &NvPolicy::DEFAULT, None, None));
-        let writer = AbWriter::after_boot(&slots[0], &slots[1]);
-        Mcu { guard: GuardOf::new(&cfg, restore), link: Link::new(), slots, writer, last_slot: 0 }
+    fn boot(board: Box<MemBoard>) -> Self {
+        Mcu { app: AppTarget::boot(&GuardConfig::DEFAULT, board) }
     }
 
-    /// The thermal-memory writes after a tick: both RAM records in turn,
-    /// and flash when the policy says so.
-    fn save(&mut self, nv: &mut Nv) {
-        let rec = self.guard.snapshot();
-        let Mcu { writer, slots, last_slot, .. } = self;
-        writer.write(&rec, |i, r| {
-            if let Some(s) = slots.get_mut(i) {
-                *s = *r;
-                *last_slot = i;
+    /// A reset: no-init RAM and flash keep their contents.
+    fn reset(self, damage_newest_record: bool) -> Self {
+        let mut board = self.app.into_board();
+        board.warm_reset();
+        if damage_newest_record {
+            // The reset hit the write of the newest record: one word half written.
+            let [a, b] = board.records;
+            let newest = usize::from(eha_guard::memory::seq_newer(b.seq(), a.seq()));
+            if let Some(r) = board.records.get_mut(newest) {
+                r.temps_c[0] = f32::from_bits(r.temps_c[0].to_bits() ^ 0x0040_0000);
             }
-        });
-        nv.save_if_due(&rec);
-    }
-
-    /// One 10 ms tick of the product loop: the bytes received since the
-    /// last tick go through the frame [`Link`]; the newest accepted sample
-    /// ticks the guard, and a tick without one is a missing sample.
-    fn tick(&mut self, bytes: &[u8]) -> Output {
-        let Mcu { guard, link, .. } = self;
-        let mut newest: Option<Request> = None;
-        // The link's replies are not used here: the tick's output is the guard's.
-        link.push_bytes(bytes, |r: &Request, _gap| {
-            newest = Some(*r);
-            (Output::default(), 0)
-        }, |_, _| {});
-        match newest {
-            Some(r) => {
-                if let Some(open) = r.valve_fb {
-                    guard.valve_feedback(open);
-                }
-                guard.tick(&r.sample())
-            }
-            None => guard.tick_missing(),
         }
+        Mcu::boot(board)
     }
 }
 
 /// A record whose LNG charge is used up, node temperatures at `ambient_c`.
 fn lng_empty_record(cfg: &GuardConfig, ambient_c: f32) -> ThermalRecord {
     let used_cj = (f64::from(cfg.lng.charge_kg()) * f64::from(cfg.lng.j_per_kg()) * 100.0).ceil() as u32;
-    ThermalRecord::new([ambient_c; eha_guard::params::N_NODES], ambient_c, used_cj, 0, 0)
+    ThermalRecord::new([ambient_c; eha_guard::params::N_NODES], ambient_c, used_cj, 0, 0).with_seq(1, false)
 }
 
 /// Run one fault in one scenario on the host build of the guard (SIL).
@@ -166,31 +119,35 @@ pub fn run_one(fault: Fault, scenario_name: &str, scenario: &Scenario) -> Result
     run_on(fault, scenario_name, scenario, None)
 }
 
-/// Run one fault in one scenario; with `target` (the firmware in QEMU through
-/// the lockstep PIL, one frame per tick) instead of the host guard. The
-/// lockstep firmware ticks once per frame, so only the input faults (every tick
-/// still carries one frame) run on a target; they must give the same result
-/// as on the host, bit for bit.
+/// Whether a fault runs on a target given from outside (the PIL image in
+/// QEMU): those that need no reboot and no preset memory.
+pub fn runs_on_a_target(fault: Fault) -> bool {
+    !matches!(fault, Fault::WarmReset | Fault::PowerLoss | Fault::TornRecordWrite | Fault::LngEmpty)
+}
+
+/// Run one fault in one scenario; with `target` (the PIL image in QEMU, in
+/// lockstep) instead of the host application. It must give the same result
+/// as on the host, bit for bit ([`runs_on_a_target`] says which faults can).
 pub fn run_on(
     fault: Fault,
     scenario_name: &str,
     scenario: &Scenario,
     mut target: Option<&mut dyn crate::pil::Target>,
 ) -> Result<FaultResult> {
-    if target.is_some() && !matches!(fault, Fault::Input(..)) {
-        anyhow::bail!("{}: only input faults run on a lockstep target", fault.name());
+    if target.is_some() && !runs_on_a_target(fault) {
+        anyhow::bail!("{}: reboots and preset memories run on the host application only", fault.name());
     }
     let mut target_error: Option<anyhow::Error> = None;
     let rig = Rig::default();
     let mut plant = Plant::new(&rig, scenario).context("plant")?;
     let cfg = GuardConfig::DEFAULT;
     let first = Sensors::from(&plant.snapshot()).sample();
-    let mut nv = Nv::new()?;
-    let restore = match fault {
-        Fault::LngEmpty => Some(Restore::from_record(&lng_empty_record(&cfg, first.ambient_c))),
-        _ => None,
-    };
-    let mut mcu = Some(Mcu::boot(cfg, [ThermalRecord::EMPTY; 2], &mut nv, restore));
+    let mut board = Box::new(MemBoard::new().with_nv());
+    if fault == Fault::LngEmpty {
+        board.records[0] = lng_empty_record(&cfg, first.ambient_c);
+    }
+    let mut mcu = Some(Mcu::boot(board));
+    let mut off_board: Option<Box<MemBoard>> = None;
     let mut rng = Gauss::new(0x5EED ^ fault.name().len() as u64);
     let mut seq: u16 = 0;
     let mut out: Option<Output> = None;
@@ -214,23 +171,17 @@ pub fn run_on(
             if active && k == (FAULT_AT_S / TICK_S).round() as u64 {
                 latched_before = out.map_or(eha_guard::Faults::NONE, |o| o.faults & fbits::LATCHED);
                 match fault {
-                    Fault::WarmReset => {
+                    Fault::WarmReset | Fault::TornRecordWrite => {
                         if let Some(m) = mcu.take() {
-                            mcu = Some(Mcu::boot(cfg, m.slots, &mut nv, None));
-                        }
-                    }
-                    Fault::TornRecordWrite => {
-                        if let Some(m) = mcu.take() {
-                            // The reset hit the write of the newest record: one word half written.
-                            let mut slots = m.slots;
-                            if let Some(r) = slots.get_mut(m.last_slot) {
-                                r.temps_c[0] = f32::from_bits(r.temps_c[0].to_bits() ^ 0x0040_0000);
-                            }
-                            mcu = Some(Mcu::boot(cfg, slots, &mut nv, None));
+                            mcu = Some(m.reset(fault == Fault::TornRecordWrite));
                         }
                     }
                     Fault::PowerLoss => {
-                        mcu = None;
+                        if let Some(m) = mcu.take() {
+                            let mut b = m.app.into_board();
+                            b.power_loss();
+                            off_board = Some(b);
+                        }
                         powered_off_until = Some(t + POWER_OFF_S);
                     }
                     Fault::ValveStuckClosed => stuck_closed = true,
@@ -243,7 +194,9 @@ pub fn run_on(
             if let Some(until) = powered_off_until {
                 if t >= until - 1e-9 {
                     // Power back: RAM is lost, the non-volatile record remains.
-                    mcu = Some(Mcu::boot(cfg, [ThermalRecord::EMPTY; 2], &mut nv, None));
+                    if let Some(b) = off_board.take() {
+                        mcu = Some(Mcu::boot(b));
+                    }
                     powered_off_until = None;
                     seq = 0;
                 }
@@ -287,17 +240,15 @@ pub fn run_on(
                         }
                     }
                 }
-                match target.as_deref_mut() {
-                    Some(t) => match t.exchange(&wire, k) {
-                        Ok(r) => out = Some(r.out),
-                        Err(e) => {
-                            target_error = Some(e.into());
-                            return Ok(Control { lng_valve: None, stop: true });
-                        }
-                    },
-                    None => {
-                        out = Some(m.tick(&wire));
-                        m.save(&mut nv);
+                let res = match target.as_deref_mut() {
+                    Some(t) => t.tick(&wire, k),
+                    None => m.app.tick(&wire, k),
+                };
+                match res {
+                    Ok(r) => out = Some(r.reply.out),
+                    Err(e) => {
+                        target_error = Some(e.into());
+                        return Ok(Control { lng_valve: None, stop: true });
                     }
                 }
             } else {

@@ -14,9 +14,9 @@ use eha_guard::memory::nv::NvPolicy;
 use eha_guard::memory::{boot_restore, Restore, ThermalRecord};
 use eha_guard::model::{Model, ModelInputN};
 use eha_guard::params::{DEFAULT, DEFAULT_CONSTS, N_NODES, TICKS_PER_STEP};
-use eha_guard::protocol::tick_guard;
-use eha_guard::{GuardConfig, GuardOf};
-use eha_sim::pil::sil::SilTarget;
+use eha_guard::product::mem_board::MemBoard;
+use eha_guard::GuardConfig;
+use eha_sim::pil::sil::AppTarget;
 use eha_sim::pil::{run_closed_loop, LoopOptions};
 use eha_sim::plant::{Control, Plant, Sensors};
 use eha_sim::rig::Rig;
@@ -66,11 +66,10 @@ fn model_at_rest(temps: &[f32; N_NODES], air: f32, off_s: u32) -> [f64; N_NODES]
 fn restore_after_a_measured_off_time_is_cooled_and_never_below_the_reference() {
     let rig = Rig::default();
     let mut plant = Plant::new(&rig, &Scenario::Mission(mission())).expect("plant");
-    let mut guard = GuardOf::<f32>::new(&GuardConfig::DEFAULT, Restore::Cold);
-    let mut sil = SilTarget::new(|r: &eha_guard::protocol::Request, gap| tick_guard(&mut guard, r, gap));
+    let mut sil = AppTarget::<f32>::boot(&GuardConfig::DEFAULT, Box::new(MemBoard::new()));
     let opts = LoopOptions { tick_s: eha_guard::params::S_PER_TICK, duration_s: HOT_S };
     let rec = run_closed_loop(&mut plant, &mut sil, &opts).unwrap_or_else(|f| panic!("{:#}", f.error));
-    drop(sil);
+    let guard = sil.app().guard();
     let last = rec.last().expect("steps");
     let saved = guard.snapshot().with_rtc(Some(T0_S));
     assert!(guard.faults().is_empty(), "a clean hot run");

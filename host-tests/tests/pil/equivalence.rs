@@ -1,8 +1,9 @@
-//! The firmware in QEMU answers exactly like the same core code on the host
-//! (SIL), frame by frame, for both numeric builds.
+//! The product application in QEMU (the PIL image) answers exactly like the
+//! same application on the host (SIL, the shared in-memory board), tick by
+//! tick, for both numeric builds.
 //!
-//! Open loop here (the closed-loop scenarios are in `pil_scenarios.rs`): the
-//! drill sequence of `eha_sim::pil::drill` (60,000 frames at the firmware's
+//! Open loop here (the closed-loop scenarios are in `scenarios.rs`): the
+//! drill sequence of `eha_sim::pil::drill` (60,000 ticks at the firmware's
 //! 10 ms step, valve open/close, lost frames, non-finite and out-of-range
 //! samples), so the fault paths are compared too.
 //!
@@ -16,47 +17,39 @@
 
 use std::time::Instant;
 
-use eha_guard::protocol::{Reply, ReplyKind, Request};
+use eha_guard::product::wire::TickReply;
 use eha_sim::pil::report::compare;
-use eha_sim::pil::sil::{sil_core, SilTarget};
+use eha_sim::pil::sil::SilTarget;
 use eha_sim::pil::{firmware_for_tests, require_qemu, Build, QemuOptions, QemuSession, Target};
 
 const STEPS: u32 = eha_sim::pil::drill::STEPS;
 
-fn inputs() -> Vec<Request> {
-    eha_sim::pil::drill::inputs()
-}
-
-fn run_qemu(build: Build, reqs: &[Request]) -> (Vec<Reply>, f64) {
+fn run_qemu(build: Build, inputs: &[Vec<u8>]) -> (Vec<TickReply>, f64) {
     require_qemu();
     let elf = firmware_for_tests(build);
     let mut opts = QemuOptions::new(build, &elf);
     opts.icount = false;
     let mut s = QemuSession::spawn(&opts).unwrap_or_else(|e| panic!("{e}"));
     let t0 = Instant::now();
-    let replies: Vec<Reply> = reqs
-        .iter()
-        .enumerate()
-        .map(|(k, r)| s.exchange(&r.encode(), k as u64).unwrap_or_else(|e| panic!("{e}")))
-        .collect();
+    let replies: Vec<TickReply> =
+        inputs.iter().enumerate().map(|(k, r)| s.tick(r, k as u64).unwrap_or_else(|e| panic!("{e}")).reply).collect();
     let secs = t0.elapsed().as_secs_f64();
-    let end = s.finish(reqs.len() as u64).unwrap_or_else(|e| panic!("{e}"));
-    assert_eq!(end.done.counters.accepted, reqs.len() as u32);
-    assert_eq!(end.done.counters.skipped, 3 + 10);
+    let end = s.finish(inputs.len() as u64).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(end.done.accepted, inputs.len() as u32 - 13);
+    assert_eq!(end.done.missing, 3 + 10);
     (replies, secs)
 }
 
 fn check(build: Build) {
-    let reqs = inputs();
-    let (fw, secs) = run_qemu(build, &reqs);
-    let mut sil = SilTarget::new(sil_core(build));
-    let host: Vec<Reply> = reqs.iter().enumerate().map(|(k, r)| sil.exchange(&r.encode(), k as u64).unwrap()).collect();
-    assert!(fw.iter().all(|r| r.kind == ReplyKind::Tick));
+    let inputs = eha_sim::pil::drill::inputs();
+    let (fw, secs) = run_qemu(build, &inputs);
+    let mut sil = SilTarget::new(build);
+    let host: Vec<TickReply> = inputs.iter().enumerate().map(|(k, r)| sil.tick(r, k as u64).unwrap().reply).collect();
     let c = compare(&fw, &host);
     let valve_steps = fw.iter().filter(|r| r.out.valve_open).count();
     let faults = fw.last().map_or(eha_guard::Faults::NONE, |r| r.out.faults);
     eprintln!(
-        "{}: {} frames in {:.2} s = {:.0} round trips/s; identical {}/{}; max drain diff {:.3e} K; valve open {} steps; final faults {:#x}; peak drain {:.2} C",
+        "{}: {} ticks in {:.2} s = {:.0} round trips/s; identical {}/{}; max drain diff {:.3e} K; valve open {} steps; final faults {:#x}; peak drain {:.2} C",
         build.name(),
         fw.len(),
         secs,

@@ -1,12 +1,12 @@
 //! A representative subset of the fault campaign (`eha_sim::faults`) with the
-//! firmware in QEMU (f32, lockstep PIL over semihosting) instead of the host
-//! guard: input faults on the three channels that carry the pump's heat
-//! (current reading low, a port pressure stuck at zero, a non-finite speed)
-//! and the speed fault the design cannot see, each during the Fig. 15 LNG case.
-//! Every tick carries one frame, so the firmware ticks exactly as the host
-//! SIL does: each result must equal the host campaign's, field for field
-//! (the guard's replies are bit-identical, `pil::equivalence`), including its
-//! pass/fail verdict.
+//! PIL image in QEMU (f32, the product application in lockstep over
+//! semihosting) instead of the host application: input faults on the three
+//! channels that carry the pump's heat (current reading low, a port
+//! pressure stuck at zero, a non-finite speed), a speed sensor reading half,
+//! and corrupted frames, each during the Fig. 15 LNG case. The image ticks
+//! exactly as the host twin does: each result must equal the host
+//! campaign's, field for field (the tick replies are bit-identical,
+//! `pil::equivalence`), including its pass/fail verdict.
 
 use eha_sim::faults::inject::{Channel, Fault, InputFault};
 use eha_sim::faults::{run_on, run_one};
@@ -23,6 +23,7 @@ fn fault_subset_in_qemu_equals_the_host_campaign() {
         Fault::Input(Channel::PressureA, InputFault::StuckZero),
         Fault::Input(Channel::Speed, InputFault::NaN),
         Fault::Input(Channel::Speed, InputFault::GainHalf),
+        Fault::CorruptedFrames,
     ];
     for f in faults {
         let mut q = QemuOptions::new(Build::F32, &elf);

@@ -2,7 +2,7 @@
 //! `ci/expected/*.run`: the f32 firmware in QEMU on the drill sequence of
 //! `eha_sim::pil::drill`.
 //!
-//! The transcript holds the replies every 10 s and at every change of valve,
+//! The transcript holds the tick replies every 10 s and at every change of valve,
 //! alarm or faults (4 decimals), the final counters and the decoded defmt
 //! log; no instruction counts (those are checked against budgets by
 //! `eha-sim fw-budget`, so a compiler update does not force a re-bless). After an intended change of the firmware,

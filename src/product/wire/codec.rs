@@ -3,20 +3,16 @@
 
 use super::*;
 
-type Buf = Vec<u8, MAX_PAYLOAD>;
-
-fn put(p: &mut Buf, b: &[u8]) {
-    // Payloads are fixed-size and below MAX_PAYLOAD; a failure would give a
-    // short frame the peer rejects, never a panic.
-    let _ = p.extend_from_slice(b);
-}
-
-fn out_fields(p: &mut Buf, o: &Output) {
-    put(p, &o.drain_c.to_le_bytes());
-    put(p, &[crate::protocol::GuardOutput::flags(o)]);
-    put(p, &o.faults.bits().to_le_bytes());
-    put(p, &o.lng_remaining_kg.to_le_bytes());
-    put(p, &o.lng_seconds_left.to_le_bytes());
+/// A frame built in place: `fill` writes the payload, then it is sealed
+/// (CRC, COBS, delimiters; `lead`: with the leading delimiter).
+#[inline(always)]
+fn framed(lead: bool, fill: impl FnOnce(&mut PutAt<'_>)) -> WireFrame {
+    let mut w = WireFrame::zeroed();
+    let mut p = w.payload();
+    fill(&mut p);
+    let n = p.len();
+    w.seal(n, lead);
+    w
 }
 
 impl Rd<'_> {
@@ -50,11 +46,11 @@ fn expect(p: &[u8], kind: u8, len: usize) -> Result<Rd<'_>, DecodeError> {
 impl Command {
     /// Wire bytes (controller side).
     pub fn encode(&self) -> WireFrame {
-        let mut p = Buf::new();
-        put(&mut p, &[KIND_COMMAND]);
-        put(&mut p, &self.token.to_le_bytes());
-        put(&mut p, &[self.cmd.code()]);
-        frame(&p, false)
+        framed(false, |p| {
+            p.u8(KIND_COMMAND);
+            p.u16(self.token);
+            p.u8(self.cmd.code());
+        })
     }
 
     /// Parses a payload (CRC checked and stripped).
@@ -69,17 +65,22 @@ impl Command {
 impl TickReply {
     /// Wire bytes (leading and trailing delimiter).
     pub fn encode(&self) -> WireFrame {
-        let mut p = Buf::new();
-        put(&mut p, &[KIND_TICK]);
-        put(&mut p, &self.tick.to_le_bytes());
-        put(&mut p, &self.sample_seq.to_le_bytes());
-        put(&mut p, &[u8::from(self.fresh) | (u8::from(self.not_commissioned) << 1)]);
-        out_fields(&mut p, &self.out);
-        put(&mut p, &[u8::from(self.pins.valve_pin) | (u8::from(self.pins.ok_pin) << 1)]);
-        put(&mut p, &self.overruns.to_le_bytes());
-        put(&mut p, &self.rejected.to_le_bytes());
-        put(&mut p, &[restore_code(self.restore), self.reset_cause as u8]);
-        frame(&p, true)
+        framed(true, |p| {
+            p.u8(KIND_TICK);
+            p.u32(self.tick);
+            p.u16(self.sample_seq);
+            p.u8(u8::from(self.fresh) | (u8::from(self.not_commissioned) << 1));
+            p.f32(self.out.drain_c);
+            p.u8(crate::protocol::GuardOutput::flags(&self.out));
+            p.u16(self.out.faults.bits());
+            p.f32(self.out.lng_remaining_kg);
+            p.f32(self.out.lng_seconds_left);
+            p.u8(u8::from(self.pins.valve_pin) | (u8::from(self.pins.ok_pin) << 1));
+            p.u16(self.overruns);
+            p.u16(self.rejected);
+            p.u8(restore_code(self.restore));
+            p.u8(self.reset_cause as u8);
+        })
     }
 
     /// Parses a payload (host side).
@@ -103,11 +104,12 @@ impl TickReply {
 impl Ack {
     /// Wire bytes.
     pub fn encode(&self) -> WireFrame {
-        let mut p = Buf::new();
-        put(&mut p, &[KIND_ACK]);
-        put(&mut p, &self.token.to_le_bytes());
-        put(&mut p, &[self.cmd.code(), self.result as u8]);
-        frame(&p, true)
+        framed(true, |p| {
+            p.u8(KIND_ACK);
+            p.u16(self.token);
+            p.u8(self.cmd.code());
+            p.u8(self.result as u8);
+        })
     }
 
     /// Parses a payload (host side).
@@ -127,24 +129,25 @@ impl Ack {
 impl Status {
     /// Wire bytes.
     pub fn encode(&self) -> WireFrame {
-        let mut p = Buf::new();
-        put(&mut p, &[KIND_STATUS]);
-        put(&mut p, &self.token.to_le_bytes());
-        put(&mut p, &self.tick.to_le_bytes());
-        put(&mut p, &self.overruns.to_le_bytes());
-        put(&mut p, &self.worst_tick_cycles.to_le_bytes());
-        put(&mut p, &self.stack_high_water_b.to_le_bytes());
-        put(&mut p, &self.boot_stack_b.to_le_bytes());
-        put(&mut p, &[self.reset_cause, self.restore]);
-        for v in [self.boots, self.rejected_crc, self.rejected_framing, self.rejected_sequence, self.superseded] {
-            put(&mut p, &v.to_le_bytes());
-        }
-        put(&mut p, &self.accepted.to_le_bytes());
-        put(&mut p, &self.missing.to_le_bytes());
-        for v in [self.rx_overflow, self.commands, self.nv_failures, self.faults.bits()] {
-            put(&mut p, &v.to_le_bytes());
-        }
-        frame(&p, true)
+        framed(true, |p| {
+            p.u8(KIND_STATUS);
+            p.u16(self.token);
+            p.u32(self.tick);
+            p.u32(self.overruns);
+            p.u32(self.worst_tick_cycles);
+            p.u16(self.stack_high_water_b);
+            p.u16(self.boot_stack_b);
+            p.u8(self.reset_cause);
+            p.u8(self.restore);
+            for v in [self.boots, self.rejected_crc, self.rejected_framing, self.rejected_sequence, self.superseded] {
+                p.u16(v);
+            }
+            p.u32(self.accepted);
+            p.u32(self.missing);
+            for v in [self.rx_overflow, self.commands, self.nv_failures, self.faults.bits()] {
+                p.u16(v);
+            }
+        })
     }
 
     /// Parses a payload (host side).
@@ -177,14 +180,16 @@ impl Status {
 impl TraceReply {
     /// Wire bytes.
     pub fn encode(&self) -> WireFrame {
-        let mut p = Buf::new();
-        put(&mut p, &[KIND_TRACE]);
-        put(&mut p, &self.token.to_le_bytes());
-        put(&mut p, &[self.index, self.count, self.event.tag]);
-        put(&mut p, &self.event.tick.to_le_bytes());
-        put(&mut p, &self.event.value.to_le_bytes());
-        put(&mut p, &self.event.aux.to_le_bytes());
-        frame(&p, true)
+        framed(true, |p| {
+            p.u8(KIND_TRACE);
+            p.u16(self.token);
+            p.u8(self.index);
+            p.u8(self.count);
+            p.u8(self.event.tag);
+            p.u32(self.event.tick);
+            p.f32(self.event.value);
+            p.u16(self.event.aux);
+        })
     }
 
     /// Parses a payload (host side).

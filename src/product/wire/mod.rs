@@ -8,10 +8,9 @@
 //! Frame layouts are in `docs/firmware.md` (section "Product protocol");
 //! all fields little-endian, floats as IEEE-754 binary32 bit patterns.
 
-use crate::protocol::{frame, DecodeError, Rd, WireFrame, MAX_PAYLOAD};
+use crate::protocol::{DecodeError, PutAt, Rd, WireFrame};
 use crate::trace::{RestoreKind, Trace};
 use crate::Output;
-use heapless::Vec;
 
 mod codec;
 
