@@ -55,14 +55,18 @@ mod fw {
 
     /// Deterministic input: 0-30 s Case 1 (60 bar, 500 rpm, 30 A) with small noise,
     /// 30-60 s sinusoidal servo (20 mm, 0.2 Hz) against the Table 3 spring.
-    /// Motor current of the reference plant at these pressures and speed (eq. 8,
-    /// |w| >= 1 rad/s): consistent sensors, so the cross-check agrees.
+    /// Motor current of the reference plant at these pressures and speed (the
+    /// extended eq. 8 with its no-load and viscous friction, as
+    /// `eha_sim::pil::drill::motor_current`): consistent sensors, so the
+    /// cross-check agrees.
     fn motor_current(p_a: f32, p_b: f32, rpm: f32) -> f32 {
         let p = &eha_guard::params::DEFAULT;
         let d = p.displacement_m3_per_rad as f32;
         let dp = (p_a - p_b) * 1e5;
+        let w = libm::fabsf(rpm * core::f32::consts::PI / 30.0);
+        let t_f = p.no_load_torque_nm as f32 + p.viscous_w_s2_per_rad2 as f32 * w + p.eta_m as f32 * d * libm::fabsf(dp);
         let s = if rpm < 0.0 { -1.0 } else { 1.0 };
-        libm::fabsf(d * dp + s * p.eta_m as f32 * d * libm::fabsf(dp)) / p.torque_constant_nm_per_a as f32
+        libm::fabsf(d * dp + s * t_f) / p.torque_constant_nm_per_a as f32
     }
 
     fn sample(k: u32, noise: &mut u32) -> Sample {
@@ -385,9 +389,11 @@ mod fw {
         // interrupt's per-byte work is not counted; the replies are dropped
         // after each tick.
         static mut APP: core::mem::MaybeUninit<eha_guard::product::App> = core::mem::MaybeUninit::uninit();
-        static mut BOARD: MemBoard = MemBoard::new();
+        // (in .bss, written at run time: as an initialised static it would
+        // put its 27 KB in .data, i.e. in flash)
+        static mut BOARD: core::mem::MaybeUninit<MemBoard> = core::mem::MaybeUninit::uninit();
         // SAFETY: the only references to APP and BOARD, taken once.
-        let board = unsafe { &mut *core::ptr::addr_of_mut!(BOARD) };
+        let board = unsafe { &mut *core::ptr::addr_of_mut!(BOARD) }.write(MemBoard::new());
         let mem = board.boot_memory();
         // SAFETY: as above.
         let app = eha_guard::product::App::boot_into(unsafe { &mut *core::ptr::addr_of_mut!(APP) }, board, &GuardConfig::DEFAULT, &mem);
@@ -417,6 +423,8 @@ mod fw {
             board.clear_tx();
         }
         core::hint::black_box(tx_bytes);
+        let ao = app.guard().output();
+        eprintln!("App run end: faults {:#06x}, valve {}, epoch {}", ao.faults.bits(), ao.valve_open, app.guard().epoch());
 
         // Where the loop's instructions go: its parts alone, same frames.
         let mut pd_stats = Stats::new();

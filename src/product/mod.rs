@@ -35,11 +35,14 @@ use crate::params_block::{self, ParamSource, BLOCK_LEN};
 use crate::{GuardConfig, GuardOf, Output, Real};
 use heapless::Deque;
 use reset::CauseRecord;
-use wire::{Command, Pins, ResetCause, TickReply};
+use wire::{Command, Pins, ReplyEncoder, ResetCause, TickReply};
 
 /// Trace events sent per tick while a dump is in progress (a whole ring at
 /// once would not fit in one tick at the UART's rate).
 pub const TRACE_EVENTS_PER_TICK: usize = 4;
+/// Bytes taken from the board's receive buffer per read (a sample frame and
+/// a command fit in one).
+pub const RX_READ: usize = 64;
 /// Commands queued per tick; more are rejected (counted as framing).
 pub const COMMAND_QUEUE: usize = 4;
 /// Most timer periods one tick catches up as missing ticks (after an
@@ -166,6 +169,11 @@ pub struct AppOf<N: Num> {
     lng: LngConfig,
     guard: GuardOf<N>,
     rx: Deframer,
+    /// The bytes of one read from the board's receive buffer.
+    rx_buf: [u8; RX_READ],
+    /// The tick reply's encoder (re-frames only the per-tick tail while
+    /// the outputs, pins and counters hold).
+    reply: ReplyEncoder,
     last_seq: Option<u16>,
     sample: Option<Request>,
     commands: Deque<Command, COMMAND_QUEUE>,
@@ -242,6 +250,8 @@ impl<N: Num> AppOf<N> {
             GuardOf::<N>::new_in(&mut *core::ptr::addr_of_mut!((*p).guard).cast::<core::mem::MaybeUninit<GuardOf<N>>>(), &cfg, restore);
             core::ptr::addr_of_mut!((*p).lng).write(cfg.lng);
             core::ptr::addr_of_mut!((*p).rx).write(Deframer::new());
+            core::ptr::addr_of_mut!((*p).rx_buf).write([0; RX_READ]);
+            core::ptr::addr_of_mut!((*p).reply).write(ReplyEncoder::new());
             core::ptr::addr_of_mut!((*p).last_seq).write(None);
             core::ptr::addr_of_mut!((*p).sample).write(None);
             core::ptr::addr_of_mut!((*p).commands).write(Deque::new());
@@ -303,21 +313,19 @@ impl<N: Num> AppOf<N> {
         self.tick = self.tick.wrapping_add(1).wrapping_add(lost);
 
         // 1. transport
-        let mut buf = [0u8; 64];
         loop {
-            let n = board.read_rx(&mut buf);
-            let Some(chunk) = buf.get(..n) else { break };
-            if chunk.is_empty() {
+            let n = board.read_rx(&mut self.rx_buf);
+            if n == 0 {
                 break;
             }
-            let mut rest = chunk;
-            while !rest.is_empty() {
-                let (n, res) = self.rx.feed(rest);
-                if let Some(res) = res {
-                    let frame = commands::Incoming::parse(res);
+            let mut at = 0;
+            while at < n {
+                let (k, res) = self.rx.feed(self.rx_buf.get(at..n).unwrap_or(&[]));
+                let frame = res.map(commands::Incoming::parse);
+                at += k;
+                if let Some(frame) = frame {
                     self.accept(frame);
                 }
-                rest = rest.get(n..).unwrap_or(&[]);
             }
         }
 
@@ -356,7 +364,7 @@ impl<N: Num> AppOf<N> {
             restore: self.restore,
             reset_cause: self.reset_cause,
         };
-        board.write_tx(&reply.encode());
+        board.write_tx(self.reply.frame(&reply, self.guard.epoch()));
         while let Some(c) = self.commands.pop_front() {
             self.execute(board, c);
         }

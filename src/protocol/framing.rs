@@ -2,7 +2,7 @@
 //! the deframer that splits a byte stream back into checked payloads (see
 //! the [module docs](super) for the format).
 
-use super::{DecodeError, WireFrame, MAX_ENCODED, MAX_PAYLOAD, MAX_RAW, MAX_WIRE};
+use super::{DecodeError, WireFrame, MAX_PAYLOAD, MAX_RAW, MAX_WIRE};
 use heapless::Vec;
 
 // ---------------------------------------------------------------- CRC-16
@@ -39,6 +39,13 @@ const CRC_TABLES: ([u16; 256], [u16; 256]) = {
 static CRC_TABLE: [u16; 256] = CRC_TABLES.0;
 static CRC_TABLE2: [u16; 256] = CRC_TABLES.1;
 
+/// One byte of CRC-16/CCITT-FALSE.
+#[inline(always)]
+pub(crate) fn crc16_byte(crc: u16, b: u8) -> u16 {
+    let idx = usize::from(((crc >> 8) as u8) ^ b);
+    (crc << 8) ^ CRC_TABLE.get(idx).copied().unwrap_or(0)
+}
+
 /// CRC-16/CCITT-FALSE of `data`.
 #[inline(never)]
 pub fn crc16(data: &[u8]) -> u16 {
@@ -53,8 +60,7 @@ pub fn crc16(data: &[u8]) -> u16 {
         }
     }
     for &b in pairs.remainder() {
-        let idx = usize::from(((crc >> 8) as u8) ^ b);
-        crc = (crc << 8) ^ CRC_TABLE.get(idx).copied().unwrap_or(0);
+        crc = crc16_byte(crc, b);
     }
     crc
 }
@@ -229,17 +235,12 @@ impl Deframer {
     #[inline(never)]
     pub fn feed(&mut self, bytes: &[u8]) -> (usize, Option<Result<&[u8], DecodeError>>) {
         if !self.active {
-            // a whole frame in `bytes` (the usual case: one sample frame per
-            // tick, read at once): decoded straight from them
-            let start = bytes.iter().take_while(|b| **b == 0).count();
-            let rest = bytes.get(start..).unwrap_or(&[]);
-            if let Some(z) = rest.iter().position(|b| *b == 0) {
-                let frame = rest.get(..z).unwrap_or(&[]);
-                let res = match cobs_decode_into(frame, &mut self.buf) {
-                    Some(n) => Self::check(self.buf.get(..n).unwrap_or(&[])),
-                    None => Err(if frame.len() > MAX_ENCODED { DecodeError::Overflow } else { DecodeError::Cobs }),
-                };
-                return (start + z + 1, Some(res));
+            // A whole frame in `bytes` (the usual case: one sample frame per
+            // tick, read at once), decoded straight from them in one pass
+            // that stops at the delimiter. A frame not complete in `bytes`
+            // goes the byte-wise way.
+            if let Some((taken, res)) = decode_whole(bytes, &mut self.buf) {
+                return (taken, res.map(|r| r.and_then(|n| Self::check(self.buf.get(..n).unwrap_or(&[])))));
             }
         }
         self.feed_bytes(bytes)
@@ -346,28 +347,59 @@ impl Deframer {
     }
 }
 
-/// COBS-decodes one whole frame `src` (no delimiter, no zero byte) into
-/// `out`; the decoded length, `None` when a block runs past the end or the
-/// result does not fit.
+/// Decodes the first frame of `src` into `out` when `src` holds all of it:
+/// leading delimiters are skipped; `Some((taken, Some(Ok(n))))` for `n`
+/// decoded bytes up to and including the delimiter, `Some((taken,
+/// Some(Err)))` for a damaged frame (a zero inside a block, or one longer
+/// than any frame, `taken` up to its delimiter), `Some((taken, None))` when
+/// `src` is only delimiters, `None` when the frame is not complete in `src`.
 #[inline(always)]
-fn cobs_decode_into(src: &[u8], out: &mut [u8; MAX_RAW]) -> Option<usize> {
+fn decode_whole(src: &[u8], out: &mut [u8; MAX_RAW]) -> Option<(usize, Option<Result<usize, DecodeError>>)> {
     let n = src.len();
-    let (mut i, mut j) = (0usize, 0usize);
-    while i < n {
-        let code = usize::from(*src.get(i)?);
+    let mut i = 0;
+    while src.get(i) == Some(&0) {
         i += 1;
-        let end = i + code - 1;
-        let block = src.get(i..end)?;
-        let dst = out.get_mut(j..j + block.len())?;
-        for (d, s) in dst.iter_mut().zip(block) {
-            *d = *s;
+    }
+    if i == n {
+        return Some((i, None));
+    }
+    // `i` is at a code byte: the zero the previous block owes (not after a
+    // 0xFF block), then `code - 1` data bytes copied in one run. Plain
+    // indices and one bounds check per block: float payloads have many
+    // short blocks.
+    let mut j = 0usize;
+    let mut owed = false;
+    loop {
+        let code = usize::from(*src.get(i)?);
+        if code == 0 {
+            // the delimiter right after a whole block
+            return Some((i + 1, Some(Ok(j))));
         }
-        j += block.len();
-        i = end;
-        if code != 0xFF && i < n {
-            *out.get_mut(j)? = 0;
+        if owed {
+            let Some(d) = out.get_mut(j) else { return skip_to_delimiter(src, i, DecodeError::Overflow) };
+            *d = 0;
             j += 1;
         }
+        owed = code != 0xFF;
+        let (from, to) = (i + 1, i + code);
+        let block = src.get(from..to)?;
+        let Some(dst) = out.get_mut(j..j + (code - 1)) else { return skip_to_delimiter(src, from, DecodeError::Overflow) };
+        let mut k = 0;
+        while let (Some(&x), Some(d)) = (block.get(k), dst.get_mut(k)) {
+            if x == 0 {
+                // a delimiter inside a block: the frame ends short
+                return Some((from + k + 1, Some(Err(DecodeError::Cobs))));
+            }
+            *d = x;
+            k += 1;
+        }
+        j += code - 1;
+        i = to;
     }
-    Some(j)
+}
+
+/// The rest of a refused frame up to its delimiter, if `src` holds it.
+fn skip_to_delimiter(src: &[u8], from: usize, e: DecodeError) -> Option<(usize, Option<Result<usize, DecodeError>>)> {
+    let z = src.get(from..)?.iter().position(|b| *b == 0)?;
+    Some((from + z + 1, Some(Err(e))))
 }

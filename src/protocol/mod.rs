@@ -156,6 +156,7 @@ pub mod lockstep;
 
 pub(crate) use codec::Rd;
 pub use framing::frame;
+pub(crate) use framing::crc16_byte;
 pub use framing::{cobs_decode, cobs_encode, crc16, Deframer};
 
 // ------------------------------------------------------------- messages

@@ -63,39 +63,54 @@ impl Command {
 }
 
 impl TickReply {
+    /// The fields that change only with the outputs, the pins or the
+    /// counters (layout: docs/firmware.md): written first, so that the
+    /// product loop re-frames only the per-tick tail ([`super::ReplyEncoder`]).
+    #[inline(always)]
+    pub(super) fn head(&self, p: &mut PutAt<'_>) {
+        p.u8(KIND_TICK);
+        p.u8(u8::from(self.not_commissioned) << 1);
+        p.f32(self.out.drain_c);
+        p.u8(crate::protocol::GuardOutput::flags(&self.out));
+        p.u16(self.out.faults.bits());
+        p.f32(self.out.lng_remaining_kg);
+        p.f32(self.out.lng_seconds_left);
+        p.u8(u8::from(self.pins.valve_pin) | (u8::from(self.pins.ok_pin) << 1));
+        p.u16(self.overruns);
+        p.u16(self.rejected);
+        p.u8(restore_code(self.restore));
+        p.u8(self.reset_cause as u8);
+    }
+
+    /// The per-tick tail: tick counter, the sample's sequence number, fresh.
+    #[inline(always)]
+    pub(super) fn tail(&self) -> [u8; TICK_TAIL_LEN] {
+        let t = self.tick.to_le_bytes();
+        let s = self.sample_seq.to_le_bytes();
+        [t[0], t[1], t[2], t[3], s[0], s[1], u8::from(self.fresh)]
+    }
+
     /// Wire bytes (leading and trailing delimiter).
     pub fn encode(&self) -> WireFrame {
         framed(true, |p| {
-            p.u8(KIND_TICK);
-            p.u32(self.tick);
-            p.u16(self.sample_seq);
-            p.u8(u8::from(self.fresh) | (u8::from(self.not_commissioned) << 1));
-            p.f32(self.out.drain_c);
-            p.u8(crate::protocol::GuardOutput::flags(&self.out));
-            p.u16(self.out.faults.bits());
-            p.f32(self.out.lng_remaining_kg);
-            p.f32(self.out.lng_seconds_left);
-            p.u8(u8::from(self.pins.valve_pin) | (u8::from(self.pins.ok_pin) << 1));
-            p.u16(self.overruns);
-            p.u16(self.rejected);
-            p.u8(restore_code(self.restore));
-            p.u8(self.reset_cause as u8);
+            self.head(p);
+            p.bytes(&self.tail());
         })
     }
 
     /// Parses a payload (host side).
     pub fn from_payload(p: &[u8]) -> Result<TickReply, DecodeError> {
         let mut r = expect(p, KIND_TICK, TICK_LEN)?;
-        let tick = r.u32()?;
-        let sample_seq = r.u16()?;
-        let fresh_byte = r.u8()?;
-        let (fresh, not_commissioned) = (fresh_byte & 1 != 0, fresh_byte & 2 != 0);
+        let not_commissioned = r.u8()? & 2 != 0;
         let out = r.out()?;
         let pins = r.u8()?;
         let overruns = r.u16()?;
         let rejected = r.u16()?;
         let restore = restore_from_code(r.u8()?).ok_or(DecodeError::Kind)?;
         let reset_cause = ResetCause::from_code(r.u8()?);
+        let tick = r.u32()?;
+        let sample_seq = r.u16()?;
+        let fresh = r.u8()? & 1 != 0;
         let pins = Pins { valve_pin: pins & 1 != 0, ok_pin: pins & 2 != 0 };
         Ok(TickReply { tick, sample_seq, fresh, not_commissioned, out, pins, overruns, rejected, restore, reset_cause })
     }

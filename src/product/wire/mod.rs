@@ -13,6 +13,9 @@ use crate::trace::{RestoreKind, Trace};
 use crate::Output;
 
 mod codec;
+mod reply;
+
+pub use reply::ReplyEncoder;
 
 /// Kind byte of a command frame (controller → guard).
 pub const KIND_COMMAND: u8 = 0x10;
@@ -28,7 +31,9 @@ pub const KIND_TRACE: u8 = 0x93;
 /// Payload length of a command, bytes.
 pub const COMMAND_LEN: usize = 4;
 /// Payload length of a tick reply, bytes.
-pub const TICK_LEN: usize = 30;
+pub const TICK_LEN: usize = 31;
+/// Bytes of the tick reply's per-tick tail (tick, sample sequence, fresh).
+pub const TICK_TAIL_LEN: usize = 7;
 /// Payload length of an acknowledgement, bytes.
 pub const ACK_LEN: usize = 5;
 /// Payload length of a status reply, bytes.
