@@ -201,12 +201,12 @@ mod fw {
             ticks: 0,
         });
         let (a, b) = noinit::load();
-        let mem = BootMemory { records: (a, b), nv: None, cause: reset::noinit::load(), hw_hint: None };
+        let mem = BootMemory { records: (a, b), nv: eha_guard::memory::nv::NvLoad::Empty, alive_s: None, cause: reset::noinit::load(), hw_hint: None };
         // The application state lives in .bss, not on the stack.
         static mut APP: MaybeUninit<App> = MaybeUninit::uninit();
         // SAFETY: `main` runs once; this is the only reference to APP.
         let app = App::boot_into(unsafe { &mut *core::ptr::addr_of_mut!(APP) }, board, &GuardConfig::DEFAULT, &mem);
-        defmt::info!("eha-fw up: build {=str}, faults {=u16:#06x}", BUILD, app.guard().faults().bits());
+        defmt::info!("eha-fw up: build {=str}, faults {=u32:#010x}", BUILD, app.guard().faults().bits());
         let mut last = app.guard().output();
         let mut last_trace = app.guard().trace().recent().copied();
         while board.next_chunk() {
@@ -252,7 +252,7 @@ mod fw {
             defmt::warn!("over-temperature alarm {=bool} at drain {=f32} C", out.alarm, out.drain_c);
         }
         if prev.faults != out.faults {
-            defmt::error!("faults {=u16:#06x} -> {=u16:#06x}", prev.faults.bits(), out.faults.bits());
+            defmt::error!("faults {=u32:#010x} -> {=u32:#010x}", prev.faults.bits(), out.faults.bits());
         }
     }
 

@@ -16,6 +16,20 @@ impl<N: Num> GuardOf<N> {
             | Faults::channels(self.bad_ch)
             | Faults::when(self.lng_low, faults::LNG_LOW)
             | Faults::when(self.untrusted, faults::UNTRUSTED)
+            | Faults::when(self.nv_failed, faults::NV_FAILED)
+    }
+
+    /// The board's report of a non-volatile save of the thermal record: a
+    /// failure raises NV_FAILED with derate at once (after a power loss the
+    /// restore could be older than the write policy promises); it clears
+    /// at the next clear that follows a good save.
+    pub fn report_nv_save(&mut self, ok: bool) {
+        self.nv_ok = ok;
+        if !ok && !self.nv_failed {
+            self.nv_failed = true;
+            self.trace.write(Trace::Fault { tick: self.tick, new_bits: faults::NV_FAILED });
+            self.refresh_out();
+        }
     }
 
     /// **Clear rule.** Latched faults (except CONFIG) clear only through this explicit
@@ -45,8 +59,9 @@ impl<N: Num> GuardOf<N> {
         }
         // The controller accepts the estimate as it is (it is not reset); the alarm
         // follows it again from the next model step.
-        let bits = bits | Faults::when(self.untrusted, faults::UNTRUSTED);
+        let bits = bits | Faults::when(self.untrusted, faults::UNTRUSTED) | Faults::when(self.nv_failed && self.nv_ok, faults::NV_FAILED);
         self.untrusted = false;
+        self.nv_failed &= !self.nv_ok;
         if !bits.is_empty() {
             self.trace.write(Trace::FaultsCleared {
                 tick: self.tick,

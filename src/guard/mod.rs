@@ -180,6 +180,11 @@ pub struct GuardOf<N: Num> {
     out: Output,
     /// Changes of the outputs and of the recorded state ([`GuardOf::epoch`]).
     epoch: u32,
+    /// A non-volatile save failed (`faults::NV_FAILED`, derate) and no
+    /// clear has seen a good save since.
+    nv_failed: bool,
+    /// The last non-volatile save succeeded.
+    nv_ok: bool,
     trace: TraceBuf,
 }
 
@@ -244,6 +249,8 @@ impl<N: Num> GuardOf<N> {
                 ..Output::default()
             },
             epoch: 0,
+            nv_failed: false,
+            nv_ok: true,
             trace: TraceBuf::new(),
             );
             &mut *p

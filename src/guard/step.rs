@@ -187,11 +187,15 @@ impl<N: Num> GuardOf<N> {
     /// Rebuilds the cached outputs from the present state.
     pub(super) fn refresh_out(&mut self) {
         self.epoch = self.epoch.wrapping_add(1);
+        // Derate: the alarm, and whatever leaves the protection weaker than
+        // the estimate says (a valve not following its command, a thermal
+        // record that could not be saved).
+        let derate = self.alarm || self.nv_failed || self.latched.contains(faults::ACTUATOR);
         self.out = Output {
             drain_c: self.out.drain_c,
             valve_open: self.valve.is_open(),
             alarm: self.alarm,
-            derate: self.alarm,
+            derate,
             faults: self.faults(),
             lng_remaining_kg: self.lng.remaining_kg(),
             lng_seconds_left: self.lng.seconds_left_cj(self.last_cj),

@@ -97,6 +97,27 @@ impl<'a> Value<'a> for ThermalRecord {
     }
 }
 
+/// What the non-volatile store holds at boot.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum NvLoad {
+    /// No record (erased store, or a board without one): nothing to restore.
+    Empty,
+    /// The newest record, checked.
+    Valid(ThermalRecord),
+    /// A record was there but could not be read or failed its check.
+    Damaged,
+}
+
+impl NvLoad {
+    /// The valid record, if any.
+    pub fn valid(&self) -> Option<ThermalRecord> {
+        match self {
+            NvLoad::Valid(r) => Some(*r),
+            _ => None,
+        }
+    }
+}
+
 /// Errors of the non-volatile store.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum NvError {
@@ -120,11 +141,15 @@ impl<F: nf::NorFlash> NvStore<F> {
         Ok(NvStore { map: MapStorage::new(flash, cfg, Cache::new_uncached()), buf: [0; BUF_BYTES] })
     }
 
-    /// The newest stored record if it is valid (magic, version, CRC,
-    /// plausible temperatures); `None` when there is none or it is damaged.
-    pub fn load(&mut self) -> Option<ThermalRecord> {
-        let r: Option<ThermalRecord> = block_on(self.map.fetch_item(&mut self.buf, &RECORD_KEY)).ok().flatten();
-        r.filter(|r| r.classify() == RecordStatus::Valid)
+    /// The newest stored record: valid (magic, version, CRC, plausible
+    /// temperatures), none, or damaged (a read error, or a record that fails
+    /// its check: the machine may be hot, so the boot is conservative).
+    pub fn load(&mut self) -> NvLoad {
+        match block_on(self.map.fetch_item::<ThermalRecord>(&mut self.buf, &RECORD_KEY)) {
+            Ok(None) => NvLoad::Empty,
+            Ok(Some(r)) if r.classify() == RecordStatus::Valid => NvLoad::Valid(r),
+            Ok(Some(_)) | Err(_) => NvLoad::Damaged,
+        }
     }
 
     /// Append `rec` (the newest value of the record).
@@ -150,7 +175,7 @@ pub struct NvPolicy {
 }
 
 impl NvPolicy {
-    /// 2 K, 20 kJ of LNG (0.9 % of the 5 L charge), 30 minutes. The valve
+    /// 2 K, 110 kJ of LNG (5 % of the 5 L charge), 30 minutes. The valve
     /// state rides along in every record but triggers no write: after a
     /// power loss the guard decides it anew from the restored temperatures.
     pub const DEFAULT: NvPolicy = NvPolicy { rise_k: 2.0, lng_rise_cj: 11_000_000, max_interval_ticks: 180_000 };
@@ -280,18 +305,18 @@ mod tests {
     #[test]
     fn stores_and_restores_the_newest_record_across_pages() {
         let mut nv: NvStore<Flash> = NvStore::new(Blocking(RamFlash::new()), 0..8192).expect("range");
-        assert_eq!(nv.load(), None, "an erased flash holds no record");
+        assert_eq!(nv.load(), NvLoad::Empty, "an erased flash holds no record");
         for k in 0..500u32 {
             nv.save(&rec(20.0 + k as f32 * 0.05, k)).expect("save");
         }
-        let r = nv.load().expect("record");
+        let r = nv.load().valid().expect("record");
         assert_eq!((r.tick, r.temps_c[0], r.valve_open()), (499, 20.0 + 499.0 * 0.05, true));
         // A power loss: a new store over the same flash reads the same record.
         let flash = nv.into_flash();
         let erases: u32 = flash.0.erase_counts().iter().sum();
         assert!(erases > 0, "500 writes of 64 B must have cycled the 8 pages");
         let mut nv2: NvStore<Flash> = NvStore::new(flash, 0..8192).expect("range");
-        assert_eq!(nv2.load(), Some(r));
+        assert_eq!(nv2.load(), NvLoad::Valid(r));
     }
 
     #[test]

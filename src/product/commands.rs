@@ -156,6 +156,7 @@ impl<N: Num> AppOf<N> {
             commands: c.commands,
             nv_failures: c.nv_failures,
             faults: self.guard.faults(),
+            protocol: crate::protocol::PROTOCOL_VERSION,
         }
     }
 }

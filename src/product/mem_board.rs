@@ -60,6 +60,10 @@ pub struct MemBoard {
     pub nv_saved: Option<ThermalRecord>,
     /// The real-time clock's reading, s (`None`: no clock).
     pub rtc: Option<u32>,
+    /// The clock's battery-backed backup register holding the last-alive
+    /// stamp (kept across a power loss, like the clock; `None`: the board
+    /// has none; 0: empty, as after a backup-domain reset).
+    pub rtc_backup: Option<u32>,
     /// The flash's parameter-block region (`None`: the board has none).
     pub block: Option<&'static [u8; BLOCK_LEN]>,
     /// The hardware reset flag the board reports at the next boot.
@@ -93,6 +97,7 @@ impl MemBoard {
             nv_calls: 0,
             nv_saved: None,
             rtc: None,
+            rtc_backup: None,
             block: None,
             hw_hint: None,
         }
@@ -151,8 +156,9 @@ impl MemBoard {
     /// What the board finds in its memories at boot (the non-volatile
     /// store is read as a board's `init` reads it).
     pub fn boot_memory(&mut self) -> BootMemory {
-        let nv = self.nv.as_mut().and_then(|s| s.load());
-        BootMemory { records: (self.records[0], self.records[1]), nv, cause: self.cause, hw_hint: self.hw_hint }
+        let nv = self.nv.as_mut().map_or(crate::memory::nv::NvLoad::Empty, |s| s.load());
+        let alive_s = self.rtc_backup.filter(|s| *s != 0);
+        BootMemory { records: (self.records[0], self.records[1]), nv, alive_s, cause: self.cause, hw_hint: self.hw_hint }
     }
 
     /// A reset (watchdog, brown-out, pin): the MCU restarts, no-init RAM and
@@ -225,14 +231,21 @@ impl Board for MemBoard {
         self.cause = *rec;
     }
 
-    fn nv_save(&mut self, rec: &ThermalRecord) -> bool {
+    fn nv_save(&mut self, rec: &ThermalRecord) -> Option<bool> {
+        let store = self.nv.as_mut()?;
         self.nv_calls = self.nv_calls.wrapping_add(1);
         self.nv_saved = Some(*rec);
-        self.nv.as_mut().is_some_and(|s| s.save(rec).is_ok())
+        Some(store.save(rec).is_ok())
     }
 
     fn rtc_s(&mut self) -> Option<u32> {
         self.rtc
+    }
+
+    fn rtc_alive(&mut self, s: u32) {
+        if let Some(r) = self.rtc_backup.as_mut() {
+            *r = s;
+        }
     }
 
     fn param_block(&self) -> Option<&'static [u8; BLOCK_LEN]> {

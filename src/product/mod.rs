@@ -23,7 +23,7 @@ pub mod mem_board;
 pub mod reset;
 pub mod wire;
 
-use crate::memory::nv::NvPolicy;
+use crate::memory::nv::{NvLoad, NvPolicy};
 use crate::protection::LngConfig;
 use crate::memory::slots::{self, AbWriter};
 use crate::memory::cooling::RestCooling;
@@ -77,11 +77,11 @@ pub trait Board {
     fn store_record(&mut self, slot: usize, rec: &ThermalRecord);
     /// Stores the reset-cause record in no-init RAM.
     fn store_cause(&mut self, rec: &CauseRecord);
-    /// Saves a record to non-volatile memory; `false` when the board has none
-    /// or the write failed. May stall (flash erase): the board keeps its
-    /// watchdog from expiring meanwhile.
-    fn nv_save(&mut self, _rec: &ThermalRecord) -> bool {
-        false
+    /// Saves a record to non-volatile memory: `Some(true)` saved,
+    /// `Some(false)` the write failed, `None` the board has none. May stall
+    /// (flash erase): the board keeps its watchdog from expiring meanwhile.
+    fn nv_save(&mut self, _rec: &ThermalRecord) -> Option<bool> {
+        None
     }
     /// Seconds of a battery-backed real-time clock that keeps running while
     /// the board is unpowered (`None`: the board has none, or it lost its
@@ -91,6 +91,13 @@ pub trait Board {
     fn rtc_s(&mut self) -> Option<u32> {
         None
     }
+    /// Stores the last-alive stamp `s` (the real-time clock's seconds) in a
+    /// battery-backed register that survives a power loss (on the STM32F411
+    /// an RTC backup register), read back at boot into
+    /// [`BootMemory::alive_s`]. The application stamps it once per
+    /// [`crate::memory::ALIVE_PERIOD_S`]; it is the only time base the
+    /// power-off cooling counts from. No-op on a board without one.
+    fn rtc_alive(&mut self, _s: u32) {}
     /// A free-running core-clock cycle stamp (0 when not available).
     fn cycle_stamp(&self) -> u32 {
         0
@@ -120,8 +127,11 @@ pub trait Board {
 pub struct BootMemory {
     /// No-init RAM slot A and B.
     pub records: (ThermalRecord, ThermalRecord),
-    /// The non-volatile record, if the board has one and it is valid.
-    pub nv: Option<ThermalRecord>,
+    /// What the non-volatile store holds (none, valid, damaged).
+    pub nv: NvLoad,
+    /// The last-alive stamp in the clock's battery-backed register, s
+    /// ([`Board::rtc_alive`]; `None`: the board has none or it is empty).
+    pub alive_s: Option<u32>,
     /// The reset-cause record left in no-init RAM.
     pub cause: CauseRecord,
     /// The board's hardware reset flag, if it names a cause (e.g. IWDG).
@@ -184,6 +194,8 @@ pub struct AppOf<N: Num> {
     record_epoch: Option<u32>,
     nv_policy: NvPolicy,
     nv_last: Option<ThermalRecord>,
+    /// Tick of the last last-alive stamp ([`Board::rtc_alive`]).
+    alive_at: u32,
     /// Tick of the last failed non-volatile save: no attempt for
     /// [`NV_RETRY_TICKS`] after it (compared by wrapping difference, so the
     /// 497-day wrap of the tick counter does not stop the saves).
@@ -240,8 +252,8 @@ impl<N: Num> AppOf<N> {
             ParamSource::Invalid(_) => None,
             _ => RestCooling::from_consts(model),
         };
-        let now_s = if mem.nv.is_some() { board.rtc_s() } else { None };
-        let restore = boot_restore(slots::restore_from(a, b), mem.nv, &nv_policy, cool.as_ref(), now_s);
+        let now_s = if mem.nv != NvLoad::Empty { board.rtc_s() } else { None };
+        let restore = boot_restore(slots::restore_from(a, b), mem.nv, &nv_policy, cool.as_ref(), now_s, mem.alive_s);
         let cfg = GuardConfig { model, ..*cfg };
         let p = slot.as_mut_ptr();
         // SAFETY: `p` points to `slot`, valid for writes; every field is written
@@ -258,7 +270,8 @@ impl<N: Num> AppOf<N> {
             core::ptr::addr_of_mut!((*p).counters).write(Counters::default());
             core::ptr::addr_of_mut!((*p).records).write(AbWriter::after_boot(a, b));
             core::ptr::addr_of_mut!((*p).nv_policy).write(nv_policy);
-            core::ptr::addr_of_mut!((*p).nv_last).write(mem.nv);
+            core::ptr::addr_of_mut!((*p).nv_last).write(mem.nv.valid());
+            core::ptr::addr_of_mut!((*p).alive_at).write(0);
             core::ptr::addr_of_mut!((*p).record_epoch).write(None);
             core::ptr::addr_of_mut!((*p).nv_failed_at).write(None);
             core::ptr::addr_of_mut!((*p).tick).write(0);
@@ -347,11 +360,15 @@ impl<N: Num> AppOf<N> {
             }
         };
 
-        // 3. outputs
-        let (out, pins) = self.drive(board, out);
-        if self.record_epoch != Some(self.guard.epoch()) {
+        // 3. outputs: the thermal record first (a failed save changes the
+        // outputs: derate), then the pins and the reply
+        let out = if self.record_epoch != Some(self.guard.epoch()) {
             self.save(board);
-        }
+            self.guard.output()
+        } else {
+            out
+        };
+        let (out, pins) = self.drive(board, out);
         let reply = TickReply {
             tick: self.tick,
             sample_seq: self.last_seq.unwrap_or(0),
@@ -370,6 +387,10 @@ impl<N: Num> AppOf<N> {
         }
         self.send_trace_chunk(board);
 
+        if self.tick.wrapping_sub(self.alive_at) >= 100 * crate::memory::ALIVE_PERIOD_S {
+            self.stamp_alive(board);
+        }
+
         let cycles = board.cycles_since(stamp);
         self.worst_tick_cycles = self.worst_tick_cycles.max(cycles);
         // 4. the tick is complete
@@ -387,13 +408,28 @@ impl<N: Num> AppOf<N> {
         let retry = self.nv_failed_at.is_none_or(|t| self.tick.wrapping_sub(t) >= NV_RETRY_TICKS);
         if retry && self.nv_policy.due(self.nv_last.as_ref(), &rec) {
             let rec = rec.with_rtc(board.rtc_s());
-            if board.nv_save(&rec) {
-                self.nv_last = Some(rec);
-                self.nv_failed_at = None;
-            } else {
-                self.counters.nv_failures = self.counters.nv_failures.saturating_add(1);
-                self.nv_failed_at = Some(self.tick);
+            match board.nv_save(&rec) {
+                None => {}
+                Some(true) => {
+                    self.nv_last = Some(rec);
+                    self.nv_failed_at = None;
+                    self.guard.report_nv_save(true);
+                }
+                Some(false) => {
+                    self.counters.nv_failures = self.counters.nv_failures.saturating_add(1);
+                    self.nv_failed_at = Some(self.tick);
+                    self.guard.report_nv_save(false);
+                }
             }
+        }
+    }
+
+    /// The last-alive stamp (when the board has a clock).
+    #[inline(never)]
+    fn stamp_alive<B: Board>(&mut self, board: &mut B) {
+        self.alive_at = self.tick;
+        if let Some(s) = board.rtc_s() {
+            board.rtc_alive(s);
         }
     }
 
@@ -434,3 +470,5 @@ impl<N: Num> AppOf<N> {
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod safety_tests;

@@ -51,6 +51,13 @@
 
 use heapless::Vec;
 
+/// Version of the controller protocol (the sample request and the product
+/// frames), reported in the status reply. 2: one application loop (the
+/// tick reply's per-tick tail last, 33 bytes), the fault word 32 bits (tick
+/// reply, status, trace), the sample's optional speed-reference and LNG
+/// supply-pressure fields. 1: the first product protocol.
+pub const PROTOCOL_VERSION: u8 = 2;
+
 /// Request flag: the valve position is reported in this frame.
 pub const FLAG_VALVE_FB: u8 = 1 << 0;
 /// Request flag: the reported valve position is open (only with [`FLAG_VALVE_FB`]).
@@ -63,7 +70,7 @@ pub const KIND_SAMPLE: u8 = 0x01;
 pub const REQUEST_LEN: usize = 28;
 /// Largest payload of any frame, the request and the product frames of
 /// [`crate::product::wire`] (the status reply is the longest).
-pub const MAX_PAYLOAD: usize = 48;
+pub const MAX_PAYLOAD: usize = 56;
 /// Largest payload + CRC of any frame.
 pub const MAX_RAW: usize = MAX_PAYLOAD + 2;
 /// Largest COBS-encoded frame without delimiters.

@@ -443,7 +443,7 @@ proptest! {
     #[test]
     fn record_roundtrip_and_single_bit_corruption(
         temps in proptest::array::uniform6(-40.0f32..200.0), amb in -40.0f32..80.0,
-        used in any::<u32>(), faults_w in any::<u16>(), step in any::<u32>(), bit in 0usize..(56 * 8),
+        used in any::<u32>(), faults_w in any::<u32>(), step in any::<u32>(), bit in 0usize..(60 * 8),
     ) {
         let r = ThermalRecord::new(temps, amb, used, faults_w, step);
         prop_assert_eq!(r.classify(), RecordStatus::Valid);
@@ -451,16 +451,16 @@ proptest! {
         let mut b = bytes;
         b[bit / 8] ^= 1 << (bit % 8);
         let c = record_from_bytes(&b);
-        // Padding-free layout: bytes 44..48 are `seq_flags`, 48..52 the RTC stamp, 52..56 the CRC; every bit counts.
+        // Padding-free layout: bytes 48..52 are `seq_flags`, 52..56 the RTC stamp, 56..60 the CRC; every bit counts.
         prop_assert_eq!(c.classify(), RecordStatus::Corrupt, "flip of bit {} undetected", bit);
     }
 }
 
-fn record_bytes(r: &ThermalRecord) -> [u8; 56] {
+fn record_bytes(r: &ThermalRecord) -> [u8; 60] {
     r.to_le_bytes()
 }
 
-fn record_from_bytes(b: &[u8; 56]) -> ThermalRecord {
+fn record_from_bytes(b: &[u8; 60]) -> ThermalRecord {
     ThermalRecord::from_le_bytes(b)
 }
 

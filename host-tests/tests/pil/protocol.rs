@@ -26,7 +26,7 @@ prop_compose! {
 prop_compose! {
     fn any_reply()(
         tick in any::<u32>(), seq in any::<u16>(), fresh in any::<bool>(), nc in any::<bool>(), drain in any_f32(), flags in 0u8..8,
-        faults in any::<u16>(), kg in any_f32(), secs in any_f32(), pins in 0u8..4, c in proptest::array::uniform2(any::<u16>()),
+        faults in any::<u32>(), kg in any_f32(), secs in any_f32(), pins in 0u8..4, c in proptest::array::uniform2(any::<u16>()),
         restore in 0u8..4, cause in 0u8..6,
     ) -> TickReply {
         TickReply {

@@ -25,7 +25,7 @@ impl Rd<'_> {
             valve_open: flags & 1 != 0,
             alarm: flags & 2 != 0,
             derate: flags & 4 != 0,
-            faults: crate::faults::Faults::from_bits(self.u16()?),
+            faults: crate::faults::Faults::from_bits(self.u32()?),
             lng_remaining_kg: self.f32()?,
             lng_seconds_left: self.f32()?,
         })
@@ -72,7 +72,7 @@ impl TickReply {
         p.u8(u8::from(self.not_commissioned) << 1);
         p.f32(self.out.drain_c);
         p.u8(crate::protocol::GuardOutput::flags(&self.out));
-        p.u16(self.out.faults.bits());
+        p.u32(self.out.faults.bits());
         p.f32(self.out.lng_remaining_kg);
         p.f32(self.out.lng_seconds_left);
         p.u8(u8::from(self.pins.valve_pin) | (u8::from(self.pins.ok_pin) << 1));
@@ -159,9 +159,11 @@ impl Status {
             }
             p.u32(self.accepted);
             p.u32(self.missing);
-            for v in [self.rx_overflow, self.commands, self.nv_failures, self.faults.bits()] {
+            for v in [self.rx_overflow, self.commands, self.nv_failures] {
                 p.u16(v);
             }
+            p.u32(self.faults.bits());
+            p.u8(self.protocol);
         })
     }
 
@@ -187,7 +189,8 @@ impl Status {
             rx_overflow: r.u16()?,
             commands: r.u16()?,
             nv_failures: r.u16()?,
-            faults: crate::faults::Faults::from_bits(r.u16()?),
+            faults: crate::faults::Faults::from_bits(r.u32()?),
+            protocol: r.u8()?,
         })
     }
 }
@@ -203,7 +206,7 @@ impl TraceReply {
             p.u8(self.event.tag);
             p.u32(self.event.tick);
             p.f32(self.event.value);
-            p.u16(self.event.aux);
+            p.u32(self.event.aux);
         })
     }
 
@@ -214,7 +217,7 @@ impl TraceReply {
         let index = r.u8()?;
         let count = r.u8()?;
         let tag = r.u8()?;
-        let event = TraceWire { tag, tick: r.u32()?, value: r.f32()?, aux: r.u16()? };
+        let event = TraceWire { tag, tick: r.u32()?, value: r.f32()?, aux: r.u32()? };
         Ok(TraceReply { token, index, count, event })
     }
 }

@@ -31,15 +31,15 @@ pub const KIND_TRACE: u8 = 0x93;
 /// Payload length of a command, bytes.
 pub const COMMAND_LEN: usize = 4;
 /// Payload length of a tick reply, bytes.
-pub const TICK_LEN: usize = 31;
+pub const TICK_LEN: usize = 33;
 /// Bytes of the tick reply's per-tick tail (tick, sample sequence, fresh).
 pub const TICK_TAIL_LEN: usize = 7;
 /// Payload length of an acknowledgement, bytes.
 pub const ACK_LEN: usize = 5;
 /// Payload length of a status reply, bytes.
-pub const STATUS_LEN: usize = 47;
+pub const STATUS_LEN: usize = 50;
 /// Payload length of a trace-event reply, bytes.
-pub const TRACE_LEN: usize = 16;
+pub const TRACE_LEN: usize = 18;
 
 /// A controller command.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -259,6 +259,8 @@ pub struct Status {
     pub nv_failures: u16,
     /// Faults now.
     pub faults: crate::faults::Faults,
+    /// Protocol version of this firmware ([`crate::protocol::PROTOCOL_VERSION`]).
+    pub protocol: u8,
 }
 
 /// One trace event in a dump.
@@ -285,25 +287,25 @@ pub struct TraceWire {
     /// Drain °C (valve/alarm events), LNG kg (LNG low), else 0.
     pub value: f32,
     /// Fault bits, restore/reset cause code, forced flag, lost ticks or command code.
-    pub aux: u16,
+    pub aux: u32,
 }
 
 /// Flattens a trace event for the wire.
 pub fn encode_trace(t: &Trace) -> TraceWire {
     let w = |tag, tick, value, aux| TraceWire { tag, tick, value, aux };
     match *t {
-        Trace::Restore { tick, kind } => w(1, tick, 0.0, u16::from(restore_code(kind))),
-        Trace::ValveOpen { tick, drain_c, forced } => w(2, tick, drain_c, u16::from(forced)),
+        Trace::Restore { tick, kind } => w(1, tick, 0.0, u32::from(restore_code(kind))),
+        Trace::ValveOpen { tick, drain_c, forced } => w(2, tick, drain_c, u32::from(forced)),
         Trace::ValveClose { tick, drain_c } => w(3, tick, drain_c, 0),
         Trace::Alarm { tick, drain_c } => w(4, tick, drain_c, 0),
         Trace::AlarmClear { tick, drain_c } => w(5, tick, drain_c, 0),
         Trace::Fault { tick, new_bits } => w(6, tick, 0.0, new_bits.bits()),
         Trace::FaultsCleared { tick, bits } => w(7, tick, 0.0, bits.bits()),
         Trace::LngLow { tick, remaining_kg } => w(8, tick, remaining_kg, 0),
-        Trace::Overrun { tick, lost_ticks } => w(9, tick, 0.0, lost_ticks),
-        Trace::Reset { tick, cause } => w(10, tick, 0.0, u16::from(cause)),
-        Trace::Command { tick, code } => w(11, tick, 0.0, u16::from(code)),
-        Trace::Params { tick, source } => w(12, tick, 0.0, u16::from(source)),
+        Trace::Overrun { tick, lost_ticks } => w(9, tick, 0.0, u32::from(lost_ticks)),
+        Trace::Reset { tick, cause } => w(10, tick, 0.0, u32::from(cause)),
+        Trace::Command { tick, code } => w(11, tick, 0.0, u32::from(code)),
+        Trace::Params { tick, source } => w(12, tick, 0.0, u32::from(source)),
     }
 }
 

@@ -1,0 +1,163 @@
+//! The safety case on the product loop: every path that could leave the
+//! valve closed while the oil may be hot, or let a fault clear itself, has a
+//! test here (thermal memory, commands, configuration, erase stalls).
+
+extern crate std;
+
+use super::tests::{board, replies, sample, ticks};
+use super::*;
+use crate::faults;
+use mem_board::MemBoard;
+use std::boxed::Box;
+
+/// A board with a non-volatile store and a clock at `rtc_s`.
+fn nv_board(rtc_s: u32) -> Box<MemBoard> {
+    let mut b = Box::new(MemBoard::new().with_nv());
+    b.rtc = Some(rtc_s);
+    b.rtc_backup = Some(0);
+    b
+}
+
+/// Boots on `b` from what its memories hold.
+fn boot(b: &mut MemBoard) -> App {
+    let mem = b.boot_memory();
+    App::boot(b, &GuardConfig::DEFAULT, &mem)
+}
+
+/// A hot record (55-60 °C) stamped at `rtc_s`.
+fn hot_record(rtc_s: u32) -> ThermalRecord {
+    ThermalRecord::new([55.0, 60.0, 50.0, 45.0, 40.0, 30.0], 20.0, 5_000_000, 0, 100).with_seq(7, true).with_rtc(Some(rtc_s))
+}
+
+/// One tick with the nominal sample `k`; the tick reply.
+fn tick(app: &mut App, b: &mut MemBoard, k: u32) -> TickReply {
+    b.push_rx(&sample((k & 0xFFFF) as u16, 20.0, 40.0).encode());
+    app.tick(b, 0);
+    *ticks(&replies(b)).last().expect("a tick reply")
+}
+
+/// A flash that cannot be read at boot is not "no record": the machine may
+/// be hot, so the start is conservative (every node at the alarm
+/// temperature, MEMORY_CORRUPT, valve open, alarm until trusted).
+#[test]
+fn an_unreadable_flash_record_is_a_conservative_start_not_a_cold_one() {
+    let mut b = nv_board(1_000);
+    b.nv.as_mut().map(|s| s.save(&hot_record(1_000)));
+    b.power_loss();
+    b.set_flash_faults(true, false);
+    let mut app = boot(&mut b);
+    let r = tick(&mut app, &mut b, 1);
+    assert_eq!(r.restore, RestoreKind::Corrupt, "restore {:?}, faults {:?}", r.restore, r.out.faults);
+    assert!(r.out.faults.contains(faults::MEMORY_CORRUPT | faults::UNTRUSTED) && r.out.valve_open && r.out.alarm, "{:?}", r.out);
+}
+
+/// A record in flash that fails its check (bad CRC, or the NaN estimate the
+/// write policy let through) is damaged, not absent: conservative start.
+#[test]
+fn a_damaged_flash_record_is_a_conservative_start_not_a_cold_one() {
+    let mut bad_crc = hot_record(1_000);
+    bad_crc.crc ^= 1;
+    let mut nan = hot_record(1_000);
+    nan.temps_c[1] = f32::NAN;
+    let nan = nan.with_rtc(Some(1_000)); // resealed: only its value is wrong
+    for (name, rec) in [("bad CRC", bad_crc), ("NaN estimate", nan)] {
+        let mut b = nv_board(1_000);
+        b.nv.as_mut().map(|s| s.save(&rec));
+        b.power_loss();
+        let mut app = boot(&mut b);
+        let r = tick(&mut app, &mut b, 1);
+        assert_eq!(r.restore, RestoreKind::Corrupt, "{name}: restore {:?}", r.restore);
+        assert!(r.out.valve_open && r.out.alarm, "{name}: {:?}", r.out);
+    }
+}
+
+/// A failed non-volatile save is reported: NV_FAILED, derate, the OK pin
+/// low (the valve is not forced: the estimate itself is good).
+#[test]
+fn a_failed_save_latches_nv_failed_with_derate() {
+    let mut b = nv_board(1_000);
+    b.set_flash_faults(false, true);
+    let mut app = boot(&mut b);
+    let r = tick(&mut app, &mut b, 1);
+    assert_eq!(b.nv_calls, 1, "the first record is due at once");
+    assert!(r.out.faults.contains(faults::NV_FAILED) && r.out.derate && !r.pins.ok_pin, "{:?}", r);
+}
+
+/// The retry timer of a failing store survives the 497-day wrap of the
+/// tick counter (a saturating deadline stopped every save until the
+/// counter came round again).
+#[test]
+fn failed_saves_are_retried_across_the_tick_counter_wrap() {
+    let mut b = nv_board(1_000);
+    b.set_flash_faults(false, true);
+    let mut app = boot(&mut b);
+    tick(&mut app, &mut b, 0);
+    // jump the application's tick counter to 7 000 ticks before the wrap
+    let before = u32::MAX - 7_000 - app.tick;
+    b.push_rx(&sample(1, 20.0, 40.0).encode());
+    app.tick(&mut *b, before);
+    let calls = b.nv_calls;
+    for k in 2..20_000u32 {
+        tick(&mut app, &mut b, k);
+    }
+    assert!(b.nv_calls >= calls + 2, "saves retried once a minute across the wrap: {} -> {}", calls, b.nv_calls);
+}
+
+/// After a power loss the LNG used is never under-counted: the restore adds
+/// the most the write policy can have left unwritten (110 kJ).
+#[test]
+fn lng_used_is_never_under_counted_after_a_power_loss() {
+    let mut b = nv_board(1_000);
+    let rec = hot_record(1_000);
+    b.nv.as_mut().map(|s| s.save(&rec));
+    b.rtc_backup = Some(1_000);
+    b.power_loss();
+    let app = boot(&mut b);
+    let used = app.guard().snapshot().lng_used_cj;
+    let unwritten = NvPolicy::DEFAULT.lng_rise_cj;
+    assert!(used >= rec.lng_used_cj + unwritten, "restored {used} cJ, saved {} cJ + up to {unwritten} cJ unwritten", rec.lng_used_cj);
+}
+
+/// Power-off cooling counts only from a time the board knows the machine
+/// stopped: the last-alive stamp in the clock's backup register. A record
+/// far older than that (its saves failed while the machine ran on) is
+/// stale: a conservative start, not a record cooled over hours the machine
+/// was running.
+#[test]
+fn no_cooling_over_hours_the_machine_ran_after_its_last_save() {
+    let mut b = nv_board(5_000);
+    let mut app = boot(&mut b);
+    tick(&mut app, &mut b, 0);
+    assert_eq!(b.nv_saved.map(|r| r.rtc_s), Some(5_000), "the first save");
+    // every save from here fails; the machine runs 2 h more
+    b.set_flash_faults(false, true);
+    for k in 1..2_000u32 {
+        b.rtc = Some(5_000 + k * 7_200 / 2_000);
+        tick(&mut app, &mut b, k);
+    }
+    b.power_loss();
+    b.set_flash_faults(false, false);
+    b.rtc = Some(5_000 + 7_200 + 86_400);
+    let mut app = boot(&mut b);
+    let r = tick(&mut app, &mut b, 1);
+    assert_eq!(r.restore, RestoreKind::Corrupt, "the 2 h stale record: restore {:?}, drain {}", r.restore, r.out.drain_c);
+}
+
+/// A valve that does not follow its command (ACTUATOR, detected from the
+/// position report) derates: the cooling the estimate needs may be missing
+/// (the campaign's stuck-shut valve reached 61.8 °C at the drain).
+#[test]
+fn a_detected_actuator_fault_derates() {
+    let mut b = board();
+    let mut app = boot(&mut b);
+    let mut last = tick(&mut app, &mut b, 0);
+    for k in 1..100u16 {
+        // the valve reports open while commanded shut (cold oil; pump at
+        // rest, so the sensor cross-check has nothing to compare)
+        b.push_rx(&Request { valve_fb: Some(true), speed_rpm: 0.0, ..sample(k, 0.0, 5.0) }.encode());
+        app.tick(&mut *b, 0);
+        last = *ticks(&replies(&mut b)).last().expect("a tick reply");
+    }
+    assert!(last.out.faults.contains(faults::ACTUATOR), "{:?}", last.out);
+    assert!(last.out.derate && !last.pins.ok_pin, "ACTUATOR must derate: {:?}", last);
+}
