@@ -173,6 +173,12 @@ impl<N: Num> GuardOf<N> {
     pub fn refuse_config(&mut self) {
         self.core_ok = false;
         self.latched |= faults::CONFIG;
+        // fail-safe outputs from this instant: valve open, alarm (OK pin low),
+        // no estimate
+        self.valve.force_open();
+        self.alarm = true;
+        self.out.drain_c = DRAIN_C_UNKNOWN;
+        self.refresh_out();
     }
 
     /// The model, when the parameters were usable.

@@ -123,9 +123,9 @@ mod tests {
         TickReply {
             tick: k,
             sample_seq: (k * 7) as u16,
-            fresh: k % 3 != 0,
-            not_commissioned: k % 5 == 0,
-            out: crate::Output { drain_c: [0.0, 40.5, 1e6][(k / 4 % 3) as usize], valve_open: k % 2 == 0, ..Default::default() },
+            fresh: !k.is_multiple_of(3),
+            not_commissioned: k.is_multiple_of(5),
+            out: crate::Output { drain_c: [0.0, 40.5, 1e6][(k / 4 % 3) as usize], valve_open: k.is_multiple_of(2), ..Default::default() },
             pins: Pins { valve_pin: k % 4 == 1, ok_pin: true },
             overruns: (k / 8) as u16,
             rejected: (k / 16) as u16,
