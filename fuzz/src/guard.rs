@@ -166,7 +166,7 @@ impl<N: Num> Run<N> {
 
     fn clear(&mut self) {
         let before = self.g.faults() & faults::LATCHED;
-        if self.g.clear_faults() {
+        if self.g.clear_faults().cleared() {
             // Maintenance that clears the faults also repairs a stuck valve.
             if matches!(self.fb, Feedback::Stuck(_)) {
                 self.fb = Feedback::Follows;

@@ -131,6 +131,9 @@ pub fn structured(data: &[u8]) -> Vec<u8> {
                 1 => Some(false),
                 _ => Some(true),
             },
+            // the optional inputs: absent, near nominal, or raw bits
+            elec_hz: (sel & 0x20 != 0).then(|| v(&mut u, 83.0, 80.0)),
+            lng_supply_bar: (sel & 0x40 != 0).then(|| v(&mut u, 3.0, 3.0)),
         };
         let wire = req.encode();
         let corrupt = if sel & 0x10 != 0 { byte(&mut u) % 10 } else { 255 };
@@ -182,8 +185,8 @@ pub fn structured(data: &[u8]) -> Vec<u8> {
                 if let Some(k) = q.first_mut() {
                     *k = KIND_SAMPLE;
                 }
-                if n == REQUEST_LEN {
-                    q.push(0);
+                if (REQUEST_LEN..=eha_guard::protocol::REQUEST_MAX_LEN).contains(&n) {
+                    q.push(0xFF);
                 }
                 raw_frame(&q, &mut out);
             }

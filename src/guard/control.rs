@@ -17,6 +17,79 @@ impl<N: Num> GuardOf<N> {
             | Faults::when(self.lng_low, faults::LNG_LOW)
             | Faults::when(self.untrusted, faults::UNTRUSTED)
             | Faults::when(self.nv_failed, faults::NV_FAILED)
+            | Faults::when(self.recovering(), faults::RECOVERING)
+            | self.cooling_status()
+    }
+
+    /// Ticks the estimate still needs to forget an unknown start (0: it
+    /// has, or it started from a known state). Before the first sample an
+    /// unknown start has not begun to recover.
+    pub fn recovery_left(&self) -> u32 {
+        match self.hold_from {
+            Some(t) => self.recovery_ticks.saturating_sub(self.tick.wrapping_sub(t)),
+            None if self.unknown_start => self.recovery_ticks,
+            None => 0,
+        }
+    }
+
+    fn recovering(&self) -> bool {
+        self.recovery_left() > 0
+    }
+
+    /// Why the cooling is not (or not fully) confirmed, while the valve is
+    /// commanded open: no position report since samples started (no credit), no supply pressure
+    /// (credit on the budget alone), or a supply pressure below its minimum
+    /// (the tank is empty: no credit, LNG_LOW).
+    fn cooling_status(&self) -> Faults {
+        let open = self.valve.is_open();
+        Faults::when(open && self.started && self.fb.is_none(), faults::NO_VALVE_FEEDBACK)
+            | Faults::when(open && self.fb == Some(true) && self.supply.is_none() && self.credited(), faults::LNG_UNCONFIRMED)
+            | Faults::when(self.supply == Some(false), faults::LNG_LOW)
+    }
+
+    /// Reports the LNG supply pressure at the valve, bar gauge (`None`: not
+    /// reported), once per tick before [`GuardOf::tick`]. Below
+    /// `LngConfig::min_supply_bar` (or NaN) the tank is taken as empty: no
+    /// cooling credit, LNG_LOW. Without the report the tank is taken as full
+    /// until the LNG budget says it is empty, and flagged LNG_UNCONFIRMED
+    /// (residual risk: docs/firmware.md).
+    pub fn lng_supply(&mut self, bar: Option<f32>) {
+        let s = bar.map(|p| p >= self.min_supply_bar);
+        if s != self.supply {
+            // The credit changes from this tick on: count the ticks before.
+            self.settle(self.tick);
+            self.supply = s;
+            self.refresh_out();
+        }
+    }
+
+    /// Speed plausibility on this tick's sample and the motor's electrical
+    /// frequency, if reported ([`crate::speedcheck`]), once per tick before
+    /// [`GuardOf::tick`]. An implausible speed latches SENSOR_DISAGREE with
+    /// the speed channel bad (its worst case from this tick on), opens the
+    /// valve and holds the alarm until a clear.
+    pub fn check_speed(&mut self, s: &Sample, elec_hz: Option<f32>) {
+        let Some(sc) = self.speed.as_mut() else { return };
+        if sc.tick(s, elec_hz) {
+            self.latch_speed();
+        }
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn latch_speed(&mut self) {
+        self.settle(self.tick);
+        let newly = !self.latched.contains(faults::SENSOR_DISAGREE) || self.bad_ch & crate::validate::CH_SPEED == 0;
+        self.latched |= faults::SENSOR_DISAGREE;
+        self.bad_ch |= crate::validate::CH_SPEED;
+        self.untrusted = true;
+        if newly {
+            self.trace.write(Trace::Fault { tick: self.tick, new_bits: faults::SENSOR_DISAGREE | Faults::channels(crate::validate::CH_SPEED) });
+        }
+        if self.valve.force_open() {
+            self.trace.write(Trace::ValveOpen { tick: self.tick, drain_c: self.out.drain_c, forced: true });
+        }
+        self.refresh_out();
     }
 
     /// The board's report of a non-volatile save of the thermal record: a
@@ -36,13 +109,15 @@ impl<N: Num> GuardOf<N> {
     /// call (maintenance / operator command), and only if the last
     /// `clear_valid_ticks` samples (1 s by default) were all valid and none is missing.
     /// The thermal estimate is *not* reset: it relaxes from its conservative value.
-    /// A successful clear also restores trust in the estimate ([`faults::UNTRUSTED`]:
-    /// after a corrupt record or no sample by the start-up timeout the alarm and
-    /// derate are held until then). Returns `true` when the faults were cleared.
-    pub fn clear_faults(&mut self) -> bool {
+    /// A clear also restores trust in the estimate ([`faults::UNTRUSTED`]: after a
+    /// sensor disagreement the estimate ran on the worst case), **except** while
+    /// the estimate is still recovering from an unknown start
+    /// ([`faults::RECOVERING`], [`super::recovery_ticks`]): then the faults clear
+    /// and UNTRUSTED holds ([`ClearResult::TrustHeld`]).
+    pub fn clear_faults(&mut self) -> ClearResult {
         let valid_run = self.tick.wrapping_sub(self.valid_since);
         if self.missing != 0 || valid_run < self.clear_valid_ticks {
-            return false;
+            return ClearResult::Refused;
         }
         let bits = (self.latched & !faults::CONFIG) | Faults::channels(self.bad_ch);
         self.settle(self.tick);
@@ -57,10 +132,20 @@ impl<N: Num> GuardOf<N> {
                 c.model.set_loss_max(cc.disagrees());
             }
         }
+        if let Some(sc) = self.speed.as_mut() {
+            sc.restart();
+        }
         // The controller accepts the estimate as it is (it is not reset); the alarm
-        // follows it again from the next model step.
-        let bits = bits | Faults::when(self.untrusted, faults::UNTRUSTED) | Faults::when(self.nv_failed && self.nv_ok, faults::NV_FAILED);
-        self.untrusted = false;
+        // follows it again from the next model step — unless it is still recovering
+        // from an unknown start.
+        let left = self.recovery_left();
+        let trust = left == 0 && self.untrusted;
+        let bits = bits | Faults::when(trust, faults::UNTRUSTED) | Faults::when(self.nv_failed && self.nv_ok, faults::NV_FAILED);
+        if left == 0 {
+            self.untrusted = false;
+            self.unknown_start = false;
+            self.hold_from = None;
+        }
         self.nv_failed &= !self.nv_ok;
         if !bits.is_empty() {
             self.trace.write(Trace::FaultsCleared {
@@ -69,7 +154,11 @@ impl<N: Num> GuardOf<N> {
             });
         }
         self.refresh_out();
-        true
+        if self.untrusted {
+            ClearResult::TrustHeld(left)
+        } else {
+            ClearResult::Cleared
+        }
     }
 
     /// Marks an actuator (valve pin) error reported by the board: latches ACTUATOR
@@ -105,6 +194,7 @@ impl<N: Num> GuardOf<N> {
             // The credit may change from this tick on: count the ticks before.
             self.settle(self.tick);
             self.fb = Some(open);
+            self.refresh_out();
         }
         if open == self.valve.is_open() {
             self.fb_mismatch = 0;
@@ -144,7 +234,7 @@ impl<N: Num> GuardOf<N> {
             }
             amb = c.model.ambient_c().to_f32();
         }
-        let mut r = ThermalRecord::unsealed(temps, amb, self.lng.used_cj(), (self.faults() & !faults::LNG_LOW).bits(), self.tick);
+        let mut r = ThermalRecord::unsealed(temps, amb, self.lng.used_cj(), (self.faults() & faults::RECORDED).bits(), self.tick);
         r.seq_flags = if self.valve.is_open() { crate::memory::FLAG_VALVE_OPEN } else { 0 };
         r
     }

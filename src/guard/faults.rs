@@ -110,7 +110,7 @@ impl core::fmt::LowerHex for Faults {
 }
 
 /// Names of the single-bit members, for `Debug`.
-const NAMES: [(Faults, &str); 13] = [
+const NAMES: [(Faults, &str); 14] = [
     (RANGE, "RANGE"),
     (RATE, "RATE"),
     (NON_FINITE, "NON_FINITE"),
@@ -124,6 +124,7 @@ const NAMES: [(Faults, &str); 13] = [
     (NV_FAILED, "NV_FAILED"),
     (LNG_UNCONFIRMED, "LNG_UNCONFIRMED"),
     (NO_VALVE_FEEDBACK, "NO_VALVE_FEEDBACK"),
+    (RECOVERING, "RECOVERING"),
 ];
 
 impl core::fmt::Debug for Faults {
@@ -189,10 +190,20 @@ pub const LNG_UNCONFIRMED: Faults = Faults(1 << 17);
 /// Status: no valve position is reported, so no cooling is credited (the
 /// estimate runs hot while the valve is open: the safe side).
 pub const NO_VALVE_FEEDBACK: Faults = Faults(1 << 18);
+/// Status: the estimate started from an unknown thermal state (a corrupt or
+/// damaged record, no sample by the start-up timeout) and has not yet run
+/// long enough to forget it; UNTRUSTED cannot be cleared before this bit
+/// goes (docs/firmware.md, "Commands"). Kept in the thermal record: a reset
+/// restarts the hold.
+pub const RECOVERING: Faults = Faults(1 << 19);
 /// Bits that latch.
 pub const LATCHED: Faults = Faults(0x7f | (1 << 14));
+/// Bits the thermal record keeps: the latched faults, the bad channels and
+/// UNTRUSTED and RECOVERING (live status bits are not saved: they would make
+/// the non-volatile write policy write at every valve change).
+pub const RECORDED: Faults = Faults(LATCHED.0 | (0x3F << CH_SHIFT) | UNTRUSTED.0 | RECOVERING.0);
 /// Bits that latch or are status, besides the channels: every named member.
-pub const ALL_NAMED: Faults = Faults(0x7f | (1 << 7) | (1 << 14) | (1 << 15) | (7 << 16));
+pub const ALL_NAMED: Faults = Faults(0x7f | (1 << 7) | (1 << 14) | (1 << 15) | (15 << 16));
 
 #[cfg(test)]
 mod tests {

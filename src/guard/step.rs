@@ -13,6 +13,10 @@ impl<N: Num> GuardOf<N> {
     #[inline(never)]
     pub(super) fn start(&mut self, ambient_c: N) {
         self.started = true;
+        if self.unknown_start {
+            // The estimate starts to forget its unknown start from here.
+            self.hold_from = Some(self.tick);
+        }
         // Nothing of the waiting time is counted: no model ran, no credit, no LNG booked.
         self.mark = self.tick;
         self.open_acc = 0;
@@ -52,15 +56,21 @@ impl<N: Num> GuardOf<N> {
         let n = upto.wrapping_sub(self.mark);
         if self.valve.is_open() {
             self.open_acc = self.open_acc.wrapping_add(n);
-            if self.latched.is_empty() && !self.lng_empty && self.fb != Some(false) {
-                // The exchanger runs over these ticks. No cooling credit under a
-                // latched fault (conservative: the exchanger itself may be what
-                // failed), with the LNG used up, or while the valve's position
-                // feedback says shut.
+            if self.credited() {
                 self.credit_acc = self.credit_acc.wrapping_add(n);
             }
         }
         self.mark = upto;
+    }
+
+    /// The exchanger is credited (with the valve commanded open): only when
+    /// the cooling is confirmed — the valve's position report says open,
+    /// the supply pressure (if reported) says the tank has LNG, the LNG
+    /// budget is not used up — and no fault is latched (conservative: the
+    /// exchanger itself may be what failed).
+    #[inline(always)]
+    pub(super) fn credited(&self) -> bool {
+        self.latched.is_empty() && !self.lng_empty && self.fb == Some(true) && self.supply != Some(false) && !self.blind
     }
 
     /// Every `TICKS_PER_STEP` ticks: the model step, then the protection.

@@ -50,12 +50,20 @@ impl<N: Num> GuardOf<N> {
     #[inline(never)]
     #[cold]
     fn tick_slow(&mut self, s: &Sample) -> Output {
-        self.missing = 0;
+        let gap = core::mem::replace(&mut self.missing, 0);
         let Some(core) = self.core_ok.then_some(&self.core) else {
             return self.slow_tail(None, Faults::NONE, N::ZERO);
         };
         let (v, nonfinite) = validate::convert(s, &core.scales);
-        let c = validate::check(&v, nonfinite, &self.prev, self.prev_ok, &core.limits);
+        // After missing ticks (samples slower than the tick, or a dropout
+        // shorter than STALE) the rate is checked over the gap: the limits
+        // times the ticks since the last sample.
+        let c = if gap > 0 && gap < self.stale_ticks {
+            let lim = core.limits.rate_over(gap + 1);
+            validate::check(&v, nonfinite, &self.prev, self.gap_ok, &lim)
+        } else {
+            validate::check(&v, nonfinite, &self.prev, self.prev_ok, &core.limits)
+        };
         let mut new_bits = Faults::NONE;
         if c.range {
             new_bits |= faults::RANGE;
@@ -97,14 +105,67 @@ impl<N: Num> GuardOf<N> {
         }
         self.missing = self.missing.saturating_add(1);
         self.valid_since = self.tick.wrapping_add(1);
+        if self.missing == 1 {
+            self.gap_ok = self.prev_ok;
+        }
         self.prev_ok = 0;
         let mut new_bits = Faults::NONE;
         if self.missing >= self.stale_ticks {
             new_bits |= faults::STALE;
             self.bad_ch = CH_ALL;
+            self.stale_alarm();
         }
         let u = self.core_ok.then(|| validate::substitute(&self.prev, self.bad_ch, None, &self.core.limits));
         self.slow_tail(u.as_ref(), new_bits, N::ZERO)
+    }
+
+    /// `n` ticks the MCU did not see at all: a flash erase stalled the core
+    /// (the board's timer counted them, no sample was read). Accounted as
+    /// missing ticks are before STALE — the last inputs held, latched
+    /// channels at their worst case, no piston work (all pump power heats)
+    /// — and with no cooling credit; the clear rule's valid run and the rate
+    /// check restart; not counted towards STALE (the controller did not go
+    /// silent, the guard did). Every channel at its worst case instead
+    /// would heat the paper rig's drain estimate by 35 K per second of gap
+    /// (measured, `tests/core/stall.rs`): every erase an alarm. The residual
+    /// risk (a load rise inside the gap) is in docs/firmware.md, "Flash
+    /// erase stall". Before the first sample: waiting ticks. The product
+    /// loop caps `n` at [`crate::product::MAX_STALL_TICKS`].
+    #[cold]
+    #[inline(never)]
+    pub fn tick_blind(&mut self, n: u32) -> Output {
+        if !self.started {
+            for _ in 0..n {
+                self.wait_tick();
+            }
+            return self.out;
+        }
+        self.settle(self.tick);
+        self.blind = true;
+        for _ in 0..n {
+            self.valid_since = self.tick.wrapping_add(1);
+            self.prev_ok = 0;
+            self.gap_ok = 0;
+            let u = self.core_ok.then(|| validate::substitute(&self.prev, self.bad_ch, None, &self.core.limits));
+            self.slow_tail(u.as_ref(), Faults::NONE, N::ZERO);
+        }
+        self.settle(self.tick);
+        self.blind = false;
+        self.out
+    }
+
+    /// STALE after the start: the controller went silent, the machine may
+    /// run on unseen; the alarm and the derate at once, held until a clear
+    /// (the estimate runs on every channel's worst case meanwhile, so the
+    /// clear restores trust at once: no unknown start).
+    #[cold]
+    #[inline(never)]
+    fn stale_alarm(&mut self) {
+        self.untrusted = true;
+        if !self.alarm {
+            self.alarm = true;
+            self.trace.write(Trace::Alarm { tick: self.tick, drain_c: self.out.drain_c });
+        }
     }
 
     /// A tick without a sample before the first sample (boot, or samples not yet
@@ -125,8 +186,10 @@ impl<N: Num> GuardOf<N> {
             }
             self.latched |= faults::STALE;
             self.bad_ch = CH_ALL;
-            // No estimate and no input: alarm and derate until a clear.
+            // No estimate and no input: alarm and derate until a clear, and
+            // the machine may have run unseen: the start state is unknown.
             self.untrusted = true;
+            self.unknown_start = true;
             if !self.alarm {
                 self.alarm = true;
                 self.trace.write(Trace::Alarm {

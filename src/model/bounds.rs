@@ -87,6 +87,7 @@ bounds! {
     lng_in: 1, [-200.0, -100.0], "LNG inlet temperature, degC (Table 6: -162)";
     k_mu: 1, [0.0, 0.1], "viscosity exponent of the leakage, 1/K (0: off)";
     t_mu: 1, [-40.0, 150.0], "reference temperature of the leakage conductance, degC";
+    pole_pairs: 1, [1.0, 50.0], "motor pole pairs (rig 4): the drive's electrical frequency is pole pairs x rev/s, the speed check's second source";
     inv_c: 1, [1.0e-4, 10.0], "1 / pump housing capacity, K/kJ: 0.1-10 000 kJ/K (rig 9.2 kJ/K)";
     inv_c: 2, [0.0, 0.0], "oil nodes: their capacity comes from rho c_p and the volume, this word must be 0";
     inv_c: 3, [1.0e-4, 10.0], "1 / capacity of the main block, ball-valve block and actuator, K/kJ";

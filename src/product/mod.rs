@@ -49,6 +49,11 @@ pub const COMMAND_QUEUE: usize = 4;
 /// overrun). After `stale_ticks` (5) misses STALE has latched and the guard
 /// runs on worst-case inputs; a longer gap would only spend time.
 pub const MAX_MISSED_TICKS: u32 = 100;
+/// Most timer periods one tick accounts as stalled by the board's own
+/// non-volatile save (a flash erase stalls the core: up to 4 s on the
+/// STM32F411; 5 s, beyond which the watchdog's erase window has reset the
+/// MCU): [`crate::GuardOf::tick_blind`], no STALE.
+pub const MAX_STALL_TICKS: u32 = 500;
 /// Ticks to wait after a failed non-volatile save before the next attempt
 /// (60 s): a dead or worn flash must not cost an erase attempt, which can
 /// stall the MCU for seconds, on every tick.
@@ -200,6 +205,9 @@ pub struct AppOf<N: Num> {
     /// [`NV_RETRY_TICKS`] after it (compared by wrapping difference, so the
     /// 497-day wrap of the tick counter does not stop the saves).
     nv_failed_at: Option<u32>,
+    /// Timer periods the last non-volatile save stalled the core (the
+    /// next tick accounts them as blind, not missing).
+    stalled: u32,
     tick: u32,
     restore: RestoreKind,
     reset_cause: ResetCause,
@@ -209,6 +217,15 @@ pub struct AppOf<N: Num> {
     dump: Option<(u16, u8, u8)>,
     /// Where the model constants of this boot come from.
     params: ParamSource,
+    /// The parameter block's rig id (all zero for the compiled-in
+    /// default): the key of armed commands.
+    rig_id: [u8; 16],
+    /// The armed clear or refill: (the arm, its nonce, its tick).
+    armed: Option<(wire::Cmd, u32, u32)>,
+    /// The last nonce handed out.
+    nonce: u32,
+    /// Tick of the last confirmed clear (0) and refill (1).
+    confirmed: [Option<u32>; 2],
 }
 
 fn restore_kind(r: &Restore) -> RestoreKind {
@@ -246,6 +263,13 @@ impl<N: Num> AppOf<N> {
             Some(Ok(Some(c))) => (c, ParamSource::Block),
             Some(Err(e)) => (cfg.model, ParamSource::Invalid(e)),
         };
+        let mut rig_id = [0u8; 16];
+        if let (ParamSource::Block, Some(b)) = (params, board.param_block()) {
+            let id = params_block::rig_id(b).as_bytes();
+            for (d, s) in rig_id.iter_mut().zip(id) {
+                *d = *s;
+            }
+        }
         let nv_policy = NvPolicy::DEFAULT;
         // The cooling bound at rest of the model in use (none under CONFIG).
         let cool = match params {
@@ -274,6 +298,7 @@ impl<N: Num> AppOf<N> {
             core::ptr::addr_of_mut!((*p).alive_at).write(0);
             core::ptr::addr_of_mut!((*p).record_epoch).write(None);
             core::ptr::addr_of_mut!((*p).nv_failed_at).write(None);
+            core::ptr::addr_of_mut!((*p).stalled).write(0);
             core::ptr::addr_of_mut!((*p).tick).write(0);
             core::ptr::addr_of_mut!((*p).restore).write(restore_kind(&restore));
             core::ptr::addr_of_mut!((*p).reset_cause).write(reset_cause);
@@ -281,6 +306,10 @@ impl<N: Num> AppOf<N> {
             core::ptr::addr_of_mut!((*p).worst_tick_cycles).write(0);
             core::ptr::addr_of_mut!((*p).dump).write(None);
             core::ptr::addr_of_mut!((*p).params).write(params);
+            core::ptr::addr_of_mut!((*p).rig_id).write(rig_id);
+            core::ptr::addr_of_mut!((*p).armed).write(None);
+            core::ptr::addr_of_mut!((*p).nonce).write(u32::from(boots));
+            core::ptr::addr_of_mut!((*p).confirmed).write([None; 2]);
             &mut *p
         };
         if let ParamSource::Invalid(_) = params {
@@ -298,16 +327,24 @@ impl<N: Num> AppOf<N> {
     pub fn run<B: Board>(&mut self, board: &mut B) -> ! {
         let mut seen = board.ticks();
         loop {
-            board.wait_tick(seen);
-            let now = board.ticks();
-            // Periods that passed with no tick at all (after an overrun).
-            let lost = now.wrapping_sub(seen).saturating_sub(1);
-            seen = now;
-            self.tick(board, lost);
-            let after = board.ticks();
-            if after != now {
-                self.overrun(after.wrapping_sub(now));
-            }
+            self.run_once(board, &mut seen);
+        }
+    }
+
+    /// One pass of [`AppOf::run`]: waits for the timer period after `seen`,
+    /// runs its tick (with the periods that passed without one as `lost`)
+    /// and counts an overrun.
+    #[inline(always)]
+    pub fn run_once<B: Board>(&mut self, board: &mut B, seen: &mut u32) {
+        board.wait_tick(*seen);
+        let now = board.ticks();
+        // Periods that passed with no tick at all (after an overrun).
+        let lost = now.wrapping_sub(*seen).saturating_sub(1);
+        *seen = now;
+        self.tick(board, lost);
+        let after = board.ticks();
+        if after != now {
+            self.overrun(after.wrapping_sub(now));
         }
     }
 
@@ -319,7 +356,9 @@ impl<N: Num> AppOf<N> {
     }
 
     /// One tick. `lost` = timer periods since the previous tick that had no
-    /// tick of their own (each becomes a missing tick, at most
+    /// tick of their own: those the board's last non-volatile save stalled
+    /// are blind ticks ([`crate::GuardOf::tick_blind`], at most
+    /// [`MAX_STALL_TICKS`]), the others missing ticks (at most
     /// [`MAX_MISSED_TICKS`]).
     pub fn tick<B: Board>(&mut self, board: &mut B, lost: u32) {
         let stamp = board.cycle_stamp();
@@ -343,16 +382,19 @@ impl<N: Num> AppOf<N> {
         }
 
         // 2. validate, estimate, protect
-        for _ in 0..lost.min(MAX_MISSED_TICKS) {
-            let _ = self.guard.tick_missing();
+        if lost > 0 {
+            self.catch_up(lost);
         }
         let fresh = self.sample.take();
         let out = match &fresh {
             Some(req) => {
+                let s = req.sample();
                 if let Some(open) = req.valve_fb {
                     self.guard.valve_feedback(open);
                 }
-                self.guard.tick(&req.sample())
+                self.guard.lng_supply(req.lng_supply_bar);
+                self.guard.check_speed(&s, req.elec_hz);
+                self.guard.tick(&s)
             }
             None => {
                 self.counters.missing = self.counters.missing.saturating_add(1);
@@ -397,6 +439,18 @@ impl<N: Num> AppOf<N> {
         board.feed_watchdog();
     }
 
+    /// The periods a tick came late by: stalled by our own save (blind),
+    /// else missing.
+    #[cold]
+    #[inline(never)]
+    fn catch_up(&mut self, lost: u32) {
+        let blind = lost.min(core::mem::replace(&mut self.stalled, 0));
+        let _ = self.guard.tick_blind(blind.min(MAX_STALL_TICKS));
+        for _ in 0..(lost - blind).min(MAX_MISSED_TICKS) {
+            let _ = self.guard.tick_missing();
+        }
+    }
+
     /// The thermal record, written when the state it holds has changed
     /// (a model step, a fault, the valve, a clear or refill: between those
     /// only its tick count would differ): the next A/B slot, and the
@@ -408,7 +462,12 @@ impl<N: Num> AppOf<N> {
         let retry = self.nv_failed_at.is_none_or(|t| self.tick.wrapping_sub(t) >= NV_RETRY_TICKS);
         if retry && self.nv_policy.due(self.nv_last.as_ref(), &rec) {
             let rec = rec.with_rtc(board.rtc_s());
-            match board.nv_save(&rec) {
+            let t0 = board.ticks();
+            let saved = board.nv_save(&rec);
+            // A flash erase stalls the core: the periods it took are
+            // accounted at the next tick, without STALE.
+            self.stalled = board.ticks().wrapping_sub(t0);
+            match saved {
                 None => {}
                 Some(true) => {
                     self.nv_last = Some(rec);

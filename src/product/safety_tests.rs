@@ -251,3 +251,368 @@ fn a_refused_block_shows_the_alarm_from_the_first_instant() {
     assert!(out.faults.contains(faults::CONFIG) && out.valve_open && out.alarm, "{out:?}");
     assert!(!b.pins.valve_pin && !b.pins.ok_pin, "valve pin and OK pin low at boot: {:?}", b.pins);
 }
+
+/// The motor current of the paper rig's pump at these pressures and speed
+/// (the extended eq. 8, as the reference plant draws it): consistent
+/// sensors for the cross-check.
+fn current_a(p_a: f32, p_b: f32, rpm: f32) -> f32 {
+    let p = &crate::params::DEFAULT;
+    let d = p.displacement_m3_per_rad as f32;
+    let dp = (p_a - p_b) * 1e5;
+    let w = (rpm * core::f32::consts::PI / 30.0).abs();
+    let t_f = p.no_load_torque_nm as f32 + p.viscous_w_s2_per_rad2 as f32 * w + p.eta_m as f32 * d * dp.abs();
+    let s = if rpm < 0.0 { -1.0 } else { 1.0 };
+    (d * dp + s * t_f).abs() / p.torque_constant_nm_per_a as f32
+}
+
+/// Case 1 at 60 bar and 500 rpm with the speed channel reading `speed(k)`,
+/// the drive's electrical frequency `elec` (4 pole pairs) and the valve
+/// position reported; the tick reply of each tick.
+fn run_case1(ticks: u32, speed: impl Fn(u32) -> f32, elec: bool) -> std::vec::Vec<TickReply> {
+    let mut b = board();
+    let mut app = boot(&mut b);
+    let mut out = std::vec::Vec::new();
+    let mut open = false;
+    for k in 0..ticks {
+        let r = Request {
+            seq: (k & 0xFFFF) as u16,
+            current_a: current_a(65.0, 5.0, 500.0),
+            p_a_bar: 65.0,
+            p_b_bar: 5.0,
+            speed_rpm: speed(k),
+            position_mm: 0.0,
+            ambient_c: 20.0,
+            valve_fb: Some(open),
+            elec_hz: elec.then_some(500.0 / 60.0 * 4.0),
+            lng_supply_bar: None,
+        };
+        b.push_rx(&r.encode());
+        app.tick(&mut *b, 0);
+        let t = *ticks_of(&mut b).last().expect("a tick reply");
+        open = t.out.valve_open;
+        out.push(t);
+    }
+    out
+}
+
+fn ticks_of(b: &mut MemBoard) -> std::vec::Vec<TickReply> {
+    ticks(&replies(b))
+}
+
+/// The first tick with SENSOR_DISAGREE and the speed channel latched bad.
+fn speed_fault_at(t: &[TickReply]) -> Option<u32> {
+    t.iter().position(|r| r.out.faults.contains(faults::SENSOR_DISAGREE | crate::Faults::channels(crate::validate::CH_SPEED)) && r.out.valve_open).map(|k| k as u32)
+}
+
+/// With the drive's electrical frequency as a second speed source, a speed
+/// sensor stuck at zero or reading half is seen within 1 s (two 0.5 s
+/// windows): SENSOR_DISAGREE, the speed channel's worst case, valve open.
+/// Before, the torque cross-check could not see it (both of its sides scale
+/// with the measured speed): 5 of 150 campaign runs failed.
+#[test]
+fn a_speed_sensor_fault_is_seen_against_the_electrical_frequency() {
+    for (name, gain) in [("stuck at zero", 0.0f32), ("gain 0.5", 0.5)] {
+        let t = run_case1(600, |k| if k < 200 { 500.0 } else { 500.0 * gain }, true);
+        let at = speed_fault_at(&t);
+        assert!(at.is_some_and(|k| (200..=300).contains(&k)), "{name}: latched at tick {at:?}");
+    }
+    // consistent sensors: nothing
+    let t = run_case1(3000, |_| 500.0, true);
+    assert!(t.iter().all(|r| !r.out.faults.intersects(faults::SENSOR_DISAGREE)), "no false alarm: {:?}", t.last());
+}
+
+/// Without a second source: the pump drawing well above its no-load current
+/// with the speed reading near zero for 2 s is implausible: SENSOR_DISAGREE
+/// with the speed's worst case (the rule a load held at standstill for
+/// longer also trips: documented).
+#[test]
+fn a_speed_stuck_at_zero_under_load_is_implausible_without_a_second_source() {
+    let t = run_case1(800, |k| if k < 200 { 500.0 } else { 0.0 }, false);
+    let at = speed_fault_at(&t);
+    // 2 s (200 ticks) after the speed went to zero at tick 200
+    assert!(at.is_some_and(|k| (399..=450).contains(&k)), "latched at tick {at:?}");
+}
+
+/// Cooling is credited only when the valve reports open: without the
+/// position report the estimate takes no credit (NO_VALVE_FEEDBACK while
+/// commanded open); with it and no supply pressure, LNG_UNCONFIRMED.
+#[test]
+fn no_cooling_credit_without_valve_feedback() {
+    let cfg = GuardConfig::DEFAULT;
+    // 300 s of Case 1 at 60 bar: (mean drain estimate over the last 100 s,
+    // the status bits seen while the valve was open)
+    let hot = |report: bool| {
+        let mut g = crate::Guard::new(&cfg, Restore::Cold);
+        let mut o = g.output();
+        let (mut sum, mut n, mut seen) = (0.0f64, 0u32, crate::Faults::NONE);
+        for k in 0..30_000 {
+            if report {
+                g.valve_feedback(o.valve_open);
+            }
+            o = g.tick(&crate::Sample { current_a: current_a(65.0, 5.0, 500.0), p_a_bar: 65.0, p_b_bar: 5.0, speed_rpm: 500.0, position_mm: 0.0, ambient_c: 20.0 });
+            if o.valve_open {
+                seen |= o.faults;
+            }
+            if k >= 20_000 {
+                sum += f64::from(o.drain_c);
+                n += 1;
+            }
+        }
+        (sum / f64::from(n), seen)
+    };
+    let (with, with_seen) = hot(true);
+    let (without, without_seen) = hot(false);
+    assert!(without > with + 1.0, "no credit without the report: {without} vs {with} degC");
+    assert!(without_seen.contains(faults::NO_VALVE_FEEDBACK), "{without_seen:?}");
+    assert!(with_seen.contains(faults::LNG_UNCONFIRMED) && !with_seen.contains(faults::NO_VALVE_FEEDBACK), "{with_seen:?}");
+}
+
+/// A supply pressure below its minimum: the tank is empty whatever the
+/// budget says, no credit, LNG_LOW.
+#[test]
+fn no_cooling_credit_with_the_supply_pressure_low() {
+    let cfg = GuardConfig::DEFAULT;
+    let hot = |supply: f32| {
+        let mut g = crate::Guard::new(&cfg, Restore::Cold);
+        let mut o = g.output();
+        let (mut sum, mut n, mut seen) = (0.0f64, 0u32, crate::Faults::NONE);
+        for k in 0..30_000 {
+            g.valve_feedback(o.valve_open);
+            g.lng_supply(Some(supply));
+            o = g.tick(&crate::Sample { current_a: current_a(65.0, 5.0, 500.0), p_a_bar: 65.0, p_b_bar: 5.0, speed_rpm: 500.0, position_mm: 0.0, ambient_c: 20.0 });
+            seen |= o.faults;
+            if k >= 20_000 {
+                sum += f64::from(o.drain_c);
+                n += 1;
+            }
+        }
+        (sum / f64::from(n), seen)
+    };
+    let ((full, full_seen), (empty, empty_seen)) = (hot(5.0), hot(0.0));
+    assert!(empty > full + 1.0, "{empty} vs {full} degC");
+    assert!(empty_seen.contains(faults::LNG_LOW) && !full_seen.intersects(faults::LNG_UNCONFIRMED | faults::LNG_LOW), "{empty_seen:?} {full_seen:?}");
+}
+
+/// Ticks `n` valid nominal samples (pump at rest, consistent sensors) and
+/// returns the last tick reply; `cmds` are sent in the first tick.
+fn settle(app: &mut App, b: &mut MemBoard, from: u16, n: u16, cmds: &[&[u8]]) -> TickReply {
+    let mut last = None;
+    for k in 0..n {
+        if k == 0 {
+            for c in cmds {
+                b.push_rx(c);
+            }
+        }
+        b.push_rx(&Request { speed_rpm: 0.0, ..sample(from.wrapping_add(k), 0.0, 5.0) }.encode());
+        app.tick(b, 0);
+        last = ticks_of(b).last().copied();
+    }
+    last.expect("a tick reply")
+}
+
+/// A CRC-valid clear frame (line noise that passes CRC-16, or a controller
+/// bug) cleared every latched fault: it must not.
+#[test]
+fn one_crc_valid_frame_does_not_clear_faults() {
+    let mut b = board();
+    let mut app = boot(&mut b);
+    b.push_rx(&Request { current_a: f32::NAN, ..sample(0, 0.0, 5.0) }.encode());
+    app.tick(&mut *b, 0);
+    let r = settle(&mut app, &mut b, 1, 150, &[]);
+    assert!(r.out.faults.contains(faults::NON_FINITE));
+    // the frame the old protocol took as "clear faults": kind, token, code 1
+    let raw = crate::protocol::frame(&[wire::KIND_COMMAND, 7, 0, 1], false);
+    let r = settle(&mut app, &mut b, 151, 5, &[&raw]);
+    assert!(r.out.faults.contains(faults::NON_FINITE), "a single CRC-valid frame cleared the faults: {:?}", r.out.faults);
+}
+
+/// After a start from an unknown thermal state (a corrupt record: every
+/// node at 60 °C) a clear one second later restored trust at once; the
+/// estimate needs hours to forget its start. The clear must not restore
+/// trust before then.
+#[test]
+fn a_clear_does_not_restore_trust_faster_than_the_estimate_recovers() {
+    let mut b = board();
+    let mut torn = ThermalRecord::new([40.0; 6], 20.0, 0, 0, 1).with_seq(1, false);
+    torn.crc ^= 1;
+    b.records = [torn, torn];
+    let mut app = boot(&mut b);
+    let r = settle(&mut app, &mut b, 0, 150, &[]);
+    assert!(r.out.faults.contains(faults::UNTRUSTED | faults::MEMORY_CORRUPT), "{:?}", r.out.faults);
+    assert!(app.guard.clear_faults() != crate::ClearResult::Cleared || app.guard.faults().contains(faults::UNTRUSTED), "trust restored 1.5 s after an unknown start");
+}
+
+/// A refill with the valve open or the guard in alarm undid the empty-tank
+/// and corrupt-boot rules: refused.
+#[test]
+fn a_refill_while_the_valve_is_open_is_refused() {
+    let mut b = board();
+    let mut torn = ThermalRecord::new([40.0; 6], 20.0, 0, 0, 1).with_seq(1, false);
+    torn.crc ^= 1;
+    b.records = [torn, torn];
+    let mut app = boot(&mut b);
+    let r = settle(&mut app, &mut b, 0, 50, &[]);
+    assert!(r.out.valve_open && r.out.alarm && r.out.lng_remaining_kg == 0.0, "{:?}", r.out);
+    let refill = crate::protocol::frame(&[wire::KIND_COMMAND, 8, 0, 2], false);
+    let r = settle(&mut app, &mut b, 50, 5, &[&refill]);
+    assert_eq!(r.out.lng_remaining_kg, 0.0, "refilled with the valve open and the alarm on");
+    // armed and keyed: refused by the rule
+    let a = super::tests::arm_confirm(&mut app, &mut b, 9, wire::Cmd::RefillArm, wire::Cmd::RefillConfirm, 55, &Request { speed_rpm: 0.0, ..sample(0, 0.0, 5.0) });
+    assert_eq!((a.result, a.value), (wire::AckResult::Refused, wire::Refusal::Rule as u32), "{a:?}");
+    assert_eq!(app.guard.output().lng_remaining_kg, 0.0);
+}
+
+/// Arm-then-confirm: a wrong key, a confirmation after the arm's window, a
+/// confirmation of the other command and a second clear within the
+/// interval are refused, each with its reason in the ack and in the trace.
+#[test]
+fn armed_commands_need_the_key_the_window_and_the_interval() {
+    use super::tests::arm_confirm;
+    use wire::{Ack, AckResult, Cmd, Command, FromGuard, Refusal};
+    let mut b = board();
+    let mut app = boot(&mut b);
+    let rest = |k: u16| Request { speed_rpm: 0.0, ..sample(k, 0.0, 5.0) };
+    settle(&mut app, &mut b, 0, 200, &[]);
+    let ack = |b: &mut MemBoard, token: u16| -> Ack {
+        replies(b).iter().find_map(|f| match f {
+            FromGuard::Ack(a) if a.token == token => Some(*a),
+            _ => None,
+        }).expect("an ack")
+    };
+    let arm = |app: &mut App, b: &mut MemBoard, token: u16, cmd: Cmd, seq: u16| -> u32 {
+        b.push_rx(&Command { token, cmd, arg: 0 }.encode());
+        b.push_rx(&rest(seq).encode());
+        app.tick(&mut *b, 0);
+        ack(b, token).value
+    };
+    let confirm = |app: &mut App, b: &mut MemBoard, token: u16, cmd: Cmd, arg: u32, seq: u16| -> Ack {
+        b.push_rx(&Command { token, cmd, arg }.encode());
+        b.push_rx(&rest(seq).encode());
+        app.tick(&mut *b, 0);
+        ack(b, token)
+    };
+    let refused = |a: Ack, r: Refusal| a.result == AckResult::Refused && a.value == r as u32;
+    // no arm
+    let a = confirm(&mut app, &mut b, 1, Cmd::ClearConfirm, 0, 200);
+    assert!(refused(a, Refusal::NotArmed), "{a:?}");
+    // a wrong key (the key of another nonce); the arm is used up
+    let n = arm(&mut app, &mut b, 2, Cmd::ClearArm, 201);
+    let a = confirm(&mut app, &mut b, 3, Cmd::ClearConfirm, wire::command_key(&[0; 16], n ^ 2, Cmd::ClearConfirm), 202);
+    assert!(refused(a, Refusal::Key), "{a:?}");
+    let a = confirm(&mut app, &mut b, 4, Cmd::ClearConfirm, wire::command_key(&[0; 16], n, Cmd::ClearConfirm), 203);
+    assert!(refused(a, Refusal::NotArmed), "one try per arm: {a:?}");
+    // the key of another rig
+    let n = arm(&mut app, &mut b, 5, Cmd::ClearArm, 204);
+    let a = confirm(&mut app, &mut b, 6, Cmd::ClearConfirm, wire::command_key(&[1; 16], n, Cmd::ClearConfirm), 205);
+    assert!(refused(a, Refusal::Key), "{a:?}");
+    // a refill confirmed on a clear's arm
+    let n = arm(&mut app, &mut b, 7, Cmd::ClearArm, 206);
+    let a = confirm(&mut app, &mut b, 8, Cmd::RefillConfirm, wire::command_key(&[0; 16], n, Cmd::RefillConfirm), 207);
+    assert!(refused(a, Refusal::NotArmed), "{a:?}");
+    // the window: 1 s
+    let n = arm(&mut app, &mut b, 9, Cmd::ClearArm, 208);
+    settle(&mut app, &mut b, 209, 101, &[]);
+    let a = confirm(&mut app, &mut b, 10, Cmd::ClearConfirm, wire::command_key(&[0; 16], n, Cmd::ClearConfirm), 310);
+    assert!(refused(a, Refusal::NotArmed), "{a:?}");
+    // done, then a second one within 10 s is refused, after 10 s done
+    let a = arm_confirm(&mut app, &mut b, 11, Cmd::ClearArm, Cmd::ClearConfirm, 311, &rest(0));
+    assert_eq!(a.result, AckResult::Done, "{a:?}");
+    let a = arm_confirm(&mut app, &mut b, 13, Cmd::ClearArm, Cmd::ClearConfirm, 313, &rest(0));
+    assert!(refused(a, Refusal::TooSoon), "{a:?}");
+    settle(&mut app, &mut b, 315, 1000, &[]);
+    let a = arm_confirm(&mut app, &mut b, 15, Cmd::ClearArm, Cmd::ClearConfirm, 1315, &rest(0));
+    assert_eq!(a.result, AckResult::Done, "{a:?}");
+    // every one is in the trace (code, result)
+    let t: std::vec::Vec<(u8, u8)> = app.guard.trace().iter().filter_map(|e| match *e {
+        crate::trace::Trace::Command { code, result, .. } => Some((code, result)),
+        _ => None,
+    }).collect();
+    let (k, na, too) = (Refusal::Key as u8, Refusal::NotArmed as u8, Refusal::TooSoon as u8);
+    assert_eq!(t, [(5, na), (1, 0), (5, k), (5, na), (1, 0), (5, k), (1, 0), (6, na), (1, 0), (5, na), (1, 0), (5, 0), (1, 0), (5, too), (1, 0), (5, 0)]);
+}
+
+/// A clear cannot be a self-resetting latch: a controller confirming a
+/// clear every tick clears at most once per 10 s.
+#[test]
+fn a_controller_clearing_in_a_loop_clears_at_most_every_ten_seconds() {
+    use wire::{AckResult, Cmd, Command, FromGuard};
+    let mut b = board();
+    let mut app = boot(&mut b);
+    let (mut done, mut rule) = (0u32, 0u32);
+    let mut nonce = None;
+    for k in 0..3000u16 {
+        // arm and confirm on alternate ticks, the right key every time
+        let c = match nonce.take() {
+            Some(n) => Command { token: k, cmd: Cmd::ClearConfirm, arg: wire::command_key(&[0; 16], n, Cmd::ClearConfirm) },
+            None => Command { token: k, cmd: Cmd::ClearArm, arg: 0 },
+        };
+        b.push_rx(&c.encode());
+        b.push_rx(&Request { speed_rpm: 0.0, ..sample(k, 0.0, 5.0) }.encode());
+        app.tick(&mut *b, 0);
+        for f in replies(&mut b) {
+            if let FromGuard::Ack(a) = f {
+                match (a.cmd, a.result) {
+                    (Cmd::ClearArm, AckResult::Done) => nonce = Some(a.value),
+                    (Cmd::ClearConfirm, AckResult::Done) => done += 1,
+                    (Cmd::ClearConfirm, AckResult::Refused) if a.value == wire::Refusal::Rule as u32 => rule += 1,
+                    _ => {}
+                }
+            }
+        }
+    }
+    // at ticks 1 (the clear rule's 1 s of valid samples not yet there),
+    // 1001 and 2001
+    assert_eq!((rule, done), (1, 2), "30 s of clears every 20 ms");
+}
+
+/// A flash erase stalls the core (the STM32F411: up to 4 s per 128 KiB
+/// sector). The periods it swallowed were replayed as missing ticks, so an
+/// erase latched STALE (valve open, alarm until a clear) about once per
+/// 1 950 writes. They are now blind ticks: the last inputs held, no credit,
+/// no STALE. Simulated here: 300 periods (3 s) per 1 KiB page erase of the
+/// in-memory store, a Case 1 run at 60 bar that writes the record often.
+#[test]
+fn a_flash_erase_stall_is_accounted_without_stale() {
+    let mut b = Box::new(MemBoard::new().with_nv());
+    // fill the store until it has wrapped once: from here on, every page
+    // it opens must be erased first
+    let mut n = 0u32;
+    while b.flash_erases() == 0 && n < 10_000 {
+        let r = ThermalRecord::new([20.0; 6], 20.0, 0, 0, n).with_seq(n, false);
+        b.nv.as_mut().map(|s| s.save(&r));
+        n += 1;
+    }
+    assert!(b.flash_erases() > 0, "the store wrapped after {n} writes");
+    b.erase_stall_ticks = 300;
+    let mut app = boot(&mut b);
+    let mut seen = b.ticks;
+    let (mut open, mut worst, mut stalls) = (false, crate::Faults::NONE, 0u32);
+    let erases0 = b.flash_erases();
+    for k in 0..60_000u32 {
+        let r = Request {
+            seq: (k & 0xFFFF) as u16,
+            current_a: current_a(65.0, 5.0, 500.0),
+            p_a_bar: 65.0,
+            p_b_bar: 5.0,
+            speed_rpm: 500.0,
+            position_mm: 0.0,
+            ambient_c: 20.0,
+            valve_fb: Some(open),
+            elec_hz: None,
+            lng_supply_bar: None,
+        };
+        b.push_rx(&r.encode());
+        let before = b.ticks;
+        app.run_once(&mut *b, &mut seen);
+        stalls += u32::from(b.ticks.wrapping_sub(before) > 1);
+        if let Some(t) = ticks_of(&mut b).last() {
+            open = t.out.valve_open;
+            worst |= t.out.faults;
+        }
+    }
+    let erased = b.flash_erases() - erases0;
+    assert!(erased >= 1 && stalls >= 1, "{erased} erases, {stalls} stalls");
+    assert!(!worst.intersects(faults::STALE | faults::LATCHED), "an erase stall latched {worst:?}");
+    let st = app.status(&*b, 0);
+    assert!(st.overruns >= 300 * erased, "the stalls are counted as overruns: {}", st.overruns);
+}

@@ -37,6 +37,8 @@ pub(super) fn sample(seq: u16, current_a: f32, p_a_bar: f32) -> Request {
         position_mm: 0.0,
         ambient_c: 30.0,
         valve_fb: None,
+        elec_hz: None,
+        lng_supply_bar: None,
     }
 }
 
@@ -142,53 +144,94 @@ fn pin_read_back_mismatch_latches_actuator_and_opens_the_valve() {
     assert!(t[0].out.valve_open && t[0].out.faults.intersects(crate::faults::ACTUATOR), "{:?}", t[0]);
 }
 
-/// Commands: status and refill are done at once; clear is refused until the
-/// clear rule holds; a trace dump arrives over several ticks; the test-only
-/// injections are refused in a build without `fault-inject`.
+/// Sends `arm` with `token`, ticks once with sample `seq`, reads the
+/// nonce from its ack and sends `confirm` with the key `command_key` makes of
+/// it (rig id all zero: the compiled-in default), ticks once more with
+/// sample `seq + 1`; the confirmation's ack.
+pub(super) fn arm_confirm(app: &mut App, b: &mut MemBoard, token: u16, arm: Cmd, confirm: Cmd, seq: u16, s: &Request) -> Ack {
+    b.push_rx(&Command { token, cmd: arm, arg: 0 }.encode());
+    b.push_rx(&Request { seq, ..*s }.encode());
+    app.tick(&mut *b, 0);
+    let nonce = replies(b)
+        .iter()
+        .find_map(|f| match f {
+            FromGuard::Ack(a) if a.token == token && a.result == AckResult::Done => Some(a.value),
+            _ => None,
+        })
+        .expect("the arm's ack");
+    let key = wire::command_key(&[0; 16], nonce, confirm);
+    let t2 = token.wrapping_add(1);
+    b.push_rx(&Command { token: t2, cmd: confirm, arg: key }.encode());
+    b.push_rx(&Request { seq: seq.wrapping_add(1), ..*s }.encode());
+    app.tick(&mut *b, 0);
+    replies(b)
+        .iter()
+        .find_map(|f| match f {
+            FromGuard::Ack(a) if a.token == t2 => Some(*a),
+            _ => None,
+        })
+        .expect("the confirmation's ack")
+}
+
+/// Commands: status at once; an armed, keyed refill is done; a clear is
+/// refused until the clear rule holds; a trace dump arrives over several
+/// ticks; the test-only injections are refused in a build without
+/// `fault-inject`.
 #[test]
 fn commands_status_refill_clear_trace() {
     let mut b = board();
     let mem = b.boot_memory();
     let mut app = App::boot(&mut *b, &GuardConfig::DEFAULT, &mem);
-    // A non-finite sample latches NON_FINITE.
+    // A non-finite sample latches NON_FINITE (the valve opens: no refill).
     b.push_rx(&sample(1, f32::NAN, 50.0).encode());
     app.tick(&mut *b, 0);
-    let cmd = |token, cmd| Command { token, cmd }.encode();
-    b.push_rx(&cmd(7, Cmd::ClearFaults));
-    b.push_rx(&cmd(8, Cmd::RefillLng));
+    let cmd = |token, cmd| Command { token, cmd, arg: 0 }.encode();
+    // the pump at rest, consistent sensors
+    let rest = |k| Request { speed_rpm: 0.0, ..sample(k, 0.0, 5.0) };
     b.push_rx(&cmd(9, Cmd::Status));
     app.tick(&mut *b, 0);
     let r = replies(&mut b);
-    let acks: StdVec<Ack> = r.iter().filter_map(|f| if let FromGuard::Ack(a) = f { Some(*a) } else { None }).collect();
-    assert_eq!(acks[0], Ack { token: 7, cmd: Cmd::ClearFaults, result: AckResult::Refused });
-    assert_eq!(acks[1], Ack { token: 8, cmd: Cmd::RefillLng, result: AckResult::Done });
     let st = r.iter().find_map(|f| if let FromGuard::Status(s) = f { Some(*s) } else { None }).expect("status");
     assert_eq!((st.token, st.tick, st.missing, st.faults.intersects(crate::faults::NON_FINITE)), (9, 2, 1, true));
-    // 100 valid ticks, then the clear succeeds.
-    for k in 2..110u16 {
-        b.push_rx(&sample(k, 10.0, 50.0).encode());
+    let a = arm_confirm(&mut app, &mut b, 7, Cmd::ClearArm, Cmd::ClearConfirm, 2, &rest(2));
+    assert_eq!((a.cmd, a.result, a.value), (Cmd::ClearConfirm, AckResult::Refused, wire::Refusal::Rule as u32), "clear rule not met");
+    // 100 valid ticks, then the clear succeeds (the interval counts
+    // confirmed commands: the refused one counted).
+    for k in 4..1100u16 {
+        b.push_rx(&rest(k).encode());
         app.tick(&mut *b, 0);
     }
     replies(&mut b);
-    b.push_rx(&cmd(10, Cmd::ClearFaults));
-    b.push_rx(&cmd(11, Cmd::Trace));
+    let a = arm_confirm(&mut app, &mut b, 10, Cmd::ClearArm, Cmd::ClearConfirm, 1100, &rest(0));
+    assert_eq!((a.result, a.value), (AckResult::Done, 0), "cleared, trusted");
+    assert!(!app.guard().faults().intersects(crate::faults::LATCHED));
+    // the valve closes after its dwell (cold oil), no alarm: the refill is done
+    for k in 1102..1400u16 {
+        b.push_rx(&rest(k).encode());
+        app.tick(&mut *b, 0);
+    }
+    replies(&mut b);
+    assert!(!app.guard().output().valve_open, "{:?}", app.guard().output());
+    let a = arm_confirm(&mut app, &mut b, 20, Cmd::RefillArm, Cmd::RefillConfirm, 1400, &rest(0));
+    assert_eq!(a.result, AckResult::Done, "{a:?}");
     b.push_rx(&cmd(12, Cmd::InjectHang));
-    b.push_rx(&sample(110, 10.0, 50.0).encode());
-    app.tick(&mut *b, 0);
-    for k in 111..130u16 {
-        b.push_rx(&sample(k, 10.0, 50.0).encode());
+    b.push_rx(&cmd(11, Cmd::Trace));
+    for k in 1402..1430u16 {
+        b.push_rx(&rest(k).encode());
         app.tick(&mut *b, 0);
     }
     let r = replies(&mut b);
-    assert!(r.contains(&FromGuard::Ack(Ack { token: 10, cmd: Cmd::ClearFaults, result: AckResult::Done })));
     #[cfg(not(feature = "fault-inject"))]
-    assert!(r.contains(&FromGuard::Ack(Ack { token: 12, cmd: Cmd::InjectHang, result: AckResult::Refused })));
+    assert!(r.contains(&FromGuard::Ack(Ack { token: 12, cmd: Cmd::InjectHang, result: AckResult::Refused, value: wire::Refusal::Unavailable as u32 })));
     let dump: StdVec<TraceReply> = r.iter().filter_map(|f| if let FromGuard::Trace(t) = f { Some(*t) } else { None }).collect();
     assert!(!dump.is_empty());
     assert_eq!(dump.len(), usize::from(dump[0].count), "the whole ring arrives");
     assert!(dump.iter().enumerate().all(|(i, t)| usize::from(t.index) == i && t.token == 11));
     assert!(dump.iter().any(|t| t.event.tag == 7), "the faults-cleared event is in the dump");
-    assert!(!app.guard().faults().intersects(crate::faults::LATCHED));
+    // every armed command is in the trace: code (aux bits 0-7), result (8-15)
+    let cmds: StdVec<u32> = dump.iter().filter(|t| t.event.tag == 11).map(|t| t.event.aux).collect();
+    let rule = wire::Refusal::Rule as u32;
+    assert_eq!(cmds, [1, 5 | rule << 8, 1, 5, 2, 6, 0xE0 | (wire::Refusal::Unavailable as u32) << 8], "{cmds:?}");
 }
 
 /// Garbage, bursts and truncated frames: counted as rejected, the tick
@@ -360,7 +403,7 @@ fn an_invalid_block_latches_config_and_opens_the_valve() {
             b.push_rx(&sample(k, 20.0, 60.0).encode());
             app.tick(&mut *b, 0);
         }
-        b.push_rx(&Command { token: 7, cmd: Cmd::ClearFaults }.encode());
+        b.push_rx(&Command { token: 7, cmd: Cmd::ClearConfirm, arg: 0 }.encode());
         app.tick(&mut *b, 0);
         let t = ticks(&replies(&mut b));
         assert!(

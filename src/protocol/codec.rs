@@ -28,19 +28,28 @@ impl Rd<'_> {
 
 impl Request {
     /// Payload bytes (without CRC).
-    pub fn to_payload(&self) -> Vec<u8, REQUEST_LEN> {
+    pub fn to_payload(&self) -> Vec<u8, REQUEST_MAX_LEN> {
         let mut p = Vec::new();
         let _ = p.push(KIND_SAMPLE);
         let _ = p.extend_from_slice(&self.seq.to_le_bytes());
         for v in [self.current_a, self.p_a_bar, self.p_b_bar, self.speed_rpm, self.position_mm, self.ambient_c] {
             let _ = p.extend_from_slice(&v.to_le_bytes());
         }
-        let flags = match self.valve_fb {
+        let mut flags = match self.valve_fb {
             None => 0,
             Some(false) => FLAG_VALVE_FB,
             Some(true) => FLAG_VALVE_FB | FLAG_VALVE_FB_OPEN,
         };
+        if self.elec_hz.is_some() {
+            flags |= FLAG_ELEC_HZ;
+        }
+        if self.lng_supply_bar.is_some() {
+            flags |= FLAG_LNG_SUPPLY;
+        }
         let _ = p.push(flags);
+        for v in [self.elec_hz, self.lng_supply_bar].into_iter().flatten() {
+            let _ = p.extend_from_slice(&v.to_le_bytes());
+        }
         p
     }
 
@@ -50,7 +59,12 @@ impl Request {
         if r.u8()? != KIND_SAMPLE {
             return Err(DecodeError::Kind);
         }
-        if p.len() != REQUEST_LEN {
+        let flags = p.get(REQUEST_LEN - 1).copied().ok_or(DecodeError::Length)?;
+        if flags & !(FLAG_VALVE_FB | FLAG_VALVE_FB_OPEN | FLAG_ELEC_HZ | FLAG_LNG_SUPPLY) != 0 || flags & (FLAG_VALVE_FB | FLAG_VALVE_FB_OPEN) == FLAG_VALVE_FB_OPEN {
+            return Err(DecodeError::Kind);
+        }
+        let want = REQUEST_LEN + 4 * usize::from(flags & FLAG_ELEC_HZ != 0) + 4 * usize::from(flags & FLAG_LNG_SUPPLY != 0);
+        if p.len() != want {
             return Err(DecodeError::Length);
         }
         let mut q = Request {
@@ -62,13 +76,17 @@ impl Request {
             position_mm: r.f32()?,
             ambient_c: r.f32()?,
             valve_fb: None,
+            elec_hz: None,
+            lng_supply_bar: None,
         };
-        q.valve_fb = match r.u8()? {
-            0 => None,
-            FLAG_VALVE_FB => Some(false),
-            f if f == FLAG_VALVE_FB | FLAG_VALVE_FB_OPEN => Some(true),
-            _ => return Err(DecodeError::Kind),
-        };
+        let _ = r.u8()?;
+        q.valve_fb = (flags & FLAG_VALVE_FB != 0).then_some(flags & FLAG_VALVE_FB_OPEN != 0);
+        if flags & FLAG_ELEC_HZ != 0 {
+            q.elec_hz = Some(r.f32()?);
+        }
+        if flags & FLAG_LNG_SUPPLY != 0 {
+            q.lng_supply_bar = Some(r.f32()?);
+        }
         Ok(q)
     }
 

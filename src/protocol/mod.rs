@@ -27,10 +27,10 @@
 //! and out). The unit tests check the published CRC check value and the
 //! COBS round trip against a reference encoder.
 //!
-//! # Request (host → guard), payload 28 bytes
+//! # Request (host → guard), payload 28, 32 or 36 bytes
 //! | off | type | field |
 //! |---|---|---|
-//! | 0 | u8 | kind = [`KIND_SAMPLE`] |
+//! | 0 | u8 | kind = [`KIND_SAMPLE`] (`0x02`: protocol version 2) |
 //! | 1 | u16 | sequence number |
 //! | 3 | f32 | `current_a` (A rms) |
 //! | 7 | f32 | `p_a_bar` |
@@ -38,12 +38,20 @@
 //! | 15 | f32 | `speed_rpm` |
 //! | 19 | f32 | `position_mm` |
 //! | 23 | f32 | `ambient_c` |
-//! | 27 | u8 | flags: bit0 valve position reported, bit1 valve reported open (only with bit0); bits 2-7 reserved, 0 |
+//! | 27 | u8 | flags: bit0 valve position reported, bit1 valve reported open (only with bit0), bit2 motor electrical frequency follows, bit3 LNG supply pressure follows; bits 4-7 reserved, 0 |
+//! | 28 | f32 | `elec_hz`: the motor drive's electrical (commutation) frequency, Hz, signed like the speed (only with bit2) |
+//! | 28 or 32 | f32 | `lng_supply_bar`: LNG supply pressure at the valve, bar gauge (only with bit3) |
 //!
-//! A frame with a reserved flag bit set, or bit1 without bit0, is rejected
-//! ([`DecodeError::Kind`]). The valve position is the read-back of the LNG valve
-//! ([`crate::GuardOf::valve_feedback`]); without it (bit0 clear) the guard takes
-//! the command as the position.
+//! A frame with a reserved flag bit set, bit1 without bit0, or a length that
+//! does not match its flags is rejected ([`DecodeError::Kind`],
+//! [`DecodeError::Length`]). The valve position is the read-back of the LNG
+//! valve ([`crate::GuardOf::valve_feedback`]); without it (bit0 clear) the
+//! guard takes no cooling credit. The electrical frequency is the second,
+//! independent speed source ([`crate::speedcheck`]); the supply pressure
+//! confirms that the tank has LNG ([`crate::GuardOf::lng_supply`]).
+//! Version 1 frames (kind `0x01`, 28 bytes) are refused: a controller of
+//! the old protocol gets no sample accepted and the guard goes STALE,
+//! fail-safe.
 //!
 //! The guard's frames back (tick reply, acknowledgements, status, trace)
 //! are the product frames of [`crate::product::wire`]; the sequence rule
@@ -55,19 +63,26 @@ use heapless::Vec;
 /// frames), reported in the status reply. 2: one application loop (the
 /// tick reply's per-tick tail last, 33 bytes), the fault word 32 bits (tick
 /// reply, status, trace), the sample's optional speed-reference and LNG
-/// supply-pressure fields. 1: the first product protocol.
+/// supply-pressure fields, the keyed clear and refill (arm, then confirm
+/// with a key; 8-byte command, 9-byte ack). 1: the first product protocol.
 pub const PROTOCOL_VERSION: u8 = 2;
 
 /// Request flag: the valve position is reported in this frame.
 pub const FLAG_VALVE_FB: u8 = 1 << 0;
 /// Request flag: the reported valve position is open (only with [`FLAG_VALVE_FB`]).
 pub const FLAG_VALVE_FB_OPEN: u8 = 1 << 1;
+/// Request flag: the motor's electrical frequency follows.
+pub const FLAG_ELEC_HZ: u8 = 1 << 2;
+/// Request flag: the LNG supply pressure follows.
+pub const FLAG_LNG_SUPPLY: u8 = 1 << 3;
 
-/// Request kind: one sensor sample, one guard tick.
-pub const KIND_SAMPLE: u8 = 0x01;
+/// Request kind: one sensor sample (protocol version 2).
+pub const KIND_SAMPLE: u8 = 0x02;
 
-/// Length of a request payload (without CRC).
+/// Length of a request payload without its optional fields (without CRC).
 pub const REQUEST_LEN: usize = 28;
+/// Longest request payload (both optional fields).
+pub const REQUEST_MAX_LEN: usize = REQUEST_LEN + 8;
 /// Largest payload of any frame, the request and the product frames of
 /// [`crate::product::wire`] (the status reply is the longest).
 pub const MAX_PAYLOAD: usize = 56;
@@ -187,6 +202,11 @@ pub struct Request {
     pub ambient_c: f32,
     /// LNG valve position read back (`Some(true)` open), `None` when not reported.
     pub valve_fb: Option<bool>,
+    /// The motor drive's electrical (commutation) frequency, Hz, signed like
+    /// the speed; `None` when not reported.
+    pub elec_hz: Option<f32>,
+    /// LNG supply pressure at the valve, bar gauge; `None` when not reported.
+    pub lng_supply_bar: Option<f32>,
 }
 
 /// What the guard reports after a tick: the guard's own [`crate::Output`].

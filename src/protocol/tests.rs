@@ -14,6 +14,8 @@ fn req(seq: u16) -> Request {
         position_mm: 42.0,
         ambient_c: 21.0,
         valve_fb: None,
+        elec_hz: None,
+        lng_supply_bar: None,
     }
 }
 
@@ -81,12 +83,29 @@ fn request_valve_feedback_flags() {
         assert_eq!(p[27], match fb { None => 0, Some(false) => 1, Some(true) => 3 });
         assert_eq!(Request::from_payload(&p), Ok(r));
     }
-    // Reserved bits, or "open" without "reported", are rejected.
-    for flags in [2u8, 4, 0x80, 0xff, 7] {
+    // Reserved bits, or "open" without "reported", are rejected; a flag
+    // for an optional field that is not there is a length error.
+    for flags in [2u8, 0x10, 0x80, 0xff, 0x06] {
         let mut p = req(3).to_payload();
         p[27] = flags;
         assert_eq!(Request::from_payload(&p), Err(DecodeError::Kind), "flags {flags:#x}");
     }
+    for flags in [FLAG_ELEC_HZ, FLAG_LNG_SUPPLY, FLAG_ELEC_HZ | FLAG_LNG_SUPPLY] {
+        let mut p = req(3).to_payload();
+        p[27] = flags;
+        assert_eq!(Request::from_payload(&p), Err(DecodeError::Length), "flags {flags:#x}");
+    }
+    // The optional fields round-trip, each alone and both.
+    for (hz, lng) in [(Some(33.5), None), (None, Some(4.5)), (Some(-12.0), Some(0.0))] {
+        let r = Request { elec_hz: hz, lng_supply_bar: lng, valve_fb: Some(true), ..req(4) };
+        let p = r.to_payload();
+        assert_eq!(p.len(), REQUEST_LEN + 4 * usize::from(hz.is_some()) + 4 * usize::from(lng.is_some()));
+        assert_eq!(Request::from_payload(&p), Ok(r));
+    }
+    // A version-1 frame (kind 0x01) is refused.
+    let mut p = req(3).to_payload();
+    p[0] = 0x01;
+    assert_eq!(Request::from_payload(&p), Err(DecodeError::Kind));
 }
 
 #[test]

@@ -191,7 +191,7 @@ fn clear_after_the_sensors_agree_again() {
         Sample { current_a: f * current(65.0, 5.0, 500.0), ..sample(65.0, 5.0, 500.0) }
     });
     assert!(out[2999].faults.intersects(faults::SENSOR_DISAGREE));
-    assert!(g.clear_faults());
+    assert_eq!(g.clear_faults(), eha_guard::ClearResult::Cleared, "the estimate ran on the worst case: trusted again");
     let out = run(&mut g, 3000, |_| sample(65.0, 5.0, 500.0));
     assert!(out.iter().all(|o| !o.faults.intersects(faults::LATCHED) && !o.faults.intersects(faults::UNTRUSTED)));
 }

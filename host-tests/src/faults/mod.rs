@@ -216,6 +216,8 @@ pub fn run_on(
                 seq,
                 // The valve's position switch: where the valve really is.
                 valve_fb: Some(valve_position),
+                elec_hz: None,
+                lng_supply_bar: None,
                 current_a: sample.current_a,
                 p_a_bar: sample.p_a_bar,
                 p_b_bar: sample.p_b_bar,

@@ -103,9 +103,11 @@ const IMAGES: [Image; 4] = [
 fn run_product(elf: &Path) -> Result<ImageBudget> {
     let mut s = super::product::ProductSession::spawn(elf, &[])?;
     let mut others = Vec::new();
-    for r in super::drill::inputs().iter().take(300) {
-        s.send(r)?;
-        s.next_tick(Duration::from_secs(2), &mut others)?.context("no tick reply from the product image")?;
+    let mut open = false;
+    for r in super::drill::requests().iter().take(300) {
+        s.send(&super::drill::bytes(r, open))?;
+        let (_, t) = s.next_tick(Duration::from_secs(2), &mut others)?.context("no tick reply from the product image")?;
+        open = t.out.valve_open;
     }
     let st = s.status(1, &mut Vec::new())?;
     Ok(ImageBudget {

@@ -15,8 +15,9 @@
 //! - tick 45,000: 10 lost frames (STALE fault latches, fail-safe valve open);
 //! - tick 50,000: a NaN current (non-finite fault); tick 55,000: 5000 bar (range fault).
 //!
-//! The piston moves ±20 mm slowly throughout; ambient 16 °C. No valve position is
-//! reported.
+//! The piston moves ±20 mm slowly throughout; ambient 16 °C. The valve's
+//! position switch reports the valve the last tick commanded ([`bytes`]: the
+//! harness passes the last tick reply's command; a valve that follows).
 
 use eha_guard::protocol::Request;
 
@@ -37,9 +38,10 @@ pub fn motor_current(p_a_bar: f32, p_b_bar: f32, speed_rpm: f32) -> f32 {
 /// Number of ticks.
 pub const STEPS: u32 = 60_000;
 
-/// Per tick, the sample frame's bytes (empty: the frame was lost).
-pub fn inputs() -> Vec<Vec<u8>> {
-    requests().iter().map(|r| r.map_or_else(Vec::new, |r| r.encode().to_vec())).collect()
+/// The bytes of tick `k` of the drill (empty: the frame was lost), with the
+/// valve's position as the last tick commanded it (`last_open`).
+pub fn bytes(r: &Option<Request>, last_open: bool) -> Vec<u8> {
+    r.map_or_else(Vec::new, |r| Request { valve_fb: Some(last_open), ..r }.encode().to_vec())
 }
 
 /// Per tick, the sample the controller sent (`None`: lost on the way).
@@ -60,6 +62,8 @@ pub fn requests() -> Vec<Option<Request>> {
             position_mm: 20.0 * (0.05 * t).sin(),
             ambient_c: 16.0,
             valve_fb: None,
+        elec_hz: None,
+        lng_supply_bar: None,
         };
         if k == 50_000 {
             r.current_a = f32::NAN;

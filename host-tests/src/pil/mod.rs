@@ -53,6 +53,10 @@ pub struct PlantSensors {
     /// LNG valve position read back (the valve the plant ran during the last tick),
     /// if the plant reports it; sent in the request's flags byte.
     pub valve_fb: Option<bool>,
+    /// The motor drive's electrical frequency, Hz (signed), if the controller sends it.
+    pub elec_hz: Option<f32>,
+    /// LNG supply pressure at the valve, bar gauge, if the controller sends it.
+    pub lng_supply_bar: Option<f32>,
 }
 
 impl PlantSensors {
@@ -67,6 +71,8 @@ impl PlantSensors {
             position_mm: self.position_mm as f32,
             ambient_c: self.ambient_c as f32,
             valve_fb: self.valve_fb,
+            elec_hz: self.elec_hz,
+            lng_supply_bar: self.lng_supply_bar,
         }
     }
 }
@@ -343,17 +349,25 @@ pub struct OpenLoopRun {
     pub icount: bool,
 }
 
-/// Send `inputs` (per tick: the bytes received, e.g. a sample frame; empty:
-/// a missing sample) in lockstep, then end the input and collect the
-/// completion marker and the decoded defmt log.
-pub fn run_open_loop(qemu: &QemuOptions, inputs: &[Vec<u8>]) -> anyhow::Result<OpenLoopRun> {
+/// Runs the drill's samples (per tick: a sample, or `None`: lost) on
+/// `target` in lockstep, each reporting the valve the previous tick
+/// commanded ([`drill::bytes`]); the tick frames.
+pub fn run_drill(target: &mut dyn Target, samples: &[Option<Request>]) -> Result<Vec<TickOut>, PilError> {
+    let mut ticks: Vec<TickOut> = Vec::with_capacity(samples.len());
+    for (k, r) in samples.iter().enumerate() {
+        let open = ticks.last().is_some_and(|t| t.reply.out.valve_open);
+        ticks.push(target.tick(&drill::bytes(r, open), k as u64)?);
+    }
+    Ok(ticks)
+}
+
+/// Runs the drill's samples in QEMU ([`run_drill`]), then ends the input
+/// and collects the completion marker and the decoded defmt log.
+pub fn run_open_loop(qemu: &QemuOptions, samples: &[Option<Request>]) -> anyhow::Result<OpenLoopRun> {
     let start = Instant::now();
     let mut s = QemuSession::spawn(qemu)?;
-    let mut ticks = Vec::with_capacity(inputs.len());
-    for (k, r) in inputs.iter().enumerate() {
-        ticks.push(s.tick(r, k as u64)?);
-    }
-    let end = s.finish(inputs.len() as u64)?;
+    let ticks = run_drill(&mut s, samples)?;
+    let end = s.finish(samples.len() as u64)?;
     let log = defmt_log::decode(&qemu.elf, &end.defmt)?;
     Ok(OpenLoopRun { build: qemu.build, ticks, done: end.done, log, wall: start.elapsed(), icount: qemu.icount })
 }

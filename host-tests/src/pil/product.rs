@@ -213,7 +213,7 @@ impl ProductSession {
 
     /// Sends a command.
     pub fn command(&mut self, token: u16, cmd: Cmd) -> Result<()> {
-        self.send(&GuardCommand { token, cmd }.encode())
+        self.send(&GuardCommand { token, cmd, arg: 0 }.encode())
     }
 
     /// The next frame, waiting at most `timeout`.

@@ -25,7 +25,7 @@ pub struct ParamsBlockArgs {
 #[derive(Subcommand, Debug)]
 enum BlockCmd {
     /// Reduce a rig file to the firmware's model constants and write the
-    /// parameter block (1084 bytes) to flash at the PARAMS region
+    /// parameter block (1088 bytes) to flash at the PARAMS region
     /// (STM32F411: 0x0802_0000; QEMU mps2: 0x0003_F000).
     Write {
         /// Rig file (TOML, as `host-tests/rig/liu2024.toml`).
@@ -114,7 +114,7 @@ fn block_error_text(e: BlockError) -> String {
         BlockError::Magic => "bytes 0..4: not the parameter-block magic \"EHAP\" (and not erased)".into(),
         BlockError::Version => format!("bytes 4..6: format version is not {} (this firmware's)", params_block::VERSION),
         BlockError::Words => format!("bytes 6..8: word count is not {} (another model structure)", consts::N_WORDS),
-        BlockError::Crc => "bytes 1020..1024: CRC-32 mismatch (torn or corrupted block)".into(),
+        BlockError::Crc => "bytes 1084..1088: CRC-32 mismatch (torn or corrupted block)".into(),
         BlockError::Alignment => "block not 4-byte aligned".into(),
     }
 }

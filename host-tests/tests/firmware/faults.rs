@@ -17,8 +17,6 @@ const SPEED_UNSEEN: &str = "a speed sensor error is invisible to the torque cros
 
 /// (fault, scenario, why the design cannot meet the pass rule).
 const KNOWN_FAILING: &[(&str, &str, &str)] = &[
-    ("speed/stuck-zero", "lng", SPEED_UNSEEN),
-    ("speed/stuck-zero", "random-1", SPEED_UNSEEN),
     ("speed/gain-x0.5", "lng", SPEED_UNSEEN),
     ("speed/gain-x0.5", "random-1", SPEED_UNSEEN),
     ("speed/drift", "lng", SPEED_UNSEEN),

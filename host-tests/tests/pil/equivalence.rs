@@ -20,31 +20,30 @@ use std::time::Instant;
 use eha_guard::product::wire::TickReply;
 use eha_sim::pil::report::compare;
 use eha_sim::pil::sil::SilTarget;
-use eha_sim::pil::{firmware_for_tests, require_qemu, Build, QemuOptions, QemuSession, Target};
+use eha_sim::pil::{firmware_for_tests, require_qemu, run_drill, Build, QemuOptions, QemuSession};
 
 const STEPS: u32 = eha_sim::pil::drill::STEPS;
 
-fn run_qemu(build: Build, inputs: &[Vec<u8>]) -> (Vec<TickReply>, f64) {
+fn run_qemu(build: Build, samples: &[Option<eha_guard::protocol::Request>]) -> (Vec<TickReply>, f64) {
     require_qemu();
     let elf = firmware_for_tests(build);
     let mut opts = QemuOptions::new(build, &elf);
     opts.icount = false;
     let mut s = QemuSession::spawn(&opts).unwrap_or_else(|e| panic!("{e}"));
     let t0 = Instant::now();
-    let replies: Vec<TickReply> =
-        inputs.iter().enumerate().map(|(k, r)| s.tick(r, k as u64).unwrap_or_else(|e| panic!("{e}")).reply).collect();
+    let replies: Vec<TickReply> = run_drill(&mut s, samples).unwrap_or_else(|e| panic!("{e}")).into_iter().map(|o| o.reply).collect();
     let secs = t0.elapsed().as_secs_f64();
-    let end = s.finish(inputs.len() as u64).unwrap_or_else(|e| panic!("{e}"));
-    assert_eq!(end.done.accepted, inputs.len() as u32 - 13);
+    let end = s.finish(samples.len() as u64).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(end.done.accepted, samples.len() as u32 - 13);
     assert_eq!(end.done.missing, 3 + 10);
     (replies, secs)
 }
 
 fn check(build: Build) {
-    let inputs = eha_sim::pil::drill::inputs();
-    let (fw, secs) = run_qemu(build, &inputs);
+    let samples = eha_sim::pil::drill::requests();
+    let (fw, secs) = run_qemu(build, &samples);
     let mut sil = SilTarget::new(build);
-    let host: Vec<TickReply> = inputs.iter().enumerate().map(|(k, r)| sil.tick(r, k as u64).unwrap().reply).collect();
+    let host: Vec<TickReply> = run_drill(&mut sil, &samples).unwrap().into_iter().map(|o| o.reply).collect();
     let c = compare(&fw, &host);
     let valve_steps = fw.iter().filter(|r| r.out.valve_open).count();
     let faults = fw.last().map_or(eha_guard::Faults::NONE, |r| r.out.faults);
@@ -61,7 +60,7 @@ fn check(build: Build) {
         faults,
         fw.iter().map(|r| r.out.drain_c).fold(f32::MIN, f32::max),
     );
-    let first_fault = fw.iter().position(|r| !r.out.faults.is_empty());
+    let first_fault = fw.iter().position(|r| r.out.faults.intersects(eha_guard::faults::LATCHED));
     let first_open = fw.iter().position(|r| r.out.valve_open);
     let drains: Vec<String> = fw.iter().step_by(5000).map(|r| format!("{:.2}", r.out.drain_c)).collect();
     eprintln!("  first fault at step {first_fault:?}, first valve open at {first_open:?}, drain every 50 s: {}", drains.join(" "));

@@ -18,8 +18,9 @@ fn any_f32() -> impl Strategy<Value = f32> {
 }
 
 prop_compose! {
-    fn any_request()(seq in any::<u16>(), v in proptest::array::uniform6(any_f32()), fb in proptest::option::of(any::<bool>())) -> Request {
-        Request { seq, current_a: v[0], p_a_bar: v[1], p_b_bar: v[2], speed_rpm: v[3], position_mm: v[4], ambient_c: v[5], valve_fb: fb }
+    fn any_request()(seq in any::<u16>(), v in proptest::array::uniform6(any_f32()), fb in proptest::option::of(any::<bool>()),
+                     hz in proptest::option::of(any_f32()), lng in proptest::option::of(any_f32())) -> Request {
+        Request { seq, current_a: v[0], p_a_bar: v[1], p_b_bar: v[2], speed_rpm: v[3], position_mm: v[4], ambient_c: v[5], valve_fb: fb, elec_hz: hz, lng_supply_bar: lng }
     }
 }
 
@@ -77,6 +78,8 @@ proptest! {
         prop_assert_eq!(back.seq, r.seq);
         prop_assert_eq!(bits(&back), bits(&r));
         prop_assert_eq!(back.valve_fb, r.valve_fb);
+        prop_assert_eq!(back.elec_hz.map(f32::to_bits), r.elec_hz.map(f32::to_bits));
+        prop_assert_eq!(back.lng_supply_bar.map(f32::to_bits), r.lng_supply_bar.map(f32::to_bits));
     }
 
     #[test]

@@ -233,7 +233,9 @@ impl F411 {
         // 5. Memories: no-init RAM records, the non-volatile record, the cause.
         let (a, b) = noinit::load();
         let mut nv = NvStore::new(Blocking(Flash(LockedFlash::new(dp.FLASH))), NV_RANGE).ok();
-        let nv_rec = nv.as_mut().map_or(NvLoad::Empty, |n| n.load());
+        // A store that cannot be opened is a damaged record, not an empty
+        // one: the machine may be hot (conservative start).
+        let nv_rec = nv.as_mut().map_or(NvLoad::Damaged, |n| n.load());
         let mem = BootMemory { records: (a, b), nv: nv_rec, alive_s: crate::rtc::alive_load(), cause: reset::noinit::load(), hw_hint: hw_hint(csr) };
         defmt::info!(
             "RCC_CSR {=u32:#010x}, sysclk {=u32} Hz, NV store {}, NV record {}",

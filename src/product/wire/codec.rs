@@ -50,6 +50,7 @@ impl Command {
             p.u8(KIND_COMMAND);
             p.u16(self.token);
             p.u8(self.cmd.code());
+            p.u32(self.arg);
         })
     }
 
@@ -58,7 +59,7 @@ impl Command {
         let mut r = expect(p, KIND_COMMAND, COMMAND_LEN)?;
         let token = r.u16()?;
         let cmd = Cmd::from_code(r.u8()?).ok_or(DecodeError::Kind)?;
-        Ok(Command { token, cmd })
+        Ok(Command { token, cmd, arg: r.u32()? })
     }
 }
 
@@ -124,6 +125,7 @@ impl Ack {
             p.u16(self.token);
             p.u8(self.cmd.code());
             p.u8(self.result as u8);
+            p.u32(self.value);
         })
     }
 
@@ -137,7 +139,7 @@ impl Ack {
             1 => AckResult::Refused,
             _ => return Err(DecodeError::Kind),
         };
-        Ok(Ack { token, cmd, result })
+        Ok(Ack { token, cmd, result, value: r.u32()? })
     }
 }
 
