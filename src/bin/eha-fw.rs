@@ -201,7 +201,7 @@ mod fw {
             ticks: 0,
         });
         let (a, b) = noinit::load();
-        let mem = BootMemory { records: (a, b), nv: eha_guard::memory::nv::NvLoad::Empty, alive_s: None, cause: reset::noinit::load(), hw_hint: None };
+        let mem = BootMemory { records: (a, b), nv: eha_guard::memory::nv::NvLoad::Empty, alive_s: None, nv_failing: false, cause: reset::noinit::load(), hw_hint: None };
         // The application state lives in .bss, not on the stack.
         static mut APP: MaybeUninit<App> = MaybeUninit::uninit();
         // SAFETY: `main` runs once; this is the only reference to APP.

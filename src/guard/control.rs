@@ -26,8 +26,8 @@ impl<N: Num> GuardOf<N> {
     /// unknown start has not begun to recover.
     pub fn recovery_left(&self) -> u32 {
         match self.hold_from {
+            _ if self.hold_pending => self.recovery_ticks,
             Some(t) => self.recovery_ticks.saturating_sub(self.tick.wrapping_sub(t)),
-            None if self.unknown_start => self.recovery_ticks,
             None => 0,
         }
     }
@@ -110,10 +110,12 @@ impl<N: Num> GuardOf<N> {
     /// `clear_valid_ticks` samples (1 s by default) were all valid and none is missing.
     /// The thermal estimate is *not* reset: it relaxes from its conservative value.
     /// A clear also restores trust in the estimate ([`faults::UNTRUSTED`]: after a
-    /// sensor disagreement the estimate ran on the worst case), **except** while
-    /// the estimate is still recovering from an unknown start
-    /// ([`faults::RECOVERING`], [`super::recovery_ticks`]): then the faults clear
-    /// and UNTRUSTED holds ([`ClearResult::TrustHeld`]).
+    /// STALE dropout the estimate ran on every channel's worst case), **except**
+    /// while the estimate is still recovering from an unknown state
+    /// ([`faults::RECOVERING`], [`super::recovery_ticks`]: an unknown start,
+    /// counted from the first sample, or inputs that disagreed, counted from
+    /// this clear): then the faults clear and UNTRUSTED holds
+    /// ([`ClearResult::TrustHeld`]).
     pub fn clear_faults(&mut self) -> ClearResult {
         let valid_run = self.tick.wrapping_sub(self.valid_since);
         if self.missing != 0 || valid_run < self.clear_valid_ticks {
@@ -137,13 +139,18 @@ impl<N: Num> GuardOf<N> {
         }
         // The controller accepts the estimate as it is (it is not reset); the alarm
         // follows it again from the next model step — unless it is still recovering
-        // from an unknown start.
+        // from an unknown state: after a disagreement that recovery starts now,
+        // with the inputs good again.
+        if self.hold_pending && self.started {
+            self.hold_pending = false;
+            self.hold_from = Some(self.tick);
+        }
         let left = self.recovery_left();
         let trust = left == 0 && self.untrusted;
         let bits = bits | Faults::when(trust, faults::UNTRUSTED) | Faults::when(self.nv_failed && self.nv_ok, faults::NV_FAILED);
         if left == 0 {
             self.untrusted = false;
-            self.unknown_start = false;
+            self.hold_pending = false;
             self.hold_from = None;
         }
         self.nv_failed &= !self.nv_ok;

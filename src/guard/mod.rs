@@ -190,8 +190,13 @@ pub struct GuardOf<N: Num> {
     /// `prev_ok` before the missing ticks since the last sample: the rate
     /// check of the next sample over the gap.
     gap_ok: u8,
-    /// Inside [`GuardOf::tick_blind`]: no cooling credit.
+    /// Inside [`GuardOf::tick_blind`] or the replay of the wait: no
+    /// cooling credit.
     blind: bool,
+    /// Ticks waited for the first sample (replayed at the start).
+    waited: u32,
+    /// The first sample's own inputs, for that replay.
+    replay_u: ModelInputN<N>,
     missing: u32,
     /// Tick index from which every sample was present and valid (the run of valid
     /// samples of the clear rule is `tick - valid_since`).
@@ -234,10 +239,12 @@ pub struct GuardOf<N: Num> {
     /// The estimate is not trusted (corrupt record at boot, no sample by the start-up
     /// timeout): alarm and derate held until a successful `clear_faults`.
     untrusted: bool,
-    /// The start state is unknown (corrupt or damaged record, no sample by
-    /// the start-up timeout, a record saved while recovering): the trust
-    /// hold starts with the first sample.
-    unknown_start: bool,
+    /// The estimate's state is unknown: a corrupt or damaged record, no
+    /// sample by the start-up timeout, a record saved while recovering (the
+    /// trust hold starts with the first sample), or inputs found to
+    /// disagree (SENSOR_DISAGREE: the hold starts at the clear, when the
+    /// inputs are good again).
+    hold_pending: bool,
     /// Tick the estimate started from an unknown state (`None`: it did not).
     hold_from: Option<u32>,
     /// Ticks the estimate needs to forget an unknown start
@@ -298,6 +305,8 @@ impl<N: Num> GuardOf<N> {
             prev_ok: 0,
             gap_ok: 0,
             blind: false,
+            waited: 0,
+            replay_u: ModelInputN { current_ha: N::ZERO, p_a_hbar: N::ZERO, p_b_hbar: N::ZERO, speed_hrads: N::ZERO, dpos_mm: N::ZERO, ambient_c: N::ZERO },
             missing: 0,
             valid_since: 0,
             started: false,
@@ -318,7 +327,7 @@ impl<N: Num> GuardOf<N> {
             lng_empty: false,
             alarm: false,
             untrusted: false,
-            unknown_start: false,
+            hold_pending: false,
             hold_from: None,
             recovery_ticks: recovery_ticks(config.model),
             lng: LngBudget::new(&config.lng),
@@ -354,7 +363,7 @@ impl<N: Num> GuardOf<N> {
                 // Saved before a clear restored trust: still not trusted; saved
                 // while recovering from an unknown start: the hold starts again.
                 g.untrusted = saved.contains(faults::UNTRUSTED);
-                g.unknown_start = saved.contains(faults::RECOVERING);
+                g.hold_pending = saved.contains(faults::RECOVERING);
                 if let Some(c) = g.core_ok.then_some(&mut g.core) {
                     c.model.set_loss_max(g.latched.contains(faults::SENSOR_DISAGREE));
                 }
@@ -373,7 +382,7 @@ impl<N: Num> GuardOf<N> {
                 g.lng.set_used_cj(u32::MAX);
                 g.latched |= faults::MEMORY_CORRUPT;
                 g.untrusted = true;
-                g.unknown_start = true;
+                g.hold_pending = true;
                 RestoreKind::Corrupt
             }
         };

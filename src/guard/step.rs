@@ -13,8 +13,9 @@ impl<N: Num> GuardOf<N> {
     #[inline(never)]
     pub(super) fn start(&mut self, ambient_c: N) {
         self.started = true;
-        if self.unknown_start {
+        if self.hold_pending {
             // The estimate starts to forget its unknown start from here.
+            self.hold_pending = false;
             self.hold_from = Some(self.tick);
         }
         // Nothing of the waiting time is counted: no model ran, no credit, no LNG booked.
@@ -122,6 +123,10 @@ impl<N: Num> GuardOf<N> {
             });
         }
         self.untrusted = true;
+        // The estimate ran on inputs that disagree (the larger shaft loss
+        // covers the shaft, not the throttling heat a wrong pressure hides):
+        // its state is unknown until it has recovered on good inputs.
+        self.hold_pending = true;
     }
 
     /// Valve hysteresis and dwell, alarm, LNG budget (`open_ticks` ticks of the model
@@ -194,7 +199,9 @@ impl<N: Num> GuardOf<N> {
         self.refresh_out();
     }
 
-    /// Rebuilds the cached outputs from the present state.
+    /// Rebuilds the cached outputs from the present state (one copy: it
+    /// runs at model steps and state changes, never on the tick's fast path).
+    #[inline(never)]
     pub(super) fn refresh_out(&mut self) {
         self.epoch = self.epoch.wrapping_add(1);
         // Derate: the alarm, and whatever leaves the protection weaker than

@@ -23,7 +23,8 @@ impl<N: Num> GuardOf<N> {
                 let u = if self.bad_ch == 0 {
                     validate::direct(&v, &self.prev)
                 } else {
-                    Self::substitute_latched(&v, &self.prev, self.bad_ch, &core.limits)
+                    let [_, _, _, _, prev_pos, _] = self.prev;
+                    Self::subst(&v, self.bad_ch, Some(prev_pos), &core.limits)
                 };
                 self.prev = v;
                 return self.advance(&u);
@@ -32,17 +33,13 @@ impl<N: Num> GuardOf<N> {
         self.tick_slow(s)
     }
 
-    /// Fast-path inputs while channels are latched bad: their worst cases.
+    /// [`validate::substitute`], one copy for every caller off the
+    /// per-tick fast path (flash): a sample's channels with the `bad` ones
+    /// at their worst case.
     #[inline(never)]
     #[cold]
-    fn substitute_latched(
-        v: &Channels<N>,
-        prev: &Channels<N>,
-        bad_ch: u8,
-        limits: &LimitsN<N>,
-    ) -> ModelInputN<N> {
-        let [_, _, _, _, prev_pos, _] = *prev;
-        validate::substitute(v, bad_ch, Some(prev_pos), limits)
+    fn subst(v: &Channels<N>, bad: u8, prev_pos: Option<N>, limits: &LimitsN<N>) -> ModelInputN<N> {
+        validate::substitute(v, bad, prev_pos, limits)
     }
 
     /// [`GuardOf::tick`] off the fast path: classifies the sample (distinct fault and
@@ -51,6 +48,7 @@ impl<N: Num> GuardOf<N> {
     #[cold]
     fn tick_slow(&mut self, s: &Sample) -> Output {
         let gap = core::mem::replace(&mut self.missing, 0);
+        let first = !self.started;
         let Some(core) = self.core_ok.then_some(&self.core) else {
             return self.slow_tail(None, Faults::NONE, N::ZERO);
         };
@@ -58,12 +56,14 @@ impl<N: Num> GuardOf<N> {
         // After missing ticks (samples slower than the tick, or a dropout
         // shorter than STALE) the rate is checked over the gap: the limits
         // times the ticks since the last sample.
-        let c = if gap > 0 && gap < self.stale_ticks {
-            let lim = core.limits.rate_over(gap + 1);
-            validate::check(&v, nonfinite, &self.prev, self.gap_ok, &lim)
+        let over_gap;
+        let (ok_before, lim) = if gap > 0 && gap < self.stale_ticks {
+            over_gap = core.limits.rate_over(gap + 1);
+            (self.gap_ok, &over_gap)
         } else {
-            validate::check(&v, nonfinite, &self.prev, self.prev_ok, &core.limits)
+            (self.prev_ok, &core.limits)
         };
+        let c = validate::check(&v, nonfinite, &self.prev, ok_before, lim);
         let mut new_bits = Faults::NONE;
         if c.range {
             new_bits |= faults::RANGE;
@@ -84,7 +84,15 @@ impl<N: Num> GuardOf<N> {
         } else {
             None
         };
-        let u = validate::substitute(&v, self.bad_ch, prev_pos, &core.limits);
+        let u = Self::subst(&v, self.bad_ch, prev_pos, &core.limits);
+        if first {
+            // The ticks waited for this first sample, replayed at its start
+            // with its own inputs (its own bad channels at their worst case;
+            // not the STALE substitution of a timeout: that says nothing
+            // about what the machine did).
+            self.waited = gap;
+            self.replay_u = Self::subst(&v, c.bad, None, &core.limits);
+        }
         // A cold start takes this sample's own ambient when it is valid (also when
         // an earlier STALE makes the model run on the worst case from now on), else
         // the worst case.
@@ -115,7 +123,7 @@ impl<N: Num> GuardOf<N> {
             self.bad_ch = CH_ALL;
             self.stale_alarm();
         }
-        let u = self.core_ok.then(|| validate::substitute(&self.prev, self.bad_ch, None, &self.core.limits));
+        let u = self.core_ok.then(|| Self::subst(&self.prev, self.bad_ch, None, &self.core.limits));
         self.slow_tail(u.as_ref(), new_bits, N::ZERO)
     }
 
@@ -146,7 +154,7 @@ impl<N: Num> GuardOf<N> {
             self.valid_since = self.tick.wrapping_add(1);
             self.prev_ok = 0;
             self.gap_ok = 0;
-            let u = self.core_ok.then(|| validate::substitute(&self.prev, self.bad_ch, None, &self.core.limits));
+            let u = self.core_ok.then(|| Self::subst(&self.prev, self.bad_ch, None, &self.core.limits));
             self.slow_tail(u.as_ref(), Faults::NONE, N::ZERO);
         }
         self.settle(self.tick);
@@ -189,7 +197,7 @@ impl<N: Num> GuardOf<N> {
             // No estimate and no input: alarm and derate until a clear, and
             // the machine may have run unseen: the start state is unknown.
             self.untrusted = true;
-            self.unknown_start = true;
+            self.hold_pending = true;
             if !self.alarm {
                 self.alarm = true;
                 self.trace.write(Trace::Alarm {
@@ -230,9 +238,10 @@ impl<N: Num> GuardOf<N> {
             Some(u) if self.core_ok => {
                 if !self.started {
                     self.start(start_amb);
+                    self.replay_wait();
                 }
                 self.refresh_out();
-                self.advance(u)
+                self.advance_slow(u)
             }
             _ => {
                 // No model (CONFIG): fail-safe outputs, nothing to estimate.
@@ -243,6 +252,40 @@ impl<N: Num> GuardOf<N> {
                 self.out
             }
         }
+    }
+
+    /// The ticks the guard waited for its first sample (at most the
+    /// start-up timeout): the machine may have run meanwhile, unseen. They
+    /// are replayed at the first sample with its inputs (no piston work:
+    /// the first sample has no position derivative), no cooling credit:
+    /// the machine is taken to have done then what it does now. Before
+    /// issue 33 they were not counted: a controller starting 5 s late on a
+    /// machine at 60 bar left the estimate 1.2 K low.
+    #[cold]
+    #[inline(never)]
+    fn replay_wait(&mut self) {
+        let n = core::mem::replace(&mut self.waited, 0).min(self.startup_timeout_ticks);
+        if n == 0 {
+            return;
+        }
+        let u = self.replay_u;
+        let now = self.tick;
+        self.tick = now.wrapping_sub(n);
+        self.mark = self.tick;
+        self.blind = true;
+        for _ in 0..n {
+            self.advance_slow(&u);
+        }
+        self.settle(self.tick);
+        self.blind = false;
+        self.tick = now;
+    }
+
+    /// [`GuardOf::advance`] off the fast path: one copy of the model's tick
+    /// accumulation for the slow paths (flash).
+    #[inline(never)]
+    fn advance_slow(&mut self, u: &ModelInputN<N>) -> Output {
+        self.advance(u)
     }
 
     /// The per-tick part common to both paths: the model's tick accumulation, and

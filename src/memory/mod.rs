@@ -341,6 +341,19 @@ pub mod slots;
 /// long after the stamp.
 pub const ALIVE_PERIOD_S: u32 = 1;
 
+/// The last-alive word in the clock's backup register: the seconds `s`
+/// shifted left by one, bit 0 set while the non-volatile saves are failing
+/// (since the last good save: the record misses the machine's state since).
+/// 31 bits of seconds: 68 years of the clock.
+pub fn alive_word(s: u32, nv_failing: bool) -> u32 {
+    (s << 1) | u32::from(nv_failing)
+}
+
+/// The seconds and the failing flag of a last-alive word (0: none stored).
+pub fn alive_from_word(w: u32) -> Option<(u32, bool)> {
+    (w != 0).then_some((w >> 1, w & 1 != 0))
+}
+
 /// The boot rule over both memories: the RAM records' rule
 /// ([`slots::restore_from`]) unless RAM holds nothing (power-on), then the
 /// non-volatile record (a power loss), else a cold start. A damaged RAM
@@ -358,8 +371,10 @@ pub const ALIVE_PERIOD_S: u32 = 1;
 /// stale (its saves failed while the machine ran on: its state is unknown)
 /// and the start is conservative; otherwise the state is cooled by the
 /// model's bound at rest ([`cooling::RestCooling`]) over `now - alive`.
-/// Without the stamp, a clock or a bound, the saved temperatures stand
-/// (power loss of unknown length: conservative).
+/// So is a record the stamp says the saves were failing after
+/// (`nv_failing`): the machine ran on unrecorded. Without the stamp, a clock
+/// or a bound, the saved temperatures stand (power loss of unknown length:
+/// conservative).
 pub fn boot_restore(
     ram: Restore,
     nv: nv::NvLoad,
@@ -367,9 +382,11 @@ pub fn boot_restore(
     cool: Option<&cooling::RestCooling>,
     now_rtc_s: Option<u32>,
     alive_s: Option<u32>,
+    nv_failing: bool,
 ) -> Restore {
     let r = match (ram, nv) {
         (Restore::Cold, nv::NvLoad::Damaged) => return Restore::Corrupt,
+        (Restore::Cold, nv::NvLoad::Valid(_)) if nv_failing => return Restore::Corrupt,
         (Restore::Cold, nv::NvLoad::Valid(r)) => r,
         (ram, _) => return ram,
     };

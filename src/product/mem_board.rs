@@ -61,7 +61,7 @@ pub struct MemBoard {
     /// The real-time clock's reading, s (`None`: no clock).
     pub rtc: Option<u32>,
     /// The clock's battery-backed backup register holding the last-alive
-    /// stamp (kept across a power loss, like the clock; `None`: the board
+    /// word (`memory::alive_word`) (kept across a power loss, like the clock; `None`: the board
     /// has none; 0: empty, as after a backup-domain reset).
     pub rtc_backup: Option<u32>,
     /// The flash's parameter-block region (`None`: the board has none).
@@ -170,8 +170,15 @@ impl MemBoard {
     /// store is read as a board's `init` reads it).
     pub fn boot_memory(&mut self) -> BootMemory {
         let nv = self.nv.as_mut().map_or(crate::memory::nv::NvLoad::Empty, |s| s.load());
-        let alive_s = self.rtc_backup.filter(|s| *s != 0);
-        BootMemory { records: (self.records[0], self.records[1]), nv, alive_s, cause: self.cause, hw_hint: self.hw_hint }
+        let alive = self.rtc_backup.and_then(crate::memory::alive_from_word);
+        BootMemory {
+            records: (self.records[0], self.records[1]),
+            nv,
+            alive_s: alive.map(|a| a.0),
+            nv_failing: alive.is_some_and(|a| a.1),
+            cause: self.cause,
+            hw_hint: self.hw_hint,
+        }
     }
 
     /// A reset (watchdog, brown-out, pin): the MCU restarts, no-init RAM and
@@ -263,9 +270,9 @@ impl Board for MemBoard {
         self.rtc
     }
 
-    fn rtc_alive(&mut self, s: u32) {
+    fn rtc_alive(&mut self, word: u32) {
         if let Some(r) = self.rtc_backup.as_mut() {
-            *r = s;
+            *r = word;
         }
     }
 

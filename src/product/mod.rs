@@ -96,13 +96,15 @@ pub trait Board {
     fn rtc_s(&mut self) -> Option<u32> {
         None
     }
-    /// Stores the last-alive stamp `s` (the real-time clock's seconds) in a
-    /// battery-backed register that survives a power loss (on the STM32F411
-    /// an RTC backup register), read back at boot into
-    /// [`BootMemory::alive_s`]. The application stamps it once per
-    /// [`crate::memory::ALIVE_PERIOD_S`]; it is the only time base the
-    /// power-off cooling counts from. No-op on a board without one.
-    fn rtc_alive(&mut self, _s: u32) {}
+    /// Stores the last-alive word ([`crate::memory::alive_word`]: the
+    /// real-time clock's seconds and whether the non-volatile saves are
+    /// failing) in a battery-backed register that survives a power loss (on
+    /// the STM32F411 an RTC backup register), read back at boot into
+    /// [`BootMemory::alive_s`] and [`BootMemory::nv_failing`]. The
+    /// application stamps it once per [`crate::memory::ALIVE_PERIOD_S`]; it
+    /// is the only time base the power-off cooling counts from. No-op on a
+    /// board without one.
+    fn rtc_alive(&mut self, _word: u32) {}
     /// A free-running core-clock cycle stamp (0 when not available).
     fn cycle_stamp(&self) -> u32 {
         0
@@ -137,6 +139,10 @@ pub struct BootMemory {
     /// The last-alive stamp in the clock's battery-backed register, s
     /// ([`Board::rtc_alive`]; `None`: the board has none or it is empty).
     pub alive_s: Option<u32>,
+    /// The last-alive word says the non-volatile saves were failing: the
+    /// flash record misses the machine's state since (a conservative
+    /// start after a power loss).
+    pub nv_failing: bool,
     /// The reset-cause record left in no-init RAM.
     pub cause: CauseRecord,
     /// The board's hardware reset flag, if it names a cause (e.g. IWDG).
@@ -277,7 +283,7 @@ impl<N: Num> AppOf<N> {
             _ => RestCooling::from_consts(model),
         };
         let now_s = if mem.nv != NvLoad::Empty { board.rtc_s() } else { None };
-        let restore = boot_restore(slots::restore_from(a, b), mem.nv, &nv_policy, cool.as_ref(), now_s, mem.alive_s);
+        let restore = boot_restore(slots::restore_from(a, b), mem.nv, &nv_policy, cool.as_ref(), now_s, mem.alive_s, mem.nv_failing);
         let cfg = GuardConfig { model, ..*cfg };
         let p = slot.as_mut_ptr();
         // SAFETY: `p` points to `slot`, valid for writes; every field is written
@@ -488,7 +494,7 @@ impl<N: Num> AppOf<N> {
     fn stamp_alive<B: Board>(&mut self, board: &mut B) {
         self.alive_at = self.tick;
         if let Some(s) = board.rtc_s() {
-            board.rtc_alive(s);
+            board.rtc_alive(crate::memory::alive_word(s, self.nv_failed_at.is_some()));
         }
     }
 

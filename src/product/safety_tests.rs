@@ -110,7 +110,7 @@ fn lng_used_is_never_under_counted_after_a_power_loss() {
     let mut b = nv_board(1_000);
     let rec = hot_record(1_000);
     b.nv.as_mut().map(|s| s.save(&rec));
-    b.rtc_backup = Some(1_000);
+    b.rtc_backup = Some(crate::memory::alive_word(1_000, false));
     b.power_loss();
     let app = boot(&mut b);
     let used = app.guard().snapshot().lng_used_cj;
@@ -141,6 +141,30 @@ fn no_cooling_over_hours_the_machine_ran_after_its_last_save() {
     let mut app = boot(&mut b);
     let r = tick(&mut app, &mut b, 1);
     assert_eq!(r.restore, RestoreKind::Corrupt, "the 2 h stale record: restore {:?}, drain {}", r.restore, r.out.drain_c);
+}
+
+/// Saves that fail for two minutes before a power loss: the flash record
+/// misses those minutes of heating. The last-alive word carries the
+/// failing flag, so the restore is conservative; before, the old record
+/// (+2 K) was cooled over the off-time (the campaign's flash-write-fail run
+/// under-predicted by 10.0 K).
+#[test]
+fn a_power_loss_after_failed_saves_is_a_conservative_start() {
+    let mut b = nv_board(5_000);
+    let mut app = boot(&mut b);
+    tick(&mut app, &mut b, 0);
+    assert_eq!(b.nv_saved.map(|r| r.rtc_s), Some(5_000), "the first save");
+    b.set_flash_faults(false, true);
+    for k in 1..12_000u32 {
+        b.rtc = Some(5_000 + k / 100);
+        tick(&mut app, &mut b, k);
+    }
+    b.power_loss();
+    b.set_flash_faults(false, false);
+    b.rtc = Some(5_000 + 120 + 60);
+    let mut app = boot(&mut b);
+    let r = tick(&mut app, &mut b, 1);
+    assert_eq!(r.restore, RestoreKind::Corrupt, "saves failing at the power loss: restore {:?}, drain {}", r.restore, r.out.drain_c);
 }
 
 /// A valve that does not follow its command (ACTUATOR, detected from the

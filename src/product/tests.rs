@@ -435,7 +435,7 @@ fn power_loss_restore_is_cooled_over_the_clocks_off_time() {
         let mut b = board();
         b.rtc = rtc;
         // the clock's last-alive stamp: the machine stopped at the save
-        let mem = BootMemory { nv: crate::memory::nv::NvLoad::Valid(hot), alive_s: rtc.map(|_| 5_000), ..b.boot_memory() };
+        let mem = BootMemory { nv: crate::memory::nv::NvLoad::Valid(hot), alive_s: rtc.map(|_| 5_000), nv_failing: false, ..b.boot_memory() };
         let mut app = App::boot(&mut *b, &GuardConfig::DEFAULT, &mem);
         let mut s = sample(1, 0.0, 3.0);
         s.speed_rpm = 0.0;

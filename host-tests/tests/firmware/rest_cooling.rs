@@ -98,7 +98,7 @@ fn restore_after_a_measured_off_time_is_cooled_and_never_below_the_reference() {
     for (h, truth) in OFF_H.iter().zip(&ref_drain) {
         let off = h * 3600;
         // the machine stopped at the save: the clock's last-alive stamp
-        let Restore::PowerLoss(r) = boot_restore(Restore::Cold, NvLoad::Valid(saved), &policy, Some(&cool), Some(T0_S + off), Some(T0_S)) else {
+        let Restore::PowerLoss(r) = boot_restore(Restore::Cold, NvLoad::Valid(saved), &policy, Some(&cool), Some(T0_S + off), Some(T0_S), false) else {
             panic!("a power-loss restore")
         };
         let own = model_at_rest(&saved.temps_c, saved.ambient_c, off);
@@ -121,7 +121,7 @@ fn restore_after_a_measured_off_time_is_cooled_and_never_below_the_reference() {
     // The gain: after 24 h the restore keeps at most a quarter of the saved
     // excess over the air (measured 0.13; the bound's slowest group decays
     // with 20 h, the pump's with 11.5 h).
-    let Restore::PowerLoss(r) = boot_restore(Restore::Cold, NvLoad::Valid(saved), &policy, Some(&cool), Some(T0_S + 24 * 3600), Some(T0_S)) else { panic!() };
+    let Restore::PowerLoss(r) = boot_restore(Restore::Cold, NvLoad::Valid(saved), &policy, Some(&cool), Some(T0_S + 24 * 3600), Some(T0_S), false) else { panic!() };
     let excess = saved.temps_c[1] + policy.rise_k - saved.ambient_c;
     assert!(r.temps_c[1] - saved.ambient_c <= excess * 0.25, "24 h: {} of {excess} K left", r.temps_c[1] - saved.ambient_c);
 }
@@ -143,10 +143,10 @@ fn no_cooling_without_a_trustworthy_off_time() {
         (Some(5000), None, Some(5000)),
         (Some(5000), Some(90_000), None),
     ] {
-        let Restore::PowerLoss(r) = boot_restore(Restore::Cold, NvLoad::Valid(rec.with_rtc(stamp)), &policy, Some(&cool), now, alive) else { panic!() };
+        let Restore::PowerLoss(r) = boot_restore(Restore::Cold, NvLoad::Valid(rec.with_rtc(stamp)), &policy, Some(&cool), now, alive, false) else { panic!() };
         assert!(r.temps_c.iter().all(|t| *t == 50.0 + policy.rise_k), "{stamp:?} {now:?} {alive:?}: {:?}", r.temps_c);
     }
     // Stale: the last save 30 min + 2 s before the machine stopped.
-    let stale = boot_restore(Restore::Cold, NvLoad::Valid(rec.with_rtc(Some(5000))), &policy, Some(&cool), Some(90_000), Some(5000 + 1802));
+    let stale = boot_restore(Restore::Cold, NvLoad::Valid(rec.with_rtc(Some(5000))), &policy, Some(&cool), Some(90_000), Some(5000 + 1802), false);
     assert_eq!(stale, Restore::Corrupt);
 }

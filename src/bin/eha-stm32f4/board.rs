@@ -236,7 +236,15 @@ impl F411 {
         // A store that cannot be opened is a damaged record, not an empty
         // one: the machine may be hot (conservative start).
         let nv_rec = nv.as_mut().map_or(NvLoad::Damaged, |n| n.load());
-        let mem = BootMemory { records: (a, b), nv: nv_rec, alive_s: crate::rtc::alive_load(), cause: reset::noinit::load(), hw_hint: hw_hint(csr) };
+        let alive = crate::rtc::alive_load().and_then(eha_guard::memory::alive_from_word);
+        let mem = BootMemory {
+            records: (a, b),
+            nv: nv_rec,
+            alive_s: alive.map(|a| a.0),
+            nv_failing: alive.is_some_and(|a| a.1),
+            cause: reset::noinit::load(),
+            hw_hint: hw_hint(csr),
+        };
         defmt::info!(
             "RCC_CSR {=u32:#010x}, sysclk {=u32} Hz, NV store {}, NV record {}",
             csr,
@@ -384,8 +392,8 @@ impl Board for F411 {
         self.rtc.seconds()
     }
 
-    fn rtc_alive(&mut self, s: u32) {
-        crate::rtc::alive_store(s);
+    fn rtc_alive(&mut self, word: u32) {
+        crate::rtc::alive_store(word);
     }
 }
 

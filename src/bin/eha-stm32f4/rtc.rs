@@ -70,7 +70,7 @@ impl Rtc {
     }
 }
 
-/// The last-alive stamp kept in RTC backup register 0 (VBAT domain: it
+/// The last-alive word (`eha_guard::memory::alive_word`) kept in RTC backup register 0 (VBAT domain: it
 /// survives a power loss; reads 0, i.e. `None`, after a backup-domain reset
 /// or on a board without VBAT).
 pub fn alive_load() -> Option<u32> {
@@ -80,7 +80,7 @@ pub fn alive_load() -> Option<u32> {
     (v != 0).then_some(v)
 }
 
-/// Stores the last-alive stamp (called only once [`Rtc::seconds`] has run
+/// Stores the last-alive word (called only once [`Rtc::seconds`] has run
 /// the clock, which also enabled backup-domain writes, PWR_CR.DBP).
 pub fn alive_store(s: u32) {
     // SAFETY: BKP0R belongs to this function (see `alive_load`); a plain
