@@ -124,7 +124,10 @@ impl<N: Num> Run<N> {
         if o.faults.intersects(faults::LATCHED) {
             assert!(o.valve_open, "{what}: latched fault {:#x} but valve closed: {o:?}", o.faults);
         }
-        assert_eq!(o.alarm, o.derate, "{what}: derate must follow the alarm: {o:?}");
+        // derate: the alarm, a valve that does not follow its command, or a
+        // failed non-volatile save (issue 33); never without one of them
+        let derate = o.alarm || o.faults.intersects(faults::ACTUATOR | faults::NV_FAILED);
+        assert_eq!(o.derate, derate, "{what}: derate must follow the alarm, ACTUATOR or NV_FAILED: {o:?}");
         assert!(
             o.lng_remaining_kg >= 0.0 && o.lng_remaining_kg <= self.full_kg,
             "{what}: LNG {} kg outside [0, {}]: {o:?}",
