@@ -46,6 +46,7 @@ pub const DEFAULT_CONSTS: ModelConsts<f32> = ModelConsts {
     lng_in: -162.0,
     k_mu: 0.0,
     t_mu: 40.0,
+    pole_pairs: 4.0,
     inv_c: [
         0.10869565,
         0.0,

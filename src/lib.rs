@@ -16,6 +16,11 @@
 #![warn(missing_docs)]
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing))]
 
+// The hang and panic injection commands are for the QEMU test image only: a
+// flashed board must never obey them.
+#[cfg(all(feature = "board-stm32f4", feature = "fault-inject"))]
+compile_error!("`fault-inject` is for the QEMU test images only: never in the flashed STM32F411 image (`board-stm32f4`)");
+
 pub mod crosscheck;
 mod default_consts;
 pub mod guard;
@@ -28,6 +33,7 @@ pub mod params_block;
 pub mod product;
 pub mod protection;
 pub mod protocol;
+pub mod speedcheck;
 #[cfg(target_os = "none")]
 pub mod stack;
 pub mod trace;
@@ -35,7 +41,7 @@ pub mod validate;
 #[cfg(all(target_os = "none", not(feature = "board-stm32f4")))]
 mod vectors;
 
-pub use guard::{faults, Faults, Guard, GuardConfig, GuardOf, Output, Real, Sample};
+pub use guard::{faults, ClearResult, Faults, Guard, GuardConfig, GuardOf, Output, Real, Sample};
 pub use memory::{Restore, ThermalRecord};
 
 #[cfg(test)]

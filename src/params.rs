@@ -130,6 +130,9 @@ pub struct ReducedParams {
     /// by the sensor cross-check (shaft power `Kt |I| |w|` against the hydraulic
     /// power and eq. 8); 0 disables the cross-check.
     pub torque_constant_nm_per_a: f64,
+    /// Motor pole pairs: the drive's electrical frequency is pole pairs x
+    /// rev/s (the second speed source of the speed check, `crate::speedcheck`).
+    pub pole_pairs: f64,
     /// Iron loss, hysteresis term: `k_fe1 |w|`, W s/rad (eq. 2 with f ∝ w).
     pub k_fe1_w_s_per_rad: f64,
     /// Iron loss, eddy term: `k_fe2 w^2`, W s^2/rad^2 (eq. 2).
@@ -228,6 +231,7 @@ impl ReducedParams {
             self.phases,
             self.r_ohm,
             self.torque_constant_nm_per_a,
+            self.pole_pairs,
             self.k_fe1_w_s_per_rad,
             self.k_fe2_w_s2_per_rad2,
             self.k_fe15_w_per_rad15,
@@ -301,6 +305,7 @@ pub const DEFAULT: ReducedParams = ReducedParams {
     phases: 3.0,
     r_ohm: 0.074,
     torque_constant_nm_per_a: 0.75,
+    pole_pairs: 4.0,
     k_fe1_w_s_per_rad: 0.37433242615213785,
     k_fe2_w_s2_per_rad2: 0.0015887161595118564,
     k_fe15_w_per_rad15: 0.008414188516295527,

@@ -202,6 +202,9 @@ pub struct LngConfig {
     pub delta_t_k: f32,
     /// LNG-low raised below this fraction of the charge (0.2 = 20 %).
     pub low_fraction: f32,
+    /// Least LNG supply pressure at the valve that says the tank has LNG,
+    /// bar gauge (when the pressure is reported: [`crate::GuardOf::lng_supply`]).
+    pub min_supply_bar: f32,
 }
 
 impl LngConfig {
@@ -213,6 +216,7 @@ impl LngConfig {
         sensible_j_per_kg_k: 2.9e3,
         delta_t_k: 180.0,
         low_fraction: 0.2,
+        min_supply_bar: 1.0,
     };
 
     /// Eq. (25): `M = V rho`, kg (5 L → 2.15 kg).

@@ -24,6 +24,14 @@ pub fn paint() {
     }
 }
 
+/// Bytes of stack in use at the call (from its top to SP): what a
+/// [`high_water`] after a [`paint`] here includes of the caller's frames.
+pub fn depth() -> u32 {
+    let hi = core::ptr::addr_of!(_stack_start) as usize;
+    let sp = cortex_m::register::msp::read() as usize;
+    hi.saturating_sub(sp) as u32
+}
+
 /// Bytes of stack ever used since the last [`paint`].
 pub fn high_water() -> u32 {
     let lo = core::ptr::addr_of!(_stack_end) as usize;

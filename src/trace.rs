@@ -105,6 +105,8 @@ pub enum Trace {
         tick: u32,
         /// Command code.
         code: u8,
+        /// 0 done, else why refused (`product::wire::Refusal`).
+        result: u8,
     },
     /// Where this boot's model constants come from
     /// ([`crate::params_block::ParamSource::code`]: 0 compiled-in default,

@@ -91,6 +91,14 @@ pub struct LimitsN<N: Num> {
 }
 
 impl<N: Num> LimitsN<N> {
+    /// The limits over `ticks` ticks: the rates times `ticks` (small counts:
+    /// below the STALE count, so the products stay far inside the number
+    /// type's range).
+    pub fn rate_over(&self, ticks: u32) -> Self {
+        let n = N::from_f32(ticks as f32);
+        LimitsN { lo: self.lo, hi: self.hi, rate: self.rate.map(|r| r.mul(n)) }
+    }
+
     /// Converts `l`; `None` when a limit does not fit the number type (|x| ≥ 250).
     pub fn new(l: &InputLimits, sc: &InputScales<N>) -> Option<Self> {
         let ok = |x: f32| x.is_finite() && x.abs() < 250.0;

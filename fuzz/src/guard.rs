@@ -124,7 +124,10 @@ impl<N: Num> Run<N> {
         if o.faults.intersects(faults::LATCHED) {
             assert!(o.valve_open, "{what}: latched fault {:#x} but valve closed: {o:?}", o.faults);
         }
-        assert_eq!(o.alarm, o.derate, "{what}: derate must follow the alarm: {o:?}");
+        // derate: the alarm, a valve that does not follow its command, or a
+        // failed non-volatile save (issue 33); never without one of them
+        let derate = o.alarm || o.faults.intersects(faults::ACTUATOR | faults::NV_FAILED);
+        assert_eq!(o.derate, derate, "{what}: derate must follow the alarm, ACTUATOR or NV_FAILED: {o:?}");
         assert!(
             o.lng_remaining_kg >= 0.0 && o.lng_remaining_kg <= self.full_kg,
             "{what}: LNG {} kg outside [0, {}]: {o:?}",
@@ -166,7 +169,7 @@ impl<N: Num> Run<N> {
 
     fn clear(&mut self) {
         let before = self.g.faults() & faults::LATCHED;
-        if self.g.clear_faults() {
+        if self.g.clear_faults().cleared() {
             // Maintenance that clears the faults also repairs a stuck valve.
             if matches!(self.fb, Feedback::Stuck(_)) {
                 self.fb = Feedback::Follows;
@@ -211,7 +214,7 @@ fn restore(u: &mut Unstructured<'_>, variant: u8) -> Restore {
             }
             let amb = -20.0 + 0.25 * f32::from(byte(u));
             let used = u.arbitrary::<u32>().unwrap_or(0);
-            let fb = u.arbitrary::<u16>().unwrap_or(0) & (faults::LATCHED | eha_guard::Faults::channels(0x3F)).bits();
+            let fb = u.arbitrary::<u32>().unwrap_or(0) & (faults::LATCHED | eha_guard::Faults::channels(0x3F)).bits();
             let fb = if byte(u) & 1 == 0 { 0 } else { fb };
             Restore::from_record(&ThermalRecord::new(temps, amb, used, fb, 0))
         }

@@ -1,46 +1,40 @@
-//! Protocol fuzzing: `Link::push_bytes` (deframer, COBS, CRC, sequence rule,
-//! counters) driving a real f32 guard through `protocol::tick_guard`, and the
-//! request/reply decoders on the raw input.
+//! Frame fuzzing: the product application's receive path (deframer, COBS,
+//! CRC, frame kinds, the sequence rule, the command queue, counters) on the
+//! shared in-memory board, driving the real f32 guard, one tick per chunk of
+//! bytes; and the request / product-frame decoders on the raw input.
 //!
 //! Input: byte 0 is the mode. Even: the rest is the byte stream as it is
 //! (garbage, truncation, overflow, stray delimiters). Odd: the rest is read as
-//! a list of operations that build well-formed request frames with chosen
+//! a list of operations that build well-formed sample frames with chosen
 //! sequence numbers (next, duplicate, older, gaps, the half-range boundary),
 //! sample values (near a nominal operating point or raw `f32` bits) and a
 //! corruption (bit flip, truncation, lost delimiter, junk, empty frames, a
-//! reply sent as request, a CRC-valid payload of the wrong length or kind).
-//! Bits 1..7 of the mode give the chunk size in which the stream reaches the
-//! link; the same stream is also pushed in one call, and both must give the
-//! same replies.
+//! tick reply sent as a request, a CRC-valid payload of the wrong length or
+//! kind). Bits 1..7 of the mode give the chunk size, the bytes received per
+//! tick; the same stream is also fed in one tick, and the frame counters
+//! must agree.
 //!
-//! Checked: no panic; exactly one reply per non-empty frame; every reply's
-//! wire bytes deframe to one CRC-valid payload that decodes to the same reply;
-//! counters: accepted = guard ticks, accepted + rejected = replies, skipped =
-//! the saturated sum of the gaps handed to the step; guard outputs finite, a
-//! latched fault implies the valve open; `Request::from_payload` ok ⇒
-//! `to_payload` gives the same bytes; `Reply::from_payload` ok ⇒ its
-//! re-encoding decodes to the same reply; COBS encode → decode is the
+//! Checked: no panic; exactly one tick reply per tick, CRC-valid and
+//! decodable; frames counted once: accepted + rejected + commands = the
+//! non-empty frames; outputs finite, a latched fault implies the valve open;
+//! `Request::from_payload` ok ⇒ `to_payload` gives the same bytes; a decoded
+//! product frame re-encodes to the same frame; COBS encode → decode is the
 //! identity and the encoding has no zero byte.
 
 use eha_guard::faults;
+use eha_guard::product::mem_board::MemBoard;
+use eha_guard::product::wire::{FromGuard, Pins, ResetCause, TickReply};
+use eha_guard::product::App;
 use eha_guard::protection::LngBudget;
-use eha_guard::protocol::{
-    cobs_decode, cobs_encode, crc16, tick_guard, Deframer, Link, RejectReason, Reply, ReplyKind, Request,
-    KIND_SAMPLE, REQUEST_LEN,
-};
-use eha_guard::{Guard, GuardConfig, Output, Restore};
+use eha_guard::protocol::{cobs_decode, cobs_encode, crc16, Deframer, Request, KIND_SAMPLE, REQUEST_LEN};
+use eha_guard::trace::RestoreKind;
+use eha_guard::{GuardConfig, Output};
 use heapless::Vec as HVec;
 use libfuzzer_sys::arbitrary::Unstructured;
 use std::sync::OnceLock;
 
-static TEMPLATE: OnceLock<Guard> = OnceLock::new();
-
 /// Longest byte stream the structured mode builds.
 const MAX_STREAM: usize = 8192;
-
-fn same(a: &Reply, b: &Reply) -> bool {
-    a.kind == b.kind && a.seq == b.seq && a.counters == b.counters && a.tick_cycles == b.tick_cycles && a.out.bit_eq(&b.out)
-}
 
 fn check_output(o: &Output, full_kg: f32) {
     assert!(
@@ -58,14 +52,21 @@ pub fn decoders(data: &[u8]) {
     if let Ok(r) = Request::from_payload(data) {
         assert_eq!(&r.to_payload()[..], data, "request re-encoding differs");
     }
-    if let Ok(r) = Reply::from_payload(data) {
-        let back = Reply::from_payload(&r.to_payload()).expect("a decoded reply must re-decode");
-        assert!(same(&r, &back), "reply re-encoding differs: {r:?} vs {back:?}");
-    }
-    if let Some(&b) = data.first() {
-        if let Some(r) = RejectReason::from_u8(b) {
-            assert_eq!(r as u8, b);
-        }
+    if let Ok(f) = FromGuard::from_payload(data) {
+        // decode ∘ encode is the identity on what decodes (codes outside
+        // an enum decode to its catch-all, so compare re-encodings)
+        let enc = |f: &FromGuard| match f {
+            FromGuard::Tick(t) => t.encode(),
+            FromGuard::Ack(a) => a.encode(),
+            FromGuard::Status(s) => s.encode(),
+            FromGuard::Trace(t) => t.encode(),
+        };
+        let wire = enc(&f);
+        let mut d = Deframer::new();
+        let back: Vec<Vec<u8>> = wire.iter().filter_map(|&b| d.push(b).map(|r| r.expect("own frame").to_vec())).collect();
+        assert_eq!(back.len(), 1);
+        let again = FromGuard::from_payload(&back[0]).expect("own frame decodes");
+        assert_eq!(&enc(&again)[..], &wire[..], "product frame re-encoding differs");
     }
     let mut out: HVec<u8, 1200> = HVec::new();
     let _ = cobs_decode(data, &mut out);
@@ -130,6 +131,9 @@ pub fn structured(data: &[u8]) -> Vec<u8> {
                 1 => Some(false),
                 _ => Some(true),
             },
+            // the optional inputs: absent, near nominal, or raw bits
+            elec_hz: (sel & 0x20 != 0).then(|| v(&mut u, 83.0, 80.0)),
+            lng_supply_bar: (sel & 0x40 != 0).then(|| v(&mut u, 3.0, 3.0)),
         };
         let wire = req.encode();
         let corrupt = if sel & 0x10 != 0 { byte(&mut u) % 10 } else { 255 };
@@ -158,13 +162,18 @@ pub fn structured(data: &[u8]) -> Vec<u8> {
                 out.extend_from_slice(&wire);
             }
             5 => {
-                // A reply where a request is expected (kind mismatch, CRC good).
-                let rep = Reply {
-                    kind: ReplyKind::Tick,
-                    seq,
+                // A tick reply where a request is expected (kind mismatch, CRC good).
+                let rep = TickReply {
+                    tick: u32::from(seq),
+                    sample_seq: seq,
+                    fresh: true,
+                    not_commissioned: false,
                     out: Output::default(),
-                    counters: Default::default(),
-                    tick_cycles: 0,
+                    pins: Pins::default(),
+                    overruns: 0,
+                    rejected: 0,
+                    restore: RestoreKind::Cold,
+                    reset_cause: ResetCause::PowerOn,
                 };
                 out.extend_from_slice(&rep.encode());
             }
@@ -176,8 +185,8 @@ pub fn structured(data: &[u8]) -> Vec<u8> {
                 if let Some(k) = q.first_mut() {
                     *k = KIND_SAMPLE;
                 }
-                if n == REQUEST_LEN {
-                    q.push(0);
+                if (REQUEST_LEN..=eha_guard::protocol::REQUEST_MAX_LEN).contains(&n) {
+                    q.push(0xFF);
                 }
                 raw_frame(&q, &mut out);
             }
@@ -204,67 +213,56 @@ pub fn structured(data: &[u8]) -> Vec<u8> {
     out
 }
 
-/// Pushes `stream` into a fresh link in chunks of `chunk` bytes, stepping a
-/// fresh guard; returns the replies after checking every invariant.
-fn drive(stream: &[u8], chunk: usize) -> Vec<Reply> {
-    let template = TEMPLATE.get_or_init(|| Guard::new(&GuardConfig::DEFAULT, Restore::Cold));
+/// Feeds `stream` to a freshly booted application, `chunk` bytes per tick;
+/// returns (accepted, rejected, commands) after checking every invariant.
+fn drive(stream: &[u8], chunk: usize) -> (u32, u32, u16) {
+    static TEMPLATE: OnceLock<App> = OnceLock::new();
     let full_kg = LngBudget::new(&GuardConfig::DEFAULT.lng).remaining_kg();
-    let mut g = template.clone();
-    let mut link = Link::new();
-    let mut replies = Vec::new();
-    let mut ticks = 0u32;
-    let mut gaps = 0u64;
+    let mut board = Box::new(MemBoard::new());
+    let template = TEMPLATE.get_or_init(|| {
+        let mut b = Box::new(MemBoard::new());
+        let mem = b.boot_memory();
+        App::boot(&mut *b, &GuardConfig::DEFAULT, &mem)
+    });
+    let mut app = template.clone();
     for part in stream.chunks(chunk.max(1)) {
-        link.push_bytes(
-            part,
-            |req, skipped| {
-                ticks += 1;
-                gaps += u64::from(skipped);
-                let o = tick_guard(&mut g, req, skipped);
-                check_output(&o, full_kg);
-                (o, ticks)
-            },
-            |rep, wire| {
-                assert_eq!(wire.first(), Some(&0), "reply must start with a delimiter");
-                assert_eq!(wire.last(), Some(&0), "reply must end with a delimiter");
-                let mut d = Deframer::new();
-                let got: Vec<_> = wire.iter().filter_map(|&b| d.push(b)).collect();
-                assert_eq!(got.len(), 1, "one reply frame must deframe to one payload");
-                assert!(!d.pending());
-                let p = got[0].as_ref().expect("own reply frame must pass COBS and CRC");
-                let back = Reply::from_payload(p).expect("own reply payload must decode");
-                assert!(same(rep, &back), "reply changed on the wire: {rep:?} vs {back:?}");
-                replies.push(*rep);
-            },
-        );
+        board.push_rx(part);
+        app.tick(&mut *board, 0);
+        let mut d = Deframer::new();
+        let mut ticks = 0;
+        for &b in board.take_tx().iter() {
+            if let Some(r) = d.push(b) {
+                let p = r.expect("own frames must pass COBS and CRC");
+                match FromGuard::from_payload(p).expect("own frames must decode") {
+                    FromGuard::Tick(t) => {
+                        ticks += 1;
+                        check_output(&t.out, full_kg);
+                    }
+                    _ => {}
+                }
+            }
+        }
+        assert!(!d.pending());
+        assert_eq!(ticks, 1, "one tick reply per tick");
     }
-    // One reply per non-empty frame; a partial frame stays pending.
-    let mut frames = 0usize;
+    // The rest of the stream's last frame, if unterminated, stays pending;
+    // count the frames the application saw.
+    let mut frames = 0u32;
     let mut len = 0usize;
     for &b in stream {
         if b == 0 {
-            frames += usize::from(len > 0);
+            frames += u32::from(len > 0);
             len = 0;
         } else {
             len += 1;
         }
     }
-    assert_eq!(replies.len(), frames, "replies vs non-empty frames");
-    assert_eq!(link.pending(), len > 0);
-    let c = link.counters();
-    assert_eq!(c.accepted, ticks, "accepted vs guard ticks");
-    assert_eq!(replies.iter().filter(|r| r.kind == ReplyKind::Tick).count(), ticks as usize);
-    if replies.len() < usize::from(u16::MAX) {
-        assert_eq!(c.accepted as usize + c.rejected() as usize, replies.len(), "counters: {c:?}");
+    let c = app.counters();
+    let rejected = u32::from(c.rejected_crc) + u32::from(c.rejected_framing) + u32::from(c.rejected_sequence);
+    if frames < u32::from(u16::MAX) {
+        assert_eq!(c.accepted + rejected + u32::from(c.commands), frames, "frames counted once: {c:?}");
     }
-    assert_eq!(u64::from(c.skipped), gaps.min(u64::from(u16::MAX)), "skipped vs gaps");
-    if let Some(last) = replies.last() {
-        assert_eq!(last.counters, c);
-    }
-    let done = link.done();
-    assert_eq!(done.kind, ReplyKind::Done);
-    assert_eq!(done.seq, link.last_seq().unwrap_or(0));
-    replies
+    (c.accepted, rejected, c.commands)
 }
 
 /// Runs one input.
@@ -280,12 +278,9 @@ pub fn run(data: &[u8]) {
     };
     let chunk = usize::from(mode >> 1) + 1;
     let a = drive(stream, chunk);
-    if chunk >= stream.len() {
+    if chunk >= stream.len() || stream.len() > eha_guard::product::mem_board::MEM_RX {
         return;
     }
     let b = drive(stream, stream.len());
-    assert_eq!(a.len(), b.len());
-    for (x, y) in a.iter().zip(&b) {
-        assert!(same(x, y), "chunking changed a reply: {x:?} vs {y:?}");
-    }
+    assert_eq!(a, b, "the bytes per tick changed the frame counters");
 }

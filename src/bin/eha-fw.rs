@@ -1,19 +1,23 @@
-//! EHA thermal-guard firmware for QEMU processor-in-the-loop runs.
+//! The product application in QEMU for processor-in-the-loop runs: the same
+//! [`eha_guard::product::App`] as the flashed image, on a semihosting board
+//! that ticks once per chunk of bytes the host sends (lockstep: a run is
+//! deterministic and as fast as the emulator). What is tested is what ships;
+//! only the board differs.
 //!
 //! One source for both numeric builds:
 //! - `cargo fw-build`    : f32, thumbv7em-none-eabihf, QEMU `mps2-an386` (Cortex-M4F)
 //! - `cargo fw-build-m3` : fixed point, thumbv7m-none-eabi, QEMU `mps2-an385` (Cortex-M3)
 //!
-//! Channels (semihosting; see `shared/toolchain-notes.md`):
-//! - request frames come in on stdin (`:tt` read);
-//! - reply frames go out on `:tt` opened for append (host **stderr**);
-//! - the defmt log goes out on stdout (`defmt-semihosting`).
+//! Channels (semihosting; transport in [`eha_guard::protocol::lockstep`]):
+//! - per tick, a length-prefixed chunk of received bytes on stdin (`:tt` read);
+//! - the tick's frames and an end-of-tick frame (its cost in SysTick cycles)
+//!   on `:tt` opened for append (host **stderr**);
+//! - the defmt log on stdout (`defmt-semihosting`).
 //!
-//! The frame handling is [`eha_guard::protocol::Link`], which only sees bytes:
-//! a board build hands it the bytes from its UART instead of stdin.
-//!
-//! At end of input (stdin EOF) the firmware sends the completion marker (a
-//! `Done` reply with the final counters), logs a summary and exits 0.
+//! The thermal records live in no-init RAM as on the boards (QEMU starts with
+//! zeroed RAM: a cold start). At end of input the firmware sends the
+//! completion marker (a status reply with token
+//! [`eha_guard::protocol::lockstep::DONE_TOKEN`]), logs a summary and exits 0.
 //!
 //! Exit codes (`semihosting::process::exit`), decoded by the host harness:
 //! | code | meaning |
@@ -22,7 +26,7 @@
 //! | 2 | panic |
 //! | 3 | HardFault |
 //! | 4 | unexpected exception or interrupt (DefaultHandler) |
-//! | 5 | semihosting read (stdin) failed |
+//! | 5 | semihosting read (stdin) failed, or a chunk was cut short |
 //! | 6 | semihosting write (replies) failed |
 //! | 7 | semihosting open of stdin/stderr failed |
 #![cfg_attr(target_os = "none", no_std, no_main)]
@@ -32,13 +36,18 @@ fn main() {}
 
 #[cfg(target_os = "none")]
 mod fw {
+    use core::mem::MaybeUninit;
     use cortex_m::peripheral::{syst::SystClkSource, SYST};
     use cortex_m_rt::{entry, exception, ExceptionFrame};
     use defmt_semihosting as _;
-    use eha_guard::memory::slots::{self, noinit, AbWriter};
-    use eha_guard::memory::Restore;
-    use eha_guard::protocol::{tick_guard, GuardOutput, Link, Reply, ReplyKind, Request};
-    use eha_guard::{Guard, GuardConfig};
+    use eha_guard::memory::slots::noinit;
+    use eha_guard::memory::ThermalRecord;
+    use eha_guard::product::reset::{self, CauseRecord};
+    use eha_guard::product::wire::Pins;
+    use eha_guard::product::{App, Board, BootMemory};
+    use eha_guard::protocol::lockstep::{tick_end, DONE_TOKEN};
+    use eha_guard::{GuardConfig, Output};
+    use semihosting::io::{Stderr, Stdin};
     use semihosting::io::{Read as _, Write as _};
     use semihosting::process::exit;
 
@@ -60,6 +69,109 @@ mod fw {
     });
     static TICKS: core::sync::atomic::AtomicU32 = core::sync::atomic::AtomicU32::new(0);
 
+    /// Largest chunk of received bytes per tick (the host's chunks are one
+    /// sample frame and a few commands; more is a harness error).
+    const RX_CHUNK: usize = 1024;
+    /// Bytes a tick may send (reply, acks, status, trace: under 400).
+    const TX_CHUNK: usize = 1024;
+
+    /// The lockstep board: the tick's received bytes come from the host's
+    /// chunk, sent bytes collect until the end of the tick, pins echo,
+    /// records in no-init RAM as on the product boards.
+    struct Lockstep {
+        stdin: Stdin,
+        out: Stderr,
+        rx: [u8; RX_CHUNK],
+        rx_len: usize,
+        rx_at: usize,
+        tx: heapless::Vec<u8, TX_CHUNK>,
+        tx_lost: u32,
+        ticks: u32,
+    }
+
+    impl Lockstep {
+        /// Reads the next tick's chunk; `false` at end of input.
+        fn next_chunk(&mut self) -> bool {
+            let mut hdr = [0u8; 2];
+            match read_exact(&mut self.stdin, &mut hdr) {
+                Ok(true) => {}
+                Ok(false) => return false,
+                Err(()) => exit(EXIT_READ),
+            }
+            let n = usize::from(u16::from_le_bytes(hdr));
+            let Some(dst) = self.rx.get_mut(..n) else { exit(EXIT_READ) };
+            if read_exact(&mut self.stdin, dst) != Ok(true) && n > 0 {
+                exit(EXIT_READ)
+            }
+            self.rx_len = n;
+            self.rx_at = 0;
+            true
+        }
+
+        /// Sends the tick's frames and its end-of-tick frame.
+        fn end_tick(&mut self, cycles: u32) {
+            let end = tick_end(cycles);
+            if self.tx.extend_from_slice(&end).is_err() {
+                self.tx_lost = self.tx_lost.saturating_add(1);
+            }
+            if self.out.write_all(&self.tx).is_err() {
+                exit(EXIT_WRITE)
+            }
+            self.tx.clear();
+        }
+    }
+
+    /// Fills `buf`; `Ok(false)` at end of input before the first byte.
+    fn read_exact(fd: &mut Stdin, buf: &mut [u8]) -> Result<bool, ()> {
+        let mut at = 0;
+        while at < buf.len() {
+            let Some(rest) = buf.get_mut(at..) else { return Err(()) };
+            match fd.read(rest) {
+                Ok(0) if at == 0 => return Ok(false),
+                Ok(0) => return Err(()),
+                Ok(n) => at += n,
+                Err(_) => return Err(()),
+            }
+        }
+        Ok(true)
+    }
+
+    impl Board for Lockstep {
+        fn read_rx(&mut self, buf: &mut [u8]) -> usize {
+            let n = buf.len().min(self.rx_len - self.rx_at);
+            if let (Some(d), Some(s)) = (buf.get_mut(..n), self.rx.get(self.rx_at..self.rx_at + n)) {
+                d.copy_from_slice(s);
+                self.rx_at += n;
+                return n;
+            }
+            0
+        }
+        fn rx_dropped(&self) -> u32 {
+            0
+        }
+        fn write_tx(&mut self, bytes: &[u8]) {
+            if self.tx.extend_from_slice(bytes).is_err() {
+                self.tx_lost = self.tx_lost.saturating_add(1);
+            }
+        }
+        fn set_pins(&mut self, pins: Pins) -> Pins {
+            pins
+        }
+        fn feed_watchdog(&mut self) {}
+        fn ticks(&self) -> u32 {
+            self.ticks
+        }
+        fn wait_tick(&mut self, _seen: u32) {
+            self.ticks = self.ticks.wrapping_add(1);
+        }
+        fn store_record(&mut self, slot: usize, rec: &ThermalRecord) {
+            noinit::store(slot, rec);
+        }
+        fn store_cause(&mut self, rec: &CauseRecord) {
+            reset::noinit::store(rec);
+        }
+    }
+
     /// SysTick ticks elapsed between two readings of the 24-bit down counter.
     fn ticks_between(start: u32, end: u32) -> u32 {
         start.wrapping_sub(end) & 0x00FF_FFFF
@@ -75,97 +187,64 @@ mod fw {
         cp.SYST.clear_current();
         cp.SYST.enable_counter();
 
-        let (Ok(mut stdin), Ok(mut replies)) = (semihosting::io::stdin(), semihosting::io::stderr()) else {
-            exit(EXIT_OPEN)
-        };
-
-        // Thermal memory: a warm reset restores the newest valid no-init
-        // record (A/B), a cold boot (QEMU starts with zeroed RAM) starts at
-        // ambient, damaged records start conservatively (`eha_guard::memory`).
-        let (rec_a, rec_b) = noinit::load();
-        let restore = slots::restore_from(&rec_a, &rec_b);
-        let mut records = AbWriter::after_boot(&rec_a, &rec_b);
-        let mut guard = Guard::new(&GuardConfig::DEFAULT, restore);
-        defmt::info!("eha-fw up: build {=str}, restore {=str}, faults {=u16:#06x}", BUILD, restore_name(&restore), guard.faults().bits());
-        let mut last_trace = guard.trace().recent().copied();
-
-        let mut link = Link::new();
-        // The outputs at boot (valve open while waiting for the first frame), so the
-        // first frame's changes are logged against them.
-        let mut last = guard.output();
-        let mut buf = [0u8; 64];
-        loop {
-            let n = match stdin.read(&mut buf) {
-                Ok(n) => n,
-                Err(_) => {
-                    defmt::error!("stdin read failed");
-                    exit(EXIT_READ)
+        let (Ok(stdin), Ok(out)) = (semihosting::io::stdin(), semihosting::io::stderr()) else { exit(EXIT_OPEN) };
+        static mut BOARD: MaybeUninit<Lockstep> = MaybeUninit::uninit();
+        // SAFETY: `main` runs once; this is the only reference to BOARD.
+        let board = unsafe { &mut *core::ptr::addr_of_mut!(BOARD) }.write(Lockstep {
+            stdin,
+            out,
+            rx: [0; RX_CHUNK],
+            rx_len: 0,
+            rx_at: 0,
+            tx: heapless::Vec::new(),
+            tx_lost: 0,
+            ticks: 0,
+        });
+        let (a, b) = noinit::load();
+        let mem = BootMemory { records: (a, b), nv: eha_guard::memory::nv::NvLoad::Empty, alive_s: None, nv_failing: false, cause: reset::noinit::load(), hw_hint: None };
+        // The application state lives in .bss, not on the stack.
+        static mut APP: MaybeUninit<App> = MaybeUninit::uninit();
+        // SAFETY: `main` runs once; this is the only reference to APP.
+        let app = App::boot_into(unsafe { &mut *core::ptr::addr_of_mut!(APP) }, board, &GuardConfig::DEFAULT, &mem);
+        defmt::info!("eha-fw up: build {=str}, faults {=u32:#010x}", BUILD, app.guard().faults().bits());
+        let mut last = app.guard().output();
+        let mut last_trace = app.guard().trace().recent().copied();
+        while board.next_chunk() {
+            board.wait_tick(0);
+            let t0 = SYST::get_current();
+            app.tick(board, 0);
+            let t1 = SYST::get_current();
+            board.end_tick(ticks_between(t0, t1));
+            TICKS.fetch_add(1, core::sync::atomic::Ordering::Relaxed);
+            let out = app.guard().output();
+            log_changes(&last, &out);
+            last = out;
+            let trace = app.guard().trace().recent().copied();
+            if trace != last_trace {
+                if let Some(ev) = trace {
+                    defmt::info!("trace {}", ev);
                 }
-            };
-            let Some(chunk) = buf.get(..n) else { exit(EXIT_READ) };
-            if chunk.is_empty() {
-                // End of input: completion marker, summary, clean exit.
-                let done = link.done();
-                if replies.write_all(&done.encode()).is_err() {
-                    exit(EXIT_WRITE);
-                }
-                let c = link.counters();
-                defmt::info!(
-                    "end of input: accepted={=u32} rejected crc={=u16} framing={=u16} sequence={=u16} skipped={=u16} pending_partial={=bool}",
-                    c.accepted,
-                    c.rejected_crc,
-                    c.rejected_framing,
-                    c.rejected_sequence,
-                    c.skipped,
-                    link.pending()
-                );
-                exit(0)
-            }
-            let mut write_failed = false;
-            link.push_bytes(
-                chunk,
-                |req: &Request, skipped: u16| {
-                    let t0 = SYST::get_current();
-                    let out = tick_guard(&mut guard, req, skipped);
-                    let t1 = SYST::get_current();
-                    records.write(&guard.snapshot(), noinit::store);
-                    TICKS.fetch_add(1, core::sync::atomic::Ordering::Relaxed);
-                    log_changes(&last, &out);
-                    let trace = guard.trace().recent().copied();
-                    if trace != last_trace {
-                        if let Some(ev) = trace {
-                            defmt::info!("trace {}", ev);
-                        }
-                        last_trace = trace;
-                    }
-                    last = out;
-                    (out, ticks_between(t0, t1))
-                },
-                |reply: &Reply, wire: &[u8]| {
-                    if let ReplyKind::Reject(reason) = reply.kind {
-                        defmt::warn!("frame rejected: reason={=u8} seq={=u16} total={=u32}", reason as u8, reply.seq, reply.counters.rejected());
-                    }
-                    if replies.write_all(wire).is_err() {
-                        write_failed = true;
-                    }
-                },
-            );
-            if write_failed {
-                exit(EXIT_WRITE);
+                last_trace = trace;
             }
         }
+        // End of input: completion marker, summary, clean exit.
+        let st = app.status(board, DONE_TOKEN);
+        board.write_tx(&st.encode());
+        board.end_tick(0);
+        let c = app.counters();
+        defmt::info!(
+            "end of input: accepted={=u32} missing={=u32} rejected crc={=u16} framing={=u16} sequence={=u16} tx lost={=u32}",
+            c.accepted,
+            c.missing,
+            c.rejected_crc,
+            c.rejected_framing,
+            c.rejected_sequence,
+            board.tx_lost
+        );
+        exit(0)
     }
 
-    fn restore_name(r: &Restore) -> &'static str {
-        match r {
-            Restore::Cold => "cold",
-            Restore::Warm(_) => "warm",
-            Restore::Corrupt => "corrupt record",
-            Restore::PowerLoss(_) => "power loss (non-volatile record)",
-        }
-    }
-
-    fn log_changes(prev: &GuardOutput, out: &GuardOutput) {
+    fn log_changes(prev: &Output, out: &Output) {
         if prev.valve_open != out.valve_open {
             defmt::info!("LNG valve {=str} at drain {=f32} C", if out.valve_open { "OPEN" } else { "CLOSED" }, out.drain_c);
         }
@@ -173,7 +252,7 @@ mod fw {
             defmt::warn!("over-temperature alarm {=bool} at drain {=f32} C", out.alarm, out.drain_c);
         }
         if prev.faults != out.faults {
-            defmt::error!("faults {=u16:#06x} -> {=u16:#06x}", prev.faults.bits(), out.faults.bits());
+            defmt::error!("faults {=u32:#010x} -> {=u32:#010x}", prev.faults.bits(), out.faults.bits());
         }
     }
 
@@ -193,4 +272,3 @@ mod fw {
         exit(EXIT_PANIC)
     }
 }
-

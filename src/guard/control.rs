@@ -16,19 +16,110 @@ impl<N: Num> GuardOf<N> {
             | Faults::channels(self.bad_ch)
             | Faults::when(self.lng_low, faults::LNG_LOW)
             | Faults::when(self.untrusted, faults::UNTRUSTED)
+            | Faults::when(self.nv_failed, faults::NV_FAILED)
+            | Faults::when(self.recovering(), faults::RECOVERING)
+            | self.cooling_status()
+    }
+
+    /// Ticks the estimate still needs to forget an unknown start (0: it
+    /// has, or it started from a known state). Before the first sample an
+    /// unknown start has not begun to recover.
+    pub fn recovery_left(&self) -> u32 {
+        match self.hold_from {
+            _ if self.hold_pending => self.recovery_ticks,
+            Some(t) => self.recovery_ticks.saturating_sub(self.tick.wrapping_sub(t)),
+            None => 0,
+        }
+    }
+
+    fn recovering(&self) -> bool {
+        self.recovery_left() > 0
+    }
+
+    /// Why the cooling is not (or not fully) confirmed, while the valve is
+    /// commanded open: no position report since samples started (no credit), no supply pressure
+    /// (credit on the budget alone), or a supply pressure below its minimum
+    /// (the tank is empty: no credit, LNG_LOW).
+    fn cooling_status(&self) -> Faults {
+        let open = self.valve.is_open();
+        Faults::when(open && self.started && self.fb.is_none(), faults::NO_VALVE_FEEDBACK)
+            | Faults::when(open && self.fb == Some(true) && self.supply.is_none() && self.credited(), faults::LNG_UNCONFIRMED)
+            | Faults::when(self.supply == Some(false), faults::LNG_LOW)
+    }
+
+    /// Reports the LNG supply pressure at the valve, bar gauge (`None`: not
+    /// reported), once per tick before [`GuardOf::tick`]. Below
+    /// `LngConfig::min_supply_bar` (or NaN) the tank is taken as empty: no
+    /// cooling credit, LNG_LOW. Without the report the tank is taken as full
+    /// until the LNG budget says it is empty, and flagged LNG_UNCONFIRMED
+    /// (residual risk: docs/firmware.md).
+    pub fn lng_supply(&mut self, bar: Option<f32>) {
+        let s = bar.map(|p| p >= self.min_supply_bar);
+        if s != self.supply {
+            // The credit changes from this tick on: count the ticks before.
+            self.settle(self.tick);
+            self.supply = s;
+            self.refresh_out();
+        }
+    }
+
+    /// Speed plausibility on this tick's sample and the motor's electrical
+    /// frequency, if reported ([`crate::speedcheck`]), once per tick before
+    /// [`GuardOf::tick`]. An implausible speed latches SENSOR_DISAGREE with
+    /// the speed channel bad (its worst case from this tick on), opens the
+    /// valve and holds the alarm until a clear.
+    pub fn check_speed(&mut self, s: &Sample, elec_hz: Option<f32>) {
+        let Some(sc) = self.speed.as_mut() else { return };
+        if sc.tick(s, elec_hz) {
+            self.latch_speed();
+        }
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn latch_speed(&mut self) {
+        self.settle(self.tick);
+        let newly = !self.latched.contains(faults::SENSOR_DISAGREE) || self.bad_ch & crate::validate::CH_SPEED == 0;
+        self.latched |= faults::SENSOR_DISAGREE;
+        self.bad_ch |= crate::validate::CH_SPEED;
+        self.untrusted = true;
+        if newly {
+            self.trace.write(Trace::Fault { tick: self.tick, new_bits: faults::SENSOR_DISAGREE | Faults::channels(crate::validate::CH_SPEED) });
+        }
+        if self.valve.force_open() {
+            self.trace.write(Trace::ValveOpen { tick: self.tick, drain_c: self.out.drain_c, forced: true });
+        }
+        self.refresh_out();
+    }
+
+    /// The board's report of a non-volatile save of the thermal record: a
+    /// failure raises NV_FAILED with derate at once (after a power loss the
+    /// restore could be older than the write policy promises); it clears
+    /// at the next clear that follows a good save.
+    pub fn report_nv_save(&mut self, ok: bool) {
+        self.nv_ok = ok;
+        if !ok && !self.nv_failed {
+            self.nv_failed = true;
+            self.trace.write(Trace::Fault { tick: self.tick, new_bits: faults::NV_FAILED });
+            self.refresh_out();
+        }
     }
 
     /// **Clear rule.** Latched faults (except CONFIG) clear only through this explicit
     /// call (maintenance / operator command), and only if the last
     /// `clear_valid_ticks` samples (1 s by default) were all valid and none is missing.
     /// The thermal estimate is *not* reset: it relaxes from its conservative value.
-    /// A successful clear also restores trust in the estimate ([`faults::UNTRUSTED`]:
-    /// after a corrupt record or no sample by the start-up timeout the alarm and
-    /// derate are held until then). Returns `true` when the faults were cleared.
-    pub fn clear_faults(&mut self) -> bool {
+    /// A clear also restores trust in the estimate ([`faults::UNTRUSTED`]: after a
+    /// STALE dropout the estimate ran on every channel's worst case), **except**
+    /// while the estimate is still recovering from an unknown state
+    /// ([`faults::RECOVERING`], [`super::recovery_ticks`]: an unknown start,
+    /// counted from the first sample, or inputs that disagreed, counted from
+    /// this clear): then the faults clear and UNTRUSTED holds
+    /// ([`ClearResult::TrustHeld`]).
+    pub fn clear_faults(&mut self) -> ClearResult {
         let valid_run = self.tick.wrapping_sub(self.valid_since);
         if self.missing != 0 || valid_run < self.clear_valid_ticks {
-            return false;
+            return ClearResult::Refused;
         }
         let bits = (self.latched & !faults::CONFIG) | Faults::channels(self.bad_ch);
         self.settle(self.tick);
@@ -43,10 +134,26 @@ impl<N: Num> GuardOf<N> {
                 c.model.set_loss_max(cc.disagrees());
             }
         }
+        if let Some(sc) = self.speed.as_mut() {
+            sc.restart();
+        }
         // The controller accepts the estimate as it is (it is not reset); the alarm
-        // follows it again from the next model step.
-        let bits = bits | Faults::when(self.untrusted, faults::UNTRUSTED);
-        self.untrusted = false;
+        // follows it again from the next model step — unless it is still recovering
+        // from an unknown state: after a disagreement that recovery starts now,
+        // with the inputs good again.
+        if self.hold_pending && self.started {
+            self.hold_pending = false;
+            self.hold_from = Some(self.tick);
+        }
+        let left = self.recovery_left();
+        let trust = left == 0 && self.untrusted;
+        let bits = bits | Faults::when(trust, faults::UNTRUSTED) | Faults::when(self.nv_failed && self.nv_ok, faults::NV_FAILED);
+        if left == 0 {
+            self.untrusted = false;
+            self.hold_pending = false;
+            self.hold_from = None;
+        }
+        self.nv_failed &= !self.nv_ok;
         if !bits.is_empty() {
             self.trace.write(Trace::FaultsCleared {
                 tick: self.tick,
@@ -54,7 +161,11 @@ impl<N: Num> GuardOf<N> {
             });
         }
         self.refresh_out();
-        true
+        if self.untrusted {
+            ClearResult::TrustHeld(left)
+        } else {
+            ClearResult::Cleared
+        }
     }
 
     /// Marks an actuator (valve pin) error reported by the board: latches ACTUATOR
@@ -90,6 +201,7 @@ impl<N: Num> GuardOf<N> {
             // The credit may change from this tick on: count the ticks before.
             self.settle(self.tick);
             self.fb = Some(open);
+            self.refresh_out();
         }
         if open == self.valve.is_open() {
             self.fb_mismatch = 0;
@@ -114,6 +226,13 @@ impl<N: Num> GuardOf<N> {
     /// Thermal-memory record of the present state, valve state included
     /// (sealed with its CRC; sequence number 0: the writer sets it).
     pub fn snapshot(&self) -> ThermalRecord {
+        let r = self.snapshot_unsealed();
+        r.with_seq(r.seq(), r.valve_open())
+    }
+
+    /// [`GuardOf::snapshot`] without its CRC, for a writer that seals it
+    /// ([`crate::memory::slots::AbWriter::write`]): one CRC per record.
+    pub fn snapshot_unsealed(&self) -> ThermalRecord {
         let mut temps = [0.0f32; N_NODES];
         let mut amb = 0.0;
         if let Some(c) = self.core_ok.then_some(&self.core) {
@@ -122,14 +241,16 @@ impl<N: Num> GuardOf<N> {
             }
             amb = c.model.ambient_c().to_f32();
         }
-        ThermalRecord::new(
-            temps,
-            amb,
-            self.lng.used_cj(),
-            (self.faults() & !faults::LNG_LOW).bits(),
-            self.tick,
-        )
-        .with_seq(0, self.valve.is_open())
+        let mut r = ThermalRecord::unsealed(temps, amb, self.lng.used_cj(), (self.faults() & faults::RECORDED).bits(), self.tick);
+        r.seq_flags = if self.valve.is_open() { crate::memory::FLAG_VALVE_OPEN } else { 0 };
+        r
+    }
+
+    /// Counts every change of the outputs or of the state the thermal record
+    /// holds (model step, fault latched or cleared, valve, LNG refill): a
+    /// record written at one value of it is still current while it holds.
+    pub fn epoch(&self) -> u32 {
+        self.epoch
     }
 
     /// The event trace (most recent [`crate::trace::TRACE_LEN`] events).
@@ -149,6 +270,12 @@ impl<N: Num> GuardOf<N> {
     pub fn refuse_config(&mut self) {
         self.core_ok = false;
         self.latched |= faults::CONFIG;
+        // fail-safe outputs from this instant: valve open, alarm (OK pin low),
+        // no estimate
+        self.valve.force_open();
+        self.alarm = true;
+        self.out.drain_c = DRAIN_C_UNKNOWN;
+        self.refresh_out();
     }
 
     /// The model, when the parameters were usable.

@@ -2,20 +2,22 @@
 //! (`faults::RANGE`, …). Bits 0-6 and 14 latch until the clear rule
 //! ([`super::GuardOf::clear_faults`]); bits 7 and 15 are live status; bits
 //! 8-13 name the latched bad input channels (`validate::CH_*` shifted by
-//! [`CH_SHIFT`]). The same 16 bits go on the wire ([`Faults::bits`],
-//! `crate::protocol`) and into the thermal record.
+//! [`CH_SHIFT`]); bits 16.. are the status bits added with the safety case
+//! (non-volatile save failed, cooling not confirmed). The same 32 bits go
+//! on the wire ([`Faults::bits`], `crate::product::wire`) and into the
+//! thermal record.
 
 use core::ops::{BitAnd, BitAndAssign, BitOr, BitOrAssign, Not};
 
 /// A set of guard faults (the 16-bit fault word).
 #[derive(Clone, Copy, Default, PartialEq, Eq)]
-pub struct Faults(u16);
+pub struct Faults(u32);
 
 /// In the defmt log: the word in hex, as on the wire.
 #[cfg(any(target_os = "none", feature = "defmt"))]
 impl defmt::Format for Faults {
     fn format(&self, f: defmt::Formatter) {
-        defmt::write!(f, "{=u16:#06x}", self.0)
+        defmt::write!(f, "{=u32:#010x}", self.0)
     }
 }
 
@@ -24,18 +26,18 @@ impl Faults {
     pub const NONE: Faults = Faults(0);
 
     /// The word's bits (wire and record form).
-    pub const fn bits(self) -> u16 {
+    pub const fn bits(self) -> u32 {
         self.0
     }
 
     /// The set of a fault word (every bit has a meaning; none is dropped).
-    pub const fn from_bits(bits: u16) -> Faults {
+    pub const fn from_bits(bits: u32) -> Faults {
         Faults(bits)
     }
 
     /// The latched bad-channel mask `ch` (`validate::CH_*`) as fault bits.
     pub const fn channels(ch: u8) -> Faults {
-        Faults(((ch & 0x3F) as u16) << CH_SHIFT)
+        Faults(((ch & 0x3F) as u32) << CH_SHIFT)
     }
 
     /// The bad-channel mask in this set (`validate::CH_*`).
@@ -108,7 +110,7 @@ impl core::fmt::LowerHex for Faults {
 }
 
 /// Names of the single-bit members, for `Debug`.
-const NAMES: [(Faults, &str); 10] = [
+const NAMES: [(Faults, &str); 14] = [
     (RANGE, "RANGE"),
     (RATE, "RATE"),
     (NON_FINITE, "NON_FINITE"),
@@ -119,6 +121,10 @@ const NAMES: [(Faults, &str); 10] = [
     (LNG_LOW, "LNG_LOW"),
     (SENSOR_DISAGREE, "SENSOR_DISAGREE"),
     (UNTRUSTED, "UNTRUSTED"),
+    (NV_FAILED, "NV_FAILED"),
+    (LNG_UNCONFIRMED, "LNG_UNCONFIRMED"),
+    (NO_VALVE_FEEDBACK, "NO_VALVE_FEEDBACK"),
+    (RECOVERING, "RECOVERING"),
 ];
 
 impl core::fmt::Debug for Faults {
@@ -166,16 +172,38 @@ pub const LNG_LOW: Faults = Faults(1 << 7);
 /// (UNTRUSTED), the model heats with the larger of the two losses.
 pub const SENSOR_DISAGREE: Faults = Faults(1 << 14);
 /// Shift of the latched bad-channel mask inside the fault word.
-pub const CH_SHIFT: u16 = 8;
+pub const CH_SHIFT: u32 = 8;
 /// The estimate is not trusted (corrupt thermal record at boot, or no sample by
 /// the start-up timeout): alarm and derate are held until a successful
 /// [`super::GuardOf::clear_faults`]. Status, not a latched fault; kept in the
 /// thermal record so a warm reset does not drop it.
 pub const UNTRUSTED: Faults = Faults(1 << 15);
+/// A non-volatile save of the thermal record failed: after a power loss the
+/// guard could restore a state older than its write policy promises. Status
+/// with derate (the controller is told; the valve is not forced: the
+/// estimate itself is still good), held until a clear after a good save.
+pub const NV_FAILED: Faults = Faults(1 << 16);
+/// Status: the cooling is credited on the LNG budget alone, no supply
+/// pressure confirms the tank has LNG (a tank emptier than the budget says
+/// would be credited: docs/firmware.md, residual risk).
+pub const LNG_UNCONFIRMED: Faults = Faults(1 << 17);
+/// Status: no valve position is reported, so no cooling is credited (the
+/// estimate runs hot while the valve is open: the safe side).
+pub const NO_VALVE_FEEDBACK: Faults = Faults(1 << 18);
+/// Status: the estimate started from an unknown thermal state (a corrupt or
+/// damaged record, no sample by the start-up timeout) and has not yet run
+/// long enough to forget it; UNTRUSTED cannot be cleared before this bit
+/// goes (docs/firmware.md, "Commands"). Kept in the thermal record: a reset
+/// restarts the hold.
+pub const RECOVERING: Faults = Faults(1 << 19);
 /// Bits that latch.
 pub const LATCHED: Faults = Faults(0x7f | (1 << 14));
+/// Bits the thermal record keeps: the latched faults, the bad channels and
+/// UNTRUSTED and RECOVERING (live status bits are not saved: they would make
+/// the non-volatile write policy write at every valve change).
+pub const RECORDED: Faults = Faults(LATCHED.0 | (0x3F << CH_SHIFT) | UNTRUSTED.0 | RECOVERING.0);
 /// Bits that latch or are status, besides the channels: every named member.
-pub const ALL_NAMED: Faults = Faults(0x7f | (1 << 7) | (1 << 14) | (1 << 15));
+pub const ALL_NAMED: Faults = Faults(0x7f | (1 << 7) | (1 << 14) | (1 << 15) | (15 << 16));
 
 #[cfg(test)]
 mod tests {

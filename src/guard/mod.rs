@@ -14,6 +14,7 @@ mod types;
 pub mod faults;
 pub use faults::Faults;
 pub use types::{GuardConfig, Output, Sample, DRAIN_C_UNKNOWN};
+// `ClearResult`, `recovery_ticks` and the trust constants are defined below.
 
 use crate::crosscheck::{CrossCheck, Verdict};
 use crate::memory::{Restore, ThermalRecord};
@@ -37,6 +38,56 @@ pub type Real = crate::num::Fx;
 
 /// The guard of the firmware build's number type.
 pub type Guard = GuardOf<Real>;
+
+/// The outcome of [`GuardOf::clear_faults`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ClearResult {
+    /// The latched faults cleared and the estimate is trusted (or was).
+    Cleared,
+    /// The latched faults cleared, but the estimate started from an unknown
+    /// state less than [`recovery_ticks`] ago: UNTRUSTED (alarm, derate)
+    /// holds for this many more ticks, then a clear restores it.
+    TrustHeld(u32),
+    /// The clear rule was not met (a missing or invalid sample in the last
+    /// `clear_valid_ticks`): nothing cleared.
+    Refused,
+}
+
+impl ClearResult {
+    /// The latched faults were cleared.
+    pub fn cleared(self) -> bool {
+        self != ClearResult::Refused
+    }
+}
+
+/// The largest error of an estimate that started from an unknown state, K:
+/// a start at the alarm temperature (60 °C) against an oil up to 100 °C.
+pub const TRUST_START_ERROR_K: f32 = 40.0;
+/// The error below which the estimate has forgotten its start, K.
+pub const TRUST_TOLERANCE_K: f32 = 0.5;
+/// `ln(TRUST_START_ERROR_K / TRUST_TOLERANCE_K)` = ln 80 (no `ln` in `core`;
+/// checked by a test).
+const LN_ERROR_RATIO: f32 = 4.382_027;
+
+/// Ticks (10 ms) an estimate needs to forget an unknown start: its error
+/// decays at least as fast as the slowest cooling rate at rest of the model
+/// (`rest_rate`, the bound the power-off cooling uses), so after
+/// `ln(40 K / 0.5 K) / min(rest_rate)` it is within 0.5 K of the truth
+/// (56.2 h for the paper rig). Without a cooling bound (a rate of 0 or not
+/// finite) the recovery is unknown: never (capped at 2^30 ticks, 124 days).
+pub fn recovery_ticks(model: &crate::model::ModelConsts<f32>) -> u32 {
+    const CAP: u32 = 1 << 30;
+    let min = model.rest_rate.iter().fold(f32::INFINITY, |m, r| m.min(*r));
+    if !(min > 0.0 && min.is_finite()) {
+        return CAP;
+    }
+    let ticks = LN_ERROR_RATIO / min * 100.0;
+    if ticks >= CAP as f32 {
+        CAP
+    } else {
+        ticks as u32 + 1
+    }
+}
 
 /// Protection thresholds converted to the model number type (degC).
 #[derive(Clone, Copy, Debug)]
@@ -136,6 +187,16 @@ pub struct GuardOf<N: Num> {
     bad_ch: u8,
     prev: Channels<N>,
     prev_ok: u8,
+    /// `prev_ok` before the missing ticks since the last sample: the rate
+    /// check of the next sample over the gap.
+    gap_ok: u8,
+    /// Inside [`GuardOf::tick_blind`] or the replay of the wait: no
+    /// cooling credit.
+    blind: bool,
+    /// Ticks waited for the first sample (replayed at the start).
+    waited: u32,
+    /// The first sample's own inputs, for that replay.
+    replay_u: ModelInputN<N>,
     missing: u32,
     /// Tick index from which every sample was present and valid (the run of valid
     /// samples of the clear rule is `tick - valid_since`).
@@ -161,6 +222,13 @@ pub struct GuardOf<N: Num> {
     valve: Valve,
     /// Last valve position reported by [`GuardOf::valve_feedback`] (None: no feedback).
     fb: Option<bool>,
+    /// The LNG supply pressure says the tank has LNG (None: not reported,
+    /// [`GuardOf::lng_supply`]).
+    supply: Option<bool>,
+    /// Least supply pressure that says the tank has LNG, bar.
+    min_supply_bar: f32,
+    /// Speed plausibility (`None`: no usable constants, CONFIG).
+    speed: Option<crate::speedcheck::SpeedCheck>,
     /// Consecutive reports differing from the command.
     fb_mismatch: u32,
     /// Reports differing from the command that latch ACTUATOR.
@@ -171,6 +239,17 @@ pub struct GuardOf<N: Num> {
     /// The estimate is not trusted (corrupt record at boot, no sample by the start-up
     /// timeout): alarm and derate held until a successful `clear_faults`.
     untrusted: bool,
+    /// The estimate's state is unknown: a corrupt or damaged record, no
+    /// sample by the start-up timeout, a record saved while recovering (the
+    /// trust hold starts with the first sample), or inputs found to
+    /// disagree (SENSOR_DISAGREE: the hold starts at the clear, when the
+    /// inputs are good again).
+    hold_pending: bool,
+    /// Tick the estimate started from an unknown state (`None`: it did not).
+    hold_from: Option<u32>,
+    /// Ticks the estimate needs to forget an unknown start
+    /// ([`recovery_ticks`]).
+    recovery_ticks: u32,
     lng: LngBudget,
     lng_low: bool,
     tick: u32,
@@ -178,6 +257,13 @@ pub struct GuardOf<N: Num> {
     /// fail-safe opening, a model step, clear/refill): a tick on the fast path
     /// returns them as they are.
     out: Output,
+    /// Changes of the outputs and of the recorded state ([`GuardOf::epoch`]).
+    epoch: u32,
+    /// A non-volatile save failed (`faults::NV_FAILED`, derate) and no
+    /// clear has seen a good save since.
+    nv_failed: bool,
+    /// The last non-volatile save succeeded.
+    nv_ok: bool,
     trace: TraceBuf,
 }
 
@@ -217,6 +303,10 @@ impl<N: Num> GuardOf<N> {
             bad_ch: 0,
             prev: [N::ZERO; 6],
             prev_ok: 0,
+            gap_ok: 0,
+            blind: false,
+            waited: 0,
+            replay_u: ModelInputN { current_ha: N::ZERO, p_a_hbar: N::ZERO, p_b_hbar: N::ZERO, speed_hrads: N::ZERO, dpos_mm: N::ZERO, ambient_c: N::ZERO },
             missing: 0,
             valid_since: 0,
             started: false,
@@ -229,11 +319,17 @@ impl<N: Num> GuardOf<N> {
             // Open from boot: the safe state while the guard waits for its first sample.
             valve: Valve::open(),
             fb: None,
+            supply: None,
+            min_supply_bar: config.lng.min_supply_bar,
+            speed: if ok { crate::speedcheck::SpeedCheck::new(&config.speed, config.model) } else { None },
             fb_mismatch: 0,
             mismatch_ticks: config.actuator_mismatch_ticks,
             lng_empty: false,
             alarm: false,
             untrusted: false,
+            hold_pending: false,
+            hold_from: None,
+            recovery_ticks: recovery_ticks(config.model),
             lng: LngBudget::new(&config.lng),
             lng_low: false,
             tick: 0,
@@ -241,6 +337,9 @@ impl<N: Num> GuardOf<N> {
                 drain_c: DRAIN_C_UNKNOWN,
                 ..Output::default()
             },
+            epoch: 0,
+            nv_failed: false,
+            nv_ok: true,
             trace: TraceBuf::new(),
             );
             &mut *p
@@ -261,8 +360,10 @@ impl<N: Num> GuardOf<N> {
                     // The valve was open: it stays open for at least its dwell.
                     g.valve.force_open();
                 }
-                // Saved before a clear restored trust: still not trusted.
+                // Saved before a clear restored trust: still not trusted; saved
+                // while recovering from an unknown start: the hold starts again.
                 g.untrusted = saved.contains(faults::UNTRUSTED);
+                g.hold_pending = saved.contains(faults::RECOVERING);
                 if let Some(c) = g.core_ok.then_some(&mut g.core) {
                     c.model.set_loss_max(g.latched.contains(faults::SENSOR_DISAGREE));
                 }
@@ -281,6 +382,7 @@ impl<N: Num> GuardOf<N> {
                 g.lng.set_used_cj(u32::MAX);
                 g.latched |= faults::MEMORY_CORRUPT;
                 g.untrusted = true;
+                g.hold_pending = true;
                 RestoreKind::Corrupt
             }
         };

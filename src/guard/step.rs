@@ -13,6 +13,11 @@ impl<N: Num> GuardOf<N> {
     #[inline(never)]
     pub(super) fn start(&mut self, ambient_c: N) {
         self.started = true;
+        if self.hold_pending {
+            // The estimate starts to forget its unknown start from here.
+            self.hold_pending = false;
+            self.hold_from = Some(self.tick);
+        }
         // Nothing of the waiting time is counted: no model ran, no credit, no LNG booked.
         self.mark = self.tick;
         self.open_acc = 0;
@@ -52,15 +57,21 @@ impl<N: Num> GuardOf<N> {
         let n = upto.wrapping_sub(self.mark);
         if self.valve.is_open() {
             self.open_acc = self.open_acc.wrapping_add(n);
-            if self.latched.is_empty() && !self.lng_empty && self.fb != Some(false) {
-                // The exchanger runs over these ticks. No cooling credit under a
-                // latched fault (conservative: the exchanger itself may be what
-                // failed), with the LNG used up, or while the valve's position
-                // feedback says shut.
+            if self.credited() {
                 self.credit_acc = self.credit_acc.wrapping_add(n);
             }
         }
         self.mark = upto;
+    }
+
+    /// The exchanger is credited (with the valve commanded open): only when
+    /// the cooling is confirmed — the valve's position report says open,
+    /// the supply pressure (if reported) says the tank has LNG, the LNG
+    /// budget is not used up — and no fault is latched (conservative: the
+    /// exchanger itself may be what failed).
+    #[inline(always)]
+    pub(super) fn credited(&self) -> bool {
+        self.latched.is_empty() && !self.lng_empty && self.fb == Some(true) && self.supply != Some(false) && !self.blind
     }
 
     /// Every `TICKS_PER_STEP` ticks: the model step, then the protection.
@@ -112,6 +123,10 @@ impl<N: Num> GuardOf<N> {
             });
         }
         self.untrusted = true;
+        // The estimate ran on inputs that disagree (the larger shaft loss
+        // covers the shaft, not the throttling heat a wrong pressure hides):
+        // its state is unknown until it has recovered on good inputs.
+        self.hold_pending = true;
     }
 
     /// Valve hysteresis and dwell, alarm, LNG budget (`open_ticks` ticks of the model
@@ -184,13 +199,20 @@ impl<N: Num> GuardOf<N> {
         self.refresh_out();
     }
 
-    /// Rebuilds the cached outputs from the present state.
+    /// Rebuilds the cached outputs from the present state (one copy: it
+    /// runs at model steps and state changes, never on the tick's fast path).
+    #[inline(never)]
     pub(super) fn refresh_out(&mut self) {
+        self.epoch = self.epoch.wrapping_add(1);
+        // Derate: the alarm, and whatever leaves the protection weaker than
+        // the estimate says (a valve not following its command, a thermal
+        // record that could not be saved).
+        let derate = self.alarm || self.nv_failed || self.latched.contains(faults::ACTUATOR);
         self.out = Output {
             drain_c: self.out.drain_c,
             valve_open: self.valve.is_open(),
             alarm: self.alarm,
-            derate: self.alarm,
+            derate,
             faults: self.faults(),
             lng_remaining_kg: self.lng.remaining_kg(),
             lng_seconds_left: self.lng.seconds_left_cj(self.last_cj),

@@ -23,7 +23,8 @@ impl<N: Num> GuardOf<N> {
                 let u = if self.bad_ch == 0 {
                     validate::direct(&v, &self.prev)
                 } else {
-                    Self::substitute_latched(&v, &self.prev, self.bad_ch, &core.limits)
+                    let [_, _, _, _, prev_pos, _] = self.prev;
+                    Self::subst(&v, self.bad_ch, Some(prev_pos), &core.limits)
                 };
                 self.prev = v;
                 return self.advance(&u);
@@ -32,17 +33,13 @@ impl<N: Num> GuardOf<N> {
         self.tick_slow(s)
     }
 
-    /// Fast-path inputs while channels are latched bad: their worst cases.
+    /// [`validate::substitute`], one copy for every caller off the
+    /// per-tick fast path (flash): a sample's channels with the `bad` ones
+    /// at their worst case.
     #[inline(never)]
     #[cold]
-    fn substitute_latched(
-        v: &Channels<N>,
-        prev: &Channels<N>,
-        bad_ch: u8,
-        limits: &LimitsN<N>,
-    ) -> ModelInputN<N> {
-        let [_, _, _, _, prev_pos, _] = *prev;
-        validate::substitute(v, bad_ch, Some(prev_pos), limits)
+    fn subst(v: &Channels<N>, bad: u8, prev_pos: Option<N>, limits: &LimitsN<N>) -> ModelInputN<N> {
+        validate::substitute(v, bad, prev_pos, limits)
     }
 
     /// [`GuardOf::tick`] off the fast path: classifies the sample (distinct fault and
@@ -50,12 +47,23 @@ impl<N: Num> GuardOf<N> {
     #[inline(never)]
     #[cold]
     fn tick_slow(&mut self, s: &Sample) -> Output {
-        self.missing = 0;
+        let gap = core::mem::replace(&mut self.missing, 0);
+        let first = !self.started;
         let Some(core) = self.core_ok.then_some(&self.core) else {
             return self.slow_tail(None, Faults::NONE, N::ZERO);
         };
         let (v, nonfinite) = validate::convert(s, &core.scales);
-        let c = validate::check(&v, nonfinite, &self.prev, self.prev_ok, &core.limits);
+        // After missing ticks (samples slower than the tick, or a dropout
+        // shorter than STALE) the rate is checked over the gap: the limits
+        // times the ticks since the last sample.
+        let over_gap;
+        let (ok_before, lim) = if gap > 0 && gap < self.stale_ticks {
+            over_gap = core.limits.rate_over(gap + 1);
+            (self.gap_ok, &over_gap)
+        } else {
+            (self.prev_ok, &core.limits)
+        };
+        let c = validate::check(&v, nonfinite, &self.prev, ok_before, lim);
         let mut new_bits = Faults::NONE;
         if c.range {
             new_bits |= faults::RANGE;
@@ -76,7 +84,15 @@ impl<N: Num> GuardOf<N> {
         } else {
             None
         };
-        let u = validate::substitute(&v, self.bad_ch, prev_pos, &core.limits);
+        let u = Self::subst(&v, self.bad_ch, prev_pos, &core.limits);
+        if first {
+            // The ticks waited for this first sample, replayed at its start
+            // with its own inputs (its own bad channels at their worst case;
+            // not the STALE substitution of a timeout: that says nothing
+            // about what the machine did).
+            self.waited = gap;
+            self.replay_u = Self::subst(&v, c.bad, None, &core.limits);
+        }
         // A cold start takes this sample's own ambient when it is valid (also when
         // an earlier STALE makes the model run on the worst case from now on), else
         // the worst case.
@@ -97,14 +113,67 @@ impl<N: Num> GuardOf<N> {
         }
         self.missing = self.missing.saturating_add(1);
         self.valid_since = self.tick.wrapping_add(1);
+        if self.missing == 1 {
+            self.gap_ok = self.prev_ok;
+        }
         self.prev_ok = 0;
         let mut new_bits = Faults::NONE;
         if self.missing >= self.stale_ticks {
             new_bits |= faults::STALE;
             self.bad_ch = CH_ALL;
+            self.stale_alarm();
         }
-        let u = self.core_ok.then(|| validate::substitute(&self.prev, self.bad_ch, None, &self.core.limits));
+        let u = self.core_ok.then(|| Self::subst(&self.prev, self.bad_ch, None, &self.core.limits));
         self.slow_tail(u.as_ref(), new_bits, N::ZERO)
+    }
+
+    /// `n` ticks the MCU did not see at all: a flash erase stalled the core
+    /// (the board's timer counted them, no sample was read). Accounted as
+    /// missing ticks are before STALE — the last inputs held, latched
+    /// channels at their worst case, no piston work (all pump power heats)
+    /// — and with no cooling credit; the clear rule's valid run and the rate
+    /// check restart; not counted towards STALE (the controller did not go
+    /// silent, the guard did). Every channel at its worst case instead
+    /// would heat the paper rig's drain estimate by 35 K per second of gap
+    /// (measured, `tests/core/stall.rs`): every erase an alarm. The residual
+    /// risk (a load rise inside the gap) is in docs/firmware.md, "Flash
+    /// erase stall". Before the first sample: waiting ticks. The product
+    /// loop caps `n` at [`crate::product::MAX_STALL_TICKS`].
+    #[cold]
+    #[inline(never)]
+    pub fn tick_blind(&mut self, n: u32) -> Output {
+        if !self.started {
+            for _ in 0..n {
+                self.wait_tick();
+            }
+            return self.out;
+        }
+        self.settle(self.tick);
+        self.blind = true;
+        for _ in 0..n {
+            self.valid_since = self.tick.wrapping_add(1);
+            self.prev_ok = 0;
+            self.gap_ok = 0;
+            let u = self.core_ok.then(|| Self::subst(&self.prev, self.bad_ch, None, &self.core.limits));
+            self.slow_tail(u.as_ref(), Faults::NONE, N::ZERO);
+        }
+        self.settle(self.tick);
+        self.blind = false;
+        self.out
+    }
+
+    /// STALE after the start: the controller went silent, the machine may
+    /// run on unseen; the alarm and the derate at once, held until a clear
+    /// (the estimate runs on every channel's worst case meanwhile, so the
+    /// clear restores trust at once: no unknown start).
+    #[cold]
+    #[inline(never)]
+    fn stale_alarm(&mut self) {
+        self.untrusted = true;
+        if !self.alarm {
+            self.alarm = true;
+            self.trace.write(Trace::Alarm { tick: self.tick, drain_c: self.out.drain_c });
+        }
     }
 
     /// A tick without a sample before the first sample (boot, or samples not yet
@@ -125,8 +194,10 @@ impl<N: Num> GuardOf<N> {
             }
             self.latched |= faults::STALE;
             self.bad_ch = CH_ALL;
-            // No estimate and no input: alarm and derate until a clear.
+            // No estimate and no input: alarm and derate until a clear, and
+            // the machine may have run unseen: the start state is unknown.
             self.untrusted = true;
+            self.hold_pending = true;
             if !self.alarm {
                 self.alarm = true;
                 self.trace.write(Trace::Alarm {
@@ -167,9 +238,10 @@ impl<N: Num> GuardOf<N> {
             Some(u) if self.core_ok => {
                 if !self.started {
                     self.start(start_amb);
+                    self.replay_wait();
                 }
                 self.refresh_out();
-                self.advance(u)
+                self.advance_slow(u)
             }
             _ => {
                 // No model (CONFIG): fail-safe outputs, nothing to estimate.
@@ -180,6 +252,40 @@ impl<N: Num> GuardOf<N> {
                 self.out
             }
         }
+    }
+
+    /// The ticks the guard waited for its first sample (at most the
+    /// start-up timeout): the machine may have run meanwhile, unseen. They
+    /// are replayed at the first sample with its inputs (no piston work:
+    /// the first sample has no position derivative), no cooling credit:
+    /// the machine is taken to have done then what it does now. Before
+    /// issue 33 they were not counted: a controller starting 5 s late on a
+    /// machine at 60 bar left the estimate 1.2 K low.
+    #[cold]
+    #[inline(never)]
+    fn replay_wait(&mut self) {
+        let n = core::mem::replace(&mut self.waited, 0).min(self.startup_timeout_ticks);
+        if n == 0 {
+            return;
+        }
+        let u = self.replay_u;
+        let now = self.tick;
+        self.tick = now.wrapping_sub(n);
+        self.mark = self.tick;
+        self.blind = true;
+        for _ in 0..n {
+            self.advance_slow(&u);
+        }
+        self.settle(self.tick);
+        self.blind = false;
+        self.tick = now;
+    }
+
+    /// [`GuardOf::advance`] off the fast path: one copy of the model's tick
+    /// accumulation for the slow paths (flash).
+    #[inline(never)]
+    fn advance_slow(&mut self, u: &ModelInputN<N>) -> Output {
+        self.advance(u)
     }
 
     /// The per-tick part common to both paths: the model's tick accumulation, and

@@ -78,6 +78,8 @@ pub struct GuardConfig<'a> {
     pub actuator_mismatch_ticks: u32,
     /// Sensor cross-check (current against pressures and speed).
     pub crosscheck: crate::crosscheck::CrossCheckConfig,
+    /// Speed plausibility (electrical frequency, piston flow, stall).
+    pub speed: crate::speedcheck::SpeedCheckConfig,
 }
 
 impl GuardConfig<'static> {
@@ -93,5 +95,6 @@ impl GuardConfig<'static> {
         clear_valid_ticks: 100,
         actuator_mismatch_ticks: 50,
         crosscheck: crate::crosscheck::CrossCheckConfig::DEFAULT,
+        speed: crate::speedcheck::SpeedCheckConfig::DEFAULT,
     };
 }

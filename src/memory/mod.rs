@@ -33,13 +33,14 @@ use crate::params::N_NODES;
 
 /// Record magic: "EHAT".
 pub const MAGIC: u32 = 0x4548_4154;
-/// Record layout version. 4: the RTC time of the write ([`ThermalRecord::rtc_s`]).
+/// Record layout version. 5: the fault word is 32 bits (60 bytes).
+/// 4: the RTC time of the write ([`ThermalRecord::rtc_s`]).
 /// 3: the former reserved word holds the sequence
 /// number and the valve state ([`ThermalRecord::seq`], [`ThermalRecord::valve_open`]).
 /// 2: the six temperatures are the reduced model's nodes (pump housing, case
 /// oil, loop oil, main block, ball-valve block, actuator). An older record is
 /// treated as corrupt (conservative).
-pub const VERSION: u16 = 4;
+pub const VERSION: u16 = 5;
 /// [`ThermalRecord::rtc_s`] of a board without a real-time clock.
 pub const RTC_NONE: u32 = u32::MAX;
 /// Bit of [`ThermalRecord::seq_flags`] that holds the valve state (1 = open).
@@ -48,9 +49,9 @@ pub const FLAG_VALVE_OPEN: u32 = 1 << 31;
 pub const PLAUSIBLE_C: (f32, f32) = (-80.0, 250.0);
 
 /// Size of a [`ThermalRecord`] and of its byte form, bytes.
-pub const RECORD_BYTES: usize = 56;
+pub const RECORD_BYTES: usize = 60;
 
-/// Persistent thermal record, 56 bytes, no implicit padding.
+/// Persistent thermal record, 60 bytes, no implicit padding.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C)]
 pub struct ThermalRecord {
@@ -62,8 +63,10 @@ pub struct ThermalRecord {
     pub magic: u32,
     /// [`VERSION`].
     pub version: u16,
-    /// Latched fault bits at save time.
-    pub faults: u16,
+    /// Reserved, 0.
+    pub reserved: u16,
+    /// Latched fault bits at save time (the 32-bit fault word).
+    pub faults: u32,
     /// Node temperatures, degC, contract order.
     pub temps_c: [f32; N_NODES],
     /// Ambient the temperatures were referred to, degC.
@@ -129,6 +132,7 @@ impl ThermalRecord {
         lng_used_cj: 0,
         magic: 0,
         version: 0,
+        reserved: 0,
         faults: 0,
         temps_c: [0.0; N_NODES],
         ambient_c: 0.0,
@@ -144,6 +148,7 @@ impl ThermalRecord {
         c = crc32_update(c, &self.tick.to_le_bytes());
         c = crc32_update(c, &self.magic.to_le_bytes());
         c = crc32_update(c, &self.version.to_le_bytes());
+        c = crc32_update(c, &self.reserved.to_le_bytes());
         c = crc32_update(c, &self.faults.to_le_bytes());
         for t in self.temps_c.iter() {
             c = crc32_update(c, &t.to_bits().to_le_bytes());
@@ -159,13 +164,28 @@ impl ThermalRecord {
         temps_c: [f32; N_NODES],
         ambient_c: f32,
         lng_used_cj: u32,
-        faults: u16,
+        faults: u32,
         tick: u32,
     ) -> Self {
-        let mut r = ThermalRecord {
+        let mut r = Self::unsealed(temps_c, ambient_c, lng_used_cj, faults, tick);
+        r.crc = r.body_crc();
+        r
+    }
+
+    /// [`ThermalRecord::new`] without its CRC (0): for a writer that seals it
+    /// itself ([`ThermalRecord::with_seq`]), so the CRC is taken once.
+    pub fn unsealed(
+        temps_c: [f32; N_NODES],
+        ambient_c: f32,
+        lng_used_cj: u32,
+        faults: u32,
+        tick: u32,
+    ) -> Self {
+        ThermalRecord {
             lng_used_cj,
             magic: MAGIC,
             version: VERSION,
+            reserved: 0,
             faults,
             temps_c,
             ambient_c,
@@ -173,9 +193,7 @@ impl ThermalRecord {
             seq_flags: 0,
             rtc_s: RTC_NONE,
             crc: 0,
-        };
-        r.crc = r.body_crc();
-        r
+        }
     }
 
     /// The same record stamped with the real-time clock `rtc_s` (seconds;
@@ -201,14 +219,15 @@ impl ThermalRecord {
         words[0] = self.lng_used_cj;
         words[1] = self.tick;
         words[2] = self.magic;
-        words[3] = u32::from(self.version) | (u32::from(self.faults) << 16);
-        for (w, t) in words[4..4 + N_NODES].iter_mut().zip(self.temps_c.iter()) {
+        words[3] = u32::from(self.version) | (u32::from(self.reserved) << 16);
+        words[4] = self.faults;
+        for (w, t) in words[5..5 + N_NODES].iter_mut().zip(self.temps_c.iter()) {
             *w = t.to_bits();
         }
-        words[10] = self.ambient_c.to_bits();
-        words[11] = self.seq_flags;
-        words[12] = self.rtc_s;
-        words[13] = self.crc;
+        words[11] = self.ambient_c.to_bits();
+        words[12] = self.seq_flags;
+        words[13] = self.rtc_s;
+        words[14] = self.crc;
         let mut out = [0u8; RECORD_BYTES];
         for (chunk, w) in out.chunks_exact_mut(4).zip(words.iter()) {
             chunk.copy_from_slice(&w.to_le_bytes());
@@ -225,7 +244,7 @@ impl ThermalRecord {
             *x = u32::from_le_bytes(a);
         }
         let mut temps_c = [0.0f32; N_NODES];
-        for (t, x) in temps_c.iter_mut().zip(w[4..4 + N_NODES].iter()) {
+        for (t, x) in temps_c.iter_mut().zip(w[5..5 + N_NODES].iter()) {
             *t = f32::from_bits(*x);
         }
         ThermalRecord {
@@ -233,12 +252,13 @@ impl ThermalRecord {
             tick: w[1],
             magic: w[2],
             version: (w[3] & 0xFFFF) as u16,
-            faults: (w[3] >> 16) as u16,
+            reserved: (w[3] >> 16) as u16,
+            faults: w[4],
             temps_c,
-            ambient_c: f32::from_bits(w[10]),
-            seq_flags: w[11],
-            rtc_s: w[12],
-            crc: w[13],
+            ambient_c: f32::from_bits(w[11]),
+            seq_flags: w[12],
+            rtc_s: w[13],
+            crc: w[14],
         }
     }
 
@@ -316,39 +336,80 @@ pub mod cooling;
 pub mod nv;
 pub mod slots;
 
+/// Period of the last-alive stamp in the clock's backup register, s
+/// ([`crate::product::Board::rtc_alive`]): the machine stopped at most this
+/// long after the stamp.
+pub const ALIVE_PERIOD_S: u32 = 1;
+
+/// The last-alive word in the clock's backup register: the seconds `s`
+/// shifted left by one, bit 0 set while the non-volatile saves are failing
+/// (since the last good save: the record misses the machine's state since).
+/// 31 bits of seconds: 68 years of the clock.
+pub fn alive_word(s: u32, nv_failing: bool) -> u32 {
+    (s << 1) | u32::from(nv_failing)
+}
+
+/// The seconds and the failing flag of a last-alive word (0: none stored).
+pub fn alive_from_word(w: u32) -> Option<(u32, bool)> {
+    (w != 0).then_some((w >> 1, w & 1 != 0))
+}
+
 /// The boot rule over both memories: the RAM records' rule
 /// ([`slots::restore_from`]) unless RAM holds nothing (power-on), then the
 /// non-volatile record (a power loss), else a cold start. A damaged RAM
-/// record stays a conservative start even when flash holds an older valid one.
+/// record stays a conservative start even when flash holds an older valid
+/// one, and so does a damaged or unreadable flash record
+/// ([`nv::NvLoad::Damaged`]): the machine may be hot.
 ///
-/// After a power loss every node is first raised by the write policy's
-/// `rise_k` (the most the estimate can have risen since that record was
-/// written, so the state is never colder than at power-off). Then, when the
-/// record and the board both have a clock reading (`now_rtc_s`) and the clock
-/// has not gone back, the state is cooled by the model's bound at rest
-/// ([`cooling::RestCooling`]) over the off-time minus the policy's longest
-/// write interval (the machine may have run that long after the write);
-/// without a clock or a bound, the saved temperatures stand (power loss of
-/// unknown length: conservative).
-pub fn boot_restore(ram: Restore, nv: Option<ThermalRecord>, policy: &nv::NvPolicy, cool: Option<&cooling::RestCooling>, now_rtc_s: Option<u32>) -> Restore {
-    match (ram, nv) {
-        (Restore::Cold, Some(r)) => {
-            let mut hot = r.temps_c;
-            for t in hot.iter_mut() {
-                *t += policy.rise_k;
-            }
-            let run_s = policy.max_interval_ticks / 100;
-            let off_s = match (now_rtc_s, r.rtc_s) {
-                (Some(now), saved) if saved != RTC_NONE && now >= saved => Some((now - saved).saturating_sub(run_s)).filter(|s| *s > 0),
-                _ => None,
-            };
-            if let (Some(b), Some(off)) = (cool, off_s) {
-                hot = b.cool(&hot, r.ambient_c, off);
-            }
-            Restore::PowerLoss(ThermalRecord::new(hot, r.ambient_c, r.lng_used_cj, r.faults, r.tick).with_seq(r.seq(), r.valve_open()).with_rtc(Some(r.rtc_s)))
-        }
-        (ram, _) => ram,
+/// After a power loss every node is raised by the write policy's `rise_k`
+/// (the most the estimate can have risen since that record was written, so
+/// the state is never colder than at power-off) and the LNG used by its
+/// `lng_rise_cj` (the most that can be unwritten: never under-counted).
+/// The off-time is known only from the clock's last-alive stamp
+/// (`alive_s`, battery-backed, [`ALIVE_PERIOD_S`]): then a record older
+/// than the stamp by more than the policy's longest write interval is
+/// stale (its saves failed while the machine ran on: its state is unknown)
+/// and the start is conservative; otherwise the state is cooled by the
+/// model's bound at rest ([`cooling::RestCooling`]) over `now - alive`.
+/// So is a record the stamp says the saves were failing after
+/// (`nv_failing`): the machine ran on unrecorded. Without the stamp, a clock
+/// or a bound, the saved temperatures stand (power loss of unknown length:
+/// conservative).
+pub fn boot_restore(
+    ram: Restore,
+    nv: nv::NvLoad,
+    policy: &nv::NvPolicy,
+    cool: Option<&cooling::RestCooling>,
+    now_rtc_s: Option<u32>,
+    alive_s: Option<u32>,
+    nv_failing: bool,
+) -> Restore {
+    let r = match (ram, nv) {
+        (Restore::Cold, nv::NvLoad::Damaged) => return Restore::Corrupt,
+        (Restore::Cold, nv::NvLoad::Valid(_)) if nv_failing => return Restore::Corrupt,
+        (Restore::Cold, nv::NvLoad::Valid(r)) => r,
+        (ram, _) => return ram,
+    };
+    let mut hot = r.temps_c;
+    for t in hot.iter_mut() {
+        *t += policy.rise_k;
     }
+    let saved = (r.rtc_s != RTC_NONE).then_some(r.rtc_s);
+    if let (Some(saved), Some(alive)) = (saved, alive_s) {
+        let longest_s = policy.max_interval_ticks / 100 + ALIVE_PERIOD_S;
+        if alive >= saved && alive - saved > longest_s {
+            return Restore::Corrupt;
+        }
+    }
+    let off_s = match (now_rtc_s, alive_s, saved) {
+        (Some(now), Some(alive), Some(saved)) if alive >= saved && now >= alive => Some(now - alive).filter(|s| *s > ALIVE_PERIOD_S).map(|s| s - ALIVE_PERIOD_S),
+        _ => None,
+    };
+    if let (Some(b), Some(off)) = (cool, off_s) {
+        hot = b.cool(&hot, r.ambient_c, off);
+    }
+    let used = r.lng_used_cj.saturating_add(policy.lng_rise_cj);
+    Restore::PowerLoss(ThermalRecord::new(hot, r.ambient_c, used, r.faults, r.tick).with_seq(r.seq(), r.valve_open()).with_rtc(saved))
 }
 
 /// Whether sequence number `a` is newer than `b` (31-bit wrapping order).
@@ -369,7 +430,7 @@ mod tests {
 
     #[test]
     fn record_has_no_padding() {
-        // 4 + 4 + 4 + 2 + 2 + 6*4 + 4 + 4 + 4 + 4 = 56 bytes of fields.
+        // 4 + 4 + 4 + 2 + 2 + 4 + 6*4 + 4 + 4 + 4 + 4 = 60 bytes of fields.
         assert_eq!(core::mem::size_of::<ThermalRecord>(), RECORD_BYTES);
     }
 }

@@ -97,6 +97,27 @@ impl<'a> Value<'a> for ThermalRecord {
     }
 }
 
+/// What the non-volatile store holds at boot.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum NvLoad {
+    /// No record (erased store, or a board without one): nothing to restore.
+    Empty,
+    /// The newest record, checked.
+    Valid(ThermalRecord),
+    /// A record was there but could not be read or failed its check.
+    Damaged,
+}
+
+impl NvLoad {
+    /// The valid record, if any.
+    pub fn valid(&self) -> Option<ThermalRecord> {
+        match self {
+            NvLoad::Valid(r) => Some(*r),
+            _ => None,
+        }
+    }
+}
+
 /// Errors of the non-volatile store.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum NvError {
@@ -120,11 +141,15 @@ impl<F: nf::NorFlash> NvStore<F> {
         Ok(NvStore { map: MapStorage::new(flash, cfg, Cache::new_uncached()), buf: [0; BUF_BYTES] })
     }
 
-    /// The newest stored record if it is valid (magic, version, CRC,
-    /// plausible temperatures); `None` when there is none or it is damaged.
-    pub fn load(&mut self) -> Option<ThermalRecord> {
-        let r: Option<ThermalRecord> = block_on(self.map.fetch_item(&mut self.buf, &RECORD_KEY)).ok().flatten();
-        r.filter(|r| r.classify() == RecordStatus::Valid)
+    /// The newest stored record: valid (magic, version, CRC, plausible
+    /// temperatures), none, or damaged (a read error, or a record that fails
+    /// its check: the machine may be hot, so the boot is conservative).
+    pub fn load(&mut self) -> NvLoad {
+        match block_on(self.map.fetch_item::<ThermalRecord>(&mut self.buf, &RECORD_KEY)) {
+            Ok(None) => NvLoad::Empty,
+            Ok(Some(r)) if r.classify() == RecordStatus::Valid => NvLoad::Valid(r),
+            Ok(Some(_)) | Err(_) => NvLoad::Damaged,
+        }
     }
 
     /// Append `rec` (the newest value of the record).
@@ -150,7 +175,7 @@ pub struct NvPolicy {
 }
 
 impl NvPolicy {
-    /// 2 K, 20 kJ of LNG (0.9 % of the 5 L charge), 30 minutes. The valve
+    /// 2 K, 110 kJ of LNG (5 % of the 5 L charge), 30 minutes. The valve
     /// state rides along in every record but triggers no write: after a
     /// power loss the guard decides it anew from the restored temperatures.
     pub const DEFAULT: NvPolicy = NvPolicy { rise_k: 2.0, lng_rise_cj: 11_000_000, max_interval_ticks: 180_000 };
@@ -175,6 +200,10 @@ impl NvPolicy {
 pub struct RamFlash<const BYTES: usize> {
     mem: [u8; BYTES],
     erases: [u32; 64],
+    /// Every read fails (a dead flash or bus: fault injection).
+    pub fail_reads: bool,
+    /// Every write and erase fails (a worn or locked flash: fault injection).
+    pub fail_writes: bool,
 }
 
 /// Erase page of [`RamFlash`], bytes.
@@ -183,7 +212,7 @@ pub const RAM_FLASH_PAGE: usize = 1024;
 impl<const BYTES: usize> RamFlash<BYTES> {
     /// An erased flash (all ones).
     pub fn new() -> Self {
-        RamFlash { mem: [0xFF; BYTES], erases: [0; 64] }
+        RamFlash { mem: [0xFF; BYTES], erases: [0; 64], fail_reads: false, fail_writes: false }
     }
 
     /// Erase count of each page (the first `BYTES / 1024`).
@@ -215,6 +244,9 @@ impl<const BYTES: usize> blocking::ErrorType for RamFlash<BYTES> {
 impl<const BYTES: usize> blocking::ReadNorFlash for RamFlash<BYTES> {
     const READ_SIZE: usize = 1;
     fn read(&mut self, offset: u32, bytes: &mut [u8]) -> Result<(), RamFlashError> {
+        if self.fail_reads {
+            return Err(RamFlashError);
+        }
         let o = offset as usize;
         let src = self.mem.get(o..o + bytes.len()).ok_or(RamFlashError)?;
         bytes.copy_from_slice(src);
@@ -229,6 +261,9 @@ impl<const BYTES: usize> blocking::NorFlash for RamFlash<BYTES> {
     const WRITE_SIZE: usize = 4;
     const ERASE_SIZE: usize = RAM_FLASH_PAGE;
     fn erase(&mut self, from: u32, to: u32) -> Result<(), RamFlashError> {
+        if self.fail_writes {
+            return Err(RamFlashError);
+        }
         let (f, t) = (from as usize, to as usize);
         if !f.is_multiple_of(RAM_FLASH_PAGE) || !t.is_multiple_of(RAM_FLASH_PAGE) || t > BYTES || f > t {
             return Err(RamFlashError);
@@ -242,6 +277,9 @@ impl<const BYTES: usize> blocking::NorFlash for RamFlash<BYTES> {
         Ok(())
     }
     fn write(&mut self, offset: u32, bytes: &[u8]) -> Result<(), RamFlashError> {
+        if self.fail_writes {
+            return Err(RamFlashError);
+        }
         let o = offset as usize;
         if !o.is_multiple_of(4) || !bytes.len().is_multiple_of(4) {
             return Err(RamFlashError);
@@ -267,18 +305,18 @@ mod tests {
     #[test]
     fn stores_and_restores_the_newest_record_across_pages() {
         let mut nv: NvStore<Flash> = NvStore::new(Blocking(RamFlash::new()), 0..8192).expect("range");
-        assert_eq!(nv.load(), None, "an erased flash holds no record");
+        assert_eq!(nv.load(), NvLoad::Empty, "an erased flash holds no record");
         for k in 0..500u32 {
             nv.save(&rec(20.0 + k as f32 * 0.05, k)).expect("save");
         }
-        let r = nv.load().expect("record");
+        let r = nv.load().valid().expect("record");
         assert_eq!((r.tick, r.temps_c[0], r.valve_open()), (499, 20.0 + 499.0 * 0.05, true));
         // A power loss: a new store over the same flash reads the same record.
         let flash = nv.into_flash();
         let erases: u32 = flash.0.erase_counts().iter().sum();
         assert!(erases > 0, "500 writes of 64 B must have cycled the 8 pages");
         let mut nv2: NvStore<Flash> = NvStore::new(flash, 0..8192).expect("range");
-        assert_eq!(nv2.load(), Some(r));
+        assert_eq!(nv2.load(), NvLoad::Valid(r));
     }
 
     #[test]

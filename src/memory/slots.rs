@@ -46,11 +46,13 @@ impl AbWriter {
 
     /// Seal `rec` with the next sequence number (keeping its valve state) and
     /// hand it to `store(slot, record)`; then advance to the other slot.
-    pub fn write(&mut self, rec: &ThermalRecord, mut store: impl FnMut(usize, &ThermalRecord)) {
+    /// Returns the sealed record.
+    pub fn write(&mut self, rec: &ThermalRecord, mut store: impl FnMut(usize, &ThermalRecord)) -> ThermalRecord {
         let sealed = rec.with_seq(self.next_seq, rec.valve_open());
         store(self.next_slot, &sealed);
         self.next_slot ^= 1;
         self.next_seq = self.next_seq.wrapping_add(1) & 0x7FFF_FFFF;
+        sealed
     }
 }
 

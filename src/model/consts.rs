@@ -92,6 +92,8 @@ pub struct ModelConsts<S> {
     pub k_mu: S,
     /// Reference temperature of the leakage conductance, degC.
     pub t_mu: S,
+    /// Motor pole pairs (the speed check's electrical frequency, `crate::speedcheck`).
+    pub pole_pairs: S,
     /// 1 / capacity of the metal nodes, K/kJ (oil nodes 0).
     pub inv_c: [S; N_NODES],
     /// Outer surfaces, constant conductance, kW/K (eqs. 15-16).
@@ -164,8 +166,8 @@ impl Word for f64 {
     }
 }
 
-/// Scalar words at the head of a [`ModelConsts`] (`p_case` .. `t_mu`).
-pub const N_SCALARS: usize = 38;
+/// Scalar words at the head of a [`ModelConsts`] (`p_case` .. `pole_pairs`).
+pub const N_SCALARS: usize = 39;
 /// Number of words in a [`ModelConsts`].
 pub const N_WORDS: usize = N_SCALARS + N_NODES + 12 + 5 * N_TABLE + 2 * N_NODES + N_NODES * N_NODES;
 
@@ -219,6 +221,7 @@ impl<S: Copy> ModelConsts<S> {
             lng_in: f(c.lng_in),
             k_mu: f(c.k_mu),
             t_mu: f(c.t_mu),
+            pole_pairs: f(c.pole_pairs),
             inv_c: c.inv_c.map(&mut f),
             ga: c.ga.map(&mut f),
             gb: c.gb.map(&mut f),
@@ -287,6 +290,7 @@ impl ModelConsts<()> {
         lng_in: (),
         k_mu: (),
         t_mu: (),
+        pole_pairs: (),
         inv_c: [(); N_NODES],
         ga: [(); 4],
         gb: [(); 4],
@@ -421,6 +425,7 @@ pub fn derive(p: &ReducedParams) -> Result<ModelConsts<f64>, ConfigError> {
         lng_in: p.lng_inlet_c,
         k_mu: p.k_mu_per_k,
         t_mu: p.t_mu_ref_c,
+        pole_pairs: p.pole_pairs,
         inv_c,
         ga: p.outer_w_per_k.map(|x| x * KW_PER_W),
         gb: p.outer_quarter_w_per_k125.map(|x| x * KW_PER_W),

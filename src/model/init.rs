@@ -10,6 +10,7 @@ impl<N: Num> Model<N> {
     /// `dst` must be valid for writes of a `Model<N>`.
     pub(super) unsafe fn init_values_in<S: Word>(dst: *mut Self, c: &ModelConsts<S>) -> Result<(), ConfigError> {
         c.check_values()?;
+        c.check_bounds()?;
         let max_row = N::MAX_ROW_SUM as f32;
         let mut phi = [[N::coef_from_f32(0.0).ok_or(ConfigError::CoefficientRange)?; N_NODES]; N_NODES];
         for (pr, dr) in phi.iter_mut().zip(c.phi.iter()) {

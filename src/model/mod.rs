@@ -21,7 +21,9 @@
 //! `T(k+1) = T(k) + Phi F(T(k), u(k))`, `Phi = h phi1(h A)` from the matrix
 //! exponential of the nominal Jacobian `A`, built once at init.
 
+pub mod bounds;
 pub mod consts;
+pub mod physics_checks;
 mod init;
 mod input;
 mod rhs;
@@ -66,6 +68,18 @@ pub enum ConfigError {
     /// ([`Model::check_stability`]), or its `Phi` does not belong to its own
     /// Jacobian.
     Unstable,
+    /// A word outside its physical range ([`bounds::BOUNDS`]; the word's
+    /// index in field order).
+    OutOfBounds(u16),
+    /// A word derived from others (`k_lf_half`, `k_lp`, `k_hyd`,
+    /// `alpha_t0`) differs from its derivation.
+    Inconsistent,
+    /// The model does not heat its drain oil at the stated minimum rate
+    /// under the reference load ([`Model::check_physics`]).
+    NoHeating,
+    /// The block's cooling bound at rest claims faster cooling than its own
+    /// model ([`Model::check_physics`]).
+    RestBound,
 }
 
 /// Constants in model units (built once).
@@ -242,7 +256,11 @@ impl<N: Num> Model<N> {
         unsafe { Self::init_values_in(dst, c)? };
         let phi_s = c.phi.map(|r| r.map(Word::to_f32));
         // SAFETY: written by `init_values_in`.
-        unsafe { (*dst).check_stability(&phi_s) }
+        unsafe {
+            (*dst).check_stability(&phi_s)?;
+            let rest = (c.rest_rate.map(Word::to_f32), c.rest_mode.map(Word::to_f32));
+            (*dst).check_physics(&rest.0, &rest.1)
+        }
     }
 
     /// The model of `c` without the stability check of `Phi`: for the

@@ -115,6 +115,7 @@ unsafe impl Num for Fx {
     const ACC_ZERO: FxAcc = 0;
     /// Σ|c| < 3.9 keeps `Σ c_bits v_bits` (< 3.9 · 2^30 · 2^31 plus rounding) inside `i64`.
     const MAX_ROW_SUM: f64 = 3.9;
+    const FLOAT: bool = false;
     fn from_f64(x: f64) -> Self {
         // checked (NaN → None) instead of saturating_from_num, which panics on NaN.
         Fx::checked_from_num(x).unwrap_or(if x > 0.0 {

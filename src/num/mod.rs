@@ -42,6 +42,8 @@ pub unsafe trait Num: Copy + PartialOrd + core::fmt::Debug {
     /// Largest allowed Σ|coefficient| of one discretised row (fixed point: keeps the
     /// `i64` accumulation free of overflow; floating point: unbounded).
     const MAX_ROW_SUM: f64;
+    /// Floating point (`f32`, `f64`); `false`: fixed point.
+    const FLOAT: bool;
     /// Conversion at init (saturating for fixed point).
     fn from_f64(x: f64) -> Self;
     /// Coefficient conversion at init; `None` when `x` is outside the coefficient range.
@@ -130,6 +132,7 @@ unsafe impl Num for f64 {
     const ZERO: Self = 0.0;
     const ACC_ZERO: f64 = 0.0;
     const MAX_ROW_SUM: f64 = f64::INFINITY;
+    const FLOAT: bool = true;
     fn from_f64(x: f64) -> Self {
         x
     }
@@ -289,6 +292,7 @@ unsafe impl Num for f32 {
     const ZERO: Self = 0.0;
     const ACC_ZERO: f32 = 0.0;
     const MAX_ROW_SUM: f64 = f64::INFINITY;
+    const FLOAT: bool = true;
     // (inlined: called with compile-time constants, so the conversion folds
     // and no f64 soft-float routine is linked)
     #[inline(always)]

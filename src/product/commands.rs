@@ -2,12 +2,46 @@
 //! received frames accepted or rejected (sequence rule, counters), commands
 //! executed and acknowledged, trace dumps and the status reply.
 
-use super::wire::{self, Ack, AckResult, Cmd, Command, Status, TraceReply, KIND_COMMAND};
-use super::{App, Board, TRACE_EVENTS_PER_TICK};
+use super::wire::{self, command_key, Ack, AckResult, Cmd, Command, Refusal, Status, TraceReply, ARM_WINDOW_TICKS, COMMAND_INTERVAL_TICKS, KIND_COMMAND};
+use crate::guard::ClearResult;
+use super::{AppOf, Board, TRACE_EVENTS_PER_TICK};
+use crate::num::Num;
 use crate::protocol::{DecodeError, Request};
 use crate::trace::Trace;
 
-impl App {
+/// Two byte arrays as one (for the nonce's CRC input).
+trait ConcatFixed {
+    fn concat_fixed(&self) -> [u8; 8];
+}
+
+impl ConcatFixed for [[u8; 4]; 2] {
+    fn concat_fixed(&self) -> [u8; 8] {
+        let [a, b] = *self;
+        [a[0], a[1], a[2], a[3], b[0], b[1], b[2], b[3]]
+    }
+}
+
+/// A received frame, parsed: a sample or a command.
+pub(super) enum Incoming {
+    /// A sample request.
+    Sample(Request),
+    /// A command.
+    Command(Command),
+}
+
+impl Incoming {
+    /// The frame a CRC-checked payload holds (by its kind byte).
+    #[inline(always)]
+    pub(super) fn parse(res: Result<&[u8], DecodeError>) -> Result<Incoming, DecodeError> {
+        let payload = res?;
+        if payload.first() == Some(&KIND_COMMAND) {
+            return Command::from_payload(payload).map(Incoming::Command);
+        }
+        Request::from_payload(payload).map(Incoming::Sample)
+    }
+}
+
+impl<N: Num> AppOf<N> {
     // cold path, kept out of the tick loop's code (flash)
     #[inline(never)]
     pub(super) fn reject(&mut self, e: DecodeError) {
@@ -21,24 +55,15 @@ impl App {
 
     /// One received frame: a sample (sequence rule: newer than the last
     /// accepted, within half the u16 range) or a command.
-    pub(super) fn accept(&mut self, res: Result<crate::protocol::Payload, DecodeError>) {
-        let payload = match res {
-            Ok(p) => p,
-            Err(e) => return self.reject(e),
-        };
-        if payload.first() == Some(&KIND_COMMAND) {
-            match Command::from_payload(&payload) {
-                Ok(c) => {
-                    if self.commands.push_back(c).is_err() {
-                        self.reject(DecodeError::Overflow);
-                    }
+    pub(super) fn accept(&mut self, frame: Result<Incoming, DecodeError>) {
+        let req = match frame {
+            Ok(Incoming::Sample(r)) => r,
+            Ok(Incoming::Command(c)) => {
+                if self.commands.push_back(c).is_err() {
+                    self.reject(DecodeError::Overflow);
                 }
-                Err(e) => self.reject(e),
+                return;
             }
-            return;
-        }
-        let req = match Request::from_payload(&payload) {
-            Ok(r) => r,
             Err(e) => return self.reject(e),
         };
         if let Some(last) = self.last_seq {
@@ -59,30 +84,82 @@ impl App {
     #[inline(never)]
     pub(super) fn execute<B: Board>(&mut self, board: &mut B, c: Command) {
         self.counters.commands = self.counters.commands.saturating_add(1);
-        self.guard.trace_event(Trace::Command { tick: self.guard.ticks(), code: c.cmd.code() });
-        let ack = |result| Ack { token: c.token, cmd: c.cmd, result };
-        match c.cmd {
-            Cmd::ClearFaults => {
-                let ok = self.guard.clear_faults();
-                board.write_tx(&ack(if ok { AckResult::Done } else { AckResult::Refused }).encode());
+        let (result, value) = match c.cmd {
+            Cmd::ClearArm | Cmd::RefillArm => (AckResult::Done, self.arm(c.cmd)),
+            Cmd::ClearConfirm | Cmd::RefillConfirm => match self.confirm(c) {
+                Ok(v) => (AckResult::Done, v),
+                Err(r) => (AckResult::Refused, r as u32),
+            },
+            Cmd::Status => {
+                board.write_tx(&self.status(board, c.token).encode());
+                return;
             }
-            Cmd::RefillLng => {
-                let lng = self.lng;
-                self.guard.refill_lng(&lng);
-                board.write_tx(&ack(AckResult::Done).encode());
-            }
-            Cmd::Status => board.write_tx(&self.status(board, c.token).encode()),
             Cmd::Trace => {
                 let count = u8::try_from(self.guard.trace().len()).unwrap_or(u8::MAX);
                 self.dump = Some((c.token, 0, count));
+                return;
             }
-            Cmd::InjectHang | Cmd::InjectPanic => self.inject(board, c, ack),
+            Cmd::InjectHang | Cmd::InjectPanic => (AckResult::Refused, self.inject(board, c)),
+        };
+        let code = if result == AckResult::Done { 0 } else { u8::try_from(value).unwrap_or(u8::MAX) };
+        self.guard.trace_event(Trace::Command { tick: self.guard.ticks(), code: c.cmd.code(), result: code });
+        board.write_tx(&Ack { token: c.token, cmd: c.cmd, result, value }.encode());
+    }
+
+    /// Arms a clear or a refill: a fresh nonce (from the tick counter and the
+    /// last one; not secret: the key guards against accidents, not attacks).
+    fn arm(&mut self, cmd: Cmd) -> u32 {
+        let nonce = crate::memory::crc32(&[self.tick.to_le_bytes(), self.nonce.to_le_bytes()].concat_fixed()) | 1;
+        self.nonce = nonce;
+        self.armed = Some((cmd, nonce, self.tick));
+        nonce
+    }
+
+    /// A confirmation: the matching arm within its window, the key, the
+    /// interval since the last one, then the guard's own rule. A confirmed
+    /// clear answers the seconds UNTRUSTED still holds (0: trust restored).
+    fn confirm(&mut self, c: Command) -> Result<u32, Refusal> {
+        let (want, slot) = match c.cmd {
+            Cmd::ClearConfirm => (Cmd::ClearArm, 0),
+            _ => (Cmd::RefillArm, 1),
+        };
+        let (armed, nonce, at) = self.armed.take().ok_or(Refusal::NotArmed)?;
+        if armed != want || self.tick.wrapping_sub(at) > ARM_WINDOW_TICKS {
+            return Err(Refusal::NotArmed);
+        }
+        if c.arg != command_key(&self.rig_id, nonce, c.cmd) {
+            return Err(Refusal::Key);
+        }
+        let last = self.confirmed.get(slot).copied().flatten();
+        if last.is_some_and(|t| self.tick.wrapping_sub(t) < COMMAND_INTERVAL_TICKS) {
+            return Err(Refusal::TooSoon);
+        }
+        if let Some(t) = self.confirmed.get_mut(slot) {
+            *t = Some(self.tick);
+        }
+        match c.cmd {
+            Cmd::ClearConfirm => match self.guard.clear_faults() {
+                ClearResult::Cleared => Ok(0),
+                ClearResult::TrustHeld(left) => Ok(left.div_ceil(100).max(1)),
+                ClearResult::Refused => Err(Refusal::Rule),
+            },
+            _ => {
+                // A refill with the valve open or in alarm would undo the
+                // empty-tank and corrupt-boot rules while they protect.
+                let o = self.guard.output();
+                if o.valve_open || o.alarm {
+                    return Err(Refusal::Rule);
+                }
+                let lng = self.lng;
+                self.guard.refill_lng(&lng);
+                Ok(0)
+            }
         }
     }
 
     #[cfg(feature = "fault-inject")]
-    fn inject<B: Board>(&mut self, board: &mut B, c: Command, ack: impl Fn(AckResult) -> Ack) {
-        board.write_tx(&ack(AckResult::Done).encode());
+    fn inject<B: Board>(&mut self, board: &mut B, c: Command) -> u32 {
+        board.write_tx(&Ack { token: c.token, cmd: c.cmd, result: AckResult::Done, value: 0 }.encode());
         if c.cmd == Cmd::InjectPanic {
             // Test builds only: exercises the board's panic path.
             #[allow(clippy::panic)]
@@ -97,8 +174,8 @@ impl App {
     }
 
     #[cfg(not(feature = "fault-inject"))]
-    fn inject<B: Board>(&mut self, board: &mut B, _c: Command, ack: impl Fn(AckResult) -> Ack) {
-        board.write_tx(&ack(AckResult::Refused).encode());
+    fn inject<B: Board>(&mut self, _board: &mut B, _c: Command) -> u32 {
+        Refusal::Unavailable as u32
     }
 
     /// Sends the next events of a dump. The dump reads the live ring by
@@ -144,6 +221,7 @@ impl App {
             commands: c.commands,
             nv_failures: c.nv_failures,
             faults: self.guard.faults(),
+            protocol: crate::protocol::PROTOCOL_VERSION,
         }
     }
 }

@@ -19,27 +19,41 @@
 
 pub mod clock;
 mod commands;
+pub mod mem_board;
 pub mod reset;
 pub mod wire;
 
-use crate::memory::nv::NvPolicy;
+use crate::memory::nv::{NvLoad, NvPolicy};
 use crate::protection::LngConfig;
 use crate::memory::slots::{self, AbWriter};
 use crate::memory::cooling::RestCooling;
 use crate::memory::{boot_restore, Restore, ThermalRecord};
-use crate::protocol::{Deframer, Request, MAX_MISSED_TICKS};
+use crate::num::Num;
+use crate::protocol::{Deframer, Request};
 use crate::trace::{RestoreKind, Trace};
 use crate::params_block::{self, ParamSource, BLOCK_LEN};
-use crate::{Guard, GuardConfig, Output};
+use crate::{GuardConfig, GuardOf, Output, Real};
 use heapless::Deque;
 use reset::CauseRecord;
-use wire::{Command, Pins, ResetCause, TickReply};
+use wire::{Command, Pins, ReplyEncoder, ResetCause, TickReply};
 
 /// Trace events sent per tick while a dump is in progress (a whole ring at
 /// once would not fit in one tick at the UART's rate).
 pub const TRACE_EVENTS_PER_TICK: usize = 4;
+/// Bytes taken from the board's receive buffer per read (a sample frame and
+/// a command fit in one).
+pub const RX_READ: usize = 64;
 /// Commands queued per tick; more are rejected (counted as framing).
 pub const COMMAND_QUEUE: usize = 4;
+/// Most timer periods one tick catches up as missing ticks (after an
+/// overrun). After `stale_ticks` (5) misses STALE has latched and the guard
+/// runs on worst-case inputs; a longer gap would only spend time.
+pub const MAX_MISSED_TICKS: u32 = 100;
+/// Most timer periods one tick accounts as stalled by the board's own
+/// non-volatile save (a flash erase stalls the core: up to 4 s on the
+/// STM32F411; 5 s, beyond which the watchdog's erase window has reset the
+/// MCU): [`crate::GuardOf::tick_blind`], no STALE.
+pub const MAX_STALL_TICKS: u32 = 500;
 /// Ticks to wait after a failed non-volatile save before the next attempt
 /// (60 s): a dead or worn flash must not cost an erase attempt, which can
 /// stall the MCU for seconds, on every tick.
@@ -68,11 +82,11 @@ pub trait Board {
     fn store_record(&mut self, slot: usize, rec: &ThermalRecord);
     /// Stores the reset-cause record in no-init RAM.
     fn store_cause(&mut self, rec: &CauseRecord);
-    /// Saves a record to non-volatile memory; `false` when the board has none
-    /// or the write failed. May stall (flash erase): the board keeps its
-    /// watchdog from expiring meanwhile.
-    fn nv_save(&mut self, _rec: &ThermalRecord) -> bool {
-        false
+    /// Saves a record to non-volatile memory: `Some(true)` saved,
+    /// `Some(false)` the write failed, `None` the board has none. May stall
+    /// (flash erase): the board keeps its watchdog from expiring meanwhile.
+    fn nv_save(&mut self, _rec: &ThermalRecord) -> Option<bool> {
+        None
     }
     /// Seconds of a battery-backed real-time clock that keeps running while
     /// the board is unpowered (`None`: the board has none, or it lost its
@@ -82,6 +96,15 @@ pub trait Board {
     fn rtc_s(&mut self) -> Option<u32> {
         None
     }
+    /// Stores the last-alive word ([`crate::memory::alive_word`]: the
+    /// real-time clock's seconds and whether the non-volatile saves are
+    /// failing) in a battery-backed register that survives a power loss (on
+    /// the STM32F411 an RTC backup register), read back at boot into
+    /// [`BootMemory::alive_s`] and [`BootMemory::nv_failing`]. The
+    /// application stamps it once per [`crate::memory::ALIVE_PERIOD_S`]; it
+    /// is the only time base the power-off cooling counts from. No-op on a
+    /// board without one.
+    fn rtc_alive(&mut self, _word: u32) {}
     /// A free-running core-clock cycle stamp (0 when not available).
     fn cycle_stamp(&self) -> u32 {
         0
@@ -111,8 +134,15 @@ pub trait Board {
 pub struct BootMemory {
     /// No-init RAM slot A and B.
     pub records: (ThermalRecord, ThermalRecord),
-    /// The non-volatile record, if the board has one and it is valid.
-    pub nv: Option<ThermalRecord>,
+    /// What the non-volatile store holds (none, valid, damaged).
+    pub nv: NvLoad,
+    /// The last-alive stamp in the clock's battery-backed register, s
+    /// ([`Board::rtc_alive`]; `None`: the board has none or it is empty).
+    pub alive_s: Option<u32>,
+    /// The last-alive word says the non-volatile saves were failing: the
+    /// flash record misses the machine's state since (a conservative
+    /// start after a power loss).
+    pub nv_failing: bool,
     /// The reset-cause record left in no-init RAM.
     pub cause: CauseRecord,
     /// The board's hardware reset flag, if it names a cause (e.g. IWDG).
@@ -149,20 +179,41 @@ impl Counters {
     }
 }
 
-/// The product application state (one per board, lives for the whole run).
-pub struct App {
+/// The product application of the firmware build's number type.
+pub type App = AppOf<Real>;
+
+/// The product application state (one per board, lives for the whole run),
+/// generic over the guard's number type (the boards run [`App`]; the host
+/// runs the fixed-point build's too, as the twin of the M3 PIL image).
+#[derive(Clone)]
+pub struct AppOf<N: Num> {
     lng: LngConfig,
-    guard: Guard,
+    guard: GuardOf<N>,
     rx: Deframer,
+    /// The bytes of one read from the board's receive buffer.
+    rx_buf: [u8; RX_READ],
+    /// The tick reply's encoder (re-frames only the per-tick tail while
+    /// the outputs, pins and counters hold).
+    reply: ReplyEncoder,
     last_seq: Option<u16>,
     sample: Option<Request>,
     commands: Deque<Command, COMMAND_QUEUE>,
     counters: Counters,
     records: AbWriter,
+    /// The guard's [`GuardOf::epoch`] when the A/B record was last written
+    /// (the record is rewritten only when the state it holds changed).
+    record_epoch: Option<u32>,
     nv_policy: NvPolicy,
     nv_last: Option<ThermalRecord>,
-    /// No non-volatile save attempt before this tick (after a failure).
-    nv_retry_at: u32,
+    /// Tick of the last last-alive stamp ([`Board::rtc_alive`]).
+    alive_at: u32,
+    /// Tick of the last failed non-volatile save: no attempt for
+    /// [`NV_RETRY_TICKS`] after it (compared by wrapping difference, so the
+    /// 497-day wrap of the tick counter does not stop the saves).
+    nv_failed_at: Option<u32>,
+    /// Timer periods the last non-volatile save stalled the core (the
+    /// next tick accounts them as blind, not missing).
+    stalled: u32,
     tick: u32,
     restore: RestoreKind,
     reset_cause: ResetCause,
@@ -172,6 +223,15 @@ pub struct App {
     dump: Option<(u16, u8, u8)>,
     /// Where the model constants of this boot come from.
     params: ParamSource,
+    /// The parameter block's rig id (all zero for the compiled-in
+    /// default): the key of armed commands.
+    rig_id: [u8; 16],
+    /// The armed clear or refill: (the arm, its nonce, its tick).
+    armed: Option<(wire::Cmd, u32, u32)>,
+    /// The last nonce handed out.
+    nonce: u32,
+    /// Tick of the last confirmed clear (0) and refill (1).
+    confirmed: [Option<u32>; 2],
 }
 
 fn restore_kind(r: &Restore) -> RestoreKind {
@@ -183,11 +243,11 @@ fn restore_kind(r: &Restore) -> RestoreKind {
     }
 }
 
-impl App {
+impl<N: Num> AppOf<N> {
     /// Boots: the reset cause, the thermal state (RAM records, else the
     /// non-volatile one, see [`boot_restore`]), the guard, and the safe
     /// outputs of a guard waiting for its first sample (valve open).
-    pub fn boot<B: Board>(board: &mut B, cfg: &GuardConfig, mem: &BootMemory) -> App {
+    pub fn boot<B: Board>(board: &mut B, cfg: &GuardConfig, mem: &BootMemory) -> Self {
         let mut slot = core::mem::MaybeUninit::uninit();
         Self::boot_into(&mut slot, board, cfg, mem);
         // SAFETY: `boot_into` initialised every field.
@@ -197,7 +257,7 @@ impl App {
     /// [`App::boot`] into `slot` (a static on the target): each field is
     /// written in place, so the boot stack holds no copy of the whole state.
     #[inline(never)]
-    pub fn boot_into<'a, B: Board>(slot: &'a mut core::mem::MaybeUninit<App>, board: &mut B, cfg: &GuardConfig, mem: &BootMemory) -> &'a mut App {
+    pub fn boot_into<'a, B: Board>(slot: &'a mut core::mem::MaybeUninit<Self>, board: &mut B, cfg: &GuardConfig, mem: &BootMemory) -> &'a mut Self {
         let (reset_cause, boots, running) = reset::at_boot(&mem.cause, mem.hw_hint);
         board.store_cause(&running);
         let (a, b) = &mem.records;
@@ -209,30 +269,42 @@ impl App {
             Some(Ok(Some(c))) => (c, ParamSource::Block),
             Some(Err(e)) => (cfg.model, ParamSource::Invalid(e)),
         };
+        let mut rig_id = [0u8; 16];
+        if let (ParamSource::Block, Some(b)) = (params, board.param_block()) {
+            let id = params_block::rig_id(b).as_bytes();
+            for (d, s) in rig_id.iter_mut().zip(id) {
+                *d = *s;
+            }
+        }
         let nv_policy = NvPolicy::DEFAULT;
         // The cooling bound at rest of the model in use (none under CONFIG).
         let cool = match params {
             ParamSource::Invalid(_) => None,
             _ => RestCooling::from_consts(model),
         };
-        let now_s = if mem.nv.is_some() { board.rtc_s() } else { None };
-        let restore = boot_restore(slots::restore_from(a, b), mem.nv, &nv_policy, cool.as_ref(), now_s);
+        let now_s = if mem.nv != NvLoad::Empty { board.rtc_s() } else { None };
+        let restore = boot_restore(slots::restore_from(a, b), mem.nv, &nv_policy, cool.as_ref(), now_s, mem.alive_s, mem.nv_failing);
         let cfg = GuardConfig { model, ..*cfg };
         let p = slot.as_mut_ptr();
         // SAFETY: `p` points to `slot`, valid for writes; every field is written
         // exactly once below before the reference is created.
         let app = unsafe {
-            Guard::new_in(&mut *core::ptr::addr_of_mut!((*p).guard).cast::<core::mem::MaybeUninit<Guard>>(), &cfg, restore);
+            GuardOf::<N>::new_in(&mut *core::ptr::addr_of_mut!((*p).guard).cast::<core::mem::MaybeUninit<GuardOf<N>>>(), &cfg, restore);
             core::ptr::addr_of_mut!((*p).lng).write(cfg.lng);
             core::ptr::addr_of_mut!((*p).rx).write(Deframer::new());
+            core::ptr::addr_of_mut!((*p).rx_buf).write([0; RX_READ]);
+            core::ptr::addr_of_mut!((*p).reply).write(ReplyEncoder::new());
             core::ptr::addr_of_mut!((*p).last_seq).write(None);
             core::ptr::addr_of_mut!((*p).sample).write(None);
             core::ptr::addr_of_mut!((*p).commands).write(Deque::new());
             core::ptr::addr_of_mut!((*p).counters).write(Counters::default());
             core::ptr::addr_of_mut!((*p).records).write(AbWriter::after_boot(a, b));
             core::ptr::addr_of_mut!((*p).nv_policy).write(nv_policy);
-            core::ptr::addr_of_mut!((*p).nv_last).write(mem.nv);
-            core::ptr::addr_of_mut!((*p).nv_retry_at).write(0);
+            core::ptr::addr_of_mut!((*p).nv_last).write(mem.nv.valid());
+            core::ptr::addr_of_mut!((*p).alive_at).write(0);
+            core::ptr::addr_of_mut!((*p).record_epoch).write(None);
+            core::ptr::addr_of_mut!((*p).nv_failed_at).write(None);
+            core::ptr::addr_of_mut!((*p).stalled).write(0);
             core::ptr::addr_of_mut!((*p).tick).write(0);
             core::ptr::addr_of_mut!((*p).restore).write(restore_kind(&restore));
             core::ptr::addr_of_mut!((*p).reset_cause).write(reset_cause);
@@ -240,6 +312,10 @@ impl App {
             core::ptr::addr_of_mut!((*p).worst_tick_cycles).write(0);
             core::ptr::addr_of_mut!((*p).dump).write(None);
             core::ptr::addr_of_mut!((*p).params).write(params);
+            core::ptr::addr_of_mut!((*p).rig_id).write(rig_id);
+            core::ptr::addr_of_mut!((*p).armed).write(None);
+            core::ptr::addr_of_mut!((*p).nonce).write(u32::from(boots));
+            core::ptr::addr_of_mut!((*p).confirmed).write([None; 2]);
             &mut *p
         };
         if let ParamSource::Invalid(_) = params {
@@ -257,16 +333,24 @@ impl App {
     pub fn run<B: Board>(&mut self, board: &mut B) -> ! {
         let mut seen = board.ticks();
         loop {
-            board.wait_tick(seen);
-            let now = board.ticks();
-            // Periods that passed with no tick at all (after an overrun).
-            let lost = now.wrapping_sub(seen).saturating_sub(1);
-            seen = now;
-            self.tick(board, lost);
-            let after = board.ticks();
-            if after != now {
-                self.overrun(after.wrapping_sub(now));
-            }
+            self.run_once(board, &mut seen);
+        }
+    }
+
+    /// One pass of [`AppOf::run`]: waits for the timer period after `seen`,
+    /// runs its tick (with the periods that passed without one as `lost`)
+    /// and counts an overrun.
+    #[inline(always)]
+    pub fn run_once<B: Board>(&mut self, board: &mut B, seen: &mut u32) {
+        board.wait_tick(*seen);
+        let now = board.ticks();
+        // Periods that passed with no tick at all (after an overrun).
+        let lost = now.wrapping_sub(*seen).saturating_sub(1);
+        *seen = now;
+        self.tick(board, lost);
+        let after = board.ticks();
+        if after != now {
+            self.overrun(after.wrapping_sub(now));
         }
     }
 
@@ -278,38 +362,45 @@ impl App {
     }
 
     /// One tick. `lost` = timer periods since the previous tick that had no
-    /// tick of their own (each becomes a missing tick, at most
+    /// tick of their own: those the board's last non-volatile save stalled
+    /// are blind ticks ([`crate::GuardOf::tick_blind`], at most
+    /// [`MAX_STALL_TICKS`]), the others missing ticks (at most
     /// [`MAX_MISSED_TICKS`]).
     pub fn tick<B: Board>(&mut self, board: &mut B, lost: u32) {
         let stamp = board.cycle_stamp();
         self.tick = self.tick.wrapping_add(1).wrapping_add(lost);
 
         // 1. transport
-        let mut buf = [0u8; 32];
         loop {
-            let n = board.read_rx(&mut buf);
-            let Some(chunk) = buf.get(..n) else { break };
-            if chunk.is_empty() {
+            let n = board.read_rx(&mut self.rx_buf);
+            if n == 0 {
                 break;
             }
-            for &b in chunk {
-                if let Some(res) = self.rx.push(b) {
-                    self.accept(res);
+            let mut at = 0;
+            while at < n {
+                let (k, res) = self.rx.feed(self.rx_buf.get(at..n).unwrap_or(&[]));
+                let frame = res.map(commands::Incoming::parse);
+                at += k;
+                if let Some(frame) = frame {
+                    self.accept(frame);
                 }
             }
         }
 
         // 2. validate, estimate, protect
-        for _ in 0..lost.min(u32::from(MAX_MISSED_TICKS)) {
-            let _ = self.guard.tick_missing();
+        if lost > 0 {
+            self.catch_up(lost);
         }
         let fresh = self.sample.take();
         let out = match &fresh {
             Some(req) => {
+                let s = req.sample();
                 if let Some(open) = req.valve_fb {
                     self.guard.valve_feedback(open);
                 }
-                self.guard.tick(&req.sample())
+                self.guard.lng_supply(req.lng_supply_bar);
+                self.guard.check_speed(&s, req.elec_hz);
+                self.guard.tick(&s)
             }
             None => {
                 self.counters.missing = self.counters.missing.saturating_add(1);
@@ -317,19 +408,15 @@ impl App {
             }
         };
 
-        // 3. outputs
+        // 3. outputs: the thermal record first (a failed save changes the
+        // outputs: derate), then the pins and the reply
+        let out = if self.record_epoch != Some(self.guard.epoch()) {
+            self.save(board);
+            self.guard.output()
+        } else {
+            out
+        };
         let (out, pins) = self.drive(board, out);
-        let rec = self.guard.snapshot();
-        self.records.write(&rec, |slot, r| board.store_record(slot, r));
-        if self.tick >= self.nv_retry_at && self.nv_policy.due(self.nv_last.as_ref(), &rec) {
-            let rec = rec.with_rtc(board.rtc_s());
-            if board.nv_save(&rec) {
-                self.nv_last = Some(rec);
-            } else {
-                self.counters.nv_failures = self.counters.nv_failures.saturating_add(1);
-                self.nv_retry_at = self.tick.saturating_add(NV_RETRY_TICKS);
-            }
-        }
         let reply = TickReply {
             tick: self.tick,
             sample_seq: self.last_seq.unwrap_or(0),
@@ -342,16 +429,73 @@ impl App {
             restore: self.restore,
             reset_cause: self.reset_cause,
         };
-        board.write_tx(&reply.encode());
+        board.write_tx(self.reply.frame(&reply, self.guard.epoch()));
         while let Some(c) = self.commands.pop_front() {
             self.execute(board, c);
         }
         self.send_trace_chunk(board);
 
+        if self.tick.wrapping_sub(self.alive_at) >= 100 * crate::memory::ALIVE_PERIOD_S {
+            self.stamp_alive(board);
+        }
+
         let cycles = board.cycles_since(stamp);
         self.worst_tick_cycles = self.worst_tick_cycles.max(cycles);
         // 4. the tick is complete
         board.feed_watchdog();
+    }
+
+    /// The periods a tick came late by: stalled by our own save (blind),
+    /// else missing.
+    #[cold]
+    #[inline(never)]
+    fn catch_up(&mut self, lost: u32) {
+        let blind = lost.min(core::mem::replace(&mut self.stalled, 0));
+        let _ = self.guard.tick_blind(blind.min(MAX_STALL_TICKS));
+        for _ in 0..(lost - blind).min(MAX_MISSED_TICKS) {
+            let _ = self.guard.tick_missing();
+        }
+    }
+
+    /// The thermal record, written when the state it holds has changed
+    /// (a model step, a fault, the valve, a clear or refill: between those
+    /// only its tick count would differ): the next A/B slot, and the
+    /// non-volatile store when its policy says so.
+    #[inline(never)]
+    fn save<B: Board>(&mut self, board: &mut B) {
+        self.record_epoch = Some(self.guard.epoch());
+        let rec = self.records.write(&self.guard.snapshot_unsealed(), |slot, r| board.store_record(slot, r));
+        let retry = self.nv_failed_at.is_none_or(|t| self.tick.wrapping_sub(t) >= NV_RETRY_TICKS);
+        if retry && self.nv_policy.due(self.nv_last.as_ref(), &rec) {
+            let rec = rec.with_rtc(board.rtc_s());
+            let t0 = board.ticks();
+            let saved = board.nv_save(&rec);
+            // A flash erase stalls the core: the periods it took are
+            // accounted at the next tick, without STALE.
+            self.stalled = board.ticks().wrapping_sub(t0);
+            match saved {
+                None => {}
+                Some(true) => {
+                    self.nv_last = Some(rec);
+                    self.nv_failed_at = None;
+                    self.guard.report_nv_save(true);
+                }
+                Some(false) => {
+                    self.counters.nv_failures = self.counters.nv_failures.saturating_add(1);
+                    self.nv_failed_at = Some(self.tick);
+                    self.guard.report_nv_save(false);
+                }
+            }
+        }
+    }
+
+    /// The last-alive stamp (when the board has a clock).
+    #[inline(never)]
+    fn stamp_alive<B: Board>(&mut self, board: &mut B) {
+        self.alive_at = self.tick;
+        if let Some(s) = board.rtc_s() {
+            board.rtc_alive(crate::memory::alive_word(s, self.nv_failed_at.is_some()));
+        }
     }
 
     /// Writes the pins for `out`; a read-back that differs latches ACTUATOR,
@@ -369,7 +513,7 @@ impl App {
     }
 
     /// The guard (read only).
-    pub fn guard(&self) -> &Guard {
+    pub fn guard(&self) -> &GuardOf<N> {
         &self.guard
     }
 
@@ -391,3 +535,5 @@ impl App {
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod safety_tests;

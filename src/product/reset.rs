@@ -26,6 +26,9 @@ pub struct CauseRecord {
 }
 
 impl CauseRecord {
+    /// What RAM holds after power-on: no valid record (all zero here).
+    pub const POWER_ON: CauseRecord = CauseRecord { magic: 0, boots: 0, cause: 0, _pad: 0, check: 0 };
+
     /// A sealed record.
     pub fn new(cause: u8, boots: u16) -> Self {
         let mut r = CauseRecord { magic: MAGIC, boots, cause, _pad: 0, check: 0 };

@@ -7,113 +7,27 @@ use super::*;
 use crate::protocol::Deframer;
 use wire::{Ack, AckResult, Cmd, FromGuard, TraceReply};
 
-/// A board in memory: RX bytes queued by the test, TX bytes collected,
-/// pins with an optional stuck valve pin, records kept like no-init RAM.
-struct SimBoard {
-    rx: StdVec<u8>,
-    tx: StdVec<u8>,
-    pins: Pins,
-    stuck_valve_pin: Option<bool>,
-    feeds: u32,
-    ticks: u32,
-    records: [ThermalRecord; 2],
-    cause: CauseRecord,
-    /// `Some(ok)`: the board has a non-volatile store whose saves return `ok`.
-    nv: Option<bool>,
-    nv_calls: u32,
-    /// The flash's parameter-block region (`None`: the board has none).
-    block: Option<&'static [u8; BLOCK_LEN]>,
-    /// The real-time clock's reading, s (`None`: no clock).
-    rtc: Option<u32>,
-    /// The last record handed to `nv_save`.
-    nv_saved: Option<ThermalRecord>,
-}
+use crate::Guard;
+use mem_board::MemBoard;
 
-impl SimBoard {
-    fn new() -> Self {
-        SimBoard {
-            rx: StdVec::new(),
-            tx: StdVec::new(),
-            pins: Pins::default(),
-            stuck_valve_pin: None,
-            feeds: 0,
-            ticks: 0,
-            records: [ThermalRecord::EMPTY; 2],
-            cause: CauseRecord::new(0, 0),
-            nv: None,
-            nv_calls: 0,
-            block: None,
-            rtc: None,
-            nv_saved: None,
+/// Everything the guard sent since the last call, decoded.
+pub(super) fn replies(b: &mut MemBoard) -> StdVec<FromGuard> {
+    let mut d = Deframer::new();
+    let mut out = StdVec::new();
+    for &x in b.take_tx().iter() {
+        if let Some(Ok(p)) = d.push(x) {
+            out.push(FromGuard::from_payload(p).expect("guard frames decode"));
         }
     }
-
-    fn mem(&self) -> BootMemory {
-        BootMemory { records: (self.records[0], self.records[1]), nv: None, cause: self.cause, hw_hint: None }
-    }
-
-    /// Everything the guard sent since the last call, decoded.
-    fn replies(&mut self) -> StdVec<FromGuard> {
-        let mut d = Deframer::new();
-        let mut out = StdVec::new();
-        for b in core::mem::take(&mut self.tx) {
-            if let Some(Ok(p)) = d.push(b) {
-                out.push(FromGuard::from_payload(&p).expect("guard frames decode"));
-            }
-        }
-        out
-    }
+    out
 }
 
-impl Board for SimBoard {
-    fn read_rx(&mut self, buf: &mut [u8]) -> usize {
-        let n = buf.len().min(self.rx.len());
-        buf[..n].copy_from_slice(&self.rx[..n]);
-        self.rx.drain(..n);
-        n
-    }
-    fn rx_dropped(&self) -> u32 {
-        0
-    }
-    fn write_tx(&mut self, bytes: &[u8]) {
-        self.tx.extend_from_slice(bytes);
-    }
-    fn set_pins(&mut self, pins: Pins) -> Pins {
-        self.pins = pins;
-        if let Some(v) = self.stuck_valve_pin {
-            self.pins.valve_pin = v;
-        }
-        self.pins
-    }
-    fn feed_watchdog(&mut self) {
-        self.feeds += 1;
-    }
-    fn ticks(&self) -> u32 {
-        self.ticks
-    }
-    fn wait_tick(&mut self, _seen: u32) {
-        self.ticks += 1;
-    }
-    fn store_record(&mut self, slot: usize, rec: &ThermalRecord) {
-        self.records[slot & 1] = *rec;
-    }
-    fn store_cause(&mut self, rec: &CauseRecord) {
-        self.cause = *rec;
-    }
-    fn nv_save(&mut self, rec: &ThermalRecord) -> bool {
-        self.nv_calls += 1;
-        self.nv_saved = Some(*rec);
-        self.nv.unwrap_or(false)
-    }
-    fn rtc_s(&mut self) -> Option<u32> {
-        self.rtc
-    }
-    fn param_block(&self) -> Option<&'static [u8; BLOCK_LEN]> {
-        self.block
-    }
+/// A powered-on board (boxed: it holds a 16 KiB flash).
+pub(super) fn board() -> std::boxed::Box<MemBoard> {
+    std::boxed::Box::new(MemBoard::new())
 }
 
-fn sample(seq: u16, current_a: f32, p_a_bar: f32) -> Request {
+pub(super) fn sample(seq: u16, current_a: f32, p_a_bar: f32) -> Request {
     Request {
         seq,
         current_a,
@@ -123,10 +37,12 @@ fn sample(seq: u16, current_a: f32, p_a_bar: f32) -> Request {
         position_mm: 0.0,
         ambient_c: 30.0,
         valve_fb: None,
+        elec_hz: None,
+        lng_supply_bar: None,
     }
 }
 
-fn ticks(r: &[FromGuard]) -> StdVec<TickReply> {
+pub(super) fn ticks(r: &[FromGuard]) -> StdVec<TickReply> {
     r.iter().filter_map(|f| if let FromGuard::Tick(t) = f { Some(*t) } else { None }).collect()
 }
 
@@ -134,15 +50,15 @@ fn ticks(r: &[FromGuard]) -> StdVec<TickReply> {
 /// guard waits without a fault; the watchdog is fed once per completed tick.
 #[test]
 fn waits_with_valve_open_until_the_first_sample() {
-    let mut b = SimBoard::new();
-    let mem = b.mem();
-    let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
+    let mut b = board();
+    let mem = b.boot_memory();
+    let mut app = App::boot(&mut *b, &GuardConfig::DEFAULT, &mem);
     assert_eq!(b.pins, Pins { valve_pin: false, ok_pin: true }, "boot: valve open (pin low), no alarm");
     assert_eq!(app.reset_cause(), ResetCause::PowerOn);
     for _ in 0..20 {
-        app.tick(&mut b, 0);
+        app.tick(&mut *b, 0);
     }
-    let t = ticks(&b.replies());
+    let t = ticks(&replies(&mut b));
     assert_eq!(t.len(), 20, "one tick reply per tick");
     assert!(t.iter().all(|r| !r.fresh && r.out.valve_open && r.out.faults.is_empty() && !r.pins.valve_pin));
     assert_eq!(b.feeds, 20);
@@ -152,16 +68,16 @@ fn waits_with_valve_open_until_the_first_sample() {
 /// samples (bit-identical outputs), one tick reply per tick.
 #[test]
 fn one_sample_per_tick_matches_the_bare_guard() {
-    let mut b = SimBoard::new();
-    let mem = b.mem();
-    let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
+    let mut b = board();
+    let mem = b.boot_memory();
+    let mut app = App::boot(&mut *b, &GuardConfig::DEFAULT, &mem);
     let mut bare = Guard::new(&GuardConfig::DEFAULT, Restore::Cold);
     for k in 0..300u16 {
         let s = sample(k, 20.0 + f32::from(k % 7), 60.0);
-        b.rx.extend_from_slice(&s.encode());
-        app.tick(&mut b, 0);
+        b.push_rx(&s.encode());
+        app.tick(&mut *b, 0);
         let want = bare.tick(&s.sample());
-        let t = ticks(&b.replies());
+        let t = ticks(&replies(&mut b));
         assert_eq!(t.len(), 1);
         assert!(t[0].fresh && t[0].sample_seq == k);
         assert!(crate::protocol::GuardOutput::bit_eq(&t[0].out, &want), "tick {k}: {:?} vs {want:?}", t[0].out);
@@ -175,16 +91,16 @@ fn one_sample_per_tick_matches_the_bare_guard() {
 /// rejected.
 #[test]
 fn newest_sample_wins_missing_ticks_count_and_old_frames_are_rejected() {
-    let mut b = SimBoard::new();
-    let mem = b.mem();
-    let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
-    b.rx.extend_from_slice(&sample(1, 10.0, 50.0).encode());
-    b.rx.extend_from_slice(&sample(2, 11.0, 50.0).encode());
-    app.tick(&mut b, 0);
-    app.tick(&mut b, 0);
-    b.rx.extend_from_slice(&sample(2, 11.0, 50.0).encode());
-    app.tick(&mut b, 0);
-    let t = ticks(&b.replies());
+    let mut b = board();
+    let mem = b.boot_memory();
+    let mut app = App::boot(&mut *b, &GuardConfig::DEFAULT, &mem);
+    b.push_rx(&sample(1, 10.0, 50.0).encode());
+    b.push_rx(&sample(2, 11.0, 50.0).encode());
+    app.tick(&mut *b, 0);
+    app.tick(&mut *b, 0);
+    b.push_rx(&sample(2, 11.0, 50.0).encode());
+    app.tick(&mut *b, 0);
+    let t = ticks(&replies(&mut b));
     assert_eq!((t[0].fresh, t[0].sample_seq, t[1].fresh, t[2].fresh), (true, 2, false, false));
     let c = app.counters();
     assert_eq!((c.accepted, c.superseded, c.missing, c.rejected_sequence), (2, 1, 2, 1));
@@ -195,19 +111,19 @@ fn newest_sample_wins_missing_ticks_count_and_old_frames_are_rejected() {
 /// tick (the model's clock keeps up), and the overrun is counted and traced.
 #[test]
 fn overrun_periods_become_missing_ticks_and_are_counted() {
-    let mut b = SimBoard::new();
-    let mem = b.mem();
-    let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
-    b.rx.extend_from_slice(&sample(1, 10.0, 50.0).encode());
-    app.tick(&mut b, 0);
+    let mut b = board();
+    let mem = b.boot_memory();
+    let mut app = App::boot(&mut *b, &GuardConfig::DEFAULT, &mem);
+    b.push_rx(&sample(1, 10.0, 50.0).encode());
+    app.tick(&mut *b, 0);
     let before = app.guard().ticks();
     app.overrun(2);
-    b.rx.extend_from_slice(&sample(2, 10.0, 50.0).encode());
-    app.tick(&mut b, 2);
+    b.push_rx(&sample(2, 10.0, 50.0).encode());
+    app.tick(&mut *b, 2);
     assert_eq!(app.guard().ticks() - before, 3, "two catch-up ticks and the tick's own");
     assert_eq!(app.counters().overruns, 2);
     assert!(app.guard().trace().iter().any(|e| matches!(e, Trace::Overrun { lost_ticks: 2, .. })));
-    let t = ticks(&b.replies());
+    let t = ticks(&replies(&mut b));
     assert_eq!(t.last().map(|r| r.overruns), Some(2));
 }
 
@@ -215,89 +131,130 @@ fn overrun_periods_become_missing_ticks_and_are_counted() {
 /// in the same tick.
 #[test]
 fn pin_read_back_mismatch_latches_actuator_and_opens_the_valve() {
-    let mut b = SimBoard::new();
-    let mem = b.mem();
-    let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
-    b.rx.extend_from_slice(&sample(1, 10.0, 50.0).encode());
-    app.tick(&mut b, 0);
-    assert!(!ticks(&b.replies())[0].out.valve_open, "cold oil: valve closed");
+    let mut b = board();
+    let mem = b.boot_memory();
+    let mut app = App::boot(&mut *b, &GuardConfig::DEFAULT, &mem);
+    b.push_rx(&sample(1, 10.0, 50.0).encode());
+    app.tick(&mut *b, 0);
+    assert!(!ticks(&replies(&mut b))[0].out.valve_open, "cold oil: valve closed");
     b.stuck_valve_pin = Some(false);
-    b.rx.extend_from_slice(&sample(2, 10.0, 50.0).encode());
-    app.tick(&mut b, 0);
-    let t = ticks(&b.replies());
+    b.push_rx(&sample(2, 10.0, 50.0).encode());
+    app.tick(&mut *b, 0);
+    let t = ticks(&replies(&mut b));
     assert!(t[0].out.valve_open && t[0].out.faults.intersects(crate::faults::ACTUATOR), "{:?}", t[0]);
 }
 
-/// Commands: status and refill are done at once; clear is refused until the
-/// clear rule holds; a trace dump arrives over several ticks; the test-only
-/// injections are refused in a build without `fault-inject`.
+/// Sends `arm` with `token`, ticks once with sample `seq`, reads the
+/// nonce from its ack and sends `confirm` with the key `command_key` makes of
+/// it (rig id all zero: the compiled-in default), ticks once more with
+/// sample `seq + 1`; the confirmation's ack.
+pub(super) fn arm_confirm(app: &mut App, b: &mut MemBoard, token: u16, arm: Cmd, confirm: Cmd, seq: u16, s: &Request) -> Ack {
+    b.push_rx(&Command { token, cmd: arm, arg: 0 }.encode());
+    b.push_rx(&Request { seq, ..*s }.encode());
+    app.tick(&mut *b, 0);
+    let nonce = replies(b)
+        .iter()
+        .find_map(|f| match f {
+            FromGuard::Ack(a) if a.token == token && a.result == AckResult::Done => Some(a.value),
+            _ => None,
+        })
+        .expect("the arm's ack");
+    let key = wire::command_key(&[0; 16], nonce, confirm);
+    let t2 = token.wrapping_add(1);
+    b.push_rx(&Command { token: t2, cmd: confirm, arg: key }.encode());
+    b.push_rx(&Request { seq: seq.wrapping_add(1), ..*s }.encode());
+    app.tick(&mut *b, 0);
+    replies(b)
+        .iter()
+        .find_map(|f| match f {
+            FromGuard::Ack(a) if a.token == t2 => Some(*a),
+            _ => None,
+        })
+        .expect("the confirmation's ack")
+}
+
+/// Commands: status at once; an armed, keyed refill is done; a clear is
+/// refused until the clear rule holds; a trace dump arrives over several
+/// ticks; the test-only injections are refused in a build without
+/// `fault-inject`.
 #[test]
 fn commands_status_refill_clear_trace() {
-    let mut b = SimBoard::new();
-    let mem = b.mem();
-    let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
-    // A non-finite sample latches NON_FINITE.
-    b.rx.extend_from_slice(&sample(1, f32::NAN, 50.0).encode());
-    app.tick(&mut b, 0);
-    let cmd = |token, cmd| Command { token, cmd }.encode();
-    b.rx.extend_from_slice(&cmd(7, Cmd::ClearFaults));
-    b.rx.extend_from_slice(&cmd(8, Cmd::RefillLng));
-    b.rx.extend_from_slice(&cmd(9, Cmd::Status));
-    app.tick(&mut b, 0);
-    let r = b.replies();
-    let acks: StdVec<Ack> = r.iter().filter_map(|f| if let FromGuard::Ack(a) = f { Some(*a) } else { None }).collect();
-    assert_eq!(acks[0], Ack { token: 7, cmd: Cmd::ClearFaults, result: AckResult::Refused });
-    assert_eq!(acks[1], Ack { token: 8, cmd: Cmd::RefillLng, result: AckResult::Done });
+    let mut b = board();
+    let mem = b.boot_memory();
+    let mut app = App::boot(&mut *b, &GuardConfig::DEFAULT, &mem);
+    // A non-finite sample latches NON_FINITE (the valve opens: no refill).
+    b.push_rx(&sample(1, f32::NAN, 50.0).encode());
+    app.tick(&mut *b, 0);
+    let cmd = |token, cmd| Command { token, cmd, arg: 0 }.encode();
+    // the pump at rest, consistent sensors
+    let rest = |k| Request { speed_rpm: 0.0, ..sample(k, 0.0, 5.0) };
+    b.push_rx(&cmd(9, Cmd::Status));
+    app.tick(&mut *b, 0);
+    let r = replies(&mut b);
     let st = r.iter().find_map(|f| if let FromGuard::Status(s) = f { Some(*s) } else { None }).expect("status");
     assert_eq!((st.token, st.tick, st.missing, st.faults.intersects(crate::faults::NON_FINITE)), (9, 2, 1, true));
-    // 100 valid ticks, then the clear succeeds.
-    for k in 2..110u16 {
-        b.rx.extend_from_slice(&sample(k, 10.0, 50.0).encode());
-        app.tick(&mut b, 0);
+    let a = arm_confirm(&mut app, &mut b, 7, Cmd::ClearArm, Cmd::ClearConfirm, 2, &rest(2));
+    assert_eq!((a.cmd, a.result, a.value), (Cmd::ClearConfirm, AckResult::Refused, wire::Refusal::Rule as u32), "clear rule not met");
+    // 100 valid ticks, then the clear succeeds (the interval counts
+    // confirmed commands: the refused one counted).
+    for k in 4..1100u16 {
+        b.push_rx(&rest(k).encode());
+        app.tick(&mut *b, 0);
     }
-    b.replies();
-    b.rx.extend_from_slice(&cmd(10, Cmd::ClearFaults));
-    b.rx.extend_from_slice(&cmd(11, Cmd::Trace));
-    b.rx.extend_from_slice(&cmd(12, Cmd::InjectHang));
-    b.rx.extend_from_slice(&sample(110, 10.0, 50.0).encode());
-    app.tick(&mut b, 0);
-    for k in 111..130u16 {
-        b.rx.extend_from_slice(&sample(k, 10.0, 50.0).encode());
-        app.tick(&mut b, 0);
+    replies(&mut b);
+    let a = arm_confirm(&mut app, &mut b, 10, Cmd::ClearArm, Cmd::ClearConfirm, 1100, &rest(0));
+    assert_eq!((a.result, a.value), (AckResult::Done, 0), "cleared, trusted");
+    assert!(!app.guard().faults().intersects(crate::faults::LATCHED));
+    // the valve closes after its dwell (cold oil), no alarm: the refill is done
+    for k in 1102..1400u16 {
+        b.push_rx(&rest(k).encode());
+        app.tick(&mut *b, 0);
     }
-    let r = b.replies();
-    assert!(r.contains(&FromGuard::Ack(Ack { token: 10, cmd: Cmd::ClearFaults, result: AckResult::Done })));
+    replies(&mut b);
+    assert!(!app.guard().output().valve_open, "{:?}", app.guard().output());
+    let a = arm_confirm(&mut app, &mut b, 20, Cmd::RefillArm, Cmd::RefillConfirm, 1400, &rest(0));
+    assert_eq!(a.result, AckResult::Done, "{a:?}");
+    b.push_rx(&cmd(12, Cmd::InjectHang));
+    b.push_rx(&cmd(11, Cmd::Trace));
+    for k in 1402..1430u16 {
+        b.push_rx(&rest(k).encode());
+        app.tick(&mut *b, 0);
+    }
+    let r = replies(&mut b);
     #[cfg(not(feature = "fault-inject"))]
-    assert!(r.contains(&FromGuard::Ack(Ack { token: 12, cmd: Cmd::InjectHang, result: AckResult::Refused })));
+    assert!(r.contains(&FromGuard::Ack(Ack { token: 12, cmd: Cmd::InjectHang, result: AckResult::Refused, value: wire::Refusal::Unavailable as u32 })));
     let dump: StdVec<TraceReply> = r.iter().filter_map(|f| if let FromGuard::Trace(t) = f { Some(*t) } else { None }).collect();
     assert!(!dump.is_empty());
     assert_eq!(dump.len(), usize::from(dump[0].count), "the whole ring arrives");
     assert!(dump.iter().enumerate().all(|(i, t)| usize::from(t.index) == i && t.token == 11));
     assert!(dump.iter().any(|t| t.event.tag == 7), "the faults-cleared event is in the dump");
-    assert!(!app.guard().faults().intersects(crate::faults::LATCHED));
+    // every armed command is in the trace: code (aux bits 0-7), result (8-15)
+    let cmds: StdVec<u32> = dump.iter().filter(|t| t.event.tag == 11).map(|t| t.event.aux).collect();
+    let rule = wire::Refusal::Rule as u32;
+    assert_eq!(cmds, [1, 5 | rule << 8, 1, 5, 2, 6, 0xE0 | (wire::Refusal::Unavailable as u32) << 8], "{cmds:?}");
 }
 
 /// Garbage, bursts and truncated frames: counted as rejected, the tick
 /// still completes with its one reply and the watchdog is still fed.
 #[test]
 fn garbage_is_counted_and_every_tick_completes() {
-    let mut b = SimBoard::new();
-    let mem = b.mem();
-    let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
+    let mut b = board();
+    let mem = b.boot_memory();
+    let mut app = App::boot(&mut *b, &GuardConfig::DEFAULT, &mem);
     let mut x: u32 = 12345;
     for k in 0..200u16 {
         for _ in 0..(k % 97) {
             x = x.wrapping_mul(1_103_515_245).wrapping_add(12345);
-            b.rx.push((x >> 16) as u8);
+            b.push_rx(&[(x >> 16) as u8]);
         }
         if k % 3 == 0 {
             let f = sample(1000 + k, 10.0, 50.0).encode();
-            b.rx.push(0);
-            b.rx.extend_from_slice(&f);
+            b.push_rx(&[0]);
+            b.push_rx(&f);
         }
-        app.tick(&mut b, 0);
+        app.tick(&mut *b, 0);
     }
-    let t = ticks(&b.replies());
+    let t = ticks(&replies(&mut b));
     assert_eq!(t.len(), 200);
     assert_eq!(b.feeds, 200);
     let c = app.counters();
@@ -309,17 +266,17 @@ fn garbage_is_counted_and_every_tick_completes() {
 /// the recorded reset cause.
 #[test]
 fn warm_reboot_restores_the_estimate_and_the_cause() {
-    let mut b = SimBoard::new();
-    let mem = b.mem();
-    let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
+    let mut b = board();
+    let mem = b.boot_memory();
+    let mut app = App::boot(&mut *b, &GuardConfig::DEFAULT, &mem);
     for k in 0..500u16 {
-        b.rx.extend_from_slice(&sample(k, 40.0, 150.0).encode());
-        app.tick(&mut b, 0);
+        b.push_rx(&sample(k, 40.0, 150.0).encode());
+        app.tick(&mut *b, 0);
     }
     let before = app.guard().output().drain_c;
     b.cause = b.cause.with_cause(ResetCause::Watchdog);
-    let mem = b.mem();
-    let app2 = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
+    let mem = b.boot_memory();
+    let app2 = App::boot(&mut *b, &GuardConfig::DEFAULT, &mem);
     assert_eq!(app2.reset_cause(), ResetCause::Watchdog);
     let after = app2.guard().snapshot().temps_c;
     let was = app.guard().snapshot().temps_c;
@@ -333,24 +290,23 @@ fn warm_reboot_restores_the_estimate_and_the_cause() {
 /// one is written by the policy (first record at once, then on a 2 K rise).
 #[test]
 fn failing_nv_store_is_retried_once_a_minute_not_every_tick() {
-    let mut b = SimBoard::new();
-    b.nv = Some(false);
-    let mem = b.mem();
-    let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
+    let mut b = std::boxed::Box::new(MemBoard::new().with_nv());
+    b.set_flash_faults(false, true);
+    let mem = b.boot_memory();
+    let mut app = App::boot(&mut *b, &GuardConfig::DEFAULT, &mem);
     for k in 0..12_000u32 {
-        b.rx.extend_from_slice(&sample((k & 0xFFFF) as u16, 30.0, 150.0).encode());
-        app.tick(&mut b, 0);
+        b.push_rx(&sample((k & 0xFFFF) as u16, 30.0, 150.0).encode());
+        app.tick(&mut *b, 0);
     }
-    b.replies();
+    replies(&mut b);
     assert_eq!(b.nv_calls, 2, "ticks 1 and 6001 of 12 000");
     assert_eq!(app.counters().nv_failures, 2);
-    let mut ok = SimBoard::new();
-    ok.nv = Some(true);
-    let mem = ok.mem();
-    let mut app = App::boot(&mut ok, &GuardConfig::DEFAULT, &mem);
+    let mut ok = std::boxed::Box::new(MemBoard::new().with_nv());
+    let mem = ok.boot_memory();
+    let mut app = App::boot(&mut *ok, &GuardConfig::DEFAULT, &mem);
     for k in 0..50u32 {
-        ok.rx.extend_from_slice(&sample(k as u16, 30.0, 150.0).encode());
-        app.tick(&mut ok, 0);
+        ok.push_rx(&sample(k as u16, 30.0, 150.0).encode());
+        app.tick(&mut *ok, 0);
     }
     // The estimate rises ~0.7 K in these 0.5 s, no fault: nothing due after the first.
     assert_eq!(ok.nv_calls, 1, "one record at the start; the next on a 2 K rise");
@@ -359,7 +315,7 @@ fn failing_nv_store_is_retried_once_a_minute_not_every_tick() {
 
 /// Flash storage of a parameter block for a test (4-byte aligned, leaked: it
 /// lives as long as the flash it stands for).
-fn flash_block(bytes: [u8; BLOCK_LEN]) -> &'static [u8; BLOCK_LEN] {
+pub(super) fn flash_block(bytes: [u8; BLOCK_LEN]) -> &'static [u8; BLOCK_LEN] {
     #[repr(C, align(4))]
     struct Aligned([u8; BLOCK_LEN]);
     &std::boxed::Box::leak(std::boxed::Box::new(Aligned(bytes))).0
@@ -367,7 +323,7 @@ fn flash_block(bytes: [u8; BLOCK_LEN]) -> &'static [u8; BLOCK_LEN] {
 
 /// Another EHA's constants: the pump's mechanical loss 1.5× the paper rig's
 /// (eq. 8; Phi does not depend on it, so the block stays consistent).
-fn other_rig() -> crate::model::ModelConsts<f32> {
+pub(super) fn other_rig() -> crate::model::ModelConsts<f32> {
     crate::model::ModelConsts { k_mech: crate::params::DEFAULT_CONSTS.k_mech * 1.5, ..crate::params::DEFAULT_CONSTS }
 }
 
@@ -376,16 +332,16 @@ fn other_rig() -> crate::model::ModelConsts<f32> {
 #[test]
 fn without_a_block_the_default_runs_and_every_reply_says_not_commissioned() {
     for block in [None, Some(flash_block([0xFF; BLOCK_LEN]))] {
-        let mut b = SimBoard::new();
+        let mut b = board();
         b.block = block;
-        let mem = b.mem();
-        let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
+        let mem = b.boot_memory();
+        let mut app = App::boot(&mut *b, &GuardConfig::DEFAULT, &mem);
         assert_eq!(app.params(), ParamSource::Default);
         for k in 0..30u16 {
-            b.rx.extend_from_slice(&sample(k, 20.0, 60.0).encode());
-            app.tick(&mut b, 0);
+            b.push_rx(&sample(k, 20.0, 60.0).encode());
+            app.tick(&mut *b, 0);
         }
-        let t = ticks(&b.replies());
+        let t = ticks(&replies(&mut b));
         assert!(t.iter().all(|r| r.not_commissioned && r.out.faults.is_empty()), "{t:?}");
         assert!(app.guard().trace().iter().any(|e| matches!(e, Trace::Params { source: 0, .. })));
     }
@@ -398,21 +354,21 @@ fn without_a_block_the_default_runs_and_every_reply_says_not_commissioned() {
 #[test]
 fn a_valid_block_runs_its_own_rig() {
     let other = other_rig();
-    let mut b = SimBoard::new();
+    let mut b = board();
     b.block = Some(flash_block(params_block::encode(&other, "other-eha")));
-    let mem = b.mem();
-    let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
+    let mem = b.boot_memory();
+    let mut app = App::boot(&mut *b, &GuardConfig::DEFAULT, &mem);
     assert_eq!(app.params(), ParamSource::Block);
     let mut bare = Guard::new(&GuardConfig { model: &other, ..GuardConfig::DEFAULT }, Restore::Cold);
     let mut paper = Guard::new(&GuardConfig::DEFAULT, Restore::Cold);
     let (mut last, mut last_paper) = (0.0, 0.0);
     for k in 0..3000u16 {
         let s = sample(k, 30.0, 60.0);
-        b.rx.extend_from_slice(&s.encode());
-        app.tick(&mut b, 0);
+        b.push_rx(&s.encode());
+        app.tick(&mut *b, 0);
         let want = bare.tick(&s.sample());
         last_paper = paper.tick(&s.sample()).drain_c;
-        let t = ticks(&b.replies());
+        let t = ticks(&replies(&mut b));
         assert!(!t[0].not_commissioned);
         assert!(crate::protocol::GuardOutput::bit_eq(&t[0].out, &want), "tick {k}: {:?} vs {want:?}", t[0].out);
         last = want.drain_c;
@@ -437,19 +393,19 @@ fn an_invalid_block_latches_config_and_opens_the_valve() {
         ("torn", torn, ParamSource::Invalid(params_block::BlockError::Crc)),
         ("phi of another rig", params_block::encode(&wrong_phi, "bad-phi"), ParamSource::Block),
     ] {
-        let mut b = SimBoard::new();
+        let mut b = board();
         b.block = Some(flash_block(bytes));
-        let mem = b.mem();
-        let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
+        let mem = b.boot_memory();
+        let mut app = App::boot(&mut *b, &GuardConfig::DEFAULT, &mem);
         assert_eq!(app.params(), source, "{name}");
         assert!(!b.pins.valve_pin, "{name}: valve open (pin low) from boot");
         for k in 0..50u16 {
-            b.rx.extend_from_slice(&sample(k, 20.0, 60.0).encode());
-            app.tick(&mut b, 0);
+            b.push_rx(&sample(k, 20.0, 60.0).encode());
+            app.tick(&mut *b, 0);
         }
-        b.rx.extend_from_slice(&Command { token: 7, cmd: Cmd::ClearFaults }.encode());
-        app.tick(&mut b, 0);
-        let t = ticks(&b.replies());
+        b.push_rx(&Command { token: 7, cmd: Cmd::ClearConfirm, arg: 0 }.encode());
+        app.tick(&mut *b, 0);
+        let t = ticks(&replies(&mut b));
         assert!(
             t.iter().all(|r| r.out.faults.intersects(crate::guard::faults::CONFIG) && r.out.valve_open && !r.pins.valve_pin && r.out.alarm),
             "{name}: {t:?}"
@@ -466,27 +422,27 @@ fn an_invalid_block_latches_config_and_opens_the_valve() {
 #[test]
 fn power_loss_restore_is_cooled_over_the_clocks_off_time() {
     // the save carries the clock
-    let mut b = SimBoard::new();
-    b.nv = Some(true);
+    let mut b = std::boxed::Box::new(MemBoard::new().with_nv());
     b.rtc = Some(5_000);
-    let mem = b.mem();
-    let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
-    b.rx.extend_from_slice(&sample(1, 10.0, 40.0).encode());
-    app.tick(&mut b, 0);
+    let mem = b.boot_memory();
+    let mut app = App::boot(&mut *b, &GuardConfig::DEFAULT, &mem);
+    b.push_rx(&sample(1, 10.0, 40.0).encode());
+    app.tick(&mut *b, 0);
     assert_eq!(b.nv_saved.map(|r| r.rtc_s), Some(5_000), "the first save is stamped");
 
     let hot = ThermalRecord::new([55.0, 60.0, 50.0, 45.0, 40.0, 30.0], 20.0, 0, 0, 100).with_rtc(Some(5_000));
     let boot_after = |rtc: Option<u32>, ambient_c: f32| {
-        let mut b = SimBoard::new();
+        let mut b = board();
         b.rtc = rtc;
-        let mem = BootMemory { nv: Some(hot), ..b.mem() };
-        let mut app = App::boot(&mut b, &GuardConfig::DEFAULT, &mem);
+        // the clock's last-alive stamp: the machine stopped at the save
+        let mem = BootMemory { nv: crate::memory::nv::NvLoad::Valid(hot), alive_s: rtc.map(|_| 5_000), nv_failing: false, ..b.boot_memory() };
+        let mut app = App::boot(&mut *b, &GuardConfig::DEFAULT, &mem);
         let mut s = sample(1, 0.0, 3.0);
         s.speed_rpm = 0.0;
         s.ambient_c = ambient_c;
-        b.rx.extend_from_slice(&s.encode());
-        app.tick(&mut b, 0);
-        let t = ticks(&b.replies());
+        b.push_rx(&s.encode());
+        app.tick(&mut *b, 0);
+        let t = ticks(&replies(&mut b));
         let last = *t.last().expect("a tick reply");
         (last.restore, last.out.drain_c)
     };
@@ -494,7 +450,7 @@ fn power_loss_restore_is_cooled_over_the_clocks_off_time() {
     assert_eq!(kind, RestoreKind::PowerLoss);
     assert!((uncooled - 62.0).abs() < 0.05, "no clock: saved + 2 K, got {uncooled}");
     let (_, day) = boot_after(Some(5_000 + 86_400), 20.0);
-    // pump group bound: 11.5 h; 23.5 h counted (the 30-minute write interval off)
+    // pump group bound: 11.5 h; 24 h counted (from the last-alive stamp)
     assert!(day > 20.0 && day < 35.0, "24 h off: {day}");
     let (_, warmer) = boot_after(Some(5_000 + 86_400), 25.0);
     assert!((warmer - day - 5.0).abs() < 0.05, "a 5 K warmer first ambient raises the drain by 5 K: {day} -> {warmer}");

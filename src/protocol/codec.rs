@@ -1,4 +1,4 @@
-//! Field encoders and decoders of the request and reply payloads (layouts in
+//! Field encoder and decoder of the sample request payload (layout in
 //! the [module docs](super)).
 
 use super::*;
@@ -28,19 +28,28 @@ impl Rd<'_> {
 
 impl Request {
     /// Payload bytes (without CRC).
-    pub fn to_payload(&self) -> Vec<u8, REQUEST_LEN> {
+    pub fn to_payload(&self) -> Vec<u8, REQUEST_MAX_LEN> {
         let mut p = Vec::new();
         let _ = p.push(KIND_SAMPLE);
         let _ = p.extend_from_slice(&self.seq.to_le_bytes());
         for v in [self.current_a, self.p_a_bar, self.p_b_bar, self.speed_rpm, self.position_mm, self.ambient_c] {
             let _ = p.extend_from_slice(&v.to_le_bytes());
         }
-        let flags = match self.valve_fb {
+        let mut flags = match self.valve_fb {
             None => 0,
             Some(false) => FLAG_VALVE_FB,
             Some(true) => FLAG_VALVE_FB | FLAG_VALVE_FB_OPEN,
         };
+        if self.elec_hz.is_some() {
+            flags |= FLAG_ELEC_HZ;
+        }
+        if self.lng_supply_bar.is_some() {
+            flags |= FLAG_LNG_SUPPLY;
+        }
         let _ = p.push(flags);
+        for v in [self.elec_hz, self.lng_supply_bar].into_iter().flatten() {
+            let _ = p.extend_from_slice(&v.to_le_bytes());
+        }
         p
     }
 
@@ -50,7 +59,12 @@ impl Request {
         if r.u8()? != KIND_SAMPLE {
             return Err(DecodeError::Kind);
         }
-        if p.len() != REQUEST_LEN {
+        let flags = p.get(REQUEST_LEN - 1).copied().ok_or(DecodeError::Length)?;
+        if flags & !(FLAG_VALVE_FB | FLAG_VALVE_FB_OPEN | FLAG_ELEC_HZ | FLAG_LNG_SUPPLY) != 0 || flags & (FLAG_VALVE_FB | FLAG_VALVE_FB_OPEN) == FLAG_VALVE_FB_OPEN {
+            return Err(DecodeError::Kind);
+        }
+        let want = REQUEST_LEN + 4 * usize::from(flags & FLAG_ELEC_HZ != 0) + 4 * usize::from(flags & FLAG_LNG_SUPPLY != 0);
+        if p.len() != want {
             return Err(DecodeError::Length);
         }
         let mut q = Request {
@@ -62,97 +76,22 @@ impl Request {
             position_mm: r.f32()?,
             ambient_c: r.f32()?,
             valve_fb: None,
+            elec_hz: None,
+            lng_supply_bar: None,
         };
-        q.valve_fb = match r.u8()? {
-            0 => None,
-            FLAG_VALVE_FB => Some(false),
-            f if f == FLAG_VALVE_FB | FLAG_VALVE_FB_OPEN => Some(true),
-            _ => return Err(DecodeError::Kind),
-        };
+        let _ = r.u8()?;
+        q.valve_fb = (flags & FLAG_VALVE_FB != 0).then_some(flags & FLAG_VALVE_FB_OPEN != 0);
+        if flags & FLAG_ELEC_HZ != 0 {
+            q.elec_hz = Some(r.f32()?);
+        }
+        if flags & FLAG_LNG_SUPPLY != 0 {
+            q.lng_supply_bar = Some(r.f32()?);
+        }
         Ok(q)
     }
 
     /// Wire bytes: COBS frame terminated by `0x00` (no leading delimiter).
     pub fn encode(&self) -> WireFrame {
         frame(&self.to_payload(), false)
-    }
-}
-
-impl Reply {
-    /// Payload bytes (without CRC).
-    pub fn to_payload(&self) -> Vec<u8, REPLY_LEN> {
-        let (kind, reason) = match self.kind {
-            ReplyKind::Tick => (KIND_TICK, 0u8),
-            ReplyKind::Reject(r) => (KIND_REJECT, r as u8),
-            ReplyKind::Done => (KIND_DONE, 0u8),
-        };
-        let c = &self.counters;
-        let mut p = Vec::new();
-        let _ = p.push(kind);
-        let _ = p.extend_from_slice(&self.seq.to_le_bytes());
-        let _ = p.push(reason);
-        let _ = p.extend_from_slice(&self.out.drain_c.to_le_bytes());
-        let _ = p.push(self.out.flags());
-        let _ = p.extend_from_slice(&self.out.faults.bits().to_le_bytes());
-        let _ = p.extend_from_slice(&self.out.lng_remaining_kg.to_le_bytes());
-        let _ = p.extend_from_slice(&self.out.lng_seconds_left.to_le_bytes());
-        let _ = p.extend_from_slice(&c.rejected_crc.to_le_bytes());
-        let _ = p.extend_from_slice(&c.rejected_framing.to_le_bytes());
-        let _ = p.extend_from_slice(&c.rejected_sequence.to_le_bytes());
-        let _ = p.extend_from_slice(&c.skipped.to_le_bytes());
-        let _ = p.extend_from_slice(&c.accepted.to_le_bytes());
-        let _ = p.extend_from_slice(&self.tick_cycles.to_le_bytes());
-        let _ = p.extend_from_slice(&0u16.to_le_bytes());
-        p
-    }
-
-    /// Parse a payload (CRC already checked and stripped).
-    pub fn from_payload(p: &[u8]) -> Result<Self, DecodeError> {
-        if p.len() != REPLY_LEN {
-            return Err(DecodeError::Length);
-        }
-        let mut r = Rd(p);
-        let kind_b = r.u8()?;
-        let seq = r.u16()?;
-        let reason = r.u8()?;
-        let kind = match kind_b {
-            KIND_TICK => ReplyKind::Tick,
-            KIND_DONE => ReplyKind::Done,
-            KIND_REJECT => ReplyKind::Reject(RejectReason::from_u8(reason).ok_or(DecodeError::Kind)?),
-            _ => return Err(DecodeError::Kind),
-        };
-        let drain_c = r.f32()?;
-        let flags = r.u8()?;
-        let faults = crate::faults::Faults::from_bits(r.u16()?);
-        let lng_remaining_kg = r.f32()?;
-        let lng_seconds_left = r.f32()?;
-        let counters = Counters {
-            rejected_crc: r.u16()?,
-            rejected_framing: r.u16()?,
-            rejected_sequence: r.u16()?,
-            skipped: r.u16()?,
-            accepted: r.u32()?,
-        };
-        let tick_cycles = r.u32()?;
-        Ok(Reply {
-            kind,
-            seq,
-            out: GuardOutput {
-                drain_c,
-                valve_open: flags & 1 != 0,
-                alarm: flags & 2 != 0,
-                derate: flags & 4 != 0,
-                faults,
-                lng_remaining_kg,
-                lng_seconds_left,
-            },
-            counters,
-            tick_cycles,
-        })
-    }
-
-    /// Wire bytes: `0x00`, COBS frame, `0x00`.
-    pub fn encode(&self) -> WireFrame {
-        frame(&self.to_payload(), true)
     }
 }

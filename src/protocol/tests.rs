@@ -14,6 +14,8 @@ fn req(seq: u16) -> Request {
         position_mm: 42.0,
         ambient_c: 21.0,
         valve_fb: None,
+        elec_hz: None,
+        lng_supply_bar: None,
     }
 }
 
@@ -63,9 +65,9 @@ fn request_round_trip_and_size() {
     assert_eq!(wire.iter().filter(|&&b| b == 0).count(), 1);
     let mut d = Deframer::new();
     let mut got = None;
-    for &b in &wire {
+    for &b in wire.iter() {
         if let Some(p) = d.push(b) {
-            got = Some(Request::from_payload(&p.unwrap()).unwrap());
+            got = Some(Request::from_payload(p.unwrap()).unwrap());
         }
     }
     assert_eq!(got, Some(r));
@@ -81,136 +83,84 @@ fn request_valve_feedback_flags() {
         assert_eq!(p[27], match fb { None => 0, Some(false) => 1, Some(true) => 3 });
         assert_eq!(Request::from_payload(&p), Ok(r));
     }
-    // Reserved bits, or "open" without "reported", are rejected.
-    for flags in [2u8, 4, 0x80, 0xff, 7] {
+    // Reserved bits, or "open" without "reported", are rejected; a flag
+    // for an optional field that is not there is a length error.
+    for flags in [2u8, 0x10, 0x80, 0xff, 0x06] {
         let mut p = req(3).to_payload();
         p[27] = flags;
         assert_eq!(Request::from_payload(&p), Err(DecodeError::Kind), "flags {flags:#x}");
     }
-}
-
-#[test]
-fn tick_guard_passes_the_valve_feedback() {
-    // A cold guard commands the valve shut at 21 degC; 50 frames reporting it
-    // open latch ACTUATOR (GuardConfig::DEFAULT.actuator_mismatch_ticks = 50).
-    let mut g = crate::GuardOf::<f32>::new(&crate::GuardConfig::DEFAULT, crate::Restore::Cold);
-    let s = Request { current_a: 0.0, p_a_bar: 5.0, p_b_bar: 5.0, speed_rpm: 500.0, ..req(0) };
-    let o = tick_guard(&mut g, &s, 0);
-    assert!(!o.valve_open && o.faults.is_empty(), "{o:?}");
-    let mut o = o;
-    for k in 1..=50u16 {
-        o = tick_guard(&mut g, &Request { seq: k, valve_fb: Some(true), ..s }, 0);
+    for flags in [FLAG_ELEC_HZ, FLAG_LNG_SUPPLY, FLAG_ELEC_HZ | FLAG_LNG_SUPPLY] {
+        let mut p = req(3).to_payload();
+        p[27] = flags;
+        assert_eq!(Request::from_payload(&p), Err(DecodeError::Length), "flags {flags:#x}");
     }
-    assert!(o.valve_open && o.faults.contains(crate::faults::ACTUATOR), "{o:?}");
+    // The optional fields round-trip, each alone and both.
+    for (hz, lng) in [(Some(33.5), None), (None, Some(4.5)), (Some(-12.0), Some(0.0))] {
+        let r = Request { elec_hz: hz, lng_supply_bar: lng, valve_fb: Some(true), ..req(4) };
+        let p = r.to_payload();
+        assert_eq!(p.len(), REQUEST_LEN + 4 * usize::from(hz.is_some()) + 4 * usize::from(lng.is_some()));
+        assert_eq!(Request::from_payload(&p), Ok(r));
+    }
+    // A version-1 frame (kind 0x01) is refused.
+    let mut p = req(3).to_payload();
+    p[0] = 0x01;
+    assert_eq!(Request::from_payload(&p), Err(DecodeError::Kind));
 }
 
 #[test]
-fn reply_round_trip() {
-    let rep = Reply {
-        kind: ReplyKind::Reject(RejectReason::Sequence),
-        seq: 65535,
-        out: GuardOutput {
-            drain_c: 40.125,
-            valve_open: true,
-            alarm: false,
-            derate: true,
-            faults: crate::faults::Faults::from_bits(0xA5A5),
-            lng_remaining_kg: 2.0,
-            lng_seconds_left: f32::INFINITY,
-        },
-        counters: Counters { rejected_crc: 1, rejected_framing: 2, rejected_sequence: 3, skipped: 4, accepted: 5 },
-        tick_cycles: 1234,
-    };
-    let wire = rep.encode();
-    assert_eq!(wire.first(), Some(&0));
-    let mut d = Deframer::new();
-    let got: std::vec::Vec<_> = wire.iter().filter_map(|&b| d.push(b)).collect();
-    assert_eq!(got.len(), 1);
-    assert_eq!(Reply::from_payload(got[0].as_ref().unwrap()).unwrap(), rep);
-}
-
-fn run(link: &mut Link, bytes: &[u8]) -> std::vec::Vec<Reply> {
-    let mut replies = std::vec::Vec::new();
-    link.push_bytes(
-        bytes,
-        |r, _| (GuardOutput { drain_c: r.seq as f32, ..Default::default() }, 0),
-        |rep, _| replies.push(*rep),
-    );
-    replies
-}
-
-#[test]
-fn sequence_rules() {
-    let mut l = Link::new();
-    assert_eq!(run(&mut l, &req(10).encode())[0].kind, ReplyKind::Tick);
-    // duplicate
-    assert_eq!(run(&mut l, &req(10).encode())[0].kind, ReplyKind::Reject(RejectReason::Sequence));
-    // older
-    assert_eq!(run(&mut l, &req(9).encode())[0].kind, ReplyKind::Reject(RejectReason::Sequence));
-    // next
-    let r = run(&mut l, &req(11).encode());
-    assert_eq!((r[0].kind, r[0].seq, r[0].out.drain_c), (ReplyKind::Tick, 11, 11.0));
-    // gap of 2 is accepted and counted
-    let r = run(&mut l, &req(14).encode());
-    assert_eq!(r[0].kind, ReplyKind::Tick);
-    assert_eq!(r[0].counters.skipped, 2);
-    assert_eq!(r[0].counters.rejected_sequence, 2);
-    assert_eq!(r[0].counters.accepted, 3);
-    // wrap-around
-    let mut l = Link::new();
-    run(&mut l, &req(65535).encode());
-    assert_eq!(run(&mut l, &req(0).encode())[0].kind, ReplyKind::Tick);
-}
-
-#[test]
-fn rejected_frame_does_not_tick_and_keeps_last_output() {
-    let mut l = Link::new();
-    run(&mut l, &req(1).encode());
-    let mut bad = req(2).encode();
-    bad[3] ^= 0x40;
-    let mut stepped = false;
-    let mut replies = std::vec::Vec::new();
-    l.push_bytes(&bad, |_, _| { stepped = true; (GuardOutput::default(), 0) }, |r, _| replies.push(*r));
-    assert!(!stepped);
-    assert!(matches!(replies[0].kind, ReplyKind::Reject(RejectReason::Crc | RejectReason::Cobs)));
-    assert_eq!(replies[0].out.drain_c, 1.0);
-    assert_eq!(replies[0].seq, 1);
-    // the link recovers on the next good frame
-    assert_eq!(run(&mut l, &req(2).encode())[0].kind, ReplyKind::Tick);
-}
-
-#[test]
-fn truncated_frame_rejected() {
+fn deframer_refuses_damaged_frames_and_recovers() {
     let wire = req(1).encode();
-    let n = wire.len();
-    for cut in 1..n - 1 {
-        let mut l = Link::new();
-        let mut bytes: std::vec::Vec<u8> = wire[..cut].to_vec();
-        bytes.push(0);
-        let r = run(&mut l, &bytes);
-        assert_eq!(r.len(), 1, "cut {cut}");
-        assert!(matches!(r[0].kind, ReplyKind::Reject(_)), "cut {cut}");
-        assert_eq!(l.counters().accepted, 0);
-        assert_eq!(l.counters().rejected(), 1);
+    let mut d = Deframer::new();
+    // every single-bit flip: refused (or split into refused pieces), never accepted
+    for bit in 0..wire.len() * 8 {
+        let mut bad = wire.to_vec();
+        bad[bit / 8] ^= 1 << (bit % 8);
+        bad.push(0);
+        for &b in &bad {
+            if let Some(r) = d.push(b) {
+                assert!(r.is_err(), "bit {bit}: accepted");
+            }
+        }
+        assert!(!d.pending());
     }
-}
-
-#[test]
-fn overflow_rejected_once_and_recovers() {
-    let mut l = Link::new();
-    let garbage = [0x55u8; 500];
-    let mut bytes = garbage.to_vec();
+    // truncation at every length
+    for cut in 1..wire.len() - 1 {
+        let mut bytes = wire[..cut].to_vec();
+        bytes.push(0);
+        let got: std::vec::Vec<bool> = bytes.iter().filter_map(|&b| d.push(b).map(|r| r.is_ok())).collect();
+        assert_eq!(got, [false], "cut {cut}");
+    }
+    // overflow: refused once, then the next frame is accepted
+    let mut bytes = [0x55u8; 500].to_vec();
     bytes.push(0);
-    bytes.extend_from_slice(&req(3).encode());
-    let r = run(&mut l, &bytes);
-    assert_eq!(r.len(), 2);
-    assert_eq!(r[0].kind, ReplyKind::Reject(RejectReason::Overflow));
-    assert_eq!(r[1].kind, ReplyKind::Tick);
+    bytes.extend_from_slice(&wire);
+    let got: std::vec::Vec<Result<std::vec::Vec<u8>, DecodeError>> =
+        bytes.iter().filter_map(|&b| d.push(b).map(|r| r.map(|p| p.to_vec()))).collect();
+    assert_eq!(got.len(), 2);
+    assert_eq!(got[0], Err(DecodeError::Overflow));
+    assert_eq!(Request::from_payload(got[1].as_ref().unwrap()), Ok(req(1)));
+    // empty frames are ignored
+    assert!([0u8, 0, 0].iter().all(|&b| d.push(b).is_none()));
 }
 
+/// The one-pass encoder gives the bytes of the reference COBS encoder over
+/// payload + CRC, for every payload length up to the largest.
 #[test]
-fn empty_frames_ignored() {
-    let mut l = Link::new();
-    assert!(run(&mut l, &[0, 0, 0]).is_empty());
-    assert_eq!(l.counters(), Counters::default());
+fn frame_equals_the_reference_encoding() {
+    for n in 0..=MAX_PAYLOAD {
+        let payload: std::vec::Vec<u8> = (0..n).map(|i| [0u8, 1, 0xFF, 7][i % 4] ^ (i as u8)).collect();
+        for lead in [false, true] {
+            let mut raw: Vec<u8, MAX_RAW> = Vec::new();
+            raw.extend_from_slice(&payload).unwrap();
+            raw.extend_from_slice(&crc16(&payload).to_le_bytes()).unwrap();
+            let mut want: Vec<u8, MAX_WIRE> = Vec::new();
+            if lead {
+                want.push(0).unwrap();
+            }
+            cobs_encode(&raw, &mut want).unwrap();
+            want.push(0).unwrap();
+            assert_eq!(&framing::frame(&payload, lead)[..], &want[..], "n {n} lead {lead}");
+        }
+    }
 }

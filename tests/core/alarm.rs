@@ -165,6 +165,8 @@ fn alarm_round_trip<N: Num>() -> (u32, u32) {
             None => ramp(&idle(), &load(), k),
             Some(k0) => ramp(&load(), &idle(), k - k0),
         };
+        // a valve with a position switch that follows its command
+        g.valve_feedback(g.output().valve_open);
         let o = g.tick(&s);
         let m = g.model().expect("default parameters build a model");
         let d = m.drain_c();

@@ -8,6 +8,8 @@ mod lng_credit;
 mod model_accuracy;
 mod plant;
 mod protection_props;
+mod rate;
+mod stall;
 mod startup;
 mod untrusted;
 mod valve;

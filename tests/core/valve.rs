@@ -182,6 +182,7 @@ fn guard_opens_at_the_first_model_step_above_40_also_right_after_a_closing() {
                     sample(10.0 + 330.0 * f, 500.0 + 2000.0 * f)
                 }
             };
+            g.valve_feedback(g.output().valve_open);
             let o = g.tick(&s);
             assert!(!o.faults.intersects(faults::LATCHED), "tick {k}: {o:?}");
             let d = g.model().unwrap().drain_c();

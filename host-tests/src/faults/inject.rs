@@ -143,6 +143,8 @@ impl InputFault {
 /// One fault of the campaign.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Fault {
+    /// No fault: the scenario as it is (the baseline of the start times).
+    None,
     /// A faulty input channel.
     Input(Channel, InputFault),
     /// Bursts of lost frames: 0.5 s of every 10 s.
@@ -155,20 +157,46 @@ pub enum Fault {
     OutOfOrderFrames,
     /// The MCU resets (watchdog, brown-out) and restores its thermal record.
     WarmReset,
-    /// Power is lost for 60 s; RAM is gone; the guard boots from its
-    /// non-volatile record.
+    /// The whole EHA loses power for [`super::POWER_OFF_S`]: the pump
+    /// stops, RAM is gone, the clock runs on; the guard boots from its
+    /// non-volatile record cooled over the measured off-time.
     PowerLoss,
+    /// Only the guard's MCU loses power for [`super::POWER_OFF_S`] while
+    /// the machine runs on (the residual risk of the power-off cooling).
+    PowerLossMachineRunning,
     /// A reset during the record write: the record reads corrupt at boot.
     TornRecordWrite,
     /// The LNG tank is empty (and the guard's budget knows it: its record
     /// says the charge is used up); the exchanger does not cool.
     LngEmpty,
+    /// The tank runs physically empty (or the line blocks) at the fault's
+    /// start; the guard's budget still says there is LNG.
+    LngEmptyPhysical,
+    /// The tank is empty and the budget knows it ([`Fault::LngEmpty`]), and
+    /// the controller asks for a refill (armed, keyed) every 10 s: no new
+    /// charge was installed.
+    RefillWhileEmpty,
     /// The valve sticks closed whatever it is commanded.
     ValveStuckClosed,
+    /// The frames stop carrying the valve's position report.
+    NoValveFeedback,
+    /// Every flash write fails from the start; the EHA loses power
+    /// 120 s later (60 s off) and boots from what the flash still holds.
+    FlashWriteFail,
+    /// The EHA loses power at the start (60 s off) and the flash cannot be
+    /// read at the next boot.
+    FlashReadFail,
+    /// A port-A pressure stuck at zero (a fault that latches) with the
+    /// controller confirming a clear (armed, keyed) every second.
+    ClearSpam,
+    /// A reset that leaves both RAM records torn and the flash unreadable
+    /// (an unknown start), the controller confirming a clear 2 s after the
+    /// boot and every 10 s.
+    CorruptStartClear,
 }
 
 impl Fault {
-    /// Every fault of the campaign.
+    /// Every fault of the campaign (not [`Fault::None`]: the baseline).
     pub fn all() -> Vec<Fault> {
         let mut v: Vec<Fault> =
             Channel::ALL.iter().flat_map(|&c| InputFault::ALL.iter().map(move |&f| Fault::Input(c, f))).collect();
@@ -179,16 +207,42 @@ impl Fault {
             Fault::OutOfOrderFrames,
             Fault::WarmReset,
             Fault::PowerLoss,
+            Fault::PowerLossMachineRunning,
             Fault::TornRecordWrite,
             Fault::LngEmpty,
+            Fault::LngEmptyPhysical,
+            Fault::RefillWhileEmpty,
             Fault::ValveStuckClosed,
+            Fault::NoValveFeedback,
+            Fault::FlashWriteFail,
+            Fault::FlashReadFail,
+            Fault::ClearSpam,
+            Fault::CorruptStartClear,
         ]);
         v
+    }
+
+    /// The fault is the same whenever it starts (it acts from boot): run
+    /// at one start time only.
+    pub fn from_boot(&self) -> bool {
+        matches!(self, Fault::None | Fault::LateStart | Fault::LngEmpty | Fault::RefillWhileEmpty)
+    }
+
+    /// A fault of the speed channel (run with and without the drive's
+    /// electrical frequency).
+    pub fn is_speed(&self) -> bool {
+        matches!(self, Fault::Input(Channel::Speed, _))
+    }
+
+    /// A fault the LNG supply pressure sees (run with and without it).
+    pub fn is_supply(&self) -> bool {
+        matches!(self, Fault::LngEmptyPhysical | Fault::RefillWhileEmpty)
     }
 
     /// Name used in the campaign's table, e.g. `current/gain-x0.5`.
     pub fn name(&self) -> String {
         match self {
+            Fault::None => "none".into(),
             Fault::Input(c, f) => format!("{}/{}", c.name(), f.name()),
             Fault::DropoutBursts => "dropout-bursts".into(),
             Fault::LateStart => "late-start".into(),
@@ -196,9 +250,17 @@ impl Fault {
             Fault::OutOfOrderFrames => "out-of-order-frames".into(),
             Fault::WarmReset => "warm-reset".into(),
             Fault::PowerLoss => "power-loss".into(),
+            Fault::PowerLossMachineRunning => "power-loss-machine-running".into(),
             Fault::TornRecordWrite => "torn-record-write".into(),
             Fault::LngEmpty => "lng-empty".into(),
             Fault::ValveStuckClosed => "valve-stuck-closed".into(),
+            Fault::LngEmptyPhysical => "lng-empty-physical".into(),
+            Fault::RefillWhileEmpty => "refill-while-empty".into(),
+            Fault::NoValveFeedback => "no-valve-feedback".into(),
+            Fault::FlashWriteFail => "flash-write-fail".into(),
+            Fault::FlashReadFail => "flash-read-fail".into(),
+            Fault::ClearSpam => "clear-spam".into(),
+            Fault::CorruptStartClear => "corrupt-start-clear".into(),
         }
     }
 }

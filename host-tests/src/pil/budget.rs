@@ -103,9 +103,11 @@ const IMAGES: [Image; 4] = [
 fn run_product(elf: &Path) -> Result<ImageBudget> {
     let mut s = super::product::ProductSession::spawn(elf, &[])?;
     let mut others = Vec::new();
-    for r in super::drill::inputs().iter().take(300) {
-        s.send_sample(r)?;
-        s.next_tick(Duration::from_secs(2), &mut others)?.context("no tick reply from the product image")?;
+    let mut open = false;
+    for r in super::drill::requests().iter().take(300) {
+        s.send(&super::drill::bytes(r, open))?;
+        let (_, t) = s.next_tick(Duration::from_secs(2), &mut others)?.context("no tick reply from the product image")?;
+        open = t.out.valve_open;
     }
     let st = s.status(1, &mut Vec::new())?;
     Ok(ImageBudget {
@@ -286,15 +288,17 @@ pub fn regressions(measured: &BTreeMap<String, ImageBudget>, budget: &BTreeMap<S
     v
 }
 
-/// The product image's absolute budgets (issue 14): `Guard::tick` ≤ 400
-/// instructions per tick on the mean, `Guard::new` ≤ 100 k, boot stack ≤ 4 KiB,
-/// tick-loop stack ≤ 2 KiB, flash (`.text` + `.rodata`) ≤ 32 KiB.
+/// The product image's absolute budgets: `Guard::tick` ≤ 400 instructions
+/// per tick on the mean, `Guard::new` ≤ 100 k, boot stack ≤ 4 KiB, tick-loop
+/// stack ≤ 2 KiB, flash (`.text` + `.rodata`) ≤ 40 KiB (was 32 KiB: the room
+/// is for the protection features of the safety case, each one's cost listed
+/// in docs/firmware-numbers.md).
 pub const PRODUCT_LIMITS: [(&str, f64); 5] = [
     ("instr_per_tick_mean", 400.0),
     ("guard_new_instr", 100_000.0),
     ("stack_boot_b", 4096.0),
     ("stack_tick_b", 2048.0),
-    ("flash_b", 32768.0),
+    ("flash_b", 40960.0),
 ];
 
 /// Every [`PRODUCT_LIMITS`] figure of `product-mps2` that is over its limit
@@ -346,7 +350,7 @@ pub fn run(a: &BudgetArgs) -> Result<()> {
         bail!("firmware budget exceeded ({}):\n  {}", path.display(), r.join("\n  "));
     }
     println!(
-        "every figure within {} + {:.0} %, and the product image within its limits (400 instr/tick, 100 k init, 4/2 KiB stack, 32 KiB flash)",
+        "every figure within {} + {:.0} %, and the product image within its limits (400 instr/tick, 100 k init, 4/2 KiB stack, 40 KiB flash)",
         path.display(),
         100.0 * REGRESSION_MARGIN
     );
@@ -380,7 +384,7 @@ mod tests {
     }
 
     /// The product image's absolute limits: the committed figures pass, one
-    /// byte over 32 KiB of flash fails, a missing figure fails.
+    /// byte over 40 KiB of flash fails, a missing figure fails.
     #[test]
     fn product_limits_are_absolute() {
         let ok = ImageBudget {
@@ -393,7 +397,7 @@ mod tests {
         };
         let m = |b: ImageBudget| BTreeMap::from([("product-mps2".to_string(), b)]);
         assert!(over_product_limits(&m(ok.clone())).is_empty());
-        assert_eq!(over_product_limits(&m(ImageBudget { flash_b: Some(32_769.0), ..ok.clone() })).len(), 1);
+        assert_eq!(over_product_limits(&m(ImageBudget { flash_b: Some(40_961.0), ..ok.clone() })).len(), 1);
         assert_eq!(over_product_limits(&m(ImageBudget { stack_boot_b: None, ..ok })).len(), 1);
     }
 }

@@ -10,7 +10,7 @@ use crate::rig::Rig;
 use crate::scenario::Scenario;
 
 use super::report::{self, Summary};
-use super::sil::{sil_core, SilTarget};
+use super::sil::SilTarget;
 use super::{build_firmware, replay, run_pil, Build, LoopOptions, QemuOptions};
 
 /// Arguments of the `pil` subcommand.
@@ -123,7 +123,7 @@ pub fn run(args: &PilArgs) -> Result<()> {
     println!("{}", report::table(&run.records, args.table_every));
     print!("{}", report::summary_text(&run, &s));
     if !args.no_sil {
-        let mut sil = SilTarget::new(sil_core(build));
+        let mut sil = SilTarget::new(build);
         let sil_replies = replay(&run.records, &mut sil)?;
         let fw: Vec<_> = run.records.iter().map(|r| r.reply).collect();
         let c = report::compare(&fw, &sil_replies);

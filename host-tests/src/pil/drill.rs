@@ -1,5 +1,6 @@
 //! The open-loop "drill" input sequence used by the PIL equivalence and
-//! golden-output tests: 600 s at the firmware's 10 ms tick (60,000 frames).
+//! golden-output tests: 600 s at the firmware's 10 ms tick (60,000 ticks,
+//! 59,987 sample frames).
 //!
 //! - 0–100 s: hard throttling (140 bar, 500 rpm): the predicted drain
 //!   temperature crosses 40 °C and the LNG valve opens (about 22 s);
@@ -10,12 +11,13 @@
 //! - 300 s: the current sensor reads 30 % low (SENSOR_DISAGREE latches after
 //!   three 2 s windows: valve forced open, alarm and derate held, the model
 //!   heats with the larger loss);
-//! - tick 10,000: 3 lost frames (sequence gap, missed ticks, below `stale_ticks`);
+//! - tick 10,000: 3 lost frames (3 ticks without a sample, below `stale_ticks`);
 //! - tick 45,000: 10 lost frames (STALE fault latches, fail-safe valve open);
 //! - tick 50,000: a NaN current (non-finite fault); tick 55,000: 5000 bar (range fault).
 //!
-//! The piston moves ±20 mm slowly throughout; ambient 16 °C. No valve position is
-//! reported.
+//! The piston moves ±20 mm slowly throughout; ambient 16 °C. The valve's
+//! position switch reports the valve the last tick commanded ([`bytes`]: the
+//! harness passes the last tick reply's command; a valve that follows).
 
 use eha_guard::protocol::Request;
 
@@ -33,11 +35,17 @@ pub fn motor_current(p_a_bar: f32, p_b_bar: f32, speed_rpm: f32) -> f32 {
     (tau.abs() / p.torque_constant_nm_per_a) as f32
 }
 
-/// Number of frames.
+/// Number of ticks.
 pub const STEPS: u32 = 60_000;
 
-/// The frames, in order (sequence numbers include the gaps).
-pub fn inputs() -> Vec<Request> {
+/// The bytes of tick `k` of the drill (empty: the frame was lost), with the
+/// valve's position as the last tick commanded it (`last_open`).
+pub fn bytes(r: &Option<Request>, last_open: bool) -> Vec<u8> {
+    r.map_or_else(Vec::new, |r| Request { valve_fb: Some(last_open), ..r }.encode().to_vec())
+}
+
+/// Per tick, the sample the controller sent (`None`: lost on the way).
+pub fn requests() -> Vec<Option<Request>> {
     let mut v = Vec::with_capacity(STEPS as usize);
     let mut seq: u16 = 0;
     for k in 0..STEPS {
@@ -54,6 +62,8 @@ pub fn inputs() -> Vec<Request> {
             position_mm: 20.0 * (0.05 * t).sin(),
             ambient_c: 16.0,
             valve_fb: None,
+        elec_hz: None,
+        lng_supply_bar: None,
         };
         if k == 50_000 {
             r.current_a = f32::NAN;
@@ -61,12 +71,9 @@ pub fn inputs() -> Vec<Request> {
         if k == 55_000 {
             r.p_a_bar = 5000.0;
         }
-        v.push(r);
-        seq = seq.wrapping_add(match k {
-            10_000 => 4,
-            45_000 => 11,
-            _ => 1,
-        });
+        let lost = (10_001..10_004).contains(&k) || (45_001..45_011).contains(&k);
+        v.push((!lost).then_some(r));
+        seq = seq.wrapping_add(1);
     }
     v
 }

@@ -1,11 +1,15 @@
-//! Processor-in-the-loop (PIL): the real firmware binary in QEMU, in
-//! closed loop and lockstep with the reference plant on the host.
+//! Processor-in-the-loop (PIL): the product application in QEMU (the PIL
+//! image `eha-fw`: [`eha_guard::product::App`] on a lockstep semihosting
+//! board), in closed loop and lockstep with the reference plant on the host.
 //!
-//! Per tick: the plant's sensor values become one request frame
-//! ([`eha_guard::protocol`]), the firmware answers with one reply frame, the
-//! reply's valve command drives the plant's LNG valve, the plant advances one
-//! tick. The same loop runs against [`sil::SilTarget`] (the same core code on
-//! the host), which is the bit-for-bit oracle for the firmware's replies.
+//! Per tick: the plant's sensor values become one sample frame
+//! ([`eha_guard::protocol`]), sent as the bytes the controller's UART
+//! delivered in that tick; the application answers with the tick's frames
+//! (its tick reply first, [`eha_guard::product::wire`]); the reply's valve
+//! command drives the plant's LNG valve, the plant advances one tick. The
+//! same loop runs against [`sil::SilTarget`] (the same application on the
+//! shared in-memory board, on the host), the bit-for-bit oracle for the
+//! firmware's frames.
 
 pub mod budget;
 pub mod defmt_log;
@@ -21,7 +25,8 @@ pub mod sil;
 
 use std::time::{Duration, Instant};
 
-use eha_guard::protocol::{Reply, ReplyKind, Request};
+use eha_guard::product::wire::{FromGuard, Status, TickReply};
+use eha_guard::protocol::Request;
 
 pub use firmware::{build_bin, build_firmware, Build};
 pub use qemu::{PilError, QemuOptions, QemuSession};
@@ -48,6 +53,10 @@ pub struct PlantSensors {
     /// LNG valve position read back (the valve the plant ran during the last tick),
     /// if the plant reports it; sent in the request's flags byte.
     pub valve_fb: Option<bool>,
+    /// The motor drive's electrical frequency, Hz (signed), if the controller sends it.
+    pub elec_hz: Option<f32>,
+    /// LNG supply pressure at the valve, bar gauge, if the controller sends it.
+    pub lng_supply_bar: Option<f32>,
 }
 
 impl PlantSensors {
@@ -62,6 +71,8 @@ impl PlantSensors {
             position_mm: self.position_mm as f32,
             ambient_c: self.ambient_c as f32,
             valve_fb: self.valve_fb,
+            elec_hz: self.elec_hz,
+            lng_supply_bar: self.lng_supply_bar,
         }
     }
 }
@@ -90,17 +101,40 @@ pub trait PlantModel {
     ) -> anyhow::Result<()>;
 }
 
-/// The thing that answers request frames: the firmware in QEMU or the SIL core.
+/// What one tick of the application sent.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TickOut {
+    /// The tick reply.
+    pub reply: TickReply,
+    /// The other frames of the tick (acknowledgements, status, trace), in order.
+    pub others: Vec<FromGuard>,
+    /// The tick's cost in core-clock cycles (SysTick; under QEMU `-icount`
+    /// 25.6 per instruction); 0 when not measured (the host twin).
+    pub cycles: u32,
+}
+
+/// The application under test, one tick at a time: the PIL image in QEMU
+/// or its host twin.
 pub trait Target {
-    /// Send one encoded frame, return the reply to it.
-    fn exchange(&mut self, wire: &[u8], tick: u64) -> Result<Reply, PilError>;
+    /// One tick: `rx` is what the controller's UART delivered since the
+    /// last tick (a sample frame, commands; empty: a missing sample).
+    fn tick(&mut self, rx: &[u8], tick: u64) -> Result<TickOut, PilError>;
 }
 
 impl Target for QemuSession {
-    fn exchange(&mut self, wire: &[u8], tick: u64) -> Result<Reply, PilError> {
-        self.send(wire)?;
-        self.recv(tick)
+    fn tick(&mut self, rx: &[u8], tick: u64) -> Result<TickOut, PilError> {
+        self.send_chunk(rx)?;
+        self.recv_tick(tick)
     }
+}
+
+/// Splits a tick's frames into its tick reply and the rest; `None` when
+/// there is no tick reply (the caller says what that means).
+pub fn tick_out(frames: Vec<FromGuard>, cycles: u32) -> Option<TickOut> {
+    let k = frames.iter().position(|f| matches!(f, FromGuard::Tick(_)))?;
+    let mut others = frames;
+    let FromGuard::Tick(reply) = others.remove(k) else { return None };
+    Some(TickOut { reply, others, cycles })
 }
 
 /// One lockstep tick.
@@ -110,10 +144,12 @@ pub struct TickRecord {
     pub t_s: f64,
     /// What the plant measured then (and its true drain temperature).
     pub sensors: PlantSensors,
-    /// The frame sent to the firmware.
+    /// The sample frame sent to the application.
     pub request: Request,
-    /// The firmware's reply to it.
-    pub reply: Reply,
+    /// The tick reply of the tick that used it.
+    pub reply: TickReply,
+    /// The tick's cost in core-clock cycles (0: not measured).
+    pub cycles: u32,
 }
 
 /// Closed-loop run options.
@@ -157,19 +193,20 @@ pub fn run_closed_loop(
             return StepControl::Stop;
         }
         let request = sensors.request((k & 0xFFFF) as u16);
-        let reply = match target.exchange(&request.encode(), k) {
+        let out = match target.tick(&request.encode(), k) {
             Ok(r) => r,
             Err(e) => {
                 failure = Some(e.into());
                 return StepControl::Stop;
             }
         };
-        if reply.kind != ReplyKind::Tick || reply.seq != request.seq {
-            let what = format!("expected a tick reply to seq {}, got {:?} for seq {}", request.seq, reply.kind, reply.seq);
+        let reply = out.reply;
+        if !reply.fresh || reply.sample_seq != request.seq {
+            let what = format!("expected the tick to use sample {}, it used {} (fresh {})", request.seq, reply.sample_seq, reply.fresh);
             failure = Some(PilError::Protocol { tick: k, what }.into());
             return StepControl::Stop;
         }
-        records.push(TickRecord { t_s, sensors: *sensors, request, reply });
+        records.push(TickRecord { t_s, sensors: *sensors, request, reply, cycles: out.cycles });
         if records.len() as u64 >= n {
             StepControl::Stop
         } else {
@@ -193,10 +230,10 @@ pub fn run_closed_loop(
     Ok(records)
 }
 
-/// Replay the exact request frames of a run through another target (SIL) and
-/// return its replies.
-pub fn replay(records: &[TickRecord], target: &mut dyn Target) -> Result<Vec<Reply>, PilError> {
-    records.iter().enumerate().map(|(k, r)| target.exchange(&r.request.encode(), k as u64)).collect()
+/// Replay the exact sample frames of a run through another target (SIL) and
+/// return its tick replies.
+pub fn replay(records: &[TickRecord], target: &mut dyn Target) -> Result<Vec<TickReply>, PilError> {
+    records.iter().enumerate().map(|(k, r)| target.tick(&r.request.encode(), k as u64).map(|o| o.reply)).collect()
 }
 
 /// Result of a full PIL session.
@@ -206,14 +243,14 @@ pub struct PilRun {
     pub build: Build,
     /// Every lockstep tick.
     pub records: Vec<TickRecord>,
-    /// The completion marker (a `Done` reply with the final counters).
-    pub done: Reply,
+    /// The completion marker (a status reply with the final counters).
+    pub done: Status,
     /// The firmware's decoded defmt log.
     pub log: Vec<defmt_log::LogLine>,
     /// Wall-clock time of the session.
     pub wall: Duration,
-    /// Whether QEMU counted instructions (`-icount`): the replies' tick
-    /// counts are then instruction counts.
+    /// Whether QEMU counted instructions (`-icount`): the ticks' cycle
+    /// counts are then instruction counts × 25.6.
     pub icount: bool,
 }
 
@@ -230,8 +267,8 @@ pub fn run_pil(plant: &mut dyn PlantModel, qemu: &QemuOptions, opts: &LoopOption
                 Ok(end) => {
                     let log = defmt_log::decode(&qemu.elf, &end.defmt)
                         .map_err(|e| PilFailure::new(records.clone(), Vec::new(), e.context("decoding the defmt log")))?;
-                    if end.done.counters.accepted != ticks as u32 {
-                        let what = format!("firmware accepted {} frames, host sent {ticks}", end.done.counters.accepted);
+                    if end.done.accepted != ticks as u32 {
+                        let what = format!("firmware accepted {} frames, host sent {ticks}", end.done.accepted);
                         return Err(PilFailure::new(records, log, PilError::Protocol { tick: ticks, what }.into()));
                     }
                     Ok(PilRun { build: qemu.build, records, done: end.done, log, wall: start.elapsed(), icount: qemu.icount })
@@ -295,15 +332,15 @@ pub fn firmware_for_tests(build: Build) -> std::path::PathBuf {
     elf
 }
 
-/// An open-loop firmware session: fixed frames in, replies out.
+/// An open-loop firmware session: fixed inputs in, tick frames out.
 #[derive(Debug)]
 pub struct OpenLoopRun {
     /// Which firmware build ran.
     pub build: Build,
-    /// One reply per request, in order.
-    pub replies: Vec<Reply>,
-    /// The completion marker (a `Done` reply with the final counters).
-    pub done: Reply,
+    /// One tick's frames per input, in order.
+    pub ticks: Vec<TickOut>,
+    /// The completion marker (a status reply with the final counters).
+    pub done: Status,
     /// The firmware's decoded defmt log.
     pub log: Vec<defmt_log::LogLine>,
     /// Wall-clock time of the session.
@@ -312,16 +349,25 @@ pub struct OpenLoopRun {
     pub icount: bool,
 }
 
-/// Send `requests` one by one in lockstep, then end the input and collect
-/// the completion marker and the decoded defmt log.
-pub fn run_open_loop(qemu: &QemuOptions, requests: &[Request]) -> anyhow::Result<OpenLoopRun> {
+/// Runs the drill's samples (per tick: a sample, or `None`: lost) on
+/// `target` in lockstep, each reporting the valve the previous tick
+/// commanded ([`drill::bytes`]); the tick frames.
+pub fn run_drill(target: &mut dyn Target, samples: &[Option<Request>]) -> Result<Vec<TickOut>, PilError> {
+    let mut ticks: Vec<TickOut> = Vec::with_capacity(samples.len());
+    for (k, r) in samples.iter().enumerate() {
+        let open = ticks.last().is_some_and(|t| t.reply.out.valve_open);
+        ticks.push(target.tick(&drill::bytes(r, open), k as u64)?);
+    }
+    Ok(ticks)
+}
+
+/// Runs the drill's samples in QEMU ([`run_drill`]), then ends the input
+/// and collects the completion marker and the decoded defmt log.
+pub fn run_open_loop(qemu: &QemuOptions, samples: &[Option<Request>]) -> anyhow::Result<OpenLoopRun> {
     let start = Instant::now();
     let mut s = QemuSession::spawn(qemu)?;
-    let mut replies = Vec::with_capacity(requests.len());
-    for (k, r) in requests.iter().enumerate() {
-        replies.push(s.exchange(&r.encode(), k as u64)?);
-    }
-    let end = s.finish(requests.len() as u64)?;
+    let ticks = run_drill(&mut s, samples)?;
+    let end = s.finish(samples.len() as u64)?;
     let log = defmt_log::decode(&qemu.elf, &end.defmt)?;
-    Ok(OpenLoopRun { build: qemu.build, replies, done: end.done, log, wall: start.elapsed(), icount: qemu.icount })
+    Ok(OpenLoopRun { build: qemu.build, ticks, done: end.done, log, wall: start.elapsed(), icount: qemu.icount })
 }

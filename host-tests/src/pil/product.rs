@@ -176,7 +176,7 @@ impl ProductSession {
                 };
                 for &b in &buf[..n] {
                     if let Some(Ok(p)) = d.push(b) {
-                        if let Ok(frame) = FromGuard::from_payload(&p) {
+                        if let Ok(frame) = FromGuard::from_payload(p) {
                             let r = Received { at_s: start.elapsed().as_secs_f64(), frame };
                             if tx.send(r).is_err() {
                                 return;
@@ -213,7 +213,7 @@ impl ProductSession {
 
     /// Sends a command.
     pub fn command(&mut self, token: u16, cmd: Cmd) -> Result<()> {
-        self.send(&GuardCommand { token, cmd }.encode())
+        self.send(&GuardCommand { token, cmd, arg: 0 }.encode())
     }
 
     /// The next frame, waiting at most `timeout`.
@@ -419,48 +419,6 @@ pub fn run_closed_loop(
     Ok(run)
 }
 
-/// A board on the host for [`sil_replay`]: the bytes of each tick, the
-/// pins echoed, records kept in memory.
-struct ReplayBoard {
-    rx: Vec<u8>,
-    tx: Vec<u8>,
-    ticks: u32,
-    records: [eha_guard::ThermalRecord; 2],
-    block: Option<&'static [u8; eha_guard::params_block::BLOCK_LEN]>,
-}
-
-impl eha_guard::product::Board for ReplayBoard {
-    fn read_rx(&mut self, buf: &mut [u8]) -> usize {
-        let n = buf.len().min(self.rx.len());
-        buf[..n].copy_from_slice(&self.rx[..n]);
-        self.rx.drain(..n);
-        n
-    }
-    fn rx_dropped(&self) -> u32 {
-        0
-    }
-    fn write_tx(&mut self, bytes: &[u8]) {
-        self.tx.extend_from_slice(bytes);
-    }
-    fn set_pins(&mut self, pins: Pins) -> Pins {
-        pins
-    }
-    fn feed_watchdog(&mut self) {}
-    fn ticks(&self) -> u32 {
-        self.ticks
-    }
-    fn wait_tick(&mut self, _seen: u32) {
-        self.ticks += 1;
-    }
-    fn store_record(&mut self, slot: usize, rec: &eha_guard::ThermalRecord) {
-        self.records[slot & 1] = *rec;
-    }
-    fn store_cause(&mut self, _rec: &eha_guard::product::reset::CauseRecord) {}
-    fn param_block(&self) -> Option<&'static [u8; eha_guard::params_block::BLOCK_LEN]> {
-        self.block
-    }
-}
-
 /// The host build of the product application (SIL) fed exactly what the
 /// firmware's tick replies say it saw: per tick, the sample it used (by
 /// sequence number) or none, and the periods an overrun swallowed (gaps in
@@ -474,22 +432,18 @@ pub fn sil_replay(run: &ProductRun) -> Vec<TickReply> {
 /// (as the firmware's PARAMS region). The block is leaked: it stands for
 /// flash, which lives as long as the program.
 pub fn sil_replay_with_block(run: &ProductRun, block: Option<&[u8; eha_guard::params_block::BLOCK_LEN]>) -> Vec<TickReply> {
-    use eha_guard::product::{App, BootMemory};
+    use eha_guard::product::mem_board::MemBoard;
+    use eha_guard::product::App;
     #[repr(C, align(4))]
     struct Aligned([u8; eha_guard::params_block::BLOCK_LEN]);
     let block = block.map(|b| &Box::leak(Box::new(Aligned(*b))).0);
     let by_seq: std::collections::HashMap<u16, Request> = run.samples.iter().map(|p| (p.request.seq, p.request)).collect();
-    let mut b = ReplayBoard { rx: Vec::new(), tx: Vec::new(), ticks: 0, records: [eha_guard::ThermalRecord::EMPTY; 2], block };
-    let mem = BootMemory {
-        records: (eha_guard::ThermalRecord::EMPTY, eha_guard::ThermalRecord::EMPTY),
-        nv: None,
-        cause: eha_guard::product::reset::CauseRecord::new(0, 0),
-        hw_hint: None,
-    };
-    let mut app = App::boot(&mut b, &eha_guard::GuardConfig::DEFAULT, &mem);
+    let mut b = Box::new(MemBoard::new());
+    b.block = block;
+    let mem = b.boot_memory();
+    let mut app = App::boot(&mut *b, &eha_guard::GuardConfig::DEFAULT, &mem);
     let mut out = Vec::new();
     let mut last_tick = 0u32;
-    let mut d = Deframer::new();
     for (_, t) in &run.ticks {
         if t.tick <= last_tick {
             break; // the firmware rebooted
@@ -498,15 +452,14 @@ pub fn sil_replay_with_block(run: &ProductRun, block: Option<&[u8; eha_guard::pa
         last_tick = t.tick;
         if t.fresh {
             if let Some(r) = by_seq.get(&t.sample_seq) {
-                b.rx.extend_from_slice(&r.encode());
+                b.push_rx(&r.encode());
             }
         }
-        app.tick(&mut b, lost);
-        for byte in std::mem::take(&mut b.tx) {
-            if let Some(Ok(p)) = d.push(byte) {
-                if let Ok(FromGuard::Tick(r)) = FromGuard::from_payload(&p) {
-                    out.push(r);
-                }
+        b.clear_tx();
+        app.tick(&mut *b, lost);
+        for f in super::sil::frames(b.tx()) {
+            if let FromGuard::Tick(r) = f {
+                out.push(r);
             }
         }
     }

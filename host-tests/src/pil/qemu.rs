@@ -1,10 +1,11 @@
-//! Running the firmware in `qemu-system-arm` and talking to it in lockstep.
+//! Running the PIL image in `qemu-system-arm` and talking to it in lockstep.
 //!
-//! Channels (see `src/bin/eha-fw.rs`): requests → QEMU stdin; replies ← QEMU
-//! stderr (semihosting `:tt` append); defmt log ← QEMU stdout. Both output
-//! pipes are drained by threads so the emulator never blocks on a full pipe;
-//! replies reach the lockstep loop over a channel, which is what gives the
-//! timeout.
+//! Channels (see `src/bin/eha-fw.rs`, `eha_guard::protocol::lockstep`):
+//! per-tick chunks of received bytes → QEMU stdin; the tick's frames and its
+//! end-of-tick frame ← QEMU stderr (semihosting `:tt` append); defmt log ←
+//! QEMU stdout. Both output pipes are drained by threads so the emulator
+//! never blocks on a full pipe; frames reach the lockstep loop over a
+//! channel, which is what gives the timeout.
 
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
@@ -13,7 +14,9 @@ use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-use eha_guard::protocol::{Deframer, Reply};
+use eha_guard::product::wire::{FromGuard, Status};
+use eha_guard::protocol::lockstep::{parse_tick_end, DONE_TOKEN};
+use eha_guard::protocol::Deframer;
 
 use super::firmware::Build;
 
@@ -24,7 +27,7 @@ pub fn exit_meaning(code: i32) -> &'static str {
         2 => "firmware panic",
         3 => "firmware HardFault",
         4 => "unexpected exception/interrupt (DefaultHandler)",
-        5 => "firmware could not read stdin",
+        5 => "firmware could not read stdin (or a chunk was cut short)",
         6 => "firmware could not write replies",
         7 => "firmware could not open semihosting stdio",
         _ => "unknown exit code (QEMU itself failed?)",
@@ -62,7 +65,7 @@ pub enum PilError {
         /// QEMU's stderr text.
         text: String,
     },
-    /// The firmware exited without its `Done` reply.
+    /// The firmware exited without its completion marker.
     #[error("firmware exited without the completion marker (exit status {status}); the run is not trustworthy. QEMU stderr text: {text:?}")]
     NoCompletionMarker {
         /// QEMU's exit status.
@@ -70,7 +73,7 @@ pub enum PilError {
         /// QEMU's stderr text.
         text: String,
     },
-    /// A reply frame that does not decode or does not answer the request.
+    /// A tick whose frames do not decode or do not answer the input.
     #[error("protocol error at tick {tick}: {what}")]
     Protocol {
         /// Step of the bad reply.
@@ -95,10 +98,10 @@ pub struct QemuOptions {
     pub machine: String,
     /// QEMU CPU (see `machine`).
     pub cpu: String,
-    /// How long to wait for one reply before declaring the firmware dead.
+    /// How long to wait for one tick's frames before declaring the firmware dead.
     pub reply_timeout: Duration,
     /// Deterministic instruction counting (`-icount shift=10`): the SysTick
-    /// ticks in each reply then count instructions × 25.6.
+    /// cycles of each tick then count instructions × 25.6.
     pub icount: bool,
     /// Extra arguments (e.g. `-S` to start with the CPU stopped, which is how
     /// the tests simulate a firmware that never answers).
@@ -154,11 +157,20 @@ pub fn ensure_qemu() -> Result<String, PilError> {
     qemu_available()
 }
 
+/// One item read from the firmware's frame stream.
+#[derive(Debug)]
+enum Item {
+    /// A product frame.
+    Frame(FromGuard),
+    /// The end of a tick, with its cost in cycles.
+    TickEnd(u32),
+}
+
 /// What a finished session leaves behind.
 #[derive(Debug)]
 pub struct SessionEnd {
-    /// The completion marker (a `Done` reply with the final counters).
-    pub done: Reply,
+    /// The completion marker (a status reply with the final counters).
+    pub done: Status,
     /// QEMU's exit status.
     pub status: ExitStatus,
     /// Raw defmt bytes from stdout.
@@ -174,7 +186,7 @@ pub struct QemuSession {
     replies: Receiver<Vec<u8>>,
     stdout_thread: Option<JoinHandle<Vec<u8>>>,
     deframer: Deframer,
-    pending: std::collections::VecDeque<Reply>,
+    pending: std::collections::VecDeque<Item>,
     /// Non-frame bytes seen on stderr (kept for error messages).
     junk: Vec<u8>,
     reply_timeout: Duration,
@@ -240,9 +252,19 @@ impl QemuSession {
         })
     }
 
-    /// Send raw bytes to the firmware.
-    pub fn send(&mut self, bytes: &[u8]) -> Result<(), PilError> {
+    /// Send raw bytes to the firmware's stdin (tests of a broken harness).
+    pub fn send_raw(&mut self, bytes: &[u8]) -> Result<(), PilError> {
         let stdin = self.stdin.as_mut().ok_or_else(|| PilError::Io(std::io::Error::other("stdin already closed")))?;
+        stdin.write_all(bytes)?;
+        stdin.flush()?;
+        Ok(())
+    }
+
+    /// Send one tick's received bytes (a length-prefixed chunk).
+    pub fn send_chunk(&mut self, bytes: &[u8]) -> Result<(), PilError> {
+        let n = u16::try_from(bytes.len()).map_err(|_| PilError::Io(std::io::Error::other("a tick's chunk is longer than 65535 bytes")))?;
+        let stdin = self.stdin.as_mut().ok_or_else(|| PilError::Io(std::io::Error::other("stdin already closed")))?;
+        stdin.write_all(&n.to_le_bytes())?;
         stdin.write_all(bytes)?;
         stdin.flush()?;
         Ok(())
@@ -252,8 +274,23 @@ impl QemuSession {
         String::from_utf8_lossy(&self.junk).trim().to_string()
     }
 
-    /// Receive the next reply frame, waiting at most the reply timeout.
-    pub fn recv(&mut self, tick: u64) -> Result<Reply, PilError> {
+    /// The frames of the next tick, up to its end-of-tick frame, waiting at
+    /// most the reply timeout for each.
+    pub fn recv_tick(&mut self, tick: u64) -> Result<super::TickOut, PilError> {
+        let mut frames = Vec::new();
+        loop {
+            match self.recv(tick)? {
+                Item::Frame(f) => frames.push(f),
+                Item::TickEnd(cycles) => {
+                    return super::tick_out(frames, cycles)
+                        .ok_or_else(|| PilError::Protocol { tick, what: "a tick without a tick reply".into() });
+                }
+            }
+        }
+    }
+
+    /// Receive the next item, waiting at most the reply timeout.
+    fn recv(&mut self, tick: u64) -> Result<Item, PilError> {
         let deadline = Instant::now() + self.reply_timeout;
         loop {
             if let Some(r) = self.pending.pop_front() {
@@ -286,10 +323,14 @@ impl QemuSession {
             match self.deframer.push(b) {
                 None => {}
                 Some(Ok(p)) => {
-                    // A payload that is not a reply stays as text.
-                    if let Ok(r) = Reply::from_payload(&p) {
-                        self.junk_drop_frame(&p);
-                        self.pending.push_back(r);
+                    // A payload that is not a frame of ours stays as text.
+                    let item = match parse_tick_end(p) {
+                        Some(c) => Some(Item::TickEnd(c)),
+                        None => FromGuard::from_payload(p).ok().map(Item::Frame),
+                    };
+                    if let Some(item) = item {
+                        self.pending.push_back(item);
+                        self.junk_drop_frame();
                     }
                 }
                 Some(Err(_)) => {} // not a frame: keep as text
@@ -305,7 +346,7 @@ impl QemuSession {
         }
     }
 
-    fn junk_drop_frame(&mut self, _payload: &[u8]) {
+    fn junk_drop_frame(&mut self) {
         // A decoded reply's COBS bytes are the last bytes in `junk` up to the
         // previous '\n' marker: remove them so only genuine text remains.
         let start = self.junk.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
@@ -325,8 +366,8 @@ impl QemuSession {
         drop(self.stdin.take());
         let done = loop {
             match self.recv(tick) {
-                Ok(r) if r.kind == eha_guard::protocol::ReplyKind::Done => break Some(r),
-                Ok(_) => continue, // a late reply (e.g. to trailing garbage)
+                Ok(Item::Frame(FromGuard::Status(s))) if s.token == DONE_TOKEN => break Some(s),
+                Ok(_) => continue,
                 Err(PilError::Exited { code: Some(0), .. }) => break None,
                 Err(e) => return Err(e),
             }

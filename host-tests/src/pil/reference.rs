@@ -22,6 +22,8 @@ pub fn sensors(snap: &Snapshot) -> PlantSensors {
         t_drain_c: snap.temp(Node::Case),
         t_oil_c: Some(snap.temp(Node::Sensor)),
         valve_fb: Some(snap.lng_open),
+        elec_hz: None,
+        lng_supply_bar: None,
     }
 }
 

@@ -5,7 +5,7 @@ use std::io::Write as _;
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use eha_guard::protocol::Reply;
+use eha_guard::product::wire::TickReply;
 
 use super::qemu::TICKS_PER_INSTRUCTION;
 use super::{PilRun, TickRecord};
@@ -55,7 +55,7 @@ impl Summary {
                 valve_events.push((r.t_s, r.reply.out.valve_open));
                 prev = r.reply.out.valve_open;
             }
-            let instr = f64::from(r.reply.tick_cycles) / TICKS_PER_INSTRUCTION;
+            let instr = f64::from(r.cycles) / TICKS_PER_INSTRUCTION;
             tsum += instr;
             tmax = tmax.max(instr);
         }
@@ -113,10 +113,10 @@ pub fn table(records: &[TickRecord], every_s: f64) -> String {
 /// Human summary lines.
 pub fn summary_text(run: &PilRun, s: &Summary) -> String {
     let mut t = String::new();
-    let c = run.done.counters;
+    let c = run.done;
     let _ = writeln!(t, "firmware build      : {} ({} in QEMU)", run.build.name(), run.build.machine());
     let _ = writeln!(t, "ticks               : {} ({:.1} s of plant time)", s.ticks, s.plant_time_s);
-    let _ = writeln!(t, "frames              : accepted {}, rejected crc {} framing {} sequence {}, skipped {}", c.accepted, c.rejected_crc, c.rejected_framing, c.rejected_sequence, c.skipped);
+    let _ = writeln!(t, "frames              : accepted {}, rejected crc {} framing {} sequence {}, missing ticks {}", c.accepted, c.rejected_crc, c.rejected_framing, c.rejected_sequence, c.missing);
     let ev: Vec<String> = s.valve_events.iter().map(|(t, o)| format!("{} at {t:.1} s", if *o { "open" } else { "close" })).collect();
     let _ = writeln!(t, "LNG valve events    : {}", if ev.is_empty() { "none".into() } else { ev.join(", ") });
     let crossing = run.records.iter().find(|r| r.sensors.t_drain_c >= 40.0).map(|r| r.t_s);
@@ -130,7 +130,7 @@ pub fn summary_text(run: &PilRun, s: &Summary) -> String {
     let _ = writeln!(t, "max |fw − ref|      : {:.3} K (max under-prediction {:.3} K)", s.max_abs_err_k, s.max_under_k);
     match s.instructions {
         Some((mean, max)) => {
-            let _ = writeln!(t, "instructions / tick : mean {mean:.0}, max {max:.0} (QEMU -icount, SysTick around Guard::tick)");
+            let _ = writeln!(t, "instructions / tick : mean {mean:.0}, max {max:.0} (QEMU -icount, SysTick around App::tick: the whole product loop)");
         }
         None => {
             let _ = writeln!(t, "instructions / tick : not measured (run without -icount)");
@@ -144,9 +144,10 @@ pub fn summary_text(run: &PilRun, s: &Summary) -> String {
 pub fn transcript(run: &PilRun, every_s: f64) -> String {
     let s = Summary::of(&run.records, run.icount);
     let mut t = String::new();
-    let c = run.done.counters;
+    let c = run.done;
     let _ = writeln!(t, "build {} machine {}", run.build.name(), run.build.machine());
-    let _ = writeln!(t, "ticks {} accepted {} rejected {} skipped {}", s.ticks, c.accepted, c.rejected(), c.skipped);
+    let rejected = u32::from(c.rejected_crc) + u32::from(c.rejected_framing) + u32::from(c.rejected_sequence);
+    let _ = writeln!(t, "ticks {} accepted {} rejected {} missing {}", s.ticks, c.accepted, rejected, c.missing);
     t.push_str(&table(&run.records, every_s));
     for (tm, open) in &s.valve_events {
         let _ = writeln!(t, "valve {} at {tm:.1} s", if *open { "open" } else { "close" });
@@ -163,12 +164,26 @@ pub fn transcript(run: &PilRun, every_s: f64) -> String {
     t
 }
 
+/// Bitwise equality of two tick replies (floats by bit pattern).
+pub fn same_reply(a: &TickReply, b: &TickReply) -> bool {
+    a.tick == b.tick
+        && a.sample_seq == b.sample_seq
+        && a.fresh == b.fresh
+        && a.not_commissioned == b.not_commissioned
+        && a.out.bit_eq(&b.out)
+        && a.pins == b.pins
+        && a.overruns == b.overruns
+        && a.rejected == b.rejected
+        && a.restore == b.restore
+        && a.reset_cause == b.reset_cause
+}
+
 /// Per-tick comparison of two reply streams (firmware vs SIL).
 #[derive(Clone, Debug, Default)]
 pub struct Comparison {
     /// Steps compared (the shorter stream's length).
     pub ticks: usize,
-    /// Steps whose replies are bit-identical (all outputs, counters and seq; ticks ignored).
+    /// Steps whose replies are bit-identical (every field).
     pub identical: usize,
     /// Index of the first tick that is not bit-identical.
     pub first_difference: Option<usize>,
@@ -184,10 +199,10 @@ pub struct Comparison {
 }
 
 /// Compares the firmware's replies with the SIL's, tick by tick.
-pub fn compare(fw: &[Reply], sil: &[Reply]) -> Comparison {
+pub fn compare(fw: &[TickReply], sil: &[TickReply]) -> Comparison {
     let mut c = Comparison { ticks: fw.len().min(sil.len()), ..Default::default() };
     for (k, (a, b)) in fw.iter().zip(sil).enumerate() {
-        let same = a.kind == b.kind && a.seq == b.seq && a.counters == b.counters && a.out.bit_eq(&b.out);
+        let same = same_reply(a, b);
         if same {
             c.identical += 1;
         } else if c.first_difference.is_none() {
@@ -253,8 +268,8 @@ pub fn write_csv(path: &Path, records: &[TickRecord], meta: &[(&str, String)]) -
                 // The format forbids non-finite values: an infinite "seconds
                 // left" (no dissipation) is written as an empty cell.
                 if o.lng_seconds_left.is_finite() { o.lng_seconds_left.to_string() } else { String::new() },
-                r.reply.tick_cycles,
-                r.reply.seq,
+                r.cycles,
+                r.reply.sample_seq,
             )?;
         }
         w.flush()?;
@@ -279,17 +294,17 @@ pub fn write_log(path: &Path, log: &[super::defmt_log::LogLine]) -> Result<()> {
 /// (`eha-sim fw-budget`) against committed budgets with a regression margin.
 pub fn open_loop_transcript(run: &super::OpenLoopRun, tick_s: f64, every: usize) -> String {
     let mut t = String::new();
-    let _ = writeln!(t, "build {} machine {} frames {}", run.build.name(), run.build.machine(), run.replies.len());
+    let _ = writeln!(t, "build {} machine {} ticks {}", run.build.name(), run.build.machine(), run.ticks.len());
     let _ = writeln!(t, "{:>8} {:>6} {:>12} {:>5} {:>5} {:>6} {:>8}", "time_s", "seq", "fw_drain_c", "valve", "alarm", "faults", "lng_kg");
-    let mut prev: Option<&Reply> = None;
-    for (k, r) in run.replies.iter().enumerate() {
+    let mut prev: Option<&TickReply> = None;
+    for (k, r) in run.ticks.iter().map(|o| &o.reply).enumerate() {
         let changed = prev.is_some_and(|p| p.out.flags() != r.out.flags() || p.out.faults != r.out.faults);
         if k % every == 0 || changed {
             let _ = writeln!(
                 t,
                 "{:>8.2} {:>6} {:>12.4} {:>5} {:>5} {:>#6x} {:>8.4}{}",
                 k as f64 * tick_s,
-                r.seq,
+                r.sample_seq,
                 r.out.drain_c,
                 u8::from(r.out.valve_open),
                 u8::from(r.out.alarm),
@@ -300,8 +315,8 @@ pub fn open_loop_transcript(run: &super::OpenLoopRun, tick_s: f64, every: usize)
         }
         prev = Some(r);
     }
-    let c = run.done.counters;
-    let _ = writeln!(t, "done: accepted {} skipped {} rejected crc {} framing {} sequence {}", c.accepted, c.skipped, c.rejected_crc, c.rejected_framing, c.rejected_sequence);
+    let c = run.done;
+    let _ = writeln!(t, "done: accepted {} missing {} rejected crc {} framing {} sequence {}", c.accepted, c.missing, c.rejected_crc, c.rejected_framing, c.rejected_sequence);
     t.push_str("defmt log:\n");
     for l in &run.log {
         let _ = writeln!(t, "  {l}");

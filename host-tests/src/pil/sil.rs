@@ -1,55 +1,93 @@
-//! Software in the loop: the firmware's frame handling ([`Link`]) and core
-//! step run on the host, fed the same bytes as the firmware in QEMU.
+//! Software in the loop: the product application on the host, on the shared
+//! in-memory board ([`MemBoard`]), fed the same bytes per tick as the PIL
+//! image in QEMU: the bit-for-bit twin of the firmware.
 
-use eha_guard::protocol::{GuardOutput, Link, Reply, Request};
+use eha_guard::num::{Fx, Num};
+use eha_guard::product::mem_board::MemBoard;
+use eha_guard::product::wire::FromGuard;
+use eha_guard::product::AppOf;
+use eha_guard::protocol::Deframer;
+use eha_guard::GuardConfig;
 
-use super::{PilError, Target};
+use super::{tick_out, PilError, Target, TickOut};
 
-/// The host twin of the firmware main loop: same `Link`, same core step.
-pub struct SilTarget<F> {
-    link: Link,
-    core: F,
+/// The application of one number type on an in-memory board.
+pub struct AppTarget<N: Num> {
+    app: AppOf<N>,
+    /// The board (records, non-volatile store, pins, clock).
+    pub board: Box<MemBoard>,
 }
 
-impl<F: FnMut(&Request, u16) -> GuardOutput> SilTarget<F> {
-    /// A fresh link around the core step `core`.
-    pub fn new(core: F) -> Self {
-        Self { link: Link::new(), core }
+impl<N: Num> AppTarget<N> {
+    /// Boots the application on `board` with `cfg` (from what the board's
+    /// memories hold).
+    pub fn boot(cfg: &GuardConfig, mut board: Box<MemBoard>) -> Self {
+        let mem = board.boot_memory();
+        let app = AppOf::<N>::boot(&mut *board, cfg, &mem);
+        board.clear_tx();
+        AppTarget { app, board }
     }
 
-    /// The frame handler (its counters).
-    pub fn link(&self) -> &Link {
-        &self.link
+    /// The application (read only).
+    pub fn app(&self) -> &AppOf<N> {
+        &self.app
+    }
+
+    /// Gives the board back (to boot again from what it keeps).
+    pub fn into_board(self) -> Box<MemBoard> {
+        self.board
     }
 }
 
-impl<F: FnMut(&Request, u16) -> GuardOutput> Target for SilTarget<F> {
-    fn exchange(&mut self, wire: &[u8], tick: u64) -> Result<Reply, PilError> {
-        let Self { link, core } = self;
-        let mut got = None;
-        link.push_bytes(wire, |r, gap| (core(r, gap), 0), |rep, _| got = Some(*rep));
-        got.ok_or_else(|| PilError::Protocol { tick, what: "SIL link produced no reply to a frame".into() })
-    }
-}
-
-/// One firmware tick on the host: the request and the sequence gap in,
-/// the guard's outputs out.
-pub type GuardCore = Box<dyn FnMut(&Request, u16) -> GuardOutput>;
-
-/// The firmware's core for `build`, on the host: the same `GuardOf<N>` with
-/// the same number type, configuration and boot rule (cold: QEMU starts
-/// with zeroed RAM, which reads as an absent thermal record) and the same
-/// [`eha_guard::protocol::tick_guard`].
-pub fn sil_core(build: super::Build) -> GuardCore {
-    use eha_guard::{GuardConfig, GuardOf, Restore};
-    match build {
-        super::Build::F32 => {
-            let mut g = GuardOf::<f32>::new(&GuardConfig::DEFAULT, Restore::Cold);
-            Box::new(move |r, gap| eha_guard::protocol::tick_guard(&mut g, r, gap))
+/// Decodes the frames in `bytes` (sent by the application).
+pub fn frames(bytes: &[u8]) -> Vec<FromGuard> {
+    let mut d = Deframer::new();
+    let mut out = Vec::new();
+    for &b in bytes {
+        if let Some(Ok(p)) = d.push(b) {
+            if let Ok(f) = FromGuard::from_payload(p) {
+                out.push(f);
+            }
         }
-        super::Build::Fixed => {
-            let mut g = GuardOf::<eha_guard::num::Fx>::new(&GuardConfig::DEFAULT, Restore::Cold);
-            Box::new(move |r, gap| eha_guard::protocol::tick_guard(&mut g, r, gap))
+    }
+    out
+}
+
+impl<N: Num> Target for AppTarget<N> {
+    fn tick(&mut self, rx: &[u8], tick: u64) -> Result<TickOut, PilError> {
+        if self.board.push_rx(rx) < rx.len() {
+            return Err(PilError::Protocol { tick, what: "more bytes in one tick than the board's receive buffer holds".into() });
         }
+        self.app.tick(&mut *self.board, 0);
+        let sent = self.board.take_tx();
+        tick_out(frames(&sent), 0).ok_or_else(|| PilError::Protocol { tick, what: "the host application sent no tick reply".into() })
+    }
+}
+
+/// The host twin of the PIL image for `build`: the same application with
+/// the same number type, configuration and boot (cold: QEMU starts with
+/// zeroed RAM), on the in-memory board.
+pub struct SilTarget(Box<dyn Target>);
+
+impl SilTarget {
+    /// The twin of the `build` image.
+    pub fn new(build: super::Build) -> Self {
+        Self::with_config(build, &GuardConfig::DEFAULT)
+    }
+
+    /// The twin with another configuration (e.g. a commissioned machine's
+    /// constants, other thresholds).
+    pub fn with_config(build: super::Build, cfg: &GuardConfig) -> Self {
+        let board = Box::new(MemBoard::new());
+        match build {
+            super::Build::F32 => SilTarget(Box::new(AppTarget::<f32>::boot(cfg, board))),
+            super::Build::Fixed => SilTarget(Box::new(AppTarget::<Fx>::boot(cfg, board))),
+        }
+    }
+}
+
+impl Target for SilTarget {
+    fn tick(&mut self, rx: &[u8], tick: u64) -> Result<TickOut, PilError> {
+        self.0.tick(rx, tick)
     }
 }

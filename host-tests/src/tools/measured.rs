@@ -46,6 +46,14 @@ pub enum Channel {
     /// bench thermocouple for commissioning (not in [`Channel::ALL`], which
     /// the fault campaign and the generators iterate; see [`Channel::FORMAT`]).
     TDrainC,
+    /// `elec_hz`: the motor drive's electrical (commutation) frequency, Hz,
+    /// signed like the speed — the guard's second speed source (optional;
+    /// not in [`Channel::ALL`]).
+    ElecHz,
+    /// `lng_supply_bar`: LNG supply pressure at the valve, bar (gauge) — the
+    /// guard's confirmation that the tank has LNG (optional; not in
+    /// [`Channel::ALL`]).
+    LngSupplyBar,
 }
 
 impl Channel {
@@ -68,14 +76,17 @@ impl Channel {
     ];
 
     /// Every column of the format other than `time_s`: [`Channel::ALL`] plus
-    /// the bench-only `t_drain_c`, in the writer's column order.
-    pub const FORMAT: [Channel; 14] = {
-        let mut f = [Channel::TDrainC; 14];
+    /// the bench-only `t_drain_c` and the guard's optional inputs `elec_hz`
+    /// and `lng_supply_bar`, in the writer's column order.
+    pub const FORMAT: [Channel; 16] = {
+        let mut f = [Channel::TDrainC; 16];
         let mut i = 0;
         while i < Channel::ALL.len() {
             f[i] = Channel::ALL[i];
             i += 1;
         }
+        f[14] = Channel::ElecHz;
+        f[15] = Channel::LngSupplyBar;
         f
     };
 
@@ -106,6 +117,8 @@ impl Channel {
             Channel::LngValve => "lng_valve",
             Channel::AirSpeedMps => "air_speed_mps",
             Channel::TDrainC => "t_drain_c",
+            Channel::ElecHz => "elec_hz",
+            Channel::LngSupplyBar => "lng_supply_bar",
         }
     }
 
@@ -119,7 +132,8 @@ impl Channel {
         match self {
             Channel::SpeedRpm => "rpm",
             Channel::CurrentA => "A",
-            Channel::PABar | Channel::PBBar => "bar",
+            Channel::PABar | Channel::PBBar | Channel::LngSupplyBar => "bar",
+            Channel::ElecHz => "Hz",
             Channel::PositionMm => "mm",
             Channel::LngValve => "0/1",
             Channel::AirSpeedMps => "m/s",
@@ -142,14 +156,16 @@ impl Channel {
 
     /// Inclusive physical range `(lo, hi)` a value must lie in. The format
     /// fixes temperatures −60…250 °C, pressures −1…700 bar, speed ±20000 rpm
-    /// and current 0…2000 A. It gives none for position; for `lng_valve` the
+    /// and current 0…2000 A (and the LNG supply pressure like a pressure,
+    /// the electrical frequency ±5000 Hz). It gives none for position; for `lng_valve` the
     /// 0/1 command range and for `air_speed_mps` non-negative speeds below
     /// 1000 m/s (far above any ram-air speed) are enforced here.
     pub fn range(self) -> Option<(f64, f64)> {
         match self {
             Channel::SpeedRpm => Some((-20000.0, 20000.0)),
             Channel::CurrentA => Some((0.0, 2000.0)),
-            Channel::PABar | Channel::PBBar => Some((-1.0, 700.0)),
+            Channel::PABar | Channel::PBBar | Channel::LngSupplyBar => Some((-1.0, 700.0)),
+            Channel::ElecHz => Some((-5000.0, 5000.0)),
             Channel::PositionMm => None,
             Channel::LngValve => Some((0.0, 1.0)),
             Channel::AirSpeedMps => Some((0.0, 1000.0)),

@@ -25,7 +25,7 @@ pub struct ParamsBlockArgs {
 #[derive(Subcommand, Debug)]
 enum BlockCmd {
     /// Reduce a rig file to the firmware's model constants and write the
-    /// parameter block (1084 bytes) to flash at the PARAMS region
+    /// parameter block (1088 bytes) to flash at the PARAMS region
     /// (STM32F411: 0x0802_0000; QEMU mps2: 0x0003_F000).
     Write {
         /// Rig file (TOML, as `host-tests/rig/liu2024.toml`).
@@ -96,7 +96,7 @@ pub fn check_bytes(bytes: &[u8; BLOCK_LEN]) -> Result<String> {
         Ok(None) => bail!("no block: erased or empty (the firmware runs its compiled-in default and reports NOT_COMMISSIONED)"),
         Err(e) => bail!("{}", block_error_text(e)),
     };
-    let model = Model::<f32>::from_consts(&c).map_err(|e| anyhow::anyhow!("{}", config_error_text(e)))?;
+    let model = Model::<f32>::from_consts(&c).map_err(|e| anyhow::anyhow!("{}", config_error_text(e, &c)))?;
     let j = model.nominal_jacobian_f32();
     let mismatch = eha_guard::model::stability::phi_mismatch_s(&c.phi, &j);
     let gain = eha_guard::model::stability::step_gain(&c.phi, &j);
@@ -114,17 +114,34 @@ fn block_error_text(e: BlockError) -> String {
         BlockError::Magic => "bytes 0..4: not the parameter-block magic \"EHAP\" (and not erased)".into(),
         BlockError::Version => format!("bytes 4..6: format version is not {} (this firmware's)", params_block::VERSION),
         BlockError::Words => format!("bytes 6..8: word count is not {} (another model structure)", consts::N_WORDS),
-        BlockError::Crc => "bytes 1020..1024: CRC-32 mismatch (torn or corrupted block)".into(),
+        BlockError::Crc => "bytes 1084..1088: CRC-32 mismatch (torn or corrupted block)".into(),
         BlockError::Alignment => "block not 4-byte aligned".into(),
     }
 }
 
-fn config_error_text(e: ConfigError) -> String {
+fn config_error_text(e: ConfigError, c: &eha_guard::model::ModelConsts<f32>) -> String {
     match e {
         ConfigError::Implausible => "a constant is out of its physical range (negative conductance, capacity or share > 1)".into(),
         ConfigError::CoefficientRange => "a row of Phi exceeds the coefficient format".into(),
         ConfigError::ConstantRange => "a constant is not finite or exceeds 250 in model units".into(),
         ConfigError::Unstable => "the discretisation does not belong to the constants or amplifies (Phi mismatch or step gain)".into(),
+        ConfigError::OutOfBounds(w) => {
+            let w = usize::from(w);
+            let value = c.as_words().get(w).copied().unwrap_or(f32::NAN);
+            match eha_guard::model::bounds::word_bound(w) {
+                Some((field, k, b, why)) => format!(
+                    "word {w} ({field}[{k}]) = {value:e} is outside its range [{:e}, {:e}]: {why} (src/model/bounds.rs)",
+                    b.lo, b.hi
+                ),
+                None => format!("word {w} = {value:e} is outside its range"),
+            }
+        }
+        ConfigError::Inconsistent => "a derived word differs from its derivation (k_lf_half = k_lf / 2, k_lp = 10 k_lf, k_hyd = 10 k_q, alpha_t0 = 273.15 alpha)".into(),
+        ConfigError::NoHeating => format!(
+            "the block's model does not heat its drain oil at {} K/s under the reference load (60 bar, 500 rpm, 20 degC): are its loss coefficients filled in? (src/model/physics_checks.rs)",
+            eha_guard::model::physics_checks::MIN_HEATING_K_PER_S
+        ),
+        ConfigError::RestBound => "the block's cooling bound at rest (rest_rate, rest_mode) claims faster cooling than its own model (src/model/physics_checks.rs)".into(),
     }
 }
 

@@ -166,6 +166,7 @@ pub fn reduce_without_jacobian(rig: &Rig) -> ReducedParams {
         phases: m.phases,
         r_ohm: m.r25_ohm,
         torque_constant_nm_per_a: m.torque_constant_nm_per_a,
+        pole_pairs: fe.pole_pairs,
         k_fe1_w_s_per_rad: fe.k_h * fe.b_peak_t * fe.b_peak_t * c,
         k_fe2_w_s2_per_rad2: fe.k_c * fe.b_peak_t * fe.b_peak_t * c * c,
         k_fe15_w_per_rad15: fe.k_e * (fe.b_peak_t * c).powf(1.5),
@@ -367,7 +368,7 @@ fn row(r: &[f64]) -> String {
 
 /// The scalar fields of `p` by name, in `DEFAULT`'s order (the renderer writes
 /// them; the acceptance test compares them with the reduction).
-pub fn scalar_fields(p: &ReducedParams) -> [(&'static str, f64); 37] {
+pub fn scalar_fields(p: &ReducedParams) -> [(&'static str, f64); 38] {
     [
         ("pump_j_per_k", p.pump_j_per_k),
         ("main_block_j_per_k", p.main_block_j_per_k),
@@ -400,6 +401,7 @@ pub fn scalar_fields(p: &ReducedParams) -> [(&'static str, f64); 37] {
         ("phases", p.phases),
         ("r_ohm", p.r_ohm),
         ("torque_constant_nm_per_a", p.torque_constant_nm_per_a),
+        ("pole_pairs", p.pole_pairs),
         ("k_fe1_w_s_per_rad", p.k_fe1_w_s_per_rad),
         ("k_fe2_w_s2_per_rad2", p.k_fe2_w_s2_per_rad2),
         ("k_fe15_w_per_rad15", p.k_fe15_w_per_rad15),

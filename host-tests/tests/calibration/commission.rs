@@ -73,10 +73,9 @@ fn other_rig_commissioned_firmware_meets_drain_bounds_on_held_out_mission() {
 /// reported beside it.
 #[test]
 fn commissioned_block_in_closed_loop_on_the_held_out_mission() {
-    use eha_guard::protocol::tick_guard;
-    use eha_guard::{GuardConfig, GuardOf, Restore};
+    use eha_guard::GuardConfig;
     use eha_sim::pil::sil::SilTarget;
-    use eha_sim::pil::{run_closed_loop, LoopOptions};
+    use eha_sim::pil::{run_closed_loop, Build, LoopOptions};
     use eha_sim::plant::Plant;
     use eha_sim::scenario::Scenario;
 
@@ -104,9 +103,8 @@ fn commissioned_block_in_closed_loop_on_the_held_out_mission() {
         fault: Option<(f64, eha_guard::Faults)>,
     }
     let run = |cfg: &GuardConfig| {
-        let mut guard = GuardOf::<f32>::new(cfg, Restore::Cold);
-        assert!(guard.faults().is_empty(), "configuration accepted");
-        let mut sil = SilTarget::new(move |r: &eha_guard::protocol::Request, gap| tick_guard(&mut guard, r, gap));
+        assert!(eha_guard::GuardOf::<f32>::new(cfg, eha_guard::Restore::Cold).faults().is_empty(), "configuration accepted");
+        let mut sil = SilTarget::with_config(Build::F32, cfg);
         let m = mission(Kind::SoakThenMixed, 1800.0, 33);
         let mut plant = Plant::new(&other_rig_truth(), &Scenario::Mission(m)).expect("plant");
         let opts = LoopOptions { tick_s: eha_guard::params::S_PER_TICK, duration_s: 1800.0 };

@@ -1,54 +1,70 @@
-//! The fault campaign (`eha-sim faults`, `eha_sim::faults`) as a test: every
-//! sensor, transport, memory and actuator fault, each during the Fig. 15 LNG
-//! case and one random mission, in closed loop with the reference plant.
+//! The fault campaign (`eha-sim faults`, `eha_sim::faults`) as tests: the
+//! product application on the in-memory board in closed loop with the
+//! reference plant, every sensor, transport, memory, command and actuator
+//! fault in three scenarios at up to three start times (early, after the
+//! valve first opened, hot).
 //!
-//! Pass rule per fault and scenario (issue "No silent protection failure"):
-//! the guard latches a fault and opens the valve within 1 s of the fault
-//! becoming observable, or its drain estimate never under-predicts the true
-//! drain by more than 1 K and the true drain never exceeds 42 °C while the
-//! valve is closed. Faults the design cannot meet are listed in
-//! [`KNOWN_FAILING`] with the reason, not removed: the test fails when a
-//! listed fault starts passing (update the list and the README) or an
-//! unlisted one fails. The table is written to `out/faults/`.
+//! Pass rule (issue 33): whenever the guard is not protecting (a latched
+//! fault with the valve commanded open, or the estimate untrusted), its
+//! estimate is at most 1 K below the true drain and the true drain at most
+//! 42 °C with the valve closed; a protected detection within 1 s exempts
+//! the time before it. A failing run must be a listed design limit
+//! (`eha_sim::faults::limits::KNOWN_LIMITS`, with its reason).
+//!
+//! Fast tier: a representative subset (about 20 runs, one per kind of fault,
+//! the hot starts and every new fault of issue 33). Slow tier: the whole
+//! campaign (751 runs, ~1.5 min on two cores), which also checks that every
+//! listed limit still fails somewhere, that with the drive's electrical
+//! frequency no speed fault fails, and that `docs/failure-modes.md` is the
+//! table generated from this run.
 
-use eha_sim::faults::{campaign, table, write};
+use eha_sim::faults::limits::KNOWN_LIMITS;
+use eha_sim::faults::{campaign, fast_campaign, modes, table, unlisted_failures, write, FaultResult};
 
-const SPEED_UNSEEN: &str = "a speed sensor error is invisible to the torque cross-check: both loss estimates (from the current and from the port pressures) scale with the measured speed, and the pump's heat with the true speed; a second speed source (the motor drive's commutation frequency) would be needed";
-
-/// (fault, scenario, why the design cannot meet the pass rule).
-const KNOWN_FAILING: &[(&str, &str, &str)] = &[
-    ("speed/stuck-zero", "lng", SPEED_UNSEEN),
-    ("speed/stuck-zero", "random-1", SPEED_UNSEEN),
-    ("speed/gain-x0.5", "lng", SPEED_UNSEEN),
-    ("speed/gain-x0.5", "random-1", SPEED_UNSEEN),
-    ("speed/drift", "lng", SPEED_UNSEEN),
-];
+fn report(rows: &[FaultResult], dir: &str) {
+    println!("{}", table(rows));
+    let out = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(dir);
+    write(&out, rows).expect("write the results");
+    let pass = rows.iter().filter(|r| r.pass).count();
+    let limited = rows.iter().filter(|r| !r.pass && r.limit.is_some()).count();
+    println!("{} runs: {pass} pass, {limited} listed design limits", rows.len());
+}
 
 #[test]
-fn fault_campaign_passes_except_the_listed_design_limits() {
+fn fault_campaign_subset_passes_except_the_listed_design_limits() {
+    let rows = fast_campaign().expect("campaign runs");
+    report(&rows, "out/faults-fast");
+    let bad = unlisted_failures(&rows);
+    assert!(bad.is_empty(), "{}", bad.join("\n"));
+    // the subset's new faults of issue 33 are not limits: they pass
+    for f in ["clear-spam", "corrupt-start-clear", "flash-write-fail", "flash-read-fail", "power-loss", "warm-reset", "no-valve-feedback", "lng-empty-physical+supply"] {
+        assert!(rows.iter().filter(|r| r.fault == f).all(|r| r.pass), "{f}: {:?}", rows.iter().find(|r| r.fault == f));
+    }
+}
+
+#[test]
+#[ignore = "slow tier: the whole fault campaign (751 runs)"]
+fn slow_fault_campaign_passes_except_the_listed_design_limits() {
     let rows = campaign().expect("campaign runs");
-    let md = table(&rows);
-    println!("{md}");
-    let out = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../out/faults");
-    write(&out, &rows).expect("write out/faults");
-    let mut problems = Vec::new();
-    for r in &rows {
-        let listed = KNOWN_FAILING.iter().find(|(f, s, _)| *f == r.fault && *s == r.scenario);
-        match (r.pass, listed) {
-            (true, Some((_, _, why))) => problems.push(format!("{} / {} now passes (listed as failing: {why})", r.fault, r.scenario)),
-            (false, None) => problems.push(format!(
-                "{} / {} fails: detected {} after {:?} s, max under {:.3} K, max true drain with the valve closed {:.2} °C",
-                r.fault, r.scenario, r.detected, r.detect_s, r.max_under_k, r.max_true_drain_closed_c
-            )),
-            _ => {}
+    report(&rows, "out/faults");
+    let mut problems = unlisted_failures(&rows);
+    for l in KNOWN_LIMITS {
+        let covers = |r: &&FaultResult| r.fault == l.fault && l.scenario.is_none_or(|s| s == r.scenario) && l.start.is_none_or(|s| s == r.start);
+        if !rows.iter().filter(covers).any(|r| !r.pass) {
+            problems.push(format!("{} ({:?}, {:?}) is listed as a design limit but every run of it passes: remove it", l.fault, l.scenario, l.start));
         }
     }
-    for (f, s, _) in KNOWN_FAILING {
-        if !rows.iter().any(|r| r.fault == *f && r.scenario == *s) {
-            problems.push(format!("{f} / {s} is listed but not in the campaign"));
+    // with the second speed source no speed fault fails
+    for r in rows.iter().filter(|r| r.fault.starts_with("speed/") && !r.fault.contains("+no-elec")) {
+        if !r.pass {
+            problems.push(format!("{} / {} / {} fails with the electrical frequency", r.fault, r.scenario, r.start));
         }
     }
-    let failing = rows.iter().filter(|r| !r.pass).count();
-    println!("{} runs, {failing} failing ({} listed)", rows.len(), KNOWN_FAILING.len());
+    // the failure-mode table in docs/ is this run's
+    let doc = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/failure-modes.md");
+    let have = std::fs::read_to_string(&doc).unwrap_or_default();
+    if have != modes::document(&rows, "out/faults/faults.json") {
+        problems.push("docs/failure-modes.md is not the table of this run: regenerate it with `eha-sim faults --from out/faults/faults.json`".into());
+    }
     assert!(problems.is_empty(), "{}", problems.join("\n"));
 }

@@ -42,6 +42,7 @@ fn run(scenario: &Scenario) -> (u64, f64) {
     let mut writes = 0u64;
     plant
         .run(0.01, scenario.duration_s(), |snap| {
+            guard.valve_feedback(snap.lng_open);
             let o = guard.tick(&Sensors::from(snap).sample());
             let rec = guard.snapshot();
             if NvPolicy::DEFAULT.due(last.as_ref(), &rec) {

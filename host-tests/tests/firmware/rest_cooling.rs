@@ -4,19 +4,19 @@
 //! air) for 1, 6 and 24 hours. The restore of the product's boot rule
 //! (`memory::boot_restore`: the non-volatile record raised by the write
 //! policy's 2 K, cooled by the model's rest bound over the clock's off-time
-//! minus the 30-minute write interval) must never read below the reference
+//! from the last-alive stamp) must never read below the reference
 //! drain (the truth here: the full reference model, not the firmware's own),
 //! and the bound itself must hold against the firmware model's own rest
 //! dynamics (the derivation's claim).
 
 use eha_guard::memory::cooling::RestCooling;
-use eha_guard::memory::nv::NvPolicy;
+use eha_guard::memory::nv::{NvLoad, NvPolicy};
 use eha_guard::memory::{boot_restore, Restore, ThermalRecord};
 use eha_guard::model::{Model, ModelInputN};
 use eha_guard::params::{DEFAULT, DEFAULT_CONSTS, N_NODES, TICKS_PER_STEP};
-use eha_guard::protocol::tick_guard;
-use eha_guard::{GuardConfig, GuardOf};
-use eha_sim::pil::sil::SilTarget;
+use eha_guard::product::mem_board::MemBoard;
+use eha_guard::GuardConfig;
+use eha_sim::pil::sil::AppTarget;
 use eha_sim::pil::{run_closed_loop, LoopOptions};
 use eha_sim::plant::{Control, Plant, Sensors};
 use eha_sim::rig::Rig;
@@ -66,11 +66,10 @@ fn model_at_rest(temps: &[f32; N_NODES], air: f32, off_s: u32) -> [f64; N_NODES]
 fn restore_after_a_measured_off_time_is_cooled_and_never_below_the_reference() {
     let rig = Rig::default();
     let mut plant = Plant::new(&rig, &Scenario::Mission(mission())).expect("plant");
-    let mut guard = GuardOf::<f32>::new(&GuardConfig::DEFAULT, Restore::Cold);
-    let mut sil = SilTarget::new(|r: &eha_guard::protocol::Request, gap| tick_guard(&mut guard, r, gap));
+    let mut sil = AppTarget::<f32>::boot(&GuardConfig::DEFAULT, Box::new(MemBoard::new()));
     let opts = LoopOptions { tick_s: eha_guard::params::S_PER_TICK, duration_s: HOT_S };
     let rec = run_closed_loop(&mut plant, &mut sil, &opts).unwrap_or_else(|f| panic!("{:#}", f.error));
-    drop(sil);
+    let guard = sil.app().guard();
     let last = rec.last().expect("steps");
     let saved = guard.snapshot().with_rtc(Some(T0_S));
     assert!(guard.faults().is_empty(), "a clean hot run");
@@ -98,7 +97,8 @@ fn restore_after_a_measured_off_time_is_cooled_and_never_below_the_reference() {
     let policy = NvPolicy::DEFAULT;
     for (h, truth) in OFF_H.iter().zip(&ref_drain) {
         let off = h * 3600;
-        let Restore::PowerLoss(r) = boot_restore(Restore::Cold, Some(saved), &policy, Some(&cool), Some(T0_S + off)) else {
+        // the machine stopped at the save: the clock's last-alive stamp
+        let Restore::PowerLoss(r) = boot_restore(Restore::Cold, NvLoad::Valid(saved), &policy, Some(&cool), Some(T0_S + off), Some(T0_S), false) else {
             panic!("a power-loss restore")
         };
         let own = model_at_rest(&saved.temps_c, saved.ambient_c, off);
@@ -121,24 +121,32 @@ fn restore_after_a_measured_off_time_is_cooled_and_never_below_the_reference() {
     // The gain: after 24 h the restore keeps at most a quarter of the saved
     // excess over the air (measured 0.13; the bound's slowest group decays
     // with 20 h, the pump's with 11.5 h).
-    let Restore::PowerLoss(r) = boot_restore(Restore::Cold, Some(saved), &policy, Some(&cool), Some(T0_S + 24 * 3600)) else { panic!() };
+    let Restore::PowerLoss(r) = boot_restore(Restore::Cold, NvLoad::Valid(saved), &policy, Some(&cool), Some(T0_S + 24 * 3600), Some(T0_S), false) else { panic!() };
     let excess = saved.temps_c[1] + policy.rise_k - saved.ambient_c;
     assert!(r.temps_c[1] - saved.ambient_c <= excess * 0.25, "24 h: {} of {excess} K left", r.temps_c[1] - saved.ambient_c);
 }
 
-/// A clock that reads earlier than the record (reset, battery change) or a
-/// record without a clock reading: no cooling, the saved temperatures plus
-/// the write policy's margin.
+/// A clock that reads earlier than the last-alive stamp (reset, battery
+/// change), a record or a board without a clock reading, or no last-alive
+/// stamp (the stop time is unknown: the machine may have run on after the
+/// record): no cooling, the saved temperatures plus the write policy's
+/// margin. A record older than the stamp by more than the write policy's
+/// longest interval (its saves failed) is stale: a conservative start.
 #[test]
 fn no_cooling_without_a_trustworthy_off_time() {
     let cool = RestCooling::from_consts(&DEFAULT_CONSTS).expect("bound");
     let policy = NvPolicy::DEFAULT;
     let rec = ThermalRecord::new([50.0; N_NODES], 20.0, 0, 0, 1);
-    for (stamp, now) in [(Some(5000), Some(4000)), (None, Some(90_000)), (Some(5000), None)] {
-        let Restore::PowerLoss(r) = boot_restore(Restore::Cold, Some(rec.with_rtc(stamp)), &policy, Some(&cool), now) else { panic!() };
-        assert!(r.temps_c.iter().all(|t| *t == 50.0 + policy.rise_k), "{stamp:?} {now:?}: {:?}", r.temps_c);
+    for (stamp, now, alive) in [
+        (Some(5000), Some(4000), Some(5000)),
+        (None, Some(90_000), Some(5000)),
+        (Some(5000), None, Some(5000)),
+        (Some(5000), Some(90_000), None),
+    ] {
+        let Restore::PowerLoss(r) = boot_restore(Restore::Cold, NvLoad::Valid(rec.with_rtc(stamp)), &policy, Some(&cool), now, alive, false) else { panic!() };
+        assert!(r.temps_c.iter().all(|t| *t == 50.0 + policy.rise_k), "{stamp:?} {now:?} {alive:?}: {:?}", r.temps_c);
     }
-    // An off-time shorter than the write interval: no cooling either.
-    let Restore::PowerLoss(r) = boot_restore(Restore::Cold, Some(rec.with_rtc(Some(5000))), &policy, Some(&cool), Some(5000 + 1799)) else { panic!() };
-    assert!(r.temps_c.iter().all(|t| *t == 50.0 + policy.rise_k), "{:?}", r.temps_c);
+    // Stale: the last save 30 min + 2 s before the machine stopped.
+    let stale = boot_restore(Restore::Cold, NvLoad::Valid(rec.with_rtc(Some(5000))), &policy, Some(&cool), Some(90_000), Some(5000 + 1802), false);
+    assert_eq!(stale, Restore::Corrupt);
 }

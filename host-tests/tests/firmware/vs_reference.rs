@@ -118,6 +118,8 @@ fn closed_loop(name: &str, scenario: &Scenario) -> Run {
     plant
         .run(0.01, scenario.duration_s(), |snap| {
             let s = Sensors::from(snap);
+            // the valve's position switch: the valve the plant ran last tick
+            guard.valve_feedback(snap.lng_open);
             let o = guard.tick(&s.sample());
             run.faults |= o.faults;
             run.pred.push(o.drain_c as f64);
@@ -161,6 +163,8 @@ fn guard_drain_valve<N: Num>(run: &Run) -> (Vec<f64>, Vec<bool>, eha_guard::Faul
     let (mut out, mut valve) = (Vec::with_capacity(n), Vec::with_capacity(n));
     let mut faults = eha_guard::Faults::NONE;
     for s in &run.sensors[..n] {
+        // a valve that follows the command (its position switch reports it)
+        g.valve_feedback(g.output().valve_open);
         let o = g.tick(&s.sample());
         faults |= o.faults;
         out.push(o.drain_c as f64);

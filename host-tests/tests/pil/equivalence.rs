@@ -1,8 +1,9 @@
-//! The firmware in QEMU answers exactly like the same core code on the host
-//! (SIL), frame by frame, for both numeric builds.
+//! The product application in QEMU (the PIL image) answers exactly like the
+//! same application on the host (SIL, the shared in-memory board), tick by
+//! tick, for both numeric builds.
 //!
-//! Open loop here (the closed-loop scenarios are in `pil_scenarios.rs`): the
-//! drill sequence of `eha_sim::pil::drill` (60,000 frames at the firmware's
+//! Open loop here (the closed-loop scenarios are in `scenarios.rs`): the
+//! drill sequence of `eha_sim::pil::drill` (60,000 ticks at the firmware's
 //! 10 ms step, valve open/close, lost frames, non-finite and out-of-range
 //! samples), so the fault paths are compared too.
 //!
@@ -16,47 +17,38 @@
 
 use std::time::Instant;
 
-use eha_guard::protocol::{Reply, ReplyKind, Request};
+use eha_guard::product::wire::TickReply;
 use eha_sim::pil::report::compare;
-use eha_sim::pil::sil::{sil_core, SilTarget};
-use eha_sim::pil::{firmware_for_tests, require_qemu, Build, QemuOptions, QemuSession, Target};
+use eha_sim::pil::sil::SilTarget;
+use eha_sim::pil::{firmware_for_tests, require_qemu, run_drill, Build, QemuOptions, QemuSession};
 
 const STEPS: u32 = eha_sim::pil::drill::STEPS;
 
-fn inputs() -> Vec<Request> {
-    eha_sim::pil::drill::inputs()
-}
-
-fn run_qemu(build: Build, reqs: &[Request]) -> (Vec<Reply>, f64) {
+fn run_qemu(build: Build, samples: &[Option<eha_guard::protocol::Request>]) -> (Vec<TickReply>, f64) {
     require_qemu();
     let elf = firmware_for_tests(build);
     let mut opts = QemuOptions::new(build, &elf);
     opts.icount = false;
     let mut s = QemuSession::spawn(&opts).unwrap_or_else(|e| panic!("{e}"));
     let t0 = Instant::now();
-    let replies: Vec<Reply> = reqs
-        .iter()
-        .enumerate()
-        .map(|(k, r)| s.exchange(&r.encode(), k as u64).unwrap_or_else(|e| panic!("{e}")))
-        .collect();
+    let replies: Vec<TickReply> = run_drill(&mut s, samples).unwrap_or_else(|e| panic!("{e}")).into_iter().map(|o| o.reply).collect();
     let secs = t0.elapsed().as_secs_f64();
-    let end = s.finish(reqs.len() as u64).unwrap_or_else(|e| panic!("{e}"));
-    assert_eq!(end.done.counters.accepted, reqs.len() as u32);
-    assert_eq!(end.done.counters.skipped, 3 + 10);
+    let end = s.finish(samples.len() as u64).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(end.done.accepted, samples.len() as u32 - 13);
+    assert_eq!(end.done.missing, 3 + 10);
     (replies, secs)
 }
 
 fn check(build: Build) {
-    let reqs = inputs();
-    let (fw, secs) = run_qemu(build, &reqs);
-    let mut sil = SilTarget::new(sil_core(build));
-    let host: Vec<Reply> = reqs.iter().enumerate().map(|(k, r)| sil.exchange(&r.encode(), k as u64).unwrap()).collect();
-    assert!(fw.iter().all(|r| r.kind == ReplyKind::Tick));
+    let samples = eha_sim::pil::drill::requests();
+    let (fw, secs) = run_qemu(build, &samples);
+    let mut sil = SilTarget::new(build);
+    let host: Vec<TickReply> = run_drill(&mut sil, &samples).unwrap().into_iter().map(|o| o.reply).collect();
     let c = compare(&fw, &host);
     let valve_steps = fw.iter().filter(|r| r.out.valve_open).count();
     let faults = fw.last().map_or(eha_guard::Faults::NONE, |r| r.out.faults);
     eprintln!(
-        "{}: {} frames in {:.2} s = {:.0} round trips/s; identical {}/{}; max drain diff {:.3e} K; valve open {} steps; final faults {:#x}; peak drain {:.2} C",
+        "{}: {} ticks in {:.2} s = {:.0} round trips/s; identical {}/{}; max drain diff {:.3e} K; valve open {} steps; final faults {:#x}; peak drain {:.2} C",
         build.name(),
         fw.len(),
         secs,
@@ -68,7 +60,7 @@ fn check(build: Build) {
         faults,
         fw.iter().map(|r| r.out.drain_c).fold(f32::MIN, f32::max),
     );
-    let first_fault = fw.iter().position(|r| !r.out.faults.is_empty());
+    let first_fault = fw.iter().position(|r| r.out.faults.intersects(eha_guard::faults::LATCHED));
     let first_open = fw.iter().position(|r| r.out.valve_open);
     let drains: Vec<String> = fw.iter().step_by(5000).map(|r| format!("{:.2}", r.out.drain_c)).collect();
     eprintln!("  first fault at step {first_fault:?}, first valve open at {first_open:?}, drain every 50 s: {}", drains.join(" "));

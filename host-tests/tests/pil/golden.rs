@@ -2,7 +2,7 @@
 //! `ci/expected/*.run`: the f32 firmware in QEMU on the drill sequence of
 //! `eha_sim::pil::drill`.
 //!
-//! The transcript holds the replies every 10 s and at every change of valve,
+//! The transcript holds the tick replies every 10 s and at every change of valve,
 //! alarm or faults (4 decimals), the final counters and the decoded defmt
 //! log; no instruction counts (those are checked against budgets by
 //! `eha-sim fw-budget`, so a compiler update does not force a re-bless). After an intended change of the firmware,
@@ -19,7 +19,7 @@ fn f32_drill_matches_golden_output() {
     require_qemu();
     let elf = firmware_for_tests(Build::F32);
     let q = QemuOptions::new(Build::F32, &elf);
-    let run = run_open_loop(&q, &drill::inputs()).unwrap_or_else(|e| panic!("{e:#}"));
+    let run = run_open_loop(&q, &drill::requests()).unwrap_or_else(|e| panic!("{e:#}"));
     let got = open_loop_transcript(&run, eha_guard::params::S_PER_TICK, 1000);
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/pil/expected/pil_drill_f32.run");
     if std::env::var_os("PIL_BLESS").is_some() {

@@ -7,33 +7,42 @@
 //! account: the plant used LNG (eq. 24) only while commanded, and its true
 //! drain temperature ends lower than in the same run with the valve held shut.
 
-use eha_guard::protocol::tick_guard;
-use eha_guard::{GuardConfig, GuardOf, Restore};
+use eha_guard::GuardConfig;
 use eha_sim::pil::sil::SilTarget;
-use eha_sim::pil::{run_closed_loop, LoopOptions, TickRecord};
+use eha_sim::pil::{run_closed_loop, Build, LoopOptions, PilError, Target, TickOut, TickRecord};
 use eha_sim::plant::Plant;
 use eha_sim::rig::Rig;
 use eha_sim::scenario::Scenario;
 
 /// `open_c`: the guard's valve threshold; `None`: no guard, the valve held shut.
 fn closed_loop(open_c: Option<f32>) -> (Vec<TickRecord>, Plant) {
-    let mut core: eha_sim::pil::sil::GuardCore = match open_c {
-        Some(open_c) => {
-            let mut cfg = GuardConfig::DEFAULT;
-            cfg.valve.open_c = open_c;
-            cfg.valve.close_c = open_c - 2.0;
-            let mut guard = GuardOf::<f32>::new(&cfg, Restore::Cold);
-            assert!(guard.faults().is_empty(), "configuration accepted");
-            Box::new(move |r, gap| tick_guard(&mut guard, r, gap))
+    let mut cfg = GuardConfig::DEFAULT;
+    cfg.valve.open_c = open_c.unwrap_or(40.0);
+    cfg.valve.close_c = cfg.valve.open_c - 2.0;
+    let mut app = SilTarget::with_config(Build::F32, &cfg);
+    // no guard: the valve held shut
+    let mut sil = move |rx: &[u8], k: u64| -> Result<TickOut, PilError> {
+        let mut o = app.tick(rx, k)?;
+        if open_c.is_none() {
+            o.reply.out = eha_guard::Output::default();
         }
-        None => Box::new(|_, _| eha_guard::Output::default()),
+        Ok(o)
     };
-    let mut sil = SilTarget::new(move |r: &eha_guard::protocol::Request, gap| core(r, gap));
+    let mut sil = FnTarget(&mut sil);
     let duration_s = 120.0;
     let mut plant = Plant::new(&Rig::default(), &Scenario::Lng { duration_s }).unwrap();
     let opts = LoopOptions { tick_s: eha_guard::params::S_PER_TICK, duration_s };
     let records = run_closed_loop(&mut plant, &mut sil, &opts).unwrap_or_else(|f| panic!("{:#}", f.error));
     (records, plant)
+}
+
+/// A target made of a closure.
+struct FnTarget<'a>(&'a mut dyn FnMut(&[u8], u64) -> Result<TickOut, PilError>);
+
+impl Target for FnTarget<'_> {
+    fn tick(&mut self, rx: &[u8], tick: u64) -> Result<TickOut, PilError> {
+        (self.0)(rx, tick)
+    }
 }
 
 #[test]

@@ -99,7 +99,7 @@ impl Mps2 {
         wr(WDOG + 0x008, 0b11);
         wr(WDOG + 0xC00, 0);
         let (a, b) = noinit::load();
-        let mem = BootMemory { records: (a, b), nv: None, cause: reset::noinit::load(), hw_hint: None };
+        let mem = BootMemory { records: (a, b), nv: eha_guard::memory::nv::NvLoad::Empty, alive_s: None, nv_failing: false, cause: reset::noinit::load(), hw_hint: None };
         (Mps2 { syst, boot_stack_b: 0 }, mem)
     }
 

@@ -24,7 +24,7 @@ use core::sync::atomic::{AtomicU32, Ordering::Relaxed};
 use cortex_m::interrupt::{self as irq, Mutex};
 use cortex_m::peripheral::{DWT, NVIC, SCB};
 use cortex_m_rt::{exception, ExceptionFrame};
-use eha_guard::memory::nv::{Blocking, NvStore};
+use eha_guard::memory::nv::{Blocking, NvLoad, NvStore};
 use eha_guard::memory::slots::noinit;
 use eha_guard::memory::ThermalRecord;
 use eha_guard::product::reset::{self, CauseRecord};
@@ -233,14 +233,24 @@ impl F411 {
         // 5. Memories: no-init RAM records, the non-volatile record, the cause.
         let (a, b) = noinit::load();
         let mut nv = NvStore::new(Blocking(Flash(LockedFlash::new(dp.FLASH))), NV_RANGE).ok();
-        let nv_rec = nv.as_mut().and_then(|n| n.load());
-        let mem = BootMemory { records: (a, b), nv: nv_rec, cause: reset::noinit::load(), hw_hint: hw_hint(csr) };
+        // A store that cannot be opened is a damaged record, not an empty
+        // one: the machine may be hot (conservative start).
+        let nv_rec = nv.as_mut().map_or(NvLoad::Damaged, |n| n.load());
+        let alive = crate::rtc::alive_load().and_then(eha_guard::memory::alive_from_word);
+        let mem = BootMemory {
+            records: (a, b),
+            nv: nv_rec,
+            alive_s: alive.map(|a| a.0),
+            nv_failing: alive.is_some_and(|a| a.1),
+            cause: reset::noinit::load(),
+            hw_hint: hw_hint(csr),
+        };
         defmt::info!(
             "RCC_CSR {=u32:#010x}, sysclk {=u32} Hz, NV store {}, NV record {}",
             csr,
             rcc.clocks.sysclk().raw(),
             nv.is_some(),
-            nv_rec.is_some()
+            nv_rec != NvLoad::Empty
         );
         // The RTC: started here (the LSE crystal needs up to ~2 s; never waited for).
         let mut rtc = crate::rtc::Rtc::new();
@@ -341,8 +351,8 @@ impl Board for F411 {
     /// period only, so the periods the stall swallowed are added here from
     /// the cycle counter (rounded down: never ahead of real time), and the
     /// application sees them as an overrun and missing steps.
-    fn nv_save(&mut self, rec: &ThermalRecord) -> bool {
-        let Some(nv) = self.nv.as_mut() else { return false };
+    fn nv_save(&mut self, rec: &ThermalRecord) -> Option<bool> {
+        let nv = self.nv.as_mut()?;
         let (t0, c0) = (TICKS.load(Relaxed), DWT::cycle_count());
         let ok = nv.save(rec).is_ok();
         let elapsed = DWT::cycle_count().wrapping_sub(c0) / CYCLES_PER_TICK;
@@ -356,7 +366,7 @@ impl Board for F411 {
                 defmt::warn!("NV save failed ({=u32} so far)", self.nv_errors);
             }
         }
-        ok
+        Some(ok)
     }
 
     fn cycle_stamp(&self) -> u32 {
@@ -380,6 +390,10 @@ impl Board for F411 {
     }
     fn rtc_s(&mut self) -> Option<u32> {
         self.rtc.seconds()
+    }
+
+    fn rtc_alive(&mut self, word: u32) {
+        crate::rtc::alive_store(word);
     }
 }
 

@@ -47,7 +47,7 @@ mod fw {
         // SAFETY: `main` runs once; this is the only reference to APP.
         let app = App::boot_into(unsafe { &mut *core::ptr::addr_of_mut!(APP) }, &mut b, &GuardConfig::DEFAULT, &mem);
         b.boot_done();
-        defmt::info!("eha-stm32f4 up: reset cause {}, faults {=u16:#06x}", app.reset_cause(), app.guard().faults().bits());
+        defmt::info!("eha-stm32f4 up: reset cause {}, faults {=u32:#010x}", app.reset_cause(), app.guard().faults().bits());
         board::start(&mut b);
         app.run(&mut b)
     }

@@ -70,6 +70,25 @@ impl Rtc {
     }
 }
 
+/// The last-alive word (`eha_guard::memory::alive_word`) kept in RTC backup register 0 (VBAT domain: it
+/// survives a power loss; reads 0, i.e. `None`, after a backup-domain reset
+/// or on a board without VBAT).
+pub fn alive_load() -> Option<u32> {
+    // SAFETY: BKP0R is read only here and written only by `alive_store`.
+    let rtc = unsafe { &*pac::RTC::ptr() };
+    let v = rtc.bkpr(0).read().bits();
+    (v != 0).then_some(v)
+}
+
+/// Stores the last-alive word (called only once [`Rtc::seconds`] has run
+/// the clock, which also enabled backup-domain writes, PWR_CR.DBP).
+pub fn alive_store(s: u32) {
+    // SAFETY: BKP0R belongs to this function (see `alive_load`); a plain
+    // 32-bit data register.
+    let rtc = unsafe { &*pac::RTC::ptr() };
+    rtc.bkpr(0).write(|w| unsafe { w.bits(s) });
+}
+
 fn poll(mut done: impl FnMut() -> bool) -> bool {
     (0..POLLS).any(|_| done())
 }

@@ -3,20 +3,16 @@
 
 use super::*;
 
-type Buf = Vec<u8, MAX_PAYLOAD>;
-
-fn put(p: &mut Buf, b: &[u8]) {
-    // Payloads are fixed-size and below MAX_PAYLOAD; a failure would give a
-    // short frame the peer rejects, never a panic.
-    let _ = p.extend_from_slice(b);
-}
-
-fn out_fields(p: &mut Buf, o: &Output) {
-    put(p, &o.drain_c.to_le_bytes());
-    put(p, &[crate::protocol::GuardOutput::flags(o)]);
-    put(p, &o.faults.bits().to_le_bytes());
-    put(p, &o.lng_remaining_kg.to_le_bytes());
-    put(p, &o.lng_seconds_left.to_le_bytes());
+/// A frame built in place: `fill` writes the payload, then it is sealed
+/// (CRC, COBS, delimiters; `lead`: with the leading delimiter).
+#[inline(always)]
+fn framed(lead: bool, fill: impl FnOnce(&mut PutAt<'_>)) -> WireFrame {
+    let mut w = WireFrame::zeroed();
+    let mut p = w.payload();
+    fill(&mut p);
+    let n = p.len();
+    w.seal(n, lead);
+    w
 }
 
 impl Rd<'_> {
@@ -29,7 +25,7 @@ impl Rd<'_> {
             valve_open: flags & 1 != 0,
             alarm: flags & 2 != 0,
             derate: flags & 4 != 0,
-            faults: crate::faults::Faults::from_bits(self.u16()?),
+            faults: crate::faults::Faults::from_bits(self.u32()?),
             lng_remaining_kg: self.f32()?,
             lng_seconds_left: self.f32()?,
         })
@@ -50,11 +46,12 @@ fn expect(p: &[u8], kind: u8, len: usize) -> Result<Rd<'_>, DecodeError> {
 impl Command {
     /// Wire bytes (controller side).
     pub fn encode(&self) -> WireFrame {
-        let mut p = Buf::new();
-        put(&mut p, &[KIND_COMMAND]);
-        put(&mut p, &self.token.to_le_bytes());
-        put(&mut p, &[self.cmd.code()]);
-        frame(&p, false)
+        framed(false, |p| {
+            p.u8(KIND_COMMAND);
+            p.u16(self.token);
+            p.u8(self.cmd.code());
+            p.u32(self.arg);
+        })
     }
 
     /// Parses a payload (CRC checked and stripped).
@@ -62,39 +59,59 @@ impl Command {
         let mut r = expect(p, KIND_COMMAND, COMMAND_LEN)?;
         let token = r.u16()?;
         let cmd = Cmd::from_code(r.u8()?).ok_or(DecodeError::Kind)?;
-        Ok(Command { token, cmd })
+        Ok(Command { token, cmd, arg: r.u32()? })
     }
 }
 
 impl TickReply {
+    /// The fields that change only with the outputs, the pins or the
+    /// counters (layout: docs/firmware.md): written first, so that the
+    /// product loop re-frames only the per-tick tail ([`super::ReplyEncoder`]).
+    #[inline(always)]
+    pub(super) fn head(&self, p: &mut PutAt<'_>) {
+        p.u8(KIND_TICK);
+        p.u8(u8::from(self.not_commissioned) << 1);
+        p.f32(self.out.drain_c);
+        p.u8(crate::protocol::GuardOutput::flags(&self.out));
+        p.u32(self.out.faults.bits());
+        p.f32(self.out.lng_remaining_kg);
+        p.f32(self.out.lng_seconds_left);
+        p.u8(u8::from(self.pins.valve_pin) | (u8::from(self.pins.ok_pin) << 1));
+        p.u16(self.overruns);
+        p.u16(self.rejected);
+        p.u8(restore_code(self.restore));
+        p.u8(self.reset_cause as u8);
+    }
+
+    /// The per-tick tail: tick counter, the sample's sequence number, fresh.
+    #[inline(always)]
+    pub(super) fn tail(&self) -> [u8; TICK_TAIL_LEN] {
+        let t = self.tick.to_le_bytes();
+        let s = self.sample_seq.to_le_bytes();
+        [t[0], t[1], t[2], t[3], s[0], s[1], u8::from(self.fresh)]
+    }
+
     /// Wire bytes (leading and trailing delimiter).
     pub fn encode(&self) -> WireFrame {
-        let mut p = Buf::new();
-        put(&mut p, &[KIND_TICK]);
-        put(&mut p, &self.tick.to_le_bytes());
-        put(&mut p, &self.sample_seq.to_le_bytes());
-        put(&mut p, &[u8::from(self.fresh) | (u8::from(self.not_commissioned) << 1)]);
-        out_fields(&mut p, &self.out);
-        put(&mut p, &[u8::from(self.pins.valve_pin) | (u8::from(self.pins.ok_pin) << 1)]);
-        put(&mut p, &self.overruns.to_le_bytes());
-        put(&mut p, &self.rejected.to_le_bytes());
-        put(&mut p, &[restore_code(self.restore), self.reset_cause as u8]);
-        frame(&p, true)
+        framed(true, |p| {
+            self.head(p);
+            p.bytes(&self.tail());
+        })
     }
 
     /// Parses a payload (host side).
     pub fn from_payload(p: &[u8]) -> Result<TickReply, DecodeError> {
         let mut r = expect(p, KIND_TICK, TICK_LEN)?;
-        let tick = r.u32()?;
-        let sample_seq = r.u16()?;
-        let fresh_byte = r.u8()?;
-        let (fresh, not_commissioned) = (fresh_byte & 1 != 0, fresh_byte & 2 != 0);
+        let not_commissioned = r.u8()? & 2 != 0;
         let out = r.out()?;
         let pins = r.u8()?;
         let overruns = r.u16()?;
         let rejected = r.u16()?;
         let restore = restore_from_code(r.u8()?).ok_or(DecodeError::Kind)?;
         let reset_cause = ResetCause::from_code(r.u8()?);
+        let tick = r.u32()?;
+        let sample_seq = r.u16()?;
+        let fresh = r.u8()? & 1 != 0;
         let pins = Pins { valve_pin: pins & 1 != 0, ok_pin: pins & 2 != 0 };
         Ok(TickReply { tick, sample_seq, fresh, not_commissioned, out, pins, overruns, rejected, restore, reset_cause })
     }
@@ -103,11 +120,13 @@ impl TickReply {
 impl Ack {
     /// Wire bytes.
     pub fn encode(&self) -> WireFrame {
-        let mut p = Buf::new();
-        put(&mut p, &[KIND_ACK]);
-        put(&mut p, &self.token.to_le_bytes());
-        put(&mut p, &[self.cmd.code(), self.result as u8]);
-        frame(&p, true)
+        framed(true, |p| {
+            p.u8(KIND_ACK);
+            p.u16(self.token);
+            p.u8(self.cmd.code());
+            p.u8(self.result as u8);
+            p.u32(self.value);
+        })
     }
 
     /// Parses a payload (host side).
@@ -120,31 +139,34 @@ impl Ack {
             1 => AckResult::Refused,
             _ => return Err(DecodeError::Kind),
         };
-        Ok(Ack { token, cmd, result })
+        Ok(Ack { token, cmd, result, value: r.u32()? })
     }
 }
 
 impl Status {
     /// Wire bytes.
     pub fn encode(&self) -> WireFrame {
-        let mut p = Buf::new();
-        put(&mut p, &[KIND_STATUS]);
-        put(&mut p, &self.token.to_le_bytes());
-        put(&mut p, &self.tick.to_le_bytes());
-        put(&mut p, &self.overruns.to_le_bytes());
-        put(&mut p, &self.worst_tick_cycles.to_le_bytes());
-        put(&mut p, &self.stack_high_water_b.to_le_bytes());
-        put(&mut p, &self.boot_stack_b.to_le_bytes());
-        put(&mut p, &[self.reset_cause, self.restore]);
-        for v in [self.boots, self.rejected_crc, self.rejected_framing, self.rejected_sequence, self.superseded] {
-            put(&mut p, &v.to_le_bytes());
-        }
-        put(&mut p, &self.accepted.to_le_bytes());
-        put(&mut p, &self.missing.to_le_bytes());
-        for v in [self.rx_overflow, self.commands, self.nv_failures, self.faults.bits()] {
-            put(&mut p, &v.to_le_bytes());
-        }
-        frame(&p, true)
+        framed(true, |p| {
+            p.u8(KIND_STATUS);
+            p.u16(self.token);
+            p.u32(self.tick);
+            p.u32(self.overruns);
+            p.u32(self.worst_tick_cycles);
+            p.u16(self.stack_high_water_b);
+            p.u16(self.boot_stack_b);
+            p.u8(self.reset_cause);
+            p.u8(self.restore);
+            for v in [self.boots, self.rejected_crc, self.rejected_framing, self.rejected_sequence, self.superseded] {
+                p.u16(v);
+            }
+            p.u32(self.accepted);
+            p.u32(self.missing);
+            for v in [self.rx_overflow, self.commands, self.nv_failures] {
+                p.u16(v);
+            }
+            p.u32(self.faults.bits());
+            p.u8(self.protocol);
+        })
     }
 
     /// Parses a payload (host side).
@@ -169,7 +191,8 @@ impl Status {
             rx_overflow: r.u16()?,
             commands: r.u16()?,
             nv_failures: r.u16()?,
-            faults: crate::faults::Faults::from_bits(r.u16()?),
+            faults: crate::faults::Faults::from_bits(r.u32()?),
+            protocol: r.u8()?,
         })
     }
 }
@@ -177,14 +200,16 @@ impl Status {
 impl TraceReply {
     /// Wire bytes.
     pub fn encode(&self) -> WireFrame {
-        let mut p = Buf::new();
-        put(&mut p, &[KIND_TRACE]);
-        put(&mut p, &self.token.to_le_bytes());
-        put(&mut p, &[self.index, self.count, self.event.tag]);
-        put(&mut p, &self.event.tick.to_le_bytes());
-        put(&mut p, &self.event.value.to_le_bytes());
-        put(&mut p, &self.event.aux.to_le_bytes());
-        frame(&p, true)
+        framed(true, |p| {
+            p.u8(KIND_TRACE);
+            p.u16(self.token);
+            p.u8(self.index);
+            p.u8(self.count);
+            p.u8(self.event.tag);
+            p.u32(self.event.tick);
+            p.f32(self.event.value);
+            p.u32(self.event.aux);
+        })
     }
 
     /// Parses a payload (host side).
@@ -194,7 +219,7 @@ impl TraceReply {
         let index = r.u8()?;
         let count = r.u8()?;
         let tag = r.u8()?;
-        let event = TraceWire { tag, tick: r.u32()?, value: r.f32()?, aux: r.u16()? };
+        let event = TraceWire { tag, tick: r.u32()?, value: r.f32()?, aux: r.u32()? };
         Ok(TraceReply { token, index, count, event })
     }
 }

@@ -2,18 +2,21 @@
 //! [`crate::protocol`] (same framing: COBS, CRC-16, `0x00` delimiters).
 //!
 //! Controller → guard: sample requests ([`crate::protocol::Request`], kind
-//! `0x01`) at the 10 ms tick rate, and [`Command`] frames (kind `0x10`).
+//! `0x02`) at the 10 ms tick rate, and [`Command`] frames (kind `0x10`).
 //! Guard → controller: one [`TickReply`] per tick, an [`Ack`] per command,
 //! a [`Status`] on request, and a trace dump as one [`TraceReply`] per event.
-//! Frame layouts are in `docs/firmware.md` (section "Product protocol");
+//! Frame layouts are in `docs/firmware.md` ("What the controller must send,
+//! and what it gets back"; the commands under "Commands: arm, then confirm");
 //! all fields little-endian, floats as IEEE-754 binary32 bit patterns.
 
-use crate::protocol::{frame, DecodeError, Rd, WireFrame, MAX_PAYLOAD};
+use crate::protocol::{DecodeError, PutAt, Rd, WireFrame};
 use crate::trace::{RestoreKind, Trace};
 use crate::Output;
-use heapless::Vec;
 
 mod codec;
+mod reply;
+
+pub use reply::ReplyEncoder;
 
 /// Kind byte of a command frame (controller → guard).
 pub const KIND_COMMAND: u8 = 0x10;
@@ -27,25 +30,40 @@ pub const KIND_STATUS: u8 = 0x92;
 pub const KIND_TRACE: u8 = 0x93;
 
 /// Payload length of a command, bytes.
-pub const COMMAND_LEN: usize = 4;
+pub const COMMAND_LEN: usize = 8;
 /// Payload length of a tick reply, bytes.
-pub const TICK_LEN: usize = 30;
+pub const TICK_LEN: usize = 33;
+/// Bytes of the tick reply's per-tick tail (tick, sample sequence, fresh).
+pub const TICK_TAIL_LEN: usize = 7;
 /// Payload length of an acknowledgement, bytes.
-pub const ACK_LEN: usize = 5;
+pub const ACK_LEN: usize = 9;
 /// Payload length of a status reply, bytes.
-pub const STATUS_LEN: usize = 47;
+pub const STATUS_LEN: usize = 50;
 /// Payload length of a trace-event reply, bytes.
-pub const TRACE_LEN: usize = 16;
+pub const TRACE_LEN: usize = 18;
 
 /// A controller command.
+///
+/// Clear and refill cannot undo protection by accident: each is a pair,
+/// **arm** then **confirm** within [`ARM_WINDOW_TICKS`] with the key
+/// [`command_key`] of the nonce the arm's acknowledgement carries and the
+/// parameter block's rig id; a confirmed clear or refill at most once per
+/// [`COMMAND_INTERVAL_TICKS`]; every one traced. A refill is refused with the
+/// valve open or the guard in alarm; a clear never restores trust in the
+/// estimate before it can have recovered (docs/firmware.md, "Commands").
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(any(target_os = "none", feature = "defmt"), derive(defmt::Format))]
 pub enum Cmd {
-    /// Clear latched faults (the guard's clear rule: 100 fully valid ticks in
-    /// a row and no CONFIG fault; refused otherwise).
-    ClearFaults,
-    /// A new LNG charge was installed: the budget is full again.
-    RefillLng,
+    /// Arm a clear of the latched faults; the ack carries the nonce.
+    ClearArm,
+    /// Confirm the armed clear (argument: the key). Done under the guard's
+    /// clear rule (100 fully valid ticks in a row, no CONFIG).
+    ClearConfirm,
+    /// Arm a refill of the LNG budget (a new charge installed); the ack
+    /// carries the nonce.
+    RefillArm,
+    /// Confirm the armed refill (argument: the key).
+    RefillConfirm,
     /// Send a [`Status`] reply.
     Status,
     /// Send the trace ring, oldest event first, as [`TraceReply`] frames.
@@ -60,10 +78,12 @@ impl Cmd {
     /// Wire code.
     pub fn code(self) -> u8 {
         match self {
-            Cmd::ClearFaults => 1,
-            Cmd::RefillLng => 2,
+            Cmd::ClearArm => 1,
+            Cmd::RefillArm => 2,
             Cmd::Status => 3,
             Cmd::Trace => 4,
+            Cmd::ClearConfirm => 5,
+            Cmd::RefillConfirm => 6,
             Cmd::InjectHang => 0xE0,
             Cmd::InjectPanic => 0xE1,
         }
@@ -72,10 +92,12 @@ impl Cmd {
     /// From a wire code.
     pub fn from_code(c: u8) -> Option<Cmd> {
         Some(match c {
-            1 => Cmd::ClearFaults,
-            2 => Cmd::RefillLng,
+            1 => Cmd::ClearArm,
+            2 => Cmd::RefillArm,
             3 => Cmd::Status,
             4 => Cmd::Trace,
+            5 => Cmd::ClearConfirm,
+            6 => Cmd::RefillConfirm,
             0xE0 => Cmd::InjectHang,
             0xE1 => Cmd::InjectPanic,
             _ => return None,
@@ -83,22 +105,60 @@ impl Cmd {
     }
 }
 
-/// A command frame: the command and a token the reply echoes.
+/// Ticks a confirmation may follow its arm (100 = 1 s).
+pub const ARM_WINDOW_TICKS: u32 = 100;
+/// Least ticks between two confirmed clears, or two confirmed refills
+/// (1000 = 10 s): a controller clearing in a loop cannot make a latch
+/// self-resetting.
+pub const COMMAND_INTERVAL_TICKS: u32 = 1000;
+
+/// The key that confirms an armed command: CRC-32 of the parameter block's
+/// rig id (16 bytes, zero-padded; all zero for the compiled-in default), the
+/// arm's nonce (little-endian) and the confirming command's code. Line
+/// noise, a stray frame or a controller bug does not produce it; a
+/// controller that means the command computes it from the ack.
+pub fn command_key(rig_id: &[u8; 16], nonce: u32, confirm: Cmd) -> u32 {
+    let mut c = crate::memory::crc32_update(0xFFFF_FFFF, rig_id);
+    c = crate::memory::crc32_update(c, &nonce.to_le_bytes());
+    !crate::memory::crc32_update(c, &[confirm.code()])
+}
+
+/// A command frame: the command, a token the reply echoes, and its
+/// argument (a confirmation's key; 0 otherwise).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Command {
     /// Echoed in the reply so the controller can match it.
     pub token: u16,
     /// What to do.
     pub cmd: Cmd,
+    /// The key of a confirmation ([`command_key`]); 0 otherwise.
+    pub arg: u32,
 }
 
 /// Outcome of a command, in its [`Ack`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum AckResult {
-    /// Done.
+    /// Done (an arm: armed, the nonce in [`Ack::value`]).
     Done = 0,
-    /// Refused (clear rule not met, or not available in this build).
+    /// Refused ([`Ack::value`] says why: [`Refusal`]).
     Refused = 1,
+}
+
+/// Why a command was refused (the [`Ack::value`] of a refusal).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u32)]
+pub enum Refusal {
+    /// Not available in this build (fault injection).
+    Unavailable = 1,
+    /// No matching arm within [`ARM_WINDOW_TICKS`].
+    NotArmed = 2,
+    /// Wrong key.
+    Key = 3,
+    /// Within [`COMMAND_INTERVAL_TICKS`] of the last one.
+    TooSoon = 4,
+    /// The guard's rule: the clear rule not met (faults remain), or a
+    /// refill with the valve open or in alarm.
+    Rule = 5,
 }
 
 /// Acknowledgement of a command.
@@ -110,6 +170,10 @@ pub struct Ack {
     pub cmd: Cmd,
     /// Its outcome.
     pub result: AckResult,
+    /// An arm's nonce; a confirmed clear: the seconds UNTRUSTED still holds
+    /// (0: trust restored, [`crate::guard::recovery_ticks`]); a refusal: why
+    /// ([`Refusal`]); 0 otherwise.
+    pub value: u32,
 }
 
 /// Output pin levels read back from the port's output register.
@@ -255,6 +319,8 @@ pub struct Status {
     pub nv_failures: u16,
     /// Faults now.
     pub faults: crate::faults::Faults,
+    /// Protocol version of this firmware ([`crate::protocol::PROTOCOL_VERSION`]).
+    pub protocol: u8,
 }
 
 /// One trace event in a dump.
@@ -280,26 +346,27 @@ pub struct TraceWire {
     pub tick: u32,
     /// Drain °C (valve/alarm events), LNG kg (LNG low), else 0.
     pub value: f32,
-    /// Fault bits, restore/reset cause code, forced flag, lost ticks or command code.
-    pub aux: u16,
+    /// Fault bits, restore/reset cause code, forced flag, lost ticks, or a
+    /// command's code and (bits 8-15) its result (0 done, else the [`Refusal`]).
+    pub aux: u32,
 }
 
 /// Flattens a trace event for the wire.
 pub fn encode_trace(t: &Trace) -> TraceWire {
     let w = |tag, tick, value, aux| TraceWire { tag, tick, value, aux };
     match *t {
-        Trace::Restore { tick, kind } => w(1, tick, 0.0, u16::from(restore_code(kind))),
-        Trace::ValveOpen { tick, drain_c, forced } => w(2, tick, drain_c, u16::from(forced)),
+        Trace::Restore { tick, kind } => w(1, tick, 0.0, u32::from(restore_code(kind))),
+        Trace::ValveOpen { tick, drain_c, forced } => w(2, tick, drain_c, u32::from(forced)),
         Trace::ValveClose { tick, drain_c } => w(3, tick, drain_c, 0),
         Trace::Alarm { tick, drain_c } => w(4, tick, drain_c, 0),
         Trace::AlarmClear { tick, drain_c } => w(5, tick, drain_c, 0),
         Trace::Fault { tick, new_bits } => w(6, tick, 0.0, new_bits.bits()),
         Trace::FaultsCleared { tick, bits } => w(7, tick, 0.0, bits.bits()),
         Trace::LngLow { tick, remaining_kg } => w(8, tick, remaining_kg, 0),
-        Trace::Overrun { tick, lost_ticks } => w(9, tick, 0.0, lost_ticks),
-        Trace::Reset { tick, cause } => w(10, tick, 0.0, u16::from(cause)),
-        Trace::Command { tick, code } => w(11, tick, 0.0, u16::from(code)),
-        Trace::Params { tick, source } => w(12, tick, 0.0, u16::from(source)),
+        Trace::Overrun { tick, lost_ticks } => w(9, tick, 0.0, u32::from(lost_ticks)),
+        Trace::Reset { tick, cause } => w(10, tick, 0.0, u32::from(cause)),
+        Trace::Command { tick, code, result } => w(11, tick, 0.0, u32::from(code) | (u32::from(result) << 8)),
+        Trace::Params { tick, source } => w(12, tick, 0.0, u32::from(source)),
     }
 }
 
