@@ -54,6 +54,11 @@ pub struct Losses {
     pub act_leak: f64,
     /// Piston seal friction (viscous + Coulomb).
     pub act_friction: f64,
+    /// The part of [`Losses::mechanical`] that heats metal (the pump's
+    /// housing and rotating group) rather than oil, W: where the
+    /// sliding-pair rule puts it ([`Model::friction_heat`]). Not a loss of
+    /// its own: [`Losses::total`] counts it once, inside `mechanical`.
+    pub mech_metal: f64,
 }
 
 impl Losses {
@@ -79,6 +84,24 @@ impl Losses {
             ("p_act_friction_w", self.act_friction),
         ]
     }
+
+    /// The pump friction of eq. (8) split by what it heats: (oil, metal), W.
+    /// Output channels `p_mech_oil_w`, `p_mech_metal_w` (they add up to `p_mech_w`).
+    pub fn friction_split_channels(&self) -> [(&'static str, f64); 2] {
+        [("p_mech_oil_w", self.mechanical - self.mech_metal), ("p_mech_metal_w", self.mech_metal)]
+    }
+}
+
+/// Where the pump's friction heat (extended eq. 8) goes at one instant, W:
+/// the sliding-pair rule of [`crate::rig::FrictionPairs`].
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct FrictionHeat {
+    /// Into the delivered (high-pressure port) oil.
+    pub delivered: f64,
+    /// Into the case oil.
+    pub case: f64,
+    /// Into the pump's metal.
+    pub metal: f64,
 }
 
 /// Linear interpolation in measured inputs.
@@ -325,6 +348,16 @@ impl Model {
         losses::PumpFriction::new(p.no_load_torque_nm, p.viscous_torque_coeff, p.eta_m, self.rig.displacement_m3_per_rad(), mu, op.p_a - op.p_b, op.omega)
     }
 
+    /// The pump's friction heat placed by the sliding-pair rule: the no-load
+    /// term (bearings, shaft seal) heats the metal, the viscous and pressure
+    /// terms divide by [`crate::rig::FrictionPairs::shares`], W.
+    pub fn friction_heat(&self, op: &OpPoint, t_case: f64) -> FrictionHeat {
+        let fr = self.pump_friction(op, t_case);
+        let (f_del, f_case, f_metal) = self.rig.pump.friction_pairs.shares();
+        let shared = fr.viscous_w + fr.pressure_w;
+        FrictionHeat { delivered: f_del * shared, case: f_case * shared, metal: fr.no_load_w + f_metal * shared }
+    }
+
     /// All losses at an operating point and temperatures, W.
     pub fn losses(&self, t: f64, op: &OpPoint, temps: &[f64]) -> Losses {
         let rig = &self.rig;
@@ -361,6 +394,7 @@ impl Model {
             bearing: rig.motor.bearing_friction_nm.map_or(0.0, |m| losses::bearing_w(m, op.omega)),
             leakage: f.leak_a * (op.p_a - op.p_case) + f.leak_b * (op.p_b - op.p_case),
             mechanical: self.pump_friction(op, tc(Node::Case)).total_w(),
+            mech_metal: self.friction_heat(op, tc(Node::Case)).metal,
             churning: rig.ext.churning_loss.map_or(0.0, |k| losses::churning_w(k, op.omega)),
             line,
             needle,
@@ -387,15 +421,13 @@ impl Model {
         let mut q_in = 0.0;
         // Heat sources (losses that are not a pressure drop of the ring) into their nodes.
         let hp = if op.p_a >= op.p_b { Node::Outlet } else { Node::Inlet };
-        let fr = self.pump_friction(op, tc(Node::Case));
-        let (f_del, f_case, f_metal) = rig.pump.friction_pairs.shares();
-        let shared = fr.viscous_w + fr.pressure_w;
+        let fh = self.friction_heat(op, tc(Node::Case));
         for (n, w) in [
             (Node::Winding, l.copper),
             (Node::Motor, l.iron + l.bearing),
-            (Node::Pump, fr.no_load_w + f_metal * shared),
-            (Node::Case, f_case * shared + l.churning),
-            (hp, f_del * shared),
+            (Node::Pump, fh.metal),
+            (Node::Case, fh.case + l.churning),
+            (hp, fh.delivered),
             (Node::Loop, l.valves),
             (Node::Actuator, l.act_leak + l.act_friction),
         ] {

@@ -196,11 +196,13 @@ const CASE2_WINDOW: usize = 6;
 /// it, i.e. 90 % of it leaves (the 90 % settling of a first-order lag).
 const CASE2_EPS: f64 = 0.10;
 /// Loss channels that heat oil nodes (model.rs `thermal`: leakage, the
-/// pump's friction split between case and high-pressure port, churning, line
-/// and valve losses into the loop oil, needle throttling into the ball-valve
-/// oil) and those that heat metal (winding, motor, actuator).
-const OIL_LOSSES: [&str; 6] = ["p_leak_w", "p_mech_w", "p_churn_w", "p_line_w", "p_throttle_w", "p_valves_w"];
-const METAL_LOSSES: [&str; 5] = ["p_cu_w", "p_fe_w", "p_bearing_w", "p_act_leak_w", "p_act_friction_w"];
+/// pump's friction that the sliding-pair rule puts into the case and
+/// high-pressure port oil, churning, line and valve losses into the loop oil,
+/// needle throttling into the ball-valve oil) and those that heat metal
+/// (winding, motor, actuator, the pump friction's metal part: bearings,
+/// shaft seal and the films' share on the metal faces).
+const OIL_LOSSES: [&str; 6] = ["p_leak_w", "p_mech_oil_w", "p_churn_w", "p_line_w", "p_throttle_w", "p_valves_w"];
+const METAL_LOSSES: [&str; 6] = ["p_cu_w", "p_fe_w", "p_bearing_w", "p_act_leak_w", "p_act_friction_w", "p_mech_metal_w"];
 
 /// Balance time: the centre of the first window from which on every window's
 /// ratio (stored / lost power, `(centre s, ratio)`) is below `eps` in
@@ -225,12 +227,14 @@ fn balance_from(ratios: &[(f64, f64)], eps: f64) -> Option<f64> {
 /// stores the rest; printed), so the paper's statement can only mean the oil.
 ///
 /// Paper: ≈ 200 s, read as ±50 s (half a 100 s division of a 600 s axis).
-/// **Known miss**: measured oil 305.0 s, inlet 212.5 s, outlet 212.5 s, drain
-/// not within 600 s (issue 16's pump energy balance moved them from 390 /
-/// 382.5 / 382.5 / 517.5 s: part of the pump's friction now heats the housing
-/// directly, and the "oil losses" below still count the whole of eq. 8 as
-/// oil heat, so the oil ratio is an upper bound). Printed beside: the 20 %
-/// and 5 % crossings.
+/// **Known miss**: measured oil 515.0 s, inlet 502.5 s, outlet 502.5 s, drain
+/// not within 600 s. The denominator is the friction heat that really enters
+/// the oil: the sliding-pair rule puts the no-load term and a quarter of the
+/// films' heat into the pump's metal (`p_mech_metal_w`), which the oil never
+/// receives. Counting all of eq. (8) as oil heat (the earlier accounting)
+/// overstated the oil's input by that much and gave 305.0 / 212.5 / 212.5 s,
+/// an upper bound, not a balance time (before issue 16's energy balance:
+/// 390 / 382.5 / 382.5 / 517.5 s). Printed beside: the 20 % and 5 % crossings.
 /// Asserted: each time within ±15 s of the measured (three periods: near the
 /// crossing the ratio falls ≈ 0.001 per 15 s and scatters ≈ ±0.0005 between
 /// windows; 30 s windows of 3–10 periods and a 0.05 s output grid give times
@@ -294,9 +298,9 @@ fn case2_periodic_balance_time_known_miss() {
     // (name, measured balance time at CASE2_EPS, s)
     type Series = Vec<(f64, f64)>;
     let cases: [(&str, Series, Option<f64>); 4] = [
-        ("oil (energy)", oil, Some(305.0)),
-        ("t_inlet_c", node("t_inlet_c"), Some(212.5)),
-        ("t_outlet_c", node("t_outlet_c"), Some(212.5)),
+        ("oil (energy)", oil, Some(515.0)),
+        ("t_inlet_c", node("t_inlet_c"), Some(502.5)),
+        ("t_outlet_c", node("t_outlet_c"), Some(502.5)),
         ("t_drain_c", node("t_drain_c"), None),
     ];
     let mut failures = vec![];
@@ -332,4 +336,54 @@ fn case2_periodic_balance_time_known_miss() {
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// Losses of the energy transfer at `t`: every loss but the needle's
+/// throttling (the load the paper's Case 1 sets), W.
+fn transfer_loss_w(out: &SimOutput, t: f64) -> f64 {
+    out.at("p_total_w", t).unwrap_or(f64::NAN) - out.at("p_throttle_w", t).unwrap_or(f64::NAN)
+}
+
+/// The paper (Section IV.B): "In Case 1 the power loss at 60 bar pressure is
+/// 0.7 kW and the combined system thermal power is about 1.5 kW", the
+/// latter used to size the LNG (eqs. 23–25, 2.3 L).
+///
+/// Ours, Case 1 at 60 bar, mean over 0–600 s: the losses of the energy
+/// transfer (motor copper and iron, pump leakage and friction, lines: every
+/// loss but the needle's throttling, which is the load Case 1 sets) and the
+/// combined thermal power (all of them). The paper prints one significant
+/// figure, so its 0.7 kW stands for [0.65, 0.75) kW and its 1.5 kW for
+/// [1.45, 1.55) kW. **Measured**: transfer 0.571 kW (a known miss, 0.08 kW
+/// below the interval), combined 1.485 kW (inside). Asserted as measured,
+/// ±0.005 kW (deterministic runs; catches any change of a loss law).
+///
+/// LNG sizing from the model's own dissipation beside the paper's input:
+/// eqs. (23)–(25) with the same mission time (680 s, the one that gives the
+/// paper's 2.3 L at 1.5 kW): measured 2.28 L from our 1.485 kW, against the
+/// paper's 2.30 L (asserted as measured, ±0.01 L).
+#[test]
+fn power_loss_at_60bar_against_the_paper_and_lng_sized_from_the_model() {
+    let out = case1(&Rig::default(), 60.0);
+    let ts: Vec<f64> = out.time_s.clone();
+    let mean = |f: &dyn Fn(f64) -> f64| ts.windows(2).map(|w| 0.5 * (f(w[0]) + f(w[1])) * (w[1] - w[0])).sum::<f64>() / 600.0;
+    let transfer = mean(&|t| transfer_loss_w(&out, t)) * 1e-3;
+    let combined = mean(&|t| out.at("p_total_w", t).unwrap_or(f64::NAN)) * 1e-3;
+    let at600 = (transfer_loss_w(&out, 600.0) * 1e-3, out.last("p_total_w").unwrap_or(f64::NAN) * 1e-3);
+    let lng = Lng::default();
+    let ours = size(&lng, combined * 1e3, 680.0, 2.0);
+    let paper = size(&lng, 1500.0, 680.0, 2.0);
+    println!(
+        "60 bar, mean 0-600 s: transfer losses {transfer:.3} kW (paper 0.7), combined {combined:.3} kW (paper 1.5); at 600 s {:.3} / {:.3} kW",
+        at600.0, at600.1
+    );
+    println!(
+        "LNG for 680 s: {:.3} L from the model's {combined:.3} kW ({:.2} L with 2x), paper's 1.5 kW {:.3} L",
+        ours.volume_m3 * 1e3,
+        ours.volume_with_redundancy_m3 * 1e3,
+        paper.volume_m3 * 1e3
+    );
+    assert!((transfer - 0.571).abs() <= 0.005, "transfer losses {transfer:.4} kW: re-measure");
+    assert!((combined - 1.485).abs() <= 0.005, "combined {combined:.4} kW: re-measure");
+    assert!((1.45..1.55).contains(&combined), "combined thermal power {combined:.3} kW outside the paper's 1.5 kW");
+    assert!((ours.volume_m3 * 1e3 - 2.28).abs() <= 0.01, "LNG {:.3} L: re-measure", ours.volume_m3 * 1e3);
 }
