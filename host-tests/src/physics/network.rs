@@ -79,26 +79,48 @@ impl Node {
     }
 }
 
-/// Masses of the nodes, kg (oil masses at the 40 °C density) and, for
-/// metal nodes, their specific heats, J/(kg·K).
-pub fn masses(rig: &Rig) -> [(f64, f64); N_NODES] {
-    let rho = rig.oil.rho(40.0, 0.0) * rig.nuisance.oil_capacity_scale;
+/// What each node holds: metal nodes (mass kg, specific heat J/(kg·K)), oil
+/// nodes (volume m³, 0): an oil node's capacity is its volume times
+/// ρ(T)·c_p(T) at its own temperature ([`capacity_j_per_k`]). The nuisance
+/// capacity scales are applied here.
+pub fn contents(rig: &Rig) -> [(f64, f64); N_NODES] {
+    let v = rig.nuisance.oil_capacity_scale;
     let ms = rig.nuisance.metal_capacity_scale;
     let m = &rig.motor;
     [
         (m.winding_mass_kg * ms, m.winding_cp),
         ((m.mass_kg - m.winding_mass_kg) * ms, m.body_cp),
         (rig.pump.mass_kg * ms, rig.pump.cp),
-        (rho * rig.pump.case_oil_m3, 0.0),
-        (rho * rig.pump.port_oil_m3, 0.0),
-        (rho * rig.pump.port_oil_m3, 0.0),
-        (rho * rig.blocks.loop_oil_m3, 0.0),
+        (v * rig.pump.case_oil_m3, 0.0),
+        (v * rig.pump.port_oil_m3, 0.0),
+        (v * rig.pump.port_oil_m3, 0.0),
+        (v * rig.blocks.loop_oil_m3, 0.0),
         (rig.blocks.main_mass_kg * ms, rig.blocks.cp),
         (rig.blocks.ball_mass_kg * ms, rig.blocks.cp),
-        (rho * rig.blocks.ball_oil_m3, 0.0),
-        (rho * rig.blocks.sensor_oil_m3, 0.0),
+        (v * rig.blocks.ball_oil_m3, 0.0),
+        (v * rig.blocks.sensor_oil_m3, 0.0),
         (rig.actuator.body_mass_kg * ms, rig.actuator.body_cp),
     ]
+}
+
+/// Heat capacity of node `n` holding `content` (an entry of [`contents`]) at
+/// `t_c`, J/K: m·c for metal, V·ρ(T)·c_p(T) for oil.
+pub fn capacity_j_per_k(rig: &Rig, n: Node, content: (f64, f64), t_c: f64) -> f64 {
+    if n.is_oil() {
+        content.0 * rig.oil.rho_cp(t_c)
+    } else {
+        content.0 * content.1
+    }
+}
+
+/// Heat stored in node `n` at `t_c` relative to 20 °C, J (consistent with
+/// [`capacity_j_per_k`]: its derivative in `t_c`).
+pub fn stored_j(rig: &Rig, n: Node, content: (f64, f64), t_c: f64) -> f64 {
+    if n.is_oil() {
+        content.0 * rig.oil.volumetric_enthalpy(t_c)
+    } else {
+        content.0 * content.1 * (t_c - 20.0)
+    }
 }
 
 /// Oil-to-metal conductance of a duct: forced convection by eqs. (13)/(14)
@@ -158,14 +180,18 @@ pub fn q_outer_exposed(rig: &Rig, area: f64, shape: Shape, t_wall: f64, t_air: f
 }
 
 /// Convective coefficient of an outer surface: free convection (eq. 15 or
-/// 16) combined with forced convection at `air_mps` (ram air), W/(m²·K).
+/// 16) combined with forced convection at `air_mps` (ram air), W/(m²·K); the
+/// air at `t_air` and the pressure of the rig's altitude.
 pub fn h_outer(rig: &Rig, shape: Shape, t_wall: f64, t_air: f64, air_mps: f64) -> f64 {
+    let p_air = rig.outside.air_pressure_pa();
     let free = match shape {
-        Shape::Cylinder(d) => h_free_cylinder(t_wall, t_air, d),
-        Shape::Cube(a) => h_free_cube(t_wall, t_air, a),
+        Shape::Cylinder(d) => h_free_cylinder(t_wall, t_air, p_air, d),
+        Shape::Cube(a) => h_free_cube(t_wall, t_air, p_air, a),
     };
     if air_mps > 0.0 {
-        h_mixed(free, h_forced_plate(air_mps, rig.outside.ram_run_length_m, rig.outside.ram_property_c))
+        // forced convection with the stream's properties: its static
+        // temperature (the ambient) and the altitude's pressure
+        h_mixed(free, h_forced_plate(air_mps, rig.outside.ram_run_length_m, t_air, p_air))
     } else {
         free
     }

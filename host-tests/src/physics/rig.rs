@@ -271,8 +271,22 @@ pub struct Outside {
     /// rest stays in free convection: flange, shadowed faces), fitted to
     /// Table 5's pump shell at 30 m/s.
     pub pump_ram_exposure: f64,
-    /// Air temperature at which ram-air properties are taken, °C (the Case 1 ambient).
-    pub ram_property_c: f64,
+    /// Altitude of the air around the rig, m: its static pressure (ICAO
+    /// standard atmosphere) sets the air density of free and forced
+    /// convection (0: sea level, the paper's laboratory).
+    #[serde(default)]
+    pub altitude_m: f64,
+    /// Removed: ram-air properties are now taken at the air temperature and
+    /// the altitude's pressure. Present only to refuse old rig files clearly.
+    #[serde(default, skip_serializing)]
+    pub ram_property_c: Option<f64>,
+}
+
+impl Outside {
+    /// Static pressure of the air, Pa (ISA at [`Outside::altitude_m`]).
+    pub fn air_pressure_pa(&self) -> f64 {
+        crate::fluid::isa_pressure_pa(self.altitude_m)
+    }
 }
 
 /// Nuisance multipliers: the parameters a thermal engineer does not know on a
@@ -296,9 +310,10 @@ pub struct Nuisance {
 pub struct Extensions {
     /// `winding-resistance-temperature`: copper resistance coefficient α, 1/K.
     pub winding_resistance_temperature: Option<f64>,
-    /// `viscosity-temperature`: viscosity follows the Walther line at each
-    /// node's temperature (the baseline holds it at its 40 °C value).
-    pub viscosity_temperature: bool,
+    /// Removed: the viscosity always follows the oil's Walther line at each
+    /// node's temperature. Present only to refuse old rig files clearly.
+    #[serde(default, skip_serializing)]
+    pub viscosity_temperature: Option<bool>,
     /// `sensor-lag`: time constant of the manifold sensor in its dead-end branch, s.
     pub sensor_lag: Option<f64>,
     /// `coulomb-friction`: Coulomb friction force of the piston seals, N.
@@ -375,7 +390,7 @@ impl Default for Rig {
                     port_gap_m: 12e-6,
                     port_seal_m: 0.005,
                 },
-                eta_m: 0.276_656,
+                eta_m: 0.443_590,
                 no_load_torque_nm: 0.3,
                 viscous_torque_coeff: 5.0e4,
                 friction_pairs: FrictionPairs { piston_bore: 0.5, slipper_swash: 0.3, valve_plate: 0.2 },
@@ -398,10 +413,10 @@ impl Default for Rig {
                 ball_mass_kg: 30.0,
                 ball_area_m2: 0.08,
                 cp: 460.0,
-                loop_oil_m3: 1.427_525e-3,
+                loop_oil_m3: 1.669_741e-3,
                 loop_d_m: 0.010,
                 loop_len_m: 1.0,
-                loop_area_scale: 4.917_591,
+                loop_area_scale: 5.599_682,
                 ball_oil_m3: 0.05e-3,
                 ball_d_m: 0.008,
                 ball_len_m: 0.3,
@@ -435,7 +450,7 @@ impl Default for Rig {
                 diameter_m: 0.09,
                 position_gain_per_s: 20.0,
             },
-            outside: Outside { emissivity: 0.85, ram_run_length_m: 0.352_009, pump_ram_exposure: 0.849_688, ram_property_c: 16.0 },
+            outside: Outside { emissivity: 0.85, ram_run_length_m: 0.352_009, pump_ram_exposure: 1.0, altitude_m: 0.0, ram_property_c: None },
             lng: Lng::default(),
             nuisance: Nuisance { outer_scale: 1.0, inner_scale: 1.0, metal_capacity_scale: 1.0, oil_capacity_scale: 1.0 },
             ext: Extensions::default(),
@@ -515,6 +530,21 @@ impl Rig {
                 return Err(RigError::Invalid(name, format!("must be > 0, got {v}")));
             }
         }
+        if self.ext.viscosity_temperature.is_some() {
+            return Err(RigError::Invalid(
+                "ext.viscosity_temperature",
+                "no longer exists: the oil's viscosity always follows its Walther line (oil.nu40_cst, oil.nu100_cst); remove the line".into(),
+            ));
+        }
+        if self.outside.ram_property_c.is_some() {
+            return Err(RigError::Invalid(
+                "outside.ram_property_c",
+                "no longer exists: ram-air properties are taken at the air temperature and the pressure of outside.altitude_m; remove the line".into(),
+            ));
+        }
+        if !(self.outside.altitude_m.is_finite() && (-500.0..=11_000.0).contains(&self.outside.altitude_m)) {
+            return Err(RigError::Invalid("outside.altitude_m", format!("must be within -500..11000 m (troposphere), got {}", self.outside.altitude_m)));
+        }
         if let Some(tau) = self.ext.sensor_lag {
             if !(tau.is_finite() && tau > 0.0) {
                 return Err(RigError::Invalid("ext.sensor_lag", format!("must be > 0 s, got {tau}")));
@@ -548,5 +578,17 @@ mod tests {
         assert!(r.set_override("pump.nope=1").is_err());
         assert!(r.set_override("pump.eta_m").is_err());
         assert!(r.set_override("motor.r25_ohm=-1").is_err());
+    }
+
+    /// Keys that changed meaning are refused with a message, not ignored.
+    #[test]
+    fn removed_keys_are_refused() {
+        let text = Rig::default().to_toml();
+        let old = text.replace("[ext]", "[ext]\nviscosity_temperature = false");
+        let e = Rig::from_toml_str(&old, "old").expect_err("refused");
+        assert!(e.to_string().contains("Walther"), "{e}");
+        let old = text.replace("emissivity = 0.85", "emissivity = 0.85\nram_property_c = 16.0");
+        let e = Rig::from_toml_str(&old, "old").expect_err("refused");
+        assert!(e.to_string().contains("altitude"), "{e}");
     }
 }

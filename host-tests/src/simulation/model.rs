@@ -210,7 +210,8 @@ impl ReplayDrive {
             air_mps: logged_air + rig.ext.forced_convection.unwrap_or(0.0),
         };
         if circuit == Circuit::Throttle {
-            // The pump's delivered flow goes through the throttle path.
+            // The pump's delivered flow goes through the throttle path (the
+            // leakage here at 40 °C; `Model::op_point` takes it at the case oil).
             let k = rig.pump.gaps.conductance(rig.oil.mu_pa_s(40.0));
             op.q_path = rig.displacement_m3_per_rad() * omega - k * (p_a - op.p_case);
         }
@@ -242,37 +243,37 @@ pub struct Model {
     pub drive: Drive,
     /// LNG valve open (set between solver segments).
     pub lng_open: Cell<bool>,
-    masses: [(f64, f64); N_NODES],
-    k_leak40: f64,
-    nu40: f64,
+    contents: [(f64, f64); N_NODES],
 }
 
 impl Model {
     /// Build a model.
     pub fn new(rig: Rig, drive: Drive) -> Self {
-        let masses = network::masses(&rig);
-        let k_leak40 = rig.pump.gaps.conductance(rig.oil.mu_pa_s(40.0));
-        let nu40 = rig.oil.nu_m2_per_s(40.0);
-        Self { rig, drive, lng_open: Cell::new(false), masses, k_leak40, nu40 }
+        let contents = network::contents(&rig);
+        Self { rig, drive, lng_open: Cell::new(false), contents }
     }
 
-    /// Kinematic viscosity used at an oil temperature: the 40 °C value in the
-    /// baseline, the Walther value with `viscosity-temperature`, m²/s.
+    /// Kinematic viscosity of the oil at `t_oil` (its Walther line), m²/s.
     pub fn nu(&self, t_oil: f64) -> f64 {
-        if self.rig.ext.viscosity_temperature {
-            self.rig.oil.nu_m2_per_s(t_oil)
-        } else {
-            self.nu40
-        }
+        self.rig.oil.nu_m2_per_s(t_oil)
     }
 
-    /// Pump leakage conductance at the case-oil temperature, m³/(s·Pa).
+    /// Pump leakage conductance of eqs. (5)–(7) at the case-oil temperature
+    /// (the films' viscosity), m³/(s·Pa).
     pub fn k_leak(&self, t_case: f64) -> f64 {
-        if self.rig.ext.viscosity_temperature {
-            self.rig.pump.gaps.conductance(self.rig.oil.mu_pa_s(t_case))
-        } else {
-            self.k_leak40
-        }
+        self.rig.pump.gaps.conductance(self.rig.oil.mu_pa_s(t_case))
+    }
+
+    /// Heat capacity of node `n` at `t_c`, J/K (oil: V·ρ(T)·c_p(T)).
+    pub fn capacity(&self, n: Node, t_c: f64) -> f64 {
+        network::capacity_j_per_k(&self.rig, n, self.contents[n as usize], t_c)
+    }
+
+    /// Mass flow of a volumetric flow `q` (m³/s) around the oil ring, kg/s:
+    /// at the density of the loop oil (the pump's suction side), one value
+    /// for every link of the ring so that the ring conserves mass.
+    fn ring_mass_flow(&self, q: f64, t_loop: f64) -> f64 {
+        self.rig.oil.rho(t_loop, 0.0) * q
     }
 
     /// Initial state: hydraulics at rest (lines at the accumulator pressure),
@@ -301,10 +302,9 @@ impl Model {
         match &self.drive {
             Drive::Replay(r) => {
                 let mut op = r.op(&self.rig, t);
-                if self.rig.ext.viscosity_temperature && op.circuit == Circuit::Throttle {
+                if op.circuit == Circuit::Throttle {
                     // The throttle path takes what the pump delivers minus
-                    // its leakage at the case-oil viscosity, as in a mission
-                    // (the baseline's 40 °C value otherwise).
+                    // its leakage at the case-oil viscosity, as in a mission.
                     let k = self.k_leak(y[t_ix(Node::Case)]);
                     op.q_path = self.rig.displacement_m3_per_rad() * op.omega - k * (op.p_a - op.p_case);
                 }
@@ -326,8 +326,7 @@ impl Model {
                 };
                 if m.circuit == Circuit::Throttle {
                     let needle = hydraulics::needle_k(&self.rig, m.needle_bar.at(t));
-                    let nu = self.nu(y[t_ix(Node::BallOil)]);
-                    op.q_path = hydraulics::path_flow(&self.rig, op.p_a - op.p_b, nu, needle);
+                    op.q_path = hydraulics::path_flow(&self.rig, op.p_a - op.p_b, y[t_ix(Node::BallOil)], needle);
                 }
                 let fr = self.pump_friction(&op, y[t_ix(Node::Case)]).total_w()
                     + self.rig.ext.churning_loss.map_or(0.0, |k| losses::churning_w(k, op.omega))
@@ -340,11 +339,10 @@ impl Model {
     }
 
     /// The pump's friction heat by term (extended eq. 8), with the film
-    /// viscosity at the case-oil temperature `t_case` (its 40 °C value in the
-    /// baseline), W.
+    /// viscosity at the case-oil temperature `t_case`, W.
     pub fn pump_friction(&self, op: &OpPoint, t_case: f64) -> losses::PumpFriction {
         let p = &self.rig.pump;
-        let mu = self.nu(t_case) * self.rig.oil.rho(40.0, 0.0);
+        let mu = self.rig.oil.mu_pa_s(t_case);
         losses::PumpFriction::new(p.no_load_torque_nm, p.viscous_torque_coeff, p.eta_m, self.rig.displacement_m3_per_rad(), mu, op.p_a - op.p_b, op.omega)
     }
 
@@ -367,11 +365,11 @@ impl Model {
         let (line, needle) = match (&self.drive, op.circuit) {
             (Drive::Mission(m), Circuit::Throttle) => {
                 let nk = hydraulics::needle_k(rig, m.needle_bar.at(t));
-                let (l, n) = hydraulics::path_dp(rig, op.q_path, self.nu(tc(Node::BallOil)), nk);
+                let (l, n) = hydraulics::path_dp(rig, op.q_path, tc(Node::BallOil), nk);
                 (l * op.q_path, n * op.q_path)
             }
             (Drive::Replay(_), Circuit::Throttle) => {
-                let (l, _) = hydraulics::path_dp(rig, op.q_path, self.nu(tc(Node::BallOil)), None);
+                let (l, _) = hydraulics::path_dp(rig, op.q_path, tc(Node::BallOil), None);
                 let line = l * op.q_path;
                 (line, losses::throttle_w(dp, op.q_path) - line)
             }
@@ -459,7 +457,7 @@ impl Model {
         link(&mut q, Node::BallOil, Node::BallBlock, network::block_path(rig, g_ball, b.ball_area_m2));
         // Manifold sensor pocket: in the flowing manifold in the baseline; in
         // a dead-end branch (Figs. 9–10) with `sensor-lag`.
-        let c_sensor = self.masses[Node::Sensor as usize].0 * oil.cp(tc(Node::Sensor));
+        let c_sensor = self.capacity(Node::Sensor, tc(Node::Sensor));
         match rig.ext.sensor_lag {
             None => link(&mut q, Node::Loop, Node::Sensor, c_sensor / b.sensor_tau_s),
             Some(tau) => {
@@ -476,10 +474,9 @@ impl Model {
         // the pump's work m·Δp/ρ enters the delivered port (net warming by
         // compression αTΔp/(ρc_p)); in the servo circuit the actuator takes
         // m·Δp/ρ out of the oil it passes to the loop.
-        let rho = oil.rho(40.0, 0.0);
-        let m_c = rho * qc.abs();
+        let m_c = self.ring_mass_flow(qc.abs(), tc(Node::Loop));
         let f = hydraulics::flows(rig, op, self.k_leak(tc(Node::Case)));
-        let m_l = rho * (hydraulics::soft_pos(f.leak_a, 1e-9) + hydraulics::soft_pos(f.leak_b, 1e-9));
+        let m_l = self.ring_mass_flow(hydraulics::soft_pos(f.leak_a, 1e-9) + hydraulics::soft_pos(f.leak_b, 1e-9), tc(Node::Loop));
         let forward = qc >= 0.0;
         let ring: &[Node] = match (op.circuit, forward) {
             (Circuit::Throttle, true) => &[Node::Loop, Node::Inlet, Node::Outlet, Node::BallOil],
@@ -493,7 +490,7 @@ impl Model {
         // loop at the pump's suction pressure (the actuator does the work between).
         let p_suction = if forward { op.p_b } else { op.p_a };
         let line_dp = match op.circuit {
-            Circuit::Throttle => hydraulics::path_dp(rig, op.q_path.abs(), self.nu(tc(Node::BallOil)), None).0.max(0.0),
+            Circuit::Throttle => hydraulics::path_dp(rig, op.q_path.abs(), tc(Node::BallOil), None).0.max(0.0),
             Circuit::Servo => 0.0,
         };
         let (p_loop, p_ball) = match (op.circuit, forward) {
@@ -523,7 +520,8 @@ impl Model {
             let pump = matches!((from, to), (Node::Inlet, Node::Outlet) | (Node::Outlet, Node::Inlet));
             let actuator = op.circuit == Circuit::Servo && to == Node::Loop;
             if pump || actuator {
-                let work = m / rho * (pres(to) - pres(from));
+                // volume flow × Δp, the volume at the density the mass flow was taken at
+                let work = m / oil.rho(tc(Node::Loop), 0.0) * (pres(to) - pres(from));
                 w += work;
                 q_in += work;
             }
@@ -547,9 +545,7 @@ impl Model {
         q[Node::MainBlock as usize] -= w_mount;
         q_amb += w_mount;
         for (i, n) in NODES.iter().enumerate() {
-            let (m, c) = self.masses[i];
-            let cap = if n.is_oil() { m * oil.cp(temps[i]) } else { m * c };
-            dt[i] = q[i] / cap;
+            dt[i] = q[i] / self.capacity(*n, temps[i]);
         }
         (q_in, q_amb, q_lng)
     }
@@ -562,7 +558,7 @@ impl Model {
         match &self.drive {
             Drive::Mission(m) => {
                 let f = hydraulics::flows(&self.rig, &op, self.k_leak(temps[Node::Case as usize]));
-                hydraulics::derivatives(&self.rig, m, t, y, &op, &f, self.nu(temps[Node::BallOil as usize]), dy);
+                hydraulics::derivatives(&self.rig, m, t, &op, &f, dy);
             }
             Drive::Replay(_) => dy[..ix::N].iter_mut().for_each(|d| *d = 0.0),
         }
@@ -589,18 +585,12 @@ impl Model {
 
     /// Energy stored in the nodes relative to the state `y0`, J.
     pub fn stored_energy(&self, y0: &[f64], y: &[f64]) -> f64 {
-        let oil = &self.rig.oil;
         NODES
             .iter()
             .enumerate()
             .map(|(i, n)| {
-                let (m, c) = self.masses[i];
-                let (a, b) = (y0[T0 + i], y[T0 + i]);
-                if n.is_oil() {
-                    m * (oil.enthalpy(b) - oil.enthalpy(a))
-                } else {
-                    m * c * (b - a)
-                }
+                let c = self.contents[i];
+                network::stored_j(&self.rig, *n, c, y[T0 + i]) - network::stored_j(&self.rig, *n, c, y0[T0 + i])
             })
             .sum()
     }

@@ -127,12 +127,10 @@ pub fn reduce_without_jacobian(rig: &Rig) -> ReducedParams {
     let la = line.area_m2();
     let fe = &m.iron;
     let c = fe.pole_pairs / (2.0 * PI);
-    let k_mu = if rig.ext.viscosity_temperature {
+    let k_mu = {
         // K ∝ 1/mu: d ln K / dT at the reference temperature (central difference)
         let k = |t: f64| p.gaps.conductance(oil.mu_pa_s(t)).ln();
         (k(41.0) - k(39.0)) / 2.0
-    } else {
-        0.0
     };
     ReducedParams {
         pump_j_per_k: p.mass_kg * ms * p.cp,
