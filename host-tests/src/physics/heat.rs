@@ -75,6 +75,13 @@ pub fn nu_taylor_couette(ta: f64) -> f64 {
     }
 }
 
+/// Mean Nusselt number Nu = h·L/k of a laminar boundary layer over a plate
+/// of length L moving through a fluid at rest (Pohlhausen):
+/// Nu = 0.664·Re^½·Pr^⅓ (Pr ≥ 0.6, Re below transition); 0 at rest.
+pub fn nu_flat_plate_laminar(re: f64, pr: f64) -> f64 {
+    0.664 * re.max(0.0).sqrt() * pr.cbrt()
+}
+
 /// Rayleigh number Gr·Pr of free convection (Table 1 Grashof number times Pr)
 /// for a surface at `t_wall_c` in air at `t_air_c` and static pressure
 /// `p_pa`, length `l_m`; properties at the film temperature ½(T_w + T_air)

@@ -13,7 +13,7 @@ pub enum Node {
     Winding = 0,
     /// Motor housing: Point 1 of the rig.
     Motor,
-    /// Pump housing: Point 3.
+    /// Pump housing (with its end cap): Point 3.
     Pump,
     /// Oil in the pump case, which leaves through the drain port.
     Case,
@@ -33,10 +33,13 @@ pub enum Node {
     Sensor,
     /// Actuator (cylinder body with its oil).
     Actuator,
+    /// The pump's internals: cylinder barrel, pistons and slippers, swash and
+    /// valve plates, shaft; every sliding pair's faces.
+    PumpInternals,
 }
 
 /// Number of thermal nodes.
-pub const N_NODES: usize = 12;
+pub const N_NODES: usize = 13;
 
 /// All nodes in index order.
 pub const NODES: [Node; N_NODES] = [
@@ -52,6 +55,7 @@ pub const NODES: [Node; N_NODES] = [
     Node::BallOil,
     Node::Sensor,
     Node::Actuator,
+    Node::PumpInternals,
 ];
 
 impl Node {
@@ -70,6 +74,7 @@ impl Node {
             Node::BallOil => "t_ball_oil_c",
             Node::Sensor => "t_oil_c",
             Node::Actuator => "t_actuator_c",
+            Node::PumpInternals => "t_pump_internals_c",
         }
     }
 
@@ -90,7 +95,7 @@ pub fn contents(rig: &Rig) -> [(f64, f64); N_NODES] {
     [
         (m.winding_mass_kg * ms, m.winding_cp),
         ((m.mass_kg - m.winding_mass_kg) * ms, m.body_cp),
-        (rig.pump.mass_kg * ms, rig.pump.cp),
+        ((rig.pump.mass_kg - rig.pump.internals_mass_kg) * ms, rig.pump.cp),
         (v * rig.pump.case_oil_m3, 0.0),
         (v * rig.pump.port_oil_m3, 0.0),
         (v * rig.pump.port_oil_m3, 0.0),
@@ -100,6 +105,7 @@ pub fn contents(rig: &Rig) -> [(f64, f64); N_NODES] {
         (v * rig.blocks.ball_oil_m3, 0.0),
         (v * rig.blocks.sensor_oil_m3, 0.0),
         (rig.actuator.body_mass_kg * ms, rig.actuator.body_cp),
+        (rig.pump.internals_mass_kg * ms, rig.pump.cp),
     ]
 }
 
@@ -132,17 +138,49 @@ pub fn duct_conductance(rig: &Rig, q_m3_per_s: f64, d: f64, len: f64, area_scale
     h * std::f64::consts::PI * d * len * area_scale * rig.nuisance.inner_scale
 }
 
-/// Case-oil film between the pump case and the oil the rotating cylinder
-/// barrel drags round (Taylor–Couette flow in the radial gap), W/K:
+/// Film coefficient of the oil between the pump case and the rotating
+/// cylinder barrel (Taylor–Couette flow in the radial gap), W/(m²·K):
 /// h = Nu·k/(2e) with Nu from [`heat::nu_taylor_couette`] at the barrel's
-/// speed `omega` (rad/s, either sign), on the case's real inner area.
+/// speed `omega` (rad/s, either sign); it holds on both walls of the gap.
 /// `t_oil` °C and `nu` m²/s are the case oil's.
-pub fn case_film_w_per_k(rig: &Rig, omega: f64, t_oil: f64, nu: f64) -> f64 {
+pub fn case_gap_h(rig: &Rig, omega: f64, t_oil: f64, nu: f64) -> f64 {
     let p = &rig.pump;
     let e = p.case_gap_m;
     let r_mean = p.rotor_radius_m + 0.5 * e;
     let ta = omega * omega * r_mean * e.powi(3) / (nu * nu);
-    heat::nu_taylor_couette(ta) * rig.oil.k(t_oil) / (2.0 * e) * p.case_inner_area_m2 * rig.nuisance.inner_scale
+    heat::nu_taylor_couette(ta) * rig.oil.k(t_oil) / (2.0 * e)
+}
+
+/// Case-oil film to the pump housing: [`case_gap_h`] on the case's inner
+/// area, W/K.
+pub fn case_film_w_per_k(rig: &Rig, omega: f64, t_oil: f64, nu: f64) -> f64 {
+    case_gap_h(rig, omega, t_oil, nu) * rig.pump.case_inner_area_m2 * rig.nuisance.inner_scale
+}
+
+/// Case-oil film to the pump's internals, W/K: the barrel's periphery
+/// through the case gap ([`case_gap_h`] on 2π·r·L) plus the slippers and
+/// piston shanks swept through the case oil at the barrel's rim speed, a
+/// laminar flat plate of the slipper's length ([`heat::nu_flat_plate_laminar`]).
+pub fn internals_case_film_w_per_k(rig: &Rig, omega: f64, t_oil: f64, nu: f64) -> f64 {
+    let p = &rig.pump;
+    let barrel = case_gap_h(rig, omega, t_oil, nu) * 2.0 * std::f64::consts::PI * p.rotor_radius_m * p.barrel_length_m;
+    let u = omega.abs() * p.rotor_radius_m;
+    let re = u * p.swept_length_m / nu;
+    let h_swept = heat::nu_flat_plate_laminar(re, rig.oil.prandtl(t_oil, nu)) * rig.oil.k(t_oil) / p.swept_length_m;
+    (barrel + h_swept * p.case_swept_area_m2) * rig.nuisance.inner_scale
+}
+
+/// Film between the pump's internals and one port's oil through the
+/// displacement chambers, W/K: half the pistons' bores face each kidney, each
+/// passing its share of the displaced flow `q_displaced` (m³/s, either sign)
+/// as a laminar developing duct flow (eq. 13) over the chamber length that
+/// makes their wall area half of [`crate::rig::Pump::bore_area_m2`].
+pub fn bore_film_w_per_k(rig: &Rig, q_displaced: f64, t_oil: f64, nu: f64) -> f64 {
+    let p = &rig.pump;
+    let n = 0.5 * p.gaps.pistons;
+    let d = p.gaps.piston_d_m;
+    let len = 0.5 * p.bore_area_m2 / (n * std::f64::consts::PI * d);
+    n * duct_conductance(rig, q_displaced.abs() / n, d, len, 1.0, t_oil, nu)
 }
 
 /// Outer surfaces exchanging heat with ambient.

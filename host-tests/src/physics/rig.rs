@@ -10,6 +10,7 @@
 use crate::cooling::Lng;
 use crate::fluid::Oil;
 use crate::losses::{IronLoss, Line, PumpGaps};
+
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 use std::path::Path;
@@ -99,9 +100,50 @@ pub struct Pump {
     /// Viscous friction coefficient C_v of the extended eq. (8) (Wilson's
     /// model: T_v = C_v·μ·D·|ω|), dimensionless (assumed).
     pub viscous_torque_coeff: f64,
-    /// How the viscous and pressure friction heat divides between the sliding
-    /// pairs, and so between the delivered oil and the case oil (assumed).
-    pub friction_pairs: FrictionPairs,
+    /// Removed: every face of the three sliding pairs belongs to the pump's
+    /// internals ([`Pump::internals_mass_kg`]), so the per-pair shares no
+    /// longer decide where the friction heat goes. Present only to refuse
+    /// old rig files clearly.
+    #[serde(default, skip_serializing)]
+    pub friction_pairs: Option<toml::Value>,
+    /// Share of the no-load friction T₀·|ω| (bearings, shaft seal) that heats
+    /// the housing, the rest the internals (a priori 0.5: each rolling
+    /// bearing's heat leaves through both races, the inner on the shaft, the
+    /// outer in the housing; the lip seal sits in the housing's front cover;
+    /// range 0.3–0.7).
+    pub no_load_to_housing: f64,
+    /// Mass of the pump's internals: cylinder barrel, pistons and slippers,
+    /// swash and valve plates, shaft, kg (a priori 3.5 kg, range 2.5–5.0:
+    /// steel parts sized from this rig file's barrel radius 30 mm, nine
+    /// 10 mm pistons and the 26.9 mm stroke of 19 cm³/rev — barrel ≈ 1.0,
+    /// pistons and slippers ≈ 0.35, swash plate ≈ 1.0, valve plate ≈ 0.25,
+    /// shaft ≈ 0.4, bearings and retainer ≈ 0.5 kg). The housing is the rest
+    /// of Table 2's 20 kg.
+    pub internals_mass_kg: f64,
+    /// Area of the displacement chambers (bores and piston faces) wetted by
+    /// the port oil, both kidneys together, m² (a priori 5.9e-3, range
+    /// 4e-3–8e-3: nine 10 mm bores over the mean chamber length of 18.4 mm,
+    /// a 5 mm dead length plus half the stroke, and the piston faces). Half
+    /// of it exchanges with each port's oil through a laminar developing duct
+    /// film (eq. 13) of the bores' share of the flow.
+    pub bore_area_m2: f64,
+    /// Area of the internals swept through the case oil (slippers, piston
+    /// shanks outside the bores, retainer plate), m² (a priori 7e-3, range
+    /// 5e-3–1e-2: nine slippers of about 3e-4 m² and nine shanks of 10 mm
+    /// over a mean exposed 15 mm). Laminar flat-plate film (Pohlhausen,
+    /// Nu = 0.664·Re^½·Pr^⅓) over the slipper length at the barrel's rim
+    /// speed; the barrel's own periphery exchanges through the Taylor–Couette
+    /// film of the case gap ([`Pump::case_gap_m`]).
+    pub case_swept_area_m2: f64,
+    /// Characteristic length of the swept surfaces, m (a priori 0.015: a
+    /// slipper's length; range 0.01–0.025).
+    pub swept_length_m: f64,
+    /// Length of the barrel (its periphery faces the case gap), m (a priori
+    /// 0.06, range 0.05–0.07: about twice the 26.9 mm stroke).
+    pub barrel_length_m: f64,
+    /// Conduction internals → housing through the swash plate's cradle and
+    /// the valve plate's seat on the end cap.
+    pub seats: WallPath,
     /// Pump mass, kg (Table 2: 20 kg).
     pub mass_kg: f64,
     /// Housing specific heat, J/(kg·K) (steel, 460).
@@ -129,35 +171,45 @@ pub struct Pump {
     pub port_area_scale: f64,
 }
 
-/// Shares of the pump's viscous and pressure friction (the C_v and C_p terms
-/// of the extended eq. 8) by sliding pair. The rule that places each pair's
-/// heat (docs/calibration.md): the piston/bore film is swept by the displaced
-/// oil every stroke (all to the delivered oil); the slipper/swash-plate film
-/// lies between the case oil and the swash plate, which sits in the housing
-/// (half to the case oil, half to the housing metal); the valve-plate film
-/// lies between the kidney ports' oil and the port plate bolted to the
-/// housing (half to the delivered oil, half to the housing metal). The
-/// no-load torque (bearings, shaft seal, both seated in the housing) heats
-/// the housing metal.
+/// A conduction path through a wall and a bolted or seated joint:
+/// G = 1 / (L/(k·A) + 1/(h_c·A_c)) (eq. 18's k·A/L in series with a contact
+/// conductance), W/K. The body on the far side is lumped at its mean
+/// temperature, its own spreading resistance is left out (it would lower G).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct FrictionPairs {
-    /// Piston/bore share (assumed 0.5).
-    pub piston_bore: f64,
-    /// Slipper/swash-plate share (assumed 0.3).
-    pub slipper_swash: f64,
-    /// Valve-plate share (assumed 0.2).
-    pub valve_plate: f64,
+pub struct WallPath {
+    /// Thermal conductivity of the wall's material, W/(m·K).
+    pub k_w_per_m_k: f64,
+    /// Cross-section of the wall the heat flows through, m².
+    pub area_m2: f64,
+    /// Length of the conduction path through the wall, m.
+    pub length_m: f64,
+    /// Area of the joint, m².
+    pub contact_area_m2: f64,
+    /// Contact conductance of the joint, W/(m²·K).
+    pub contact_w_per_m2_k: f64,
 }
 
-impl FrictionPairs {
-    /// Shares of the C_v and C_p friction heat that enter (delivered oil,
-    /// case oil, housing metal); they add up to 1.
-    pub fn shares(&self) -> (f64, f64, f64) {
-        let sum = self.piston_bore + self.slipper_swash + self.valve_plate;
-        let (p, s, v) = (self.piston_bore / sum, self.slipper_swash / sum, self.valve_plate / sum);
-        (p + 0.5 * v, 0.5 * s, 0.5 * s + 0.5 * v)
+impl WallPath {
+    /// Conductance of the path, W/K (0 when any part is 0).
+    pub fn conductance_w_per_k(&self) -> f64 {
+        let wall = self.k_w_per_m_k * self.area_m2 / self.length_m;
+        let joint = self.contact_w_per_m2_k * self.contact_area_m2;
+        crate::heat::series(wall, joint)
     }
+}
+
+/// Metal paths from the pump housing to its neighbours (a priori, no fitted
+/// value; docs/calibration.md, "The pump as it is built").
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Joints {
+    /// Pump housing → motor flange: the housing's cylindrical wall from its
+    /// mid-length to the mounting flange, then the bolted flange face.
+    pub pump_motor: WallPath,
+    /// Pump housing → manifold (the main block): the end cap's wall to the
+    /// port face, then the bolted port face.
+    pub pump_manifold: WallPath,
 }
 
 /// The two valve blocks and the oil in them.
@@ -344,6 +396,8 @@ pub struct Rig {
     pub actuator: Actuator,
     /// Outer heat transfer.
     pub outside: Outside,
+    /// Metal paths from the pump housing to the motor and the manifold.
+    pub joints: Joints,
     /// LNG cooling (Table 6).
     pub lng: Lng,
     /// Nuisance multipliers.
@@ -393,7 +447,17 @@ impl Default for Rig {
                 eta_m: 0.443_590,
                 no_load_torque_nm: 0.3,
                 viscous_torque_coeff: 5.0e4,
-                friction_pairs: FrictionPairs { piston_bore: 0.5, slipper_swash: 0.3, valve_plate: 0.2 },
+                friction_pairs: None,
+                no_load_to_housing: 0.5,
+                internals_mass_kg: 3.5,
+                bore_area_m2: 5.9e-3,
+                case_swept_area_m2: 7.0e-3,
+                swept_length_m: 0.015,
+                barrel_length_m: 0.06,
+                // swash plate (20 mm) and valve plate (8 mm), steel (45 W/(m·K)),
+                // 6.1e-3 m² of seat in all, oil-filled machined joints under the
+                // hydraulic load: 5000 W/(m²·K) (2000–20000)
+                seats: WallPath { k_w_per_m_k: 45.0, area_m2: 6.1e-3, length_m: 0.014, contact_area_m2: 6.1e-3, contact_w_per_m2_k: 5000.0 },
                 mass_kg: 20.0,
                 cp: 460.0,
                 area_m2: 0.1,
@@ -451,6 +515,13 @@ impl Default for Rig {
                 position_gain_per_s: 20.0,
             },
             outside: Outside { emissivity: 0.85, ram_run_length_m: 0.352_009, pump_ram_exposure: 1.0, altitude_m: 0.0, ram_property_c: None },
+            // grey cast iron housing (EN-GJL-250, 48 W/(m·K); an aluminium
+            // housing would be ≈ 150): the wall Ø112 mm mean × 8 mm; dry bolted
+            // faces 2000 W/(m²·K) (500–5000)
+            joints: Joints {
+                pump_motor: WallPath { k_w_per_m_k: 48.0, area_m2: 2.8e-3, length_m: 0.06, contact_area_m2: 7.5e-3, contact_w_per_m2_k: 2000.0 },
+                pump_manifold: WallPath { k_w_per_m_k: 48.0, area_m2: 2.8e-3, length_m: 0.05, contact_area_m2: 4.0e-3, contact_w_per_m2_k: 2000.0 },
+            },
             lng: Lng::default(),
             nuisance: Nuisance { outer_scale: 1.0, inner_scale: 1.0, metal_capacity_scale: 1.0, oil_capacity_scale: 1.0 },
             ext: Extensions::default(),
@@ -534,6 +605,12 @@ impl Rig {
             return Err(RigError::Invalid(
                 "ext.viscosity_temperature",
                 "no longer exists: the oil's viscosity always follows its Walther line (oil.nu40_cst, oil.nu100_cst); remove the line".into(),
+            ));
+        }
+        if self.pump.friction_pairs.is_some() {
+            return Err(RigError::Invalid(
+                "pump.friction_pairs",
+                "no longer exists: every face of the three sliding pairs belongs to the pump's internals (pump.internals_mass_kg); remove the section".into(),
             ));
         }
         if self.outside.ram_property_c.is_some() {

@@ -93,15 +93,20 @@ impl Losses {
 }
 
 /// Where the pump's friction heat (extended eq. 8) goes at one instant, W:
-/// the sliding-pair rule of [`crate::rig::FrictionPairs`].
+/// the faces of the sliding pairs ([`Model::friction_heat`]).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct FrictionHeat {
-    /// Into the delivered (high-pressure port) oil.
-    pub delivered: f64,
-    /// Into the case oil.
-    pub case: f64,
-    /// Into the pump's metal.
-    pub metal: f64,
+    /// Into the pump's internals.
+    pub internals: f64,
+    /// Into the pump housing.
+    pub housing: f64,
+}
+
+impl FrictionHeat {
+    /// All of it: every part heats metal, W.
+    pub fn metal(&self) -> f64 {
+        self.internals + self.housing
+    }
 }
 
 /// Linear interpolation in measured inputs.
@@ -346,14 +351,18 @@ impl Model {
         losses::PumpFriction::new(p.no_load_torque_nm, p.viscous_torque_coeff, p.eta_m, self.rig.displacement_m3_per_rad(), mu, op.p_a - op.p_b, op.omega)
     }
 
-    /// The pump's friction heat placed by the sliding-pair rule: the no-load
-    /// term (bearings, shaft seal) heats the metal, the viscous and pressure
-    /// terms divide by [`crate::rig::FrictionPairs::shares`], W.
+    /// The pump's friction heat placed on the faces of its sliding pairs,
+    /// W. The viscous and pressure terms of the extended eq. (8) arise in the
+    /// three lubricating films (piston/bore, slipper/swash plate,
+    /// barrel/valve plate); a film of a few µm conducts its heat into its two
+    /// faces (δ/k ≈ 1e-4 m²·K/W, a hundredth of the faces' films to the
+    /// oil; its own leakage convects a few per cent), and every one of those
+    /// faces belongs to the internals. The no-load term (bearings, shaft
+    /// seal) divides by [`crate::rig::Pump::no_load_to_housing`].
     pub fn friction_heat(&self, op: &OpPoint, t_case: f64) -> FrictionHeat {
         let fr = self.pump_friction(op, t_case);
-        let (f_del, f_case, f_metal) = self.rig.pump.friction_pairs.shares();
-        let shared = fr.viscous_w + fr.pressure_w;
-        FrictionHeat { delivered: f_del * shared, case: f_case * shared, metal: fr.no_load_w + f_metal * shared }
+        let to_housing = self.rig.pump.no_load_to_housing * fr.no_load_w;
+        FrictionHeat { internals: fr.viscous_w + fr.pressure_w + fr.no_load_w - to_housing, housing: to_housing }
     }
 
     /// All losses at an operating point and temperatures, W.
@@ -392,7 +401,7 @@ impl Model {
             bearing: rig.motor.bearing_friction_nm.map_or(0.0, |m| losses::bearing_w(m, op.omega)),
             leakage: f.leak_a * (op.p_a - op.p_case) + f.leak_b * (op.p_b - op.p_case),
             mechanical: self.pump_friction(op, tc(Node::Case)).total_w(),
-            mech_metal: self.friction_heat(op, tc(Node::Case)).metal,
+            mech_metal: self.friction_heat(op, tc(Node::Case)).metal(),
             churning: rig.ext.churning_loss.map_or(0.0, |k| losses::churning_w(k, op.omega)),
             line,
             needle,
@@ -423,9 +432,9 @@ impl Model {
         for (n, w) in [
             (Node::Winding, l.copper),
             (Node::Motor, l.iron + l.bearing),
-            (Node::Pump, fh.metal),
-            (Node::Case, fh.case + l.churning),
-            (hp, fh.delivered),
+            (Node::Pump, fh.housing),
+            (Node::PumpInternals, fh.internals),
+            (Node::Case, l.churning),
             (Node::Loop, l.valves),
             (Node::Actuator, l.act_leak + l.act_friction),
         ] {
@@ -445,12 +454,20 @@ impl Model {
         if let Some(g) = rig.ext.motor_pump_conduction {
             link(&mut q, Node::Motor, Node::Pump, g);
         }
-        let g_case = network::case_film_w_per_k(rig, op.omega, tc(Node::Case), self.nu(tc(Node::Case)));
-        link(&mut q, Node::Case, Node::Pump, g_case);
+        let nu_case = self.nu(tc(Node::Case));
+        link(&mut q, Node::Case, Node::Pump, network::case_film_w_per_k(rig, op.omega, tc(Node::Case), nu_case));
+        link(&mut q, Node::Case, Node::PumpInternals, network::internals_case_film_w_per_k(rig, op.omega, tc(Node::Case), nu_case));
+        let q_displaced = rig.displacement_m3_per_rad() * op.omega;
         for port in [Node::Inlet, Node::Outlet] {
             let g = network::duct_conductance(rig, qc, p.port_d_m, p.port_len_m, p.port_area_scale, tc(port), self.nu(tc(port)));
             link(&mut q, port, Node::Pump, g);
+            link(&mut q, port, Node::PumpInternals, network::bore_film_w_per_k(rig, q_displaced, tc(port), self.nu(tc(port))));
         }
+        // metal paths: the internals' seats in the housing, the housing's
+        // flange on the motor and its port face on the manifold (main block)
+        link(&mut q, Node::PumpInternals, Node::Pump, p.seats.conductance_w_per_k());
+        link(&mut q, Node::Pump, Node::Motor, rig.joints.pump_motor.conductance_w_per_k());
+        link(&mut q, Node::Pump, Node::MainBlock, rig.joints.pump_manifold.conductance_w_per_k());
         let g_loop = network::duct_conductance(rig, qc, b.loop_d_m, b.loop_len_m, b.loop_area_scale, tc(Node::Loop), self.nu(tc(Node::Loop)));
         link(&mut q, Node::Loop, Node::MainBlock, network::block_path(rig, g_loop, b.main_area_m2));
         let g_ball = network::duct_conductance(rig, qc, b.ball_d_m, b.ball_len_m, 1.0, tc(Node::BallOil), self.nu(tc(Node::BallOil)));
