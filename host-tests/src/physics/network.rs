@@ -180,6 +180,9 @@ pub fn bore_film_w_per_k(rig: &Rig, q_displaced: f64, t_oil: f64, nu: f64) -> f6
     let n = 0.5 * p.gaps.pistons;
     let d = p.gaps.piston_d_m;
     let len = 0.5 * p.bore_area_m2 / (n * std::f64::consts::PI * d);
+    if len <= 0.0 {
+        return 0.0;
+    }
     n * duct_conductance(rig, q_displaced.abs() / n, d, len, 1.0, t_oil, nu)
 }
 

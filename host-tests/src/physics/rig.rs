@@ -444,7 +444,7 @@ impl Default for Rig {
                     port_gap_m: 12e-6,
                     port_seal_m: 0.005,
                 },
-                eta_m: 0.443_590,
+                eta_m: 0.475_534,
                 no_load_torque_nm: 0.3,
                 viscous_torque_coeff: 5.0e4,
                 friction_pairs: None,
@@ -477,10 +477,10 @@ impl Default for Rig {
                 ball_mass_kg: 30.0,
                 ball_area_m2: 0.08,
                 cp: 460.0,
-                loop_oil_m3: 1.669_741e-3,
+                loop_oil_m3: 1.145_368e-3,
                 loop_d_m: 0.010,
                 loop_len_m: 1.0,
-                loop_area_scale: 5.599_682,
+                loop_area_scale: 3.931_983,
                 ball_oil_m3: 0.05e-3,
                 ball_d_m: 0.008,
                 ball_len_m: 0.3,
@@ -655,6 +655,19 @@ mod tests {
         assert!(r.set_override("pump.nope=1").is_err());
         assert!(r.set_override("pump.eta_m").is_err());
         assert!(r.set_override("motor.r25_ohm=-1").is_err());
+    }
+
+    /// The a-priori metal paths of the pump (docs/calibration.md) by hand:
+    /// seats 1/(0.014/(45·6.1e-3) + 1/(5000·6.1e-3)) = 11.93 W/K, motor
+    /// flange 1/(0.06/(48·2.8e-3) + 1/(2000·7.5e-3)) = 1.949 W/K, manifold
+    /// 1/(0.05/(48·2.8e-3) + 1/(2000·4e-3)) = 2.012 W/K (to 1e-3 W/K).
+    #[test]
+    fn pump_metal_paths_by_hand() {
+        let r = Rig::default();
+        let g = |w: &WallPath| w.conductance_w_per_k();
+        for (got, want) in [(g(&r.pump.seats), 11.93), (g(&r.joints.pump_motor), 1.949), (g(&r.joints.pump_manifold), 2.012)] {
+            assert!((got - want).abs() < 1e-3 * want.max(1.0) + 5e-3, "{got} vs {want}");
+        }
     }
 
     /// Keys that changed meaning are refused with a message, not ignored.
