@@ -3,7 +3,7 @@
 //! matrix included), with a header and a CRC, flashed into its own region (the
 //! `PARAMS` region of the board's `memory.x`) and read at boot.
 //!
-//! Layout (little-endian, [`BLOCK_LEN`] = 1084 bytes):
+//! Layout (little-endian, [`BLOCK_LEN`] = 2708 bytes):
 //!
 //! | offset | size | field |
 //! |---|---|---|
@@ -12,7 +12,7 @@
 //! | 6 | 2 | number of words ([`N_WORDS`]) |
 //! | 8 | 16 | rig id, ASCII, zero-padded |
 //! | 24 | 4 × N_WORDS | the words of [`ModelConsts`] in field order |
-//! | 1020 | 4 | CRC-32 (IEEE) of bytes 0..1020 |
+//! | 2704 | 4 | CRC-32 (IEEE) of bytes 0..2704 |
 //!
 //! Erased flash (`0xFF…`) or empty memory (`0x00…`, QEMU) at the magic means
 //! *absent*: the firmware runs the compiled-in [`crate::params::DEFAULT_CONSTS`]
@@ -29,12 +29,18 @@ use crate::model::ModelConsts;
 pub const BLOCK_LEN: usize = WORDS_AT + 4 * N_WORDS + 4;
 /// `"EHAP"` little-endian.
 pub const MAGIC: u32 = u32::from_le_bytes(*b"EHAP");
-/// Format version of this firmware. 4: the pump's no-load and viscous
+/// Format version of this firmware. 5: the oil over temperature and the pump
+/// as it is built (670 words, 2708 bytes): the tables over the oil temperature
+/// (`leak_ratio`, `visc_ratio`, `tc_speed`, `swept_ratio`), the internals', motor's
+/// and winding's capacities and paths (`h0`, `barrel_ratio`, `g_seat`, `g_pm`,
+/// `g_pmf`, `g_wm`, `g_swept`, `g_bore`), `rc2`, a fifth outer surface (the
+/// motor) and `Phi` over seven states; `f_out`, `f_case`, `k_mu`, `t_mu` gone.
+/// 4: the pump's no-load and viscous
 /// friction and the oil's expansion coefficient (`k_m0`, `k_mv`, `alpha`,
 /// `alpha_t0`, `g_case_slope`; 264 words, 1084 bytes). 3: without `irc0`/`irc1` (the oil
 /// capacity's inverse is exact; 259 words, 1064 bytes). 2: the rest-cooling
 /// words (`rest_rate`, `rest_mode`). Older blocks are refused.
-pub const VERSION: u16 = 4;
+pub const VERSION: u16 = 5;
 /// Offset of the rig id.
 const ID_AT: usize = 8;
 /// Length of the rig id, bytes.

@@ -11,7 +11,7 @@ impl<N: Num> Model<N> {
     pub(super) unsafe fn init_values_in<S: Word>(dst: *mut Self, c: &ModelConsts<S>) -> Result<(), ConfigError> {
         c.check_values()?;
         let max_row = N::MAX_ROW_SUM as f32;
-        let mut phi = [[N::coef_from_f32(0.0).ok_or(ConfigError::CoefficientRange)?; N_NODES]; N_NODES];
+        let mut phi = [[N::coef_from_f32(0.0).ok_or(ConfigError::CoefficientRange)?; N_PHI]; N_PHI];
         for (pr, dr) in phi.iter_mut().zip(c.phi.iter()) {
             if dr.iter().map(|x| x.to_f32().abs()).sum::<f32>() >= max_row {
                 return Err(ConfigError::CoefficientRange);
@@ -58,6 +58,7 @@ impl<N: Num> Model<N> {
             w_scale: f(c.w_scale),
             rc0: f(c.rc0),
             rc1: f(c.rc1),
+            rc2: f(c.rc2),
             inv_v_case: f(c.inv_v_case),
             inv_v_loop: f(c.inv_v_loop),
             inv_n,
@@ -66,8 +67,7 @@ impl<N: Num> Model<N> {
             v_ball: f(c.v_ball),
             inv_v_ring: f(c.inv_v_ring),
             inv_c: c.inv_c.map(f),
-            f_out: f(c.f_out),
-            f_case: f(c.f_case),
+            h0: f(c.h0),
             k_m0: f(c.k_m0),
             k_mv: f(c.k_mv),
             alpha: f(c.alpha),
@@ -75,9 +75,17 @@ impl<N: Num> Model<N> {
             t_film: exact!(crate::params::FILM_PROPERTY_C),
             alpha_t0: f(c.alpha_t0),
             lng_in: f(c.lng_in),
-            k_mu: f(c.k_mu),
-            t_mu: f(c.t_mu),
-            use_mu: c.k_mu.to_f32() != 0.0,
+            barrel_ratio: f(c.barrel_ratio),
+            g_seat: f(c.g_seat),
+            g_pm: f(c.g_pm),
+            g_pmf: f(c.g_pmf),
+            g_wm: f(c.g_wm),
+            t_scale: exact!(1.0 / crate::params::TEMP_TABLE_STEP_K),
+            inv_stride: exact!(1.0 / crate::params::COARSE_STRIDE as f64),
+            re_q: c.re_q.map(f),
+            re_lam: exact!(0.23),
+            inv_span: exact!(1.0 / 0.77),
+            t_min: exact!(crate::params::TEMP_TABLE_MIN_C),
             ga: c.ga.map(f),
             gb: c.gb.map(f),
             gr: c.gr.map(f),
@@ -88,31 +96,61 @@ impl<N: Num> Model<N> {
             rad_offset: exact!(273.15 / RAD_T_K),
             one: exact!(1.0),
         };
-        // SAFETY: the caller guarantees `dst` is valid for writes.
-        unsafe { dst.write(Model {
-            temp: [N::state(N::ZERO); N_NODES],
-            links: [N::ZERO; 3],
-            ring_rate: N::ZERO,
-            lng_hist: 0,
-            ambient_c: N::ZERO,
-            sums: Sums::ZERO,
-            phi,
-            k,
-            g_case: c.g_case.map(f),
-            g_port: c.g_port.map(f),
-            g_loop: c.g_loop.map(f),
-            g_ball: c.g_ball.map(f),
-            g_lng: c.g_lng.map(f),
-            last_total_kw: N::ZERO,
-            last_lng_kw: N::ZERO,
-            last_heat_kw: N::ZERO,
-            last_outer_kw: N::ZERO,
-            last_losses_kw: [N::ZERO; N_LOSSES],
-            last_mech_pair_kw: (N::ZERO, N::ZERO),
-            loss_max: false,
-            outer_g: [N::ZERO; 4],
-            outer_phase: 0,
-        }) };
+        // Written field by field in place: the tables are most of the model
+        // (2.9 KiB in f32), and a `Model` value built first would take as much boot
+        // stack.
+        // SAFETY: the caller guarantees `dst` is valid for writes of a `Model<N>`;
+        // every field is written below (the arrays element by element through
+        // pointers into their own field), none is read.
+        unsafe {
+            use core::ptr::addr_of_mut;
+            addr_of_mut!((*dst).temp).write([N::state(N::ZERO); N_STATES]);
+            addr_of_mut!((*dst).links).write([N::ZERO; 3]);
+            addr_of_mut!((*dst).ring_rate).write(N::ZERO);
+            addr_of_mut!((*dst).lng_hist).write(0);
+            addr_of_mut!((*dst).ambient_c).write(N::ZERO);
+            addr_of_mut!((*dst).sums).write(Sums::ZERO);
+            addr_of_mut!((*dst).phi).write(phi);
+            addr_of_mut!((*dst).k_mv_t).write(k.k_mv);
+            addr_of_mut!((*dst).k_lf_t).write(k.k_lf);
+            addr_of_mut!((*dst).k).write(k);
+            let tables: [(*mut [N; N_TABLE], &[S; N_TABLE]); 7] = [
+                (addr_of_mut!((*dst).g_case), &c.g_case),
+                (addr_of_mut!((*dst).g_port), &c.g_port),
+                (addr_of_mut!((*dst).g_loop), &c.g_loop),
+                (addr_of_mut!((*dst).g_ball), &c.g_ball),
+                (addr_of_mut!((*dst).g_lng), &c.g_lng),
+                (addr_of_mut!((*dst).g_swept), &c.g_swept),
+                (addr_of_mut!((*dst).g_bore), &c.g_bore),
+            ];
+            for (d, src) in tables {
+                let d = d.cast::<N>();
+                for (j, x) in src.iter().enumerate() {
+                    d.add(j).write(f(*x));
+                }
+            }
+            let tt = addr_of_mut!((*dst).t_tab).cast::<N>();
+            for (m, tab) in [&c.leak_ratio, &c.visc_ratio, &c.tc_speed, &c.swept_ratio].into_iter().enumerate() {
+                for (j, x) in tab.iter().enumerate() {
+                    tt.add(j * 4 + m).write(f(*x));
+                }
+            }
+            let gt = addr_of_mut!((*dst).g_trans).cast::<N>();
+            for (j, row) in c.g_trans.iter().enumerate() {
+                for (m, x) in row.iter().enumerate() {
+                    gt.add(j * row.len() + m).write(f(*x));
+                }
+            }
+            addr_of_mut!((*dst).last_total_kw).write(N::ZERO);
+            addr_of_mut!((*dst).last_lng_kw).write(N::ZERO);
+            addr_of_mut!((*dst).last_heat_kw).write(N::ZERO);
+            addr_of_mut!((*dst).last_outer_kw).write(N::ZERO);
+            addr_of_mut!((*dst).last_losses_kw).write([N::ZERO; N_LOSSES]);
+            addr_of_mut!((*dst).last_mech_pair_kw).write((N::ZERO, N::ZERO));
+            addr_of_mut!((*dst).loss_max).write(false);
+            addr_of_mut!((*dst).outer_g).write([N::ZERO; N_OUTER]);
+            addr_of_mut!((*dst).outer_phase).write(0);
+        }
         Ok(())
     }
 }

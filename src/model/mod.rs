@@ -34,8 +34,8 @@ use crate::linalg::expm1m;
 use crate::num::Num;
 pub use consts::{ModelConsts, Word};
 pub use crate::params::{
-    ReducedParams, N_NODES, N_TABLE, NODE_ACTUATOR, NODE_BALL_BLOCK, NODE_DRAIN, NODE_LOOP, NODE_MAIN_BLOCK, NODE_PUMP,
-    OUTER_NODES, S_PER_STEP, S_PER_TICK, TICKS_PER_STEP,
+    ReducedParams, N_NODES, N_OUTER, N_PHI, N_STATES, N_TABLE, N_TEMP, NODE_ACTUATOR, NODE_BALL_BLOCK, NODE_DRAIN, NODE_INTERNALS,
+    NODE_LOOP, NODE_MAIN_BLOCK, NODE_MOTOR, NODE_PUMP, NODE_WINDING, OUTER_NODES, S_PER_STEP, S_PER_TICK, TICKS_PER_STEP,
 };
 pub use input::{InputScales, ModelInputN, HA_PER_A, HBAR_PER_BAR, HRADS_PER_RPM};
 use ring::{Ring, RingIn};
@@ -97,6 +97,7 @@ struct Consts<N> {
     w_scale: N,   // (N_TABLE-1) / sqrt(w_max), per sqrt(hrad/s)
     rc0: N,       // rho c_p at 0 degC, kJ/(L K)
     rc1: N,       // d(rho c_p)/dT, kJ/(L K^2)
+    rc2: N,       // curvature of rho c_p, kJ/(L K^3)
     inv_v_case: N, // 1/L
     inv_v_loop: N, // 1/L
     inv_n: [N; TICKS_PER_STEP as usize + 1], // 1/n for partial steps (inv_n[0] = 0)
@@ -104,22 +105,29 @@ struct Consts<N> {
     v_port: N,    // L
     v_ball: N,    // L
     inv_v_ring: N, // 1 / (V_loop + 2 V_port + V_ball), 1/L
-    inv_c: [N; N_NODES], // 1/C of the metal nodes, K/kJ (oil nodes unused)
-    f_out: N,
-    f_case: N,    // the rest, 1 - f_out - f_case, heats the pump housing
-    k_m0: N,      // pump no-load friction, kW per hrad/s (pump housing)
-    k_mv: N,      // pump viscous friction, kW per (hrad/s)^2 (split f_out/f_case)
+    inv_c: [N; N_STATES], // 1/C of the metal states, K/kJ (oil nodes unused)
+    h0: N,        // share of the no-load friction into the housing
+    k_m0: N,      // pump no-load friction, kW per hrad/s
+    k_mv: N,      // pump viscous friction at 40 degC, kW per (hrad/s)^2 (internals)
     alpha: N,     // oil expansion, 1/K
     g_case_slope: N, // relative slope of the case film with the case-oil temperature, 1/K
     t_film: N,    // FILM_PROPERTY_C, degC
     alpha_t0: N,  // alpha 273.15
     lng_in: N,    // degC
-    k_mu: N,
-    t_mu: N,
-    use_mu: bool,
-    ga: [N; 4],   // outer, kW/K
-    gb: [N; 4],   // outer, kW/K^1.25
-    gr: [N; 4],   // outer radiation 4 eps sigma A (300 K)^3, kW/K per (T_m / 300 K)^3
+    barrel_ratio: N, // internals' share of the case gap's film, of the case wall's
+    g_seat: N,    // internals <-> housing, kW/K
+    g_pm: N,      // housing <-> motor, kW/K
+    g_pmf: N,     // housing <-> main block, kW/K
+    g_wm: N,      // winding <-> motor, kW/K
+    t_scale: N,   // 1 / TEMP_TABLE_STEP_K, 1/K
+    inv_stride: N, // 1 / COARSE_STRIDE
+    re_q: [N; crate::params::N_DUCTS], // ducts' Re / 1e4 per L/s at 40 degC
+    re_lam: N,    // 0.23: Re = 2300, the end of the laminar range, / 1e4
+    inv_span: N,  // 1 / 0.77: the transition's width in Re / 1e4
+    t_min: N,     // TEMP_TABLE_MIN_C, degC
+    ga: [N; N_OUTER],   // outer, kW/K
+    gb: [N; N_OUTER],   // outer, kW/K^1.25
+    gr: [N; N_OUTER],   // outer radiation 4 eps sigma A (300 K)^3, kW/K per (T_m / 300 K)^3
     h: N,         // s
     inv_h: N,     // 1/s
     half: N,
@@ -131,7 +139,7 @@ struct Consts<N> {
 /// The reduced-order model in number type `N` (`f64`, `f32` or [`crate::num::Fx`]).
 #[derive(Clone, Copy, Debug)]
 pub struct Model<N: Num> {
-    temp: [N::State; N_NODES],
+    temp: [N::State; N_STATES],
     /// Quasi-steady link temperatures of the last step: inlet, outlet, ball oil, degC.
     links: [N; 3],
     /// Ring rate of the last step, K/s.
@@ -140,13 +148,20 @@ pub struct Model<N: Num> {
     lng_hist: u32,
     ambient_c: N,
     sums: Sums<N>,
-    phi: [[N::Coef; N_NODES]; N_NODES],
+    phi: [[N::Coef; N_PHI]; N_PHI],
     k: Consts<N>,
     g_case: [N; N_TABLE],
     g_port: [N; N_TABLE],
     g_loop: [N; N_TABLE],
     g_ball: [N; N_TABLE],
     g_lng: [N; N_TABLE],
+    g_swept: [N; N_TABLE],
+    g_bore: [N; N_TABLE],
+    /// Temperature tables at the case oil: leakage, viscous friction, gap speed
+    /// factor, swept film ([`ModelConsts::leak_ratio`] ...), point by point.
+    t_tab: [[N; 4]; N_TEMP],
+    /// The ducts' films at Re = 2300 and 1e4 on the coarse temperature grid.
+    g_trans: [[N; 2 * crate::params::N_DUCTS]; crate::params::N_COARSE],
     last_total_kw: N,
     last_lng_kw: N,
     last_heat_kw: N,
@@ -157,8 +172,16 @@ pub struct Model<N: Num> {
     last_mech_pair_kw: (N, N),
     /// Take the larger of the two mechanical-loss estimates (sensor disagreement).
     loss_max: bool,
+    /// The viscous friction coefficient at the case oil of the last step, kW per
+    /// (hrad/s)^2: the tick's estimate of the shaft's friction torque (the sign of
+    /// the shaft power, cross-check) follows the oil's viscosity.
+    k_mv_t: N,
+    /// The leakage flow conductance at the case oil of the last step, L/s per hbar:
+    /// the tick's pump delivery `D w - K (p_A - p_case)` (in hot oil the leakage is
+    /// several times its 40 degC value and takes a tenth of the flow).
+    k_lf_t: N,
     /// Outer conductances of [`OUTER_NODES`], kW/K, refreshed one per step.
-    outer_g: [N; 4],
+    outer_g: [N; N_OUTER],
     outer_phase: u8,
 }
 
@@ -192,21 +215,21 @@ pub const N_LOSSES: usize = 6;
 
 /// `Phi = h phi1(h A) = integral_0^h exp(A s) ds`, from the exponential of the
 /// augmented matrix `[[A h, I h], [0, 0]]` (upper-right block).
-pub fn etd_matrix(a: &[[f64; N_NODES]; N_NODES], h: f64) -> [[f64; N_NODES]; N_NODES] {
-    const M: usize = 2 * N_NODES;
+pub fn etd_matrix(a: &[[f64; N_PHI]; N_PHI], h: f64) -> [[f64; N_PHI]; N_PHI] {
+    const M: usize = 2 * N_PHI;
     let mut aug = [[0.0f64; M]; M];
     for (i, (row, arow)) in aug.iter_mut().zip(a.iter()).enumerate() {
         for (x, v) in row.iter_mut().zip(arow.iter()) {
             *x = v * h;
         }
-        if let Some(x) = row.get_mut(N_NODES + i) {
+        if let Some(x) = row.get_mut(N_PHI + i) {
             *x = h;
         }
     }
     let e = expm1m(&aug);
-    let mut phi = [[0.0; N_NODES]; N_NODES];
+    let mut phi = [[0.0; N_PHI]; N_PHI];
     for (prow, erow) in phi.iter_mut().zip(e.iter()) {
-        for (p, x) in prow.iter_mut().zip(erow.iter().skip(N_NODES)) {
+        for (p, x) in prow.iter_mut().zip(erow.iter().skip(N_PHI)) {
             *p = *x;
         }
     }
@@ -253,7 +276,7 @@ impl<N: Num> Model<N> {
         unsafe { Self::init_values_in(m.as_mut_ptr(), c).map(|()| m.assume_init()) }
     }
 
-    /// Sets every node, the ring links and the ambient to `t_c` (degC): cold start.
+    /// Sets every state, the ring links and the ambient to `t_c` (degC): cold start.
     pub fn set_uniform(&mut self, t_c: N) {
         self.ambient_c = t_c;
         for th in self.temp.iter_mut() {
@@ -261,11 +284,15 @@ impl<N: Num> Model<N> {
         }
         self.links = [t_c; 3];
         self.ring_rate = N::ZERO;
-        self.outer_g = self.outer_all(&[t_c; N_NODES], t_c);
+        self.outer_g = self.outer_all(&[t_c; N_STATES], t_c);
     }
 
-    /// Sets every node's temperature (degC, node order) and the ambient from `f32`
-    /// (warm restore, thermal memory); the ring links start at the loop temperature.
+    /// Sets the contract nodes' temperatures (degC, node order) and the ambient
+    /// from `f32` (warm restore, thermal memory). The states the record does not
+    /// hold are set on the hot side: the internals at the warmer of the case oil
+    /// and the housing they sit between, the motor and its winding at the pump
+    /// housing (a motor colder than that would draw heat from the pump). The ring
+    /// links start at the loop temperature.
     pub fn set_temperatures(&mut self, temps_c: &[f32; N_NODES], ambient_c: f32) {
         let conv = |x: f32| match N::scale_from_f64(1.0) {
             Some(s) => N::from_f32_scaled(x, s),
@@ -275,10 +302,18 @@ impl<N: Num> Model<N> {
         for (th, t) in self.temp.iter_mut().zip(temps_c.iter()) {
             *th = N::state(conv(*t));
         }
+        let t_pump = temps_c.get(NODE_PUMP).map_or(self.ambient_c, |t| conv(*t));
+        let t_case = temps_c.get(NODE_DRAIN).map_or(self.ambient_c, |t| conv(*t));
+        let t_int = if t_case > t_pump { t_case } else { t_pump };
+        for (i, t) in [(NODE_INTERNALS, t_int), (NODE_MOTOR, t_pump), (NODE_WINDING, t_pump)] {
+            if let Some(th) = self.temp.get_mut(i) {
+                *th = N::state(t);
+            }
+        }
         let tl = temps_c.get(NODE_LOOP).map_or(self.ambient_c, |t| conv(*t));
         self.links = [tl; 3];
         self.ring_rate = N::ZERO;
-        self.outer_g = self.outer_all(&self.temperatures_c(), self.ambient_c);
+        self.outer_g = self.outer_all(&self.states_c(), self.ambient_c);
     }
 
     /// Accumulates one 10 ms tick (losses of eqs. 5-11 and the flows at this tick's
@@ -286,7 +321,7 @@ impl<N: Num> Model<N> {
     /// then calls [`Model::update`].
     #[inline(always)]
     pub fn tick_n(&mut self, u: &ModelInputN<N>) -> bool {
-        self.sums.add_tick(&self.k, u)
+        self.sums.add_tick(&self.k, self.k_mv_t, self.k_lf_t, u)
     }
 
     /// One model step of [`S_PER_STEP`] with the means of the accumulated ticks.
@@ -303,10 +338,15 @@ impl<N: Num> Model<N> {
         let on = lng_ticks.min(ticks);
         let share = inv.mul(k.count.get(on as usize).copied().unwrap_or(k.one));
         let mut m = self.sums.means(inv, &self.k);
+        let t = self.states_c();
+        let f = self.oil_factors(t.get(NODE_DRAIN).copied().unwrap_or(N::ZERO));
         let from_current = m.shaft_kw.sub(m.hyd_kw);
         // the model's whole pump friction: pressure term plus no-load and viscous
+        // (the latter at the case oil's viscosity)
         let aw = m.abs_speed;
-        let speed_kw = aw.mul(k.k_m0).add(m.visc_kw);
+        let speed_kw = aw.mul(k.k_m0).add(m.visc_kw.mul(f[1]));
+        self.k_mv_t = k.k_mv.mul(f[1]);
+        self.k_lf_t = k.k_lf.mul(f[0]);
         let model_kw = m.mech_kw.add(speed_kw);
         self.last_mech_pair_kw = (model_kw, from_current);
         if self.loss_max && from_current > model_kw {
@@ -314,9 +354,8 @@ impl<N: Num> Model<N> {
         }
         self.sums = Sums::ZERO;
         self.ambient_c = m.ambient;
-        let t = self.temperatures_c();
         self.lng_hist = (self.lng_hist << 1) | u32::from(2 * on >= ticks && on > 0);
-        // One outer surface's conductance is refreshed per step (each every 0.4 s; the
+        // One outer surface's conductance is refreshed per step (each every 0.5 s; the
         // metal temperatures move by millikelvin in that time).
         let i = self.outer_phase as usize % OUTER_NODES.len();
         if let (Some(g), Some(n)) = (self.outer_g.get_mut(i), OUTER_NODES.get(i)) {
@@ -324,7 +363,7 @@ impl<N: Num> Model<N> {
             *g = Self::outer_conductance_of(&self.k, i, tw, m.ambient);
         }
         self.outer_phase = self.outer_phase.wrapping_add(1);
-        let r = self.rhs(&t, &m, self.lng_hist, share, Some(self.links), self.ring_rate, &self.outer_g);
+        let r = self.rhs(&t, &m, &f, self.lng_hist, share, Some(self.links), self.ring_rate, &self.outer_g);
         self.links = r.links;
         self.ring_rate = r.ring_rate;
         self.last_total_kw = r.total_kw;
@@ -332,27 +371,36 @@ impl<N: Num> Model<N> {
         self.last_heat_kw = r.heat_kw;
         self.last_outer_kw = r.outer_kw;
         self.last_losses_kw = r.losses_kw;
-        let [p0, p1, p2, p3, p4, p5] = &self.phi;
-        let [s0, s1, s2, s3, s4, s5] = &mut self.temp;
-        *s0 = N::accumulate(*s0, p0, &r.rates);
-        *s1 = N::accumulate(*s1, p1, &r.rates);
-        *s2 = N::accumulate(*s2, p2, &r.rates);
-        *s3 = N::accumulate(*s3, p3, &r.rates);
-        *s4 = N::accumulate(*s4, p4, &r.rates);
-        *s5 = N::accumulate(*s5, p5, &r.rates);
+        // `PHI_STATES` (pump housing, case oil, loop oil, internals) by `Phi`, the
+        // slow states by explicit Euler (`EULER_STATES`)
+        let [p0, p1, p2, p3] = &self.phi;
+        let [s0, s1, s2, s3, s4, s5, s6, s7, s8] = &mut self.temp;
+        let [r0, r1, r2, r3, r4, r5, r6, r7, r8] = r.rates;
+        let rp = [r0, r1, r2, r6];
+        *s0 = N::accumulate(*s0, p0, &rp);
+        *s1 = N::accumulate(*s1, p1, &rp);
+        *s2 = N::accumulate(*s2, p2, &rp);
+        *s6 = N::accumulate(*s6, p3, &rp);
+        let h = self.k.h;
+        *s3 = N::add_product(*s3, h, r3);
+        *s4 = N::add_product(*s4, h, r4);
+        *s5 = N::add_product(*s5, h, r5);
+        *s7 = N::add_product(*s7, h, r7);
+        *s8 = N::add_product(*s8, h, r8);
     }
 
-    /// Right-hand side `dT/dt` (K/s, node order) at temperatures `t` with every tick
+    /// Right-hand side `dT/dt` (K/s, state order) at temperatures `t` with every tick
     /// at inputs `u`, the ring in steady flow (links stored nothing, no transport lag):
     /// the function whose Jacobian at the nominal point is `A` (reduction tool).
     #[inline(never)]
-    pub fn derivative(&self, t: &[N; N_NODES], u: &ModelInputN<N>, lng_open: bool) -> [N; N_NODES] {
+    pub fn derivative(&self, t: &[N; N_STATES], u: &ModelInputN<N>, lng_open: bool) -> [N; N_STATES] {
         let mut sums = Sums::ZERO;
-        let _ = sums.add_tick(&self.k, u);
+        let f = self.oil_factors(t.get(NODE_DRAIN).copied().unwrap_or(N::ZERO));
+        let _ = sums.add_tick(&self.k, self.k.k_mv.mul(f[1]), self.k.k_lf.mul(f[0]), u);
         let m = sums.means(self.k.one, &self.k);
         let share = if lng_open { self.k.one } else { N::ZERO };
         let og = self.outer_all(t, m.ambient);
-        self.rhs(t, &m, u32::from(lng_open), share, None, N::ZERO, &og).rates
+        self.rhs(t, &m, &f, u32::from(lng_open), share, None, N::ZERO, &og).rates
     }
 
     /// Advances one model step with every tick at the same inputs (tests, tools).
@@ -367,9 +415,19 @@ impl<N: Num> Model<N> {
         self.temp.get(NODE_DRAIN).map_or(N::ZERO, |s| N::value(*s))
     }
 
-    /// All node temperatures, degC, in node order.
+    /// The contract nodes' temperatures, degC, in node order.
     pub fn temperatures_c(&self) -> [N; N_NODES] {
         let mut t = [N::ZERO; N_NODES];
+        for (o, th) in t.iter_mut().zip(self.temp.iter()) {
+            *o = N::value(*th);
+        }
+        t
+    }
+
+    /// Every state's temperature, degC, in state order (the contract nodes, then
+    /// the pump's internals, the motor housing and the winding).
+    pub fn states_c(&self) -> [N; N_STATES] {
+        let mut t = [N::ZERO; N_STATES];
         for (o, th) in t.iter_mut().zip(self.temp.iter()) {
             *o = N::value(*th);
         }

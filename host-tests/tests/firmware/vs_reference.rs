@@ -1,8 +1,10 @@
 //! Acceptance of the firmware's reduced model (issue 3, "Host tests") against
-//! the full reference simulation: Case 1 at 0/20/40/60 bar, Case 2, the LNG case
-//! and five random missions (`missions::TEST_SEEDS`); the reduced model is
-//! computed from the rig (`eha_sim::reduce`), fitted to no run, so every run is
-//! unseen.
+//! the full reference simulation: Case 1 at 0/20/40/60 bar, Case 2, the LNG case,
+//! five random missions (`missions::TEST_SEEDS`), a long hot run (Case 1 at 60 bar
+//! for an hour on a rig without LNG: the drain passes 60 °C, the oil thins to
+//! ≈ 8 cSt) and a cold start (Case 1 at 60 bar in 0 °C air: ≈ 580 cSt at the
+//! start); the reduced model is computed from the rig (`eha_sim::reduce`), fitted
+//! to no run, so every run is unseen.
 //!
 //! Every run is **closed loop**, as on the actuator: the guard (`GuardOf<f64>`,
 //! validation included, reduced `eha_guard::params::DEFAULT`) is fed the
@@ -33,8 +35,11 @@ use std::sync::OnceLock;
 
 /// Duration of every acceptance run, s (the paper's 600 s).
 const DURATION_S: f64 = 600.0;
-/// Issue bound on max |drain error|, K.
+/// Issue bound on max |drain error|, K (issue 3).
 const MAX_ABS_K: f64 = 1.0;
+/// Bound on max |drain error| once the oil follows its viscosity line and the pump
+/// is split (issue 34), K: the firmware stays within 0.1 K of the reference.
+const MAX_ABS_34_K: f64 = 0.1;
 /// Issue goal on max |drain error|, K (reported, not asserted).
 const GOAL_K: f64 = 0.5;
 /// Issue bound on drain under-prediction, K.
@@ -58,13 +63,47 @@ const REG_SWITCH_S: f64 = 1.2;
 /// (Case 1 40 bar), 2.1×.
 const REG_FIRST_OPEN_S: f64 = 0.3;
 
+/// One run of the suite: its name, its scenario, and whether the rig has an LNG
+/// cooler (the hot run has none: the reference's exchanger takes nothing and the
+/// guard's tank is empty, so it credits nothing).
+#[derive(Clone)]
+struct Case {
+    name: String,
+    scenario: Scenario,
+    lng: bool,
+}
+
+impl Case {
+    fn new(name: &str, scenario: Scenario) -> Self {
+        Case { name: name.into(), scenario, lng: true }
+    }
+
+    /// The reference rig of this run.
+    fn rig(&self) -> Rig {
+        let mut rig = Rig::default();
+        if !self.lng {
+            rig.lng.flow_kg_per_s = 0.0;
+        }
+        rig
+    }
+
+    /// The guard's configuration of this run.
+    fn config(&self) -> GuardConfig<'static> {
+        let mut cfg = GuardConfig::DEFAULT;
+        if !self.lng {
+            cfg.lng.charge_l = 0.0;
+        }
+        cfg
+    }
+}
+
 /// The acceptance runs (drain-error bounds) followed by load-then-idle (valve
 /// switching only).
-fn cases() -> &'static [(String, Scenario)] {
-    static C: OnceLock<Vec<(String, Scenario)>> = OnceLock::new();
+fn cases() -> &'static [Case] {
+    static C: OnceLock<Vec<Case>> = OnceLock::new();
     C.get_or_init(|| {
         let mut v = scenarios();
-        v.push(("load-then-idle".into(), load_then_idle()));
+        v.push(Case::new("load-then-idle", load_then_idle()));
         v
     })
 }
@@ -77,16 +116,28 @@ const STOPPED_RPM: f64 = 6.2;
 /// 7 s; 10 s bound.
 const STOPPED_LATE_S: f64 = 10.0;
 
-fn scenarios() -> Vec<(String, Scenario)> {
-    let mut v: Vec<(String, Scenario)> = [0.0, 20.0, 40.0, 60.0]
+/// Duration of the long hot run, s.
+const HOT_S: f64 = 3600.0;
+/// Air temperature of the cold start, °C.
+const COLD_AIR_C: f64 = 0.0;
+/// Duration of the cold start, s (long enough for the valve to open).
+const COLD_S: f64 = 900.0;
+
+fn scenarios() -> Vec<Case> {
+    let mut v: Vec<Case> = [0.0, 20.0, 40.0, 60.0]
         .iter()
-        .map(|&b| (format!("case1-{b}bar"), Scenario::Case1 { needle_bar: b, duration_s: DURATION_S }))
+        .map(|&b| Case::new(&format!("case1-{b}bar"), Scenario::Case1 { needle_bar: b, duration_s: DURATION_S }))
         .collect();
-    v.push(("case2".into(), Scenario::Case2 { duration_s: DURATION_S }));
-    v.push(("lng".into(), Scenario::Lng { duration_s: DURATION_S }));
+    v.push(Case::new("case2", Scenario::Case2 { duration_s: DURATION_S }));
+    v.push(Case::new("lng", Scenario::Lng { duration_s: DURATION_S }));
     for s in TEST_SEEDS {
-        v.push((format!("random-{s}"), Scenario::Mission(random_mission(s, DURATION_S))));
+        v.push(Case::new(&format!("random-{s}"), Scenario::Mission(random_mission(s, DURATION_S))));
     }
+    v.push(Case { lng: false, ..Case::new("hot-1h-no-lng", Scenario::Case1 { needle_bar: 60.0, duration_s: HOT_S }) });
+    let mut cold: Mission = Scenario::Case1 { needle_bar: 60.0, duration_s: COLD_S }.mission().expect("mission");
+    cold.name = "cold-start".into();
+    cold.ambient_c = Schedule::constant(COLD_AIR_C);
+    v.push(Case::new("cold-start-0c", Scenario::Mission(cold)));
     v
 }
 
@@ -107,13 +158,14 @@ struct Run {
     mech_pairs: Vec<(f64, f64)>,
 }
 
-/// Runs `scenario` in closed loop, the valve following the guard.
-fn closed_loop(name: &str, scenario: &Scenario) -> Run {
-    let rig = Rig::default();
+/// Runs `case` in closed loop, the valve following the guard.
+fn closed_loop(case: &Case) -> Run {
+    let scenario = &case.scenario;
+    let rig = case.rig();
     let mut plant = Plant::new(&rig, scenario).expect("plant");
-    let cfg = GuardConfig::DEFAULT;
+    let cfg = case.config();
     let mut guard = GuardOf::<f64>::new(&cfg, Restore::Cold);
-    let mut run = Run { name: name.into(), sensors: vec![], pred: vec![], faults: eha_guard::Faults::NONE, events: vec![], mech_pairs: vec![] };
+    let mut run = Run { name: case.name.clone(), sensors: vec![], pred: vec![], faults: eha_guard::Faults::NONE, events: vec![], mech_pairs: vec![] };
     let mut open = false;
     plant
         .run(0.01, scenario.duration_s(), |snap| {
@@ -140,7 +192,7 @@ fn closed_loop(name: &str, scenario: &Scenario) -> Run {
 /// The guard-driven run of every case of [`cases`], in its order.
 fn runs() -> &'static [Run] {
     static R: OnceLock<Vec<Run>> = OnceLock::new();
-    R.get_or_init(|| cases().par_iter().map(|(n, s)| closed_loop(n, s)).collect())
+    R.get_or_init(|| cases().par_iter().map(closed_loop).collect())
 }
 
 /// For every case of [`cases`], in its order: when a thermostat with the guard's
@@ -149,14 +201,15 @@ fn runs() -> &'static [Run] {
 /// [`thermostat_from_branch`], shared by both valve tests.
 fn thermostat_first_switch() -> &'static [Option<f64>] {
     static T: OnceLock<Vec<Option<f64>>> = OnceLock::new();
-    T.get_or_init(|| cases().par_iter().map(|(_, sc)| thermostat_from_branch(sc, &[], 0).map(|(t, _)| t)).collect())
+    T.get_or_init(|| cases().par_iter().map(|c| thermostat_from_branch(c, &[], 0).map(|(t, _)| t)).collect())
 }
 
 /// The guard of number type `N` on a run's sensor signals: drain estimate
 /// (element k: after sample k), its own valve command (which sets its
 /// exchanger credit) per tick, faults at the end.
 fn guard_drain_valve<N: Num>(run: &Run) -> (Vec<f64>, Vec<bool>, eha_guard::Faults) {
-    let mut g = GuardOf::<N>::new(&GuardConfig::DEFAULT, Restore::Cold);
+    let cfg = cases().iter().find(|c| c.name == run.name).map_or(GuardConfig::DEFAULT, Case::config);
+    let mut g = GuardOf::<N>::new(&cfg, Restore::Cold);
     let n = run.sensors.len() - 1;
     let (mut out, mut valve) = (Vec::with_capacity(n), Vec::with_capacity(n));
     let mut faults = eha_guard::Faults::NONE;
@@ -199,6 +252,8 @@ fn assert_bounds(rows: &[(String, ErrorStats, eha_guard::Faults)]) {
         assert!(!f.intersects(faults::LATCHED), "{n}: guard faulted on reference signals");
         // Issue: max |drain error| <= 1.0 K.
         assert!(e.max_abs <= MAX_ABS_K, "{n}: max |error| {:.3} K > {MAX_ABS_K} K", e.max_abs);
+        // Issue 34: within 0.1 K of the reference on every acceptance run.
+        assert!(e.max_abs <= MAX_ABS_34_K, "{n}: max |error| {:.3} K > {MAX_ABS_34_K} K", e.max_abs);
         // Issue: under-prediction is the unsafe side, never more than 0.5 K.
         assert!(e.max_under <= MAX_UNDER_K, "{n}: under-prediction {:.3} K > {MAX_UNDER_K} K", e.max_under);
         // Regression bounds (2-3x the measured worst; the spec bounds above are what the issue demands).
@@ -217,6 +272,24 @@ fn case1_all_pressures_drain_within_bounds() {
 #[test]
 fn case2_drain_within_bounds() {
     assert_bounds(&report(&["case2"]));
+}
+
+/// The long hot run: Case 1 at 60 bar for an hour on a rig without LNG (the drain
+/// passes 60 °C after ≈ 10 minutes and reaches ≈ 92 °C, the oil ≈ 8 cSt: leakage
+/// ≈ 6 times, viscous friction a sixth of their 40 °C values), and the cold start:
+/// Case 1 at 60 bar in 0 °C air (the oil starts at ≈ 580 cSt: viscous friction 12
+/// times its 40 °C value).
+#[test]
+fn hot_run_and_cold_start_drain_within_bounds() {
+    let rows = report(&["hot-1h", "cold-start"]);
+    assert_eq!(rows.len(), 2);
+    let hot = runs().iter().find(|r| r.name.starts_with("hot-1h")).expect("hot run");
+    let peak = hot.sensors.iter().map(|s| s.t_drain_c).fold(f64::NEG_INFINITY, f64::max);
+    println!("hot run: reference drain peaks at {peak:.2} °C");
+    assert!(peak > 60.0, "the hot run must take the drain past 60 °C: {peak:.2}");
+    let cold = runs().iter().find(|r| r.name.starts_with("cold-start")).expect("cold run");
+    assert!(cold.sensors[0].t_drain_c.abs() < 1e-9, "the cold start starts at 0 °C");
+    assert_bounds(&rows);
 }
 
 /// Five random missions (the model is reduced from the rig, fitted to no run).
@@ -332,7 +405,7 @@ fn stop_with_valve_open() -> Scenario {
 /// the stop.
 #[test]
 fn pump_stopped_with_valve_open_drain_within_bounds() {
-    let r = closed_loop("lng-stop-valve-open", &stop_with_valve_open());
+    let r = closed_loop(&Case::new("lng-stop-valve-open", stop_with_valve_open()));
     let open_at_stop = r.events.iter().take_while(|(t, _)| *t <= 285.0).last().is_some_and(|e| e.1);
     assert!(open_at_stop, "the scenario needs the valve open when the pump stops: {:?}", r.events);
     let e = drain_stats(&r);
@@ -384,11 +457,12 @@ fn valve_first_opening_within_2s() {
 /// (None: not before the end of the run). Same plant, same state, same valve
 /// history up to the branch point: the difference to the guard's event is the
 /// switching delay due to the estimate alone.
-fn thermostat_from_branch(scenario: &Scenario, events: &[(f64, bool)], i: usize) -> Option<(f64, f64)> {
+fn thermostat_from_branch(case: &Case, events: &[(f64, bool)], i: usize) -> Option<(f64, f64)> {
+    let scenario = &case.scenario;
     let (branch_t, open_at_branch) = if i == 0 { (f64::NEG_INFINITY, false) } else { events[i - 1] };
-    let rig = Rig::default();
+    let rig = case.rig();
     let mut plant = Plant::new(&rig, scenario).expect("plant");
-    let cfg = GuardConfig::DEFAULT;
+    let cfg = case.config();
     let mut valve = Valve::new();
     let mut branched = false;
     let mut switched = None;
@@ -450,7 +524,7 @@ fn valve_switching_times_match_true_drain() {
         .filter(|(_, run)| !run.events.is_empty())
         .map(|(r, _)| (r, 0, first[r].map(|t| (t, f64::NAN))))
         .collect();
-    results.par_extend(jobs.par_iter().map(|&(r, i)| (r, i, thermostat_from_branch(&cases[r].1, &guard_runs[r].events, i))));
+    results.par_extend(jobs.par_iter().map(|&(r, i)| (r, i, thermostat_from_branch(&cases[r], &guard_runs[r].events, i))));
     results.sort_by_key(|x| (x.0, x.1));
     let mut worst = 0.0f64;
     let mut failures = vec![];
