@@ -102,6 +102,9 @@ pub struct ModelConsts<S> {
     pub g_pmf: S,
     /// Winding <-> motor housing, kW/K, in [0, 1].
     pub g_wm: S,
+    /// Case oil <-> internals, swept slippers and shanks, at 40 degC, kW/K per
+    /// sqrt(hrad/s) (`G = this sqrt(|w|)`), in [0, 1].
+    pub k_sw: S,
     /// 1 / capacity of the metal states, K/kJ (oil nodes 0).
     pub inv_c: [S; N_STATES],
     /// Outer surfaces, constant conductance, kW/K (eqs. 15-16).
@@ -120,8 +123,6 @@ pub struct ModelConsts<S> {
     pub g_ball: [S; N_TABLE],
     /// LNG exchanger `eps C_min` over flow, kW/K (eqs. 20-22).
     pub g_lng: [S; N_TABLE],
-    /// Case oil <-> internals, swept slippers and shanks, over the speed grid, kW/K.
-    pub g_swept: [S; N_TABLE],
     /// One port's oil <-> internals through the bores, over flow, kW/K.
     pub g_bore: [S; N_TABLE],
     /// Leakage ratio `mu(40) / mu(T)` over the temperature grid (1 at 40 degC,
@@ -138,6 +139,8 @@ pub struct ModelConsts<S> {
     /// Reynolds number of each duct (port, loop, ball) over 1e4 per L/s of flow at
     /// the 40 degC viscosity.
     pub re_q: [S; N_DUCTS],
+    /// Block walls behind the loop's and the ball-valve passage's films, kW/K.
+    pub g_wall: [S; 2],
     /// The ducts' films at Re = 2300 and Re = 1e4 on the coarse temperature grid,
     /// kW/K: per point `[port 2300, port 1e4, loop 2300, loop 1e4, ball 2300, ball 1e4]`.
     pub g_trans: [[S; 2 * N_DUCTS]; N_COARSE],
@@ -196,11 +199,11 @@ impl Word for f64 {
     }
 }
 
-/// Scalar words at the head of a [`ModelConsts`] (`p_case` .. `g_wm`).
-pub const N_SCALARS: usize = 41;
+/// Scalar words at the head of a [`ModelConsts`] (`p_case` .. `k_sw`).
+pub const N_SCALARS: usize = 42;
 /// Number of words in a [`ModelConsts`].
 pub const N_WORDS: usize =
-    N_SCALARS + N_STATES + 3 * N_OUTER + 7 * N_TABLE + 4 * N_TEMP + N_DUCTS + 2 * N_DUCTS * N_COARSE + 2 * N_NODES + N_PHI * N_PHI;
+    N_SCALARS + N_STATES + 3 * N_OUTER + 6 * N_TABLE + 4 * N_TEMP + N_DUCTS + 2 + 2 * N_DUCTS * N_COARSE + 2 * N_NODES + N_PHI * N_PHI;
 
 // Every field is a word: no padding, no other data.
 const _: () = assert!(core::mem::size_of::<ModelConsts<f32>>() == 4 * N_WORDS);
@@ -255,6 +258,7 @@ impl<S: Copy> ModelConsts<S> {
             g_pm: f(c.g_pm),
             g_pmf: f(c.g_pmf),
             g_wm: f(c.g_wm),
+            k_sw: f(c.k_sw),
             inv_c: c.inv_c.map(&mut f),
             ga: c.ga.map(&mut f),
             gb: c.gb.map(&mut f),
@@ -264,13 +268,13 @@ impl<S: Copy> ModelConsts<S> {
             g_loop: c.g_loop.map(&mut f),
             g_ball: c.g_ball.map(&mut f),
             g_lng: c.g_lng.map(&mut f),
-            g_swept: c.g_swept.map(&mut f),
             g_bore: c.g_bore.map(&mut f),
             leak_ratio: c.leak_ratio.map(&mut f),
             visc_ratio: c.visc_ratio.map(&mut f),
             tc_speed: c.tc_speed.map(&mut f),
             swept_ratio: c.swept_ratio.map(&mut f),
             re_q: c.re_q.map(&mut f),
+            g_wall: c.g_wall.map(&mut f),
             g_trans: c.g_trans.map(|r| r.map(&mut f)),
             rest_rate: c.rest_rate.map(&mut f),
             rest_mode: c.rest_mode.map(&mut f),
@@ -334,6 +338,7 @@ impl ModelConsts<()> {
         g_pm: (),
         g_pmf: (),
         g_wm: (),
+        k_sw: (),
         inv_c: [(); N_STATES],
         ga: [(); N_OUTER],
         gb: [(); N_OUTER],
@@ -343,13 +348,13 @@ impl ModelConsts<()> {
         g_loop: [(); N_TABLE],
         g_ball: [(); N_TABLE],
         g_lng: [(); N_TABLE],
-        g_swept: [(); N_TABLE],
         g_bore: [(); N_TABLE],
         leak_ratio: [(); N_TEMP],
         visc_ratio: [(); N_TEMP],
         tc_speed: [(); N_TEMP],
         swept_ratio: [(); N_TEMP],
         re_q: [(); N_DUCTS],
+        g_wall: [(); 2],
         g_trans: [[(); 2 * N_DUCTS]; N_COARSE],
         rest_rate: [(); N_NODES],
         rest_mode: [(); N_NODES],
@@ -391,7 +396,7 @@ impl<S: Word> ModelConsts<S> {
         let scalars_non_neg = [
             c.k_lf, c.k_lf_half, c.k_lp, c.k_mech, c.k_q, c.k_a, c.k_dpq, c.r1, c.r2, c.w_dp, c.w_dx, c.k_act, c.k_cu, c.k_sh, c.k_hyd,
             c.fe1, c.fe2, c.fe15, c.inv_v_case, c.inv_v_loop, c.v_port, c.v_ball, c.inv_v_ring, c.h0,
-            c.k_m0, c.k_mv, c.alpha, c.alpha_t0, c.barrel_ratio, c.g_seat, c.g_pm, c.g_pmf, c.g_wm,
+            c.k_m0, c.k_mv, c.alpha, c.alpha_t0, c.barrel_ratio, c.g_seat, c.g_pm, c.g_pmf, c.g_wm, c.k_sw,
         ];
         // inv_c, outer conductances and the tables: every word between the
         // scalars and Phi (a rolled loop: init code, flash)
@@ -407,15 +412,19 @@ impl<S: Word> ModelConsts<S> {
         let rc = rc(-60.0) > 0.0 && rc(40.0) > 0.0 && rc(150.0) > 0.0;
         // the pump's metal paths: at most 1 kW/K (physical ones are a few W/K),
         // the barrel's share of the case gap at most 10 times the case wall's
-        let paths = [c.g_seat, c.g_pm, c.g_pmf, c.g_wm].iter().all(|g| w(*g) <= 1.0) && w(c.barrel_ratio) <= 10.0;
+        let paths = [c.g_seat, c.g_pm, c.g_pmf, c.g_wm, c.k_sw].iter().all(|g| w(*g) <= 1.0) && w(c.barrel_ratio) <= 10.0;
         // the temperature tables: 1 at 40 degC (where the other words are
         // referred; 1e-3 covers f32 rounding), monotonic as the viscosity
         // falls with temperature (the leakage and the gap's Taylor number rise,
         // the viscous friction falls), positive (every word >= 0 is checked above)
         let at40 = ((FILM_PROPERTY_C - TEMP_TABLE_MIN_C) / TEMP_TABLE_STEP_K) as usize;
-        let unit = |t: &[S; N_TEMP]| t.get(at40).is_some_and(|x| (w(*x) - 1.0).abs() <= 1e-3) && t.iter().all(|x| w(*x) > 0.0);
-        let rising = |t: &[S; N_TEMP]| t.windows(2).all(|p| w(p[1]) >= w(p[0]));
-        let falling = |t: &[S; N_TEMP]| t.windows(2).all(|p| w(p[1]) <= w(p[0]));
+        // (slices of a black-boxed length: rolled loops, init code, flash)
+        fn sl<S>(t: &[S; N_TEMP]) -> &[S] {
+            t.get(..core::hint::black_box(N_TEMP)).unwrap_or(&[])
+        }
+        let unit = |t: &[S; N_TEMP]| t.get(at40).is_some_and(|x| (w(*x) - 1.0).abs() <= 1e-3) && sl(t).iter().all(|x| w(*x) > 0.0);
+        let rising = |t: &[S; N_TEMP]| sl(t).windows(2).all(|p| p.first().zip(p.get(1)).is_some_and(|(a, b)| w(*b) >= w(*a)));
+        let falling = |t: &[S; N_TEMP]| sl(t).windows(2).all(|p| p.first().zip(p.get(1)).is_some_and(|(a, b)| w(*b) <= w(*a)));
         let temp = unit(&c.leak_ratio)
             && unit(&c.visc_ratio)
             && unit(&c.tc_speed)
@@ -446,7 +455,7 @@ impl<S: Word> ModelConsts<S> {
     fn euler_steps_are_small(&self) -> bool {
         let c = self;
         let w = |x: S| x.to_f32();
-        let max = |t: &[S; N_TABLE]| t.iter().fold(0.0f32, |m, x| m.max(w(*x)));
+        let max = |t: &[S; N_TABLE]| t.get(..core::hint::black_box(N_TABLE)).unwrap_or(&[]).iter().fold(0.0f32, |m, x| m.max(w(*x)));
         // (200 K)^(1/4) = 3.76; T_m (T_m^2 + d^2) at T_m = 1.6 (480 K), d = 0.33 in units of 300 K: 4.3
         let outer = |i: usize| match (c.ga.get(i), c.gb.get(i), c.gr.get(i)) {
             (Some(a), Some(b), Some(r)) => w(*a) + 3.8 * w(*b) + 4.3 * w(*r),
@@ -546,6 +555,7 @@ pub fn derive(p: &ReducedParams) -> Result<ModelConsts<f64>, ConfigError> {
         g_pm: p.pump_motor_w_per_k * KW_PER_W,
         g_pmf: p.pump_manifold_w_per_k * KW_PER_W,
         g_wm: p.winding_motor_w_per_k * KW_PER_W,
+        k_sw: p.swept_w_per_k_root * KW_PER_W * 10.0,
         inv_c,
         ga: p.outer_w_per_k.map(|x| x * KW_PER_W),
         gb: p.outer_quarter_w_per_k125.map(|x| x * KW_PER_W),
@@ -557,13 +567,13 @@ pub fn derive(p: &ReducedParams) -> Result<ModelConsts<f64>, ConfigError> {
         g_loop: kw(&p.g_loop_block_w_per_k),
         g_ball: kw(&p.g_ball_block_w_per_k),
         g_lng: kw(&p.g_lng_w_per_k),
-        g_swept: kw(&p.g_swept_w_per_k),
         g_bore: kw(&p.g_bore_w_per_k),
         leak_ratio: p.leak_ratio,
         visc_ratio: p.visc_ratio,
         tc_speed: p.tc_speed_ratio,
         swept_ratio: p.swept_ratio,
         re_q: p.re_per_flow.map(|x| x / L_PER_M3),
+        g_wall: p.duct_wall_w_per_k.map(|x| x * KW_PER_W),
         g_trans: {
             let mut t = [[0.0; 2 * N_DUCTS]; N_COARSE];
             for (j, row) in t.iter_mut().enumerate() {
@@ -648,9 +658,11 @@ mod tests {
         let mut c = DEFAULT_CONSTS;
         c.h0 = 1.5;
         assert_eq!(c.check_values(), Err(ConfigError::Implausible));
-        // an Euler state with a capacity so small that its step would overshoot
+        // an Euler state with a capacity so small against its conductance that its
+        // step would overshoot (the winding at 31 J/K on 0.5 kW/K: h G / C = 1.6)
         let mut c = DEFAULT_CONSTS;
-        c.inv_c[crate::params::NODE_WINDING] *= 1e4;
+        c.inv_c[crate::params::NODE_WINDING] *= 100.0;
+        c.g_wm = 0.5;
         assert_eq!(c.check_values(), Err(ConfigError::Implausible));
         assert_eq!(DEFAULT_CONSTS.check_values(), Ok(()));
     }

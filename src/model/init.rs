@@ -80,9 +80,11 @@ impl<N: Num> Model<N> {
             g_pm: f(c.g_pm),
             g_pmf: f(c.g_pmf),
             g_wm: f(c.g_wm),
+            k_sw: f(c.k_sw),
             t_scale: exact!(1.0 / crate::params::TEMP_TABLE_STEP_K),
             inv_stride: exact!(1.0 / crate::params::COARSE_STRIDE as f64),
             re_q: c.re_q.map(f),
+            g_wall: c.g_wall.map(f),
             re_lam: exact!(0.23),
             inv_span: exact!(1.0 / 0.77),
             t_min: exact!(crate::params::TEMP_TABLE_MIN_C),
@@ -114,32 +116,24 @@ impl<N: Num> Model<N> {
             addr_of_mut!((*dst).k_mv_t).write(k.k_mv);
             addr_of_mut!((*dst).k_lf_t).write(k.k_lf);
             addr_of_mut!((*dst).k).write(k);
-            let tables: [(*mut [N; N_TABLE], &[S; N_TABLE]); 7] = [
+            let tables: [(*mut [N; N_TABLE], &[S; N_TABLE]); 6] = [
                 (addr_of_mut!((*dst).g_case), &c.g_case),
                 (addr_of_mut!((*dst).g_port), &c.g_port),
                 (addr_of_mut!((*dst).g_loop), &c.g_loop),
                 (addr_of_mut!((*dst).g_ball), &c.g_ball),
                 (addr_of_mut!((*dst).g_lng), &c.g_lng),
-                (addr_of_mut!((*dst).g_swept), &c.g_swept),
                 (addr_of_mut!((*dst).g_bore), &c.g_bore),
             ];
             for (d, src) in tables {
-                let d = d.cast::<N>();
-                for (j, x) in src.iter().enumerate() {
-                    d.add(j).write(f(*x));
-                }
-            }
-            let tt = addr_of_mut!((*dst).t_tab).cast::<N>();
-            for (m, tab) in [&c.leak_ratio, &c.visc_ratio, &c.tc_speed, &c.swept_ratio].into_iter().enumerate() {
-                for (j, x) in tab.iter().enumerate() {
-                    tt.add(j * 4 + m).write(f(*x));
-                }
+                copy_words::<N, S>(d.cast::<N>(), src, 1);
             }
             let gt = addr_of_mut!((*dst).g_trans).cast::<N>();
             for (j, row) in c.g_trans.iter().enumerate() {
-                for (m, x) in row.iter().enumerate() {
-                    gt.add(j * row.len() + m).write(f(*x));
-                }
+                copy_words::<N, S>(gt.add(j * row.len()), row, 1);
+            }
+            let tt = addr_of_mut!((*dst).t_tab).cast::<N>();
+            for (m, tab) in [&c.leak_ratio, &c.visc_ratio, &c.tc_speed, &c.swept_ratio].into_iter().enumerate() {
+                copy_words::<N, S>(tt.add(m), tab, 4);
             }
             addr_of_mut!((*dst).last_total_kw).write(N::ZERO);
             addr_of_mut!((*dst).last_lng_kw).write(N::ZERO);
@@ -149,8 +143,28 @@ impl<N: Num> Model<N> {
             addr_of_mut!((*dst).last_mech_pair_kw).write((N::ZERO, N::ZERO));
             addr_of_mut!((*dst).loss_max).write(false);
             addr_of_mut!((*dst).outer_g).write([N::ZERO; N_OUTER]);
+            let one = exact!(1.0);
+            addr_of_mut!((*dst).slow).write(Slow { case: [one; 4], duct: [one; 2] });
             addr_of_mut!((*dst).outer_phase).write(0);
+            // every field is written: the oil's factors at the start (0 degC, like
+            // the states)
+            (*dst).refresh_slow(N::ZERO, N::ZERO);
         }
         Ok(())
+    }
+}
+
+/// Converts `src` into the number type, writing word `j` at `dst + j * stride`. One
+/// rolled copy for every table (unrolled per table, the init grew by 5 KiB of flash).
+///
+/// # Safety
+/// `dst + j * stride` must be valid for writes for every `j < src.len()`.
+#[inline(never)]
+unsafe fn copy_words<N: Num, S: Word>(dst: *mut N, src: &[S], stride: usize) {
+    for j in 0..core::hint::black_box(src.len()) {
+        if let Some(x) = src.get(j) {
+            // SAFETY: as this function's.
+            unsafe { dst.add(j * stride).write(x.to_n::<N>()) };
+        }
     }
 }

@@ -119,9 +119,11 @@ struct Consts<N> {
     g_pm: N,      // housing <-> motor, kW/K
     g_pmf: N,     // housing <-> main block, kW/K
     g_wm: N,      // winding <-> motor, kW/K
+    k_sw: N,      // swept film at 40 degC, kW/K per sqrt(hrad/s)
     t_scale: N,   // 1 / TEMP_TABLE_STEP_K, 1/K
     inv_stride: N, // 1 / COARSE_STRIDE
     re_q: [N; crate::params::N_DUCTS], // ducts' Re / 1e4 per L/s at 40 degC
+    g_wall: [N; 2], // walls behind the loop's and the ball passage's films, kW/K
     re_lam: N,    // 0.23: Re = 2300, the end of the laminar range, / 1e4
     inv_span: N,  // 1 / 0.77: the transition's width in Re / 1e4
     t_min: N,     // TEMP_TABLE_MIN_C, degC
@@ -137,9 +139,26 @@ struct Consts<N> {
 }
 
 /// The reduced-order model in number type `N` (`f64`, `f32` or [`crate::num::Fx`]).
+///
+/// `repr(C)`, hot fields first: the tick's sums and constants, the states and the
+/// step's scalars sit in the first kilobyte (a Cortex-M4 `vldr` reaches 1020 bytes
+/// from its base; a field past that costs an address computation per load), the
+/// tables after them.
 #[derive(Clone, Copy, Debug)]
+#[repr(C)]
 pub struct Model<N: Num> {
+    sums: Sums<N>,
+    /// The viscous friction coefficient at the case oil of the last step, kW per
+    /// (hrad/s)^2: the tick's estimate of the shaft's friction torque (the sign of
+    /// the shaft power, cross-check) follows the oil's viscosity.
+    k_mv_t: N,
+    /// The leakage flow conductance at the case oil of the last step, L/s per hbar:
+    /// the tick's pump delivery `D w - K (p_A - p_case)` (in hot oil the leakage is
+    /// several times its 40 degC value and takes a tenth of the flow).
+    k_lf_t: N,
+    k: Consts<N>,
     temp: [N::State; N_STATES],
+    phi: [[N::Coef; N_PHI]; N_PHI],
     /// Quasi-steady link temperatures of the last step: inlet, outlet, ball oil, degC.
     links: [N; 3],
     /// Ring rate of the last step, K/s.
@@ -147,21 +166,10 @@ pub struct Model<N: Num> {
     /// Exchanger credit of the past steps, bit k = step k ago.
     lng_hist: u32,
     ambient_c: N,
-    sums: Sums<N>,
-    phi: [[N::Coef; N_PHI]; N_PHI],
-    k: Consts<N>,
-    g_case: [N; N_TABLE],
-    g_port: [N; N_TABLE],
-    g_loop: [N; N_TABLE],
-    g_ball: [N; N_TABLE],
-    g_lng: [N; N_TABLE],
-    g_swept: [N; N_TABLE],
-    g_bore: [N; N_TABLE],
-    /// Temperature tables at the case oil: leakage, viscous friction, gap speed
-    /// factor, swept film ([`ModelConsts::leak_ratio`] ...), point by point.
-    t_tab: [[N; 4]; N_TEMP],
-    /// The ducts' films at Re = 2300 and 1e4 on the coarse temperature grid.
-    g_trans: [[N; 2 * crate::params::N_DUCTS]; crate::params::N_COARSE],
+    /// Outer conductances of [`OUTER_NODES`], kW/K, refreshed one per step.
+    outer_g: [N; N_OUTER],
+    /// The oil's temperature factors ([`Slow`]), refreshed in the same round.
+    slow: Slow<N>,
     last_total_kw: N,
     last_lng_kw: N,
     last_heat_kw: N,
@@ -172,17 +180,30 @@ pub struct Model<N: Num> {
     last_mech_pair_kw: (N, N),
     /// Take the larger of the two mechanical-loss estimates (sensor disagreement).
     loss_max: bool,
-    /// The viscous friction coefficient at the case oil of the last step, kW per
-    /// (hrad/s)^2: the tick's estimate of the shaft's friction torque (the sign of
-    /// the shaft power, cross-check) follows the oil's viscosity.
-    k_mv_t: N,
-    /// The leakage flow conductance at the case oil of the last step, L/s per hbar:
-    /// the tick's pump delivery `D w - K (p_A - p_case)` (in hot oil the leakage is
-    /// several times its 40 degC value and takes a tenth of the flow).
-    k_lf_t: N,
-    /// Outer conductances of [`OUTER_NODES`], kW/K, refreshed one per step.
-    outer_g: [N; N_OUTER],
     outer_phase: u8,
+    g_case: [N; N_TABLE],
+    g_port: [N; N_TABLE],
+    g_loop: [N; N_TABLE],
+    g_ball: [N; N_TABLE],
+    g_lng: [N; N_TABLE],
+    g_bore: [N; N_TABLE],
+    /// The ducts' films at Re = 2300 and 1e4 on the coarse temperature grid.
+    g_trans: [[N; 2 * crate::params::N_DUCTS]; crate::params::N_COARSE],
+    /// Temperature tables at the case oil: leakage, viscous friction, gap speed
+    /// factor, swept film ([`ModelConsts::leak_ratio`] ...), point by point.
+    t_tab: [[N; 4]; N_TEMP],
+}
+
+/// The oil's temperature factors the step uses, refreshed round robin
+/// ([`Model::update`]).
+#[derive(Clone, Copy, Debug)]
+struct Slow<N> {
+    /// At the case oil: leakage, viscous friction, case-gap speed, swept film
+    /// ([`Model::oil_factors`]).
+    case: [N; 4],
+    /// `nu(40) / nu(T)` at the loop oil and at the ball-valve passage's oil
+    /// ([`Model::duct_factors`]).
+    duct: [N; 2],
 }
 
 /// `1/n` for partial model steps of `n` ticks (`[0]` = 0), f64 and rounded to f32.
@@ -276,6 +297,14 @@ impl<N: Num> Model<N> {
         unsafe { Self::init_values_in(m.as_mut_ptr(), c).map(|()| m.assume_init()) }
     }
 
+    /// Recomputes every [`Slow`] factor at the case oil `t_case` and the loop oil
+    /// `t_loop` (start, restore).
+    fn refresh_slow(&mut self, t_case: N, t_loop: N) {
+        self.slow = Slow { case: self.oil_factors(t_case), duct: self.duct_factors(t_loop, None) };
+        self.k_mv_t = self.k.k_mv.mul(self.slow.case[1]);
+        self.k_lf_t = self.k.k_lf.mul(self.slow.case[0]);
+    }
+
     /// Sets every state, the ring links and the ambient to `t_c` (degC): cold start.
     pub fn set_uniform(&mut self, t_c: N) {
         self.ambient_c = t_c;
@@ -285,14 +314,11 @@ impl<N: Num> Model<N> {
         self.links = [t_c; 3];
         self.ring_rate = N::ZERO;
         self.outer_g = self.outer_all(&[t_c; N_STATES], t_c);
+        self.refresh_slow(t_c, t_c);
     }
 
-    /// Sets the contract nodes' temperatures (degC, node order) and the ambient
-    /// from `f32` (warm restore, thermal memory). The states the record does not
-    /// hold are set on the hot side: the internals at the warmer of the case oil
-    /// and the housing they sit between, the motor and its winding at the pump
-    /// housing (a motor colder than that would draw heat from the pump). The ring
-    /// links start at the loop temperature.
+    /// Sets every node's temperature (degC, node order) and the ambient from `f32`
+    /// (warm restore, thermal memory); the ring links start at the loop temperature.
     pub fn set_temperatures(&mut self, temps_c: &[f32; N_NODES], ambient_c: f32) {
         let conv = |x: f32| match N::scale_from_f64(1.0) {
             Some(s) => N::from_f32_scaled(x, s),
@@ -302,18 +328,12 @@ impl<N: Num> Model<N> {
         for (th, t) in self.temp.iter_mut().zip(temps_c.iter()) {
             *th = N::state(conv(*t));
         }
-        let t_pump = temps_c.get(NODE_PUMP).map_or(self.ambient_c, |t| conv(*t));
         let t_case = temps_c.get(NODE_DRAIN).map_or(self.ambient_c, |t| conv(*t));
-        let t_int = if t_case > t_pump { t_case } else { t_pump };
-        for (i, t) in [(NODE_INTERNALS, t_int), (NODE_MOTOR, t_pump), (NODE_WINDING, t_pump)] {
-            if let Some(th) = self.temp.get_mut(i) {
-                *th = N::state(t);
-            }
-        }
         let tl = temps_c.get(NODE_LOOP).map_or(self.ambient_c, |t| conv(*t));
         self.links = [tl; 3];
         self.ring_rate = N::ZERO;
-        self.outer_g = self.outer_all(&self.states_c(), self.ambient_c);
+        self.outer_g = self.outer_all(&self.temperatures_c(), self.ambient_c);
+        self.refresh_slow(t_case, tl);
     }
 
     /// Accumulates one 10 ms tick (losses of eqs. 5-11 and the flows at this tick's
@@ -338,15 +358,18 @@ impl<N: Num> Model<N> {
         let on = lng_ticks.min(ticks);
         let share = inv.mul(k.count.get(on as usize).copied().unwrap_or(k.one));
         let mut m = self.sums.means(inv, &self.k);
-        let t = self.states_c();
-        let f = self.oil_factors(t.get(NODE_DRAIN).copied().unwrap_or(N::ZERO));
+        let t = self.temperatures_c();
+        // the oil's factors at the case oil every step (the viscous friction follows
+        // the viscosity's 4 %/K at 0 degC: the cross-check compares it with the
+        // current within watts)
+        self.slow.case = self.oil_factors(t.get(NODE_DRAIN).copied().unwrap_or(N::ZERO));
+        self.k_mv_t = k.k_mv.mul(self.slow.case[1]);
+        self.k_lf_t = k.k_lf.mul(self.slow.case[0]);
         let from_current = m.shaft_kw.sub(m.hyd_kw);
         // the model's whole pump friction: pressure term plus no-load and viscous
         // (the latter at the case oil's viscosity)
         let aw = m.abs_speed;
-        let speed_kw = aw.mul(k.k_m0).add(m.visc_kw.mul(f[1]));
-        self.k_mv_t = k.k_mv.mul(f[1]);
-        self.k_lf_t = k.k_lf.mul(f[0]);
+        let speed_kw = aw.mul(k.k_m0).add(m.visc_kw.mul(self.slow.case[1]));
         let model_kw = m.mech_kw.add(speed_kw);
         self.last_mech_pair_kw = (model_kw, from_current);
         if self.loss_max && from_current > model_kw {
@@ -355,15 +378,18 @@ impl<N: Num> Model<N> {
         self.sums = Sums::ZERO;
         self.ambient_c = m.ambient;
         self.lng_hist = (self.lng_hist << 1) | u32::from(2 * on >= ticks && on > 0);
-        // One outer surface's conductance is refreshed per step (each every 0.5 s; the
-        // metal temperatures move by millikelvin in that time).
-        let i = self.outer_phase as usize % OUTER_NODES.len();
+        // Slowly varying factors are refreshed round robin, one per step: each outer
+        // surface's conductance and the ducts' Reynolds factors, each every 0.6 s,
+        // in which the metal and loop temperatures move by hundredths of a kelvin.
+        let i = self.outer_phase as usize % (N_OUTER + 1);
         if let (Some(g), Some(n)) = (self.outer_g.get_mut(i), OUTER_NODES.get(i)) {
             let tw = t.get(*n).copied().unwrap_or(m.ambient);
             *g = Self::outer_conductance_of(&self.k, i, tw, m.ambient);
+        } else {
+            self.slow.duct = self.duct_factors(t.get(NODE_LOOP).copied().unwrap_or(N::ZERO), self.links.get(2).copied());
         }
         self.outer_phase = self.outer_phase.wrapping_add(1);
-        let r = self.rhs(&t, &m, &f, self.lng_hist, share, Some(self.links), self.ring_rate, &self.outer_g);
+        let r = self.rhs(&t, &m, &self.slow, self.lng_hist, share, Some(self.links), self.ring_rate, &self.outer_g);
         self.links = r.links;
         self.ring_rate = r.ring_rate;
         self.last_total_kw = r.total_kw;
@@ -400,7 +426,8 @@ impl<N: Num> Model<N> {
         let m = sums.means(self.k.one, &self.k);
         let share = if lng_open { self.k.one } else { N::ZERO };
         let og = self.outer_all(t, m.ambient);
-        self.rhs(t, &m, &f, u32::from(lng_open), share, None, N::ZERO, &og).rates
+        let slow = Slow { case: f, duct: self.duct_factors(t.get(NODE_LOOP).copied().unwrap_or(N::ZERO), None) };
+        self.rhs(t, &m, &slow, u32::from(lng_open), share, None, N::ZERO, &og).rates
     }
 
     /// Advances one model step with every tick at the same inputs (tests, tools).
@@ -415,19 +442,9 @@ impl<N: Num> Model<N> {
         self.temp.get(NODE_DRAIN).map_or(N::ZERO, |s| N::value(*s))
     }
 
-    /// The contract nodes' temperatures, degC, in node order.
+    /// All node temperatures, degC, in node order.
     pub fn temperatures_c(&self) -> [N; N_NODES] {
         let mut t = [N::ZERO; N_NODES];
-        for (o, th) in t.iter_mut().zip(self.temp.iter()) {
-            *o = N::value(*th);
-        }
-        t
-    }
-
-    /// Every state's temperature, degC, in state order (the contract nodes, then
-    /// the pump's internals, the motor housing and the winding).
-    pub fn states_c(&self) -> [N; N_STATES] {
-        let mut t = [N::ZERO; N_STATES];
         for (o, th) in t.iter_mut().zip(self.temp.iter()) {
             *o = N::value(*th);
         }

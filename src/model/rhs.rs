@@ -26,11 +26,11 @@ impl<N: Num> Model<N> {
     // check ([`Model::derivative`]); the call costs a few instructions per step.
     #[inline(never)]
     #[allow(clippy::too_many_arguments)]
-    pub(super) fn rhs(&self, t: &[N; N_STATES], m: &Sums<N>, f: &[N; 4], hist: u32, share: N, links: Option<[N; 3]>, rate: N, outer_g: &[N; N_OUTER]) -> Rhs<N> {
+    pub(super) fn rhs(&self, t: &[N; N_STATES], m: &Sums<N>, slow: &Slow<N>, hist: u32, share: N, links: Option<[N; 3]>, rate: N, outer_g: &[N; N_OUTER]) -> Rhs<N> {
         let k = &self.k;
         let amb = m.ambient;
         let [t_p, t_c, t_l, t_mb, t_bb, t_a, t_i, t_m, t_w] = *t;
-        let [r_leak, r_visc, r_tc, r_swept] = *f;
+        let [r_leak, r_visc, r_tc, r_swept] = slow.case;
         let leak_kw = m.leak_kw.mul(r_leak);
         let leak_lps = m.leak_lps.mul(r_leak);
         let aq = m.abs_pump_lps;
@@ -54,13 +54,13 @@ impl<N: Num> Model<N> {
         let expand_kw = at_l.mul(m.hyd_kw.sub(leak_kw).sub(m.line_kw).sub(m.needle_kw));
         // conductances of eqs. (12)-(14), (20)-(22) at this step's flows
         let at_q = table::locate(aq, k.q_scale, k.one);
-        let at_w = table::locate(aw, k.w_scale, k.one);
         // the case gap (Taylor-Couette): its Nusselt number depends on the Taylor
         // number (w / nu)^2 only, so the 40 degC table is read at w nu(40)/nu(T);
         // its k(T) by the slope
         let at_tc = table::locate(aw.mul(r_tc), k.w_scale, k.one);
         let g_case = table::value(&self.g_case, &at_tc).mul(k.one.add(k.g_case_slope.mul(t_c.sub(k.t_film))));
-        let g_ic = g_case.mul(k.barrel_ratio).add(table::value(&self.g_swept, &at_w).mul(r_swept));
+        // the swept slippers and shanks: a laminar flat plate, Nu ∝ Re^(1/2) (∝ sqrt |w|)
+        let g_ic = g_case.mul(k.barrel_ratio).add(k.k_sw.mul(aw.sqrt_abs()).mul(r_swept));
         // (the bores' flow is the pump's displaced flow; |q_p| differs from it by the
         // leakage, ≈ 1 %, and the laminar film goes with its cube root)
         let g_bore = table::value(&self.g_bore, &at_q);
@@ -73,20 +73,23 @@ impl<N: Num> Model<N> {
         // oil of the last step (the needle's throttling warms it ≈ 3 K above the loop
         // at 60 bar: 10 % on its Re)
         let mut g_duct = [table::value(&self.g_port, &at_q), table::value(&self.g_loop, &at_q), table::value(&self.g_ball, &at_q)];
-        let u_l = t_l.sub(k.t_min).mul(k.t_scale);
-        let u_b = links.map_or(t_l, |l| l[2]).sub(k.t_min).mul(k.t_scale);
-        let s_l = table::value_col(&self.t_tab, &table::locate_uniform::<N, N_TEMP>(u_l, k.one), 2);
-        let s_b = table::value_col(&self.t_tab, &table::locate_uniform::<N, N_TEMP>(u_b, k.one), 2);
+        let [s_l, s_b] = slow.duct;
         let [rq_p, rq_l, rq_b] = k.re_q;
         let re = [rq_p.mul(aq).mul(s_l), rq_l.mul(aq).mul(s_l), rq_b.mul(aq).mul(s_b)];
         if re.iter().any(|r| *r > k.re_lam) {
+            let u_l = t_l.sub(k.t_min).mul(k.t_scale);
             let ab = table::values(&self.g_trans, &table::locate_uniform::<N, { crate::params::N_COARSE }>(u_l.mul(k.inv_stride), k.one));
             for (d, (g, r)) in g_duct.iter_mut().zip(re.iter()).enumerate() {
                 if *r > k.re_lam {
                     let gam = r.sub(k.re_lam).mul(k.inv_span);
                     let gam = if gam > k.one { k.one } else { gam };
                     if let (Some(a), Some(b)) = (ab.get(2 * d), ab.get(2 * d + 1)) {
-                        let blend = a.add(gam.mul(b.sub(*a)));
+                        let film = a.add(gam.mul(b.sub(*a)));
+                        // the loop's and the ball passage's film in series with their block wall
+                        let blend = match k.g_wall.get(d.wrapping_sub(1)) {
+                            Some(w) => film.mul(*w).div_pos(film.add(*w)),
+                            None => film,
+                        };
                         if blend > *g {
                             *g = blend;
                         }
@@ -252,6 +255,15 @@ impl<N: Num> Model<N> {
             outer_kw: o_p.add(o_mb).add(o_bb).add(o_a).add(o_m),
             losses_kw: [m.copper_kw, iron, leak_kw, mech_kw, m.line_kw.add(m.needle_kw), m.act_kw],
         }
+    }
+
+    /// The ducts' Reynolds factors `nu(40) / nu(T)` at the loop oil `t_loop` and at
+    /// the ball-valve passage's oil `t_ball` (the loop's when `None`).
+    #[inline(always)]
+    pub(super) fn duct_factors(&self, t_loop: N, t_ball: Option<N>) -> [N; 2] {
+        let k = &self.k;
+        let s = |t: N| table::value_col(&self.t_tab, &table::locate_uniform::<N, N_TEMP>(t.sub(k.t_min).mul(k.t_scale), k.one), 2);
+        [s(t_loop), s(t_ball.unwrap_or(t_loop))]
     }
 
     /// The oil's factors at the case oil `t_c` (the pump's films): leakage

@@ -54,6 +54,7 @@ fn consistent_sensors_never_disagree() {
         let (mut sp, mut si, mut n) = (0.0f64, 0.0f64, 0u32);
         for k in 0..60_000u32 {
             let o = g.tick(&mission(k));
+            crate::plant::follow(&g);
             assert!(!o.faults.intersects(faults::LATCHED), "{name} tick {k}: {o:?}");
             let m = g.model().unwrap();
             if m.pending_ticks() == 0 {
@@ -77,7 +78,13 @@ fn consistent_sensors_never_disagree() {
 
 /// Runs `ticks` of `s(k)` and returns the outputs.
 fn run(g: &mut GuardOf<f32>, ticks: u32, s: impl Fn(u32) -> Sample) -> Vec<Output> {
-    (0..ticks).map(|k| g.tick(&s(k))).collect()
+    (0..ticks)
+        .map(|k| {
+            let o = g.tick(&s(k));
+            crate::plant::follow(g);
+            o
+        })
+        .collect()
 }
 
 fn latched_at(out: &[Output]) -> Option<usize> {
@@ -139,7 +146,9 @@ fn while_disagreeing_the_model_heats_with_the_larger_loss() {
     let mut first_max = None;
     for k in 0..6000u32 {
         g.tick(&s(k));
+        crate::plant::follow(&g);
         off.tick(&s(k));
+        crate::plant::follow(&off);
         let m = g.model().unwrap();
         if m.pending_ticks() == 0 && k > window() {
             let (lp, li) = m.last_mech_pair_kw();

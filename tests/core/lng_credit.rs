@@ -30,7 +30,7 @@ fn input<N: Num>(p_a_bar: f64, rpm: f64) -> ModelInputN<N> {
 /// after the stop: (pump flow L/s, LNG credit kW, links, nodes).
 fn stop_with_valve_open<N: Num>() -> Vec<(f64, f64, [f64; 3], [f64; 6])> {
     let mut m = Model::<N>::new(&DEFAULT).expect("model");
-    m.set_temperatures(&[18.1, 38.7, 19.8, 17.2, 16.7, 16.0], 20.0);
+    m.set_temperatures(&[18.1, 38.7, 19.8, 17.2, 16.7, 16.0, 40.0, 17.0, 19.0], 20.0);
     for _ in 0..100 {
         m.step(&input::<N>(65.0, 500.0), true);
     }
@@ -83,7 +83,7 @@ fn load() -> Sample {
 /// Warm restore at 45 degC (the valve opens at the first sample), `used_cj` of the
 /// LNG charge already used.
 fn warm45(cfg: &GuardConfig, used_cj: u32) -> GuardOf<f32> {
-    let rec = ThermalRecord::new([45.0; 6], 20.0, used_cj, 0, 1);
+    let rec = ThermalRecord::new([45.0; eha_guard::params::N_NODES], 20.0, used_cj, 0, 1);
     GuardOf::<f32>::new(cfg, Restore::from_record(&rec))
 }
 
@@ -107,6 +107,7 @@ fn no_credit_while_the_lng_budget_is_empty() {
     let mut first_credit = None;
     for k in 0..3000u32 {
         let o = g.tick(&load());
+        crate::plant::follow(&g);
         assert!(o.valve_open, "tick {k}: {o:?}");
         if let Some(c) = credit_kw(&g) {
             first_credit.get_or_insert(c);
@@ -129,6 +130,7 @@ fn no_credit_while_the_lng_budget_is_empty() {
     assert!(LngBudget::new(&LngConfig::DEFAULT).remaining_j() < u32::MAX as f32 * 0.01);
     for k in 0..500u32 {
         g.tick(&load());
+        crate::plant::follow(&g);
         if let Some(c) = credit_kw(&g) {
             assert_eq!(c, 0.0, "tick {k}: credited with the LNG used up");
         }
@@ -136,6 +138,7 @@ fn no_credit_while_the_lng_budget_is_empty() {
     g.refill_lng(&LngConfig::DEFAULT);
     for _ in 0..10 {
         g.tick(&load());
+        crate::plant::follow(&g);
     }
     assert!(credit_kw(&g).unwrap() > 1.0);
 }
@@ -150,6 +153,7 @@ fn with_feedback(g: &mut GuardOf<f32>, ticks: u32, fb: impl Fn(u32, bool) -> Opt
             g.valve_feedback(v);
         }
         let o = g.tick(&load());
+        crate::plant::follow(&g);
         commanded = o.valve_open;
         out.push(o);
     }
@@ -170,6 +174,7 @@ fn valve_reported_shut_while_commanded_open_gets_no_credit_and_latches_actuator_
     for k in 0..400u32 {
         g.valve_feedback(false);
         let o = g.tick(&load());
+        crate::plant::follow(&g);
         assert!(o.valve_open, "tick {k}: {o:?}");
         if let Some(c) = credit_kw(&g) {
             assert_eq!(c, 0.0, "tick {k}: {c} kW credited with the valve reported shut");

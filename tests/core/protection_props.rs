@@ -4,7 +4,7 @@
 //! latching and the clear rule, thermal-memory CRC, LNG arithmetic.
 
 use eha_guard::faults;
-use eha_guard::memory::{RecordStatus, Restore, ThermalRecord};
+use eha_guard::memory::{RecordStatus, Restore, ThermalRecord, RECORD_BYTES};
 use eha_guard::num::Fx;
 use eha_guard::protection::{LngBudget, LngConfig, Valve, ValveConfig};
 use eha_guard::validate::InputLimits;
@@ -255,6 +255,12 @@ fn run_valid<N: eha_guard::num::Num>(ticks: &[(Tick, Option<Fault>)], clear_ever
     // successful clear: valid, rate-limited input never latches anything.
     let mut may_latch = false;
     let mut missing_run = 0u32;
+    let mut prev_current: Option<f32> = None;
+    let mut cold_until = 0usize;
+    // the plant's oil starts at the air, as the model does
+    if let Some(Tick::Sample(s)) = ticks.iter().map(|t| t.0).find(|t| matches!(t, Tick::Sample(_))) {
+        crate::plant::set_case_oil(s.ambient_c);
+    }
     for (k, (t, f)) in ticks.iter().enumerate() {
         if let Some(p) = clear_every {
             if k > 0 && (k as u32).is_multiple_of(p) && g.clear_faults() {
@@ -265,7 +271,34 @@ fn run_valid<N: eha_guard::num::Num>(ticks: &[(Tick, Option<Fault>)], clear_ever
         let o = match t {
             Tick::Sample(s) => {
                 missing_run = 0;
-                g.tick(s)
+                // a valid sample's current follows the plant's oil (its viscous
+                // friction), as the generator's note above says
+                let mut s = *s;
+                let current_faulted = matches!(f, Some(Fault::NonFinite { ch: 0, .. } | Fault::Range { ch: 0, .. } | Fault::Rate { ch: 0, .. }));
+                if !current_faulted {
+                    let i = crate::plant::motor_current(s.p_a_bar, s.p_b_bar, s.speed_rpm);
+                    // in oil colder than the model's range (the viscous friction held at
+                    // its -20 degC value) a fast shaft would need more current than the
+                    // sensor reads: the drive limits it, the sensors disagree
+                    // (and its change per tick can pass the rate limit when the speed's
+                    // sign flips)
+                    let max = 0.99 * cfg.limits.current_a_max;
+                    let i = i.clamp(-max, max);
+                    // (and below the oil's validity the cross-check may disagree: the
+                    // plant's laws stop holding there, docs/reduction.md)
+                    if crate::plant::case_oil_c() < crate::plant::COLDEST_VALID_C {
+                        // the cross-check remembers its windows: inconsistent for as long
+                        cold_until = k + (cfg.crosscheck.persist_windows + 1) as usize * cfg.crosscheck.window_ticks as usize;
+                    }
+                    if k < cold_until || i.abs() >= max || prev_current.is_some_and(|p: f32| (i - p).abs() > cfg.limits.current_a_per_tick) {
+                        may_latch = true;
+                    }
+                    s.current_a = i;
+                }
+                prev_current = Some(s.current_a).filter(|c| c.is_finite());
+                let o = g.tick(&s);
+                crate::plant::follow(&g);
+                o
             }
             Tick::Missing => {
                 missing_run += 1;
@@ -357,6 +390,7 @@ proptest! {
         let mut g = GuardOf::<f32>::new(&GuardConfig::DEFAULT, Restore::Cold);
         for _ in 0..warm {
             let o = g.tick(&nominal());
+            crate::plant::follow(&g);
             prop_assert!(!o.valve_open && o.faults.is_empty(), "nominal must be quiet: {:?}", o);
         }
         let mut s = nominal();
@@ -365,6 +399,7 @@ proptest! {
             3 => s.speed_rpm = bad, 4 => s.position_mm = bad, _ => s.ambient_c = bad,
         }
         let o = g.tick(&s);
+        crate::plant::follow(&g);
         prop_assert!(o.valve_open, "valve must open in the faulting step");
         let class = if bad.is_finite() { faults::RANGE } else { faults::NON_FINITE };
         prop_assert!(o.faults.intersects(class), "fault bits {:#x}", o.faults);
@@ -377,6 +412,7 @@ proptest! {
         let mut g = GuardOf::<f32>::new(&cfg, Restore::Cold);
         for _ in 0..warm {
             g.tick(&nominal());
+            crate::plant::follow(&g);
         }
         for k in 1..=cfg.stale_ticks {
             let o = g.tick_missing();
@@ -427,23 +463,27 @@ proptest! {
         let cfg = GuardConfig::DEFAULT;
         let mut g = GuardOf::<f32>::new(&cfg, Restore::Cold);
         g.tick(&nominal());
+        crate::plant::follow(&g);
         let mut s = nominal();
         s.p_a_bar = f32::NAN;
         g.tick(&s);
+        crate::plant::follow(&g);
         for _ in 0..valid_after {
             let o = g.tick(&nominal());
+            crate::plant::follow(&g);
             prop_assert!(o.valve_open && o.faults.intersects(faults::NON_FINITE), "fault must stay latched");
         }
         let cleared = g.clear_faults();
         prop_assert_eq!(cleared, valid_after >= cfg.clear_valid_ticks, "clear rule: {} valid steps", valid_after);
         let o = g.tick(&nominal());
+        crate::plant::follow(&g);
         prop_assert_eq!(!o.faults.intersects(faults::LATCHED), cleared);
     }
 
     #[test]
     fn record_roundtrip_and_single_bit_corruption(
-        temps in proptest::array::uniform6(-40.0f32..200.0), amb in -40.0f32..80.0,
-        used in any::<u32>(), faults_w in any::<u16>(), step in any::<u32>(), bit in 0usize..(56 * 8),
+        temps in proptest::array::uniform9(-40.0f32..200.0), amb in -40.0f32..80.0,
+        used in any::<u32>(), faults_w in any::<u16>(), step in any::<u32>(), bit in 0usize..(RECORD_BYTES * 8),
     ) {
         let r = ThermalRecord::new(temps, amb, used, faults_w, step);
         prop_assert_eq!(r.classify(), RecordStatus::Valid);
@@ -451,16 +491,16 @@ proptest! {
         let mut b = bytes;
         b[bit / 8] ^= 1 << (bit % 8);
         let c = record_from_bytes(&b);
-        // Padding-free layout: bytes 44..48 are `seq_flags`, 48..52 the RTC stamp, 52..56 the CRC; every bit counts.
+        // Padding-free layout: bytes 56..60 are `seq_flags`, 60..64 the RTC stamp, 64..68 the CRC; every bit counts.
         prop_assert_eq!(c.classify(), RecordStatus::Corrupt, "flip of bit {} undetected", bit);
     }
 }
 
-fn record_bytes(r: &ThermalRecord) -> [u8; 56] {
+fn record_bytes(r: &ThermalRecord) -> [u8; RECORD_BYTES] {
     r.to_le_bytes()
 }
 
-fn record_from_bytes(b: &[u8; 56]) -> ThermalRecord {
+fn record_from_bytes(b: &[u8; RECORD_BYTES]) -> ThermalRecord {
     ThermalRecord::from_le_bytes(b)
 }
 
@@ -470,6 +510,7 @@ fn boot_rules_cold_warm_corrupt() {
     // Cold: starts at the first ambient sample (16 degC), valve closed.
     let mut g = GuardOf::<f32>::new(&cfg, Restore::from_record(&ThermalRecord::EMPTY));
     let o = g.tick(&nominal());
+    crate::plant::follow(&g);
     assert!(
         (o.drain_c - 16.0).abs() < 0.01 && !o.valve_open,
         "cold: {o:?}"
@@ -479,7 +520,7 @@ fn boot_rules_cold_warm_corrupt() {
     assert!((o.drain_c - 16.0).abs() <= ulp32(16.0), "cold: {o:?}");
     // Warm: 45 degC record restored although the ambient is 16 degC → valve opens.
     let rec = ThermalRecord::new(
-        [50.0, 45.0, 46.0, 44.0, 30.0, 45.0],
+        [50.0, 45.0, 46.0, 44.0, 30.0, 45.0, 52.0, 35.0, 38.0],
         20.0,
         1_000_000,
         0,
@@ -487,6 +528,7 @@ fn boot_rules_cold_warm_corrupt() {
     );
     let mut g = GuardOf::<f32>::new(&cfg, Restore::from_record(&rec));
     let o = g.tick(&nominal());
+    crate::plant::follow(&g);
     assert!(
         (o.drain_c - 45.0).abs() < 0.05 && o.valve_open && o.faults.is_empty(),
         "warm: {o:?}"
@@ -512,6 +554,7 @@ fn boot_rules_cold_warm_corrupt() {
     assert_eq!(bad.classify(), RecordStatus::Corrupt);
     let mut g = GuardOf::<f32>::new(&cfg, Restore::from_record(&bad));
     let o = g.tick(&nominal());
+    crate::plant::follow(&g);
     assert!(
         (o.drain_c - 60.0).abs() < 0.05 && o.valve_open,
         "corrupt: {o:?}"
@@ -583,6 +626,7 @@ fn case1_60bar_opens_valve_by_temperature() {
     let mut o = Output::default();
     for k in 0..360_000 {
         o = g.tick(&nominal());
+        crate::plant::follow(&g);
         if o.valve_open && opened.is_none() {
             opened = Some(k);
         }
@@ -632,6 +676,7 @@ fn stale_input_integrates_worst_case_loss() {
     let mut g = GuardOf::<f64>::new(&cfg, Restore::Cold);
     for _ in 0..100 {
         g.tick(&nominal());
+        crate::plant::follow(&g);
     }
     let mut nominal_g = g.clone();
     for _ in 0..cfg.stale_ticks {
@@ -681,6 +726,7 @@ fn stale_input_integrates_worst_case_loss() {
     for _ in 0..500 {
         o = g.tick_missing();
         n = nominal_g.tick(&nominal());
+        crate::plant::follow(&nominal_g);
     }
     println!(
         "5 s after STALE: fail-safe drain {:.4} degC, nominal {:.4} degC (from {:.4})",
@@ -701,19 +747,23 @@ fn guard_dwell_qualifies_the_closing_at_the_model_step() {
     // protection failure"; before, the dwell also delayed openings): an opening is
     // never delayed (estimate above the threshold at a model step => valve open in
     // that tick); a closing comes only after 20 consecutive model steps below the
-    // closing threshold, so every open period lasts at least 2 s. A narrow band just
-    // above the ambient and alternating load / idle make the estimate cross it often.
+    // closing threshold, so every open period lasts at least 2 s. A narrow band at
+    // 40 degC, a warm start just below it (39.5 degC) and 10 s of load, 10 s of idle
+    // make the estimate cross it often: warm oil leaks enough for the exchanger's
+    // cooling of the ring to reach the drain (near the air, the pump's internals,
+    // which the friction heats, hold the drain up and the valve never closes).
     let mut cfg = GuardConfig::DEFAULT;
-    cfg.valve.open_c = 16.3;
-    cfg.valve.close_c = 16.25;
+    cfg.valve.open_c = 40.0;
+    cfg.valve.close_c = 39.95;
     let dwell = cfg.valve.dwell_ticks / eha_guard::params::TICKS_PER_STEP;
-    let mut g = GuardOf::<f32>::new(&cfg, Restore::Cold);
-    let load = nominal();
-    let idle = Sample { current_a: crate::plant::motor_current(5.0, 5.0, 500.0), p_a_bar: 5.0, p_b_bar: 5.0, speed_rpm: 500.0, ..nominal() };
+    let warm = ThermalRecord::new([39.5; eha_guard::params::N_NODES], 16.0, 0, 0, 0);
+    let mut g = GuardOf::<f32>::new(&cfg, Restore::from_record(&warm));
+    let idle = || Sample { current_a: crate::plant::motor_current(5.0, 5.0, 500.0), p_a_bar: 5.0, p_b_bar: 5.0, speed_rpm: 500.0, ..nominal() };
     let mut below_run = 0u32;
     let mut was_open = false;
     for k in 0..20_000u32 {
-        let o = g.tick(if (k / 150) % 2 == 0 { &load } else { &idle });
+        let o = g.tick(&if (k / 1000) % 2 == 0 { nominal() } else { idle() });
+        crate::plant::follow(&g);
         assert!(!o.faults.intersects(faults::LATCHED));
         let m = g.model().unwrap();
         if m.pending_ticks() == 0 {

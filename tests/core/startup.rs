@@ -36,6 +36,7 @@ fn missing_tick_at_boot_does_not_start_the_model_at_0_degc() {
         let mut o = o;
         for _ in 0..12 {
             o = g.tick(&idle30());
+            crate::plant::follow(&g);
         }
         assert_eq!(o.faults, eha_guard::Faults::NONE, "{o:?}");
         assert!(!o.valve_open, "{o:?}");
@@ -68,6 +69,7 @@ fn guard_waits_for_the_first_sample_valve_open_no_stale() {
         assert_eq!(g.model().unwrap().pending_ticks(), 0, "tick {k}: the model accumulated a tick while waiting");
     }
     let o = g.tick(&idle30());
+    crate::plant::follow(&g);
     assert_eq!(o.faults, eha_guard::Faults::NONE, "{o:?}");
     assert!(!o.valve_open, "the valve closes at the first sample of a cold start: {o:?}");
     assert_eq!(o.drain_c, 30.0, "cold start at the first sample's ambient");
@@ -99,6 +101,7 @@ fn stale_after_the_startup_timeout_without_any_sample() {
     }
     assert!(g.trace().iter().any(|e| matches!(e, Trace::Fault { tick: 999, new_bits } if new_bits.intersects(faults::STALE))));
     let o = g.tick(&idle30());
+    crate::plant::follow(&g);
     assert!(o.valve_open && o.faults.intersects(faults::STALE), "{o:?}");
     // The model starts at the sample's own (valid) ambient, not at the worst case
     // that STALE substitutes from then on.
@@ -119,7 +122,7 @@ fn warm_restore_waits_and_starts_from_the_record() {
     // at the first sample the model starts from the record, not from the ambient, and
     // no STALE is latched. Before: STALE latched at the 5th tick (and a warm reset
     // would restore it from the record the firmware saves).
-    let rec = ThermalRecord::new([50.0, 45.0, 46.0, 44.0, 30.0, 45.0], 20.0, 0, 0, 123);
+    let rec = ThermalRecord::new([50.0, 45.0, 46.0, 44.0, 30.0, 45.0, 52.0, 35.0, 38.0], 20.0, 0, 0, 123);
     let mut g = GuardOf::<f32>::new(&GuardConfig::DEFAULT, Restore::from_record(&rec));
     for k in 0..200 {
         let o = g.tick_missing();
@@ -127,6 +130,7 @@ fn warm_restore_waits_and_starts_from_the_record() {
         assert_eq!(o.drain_c, 45.0, "tick {k}: the restored estimate");
     }
     let o = g.tick(&idle30());
+    crate::plant::follow(&g);
     assert!(o.valve_open && o.faults.is_empty(), "{o:?}");
     assert_eq!(o.drain_c, 45.0, "{o:?}");
     let snap = g.snapshot();

@@ -19,7 +19,7 @@ fn idle() -> Sample {
 }
 
 fn corrupt_record() -> ThermalRecord {
-    let mut r = ThermalRecord::new([40.0; 6], 20.0, 0, 0, 7);
+    let mut r = ThermalRecord::new([40.0; eha_guard::params::N_NODES], 20.0, 0, 0, 7);
     r.crc ^= 1;
     assert_eq!(r.classify(), RecordStatus::Corrupt);
     r
@@ -39,7 +39,7 @@ fn corrupt_record_raises_alarm_and_derate_until_a_clear() {
         let mut g = GuardOf::<N>::new(&cfg, Restore::from_record(&corrupt_record()));
         // The same temperatures from a valid record: a trusted estimate, whose alarm
         // follows the 60/58 degC relay.
-        let rec = ThermalRecord::new([60.0; 6], 60.0, 0, 0, 7);
+        let rec = ThermalRecord::new([60.0; eha_guard::params::N_NODES], 60.0, 0, 0, 7);
         let mut trusted = GuardOf::<N>::new(&cfg, Restore::from_record(&rec));
         let o = g.output();
         assert!(held(&o) && o.valve_open && o.faults.intersects(faults::MEMORY_CORRUPT), "at boot: {o:?}");
@@ -50,6 +50,7 @@ fn corrupt_record_raises_alarm_and_derate_until_a_clear() {
         let mut trusted_off = 0;
         for k in 0..60_000 {
             o = g.tick(&idle());
+            crate::plant::follow(&g);
             assert!(held(&o), "tick {k}: {o:?}");
             trusted_off += u32::from(!trusted.tick(&idle()).alarm);
         }
@@ -66,6 +67,7 @@ fn corrupt_record_raises_alarm_and_derate_until_a_clear() {
         let mut cleared = false;
         for k in 0..60_000u32 {
             let o = g.tick(&idle());
+            crate::plant::follow(&g);
             let m = g.model().unwrap();
             if m.pending_ticks() == 0 {
                 // The relay on the estimate (it was on at the clear: off only below 58).
@@ -90,6 +92,7 @@ fn a_rejected_clear_keeps_the_alarm() {
     let mut g = GuardOf::<f32>::new(&GuardConfig::DEFAULT, Restore::from_record(&corrupt_record()));
     for _ in 0..50 {
         g.tick(&idle());
+        crate::plant::follow(&g);
     }
     // 50 valid samples < clear_valid_ticks (100): the clear is refused.
     assert!(!g.clear_faults());
@@ -108,6 +111,7 @@ fn no_sample_by_the_startup_timeout_raises_alarm_and_derate() {
     }
     for k in 0..200 {
         let o = g.tick(&idle());
+        crate::plant::follow(&g);
         assert!(held(&o) && o.faults.intersects(faults::STALE), "tick {k}: {o:?}");
     }
     assert!(g.clear_faults());
@@ -121,6 +125,7 @@ fn untrusted_survives_a_warm_reset() {
     let mut g = GuardOf::<f32>::new(&GuardConfig::DEFAULT, Restore::from_record(&corrupt_record()));
     for _ in 0..1000 {
         g.tick(&idle());
+        crate::plant::follow(&g);
     }
     let rec = g.snapshot();
     assert_eq!(rec.classify(), RecordStatus::Valid);
@@ -128,7 +133,7 @@ fn untrusted_survives_a_warm_reset() {
     assert!(held(&g2.output()), "{:?}", g2.output());
     assert!(held(&g2.tick(&idle())));
     // A normal warm record is trusted.
-    let rec = ThermalRecord::new([30.0; 6], 20.0, 0, 0, 1);
+    let rec = ThermalRecord::new([30.0; eha_guard::params::N_NODES], 20.0, 0, 0, 1);
     let g3 = GuardOf::<f32>::new(&GuardConfig::DEFAULT, Restore::from_record(&rec));
     assert!(!g3.output().alarm && g3.output().faults.is_empty(), "{:?}", g3.output());
 }

@@ -119,7 +119,8 @@ pub fn reduce_without_jacobian(rig: &Rig) -> ReducedParams {
     let barrel = 2.0 * PI * p.rotor_radius_m * p.barrel_length_m;
     let barrel_ratio = barrel / p.case_inner_area_m2;
     let swept = |w: f64, t: f64| network::internals_case_film_w_per_k(rig, w, t, oil.nu_m2_per_s(t)) - network::case_gap_h(rig, w, t, oil.nu_m2_per_s(t)) * barrel * rig.nuisance.inner_scale;
-    let g_swept = table(w_max, |w| swept(w, t40));
+    // Nu = 0.664 Re^(1/2) Pr^(1/3): exactly sqrt(w) at one temperature
+    let swept_root = swept(w_nom, t40) / w_nom.sqrt();
     // the swept film's temperature factor (nu^-1/6, Pr^1/3, k: one law at every speed)
     let swept_ratio = temp_table(|t| swept(w_nom, t) / swept(w_nom, t40));
     let g_port = table(q_max, |q| duct(q, p.port_d_m, p.port_len_m, p.port_area_scale));
@@ -135,7 +136,10 @@ pub fn reduce_without_jacobian(rig: &Rig) -> ReducedParams {
         (b.ball_d_m, b.ball_len_m, 1.0, Some(b.ball_area_m2)),
     ];
     let re_per_flow = ducts.map(|(dd, _, _, _)| 4.0 / (PI * dd * nu) / 1e4);
-    let wall = |g: f64, block: Option<f64>| block.map_or(g, |area| network::block_path(rig, g, area));
+    // the films alone: the firmware blends them and puts the block wall in series after
+    let wall = |g: f64, _block: Option<f64>| g;
+    let wall_of = |area: f64| heat::g_plane_wall(b.steel_k, (area / 6.0).sqrt(), b.wall_m);
+    let duct_wall_w_per_k = [wall_of(b.main_area_m2), wall_of(b.ball_area_m2)];
     let coarse = |f: &dyn Fn(f64) -> f64| {
         let mut t = [0.0; N_COARSE];
         for (j, v) in t.iter_mut().enumerate() {
@@ -226,7 +230,7 @@ pub fn reduce_without_jacobian(rig: &Rig) -> ReducedParams {
         flow_table_max_m3_per_s: q_max,
         g_case_w_per_k: g_case,
         barrel_case_ratio: barrel_ratio,
-        g_swept_w_per_k: g_swept,
+        swept_w_per_k_root: swept_root,
         g_bore_w_per_k: g_bore,
         seats_w_per_k: p.seats.conductance_w_per_k(),
         pump_motor_w_per_k: rig.joints.pump_motor.conductance_w_per_k(),
@@ -240,6 +244,7 @@ pub fn reduce_without_jacobian(rig: &Rig) -> ReducedParams {
         tc_speed_ratio,
         swept_ratio,
         re_per_flow,
+        duct_wall_w_per_k,
         g_port_re2300_w_per_k: re2300(0),
         g_port_re1e4_w_per_k: re1e4(0),
         g_loop_re2300_w_per_k: re2300(1),
@@ -449,7 +454,7 @@ fn row(r: &[f64]) -> String {
 
 /// The scalar fields of `p` by name, in `DEFAULT`'s order (the renderer writes
 /// them; the acceptance test compares them with the reduction).
-pub fn scalar_fields(p: &ReducedParams) -> [(&'static str, f64); 43] {
+pub fn scalar_fields(p: &ReducedParams) -> [(&'static str, f64); 44] {
     [
         ("pump_j_per_k", p.pump_j_per_k),
         ("main_block_j_per_k", p.main_block_j_per_k),
@@ -486,6 +491,7 @@ pub fn scalar_fields(p: &ReducedParams) -> [(&'static str, f64); 43] {
         ("speed_table_max_rad_s", p.speed_table_max_rad_s),
         ("flow_table_max_m3_per_s", p.flow_table_max_m3_per_s),
         ("barrel_case_ratio", p.barrel_case_ratio),
+        ("swept_w_per_k_root", p.swept_w_per_k_root),
         ("seats_w_per_k", p.seats_w_per_k),
         ("pump_motor_w_per_k", p.pump_motor_w_per_k),
         ("pump_manifold_w_per_k", p.pump_manifold_w_per_k),
@@ -501,13 +507,13 @@ pub fn scalar_fields(p: &ReducedParams) -> [(&'static str, f64); 43] {
 pub fn array_fields(p: &ReducedParams) -> [(&'static str, &[f64]); 21] {
     [
         ("g_case_w_per_k", &p.g_case_w_per_k),
-        ("g_swept_w_per_k", &p.g_swept_w_per_k),
         ("g_bore_w_per_k", &p.g_bore_w_per_k),
         ("leak_ratio", &p.leak_ratio),
         ("visc_ratio", &p.visc_ratio),
         ("tc_speed_ratio", &p.tc_speed_ratio),
         ("swept_ratio", &p.swept_ratio),
         ("re_per_flow", &p.re_per_flow),
+        ("duct_wall_w_per_k", &p.duct_wall_w_per_k),
         ("g_port_re2300_w_per_k", &p.g_port_re2300_w_per_k),
         ("g_port_re1e4_w_per_k", &p.g_port_re1e4_w_per_k),
         ("g_loop_re2300_w_per_k", &p.g_loop_re2300_w_per_k),
