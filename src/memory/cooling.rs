@@ -70,7 +70,7 @@ mod tests {
     /// No time off: every node at least its saved temperature, none above the hottest.
     #[test]
     fn zero_off_time_keeps_the_state_or_raises_it() {
-        let t = [45.0, 52.0, 48.0, 41.0, 39.0, 30.0, 50.0, 25.0, 28.0];
+        let t = [45.0, 52.0, 48.0, 41.0, 39.0, 30.0];
         let out = bound().cool(&t, 20.0, 0);
         for (o, s) in out.iter().zip(t.iter()) {
             assert!(*o >= *s - 1e-4 && *o <= 52.0 + 1e-4, "{out:?}");

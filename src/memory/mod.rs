@@ -33,15 +33,13 @@ use crate::params::N_NODES;
 
 /// Record magic: "EHAT".
 pub const MAGIC: u32 = 0x4548_4154;
-/// Record layout version. 5: the nine nodes of the reduced model (the pump's
-/// internals, the motor housing and its winding after the six; 68 bytes).
-/// 4: the RTC time of the write ([`ThermalRecord::rtc_s`]).
+/// Record layout version. 4: the RTC time of the write ([`ThermalRecord::rtc_s`]).
 /// 3: the former reserved word holds the sequence
 /// number and the valve state ([`ThermalRecord::seq`], [`ThermalRecord::valve_open`]).
 /// 2: the six temperatures are the reduced model's nodes (pump housing, case
 /// oil, loop oil, main block, ball-valve block, actuator). An older record is
 /// treated as corrupt (conservative).
-pub const VERSION: u16 = 5;
+pub const VERSION: u16 = 4;
 /// [`ThermalRecord::rtc_s`] of a board without a real-time clock.
 pub const RTC_NONE: u32 = u32::MAX;
 /// Bit of [`ThermalRecord::seq_flags`] that holds the valve state (1 = open).
@@ -49,13 +47,10 @@ pub const FLAG_VALVE_OPEN: u32 = 1 << 31;
 /// Plausible stored temperature range, degC (anything else is treated as corrupt).
 pub const PLAUSIBLE_C: (f32, f32) = (-80.0, 250.0);
 
-/// Size of a [`ThermalRecord`] and of its byte form, bytes: eight words and the
-/// node temperatures.
-pub const RECORD_BYTES: usize = 4 * (8 + N_NODES);
-/// Word index of [`ThermalRecord::ambient_c`] (after the node temperatures).
-const W_AMBIENT: usize = 4 + N_NODES;
+/// Size of a [`ThermalRecord`] and of its byte form, bytes.
+pub const RECORD_BYTES: usize = 56;
 
-/// Persistent thermal record, [`RECORD_BYTES`] (68) bytes, no implicit padding.
+/// Persistent thermal record, 56 bytes, no implicit padding.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C)]
 pub struct ThermalRecord {
@@ -210,10 +205,10 @@ impl ThermalRecord {
         for (w, t) in words[4..4 + N_NODES].iter_mut().zip(self.temps_c.iter()) {
             *w = t.to_bits();
         }
-        words[W_AMBIENT] = self.ambient_c.to_bits();
-        words[W_AMBIENT + 1] = self.seq_flags;
-        words[W_AMBIENT + 2] = self.rtc_s;
-        words[W_AMBIENT + 3] = self.crc;
+        words[10] = self.ambient_c.to_bits();
+        words[11] = self.seq_flags;
+        words[12] = self.rtc_s;
+        words[13] = self.crc;
         let mut out = [0u8; RECORD_BYTES];
         for (chunk, w) in out.chunks_exact_mut(4).zip(words.iter()) {
             chunk.copy_from_slice(&w.to_le_bytes());
@@ -240,10 +235,10 @@ impl ThermalRecord {
             version: (w[3] & 0xFFFF) as u16,
             faults: (w[3] >> 16) as u16,
             temps_c,
-            ambient_c: f32::from_bits(w[W_AMBIENT]),
-            seq_flags: w[W_AMBIENT + 1],
-            rtc_s: w[W_AMBIENT + 2],
-            crc: w[W_AMBIENT + 3],
+            ambient_c: f32::from_bits(w[10]),
+            seq_flags: w[11],
+            rtc_s: w[12],
+            crc: w[13],
         }
     }
 
@@ -374,7 +369,7 @@ mod tests {
 
     #[test]
     fn record_has_no_padding() {
-        // 4 + 4 + 4 + 2 + 2 + 9*4 + 4 + 4 + 4 + 4 = 68 bytes of fields.
+        // 4 + 4 + 4 + 2 + 2 + 6*4 + 4 + 4 + 4 + 4 = 56 bytes of fields.
         assert_eq!(core::mem::size_of::<ThermalRecord>(), RECORD_BYTES);
     }
 }

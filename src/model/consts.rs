@@ -8,7 +8,7 @@
 use super::{ConfigError, HA_PER_A, KW_PER_W, L_PER_M3, PA_PER_HBAR, RAD_T_K};
 use crate::num::Num;
 use crate::params::{
-    ReducedParams, FILM_PROPERTY_C, N_COARSE, N_DUCTS, NODE_ACTUATOR, NODE_BALL_BLOCK, NODE_MAIN_BLOCK, NODE_MOTOR, NODE_WINDING, N_NODES, N_OUTER, N_PHI, N_STATES,
+    ReducedParams, FILM_PROPERTY_C, N_COARSE, N_DUCTS, NODE_ACTUATOR, NODE_BALL_BLOCK, NODE_MAIN_BLOCK, N_NODES, N_OUTER, N_PHI, N_STATES,
     N_TABLE, N_TEMP, S_PER_STEP, S_PER_TICK, TEMP_TABLE_MIN_C, TEMP_TABLE_STEP_K,
 };
 
@@ -75,9 +75,11 @@ pub struct ModelConsts<S> {
     pub v_ball: S,
     /// 1 / ring oil volume, 1/L.
     pub inv_v_ring: S,
-    /// Share of the no-load friction into the pump housing (the rest and all the
-    /// viscous and pressure friction heat the internals), in [0, 1].
-    pub h0: S,
+    /// Share of the pump's viscous and pressure friction into the delivered oil.
+    pub f_out: S,
+    /// Share of the pump's viscous and pressure friction into the case oil;
+    /// `1 - f_out - f_case` heats the pump housing (with the no-load friction).
+    pub f_case: S,
     /// Pump no-load friction, kW per hrad/s (extended eq. 8).
     pub k_m0: S,
     /// Pump viscous friction at 40 degC, kW per (hrad/s)^2 (extended eq. 8).
@@ -91,20 +93,6 @@ pub struct ModelConsts<S> {
     pub alpha_t0: S,
     /// LNG inlet temperature, degC (eqs. 20-22).
     pub lng_in: S,
-    /// Case oil <-> internals through the barrel's periphery, as a multiple of the
-    /// case gap's film [`Self::g_case`], in [0, 10].
-    pub barrel_ratio: S,
-    /// Internals <-> pump housing (plate seats), kW/K, in [0, 1].
-    pub g_seat: S,
-    /// Pump housing <-> motor housing (flange), kW/K, in [0, 1].
-    pub g_pm: S,
-    /// Pump housing <-> main block (port face on the manifold), kW/K, in [0, 1].
-    pub g_pmf: S,
-    /// Winding <-> motor housing, kW/K, in [0, 1].
-    pub g_wm: S,
-    /// Case oil <-> internals, swept slippers and shanks, at 40 degC, kW/K per
-    /// sqrt(hrad/s) (`G = this sqrt(|w|)`), in [0, 1].
-    pub k_sw: S,
     /// 1 / capacity of the metal states, K/kJ (oil nodes 0).
     pub inv_c: [S; N_STATES],
     /// Outer surfaces, constant conductance, kW/K (eqs. 15-16).
@@ -123,8 +111,6 @@ pub struct ModelConsts<S> {
     pub g_ball: [S; N_TABLE],
     /// LNG exchanger `eps C_min` over flow, kW/K (eqs. 20-22).
     pub g_lng: [S; N_TABLE],
-    /// One port's oil <-> internals through the bores, over flow, kW/K.
-    pub g_bore: [S; N_TABLE],
     /// Leakage ratio `mu(40) / mu(T)` over the temperature grid (1 at 40 degC,
     /// non-decreasing).
     pub leak_ratio: [S; N_TEMP],
@@ -134,8 +120,6 @@ pub struct ModelConsts<S> {
     /// Case-gap speed factor `nu(40) / nu(T)` over the temperature grid (1 at
     /// 40 degC, non-decreasing).
     pub tc_speed: [S; N_TEMP],
-    /// Swept-film factor over the temperature grid (1 at 40 degC).
-    pub swept_ratio: [S; N_TEMP],
     /// Reynolds number of each duct (port, loop, ball) over 1e4 per L/s of flow at
     /// the 40 degC viscosity.
     pub re_q: [S; N_DUCTS],
@@ -199,11 +183,11 @@ impl Word for f64 {
     }
 }
 
-/// Scalar words at the head of a [`ModelConsts`] (`p_case` .. `k_sw`).
-pub const N_SCALARS: usize = 42;
+/// Scalar words at the head of a [`ModelConsts`] (`p_case` .. `lng_in`).
+pub const N_SCALARS: usize = 37;
 /// Number of words in a [`ModelConsts`].
 pub const N_WORDS: usize =
-    N_SCALARS + N_STATES + 3 * N_OUTER + 6 * N_TABLE + 4 * N_TEMP + N_DUCTS + 2 + 2 * N_DUCTS * N_COARSE + 2 * N_NODES + N_PHI * N_PHI;
+    N_SCALARS + N_STATES + 3 * N_OUTER + 5 * N_TABLE + 3 * N_TEMP + N_DUCTS + 2 + 2 * N_DUCTS * N_COARSE + 2 * N_NODES + N_PHI * N_PHI;
 
 // Every field is a word: no padding, no other data.
 const _: () = assert!(core::mem::size_of::<ModelConsts<f32>>() == 4 * N_WORDS);
@@ -246,19 +230,14 @@ impl<S: Copy> ModelConsts<S> {
             v_port: f(c.v_port),
             v_ball: f(c.v_ball),
             inv_v_ring: f(c.inv_v_ring),
-            h0: f(c.h0),
+            f_out: f(c.f_out),
+            f_case: f(c.f_case),
             k_m0: f(c.k_m0),
             k_mv: f(c.k_mv),
             alpha: f(c.alpha),
             g_case_slope: f(c.g_case_slope),
             alpha_t0: f(c.alpha_t0),
             lng_in: f(c.lng_in),
-            barrel_ratio: f(c.barrel_ratio),
-            g_seat: f(c.g_seat),
-            g_pm: f(c.g_pm),
-            g_pmf: f(c.g_pmf),
-            g_wm: f(c.g_wm),
-            k_sw: f(c.k_sw),
             inv_c: c.inv_c.map(&mut f),
             ga: c.ga.map(&mut f),
             gb: c.gb.map(&mut f),
@@ -268,11 +247,9 @@ impl<S: Copy> ModelConsts<S> {
             g_loop: c.g_loop.map(&mut f),
             g_ball: c.g_ball.map(&mut f),
             g_lng: c.g_lng.map(&mut f),
-            g_bore: c.g_bore.map(&mut f),
             leak_ratio: c.leak_ratio.map(&mut f),
             visc_ratio: c.visc_ratio.map(&mut f),
             tc_speed: c.tc_speed.map(&mut f),
-            swept_ratio: c.swept_ratio.map(&mut f),
             re_q: c.re_q.map(&mut f),
             g_wall: c.g_wall.map(&mut f),
             g_trans: c.g_trans.map(|r| r.map(&mut f)),
@@ -326,19 +303,14 @@ impl ModelConsts<()> {
         v_port: (),
         v_ball: (),
         inv_v_ring: (),
-        h0: (),
+        f_out: (),
+        f_case: (),
         k_m0: (),
         k_mv: (),
         alpha: (),
         g_case_slope: (),
         alpha_t0: (),
         lng_in: (),
-        barrel_ratio: (),
-        g_seat: (),
-        g_pm: (),
-        g_pmf: (),
-        g_wm: (),
-        k_sw: (),
         inv_c: [(); N_STATES],
         ga: [(); N_OUTER],
         gb: [(); N_OUTER],
@@ -348,11 +320,9 @@ impl ModelConsts<()> {
         g_loop: [(); N_TABLE],
         g_ball: [(); N_TABLE],
         g_lng: [(); N_TABLE],
-        g_bore: [(); N_TABLE],
         leak_ratio: [(); N_TEMP],
         visc_ratio: [(); N_TEMP],
         tc_speed: [(); N_TEMP],
-        swept_ratio: [(); N_TEMP],
         re_q: [(); N_DUCTS],
         g_wall: [(); 2],
         g_trans: [[(); 2 * N_DUCTS]; N_COARSE],
@@ -395,8 +365,8 @@ impl<S: Word> ModelConsts<S> {
         let w = |x: S| x.to_f32();
         let scalars_non_neg = [
             c.k_lf, c.k_lf_half, c.k_lp, c.k_mech, c.k_q, c.k_a, c.k_dpq, c.r1, c.r2, c.w_dp, c.w_dx, c.k_act, c.k_cu, c.k_sh, c.k_hyd,
-            c.fe1, c.fe2, c.fe15, c.inv_v_case, c.inv_v_loop, c.v_port, c.v_ball, c.inv_v_ring, c.h0,
-            c.k_m0, c.k_mv, c.alpha, c.alpha_t0, c.barrel_ratio, c.g_seat, c.g_pm, c.g_pmf, c.g_wm, c.k_sw,
+            c.fe1, c.fe2, c.fe15, c.inv_v_case, c.inv_v_loop, c.v_port, c.v_ball, c.inv_v_ring, c.f_out,
+            c.f_case, c.k_m0, c.k_mv, c.alpha, c.alpha_t0,
         ];
         // inv_c, outer conductances and the tables: every word between the
         // scalars and Phi (a rolled loop: init code, flash)
@@ -405,14 +375,11 @@ impl<S: Word> ModelConsts<S> {
         let pos = [c.q_scale, c.w_scale, c.inv_v_case, c.inv_v_loop, c.v_port, c.v_ball, c.inv_v_ring, c.g_port[0], c.g_ball[0]]
             .iter()
             .all(|x| w(*x) > 0.0);
-        let shares = w(c.w_dp) <= 1.0 && w(c.w_dx) <= 1.0 && w(c.h0) <= 1.0;
+        let shares = w(c.w_dp) <= 1.0 && w(c.w_dx) <= 1.0 && w(c.f_out) + w(c.f_case) <= 1.0;
         let mode = c.rest_mode.iter().all(|v| w(*v) <= 1.0);
         // rho c_p stays positive over the oil's range (-60..150 degC)
         let rc = |t: f32| w(c.rc0) + w(c.rc1) * t + w(c.rc2) * t * t;
         let rc = rc(-60.0) > 0.0 && rc(40.0) > 0.0 && rc(150.0) > 0.0;
-        // the pump's metal paths: at most 1 kW/K (physical ones are a few W/K),
-        // the barrel's share of the case gap at most 10 times the case wall's
-        let paths = [c.g_seat, c.g_pm, c.g_pmf, c.g_wm, c.k_sw].iter().all(|g| w(*g) <= 1.0) && w(c.barrel_ratio) <= 10.0;
         // the temperature tables: 1 at 40 degC (where the other words are
         // referred; 1e-3 covers f32 rounding), monotonic as the viscosity
         // falls with temperature (the leakage and the gap's Taylor number rise,
@@ -428,12 +395,11 @@ impl<S: Word> ModelConsts<S> {
         let temp = unit(&c.leak_ratio)
             && unit(&c.visc_ratio)
             && unit(&c.tc_speed)
-            && unit(&c.swept_ratio)
             && rising(&c.leak_ratio)
             && rising(&c.tc_speed)
             && falling(&c.visc_ratio);
         let euler = self.euler_steps_are_small();
-        if non_neg && pos && shares && mode && rc && paths && temp && euler {
+        if non_neg && pos && shares && mode && rc && temp && euler {
             Ok(())
         } else {
             Err(ConfigError::Implausible)
@@ -464,11 +430,9 @@ impl<S: Word> ModelConsts<S> {
         let rc_max = w(c.rc0).abs() + 150.0 * w(c.rc1).abs() + 22_500.0 * w(c.rc2).abs();
         let tidal = rc_max * w(c.k_a) * MAX_DPOS_MM_PER_TICK;
         let sums = [
-            (NODE_MAIN_BLOCK, max(&c.g_loop) + w(c.g_pmf) + outer(1)),
+            (NODE_MAIN_BLOCK, max(&c.g_loop) + outer(1)),
             (NODE_BALL_BLOCK, max(&c.g_ball) + outer(2)),
             (NODE_ACTUATOR, tidal + outer(3)),
-            (NODE_MOTOR, w(c.g_wm) + w(c.g_pm) + outer(4)),
-            (NODE_WINDING, w(c.g_wm)),
         ];
         sums.iter().all(|(i, g)| c.inv_c.get(*i).is_some_and(|ic| S_PER_STEP as f32 * g * w(*ic) <= 0.5))
     }
@@ -500,9 +464,6 @@ pub fn derive(p: &ReducedParams) -> Result<ModelConsts<f64>, ConfigError> {
         p.main_block_j_per_k,
         p.ball_block_j_per_k,
         p.actuator_j_per_k,
-        p.internals_j_per_k,
-        p.motor_j_per_k,
-        p.winding_j_per_k,
     ];
     let inv_c = caps_kj.map(|c| if c > 0.0 { 1e3 / c } else { 0.0 });
     let k_lf = kl * PA_PER_HBAR * L_PER_M3;
@@ -543,19 +504,14 @@ pub fn derive(p: &ReducedParams) -> Result<ModelConsts<f64>, ConfigError> {
         v_port: p.port_oil_m3 * L_PER_M3,
         v_ball: p.ball_oil_m3 * L_PER_M3,
         inv_v_ring: 1.0 / v_ring,
-        h0: p.no_load_to_housing,
+        f_out: p.mech_to_outlet,
+        f_case: p.mech_to_case,
         k_m0: p.no_load_torque_nm * 100.0 * KW_PER_W,
         k_mv: p.viscous_w_s2_per_rad2 * 1e4 * KW_PER_W,
         alpha: p.expansion_per_k,
         g_case_slope: p.case_film_slope_per_k,
         alpha_t0: p.expansion_per_k * 273.15,
         lng_in: p.lng_inlet_c,
-        barrel_ratio: p.barrel_case_ratio,
-        g_seat: p.seats_w_per_k * KW_PER_W,
-        g_pm: p.pump_motor_w_per_k * KW_PER_W,
-        g_pmf: p.pump_manifold_w_per_k * KW_PER_W,
-        g_wm: p.winding_motor_w_per_k * KW_PER_W,
-        k_sw: p.swept_w_per_k_root * KW_PER_W * 10.0,
         inv_c,
         ga: p.outer_w_per_k.map(|x| x * KW_PER_W),
         gb: p.outer_quarter_w_per_k125.map(|x| x * KW_PER_W),
@@ -567,11 +523,9 @@ pub fn derive(p: &ReducedParams) -> Result<ModelConsts<f64>, ConfigError> {
         g_loop: kw(&p.g_loop_block_w_per_k),
         g_ball: kw(&p.g_ball_block_w_per_k),
         g_lng: kw(&p.g_lng_w_per_k),
-        g_bore: kw(&p.g_bore_w_per_k),
         leak_ratio: p.leak_ratio,
         visc_ratio: p.visc_ratio,
         tc_speed: p.tc_speed_ratio,
-        swept_ratio: p.swept_ratio,
         re_q: p.re_per_flow.map(|x| x / L_PER_M3),
         g_wall: p.duct_wall_w_per_k.map(|x| x * KW_PER_W),
         g_trans: {
@@ -644,11 +598,8 @@ mod tests {
         let mut c = DEFAULT_CONSTS;
         c.rc1 = 300.0;
         assert_eq!(c.check_values(), Err(ConfigError::ConstantRange));
-        // the new words' bounds: a metal path over 1 kW/K, a temperature table
-        // not referred to 40 degC or not monotonic, a share over 1
-        let mut c = DEFAULT_CONSTS;
-        c.g_seat = 2.0;
-        assert_eq!(c.check_values(), Err(ConfigError::Implausible));
+        // the new words' bounds: a temperature table not referred to 40 degC or
+        // not monotonic, shares over 1
         let mut c = DEFAULT_CONSTS;
         c.leak_ratio = c.leak_ratio.map(|x| x * 1.01);
         assert_eq!(c.check_values(), Err(ConfigError::Implausible));
@@ -656,13 +607,13 @@ mod tests {
         c.visc_ratio.swap(0, 1);
         assert_eq!(c.check_values(), Err(ConfigError::Implausible));
         let mut c = DEFAULT_CONSTS;
-        c.h0 = 1.5;
+        c.f_out = 0.9;
         assert_eq!(c.check_values(), Err(ConfigError::Implausible));
         // an Euler state with a capacity so small against its conductance that its
-        // step would overshoot (the winding at 31 J/K on 0.5 kW/K: h G / C = 1.6)
+        // step would overshoot (the actuator at 1/20 of its capacity: its tidal
+        // exchange at 1 m/s piston speed then gives h G / C = 0.9)
         let mut c = DEFAULT_CONSTS;
-        c.inv_c[crate::params::NODE_WINDING] *= 100.0;
-        c.g_wm = 0.5;
+        c.inv_c[crate::params::NODE_ACTUATOR] *= 20.0;
         assert_eq!(c.check_values(), Err(ConfigError::Implausible));
         assert_eq!(DEFAULT_CONSTS.check_values(), Ok(()));
     }

@@ -67,7 +67,8 @@ impl<N: Num> Model<N> {
             v_ball: f(c.v_ball),
             inv_v_ring: f(c.inv_v_ring),
             inv_c: c.inv_c.map(f),
-            h0: f(c.h0),
+            f_out: f(c.f_out),
+            f_case: f(c.f_case),
             k_m0: f(c.k_m0),
             k_mv: f(c.k_mv),
             alpha: f(c.alpha),
@@ -75,12 +76,6 @@ impl<N: Num> Model<N> {
             t_film: exact!(crate::params::FILM_PROPERTY_C),
             alpha_t0: f(c.alpha_t0),
             lng_in: f(c.lng_in),
-            barrel_ratio: f(c.barrel_ratio),
-            g_seat: f(c.g_seat),
-            g_pm: f(c.g_pm),
-            g_pmf: f(c.g_pmf),
-            g_wm: f(c.g_wm),
-            k_sw: f(c.k_sw),
             t_scale: exact!(1.0 / crate::params::TEMP_TABLE_STEP_K),
             inv_stride: exact!(1.0 / crate::params::COARSE_STRIDE as f64),
             re_q: c.re_q.map(f),
@@ -116,13 +111,12 @@ impl<N: Num> Model<N> {
             addr_of_mut!((*dst).k_mv_t).write(k.k_mv);
             addr_of_mut!((*dst).k_lf_t).write(k.k_lf);
             addr_of_mut!((*dst).k).write(k);
-            let tables: [(*mut [N; N_TABLE], &[S; N_TABLE]); 6] = [
+            let tables: [(*mut [N; N_TABLE], &[S; N_TABLE]); 5] = [
                 (addr_of_mut!((*dst).g_case), &c.g_case),
                 (addr_of_mut!((*dst).g_port), &c.g_port),
                 (addr_of_mut!((*dst).g_loop), &c.g_loop),
                 (addr_of_mut!((*dst).g_ball), &c.g_ball),
                 (addr_of_mut!((*dst).g_lng), &c.g_lng),
-                (addr_of_mut!((*dst).g_bore), &c.g_bore),
             ];
             for (d, src) in tables {
                 copy_words::<N, S>(d.cast::<N>(), src, 1);
@@ -132,8 +126,8 @@ impl<N: Num> Model<N> {
                 copy_words::<N, S>(gt.add(j * row.len()), row, 1);
             }
             let tt = addr_of_mut!((*dst).t_tab).cast::<N>();
-            for (m, tab) in [&c.leak_ratio, &c.visc_ratio, &c.tc_speed, &c.swept_ratio].into_iter().enumerate() {
-                copy_words::<N, S>(tt.add(m), tab, 4);
+            for (m, tab) in [&c.leak_ratio, &c.visc_ratio, &c.tc_speed].into_iter().enumerate() {
+                copy_words::<N, S>(tt.add(m), tab, 3);
             }
             addr_of_mut!((*dst).last_total_kw).write(N::ZERO);
             addr_of_mut!((*dst).last_lng_kw).write(N::ZERO);
@@ -144,7 +138,7 @@ impl<N: Num> Model<N> {
             addr_of_mut!((*dst).loss_max).write(false);
             addr_of_mut!((*dst).outer_g).write([N::ZERO; N_OUTER]);
             let one = exact!(1.0);
-            addr_of_mut!((*dst).slow).write(Slow { case: [one; 4], duct: [one; 2] });
+            addr_of_mut!((*dst).slow).write(Slow { case: [one; 3], duct: [one; 2] });
             addr_of_mut!((*dst).outer_phase).write(0);
             // every field is written: the oil's factors at the start (0 degC, like
             // the states)

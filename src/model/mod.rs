@@ -17,9 +17,16 @@
 //! * the drain is fed from the high-pressure port; the exchanger's cooling reaches
 //!   that port after the transport time of the port passages, `(C_in + C_out) / (m c_p)`.
 //!
-//! Time stepping: exponential Euler (exact zero-order hold of the linear part):
-//! `T(k+1) = T(k) + Phi F(T(k), u(k))`, `Phi = h phi1(h A)` from the matrix
-//! exponential of the nominal Jacobian `A`, built once at init.
+//! Time stepping: exponential Euler (exact zero-order hold of the linear part) for
+//! the fast, strongly coupled [`crate::params::PHI_STATES`] (pump housing, case
+//! oil, loop oil): `T(k+1) = T(k) + Phi F(T(k), u(k))`, `Phi = h phi1(h A)` from the
+//! matrix exponential of the nominal Jacobian `A` over them (computed on the host);
+//! explicit Euler for the slow blocks and actuator ([`crate::params::EULER_STATES`]).
+//!
+//! The oil's viscosity follows its Walther line: the leakage, the viscous friction
+//! and the case gap's Taylor number are read from tables over the case-oil
+//! temperature, the ducts' films blend into their transitional range (eqs. 13-14)
+//! as the hot oil's Reynolds number passes 2300 (docs/reduction.md).
 
 pub mod consts;
 mod init;
@@ -34,8 +41,8 @@ use crate::linalg::expm1m;
 use crate::num::Num;
 pub use consts::{ModelConsts, Word};
 pub use crate::params::{
-    ReducedParams, N_NODES, N_OUTER, N_PHI, N_STATES, N_TABLE, N_TEMP, NODE_ACTUATOR, NODE_BALL_BLOCK, NODE_DRAIN, NODE_INTERNALS,
-    NODE_LOOP, NODE_MAIN_BLOCK, NODE_MOTOR, NODE_PUMP, NODE_WINDING, OUTER_NODES, S_PER_STEP, S_PER_TICK, TICKS_PER_STEP,
+    ReducedParams, N_NODES, N_OUTER, N_PHI, N_STATES, N_TABLE, N_TEMP, NODE_ACTUATOR, NODE_BALL_BLOCK, NODE_DRAIN, NODE_LOOP,
+    NODE_MAIN_BLOCK, NODE_PUMP, OUTER_NODES, S_PER_STEP, S_PER_TICK, TICKS_PER_STEP,
 };
 pub use input::{InputScales, ModelInputN, HA_PER_A, HBAR_PER_BAR, HRADS_PER_RPM};
 use ring::{Ring, RingIn};
@@ -106,20 +113,15 @@ struct Consts<N> {
     v_ball: N,    // L
     inv_v_ring: N, // 1 / (V_loop + 2 V_port + V_ball), 1/L
     inv_c: [N; N_STATES], // 1/C of the metal states, K/kJ (oil nodes unused)
-    h0: N,        // share of the no-load friction into the housing
+    f_out: N,     // share of the viscous and pressure friction into the delivered oil
+    f_case: N,    // share into the case oil
     k_m0: N,      // pump no-load friction, kW per hrad/s
-    k_mv: N,      // pump viscous friction at 40 degC, kW per (hrad/s)^2 (internals)
+    k_mv: N,      // pump viscous friction at 40 degC, kW per (hrad/s)^2
     alpha: N,     // oil expansion, 1/K
     g_case_slope: N, // relative slope of the case film with the case-oil temperature, 1/K
     t_film: N,    // FILM_PROPERTY_C, degC
     alpha_t0: N,  // alpha 273.15
     lng_in: N,    // degC
-    barrel_ratio: N, // internals' share of the case gap's film, of the case wall's
-    g_seat: N,    // internals <-> housing, kW/K
-    g_pm: N,      // housing <-> motor, kW/K
-    g_pmf: N,     // housing <-> main block, kW/K
-    g_wm: N,      // winding <-> motor, kW/K
-    k_sw: N,      // swept film at 40 degC, kW/K per sqrt(hrad/s)
     t_scale: N,   // 1 / TEMP_TABLE_STEP_K, 1/K
     inv_stride: N, // 1 / COARSE_STRIDE
     re_q: [N; crate::params::N_DUCTS], // ducts' Re / 1e4 per L/s at 40 degC
@@ -186,21 +188,20 @@ pub struct Model<N: Num> {
     g_loop: [N; N_TABLE],
     g_ball: [N; N_TABLE],
     g_lng: [N; N_TABLE],
-    g_bore: [N; N_TABLE],
     /// The ducts' films at Re = 2300 and 1e4 on the coarse temperature grid.
     g_trans: [[N; 2 * crate::params::N_DUCTS]; crate::params::N_COARSE],
     /// Temperature tables at the case oil: leakage, viscous friction, gap speed
-    /// factor, swept film ([`ModelConsts::leak_ratio`] ...), point by point.
-    t_tab: [[N; 4]; N_TEMP],
+    /// factor ([`ModelConsts::leak_ratio`] ...), point by point.
+    t_tab: [[N; 3]; N_TEMP],
 }
 
 /// The oil's temperature factors the step uses, refreshed round robin
 /// ([`Model::update`]).
 #[derive(Clone, Copy, Debug)]
 struct Slow<N> {
-    /// At the case oil: leakage, viscous friction, case-gap speed, swept film
+    /// At the case oil: leakage, viscous friction, case-gap speed
     /// ([`Model::oil_factors`]).
-    case: [N; 4],
+    case: [N; 3],
     /// `nu(40) / nu(T)` at the loop oil and at the ball-valve passage's oil
     /// ([`Model::duct_factors`]).
     duct: [N; 2],
@@ -300,9 +301,8 @@ impl<N: Num> Model<N> {
     /// Recomputes every [`Slow`] factor at the case oil `t_case` and the loop oil
     /// `t_loop` (start, restore).
     fn refresh_slow(&mut self, t_case: N, t_loop: N) {
-        self.slow = Slow { case: self.oil_factors(t_case), duct: self.duct_factors(t_loop, None) };
-        self.k_mv_t = self.k.k_mv.mul(self.slow.case[1]);
-        self.k_lf_t = self.k.k_lf.mul(self.slow.case[0]);
+        self.slow.duct = self.duct_factors(t_loop, None);
+        self.refresh_case(t_case);
     }
 
     /// Sets every state, the ring links and the ambient to `t_c` (degC): cold start.
@@ -359,12 +359,8 @@ impl<N: Num> Model<N> {
         let share = inv.mul(k.count.get(on as usize).copied().unwrap_or(k.one));
         let mut m = self.sums.means(inv, &self.k);
         let t = self.temperatures_c();
-        // the oil's factors at the case oil every step (the viscous friction follows
-        // the viscosity's 4 %/K at 0 degC: the cross-check compares it with the
-        // current within watts)
-        self.slow.case = self.oil_factors(t.get(NODE_DRAIN).copied().unwrap_or(N::ZERO));
-        self.k_mv_t = k.k_mv.mul(self.slow.case[1]);
-        self.k_lf_t = k.k_lf.mul(self.slow.case[0]);
+        // (`slow.case`, `k_mv_t`, `k_lf_t`: the oil's factors at this step's case oil,
+        // set at the end of the last step)
         let from_current = m.shaft_kw.sub(m.hyd_kw);
         // the model's whole pump friction: pressure term plus no-load and viscous
         // (the latter at the case oil's viscosity)
@@ -397,22 +393,35 @@ impl<N: Num> Model<N> {
         self.last_heat_kw = r.heat_kw;
         self.last_outer_kw = r.outer_kw;
         self.last_losses_kw = r.losses_kw;
-        // `PHI_STATES` (pump housing, case oil, loop oil, internals) by `Phi`, the
-        // slow states by explicit Euler (`EULER_STATES`)
-        let [p0, p1, p2, p3] = &self.phi;
-        let [s0, s1, s2, s3, s4, s5, s6, s7, s8] = &mut self.temp;
-        let [r0, r1, r2, r3, r4, r5, r6, r7, r8] = r.rates;
-        let rp = [r0, r1, r2, r6];
+        // `PHI_STATES` (pump housing, case oil, loop oil) by `Phi`, the slow
+        // states by explicit Euler (`EULER_STATES`)
+        let [p0, p1, p2] = &self.phi;
+        let [s0, s1, s2, s3, s4, s5] = &mut self.temp;
+        let [r0, r1, r2, r3, r4, r5] = r.rates;
+        let rp = [r0, r1, r2];
         *s0 = N::accumulate(*s0, p0, &rp);
         *s1 = N::accumulate(*s1, p1, &rp);
         *s2 = N::accumulate(*s2, p2, &rp);
-        *s6 = N::accumulate(*s6, p3, &rp);
         let h = self.k.h;
         *s3 = N::add_product(*s3, h, r3);
         *s4 = N::add_product(*s4, h, r4);
         *s5 = N::add_product(*s5, h, r5);
-        *s7 = N::add_product(*s7, h, r7);
-        *s8 = N::add_product(*s8, h, r8);
+        // the oil's factors at the new case oil, every step: the next step's heat
+        // balance and, from the next tick on, the ticks' viscous friction (the
+        // shaft torque's sign and the cross-check, which compares it with the
+        // current within watts: the viscosity moves 4 %/K at 0 degC) and the pump's
+        // delivery past its leakage
+        let t_case = N::value(*s1);
+        self.refresh_case(t_case);
+    }
+
+    /// The oil's factors at the case oil `t_case` ([`Model::oil_factors`]) and the
+    /// ticks' viscous friction and leakage coefficients from them.
+    #[inline(always)]
+    fn refresh_case(&mut self, t_case: N) {
+        self.slow.case = self.oil_factors(t_case);
+        self.k_mv_t = self.k.k_mv.mul(self.slow.case[1]);
+        self.k_lf_t = self.k.k_lf.mul(self.slow.case[0]);
     }
 
     /// Right-hand side `dT/dt` (K/s, state order) at temperatures `t` with every tick

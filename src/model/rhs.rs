@@ -1,4 +1,4 @@
-//! The model's right-hand side: the node heat balances of one model step
+//! The model's right-hand side: the six node heat balances of one model step
 //! (eqs. 5–19 reduced) and the outer conductances.
 
 use super::*;
@@ -29,19 +29,19 @@ impl<N: Num> Model<N> {
     pub(super) fn rhs(&self, t: &[N; N_STATES], m: &Sums<N>, slow: &Slow<N>, hist: u32, share: N, links: Option<[N; 3]>, rate: N, outer_g: &[N; N_OUTER]) -> Rhs<N> {
         let k = &self.k;
         let amb = m.ambient;
-        let [t_p, t_c, t_l, t_mb, t_bb, t_a, t_i, t_m, t_w] = *t;
-        let [r_leak, r_visc, r_tc, r_swept] = slow.case;
+        let [t_p, t_c, t_l, t_mb, t_bb, t_a] = *t;
+        let [r_leak, r_visc, r_tc] = slow.case;
         let leak_kw = m.leak_kw.mul(r_leak);
         let leak_lps = m.leak_lps.mul(r_leak);
         let aq = m.abs_pump_lps;
         let aw = m.abs_speed;
-        // pump friction (extended eq. 8): the viscous and pressure terms arise in the
-        // lubricating films, whose faces are the internals; the no-load term (bearings,
-        // shaft seal) heats the housing by the share h0, the rest the internals
+        // pump friction (extended eq. 8): no-load term into the housing; the
+        // viscous (at the case oil's viscosity) and pressure terms split between
+        // delivered oil, case oil and housing (sliding-pair rule)
         let m0_kw = k.k_m0.mul(aw);
-        let m0_house = k.h0.mul(m0_kw);
-        let mech_kw = m.mech_kw.add(m.visc_kw.mul(r_visc)).add(m0_kw);
-        let p_int = mech_kw.sub(m0_house);
+        let split_kw = m.mech_kw.add(m.visc_kw.mul(r_visc));
+        let mech_kw = split_kw.add(m0_kw);
+        let metal_kw = m0_kw.add(k.one.sub(k.f_out).sub(k.f_case).mul(split_kw));
         // oil enthalpy h(T, p): alpha T (absolute) at the loop and case oil; the
         // pump's compression warms the delivered oil by alpha T dp q, every
         // throttling releases (1 - alpha T) dp q, the actuator's work leaves
@@ -59,11 +59,6 @@ impl<N: Num> Model<N> {
         // its k(T) by the slope
         let at_tc = table::locate(aw.mul(r_tc), k.w_scale, k.one);
         let g_case = table::value(&self.g_case, &at_tc).mul(k.one.add(k.g_case_slope.mul(t_c.sub(k.t_film))));
-        // the swept slippers and shanks: a laminar flat plate, Nu ∝ Re^(1/2) (∝ sqrt |w|)
-        let g_ic = g_case.mul(k.barrel_ratio).add(k.k_sw.mul(aw.sqrt_abs()).mul(r_swept));
-        // (the bores' flow is the pump's displaced flow; |q_p| differs from it by the
-        // leakage, ≈ 1 %, and the laminar film goes with its cube root)
-        let g_bore = table::value(&self.g_bore, &at_q);
         // the ducts' films: the tables hold them at 40 degC, exact in the laminar
         // range (Nu depends on Re Pr, not on the viscosity); in hot oil a duct's
         // Reynolds number `Re(40) nu(40)/nu(T)` passes 2300 and its film follows the
@@ -140,20 +135,18 @@ impl<N: Num> Model<N> {
             (false, false) => N::ZERO,
         };
         let q_lng_full = g_lng.mul(t_l.sub(k.lng_in));
-        // each port passage exchanges with the housing (its film) and the internals
-        // (the bores)
         let ring = Ring::solve(&RingIn {
             t_loop: t_l,
-            gt_port: g_port.mul(t_p).add(g_bore.mul(t_i)),
+            t_pump: t_p,
             t_ball_block: t_bb,
             m_c,
             m_thr,
             m_l,
-            g_port: g_port.add(g_bore),
+            g_port,
             g_ball,
             q_lng: q_lng_full.mul(share),
             q_lng_port: q_lng_full.mul(port_share),
-            p_hp: at_l.mul(m.hyd_kw),
+            p_hp: k.f_out.mul(split_kw).add(at_l.mul(m.hyd_kw)),
             p_needle: needle_kw,
             c_port,
             c_ball,
@@ -166,41 +159,27 @@ impl<N: Num> Model<N> {
         let t_mean = ring.t_feed.add(t_c).mul(k.half);
         let m_lk = k.rc0.add(t_mean.mul(k.rc1.add(k.rc2.mul(t_mean)))).mul(leak_lps);
         let adv = m_lk.mul(ring.t_feed.sub(t_c));
-        let [g_op, g_omb, g_obb, g_oa, g_om] = *outer_g;
-        let (o_p, o_mb, o_bb, o_a, o_m) =
-            (g_op.mul(t_p.sub(amb)), g_omb.mul(t_mb.sub(amb)), g_obb.mul(t_bb.sub(amb)), g_oa.mul(t_a.sub(amb)), g_om.mul(t_m.sub(amb)));
-        // metal paths: the internals' seats, the housing's flange and port face
-        let seat = k.g_seat.mul(t_i.sub(t_p));
-        let flange = k.g_pm.mul(t_p.sub(t_m));
-        let face = k.g_pmf.mul(t_p.sub(t_mb));
-        let q_pump = m0_house
+        let [g_op, g_omb, g_obb, g_oa] = *outer_g;
+        let (o_p, o_mb, o_bb, o_a) = (g_op.mul(t_p.sub(amb)), g_omb.mul(t_mb.sub(amb)), g_obb.mul(t_bb.sub(amb)), g_oa.mul(t_a.sub(amb)));
+        let q_pump = metal_kw
             .add(g_case.mul(t_c.sub(t_p)))
             .add(g_port.mul(ring.t_in.sub(t_p)))
             .add(g_port.mul(ring.t_out.sub(t_p)))
-            .add(seat)
-            .sub(flange)
-            .sub(face)
             .sub(o_p);
-        let q_int = p_int
-            .add(g_ic.mul(t_c.sub(t_i)))
-            .add(g_bore.mul(ring.t_in.sub(t_i)))
-            .add(g_bore.mul(ring.t_out.sub(t_i)))
-            .sub(seat);
         let q_case = k
             .one
             .sub(at_c)
             .mul(leak_kw)
+            .add(k.f_case.mul(split_kw))
             .add(g_case.mul(t_p.sub(t_c)))
-            .add(g_ic.mul(t_i.sub(t_c)))
             .add(adv);
         let q_ring = line_kw
             .add(needle_kw)
+            .add(k.f_out.mul(split_kw))
             .add(at_l.mul(m.hyd_kw))
             .sub(expand_kw)
             .add(g_port.mul(t_p.sub(ring.t_in)))
             .add(g_port.mul(t_p.sub(ring.t_out)))
-            .add(g_bore.mul(t_i.sub(ring.t_in)))
-            .add(g_bore.mul(t_i.sub(ring.t_out)))
             .add(g_ball.mul(t_bb.sub(ring.t_ball)))
             .add(g_loop.mul(t_mb.sub(t_l)))
             .sub(adv)
@@ -220,15 +199,12 @@ impl<N: Num> Model<N> {
         let inv_rc_l = k.one.div_pos(rc_l);
         let inv_rc_c = k.one.div_pos(k.rc0.add(t_c.mul(k.rc1.add(k.rc2.mul(t_c)))));
         let q_loop = q_ring.sub(stored.mul(k.inv_h));
-        let q_mb = g_loop.mul(t_l.sub(t_mb)).add(face).sub(o_mb);
+        let q_mb = g_loop.mul(t_l.sub(t_mb)).sub(o_mb);
         let q_bb = g_ball.mul(ring.t_ball.sub(t_bb)).sub(o_bb);
         let q_act = m.act_kw.add(g_tidal.mul(t_l.sub(t_a))).sub(o_a);
-        // the motor: iron loss (eq. 2) in the housing, copper loss (eq. 1) in the
-        // winding, the pump's flange on the housing
+        // iron loss (eq. 2): the motor is not a state (no thermal path to the pump
+        // side in the reference), its losses enter the dissipation total only
         let iron = aw.mul(k.fe1.add(k.fe2.mul(aw)).add(k.fe15.mul(aw.sqrt_abs())));
-        let wind = k.g_wm.mul(t_w.sub(t_m));
-        let q_mot = iron.add(wind).add(flange).sub(o_m);
-        let q_wind = m.copper_kw.sub(wind);
         let ic = &k.inv_c;
         let cap = |q: N, i: usize| q.mul(ic.get(i).copied().unwrap_or(N::ZERO));
         let rates = [
@@ -238,9 +214,6 @@ impl<N: Num> Model<N> {
             cap(q_mb, NODE_MAIN_BLOCK),
             cap(q_bb, NODE_BALL_BLOCK),
             cap(q_act, NODE_ACTUATOR),
-            cap(q_int, NODE_INTERNALS),
-            cap(q_mot, NODE_MOTOR),
-            cap(q_wind, NODE_WINDING),
         ];
         // dissipation total (eq. 23's P_sum): every loss of eqs. (1)-(11)
         let heat_kw = leak_kw.add(mech_kw).add(m.line_kw).add(m.needle_kw).add(m.act_kw);
@@ -252,7 +225,7 @@ impl<N: Num> Model<N> {
             total_kw,
             lng_kw: ring.q_lng,
             heat_kw,
-            outer_kw: o_p.add(o_mb).add(o_bb).add(o_a).add(o_m),
+            outer_kw: o_p.add(o_mb).add(o_bb).add(o_a),
             losses_kw: [m.copper_kw, iron, leak_kw, mech_kw, m.line_kw.add(m.needle_kw), m.act_kw],
         }
     }
@@ -268,10 +241,10 @@ impl<N: Num> Model<N> {
 
     /// The oil's factors at the case oil `t_c` (the pump's films): leakage
     /// conductance (eqs. 5-7) and viscous friction on the Walther line, the case
-    /// gap's speed factor (its Taylor number is `(w / nu)^2`), the swept film; from
-    /// the tables over temperature, each 1 at 40 degC.
+    /// gap's speed factor (its Taylor number is `(w / nu)^2`); from the tables over
+    /// temperature, each 1 at 40 degC.
     #[inline(always)]
-    pub(super) fn oil_factors(&self, t_c: N) -> [N; 4] {
+    pub(super) fn oil_factors(&self, t_c: N) -> [N; 3] {
         let k = &self.k;
         table::values(&self.t_tab, &table::locate_uniform::<N, N_TEMP>(t_c.sub(k.t_min).mul(k.t_scale), k.one))
     }

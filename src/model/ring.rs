@@ -2,7 +2,7 @@
 //! the ball/needle-valve passage, solved in flow order from the loop node.
 //!
 //! Each link `i` with inflow capacity rate `m_in` at `T_up`, film conductance `g`
-//! to its metal at `T_m` (the port passages: the sum over housing and internals), heat input `P` and capacity `C` moving at the ring's rate
+//! to its metal at `T_m`, heat input `P` and capacity `C` moving at the ring's rate
 //! `r` satisfies `C r = m_in (T_up - T_i) + g (T_m - T_i) + P`, so
 //! `T_i = (m_in T_up + g T_m + P - C r) / (m_in + g)` (mass-consistent: what flows
 //! in flows out). With the flow stopped (`m = 0`) a link relaxes onto its metal.
@@ -19,9 +19,8 @@ use crate::num::Num;
 pub struct RingIn<N> {
     /// Loop node temperature, degC.
     pub t_loop: N,
-    /// `sum g T` of the metals one port passage exchanges with (the pump housing
-    /// through the passage's film, the internals through the bores), kW.
-    pub gt_port: N,
+    /// Pump housing temperature, degC.
+    pub t_pump: N,
     /// Ball-valve block temperature, degC.
     pub t_ball_block: N,
     /// Circulating capacity rate through the pump, kW/K.
@@ -30,7 +29,7 @@ pub struct RingIn<N> {
     pub m_thr: N,
     /// Leakage capacity rate (high-pressure port → case → loop), kW/K.
     pub m_l: N,
-    /// One port passage ↔ its metals (housing and internals) conductance, kW/K (> 0).
+    /// One port passage ↔ pump housing conductance, kW/K (> 0).
     pub g_port: N,
     /// Ball-valve passage ↔ its block, kW/K (> 0).
     pub g_ball: N,
@@ -38,8 +37,7 @@ pub struct RingIn<N> {
     pub q_lng: N,
     /// The same as it has reached the high-pressure port (transport delay), kW.
     pub q_lng_port: N,
-    /// Heat input of the high-pressure port oil (the compression's share of the
-    /// pump's work), kW.
+    /// Mechanical-loss share heating the high-pressure port oil, kW.
     pub p_hp: N,
     /// Needle-valve throttling heat in the ball-valve passage, kW.
     pub p_needle: N,
@@ -78,7 +76,7 @@ impl<N: Num> Ring<N> {
     #[inline(always)]
     pub fn solve(x: &RingIn<N>) -> Self {
         let m0 = x.m_c.add(x.m_l);
-        let one_pump = x.gt_port;
+        let one_pump = x.g_port.mul(x.t_pump);
         let cr_port = x.c_port.mul(x.rate);
         let cr_ball = x.c_ball.mul(x.rate);
         // Heat input of a port passage: the mechanical share at the high-pressure one.
@@ -152,7 +150,7 @@ mod tests {
     fn base(forward: bool, hp_is_a: bool) -> RingIn<f64> {
         RingIn {
             t_loop: 40.0,
-            gt_port: 0.002 * 40.0,
+            t_pump: 40.0,
             t_ball_block: 40.0,
             m_c: 0.26,
             m_thr: 0.26,
@@ -225,7 +223,7 @@ mod tests {
         x.m_c = 0.0;
         x.m_thr = 0.0;
         x.m_l = 0.0;
-        x.gt_port = x.g_port * 30.0;
+        x.t_pump = 30.0;
         x.t_ball_block = 25.0;
         x.p_needle = 0.001;
         let r = Ring::solve(&x);

@@ -475,7 +475,7 @@ fn power_loss_restore_is_cooled_over_the_clocks_off_time() {
     app.tick(&mut b, 0);
     assert_eq!(b.nv_saved.map(|r| r.rtc_s), Some(5_000), "the first save is stamped");
 
-    let hot = ThermalRecord::new([55.0, 60.0, 50.0, 45.0, 40.0, 30.0, 62.0, 35.0, 38.0], 20.0, 0, 0, 100).with_rtc(Some(5_000));
+    let hot = ThermalRecord::new([55.0, 60.0, 50.0, 45.0, 40.0, 30.0], 20.0, 0, 0, 100).with_rtc(Some(5_000));
     let boot_after = |rtc: Option<u32>, ambient_c: f32| {
         let mut b = SimBoard::new();
         b.rtc = rtc;

@@ -227,7 +227,7 @@ impl EmuParams {
             ("g_stator_case W/K", self.g_stator_case, "motor.winding_to_housing_w_per_k", 15.0, ""),
             ("leakage conductance (gap³)", leak_ratio, "pump.gaps.*_gap_m = 12 µm", 1.0, "gap 13.5 µm"),
             ("eta_m", self.eta_m, "pump.eta_m", 0.277, "eq. 8 (the reference adds T0 and C_v)"),
-            ("mech share to delivered oil", self.mech_split[0], "(the reference: all friction into the pump internals)", 1.0, "20 % to port-plate metal, 30 % to case oil"),
+            ("mech share to delivered oil", self.mech_split[0], "pump.friction_pairs (delivered share)", 0.6, "20 % goes to port-plate metal (no counterpart)"),
             ("v_case m³", self.v_case, "pump.case_oil_m3", 0.15e-3, ""),
             ("case wetted area m²", self.a_case[0] + self.a_case[1], "pump.case_inner_area_m2", 0.02, "other correlation"),
             ("v_port m³", self.v_port, "2·pump.port_oil_m3", 0.10e-3, ""),

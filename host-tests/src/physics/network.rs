@@ -3,7 +3,7 @@
 //! evaluated at the current temperatures and flows.
 
 use crate::heat::{self, h_forced_plate, h_free_cube, h_free_cylinder, h_mixed, radiation_w, series};
-use crate::rig::Rig;
+use crate::rig::{PumpSplit, Rig};
 
 /// Thermal nodes. Index into the temperature part of the state.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -34,7 +34,9 @@ pub enum Node {
     /// Actuator (cylinder body with its oil).
     Actuator,
     /// The pump's internals: cylinder barrel, pistons and slippers, swash and
-    /// valve plates, shaft; every sliding pair's faces.
+    /// valve plates, shaft; every sliding pair's faces. A node of its own only
+    /// with [`crate::rig::Pump::split`]; otherwise it holds nothing and
+    /// follows the pump housing.
     PumpInternals,
 }
 
@@ -89,13 +91,15 @@ impl Node {
 /// ρ(T)·c_p(T) at its own temperature ([`capacity_j_per_k`]). The nuisance
 /// capacity scales are applied here.
 pub fn contents(rig: &Rig) -> [(f64, f64); N_NODES] {
+    // the internals hold no heat of their own unless the pump is split
+    let internals_kg = rig.pump.split.map_or(0.0, |s| s.internals_mass_kg);
     let v = rig.nuisance.oil_capacity_scale;
     let ms = rig.nuisance.metal_capacity_scale;
     let m = &rig.motor;
     [
         (m.winding_mass_kg * ms, m.winding_cp),
         ((m.mass_kg - m.winding_mass_kg) * ms, m.body_cp),
-        ((rig.pump.mass_kg - rig.pump.internals_mass_kg) * ms, rig.pump.cp),
+        ((rig.pump.mass_kg - internals_kg) * ms, rig.pump.cp),
         (v * rig.pump.case_oil_m3, 0.0),
         (v * rig.pump.port_oil_m3, 0.0),
         (v * rig.pump.port_oil_m3, 0.0),
@@ -105,7 +109,7 @@ pub fn contents(rig: &Rig) -> [(f64, f64); N_NODES] {
         (v * rig.blocks.ball_oil_m3, 0.0),
         (v * rig.blocks.sensor_oil_m3, 0.0),
         (rig.actuator.body_mass_kg * ms, rig.actuator.body_cp),
-        (rig.pump.internals_mass_kg * ms, rig.pump.cp),
+        (internals_kg * ms, rig.pump.cp),
     ]
 }
 
@@ -161,25 +165,26 @@ pub fn case_film_w_per_k(rig: &Rig, omega: f64, t_oil: f64, nu: f64) -> f64 {
 /// through the case gap ([`case_gap_h`] on 2π·r·L) plus the slippers and
 /// piston shanks swept through the case oil at the barrel's rim speed, a
 /// laminar flat plate of the slipper's length ([`heat::nu_flat_plate_laminar`]).
-pub fn internals_case_film_w_per_k(rig: &Rig, omega: f64, t_oil: f64, nu: f64) -> f64 {
+pub fn internals_case_film_w_per_k(rig: &Rig, split: &PumpSplit, omega: f64, t_oil: f64, nu: f64) -> f64 {
     let p = &rig.pump;
-    let barrel = case_gap_h(rig, omega, t_oil, nu) * 2.0 * std::f64::consts::PI * p.rotor_radius_m * p.barrel_length_m;
+    let s = split;
+    let barrel = case_gap_h(rig, omega, t_oil, nu) * 2.0 * std::f64::consts::PI * p.rotor_radius_m * s.barrel_length_m;
     let u = omega.abs() * p.rotor_radius_m;
-    let re = u * p.swept_length_m / nu;
-    let h_swept = heat::nu_flat_plate_laminar(re, rig.oil.prandtl(t_oil, nu)) * rig.oil.k(t_oil) / p.swept_length_m;
-    (barrel + h_swept * p.case_swept_area_m2) * rig.nuisance.inner_scale
+    let re = u * s.swept_length_m / nu;
+    let h_swept = heat::nu_flat_plate_laminar(re, rig.oil.prandtl(t_oil, nu)) * rig.oil.k(t_oil) / s.swept_length_m;
+    (barrel + h_swept * s.case_swept_area_m2) * rig.nuisance.inner_scale
 }
 
 /// Film between the pump's internals and one port's oil through the
 /// displacement chambers, W/K: half the pistons' bores face each kidney, each
 /// passing its share of the displaced flow `q_displaced` (m³/s, either sign)
 /// as a laminar developing duct flow (eq. 13) over the chamber length that
-/// makes their wall area half of [`crate::rig::Pump::bore_area_m2`].
-pub fn bore_film_w_per_k(rig: &Rig, q_displaced: f64, t_oil: f64, nu: f64) -> f64 {
+/// makes their wall area half of [`PumpSplit::bore_area_m2`].
+pub fn bore_film_w_per_k(rig: &Rig, split: &PumpSplit, q_displaced: f64, t_oil: f64, nu: f64) -> f64 {
     let p = &rig.pump;
     let n = 0.5 * p.gaps.pistons;
     let d = p.gaps.piston_d_m;
-    let len = 0.5 * p.bore_area_m2 / (n * std::f64::consts::PI * d);
+    let len = 0.5 * split.bore_area_m2 / (n * std::f64::consts::PI * d);
     if len <= 0.0 {
         return 0.0;
     }

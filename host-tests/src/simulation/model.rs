@@ -92,18 +92,22 @@ impl Losses {
     }
 }
 
-/// Where the pump's friction heat (extended eq. 8) goes at one instant, W:
-/// the faces of the sliding pairs ([`Model::friction_heat`]).
+/// Where the pump's friction heat (extended eq. 8) goes at one instant, W
+/// ([`Model::friction_heat`]).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct FrictionHeat {
-    /// Into the pump's internals.
-    pub internals: f64,
+    /// Into the delivered (high-pressure port) oil.
+    pub delivered: f64,
+    /// Into the case oil.
+    pub case: f64,
     /// Into the pump housing.
     pub housing: f64,
+    /// Into the pump's internals (only with [`crate::rig::Pump::split`]).
+    pub internals: f64,
 }
 
 impl FrictionHeat {
-    /// All of it: every part heats metal, W.
+    /// The part that heats metal (housing and internals), W.
     pub fn metal(&self) -> f64 {
         self.internals + self.housing
     }
@@ -351,18 +355,32 @@ impl Model {
         losses::PumpFriction::new(p.no_load_torque_nm, p.viscous_torque_coeff, p.eta_m, self.rig.displacement_m3_per_rad(), mu, op.p_a - op.p_b, op.omega)
     }
 
-    /// The pump's friction heat placed on the faces of its sliding pairs,
-    /// W. The viscous and pressure terms of the extended eq. (8) arise in the
-    /// three lubricating films (piston/bore, slipper/swash plate,
-    /// barrel/valve plate); a film of a few µm conducts its heat into its two
-    /// faces (δ/k ≈ 1e-4 m²·K/W, a hundredth of the faces' films to the
-    /// oil; its own leakage convects a few per cent), and every one of those
-    /// faces belongs to the internals. The no-load term (bearings, shaft
-    /// seal) divides by [`crate::rig::Pump::no_load_to_housing`].
+    /// The pump's friction heat placed by the sliding pairs, W.
+    ///
+    /// One pump node (the baseline): the no-load term (bearings, shaft seal)
+    /// heats the housing, the viscous and pressure terms divide by
+    /// [`crate::rig::FrictionPairs::shares`].
+    ///
+    /// The pump as it is built ([`crate::rig::Pump::split`]): the viscous and
+    /// pressure terms arise in the three lubricating films (piston/bore,
+    /// slipper/swash plate, barrel/valve plate); a film of a few µm conducts
+    /// its heat into its two faces (δ/k ≈ 1e-4 m²·K/W, a hundredth of the
+    /// faces' films to the oil; its own leakage convects a few per cent), and
+    /// every one of those faces belongs to the internals. The no-load term
+    /// divides by [`crate::rig::PumpSplit::no_load_to_housing`].
     pub fn friction_heat(&self, op: &OpPoint, t_case: f64) -> FrictionHeat {
         let fr = self.pump_friction(op, t_case);
-        let to_housing = self.rig.pump.no_load_to_housing * fr.no_load_w;
-        FrictionHeat { internals: fr.viscous_w + fr.pressure_w + fr.no_load_w - to_housing, housing: to_housing }
+        let films = fr.viscous_w + fr.pressure_w;
+        match &self.rig.pump.split {
+            Some(s) => {
+                let to_housing = s.no_load_to_housing * fr.no_load_w;
+                FrictionHeat { internals: films + fr.no_load_w - to_housing, housing: to_housing, ..FrictionHeat::default() }
+            }
+            None => {
+                let (f_del, f_case, f_metal) = self.rig.pump.friction_pairs.shares();
+                FrictionHeat { delivered: f_del * films, case: f_case * films, housing: fr.no_load_w + f_metal * films, internals: 0.0 }
+            }
+        }
     }
 
     /// All losses at an operating point and temperatures, W.
@@ -434,7 +452,8 @@ impl Model {
             (Node::Motor, l.iron + l.bearing),
             (Node::Pump, fh.housing),
             (Node::PumpInternals, fh.internals),
-            (Node::Case, l.churning),
+            (Node::Case, fh.case + l.churning),
+            (hp, fh.delivered),
             (Node::Loop, l.valves),
             (Node::Actuator, l.act_leak + l.act_friction),
         ] {
@@ -456,18 +475,26 @@ impl Model {
         }
         let nu_case = self.nu(tc(Node::Case));
         link(&mut q, Node::Case, Node::Pump, network::case_film_w_per_k(rig, op.omega, tc(Node::Case), nu_case));
-        link(&mut q, Node::Case, Node::PumpInternals, network::internals_case_film_w_per_k(rig, op.omega, tc(Node::Case), nu_case));
-        let q_displaced = rig.displacement_m3_per_rad() * op.omega;
         for port in [Node::Inlet, Node::Outlet] {
             let g = network::duct_conductance(rig, qc, p.port_d_m, p.port_len_m, p.port_area_scale, tc(port), self.nu(tc(port)));
             link(&mut q, port, Node::Pump, g);
-            link(&mut q, port, Node::PumpInternals, network::bore_film_w_per_k(rig, q_displaced, tc(port), self.nu(tc(port))));
         }
-        // metal paths: the internals' seats in the housing, the housing's
-        // flange on the motor and its port face on the manifold (main block)
-        link(&mut q, Node::PumpInternals, Node::Pump, p.seats.conductance_w_per_k());
-        link(&mut q, Node::Pump, Node::Motor, rig.joints.pump_motor.conductance_w_per_k());
-        link(&mut q, Node::Pump, Node::MainBlock, rig.joints.pump_manifold.conductance_w_per_k());
+        if let Some(s) = &p.split {
+            // the internals: films to the case oil and, through the bores, to
+            // the port oil; their seats in the housing
+            link(&mut q, Node::Case, Node::PumpInternals, network::internals_case_film_w_per_k(rig, s, op.omega, tc(Node::Case), nu_case));
+            let q_displaced = rig.displacement_m3_per_rad() * op.omega;
+            for port in [Node::Inlet, Node::Outlet] {
+                link(&mut q, port, Node::PumpInternals, network::bore_film_w_per_k(rig, s, q_displaced, tc(port), self.nu(tc(port))));
+            }
+            link(&mut q, Node::PumpInternals, Node::Pump, s.seats.conductance_w_per_k());
+        }
+        if let Some(j) = &rig.joints {
+            // metal paths: the housing's flange on the motor and its port face
+            // on the manifold (main block)
+            link(&mut q, Node::Pump, Node::Motor, j.pump_motor.conductance_w_per_k());
+            link(&mut q, Node::Pump, Node::MainBlock, j.pump_manifold.conductance_w_per_k());
+        }
         let g_loop = network::duct_conductance(rig, qc, b.loop_d_m, b.loop_len_m, b.loop_area_scale, tc(Node::Loop), self.nu(tc(Node::Loop)));
         link(&mut q, Node::Loop, Node::MainBlock, network::block_path(rig, g_loop, b.main_area_m2));
         let g_ball = network::duct_conductance(rig, qc, b.ball_d_m, b.ball_len_m, 1.0, tc(Node::BallOil), self.nu(tc(Node::BallOil)));
@@ -562,7 +589,14 @@ impl Model {
         q[Node::MainBlock as usize] -= w_mount;
         q_amb += w_mount;
         for (i, n) in NODES.iter().enumerate() {
-            dt[i] = q[i] / self.capacity(*n, temps[i]);
+            dt[i] = match (n, &p.split) {
+                // one pump node: the internals are the housing (no heat, no
+                // capacity of their own) and follow it; started elsewhere
+                // (a state set by hand) they relax onto it at 1/s, which also
+                // fixes them in an equilibrium solve
+                (Node::PumpInternals, None) => dt[Node::Pump as usize] + (tc(Node::Pump) - tc(Node::PumpInternals)),
+                _ => q[i] / self.capacity(*n, temps[i]),
+            };
         }
         (q_in, q_amb, q_lng)
     }

@@ -114,17 +114,7 @@ pub fn reduce_without_jacobian(rig: &Rig) -> ReducedParams {
     let w_nom = 500.0 * PI / 30.0;
     let gc = |t: f64| network::case_film_w_per_k(rig, w_nom, t, nu);
     let case_film_slope = (gc(t40 + 1.0) - gc(t40 - 1.0)) / (2.0 * gc(t40));
-    // the internals in the case oil: the barrel's periphery through the same gap
-    // film (a fixed multiple of the case wall's) and the swept slippers and shanks
-    let barrel = 2.0 * PI * p.rotor_radius_m * p.barrel_length_m;
-    let barrel_ratio = barrel / p.case_inner_area_m2;
-    let swept = |w: f64, t: f64| network::internals_case_film_w_per_k(rig, w, t, oil.nu_m2_per_s(t)) - network::case_gap_h(rig, w, t, oil.nu_m2_per_s(t)) * barrel * rig.nuisance.inner_scale;
-    // Nu = 0.664 Re^(1/2) Pr^(1/3): exactly sqrt(w) at one temperature
-    let swept_root = swept(w_nom, t40) / w_nom.sqrt();
-    // the swept film's temperature factor (nu^-1/6, Pr^1/3, k: one law at every speed)
-    let swept_ratio = temp_table(|t| swept(w_nom, t) / swept(w_nom, t40));
     let g_port = table(q_max, |q| duct(q, p.port_d_m, p.port_len_m, p.port_area_scale));
-    let g_bore = table(q_max, |q| network::bore_film_w_per_k(rig, q, t40, nu));
     let g_loop = table(q_max, |q| network::block_path(rig, duct(q, b.loop_d_m, b.loop_len_m, b.loop_area_scale), b.main_area_m2));
     let g_ball = table(q_max, |q| network::block_path(rig, duct(q, b.ball_d_m, b.ball_len_m, 1.0), b.ball_area_m2));
     // the ducts' transition (eqs. 13-14 blended) on the coarse temperature grid: the
@@ -167,14 +157,13 @@ pub fn reduce_without_jacobian(rig: &Rig) -> ReducedParams {
     let leak_ratio = temp_table(|t| mu40 / oil.mu_pa_s(t));
     let visc_ratio = temp_table(|t| oil.mu_pa_s(t) / mu40);
     let tc_speed_ratio = temp_table(|t| nu / oil.nu_m2_per_s(t));
-    // outer surfaces of the pump, main block, ball block, actuator, motor
+    // outer surfaces of the pump, main block, ball block, actuator
     let side = |area: f64| (area / 6.0).sqrt();
     let surfaces = [
         (p.area_m2, Shape::Cylinder(p.diameter_m)),
         (b.main_area_m2, Shape::Cube(side(b.main_area_m2))),
         (b.ball_area_m2, Shape::Cube(side(b.ball_area_m2))),
         (a.area_m2, Shape::Cylinder(a.diameter_m)),
-        (m.area_m2, Shape::Cylinder(m.diameter_m)),
     ];
     let mut outer_w_per_k = [0.0; N_OUTER];
     let mut outer_quarter = [0.0; N_OUTER];
@@ -194,7 +183,7 @@ pub fn reduce_without_jacobian(rig: &Rig) -> ReducedParams {
     let fe = &m.iron;
     let c = fe.pole_pairs / (2.0 * PI);
     ReducedParams {
-        pump_j_per_k: (p.mass_kg - p.internals_mass_kg) * ms * p.cp,
+        pump_j_per_k: p.mass_kg * ms * p.cp,
         main_block_j_per_k: b.main_mass_kg * ms * b.cp,
         ball_block_j_per_k: b.ball_mass_kg * ms * b.cp,
         actuator_j_per_k: a.body_mass_kg * ms * a.body_cp,
@@ -210,7 +199,8 @@ pub fn reduce_without_jacobian(rig: &Rig) -> ReducedParams {
         eta_m: p.eta_m,
         no_load_torque_nm: p.no_load_torque_nm,
         viscous_w_s2_per_rad2: p.viscous_torque_coeff * mu40 * d,
-        no_load_to_housing: p.no_load_to_housing,
+        mech_to_outlet: p.friction_pairs.shares().0,
+        mech_to_case: p.friction_pairs.shares().1,
         case_film_slope_per_k: case_film_slope,
         expansion_per_k: oil.expansion_per_k,
         k_leak_m3_per_s_pa: p.gaps.conductance(mu40),
@@ -229,20 +219,9 @@ pub fn reduce_without_jacobian(rig: &Rig) -> ReducedParams {
         speed_table_max_rad_s: w_max,
         flow_table_max_m3_per_s: q_max,
         g_case_w_per_k: g_case,
-        barrel_case_ratio: barrel_ratio,
-        swept_w_per_k_root: swept_root,
-        g_bore_w_per_k: g_bore,
-        seats_w_per_k: p.seats.conductance_w_per_k(),
-        pump_motor_w_per_k: rig.joints.pump_motor.conductance_w_per_k(),
-        pump_manifold_w_per_k: rig.joints.pump_manifold.conductance_w_per_k(),
-        winding_motor_w_per_k: m.winding_to_housing_w_per_k,
-        internals_j_per_k: p.internals_mass_kg * ms * p.cp,
-        motor_j_per_k: (m.mass_kg - m.winding_mass_kg) * ms * m.body_cp,
-        winding_j_per_k: m.winding_mass_kg * ms * m.winding_cp,
         leak_ratio,
         visc_ratio,
         tc_speed_ratio,
-        swept_ratio,
         re_per_flow,
         duct_wall_w_per_k,
         g_port_re2300_w_per_k: re2300(0),
@@ -324,8 +303,6 @@ pub const REST_AIR_C: [f64; 4] = [-55.0, 0.0, 20.0, 70.0];
 /// each with its own `v` (Perron vector, max 1) and rate
 /// `r = min_i -(J v)_i / v_i` over the group's rows and over [`REST_AIR_C`].
 /// `None` if the bound does not exist (no positive `v` or no decay).
-/// The bound is derived over every state (the motor and the internals cool with
-/// the contract nodes they are coupled to) and reported for the contract nodes.
 pub fn rest_cooling(p: &ReducedParams) -> Option<([f64; N_NODES], [f64; N_NODES])> {
     let c = eha_guard::model::consts::derive(p).ok()?;
     let model = Model::<f64>::for_linearisation(&c).ok()?;
@@ -421,8 +398,13 @@ fn perron_by_group(a: &[[f64; N_STATES]; N_STATES], group: &[usize; N_STATES]) -
 }
 
 /// The whole reduction (steps 1-6). `None` if the rig gives parameters the firmware
-/// model rejects.
+/// model rejects, or has the optional pump-as-built structure
+/// ([`crate::rig::Pump::split`], [`Rig::joints`]): the firmware's six states follow
+/// the baseline's one pump node with no path to the motor.
 pub fn reduce(rig: &Rig) -> Option<ReducedParams> {
+    if rig.pump.split.is_some() || rig.joints.is_some() {
+        return None;
+    }
     let p = rediscretise(&reduce_without_jacobian(rig))?;
     Model::<f64>::new(&p).ok()?;
     Some(p)
@@ -454,7 +436,7 @@ fn row(r: &[f64]) -> String {
 
 /// The scalar fields of `p` by name, in `DEFAULT`'s order (the renderer writes
 /// them; the acceptance test compares them with the reduction).
-pub fn scalar_fields(p: &ReducedParams) -> [(&'static str, f64); 44] {
+pub fn scalar_fields(p: &ReducedParams) -> [(&'static str, f64); 36] {
     [
         ("pump_j_per_k", p.pump_j_per_k),
         ("main_block_j_per_k", p.main_block_j_per_k),
@@ -472,7 +454,8 @@ pub fn scalar_fields(p: &ReducedParams) -> [(&'static str, f64); 44] {
         ("eta_m", p.eta_m),
         ("no_load_torque_nm", p.no_load_torque_nm),
         ("viscous_w_s2_per_rad2", p.viscous_w_s2_per_rad2),
-        ("no_load_to_housing", p.no_load_to_housing),
+        ("mech_to_outlet", p.mech_to_outlet),
+        ("mech_to_case", p.mech_to_case),
         ("case_film_slope_per_k", p.case_film_slope_per_k),
         ("expansion_per_k", p.expansion_per_k),
         ("k_leak_m3_per_s_pa", p.k_leak_m3_per_s_pa),
@@ -490,28 +473,17 @@ pub fn scalar_fields(p: &ReducedParams) -> [(&'static str, f64); 44] {
         ("k_fe15_w_per_rad15", p.k_fe15_w_per_rad15),
         ("speed_table_max_rad_s", p.speed_table_max_rad_s),
         ("flow_table_max_m3_per_s", p.flow_table_max_m3_per_s),
-        ("barrel_case_ratio", p.barrel_case_ratio),
-        ("swept_w_per_k_root", p.swept_w_per_k_root),
-        ("seats_w_per_k", p.seats_w_per_k),
-        ("pump_motor_w_per_k", p.pump_motor_w_per_k),
-        ("pump_manifold_w_per_k", p.pump_manifold_w_per_k),
-        ("winding_motor_w_per_k", p.winding_motor_w_per_k),
-        ("internals_j_per_k", p.internals_j_per_k),
-        ("motor_j_per_k", p.motor_j_per_k),
-        ("winding_j_per_k", p.winding_j_per_k),
         ("lng_inlet_c", p.lng_inlet_c),
     ]
 }
 
 /// The table and array fields of `p` by name, in `DEFAULT`'s order.
-pub fn array_fields(p: &ReducedParams) -> [(&'static str, &[f64]); 21] {
+pub fn array_fields(p: &ReducedParams) -> [(&'static str, &[f64]); 19] {
     [
         ("g_case_w_per_k", &p.g_case_w_per_k),
-        ("g_bore_w_per_k", &p.g_bore_w_per_k),
         ("leak_ratio", &p.leak_ratio),
         ("visc_ratio", &p.visc_ratio),
         ("tc_speed_ratio", &p.tc_speed_ratio),
-        ("swept_ratio", &p.swept_ratio),
         ("re_per_flow", &p.re_per_flow),
         ("duct_wall_w_per_k", &p.duct_wall_w_per_k),
         ("g_port_re2300_w_per_k", &p.g_port_re2300_w_per_k),

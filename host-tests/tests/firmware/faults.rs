@@ -15,13 +15,20 @@ use eha_sim::faults::{campaign, table, write};
 
 const SPEED_UNSEEN: &str = "a speed sensor error is invisible to the torque cross-check: both loss estimates (from the current and from the port pressures) scale with the measured speed, and the pump's heat with the true speed; a second speed source (the motor drive's commutation frequency) would be needed";
 
-/// (fault, scenario, why the design cannot meet the pass rule).
+const POWER_UNSEEN: &str = "the guard is off for the 60 s of the power loss while the 60 bar load heats the drain (25.1 to 29.9 °C with the normally-open valve open); the restore without a clock reading adds the write policy's margin `rise_k` to the saved record and reads 3.0 K low at power-up (issue 34: in oil below 40 °C the viscous friction is 1.3–2.1 times its 40 °C value, so the unseen heating outgrew the margin); a clock running through the power loss or a margin scaled to the longest unpowered time under load would be needed";
+
+/// (fault, scenario, why the design cannot meet the pass rule). Re-measured
+/// with the oil on its viscosity line (issue 34): speed/gain-x0.5 on the LNG
+/// case now passes (its under-prediction stays below 1 K), speed/stuck-last and
+/// speed/drift on random-1 and the power loss on the LNG case fail.
 const KNOWN_FAILING: &[(&str, &str, &str)] = &[
+    ("speed/stuck-last", "random-1", SPEED_UNSEEN),
     ("speed/stuck-zero", "lng", SPEED_UNSEEN),
     ("speed/stuck-zero", "random-1", SPEED_UNSEEN),
-    ("speed/gain-x0.5", "lng", SPEED_UNSEEN),
     ("speed/gain-x0.5", "random-1", SPEED_UNSEEN),
     ("speed/drift", "lng", SPEED_UNSEEN),
+    ("speed/drift", "random-1", SPEED_UNSEEN),
+    ("power-loss", "lng", POWER_UNSEEN),
 ];
 
 #[test]

@@ -58,10 +58,10 @@ fn model_at_rest(temps: &[f32; N_NODES], air: f32, off_s: u32) -> [f64; N_NODES]
     m.temperatures_c()
 }
 
-/// Measured (one run): drain estimate at the save 37.77 °C (reference 37.73;
-/// the guard's valve holds it near 40 °C); restored after 1 / 6 / 24 h off:
-/// 39.21 / 34.47 / 25.22 °C (uncooled 39.77), reference 24.67 / 20.53 /
-/// 20.01, the firmware model at rest 26.55 / 20.90 / 20.01.
+/// Measured (one run, the oil on its viscosity line since issue 34): restored
+/// after 1 / 6 / 24 h off: 38.97 / 32.27 / 22.56 °C (uncooled 39.81; before
+/// 40.13 / 33.03 / 22.72 of 41.03), reference 26.54 / 21.57 / 20.02, the
+/// firmware model at rest 26.74 / 21.56 / 20.02.
 #[test]
 fn restore_after_a_measured_off_time_is_cooled_and_never_below_the_reference() {
     let rig = Rig::default();
@@ -118,16 +118,12 @@ fn restore_after_a_measured_off_time_is_cooled_and_never_below_the_reference() {
         // The product's restore never reads below the true drain.
         assert!(f64::from(r.temps_c[1]) >= *truth, "off {h} h: restored {} < reference {truth}", r.temps_c[1]);
     }
-    // The gain: after 24 h the restore keeps 0.264 of the saved excess over the
-    // air (measured; 0.13 while the pump housing had no metal path to the motor and
-    // the manifold: now the pump, its internals, the motor (33.5 kJ/K) and the main
-    // block (73.6 kJ/K) form one group at rest whose slowest mode sets the bound's
-    // rate). Asserted as measured, ±0.01 (the bound is deterministic; a quarter, the
-    // earlier aim, is missed by 0.014).
+    // The gain: after 24 h the restore keeps at most a quarter of the saved
+    // excess over the air (measured 0.13; the bound's slowest group decays
+    // with 20 h, the pump's with 11.5 h).
     let Restore::PowerLoss(r) = boot_restore(Restore::Cold, Some(saved), &policy, Some(&cool), Some(T0_S + 24 * 3600)) else { panic!() };
     let excess = saved.temps_c[1] + policy.rise_k - saved.ambient_c;
-    let kept = (r.temps_c[1] - saved.ambient_c) / excess;
-    assert!((kept - 0.264).abs() <= 0.01, "24 h: {} of {excess} K left ({kept:.3}): re-measure", r.temps_c[1] - saved.ambient_c);
+    assert!(r.temps_c[1] - saved.ambient_c <= excess * 0.25, "24 h: {} of {excess} K left", r.temps_c[1] - saved.ambient_c);
 }
 
 /// A clock that reads earlier than the record (reset, battery change) or a

@@ -37,8 +37,9 @@ use std::sync::OnceLock;
 const DURATION_S: f64 = 600.0;
 /// Issue bound on max |drain error|, K (issue 3).
 const MAX_ABS_K: f64 = 1.0;
-/// Bound on max |drain error| once the oil follows its viscosity line and the pump
-/// is split (issue 34), K: the firmware stays within 0.1 K of the reference.
+/// Bound on max |drain error| once the oil follows its viscosity line (issue 34),
+/// K: the firmware stays within 0.1 K of the reference on every acceptance run,
+/// the hour-long hot run and the 0 °C cold start included.
 const MAX_ABS_34_K: f64 = 0.1;
 /// Issue goal on max |drain error|, K (reported, not asserted).
 const GOAL_K: f64 = 0.5;
@@ -47,20 +48,25 @@ const MAX_UNDER_K: f64 = 0.5;
 /// Issue bound on a valve switching time against switching on the true drain, s.
 const MAX_SWITCH_S: f64 = 2.0;
 /// Regression bound on max |drain error| over every run, K: measured worst
-/// 0.070 K (random-1), 2.1×.
+/// 0.098 K (the pump stopped with the valve open), 1.5×; 0.063 K on the
+/// acceptance runs (random-2), 2.4× (issue 34; before, 0.070 K, random-1).
 const REG_MAX_ABS_K: f64 = 0.15;
 /// Regression bound on drain under-prediction over every run, K: measured worst
-/// 0.057 K (random-1), 2.6×.
+/// 0.059 K (random-5), 2.5× (issue 34; before, 0.057 K, random-1).
 const REG_MAX_UNDER_K: f64 = 0.15;
 /// Regression bound on |f32 − f64| drain, K: measured 3.81e-6 K (Case 1 60 bar
 /// and LNG), 2.6×. (The fixed-point spec bound, 0.1 K, is itself 2.2× the
 /// measured 4.47e-2 K, so it serves as that type's regression bound too.)
 const REG_F32_K: f64 = 1e-5;
-/// Regression bound on any switching-time difference, s: measured worst 0.54 s
-/// (random-1 event 1, random-2 event 4), 2.2×.
-const REG_SWITCH_S: f64 = 1.2;
-/// Regression bound on a first-opening difference, s: measured worst 0.14 s
-/// (Case 1 40 bar), 2.1×.
+/// Regression bound on any switching-time difference, s. Measured worst 1.90 s
+/// since the oil follows its viscosity line (issue 34; 0.54 s before): random-2
+/// event 5, a closing at 575.7 s where the drain falls slowly (≈ 0.03 K/s), so the
+/// estimate's +0.06 K there shows as 1.9 s; the next worst 0.71 s (random-1 event
+/// 1). No margin is left for a regression bound above the issue's 2 s: it is the
+/// issue's bound ([`MAX_SWITCH_S`]).
+const REG_SWITCH_S: f64 = MAX_SWITCH_S;
+/// Regression bound on a first-opening difference, s: measured worst 0.08 s
+/// (Case 1 40 bar; 0.14 s before issue 34), 3.75×.
 const REG_FIRST_OPEN_S: f64 = 0.3;
 
 /// One run of the suite: its name, its scenario, and whether the rig has an LNG
@@ -388,16 +394,20 @@ fn load_then_idle() -> Scenario {
     Scenario::Mission(m)
 }
 
-/// The LNG case's 60 bar load with the pump stopped at 285 s, while the guard's valve
-/// is open (the guard opens it at 267.0 s with a dwell on both directions, at 282.4 s
-/// with a dwell that qualifies only the closing): the drain bounds of the acceptance runs over the 300 s after the stop
-/// (the exchanger stays commanded open with no oil through it).
+/// The LNG case's 60 bar load with the pump stopped at 310 s, while the guard's valve
+/// is open (it opens at 297.8 s and would close at 323.8 s; 285 s until issue 34,
+/// when the oil on its viscosity line moved the openings): the drain bounds of the
+/// acceptance runs over the 290 s after the stop (the exchanger stays commanded open
+/// with no oil through it).
 fn stop_with_valve_open() -> Scenario {
     let mut m: Mission = Scenario::Lng { duration_s: 600.0 }.mission().expect("mission");
     m.name = "lng-stop-valve-open".into();
-    m.speed_rpm = Schedule(vec![(0.0, 500.0), (285.0, 500.0), (285.0, 0.0)]);
+    m.speed_rpm = Schedule(vec![(0.0, 500.0), (STOP_S, 500.0), (STOP_S, 0.0)]);
     Scenario::Mission(m)
 }
+
+/// When [`stop_with_valve_open`] stops the pump, s.
+const STOP_S: f64 = 310.0;
 
 /// Pump stopped with the valve open ([`stop_with_valve_open`]): before the exchanger
 /// credit was cut below the LNG table's second point (1.98e-3 L/s), the model credited
@@ -406,7 +416,7 @@ fn stop_with_valve_open() -> Scenario {
 #[test]
 fn pump_stopped_with_valve_open_drain_within_bounds() {
     let r = closed_loop(&Case::new("lng-stop-valve-open", stop_with_valve_open()));
-    let open_at_stop = r.events.iter().take_while(|(t, _)| *t <= 285.0).last().is_some_and(|e| e.1);
+    let open_at_stop = r.events.iter().take_while(|(t, _)| *t <= STOP_S).last().is_some_and(|e| e.1);
     assert!(open_at_stop, "the scenario needs the valve open when the pump stops: {:?}", r.events);
     let e = drain_stats(&r);
     println!(
@@ -439,7 +449,7 @@ fn valve_first_opening_within_2s() {
                 if !(f.1 && t.1 && d <= MAX_SWITCH_S) {
                     failures.push(format!("{n}: {d:.2} s"));
                 }
-                // Regression: 2.1x the measured worst 0.14 s.
+                // Regression: [`REG_FIRST_OPEN_S`].
                 if d > REG_FIRST_OPEN_S {
                     failures.push(format!("{n}: {d:.2} s > regression bound {REG_FIRST_OPEN_S} s"));
                 }
@@ -552,8 +562,8 @@ fn valve_switching_times_match_true_drain() {
                 if !ok {
                     failures.push(format!("{n} event {i} ({}{}) at {te:.2} s: {d:+.2} s", if open { "open" } else { "close" }, if stopped { ", pump stopped" } else { "" }));
                 }
-                // Regression: 2.2x the measured worst 0.54 s (closings with the
-                // pump stopped have their own bound above).
+                // Regression: [`REG_SWITCH_S`] (closings with the pump stopped have
+                // their own bound above).
                 if (!stopped || open) && d.abs() > REG_SWITCH_S {
                     failures.push(format!("{n} event {i} at {te:.2} s: {d:+.2} s > regression bound {REG_SWITCH_S} s"));
                 }
