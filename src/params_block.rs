@@ -3,7 +3,7 @@
 //! matrix included), with a header and a CRC, flashed into its own region (the
 //! `PARAMS` region of the board's `memory.x`) and read at boot.
 //!
-//! Layout (little-endian, [`BLOCK_LEN`] = 2216 bytes):
+//! Layout (little-endian, [`BLOCK_LEN`] = 2480 bytes):
 //!
 //! | offset | size | field |
 //! |---|---|---|
@@ -12,7 +12,7 @@
 //! | 6 | 2 | number of words ([`N_WORDS`]) |
 //! | 8 | 16 | rig id, ASCII, zero-padded |
 //! | 24 | 4 × N_WORDS | the words of [`ModelConsts`] in field order |
-//! | 2212 | 4 | CRC-32 (IEEE) of bytes 0..2212 |
+//! | 2476 | 4 | CRC-32 (IEEE) of bytes 0..2476 |
 //!
 //! Erased flash (`0xFF…`) or empty memory (`0x00…`, QEMU) at the magic means
 //! *absent*: the firmware runs the compiled-in [`crate::params::DEFAULT_CONSTS`]
@@ -29,11 +29,11 @@ use crate::model::ModelConsts;
 pub const BLOCK_LEN: usize = WORDS_AT + 4 * N_WORDS + 4;
 /// `"EHAP"` little-endian.
 pub const MAGIC: u32 = u32::from_le_bytes(*b"EHAP");
-/// Format version of this firmware. 5: the oil over temperature (547 words,
-/// 2216 bytes): the tables over the case-oil temperature (`leak_ratio`,
+/// Format version of this firmware. 5: the oil over temperature (613 words,
+/// 2480 bytes): the tables over the case-oil temperature (`leak_ratio`,
 /// `visc_ratio`, `tc_speed`: each 1 at 40 degC and monotonic, checked in
 /// [`ModelConsts::check_values`]), the ducts' transitional films (`re_q`,
-/// `g_wall`, `g_trans`), `rc2`, and `Phi` over the three fast states (pump
+/// `g_wall`, `g_trans` at Re = 2300, 1e4, 3e4, 1e5), `rc2`, and `Phi` over the three fast states (pump
 /// housing, case oil, loop oil; the blocks and actuator by explicit Euler, their
 /// step bounded in the same check); `k_mu`, `t_mu` gone.
 /// 4: the pump's no-load and viscous

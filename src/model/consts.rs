@@ -8,7 +8,7 @@
 use super::{ConfigError, HA_PER_A, KW_PER_W, L_PER_M3, PA_PER_HBAR, RAD_T_K};
 use crate::num::Num;
 use crate::params::{
-    ReducedParams, FILM_PROPERTY_C, N_COARSE, N_DUCTS, NODE_ACTUATOR, NODE_BALL_BLOCK, NODE_MAIN_BLOCK, N_NODES, N_OUTER, N_PHI, N_STATES,
+    ReducedParams, FILM_PROPERTY_C, N_COARSE, N_DUCTS, N_RE, NODE_ACTUATOR, NODE_BALL_BLOCK, NODE_MAIN_BLOCK, N_NODES, N_OUTER, N_PHI, N_STATES,
     N_TABLE, N_TEMP, S_PER_STEP, S_PER_TICK, TEMP_TABLE_MIN_C, TEMP_TABLE_STEP_K,
 };
 
@@ -125,9 +125,10 @@ pub struct ModelConsts<S> {
     pub re_q: [S; N_DUCTS],
     /// Block walls behind the loop's and the ball-valve passage's films, kW/K.
     pub g_wall: [S; 2],
-    /// The ducts' films at Re = 2300 and Re = 1e4 on the coarse temperature grid,
-    /// kW/K: per point `[port 2300, port 1e4, loop 2300, loop 1e4, ball 2300, ball 1e4]`.
-    pub g_trans: [[S; 2 * N_DUCTS]; N_COARSE],
+    /// The ducts' films at the Reynolds numbers of `params::DUCT_RE` (2300, 1e4,
+    /// 3e4, 1e5) on the coarse temperature grid, kW/K: per point `[port 2300, port
+    /// 1e4, port 3e4, port 1e5, loop ..., ball ...]`.
+    pub g_trans: [[S; N_RE * N_DUCTS]; N_COARSE],
     /// Cooling at rest: decay rate of each node's bound on its excess over
     /// the air, 1/s (all 0: no bound; [`ReducedParams::rest_rate_per_s`]).
     pub rest_rate: [S; N_NODES],
@@ -187,7 +188,7 @@ impl Word for f64 {
 pub const N_SCALARS: usize = 37;
 /// Number of words in a [`ModelConsts`].
 pub const N_WORDS: usize =
-    N_SCALARS + N_STATES + 3 * N_OUTER + 5 * N_TABLE + 3 * N_TEMP + N_DUCTS + 2 + 2 * N_DUCTS * N_COARSE + 2 * N_NODES + N_PHI * N_PHI;
+    N_SCALARS + N_STATES + 3 * N_OUTER + 5 * N_TABLE + 3 * N_TEMP + N_DUCTS + 2 + N_RE * N_DUCTS * N_COARSE + 2 * N_NODES + N_PHI * N_PHI;
 
 // Every field is a word: no padding, no other data.
 const _: () = assert!(core::mem::size_of::<ModelConsts<f32>>() == 4 * N_WORDS);
@@ -325,7 +326,7 @@ impl ModelConsts<()> {
         tc_speed: [(); N_TEMP],
         re_q: [(); N_DUCTS],
         g_wall: [(); 2],
-        g_trans: [[(); 2 * N_DUCTS]; N_COARSE],
+        g_trans: [[(); N_RE * N_DUCTS]; N_COARSE],
         rest_rate: [(); N_NODES],
         rest_mode: [(); N_NODES],
         phi: [[(); N_PHI]; N_PHI],
@@ -529,17 +530,10 @@ pub fn derive(p: &ReducedParams) -> Result<ModelConsts<f64>, ConfigError> {
         re_q: p.re_per_flow.map(|x| x / L_PER_M3),
         g_wall: p.duct_wall_w_per_k.map(|x| x * KW_PER_W),
         g_trans: {
-            let mut t = [[0.0; 2 * N_DUCTS]; N_COARSE];
+            let mut t = [[0.0; N_RE * N_DUCTS]; N_COARSE];
+            let films = p.duct_films();
             for (j, row) in t.iter_mut().enumerate() {
-                let cols = [
-                    &p.g_port_re2300_w_per_k,
-                    &p.g_port_re1e4_w_per_k,
-                    &p.g_loop_re2300_w_per_k,
-                    &p.g_loop_re1e4_w_per_k,
-                    &p.g_ball_re2300_w_per_k,
-                    &p.g_ball_re1e4_w_per_k,
-                ];
-                for (o, col) in row.iter_mut().zip(cols) {
+                for (o, col) in row.iter_mut().zip(films.iter().flatten()) {
                     *o = col.get(j).copied().unwrap_or(0.0) * KW_PER_W;
                 }
             }

@@ -128,7 +128,10 @@ struct Consts<N> {
     g_wall: [N; 2], // walls behind the loop's and the ball passage's films, kW/K
     re_lam: N,    // 0.23: Re = 2300, the end of the laminar range, / 1e4
     inv_span: N,  // 1 / 0.77: the transition's width in Re / 1e4
+    re3: N,       // 3: Re = 3e4, / 1e4
+    inv_span3: N, // 1 / 7: from Re = 3e4 to 1e5, / 1e4
     t_min: N,     // TEMP_TABLE_MIN_C, degC
+    tab_last: N,  // N_TABLE - 2 (the last interval's left point, grid units)
     ga: [N; N_OUTER],   // outer, kW/K
     gb: [N; N_OUTER],   // outer, kW/K^1.25
     gr: [N; N_OUTER],   // outer radiation 4 eps sigma A (300 K)^3, kW/K per (T_m / 300 K)^3
@@ -188,8 +191,8 @@ pub struct Model<N: Num> {
     g_loop: [N; N_TABLE],
     g_ball: [N; N_TABLE],
     g_lng: [N; N_TABLE],
-    /// The ducts' films at Re = 2300 and 1e4 on the coarse temperature grid.
-    g_trans: [[N; 2 * crate::params::N_DUCTS]; crate::params::N_COARSE],
+    /// The ducts' films at Re = 2300, 1e4, 3e4 and 1e5 on the coarse temperature grid.
+    g_trans: [[N; crate::params::N_RE * crate::params::N_DUCTS]; crate::params::N_COARSE],
     /// Temperature tables at the case oil: leakage, viscous friction, gap speed
     /// factor ([`ModelConsts::leak_ratio`] ...), point by point.
     t_tab: [[N; 3]; N_TEMP],

@@ -35,6 +35,21 @@ pub fn locate<N: Num>(x: N, root_scale: N, one: N) -> At<N> {
     }
 }
 
+/// [`locate`] that extrapolates past the last point along the last interval
+/// (`frac > 1`) instead of holding the end value: for a table whose law is close to
+/// linear in `sqrt(x)` at its end (the case gap's film, `Nu ∝ Ta^0.241 ∝ x^0.48`).
+/// `last` is `N_TABLE - 2` in the number type.
+#[inline(always)]
+pub fn locate_ext<N: Num>(x: N, root_scale: N, last: N) -> At<N> {
+    let u = x.sqrt_abs().mul(root_scale);
+    let (i, frac) = u.split_floor();
+    match usize::try_from(i) {
+        Ok(j) if j <= N_TABLE - 2 => At { j, frac },
+        Ok(_) => At { j: N_TABLE - 2, frac: u.sub(last) },
+        Err(_) => At { j: 0, frac: N::ZERO },
+    }
+}
+
 /// Value of `table` at `at` (linear interpolation).
 #[inline(always)]
 pub fn value<N: Num, const K: usize>(table: &[N; K], at: &At<N>) -> N {

@@ -288,13 +288,14 @@ pub fn regressions(measured: &BTreeMap<String, ImageBudget>, budget: &BTreeMap<S
 
 /// The product image's absolute budgets (issue 14): `Guard::tick` ≤ 400
 /// instructions per tick on the mean, `Guard::new` ≤ 100 k, boot stack ≤ 4 KiB,
-/// tick-loop stack ≤ 2 KiB, flash (`.text` + `.rodata`) ≤ 32 KiB.
+/// tick-loop stack ≤ 2 KiB, flash (`.text` + `.rodata`) ≤ 40 KiB (issue 34: the
+/// oil's tables over temperature; 32 KiB before).
 pub const PRODUCT_LIMITS: [(&str, f64); 5] = [
     ("instr_per_tick_mean", 400.0),
     ("guard_new_instr", 100_000.0),
     ("stack_boot_b", 4096.0),
     ("stack_tick_b", 2048.0),
-    ("flash_b", 32768.0),
+    ("flash_b", 40960.0),
 ];
 
 /// Every [`PRODUCT_LIMITS`] figure of `product-mps2` that is over its limit
@@ -346,7 +347,7 @@ pub fn run(a: &BudgetArgs) -> Result<()> {
         bail!("firmware budget exceeded ({}):\n  {}", path.display(), r.join("\n  "));
     }
     println!(
-        "every figure within {} + {:.0} %, and the product image within its limits (400 instr/tick, 100 k init, 4/2 KiB stack, 32 KiB flash)",
+        "every figure within {} + {:.0} %, and the product image within its limits (400 instr/tick, 100 k init, 4/2 KiB stack, 40 KiB flash)",
         path.display(),
         100.0 * REGRESSION_MARGIN
     );
@@ -380,7 +381,7 @@ mod tests {
     }
 
     /// The product image's absolute limits: the committed figures pass, one
-    /// byte over 32 KiB of flash fails, a missing figure fails.
+    /// byte over 40 KiB of flash fails, a missing figure fails.
     #[test]
     fn product_limits_are_absolute() {
         let ok = ImageBudget {

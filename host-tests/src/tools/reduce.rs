@@ -141,11 +141,12 @@ pub fn reduce_without_jacobian(rig: &Rig) -> ReducedParams {
         let (dd, len, sc, block) = ducts[k];
         coarse(&|t| wall(duct(2300.0 * PI * dd * oil.nu_m2_per_s(t) / 4.0, dd, len, sc), block))
     };
-    let re1e4 = |k: usize| {
+    // the turbulent anchors (Re = 1e4, 3e4, 1e5) with the oil's properties at T
+    let re_turb = |k: usize, re: f64| {
         let (dd, len, sc, block) = ducts[k];
         coarse(&|t| {
             let nu_t = oil.nu_m2_per_s(t);
-            wall(network::duct_conductance(rig, 1e4 * PI * dd * nu_t / 4.0, dd, len, sc, t, nu_t), block)
+            wall(network::duct_conductance(rig, re * PI * dd * nu_t / 4.0, dd, len, sc, t, nu_t), block)
         })
     };
     let rho_cp40 = rho * oil.cp(t40);
@@ -225,11 +226,17 @@ pub fn reduce_without_jacobian(rig: &Rig) -> ReducedParams {
         re_per_flow,
         duct_wall_w_per_k,
         g_port_re2300_w_per_k: re2300(0),
-        g_port_re1e4_w_per_k: re1e4(0),
+        g_port_re1e4_w_per_k: re_turb(0, 1e4),
+        g_port_re3e4_w_per_k: re_turb(0, 3e4),
+        g_port_re1e5_w_per_k: re_turb(0, 1e5),
         g_loop_re2300_w_per_k: re2300(1),
-        g_loop_re1e4_w_per_k: re1e4(1),
+        g_loop_re1e4_w_per_k: re_turb(1, 1e4),
+        g_loop_re3e4_w_per_k: re_turb(1, 3e4),
+        g_loop_re1e5_w_per_k: re_turb(1, 1e5),
         g_ball_re2300_w_per_k: re2300(2),
-        g_ball_re1e4_w_per_k: re1e4(2),
+        g_ball_re1e4_w_per_k: re_turb(2, 1e4),
+        g_ball_re3e4_w_per_k: re_turb(2, 3e4),
+        g_ball_re1e5_w_per_k: re_turb(2, 1e5),
         g_port_w_per_k: g_port,
         g_loop_block_w_per_k: g_loop,
         g_ball_block_w_per_k: g_ball,
@@ -478,7 +485,7 @@ pub fn scalar_fields(p: &ReducedParams) -> [(&'static str, f64); 36] {
 }
 
 /// The table and array fields of `p` by name, in `DEFAULT`'s order.
-pub fn array_fields(p: &ReducedParams) -> [(&'static str, &[f64]); 19] {
+pub fn array_fields(p: &ReducedParams) -> [(&'static str, &[f64]); 25] {
     [
         ("g_case_w_per_k", &p.g_case_w_per_k),
         ("leak_ratio", &p.leak_ratio),
@@ -488,10 +495,16 @@ pub fn array_fields(p: &ReducedParams) -> [(&'static str, &[f64]); 19] {
         ("duct_wall_w_per_k", &p.duct_wall_w_per_k),
         ("g_port_re2300_w_per_k", &p.g_port_re2300_w_per_k),
         ("g_port_re1e4_w_per_k", &p.g_port_re1e4_w_per_k),
+        ("g_port_re3e4_w_per_k", &p.g_port_re3e4_w_per_k),
+        ("g_port_re1e5_w_per_k", &p.g_port_re1e5_w_per_k),
         ("g_loop_re2300_w_per_k", &p.g_loop_re2300_w_per_k),
         ("g_loop_re1e4_w_per_k", &p.g_loop_re1e4_w_per_k),
+        ("g_loop_re3e4_w_per_k", &p.g_loop_re3e4_w_per_k),
+        ("g_loop_re1e5_w_per_k", &p.g_loop_re1e5_w_per_k),
         ("g_ball_re2300_w_per_k", &p.g_ball_re2300_w_per_k),
         ("g_ball_re1e4_w_per_k", &p.g_ball_re1e4_w_per_k),
+        ("g_ball_re3e4_w_per_k", &p.g_ball_re3e4_w_per_k),
+        ("g_ball_re1e5_w_per_k", &p.g_ball_re1e5_w_per_k),
         ("g_port_w_per_k", &p.g_port_w_per_k),
         ("g_loop_block_w_per_k", &p.g_loop_block_w_per_k),
         ("g_ball_block_w_per_k", &p.g_ball_block_w_per_k),
