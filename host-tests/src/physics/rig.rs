@@ -435,6 +435,69 @@ pub struct Nuisance {
     pub oil_capacity_scale: f64,
 }
 
+/// One uncertain parameter group of the rig (`[[uncertain]]` in the rig file),
+/// sampled by `eha-sim uq` (Latin hypercube, log-uniform): every field of
+/// [`Uncertain::keys`] is multiplied by one factor between [`Uncertain::low`]
+/// and [`Uncertain::high`] (the nominal, factor 1, inside). The ranges and their
+/// sources are docs/calibration.md's "Uncertain parameters".
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Uncertain {
+    /// Short name (a column of the sample table).
+    pub name: String,
+    /// Rig-file keys scaled together, as [`Rig::set_override`] names them.
+    pub keys: Vec<String>,
+    /// Lowest factor on the nominal (≤ 1).
+    pub low: f64,
+    /// Highest factor on the nominal (≥ 1).
+    pub high: f64,
+    /// Where the range comes from.
+    pub source: String,
+}
+
+impl Uncertain {
+    fn new(name: &str, keys: &[&str], low: f64, high: f64, source: &str) -> Self {
+        Uncertain { name: name.into(), keys: keys.iter().map(|k| (*k).to_string()).collect(), low, high, source: source.into() }
+    }
+
+    /// The documented ranges of the paper rig (committed before any band was
+    /// computed; docs/calibration.md). The three stage-1 values and the ram-air
+    /// share are fitted, not sampled: each sample would need its own refit.
+    pub fn paper_ranges() -> Vec<Uncertain> {
+        vec![
+            Uncertain::new(
+                "leak_gap",
+                &["pump.gaps.piston_gap_m", "pump.gaps.slipper_gap_m", "pump.gaps.port_gap_m"],
+                0.75,
+                1.25,
+                "assumed 12 µm films; 9–15 µm is the running-gap range of a small axial-piston unit (Ivantysyn & Ivantysynova, Hydrostatic Pumps and Motors, 2001, ch. 5)",
+            ),
+            Uncertain::new("no_load_torque", &["pump.no_load_torque_nm"], 0.5, 2.0, "assumed 0.3 N·m: lip seal 0.1–0.3 N·m plus two rolling bearings 0.05–0.3 N·m (SKF bearing friction model)"),
+            Uncertain::new(
+                "viscous_torque",
+                &["pump.viscous_torque_coeff"],
+                0.5,
+                2.0,
+                "assumed C_v = 5e4: the order of Wilson-model coefficients of small axial-piston units (Manring, Hydraulic Control Systems, 2005), a factor 2 either way",
+            ),
+            Uncertain::new("oil_nu40", &["oil.nu40_cst"], 0.9, 1.1, "ISO 3448: an ISO VG 46 oil has 41.4–50.6 cSt at 40 °C"),
+            Uncertain::new("oil_nu100", &["oil.nu100_cst"], 0.93, 1.07, "VG 46 hydraulic oils (HM/HV, VI 95–140): 6.4–7.3 cSt at 100 °C (data sheets)"),
+            Uncertain::new("oil_cp", &["oil.cp20_j_per_kg_k"], 0.95, 1.05, "mineral oils 1.79–1.97 kJ/(kg·K) at 20 °C (Cragoe; data sheets)"),
+            Uncertain::new("oil_k", &["oil.k0_w_per_m_k"], 0.93, 1.07, "mineral oils 0.125–0.143 W/(m·K) (Cragoe; data sheets)"),
+            Uncertain::new("case_area", &["pump.case_inner_area_m2"], 0.7, 1.4, "assumed 0.02 m² of inner case wetted by the case oil (a 19 cm³/rev housing), 0.014–0.028 m²"),
+            Uncertain::new("case_gap", &["pump.case_gap_m"], 0.67, 1.33, "assumed 3 mm radial gap barrel–case, 2–4 mm"),
+            Uncertain::new("port_area", &["pump.port_area_scale"], 0.7, 1.4, "the port passage as drawn (assumed Ø12 × 50 mm); cross drillings and kidneys add area"),
+            Uncertain::new("inner_films", &["nuisance.inner_scale"], 0.85, 1.15, "duct film correlations (Hausen, Gnielinski): ±10–15 % scatter on their data"),
+            Uncertain::new("outer_convection", &["nuisance.outer_scale"], 0.8, 1.2, "free convection correlations (Churchill–Chu, McAdams): ±20 % on real housings with fins, flanges and bolts"),
+            Uncertain::new("emissivity", &["outside.emissivity"], 0.82, 1.12, "assumed 0.85: painted or oxidised steel and cast iron 0.7–0.95 (Incropera, table A.11)"),
+            Uncertain::new("metal_capacity", &["nuisance.metal_capacity_scale"], 0.95, 1.05, "Table 2's masses to a few per cent; steel and cast iron c_p 440–490 J/(kg·K)"),
+            Uncertain::new("mount", &["blocks.mount_w_per_k"], 0.5, 2.0, "assumed 2 W/K: a 100 × 100 mm foot, dry painted contact 100–400 W/(m²·K) (Madhusudana, Thermal Contact Conductance, 2014)"),
+            Uncertain::new("sensor_tau", &["blocks.sensor_tau_s"], 0.5, 5.0, "assumed 2 s: sheathed probes in thermowells in flowing oil answer in 1–10 s (t63)"),
+            Uncertain::new("winding_r", &["motor.r25_ohm"], 0.97, 1.03, "Table 2's 0.074 Ω, read to two digits"),
+        ]
+    }
+}
+
 /// The switchable model extensions; all off (`None`/`false`) in the baseline.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -487,6 +550,9 @@ pub struct Rig {
     /// Model extensions.
     #[serde(default)]
     pub ext: Extensions,
+    /// The uncertain parameters and their ranges (`eha-sim uq`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub uncertain: Vec<Uncertain>,
 }
 
 impl Default for Rig {
@@ -592,6 +658,7 @@ impl Default for Rig {
             lng: Lng::default(),
             nuisance: Nuisance { outer_scale: 1.0, inner_scale: 1.0, metal_capacity_scale: 1.0, oil_capacity_scale: 1.0 },
             ext: Extensions::default(),
+            uncertain: Uncertain::paper_ranges(),
         }
     }
 }
@@ -683,6 +750,14 @@ impl Rig {
         if !(self.outside.altitude_m.is_finite() && (-500.0..=11_000.0).contains(&self.outside.altitude_m)) {
             return Err(RigError::Invalid("outside.altitude_m", format!("must be within -500..11000 m (troposphere), got {}", self.outside.altitude_m)));
         }
+        for u in &self.uncertain {
+            if u.name.is_empty() || u.keys.is_empty() || u.source.trim().is_empty() {
+                return Err(RigError::Invalid("uncertain", format!("`{}`: needs a name, keys and a source", u.name)));
+            }
+            if !(u.low.is_finite() && u.high.is_finite() && 0.0 < u.low && u.low <= 1.0 && u.high >= 1.0) {
+                return Err(RigError::Invalid("uncertain", format!("`{}`: the range {}..{} must hold the nominal (0 < low <= 1 <= high)", u.name, u.low, u.high)));
+            }
+        }
         if let Some(tau) = self.ext.sensor_lag {
             if !(tau.is_finite() && tau > 0.0) {
                 return Err(RigError::Invalid("ext.sensor_lag", format!("must be > 0 s, got {tau}")));
@@ -755,6 +830,24 @@ mod tests {
         let old = text.replace("emissivity = 0.85", "emissivity = 0.85\nram_property_c = 16.0");
         let e = Rig::from_toml_str(&old, "old").expect_err("refused");
         assert!(e.to_string().contains("altitude"), "{e}");
+    }
+
+    /// Every uncertain key names a number of the rig file, every range holds its
+    /// nominal and cites a source; a bad range is refused.
+    #[test]
+    fn uncertain_keys_resolve() {
+        let rig = Rig::default();
+        let doc = toml::Value::try_from(&rig).expect("toml");
+        assert!(rig.uncertain.len() >= 15);
+        for u in &rig.uncertain {
+            for k in &u.keys {
+                let v = k.split('.').try_fold(&doc, |d, p| d.get(p)).unwrap_or_else(|| panic!("{}: no key {k}", u.name));
+                assert!(v.as_float().is_some_and(|x| x > 0.0), "{}: {k} is not a positive number", u.name);
+            }
+        }
+        let mut bad = rig.clone();
+        bad.uncertain[0].low = 1.2;
+        assert!(Rig::from_toml_str(&bad.to_toml(), "bad").is_err());
     }
 
     /// The optional pump structure survives the TOML round trip and is off
