@@ -42,6 +42,10 @@ enum Cmd {
     /// Firmware parameter blocks (firmware-params.bin): write one from a rig
     /// file, or run the firmware's boot checks on one.
     ParamsBlock(eha_sim::params_block::ParamsBlockArgs),
+    /// Uncertainty bands: Case 1 over Latin-hypercube samples of the rig's
+    /// [[uncertain]] parameters (in parallel); 5/50/95 % bands of every channel
+    /// (CSV, PNG) and the paper's numbers against their 90 % bands.
+    Uq(eha_sim::uq::UqArgs),
     /// Commissioning: calibrate the reference model to your rig's logs,
     /// validate on held-out logs, reduce to firmware parameters and check
     /// them (rig.toml, params.rs, firmware-params.bin, report.md, PNGs);
@@ -60,6 +64,7 @@ fn main() -> ExitCode {
         Cmd::FwBudget(a) => eha_sim::pil::budget::run(&a),
         Cmd::Faults(a) => eha_sim::faults::run(&a),
         Cmd::ParamsBlock(a) => eha_sim::params_block::run(&a),
+        Cmd::Uq(a) => eha_sim::uq::run_cli(&a),
         // Own exit codes: 0 diagnosis made (none included), 2 bad input.
         Cmd::Diagnose(a) => return eha_sim::diagnosis::cli::run(&a),
         Cmd::DiagnoseSweep(a) => return eha_sim::diagnosis::sweep::run(&a),

@@ -303,7 +303,7 @@ mod fw {
         let Some(scales) = InputScales::<Real>::new() else {
             semihosting::process::exit(106)
         };
-        model.set_temperatures(&[16.0; 6], 16.0);
+        model.set_temperatures(&[16.0; eha_guard::params::N_NODES], 16.0);
 
         // Stack used by boot + init (f64 matrix exponential), then repaint to measure
         // the tick loop alone (its figure includes main's own frame).

@@ -22,7 +22,7 @@
 
 use super::consts::{ModelConsts, N_WORDS};
 use super::ConfigError;
-use crate::params::{N_NODES, N_TABLE};
+use crate::params::{N_COARSE, N_DUCTS, N_NODES, N_PHI, N_RE, N_TABLE, N_TEMP};
 
 /// A range of one or more consecutive words.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -72,6 +72,7 @@ bounds! {
     w_scale: 1, [1.0, 250.0], "speed table index scale 31/sqrt(w_max) (rig 12.4)";
     rc0: 1, [1.0, 2.5], "oil rho c_p at 0 degC, kJ/(L K): hydraulic oils 1.5-1.8 (rig 1.55)";
     rc1: 1, [0.0, 0.01], "slope of rho c_p, kJ/(L K^2): c_p rises with temperature (rig 0.0032)";
+    rc2: 1, [-1.0e-4, 1.0e-4], "curvature of rho c_p, kJ/(L K^3): density and c_p each linear in T (rig -2.1e-6); rho c_p > 0 over -60..150 degC checked";
     inv_v_case: 1, [0.02, 200.0], "1 / case oil volume, 1/L: 5 mL to 50 L (rig 0.15 L)";
     inv_v_loop: 1, [2.0e-3, 200.0], "1 / loop oil volume, 1/L: 5 mL to 500 L (rig 1.43 L)";
     v_port: 1, [1.0e-3, 10.0], "one port passage's oil volume, L (rig 0.05)";
@@ -85,8 +86,6 @@ bounds! {
     g_case_slope: 1, [-0.05, 0.05], "relative slope of the case film conductance, 1/K (rig -5.3e-4)";
     alpha_t0: 1, [0.109, 0.274], "alpha x 273.15 (checked)";
     lng_in: 1, [-200.0, -100.0], "LNG inlet temperature, degC (Table 6: -162)";
-    k_mu: 1, [0.0, 0.1], "viscosity exponent of the leakage, 1/K (0: off)";
-    t_mu: 1, [-40.0, 150.0], "reference temperature of the leakage conductance, degC";
     pole_pairs: 1, [1.0, 50.0], "motor pole pairs (rig 4): the drive's electrical frequency is pole pairs x rev/s, the speed check's second source";
     inv_c: 1, [1.0e-4, 10.0], "1 / pump housing capacity, K/kJ: 0.1-10 000 kJ/K (rig 9.2 kJ/K)";
     inv_c: 2, [0.0, 0.0], "oil nodes: their capacity comes from rho c_p and the volume, this word must be 0";
@@ -99,9 +98,15 @@ bounds! {
     g_loop: N_TABLE, [0.0, 1.0], "loop oil - main block over flow, kW/K";
     g_ball: N_TABLE, [0.0, 1.0], "ball-valve oil - its block over flow, kW/K (first point checked > 0)";
     g_lng: N_TABLE, [0.0, 1.0], "LNG exchanger eps C_min over flow, kW/K (eqs. 20-22)";
+    leak_ratio: N_TEMP, [1.0e-4, 100.0], "leakage ratio mu(40)/mu(T) over -20..177.5 degC (VG 46 rig 0.0098-24.9; 1 at 40 degC and rising checked)";
+    visc_ratio: N_TEMP, [1.0e-3, 250.0], "viscous friction ratio mu(T)/mu(40) (rig 102 at -20 degC to 0.040; 1 at 40 degC and falling checked)";
+    tc_speed: N_TEMP, [1.0e-4, 100.0], "case-gap speed factor nu(40)/nu(T) (rig 0.010-22.6; 1 at 40 degC and rising checked)";
+    re_q: N_DUCTS, [1.0e-3, 100.0], "duct Reynolds number / 1e4 per L/s at 40 degC: bores 2-50 mm (rig 0.23-0.35)";
+    g_wall: 2, [1.0e-4, 10.0], "block walls behind the loop and ball-valve films, kW/K (rig 0.09, 0.02)";
+    g_trans: N_COARSE * N_RE * N_DUCTS, [0.0, 100.0], "duct films at Re 2300/1e4/3e4/1e5 on the coarse temperature grid, kW/K (rig 7.9e-4 to 34)";
     rest_rate: N_NODES, [0.0, 1.0e-3], "cooling bound at rest, 1/s: time constants above 17 min (rig 5.4-20 h; checked against the model)";
     rest_mode: N_NODES, [0.0, 1.0], "cooling bound's mode shape, node order";
-    phi: N_NODES * N_NODES, [-1.0e-4, 0.1], "exact-ZOH matrix Phi of the 0.1 s step, s (diagonal near 0.1; checked against the model's own Jacobian)";
+    phi: N_PHI * N_PHI, [-1.0e-4, 0.1], "exact-ZOH matrix Phi of the 0.1 s step over the pump housing, case oil and loop oil, s (diagonal near 0.1; checked against the model's own Jacobian)";
 }
 
 // const evaluation: an out-of-range index is a compile error, never a panic

@@ -7,7 +7,10 @@
 
 use super::{ConfigError, HA_PER_A, KW_PER_W, L_PER_M3, PA_PER_HBAR, RAD_T_K};
 use crate::num::Num;
-use crate::params::{ReducedParams, N_NODES, N_TABLE, S_PER_TICK};
+use crate::params::{
+    ReducedParams, FILM_PROPERTY_C, N_COARSE, N_DUCTS, N_RE, NODE_ACTUATOR, NODE_BALL_BLOCK, NODE_MAIN_BLOCK, N_NODES, N_OUTER, N_PHI, N_STATES,
+    N_TABLE, N_TEMP, S_PER_STEP, S_PER_TICK, TEMP_TABLE_MIN_C, TEMP_TABLE_STEP_K,
+};
 
 /// Constants of the reduced model in model units, scalar type `S` (`f64` on the
 /// host, `f32` in a parameter block). Field order is the block's word order.
@@ -60,6 +63,8 @@ pub struct ModelConsts<S> {
     pub rc0: S,
     /// Slope of `rho c_p`, kJ/(L K^2).
     pub rc1: S,
+    /// Curvature of `rho c_p`, kJ/(L K^3) (density and specific heat both linear).
+    pub rc2: S,
     /// 1 / case oil volume, 1/L.
     pub inv_v_case: S,
     /// 1 / loop oil volume, 1/L.
@@ -70,14 +75,14 @@ pub struct ModelConsts<S> {
     pub v_ball: S,
     /// 1 / ring oil volume, 1/L.
     pub inv_v_ring: S,
-    /// Share of the mechanical loss into the delivered oil.
+    /// Share of the pump's viscous and pressure friction into the delivered oil.
     pub f_out: S,
-    /// Share of the pump friction's viscous and pressure terms into the case
-    /// oil; `1 - f_out - f_case` heats the pump housing.
+    /// Share of the pump's viscous and pressure friction into the case oil;
+    /// `1 - f_out - f_case` heats the pump housing (with the no-load friction).
     pub f_case: S,
-    /// Pump no-load friction, kW per hrad/s (extended eq. 8), into the pump housing.
+    /// Pump no-load friction, kW per hrad/s (extended eq. 8).
     pub k_m0: S,
-    /// Pump viscous friction, kW per (hrad/s)^2 (extended eq. 8), split `f_out`/`f_case`.
+    /// Pump viscous friction at 40 degC, kW per (hrad/s)^2 (extended eq. 8).
     pub k_mv: S,
     /// Oil expansion coefficient alpha, 1/K (compression and throttling, h(T, p)).
     pub alpha: S,
@@ -88,20 +93,16 @@ pub struct ModelConsts<S> {
     pub alpha_t0: S,
     /// LNG inlet temperature, degC (eqs. 20-22).
     pub lng_in: S,
-    /// Viscosity exponent of the leakage, 1/K (0: off).
-    pub k_mu: S,
-    /// Reference temperature of the leakage conductance, degC.
-    pub t_mu: S,
     /// Motor pole pairs (the speed check's electrical frequency, `crate::speedcheck`).
     pub pole_pairs: S,
-    /// 1 / capacity of the metal nodes, K/kJ (oil nodes 0).
-    pub inv_c: [S; N_NODES],
+    /// 1 / capacity of the metal states, K/kJ (oil nodes 0).
+    pub inv_c: [S; N_STATES],
     /// Outer surfaces, constant conductance, kW/K (eqs. 15-16).
-    pub ga: [S; 4],
+    pub ga: [S; N_OUTER],
     /// Outer surfaces, `|dT|^(1/4)` conductance, kW/K^1.25.
-    pub gb: [S; 4],
+    pub gb: [S; N_OUTER],
     /// Outer surfaces, radiation `4 eps sigma A (300 K)^3`, kW/K (eq. 19).
-    pub gr: [S; 4],
+    pub gr: [S; N_OUTER],
     /// Case oil <-> pump housing over `sqrt` speed grid, kW/K.
     pub g_case: [S; N_TABLE],
     /// Port passage <-> pump housing over flow, kW/K.
@@ -112,14 +113,33 @@ pub struct ModelConsts<S> {
     pub g_ball: [S; N_TABLE],
     /// LNG exchanger `eps C_min` over flow, kW/K (eqs. 20-22).
     pub g_lng: [S; N_TABLE],
+    /// Leakage ratio `mu(40) / mu(T)` over the temperature grid (1 at 40 degC,
+    /// non-decreasing).
+    pub leak_ratio: [S; N_TEMP],
+    /// Viscous friction ratio `mu(T) / mu(40)` over the temperature grid (1 at
+    /// 40 degC, non-increasing).
+    pub visc_ratio: [S; N_TEMP],
+    /// Case-gap speed factor `nu(40) / nu(T)` over the temperature grid (1 at
+    /// 40 degC, non-decreasing).
+    pub tc_speed: [S; N_TEMP],
+    /// Reynolds number of each duct (port, loop, ball) over 1e4 per L/s of flow at
+    /// the 40 degC viscosity.
+    pub re_q: [S; N_DUCTS],
+    /// Block walls behind the loop's and the ball-valve passage's films, kW/K.
+    pub g_wall: [S; 2],
+    /// The ducts' films at the Reynolds numbers of `params::DUCT_RE` (2300, 1e4,
+    /// 3e4, 1e5) on the coarse temperature grid, kW/K: per point `[port 2300, port
+    /// 1e4, port 3e4, port 1e5, loop ..., ball ...]`.
+    pub g_trans: [[S; N_RE * N_DUCTS]; N_COARSE],
     /// Cooling at rest: decay rate of each node's bound on its excess over
     /// the air, 1/s (all 0: no bound; [`ReducedParams::rest_rate_per_s`]).
     pub rest_rate: [S; N_NODES],
     /// Cooling at rest: the bound's mode shape, node order, in (0, 1]
     /// ([`ReducedParams::rest_mode`]).
     pub rest_mode: [S; N_NODES],
-    /// Exact-ZOH matrix `Phi = h phi1(h A)` of the model step, s.
-    pub phi: [[S; N_NODES]; N_NODES],
+    /// Exact-ZOH matrix `Phi = h phi1(h A)` of the model step over the first
+    /// [`N_PHI`] states, s.
+    pub phi: [[S; N_PHI]; N_PHI],
 }
 
 mod sealed {
@@ -167,9 +187,10 @@ impl Word for f64 {
 }
 
 /// Scalar words at the head of a [`ModelConsts`] (`p_case` .. `pole_pairs`).
-pub const N_SCALARS: usize = 39;
+pub const N_SCALARS: usize = 38;
 /// Number of words in a [`ModelConsts`].
-pub const N_WORDS: usize = N_SCALARS + N_NODES + 12 + 5 * N_TABLE + 2 * N_NODES + N_NODES * N_NODES;
+pub const N_WORDS: usize =
+    N_SCALARS + N_STATES + 3 * N_OUTER + 5 * N_TABLE + 3 * N_TEMP + N_DUCTS + 2 + N_RE * N_DUCTS * N_COARSE + 2 * N_NODES + N_PHI * N_PHI;
 
 // Every field is a word: no padding, no other data.
 const _: () = assert!(core::mem::size_of::<ModelConsts<f32>>() == 4 * N_WORDS);
@@ -206,6 +227,7 @@ impl<S: Copy> ModelConsts<S> {
             w_scale: f(c.w_scale),
             rc0: f(c.rc0),
             rc1: f(c.rc1),
+            rc2: f(c.rc2),
             inv_v_case: f(c.inv_v_case),
             inv_v_loop: f(c.inv_v_loop),
             v_port: f(c.v_port),
@@ -219,8 +241,6 @@ impl<S: Copy> ModelConsts<S> {
             g_case_slope: f(c.g_case_slope),
             alpha_t0: f(c.alpha_t0),
             lng_in: f(c.lng_in),
-            k_mu: f(c.k_mu),
-            t_mu: f(c.t_mu),
             pole_pairs: f(c.pole_pairs),
             inv_c: c.inv_c.map(&mut f),
             ga: c.ga.map(&mut f),
@@ -231,6 +251,12 @@ impl<S: Copy> ModelConsts<S> {
             g_loop: c.g_loop.map(&mut f),
             g_ball: c.g_ball.map(&mut f),
             g_lng: c.g_lng.map(&mut f),
+            leak_ratio: c.leak_ratio.map(&mut f),
+            visc_ratio: c.visc_ratio.map(&mut f),
+            tc_speed: c.tc_speed.map(&mut f),
+            re_q: c.re_q.map(&mut f),
+            g_wall: c.g_wall.map(&mut f),
+            g_trans: c.g_trans.map(|r| r.map(&mut f)),
             rest_rate: c.rest_rate.map(&mut f),
             rest_mode: c.rest_mode.map(&mut f),
             phi: c.phi.map(|r| r.map(&mut f)),
@@ -275,6 +301,7 @@ impl ModelConsts<()> {
         w_scale: (),
         rc0: (),
         rc1: (),
+        rc2: (),
         inv_v_case: (),
         inv_v_loop: (),
         v_port: (),
@@ -288,21 +315,25 @@ impl ModelConsts<()> {
         g_case_slope: (),
         alpha_t0: (),
         lng_in: (),
-        k_mu: (),
-        t_mu: (),
         pole_pairs: (),
-        inv_c: [(); N_NODES],
-        ga: [(); 4],
-        gb: [(); 4],
-        gr: [(); 4],
+        inv_c: [(); N_STATES],
+        ga: [(); N_OUTER],
+        gb: [(); N_OUTER],
+        gr: [(); N_OUTER],
         g_case: [(); N_TABLE],
         g_port: [(); N_TABLE],
         g_loop: [(); N_TABLE],
         g_ball: [(); N_TABLE],
         g_lng: [(); N_TABLE],
+        leak_ratio: [(); N_TEMP],
+        visc_ratio: [(); N_TEMP],
+        tc_speed: [(); N_TEMP],
+        re_q: [(); N_DUCTS],
+        g_wall: [(); 2],
+        g_trans: [[(); N_RE * N_DUCTS]; N_COARSE],
         rest_rate: [(); N_NODES],
         rest_mode: [(); N_NODES],
-        phi: [[(); N_NODES]; N_NODES],
+        phi: [[(); N_PHI]; N_PHI],
     };
 }
 
@@ -339,12 +370,12 @@ impl<S: Word> ModelConsts<S> {
         let w = |x: S| x.to_f32();
         let scalars_non_neg = [
             c.k_lf, c.k_lf_half, c.k_lp, c.k_mech, c.k_q, c.k_a, c.k_dpq, c.r1, c.r2, c.w_dp, c.w_dx, c.k_act, c.k_cu, c.k_sh, c.k_hyd,
-            c.fe1, c.fe2, c.fe15, c.inv_v_case, c.inv_v_loop, c.v_port, c.v_ball, c.inv_v_ring, c.f_out, c.f_case,
-            c.k_m0, c.k_mv, c.alpha, c.alpha_t0,
+            c.fe1, c.fe2, c.fe15, c.inv_v_case, c.inv_v_loop, c.v_port, c.v_ball, c.inv_v_ring, c.f_out,
+            c.f_case, c.k_m0, c.k_mv, c.alpha, c.alpha_t0,
         ];
         // inv_c, outer conductances and the tables: every word between the
         // scalars and Phi (a rolled loop: init code, flash)
-        let arrays = self.as_words().get(core::hint::black_box(N_SCALARS)..N_WORDS - N_NODES * N_NODES).unwrap_or(&[]);
+        let arrays = self.as_words().get(core::hint::black_box(N_SCALARS)..N_WORDS - N_PHI * N_PHI).unwrap_or(&[]);
         let non_neg = scalars_non_neg.iter().all(|x| w(*x) >= 0.0) && arrays.iter().all(|x| w(*x) >= 0.0);
         let pos = [c.q_scale, c.w_scale, c.inv_v_case, c.inv_v_loop, c.v_port, c.v_ball, c.inv_v_ring, c.g_port[0], c.g_ball[0]]
             .iter()
@@ -352,12 +383,63 @@ impl<S: Word> ModelConsts<S> {
         let shares = w(c.w_dp) <= 1.0 && w(c.w_dx) <= 1.0 && w(c.f_out) + w(c.f_case) <= 1.0;
         let mode = c.rest_mode.iter().all(|v| w(*v) <= 1.0);
         // rho c_p stays positive over the oil's range (-60..150 degC)
-        let rc = w(c.rc0) + w(c.rc1) * -60.0 > 0.0 && w(c.rc0) + w(c.rc1) * 150.0 > 0.0;
-        if non_neg && pos && shares && mode && rc {
+        let rc = |t: f32| w(c.rc0) + w(c.rc1) * t + w(c.rc2) * t * t;
+        let rc = rc(-60.0) > 0.0 && rc(40.0) > 0.0 && rc(150.0) > 0.0;
+        // the temperature tables: 1 at 40 degC (where the other words are
+        // referred; 1e-3 covers f32 rounding), monotonic as the viscosity
+        // falls with temperature (the leakage and the gap's Taylor number rise,
+        // the viscous friction falls), positive (every word >= 0 is checked above)
+        let at40 = ((FILM_PROPERTY_C - TEMP_TABLE_MIN_C) / TEMP_TABLE_STEP_K) as usize;
+        // (slices of a black-boxed length: rolled loops, init code, flash)
+        fn sl<S>(t: &[S; N_TEMP]) -> &[S] {
+            t.get(..core::hint::black_box(N_TEMP)).unwrap_or(&[])
+        }
+        let unit = |t: &[S; N_TEMP]| t.get(at40).is_some_and(|x| (w(*x) - 1.0).abs() <= 1e-3) && sl(t).iter().all(|x| w(*x) > 0.0);
+        let rising = |t: &[S; N_TEMP]| sl(t).windows(2).all(|p| p.first().zip(p.get(1)).is_some_and(|(a, b)| w(*b) >= w(*a)));
+        let falling = |t: &[S; N_TEMP]| sl(t).windows(2).all(|p| p.first().zip(p.get(1)).is_some_and(|(a, b)| w(*b) <= w(*a)));
+        let temp = unit(&c.leak_ratio)
+            && unit(&c.visc_ratio)
+            && unit(&c.tc_speed)
+            && rising(&c.leak_ratio)
+            && rising(&c.tc_speed)
+            && falling(&c.visc_ratio);
+        let euler = self.euler_steps_are_small();
+        if non_neg && pos && shares && mode && rc && temp && euler {
             Ok(())
         } else {
             Err(ConfigError::Implausible)
         }
+    }
+}
+
+/// Largest piston travel per tick the Euler check allows for, mm (1 m/s: beyond any
+/// EHA's rate; the tidal exchange with the loop oil grows with it).
+const MAX_DPOS_MM_PER_TICK: f32 = 10.0;
+
+impl<S: Word> ModelConsts<S> {
+    /// The states advanced by explicit Euler (`params::EULER_STATES`) take steps
+    /// small against their time constants: the model step times the largest sum of
+    /// each one's conductances over its capacity is at most 0.5 (Euler is stable up
+    /// to 2; the paper rig's are below 2e-3). The bound takes every table at its
+    /// maximum, the outer surfaces at 200 K above the air and the tidal exchange at
+    /// [`MAX_DPOS_MM_PER_TICK`].
+    fn euler_steps_are_small(&self) -> bool {
+        let c = self;
+        let w = |x: S| x.to_f32();
+        let max = |t: &[S; N_TABLE]| t.get(..core::hint::black_box(N_TABLE)).unwrap_or(&[]).iter().fold(0.0f32, |m, x| m.max(w(*x)));
+        // (200 K)^(1/4) = 3.76; T_m (T_m^2 + d^2) at T_m = 1.6 (480 K), d = 0.33 in units of 300 K: 4.3
+        let outer = |i: usize| match (c.ga.get(i), c.gb.get(i), c.gr.get(i)) {
+            (Some(a), Some(b), Some(r)) => w(*a) + 3.8 * w(*b) + 4.3 * w(*r),
+            _ => f32::INFINITY,
+        };
+        let rc_max = w(c.rc0).abs() + 150.0 * w(c.rc1).abs() + 22_500.0 * w(c.rc2).abs();
+        let tidal = rc_max * w(c.k_a) * MAX_DPOS_MM_PER_TICK;
+        let sums = [
+            (NODE_MAIN_BLOCK, max(&c.g_loop) + outer(1)),
+            (NODE_BALL_BLOCK, max(&c.g_ball) + outer(2)),
+            (NODE_ACTUATOR, tidal + outer(3)),
+        ];
+        sums.iter().all(|(i, g)| c.inv_c.get(*i).is_some_and(|ic| S_PER_STEP as f32 * g * w(*ic) <= 0.5))
     }
 }
 
@@ -370,13 +452,24 @@ pub fn derive(p: &ReducedParams) -> Result<ModelConsts<f64>, ConfigError> {
     }
     let d = p.displacement_m3_per_rad;
     let kl = p.k_leak_m3_per_s_pa;
-    let rc1 = p.rho_kg_per_m3 * p.cp_slope_j_per_kg_k2 * 1e-6;
-    let rc0 = p.rho_cp(0.0) * 1e-6;
+    // rho c_p = (r0 + r1 T)(c0 + c1 T) with T in degC
+    let (r1, c1) = (p.rho_slope_kg_per_m3_k, p.cp_slope_j_per_kg_k2);
+    let (r0, c0) = (p.rho_kg_per_m3 - 40.0 * r1, p.cp20_j_per_kg_k - 20.0 * c1);
+    let rc0 = r0 * c0 * 1e-6;
+    let rc1 = (r0 * c1 + r1 * c0) * 1e-6;
+    let rc2 = r1 * c1 * 1e-6;
     let q_max = p.flow_table_max_m3_per_s * L_PER_M3;
     let w_max = p.speed_table_max_rad_s * 0.01;
     let n1 = (N_TABLE - 1) as f64;
     let v_ring = (p.loop_oil_m3 + 2.0 * p.port_oil_m3 + p.ball_oil_m3) * L_PER_M3;
-    let caps_kj = [p.pump_j_per_k, 0.0, 0.0, p.main_block_j_per_k, p.ball_block_j_per_k, p.actuator_j_per_k];
+    let caps_kj = [
+        p.pump_j_per_k,
+        0.0,
+        0.0,
+        p.main_block_j_per_k,
+        p.ball_block_j_per_k,
+        p.actuator_j_per_k,
+    ];
     let inv_c = caps_kj.map(|c| if c > 0.0 { 1e3 / c } else { 0.0 });
     let k_lf = kl * PA_PER_HBAR * L_PER_M3;
     let k_al = p.act_leak_m3_per_s_pa * PA_PER_HBAR * PA_PER_HBAR * KW_PER_W;
@@ -410,6 +503,7 @@ pub fn derive(p: &ReducedParams) -> Result<ModelConsts<f64>, ConfigError> {
         w_scale: n1 / libm::sqrt(w_max),
         rc0,
         rc1,
+        rc2,
         inv_v_case: 1.0 / (p.case_oil_m3 * L_PER_M3),
         inv_v_loop: 1.0 / (p.loop_oil_m3 * L_PER_M3),
         v_port: p.port_oil_m3 * L_PER_M3,
@@ -423,8 +517,6 @@ pub fn derive(p: &ReducedParams) -> Result<ModelConsts<f64>, ConfigError> {
         g_case_slope: p.case_film_slope_per_k,
         alpha_t0: p.expansion_per_k * 273.15,
         lng_in: p.lng_inlet_c,
-        k_mu: p.k_mu_per_k,
-        t_mu: p.t_mu_ref_c,
         pole_pairs: p.pole_pairs,
         inv_c,
         ga: p.outer_w_per_k.map(|x| x * KW_PER_W),
@@ -437,6 +529,21 @@ pub fn derive(p: &ReducedParams) -> Result<ModelConsts<f64>, ConfigError> {
         g_loop: kw(&p.g_loop_block_w_per_k),
         g_ball: kw(&p.g_ball_block_w_per_k),
         g_lng: kw(&p.g_lng_w_per_k),
+        leak_ratio: p.leak_ratio,
+        visc_ratio: p.visc_ratio,
+        tc_speed: p.tc_speed_ratio,
+        re_q: p.re_per_flow.map(|x| x / L_PER_M3),
+        g_wall: p.duct_wall_w_per_k.map(|x| x * KW_PER_W),
+        g_trans: {
+            let mut t = [[0.0; N_RE * N_DUCTS]; N_COARSE];
+            let films = p.duct_films();
+            for (j, row) in t.iter_mut().enumerate() {
+                for (o, col) in row.iter_mut().zip(films.iter().flatten()) {
+                    *o = col.get(j).copied().unwrap_or(0.0) * KW_PER_W;
+                }
+            }
+            t
+        },
         rest_rate: p.rest_rate_per_s,
         rest_mode: p.rest_mode,
         phi: p.phi_step_s,
@@ -490,6 +597,23 @@ mod tests {
         let mut c = DEFAULT_CONSTS;
         c.rc1 = 300.0;
         assert_eq!(c.check_values(), Err(ConfigError::ConstantRange));
+        // the new words' bounds: a temperature table not referred to 40 degC or
+        // not monotonic, shares over 1
+        let mut c = DEFAULT_CONSTS;
+        c.leak_ratio = c.leak_ratio.map(|x| x * 1.01);
+        assert_eq!(c.check_values(), Err(ConfigError::Implausible));
+        let mut c = DEFAULT_CONSTS;
+        c.visc_ratio.swap(0, 1);
+        assert_eq!(c.check_values(), Err(ConfigError::Implausible));
+        let mut c = DEFAULT_CONSTS;
+        c.f_out = 0.9;
+        assert_eq!(c.check_values(), Err(ConfigError::Implausible));
+        // an Euler state with a capacity so small against its conductance that its
+        // step would overshoot (the actuator at 1/20 of its capacity: its tidal
+        // exchange at 1 m/s piston speed then gives h G / C = 0.9)
+        let mut c = DEFAULT_CONSTS;
+        c.inv_c[crate::params::NODE_ACTUATOR] *= 20.0;
+        assert_eq!(c.check_values(), Err(ConfigError::Implausible));
         assert_eq!(DEFAULT_CONSTS.check_values(), Ok(()));
     }
 }

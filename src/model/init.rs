@@ -12,7 +12,7 @@ impl<N: Num> Model<N> {
         c.check_values()?;
         c.check_bounds()?;
         let max_row = N::MAX_ROW_SUM as f32;
-        let mut phi = [[N::coef_from_f32(0.0).ok_or(ConfigError::CoefficientRange)?; N_NODES]; N_NODES];
+        let mut phi = [[N::coef_from_f32(0.0).ok_or(ConfigError::CoefficientRange)?; N_PHI]; N_PHI];
         for (pr, dr) in phi.iter_mut().zip(c.phi.iter()) {
             if dr.iter().map(|x| x.to_f32().abs()).sum::<f32>() >= max_row {
                 return Err(ConfigError::CoefficientRange);
@@ -59,6 +59,7 @@ impl<N: Num> Model<N> {
             w_scale: f(c.w_scale),
             rc0: f(c.rc0),
             rc1: f(c.rc1),
+            rc2: f(c.rc2),
             inv_v_case: f(c.inv_v_case),
             inv_v_loop: f(c.inv_v_loop),
             inv_n,
@@ -76,9 +77,16 @@ impl<N: Num> Model<N> {
             t_film: exact!(crate::params::FILM_PROPERTY_C),
             alpha_t0: f(c.alpha_t0),
             lng_in: f(c.lng_in),
-            k_mu: f(c.k_mu),
-            t_mu: f(c.t_mu),
-            use_mu: c.k_mu.to_f32() != 0.0,
+            t_scale: exact!(1.0 / crate::params::TEMP_TABLE_STEP_K),
+            inv_stride: exact!(1.0 / crate::params::COARSE_STRIDE as f64),
+            re_q: c.re_q.map(f),
+            g_wall: c.g_wall.map(f),
+            re_lam: exact!(0.23),
+            inv_span: exact!(1.0 / 0.77),
+            re3: exact!(3.0),
+            inv_span3: exact!(1.0 / 7.0),
+            t_min: exact!(crate::params::TEMP_TABLE_MIN_C),
+            tab_last: exact!((N_TABLE - 2) as f64),
             ga: c.ga.map(f),
             gb: c.gb.map(f),
             gr: c.gr.map(f),
@@ -89,31 +97,72 @@ impl<N: Num> Model<N> {
             rad_offset: exact!(273.15 / RAD_T_K),
             one: exact!(1.0),
         };
-        // SAFETY: the caller guarantees `dst` is valid for writes.
-        unsafe { dst.write(Model {
-            temp: [N::state(N::ZERO); N_NODES],
-            links: [N::ZERO; 3],
-            ring_rate: N::ZERO,
-            lng_hist: 0,
-            ambient_c: N::ZERO,
-            sums: Sums::ZERO,
-            phi,
-            k,
-            g_case: c.g_case.map(f),
-            g_port: c.g_port.map(f),
-            g_loop: c.g_loop.map(f),
-            g_ball: c.g_ball.map(f),
-            g_lng: c.g_lng.map(f),
-            last_total_kw: N::ZERO,
-            last_lng_kw: N::ZERO,
-            last_heat_kw: N::ZERO,
-            last_outer_kw: N::ZERO,
-            last_losses_kw: [N::ZERO; N_LOSSES],
-            last_mech_pair_kw: (N::ZERO, N::ZERO),
-            loss_max: false,
-            outer_g: [N::ZERO; 4],
-            outer_phase: 0,
-        }) };
+        // Written field by field in place: the tables are most of the model
+        // (2.9 KiB in f32), and a `Model` value built first would take as much boot
+        // stack.
+        // SAFETY: the caller guarantees `dst` is valid for writes of a `Model<N>`;
+        // every field is written below (the arrays element by element through
+        // pointers into their own field), none is read.
+        unsafe {
+            use core::ptr::addr_of_mut;
+            addr_of_mut!((*dst).temp).write([N::state(N::ZERO); N_STATES]);
+            addr_of_mut!((*dst).links).write([N::ZERO; 3]);
+            addr_of_mut!((*dst).ring_rate).write(N::ZERO);
+            addr_of_mut!((*dst).lng_hist).write(0);
+            addr_of_mut!((*dst).ambient_c).write(N::ZERO);
+            addr_of_mut!((*dst).sums).write(Sums::ZERO);
+            addr_of_mut!((*dst).phi).write(phi);
+            addr_of_mut!((*dst).k_mv_t).write(k.k_mv);
+            addr_of_mut!((*dst).k_lf_t).write(k.k_lf);
+            addr_of_mut!((*dst).k).write(k);
+            let tables: [(*mut [N; N_TABLE], &[S; N_TABLE]); 5] = [
+                (addr_of_mut!((*dst).g_case), &c.g_case),
+                (addr_of_mut!((*dst).g_port), &c.g_port),
+                (addr_of_mut!((*dst).g_loop), &c.g_loop),
+                (addr_of_mut!((*dst).g_ball), &c.g_ball),
+                (addr_of_mut!((*dst).g_lng), &c.g_lng),
+            ];
+            for (d, src) in tables {
+                copy_words::<N, S>(d.cast::<N>(), src, 1);
+            }
+            let gt = addr_of_mut!((*dst).g_trans).cast::<N>();
+            for (j, row) in c.g_trans.iter().enumerate() {
+                copy_words::<N, S>(gt.add(j * row.len()), row, 1);
+            }
+            let tt = addr_of_mut!((*dst).t_tab).cast::<N>();
+            for (m, tab) in [&c.leak_ratio, &c.visc_ratio, &c.tc_speed].into_iter().enumerate() {
+                copy_words::<N, S>(tt.add(m), tab, 3);
+            }
+            addr_of_mut!((*dst).last_total_kw).write(N::ZERO);
+            addr_of_mut!((*dst).last_lng_kw).write(N::ZERO);
+            addr_of_mut!((*dst).last_heat_kw).write(N::ZERO);
+            addr_of_mut!((*dst).last_outer_kw).write(N::ZERO);
+            addr_of_mut!((*dst).last_losses_kw).write([N::ZERO; N_LOSSES]);
+            addr_of_mut!((*dst).last_mech_pair_kw).write((N::ZERO, N::ZERO));
+            addr_of_mut!((*dst).loss_max).write(false);
+            addr_of_mut!((*dst).outer_g).write([N::ZERO; N_OUTER]);
+            let one = exact!(1.0);
+            addr_of_mut!((*dst).slow).write(Slow { case: [one; 3], duct: [one; 2] });
+            addr_of_mut!((*dst).outer_phase).write(0);
+            // every field is written: the oil's factors at the start (0 degC, like
+            // the states)
+            (*dst).refresh_slow(N::ZERO, N::ZERO);
+        }
         Ok(())
+    }
+}
+
+/// Converts `src` into the number type, writing word `j` at `dst + j * stride`. One
+/// rolled copy for every table (unrolled per table, the init grew by 5 KiB of flash).
+///
+/// # Safety
+/// `dst + j * stride` must be valid for writes for every `j < src.len()`.
+#[inline(never)]
+unsafe fn copy_words<N: Num, S: Word>(dst: *mut N, src: &[S], stride: usize) {
+    for j in 0..core::hint::black_box(src.len()) {
+        if let Some(x) = src.get(j) {
+            // SAFETY: as this function's.
+            unsafe { dst.add(j * stride).write(x.to_n::<N>()) };
+        }
     }
 }

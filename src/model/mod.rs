@@ -17,9 +17,16 @@
 //! * the drain is fed from the high-pressure port; the exchanger's cooling reaches
 //!   that port after the transport time of the port passages, `(C_in + C_out) / (m c_p)`.
 //!
-//! Time stepping: exponential Euler (exact zero-order hold of the linear part):
-//! `T(k+1) = T(k) + Phi F(T(k), u(k))`, `Phi = h phi1(h A)` from the matrix
-//! exponential of the nominal Jacobian `A`, built once at init.
+//! Time stepping: exponential Euler (exact zero-order hold of the linear part) for
+//! the fast, strongly coupled [`crate::params::PHI_STATES`] (pump housing, case
+//! oil, loop oil): `T(k+1) = T(k) + Phi F(T(k), u(k))`, `Phi = h phi1(h A)` from the
+//! matrix exponential of the nominal Jacobian `A` over them (computed on the host);
+//! explicit Euler for the slow blocks and actuator ([`crate::params::EULER_STATES`]).
+//!
+//! The oil's viscosity follows its Walther line: the leakage, the viscous friction
+//! and the case gap's Taylor number are read from tables over the case-oil
+//! temperature, the ducts' films blend into their transitional range (eqs. 13-14)
+//! as the hot oil's Reynolds number passes 2300 (docs/reduction.md).
 
 pub mod bounds;
 pub mod consts;
@@ -36,8 +43,8 @@ use crate::linalg::expm1m;
 use crate::num::Num;
 pub use consts::{ModelConsts, Word};
 pub use crate::params::{
-    ReducedParams, N_NODES, N_TABLE, NODE_ACTUATOR, NODE_BALL_BLOCK, NODE_DRAIN, NODE_LOOP, NODE_MAIN_BLOCK, NODE_PUMP,
-    OUTER_NODES, S_PER_STEP, S_PER_TICK, TICKS_PER_STEP,
+    ReducedParams, N_NODES, N_OUTER, N_PHI, N_STATES, N_TABLE, N_TEMP, NODE_ACTUATOR, NODE_BALL_BLOCK, NODE_DRAIN, NODE_LOOP,
+    NODE_MAIN_BLOCK, NODE_PUMP, OUTER_NODES, S_PER_STEP, S_PER_TICK, TICKS_PER_STEP,
 };
 pub use input::{InputScales, ModelInputN, HA_PER_A, HBAR_PER_BAR, HRADS_PER_RPM};
 use ring::{Ring, RingIn};
@@ -111,6 +118,7 @@ struct Consts<N> {
     w_scale: N,   // (N_TABLE-1) / sqrt(w_max), per sqrt(hrad/s)
     rc0: N,       // rho c_p at 0 degC, kJ/(L K)
     rc1: N,       // d(rho c_p)/dT, kJ/(L K^2)
+    rc2: N,       // curvature of rho c_p, kJ/(L K^3)
     inv_v_case: N, // 1/L
     inv_v_loop: N, // 1/L
     inv_n: [N; TICKS_PER_STEP as usize + 1], // 1/n for partial steps (inv_n[0] = 0)
@@ -118,22 +126,29 @@ struct Consts<N> {
     v_port: N,    // L
     v_ball: N,    // L
     inv_v_ring: N, // 1 / (V_loop + 2 V_port + V_ball), 1/L
-    inv_c: [N; N_NODES], // 1/C of the metal nodes, K/kJ (oil nodes unused)
-    f_out: N,
-    f_case: N,    // the rest, 1 - f_out - f_case, heats the pump housing
-    k_m0: N,      // pump no-load friction, kW per hrad/s (pump housing)
-    k_mv: N,      // pump viscous friction, kW per (hrad/s)^2 (split f_out/f_case)
+    inv_c: [N; N_STATES], // 1/C of the metal states, K/kJ (oil nodes unused)
+    f_out: N,     // share of the viscous and pressure friction into the delivered oil
+    f_case: N,    // share into the case oil
+    k_m0: N,      // pump no-load friction, kW per hrad/s
+    k_mv: N,      // pump viscous friction at 40 degC, kW per (hrad/s)^2
     alpha: N,     // oil expansion, 1/K
     g_case_slope: N, // relative slope of the case film with the case-oil temperature, 1/K
     t_film: N,    // FILM_PROPERTY_C, degC
     alpha_t0: N,  // alpha 273.15
     lng_in: N,    // degC
-    k_mu: N,
-    t_mu: N,
-    use_mu: bool,
-    ga: [N; 4],   // outer, kW/K
-    gb: [N; 4],   // outer, kW/K^1.25
-    gr: [N; 4],   // outer radiation 4 eps sigma A (300 K)^3, kW/K per (T_m / 300 K)^3
+    t_scale: N,   // 1 / TEMP_TABLE_STEP_K, 1/K
+    inv_stride: N, // 1 / COARSE_STRIDE
+    re_q: [N; crate::params::N_DUCTS], // ducts' Re / 1e4 per L/s at 40 degC
+    g_wall: [N; 2], // walls behind the loop's and the ball passage's films, kW/K
+    re_lam: N,    // 0.23: Re = 2300, the end of the laminar range, / 1e4
+    inv_span: N,  // 1 / 0.77: the transition's width in Re / 1e4
+    re3: N,       // 3: Re = 3e4, / 1e4
+    inv_span3: N, // 1 / 7: from Re = 3e4 to 1e5, / 1e4
+    t_min: N,     // TEMP_TABLE_MIN_C, degC
+    tab_last: N,  // N_TABLE - 2 (the last interval's left point, grid units)
+    ga: [N; N_OUTER],   // outer, kW/K
+    gb: [N; N_OUTER],   // outer, kW/K^1.25
+    gr: [N; N_OUTER],   // outer radiation 4 eps sigma A (300 K)^3, kW/K per (T_m / 300 K)^3
     h: N,         // s
     inv_h: N,     // 1/s
     half: N,
@@ -143,9 +158,26 @@ struct Consts<N> {
 }
 
 /// The reduced-order model in number type `N` (`f64`, `f32` or [`crate::num::Fx`]).
+///
+/// `repr(C)`, hot fields first: the tick's sums and constants, the states and the
+/// step's scalars sit in the first kilobyte (a Cortex-M4 `vldr` reaches 1020 bytes
+/// from its base; a field past that costs an address computation per load), the
+/// tables after them.
 #[derive(Clone, Copy, Debug)]
+#[repr(C)]
 pub struct Model<N: Num> {
-    temp: [N::State; N_NODES],
+    sums: Sums<N>,
+    /// The viscous friction coefficient at the case oil of the last step, kW per
+    /// (hrad/s)^2: the tick's estimate of the shaft's friction torque (the sign of
+    /// the shaft power, cross-check) follows the oil's viscosity.
+    k_mv_t: N,
+    /// The leakage flow conductance at the case oil of the last step, L/s per hbar:
+    /// the tick's pump delivery `D w - K (p_A - p_case)` (in hot oil the leakage is
+    /// several times its 40 degC value and takes a tenth of the flow).
+    k_lf_t: N,
+    k: Consts<N>,
+    temp: [N::State; N_STATES],
+    phi: [[N::Coef; N_PHI]; N_PHI],
     /// Quasi-steady link temperatures of the last step: inlet, outlet, ball oil, degC.
     links: [N; 3],
     /// Ring rate of the last step, K/s.
@@ -153,14 +185,10 @@ pub struct Model<N: Num> {
     /// Exchanger credit of the past steps, bit k = step k ago.
     lng_hist: u32,
     ambient_c: N,
-    sums: Sums<N>,
-    phi: [[N::Coef; N_NODES]; N_NODES],
-    k: Consts<N>,
-    g_case: [N; N_TABLE],
-    g_port: [N; N_TABLE],
-    g_loop: [N; N_TABLE],
-    g_ball: [N; N_TABLE],
-    g_lng: [N; N_TABLE],
+    /// Outer conductances of [`OUTER_NODES`], kW/K, refreshed one per step.
+    outer_g: [N; N_OUTER],
+    /// The oil's temperature factors ([`Slow`]), refreshed in the same round.
+    slow: Slow<N>,
     last_total_kw: N,
     last_lng_kw: N,
     last_heat_kw: N,
@@ -171,9 +199,29 @@ pub struct Model<N: Num> {
     last_mech_pair_kw: (N, N),
     /// Take the larger of the two mechanical-loss estimates (sensor disagreement).
     loss_max: bool,
-    /// Outer conductances of [`OUTER_NODES`], kW/K, refreshed one per step.
-    outer_g: [N; 4],
     outer_phase: u8,
+    g_case: [N; N_TABLE],
+    g_port: [N; N_TABLE],
+    g_loop: [N; N_TABLE],
+    g_ball: [N; N_TABLE],
+    g_lng: [N; N_TABLE],
+    /// The ducts' films at Re = 2300, 1e4, 3e4 and 1e5 on the coarse temperature grid.
+    g_trans: [[N; crate::params::N_RE * crate::params::N_DUCTS]; crate::params::N_COARSE],
+    /// Temperature tables at the case oil: leakage, viscous friction, gap speed
+    /// factor ([`ModelConsts::leak_ratio`] ...), point by point.
+    t_tab: [[N; 3]; N_TEMP],
+}
+
+/// The oil's temperature factors the step uses, refreshed round robin
+/// ([`Model::update`]).
+#[derive(Clone, Copy, Debug)]
+struct Slow<N> {
+    /// At the case oil: leakage, viscous friction, case-gap speed
+    /// ([`Model::oil_factors`]).
+    case: [N; 3],
+    /// `nu(40) / nu(T)` at the loop oil and at the ball-valve passage's oil
+    /// ([`Model::duct_factors`]).
+    duct: [N; 2],
 }
 
 /// `1/n` for partial model steps of `n` ticks (`[0]` = 0), f64 and rounded to f32.
@@ -206,21 +254,21 @@ pub const N_LOSSES: usize = 6;
 
 /// `Phi = h phi1(h A) = integral_0^h exp(A s) ds`, from the exponential of the
 /// augmented matrix `[[A h, I h], [0, 0]]` (upper-right block).
-pub fn etd_matrix(a: &[[f64; N_NODES]; N_NODES], h: f64) -> [[f64; N_NODES]; N_NODES] {
-    const M: usize = 2 * N_NODES;
+pub fn etd_matrix(a: &[[f64; N_PHI]; N_PHI], h: f64) -> [[f64; N_PHI]; N_PHI] {
+    const M: usize = 2 * N_PHI;
     let mut aug = [[0.0f64; M]; M];
     for (i, (row, arow)) in aug.iter_mut().zip(a.iter()).enumerate() {
         for (x, v) in row.iter_mut().zip(arow.iter()) {
             *x = v * h;
         }
-        if let Some(x) = row.get_mut(N_NODES + i) {
+        if let Some(x) = row.get_mut(N_PHI + i) {
             *x = h;
         }
     }
     let e = expm1m(&aug);
-    let mut phi = [[0.0; N_NODES]; N_NODES];
+    let mut phi = [[0.0; N_PHI]; N_PHI];
     for (prow, erow) in phi.iter_mut().zip(e.iter()) {
-        for (p, x) in prow.iter_mut().zip(erow.iter().skip(N_NODES)) {
+        for (p, x) in prow.iter_mut().zip(erow.iter().skip(N_PHI)) {
             *p = *x;
         }
     }
@@ -271,7 +319,14 @@ impl<N: Num> Model<N> {
         unsafe { Self::init_values_in(m.as_mut_ptr(), c).map(|()| m.assume_init()) }
     }
 
-    /// Sets every node, the ring links and the ambient to `t_c` (degC): cold start.
+    /// Recomputes every [`Slow`] factor at the case oil `t_case` and the loop oil
+    /// `t_loop` (start, restore).
+    fn refresh_slow(&mut self, t_case: N, t_loop: N) {
+        self.slow.duct = self.duct_factors(t_loop, None);
+        self.refresh_case(t_case);
+    }
+
+    /// Sets every state, the ring links and the ambient to `t_c` (degC): cold start.
     pub fn set_uniform(&mut self, t_c: N) {
         self.ambient_c = t_c;
         for th in self.temp.iter_mut() {
@@ -279,7 +334,8 @@ impl<N: Num> Model<N> {
         }
         self.links = [t_c; 3];
         self.ring_rate = N::ZERO;
-        self.outer_g = self.outer_all(&[t_c; N_NODES], t_c);
+        self.outer_g = self.outer_all(&[t_c; N_STATES], t_c);
+        self.refresh_slow(t_c, t_c);
     }
 
     /// Sets every node's temperature (degC, node order) and the ambient from `f32`
@@ -293,10 +349,12 @@ impl<N: Num> Model<N> {
         for (th, t) in self.temp.iter_mut().zip(temps_c.iter()) {
             *th = N::state(conv(*t));
         }
+        let t_case = temps_c.get(NODE_DRAIN).map_or(self.ambient_c, |t| conv(*t));
         let tl = temps_c.get(NODE_LOOP).map_or(self.ambient_c, |t| conv(*t));
         self.links = [tl; 3];
         self.ring_rate = N::ZERO;
         self.outer_g = self.outer_all(&self.temperatures_c(), self.ambient_c);
+        self.refresh_slow(t_case, tl);
     }
 
     /// Accumulates one 10 ms tick (losses of eqs. 5-11 and the flows at this tick's
@@ -304,7 +362,7 @@ impl<N: Num> Model<N> {
     /// then calls [`Model::update`].
     #[inline(always)]
     pub fn tick_n(&mut self, u: &ModelInputN<N>) -> bool {
-        self.sums.add_tick(&self.k, u)
+        self.sums.add_tick(&self.k, self.k_mv_t, self.k_lf_t, u)
     }
 
     /// One model step of [`S_PER_STEP`] with the means of the accumulated ticks.
@@ -321,10 +379,14 @@ impl<N: Num> Model<N> {
         let on = lng_ticks.min(ticks);
         let share = inv.mul(k.count.get(on as usize).copied().unwrap_or(k.one));
         let mut m = self.sums.means(inv, &self.k);
+        let t = self.temperatures_c();
+        // (`slow.case`, `k_mv_t`, `k_lf_t`: the oil's factors at this step's case oil,
+        // set at the end of the last step)
         let from_current = m.shaft_kw.sub(m.hyd_kw);
         // the model's whole pump friction: pressure term plus no-load and viscous
+        // (the latter at the case oil's viscosity)
         let aw = m.abs_speed;
-        let speed_kw = aw.mul(k.k_m0).add(m.visc_kw);
+        let speed_kw = aw.mul(k.k_m0).add(m.visc_kw.mul(self.slow.case[1]));
         let model_kw = m.mech_kw.add(speed_kw);
         self.last_mech_pair_kw = (model_kw, from_current);
         if self.loss_max && from_current > model_kw {
@@ -332,17 +394,19 @@ impl<N: Num> Model<N> {
         }
         self.sums = Sums::ZERO;
         self.ambient_c = m.ambient;
-        let t = self.temperatures_c();
         self.lng_hist = (self.lng_hist << 1) | u32::from(2 * on >= ticks && on > 0);
-        // One outer surface's conductance is refreshed per step (each every 0.4 s; the
-        // metal temperatures move by millikelvin in that time).
-        let i = self.outer_phase as usize % OUTER_NODES.len();
+        // Slowly varying factors are refreshed round robin, one per step: each outer
+        // surface's conductance and the ducts' Reynolds factors, each every 0.6 s,
+        // in which the metal and loop temperatures move by hundredths of a kelvin.
+        let i = self.outer_phase as usize % (N_OUTER + 1);
         if let (Some(g), Some(n)) = (self.outer_g.get_mut(i), OUTER_NODES.get(i)) {
             let tw = t.get(*n).copied().unwrap_or(m.ambient);
             *g = Self::outer_conductance_of(&self.k, i, tw, m.ambient);
+        } else {
+            self.slow.duct = self.duct_factors(t.get(NODE_LOOP).copied().unwrap_or(N::ZERO), self.links.get(2).copied());
         }
         self.outer_phase = self.outer_phase.wrapping_add(1);
-        let r = self.rhs(&t, &m, self.lng_hist, share, Some(self.links), self.ring_rate, &self.outer_g);
+        let r = self.rhs(&t, &m, &self.slow, self.lng_hist, share, Some(self.links), self.ring_rate, &self.outer_g);
         self.links = r.links;
         self.ring_rate = r.ring_rate;
         self.last_total_kw = r.total_kw;
@@ -350,27 +414,50 @@ impl<N: Num> Model<N> {
         self.last_heat_kw = r.heat_kw;
         self.last_outer_kw = r.outer_kw;
         self.last_losses_kw = r.losses_kw;
-        let [p0, p1, p2, p3, p4, p5] = &self.phi;
+        // `PHI_STATES` (pump housing, case oil, loop oil) by `Phi`, the slow
+        // states by explicit Euler (`EULER_STATES`)
+        let [p0, p1, p2] = &self.phi;
         let [s0, s1, s2, s3, s4, s5] = &mut self.temp;
-        *s0 = N::accumulate(*s0, p0, &r.rates);
-        *s1 = N::accumulate(*s1, p1, &r.rates);
-        *s2 = N::accumulate(*s2, p2, &r.rates);
-        *s3 = N::accumulate(*s3, p3, &r.rates);
-        *s4 = N::accumulate(*s4, p4, &r.rates);
-        *s5 = N::accumulate(*s5, p5, &r.rates);
+        let [r0, r1, r2, r3, r4, r5] = r.rates;
+        let rp = [r0, r1, r2];
+        *s0 = N::accumulate(*s0, p0, &rp);
+        *s1 = N::accumulate(*s1, p1, &rp);
+        *s2 = N::accumulate(*s2, p2, &rp);
+        let h = self.k.h;
+        *s3 = N::add_product(*s3, h, r3);
+        *s4 = N::add_product(*s4, h, r4);
+        *s5 = N::add_product(*s5, h, r5);
+        // the oil's factors at the new case oil, every step: the next step's heat
+        // balance and, from the next tick on, the ticks' viscous friction (the
+        // shaft torque's sign and the cross-check, which compares it with the
+        // current within watts: the viscosity moves 4 %/K at 0 degC) and the pump's
+        // delivery past its leakage
+        let t_case = N::value(*s1);
+        self.refresh_case(t_case);
     }
 
-    /// Right-hand side `dT/dt` (K/s, node order) at temperatures `t` with every tick
+    /// The oil's factors at the case oil `t_case` ([`Model::oil_factors`]) and the
+    /// ticks' viscous friction and leakage coefficients from them.
+    #[inline(always)]
+    fn refresh_case(&mut self, t_case: N) {
+        self.slow.case = self.oil_factors(t_case);
+        self.k_mv_t = self.k.k_mv.mul(self.slow.case[1]);
+        self.k_lf_t = self.k.k_lf.mul(self.slow.case[0]);
+    }
+
+    /// Right-hand side `dT/dt` (K/s, state order) at temperatures `t` with every tick
     /// at inputs `u`, the ring in steady flow (links stored nothing, no transport lag):
     /// the function whose Jacobian at the nominal point is `A` (reduction tool).
     #[inline(never)]
-    pub fn derivative(&self, t: &[N; N_NODES], u: &ModelInputN<N>, lng_open: bool) -> [N; N_NODES] {
+    pub fn derivative(&self, t: &[N; N_STATES], u: &ModelInputN<N>, lng_open: bool) -> [N; N_STATES] {
         let mut sums = Sums::ZERO;
-        let _ = sums.add_tick(&self.k, u);
+        let f = self.oil_factors(t.get(NODE_DRAIN).copied().unwrap_or(N::ZERO));
+        let _ = sums.add_tick(&self.k, self.k.k_mv.mul(f[1]), self.k.k_lf.mul(f[0]), u);
         let m = sums.means(self.k.one, &self.k);
         let share = if lng_open { self.k.one } else { N::ZERO };
         let og = self.outer_all(t, m.ambient);
-        self.rhs(t, &m, u32::from(lng_open), share, None, N::ZERO, &og).rates
+        let slow = Slow { case: f, duct: self.duct_factors(t.get(NODE_LOOP).copied().unwrap_or(N::ZERO), None) };
+        self.rhs(t, &m, &slow, u32::from(lng_open), share, None, N::ZERO, &og).rates
     }
 
     /// Advances one model step with every tick at the same inputs (tests, tools).

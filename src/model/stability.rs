@@ -3,7 +3,8 @@
 //! [`Model::derivative`]), `Phi` against it, and the stability of the linearised
 //! step `M = I + Phi J` (a thermal network must not amplify a deviation).
 
-use super::{ConfigError, Model, ModelInputN, HBAR_PER_BAR, HRADS_PER_RPM, N_NODES, S_PER_STEP};
+use super::{ConfigError, Model, ModelInputN, HBAR_PER_BAR, HRADS_PER_RPM, N_PHI, N_STATES, S_PER_STEP};
+use crate::params::PHI_STATES;
 use crate::num::Num;
 
 /// Nominal operating point of the Jacobian: 500 rpm, 30 bar across the pump
@@ -42,20 +43,22 @@ pub const PHI_TOL_S: f32 = 1e-7;
 
 impl<N: Num> Model<N> {
     /// Jacobian of [`Model::derivative`] at the nominal point, 1/s (f32).
-    pub fn nominal_jacobian_f32(&self) -> [[f32; N_NODES]; N_NODES] {
+    pub fn nominal_jacobian_f32(&self) -> [[f32; N_PHI]; N_PHI] {
         let u = nominal_input::<N>();
-        let mut j = [[0.0f32; N_NODES]; N_NODES];
-        for col in 0..rolled(N_NODES) {
-            let mut tp = [N::from_f32(NOMINAL_NODE_C); N_NODES];
+        let mut j = [[0.0f32; N_PHI]; N_PHI];
+        for col in 0..rolled(N_PHI) {
+            let mut tp = [N::from_f32(NOMINAL_NODE_C); N_STATES];
             let mut tm = tp;
-            if let (Some(p), Some(m)) = (tp.get_mut(col), tm.get_mut(col)) {
+            let state = PHI_STATES.get(col).copied().unwrap_or(usize::MAX);
+            if let (Some(p), Some(m)) = (tp.get_mut(state), tm.get_mut(state)) {
                 *p = N::from_f32(NOMINAL_NODE_C + DT_K);
                 *m = N::from_f32(NOMINAL_NODE_C - DT_K);
             }
             let fp = self.derivative(&tp, &u, false);
             let fm = self.derivative(&tm, &u, false);
-            for row in 0..rolled(N_NODES) {
-                let d = match (fp.get(row), fm.get(row)) {
+            for row in 0..rolled(N_PHI) {
+                let state = PHI_STATES.get(row).copied().unwrap_or(usize::MAX);
+                let d = match (fp.get(state), fm.get(state)) {
                     (Some(a), Some(b)) => (a.to_f32() - b.to_f32()) / (2.0 * DT_K),
                     _ => f32::NAN,
                 };
@@ -71,7 +74,7 @@ impl<N: Num> Model<N> {
     /// does not amplify (`max row sum |M^1024| <= 1.001`). Else
     /// [`ConfigError::Unstable`].
     #[inline(never)]
-    pub fn check_stability(&self, phi: &[[f32; N_NODES]; N_NODES]) -> Result<(), ConfigError> {
+    pub fn check_stability(&self, phi: &[[f32; N_PHI]; N_PHI]) -> Result<(), ConfigError> {
         let j = self.nominal_jacobian_f32();
         // (a NaN fails both)
         if phi_mismatch_s(phi, &j) <= PHI_TOL_S && step_gain(phi, &j) <= MAX_GAIN {
@@ -84,12 +87,12 @@ impl<N: Num> Model<N> {
 
 /// Largest `|Phi - h phi1(h J)|` entry, s (what [`Model::check_stability`]
 /// bounds by [`PHI_TOL_S`]); NaN if any entry is NaN.
-pub fn phi_mismatch_s(phi: &[[f32; N_NODES]; N_NODES], j: &[[f32; N_NODES]; N_NODES]) -> f32 {
+pub fn phi_mismatch_s(phi: &[[f32; N_PHI]; N_PHI], j: &[[f32; N_PHI]; N_PHI]) -> f32 {
     let h = S_PER_STEP as f32;
     let j2 = mat_mul(j, j);
     let mut worst = 0.0f32;
-    for r in 0..rolled(N_NODES) {
-        for c in 0..rolled(N_NODES) {
+    for r in 0..rolled(N_PHI) {
+        for c in 0..rolled(N_PHI) {
             let eye = if r == c { 1.0 } else { 0.0 };
             let e = (at(phi, r, c) - h * (eye + h * at(j, r, c) * 0.5 + h * h * at(&j2, r, c) / 6.0)).abs();
             worst = nan_max(worst, e);
@@ -100,9 +103,9 @@ pub fn phi_mismatch_s(phi: &[[f32; N_NODES]; N_NODES], j: &[[f32; N_NODES]; N_NO
 
 /// Largest row sum of `|M^1024|`, `M = I + Phi J`: the most a deviation can grow
 /// over 1024 linearised model steps; NaN if any entry is NaN.
-pub fn step_gain(phi: &[[f32; N_NODES]; N_NODES], j: &[[f32; N_NODES]; N_NODES]) -> f32 {
+pub fn step_gain(phi: &[[f32; N_PHI]; N_PHI], j: &[[f32; N_PHI]; N_PHI]) -> f32 {
     let mut m = mat_mul(phi, j);
-    for r in 0..rolled(N_NODES) {
+    for r in 0..rolled(N_PHI) {
         let d = at(&m, r, r) + 1.0;
         set(&mut m, r, r, d);
     }
@@ -110,9 +113,9 @@ pub fn step_gain(phi: &[[f32; N_NODES]; N_NODES], j: &[[f32; N_NODES]; N_NODES])
         m = mat_mul(&m, &m);
     }
     let mut gain = 0.0f32;
-    for r in 0..rolled(N_NODES) {
+    for r in 0..rolled(N_PHI) {
         let mut sum = 0.0f32;
-        for c in 0..rolled(N_NODES) {
+        for c in 0..rolled(N_PHI) {
             sum += at(&m, r, c).abs();
         }
         gain = nan_max(gain, sum);
@@ -138,13 +141,13 @@ fn rolled(n: usize) -> usize {
 
 /// `m[r][c]`, NaN outside the matrix (fails every check).
 #[inline(always)]
-fn at(m: &[[f32; N_NODES]; N_NODES], r: usize, c: usize) -> f32 {
+fn at(m: &[[f32; N_PHI]; N_PHI], r: usize, c: usize) -> f32 {
     m.get(r).and_then(|row| row.get(c)).copied().unwrap_or(f32::NAN)
 }
 
 /// `m[r][c] = x` (nothing outside the matrix).
 #[inline(always)]
-fn set(m: &mut [[f32; N_NODES]; N_NODES], r: usize, c: usize, x: f32) {
+fn set(m: &mut [[f32; N_PHI]; N_PHI], r: usize, c: usize, x: f32) {
     if let Some(e) = m.get_mut(r).and_then(|row| row.get_mut(c)) {
         *e = x;
     }
@@ -152,12 +155,12 @@ fn set(m: &mut [[f32; N_NODES]; N_NODES], r: usize, c: usize, x: f32) {
 
 /// `a b` for 6×6 matrices.
 #[inline(never)]
-fn mat_mul(a: &[[f32; N_NODES]; N_NODES], b: &[[f32; N_NODES]; N_NODES]) -> [[f32; N_NODES]; N_NODES] {
-    let mut o = [[0.0f32; N_NODES]; N_NODES];
-    for r in 0..rolled(N_NODES) {
-        for c in 0..rolled(N_NODES) {
+fn mat_mul(a: &[[f32; N_PHI]; N_PHI], b: &[[f32; N_PHI]; N_PHI]) -> [[f32; N_PHI]; N_PHI] {
+    let mut o = [[0.0f32; N_PHI]; N_PHI];
+    for r in 0..rolled(N_PHI) {
+        for c in 0..rolled(N_PHI) {
             let mut s = 0.0f32;
-            for k in 0..rolled(N_NODES) {
+            for k in 0..rolled(N_PHI) {
                 s += at(a, r, k) * at(b, k, c);
             }
             set(&mut o, r, c, s);
@@ -216,9 +219,9 @@ mod tests {
     #[test]
     fn gain_check_sees_an_unstable_step() {
         let h = S_PER_STEP as f32;
-        let mut phi = [[0.0f32; N_NODES]; N_NODES];
-        let mut j = [[0.0f32; N_NODES]; N_NODES];
-        for i in 0..N_NODES {
+        let mut phi = [[0.0f32; N_PHI]; N_PHI];
+        let mut j = [[0.0f32; N_PHI]; N_PHI];
+        for i in 0..N_PHI {
             phi[i][i] = h;
             j[i][i] = -1e-4;
         }

@@ -87,7 +87,10 @@ impl<N: Num> Sums<N> {
     /// Adds one tick's raw loss and flow terms (see [`Model::tick_n`]); `true` when
     /// [`TICKS_PER_STEP`] ticks are summed.
     #[inline(always)]
-    pub(super) fn add_tick(&mut self, k: &Consts<N>, u: &ModelInputN<N>) -> bool {
+    /// `k_mv_t`, `k_lf_t`: the viscous friction coefficient and the leakage flow
+    /// conductance at the oil's present viscosity (the shaft torque's sign, the
+    /// pump's delivery below).
+    pub(super) fn add_tick(&mut self, k: &Consts<N>, k_mv_t: N, k_lf_t: N, u: &ModelInputN<N>) -> bool {
         let s = self;
         // Raw per-tick terms; their constants are applied once at the model step
         // (`Sums::means`).
@@ -102,7 +105,7 @@ impl<N: Num> Sums<N> {
         // eq. (8): |dp| |w|
         s.mech_kw = s.mech_kw.add(dp.abs().mul(aw));
         // pump delivery into A, piston flow, throttled remainder (eqs. 10-11)
-        let q_pump = k.k_q.mul(u.speed_hrads).sub(k.k_lf.mul(dpa));
+        let q_pump = k.k_q.mul(u.speed_hrads).sub(k_lf_t.mul(dpa));
         let q_act = k.k_a.mul(u.dpos_mm);
         let q_thr = q_pump.sub(q_act);
         let aq_thr = q_thr.abs();
@@ -121,7 +124,7 @@ impl<N: Num> Sums<N> {
         // driving torque), and the hydraulic power D dp w; their difference is the
         // shaft's loss (eq. 8 in the model).
         let iw = u.current_ha.abs().mul(u.speed_hrads);
-        let t_f = k.k_mech.mul(dp.abs()).add(k.k_m0).add(k.k_mv.mul(aw));
+        let t_f = k.k_mech.mul(dp.abs()).add(k.k_m0).add(k_mv_t.mul(aw));
         let t_shaft = k.k_hyd.mul(dp).add(if u.speed_hrads < N::ZERO { N::ZERO.sub(t_f) } else { t_f });
         s.shaft_kw = s.shaft_kw.add(if t_shaft < N::ZERO { N::ZERO.sub(iw) } else { iw });
         s.hyd_kw = s.hyd_kw.add(dp.mul(u.speed_hrads));

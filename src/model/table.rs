@@ -35,13 +35,62 @@ pub fn locate<N: Num>(x: N, root_scale: N, one: N) -> At<N> {
     }
 }
 
+/// [`locate`] that extrapolates past the last point along the last interval
+/// (`frac > 1`) instead of holding the end value: for a table whose law is close to
+/// linear in `sqrt(x)` at its end (the case gap's film, `Nu ∝ Ta^0.241 ∝ x^0.48`).
+/// `last` is `N_TABLE - 2` in the number type.
+#[inline(always)]
+pub fn locate_ext<N: Num>(x: N, root_scale: N, last: N) -> At<N> {
+    let u = x.sqrt_abs().mul(root_scale);
+    let (i, frac) = u.split_floor();
+    match usize::try_from(i) {
+        Ok(j) if j <= N_TABLE - 2 => At { j, frac },
+        Ok(_) => At { j: N_TABLE - 2, frac: u.sub(last) },
+        Err(_) => At { j: 0, frac: N::ZERO },
+    }
+}
+
 /// Value of `table` at `at` (linear interpolation).
 #[inline(always)]
-pub fn value<N: Num>(table: &[N; N_TABLE], at: &At<N>) -> N {
+pub fn value<N: Num, const K: usize>(table: &[N; K], at: &At<N>) -> N {
     match (table.get(at.j), table.get(at.j + 1)) {
         (Some(a), Some(b)) => a.add(b.sub(*a).mul(at.frac)),
         _ => N::ZERO,
     }
+}
+
+/// Locates `u` (grid units: 0 at the first point, 1 per step) on a uniform grid of
+/// `K` points; below the first point and above the last the end value holds.
+#[inline(always)]
+pub fn locate_uniform<N: Num, const K: usize>(u: N, one: N) -> At<N> {
+    let (i, frac) = u.split_floor();
+    let last = K - 2;
+    match usize::try_from(i) {
+        Ok(j) if j <= last => At { j, frac },
+        Ok(_) => At { j: last, frac: one },
+        Err(_) => At { j: 0, frac: N::ZERO },
+    }
+}
+
+/// Value of column `m` of the interleaved tables `rows` at `at`.
+#[inline(always)]
+pub fn value_col<N: Num, const M: usize, const K: usize>(rows: &[[N; M]; K], at: &At<N>, m: usize) -> N {
+    match (rows.get(at.j).and_then(|r| r.get(m)), rows.get(at.j + 1).and_then(|r| r.get(m))) {
+        (Some(a), Some(b)) => a.add(b.sub(*a).mul(at.frac)),
+        _ => N::ZERO,
+    }
+}
+
+/// Values of the `M` interleaved tables of `rows` (point by point) at `at`.
+#[inline(always)]
+pub fn values<N: Num, const M: usize, const K: usize>(rows: &[[N; M]; K], at: &At<N>) -> [N; M] {
+    let mut o = [N::ZERO; M];
+    if let (Some(a), Some(b)) = (rows.get(at.j), rows.get(at.j + 1)) {
+        for ((o, a), b) in o.iter_mut().zip(a.iter()).zip(b.iter()) {
+            *o = a.add(b.sub(*a).mul(at.frac));
+        }
+    }
+    o
 }
 
 #[cfg(test)]
@@ -70,5 +119,17 @@ mod tests {
         assert_eq!(at(f64::NAN), 0.0);
         // sqrt_abs: a negative input reads the table at |x| (flows are magnitudes)
         assert!((at(-x10) - 10.0).abs() < 1e-12);
+    }
+
+    /// The uniform grid: interpolation between points, the end values held
+    /// outside, the interleaved tables read at one position.
+    #[test]
+    fn uniform_grid_holds_its_ends() {
+        let rows: [[f64; 2]; 4] = [[0.0, 10.0], [1.0, 20.0], [2.0, 30.0], [3.0, 40.0]];
+        let at = |u: f64| values(&rows, &locate_uniform::<f64, 4>(u, 1.0));
+        assert_eq!(at(1.5), [1.5, 25.0]);
+        assert_eq!(at(-2.0), [0.0, 10.0]);
+        assert_eq!(at(7.0), [3.0, 40.0]);
+        assert_eq!(at(f64::NAN), [0.0, 10.0]);
     }
 }

@@ -276,15 +276,26 @@ fn a_refused_block_shows_the_alarm_from_the_first_instant() {
     assert!(!b.pins.valve_pin && !b.pins.ok_pin, "valve pin and OK pin low at boot: {:?}", b.pins);
 }
 
+/// `mu(T) / mu(40 degC)` of the paper rig's oil, the linear interpolation
+/// of `DEFAULT.visc_ratio` the firmware reads (end values held).
+fn visc_ratio(oil_c: f32) -> f32 {
+    let t = &crate::params::DEFAULT.visc_ratio;
+    let u = ((f64::from(oil_c) - crate::params::TEMP_TABLE_MIN_C) / crate::params::TEMP_TABLE_STEP_K).max(0.0);
+    let last = crate::params::N_TEMP - 2;
+    let (j, f) = if u.floor() as usize > last { (last, 1.0) } else { (u.floor() as usize, u - u.floor()) };
+    (t[j] + (t[j + 1] - t[j]) * f) as f32
+}
+
 /// The motor current of the paper rig's pump at these pressures and speed
-/// (the extended eq. 8, as the reference plant draws it): consistent
-/// sensors for the cross-check.
-fn current_a(p_a: f32, p_b: f32, rpm: f32) -> f32 {
+/// and this case-oil temperature (the extended eq. 8 with the viscous
+/// friction on the oil's viscosity, as the reference plant draws it):
+/// consistent sensors for the cross-check.
+fn current_a(p_a: f32, p_b: f32, rpm: f32, oil_c: f32) -> f32 {
     let p = &crate::params::DEFAULT;
     let d = p.displacement_m3_per_rad as f32;
     let dp = (p_a - p_b) * 1e5;
     let w = (rpm * core::f32::consts::PI / 30.0).abs();
-    let t_f = p.no_load_torque_nm as f32 + p.viscous_w_s2_per_rad2 as f32 * w + p.eta_m as f32 * d * dp.abs();
+    let t_f = p.no_load_torque_nm as f32 + p.viscous_w_s2_per_rad2 as f32 * visc_ratio(oil_c) * w + p.eta_m as f32 * d * dp.abs();
     let s = if rpm < 0.0 { -1.0 } else { 1.0 };
     (d * dp + s * t_f).abs() / p.torque_constant_nm_per_a as f32
 }
@@ -296,11 +307,11 @@ fn run_case1(ticks: u32, speed: impl Fn(u32) -> f32, elec: bool) -> std::vec::Ve
     let mut b = board();
     let mut app = boot(&mut b);
     let mut out = std::vec::Vec::new();
-    let mut open = false;
+    let (mut open, mut oil_c) = (false, 20.0f32);
     for k in 0..ticks {
         let r = Request {
             seq: (k & 0xFFFF) as u16,
-            current_a: current_a(65.0, 5.0, 500.0),
+            current_a: current_a(65.0, 5.0, 500.0, oil_c),
             p_a_bar: 65.0,
             p_b_bar: 5.0,
             speed_rpm: speed(k),
@@ -314,6 +325,7 @@ fn run_case1(ticks: u32, speed: impl Fn(u32) -> f32, elec: bool) -> std::vec::Ve
         app.tick(&mut *b, 0);
         let t = *ticks_of(&mut b).last().expect("a tick reply");
         open = t.out.valve_open;
+        oil_c = t.out.drain_c;
         out.push(t);
     }
     out
@@ -373,7 +385,7 @@ fn no_cooling_credit_without_valve_feedback() {
             if report {
                 g.valve_feedback(o.valve_open);
             }
-            o = g.tick(&crate::Sample { current_a: current_a(65.0, 5.0, 500.0), p_a_bar: 65.0, p_b_bar: 5.0, speed_rpm: 500.0, position_mm: 0.0, ambient_c: 20.0 });
+            o = g.tick(&crate::Sample { current_a: current_a(65.0, 5.0, 500.0, o.drain_c), p_a_bar: 65.0, p_b_bar: 5.0, speed_rpm: 500.0, position_mm: 0.0, ambient_c: 20.0 });
             if o.valve_open {
                 seen |= o.faults;
             }
@@ -403,7 +415,7 @@ fn no_cooling_credit_with_the_supply_pressure_low() {
         for k in 0..30_000 {
             g.valve_feedback(o.valve_open);
             g.lng_supply(Some(supply));
-            o = g.tick(&crate::Sample { current_a: current_a(65.0, 5.0, 500.0), p_a_bar: 65.0, p_b_bar: 5.0, speed_rpm: 500.0, position_mm: 0.0, ambient_c: 20.0 });
+            o = g.tick(&crate::Sample { current_a: current_a(65.0, 5.0, 500.0, o.drain_c), p_a_bar: 65.0, p_b_bar: 5.0, speed_rpm: 500.0, position_mm: 0.0, ambient_c: 20.0 });
             seen |= o.faults;
             if k >= 20_000 {
                 sum += f64::from(o.drain_c);
@@ -610,12 +622,12 @@ fn a_flash_erase_stall_is_accounted_without_stale() {
     b.erase_stall_ticks = 300;
     let mut app = boot(&mut b);
     let mut seen = b.ticks;
-    let (mut open, mut worst, mut stalls) = (false, crate::Faults::NONE, 0u32);
+    let (mut open, mut worst, mut stalls, mut oil_c) = (false, crate::Faults::NONE, 0u32, 20.0f32);
     let erases0 = b.flash_erases();
     for k in 0..60_000u32 {
         let r = Request {
             seq: (k & 0xFFFF) as u16,
-            current_a: current_a(65.0, 5.0, 500.0),
+            current_a: current_a(65.0, 5.0, 500.0, oil_c),
             p_a_bar: 65.0,
             p_b_bar: 5.0,
             speed_rpm: 500.0,
@@ -631,6 +643,7 @@ fn a_flash_erase_stall_is_accounted_without_stale() {
         stalls += u32::from(b.ticks.wrapping_sub(before) > 1);
         if let Some(t) = ticks_of(&mut b).last() {
             open = t.out.valve_open;
+            oil_c = t.out.drain_c;
             worst |= t.out.faults;
         }
     }

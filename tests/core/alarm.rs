@@ -149,7 +149,7 @@ fn alarm_round_trip<N: Num>() -> (u32, u32) {
     // near 50 degC with the exchanger on and never raises the alarm: measured 49.9
     // degC after an hour.) The valve opens at once (56 > 40 degC): the test runs with
     // the exchanger on, as the guard would.
-    let rec = ThermalRecord::new([56.0; 6], 20.0, 0, 0, 0);
+    let rec = ThermalRecord::new([56.0; eha_guard::params::N_NODES], 20.0, 0, 0, 0);
     let mut g = GuardOf::<N>::new(&cfg, Restore::from_record(&rec));
     // The guard converts its thresholds with `N::from_f64(x as f64)`; the reference
     // relay below compares the model's own drain estimate against the same values.
@@ -168,6 +168,7 @@ fn alarm_round_trip<N: Num>() -> (u32, u32) {
         // a valve with a position switch that follows its command
         g.valve_feedback(g.output().valve_open);
         let o = g.tick(&s);
+        crate::plant::follow(&g);
         let m = g.model().expect("default parameters build a model");
         let d = m.drain_c();
         let model_step = m.pending_ticks() == 0;

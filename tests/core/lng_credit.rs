@@ -83,7 +83,7 @@ fn load() -> Sample {
 /// Warm restore at 45 degC (the valve opens at the first sample), `used_cj` of the
 /// LNG charge already used.
 fn warm45(cfg: &GuardConfig, used_cj: u32) -> GuardOf<f32> {
-    let rec = ThermalRecord::new([45.0; 6], 20.0, used_cj, 0, 1);
+    let rec = ThermalRecord::new([45.0; eha_guard::params::N_NODES], 20.0, used_cj, 0, 1);
     GuardOf::<f32>::new(cfg, Restore::from_record(&rec))
 }
 
@@ -108,6 +108,7 @@ fn no_credit_while_the_lng_budget_is_empty() {
     for k in 0..3000u32 {
         g.valve_feedback(g.output().valve_open);
         let o = g.tick(&load());
+        crate::plant::follow(&g);
         assert!(o.valve_open, "tick {k}: {o:?}");
         if let Some(c) = credit_kw(&g) {
             first_credit.get_or_insert(c);
@@ -131,6 +132,7 @@ fn no_credit_while_the_lng_budget_is_empty() {
     for k in 0..500u32 {
         g.valve_feedback(g.output().valve_open);
         g.tick(&load());
+        crate::plant::follow(&g);
         if let Some(c) = credit_kw(&g) {
             assert_eq!(c, 0.0, "tick {k}: credited with the LNG used up");
         }
@@ -139,6 +141,7 @@ fn no_credit_while_the_lng_budget_is_empty() {
     for _ in 0..10 {
         g.valve_feedback(g.output().valve_open);
         g.tick(&load());
+        crate::plant::follow(&g);
     }
     assert!(credit_kw(&g).unwrap() > 1.0);
 }
@@ -153,6 +156,7 @@ fn with_feedback(g: &mut GuardOf<f32>, ticks: u32, fb: impl Fn(u32, bool) -> Opt
             g.valve_feedback(v);
         }
         let o = g.tick(&load());
+        crate::plant::follow(&g);
         commanded = o.valve_open;
         out.push(o);
     }
@@ -173,6 +177,7 @@ fn valve_reported_shut_while_commanded_open_gets_no_credit_and_latches_actuator_
     for k in 0..400u32 {
         g.valve_feedback(false);
         let o = g.tick(&load());
+        crate::plant::follow(&g);
         assert!(o.valve_open, "tick {k}: {o:?}");
         if let Some(c) = credit_kw(&g) {
             assert_eq!(c, 0.0, "tick {k}: {c} kW credited with the valve reported shut");

@@ -18,14 +18,17 @@ fn a_stalled_gap_heats_the_estimate_without_stale() {
         for _ in 0..6000 {
             g.valve_feedback(g.output().valve_open);
             g.tick(&case1());
+            crate::plant::follow(&g);
         }
         let before = g.output();
         let o = g.tick_blind(gap);
         println!("gap {gap}: drain {} -> {} degC, {:?}", before.drain_c, o.drain_c, o.faults);
         assert!(!o.faults.intersects(faults::STALE | faults::LATCHED), "{o:?}");
-        // Case 1 heats 0.21 K/s with the valve shut: the gap keeps heating
+        // Case 1 heats the drain 0.25 K/s at 37 degC with the valve shut
+        // (measured 0.2525; 0.21 before the oil followed its viscosity line,
+        // issue 34): the gap keeps heating at that rate
         let rise = o.drain_c - before.drain_c;
-        assert!(rise >= 0.18 * gap as f32 / 100.0 && rise <= 0.25 * gap as f32 / 100.0, "gap {gap}: {rise} K");
+        assert!(rise >= 0.23 * gap as f32 / 100.0 && rise <= 0.28 * gap as f32 / 100.0, "gap {gap}: {rise} K");
         // and the next sample is taken without a fault
         let o = g.tick(&case1());
         assert!(!o.faults.intersects(faults::STALE | faults::LATCHED), "{o:?}");
@@ -41,15 +44,18 @@ fn no_cooling_credit_in_a_stalled_gap() {
     // heat until the valve opens, then 2 s with the exchanger on
     // (open while it waits for the first sample)
     g.tick(&case1());
+    crate::plant::follow(&g);
     let mut k = 0;
     while !g.output().valve_open && k < 100_000 {
         g.valve_feedback(false);
         g.tick(&case1());
+        crate::plant::follow(&g);
         k += 1;
     }
     for _ in 0..200 {
         g.valve_feedback(g.output().valve_open);
         g.tick(&case1());
+        crate::plant::follow(&g);
     }
     assert!(g.output().valve_open, "{:?}", g.output());
     let mut twin = g.clone();
@@ -58,6 +64,7 @@ fn no_cooling_credit_in_a_stalled_gap() {
     for _ in 0..400 {
         twin.valve_feedback(true);
         twin.tick(&case1());
+        crate::plant::follow(&twin);
     }
     let seen = twin.output().drain_c;
     assert!(blind > seen, "blind {blind} vs seen {seen} degC (from {before})");

@@ -9,8 +9,8 @@ use eha_guard::num::{Fx, Num};
 use eha_guard::trace::Trace;
 use eha_guard::{faults, GuardConfig, GuardOf, Restore, Sample, ThermalRecord};
 
-/// Pump turning with no load at 30 degC ambient (nothing heats measurably in a few
-/// ticks: the drain moves by < 1e-4 K per model step here).
+/// Pump turning with no load at 30 degC ambient (little heats in a few ticks: the
+/// drain moves by 1.6e-3 K per model step here).
 fn idle30() -> Sample {
     Sample { current_a: crate::plant::motor_current(5.0, 5.0, 500.0), p_a_bar: 5.0, p_b_bar: 5.0, speed_rpm: 500.0, position_mm: 0.0, ambient_c: 30.0 }
 }
@@ -27,8 +27,12 @@ fn missing_tick_at_boot_does_not_start_the_model_at_0_degc() {
     // One missing tick, then valid samples at 30 degC ambient. Before: the missing
     // tick started the model from the zero-initialised previous sample (ambient
     // 0 degC) and after 12 ticks the estimate read 0.05 degC with the valve closed
-    // and no fault. Now: the estimate is the first sample's ambient. Bound 1e-3 K:
-    // one model step of idle moves the drain by < 1e-4 K (measured 0 to 3e-5 K).
+    // and no fault. Now: the estimate is the first sample's ambient plus one model
+    // step of idle heating. Measured 1.63e-3 K (f32): the idle shaft's viscous
+    // friction at the oil's 30 degC viscosity (1.6 times its 40 degC value since the
+    // oil follows its viscosity line; before, 0 to 3e-5 K) puts 3.9 W into 0.26 kJ/K
+    // of case oil, 1.5e-3 K per 0.1 s step. Bound 3e-3 K, about twice that (a start
+    // at 0 degC would read 30 K off).
     fn run<N: Num>() -> f32 {
         let mut g = GuardOf::<N>::new(&GuardConfig::DEFAULT, Restore::Cold);
         let o = g.tick_missing();
@@ -36,6 +40,7 @@ fn missing_tick_at_boot_does_not_start_the_model_at_0_degc() {
         let mut o = o;
         for _ in 0..12 {
             o = g.tick(&idle30());
+            crate::plant::follow(&g);
         }
         assert_eq!(o.faults, eha_guard::Faults::NONE, "{o:?}");
         assert!(!o.valve_open, "{o:?}");
@@ -43,7 +48,7 @@ fn missing_tick_at_boot_does_not_start_the_model_at_0_degc() {
     }
     for (name, d) in [("f32", run::<f32>()), ("Fx", run::<Fx>()), ("f64", run::<f64>())] {
         println!("{name}: drain {d} degC after one missing tick and 12 samples at 30 degC");
-        assert!((d - 30.0).abs() < 1e-3, "{name}: drain {d} degC, ambient 30 degC");
+        assert!((d - 30.0).abs() < 3e-3, "{name}: drain {d} degC, ambient 30 degC");
     }
 }
 
@@ -57,6 +62,8 @@ fn guard_waits_for_the_first_sample_valve_open_no_stale() {
     // start-up state).
     let cfg = GuardConfig::DEFAULT;
     let mut g = GuardOf::<f32>::new(&cfg, Restore::Cold);
+    // (the plant's case oil at the air: the current of its viscous friction)
+    crate::plant::set_case_oil(30.0);
     let o0 = g.output();
     assert!(o0.valve_open && o0.faults.is_empty() && !o0.alarm, "at boot: {o0:?}");
     for k in 0..300 {
@@ -68,6 +75,7 @@ fn guard_waits_for_the_first_sample_valve_open_no_stale() {
         assert_eq!(g.model().unwrap().pending_ticks(), 0, "tick {k}: the model accumulated a tick while waiting");
     }
     let o = g.tick(&idle30());
+    crate::plant::follow(&g);
     assert_eq!(o.faults, eha_guard::Faults::NONE, "{o:?}");
     assert!(!o.valve_open, "the valve closes at the first sample of a cold start: {o:?}");
     // Cold start at the first sample's ambient, then the 3 s waited replayed
@@ -101,6 +109,7 @@ fn stale_after_the_startup_timeout_without_any_sample() {
     }
     assert!(g.trace().iter().any(|e| matches!(e, Trace::Fault { tick: 999, new_bits } if new_bits.intersects(faults::STALE))));
     let o = g.tick(&idle30());
+    crate::plant::follow(&g);
     assert!(o.valve_open && o.faults.intersects(faults::STALE), "{o:?}");
     // The model starts at the sample's own (valid) ambient, not at the worst case
     // that STALE substitutes from then on; the 10 s waited are replayed with the
@@ -124,12 +133,14 @@ fn warm_restore_waits_and_starts_from_the_record() {
     // would restore it from the record the firmware saves).
     let rec = ThermalRecord::new([50.0, 45.0, 46.0, 44.0, 30.0, 45.0], 20.0, 0, 0, 123);
     let mut g = GuardOf::<f32>::new(&GuardConfig::DEFAULT, Restore::from_record(&rec));
+    crate::plant::set_case_oil(45.0);
     for k in 0..200 {
         let o = g.tick_missing();
         assert!(o.valve_open && o.faults.is_empty(), "tick {k}: {o:?}");
         assert_eq!(o.drain_c, 45.0, "tick {k}: the restored estimate");
     }
     let o = g.tick(&idle30());
+    crate::plant::follow(&g);
     // (no valve position reported: the status says so, nothing latches)
     assert!(o.valve_open && o.faults == faults::NO_VALVE_FEEDBACK, "{o:?}");
     // the record's 45 degC and the 2 s waited, replayed idle: +0.05 K

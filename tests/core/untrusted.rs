@@ -25,7 +25,7 @@ fn idle() -> Sample {
 }
 
 fn corrupt_record() -> ThermalRecord {
-    let mut r = ThermalRecord::new([40.0; 6], 20.0, 0, 0, 7);
+    let mut r = ThermalRecord::new([40.0; eha_guard::params::N_NODES], 20.0, 0, 0, 7);
     r.crc ^= 1;
     assert_eq!(r.classify(), RecordStatus::Corrupt);
     r
@@ -45,7 +45,7 @@ fn corrupt_record_raises_alarm_and_derate_until_a_clear() {
         let mut g = GuardOf::<N>::new(&cfg, Restore::from_record(&corrupt_record()));
         // The same temperatures from a valid record: a trusted estimate, whose alarm
         // follows the 60/58 degC relay.
-        let rec = ThermalRecord::new([60.0; 6], 60.0, 0, 0, 7);
+        let rec = ThermalRecord::new([60.0; eha_guard::params::N_NODES], 60.0, 0, 0, 7);
         let mut trusted = GuardOf::<N>::new(&cfg, Restore::from_record(&rec));
         let o = g.output();
         assert!(held(&o) && o.valve_open && o.faults.intersects(faults::MEMORY_CORRUPT), "at boot: {o:?}");
@@ -56,6 +56,7 @@ fn corrupt_record_raises_alarm_and_derate_until_a_clear() {
         let mut trusted_off = 0;
         for k in 0..60_000 {
             o = g.tick(&idle());
+            crate::plant::follow(&g);
             assert!(held(&o), "tick {k}: {o:?}");
             trusted_off += u32::from(!trusted.tick(&idle()).alarm);
         }
@@ -78,6 +79,7 @@ fn a_rejected_clear_keeps_the_alarm() {
     let mut g = GuardOf::<f32>::new(&GuardConfig::DEFAULT, Restore::from_record(&corrupt_record()));
     for _ in 0..50 {
         g.tick(&idle());
+        crate::plant::follow(&g);
     }
     // 50 valid samples < clear_valid_ticks (100): the clear is refused.
     assert_eq!(g.clear_faults(), ClearResult::Refused);
@@ -96,6 +98,7 @@ fn no_sample_by_the_startup_timeout_raises_alarm_and_derate() {
     }
     for k in 0..200 {
         let o = g.tick(&idle());
+        crate::plant::follow(&g);
         assert!(held(&o) && o.faults.intersects(faults::STALE), "tick {k}: {o:?}");
     }
     // The machine may have run unseen for those 10 s: an unknown start.
@@ -112,7 +115,9 @@ fn trust_returns_when_the_estimate_has_recovered() {
     let cfg = GuardConfig::DEFAULT;
     let hold = eha_guard::guard::recovery_ticks(cfg.model);
     let hours = f64::from(hold) / 360_000.0;
-    assert!((56.0..56.5).contains(&hours), "{hours} h");
+    // 55.86 h with the rest rates of the oil on its viscosity line (issue 34;
+    // 56.0-56.5 h before): ln(80) over the slowest rest rate
+    assert!((55.8..56.0).contains(&hours), "{hours} h");
     // ln(40 / 0.5) as the guard's constant
     let ln = (eha_guard::guard::TRUST_START_ERROR_K / eha_guard::guard::TRUST_TOLERANCE_K).ln();
     let min_rate = cfg.model.rest_rate.iter().fold(f32::INFINITY, |m, r| m.min(*r));
@@ -147,6 +152,7 @@ fn untrusted_survives_a_warm_reset() {
     let mut g = GuardOf::<f32>::new(&GuardConfig::DEFAULT, Restore::from_record(&corrupt_record()));
     for _ in 0..1000 {
         g.tick(&idle());
+        crate::plant::follow(&g);
     }
     let rec = g.snapshot();
     assert_eq!(rec.classify(), RecordStatus::Valid);
@@ -154,7 +160,7 @@ fn untrusted_survives_a_warm_reset() {
     assert!(held(&g2.output()), "{:?}", g2.output());
     assert!(held(&g2.tick(&idle())));
     // A normal warm record is trusted.
-    let rec = ThermalRecord::new([30.0; 6], 20.0, 0, 0, 1);
+    let rec = ThermalRecord::new([30.0; eha_guard::params::N_NODES], 20.0, 0, 0, 1);
     let g3 = GuardOf::<f32>::new(&GuardConfig::DEFAULT, Restore::from_record(&rec));
     assert!(!g3.output().alarm && g3.output().faults.is_empty(), "{:?}", g3.output());
 }

@@ -169,14 +169,16 @@ fn guard_opens_at_the_first_model_step_above_40_also_right_after_a_closing() {
         let cfg = GuardConfig::DEFAULT;
         let rec = ThermalRecord::new([45.0; 6], 20.0, 0, 0, 0);
         let mut g = GuardOf::<N>::new(&cfg, Restore::from_record(&rec));
-        let idle = sample(10.0, 500.0);
+        // the plant's oil at the restored 45 degC (its viscous friction sets the
+        // current), each sample's current at the oil of the last tick
+        crate::plant::set_case_oil(45.0);
         let open_c = N::from_f64(cfg.valve.open_c as f64);
         let mut closed_at = None;
         let mut reopened_at = None;
         for k in 0..200_000u32 {
             // Ramp to the hard load over 10 ticks after the closing (rate limits).
             let s = match closed_at {
-                None => idle,
+                None => sample(10.0, 500.0),
                 Some(k0) => {
                     let f = ((k - k0) as f32 / 10.0).min(1.0);
                     sample(10.0 + 330.0 * f, 500.0 + 2000.0 * f)
@@ -184,6 +186,7 @@ fn guard_opens_at_the_first_model_step_above_40_also_right_after_a_closing() {
             };
             g.valve_feedback(g.output().valve_open);
             let o = g.tick(&s);
+            crate::plant::follow(&g);
             assert!(!o.faults.intersects(faults::LATCHED), "tick {k}: {o:?}");
             let d = g.model().unwrap().drain_c();
             if d > open_c {

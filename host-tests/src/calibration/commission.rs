@@ -224,22 +224,29 @@ pub fn commission(base: &Rig, train: &[CalLog], holdout: &[CalLog], o: &CalOptio
 /// w^2 + eta_m D |dp| |w|` (extended eq. 8). With `T0` and `C_v` held at the
 /// rig file, `eta_m` by least squares over the rows whose `D |dp| |w|` is at
 /// least 20 % of the logs' largest (light load says little), with `Kt` and `D`
-/// from the rig file.
+/// from the rig file. The viscous term at the oil's viscosity where the log
+/// reads it: its drain thermocouple, else its manifold oil sensor (a few kelvin
+/// colder than the case oil), else 40 °C. (At 40 °C throughout, the viscous
+/// friction of oil at 20 °C, 2.2 times its 40 °C value, went into `eta_m`, and the
+/// firmware, whose friction follows the oil since issue 34, saw its own
+/// cross-check disagree within a second.)
 /// `(eta_m, rows)`; `None` without current or load, or outside 0.01..2.
 pub fn eta_m_from_current(rig: &Rig, logs: &[CalLog]) -> Option<(f64, usize)> {
     use crate::measured::Channel;
     let kt = rig.motor.torque_constant_nm_per_a;
     let d = rig.displacement_m3_per_rad();
     let p = &rig.pump;
-    let mu = rig.oil.mu_pa_s(40.0);
     let mut rows = Vec::new();
     for l in logs {
         let r = &l.run;
         let (Some(i), Some(w), Some(pa), Some(pb)) = (r.get(Channel::CurrentA), r.get(Channel::SpeedRpm), r.get(Channel::PABar), r.get(Channel::PBBar)) else {
             continue;
         };
+        let (drain, oil) = (r.get(Channel::TDrainC), r.get(Channel::TOilC));
         for k in 0..r.len() {
             let (Some(i), Some(w), Some(pa), Some(pb)) = (i[k], w[k], pa[k], pb[k]) else { continue };
+            let at = |c: Option<&[Option<f64>]>| c.and_then(|v| v.get(k).copied().flatten());
+            let mu = rig.oil.mu_pa_s(at(drain).or(at(oil)).unwrap_or(40.0));
             let w = w * std::f64::consts::PI / 30.0;
             let dp = (pa - pb) * 1e5;
             let hyd = d * dp * w;

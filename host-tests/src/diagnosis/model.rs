@@ -6,13 +6,13 @@ use crate::measured::Channel;
 use std::collections::BTreeMap;
 
 /// A candidate model extension (issue 2, "Model extensions"); `None` is the
-/// baseline. Names are the exact strings of issue 5.
+/// baseline. Names are the exact strings of issue 5. `viscosity-temperature`
+/// is retired: the oil's viscosity follows its Walther line in the baseline
+/// of the reference and of the emulator, so there is nothing left to find.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Candidate {
     /// Copper resistance rising with winding temperature, R = R0(1+α(T−T0)) (eq. 1).
     WindingResistanceTemperature,
-    /// Oil viscosity following ASTM D341 instead of its 40 °C value (eqs. 5–7).
-    ViscosityTemperature,
     /// Manifold oil sensor in a dead-end pocket, first-order lag (paper Figs. 9–10).
     SensorLag,
     /// Non-linear (Coulomb) actuator friction (paper Case 2).
@@ -29,9 +29,8 @@ pub enum Candidate {
 
 impl Candidate {
     /// The extensions tried by the diagnosis, in report order.
-    pub const EXTENSIONS: [Candidate; 7] = [
+    pub const EXTENSIONS: [Candidate; 6] = [
         Candidate::WindingResistanceTemperature,
-        Candidate::ViscosityTemperature,
         Candidate::SensorLag,
         Candidate::CoulombFriction,
         Candidate::ChurningLoss,
@@ -43,7 +42,6 @@ impl Candidate {
     pub fn name(self) -> &'static str {
         match self {
             Candidate::WindingResistanceTemperature => "winding-resistance-temperature",
-            Candidate::ViscosityTemperature => "viscosity-temperature",
             Candidate::SensorLag => "sensor-lag",
             Candidate::CoulombFriction => "coulomb-friction",
             Candidate::ChurningLoss => "churning-loss",

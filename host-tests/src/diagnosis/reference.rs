@@ -117,8 +117,7 @@ pub fn replay_inputs(run: &MeasuredRun, name: &str) -> Result<ReplayInputs, Refe
 /// `alpha_per_k` 1e-4…1e-2 1/K (copper 3.9e-3; a fit at the upper bound
 /// means the extension also absorbs a winding-conductance error — a bound
 /// of 6e-3 was tried: the winding test with per-node errors then fell from
-/// 71 % to 41 % held-out gain on t_motor_c), viscosity-temperature none
-/// (a switch), `sensor_tau_s` 1…1000 s, `coulomb_n` 1…3000 N,
+/// 71 % to 41 % held-out gain on t_motor_c), `sensor_tau_s` 1…1000 s, `coulomb_n` 1…3000 N,
 /// `churning_w_per_rad2_5` 1e-7…1e-2 W/(rad/s)^2.5, `conduction_w_per_k`
 /// 0.01…50 W/K, `air_speed_mps` 0.2…40 m/s.
 pub struct ReferenceModel {
@@ -182,7 +181,6 @@ impl ReferenceModel {
         let x = ext.first().copied();
         match c {
             Candidate::WindingResistanceTemperature => e.winding_resistance_temperature = x,
-            Candidate::ViscosityTemperature => e.viscosity_temperature = true,
             Candidate::SensorLag => e.sensor_lag = x,
             Candidate::CoulombFriction => e.coulomb_friction = x,
             Candidate::ChurningLoss => e.churning_loss = x,
@@ -229,8 +227,9 @@ pub const REPLAY_RTOL: f64 = 1e-5;
 /// Solver-step budget of one replay, per second of log: a replay normally
 /// takes a few hundred steps for 20 minutes; a candidate run that makes the
 /// stiff solver crawl (measured: 58–96 thousand steps in 1.2–1.8 s for a
-/// `viscosity-temperature` fit of a load-cycle log, stalling its case for
-/// 266 s) fails instead, and the fit treats it as a failed evaluation.
+/// fit of a load-cycle log with the viscosity on its Walther line, stalling
+/// its case for 266 s) fails instead, and the fit treats it as a failed
+/// evaluation.
 pub const REPLAY_STEPS_PER_S: f64 = 20.0;
 
 /// Internal series kept for the regressors.
@@ -282,7 +281,7 @@ impl Simulator for ReferenceModel {
             Candidate::ChurningLoss => vec![ParamSpec::new("churning_w_per_rad2_5", "W/(rad/s)^2.5", 2e-4, 1e-7, 1e-2)],
             Candidate::MotorPumpConduction => vec![ParamSpec::new("conduction_w_per_k", "W/K", 1.0, 0.01, 50.0)],
             Candidate::ForcedConvection => vec![ParamSpec::new("air_speed_mps", "m/s", 3.0, 0.2, 40.0)],
-            Candidate::ViscosityTemperature | Candidate::None => vec![],
+            Candidate::None => vec![],
         }
     }
 

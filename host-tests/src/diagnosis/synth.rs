@@ -190,7 +190,7 @@ pub fn magnitude_range(c: Candidate) -> (f64, f64) {
         Candidate::MotorPumpConduction => (3.0, 8.0),
         // unlogged fan / draught, m/s (Table 5 ram air is 15–50 m/s)
         Candidate::ForcedConvection => (5.0, 12.0),
-        Candidate::ViscosityTemperature | Candidate::None => (1.0, 1.0),
+        Candidate::None => (1.0, 1.0),
     }
 }
 
@@ -422,7 +422,6 @@ pub fn truth_rig(c: &SynthCase, rng: &mut ChaCha8Rng) -> (Rig, f64) {
     let e = &mut r.ext;
     match c.hidden {
         Candidate::WindingResistanceTemperature => e.winding_resistance_temperature = Some(m),
-        Candidate::ViscosityTemperature => e.viscosity_temperature = true,
         Candidate::SensorLag => e.sensor_lag = Some(m),
         Candidate::CoulombFriction => e.coulomb_friction = Some(m),
         Candidate::ChurningLoss => e.churning_loss = Some(m),

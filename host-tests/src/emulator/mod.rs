@@ -25,6 +25,10 @@
 //!   Nu³ mixing; Hausen/Gnielinski duct films; a rotating-cylinder film for
 //!   the case oil; Cragoe oil cp and k; film conductances without the
 //!   block-wall resistance in series.
+//! - **Oil over temperature**, as the reference's baseline has it: the
+//!   emulator oil's own Walther line (46.0 / 6.7 cSt) at every node's
+//!   temperature in the leakage (eqs. 5–7), the hoses (eq. 10) and the
+//!   films, its own density law in every capacity.
 //! - **Parameters**: the open ones chosen again ([`params::EmuParams`],
 //!   with [`params::EmuParams::deviations`] listing every one against the
 //!   rig file: ratios 0.58…3.0, except the case-oil wetted area ×5.3 with
@@ -36,9 +40,7 @@
 //!   ambient drifts slowly (±0.2–0.8 K, 40 min period).
 //!
 //! The hidden effects are the diagnosis candidates, implemented here from
-//! the paper: R(T) = R25(1 + α(T − 25 °C)) (eq. 1); viscosity by the Walther
-//! line at each node's temperature in the leakage (eqs. 5–7), the hoses
-//! (eq. 10) and the films; the manifold oil sensor in a dead-end pocket
+//! the paper: R(T) = R25(1 + α(T − 25 °C)) (eq. 1); the manifold oil sensor in a dead-end pocket
 //! (Figs. 9–10, τ to the loop plus 0.03 W/K to the manifold plate); seal
 //! Coulomb friction F·|v| in the cylinder barrel (and in the load
 //! pressure); churning k·ω^2.5 in the case oil (and in the shaft torque);
@@ -80,7 +82,7 @@ fn ser_candidate<S: serde::Serializer>(c: &Candidate, s: S) -> Result<S::Ok, S::
 /// What the emulator did (never shown to the diagnosis).
 #[derive(Debug, Clone)]
 pub struct EmuTruth {
-    /// Hidden magnitude (the candidate parameter's unit; 1 for viscosity).
+    /// Hidden magnitude (the candidate parameter's unit).
     pub magnitude: f64,
     /// The drawn machine.
     pub params: params::EmuParams,

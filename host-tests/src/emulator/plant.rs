@@ -79,7 +79,7 @@ impl Acc {
 pub struct Hidden {
     /// Which effect (`Candidate::None` for none).
     pub effect: Candidate,
-    /// Magnitude (α 1/K, τ s, N, W/(rad/s)^2.5, W/K, m/s; 1 for viscosity).
+    /// Magnitude (α 1/K, τ s, N, W/(rad/s)^2.5, W/K, m/s).
     pub magnitude: f64,
 }
 
@@ -119,10 +119,10 @@ impl Plant<'_> {
         (self.h.effect == c).then_some(self.h.magnitude)
     }
 
-    /// Kinematic viscosity in use at `t_c`: the 40 °C value unless the
-    /// hidden effect is `viscosity-temperature`.
+    /// Kinematic viscosity at `t_c`: the emulator oil's own Walther line,
+    /// at every node's temperature (leakage, hoses, films).
     fn nu(&self, t_c: f64) -> f64 {
-        if self.h.effect == Candidate::ViscosityTemperature { oil_nu(t_c) } else { oil_nu(40.0) }
+        oil_nu(t_c)
     }
 
     /// Leakage conductance of eqs. (5)–(7) with the emulator's own pump

@@ -41,6 +41,10 @@ impl Walther {
     }
 }
 
+/// Largest kinematic viscosity at which the oil laws are used, cSt: the
+/// cold-start limit of axial-piston pumps (see [`Oil::coldest_valid_c`]).
+pub const MAX_VALID_NU_CST: f64 = 1000.0;
+
 /// Hydraulic oil properties (ISO VG 46 by default).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -103,6 +107,43 @@ impl Oil {
         self.nu_m2_per_s(t_c) * self.rho(t_c, 0.0)
     }
 
+    /// Volumetric heat capacity ρ(T)·c_p(T) at `t_c` and 0 bar, J/(m³·K): the
+    /// capacity of a fixed oil volume (the oil that expands out of a node
+    /// leaves for the accumulator, which the lumped model does not follow).
+    pub fn rho_cp(&self, t_c: f64) -> f64 {
+        self.rho(t_c, 0.0) * self.cp(t_c)
+    }
+
+    /// Heat stored per unit volume relative to 20 °C, J/m³: ∫ρ(T)c_p(T) dT from
+    /// 20 °C to `t_c`, exact for the linear ρ and c_p (a cubic), so that the
+    /// nodes' capacity [`Oil::rho_cp`] and the stored energy agree to round-off.
+    pub fn volumetric_enthalpy(&self, t_c: f64) -> f64 {
+        // rho = r0 + r1 (T - 20), cp = c0 + c1 (T - 20), both exact linear laws
+        let r0 = self.rho(20.0, 0.0);
+        let r1 = -self.rho15_kg_per_m3 * self.expansion_per_k;
+        let (c0, c1) = (self.cp20_j_per_kg_k, self.cp_slope_j_per_kg_k2);
+        let d = t_c - 20.0;
+        r0 * c0 * d + 0.5 * (r0 * c1 + r1 * c0) * d * d + r1 * c1 * d * d * d / 3.0
+    }
+
+    /// Lowest oil temperature at which the model's laws are used inside
+    /// their range, °C: where the Walther line reaches [`MAX_VALID_NU_CST`].
+    /// Colder, the pump runs outside the cold-start viscosity limit of
+    /// axial-piston units (1000 cSt: e.g. Bosch Rexroth's A10VSO data sheet,
+    /// RE 92711, short-term cold start) and the full-film laws behind eqs.
+    /// (5)–(8) and the viscous term of the extended eq. (8) no longer hold
+    /// (mixed friction, incomplete filling, shear heating of the films).
+    pub fn coldest_valid_c(&self) -> f64 {
+        let w = self.walther();
+        // ν falls monotonically with T: bisection on the Walther line
+        let (mut lo, mut hi) = (-80.0, 40.0);
+        for _ in 0..80 {
+            let mid = 0.5 * (lo + hi);
+            if w.nu_cst(mid) > MAX_VALID_NU_CST { lo = mid } else { hi = mid }
+        }
+        0.5 * (lo + hi)
+    }
+
     /// Specific heat at `t_c`, J/(kg·K) (linear in temperature).
     pub fn cp(&self, t_c: f64) -> f64 {
         self.cp20_j_per_kg_k + self.cp_slope_j_per_kg_k2 * (t_c - 20.0)
@@ -116,20 +157,20 @@ impl Oil {
     }
 
     /// Specific enthalpy at `t_c` °C and gauge pressure `p_pa`, J/kg, relative
-    /// to 20 °C and 0 bar: h = ∫c_p dT + (1 − α·T)·p/ρ (T absolute, ρ at 40 °C
+    /// to 20 °C and 0 bar: h = ∫c_p dT + (1 − α·T)·p/ρ (T absolute, ρ at `t_c`
     /// and 0 bar). The pressure term is the first-order one of
     /// dh = c_p dT + v(1 − αT) dp, so a reversible compression by Δp raises the
     /// temperature by αTΔp/(ρc_p) and an isenthalpic throttling by
     /// (1 − αT)Δp/(ρc_p): the two add up to the Δp/(ρc_p) of the whole
     /// hydraulic energy turned into heat.
     pub fn enthalpy_tp(&self, t_c: f64, p_pa: f64) -> f64 {
-        self.enthalpy(t_c) + (1.0 - self.expansion_per_k * (t_c + KELVIN_OFFSET)) * p_pa / self.rho(40.0, 0.0)
+        self.enthalpy(t_c) + (1.0 - self.expansion_per_k * (t_c + KELVIN_OFFSET)) * p_pa / self.rho(t_c, 0.0)
     }
 
     /// Temperature rise of a reversible (isentropic) compression by `dp_pa`
     /// from `t_c`, K: αTΔp/(ρc_p) (the leading term of (∂T/∂p)_s).
     pub fn isentropic_rise_k(&self, t_c: f64, dp_pa: f64) -> f64 {
-        self.expansion_per_k * (t_c + KELVIN_OFFSET) * dp_pa / (self.rho(40.0, 0.0) * self.cp(t_c))
+        self.expansion_per_k * (t_c + KELVIN_OFFSET) * dp_pa / self.rho_cp(t_c)
     }
 
     /// Thermal conductivity at `t_c`, W/(m·K).
@@ -143,7 +184,7 @@ impl Oil {
     }
 }
 
-/// Dry air at 1 atm: the outside medium of the free- and forced-convection
+/// Dry air: the outside medium of the free- and forced-convection
 /// correlations (eqs. 15, 16 and the ram-air model).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AirProps {
@@ -157,13 +198,30 @@ pub struct AirProps {
     pub beta: f64,
 }
 
-/// Air properties at film temperature `t_c` °C and 101325 Pa
-/// (Sutherland's law for μ, ideal-gas density, linear fits for k and cp that
-/// match the standard tables to < 1 % between −20 and 150 °C).
+/// Sea-level standard pressure, Pa.
+pub const P_SEA_LEVEL_PA: f64 = 101_325.0;
+
+/// Static pressure of the ICAO standard atmosphere at `altitude_m`
+/// (troposphere, 0–11 km: p = p₀(1 − 2.25577e-5·h)^5.25588), Pa; held at the
+/// tropopause value above 11 km (the ram-air cases of the paper fly lower).
+pub fn isa_pressure_pa(altitude_m: f64) -> f64 {
+    let h = altitude_m.clamp(-500.0, 11_000.0);
+    P_SEA_LEVEL_PA * (1.0 - 2.25577e-5 * h).powf(5.25588)
+}
+
+/// Air properties at film temperature `t_c` °C and 101325 Pa (sea level).
 pub fn air(t_c: f64) -> AirProps {
+    air_at(t_c, P_SEA_LEVEL_PA)
+}
+
+/// Air properties at film temperature `t_c` °C and static pressure `p_pa`
+/// (Sutherland's law for μ, ideal-gas density ρ = p/(R·T), linear fits for k
+/// and cp that match the standard tables to < 1 % between −20 and 150 °C; μ,
+/// k, cp and Pr do not depend on pressure at these densities, ν = μ/ρ does).
+pub fn air_at(t_c: f64, p_pa: f64) -> AirProps {
     let t_k = t_c + KELVIN_OFFSET;
     let mu = 1.716e-5 * (t_k / 273.15).powf(1.5) * (273.15 + 110.4) / (t_k + 110.4);
-    let rho = 101_325.0 / (287.05 * t_k);
+    let rho = p_pa / (287.05 * t_k);
     let k = 0.02414 + 7.4e-5 * t_c;
     let cp = 1005.0 + 0.02 * t_c;
     AirProps { nu: mu / rho, k, pr: mu * cp / k, beta: 1.0 / t_k }
@@ -224,6 +282,39 @@ mod tests {
         let want = (1.0 - 6.5e-4 * 313.15) * dp / (oil.rho(40.0, 0.0) * oil.cp(t));
         // 0.5 %: c_p(t) against its mean over the 2.75 K rise (0.26 %)
         assert!(((lo - t) - want).abs() / want < 5e-3, "{} vs {want}", lo - t);
+    }
+
+    /// The stored heat per volume is the integral of ρc_p (1e-6 by central
+    /// differences), and the ISO VG 46 line gives the viscosities the issue
+    /// quotes: ≈ 580 cSt at 0 °C, ≈ 4 500 cSt at −20 °C (±10 %: the Walther
+    /// line from the 40/100 °C grade points, as the standard extrapolates),
+    /// ≈ 20 cSt at 60 °C; the model's coldest valid oil (1000 cSt) lies
+    /// between −10 and −5 °C.
+    #[test]
+    fn oil_over_temperature() {
+        let oil = Oil::default();
+        for t in [-20.0, 20.0, 60.0, 120.0] {
+            let d = (oil.volumetric_enthalpy(t + 1e-3) - oil.volumetric_enthalpy(t - 1e-3)) / 2e-3;
+            assert!((d - oil.rho_cp(t)).abs() / oil.rho_cp(t) < 1e-6, "{t}");
+        }
+        let w = oil.walther();
+        for (t, want) in [(0.0, 580.0), (-20.0, 4500.0), (60.0, 20.0)] {
+            let nu = w.nu_cst(t);
+            assert!((nu - want).abs() / want < 0.10, "{t} °C: {nu} cSt");
+        }
+        let cold = oil.coldest_valid_c();
+        assert!((-10.0..-5.0).contains(&cold), "{cold}");
+    }
+
+    /// Air at altitude: the ISA pressure at 5 km is 54.0 kPa (ICAO table:
+    /// 54.05 kPa, 0.2 %), and ν scales with 1/p at fixed temperature.
+    #[test]
+    fn air_over_pressure() {
+        let p5 = isa_pressure_pa(5000.0);
+        assert!((p5 - 54_048.0).abs() / 54_048.0 < 2e-3, "{p5}");
+        let (a0, a5) = (air_at(0.0, P_SEA_LEVEL_PA), air_at(0.0, p5));
+        assert!((a5.nu / a0.nu - P_SEA_LEVEL_PA / p5).abs() < 1e-12);
+        assert_eq!(a5.pr, a0.pr);
     }
 
     /// Enthalpy is the integral of cp: its finite difference equals cp to 1e-6.

@@ -5,7 +5,7 @@
 //! doc says so. All areas m², lengths m, temperatures °C, results W/(m²·K),
 //! W/K or W.
 
-use crate::fluid::{air, G_M_PER_S2, KELVIN_OFFSET};
+use crate::fluid::{air_at, G_M_PER_S2, KELVIN_OFFSET};
 
 /// Stefan–Boltzmann constant, W/(m²·K⁴) (eq. 19).
 pub const SIGMA_W_PER_M2_K4: f64 = 5.670_374e-8;
@@ -75,12 +75,20 @@ pub fn nu_taylor_couette(ta: f64) -> f64 {
     }
 }
 
+/// Mean Nusselt number Nu = h·L/k of a laminar boundary layer over a plate
+/// of length L moving through a fluid at rest (Pohlhausen):
+/// Nu = 0.664·Re^½·Pr^⅓ (Pr ≥ 0.6, Re below transition); 0 at rest.
+pub fn nu_flat_plate_laminar(re: f64, pr: f64) -> f64 {
+    0.664 * re.max(0.0).sqrt() * pr.cbrt()
+}
+
 /// Rayleigh number Gr·Pr of free convection (Table 1 Grashof number times Pr)
-/// for a surface at `t_wall_c` in air at `t_air_c`, length `l_m`; properties
-/// at the film temperature ½(T_w + T_air).
-pub fn rayleigh(t_wall_c: f64, t_air_c: f64, l_m: f64) -> (f64, f64, f64) {
+/// for a surface at `t_wall_c` in air at `t_air_c` and static pressure
+/// `p_pa`, length `l_m`; properties at the film temperature ½(T_w + T_air)
+/// (Gr ∝ 1/ν² ∝ p²: thinner air at altitude convects less).
+pub fn rayleigh(t_wall_c: f64, t_air_c: f64, p_pa: f64, l_m: f64) -> (f64, f64, f64) {
     let film = 0.5 * (t_wall_c + t_air_c);
-    let a = air(film);
+    let a = air_at(film, p_pa);
     let gr = G_M_PER_S2 * a.beta * (t_wall_c - t_air_c).abs() * l_m.powi(3) / (a.nu * a.nu);
     (gr * a.pr, a.pr, a.k)
 }
@@ -91,8 +99,9 @@ pub fn rayleigh(t_wall_c: f64, t_air_c: f64, l_m: f64) -> (f64, f64, f64) {
 ///
 /// The paper prints `0.387·Gr·Pr^(1/6)`; the published correlation raises the
 /// Rayleigh number Gr·Pr as a whole to the 1/6.
-pub fn h_free_cylinder(t_wall_c: f64, t_air_c: f64, d_o: f64) -> f64 {
-    let (ra, pr, k) = rayleigh(t_wall_c, t_air_c, d_o);
+/// Air at static pressure `p_pa`.
+pub fn h_free_cylinder(t_wall_c: f64, t_air_c: f64, p_pa: f64, d_o: f64) -> f64 {
+    let (ra, pr, k) = rayleigh(t_wall_c, t_air_c, p_pa, d_o);
     let nu = (0.6 + 0.387 * ra.powf(1.0 / 6.0) / (1.0 + (0.559 / pr).powf(9.0 / 16.0)).powf(8.0 / 27.0)).powi(2);
     nu * k / d_o
 }
@@ -105,8 +114,9 @@ pub fn h_free_cylinder(t_wall_c: f64, t_air_c: f64, d_o: f64) -> f64 {
 /// The paper prints the Prandtl function with a minus sign (which makes it
 /// negative for air) and a characteristic length A_o/(4a³) that is not a
 /// length; the published plus sign and l_c = a are used.
-pub fn h_free_cube(t_wall_c: f64, t_air_c: f64, a: f64) -> f64 {
-    let (ra, pr, k) = rayleigh(t_wall_c, t_air_c, a);
+/// Air at static pressure `p_pa`.
+pub fn h_free_cube(t_wall_c: f64, t_air_c: f64, p_pa: f64, a: f64) -> f64 {
+    let (ra, pr, k) = rayleigh(t_wall_c, t_air_c, p_pa, a);
     let f = (1.0 + (0.492 / pr).powf(9.0 / 16.0)).powf(16.0 / 9.0);
     let nu = 5.748 + 0.752 * (ra / f).powf(0.252);
     nu * k / a
@@ -114,16 +124,17 @@ pub fn h_free_cube(t_wall_c: f64, t_air_c: f64, a: f64) -> f64 {
 
 /// Forced-convection (ram-air) coefficient of a housing in an air stream of
 /// `v_mps`, turbulent flat plate of run length `l_m`:
-/// Nu = 0.037·Re^0.8·Pr^(1/3), air properties at `t_air_c`.
+/// Nu = 0.037·Re^0.8·Pr^(1/3), air properties at `t_air_c` and static
+/// pressure `p_pa` (Re ∝ ρ: at altitude the same speed cools less, h ∝ p^0.8).
 ///
 /// The paper's Table 5 coefficients grow exactly as v^0.8 (66.13 → 115.13 →
 /// 173.25 W/(m²·K) for 15 → 30 → 50 m/s), the signature of this correlation;
 /// the run length is calibrated to its 15 m/s entry (see `rig::Housing`).
-pub fn h_forced_plate(v_mps: f64, l_m: f64, t_air_c: f64) -> f64 {
+pub fn h_forced_plate(v_mps: f64, l_m: f64, t_air_c: f64, p_pa: f64) -> f64 {
     if v_mps <= 0.0 {
         return 0.0;
     }
-    let a = air(t_air_c);
+    let a = air_at(t_air_c, p_pa);
     let re = v_mps * l_m / a.nu;
     0.037 * re.powf(0.8) * a.pr.cbrt() * a.k / l_m
 }
@@ -214,7 +225,7 @@ mod tests {
     /// W/(m²·K); 3 % covers the property fits.
     #[test]
     fn churchill_chu_cylinder_magnitude() {
-        let h = h_free_cylinder(50.0, 20.0, 0.1);
+        let h = h_free_cylinder(50.0, 20.0, crate::fluid::P_SEA_LEVEL_PA, 0.1);
         assert!((h - 5.03).abs() / 5.03 < 0.03, "{h}");
     }
 

@@ -101,24 +101,26 @@ pub fn needle_k(rig: &Rig, bar: f64) -> Option<f64> {
     }
 }
 
-/// Pressure drop of the throttle path at flow `q`: line friction and local
-/// losses (eq. 10) plus the needle orifice, Pa. Returns (line part, needle part).
-pub fn path_dp(rig: &Rig, q: f64, nu: f64, needle: Option<f64>) -> (f64, f64) {
-    let rho = rig.oil.rho(40.0, 0.0);
-    let line = rig.hydraulics.path.dp_pa(q, nu, rho);
+/// Pressure drop of the throttle path at flow `q` with the oil at `t_oil`
+/// (its viscosity and density): line friction and local losses (eq. 10) plus
+/// the needle orifice, Pa. Returns (line part, needle part).
+pub fn path_dp(rig: &Rig, q: f64, t_oil: f64, needle: Option<f64>) -> (f64, f64) {
+    let rho = rig.oil.rho(t_oil, 0.0);
+    let line = rig.hydraulics.path.dp_pa(q, rig.oil.nu_m2_per_s(t_oil), rho);
     let needle_dp = needle.map_or(0.0, |k| q * q.abs() / (k * k));
     (line, needle_dp)
 }
 
-/// Flow of the throttle path A → B for a pressure difference `dp` (Pa),
-/// m³/s: the inverse of Δp = R₁·q + R₂·q·|q|, with R₁ the laminar
+/// Flow of the throttle path A → B for a pressure difference `dp` (Pa) with
+/// the oil at `t_oil`, m³/s: the inverse of Δp = R₁·q + R₂·q·|q|, with R₁ the laminar
 /// (Hagen–Poiseuille, λ = 64/Re) resistance of the path's line and R₂ its
 /// local losses Σξ plus the needle orifice. The path runs laminar at the rig's
 /// flows (Re ≈ 500 at 9.5 L/min); the line heat itself is evaluated by eq. (10)
 /// with the regime-dependent friction factor.
-pub fn path_flow(rig: &Rig, dp: f64, nu: f64, needle: Option<f64>) -> f64 {
+pub fn path_flow(rig: &Rig, dp: f64, t_oil: f64, needle: Option<f64>) -> f64 {
     let line = &rig.hydraulics.path;
-    let rho = rig.oil.rho(40.0, 0.0);
+    let rho = rig.oil.rho(t_oil, 0.0);
+    let nu = rig.oil.nu_m2_per_s(t_oil);
     let a = line.area_m2();
     let r1 = 128.0 * nu * rho * line.length_m / (PI * line.diameter_m.powi(4));
     let r2 = rho * line.local_loss_coeff / (2.0 * a * a) + needle.map_or(0.0, |k| 1.0 / (k * k));
@@ -206,10 +208,9 @@ pub fn speed_limit(raw: f64, wmax: f64) -> f64 {
     }
 }
 
-/// Derivatives of the hydraulic states (`y` = full state, `dy` = its
-/// derivative), given the operating point `op` and flows `f`.
-#[allow(clippy::too_many_arguments)] // the ODE right-hand side: each argument is a distinct input
-pub fn derivatives(rig: &Rig, m: &Mission, t: f64, y: &[f64], op: &OpPoint, f: &Flows, nu: f64, dy: &mut [f64]) {
+/// Derivatives of the hydraulic states (`dy` = the derivative of the full
+/// state), given the operating point `op` and flows `f`.
+pub fn derivatives(rig: &Rig, m: &Mission, t: f64, op: &OpPoint, f: &Flows, dy: &mut [f64]) {
     let act = &rig.actuator;
     let beta = rig.hydraulics.bulk_modulus_pa;
     let v_line = rig.hydraulics.line_volume_m3;
@@ -222,7 +223,6 @@ pub fn derivatives(rig: &Rig, m: &Mission, t: f64, y: &[f64], op: &OpPoint, f: &
     };
     let relief_net = f.relief_ab - f.relief_ba;
     let q_path = op.q_path;
-    let _ = (y, nu);
     dy[ix::PA] = beta / v_a * (f.geometric - f.leak_a - q_path - q_cyl - f.act_leak + f.check_a - relief_net);
     dy[ix::PB] = beta / v_b * (-f.geometric - f.leak_b + q_path + q_cyl + f.act_leak + f.check_b + relief_net);
     match op.circuit {

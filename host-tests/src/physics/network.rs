@@ -3,7 +3,7 @@
 //! evaluated at the current temperatures and flows.
 
 use crate::heat::{self, h_forced_plate, h_free_cube, h_free_cylinder, h_mixed, radiation_w, series};
-use crate::rig::Rig;
+use crate::rig::{PumpSplit, Rig};
 
 /// Thermal nodes. Index into the temperature part of the state.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -13,7 +13,7 @@ pub enum Node {
     Winding = 0,
     /// Motor housing: Point 1 of the rig.
     Motor,
-    /// Pump housing: Point 3.
+    /// Pump housing (with its end cap): Point 3.
     Pump,
     /// Oil in the pump case, which leaves through the drain port.
     Case,
@@ -33,10 +33,15 @@ pub enum Node {
     Sensor,
     /// Actuator (cylinder body with its oil).
     Actuator,
+    /// The pump's internals: cylinder barrel, pistons and slippers, swash and
+    /// valve plates, shaft; every sliding pair's faces. A node of its own only
+    /// with [`crate::rig::Pump::split`]; otherwise it holds nothing and
+    /// follows the pump housing.
+    PumpInternals,
 }
 
 /// Number of thermal nodes.
-pub const N_NODES: usize = 12;
+pub const N_NODES: usize = 13;
 
 /// All nodes in index order.
 pub const NODES: [Node; N_NODES] = [
@@ -52,6 +57,7 @@ pub const NODES: [Node; N_NODES] = [
     Node::BallOil,
     Node::Sensor,
     Node::Actuator,
+    Node::PumpInternals,
 ];
 
 impl Node {
@@ -70,6 +76,7 @@ impl Node {
             Node::BallOil => "t_ball_oil_c",
             Node::Sensor => "t_oil_c",
             Node::Actuator => "t_actuator_c",
+            Node::PumpInternals => "t_pump_internals_c",
         }
     }
 
@@ -79,26 +86,51 @@ impl Node {
     }
 }
 
-/// Masses of the nodes, kg (oil masses at the 40 °C density) and, for
-/// metal nodes, their specific heats, J/(kg·K).
-pub fn masses(rig: &Rig) -> [(f64, f64); N_NODES] {
-    let rho = rig.oil.rho(40.0, 0.0) * rig.nuisance.oil_capacity_scale;
+/// What each node holds: metal nodes (mass kg, specific heat J/(kg·K)), oil
+/// nodes (volume m³, 0): an oil node's capacity is its volume times
+/// ρ(T)·c_p(T) at its own temperature ([`capacity_j_per_k`]). The nuisance
+/// capacity scales are applied here.
+pub fn contents(rig: &Rig) -> [(f64, f64); N_NODES] {
+    // the internals hold no heat of their own unless the pump is split
+    let internals_kg = rig.pump.split.map_or(0.0, |s| s.internals_mass_kg);
+    let v = rig.nuisance.oil_capacity_scale;
     let ms = rig.nuisance.metal_capacity_scale;
     let m = &rig.motor;
     [
         (m.winding_mass_kg * ms, m.winding_cp),
         ((m.mass_kg - m.winding_mass_kg) * ms, m.body_cp),
-        (rig.pump.mass_kg * ms, rig.pump.cp),
-        (rho * rig.pump.case_oil_m3, 0.0),
-        (rho * rig.pump.port_oil_m3, 0.0),
-        (rho * rig.pump.port_oil_m3, 0.0),
-        (rho * rig.blocks.loop_oil_m3, 0.0),
+        ((rig.pump.mass_kg - internals_kg) * ms, rig.pump.cp),
+        (v * rig.pump.case_oil_m3, 0.0),
+        (v * rig.pump.port_oil_m3, 0.0),
+        (v * rig.pump.port_oil_m3, 0.0),
+        (v * rig.blocks.loop_oil_m3, 0.0),
         (rig.blocks.main_mass_kg * ms, rig.blocks.cp),
         (rig.blocks.ball_mass_kg * ms, rig.blocks.cp),
-        (rho * rig.blocks.ball_oil_m3, 0.0),
-        (rho * rig.blocks.sensor_oil_m3, 0.0),
+        (v * rig.blocks.ball_oil_m3, 0.0),
+        (v * rig.blocks.sensor_oil_m3, 0.0),
         (rig.actuator.body_mass_kg * ms, rig.actuator.body_cp),
+        (internals_kg * ms, rig.pump.cp),
     ]
+}
+
+/// Heat capacity of node `n` holding `content` (an entry of [`contents`]) at
+/// `t_c`, J/K: m·c for metal, V·ρ(T)·c_p(T) for oil.
+pub fn capacity_j_per_k(rig: &Rig, n: Node, content: (f64, f64), t_c: f64) -> f64 {
+    if n.is_oil() {
+        content.0 * rig.oil.rho_cp(t_c)
+    } else {
+        content.0 * content.1
+    }
+}
+
+/// Heat stored in node `n` at `t_c` relative to 20 °C, J (consistent with
+/// [`capacity_j_per_k`]: its derivative in `t_c`).
+pub fn stored_j(rig: &Rig, n: Node, content: (f64, f64), t_c: f64) -> f64 {
+    if n.is_oil() {
+        content.0 * rig.oil.volumetric_enthalpy(t_c)
+    } else {
+        content.0 * content.1 * (t_c - 20.0)
+    }
 }
 
 /// Oil-to-metal conductance of a duct: forced convection by eqs. (13)/(14)
@@ -110,17 +142,53 @@ pub fn duct_conductance(rig: &Rig, q_m3_per_s: f64, d: f64, len: f64, area_scale
     h * std::f64::consts::PI * d * len * area_scale * rig.nuisance.inner_scale
 }
 
-/// Case-oil film between the pump case and the oil the rotating cylinder
-/// barrel drags round (Taylor–Couette flow in the radial gap), W/K:
+/// Film coefficient of the oil between the pump case and the rotating
+/// cylinder barrel (Taylor–Couette flow in the radial gap), W/(m²·K):
 /// h = Nu·k/(2e) with Nu from [`heat::nu_taylor_couette`] at the barrel's
-/// speed `omega` (rad/s, either sign), on the case's real inner area.
+/// speed `omega` (rad/s, either sign); it holds on both walls of the gap.
 /// `t_oil` °C and `nu` m²/s are the case oil's.
-pub fn case_film_w_per_k(rig: &Rig, omega: f64, t_oil: f64, nu: f64) -> f64 {
+pub fn case_gap_h(rig: &Rig, omega: f64, t_oil: f64, nu: f64) -> f64 {
     let p = &rig.pump;
     let e = p.case_gap_m;
     let r_mean = p.rotor_radius_m + 0.5 * e;
     let ta = omega * omega * r_mean * e.powi(3) / (nu * nu);
-    heat::nu_taylor_couette(ta) * rig.oil.k(t_oil) / (2.0 * e) * p.case_inner_area_m2 * rig.nuisance.inner_scale
+    heat::nu_taylor_couette(ta) * rig.oil.k(t_oil) / (2.0 * e)
+}
+
+/// Case-oil film to the pump housing: [`case_gap_h`] on the case's inner
+/// area, W/K.
+pub fn case_film_w_per_k(rig: &Rig, omega: f64, t_oil: f64, nu: f64) -> f64 {
+    case_gap_h(rig, omega, t_oil, nu) * rig.pump.case_inner_area_m2 * rig.nuisance.inner_scale
+}
+
+/// Case-oil film to the pump's internals, W/K: the barrel's periphery
+/// through the case gap ([`case_gap_h`] on 2π·r·L) plus the slippers and
+/// piston shanks swept through the case oil at the barrel's rim speed, a
+/// laminar flat plate of the slipper's length ([`heat::nu_flat_plate_laminar`]).
+pub fn internals_case_film_w_per_k(rig: &Rig, split: &PumpSplit, omega: f64, t_oil: f64, nu: f64) -> f64 {
+    let p = &rig.pump;
+    let s = split;
+    let barrel = case_gap_h(rig, omega, t_oil, nu) * 2.0 * std::f64::consts::PI * p.rotor_radius_m * s.barrel_length_m;
+    let u = omega.abs() * p.rotor_radius_m;
+    let re = u * s.swept_length_m / nu;
+    let h_swept = heat::nu_flat_plate_laminar(re, rig.oil.prandtl(t_oil, nu)) * rig.oil.k(t_oil) / s.swept_length_m;
+    (barrel + h_swept * s.case_swept_area_m2) * rig.nuisance.inner_scale
+}
+
+/// Film between the pump's internals and one port's oil through the
+/// displacement chambers, W/K: half the pistons' bores face each kidney, each
+/// passing its share of the displaced flow `q_displaced` (m³/s, either sign)
+/// as a laminar developing duct flow (eq. 13) over the chamber length that
+/// makes their wall area half of [`PumpSplit::bore_area_m2`].
+pub fn bore_film_w_per_k(rig: &Rig, split: &PumpSplit, q_displaced: f64, t_oil: f64, nu: f64) -> f64 {
+    let p = &rig.pump;
+    let n = 0.5 * p.gaps.pistons;
+    let d = p.gaps.piston_d_m;
+    let len = 0.5 * split.bore_area_m2 / (n * std::f64::consts::PI * d);
+    if len <= 0.0 {
+        return 0.0;
+    }
+    n * duct_conductance(rig, q_displaced.abs() / n, d, len, 1.0, t_oil, nu)
 }
 
 /// Outer surfaces exchanging heat with ambient.
@@ -158,14 +226,18 @@ pub fn q_outer_exposed(rig: &Rig, area: f64, shape: Shape, t_wall: f64, t_air: f
 }
 
 /// Convective coefficient of an outer surface: free convection (eq. 15 or
-/// 16) combined with forced convection at `air_mps` (ram air), W/(m²·K).
+/// 16) combined with forced convection at `air_mps` (ram air), W/(m²·K); the
+/// air at `t_air` and the pressure of the rig's altitude.
 pub fn h_outer(rig: &Rig, shape: Shape, t_wall: f64, t_air: f64, air_mps: f64) -> f64 {
+    let p_air = rig.outside.air_pressure_pa();
     let free = match shape {
-        Shape::Cylinder(d) => h_free_cylinder(t_wall, t_air, d),
-        Shape::Cube(a) => h_free_cube(t_wall, t_air, a),
+        Shape::Cylinder(d) => h_free_cylinder(t_wall, t_air, p_air, d),
+        Shape::Cube(a) => h_free_cube(t_wall, t_air, p_air, a),
     };
     if air_mps > 0.0 {
-        h_mixed(free, h_forced_plate(air_mps, rig.outside.ram_run_length_m, rig.outside.ram_property_c))
+        // forced convection with the stream's properties: its static
+        // temperature (the ambient) and the altitude's pressure
+        h_mixed(free, h_forced_plate(air_mps, rig.outside.ram_run_length_m, t_air, p_air))
     } else {
         free
     }

@@ -54,6 +54,11 @@ pub struct Losses {
     pub act_leak: f64,
     /// Piston seal friction (viscous + Coulomb).
     pub act_friction: f64,
+    /// The part of [`Losses::mechanical`] that heats metal (the pump's
+    /// housing and rotating group) rather than oil, W: where the
+    /// sliding-pair rule puts it ([`Model::friction_heat`]). Not a loss of
+    /// its own: [`Losses::total`] counts it once, inside `mechanical`.
+    pub mech_metal: f64,
 }
 
 impl Losses {
@@ -78,6 +83,33 @@ impl Losses {
             ("p_act_leak_w", self.act_leak),
             ("p_act_friction_w", self.act_friction),
         ]
+    }
+
+    /// The pump friction of eq. (8) split by what it heats: (oil, metal), W.
+    /// Output channels `p_mech_oil_w`, `p_mech_metal_w` (they add up to `p_mech_w`).
+    pub fn friction_split_channels(&self) -> [(&'static str, f64); 2] {
+        [("p_mech_oil_w", self.mechanical - self.mech_metal), ("p_mech_metal_w", self.mech_metal)]
+    }
+}
+
+/// Where the pump's friction heat (extended eq. 8) goes at one instant, W
+/// ([`Model::friction_heat`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct FrictionHeat {
+    /// Into the delivered (high-pressure port) oil.
+    pub delivered: f64,
+    /// Into the case oil.
+    pub case: f64,
+    /// Into the pump housing.
+    pub housing: f64,
+    /// Into the pump's internals (only with [`crate::rig::Pump::split`]).
+    pub internals: f64,
+}
+
+impl FrictionHeat {
+    /// The part that heats metal (housing and internals), W.
+    pub fn metal(&self) -> f64 {
+        self.internals + self.housing
     }
 }
 
@@ -189,7 +221,8 @@ impl ReplayDrive {
             air_mps: logged_air + rig.ext.forced_convection.unwrap_or(0.0),
         };
         if circuit == Circuit::Throttle {
-            // The pump's delivered flow goes through the throttle path.
+            // The pump's delivered flow goes through the throttle path (the
+            // leakage here at 40 °C; `Model::op_point` takes it at the case oil).
             let k = rig.pump.gaps.conductance(rig.oil.mu_pa_s(40.0));
             op.q_path = rig.displacement_m3_per_rad() * omega - k * (p_a - op.p_case);
         }
@@ -221,37 +254,37 @@ pub struct Model {
     pub drive: Drive,
     /// LNG valve open (set between solver segments).
     pub lng_open: Cell<bool>,
-    masses: [(f64, f64); N_NODES],
-    k_leak40: f64,
-    nu40: f64,
+    contents: [(f64, f64); N_NODES],
 }
 
 impl Model {
     /// Build a model.
     pub fn new(rig: Rig, drive: Drive) -> Self {
-        let masses = network::masses(&rig);
-        let k_leak40 = rig.pump.gaps.conductance(rig.oil.mu_pa_s(40.0));
-        let nu40 = rig.oil.nu_m2_per_s(40.0);
-        Self { rig, drive, lng_open: Cell::new(false), masses, k_leak40, nu40 }
+        let contents = network::contents(&rig);
+        Self { rig, drive, lng_open: Cell::new(false), contents }
     }
 
-    /// Kinematic viscosity used at an oil temperature: the 40 °C value in the
-    /// baseline, the Walther value with `viscosity-temperature`, m²/s.
+    /// Kinematic viscosity of the oil at `t_oil` (its Walther line), m²/s.
     pub fn nu(&self, t_oil: f64) -> f64 {
-        if self.rig.ext.viscosity_temperature {
-            self.rig.oil.nu_m2_per_s(t_oil)
-        } else {
-            self.nu40
-        }
+        self.rig.oil.nu_m2_per_s(t_oil)
     }
 
-    /// Pump leakage conductance at the case-oil temperature, m³/(s·Pa).
+    /// Pump leakage conductance of eqs. (5)–(7) at the case-oil temperature
+    /// (the films' viscosity), m³/(s·Pa).
     pub fn k_leak(&self, t_case: f64) -> f64 {
-        if self.rig.ext.viscosity_temperature {
-            self.rig.pump.gaps.conductance(self.rig.oil.mu_pa_s(t_case))
-        } else {
-            self.k_leak40
-        }
+        self.rig.pump.gaps.conductance(self.rig.oil.mu_pa_s(t_case))
+    }
+
+    /// Heat capacity of node `n` at `t_c`, J/K (oil: V·ρ(T)·c_p(T)).
+    pub fn capacity(&self, n: Node, t_c: f64) -> f64 {
+        network::capacity_j_per_k(&self.rig, n, self.contents[n as usize], t_c)
+    }
+
+    /// Mass flow of a volumetric flow `q` (m³/s) around the oil ring, kg/s:
+    /// at the density of the loop oil (the pump's suction side), one value
+    /// for every link of the ring so that the ring conserves mass.
+    fn ring_mass_flow(&self, q: f64, t_loop: f64) -> f64 {
+        self.rig.oil.rho(t_loop, 0.0) * q
     }
 
     /// Initial state: hydraulics at rest (lines at the accumulator pressure),
@@ -280,10 +313,9 @@ impl Model {
         match &self.drive {
             Drive::Replay(r) => {
                 let mut op = r.op(&self.rig, t);
-                if self.rig.ext.viscosity_temperature && op.circuit == Circuit::Throttle {
+                if op.circuit == Circuit::Throttle {
                     // The throttle path takes what the pump delivers minus
-                    // its leakage at the case-oil viscosity, as in a mission
-                    // (the baseline's 40 °C value otherwise).
+                    // its leakage at the case-oil viscosity, as in a mission.
                     let k = self.k_leak(y[t_ix(Node::Case)]);
                     op.q_path = self.rig.displacement_m3_per_rad() * op.omega - k * (op.p_a - op.p_case);
                 }
@@ -305,8 +337,7 @@ impl Model {
                 };
                 if m.circuit == Circuit::Throttle {
                     let needle = hydraulics::needle_k(&self.rig, m.needle_bar.at(t));
-                    let nu = self.nu(y[t_ix(Node::BallOil)]);
-                    op.q_path = hydraulics::path_flow(&self.rig, op.p_a - op.p_b, nu, needle);
+                    op.q_path = hydraulics::path_flow(&self.rig, op.p_a - op.p_b, y[t_ix(Node::BallOil)], needle);
                 }
                 let fr = self.pump_friction(&op, y[t_ix(Node::Case)]).total_w()
                     + self.rig.ext.churning_loss.map_or(0.0, |k| losses::churning_w(k, op.omega))
@@ -319,12 +350,39 @@ impl Model {
     }
 
     /// The pump's friction heat by term (extended eq. 8), with the film
-    /// viscosity at the case-oil temperature `t_case` (its 40 °C value in the
-    /// baseline), W.
+    /// viscosity at the case-oil temperature `t_case`, W.
     pub fn pump_friction(&self, op: &OpPoint, t_case: f64) -> losses::PumpFriction {
         let p = &self.rig.pump;
-        let mu = self.nu(t_case) * self.rig.oil.rho(40.0, 0.0);
+        let mu = self.rig.oil.mu_pa_s(t_case);
         losses::PumpFriction::new(p.no_load_torque_nm, p.viscous_torque_coeff, p.eta_m, self.rig.displacement_m3_per_rad(), mu, op.p_a - op.p_b, op.omega)
+    }
+
+    /// The pump's friction heat placed by the sliding pairs, W.
+    ///
+    /// One pump node (the baseline): the no-load term (bearings, shaft seal)
+    /// heats the housing, the viscous and pressure terms divide by
+    /// [`crate::rig::FrictionPairs::shares`].
+    ///
+    /// The pump as it is built ([`crate::rig::Pump::split`]): the viscous and
+    /// pressure terms arise in the three lubricating films (piston/bore,
+    /// slipper/swash plate, barrel/valve plate); a film of a few µm conducts
+    /// its heat into its two faces (δ/k ≈ 1e-4 m²·K/W, a hundredth of the
+    /// faces' films to the oil; its own leakage convects a few per cent), and
+    /// every one of those faces belongs to the internals. The no-load term
+    /// divides by [`crate::rig::PumpSplit::no_load_to_housing`].
+    pub fn friction_heat(&self, op: &OpPoint, t_case: f64) -> FrictionHeat {
+        let fr = self.pump_friction(op, t_case);
+        let films = fr.viscous_w + fr.pressure_w;
+        match &self.rig.pump.split {
+            Some(s) => {
+                let to_housing = s.no_load_to_housing * fr.no_load_w;
+                FrictionHeat { internals: films + fr.no_load_w - to_housing, housing: to_housing, ..FrictionHeat::default() }
+            }
+            None => {
+                let (f_del, f_case, f_metal) = self.rig.pump.friction_pairs.shares();
+                FrictionHeat { delivered: f_del * films, case: f_case * films, housing: fr.no_load_w + f_metal * films, internals: 0.0 }
+            }
+        }
     }
 
     /// All losses at an operating point and temperatures, W.
@@ -336,11 +394,11 @@ impl Model {
         let (line, needle) = match (&self.drive, op.circuit) {
             (Drive::Mission(m), Circuit::Throttle) => {
                 let nk = hydraulics::needle_k(rig, m.needle_bar.at(t));
-                let (l, n) = hydraulics::path_dp(rig, op.q_path, self.nu(tc(Node::BallOil)), nk);
+                let (l, n) = hydraulics::path_dp(rig, op.q_path, tc(Node::BallOil), nk);
                 (l * op.q_path, n * op.q_path)
             }
             (Drive::Replay(_), Circuit::Throttle) => {
-                let (l, _) = hydraulics::path_dp(rig, op.q_path, self.nu(tc(Node::BallOil)), None);
+                let (l, _) = hydraulics::path_dp(rig, op.q_path, tc(Node::BallOil), None);
                 let line = l * op.q_path;
                 (line, losses::throttle_w(dp, op.q_path) - line)
             }
@@ -363,6 +421,7 @@ impl Model {
             bearing: rig.motor.bearing_friction_nm.map_or(0.0, |m| losses::bearing_w(m, op.omega)),
             leakage: f.leak_a * (op.p_a - op.p_case) + f.leak_b * (op.p_b - op.p_case),
             mechanical: self.pump_friction(op, tc(Node::Case)).total_w(),
+            mech_metal: self.friction_heat(op, tc(Node::Case)).metal(),
             churning: rig.ext.churning_loss.map_or(0.0, |k| losses::churning_w(k, op.omega)),
             line,
             needle,
@@ -389,15 +448,14 @@ impl Model {
         let mut q_in = 0.0;
         // Heat sources (losses that are not a pressure drop of the ring) into their nodes.
         let hp = if op.p_a >= op.p_b { Node::Outlet } else { Node::Inlet };
-        let fr = self.pump_friction(op, tc(Node::Case));
-        let (f_del, f_case, f_metal) = rig.pump.friction_pairs.shares();
-        let shared = fr.viscous_w + fr.pressure_w;
+        let fh = self.friction_heat(op, tc(Node::Case));
         for (n, w) in [
             (Node::Winding, l.copper),
             (Node::Motor, l.iron + l.bearing),
-            (Node::Pump, fr.no_load_w + f_metal * shared),
-            (Node::Case, f_case * shared + l.churning),
-            (hp, f_del * shared),
+            (Node::Pump, fh.housing),
+            (Node::PumpInternals, fh.internals),
+            (Node::Case, fh.case + l.churning),
+            (hp, fh.delivered),
             (Node::Loop, l.valves),
             (Node::Actuator, l.act_leak + l.act_friction),
         ] {
@@ -417,11 +475,27 @@ impl Model {
         if let Some(g) = rig.ext.motor_pump_conduction {
             link(&mut q, Node::Motor, Node::Pump, g);
         }
-        let g_case = network::case_film_w_per_k(rig, op.omega, tc(Node::Case), self.nu(tc(Node::Case)));
-        link(&mut q, Node::Case, Node::Pump, g_case);
+        let nu_case = self.nu(tc(Node::Case));
+        link(&mut q, Node::Case, Node::Pump, network::case_film_w_per_k(rig, op.omega, tc(Node::Case), nu_case));
         for port in [Node::Inlet, Node::Outlet] {
             let g = network::duct_conductance(rig, qc, p.port_d_m, p.port_len_m, p.port_area_scale, tc(port), self.nu(tc(port)));
             link(&mut q, port, Node::Pump, g);
+        }
+        if let Some(s) = &p.split {
+            // the internals: films to the case oil and, through the bores, to
+            // the port oil; their seats in the housing
+            link(&mut q, Node::Case, Node::PumpInternals, network::internals_case_film_w_per_k(rig, s, op.omega, tc(Node::Case), nu_case));
+            let q_displaced = rig.displacement_m3_per_rad() * op.omega;
+            for port in [Node::Inlet, Node::Outlet] {
+                link(&mut q, port, Node::PumpInternals, network::bore_film_w_per_k(rig, s, q_displaced, tc(port), self.nu(tc(port))));
+            }
+            link(&mut q, Node::PumpInternals, Node::Pump, s.seats.conductance_w_per_k());
+        }
+        if let Some(j) = &rig.joints {
+            // metal paths: the housing's flange on the motor and its port face
+            // on the manifold (main block)
+            link(&mut q, Node::Pump, Node::Motor, j.pump_motor.conductance_w_per_k());
+            link(&mut q, Node::Pump, Node::MainBlock, j.pump_manifold.conductance_w_per_k());
         }
         let g_loop = network::duct_conductance(rig, qc, b.loop_d_m, b.loop_len_m, b.loop_area_scale, tc(Node::Loop), self.nu(tc(Node::Loop)));
         link(&mut q, Node::Loop, Node::MainBlock, network::block_path(rig, g_loop, b.main_area_m2));
@@ -429,7 +503,7 @@ impl Model {
         link(&mut q, Node::BallOil, Node::BallBlock, network::block_path(rig, g_ball, b.ball_area_m2));
         // Manifold sensor pocket: in the flowing manifold in the baseline; in
         // a dead-end branch (Figs. 9–10) with `sensor-lag`.
-        let c_sensor = self.masses[Node::Sensor as usize].0 * oil.cp(tc(Node::Sensor));
+        let c_sensor = self.capacity(Node::Sensor, tc(Node::Sensor));
         match rig.ext.sensor_lag {
             None => link(&mut q, Node::Loop, Node::Sensor, c_sensor / b.sensor_tau_s),
             Some(tau) => {
@@ -446,10 +520,9 @@ impl Model {
         // the pump's work m·Δp/ρ enters the delivered port (net warming by
         // compression αTΔp/(ρc_p)); in the servo circuit the actuator takes
         // m·Δp/ρ out of the oil it passes to the loop.
-        let rho = oil.rho(40.0, 0.0);
-        let m_c = rho * qc.abs();
+        let m_c = self.ring_mass_flow(qc.abs(), tc(Node::Loop));
         let f = hydraulics::flows(rig, op, self.k_leak(tc(Node::Case)));
-        let m_l = rho * (hydraulics::soft_pos(f.leak_a, 1e-9) + hydraulics::soft_pos(f.leak_b, 1e-9));
+        let m_l = self.ring_mass_flow(hydraulics::soft_pos(f.leak_a, 1e-9) + hydraulics::soft_pos(f.leak_b, 1e-9), tc(Node::Loop));
         let forward = qc >= 0.0;
         let ring: &[Node] = match (op.circuit, forward) {
             (Circuit::Throttle, true) => &[Node::Loop, Node::Inlet, Node::Outlet, Node::BallOil],
@@ -463,7 +536,7 @@ impl Model {
         // loop at the pump's suction pressure (the actuator does the work between).
         let p_suction = if forward { op.p_b } else { op.p_a };
         let line_dp = match op.circuit {
-            Circuit::Throttle => hydraulics::path_dp(rig, op.q_path.abs(), self.nu(tc(Node::BallOil)), None).0.max(0.0),
+            Circuit::Throttle => hydraulics::path_dp(rig, op.q_path.abs(), tc(Node::BallOil), None).0.max(0.0),
             Circuit::Servo => 0.0,
         };
         let (p_loop, p_ball) = match (op.circuit, forward) {
@@ -493,7 +566,8 @@ impl Model {
             let pump = matches!((from, to), (Node::Inlet, Node::Outlet) | (Node::Outlet, Node::Inlet));
             let actuator = op.circuit == Circuit::Servo && to == Node::Loop;
             if pump || actuator {
-                let work = m / rho * (pres(to) - pres(from));
+                // volume flow × Δp, the volume at the density the mass flow was taken at
+                let work = m / oil.rho(tc(Node::Loop), 0.0) * (pres(to) - pres(from));
                 w += work;
                 q_in += work;
             }
@@ -517,9 +591,14 @@ impl Model {
         q[Node::MainBlock as usize] -= w_mount;
         q_amb += w_mount;
         for (i, n) in NODES.iter().enumerate() {
-            let (m, c) = self.masses[i];
-            let cap = if n.is_oil() { m * oil.cp(temps[i]) } else { m * c };
-            dt[i] = q[i] / cap;
+            dt[i] = match (n, &p.split) {
+                // one pump node: the internals are the housing (no heat, no
+                // capacity of their own) and follow it; started elsewhere
+                // (a state set by hand) they relax onto it at 1/s, which also
+                // fixes them in an equilibrium solve
+                (Node::PumpInternals, None) => dt[Node::Pump as usize] + (tc(Node::Pump) - tc(Node::PumpInternals)),
+                _ => q[i] / self.capacity(*n, temps[i]),
+            };
         }
         (q_in, q_amb, q_lng)
     }
@@ -532,7 +611,7 @@ impl Model {
         match &self.drive {
             Drive::Mission(m) => {
                 let f = hydraulics::flows(&self.rig, &op, self.k_leak(temps[Node::Case as usize]));
-                hydraulics::derivatives(&self.rig, m, t, y, &op, &f, self.nu(temps[Node::BallOil as usize]), dy);
+                hydraulics::derivatives(&self.rig, m, t, &op, &f, dy);
             }
             Drive::Replay(_) => dy[..ix::N].iter_mut().for_each(|d| *d = 0.0),
         }
@@ -559,18 +638,12 @@ impl Model {
 
     /// Energy stored in the nodes relative to the state `y0`, J.
     pub fn stored_energy(&self, y0: &[f64], y: &[f64]) -> f64 {
-        let oil = &self.rig.oil;
         NODES
             .iter()
             .enumerate()
             .map(|(i, n)| {
-                let (m, c) = self.masses[i];
-                let (a, b) = (y0[T0 + i], y[T0 + i]);
-                if n.is_oil() {
-                    m * (oil.enthalpy(b) - oil.enthalpy(a))
-                } else {
-                    m * c * (b - a)
-                }
+                let c = self.contents[i];
+                network::stored_j(&self.rig, *n, c, y[T0 + i]) - network::stored_j(&self.rig, *n, c, y0[T0 + i])
             })
             .sum()
     }

@@ -66,6 +66,7 @@ pub fn channels(s: &Snapshot) -> Vec<(&'static str, f64)> {
         }
     }
     v.extend(s.losses.channels());
+    v.extend(s.losses.friction_split_channels());
     v.extend([
         ("p_total_w", s.losses.total()),
         ("e_loss_j", s.e_loss_j),

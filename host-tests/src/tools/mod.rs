@@ -5,7 +5,8 @@
 //! - [`cli`]: the `eha-sim` subcommands of the simulation;
 //! - [`plot`]: PNG plots;
 //! - [`reduce`]: the firmware's reduced-order parameters from a rig;
-//! - [`params_block`]: the firmware's flash parameter block.
+//! - [`params_block`]: the firmware's flash parameter block;
+//! - [`uq`]: uncertainty bands over the rig's documented parameter ranges.
 
 pub mod cli;
 pub mod measured;
@@ -13,6 +14,7 @@ pub mod params_block;
 pub mod plot;
 pub mod reader_checks;
 pub mod reduce;
+pub mod uq;
 
 #[cfg(test)]
 mod reader_props;

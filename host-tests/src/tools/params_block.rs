@@ -25,7 +25,7 @@ pub struct ParamsBlockArgs {
 #[derive(Subcommand, Debug)]
 enum BlockCmd {
     /// Reduce a rig file to the firmware's model constants and write the
-    /// parameter block (1088 bytes) to flash at the PARAMS region
+    /// parameter block (2484 bytes) to flash at the PARAMS region
     /// (STM32F411: 0x0802_0000; QEMU mps2: 0x0003_F000).
     Write {
         /// Rig file (TOML, as `host-tests/rig/liu2024.toml`).

@@ -18,7 +18,7 @@
 //!    oil properties at 40 °C, tabulated over flow (or shaft speed for the case oil)
 //!    on [`N_TABLE`] points uniform in `sqrt(q)`.
 //! 5. **Outer surfaces** (eqs. 15, 16, 19): the free-convection coefficient of each
-//!    surface fitted as `h = c0 + c1 |ΔT|^(1/4)` over ΔT ∈ [0.05, 40] K at 20 °C air
+//!    surface fitted as `h = c0 + c1 |ΔT|^(1/4)` over ΔT ∈ [0.05, 100] K at 20 °C air
 //!    ([`fit_free_convection`]); radiation `eps sigma A` exact, linearised in the
 //!    firmware about the mean of wall and air. Ram air is not an input.
 //! 6. **Discretisation**: the nominal Jacobian `A` of the reduced model itself at
@@ -28,7 +28,8 @@
 use crate::heat;
 use crate::network::{self, Shape};
 use crate::rig::Rig;
-use eha_guard::model::{Model, ReducedParams, ModelInputN, HBAR_PER_BAR, HRADS_PER_RPM, N_NODES, N_TABLE};
+use eha_guard::model::{Model, ReducedParams, ModelInputN, HBAR_PER_BAR, HRADS_PER_RPM, N_NODES, N_OUTER, N_PHI, N_STATES, N_TABLE, N_TEMP};
+use eha_guard::params::{COARSE_STRIDE, N_COARSE, PHI_STATES, TEMP_TABLE_MIN_C, TEMP_TABLE_STEP_K};
 use std::f64::consts::PI;
 
 /// Shaft speed of the last table point, rpm (the guard's speed range limit).
@@ -52,12 +53,12 @@ fn table(x_max: f64, f: impl Fn(f64) -> f64) -> [f64; N_TABLE] {
 }
 
 /// Least-squares fit of `h(ΔT) = c0 + c1 ΔT^(1/4)` to a free-convection law over
-/// ΔT ∈ [0.05, 40] K (log-spaced) at [`FIT_AIR_C`]; returns `(c0, c1)` with
+/// ΔT ∈ [0.05, 100] K (log-spaced) at [`FIT_AIR_C`]; returns `(c0, c1)` with
 /// `c0 >= 0` (refitted as `c1 ΔT^(1/4)` alone when the two-term fit gives `c0 < 0`).
 pub fn fit_free_convection(h: impl Fn(f64) -> f64) -> (f64, f64) {
     let (mut s11, mut s12, mut s22, mut b1, mut b2) = (0.0, 0.0, 0.0, 0.0, 0.0);
     let mut dt = 0.05;
-    while dt <= 40.0 {
+    while dt <= 100.0 {
         let y = h(dt);
         let x = dt.powf(0.25);
         s11 += 1.0;
@@ -77,6 +78,19 @@ pub fn fit_free_convection(h: impl Fn(f64) -> f64) -> (f64, f64) {
     }
 }
 
+/// Temperature of point `j` of the tables over temperature, degC.
+pub fn temp_grid(j: usize) -> f64 {
+    TEMP_TABLE_MIN_C + TEMP_TABLE_STEP_K * j as f64
+}
+
+fn temp_table(f: impl Fn(f64) -> f64) -> [f64; N_TEMP] {
+    let mut t = [0.0; N_TEMP];
+    for (j, v) in t.iter_mut().enumerate() {
+        *v = f(temp_grid(j));
+    }
+    t
+}
+
 /// The reduced parameters of `rig` (steps 1-5); the Jacobian is left at zero.
 pub fn reduce_without_jacobian(rig: &Rig) -> ReducedParams {
     let oil = &rig.oil;
@@ -85,23 +99,65 @@ pub fn reduce_without_jacobian(rig: &Rig) -> ReducedParams {
     let a = &rig.actuator;
     let m = &rig.motor;
     let ms = rig.nuisance.metal_capacity_scale;
-    let rho = oil.rho(40.0, 0.0) * rig.nuisance.oil_capacity_scale;
-    let nu = oil.nu_m2_per_s(FILM_PROPERTY_C);
+    let t40 = FILM_PROPERTY_C;
+    let rho = oil.rho(t40, 0.0) * rig.nuisance.oil_capacity_scale;
+    let rho_slope = (oil.rho(t40 + 1.0, 0.0) - oil.rho(t40 - 1.0, 0.0)) / 2.0 * rig.nuisance.oil_capacity_scale;
+    let nu = oil.nu_m2_per_s(t40);
     let d = rig.displacement_m3_per_rad();
     let w_max = TABLE_MAX_RPM * PI / 30.0;
     let q_max = d * w_max;
-    let duct = |q: f64, dd: f64, len: f64, scale: f64| network::duct_conductance(rig, q, dd, len, scale, FILM_PROPERTY_C, nu);
-    let g_case = table(w_max, |w| network::case_film_w_per_k(rig, w, FILM_PROPERTY_C, nu));
-    // d ln G_case / dT at the film temperature (central difference at 500 rpm)
+    let duct = |q: f64, dd: f64, len: f64, scale: f64| network::duct_conductance(rig, q, dd, len, scale, t40, nu);
+    // the case gap (Taylor-Couette): Nu depends on the Taylor number (w / nu)^2 only, so
+    // the table over speed at 40 degC read at w nu(40)/nu(T) is exact in nu; its k(T)
+    // by the relative slope below
+    let g_case = table(w_max, |w| network::case_film_w_per_k(rig, w, t40, nu));
     let w_nom = 500.0 * PI / 30.0;
     let gc = |t: f64| network::case_film_w_per_k(rig, w_nom, t, nu);
-    let case_film_slope = (gc(FILM_PROPERTY_C + 1.0) - gc(FILM_PROPERTY_C - 1.0)) / (2.0 * gc(FILM_PROPERTY_C));
+    let case_film_slope = (gc(t40 + 1.0) - gc(t40 - 1.0)) / (2.0 * gc(t40));
     let g_port = table(q_max, |q| duct(q, p.port_d_m, p.port_len_m, p.port_area_scale));
     let g_loop = table(q_max, |q| network::block_path(rig, duct(q, b.loop_d_m, b.loop_len_m, b.loop_area_scale), b.main_area_m2));
     let g_ball = table(q_max, |q| network::block_path(rig, duct(q, b.ball_d_m, b.ball_len_m, 1.0), b.ball_area_m2));
-    let rho_cp40 = rho * oil.cp(40.0);
+    // the ducts' transition (eqs. 13-14 blended) on the coarse temperature grid: the
+    // laminar table's law at Re = 2300 and the film at Re = 1e4 with the oil's
+    // properties at that temperature; Re per flow at 40 degC
+    let ducts = [
+        (p.port_d_m, p.port_len_m, p.port_area_scale, None),
+        (b.loop_d_m, b.loop_len_m, b.loop_area_scale, Some(b.main_area_m2)),
+        (b.ball_d_m, b.ball_len_m, 1.0, Some(b.ball_area_m2)),
+    ];
+    let re_per_flow = ducts.map(|(dd, _, _, _)| 4.0 / (PI * dd * nu) / 1e4);
+    // the films alone: the firmware blends them and puts the block wall in series after
+    let wall = |g: f64, _block: Option<f64>| g;
+    let wall_of = |area: f64| heat::g_plane_wall(b.steel_k, (area / 6.0).sqrt(), b.wall_m);
+    let duct_wall_w_per_k = [wall_of(b.main_area_m2), wall_of(b.ball_area_m2)];
+    let coarse = |f: &dyn Fn(f64) -> f64| {
+        let mut t = [0.0; N_COARSE];
+        for (j, v) in t.iter_mut().enumerate() {
+            *v = f(temp_grid(j * COARSE_STRIDE));
+        }
+        t
+    };
+    let re2300 = |k: usize| {
+        let (dd, len, sc, block) = ducts[k];
+        coarse(&|t| wall(duct(2300.0 * PI * dd * oil.nu_m2_per_s(t) / 4.0, dd, len, sc), block))
+    };
+    // the turbulent anchors (Re = 1e4, 3e4, 1e5) with the oil's properties at T
+    let re_turb = |k: usize, re: f64| {
+        let (dd, len, sc, block) = ducts[k];
+        coarse(&|t| {
+            let nu_t = oil.nu_m2_per_s(t);
+            wall(network::duct_conductance(rig, re * PI * dd * nu_t / 4.0, dd, len, sc, t, nu_t), block)
+        })
+    };
+    let rho_cp40 = rho * oil.cp(t40);
     let t_ref = 100.0;
     let g_lng = table(q_max, |q| rig.lng.exchanger_w(rho_cp40 * q, t_ref) / (t_ref - rig.lng.inlet_c));
+    // the oil's viscosity line: leakage conductance ∝ 1/mu, viscous friction ∝ mu,
+    // the gap's Taylor number ∝ 1/nu^2
+    let mu40 = oil.mu_pa_s(t40);
+    let leak_ratio = temp_table(|t| mu40 / oil.mu_pa_s(t));
+    let visc_ratio = temp_table(|t| oil.mu_pa_s(t) / mu40);
+    let tc_speed_ratio = temp_table(|t| nu / oil.nu_m2_per_s(t));
     // outer surfaces of the pump, main block, ball block, actuator
     let side = |area: f64| (area / 6.0).sqrt();
     let surfaces = [
@@ -110,9 +166,9 @@ pub fn reduce_without_jacobian(rig: &Rig) -> ReducedParams {
         (b.ball_area_m2, Shape::Cube(side(b.ball_area_m2))),
         (a.area_m2, Shape::Cylinder(a.diameter_m)),
     ];
-    let mut outer_w_per_k = [0.0; 4];
-    let mut outer_quarter = [0.0; 4];
-    let mut outer_rad = [0.0; 4];
+    let mut outer_w_per_k = [0.0; N_OUTER];
+    let mut outer_quarter = [0.0; N_OUTER];
+    let mut outer_rad = [0.0; N_OUTER];
     let os = rig.nuisance.outer_scale;
     for (i, (area, shape)) in surfaces.iter().enumerate() {
         let (c0, c1) = fit_free_convection(|dt| network::h_outer(rig, *shape, FIT_AIR_C + dt, FIT_AIR_C, 0.0));
@@ -127,13 +183,6 @@ pub fn reduce_without_jacobian(rig: &Rig) -> ReducedParams {
     let la = line.area_m2();
     let fe = &m.iron;
     let c = fe.pole_pairs / (2.0 * PI);
-    let k_mu = if rig.ext.viscosity_temperature {
-        // K ∝ 1/mu: d ln K / dT at the reference temperature (central difference)
-        let k = |t: f64| p.gaps.conductance(oil.mu_pa_s(t)).ln();
-        (k(41.0) - k(39.0)) / 2.0
-    } else {
-        0.0
-    };
     ReducedParams {
         pump_j_per_k: p.mass_kg * ms * p.cp,
         main_block_j_per_k: b.main_mass_kg * ms * b.cp,
@@ -144,20 +193,19 @@ pub fn reduce_without_jacobian(rig: &Rig) -> ReducedParams {
         port_oil_m3: p.port_oil_m3,
         ball_oil_m3: b.ball_oil_m3,
         rho_kg_per_m3: rho,
+        rho_slope_kg_per_m3_k: rho_slope,
         cp20_j_per_kg_k: oil.cp20_j_per_kg_k,
         cp_slope_j_per_kg_k2: oil.cp_slope_j_per_kg_k2,
         displacement_m3_per_rad: d,
         eta_m: p.eta_m,
         no_load_torque_nm: p.no_load_torque_nm,
-        viscous_w_s2_per_rad2: p.viscous_torque_coeff * oil.mu_pa_s(40.0) * d,
+        viscous_w_s2_per_rad2: p.viscous_torque_coeff * mu40 * d,
         mech_to_outlet: p.friction_pairs.shares().0,
         mech_to_case: p.friction_pairs.shares().1,
         case_film_slope_per_k: case_film_slope,
         expansion_per_k: oil.expansion_per_k,
-        k_leak_m3_per_s_pa: p.gaps.conductance(oil.mu_pa_s(40.0)),
+        k_leak_m3_per_s_pa: p.gaps.conductance(mu40),
         case_pressure_pa: rig.hydraulics.accumulator_pa,
-        k_mu_per_k: k_mu,
-        t_mu_ref_c: 40.0,
         line_r1_pa_s_per_m3: 128.0 * nu * rho * line.length_m / (PI * line.diameter_m.powi(4)),
         line_r2_pa_s2_per_m6: rho * line.local_loss_coeff / (2.0 * la * la),
         ram_area_m2: a.ram_area_m2,
@@ -173,6 +221,23 @@ pub fn reduce_without_jacobian(rig: &Rig) -> ReducedParams {
         speed_table_max_rad_s: w_max,
         flow_table_max_m3_per_s: q_max,
         g_case_w_per_k: g_case,
+        leak_ratio,
+        visc_ratio,
+        tc_speed_ratio,
+        re_per_flow,
+        duct_wall_w_per_k,
+        g_port_re2300_w_per_k: re2300(0),
+        g_port_re1e4_w_per_k: re_turb(0, 1e4),
+        g_port_re3e4_w_per_k: re_turb(0, 3e4),
+        g_port_re1e5_w_per_k: re_turb(0, 1e5),
+        g_loop_re2300_w_per_k: re2300(1),
+        g_loop_re1e4_w_per_k: re_turb(1, 1e4),
+        g_loop_re3e4_w_per_k: re_turb(1, 3e4),
+        g_loop_re1e5_w_per_k: re_turb(1, 1e5),
+        g_ball_re2300_w_per_k: re2300(2),
+        g_ball_re1e4_w_per_k: re_turb(2, 1e4),
+        g_ball_re3e4_w_per_k: re_turb(2, 3e4),
+        g_ball_re1e5_w_per_k: re_turb(2, 1e5),
         g_port_w_per_k: g_port,
         g_loop_block_w_per_k: g_loop,
         g_ball_block_w_per_k: g_ball,
@@ -181,8 +246,8 @@ pub fn reduce_without_jacobian(rig: &Rig) -> ReducedParams {
         outer_w_per_k,
         outer_quarter_w_per_k125: outer_quarter,
         outer_rad_w_per_k4: outer_rad,
-        nominal_jacobian_per_s: [[0.0; N_NODES]; N_NODES],
-        phi_step_s: eha_guard::model::etd_matrix(&[[0.0; N_NODES]; N_NODES], eha_guard::params::S_PER_STEP),
+        nominal_jacobian_per_s: [[0.0; N_PHI]; N_PHI],
+        phi_step_s: eha_guard::model::etd_matrix(&[[0.0; N_PHI]; N_PHI], eha_guard::params::S_PER_STEP),
         rest_rate_per_s: [0.0; N_NODES],
         rest_mode: [0.0; N_NODES],
     }
@@ -202,21 +267,24 @@ pub fn nominal_input() -> ModelInputN<f64> {
 }
 
 /// Jacobian of the reduced model's right-hand side at [`nominal_input`] with every
-/// node at 40 °C (central differences of ±0.01 K), 1/s.
-pub fn nominal_jacobian(p: &ReducedParams) -> Option<[[f64; N_NODES]; N_NODES]> {
+/// state at 40 °C over the states of `Phi`, 1/s: central differences of ±2 K, the
+/// steps of the firmware's own check of `Phi` (`model::stability`), so that the two
+/// agree where the tables over temperature have a point at 40 °C (a kink: a
+/// tangent there is not defined, a secant over ±2 K is).
+pub fn nominal_jacobian(p: &ReducedParams) -> Option<[[f64; N_PHI]; N_PHI]> {
     let model = Model::<f64>::for_linearisation(&eha_guard::model::consts::derive(p).ok()?).ok()?;
     let u = nominal_input();
-    let t0 = [40.0; N_NODES];
-    let h = 0.01;
-    let mut a = [[0.0; N_NODES]; N_NODES];
-    for j in 0..N_NODES {
+    let t0 = [40.0; N_STATES];
+    let h = 2.0;
+    let mut a = [[0.0; N_PHI]; N_PHI];
+    for (j, &sj) in PHI_STATES.iter().enumerate() {
         let (mut tp, mut tm) = (t0, t0);
-        tp[j] += h;
-        tm[j] -= h;
+        tp[sj] += h;
+        tm[sj] -= h;
         let fp = model.derivative(&tp, &u, false);
         let fm = model.derivative(&tm, &u, false);
-        for i in 0..N_NODES {
-            a[i][j] = (fp[i] - fm[i]) / (2.0 * h);
+        for (i, &si) in PHI_STATES.iter().enumerate() {
+            a[i][j] = (fp[si] - fm[si]) / (2.0 * h);
         }
     }
     Some(a)
@@ -249,13 +317,13 @@ pub fn rest_cooling(p: &ReducedParams) -> Option<([f64; N_NODES], [f64; N_NODES]
     let jac = |air: f64| {
         let u = ModelInputN { current_ha: 0.0, p_a_hbar: c.p_case, p_b_hbar: c.p_case, speed_hrads: 0.0, dpos_mm: 0.0, ambient_c: air };
         let h = 1e-3;
-        let mut a = [[0.0; N_NODES]; N_NODES];
-        for j in 0..N_NODES {
-            let (mut tp, mut tm) = ([air; N_NODES], [air; N_NODES]);
+        let mut a = [[0.0; N_STATES]; N_STATES];
+        for j in 0..N_STATES {
+            let (mut tp, mut tm) = ([air; N_STATES], [air; N_STATES]);
             tp[j] += h;
             tm[j] -= h;
             let (fp, fm) = (model.derivative(&tp, &u, false), model.derivative(&tm, &u, false));
-            for i in 0..N_NODES {
+            for i in 0..N_STATES {
                 let d = (fp[i] - fm[i]) / (2.0 * h);
                 a[i][j] = if i != j { d.max(0.0) } else { d };
             }
@@ -265,27 +333,30 @@ pub fn rest_cooling(p: &ReducedParams) -> Option<([f64; N_NODES], [f64; N_NODES]
     let jacs = REST_AIR_C.map(jac);
     let group = coupled_groups(&jacs);
     let v = perron_by_group(&jac(FIT_AIR_C), &group)?;
-    let mut rate = [f64::INFINITY; N_NODES];
+    let mut rate = [f64::INFINITY; N_STATES];
     for a in &jacs {
-        for i in 0..N_NODES {
-            let r = -(0..N_NODES).map(|k| a[i][k] * v[k]).sum::<f64>() / v[i];
-            for k in 0..N_NODES {
+        for i in 0..N_STATES {
+            let r = -(0..N_STATES).map(|k| a[i][k] * v[k]).sum::<f64>() / v[i];
+            for k in 0..N_STATES {
                 if group[k] == group[i] {
                     rate[k] = rate[k].min(r);
                 }
             }
         }
     }
-    rate.iter().all(|r| *r > 0.0 && r.is_finite()).then_some((rate, v))
+    let (mut r6, mut v6) = ([0.0; N_NODES], [0.0; N_NODES]);
+    r6.copy_from_slice(&rate[..N_NODES]);
+    v6.copy_from_slice(&v[..N_NODES]);
+    rate.iter().all(|r| *r > 0.0 && r.is_finite()).then_some((r6, v6))
 }
 
 /// Group index of each node: nodes joined by a coupling in any of `jacs`
 /// (couplings below 1e-9 of the largest diagonal are difference noise).
-fn coupled_groups(jacs: &[[[f64; N_NODES]; N_NODES]]) -> [usize; N_NODES] {
-    let tol = 1e-9 * jacs.iter().flat_map(|a| (0..N_NODES).map(move |i| a[i][i].abs())).fold(0.0, f64::max);
+fn coupled_groups(jacs: &[[[f64; N_STATES]; N_STATES]]) -> [usize; N_STATES] {
+    let tol = 1e-9 * jacs.iter().flat_map(|a| (0..N_STATES).map(move |i| a[i][i].abs())).fold(0.0, f64::max);
     let linked = |i: usize, k: usize| jacs.iter().any(|a| a[i][k] > tol || a[k][i] > tol);
-    let mut group = [usize::MAX; N_NODES];
-    for start in 0..N_NODES {
+    let mut group = [usize::MAX; N_STATES];
+    for start in 0..N_STATES {
         if group[start] != usize::MAX {
             continue;
         }
@@ -307,10 +378,10 @@ fn coupled_groups(jacs: &[[[f64; N_NODES]; N_NODES]]) -> [usize; N_NODES] {
 /// `I + dt a` by squaring), max 1 in each group; `None` unless every entry
 /// is positive. One vector for groups that exchange no heat would give the
 /// slower group's nodes all the weight and the other's none.
-fn perron_by_group(a: &[[f64; N_NODES]; N_NODES], group: &[usize; N_NODES]) -> Option<[f64; N_NODES]> {
-    let mut v = [0.0; N_NODES];
-    for g in 0..N_NODES {
-        let idx: Vec<usize> = (0..N_NODES).filter(|i| group[*i] == g).collect();
+fn perron_by_group(a: &[[f64; N_STATES]; N_STATES], group: &[usize; N_STATES]) -> Option<[f64; N_STATES]> {
+    let mut v = [0.0; N_STATES];
+    for g in 0..N_STATES {
+        let idx: Vec<usize> = (0..N_STATES).filter(|i| group[*i] == g).collect();
         if idx.is_empty() {
             continue;
         }
@@ -335,8 +406,13 @@ fn perron_by_group(a: &[[f64; N_NODES]; N_NODES], group: &[usize; N_NODES]) -> O
 }
 
 /// The whole reduction (steps 1-6). `None` if the rig gives parameters the firmware
-/// model rejects.
+/// model rejects, or has the optional pump-as-built structure
+/// ([`crate::rig::Pump::split`], [`Rig::joints`]): the firmware's six states follow
+/// the baseline's one pump node with no path to the motor.
 pub fn reduce(rig: &Rig) -> Option<ReducedParams> {
+    if rig.pump.split.is_some() || rig.joints.is_some() {
+        return None;
+    }
     let p = rediscretise(&reduce_without_jacobian(rig))?;
     Model::<f64>::new(&p).ok()?;
     Some(p)
@@ -368,7 +444,7 @@ fn row(r: &[f64]) -> String {
 
 /// The scalar fields of `p` by name, in `DEFAULT`'s order (the renderer writes
 /// them; the acceptance test compares them with the reduction).
-pub fn scalar_fields(p: &ReducedParams) -> [(&'static str, f64); 38] {
+pub fn scalar_fields(p: &ReducedParams) -> [(&'static str, f64); 37] {
     [
         ("pump_j_per_k", p.pump_j_per_k),
         ("main_block_j_per_k", p.main_block_j_per_k),
@@ -379,6 +455,7 @@ pub fn scalar_fields(p: &ReducedParams) -> [(&'static str, f64); 38] {
         ("port_oil_m3", p.port_oil_m3),
         ("ball_oil_m3", p.ball_oil_m3),
         ("rho_kg_per_m3", p.rho_kg_per_m3),
+        ("rho_slope_kg_per_m3_k", p.rho_slope_kg_per_m3_k),
         ("cp20_j_per_kg_k", p.cp20_j_per_kg_k),
         ("cp_slope_j_per_kg_k2", p.cp_slope_j_per_kg_k2),
         ("displacement_m3_per_rad", p.displacement_m3_per_rad),
@@ -391,8 +468,6 @@ pub fn scalar_fields(p: &ReducedParams) -> [(&'static str, f64); 38] {
         ("expansion_per_k", p.expansion_per_k),
         ("k_leak_m3_per_s_pa", p.k_leak_m3_per_s_pa),
         ("case_pressure_pa", p.case_pressure_pa),
-        ("k_mu_per_k", p.k_mu_per_k),
-        ("t_mu_ref_c", p.t_mu_ref_c),
         ("line_r1_pa_s_per_m3", p.line_r1_pa_s_per_m3),
         ("line_r2_pa_s2_per_m6", p.line_r2_pa_s2_per_m6),
         ("ram_area_m2", p.ram_area_m2),
@@ -412,9 +487,26 @@ pub fn scalar_fields(p: &ReducedParams) -> [(&'static str, f64); 38] {
 }
 
 /// The table and array fields of `p` by name, in `DEFAULT`'s order.
-pub fn array_fields(p: &ReducedParams) -> [(&'static str, &[f64]); 8] {
+pub fn array_fields(p: &ReducedParams) -> [(&'static str, &[f64]); 25] {
     [
         ("g_case_w_per_k", &p.g_case_w_per_k),
+        ("leak_ratio", &p.leak_ratio),
+        ("visc_ratio", &p.visc_ratio),
+        ("tc_speed_ratio", &p.tc_speed_ratio),
+        ("re_per_flow", &p.re_per_flow),
+        ("duct_wall_w_per_k", &p.duct_wall_w_per_k),
+        ("g_port_re2300_w_per_k", &p.g_port_re2300_w_per_k),
+        ("g_port_re1e4_w_per_k", &p.g_port_re1e4_w_per_k),
+        ("g_port_re3e4_w_per_k", &p.g_port_re3e4_w_per_k),
+        ("g_port_re1e5_w_per_k", &p.g_port_re1e5_w_per_k),
+        ("g_loop_re2300_w_per_k", &p.g_loop_re2300_w_per_k),
+        ("g_loop_re1e4_w_per_k", &p.g_loop_re1e4_w_per_k),
+        ("g_loop_re3e4_w_per_k", &p.g_loop_re3e4_w_per_k),
+        ("g_loop_re1e5_w_per_k", &p.g_loop_re1e5_w_per_k),
+        ("g_ball_re2300_w_per_k", &p.g_ball_re2300_w_per_k),
+        ("g_ball_re1e4_w_per_k", &p.g_ball_re1e4_w_per_k),
+        ("g_ball_re3e4_w_per_k", &p.g_ball_re3e4_w_per_k),
+        ("g_ball_re1e5_w_per_k", &p.g_ball_re1e5_w_per_k),
         ("g_port_w_per_k", &p.g_port_w_per_k),
         ("g_loop_block_w_per_k", &p.g_loop_block_w_per_k),
         ("g_ball_block_w_per_k", &p.g_ball_block_w_per_k),

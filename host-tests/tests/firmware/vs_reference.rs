@@ -1,8 +1,10 @@
 //! Acceptance of the firmware's reduced model (issue 3, "Host tests") against
-//! the full reference simulation: Case 1 at 0/20/40/60 bar, Case 2, the LNG case
-//! and five random missions (`missions::TEST_SEEDS`); the reduced model is
-//! computed from the rig (`eha_sim::reduce`), fitted to no run, so every run is
-//! unseen.
+//! the full reference simulation: Case 1 at 0/20/40/60 bar, Case 2, the LNG case,
+//! five random missions (`missions::TEST_SEEDS`), a long hot run (Case 1 at 60 bar
+//! for an hour on a rig without LNG: the drain passes 60 °C, the oil thins to
+//! ≈ 8 cSt) and a cold start (Case 1 at 60 bar in 0 °C air: ≈ 580 cSt at the
+//! start); the reduced model is computed from the rig (`eha_sim::reduce`), fitted
+//! to no run, so every run is unseen.
 //!
 //! Every run is **closed loop**, as on the actuator: the guard (`GuardOf<f64>`,
 //! validation included, reduced `eha_guard::params::DEFAULT`) is fed the
@@ -33,8 +35,12 @@ use std::sync::OnceLock;
 
 /// Duration of every acceptance run, s (the paper's 600 s).
 const DURATION_S: f64 = 600.0;
-/// Issue bound on max |drain error|, K.
+/// Issue bound on max |drain error|, K (issue 3).
 const MAX_ABS_K: f64 = 1.0;
+/// Bound on max |drain error| once the oil follows its viscosity line (issue 34),
+/// K: the firmware stays within 0.1 K of the reference on every acceptance run,
+/// the hour-long hot run and the 0 °C cold start included.
+const MAX_ABS_34_K: f64 = 0.1;
 /// Issue goal on max |drain error|, K (reported, not asserted).
 const GOAL_K: f64 = 0.5;
 /// Issue bound on drain under-prediction, K.
@@ -42,29 +48,68 @@ const MAX_UNDER_K: f64 = 0.5;
 /// Issue bound on a valve switching time against switching on the true drain, s.
 const MAX_SWITCH_S: f64 = 2.0;
 /// Regression bound on max |drain error| over every run, K: measured worst
-/// 0.070 K (random-1), 2.1×.
+/// 0.098 K (the pump stopped with the valve open), 1.5×; 0.063 K on the
+/// acceptance runs (random-2), 2.4× (issue 34; before, 0.070 K, random-1).
 const REG_MAX_ABS_K: f64 = 0.15;
 /// Regression bound on drain under-prediction over every run, K: measured worst
-/// 0.057 K (random-1), 2.6×.
+/// 0.059 K (random-5), 2.5× (issue 34; before, 0.057 K, random-1).
 const REG_MAX_UNDER_K: f64 = 0.15;
 /// Regression bound on |f32 − f64| drain, K: measured 3.81e-6 K (Case 1 60 bar
 /// and LNG), 2.6×. (The fixed-point spec bound, 0.1 K, is itself 2.2× the
 /// measured 4.47e-2 K, so it serves as that type's regression bound too.)
 const REG_F32_K: f64 = 1e-5;
-/// Regression bound on any switching-time difference, s: measured worst 0.54 s
-/// (random-1 event 1, random-2 event 4), 2.2×.
-const REG_SWITCH_S: f64 = 1.2;
-/// Regression bound on a first-opening difference, s: measured worst 0.14 s
-/// (Case 1 40 bar), 2.1×.
+/// Regression bound on any switching-time difference, s. Measured worst 1.90 s
+/// since the oil follows its viscosity line (issue 34; 0.54 s before): random-2
+/// event 5, a closing at 575.7 s where the drain falls slowly (≈ 0.03 K/s), so the
+/// estimate's +0.06 K there shows as 1.9 s; the next worst 0.71 s (random-1 event
+/// 1). No margin is left for a regression bound above the issue's 2 s: it is the
+/// issue's bound ([`MAX_SWITCH_S`]).
+const REG_SWITCH_S: f64 = MAX_SWITCH_S;
+/// Regression bound on a first-opening difference, s: measured worst 0.08 s
+/// (Case 1 40 bar; 0.14 s before issue 34), 3.75×.
 const REG_FIRST_OPEN_S: f64 = 0.3;
+
+/// One run of the suite: its name, its scenario, and whether the rig has an LNG
+/// cooler (the hot run has none: the reference's exchanger takes nothing and the
+/// guard's tank is empty, so it credits nothing).
+#[derive(Clone)]
+struct Case {
+    name: String,
+    scenario: Scenario,
+    lng: bool,
+}
+
+impl Case {
+    fn new(name: &str, scenario: Scenario) -> Self {
+        Case { name: name.into(), scenario, lng: true }
+    }
+
+    /// The reference rig of this run.
+    fn rig(&self) -> Rig {
+        let mut rig = Rig::default();
+        if !self.lng {
+            rig.lng.flow_kg_per_s = 0.0;
+        }
+        rig
+    }
+
+    /// The guard's configuration of this run.
+    fn config(&self) -> GuardConfig<'static> {
+        let mut cfg = GuardConfig::DEFAULT;
+        if !self.lng {
+            cfg.lng.charge_l = 0.0;
+        }
+        cfg
+    }
+}
 
 /// The acceptance runs (drain-error bounds) followed by load-then-idle (valve
 /// switching only).
-fn cases() -> &'static [(String, Scenario)] {
-    static C: OnceLock<Vec<(String, Scenario)>> = OnceLock::new();
+fn cases() -> &'static [Case] {
+    static C: OnceLock<Vec<Case>> = OnceLock::new();
     C.get_or_init(|| {
         let mut v = scenarios();
-        v.push(("load-then-idle".into(), load_then_idle()));
+        v.push(Case::new("load-then-idle", load_then_idle()));
         v
     })
 }
@@ -77,16 +122,28 @@ const STOPPED_RPM: f64 = 6.2;
 /// 7 s; 10 s bound.
 const STOPPED_LATE_S: f64 = 10.0;
 
-fn scenarios() -> Vec<(String, Scenario)> {
-    let mut v: Vec<(String, Scenario)> = [0.0, 20.0, 40.0, 60.0]
+/// Duration of the long hot run, s.
+const HOT_S: f64 = 3600.0;
+/// Air temperature of the cold start, °C.
+const COLD_AIR_C: f64 = 0.0;
+/// Duration of the cold start, s (long enough for the valve to open).
+const COLD_S: f64 = 900.0;
+
+fn scenarios() -> Vec<Case> {
+    let mut v: Vec<Case> = [0.0, 20.0, 40.0, 60.0]
         .iter()
-        .map(|&b| (format!("case1-{b}bar"), Scenario::Case1 { needle_bar: b, duration_s: DURATION_S }))
+        .map(|&b| Case::new(&format!("case1-{b}bar"), Scenario::Case1 { needle_bar: b, duration_s: DURATION_S }))
         .collect();
-    v.push(("case2".into(), Scenario::Case2 { duration_s: DURATION_S }));
-    v.push(("lng".into(), Scenario::Lng { duration_s: DURATION_S }));
+    v.push(Case::new("case2", Scenario::Case2 { duration_s: DURATION_S }));
+    v.push(Case::new("lng", Scenario::Lng { duration_s: DURATION_S }));
     for s in TEST_SEEDS {
-        v.push((format!("random-{s}"), Scenario::Mission(random_mission(s, DURATION_S))));
+        v.push(Case::new(&format!("random-{s}"), Scenario::Mission(random_mission(s, DURATION_S))));
     }
+    v.push(Case { lng: false, ..Case::new("hot-1h-no-lng", Scenario::Case1 { needle_bar: 60.0, duration_s: HOT_S }) });
+    let mut cold: Mission = Scenario::Case1 { needle_bar: 60.0, duration_s: COLD_S }.mission().expect("mission");
+    cold.name = "cold-start".into();
+    cold.ambient_c = Schedule::constant(COLD_AIR_C);
+    v.push(Case::new("cold-start-0c", Scenario::Mission(cold)));
     v
 }
 
@@ -107,13 +164,14 @@ struct Run {
     mech_pairs: Vec<(f64, f64)>,
 }
 
-/// Runs `scenario` in closed loop, the valve following the guard.
-fn closed_loop(name: &str, scenario: &Scenario) -> Run {
-    let rig = Rig::default();
+/// Runs `case` in closed loop, the valve following the guard.
+fn closed_loop(case: &Case) -> Run {
+    let scenario = &case.scenario;
+    let rig = case.rig();
     let mut plant = Plant::new(&rig, scenario).expect("plant");
-    let cfg = GuardConfig::DEFAULT;
+    let cfg = case.config();
     let mut guard = GuardOf::<f64>::new(&cfg, Restore::Cold);
-    let mut run = Run { name: name.into(), sensors: vec![], pred: vec![], faults: eha_guard::Faults::NONE, events: vec![], mech_pairs: vec![] };
+    let mut run = Run { name: case.name.clone(), sensors: vec![], pred: vec![], faults: eha_guard::Faults::NONE, events: vec![], mech_pairs: vec![] };
     let mut open = false;
     plant
         .run(0.01, scenario.duration_s(), |snap| {
@@ -142,7 +200,7 @@ fn closed_loop(name: &str, scenario: &Scenario) -> Run {
 /// The guard-driven run of every case of [`cases`], in its order.
 fn runs() -> &'static [Run] {
     static R: OnceLock<Vec<Run>> = OnceLock::new();
-    R.get_or_init(|| cases().par_iter().map(|(n, s)| closed_loop(n, s)).collect())
+    R.get_or_init(|| cases().par_iter().map(closed_loop).collect())
 }
 
 /// For every case of [`cases`], in its order: when a thermostat with the guard's
@@ -151,14 +209,15 @@ fn runs() -> &'static [Run] {
 /// [`thermostat_from_branch`], shared by both valve tests.
 fn thermostat_first_switch() -> &'static [Option<f64>] {
     static T: OnceLock<Vec<Option<f64>>> = OnceLock::new();
-    T.get_or_init(|| cases().par_iter().map(|(_, sc)| thermostat_from_branch(sc, &[], 0).map(|(t, _)| t)).collect())
+    T.get_or_init(|| cases().par_iter().map(|c| thermostat_from_branch(c, &[], 0).map(|(t, _)| t)).collect())
 }
 
 /// The guard of number type `N` on a run's sensor signals: drain estimate
 /// (element k: after sample k), its own valve command (which sets its
 /// exchanger credit) per tick, faults at the end.
 fn guard_drain_valve<N: Num>(run: &Run) -> (Vec<f64>, Vec<bool>, eha_guard::Faults) {
-    let mut g = GuardOf::<N>::new(&GuardConfig::DEFAULT, Restore::Cold);
+    let cfg = cases().iter().find(|c| c.name == run.name).map_or(GuardConfig::DEFAULT, Case::config);
+    let mut g = GuardOf::<N>::new(&cfg, Restore::Cold);
     let n = run.sensors.len() - 1;
     let (mut out, mut valve) = (Vec::with_capacity(n), Vec::with_capacity(n));
     let mut faults = eha_guard::Faults::NONE;
@@ -203,6 +262,8 @@ fn assert_bounds(rows: &[(String, ErrorStats, eha_guard::Faults)]) {
         assert!(!f.intersects(faults::LATCHED), "{n}: guard faulted on reference signals");
         // Issue: max |drain error| <= 1.0 K.
         assert!(e.max_abs <= MAX_ABS_K, "{n}: max |error| {:.3} K > {MAX_ABS_K} K", e.max_abs);
+        // Issue 34: within 0.1 K of the reference on every acceptance run.
+        assert!(e.max_abs <= MAX_ABS_34_K, "{n}: max |error| {:.3} K > {MAX_ABS_34_K} K", e.max_abs);
         // Issue: under-prediction is the unsafe side, never more than 0.5 K.
         assert!(e.max_under <= MAX_UNDER_K, "{n}: under-prediction {:.3} K > {MAX_UNDER_K} K", e.max_under);
         // Regression bounds (2-3x the measured worst; the spec bounds above are what the issue demands).
@@ -221,6 +282,24 @@ fn case1_all_pressures_drain_within_bounds() {
 #[test]
 fn case2_drain_within_bounds() {
     assert_bounds(&report(&["case2"]));
+}
+
+/// The long hot run: Case 1 at 60 bar for an hour on a rig without LNG (the drain
+/// passes 60 °C after ≈ 10 minutes and reaches ≈ 92 °C, the oil ≈ 8 cSt: leakage
+/// ≈ 6 times, viscous friction a sixth of their 40 °C values), and the cold start:
+/// Case 1 at 60 bar in 0 °C air (the oil starts at ≈ 580 cSt: viscous friction 12
+/// times its 40 °C value).
+#[test]
+fn hot_run_and_cold_start_drain_within_bounds() {
+    let rows = report(&["hot-1h", "cold-start"]);
+    assert_eq!(rows.len(), 2);
+    let hot = runs().iter().find(|r| r.name.starts_with("hot-1h")).expect("hot run");
+    let peak = hot.sensors.iter().map(|s| s.t_drain_c).fold(f64::NEG_INFINITY, f64::max);
+    println!("hot run: reference drain peaks at {peak:.2} °C");
+    assert!(peak > 60.0, "the hot run must take the drain past 60 °C: {peak:.2}");
+    let cold = runs().iter().find(|r| r.name.starts_with("cold-start")).expect("cold run");
+    assert!(cold.sensors[0].t_drain_c.abs() < 1e-9, "the cold start starts at 0 °C");
+    assert_bounds(&rows);
 }
 
 /// Five random missions (the model is reduced from the rig, fitted to no run).
@@ -319,16 +398,20 @@ fn load_then_idle() -> Scenario {
     Scenario::Mission(m)
 }
 
-/// The LNG case's 60 bar load with the pump stopped at 285 s, while the guard's valve
-/// is open (the guard opens it at 267.0 s with a dwell on both directions, at 282.4 s
-/// with a dwell that qualifies only the closing): the drain bounds of the acceptance runs over the 300 s after the stop
-/// (the exchanger stays commanded open with no oil through it).
+/// The LNG case's 60 bar load with the pump stopped at 310 s, while the guard's valve
+/// is open (it opens at 297.8 s and would close at 323.8 s; 285 s until issue 34,
+/// when the oil on its viscosity line moved the openings): the drain bounds of the
+/// acceptance runs over the 290 s after the stop (the exchanger stays commanded open
+/// with no oil through it).
 fn stop_with_valve_open() -> Scenario {
     let mut m: Mission = Scenario::Lng { duration_s: 600.0 }.mission().expect("mission");
     m.name = "lng-stop-valve-open".into();
-    m.speed_rpm = Schedule(vec![(0.0, 500.0), (285.0, 500.0), (285.0, 0.0)]);
+    m.speed_rpm = Schedule(vec![(0.0, 500.0), (STOP_S, 500.0), (STOP_S, 0.0)]);
     Scenario::Mission(m)
 }
+
+/// When [`stop_with_valve_open`] stops the pump, s.
+const STOP_S: f64 = 310.0;
 
 /// Pump stopped with the valve open ([`stop_with_valve_open`]): before the exchanger
 /// credit was cut below the LNG table's second point (1.98e-3 L/s), the model credited
@@ -336,8 +419,8 @@ fn stop_with_valve_open() -> Scenario {
 /// the stop.
 #[test]
 fn pump_stopped_with_valve_open_drain_within_bounds() {
-    let r = closed_loop("lng-stop-valve-open", &stop_with_valve_open());
-    let open_at_stop = r.events.iter().take_while(|(t, _)| *t <= 285.0).last().is_some_and(|e| e.1);
+    let r = closed_loop(&Case::new("lng-stop-valve-open", stop_with_valve_open()));
+    let open_at_stop = r.events.iter().take_while(|(t, _)| *t <= STOP_S).last().is_some_and(|e| e.1);
     assert!(open_at_stop, "the scenario needs the valve open when the pump stops: {:?}", r.events);
     let e = drain_stats(&r);
     println!(
@@ -370,7 +453,7 @@ fn valve_first_opening_within_2s() {
                 if !(f.1 && t.1 && d <= MAX_SWITCH_S) {
                     failures.push(format!("{n}: {d:.2} s"));
                 }
-                // Regression: 2.1x the measured worst 0.14 s.
+                // Regression: [`REG_FIRST_OPEN_S`].
                 if d > REG_FIRST_OPEN_S {
                     failures.push(format!("{n}: {d:.2} s > regression bound {REG_FIRST_OPEN_S} s"));
                 }
@@ -388,11 +471,12 @@ fn valve_first_opening_within_2s() {
 /// (None: not before the end of the run). Same plant, same state, same valve
 /// history up to the branch point: the difference to the guard's event is the
 /// switching delay due to the estimate alone.
-fn thermostat_from_branch(scenario: &Scenario, events: &[(f64, bool)], i: usize) -> Option<(f64, f64)> {
+fn thermostat_from_branch(case: &Case, events: &[(f64, bool)], i: usize) -> Option<(f64, f64)> {
+    let scenario = &case.scenario;
     let (branch_t, open_at_branch) = if i == 0 { (f64::NEG_INFINITY, false) } else { events[i - 1] };
-    let rig = Rig::default();
+    let rig = case.rig();
     let mut plant = Plant::new(&rig, scenario).expect("plant");
-    let cfg = GuardConfig::DEFAULT;
+    let cfg = case.config();
     let mut valve = Valve::new();
     let mut branched = false;
     let mut switched = None;
@@ -454,7 +538,7 @@ fn valve_switching_times_match_true_drain() {
         .filter(|(_, run)| !run.events.is_empty())
         .map(|(r, _)| (r, 0, first[r].map(|t| (t, f64::NAN))))
         .collect();
-    results.par_extend(jobs.par_iter().map(|&(r, i)| (r, i, thermostat_from_branch(&cases[r].1, &guard_runs[r].events, i))));
+    results.par_extend(jobs.par_iter().map(|&(r, i)| (r, i, thermostat_from_branch(&cases[r], &guard_runs[r].events, i))));
     results.sort_by_key(|x| (x.0, x.1));
     let mut worst = 0.0f64;
     let mut failures = vec![];
@@ -482,8 +566,8 @@ fn valve_switching_times_match_true_drain() {
                 if !ok {
                     failures.push(format!("{n} event {i} ({}{}) at {te:.2} s: {d:+.2} s", if open { "open" } else { "close" }, if stopped { ", pump stopped" } else { "" }));
                 }
-                // Regression: 2.2x the measured worst 0.54 s (closings with the
-                // pump stopped have their own bound above).
+                // Regression: [`REG_SWITCH_S`] (closings with the pump stopped have
+                // their own bound above).
                 if (!stopped || open) && d.abs() > REG_SWITCH_S {
                     failures.push(format!("{n} event {i} at {te:.2} s: {d:+.2} s > regression bound {REG_SWITCH_S} s"));
                 }

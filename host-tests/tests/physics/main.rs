@@ -5,3 +5,4 @@ mod energy;
 mod paper;
 mod pump_energy;
 mod solver;
+mod uq;

@@ -23,7 +23,7 @@
 use eha_sim::calibrate::{evaluate, PAPER};
 use eha_sim::cooling::{size, Lng};
 use eha_sim::heat::h_forced_plate;
-use eha_sim::network::{h_outer, masses, Shape, NODES};
+use eha_sim::network::{capacity_j_per_k, contents, h_outer, stored_j, Shape, NODES};
 use eha_sim::rig::Rig;
 use eha_sim::scenario::Scenario;
 use eha_sim::sim::{simulate, SimOptions, SimOutput};
@@ -40,7 +40,7 @@ fn case1(rig: &Rig, bar: f64) -> SimOutput {
 /// **Fitted, reproduces the fit**: these three temperatures are calibration
 /// targets (four targets, three parameters, least squares), so passing
 /// validates little; what it shows is that three physical parameters can
-/// meet four numbers at once. Measured: 52.97 / 54.20 / 59.67 °C.
+/// meet four numbers at once. Measured: 52.84 / 54.35 / 59.65 °C.
 #[test]
 fn table4_port_temperatures_at_600s_60bar_fitted() {
     let out = case1(&Rig::default(), 60.0);
@@ -56,8 +56,8 @@ fn table4_port_temperatures_at_600s_60bar_fitted() {
 
 /// The committed rig still reproduces its calibration (`eha-sim calibrate`,
 /// docs/calibration.md): the least-squares residuals as measured when the
-/// fit was made (inlet −0.026, outlet +0.028, drain −0.002 K; 40 °C crossing
-/// 109.99 s), each within 0.01 K (0.1 s): anything more means the physics
+/// fit was made (inlet −0.163, outlet +0.180, drain −0.023 K; 40 °C crossing
+/// 109.97 s), each within 0.01 K (0.1 s): anything more means the physics
 /// changed since the fit and `eha-sim calibrate` must be re-run, together
 /// with every number downstream of the rig. A regression guard, not a
 /// validation.
@@ -65,29 +65,31 @@ fn table4_port_temperatures_at_600s_60bar_fitted() {
 fn calibration_targets_are_reproduced() {
     let m = evaluate(&Rig::default()).expect("case 1 runs");
     let temps = [
-        ("inlet", m.inlet_c, PAPER.inlet_c, -0.026),
-        ("outlet", m.outlet_c, PAPER.outlet_c, 0.028),
-        ("drain", m.drain_c, PAPER.drain_c, -0.002),
+        ("inlet", m.inlet_c, PAPER.inlet_c, -0.163),
+        ("outlet", m.outlet_c, PAPER.outlet_c, 0.180),
+        ("drain", m.drain_c, PAPER.drain_c, -0.023),
     ];
     for (name, ours, target, residual) in temps {
         println!("{name}: ours {ours:.5} °C, target {target:.2} °C, residual {:+.4} K (at the fit {residual:+.3})", ours - target);
         assert!((ours - target - residual).abs() <= 0.01, "{name}: residual {:+.4} K: re-run `eha-sim calibrate`", ours - target);
     }
     println!("oil passes 40 °C at {:.3} s, target {:.1} s", m.t40_s, PAPER.t40_s);
-    assert!((m.t40_s - 109.99).abs() <= 0.1, "40 °C crossing {:.2} s: re-run `eha-sim calibrate`", m.t40_s);
+    assert!((m.t40_s - 109.97).abs() <= 0.1, "40 °C crossing {:.2} s: re-run `eha-sim calibrate`", m.t40_s);
 }
 
 /// Table 5's pump shell in still air at 600 s, 60 bar: paper 25.38 °C.
 /// **Predicted** (no parameter is fitted to it). **Known miss**: measured
-/// 26.82 °C, +1.44 K: with the sliding-pair rule (docs/calibration.md) the
+/// 29.43 °C, +4.05 K: with the sliding-pair rule (docs/calibration.md) the
 /// housing receives the bearings' and about a quarter of the films' friction
-/// heat; with all film heat into the oil the shell came out 3.4 K too cold
-/// (22.0 °C). Asserted as measured (±0.05 K: a deterministic run).
+/// heat, and with the oil on its viscosity line the hot case oil's film gives
+/// the housing more (26.82 °C, +1.44 K, with the viscosity held at 40 °C;
+/// with all film heat into the oil the shell came out 3.4 K too cold).
+/// Asserted as measured (±0.05 K: a deterministic run).
 #[test]
 fn still_air_pump_shell_predicted_known_miss() {
     let m = evaluate(&Rig::default()).expect("case 1 runs");
     println!("pump shell {:.3} °C, paper 25.38 (predicted, {:+.2} K)", m.pump_shell_c, m.pump_shell_c - 25.38);
-    assert!((m.pump_shell_c - 26.82).abs() <= 0.05, "shell {:.3}: re-measure", m.pump_shell_c);
+    assert!((m.pump_shell_c - 29.43).abs() <= 0.05, "shell {:.3}: re-measure", m.pump_shell_c);
 }
 
 /// Table 5: ram-air coefficients 66.13, 115.13, 173.25 W/(m²·K) at 15, 30,
@@ -102,7 +104,7 @@ fn still_air_pump_shell_predicted_known_miss() {
 fn table5_ram_air_coefficients() {
     let rig = Rig::default();
     for (v, paper, note) in [(15.0, 66.13, "fitted"), (30.0, 115.13, "predicted"), (50.0, 173.25, "predicted")] {
-        let h = h_forced_plate(v, rig.outside.ram_run_length_m, rig.outside.ram_property_c);
+        let h = h_forced_plate(v, rig.outside.ram_run_length_m, 16.0, rig.outside.air_pressure_pa());
         println!("{v} m/s: ours {h:.3}, paper {paper:.2} W/(m²·K), {:+.3} % ({note})", 100.0 * (h - paper) / paper);
         assert!((h - paper).abs() / paper < 0.01, "{v} m/s: {h}");
     }
@@ -111,7 +113,7 @@ fn table5_ram_air_coefficients() {
 /// Table 5's still-air convective coefficient of the pump shell, 1.40
 /// W/(m²·K). Ours is Churchill–Chu free convection (eq. 15) on the 0.12 m
 /// housing at its 600 s, 60 bar wall temperature (predicted) over 16 °C
-/// air. **Known miss**: measured 3.75 W/(m²·K) at the predicted 26.82 °C shell, 2.7 times the paper's; the
+/// air. **Known miss**: measured 3.98 W/(m²·K) at the predicted 29.43 °C shell, 2.8 times the paper's; the
 /// correlation's scatter is ±20 % or so, and no free-convection correlation
 /// gives 1.40 at ΔT ≈ 9.4 K (docs/calibration.md). Asserted: the measured
 /// value within ±2 % (the wall temperature is fitted to 0.01 K, h ∝ ΔT^¼
@@ -121,7 +123,7 @@ fn table5_still_air_coefficient_known_miss() {
     let rig = Rig::default();
     let shell = case1(&rig, 60.0).last("t_pump_c").expect("channel");
     let h = h_outer(&rig, Shape::Cylinder(rig.pump.diameter_m), shell, 16.0, 0.0);
-    let measured = 3.75;
+    let measured = 3.98;
     println!("still-air h of the pump shell: ours {h:.3} W/(m²·K) at {shell:.2} °C, paper 1.40 (known miss, measured {measured})");
     assert!((h - measured).abs() <= 0.02 * measured, "still-air h {h:.3}, measured {measured} (paper 1.40): re-measure");
 }
@@ -196,11 +198,13 @@ const CASE2_WINDOW: usize = 6;
 /// it, i.e. 90 % of it leaves (the 90 % settling of a first-order lag).
 const CASE2_EPS: f64 = 0.10;
 /// Loss channels that heat oil nodes (model.rs `thermal`: leakage, the
-/// pump's friction split between case and high-pressure port, churning, line
-/// and valve losses into the loop oil, needle throttling into the ball-valve
-/// oil) and those that heat metal (winding, motor, actuator).
-const OIL_LOSSES: [&str; 6] = ["p_leak_w", "p_mech_w", "p_churn_w", "p_line_w", "p_throttle_w", "p_valves_w"];
-const METAL_LOSSES: [&str; 5] = ["p_cu_w", "p_fe_w", "p_bearing_w", "p_act_leak_w", "p_act_friction_w"];
+/// pump's friction that the sliding-pair rule puts into the case and
+/// high-pressure port oil, churning, line and valve losses into the loop oil,
+/// needle throttling into the ball-valve oil) and those that heat metal
+/// (winding, motor, actuator, the pump friction's metal part: bearings,
+/// shaft seal and the films' share on the metal faces).
+const OIL_LOSSES: [&str; 6] = ["p_leak_w", "p_mech_oil_w", "p_churn_w", "p_line_w", "p_throttle_w", "p_valves_w"];
+const METAL_LOSSES: [&str; 6] = ["p_cu_w", "p_fe_w", "p_bearing_w", "p_act_leak_w", "p_act_friction_w", "p_mech_metal_w"];
 
 /// Balance time: the centre of the first window from which on every window's
 /// ratio (stored / lost power, `(centre s, ratio)`) is below `eps` in
@@ -225,12 +229,14 @@ fn balance_from(ratios: &[(f64, f64)], eps: f64) -> Option<f64> {
 /// stores the rest; printed), so the paper's statement can only mean the oil.
 ///
 /// Paper: ≈ 200 s, read as ±50 s (half a 100 s division of a 600 s axis).
-/// **Known miss**: measured oil 305.0 s, inlet 212.5 s, outlet 212.5 s, drain
-/// not within 600 s (issue 16's pump energy balance moved them from 390 /
-/// 382.5 / 382.5 / 517.5 s: part of the pump's friction now heats the housing
-/// directly, and the "oil losses" below still count the whole of eq. 8 as
-/// oil heat, so the oil ratio is an upper bound). Printed beside: the 20 %
-/// and 5 % crossings.
+/// **Known miss**: measured oil 585.0 s, inlet 547.5 s, outlet 537.5 s, drain
+/// not within 600 s (515 / 502.5 / 502.5 s with the viscosity held at 40 °C). The denominator is the friction heat that really enters
+/// the oil: the sliding-pair rule puts the no-load term and a quarter of the
+/// films' heat into the pump's metal (`p_mech_metal_w`), which the oil never
+/// receives. Counting all of eq. (8) as oil heat (the earlier accounting)
+/// overstated the oil's input by that much and gave 305.0 / 212.5 / 212.5 s,
+/// an upper bound, not a balance time (before issue 16's energy balance:
+/// 390 / 382.5 / 382.5 / 517.5 s). Printed beside: the 20 % and 5 % crossings.
 /// Asserted: each time within ±15 s of the measured (three periods: near the
 /// crossing the ratio falls ≈ 0.001 per 15 s and scatters ≈ ±0.0005 between
 /// windows; 30 s windows of 3–10 periods and a 0.05 s output grid give times
@@ -257,11 +263,11 @@ fn case2_periodic_balance_time_known_miss() {
     }
     let p_oil: Vec<f64> = (0..total.len()).map(|i| OIL_LOSSES.iter().map(|c| get(c)[i]).sum()).collect();
     // Oil energy (enthalpy) and capacity from the oil nodes.
-    let m = masses(&rig);
+    let m = contents(&rig);
     let oil_nodes: Vec<(usize, &[f64])> =
         NODES.iter().enumerate().filter(|(_, n)| n.is_oil()).map(|(i, n)| (i, get(n.channel()))).collect();
-    let e_oil = |s: usize| oil_nodes.iter().map(|&(i, t)| m[i].0 * rig.oil.enthalpy(t[s])).sum::<f64>();
-    let c_oil = |s: usize| oil_nodes.iter().map(|&(i, t)| m[i].0 * rig.oil.cp(t[s])).sum::<f64>();
+    let e_oil = |s: usize| oil_nodes.iter().map(|&(i, t)| stored_j(&rig, NODES[i], m[i], t[s])).sum::<f64>();
+    let c_oil = |s: usize| oil_nodes.iter().map(|&(i, t)| capacity_j_per_k(&rig, NODES[i], m[i], t[s])).sum::<f64>();
     let period_mean = |v: &[f64], k: usize| v[k * CASE2_PER..(k + 1) * CASE2_PER].iter().sum::<f64>() / CASE2_PER as f64;
     let w = CASE2_WINDOW;
     let span = w as f64 * CASE2_PERIOD_S;
@@ -294,9 +300,9 @@ fn case2_periodic_balance_time_known_miss() {
     // (name, measured balance time at CASE2_EPS, s)
     type Series = Vec<(f64, f64)>;
     let cases: [(&str, Series, Option<f64>); 4] = [
-        ("oil (energy)", oil, Some(305.0)),
-        ("t_inlet_c", node("t_inlet_c"), Some(212.5)),
-        ("t_outlet_c", node("t_outlet_c"), Some(212.5)),
+        ("oil (energy)", oil, Some(585.0)),
+        ("t_inlet_c", node("t_inlet_c"), Some(547.5)),
+        ("t_outlet_c", node("t_outlet_c"), Some(537.5)),
         ("t_drain_c", node("t_drain_c"), None),
     ];
     let mut failures = vec![];
@@ -332,4 +338,55 @@ fn case2_periodic_balance_time_known_miss() {
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// Losses of the energy transfer at `t`: every loss but the needle's
+/// throttling (the load the paper's Case 1 sets), W.
+fn transfer_loss_w(out: &SimOutput, t: f64) -> f64 {
+    out.at("p_total_w", t).unwrap_or(f64::NAN) - out.at("p_throttle_w", t).unwrap_or(f64::NAN)
+}
+
+/// The paper (Section IV.B): "In Case 1 the power loss at 60 bar pressure is
+/// 0.7 kW and the combined system thermal power is about 1.5 kW", the
+/// latter used to size the LNG (eqs. 23–25, 2.3 L).
+///
+/// Ours, Case 1 at 60 bar, mean over 0–600 s: the losses of the energy
+/// transfer (motor copper and iron, pump leakage and friction, lines: every
+/// loss but the needle's throttling, which is the load Case 1 sets) and the
+/// combined thermal power (all of them). The paper prints one significant
+/// figure, so its 0.7 kW stands for [0.65, 0.75) kW and its 1.5 kW for
+/// [1.45, 1.55) kW. **Measured**: transfer 0.766 kW, combined 1.657 kW:
+/// both **known misses**, above the intervals by 0.016 and 0.107 kW (with
+/// the viscosity held at 40 °C they were 0.571 and 1.485 kW: the fit now
+/// needs η_m 0.44 for Table 4, see `pump_energy.rs`). Asserted as measured,
+/// ±0.005 kW (deterministic runs; catches any change of a loss law).
+///
+/// LNG sizing from the model's own dissipation beside the paper's input:
+/// eqs. (23)–(25) with the same mission time (680 s, the one that gives the
+/// paper's 2.3 L at 1.5 kW): measured 2.54 L from our 1.657 kW, against the
+/// paper's 2.30 L (asserted as measured, ±0.01 L).
+#[test]
+fn power_loss_at_60bar_against_the_paper_and_lng_sized_from_the_model() {
+    let out = case1(&Rig::default(), 60.0);
+    let ts: Vec<f64> = out.time_s.clone();
+    let mean = |f: &dyn Fn(f64) -> f64| ts.windows(2).map(|w| 0.5 * (f(w[0]) + f(w[1])) * (w[1] - w[0])).sum::<f64>() / 600.0;
+    let transfer = mean(&|t| transfer_loss_w(&out, t)) * 1e-3;
+    let combined = mean(&|t| out.at("p_total_w", t).unwrap_or(f64::NAN)) * 1e-3;
+    let at600 = (transfer_loss_w(&out, 600.0) * 1e-3, out.last("p_total_w").unwrap_or(f64::NAN) * 1e-3);
+    let lng = Lng::default();
+    let ours = size(&lng, combined * 1e3, 680.0, 2.0);
+    let paper = size(&lng, 1500.0, 680.0, 2.0);
+    println!(
+        "60 bar, mean 0-600 s: transfer losses {transfer:.3} kW (paper 0.7), combined {combined:.3} kW (paper 1.5); at 600 s {:.3} / {:.3} kW",
+        at600.0, at600.1
+    );
+    println!(
+        "LNG for 680 s: {:.3} L from the model's {combined:.3} kW ({:.2} L with 2x), paper's 1.5 kW {:.3} L",
+        ours.volume_m3 * 1e3,
+        ours.volume_with_redundancy_m3 * 1e3,
+        paper.volume_m3 * 1e3
+    );
+    assert!((transfer - 0.766).abs() <= 0.005, "transfer losses {transfer:.4} kW: re-measure");
+    assert!((combined - 1.657).abs() <= 0.005, "combined {combined:.4} kW: re-measure");
+    assert!((ours.volume_m3 * 1e3 - 2.54).abs() <= 0.01, "LNG {:.3} L: re-measure", ours.volume_m3 * 1e3);
 }
