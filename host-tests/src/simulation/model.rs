@@ -527,17 +527,32 @@ impl Model {
         let op = self.op_point(t, y);
         let temps = &y[T0..T0 + N_NODES];
         let l = self.losses(t, &op, temps);
-        match &self.drive {
-            Drive::Mission(m) => {
-                let f = hydraulics::flows(&self.rig, &op, self.k_leak(temps[Node::Case as usize]));
-                hydraulics::derivatives(&self.rig, m, t, y, &op, &f, self.nu(temps[Node::BallOil as usize]), dy);
-            }
-            Drive::Replay(_) => dy[..ix::N].iter_mut().for_each(|d| *d = 0.0),
-        }
+        self.hydraulic_rhs_at(t, y, &op, dy);
         let (q_in, q_amb, q_lng) = self.thermal(&op, &l, temps, &mut dy[T0..T0 + N_NODES]);
         dy[E_LOSS] = q_in;
         dy[E_AMB] = q_amb;
         dy[E_LNG] = q_lng;
+    }
+
+    /// The hydraulic part of [`Model::rhs`]: fills `dy[..ix::N]` (zero in a
+    /// replay, whose operating point is imposed) and returns the operating
+    /// point at (t, y). The temperatures in `y` enter through the leakage
+    /// conductance and the oil viscosity.
+    pub fn hydraulic_rhs(&self, t: f64, y: &[f64], dy: &mut [f64]) -> OpPoint {
+        let op = self.op_point(t, y);
+        self.hydraulic_rhs_at(t, y, &op, dy);
+        op
+    }
+
+    fn hydraulic_rhs_at(&self, t: f64, y: &[f64], op: &OpPoint, dy: &mut [f64]) {
+        let temps = &y[T0..T0 + N_NODES];
+        match &self.drive {
+            Drive::Mission(m) => {
+                let f = hydraulics::flows(&self.rig, op, self.k_leak(temps[Node::Case as usize]));
+                hydraulics::derivatives(&self.rig, m, t, y, op, &f, self.nu(temps[Node::BallOil as usize]), dy);
+            }
+            Drive::Replay(_) => dy[..ix::N].iter_mut().for_each(|d| *d = 0.0),
+        }
     }
 
     /// The states no derivative of [`Model::rhs`] depends on: the energy

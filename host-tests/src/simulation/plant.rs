@@ -108,7 +108,7 @@ impl JvpBase {
 
 /// Typical magnitudes of the states, used to scale the finite-difference
 /// Jacobian–vector products.
-fn typical() -> Vec<f64> {
+pub(crate) fn typical() -> Vec<f64> {
     let mut s = vec![1.0; N_STATE];
     s[ix::PA] = 1e6;
     s[ix::PB] = 1e6;
@@ -316,21 +316,8 @@ pub struct Plant {
 impl Plant {
     /// A plant for `scenario` on `rig`, at rest at ambient.
     pub fn new(rig: &Rig, scenario: &Scenario) -> Result<Self, SimError> {
-        let drive = match scenario {
-            Scenario::Replay(r) => {
-                if r.time_s.len() < 2 {
-                    return Err(SimError::Scenario("replay needs at least two samples".into()));
-                }
-                Drive::Replay(crate::model::ReplayDrive::new(r.clone()))
-            }
-            other => Drive::Mission(other.mission().ok_or_else(|| SimError::Scenario("no mission".into()))?),
-        };
-        let model = Model::new(rig.clone(), drive);
+        let (model, t) = model_for(rig, scenario)?;
         let y = model.initial_state();
-        let t = match &model.drive {
-            Drive::Replay(r) => r.inputs().time_s.first().copied().unwrap_or(0.0),
-            Drive::Mission(_) => 0.0,
-        };
         Ok(Self { y0: y.clone(), y, t, model, stats: Stats::default(), rtol: RTOL, step_limit: None, replay_tolerances: false })
     }
 
@@ -537,14 +524,7 @@ impl Plant {
     /// The scenario's own valve rule (thermostat or logged command), detached
     /// from the plant so that a run's callback can evaluate it.
     pub fn valve_rule(&self) -> RuleEval {
-        RuleEval {
-            rule: self.model.valve_rule(),
-            lng: self.model.rig.lng,
-            replay: match &self.model.drive {
-                Drive::Replay(r) => Some(r.clone()),
-                Drive::Mission(_) => None,
-            },
-        }
+        RuleEval::for_model(&self.model)
     }
 }
 
@@ -557,6 +537,18 @@ pub struct RuleEval {
 }
 
 impl RuleEval {
+    /// The valve rule of `model`'s drive.
+    pub(crate) fn for_model(model: &Model) -> Self {
+        RuleEval {
+            rule: model.valve_rule(),
+            lng: model.rig.lng,
+            replay: match &model.drive {
+                Drive::Replay(r) => Some(r.clone()),
+                Drive::Mission(_) => None,
+            },
+        }
+    }
+
     /// The valve command at a snapshot (None: leave it to the caller).
     pub fn command(&self, snap: &Snapshot) -> Option<bool> {
         let next = |t: f64| crate::cooling::valve_next(snap.lng_open, t, &self.lng);
@@ -569,7 +561,29 @@ impl RuleEval {
     }
 }
 
-fn breakpoints(drive: &Drive, t0: f64, t1: f64) -> Vec<f64> {
+/// The model of `scenario` on `rig` and its start time (the first logged
+/// sample of a replay, else 0 s).
+pub(crate) fn model_for(rig: &Rig, scenario: &Scenario) -> Result<(Model, f64), SimError> {
+    let drive = match scenario {
+        Scenario::Replay(r) => {
+            if r.time_s.len() < 2 {
+                return Err(SimError::Scenario("replay needs at least two samples".into()));
+            }
+            Drive::Replay(crate::model::ReplayDrive::new(r.clone()))
+        }
+        other => Drive::Mission(other.mission().ok_or_else(|| SimError::Scenario("no mission".into()))?),
+    };
+    let model = Model::new(rig.clone(), drive);
+    let t = match &model.drive {
+        Drive::Replay(r) => r.inputs().time_s.first().copied().unwrap_or(0.0),
+        Drive::Mission(_) => 0.0,
+    };
+    Ok((model, t))
+}
+
+/// The times in (t0, t1) where the drive's schedules kink or step: the
+/// solvers stop there.
+pub(crate) fn breakpoints(drive: &Drive, t0: f64, t1: f64) -> Vec<f64> {
     let mut v: Vec<f64> = match drive {
         Drive::Mission(m) => m
             .ambient_c

@@ -2,7 +2,8 @@
 //! (the shared measured-data columns plus the model's internal channels).
 
 use crate::network::{Node, NODES};
-use crate::plant::{Control, Plant, SimError, Snapshot, Stats};
+use crate::fast::{FastOptions, FastPlant};
+use crate::plant::{Control, Plant, RuleEval, SimError, Snapshot, Stats};
 use crate::rig::Rig;
 use crate::scenario::Scenario;
 use std::io::Write;
@@ -188,7 +189,21 @@ pub fn simulate(rig: &Rig, scenario: &Scenario, opt: &SimOptions) -> Result<SimO
 
 /// [`simulate`] with the solver's relative tolerance `rtol`.
 pub fn simulate_rtol(rig: &Rig, scenario: &Scenario, opt: &SimOptions, rtol: f64) -> Result<SimOutput, SimError> {
-    run_plant(Plant::new(rig, scenario)?, scenario, opt, rtol, None)
+    let mut plant = Plant::new(rig, scenario)?;
+    plant.set_rtol(rtol);
+    run_plant(plant, scenario, opt)
+}
+
+/// [`simulate`] on the multirate fast path ([`crate::fast`]) with its
+/// default accuracy (within 0.01 K of the tight BDF solution on the
+/// paper's cases and the random missions, `docs/reference-speed.md`).
+pub fn simulate_fast(rig: &Rig, scenario: &Scenario, opt: &SimOptions) -> Result<SimOutput, SimError> {
+    simulate_fast_with(rig, scenario, opt, FastOptions::default())
+}
+
+/// [`simulate_fast`] with explicit accuracy settings.
+pub fn simulate_fast_with(rig: &Rig, scenario: &Scenario, opt: &SimOptions, fo: FastOptions) -> Result<SimOutput, SimError> {
+    run_plant(FastPlant::with_options(rig, scenario, fo)?, scenario, opt)
 }
 
 /// The diagnosis's replay: [`simulate_rtol`] that fails with
@@ -198,12 +213,51 @@ pub fn simulate_rtol(rig: &Rig, scenario: &Scenario, opt: &SimOptions, rtol: f64
 pub fn simulate_budget(rig: &Rig, scenario: &Scenario, opt: &SimOptions, rtol: f64, step_limit: Option<u64>) -> Result<SimOutput, SimError> {
     let mut plant = Plant::new(rig, scenario)?;
     plant.set_replay_tolerances(true);
-    run_plant(plant, scenario, opt, rtol, step_limit)
-}
-
-fn run_plant(mut plant: Plant, scenario: &Scenario, opt: &SimOptions, rtol: f64, step_limit: Option<u64>) -> Result<SimOutput, SimError> {
     plant.set_rtol(rtol);
     plant.set_step_limit(step_limit);
+    run_plant(plant, scenario, opt)
+}
+
+/// What [`run_plant`] needs of an integrator: the BDF [`Plant`] and the
+/// multirate [`FastPlant`] run the same callbacks.
+trait Runner {
+    fn time_s(&self) -> f64;
+    fn valve_rule(&self) -> RuleEval;
+    fn stats(&self) -> Stats;
+    fn run_dyn(&mut self, dt_s: f64, t_end: f64, on_step: &mut dyn FnMut(&Snapshot) -> Result<Control, SimError>) -> Result<(), SimError>;
+}
+
+impl Runner for Plant {
+    fn time_s(&self) -> f64 {
+        Plant::time_s(self)
+    }
+    fn valve_rule(&self) -> RuleEval {
+        Plant::valve_rule(self)
+    }
+    fn stats(&self) -> Stats {
+        Plant::stats(self)
+    }
+    fn run_dyn(&mut self, dt_s: f64, t_end: f64, on_step: &mut dyn FnMut(&Snapshot) -> Result<Control, SimError>) -> Result<(), SimError> {
+        self.run(dt_s, t_end, on_step)
+    }
+}
+
+impl Runner for FastPlant {
+    fn time_s(&self) -> f64 {
+        FastPlant::time_s(self)
+    }
+    fn valve_rule(&self) -> RuleEval {
+        FastPlant::valve_rule(self)
+    }
+    fn stats(&self) -> Stats {
+        FastPlant::stats(self)
+    }
+    fn run_dyn(&mut self, dt_s: f64, t_end: f64, on_step: &mut dyn FnMut(&Snapshot) -> Result<Control, SimError>) -> Result<(), SimError> {
+        self.run(dt_s, t_end, on_step)
+    }
+}
+
+fn run_plant(mut plant: impl Runner, scenario: &Scenario, opt: &SimOptions) -> Result<SimOutput, SimError> {
     let name = match scenario.mission() {
         Some(m) => m.name,
         None => match scenario {
@@ -226,7 +280,7 @@ fn run_plant(mut plant: Plant, scenario: &Scenario, opt: &SimOptions, rtol: f64,
     let mut k: u64 = 0;
     let mut last_open = false;
     let rule = plant.valve_rule();
-    plant.run(dt, t_end, |s| {
+    plant.run_dyn(dt, t_end, &mut |s| {
         let cmd = rule.command(s);
         if k.is_multiple_of(every) || s.t >= t_end - 1e-9 {
             let ch = channels(s);

@@ -1,0 +1,106 @@
+//! The hydraulic states' own integration: RODAS4 steps at the hydraulics'
+//! pace, independent of the thermal steps, kept as a short track of
+//! (t, y, f) points that the thermal scheme reads by cubic Hermite
+//! interpolation. A thermal step that is rejected and retried shorter reads
+//! the same track: the hydraulics are never integrated twice.
+
+use super::rosenbrock::{RosError, Rosenbrock};
+use crate::hydraulics::ix;
+use crate::model::{Model, N_STATE, T0};
+use crate::network::N_NODES;
+
+/// Hydraulic states.
+pub const NH: usize = ix::N;
+
+/// One (t, y, f(t, y)) point of the hydraulic integration.
+pub type HydPoint = (f64, [f64; NH], [f64; NH]);
+
+/// The integration's recent points and its integrator.
+#[derive(Debug, Clone)]
+pub struct HydTrack {
+    /// The integrator (its step size carries over between calls).
+    pub ros: Rosenbrock<NH>,
+    pts: Vec<HydPoint>,
+}
+
+impl HydTrack {
+    /// A track with `ros` as integrator, starting at (t, y).
+    pub fn new(ros: Rosenbrock<NH>, t: f64, y: [f64; NH]) -> Self {
+        Self { ros, pts: vec![(t, y, [0.0; NH])] }
+    }
+
+    /// Restart at (t, y) with step `h0`: the first point's f is computed
+    /// anew (the forcing may step here).
+    pub fn restart(&mut self, model: &Model, z: &[f64; N_NODES], t: f64, y: [f64; NH], h0: f64) {
+        let mut f = [0.0; NH];
+        rhs(model, z, t, &y, &mut f);
+        self.ros.stats.evals += 1;
+        self.pts.clear();
+        self.pts.push((t, y, f));
+        self.ros.h = h0;
+    }
+
+    /// Time of the last integrated point, s.
+    pub fn head(&self) -> f64 {
+        self.pts.last().map_or(f64::NEG_INFINITY, |p| p.0)
+    }
+
+    /// Integrates until the track covers `t` (at most up to `t_max`, a
+    /// schedule breakpoint), with the node temperatures `z` held. The
+    /// schedules are read as left limits at `t_max` (a step there belongs
+    /// to the next segment).
+    pub fn cover(&mut self, model: &Model, z: &[f64; N_NODES], t: f64, t_max: f64) -> Result<(), RosError> {
+        let Some(&(mut tt, mut y, mut f)) = self.pts.last() else { return Ok(()) };
+        let t_left = left_of(t_max);
+        let mut fun = |t: f64, y: &[f64; NH], d: &mut [f64; NH]| rhs(model, z, t.min(t_left), y, d);
+        while tt < t - 1e-12 * t.abs().max(1.0) && tt < t_max {
+            tt = self.ros.step(&mut fun, tt, &mut y, &mut f, t_max)?;
+            self.pts.push((tt, y, f));
+        }
+        Ok(())
+    }
+
+    /// The hydraulic states at `t` (inside the track), cubic Hermite.
+    pub fn at(&self, t: f64) -> [f64; NH] {
+        let n = self.pts.len();
+        if n < 2 {
+            return self.pts.first().map_or([0.0; NH], |p| p.1);
+        }
+        let i = self.pts.partition_point(|p| p.0 <= t).clamp(1, n - 1);
+        let (a, b) = (&self.pts[i - 1], &self.pts[i]);
+        let h = b.0 - a.0;
+        let (a0, b0, a1, b1) = hermite(((t - a.0) / h).clamp(0.0, 1.0));
+        std::array::from_fn(|k| a0 * a.1[k] + b0 * h * a.2[k] + a1 * b.1[k] + b1 * h * b.2[k])
+    }
+
+    /// Forgets the points before the one at or before `t`.
+    pub fn trim(&mut self, t: f64) {
+        let i = self.pts.partition_point(|p| p.0 <= t);
+        if i > 1 {
+            self.pts.drain(..i - 1);
+        }
+    }
+}
+
+/// A time just before `t` (1e-9 relative, at least 1 ns): where a segment's
+/// schedules are read at its end, so that a step at the breakpoint is not
+/// seen inside the segment.
+pub fn left_of(t: f64) -> f64 {
+    t - 1e-9 * t.abs().max(1.0)
+}
+
+/// The hydraulic derivatives at (t, y) with the node temperatures `z`.
+fn rhs(model: &Model, z: &[f64; N_NODES], t: f64, yh: &[f64; NH], d: &mut [f64; NH]) {
+    let mut y = [0.0; N_STATE];
+    y[..NH].copy_from_slice(yh);
+    y[T0..T0 + N_NODES].copy_from_slice(z);
+    let mut dy = [0.0; N_STATE];
+    model.hydraulic_rhs(t, &y, &mut dy);
+    d.copy_from_slice(&dy[..NH]);
+}
+
+/// Cubic Hermite basis at θ ∈ [0, 1]: (value 0, slope 0, value 1, slope 1).
+pub fn hermite(th: f64) -> (f64, f64, f64, f64) {
+    let (t2, t3) = (th * th, th * th * th);
+    (2.0 * t3 - 3.0 * t2 + 1.0, t3 - 2.0 * t2 + th, -2.0 * t3 + 3.0 * t2, t3 - t2)
+}
