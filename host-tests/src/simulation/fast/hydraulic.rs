@@ -1,4 +1,4 @@
-//! The hydraulic states' own integration: RODAS4 steps at the hydraulics'
+//! The hydraulic states' own integration: Rosenbrock steps at the hydraulics'
 //! pace, independent of the thermal steps, kept as a short track of
 //! (t, y, f) points that the thermal scheme reads by cubic Hermite
 //! interpolation. A thermal step that is rejected and retried shorter reads
@@ -38,6 +38,7 @@ impl HydTrack {
         self.pts.clear();
         self.pts.push((t, y, f));
         self.ros.h = h0;
+        self.ros.forget_jacobian();
     }
 
     /// Time of the last integrated point, s.
@@ -79,6 +80,56 @@ impl HydTrack {
         if i > 1 {
             self.pts.drain(..i - 1);
         }
+    }
+}
+
+/// Sign changes at which the model's heat balances switch branch: the
+/// pressure difference across the pump (which port's oil leaks to the
+/// case, where the ring's leakage flow ends), the circulation through the
+/// ring (the upwind direction) and the shaft speed (the friction torque's
+/// sign in the motor current). Values below the thresholds (1 Pa,
+/// 1e-10 m³/s, 1e-4 rad/s) are a machine at rest, not a reversal.
+fn branch_values(model: &Model, z: &[f64; N_NODES], t: f64, yh: &[f64; NH]) -> [f64; 3] {
+    let mut y = [0.0; N_STATE];
+    y[..NH].copy_from_slice(yh);
+    y[T0..T0 + N_NODES].copy_from_slice(z);
+    let op = model.op_point(t, &y);
+    [op.p_a - op.p_b, op.circulation(&model.rig), op.omega]
+}
+
+const BRANCH_THRESHOLDS: [f64; 3] = [1.0, 1e-10, 1e-4];
+
+fn crossed(a: &[f64; 3], b: &[f64; 3]) -> bool {
+    a.iter().zip(b).zip(BRANCH_THRESHOLDS).any(|((x, y), thr)| x.abs() > thr && y.abs() > thr && (*x > 0.0) != (*y > 0.0))
+}
+
+impl HydTrack {
+    /// The first branch switch (see `branch_values`) in (`t0`, `t1`] of
+    /// the covered track, as a bracket (t_lo, t_hi) narrower than 1e-7 s
+    /// (relative to t), or None.
+    pub fn first_switch(&self, model: &Model, z: &[f64; N_NODES], t0: f64, t1: f64) -> Option<(f64, f64)> {
+        let val = |t: f64| branch_values(model, z, t, &self.at(t));
+        let mut ta = t0;
+        let mut va = val(t0);
+        let inner = self.pts.iter().map(|p| p.0).filter(|&t| t > t0 && t < t1);
+        for tb in inner.chain(std::iter::once(t1)) {
+            let vb = val(tb);
+            if crossed(&va, &vb) {
+                let (mut lo, mut hi) = (ta, tb);
+                let width = 1e-7 * t1.abs().max(1.0);
+                while hi - lo > width {
+                    let mid = 0.5 * (lo + hi);
+                    if crossed(&va, &val(mid)) {
+                        hi = mid;
+                    } else {
+                        lo = mid;
+                    }
+                }
+                return Some((lo, hi));
+            }
+            (ta, va) = (tb, vb);
+        }
+        None
     }
 }
 

@@ -16,5 +16,6 @@ pub mod hydraulic;
 pub mod phi;
 pub mod plant;
 pub mod rosenbrock;
+pub mod thermal;
 
 pub use plant::{FastOptions, FastPlant, FastStats};
