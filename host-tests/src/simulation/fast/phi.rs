@@ -90,47 +90,56 @@ impl<const N: usize> Phi<N> {
 /// Largest ‖τA‖₁ for which [`solve_linear`] is cheaper than the matrices.
 pub const VECTOR_NORM_MAX: f64 = 4.0;
 
-/// z(τ) of z' = A·z + c₀ + c₁·s, z(0) = z₀, by Taylor series of the
-/// solution on substeps with ‖δA‖₁ ≤ 1/2 (each term one product A·v; the
-/// series stops below 1e-17 of the sum): the action of the φ-functions on
-/// vectors, for steps too odd to cache their matrices (a schedule
-/// breakpoint, a flow reversal). Cost ~15·‖τA‖₁/0.5 matrix–vector products.
-pub fn solve_linear<const N: usize>(a: &Mat<N>, tau: f64, z0: &[f64; N], c0: &[f64; N], c1: &[f64; N]) -> [f64; N] {
+/// z(τ) of z' = A·z + c₀ + c₁·s + c₂·s²/2, z(0) = z₀, by Taylor series of
+/// the solution on substeps with ‖δA‖₁ ≤ 1/2 (each term one product A·v;
+/// the series stops below 1e-17 of the sum): the action of the
+/// φ-functions on vectors, for steps too odd to cache their matrices (a
+/// schedule breakpoint, a flow reversal). Cost ~15·‖τA‖₁/0.5
+/// matrix–vector products.
+pub fn solve_linear<const N: usize>(a: &Mat<N>, tau: f64, z0: &[f64; N], c: [&[f64; N]; 3]) -> [f64; N] {
     let n = ((norm1(a) * tau / TAYLOR_NORM).ceil() as usize).max(1);
     let d = tau / n as f64;
     let mut z = *z0;
-    let mut c = *c0;
+    // The forcing and its first two derivatives at the substep's start.
+    let (mut f0, mut f1, f2) = (*c[0], *c[1], *c[2]);
     for _ in 0..n {
-        // Derivatives at the substep's start: u' = A·z + c, u'' = A·u' + c₁,
-        // then u^(j+1) = A·u^(j); the j-th term is d^j/j!·u^(j).
+        // First derivative A·z + f, then each next one A times the last
+        // plus the forcing's derivative of that order; the j-th term of
+        // the series is d^j/j! times the j-th derivative.
         let mut term = mul_vec(a, &z);
         for i in 0..N {
-            term[i] = (term[i] + c[i]) * d;
+            term[i] = (term[i] + f0[i]) * d;
         }
         let mut next = z;
         for i in 0..N {
             next[i] += term[i];
         }
-        let mut first = true;
         for j in 2..40 {
+            let forcing = match j {
+                2 => Some(&f1),
+                3 => Some(&f2),
+                _ => None,
+            };
             let mut t = mul_vec(a, &term);
-            let f = d / j as f64;
+            let fac = d / j as f64;
+            // d^(j−1)/(j−1)!: with the factor d/j below, d^j/j! times the forcing's derivative.
+            let dd = if j == 2 { d } else { 0.5 * d * d };
             for i in 0..N {
-                t[i] = (t[i] + if first { c1[i] * d } else { 0.0 }) * f;
+                t[i] = (t[i] + forcing.map_or(0.0, |f| f[i] * dd)) * fac;
             }
-            first = false;
             term = t;
             let (tn, zn) = term.iter().zip(&next).fold((0.0f64, 0.0f64), |(p, q), (x, y)| (p.max(x.abs()), q.max(y.abs())));
             for i in 0..N {
                 next[i] += term[i];
             }
-            if tn <= 1e-17 * zn {
+            if j > 3 && tn <= 1e-17 * zn {
                 break;
             }
         }
         z = next;
         for i in 0..N {
-            c[i] += c1[i] * d;
+            f0[i] += d * f1[i] + 0.5 * d * d * f2[i];
+            f1[i] += d * f2[i];
         }
     }
     z
@@ -141,17 +150,17 @@ mod tests {
     use super::*;
 
     /// The vector solution against the matrices: z(h) = E·z₀ + Φ₁·c₀ +
-    /// h·Φ₂·c₁ for the stiff 3×3 network of `doubling_equals_direct`, at
+    /// h·Φ₂·c₁ + h²·Φ₃·c₂ for the stiff 3×3 network of `doubling_equals_direct`, at
     /// ‖hA‖₁ from 0.02 to 4 (1e-12 relative).
     #[test]
     fn vector_solution_matches_the_matrices() {
         let a: Mat<3> = [[-2.0, 1.0, 0.5], [0.3, -0.9, 0.1], [0.0, 0.2, -0.05]];
-        let (z0, c0, c1) = ([20.0, 30.0, 25.0], [1.0, -0.5, 0.02], [0.1, 0.3, -0.2]);
+        let (z0, c0, c1, c2) = ([20.0, 30.0, 25.0], [1.0, -0.5, 0.02], [0.1, 0.3, -0.2], [0.05, -0.02, 0.01]);
         for h in [0.007, 0.3, 1.4] {
             let p = Phi::new(&a, h);
-            let got = solve_linear(&a, h, &z0, &c0, &c1);
+            let got = solve_linear(&a, h, &z0, [&c0, &c1, &c2]);
             for i in 0..3 {
-                let want: f64 = (0..3).map(|j| p.e[i][j] * z0[j] + p.p1[i][j] * c0[j] + h * p.p2[i][j] * c1[j]).sum();
+                let want: f64 = (0..3).map(|j| p.e[i][j] * z0[j] + p.p1[i][j] * c0[j] + h * p.p2[i][j] * c1[j] + h * h * p.p3[i][j] * c2[j]).sum();
                 assert!((got[i] - want).abs() < 1e-12 * want.abs(), "h {h}: {got:?} vs {want}");
             }
         }

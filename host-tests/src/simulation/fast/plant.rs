@@ -202,7 +202,7 @@ impl FastPlant {
             self.model.lng_open.set(v);
         }
         let replay = matches!(self.model.drive, Drive::Replay(_));
-        let mut th = Thermal::new(std::array::from_fn(|i| self.y[T0 + i]), std::array::from_fn(|i| self.y[T0 + NT + i]));
+        let mut th = Thermal::new(self.t, std::array::from_fn(|i| self.y[T0 + i]), std::array::from_fn(|i| self.y[T0 + NT + i]));
         let mut ladder: Vec<Option<Phi<NT>>> = vec![None; LEVELS];
         let mut yh: [f64; NH] = std::array::from_fn(|i| self.y[i]);
         let start_level = |h: f64| ((h / dt_s).log2().floor() as i32).clamp(LEVEL_MIN, LEVEL_MAX);
@@ -310,6 +310,7 @@ impl FastPlant {
             th.accept(&trial);
             yh = yh1;
             self.t = t1;
+            th.t = t1;
             self.stats.steps += 1;
             if let Some(hi) = switch {
                 todo.switch = Some(hi);
@@ -364,6 +365,7 @@ impl FastPlant {
                         yh.copy_from_slice(&self.y[..NH]);
                         th.z.copy_from_slice(&self.y[T0..T0 + NT]);
                         th.e.copy_from_slice(&self.y[T0 + NT..]);
+                        th.t = tc;
                         (origin, ticks) = (tc, 0);
                         scan_from = tc;
                         todo = Todo { fresh: true, ..Todo::default() };
