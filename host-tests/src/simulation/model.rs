@@ -275,6 +275,16 @@ impl Model {
 
     /// Hydraulic operating point at (t, y).
     pub fn op_point(&self, t: f64, y: &[f64]) -> OpPoint {
+        let mut op = self.op_hydraulic(t, y);
+        if let Drive::Mission(_) = &self.drive {
+            op.current_a = self.motor_current(&op, y[t_ix(Node::Case)]);
+        }
+        op
+    }
+
+    /// [`Model::op_point`] without the motor current of a mission (zero
+    /// there): what the hydraulic derivatives need.
+    pub fn op_hydraulic(&self, t: f64, y: &[f64]) -> OpPoint {
         match &self.drive {
             Drive::Replay(r) => {
                 let mut op = r.op(&self.rig, t);
@@ -306,14 +316,19 @@ impl Model {
                     let nu = self.nu(y[t_ix(Node::BallOil)]);
                     op.q_path = hydraulics::path_flow(&self.rig, op.p_a - op.p_b, nu, needle);
                 }
-                let fr = self.pump_friction(&op, y[t_ix(Node::Case)]).total_w()
-                    + self.rig.ext.churning_loss.map_or(0.0, |k| losses::churning_w(k, op.omega))
-                    + self.rig.motor.bearing_friction_nm.map_or(0.0, |m| losses::bearing_w(m, op.omega));
-                op.current_a = hydraulics::soft_abs(hydraulics::shaft_torque(&self.rig, &op, fr), 1e-3)
-                    / self.rig.motor.torque_constant_nm_per_a;
                 op
             }
         }
+    }
+
+    /// Motor current of a mission's operating point, A rms: the shaft
+    /// torque (pump load plus friction at the case-oil temperature
+    /// `t_case`) over the torque constant.
+    fn motor_current(&self, op: &OpPoint, t_case: f64) -> f64 {
+        let fr = self.pump_friction(op, t_case).total_w()
+            + self.rig.ext.churning_loss.map_or(0.0, |k| losses::churning_w(k, op.omega))
+            + self.rig.motor.bearing_friction_nm.map_or(0.0, |m| losses::bearing_w(m, op.omega));
+        hydraulics::soft_abs(hydraulics::shaft_torque(&self.rig, op, fr), 1e-3) / self.rig.motor.torque_constant_nm_per_a
     }
 
     /// The pump's friction heat by term (extended eq. 8), with the film
@@ -536,10 +551,11 @@ impl Model {
 
     /// The hydraulic part of [`Model::rhs`]: fills `dy[..ix::N]` (zero in a
     /// replay, whose operating point is imposed) and returns the operating
-    /// point at (t, y). The temperatures in `y` enter through the leakage
+    /// point at (t, y) without a mission's motor current
+    /// ([`Model::op_hydraulic`]). The temperatures in `y` enter through the leakage
     /// conductance and the oil viscosity.
     pub fn hydraulic_rhs(&self, t: f64, y: &[f64], dy: &mut [f64]) -> OpPoint {
-        let op = self.op_point(t, y);
+        let op = self.op_hydraulic(t, y);
         self.hydraulic_rhs_at(t, y, &op, dy);
         op
     }

@@ -93,7 +93,7 @@ fn branch_values(model: &Model, z: &[f64; N_NODES], t: f64, yh: &[f64; NH]) -> [
     let mut y = [0.0; N_STATE];
     y[..NH].copy_from_slice(yh);
     y[T0..T0 + N_NODES].copy_from_slice(z);
-    let op = model.op_point(t, &y);
+    let op = model.op_hydraulic(t, &y);
     [op.p_a - op.p_b, op.circulation(&model.rig), op.omega]
 }
 

@@ -39,6 +39,11 @@ impl<const N: usize> Phi<N> {
     /// The φ-functions of `a` (1/s) for the step `h` (s).
     pub fn new(a: &Mat<N>, h: f64) -> Self {
         let norm = norm1(a) * h;
+        if norm == 0.0 {
+            // A = 0 (no Jacobian yet): E = I, Φ_k = h/k!·I.
+            let id: Mat<N> = identity();
+            return Self { h, e: id, p1: lin2(&id, h, &id, 0.0), p2: lin2(&id, h / 2.0, &id, 0.0), p3: lin2(&id, h / 6.0, &id, 0.0) };
+        }
         let s = if norm > TAYLOR_NORM { (norm / TAYLOR_NORM).log2().ceil() as i32 } else { 0 };
         let h0 = h / 2f64.powi(s);
         let mut phi = Self::taylor(a, h0);

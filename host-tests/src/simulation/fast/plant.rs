@@ -49,6 +49,8 @@ const HYD_JACOBIAN_STEPS: u32 = 20;
 /// Growth of the thermal step (levels: factors of two) after which the
 /// thermal Jacobian is taken anew.
 const REFRESH_LEVELS: i32 = 6;
+/// Accepted steps without growth after which that Jacobian is taken anyway.
+const STALL_STEPS: u32 = 16;
 
 /// Accuracy and step settings of the multirate scheme.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -97,6 +99,10 @@ pub struct FastPlant {
     t: f64,
     opts: FastOptions,
     hyd: HydTrack,
+    /// The thermal scheme and its step levels, kept between runs, and the
+    /// valve state its Jacobian belongs to.
+    thermal: Option<(Thermal, Vec<Option<Phi<NT>>>)>,
+    jacobian_valve: bool,
     stats: FastStats,
     step_limit: Option<u64>,
 }
@@ -122,7 +128,7 @@ impl FastPlant {
         yh.copy_from_slice(&y[..NH]);
         let ros = Rosenbrock::with_method(Tableau::ros34pw2(), HYD_JACOBIAN_STEPS, opts.hyd_rtol, atol, scale, opts.h_start_s);
         let hyd = HydTrack::new(ros, t, yh);
-        Ok(Self { model, y, y0: y, t, opts, hyd, stats: FastStats::default(), step_limit: None })
+        Ok(Self { model, y, y0: y, t, opts, hyd, thermal: None, jacobian_valve: false, stats: FastStats::default(), step_limit: None })
     }
 
     /// The model.
@@ -202,14 +208,25 @@ impl FastPlant {
             self.model.lng_open.set(v);
         }
         let replay = matches!(self.model.drive, Drive::Replay(_));
-        let mut th = Thermal::new(self.t, std::array::from_fn(|i| self.y[T0 + i]), std::array::from_fn(|i| self.y[T0 + NT + i]));
-        let mut ladder: Vec<Option<Phi<NT>>> = vec![None; LEVELS];
+        // The first run starts with A = 0 (explicit steps, ample for the
+        // first milliseconds from rest) and takes the Jacobian once the step
+        // has grown 64-fold; later runs keep theirs.
+        let first_run = self.thermal.is_none();
+        let (mut th, mut ladder) = self.thermal.take().unwrap_or_else(|| (Thermal::new(self.t, [0.0; NT], [0.0; NE]), vec![None; LEVELS]));
+        th.t = self.t;
+        th.z = std::array::from_fn(|i| self.y[T0 + i]);
+        th.e = std::array::from_fn(|i| self.y[T0 + NT + i]);
         let mut yh: [f64; NH] = std::array::from_fn(|i| self.y[i]);
         let start_level = |h: f64| ((h / dt_s).log2().floor() as i32).clamp(LEVEL_MIN, LEVEL_MAX);
         let mut level = start_level(self.opts.h_start_s);
         // Pending work before the next step.
-        let mut todo = Todo { jacobian: true, hydraulics: true, ..Todo::default() };
-        let mut jac_level = level;
+        let valve_moved = self.model.lng_open.get() != self.jacobian_valve;
+        let mut todo = Todo { fresh: true, hydraulics: true, jacobian: !first_run && valve_moved, ..Todo::default() };
+        // The level of the last Jacobian, and whether the step's growth
+        // since then still calls for one (once after each start or breakpoint).
+        let (mut jac_level, mut refresh_armed) = (level, first_run);
+        // Accepted steps since the level last grew.
+        let mut stalled = 0u32;
         // Position since the grid's origin in units of the finest level:
         // step ends are origin + ticks·h_fine, free of accumulated round-off.
         let h_fine = dt_s * 2f64.powi(LEVEL_MIN);
@@ -219,6 +236,7 @@ impl FastPlant {
         let mut k: u64 = 1;
         let mut t_cb = t_start + dt_s;
         let steps_at_start = self.stats.steps;
+        let debug = std::env::var_os("FAST_DEBUG").is_some();
         'outer: while !ctl.stop && self.t < t_end - 1e-9 {
             while stops.peek().is_some_and(|&s| s <= self.t + 1e-9) {
                 stops.next();
@@ -235,6 +253,7 @@ impl FastPlant {
                 let (model, stats) = (&self.model, &mut self.stats);
                 let mut rates = |z: &[f64; NT], fz: &mut [f64; NT], q: &mut [f64; NE]| Self::rates(model, stats, t, &yy, z, fz, q);
                 if todo.jacobian {
+                    self.jacobian_valve = self.model.lng_open.get();
                     th.jacobian(&mut rates, !todo.fresh);
                     ladder.iter_mut().for_each(|p| *p = None);
                     jac_level = level;
@@ -254,8 +273,12 @@ impl FastPlant {
                 level -= 1;
             }
             let h_level = dt_s * 2f64.powi(level);
-            let partial = self.t + h_level > seg_end - 1e-9 * h_level.max(1.0);
-            let mut t1 = if partial { seg_end } else { origin + (ticks + (1u64 << (level - LEVEL_MIN))) as f64 * h_fine };
+            let t_level = origin + (ticks + (1u64 << (level - LEVEL_MIN))) as f64 * h_fine;
+            // The level's step ends at the segment's end (a ladder step), or
+            // beyond it (an odd step to the end).
+            let ends = (t_level - seg_end).abs() <= 1e-9 * seg_end.abs().max(1.0);
+            let partial = !ends && t_level > seg_end;
+            let mut t1 = if partial || ends { seg_end } else { t_level };
             // The hydraulic states at the step's end, from their own track;
             // a branch switch of the heat balances inside ends the step there.
             let mut switch = None;
@@ -273,26 +296,29 @@ impl FastPlant {
                 }
             }
             let odd = partial || switch.is_some();
+            let seg_done = (partial || ends) && switch.is_none();
             let h = t1 - self.t;
+            let odd_phi;
             let phi = if !odd {
                 Some(self.phi(&mut ladder, &th, level, dt_s))
             } else if norm1(&th.a) * h > VECTOR_NORM_MAX {
                 self.stats.phi_builds += 1;
-                Some(Phi::new(&th.a, h))
+                odd_phi = Phi::new(&th.a, h);
+                Some(&odd_phi)
             } else {
                 None
             };
             let yh1 = if replay { yh } else { self.hyd.at(t1) };
             // At a breakpoint the segment's schedules end with their left limits.
-            let t_eval = if partial && switch.is_none() { left_of(t1) } else { t1 };
+            let t_eval = if seg_done { left_of(t1) } else { t1 };
             let trial = {
                 let (model, stats) = (&self.model, &mut self.stats);
                 let mut rates = |z: &[f64; NT], fz: &mut [f64; NT], q: &mut [f64; NE]| Self::rates(model, stats, t_eval, &yh1, z, fz, q);
-                th.trial(phi.as_ref(), h, &mut rates)
+                th.trial(phi, h, &mut rates)
             };
             let err = trial.err_k / self.opts.tol_k;
             let hyd_h = if replay { f64::INFINITY } else { self.hyd.ros.h };
-            if std::env::var_os("FAST_DEBUG").is_some() {
+            if debug {
                 eprintln!("t {:.4} h {h:.3e} lvl {level} err {err:.3e} node {} hyd_h {hyd_h:.3e} odd {odd}", self.t, trial.worst);
             }
             if !(err <= 1.0) {
@@ -306,7 +332,7 @@ impl FastPlant {
                 }
                 continue;
             }
-            let (t0, th0, yh0) = (self.t, th.clone(), yh);
+            let (t0, z0, f0, e0, q0, yh0) = (self.t, th.z, th.fz, th.e, th.q, yh);
             th.accept(&trial);
             yh = yh1;
             self.t = t1;
@@ -315,12 +341,12 @@ impl FastPlant {
             if let Some(hi) = switch {
                 todo.switch = Some(hi);
                 (origin, ticks) = (self.t, 0);
-            } else if partial {
+            } else if seg_done {
                 // A schedule breakpoint (or the end): the forcing steps.
                 todo.fresh = true;
                 todo.hydraulics = true;
                 level = start_level(self.opts.h_start_s);
-                jac_level = level;
+                (jac_level, refresh_armed, stalled) = (level, true, 0);
                 (origin, ticks) = (self.t, 0);
             } else {
                 ticks += 1u64 << (level - LEVEL_MIN);
@@ -329,9 +355,17 @@ impl FastPlant {
                 let room = next <= LEVEL_MAX && 2.0 * h <= self.opts.h_max_s && 2.0 * h <= self.opts.alias_ratio * hyd_h;
                 if grow && room && ticks % (1u64 << (next - LEVEL_MIN)) == 0 {
                     level = next;
+                    stalled = 0;
+                } else {
+                    stalled += 1;
                 }
-                if level >= jac_level + REFRESH_LEVELS {
+                // After a start or a breakpoint, one Jacobian once the step
+                // has grown 64-fold (the transient is over) or stopped
+                // growing (the explicit start's stability limit, or the
+                // transient's own time scale, holds it).
+                if refresh_armed && (level >= jac_level + REFRESH_LEVELS || stalled >= STALL_STEPS) {
                     todo.jacobian = true;
+                    refresh_armed = false;
                 }
             }
             self.write_state(&yh, &th);
@@ -344,10 +378,10 @@ impl FastPlant {
                 } else {
                     let (a0, b0, a1, b1) = hermite((tc - t0) / h);
                     for i in 0..NT {
-                        self.y[T0 + i] = a0 * th0.z[i] + b0 * h * th0.fz[i] + a1 * th.z[i] + b1 * h * th.fz[i];
+                        self.y[T0 + i] = a0 * z0[i] + b0 * h * f0[i] + a1 * th.z[i] + b1 * h * th.fz[i];
                     }
                     for i in 0..NE {
-                        self.y[T0 + NT + i] = a0 * th0.e[i] + b0 * h * th0.q[i] + a1 * th.e[i] + b1 * h * th.q[i];
+                        self.y[T0 + NT + i] = a0 * e0[i] + b0 * h * q0[i] + a1 * th.e[i] + b1 * h * th.q[i];
                     }
                     let yhc = if replay { yh0 } else { self.hyd.at(tc) };
                     self.y[..NH].copy_from_slice(&yhc);
@@ -387,24 +421,24 @@ impl FastPlant {
             }
         }
         self.stats.hydraulics = self.hyd.ros.stats;
+        self.thermal = Some((th, ladder));
         Ok(())
     }
 
     /// The φ-functions of a step level: cached, by doubling the level below, or anew.
-    fn phi(&mut self, ladder: &mut [Option<Phi<NT>>], th: &Thermal, level: i32, dt: f64) -> Phi<NT> {
+    fn phi<'a>(&mut self, ladder: &'a mut [Option<Phi<NT>>], th: &Thermal, level: i32, dt: f64) -> &'a Phi<NT> {
         let i = (level - LEVEL_MIN) as usize;
-        if let Some(p) = ladder[i] {
-            return p;
+        if ladder[i].is_none() {
+            let p = match i.checked_sub(1).and_then(|j| ladder[j].as_ref()) {
+                Some(below) => below.doubled(),
+                None => {
+                    self.stats.phi_builds += 1;
+                    Phi::new(&th.a, dt * 2f64.powi(level))
+                }
+            };
+            ladder[i] = Some(p);
         }
-        let p = match i.checked_sub(1).and_then(|j| ladder[j]) {
-            Some(below) => below.doubled(),
-            None => {
-                self.stats.phi_builds += 1;
-                Phi::new(&th.a, dt * 2f64.powi(level))
-            }
-        };
-        ladder[i] = Some(p);
-        p
+        ladder[i].as_ref().expect("just built")
     }
 
     fn write_state(&mut self, yh: &[f64; NH], th: &Thermal) {

@@ -222,17 +222,16 @@ impl<const N: usize> Rosenbrock<N> {
         if t + 1.05 * h >= t_max {
             h = t_max - t;
         }
+        // ∂f/∂t anew every step (forward difference, backwards at the
+        // interval's end: a schedule may step there). Kept with the
+        // Jacobian instead, as a W-method allows, it cost Case 2 27 % more
+        // hydraulic steps and twice the rejections.
         let mut fp = [0.0; N];
-        // ∂f/∂t by a forward difference (backwards at the interval's end: a
-        // schedule may step there).
         let dt = 1e-7 * t.abs().max(1.0);
         let dt = if t + dt > t_max { -dt } else { dt };
         f(t + dt, y, &mut fp);
         self.stats.evals += 1;
-        let mut dfdt = [0.0; N];
-        for i in 0..N {
-            dfdt[i] = (fp[i] - f0[i]) / dt;
-        }
+        let dfdt: [f64; N] = std::array::from_fn(|i| (fp[i] - f0[i]) / dt);
         let mut rejected = false;
         loop {
             // A kept Jacobian serves while the step stays within 4× of the
