@@ -21,12 +21,14 @@ pub struct HydTrack {
     /// The integrator (its step size carries over between calls).
     pub ros: Rosenbrock<NH>,
     pts: Vec<HydPoint>,
+    /// The branch values of the last scan's end, (t, values).
+    last_branch: Option<(f64, [f64; 3])>,
 }
 
 impl HydTrack {
     /// A track with `ros` as integrator, starting at (t, y).
     pub fn new(ros: Rosenbrock<NH>, t: f64, y: [f64; NH]) -> Self {
-        Self { ros, pts: vec![(t, y, [0.0; NH])] }
+        Self { ros, pts: vec![(t, y, [0.0; NH])], last_branch: None }
     }
 
     /// Restart at (t, y) with step `h0`: the first point's f is computed
@@ -37,6 +39,7 @@ impl HydTrack {
         self.ros.stats.evals += 1;
         self.pts.clear();
         self.pts.push((t, y, f));
+        self.last_branch = None;
         self.ros.h = h0;
         self.ros.forget_jacobian();
     }
@@ -107,13 +110,20 @@ impl HydTrack {
     /// The first branch switch (see `branch_values`) in (`t0`, `t1`] of
     /// the covered track, as a bracket (t_lo, t_hi) narrower than 1e-7 s
     /// (relative to t), or None.
-    pub fn first_switch(&self, model: &Model, z: &[f64; N_NODES], t0: f64, t1: f64) -> Option<(f64, f64)> {
+    pub fn first_switch(&mut self, model: &Model, z: &[f64; N_NODES], t0: f64, t1: f64) -> Option<(f64, f64)> {
         let val = |t: f64| branch_values(model, z, t, &self.at(t));
         let mut ta = t0;
-        let mut va = val(t0);
+        let mut va = match self.last_branch {
+            Some((t, v)) if t == t0 => v,
+            _ => val(t0),
+        };
         let inner = self.pts.iter().map(|p| p.0).filter(|&t| t > t0 && t < t1);
+        let mut end = None;
         for tb in inner.chain(std::iter::once(t1)) {
             let vb = val(tb);
+            if tb == t1 {
+                end = Some((t1, vb));
+            }
             if crossed(&va, &vb) {
                 let (mut lo, mut hi) = (ta, tb);
                 let width = 1e-7 * t1.abs().max(1.0);
@@ -125,10 +135,12 @@ impl HydTrack {
                         lo = mid;
                     }
                 }
+                self.last_branch = None;
                 return Some((lo, hi));
             }
             (ta, va) = (tb, vb);
         }
+        self.last_branch = end;
         None
     }
 }

@@ -101,7 +101,7 @@ pub struct FastPlant {
     hyd: HydTrack,
     /// The thermal scheme and its step levels, kept between runs, and the
     /// valve state its Jacobian belongs to.
-    thermal: Option<(Thermal, Vec<Option<Phi<NT>>>)>,
+    thermal: Option<(Thermal, Vec<Option<Box<Phi<NT>>>>)>,
     jacobian_valve: bool,
     stats: FastStats,
     step_limit: Option<u64>,
@@ -212,7 +212,8 @@ impl FastPlant {
         // first milliseconds from rest) and takes the Jacobian once the step
         // has grown 64-fold; later runs keep theirs.
         let first_run = self.thermal.is_none();
-        let (mut th, mut ladder) = self.thermal.take().unwrap_or_else(|| (Thermal::new(self.t, [0.0; NT], [0.0; NE]), vec![None; LEVELS]));
+        let (mut th, mut ladder) =
+            self.thermal.take().unwrap_or_else(|| (Thermal::new(self.t, [0.0; NT], [0.0; NE]), (0..LEVELS).map(|_| None).collect()));
         th.t = self.t;
         th.z = std::array::from_fn(|i| self.y[T0 + i]);
         th.e = std::array::from_fn(|i| self.y[T0 + NT + i]);
@@ -426,19 +427,22 @@ impl FastPlant {
     }
 
     /// The φ-functions of a step level: cached, by doubling the level below, or anew.
-    fn phi<'a>(&mut self, ladder: &'a mut [Option<Phi<NT>>], th: &Thermal, level: i32, dt: f64) -> &'a Phi<NT> {
+    /// (Boxed: a level is 4.6 kB and a run uses a dozen of the 33.)
+    fn phi<'a>(&mut self, ladder: &'a mut [Option<Box<Phi<NT>>>], th: &Thermal, level: i32, dt: f64) -> &'a Phi<NT> {
         let i = (level - LEVEL_MIN) as usize;
         if ladder[i].is_none() {
+            let h = dt * 2f64.powi(level);
             let p = match i.checked_sub(1).and_then(|j| ladder[j].as_ref()) {
-                Some(below) => below.doubled(),
-                None => {
+                // A = 0 before the first Jacobian: Phi::new is closed-form there.
+                Some(below) if !th.is_zero() => below.doubled(),
+                _ => {
                     self.stats.phi_builds += 1;
-                    Phi::new(&th.a, dt * 2f64.powi(level))
+                    Phi::new(&th.a, h)
                 }
             };
-            ladder[i] = Some(p);
+            ladder[i] = Some(Box::new(p));
         }
-        ladder[i].as_ref().expect("just built")
+        ladder[i].as_deref().expect("just built")
     }
 
     fn write_state(&mut self, yh: &[f64; NH], th: &Thermal) {

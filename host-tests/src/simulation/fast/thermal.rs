@@ -89,9 +89,9 @@ impl Thermal {
         Self { z, e, fz: [0.0; NT], q: [0.0; NE], t, hist: Vec::with_capacity(3), a: [[0.0; NT]; NT], a_e: [[0.0; NT]; NE] }
     }
 
-    /// Forgets the step history (the next step is of order 1).
-    pub fn forget(&mut self) {
-        self.hist.clear();
+    /// Whether A is zero (no Jacobian taken yet).
+    pub fn is_zero(&self) -> bool {
+        self.a.iter().all(|r| r.iter().all(|&x| x == 0.0))
     }
 
     /// f anew at z, and A by forward differences (N_NODES more
