@@ -24,7 +24,7 @@
 //!   temperatures' and the hydraulic track's); a valve change there
 //!   continues from the callback time.
 
-use super::hydraulic::{hermite, left_of, HydTrack, NH};
+use super::hydraulic::{hermite, left_of, HydTrack, TempPath, NH};
 use super::phi::{Phi, VECTOR_NORM_MAX};
 use super::rosenbrock::{RosError, RosStats, Rosenbrock, Tableau};
 use super::thermal::{Thermal, NE, NT};
@@ -273,34 +273,16 @@ impl FastPlant {
             while level > LEVEL_MIN && ticks % (1u64 << (level - LEVEL_MIN)) != 0 {
                 level -= 1;
             }
-            let h_level = dt_s * 2f64.powi(level);
             let t_level = origin + (ticks + (1u64 << (level - LEVEL_MIN))) as f64 * h_fine;
             // The level's step ends at the segment's end (a ladder step), or
             // beyond it (an odd step to the end).
             let ends = (t_level - seg_end).abs() <= 1e-9 * seg_end.abs().max(1.0);
             let partial = !ends && t_level > seg_end;
             let mut t1 = if partial || ends { seg_end } else { t_level };
-            // The hydraulic states at the step's end, from their own track;
-            // a branch switch of the heat balances inside ends the step there.
-            let mut switch = None;
-            if !replay {
-                self.hyd.cover(&self.model, &th.z, t1, seg_end).map_err(hyd_error)?;
-                if let Some((lo, hi)) = self.hyd.first_switch(&self.model, &th.z, scan_from.max(self.t), t1) {
-                    scan_from = hi;
-                    if lo <= self.t + 1e-9 * self.t.abs().max(1.0) {
-                        // At the step's start: f on its far side, then on.
-                        todo.switch = Some(hi);
-                        continue;
-                    }
-                    t1 = lo;
-                    switch = Some(hi);
-                }
-            }
-            let odd = partial || switch.is_some();
-            let seg_done = (partial || ends) && switch.is_none();
-            let h = t1 - self.t;
-            let odd_phi;
-            let phi = if !odd {
+            let mut odd = partial;
+            let (odd_phi, odd_phi2);
+            let mut h = t1 - self.t;
+            let mut phi = if !odd {
                 Some(self.phi(&mut ladder, &th, level, dt_s))
             } else if norm1(&th.a) * h > VECTOR_NORM_MAX {
                 self.stats.phi_builds += 1;
@@ -309,14 +291,41 @@ impl FastPlant {
             } else {
                 None
             };
+            let (mut zp, mut g0) = th.predict(phi, h);
+            // The hydraulic states at the step's end, from their own track
+            // (seeing the temperatures on the line to the predictor); a
+            // branch switch of the heat balances inside ends the step there.
+            let mut switch = None;
+            if !replay {
+                self.hyd.set_path(TempPath::line(self.t, th.z, t1, zp));
+                self.hyd.cover(&self.model, t1, seg_end).map_err(hyd_error)?;
+                if let Some((lo, hi)) = self.hyd.first_switch(&self.model, scan_from.max(self.t), t1) {
+                    scan_from = hi;
+                    if lo <= self.t + 1e-9 * self.t.abs().max(1.0) {
+                        // At the step's start: f on its far side, then on.
+                        todo.switch = Some(hi);
+                        continue;
+                    }
+                    t1 = lo;
+                    h = t1 - self.t;
+                    switch = Some(hi);
+                    odd = true;
+                    phi = None;
+                    if norm1(&th.a) * h > VECTOR_NORM_MAX {
+                        self.stats.phi_builds += 1;
+                        odd_phi2 = Phi::new(&th.a, h);
+                        phi = Some(&odd_phi2);
+                    }
+                    (zp, g0) = th.predict(phi, h);
+                }
+            }
+            let seg_done = (partial || ends) && switch.is_none();
             let yh1 = if replay { yh } else { self.hyd.at(t1) };
             // At a breakpoint the segment's schedules end with their left limits.
             let t_eval = if seg_done { left_of(t1) } else { t1 };
-            let trial = {
-                let (model, stats) = (&self.model, &mut self.stats);
-                let mut rates = |z: &[f64; NT], fz: &mut [f64; NT], q: &mut [f64; NE]| Self::rates(model, stats, t_eval, &yh1, z, fz, q);
-                th.trial(phi, h, &mut rates)
-            };
+            let (mut fp, mut qp) = ([0.0; NT], [0.0; NE]);
+            Self::rates(&self.model, &mut self.stats, t_eval, &yh1, &zp, &mut fp, &mut qp);
+            let trial = th.correct(phi, h, &zp, &g0, &fp, &qp);
             let err = trial.err_k / self.opts.tol_k;
             let hyd_h = if replay { f64::INFINITY } else { self.hyd.ros.h };
             if debug {
@@ -324,6 +333,7 @@ impl FastPlant {
             }
             if !(err <= 1.0) {
                 self.stats.rejected += 1;
+                self.hyd.reject(self.t);
                 level = if odd { start_level(h / 2.0) } else { level - 1 };
                 if level <= LEVEL_MIN {
                     return Err(SimError::Solver { t: self.t, message: format!("thermal step underflow (error {:.2e} K)", trial.err_k) });
@@ -418,7 +428,7 @@ impl FastPlant {
             }
             self.write_state(&yh, &th);
             if !replay {
-                self.hyd.trim(self.t);
+                self.hyd.advance(&self.model, self.t, &th.z, seg_end);
             }
         }
         self.stats.hydraulics = self.hyd.ros.stats;

@@ -160,32 +160,35 @@ impl Thermal {
         }
     }
 
-    /// Tries a step of `h` s (`phi`: the level's matrices, None: an odd
-    /// step); `rates_end` evaluates the model at the step's end.
-    pub fn trial(&self, phi: Option<&Phi<NT>>, h: f64, rates_end: &mut impl Rates) -> Trial {
+    /// The predictor of a step of `h` s (`phi`: the level's matrices, None:
+    /// an odd step): z* and g₀.
+    pub fn predict(&self, phi: Option<&Phi<NT>>, h: f64) -> ([f64; NT], [f64; NT]) {
         let az0 = mul_vec(&self.a, &self.z);
         let g0: [f64; NT] = std::array::from_fn(|i| self.fz[i] - az0[i]);
-        // Predictor: the polynomial through the stored g and g₀.
+        // The polynomial through the stored g and g₀.
         let mut pts: [(f64, &[f64; NT]); 3] = [(0.0, &g0); 3];
         let n = self.hist.len().min(2);
         for (k, (t, g, _)) in self.hist[self.hist.len() - n..].iter().enumerate() {
             pts[k] = (t - self.t, g);
         }
         pts[n] = (0.0, &g0);
-        let zp = self.linear(phi, h, &g0, &derivatives(&pts[..=n]));
-        let (mut fp, mut qp) = ([0.0; NT], [0.0; NE]);
-        rates_end(&zp, &mut fp, &mut qp);
-        let azp = mul_vec(&self.a, &zp);
+        (self.linear(phi, h, &g0, &derivatives(&pts[..=n])), g0)
+    }
+
+    /// The corrector of the step predicted by [`Thermal::predict`] (`zp`,
+    /// `g0`), given the model's rates `fp`, `qp` at the predicted end.
+    pub fn correct(&self, phi: Option<&Phi<NT>>, h: f64, zp: &[f64; NT], g0: &[f64; NT], fp: &[f64; NT], qp: &[f64; NE]) -> Trial {
+        let azp = mul_vec(&self.a, zp);
         let gp: [f64; NT] = std::array::from_fn(|i| fp[i] - azp[i]);
-        // Corrector: the polynomial through the latest stored g, g₀ and g*.
-        let mut pts: [(f64, &[f64; NT]); 3] = [(0.0, &g0); 3];
+        // The polynomial through the latest stored g, g₀ and g*.
+        let mut pts: [(f64, &[f64; NT]); 3] = [(0.0, g0); 3];
         let m = self.hist.len().min(1);
         if let Some((t, g, _)) = self.hist.last() {
             pts[0] = (t - self.t, g);
         }
-        pts[m] = (0.0, &g0);
+        pts[m] = (0.0, g0);
         pts[m + 1] = (h, &gp);
-        let z1 = self.linear(phi, h, &g0, &derivatives(&pts[..m + 2]));
+        let z1 = self.linear(phi, h, g0, &derivatives(&pts[..m + 2]));
         let dz: [f64; NT] = std::array::from_fn(|i| z1[i] - zp[i]);
         let adz = mul_vec(&self.a, &dz);
         let f1 = std::array::from_fn(|i| fp[i] + adz[i]);
@@ -197,7 +200,7 @@ impl Thermal {
                 (err_k, worst) = (d.abs() / milne, i);
             }
         }
-        Trial { h, z1, f1, q1, g0, err_k, worst }
+        Trial { h, z1, f1, q1, g0: *g0, err_k, worst }
     }
 
     /// Takes the tried step.
