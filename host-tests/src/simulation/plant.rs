@@ -298,6 +298,13 @@ pub struct Stats {
     pub rhs_evals: u64,
     /// Accepted solver steps.
     pub steps: u64,
+    /// Of `rhs_evals`, those spent on Jacobian columns.
+    pub jacobian_evals: u64,
+    /// Newton iterations (BDF only).
+    pub newton_iterations: u64,
+    /// Jacobian factorisations (BDF: diffsol's linear-solver setups; fast
+    /// path: thermal Jacobians).
+    pub factorizations: u64,
 }
 
 /// The plant: model plus state.
@@ -392,6 +399,7 @@ impl Plant {
         }
         let model = &self.model;
         let evals = Cell::new(0u64);
+        let jac_evals = Cell::new(0u64);
         let scale = typical();
         let rhs = |x: &[f64], _p: &[f64], t: f64, y: &mut [f64]| {
             evals.set(evals.get() + 1);
@@ -417,8 +425,10 @@ impl Plant {
                 b.set(t, x, valve);
                 model.rhs(t, x, &mut b.f0);
                 evals.set(evals.get() + 1);
+                jac_evals.set(jac_evals.get() + 1);
             }
             evals.set(evals.get() + 1);
+            jac_evals.set(jac_evals.get() + 1);
             fd_jvp_at(|x, y| model.rhs(t, x, y), x, v, &scale, xp, &b.f0, y);
         };
         let y_init = self.y.clone();
@@ -500,7 +510,11 @@ impl Plant {
             }
         }
         let _ = stop;
-        self.stats.steps += solver.get_statistics().number_of_steps as u64;
+        let st = solver.get_statistics();
+        self.stats.steps += st.number_of_steps as u64;
+        self.stats.newton_iterations += st.number_of_nonlinear_solver_iterations as u64;
+        self.stats.factorizations += st.number_of_linear_solver_setups as u64;
+        self.stats.jacobian_evals += jac_evals.get();
         let st = solver.state();
         self.t = st.t;
         self.y.copy_from_slice(st.y.batch_as_slice(0));
