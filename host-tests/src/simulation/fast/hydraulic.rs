@@ -176,7 +176,7 @@ impl HydTrack {
         }
         // Every 16th thermal step, whether the temperatures now matter.
         self.checks = self.checks.wrapping_add(1);
-        if !self.coupled && self.checks % 16 == 0 {
+        if !self.coupled && self.checks.is_multiple_of(16) {
             if let Some(&(tp, yp, fp)) = self.pts.first() {
                 self.check_coupling(model, z, tp.min(left_of(t_max)), &yp, &fp);
             }

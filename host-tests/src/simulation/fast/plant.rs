@@ -373,7 +373,7 @@ impl FastPlant {
             if debug {
                 eprintln!("t {:.4} h {h:.3e} lvl {level} err {err:.3e} node {} hyd_h {hyd_h:.3e} odd {odd}", self.t, trial.worst);
             }
-            if !(err <= 1.0) {
+            if err.is_nan() || err > 1.0 {
                 self.stats.rejected += 1;
                 self.hyd.reject(self.t);
                 level = if odd { start_level(h / 2.0) } else { level - 1 };

@@ -83,6 +83,7 @@ impl Tableau {
     /// y₁ = y + Σ b_j k_j (the Butcher-like form of Hairer & Wanner (7.4),
     /// as PETSc's TSRosW tables list them): a = α·Γ⁻¹, c = diag(1/γ) − Γ⁻¹,
     /// m = b·Γ⁻¹, e = (b − b̂)·Γ⁻¹ (Hairer & Wanner (7.17)).
+    #[allow(clippy::needless_range_loop)] // triangular index arithmetic reads plainer with indices
     pub fn from_butcher<const S: usize>(alpha: [[f64; S]; S], gam: [[f64; S]; S], b: [f64; S], bh: [f64; S], elo: f64) -> Self {
         // Γ⁻¹ of the lower triangular Γ by forward substitution.
         let mut gi = [[0.0; S]; S];
@@ -109,6 +110,7 @@ impl Tableau {
     /// ROS34PW2 (Rang & Angermann, BIT 45, 2005), coefficients as PETSc's
     /// TSROSWRA34PW2 lists them: 4 stages, order 3 (embedded 2) for any
     /// Jacobian approximation, L-stable, stiffly accurate.
+    #[allow(clippy::excessive_precision)] // the coefficients as published, 17 digits
     pub fn ros34pw2() -> Self {
         let g = 4.3586652150845900e-01;
         let alpha = [
