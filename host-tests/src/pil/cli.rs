@@ -146,7 +146,7 @@ fn run_sil(args: &PilArgs, build: Build) -> Result<()> {
     let opts = LoopOptions { tick_s: eha_guard::params::S_PER_TICK, duration_s: args.duration };
     std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
     let csv = args.out.join(format!("sil_{}_{}.csv", args.scenario, build.name()));
-    let mut target = SilTarget::new(sil_core(build));
+    let mut target = SilTarget::new(build);
     let meta = |note: String| vec![("rig", "reference plant eha_sim (Rig::default)".to_string()), ("case", args.scenario.clone()), ("note", note)];
     let records = match super::run_closed_loop(&mut plant, &mut target, &opts) {
         Ok(r) => r,

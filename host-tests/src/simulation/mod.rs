@@ -9,6 +9,7 @@
 //! - [`equilibrium`]: the steady state of the node balances (Newton).
 
 pub mod equilibrium;
+pub mod fast;
 pub mod missions;
 pub mod model;
 pub mod plant;

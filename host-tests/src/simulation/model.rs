@@ -310,6 +310,16 @@ impl Model {
 
     /// Hydraulic operating point at (t, y).
     pub fn op_point(&self, t: f64, y: &[f64]) -> OpPoint {
+        let mut op = self.op_hydraulic(t, y);
+        if let Drive::Mission(_) = &self.drive {
+            op.current_a = self.motor_current(&op, y[t_ix(Node::Case)]);
+        }
+        op
+    }
+
+    /// [`Model::op_point`] without the motor current of a mission (zero
+    /// there): what the hydraulic derivatives need.
+    pub fn op_hydraulic(&self, t: f64, y: &[f64]) -> OpPoint {
         match &self.drive {
             Drive::Replay(r) => {
                 let mut op = r.op(&self.rig, t);
@@ -339,14 +349,19 @@ impl Model {
                     let needle = hydraulics::needle_k(&self.rig, m.needle_bar.at(t));
                     op.q_path = hydraulics::path_flow(&self.rig, op.p_a - op.p_b, y[t_ix(Node::BallOil)], needle);
                 }
-                let fr = self.pump_friction(&op, y[t_ix(Node::Case)]).total_w()
-                    + self.rig.ext.churning_loss.map_or(0.0, |k| losses::churning_w(k, op.omega))
-                    + self.rig.motor.bearing_friction_nm.map_or(0.0, |m| losses::bearing_w(m, op.omega));
-                op.current_a = hydraulics::soft_abs(hydraulics::shaft_torque(&self.rig, &op, fr), 1e-3)
-                    / self.rig.motor.torque_constant_nm_per_a;
                 op
             }
         }
+    }
+
+    /// Motor current of a mission's operating point, A rms: the shaft
+    /// torque (pump load plus friction at the case-oil temperature
+    /// `t_case`) over the torque constant.
+    fn motor_current(&self, op: &OpPoint, t_case: f64) -> f64 {
+        let fr = self.pump_friction(op, t_case).total_w()
+            + self.rig.ext.churning_loss.map_or(0.0, |k| losses::churning_w(k, op.omega))
+            + self.rig.motor.bearing_friction_nm.map_or(0.0, |m| losses::bearing_w(m, op.omega));
+        hydraulics::soft_abs(hydraulics::shaft_torque(&self.rig, op, fr), 1e-3) / self.rig.motor.torque_constant_nm_per_a
     }
 
     /// The pump's friction heat by term (extended eq. 8), with the film
@@ -608,17 +623,33 @@ impl Model {
         let op = self.op_point(t, y);
         let temps = &y[T0..T0 + N_NODES];
         let l = self.losses(t, &op, temps);
-        match &self.drive {
-            Drive::Mission(m) => {
-                let f = hydraulics::flows(&self.rig, &op, self.k_leak(temps[Node::Case as usize]));
-                hydraulics::derivatives(&self.rig, m, t, &op, &f, dy);
-            }
-            Drive::Replay(_) => dy[..ix::N].iter_mut().for_each(|d| *d = 0.0),
-        }
+        self.hydraulic_rhs_at(t, y, &op, dy);
         let (q_in, q_amb, q_lng) = self.thermal(&op, &l, temps, &mut dy[T0..T0 + N_NODES]);
         dy[E_LOSS] = q_in;
         dy[E_AMB] = q_amb;
         dy[E_LNG] = q_lng;
+    }
+
+    /// The hydraulic part of [`Model::rhs`]: fills `dy[..ix::N]` (zero in a
+    /// replay, whose operating point is imposed) and returns the operating
+    /// point at (t, y) without a mission's motor current
+    /// ([`Model::op_hydraulic`]). The temperatures in `y` enter through the leakage
+    /// conductance and the oil viscosity.
+    pub fn hydraulic_rhs(&self, t: f64, y: &[f64], dy: &mut [f64]) -> OpPoint {
+        let op = self.op_hydraulic(t, y);
+        self.hydraulic_rhs_at(t, y, &op, dy);
+        op
+    }
+
+    fn hydraulic_rhs_at(&self, t: f64, y: &[f64], op: &OpPoint, dy: &mut [f64]) {
+        let temps = &y[T0..T0 + N_NODES];
+        match &self.drive {
+            Drive::Mission(m) => {
+                let f = hydraulics::flows(&self.rig, op, self.k_leak(temps[Node::Case as usize]));
+                hydraulics::derivatives(&self.rig, m, t, op, &f, dy);
+            }
+            Drive::Replay(_) => dy[..ix::N].iter_mut().for_each(|d| *d = 0.0),
+        }
     }
 
     /// The states no derivative of [`Model::rhs`] depends on: the energy

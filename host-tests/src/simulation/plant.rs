@@ -108,7 +108,7 @@ impl JvpBase {
 
 /// Typical magnitudes of the states, used to scale the finite-difference
 /// Jacobian–vector products.
-fn typical() -> Vec<f64> {
+pub(crate) fn typical() -> Vec<f64> {
     let mut s = vec![1.0; N_STATE];
     s[ix::PA] = 1e6;
     s[ix::PB] = 1e6;
@@ -298,6 +298,13 @@ pub struct Stats {
     pub rhs_evals: u64,
     /// Accepted solver steps.
     pub steps: u64,
+    /// Of `rhs_evals`, those spent on Jacobian columns.
+    pub jacobian_evals: u64,
+    /// Newton iterations (BDF only).
+    pub newton_iterations: u64,
+    /// Jacobian factorisations (BDF: diffsol's linear-solver setups; fast
+    /// path: thermal Jacobians).
+    pub factorizations: u64,
 }
 
 /// The plant: model plus state.
@@ -316,21 +323,8 @@ pub struct Plant {
 impl Plant {
     /// A plant for `scenario` on `rig`, at rest at ambient.
     pub fn new(rig: &Rig, scenario: &Scenario) -> Result<Self, SimError> {
-        let drive = match scenario {
-            Scenario::Replay(r) => {
-                if r.time_s.len() < 2 {
-                    return Err(SimError::Scenario("replay needs at least two samples".into()));
-                }
-                Drive::Replay(crate::model::ReplayDrive::new(r.clone()))
-            }
-            other => Drive::Mission(other.mission().ok_or_else(|| SimError::Scenario("no mission".into()))?),
-        };
-        let model = Model::new(rig.clone(), drive);
+        let (model, t) = model_for(rig, scenario)?;
         let y = model.initial_state();
-        let t = match &model.drive {
-            Drive::Replay(r) => r.inputs().time_s.first().copied().unwrap_or(0.0),
-            Drive::Mission(_) => 0.0,
-        };
         Ok(Self { y0: y.clone(), y, t, model, stats: Stats::default(), rtol: RTOL, step_limit: None, replay_tolerances: false })
     }
 
@@ -415,6 +409,7 @@ impl Plant {
         }
         let model = &self.model;
         let evals = Cell::new(0u64);
+        let jac_evals = Cell::new(0u64);
         let scale = typical();
         let rhs = |x: &[f64], _p: &[f64], t: f64, y: &mut [f64]| {
             evals.set(evals.get() + 1);
@@ -440,8 +435,10 @@ impl Plant {
                 b.set(t, x, valve);
                 model.rhs(t, x, &mut b.f0);
                 evals.set(evals.get() + 1);
+                jac_evals.set(jac_evals.get() + 1);
             }
             evals.set(evals.get() + 1);
+            jac_evals.set(jac_evals.get() + 1);
             fd_jvp_at(|x, y| model.rhs(t, x, y), x, v, &scale, xp, &b.f0, y);
         };
         let y_init = self.y.clone();
@@ -523,7 +520,11 @@ impl Plant {
             }
         }
         let _ = stop;
-        self.stats.steps += solver.get_statistics().number_of_steps as u64;
+        let st = solver.get_statistics();
+        self.stats.steps += st.number_of_steps as u64;
+        self.stats.newton_iterations += st.number_of_nonlinear_solver_iterations as u64;
+        self.stats.factorizations += st.number_of_linear_solver_setups as u64;
+        self.stats.jacobian_evals += jac_evals.get();
         let st = solver.state();
         self.t = st.t;
         self.y.copy_from_slice(st.y.batch_as_slice(0));
@@ -547,14 +548,7 @@ impl Plant {
     /// The scenario's own valve rule (thermostat or logged command), detached
     /// from the plant so that a run's callback can evaluate it.
     pub fn valve_rule(&self) -> RuleEval {
-        RuleEval {
-            rule: self.model.valve_rule(),
-            lng: self.model.rig.lng,
-            replay: match &self.model.drive {
-                Drive::Replay(r) => Some(r.clone()),
-                Drive::Mission(_) => None,
-            },
-        }
+        RuleEval::for_model(&self.model)
     }
 }
 
@@ -567,6 +561,18 @@ pub struct RuleEval {
 }
 
 impl RuleEval {
+    /// The valve rule of `model`'s drive.
+    pub(crate) fn for_model(model: &Model) -> Self {
+        RuleEval {
+            rule: model.valve_rule(),
+            lng: model.rig.lng,
+            replay: match &model.drive {
+                Drive::Replay(r) => Some(r.clone()),
+                Drive::Mission(_) => None,
+            },
+        }
+    }
+
     /// The valve command at a snapshot (None: leave it to the caller).
     pub fn command(&self, snap: &Snapshot) -> Option<bool> {
         let next = |t: f64| crate::cooling::valve_next(snap.lng_open, t, &self.lng);
@@ -579,7 +585,29 @@ impl RuleEval {
     }
 }
 
-fn breakpoints(drive: &Drive, t0: f64, t1: f64) -> Vec<f64> {
+/// The model of `scenario` on `rig` and its start time (the first logged
+/// sample of a replay, else 0 s).
+pub(crate) fn model_for(rig: &Rig, scenario: &Scenario) -> Result<(Model, f64), SimError> {
+    let drive = match scenario {
+        Scenario::Replay(r) => {
+            if r.time_s.len() < 2 {
+                return Err(SimError::Scenario("replay needs at least two samples".into()));
+            }
+            Drive::Replay(crate::model::ReplayDrive::new(r.clone()))
+        }
+        other => Drive::Mission(other.mission().ok_or_else(|| SimError::Scenario("no mission".into()))?),
+    };
+    let model = Model::new(rig.clone(), drive);
+    let t = match &model.drive {
+        Drive::Replay(r) => r.inputs().time_s.first().copied().unwrap_or(0.0),
+        Drive::Mission(_) => 0.0,
+    };
+    Ok((model, t))
+}
+
+/// The times in (t0, t1) where the drive's schedules kink or step: the
+/// solvers stop there.
+pub(crate) fn breakpoints(drive: &Drive, t0: f64, t1: f64) -> Vec<f64> {
     let mut v: Vec<f64> = match drive {
         Drive::Mission(m) => m
             .ambient_c

@@ -2,7 +2,8 @@
 //! (the shared measured-data columns plus the model's internal channels).
 
 use crate::network::{Node, NODES};
-use crate::plant::{Control, Plant, SimError, Snapshot, Stats};
+use crate::fast::{FastOptions, FastPlant};
+use crate::plant::{Control, Plant, RuleEval, SimError, Snapshot, Stats};
 use crate::rig::Rig;
 use crate::scenario::Scenario;
 use std::io::Write;
@@ -45,7 +46,9 @@ pub const MEASURED_COLUMNS: [&str; 14] = [
 /// channels first (without `time_s`), then the internal ones.
 pub fn channels(s: &Snapshot) -> Vec<(&'static str, f64)> {
     let op = &s.op;
-    let mut v = vec![
+    // One allocation: the measured columns, the other nodes, 11 losses, 8 more.
+    let mut v = Vec::with_capacity(13 + NODES.len() + 19);
+    v.extend([
         ("speed_rpm", op.omega * 60.0 / (2.0 * std::f64::consts::PI)),
         ("current_a", op.current_a),
         ("p_a_bar", op.p_a * 1e-5),
@@ -59,7 +62,7 @@ pub fn channels(s: &Snapshot) -> Vec<(&'static str, f64)> {
         ("t_oil_c", s.temp(Node::Sensor)),
         ("lng_valve", if s.lng_open { 1.0 } else { 0.0 }),
         ("air_speed_mps", op.air_mps),
-    ];
+    ]);
     for n in NODES {
         if !matches!(n, Node::Motor | Node::Pump | Node::MainBlock | Node::BallBlock | Node::Sensor) {
             v.push((n.channel(), s.temp(n)));
@@ -189,7 +192,51 @@ pub fn simulate(rig: &Rig, scenario: &Scenario, opt: &SimOptions) -> Result<SimO
 
 /// [`simulate`] with the solver's relative tolerance `rtol`.
 pub fn simulate_rtol(rig: &Rig, scenario: &Scenario, opt: &SimOptions, rtol: f64) -> Result<SimOutput, SimError> {
-    run_plant(Plant::new(rig, scenario)?, scenario, opt, rtol, None)
+    let mut plant = Plant::new(rig, scenario)?;
+    plant.set_rtol(rtol);
+    run_plant(plant, scenario, opt)
+}
+
+/// [`simulate`] on the multirate fast path ([`crate::fast`]) with its
+/// accuracy for the scenario ([`FastOptions::for_scenario`]: within
+/// 0.01 K of the tight BDF solution on the paper's cases and the random
+/// missions, `docs/reference-speed.md`).
+pub fn simulate_fast(rig: &Rig, scenario: &Scenario, opt: &SimOptions) -> Result<SimOutput, SimError> {
+    simulate_fast_with(rig, scenario, opt, FastOptions::for_scenario(scenario))
+}
+
+/// [`simulate_fast`] with explicit accuracy settings.
+pub fn simulate_fast_with(rig: &Rig, scenario: &Scenario, opt: &SimOptions, fo: FastOptions) -> Result<SimOutput, SimError> {
+    run_plant(FastPlant::with_options(rig, scenario, fo)?, scenario, opt)
+}
+
+/// Which integrator runs the reference model.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum Solver {
+    /// diffsol's adaptive BDF ([`Plant`]), rtol [`crate::plant::RTOL`]: the
+    /// reference itself.
+    #[default]
+    Bdf,
+    /// The multirate scheme ([`FastPlant`]): within 0.01 K of the BDF at
+    /// rtol 1e-9 on missions, 5-6x faster (`docs/reference-speed.md`). Not
+    /// faster on replays of logged inputs.
+    Fast,
+}
+
+/// [`simulate`] with the chosen integrator.
+pub fn simulate_with(rig: &Rig, scenario: &Scenario, opt: &SimOptions, solver: Solver) -> Result<SimOutput, SimError> {
+    match solver {
+        Solver::Bdf => simulate(rig, scenario, opt),
+        Solver::Fast => simulate_fast(rig, scenario, opt),
+    }
+}
+
+/// Independent runs in parallel on rayon's work-stealing pool (the global
+/// pool: `RAYON_NUM_THREADS` threads, one per core by default; or the pool
+/// the caller `install`s), in the order given.
+pub fn simulate_batch(jobs: &[(Rig, Scenario)], opt: &SimOptions, solver: Solver) -> Vec<Result<SimOutput, SimError>> {
+    use rayon::prelude::*;
+    jobs.par_iter().map(|(rig, sc)| simulate_with(rig, sc, opt, solver)).collect()
 }
 
 /// The diagnosis's replay: [`simulate_rtol`] that fails with
@@ -199,12 +246,51 @@ pub fn simulate_rtol(rig: &Rig, scenario: &Scenario, opt: &SimOptions, rtol: f64
 pub fn simulate_budget(rig: &Rig, scenario: &Scenario, opt: &SimOptions, rtol: f64, step_limit: Option<u64>) -> Result<SimOutput, SimError> {
     let mut plant = Plant::new(rig, scenario)?;
     plant.set_replay_tolerances(true);
-    run_plant(plant, scenario, opt, rtol, step_limit)
-}
-
-fn run_plant(mut plant: Plant, scenario: &Scenario, opt: &SimOptions, rtol: f64, step_limit: Option<u64>) -> Result<SimOutput, SimError> {
     plant.set_rtol(rtol);
     plant.set_step_limit(step_limit);
+    run_plant(plant, scenario, opt)
+}
+
+/// What [`run_plant`] needs of an integrator: the BDF [`Plant`] and the
+/// multirate [`FastPlant`] run the same callbacks.
+trait Runner {
+    fn time_s(&self) -> f64;
+    fn valve_rule(&self) -> RuleEval;
+    fn stats(&self) -> Stats;
+    fn run_dyn(&mut self, dt_s: f64, t_end: f64, on_step: &mut dyn FnMut(&Snapshot) -> Result<Control, SimError>) -> Result<(), SimError>;
+}
+
+impl Runner for Plant {
+    fn time_s(&self) -> f64 {
+        Plant::time_s(self)
+    }
+    fn valve_rule(&self) -> RuleEval {
+        Plant::valve_rule(self)
+    }
+    fn stats(&self) -> Stats {
+        Plant::stats(self)
+    }
+    fn run_dyn(&mut self, dt_s: f64, t_end: f64, on_step: &mut dyn FnMut(&Snapshot) -> Result<Control, SimError>) -> Result<(), SimError> {
+        self.run(dt_s, t_end, on_step)
+    }
+}
+
+impl Runner for FastPlant {
+    fn time_s(&self) -> f64 {
+        FastPlant::time_s(self)
+    }
+    fn valve_rule(&self) -> RuleEval {
+        FastPlant::valve_rule(self)
+    }
+    fn stats(&self) -> Stats {
+        FastPlant::stats(self)
+    }
+    fn run_dyn(&mut self, dt_s: f64, t_end: f64, on_step: &mut dyn FnMut(&Snapshot) -> Result<Control, SimError>) -> Result<(), SimError> {
+        self.run(dt_s, t_end, on_step)
+    }
+}
+
+fn run_plant(mut plant: impl Runner, scenario: &Scenario, opt: &SimOptions) -> Result<SimOutput, SimError> {
     let name = match scenario.mission() {
         Some(m) => m.name,
         None => match scenario {
@@ -227,12 +313,14 @@ fn run_plant(mut plant: Plant, scenario: &Scenario, opt: &SimOptions, rtol: f64,
     let mut k: u64 = 0;
     let mut last_open = false;
     let rule = plant.valve_rule();
-    plant.run(dt, t_end, |s| {
+    plant.run_dyn(dt, t_end, &mut |s| {
         let cmd = rule.command(s);
         if k.is_multiple_of(every) || s.t >= t_end - 1e-9 {
             let ch = channels(s);
             if out.columns.is_empty() {
-                out.columns = ch.iter().map(|(n, _)| (n.to_string(), Vec::new())).collect();
+                let n = ((t_end - s.t) / opt.output_interval_s).max(0.0) as usize + 2;
+                out.columns = ch.iter().map(|(name, _)| (name.to_string(), Vec::with_capacity(n))).collect();
+                out.time_s.reserve(n);
             }
             out.time_s.push(s.t);
             for ((_, col), (_, v)) in out.columns.iter_mut().zip(ch) {

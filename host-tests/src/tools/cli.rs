@@ -5,7 +5,7 @@ use crate::calibrate::{calibrate, PAPER, PARAMS};
 use crate::cooling::size;
 use crate::rig::Rig;
 use crate::scenario::{read_mission_csv, Scenario, ValveRule};
-use crate::sim::{simulate, SimOptions, SimOutput};
+use crate::sim::{simulate, simulate_with, SimOptions, SimOutput, Solver};
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -92,6 +92,10 @@ pub struct SimulateArgs {
     /// Relative tolerance of the solver's error control.
     #[arg(long, default_value_t = crate::plant::RTOL)]
     pub rtol: f64,
+    /// Integrator: the BDF reference or the multirate fast path (within
+    /// 0.01 K of it on missions; docs/reference-speed.md).
+    #[arg(long, value_enum, default_value_t = Solver::Bdf)]
+    pub solver: Solver,
     /// Output directory.
     #[arg(long, default_value = "out")]
     pub out: PathBuf,
@@ -138,7 +142,12 @@ pub fn run_simulate(a: &SimulateArgs) -> Result<()> {
     if !(a.rtol > 0.0 && a.rtol < 1.0) {
         anyhow::bail!("--rtol {} must lie in (0, 1)", a.rtol);
     }
-    let out = crate::sim::simulate_rtol(&rig, &sc, &SimOptions { output_interval_s: a.output_interval_s, control_interval_s: 0.1 }, a.rtol)?;
+    let opt = SimOptions { output_interval_s: a.output_interval_s, control_interval_s: 0.1 };
+    let out = match a.solver {
+        Solver::Bdf => crate::sim::simulate_rtol(&rig, &sc, &opt, a.rtol)?,
+        Solver::Fast if a.rtol != crate::plant::RTOL => anyhow::bail!("--rtol sets the BDF's tolerance; the fast path has its own (docs/reference-speed.md): use --solver bdf"),
+        Solver::Fast => simulate_with(&rig, &sc, &opt, a.solver)?,
+    };
     let wall = t.elapsed();
     let csv = write_run(&out, &rig, &a.out)?;
     println!("{}: {:.0} s simulated in {:.1} ms ({} rhs evaluations, {} solver steps)", out.name, sc.duration_s(), wall.as_secs_f64() * 1e3, out.stats.rhs_evals, out.stats.steps);
@@ -237,6 +246,10 @@ pub struct SweepArgs {
     /// Output CSV.
     #[arg(long, default_value = "out/sweep.csv")]
     pub out: PathBuf,
+    /// Integrator (default: the multirate fast path, within 0.01 K of the
+    /// BDF reference on the paper's cases; `bdf` for the reference itself).
+    #[arg(long, value_enum, default_value_t = Solver::Fast)]
+    pub solver: Solver,
     #[command(flatten)]
     /// Rig.
     pub rig: RigArgs,
@@ -260,7 +273,7 @@ pub fn run_sweep(a: &SweepArgs) -> Result<()> {
                 rig.set_override(&format!("{}={v}", a.param))?;
             }
             let sc = a.case.scenario.scenario(needle, a.case.duration_s);
-            let out = simulate(&rig, &sc, &SimOptions { output_interval_s: 10.0, control_interval_s: 0.1 })?;
+            let out = simulate_with(&rig, &sc, &SimOptions { output_interval_s: 10.0, control_interval_s: 0.1 }, a.solver)?;
             bar.inc(1);
             Ok(std::iter::once(v).chain(channels.iter().map(|c| out.last(c).unwrap_or(f64::NAN))).collect())
         })

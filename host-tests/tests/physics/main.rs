@@ -2,6 +2,7 @@
 //! energy closure and the stiff solver against analytic solutions.
 
 mod energy;
+mod fast;
 mod paper;
 mod pump_energy;
 mod solver;

@@ -132,7 +132,8 @@ impl Model for GuardFmu {
             vr::VALVE => Value::Boolean(o.valve_open),
             vr::ALARM => Value::Boolean(o.alarm),
             vr::DERATE => Value::Boolean(o.derate),
-            vr::FAULTS => Value::Integer(i32::from(o.faults.bits())),
+            // the 32-bit fault word, bit for bit (FMI 2.0 has no unsigned Integer)
+            vr::FAULTS => Value::Integer(i32::from_ne_bytes(o.faults.bits().to_ne_bytes())),
             vr::LNG_KG => Value::Real(o.lng_remaining_kg as f64),
             vr::LNG_S => Value::Real(o.lng_seconds_left as f64),
             vr::VALVE_FB => Value::Integer(self.valve_fb),

@@ -1,0 +1,48 @@
+//! Work counters of the reference model's two integrators on Case 1 (60 bar)
+//! and Case 2, 600 s each, with the benchmark's outputs: steps, model
+//! evaluations (and how many built Jacobians), Newton iterations and
+//! factorisations, and for the fast path its hydraulic steps. The profile
+//! of `docs/reference-speed.md` runs this binary under
+//! `valgrind --tool=callgrind` (one case per run: `1` or `2`, both without
+//! an argument).
+//!
+//! `cargo run --profile fast -p eha-sim --example reference_profile -- 2`
+
+use eha_sim::fast::{FastOptions, FastPlant};
+use eha_sim::rig::Rig;
+use eha_sim::scenario::Scenario;
+use eha_sim::sim::{simulate, SimOptions};
+
+fn main() {
+    let which = std::env::args().nth(1);
+    let rig = Rig::default();
+    let cases = [
+        ("1", Scenario::Case1 { needle_bar: 60.0, duration_s: 600.0 }, SimOptions { output_interval_s: 10.0, control_interval_s: 10.0 }),
+        ("2", Scenario::Case2 { duration_s: 600.0 }, SimOptions { output_interval_s: 1.0, control_interval_s: 1.0 }),
+    ];
+    let fast_only = std::env::var_os("FAST_ONLY").is_some();
+    let bdf_only = std::env::var_os("BDF_ONLY").is_some();
+    for (key, sc, opt) in cases {
+        if which.as_deref().is_some_and(|w| w != key) {
+            continue;
+        }
+        if !fast_only {
+            let s = simulate(&rig, &sc, &opt).expect("BDF runs").stats;
+            println!(
+                "case {key} BDF: {} steps, {} model evaluations ({} for Jacobian columns), {} Newton iterations, {} factorisations",
+                s.steps, s.rhs_evals, s.jacobian_evals, s.newton_iterations, s.factorizations
+            );
+        }
+        if !bdf_only {
+            // The plant itself (the same steps as `simulate_fast`, whose
+            // callbacks only read the interpolants), for its own counters.
+            let mut p = FastPlant::with_options(&rig, &sc, FastOptions::for_scenario(&sc)).expect("plant");
+            p.run(opt.control_interval_s.min(opt.output_interval_s), sc.duration_s(), |_| Ok(Default::default())).expect("runs");
+            let (s, f) = (p.stats(), p.fast_stats());
+            println!(
+                "case {key} fast: {} thermal steps ({} rejected), {} model evaluations ({} for {} Jacobians), {} hydraulic steps ({} rejected, {} hydraulic evaluations)",
+                s.steps, f.rejected, s.rhs_evals, s.jacobian_evals, s.factorizations, f.hydraulics.steps, f.hydraulics.rejected, f.hydraulics.evals
+            );
+        }
+    }
+}
