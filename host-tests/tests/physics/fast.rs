@@ -12,6 +12,8 @@ use eha_sim::missions::{random_mission, TEST_SEEDS};
 use eha_sim::network::NODES;
 use eha_sim::rig::Rig;
 use eha_sim::scenario::Scenario;
+use eha_sim::fast::{FastOptions, FastPlant};
+use eha_sim::plant::Control;
 use eha_sim::sim::{simulate_fast, simulate_rtol, SimOptions, SimOutput};
 
 /// The issue's bound on every logged temperature channel, K.
@@ -46,7 +48,8 @@ fn check(rig: &Rig, sc: &Scenario, opt: &SimOptions, regression_k: f64) -> SimOu
 
 /// Case 1 at 60 bar, 600 s, with the benchmark's 10 s outputs and with the
 /// default 1 s outputs (0.1 s callbacks, read from the interpolants).
-/// Measured 1.5e-4 K and 1.1e-3 K.
+/// Measured 4.7e-4 K and 4.6e-4 K with the oil on its viscosity line
+/// (issue 34; 1.5e-4 and 1.1e-3 K before).
 #[test]
 fn case1_within_a_hundredth_of_a_kelvin() {
     let rig = Rig::default();
@@ -55,31 +58,83 @@ fn case1_within_a_hundredth_of_a_kelvin() {
     check(&rig, &sc, &SimOptions::default(), 3e-3);
 }
 
-/// Case 2 (servo, 0.2 Hz), 600 s, 1 s outputs. Measured 6.8e-3 K (the
+/// Case 2 (servo, 0.2 Hz), 600 s, 1 s outputs. Measured 6.5e-3 K (6.8e-3
+/// before issue 34; the
 /// winding, whose copper loss the steps integrate over 120 cycles).
 #[test]
 fn case2_within_a_hundredth_of_a_kelvin() {
     check(&Rig::default(), &Scenario::Case2 { duration_s: 600.0 }, &SimOptions { output_interval_s: 1.0, control_interval_s: 1.0 }, 9e-3);
 }
 
-/// Fig. 15 (Case 1 at 60 bar with the LNG thermostat), 1800 s: every one of
-/// the 60 openings and closings at the BDF's callback, and the
-/// temperatures within the spec. Measured 7.3e-4 K.
+/// Fig. 15 (Case 1 at 60 bar with the LNG thermostat on the loop oil),
+/// 1800 s, in two parts.
+///
+/// The temperatures: the fast path driven by the BDF's own valve schedule
+/// (its openings and closings at the BDF's callbacks) against the BDF, on
+/// every node, within the spec. Measured 1.6e-3 K (the ball-valve oil at
+/// 192 s, just after a switch).
+///
+/// The switching: the free-running fast path with its own thermostat opens
+/// and closes as often as the BDF, each switch within 1 s of the BDF's
+/// (measured 0.70 s at most).
+/// Not at the same callback: with the oil on its viscosity line (issue 34)
+/// the BDF's loop oil crosses 40 °C at 613.4 s by 5e-6 K, the fast path's
+/// (7.5e-5 K low, at any of its tolerances from 1e-5 to 1e-7 K per step)
+/// one callback later; a thermostat limit cycle has no restoring force on
+/// its phase, so the shift stays and grows (0.5 s by 1003 s, measured).
+/// A 0.1 s shift of a 20 K step of the inlet oil is 10 K on that channel
+/// for a second: the free-running comparison is not a temperature test.
 #[test]
 fn fig15_switches_with_the_bdf() {
     let rig = Rig::default();
     let sc = Scenario::Lng { duration_s: 1800.0 };
     let opt = SimOptions::default();
     let bdf = simulate_rtol(&rig, &sc, &opt, 1e-9).expect("BDF runs");
-    let fast = check(&rig, &sc, &opt, 2e-3);
-    assert!(fast.valve_open_times_s.len() >= 50, "{} openings", fast.valve_open_times_s.len());
-    for (a, b) in fast.valve_open_times_s.iter().zip(&bdf.valve_open_times_s).chain(fast.valve_close_times_s.iter().zip(&bdf.valve_close_times_s)) {
-        assert!((a - b).abs() < 1e-6, "switch at {a} s, BDF {b} s");
-    }
+    assert!(bdf.valve_open_times_s.len() >= 50, "{} openings", bdf.valve_open_times_s.len());
+    // The BDF's schedule: open from each opening to the next closing.
+    let open_at = |t: f64| {
+        let opened = bdf.valve_open_times_s.iter().filter(|&&o| o <= t + 1e-9).count();
+        let closed = bdf.valve_close_times_s.iter().filter(|&&c| c <= t + 1e-9).count();
+        opened > closed
+    };
+    let mut fast = FastPlant::with_options(&rig, &sc, FastOptions::for_scenario(&sc)).expect("fast plant");
+    let mut worst = (0.0f64, "", 0.0);
+    let mut k = 0usize;
+    fast.run(0.1, 1800.0, |snap| {
+        if k < bdf.time_s.len() && (snap.t - bdf.time_s[k]).abs() < 1e-6 {
+            for n in NODES {
+                let d = (snap.temp(n) - bdf.get(n.channel()).expect("channel")[k]).abs();
+                if d > worst.0 {
+                    worst = (d, n.channel(), snap.t);
+                }
+            }
+            k += 1;
+        }
+        Ok(Control { lng_valve: Some(open_at(snap.t)), stop: false })
+    })
+    .expect("fast path runs");
+    println!("lng-fig15 on the BDF's schedule: {:.2e} K on {} at {} s, {k} outputs", worst.0, worst.1, worst.2);
+    assert_eq!(k, bdf.time_s.len(), "every output compared");
+    assert!(worst.0 <= SPEC_K, "{:.3e} K on {} at {} s exceeds the {SPEC_K} K spec", worst.0, worst.1, worst.2);
+    assert!(worst.0 <= 4e-3, "{:.3e} K above the regression bound 4e-3 K", worst.0);
+
+    let free = simulate_fast(&rig, &sc, &opt).expect("fast path runs");
+    assert_eq!(free.valve_open_times_s.len(), bdf.valve_open_times_s.len(), "openings");
+    assert_eq!(free.valve_close_times_s.len(), bdf.valve_close_times_s.len(), "closings");
+    let shift = free
+        .valve_open_times_s
+        .iter()
+        .zip(&bdf.valve_open_times_s)
+        .chain(free.valve_close_times_s.iter().zip(&bdf.valve_close_times_s))
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    println!("free-running switches: largest shift {shift:.2} s");
+    assert!(shift <= 1.0, "a switch {shift:.2} s from the BDF's");
 }
 
 /// The firmware suite's five random missions (throttle and servo), 600 s.
-/// Measured 1.2e-3, 2.7e-3, 4.8e-4, 1.4e-3, 2.3e-3 K.
+/// Measured 4.2e-4, 2.3e-3, 2.4e-4, 3.4e-4, 1.9e-3 K (issue 34's oil;
+/// 1.2e-3, 2.7e-3, 4.8e-4, 1.4e-3, 2.3e-3 K before).
 #[test]
 fn random_missions_within_a_hundredth_of_a_kelvin() {
     let rig = Rig::default();
