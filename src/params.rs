@@ -271,6 +271,21 @@ pub struct ReducedParams {
 }
 
 impl ReducedParams {
+    /// `mu(T) / mu(40 degC)` of the case oil at `t_c`, degC: the linear
+    /// interpolation of [`Self::visc_ratio`] on its grid, the end values
+    /// held, as the firmware reads it. Host tests draw a consistent motor
+    /// current with it (the pump's viscous friction, extended eq. 8).
+    pub fn visc_ratio_at(&self, t_c: f64) -> f64 {
+        let u = (t_c - TEMP_TABLE_MIN_C) / TEMP_TABLE_STEP_K;
+        let u = if u > 0.0 { u } else { 0.0 };
+        let last = N_TEMP - 2;
+        // (u >= 0: the cast truncates to the floor)
+        let j = u as usize;
+        let (j, f) = if j > last { (last, 1.0) } else { (j, u - j as f64) };
+        let (a, b) = (self.visc_ratio.get(j).copied().unwrap_or(1.0), self.visc_ratio.get(j + 1).copied().unwrap_or(1.0));
+        a + (b - a) * f
+    }
+
     /// The ducts' films over the coarse temperature grid, `[duct][Re of DUCT_RE]`.
     pub fn duct_films(&self) -> [[&[f64; N_COARSE]; N_RE]; N_DUCTS] {
         [

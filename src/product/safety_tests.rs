@@ -276,16 +276,6 @@ fn a_refused_block_shows_the_alarm_from_the_first_instant() {
     assert!(!b.pins.valve_pin && !b.pins.ok_pin, "valve pin and OK pin low at boot: {:?}", b.pins);
 }
 
-/// `mu(T) / mu(40 degC)` of the paper rig's oil, the linear interpolation
-/// of `DEFAULT.visc_ratio` the firmware reads (end values held).
-fn visc_ratio(oil_c: f32) -> f32 {
-    let t = &crate::params::DEFAULT.visc_ratio;
-    let u = ((f64::from(oil_c) - crate::params::TEMP_TABLE_MIN_C) / crate::params::TEMP_TABLE_STEP_K).max(0.0);
-    let last = crate::params::N_TEMP - 2;
-    let (j, f) = if u.floor() as usize > last { (last, 1.0) } else { (u.floor() as usize, u - u.floor()) };
-    (t[j] + (t[j + 1] - t[j]) * f) as f32
-}
-
 /// The motor current of the paper rig's pump at these pressures and speed
 /// and this case-oil temperature (the extended eq. 8 with the viscous
 /// friction on the oil's viscosity, as the reference plant draws it):
@@ -295,7 +285,7 @@ fn current_a(p_a: f32, p_b: f32, rpm: f32, oil_c: f32) -> f32 {
     let d = p.displacement_m3_per_rad as f32;
     let dp = (p_a - p_b) * 1e5;
     let w = (rpm * core::f32::consts::PI / 30.0).abs();
-    let t_f = p.no_load_torque_nm as f32 + p.viscous_w_s2_per_rad2 as f32 * visc_ratio(oil_c) * w + p.eta_m as f32 * d * dp.abs();
+    let t_f = p.no_load_torque_nm as f32 + (p.viscous_w_s2_per_rad2 * p.visc_ratio_at(f64::from(oil_c))) as f32 * w + p.eta_m as f32 * d * dp.abs();
     let s = if rpm < 0.0 { -1.0 } else { 1.0 };
     (d * dp + s * t_f).abs() / p.torque_constant_nm_per_a as f32
 }

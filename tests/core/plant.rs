@@ -33,16 +33,6 @@ pub fn set_case_oil(t_c: f32) {
     CASE_OIL_C.with(|c| c.set(f64::from(t_c)));
 }
 
-/// `mu(T) / mu(40 degC)` as the firmware reads it: the linear interpolation of
-/// `DEFAULT.visc_ratio` on its temperature grid, the end values held.
-fn visc_ratio(t_c: f64) -> f64 {
-    let u = ((t_c - eha_guard::params::TEMP_TABLE_MIN_C) / eha_guard::params::TEMP_TABLE_STEP_K).max(0.0);
-    let last = eha_guard::params::N_TEMP - 2;
-    let (j, f) = if u.floor() as usize > last { (last, 1.0) } else { (u.floor() as usize, u - u.floor()) };
-    let t = &DEFAULT.visc_ratio;
-    t[j] + (t[j + 1] - t[j]) * f
-}
-
 /// Motor current, A rms, of the reference plant (`eha_sim::hydraulics::shaft_torque`
 /// with the extended eq. 8 and no other friction): `|D dp + sign(w) P_f / max(|w|,
 /// 1 rad/s)| / Kt` with the friction power `P_f = T0 |w| + C_v mu(T) D w^2 + eta_m D
@@ -55,7 +45,7 @@ pub fn motor_current(p_a_bar: f32, p_b_bar: f32, speed_rpm: f32) -> f32 {
     let dp = (p_a_bar - p_b_bar) as f64 * 1e5;
     let w = speed_rpm as f64 * std::f64::consts::PI / 30.0;
     let sign = w / (w * w + 1e-4).sqrt();
-    let visc = p.viscous_w_s2_per_rad2 * visc_ratio(CASE_OIL_C.with(|c| c.get()));
+    let visc = p.viscous_w_s2_per_rad2 * p.visc_ratio_at(CASE_OIL_C.with(|c| c.get()));
     let friction_w = p.no_load_torque_nm * w.abs() + visc * w * w + p.eta_m * d * dp.abs() * w.abs();
     let tau = d * dp + sign * friction_w / w.abs().max(1.0);
     (tau.abs() / p.torque_constant_nm_per_a) as f32

@@ -22,15 +22,16 @@
 use eha_guard::protocol::Request;
 
 /// Motor current of the reference plant, A rms: `|D dp + sign(w) T_f| / Kt` with
-/// the friction torque of the extended eq. (8), `T_f = T0 + C_v mu D |w| + eta_m D
-/// |dp|` (`eha_sim::hydraulics::shaft_torque`, |w| >= 1 rad/s), with the
-/// firmware's own parameters.
-pub fn motor_current(p_a_bar: f32, p_b_bar: f32, speed_rpm: f32) -> f32 {
+/// the friction torque of the extended eq. (8), `T_f = T0 + C_v mu(T)/mu(40) D |w|
+/// + eta_m D |dp|` at the case oil `case_oil_c`, degC
+/// (`eha_sim::hydraulics::shaft_torque`, |w| >= 1 rad/s), with the firmware's
+/// own parameters.
+pub fn motor_current(p_a_bar: f32, p_b_bar: f32, speed_rpm: f32, case_oil_c: f64) -> f32 {
     let p = eha_guard::params::DEFAULT;
     let d = p.displacement_m3_per_rad;
     let dp = (p_a_bar - p_b_bar) as f64 * 1e5;
     let w = (speed_rpm as f64 * std::f64::consts::PI / 30.0).abs();
-    let t_f = p.no_load_torque_nm + p.viscous_w_s2_per_rad2 * w + p.eta_m * d * dp.abs();
+    let t_f = p.no_load_torque_nm + p.viscous_w_s2_per_rad2 * p.visc_ratio_at(case_oil_c) * w + p.eta_m * d * dp.abs();
     let tau = d * dp + (speed_rpm as f64).signum() * t_f;
     (tau.abs() / p.torque_constant_nm_per_a) as f32
 }
@@ -46,16 +47,20 @@ pub fn bytes(r: &Option<Request>, last_open: bool) -> Vec<u8> {
 
 /// Per tick, the sample the controller sent (`None`: lost on the way).
 pub fn requests() -> Vec<Option<Request>> {
+    use eha_guard::num::Num;
     let mut v = Vec::with_capacity(STEPS as usize);
     let mut seq: u16 = 0;
+    // the case oil the current's viscous friction follows
+    let mut oil = eha_guard::GuardOf::<f64>::new(&eha_guard::GuardConfig::DEFAULT, eha_guard::Restore::Cold);
     for k in 0..STEPS {
+        let oil_c = oil.model().map_or(16.0, |m| m.drain_c().to_f64());
         let t = k as f32 * 0.01;
         let hot = t < 100.0;
         let dp = if hot { 140.0 } else { 10.0 };
         let sensor_gain = if t < 300.0 { 1.0 } else { 0.7 };
         let mut r = Request {
             seq,
-            current_a: sensor_gain * motor_current(2.0 + dp, 2.0, 500.0),
+            current_a: sensor_gain * motor_current(2.0 + dp, 2.0, 500.0, oil_c),
             p_a_bar: 2.0 + dp,
             p_b_bar: 2.0,
             speed_rpm: 500.0,
@@ -72,6 +77,19 @@ pub fn requests() -> Vec<Option<Request>> {
             r.p_a_bar = 5000.0;
         }
         let lost = (10_001..10_004).contains(&k) || (45_001..45_011).contains(&k);
+        oil.valve_feedback(oil.output().valve_open);
+        if lost {
+            oil.tick_missing();
+        } else {
+            oil.tick(&eha_guard::Sample {
+                current_a: r.current_a,
+                p_a_bar: r.p_a_bar,
+                p_b_bar: r.p_b_bar,
+                speed_rpm: r.speed_rpm,
+                position_mm: r.position_mm,
+                ambient_c: r.ambient_c,
+            });
+        }
         v.push((!lost).then_some(r));
         seq = seq.wrapping_add(1);
     }

@@ -11,7 +11,8 @@ use eha_guard::protocol::Request;
 use eha_sim::pil::{firmware_for_tests, require_qemu, Build, PilError, QemuOptions, QemuSession, Target};
 
 fn sample(seq: u16) -> Request {
-    let current_a = eha_sim::pil::drill::motor_current(60.0, 5.0, 1500.0);
+    // (the viscous friction at 40 degC: these tests are about frames, not heat)
+    let current_a = eha_sim::pil::drill::motor_current(60.0, 5.0, 1500.0, 40.0);
     Request { seq, current_a, p_a_bar: 60.0, p_b_bar: 5.0, speed_rpm: 1500.0, position_mm: 10.0, ambient_c: 22.0, valve_fb: None, elec_hz: None, lng_supply_bar: None }
 }
 
