@@ -156,7 +156,7 @@ fn with_feedback(g: &mut GuardOf<f32>, ticks: u32, fb: impl Fn(u32, bool) -> Opt
             g.valve_feedback(v);
         }
         let o = g.tick(&load());
-        crate::plant::follow(&g);
+        crate::plant::follow(g);
         commanded = o.valve_open;
         out.push(o);
     }

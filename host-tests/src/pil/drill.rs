@@ -8,8 +8,8 @@
 //! - the motor current is the one the reference plant draws at these pressures
 //!   and speed ([`motor_current`]: 84.6 A, then 6.0 A), so the sensor
 //!   cross-check agrees, until
-//! - 300 s: the current sensor reads 30 % low (SENSOR_DISAGREE latches after
-//!   three 2 s windows: valve forced open, alarm and derate held, the model
+//! - 300 s: the current sensor reads 30 % low (SENSOR_DISAGREE latches within
+//!   1 s, two 0.5 s windows: valve forced open, alarm and derate held, the model
 //!   heats with the larger loss);
 //! - tick 10,000: 3 lost frames (3 ticks without a sample, below `stale_ticks`);
 //! - tick 45,000: 10 lost frames (STALE fault latches, fail-safe valve open);
