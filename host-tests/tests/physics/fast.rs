@@ -188,7 +188,8 @@ fn slow_twenty_long_random_missions_within_a_hundredth_of_a_kelvin() {
 }
 
 /// The missions of the slow test where the fast path or the shipped BDF is
-/// more than 0.01 K from the BDF at rtol 1e-9, all at a stop or rest with
-/// the needle open (measured with the oil on its viscosity line, issue 34:
-/// see the test's output).
-const DEGENERATE: [u64; 1] = [21];
+/// more than 0.01 K from the BDF at rtol 1e-9, both at a stop or rest with
+/// the needle open. Measured with the oil on its viscosity line (issue 34),
+/// fast / shipped BDF: seed 13 7.5e-3 / 1.06e-2 K, seed 21 1.07e-2 /
+/// 1.49e-2 K; the other 18 within 8.2e-3 K (fast) and 9.9e-3 K (shipped).
+const DEGENERATE: [u64; 2] = [13, 21];
