@@ -7,5 +7,6 @@ mod fault_subset;
 mod faults;
 mod golden;
 mod protocol;
+mod readme;
 mod scenarios;
 mod valve_loop;
