@@ -27,15 +27,32 @@ fn pooled(e: &[eha_sim::calibration::ChannelError]) -> f64 {
     (e.iter().map(|c| c.rmse_k * c.rmse_k).sum::<f64>() / e.len() as f64).sqrt()
 }
 
-/// Measured (one run, ~7 s, 1212 model runs; session 15, the emulator with
-/// compression heat; session 16 with the probe fitted and the staged fit:
-/// 1282 runs, 0.41 K): pooled held-out RMSE 8.08 → 0.41 K (t_oil_c 16.1 →
-/// 0.44 K, the other channels 1.1–7.0 → 0.24–0.54 K); `film_case` 9.82
-/// where the emulator's case-oil wetted area is ×5.3 (with another film
-/// correlation); `pump_friction` 0.101 with `leak_gap`
-/// on its bound (see below); `cap_case_oil` held (no drain sensor). Not every multiplier maps
-/// one to one (the main-block mass is ×0.78 in the emulator, fitted 1.15,
-/// its manifold plate and pump→block path are missing in the reference).
+/// Measured with both oils on their viscosity lines (one run, ~11 s, 1150
+/// model runs): pooled held-out RMSE 6.01 → 0.84 K (t_oil_c 12.6 → 1.54 K,
+/// the other channels 1.1–4.1 → 0.24–0.75 K); 0.41 K while both oils had a
+/// constant viscosity. Why it moved (measured with the emulator and the rig
+/// file changed by hand, not in the suite):
+/// - The miss is the held-out oil following the shaft speed at ~70 bar
+///   (−2.5 K at 663 rpm, +2.4 K at 1164 rpm, the same run): no training log
+///   moves the speed at a high pressure drop (load cycles at one speed, speed
+///   steps at 5–25 bar), and with the viscosity falling 10× over the warm-up
+///   the leakage, the films and the loss torque now depend on the oil
+///   temperature jointly with speed and pressure.
+/// - Both oils back at a constant 46 cSt, same code: 0.67 K (t_oil_c 0.66
+///   K). Each of the emulator's viscosity paths held at 40 °C alone
+///   (leakage, films, hoses): 0.88–1.23 K. No single path; the reference's
+///   own temperature dependences against the emulator's other structure.
+/// - `pump_friction` on its lower bound 0.1 (the emulator has no T0 or
+///   C_v·μ term, and puts half its η_m heat into the delivered oil, the
+///   reference into the case); it stays there with the rig's friction
+///   scaled by 0.3 before the fit, so a wider bound would not help: the
+///   emulator's structure, not a parameter missing from the set.
+///   `leak_gap` left its ×2.5 bound (1.41): the hot oil's lower viscosity
+///   supplies the leakage the wider gap gave before.
+/// - Calibrated on two identification runs instead, the same held-out log
+///   misses by 1.87 K (the slow test below asserts that case).
+/// `film_case` 8.7 where the emulator's case-oil wetted area is ×5.3
+/// (another film correlation); `cap_case_oil` held (no drain sensor).
 #[test]
 fn emulator_machine_held_out_error_falls() {
     let p = EmuParams::default();
@@ -56,23 +73,32 @@ fn emulator_machine_held_out_error_falls() {
         eprintln!("{:14} held-out RMSE {:.3} -> {:.3} K", a.channel, b.rmse_k, a.rmse_k);
     }
     eprintln!("pooled {:.3} -> {:.3} K, {} runs", pooled(&before), pooled(&after), c.model_runs);
-    // Held out, every channel better and pooled ≤ 0.6 K (measured 0.42 K;
-    // the rest is the emulator's structure the reference lacks).
-    assert!(pooled(&after) <= 0.6, "pooled held-out {:.3} K", pooled(&after));
+    // Held out, every channel better; pooled ≤ 1.0 K (measured 0.84 K; the
+    // fit is ill-conditioned here: a change of the emulator's hose viscosity
+    // that moves the rig-as-given error by 0.004 K gave 0.98 K), the oil
+    // channel that carries the miss ≤ 1.8 K (measured 1.54 K), the others
+    // ≤ 0.8 K (measured 0.24–0.75 K).
+    assert!(pooled(&after) <= 1.0, "pooled held-out {:.3} K", pooled(&after));
+    for a in &after {
+        let bound = if a.channel == "t_oil_c" { 1.8 } else { 0.8 };
+        assert!(a.rmse_k <= bound, "{} held-out {:.3} K (bound {bound} K)", a.channel, a.rmse_k);
+    }
     for (b, a) in before.iter().zip(&after) {
         assert!(a.rmse_k < b.rmse_k, "{} got worse", a.channel);
     }
     let v = |n: &str| c.params.iter().find(|q| q.name == n).expect(n).value;
     // The deviation that maps one to one, within the range the emulator's own
-    // structure allows: case film ×5.3 (another correlation: > 2; measured 9.85).
+    // structure allows: case film ×5.3 (another correlation: > 2; measured 8.70).
     assert!(v("film_case") > 2.0, "film_case {:.3}", v("film_case"));
     // No longer one to one since issue 16 (was 0.695 for the emulator's η_m
     // ×0.72): the reference's pump now has no-load and viscous friction, a
     // housing share, the emulator (written from the paper) none of them
     // (compression heat both have since session 15), and the fit trades
-    // the friction against the leakage (leak_gap on its ×2.5 bound).
+    // the friction against the leakage (leak_gap 1.41; on its ×2.5 bound
+    // while the oils had a constant viscosity).
     // Asserted as measured (0.105 before the emulator's compression heat,
-    // 0.101 with it; ±30 %) so that a change shows.
+    // 0.101 with it, 0.100 on its lower bound with both oils on their
+    // viscosity lines; ±30 %) so that a change shows.
     let k = eha_sim::calibration::set::index("leak_gap").expect("leak_gap");
     eprintln!("pump_friction {:.3}, leak_gap {:.3} at bound {}", v("pump_friction"), v("leak_gap"), c.params[k].at_bound);
     assert!((v("pump_friction") / 0.105).ln().abs() <= 0.3, "pump_friction {:.3}", v("pump_friction"));

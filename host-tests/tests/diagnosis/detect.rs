@@ -32,10 +32,19 @@ fn find<'a>(rows: &'a [Detectability], c: &str, k: usize) -> &'a Detectability {
 /// Physical checks of the detectability table on a constant-throttle log:
 /// - Coulomb friction acts on the piston only, which does not move here:
 ///   its imprint is zero (< 1e-9 K) and it is marked not identifiable.
-/// - A 2-minute oil-probe lag (4× the typical 30 s) on the warm-up cannot
-///   be taken up by the capacities and films: best gain ≥ 50 % (measured
-///   76 % here; 90 % around the calibrated baselines of emulator logs
-///   1704 and 1708).
+/// - An oil-probe lag on the warm-up (the dead-end pocket of the candidate,
+///   which also reads towards the manifold metal): at 480 s (16× the
+///   typical 30 s) best gain ≥ 50 % (measured 64 %). At 120 s it is not
+///   showable any more on this log: measured 14 % (imprint 5.09 K, left
+///   0.070 K; 76 % while the oil had a constant viscosity). With the oil on
+///   its viscosity line the pump's heats depend on the case-oil temperature
+///   (leakage ∝ 1/μ(T), the viscous friction ∝ μ(T)), and at one operating
+///   point the physical set uses that to follow the pocket's slowly growing
+///   offset: the refit takes `cap_loop_oil` to its bound 3.0, `probe_oil`
+///   4.5, `film_port` 0.27, `film_case` 3.3, `pump_friction` 0.72 and leaves
+///   0.07 K; the same refit with the rig's oil at a constant 46 cSt leaves
+///   0.31 K (64 %). Asserted: 120 s below 50 % and 480 s above, so that
+///   either change shows.
 /// - The imprint grows with the magnitude: forced convection at 3, 12 and
 ///   40 m/s leaves a growing imprint on the logged channels.
 /// - The best gain is 1 − σ/√(σ² + left²) of the row's own numbers.
@@ -49,9 +58,11 @@ fn detectability_follows_the_physics_of_a_constant_throttle_log() {
         let c = find(&rows, "coulomb-friction", k);
         assert!(c.imprint_k.1 < 1e-9 && c.best_gain < 1e-6 && !c.note.is_empty(), "{c:?}");
     }
-    let lag = find(&rows, "sensor-lag", 1);
+    let (lag, long) = (find(&rows, "sensor-lag", 1), find(&rows, "sensor-lag", 2));
     assert_eq!(lag.imprint_k.0, "t_oil_c");
-    assert!(lag.best_gain >= 0.5, "120 s lag: best gain {:.0} %", 100.0 * lag.best_gain);
+    assert!(lag.best_gain < 0.5, "120 s lag: best gain {:.0} % (measured 14 %)", 100.0 * lag.best_gain);
+    assert_eq!(long.imprint_k.0, "t_oil_c");
+    assert!(long.best_gain >= 0.5, "480 s lag: best gain {:.0} % (measured 64 %)", 100.0 * long.best_gain);
     let fc: Vec<f64> = (0..3).map(|k| find(&rows, "forced-convection", k).imprint_k.1).collect();
     assert!(fc[0] < fc[1] && fc[1] < fc[2], "forced-convection imprints {fc:?}");
     for r in &rows {
