@@ -34,4 +34,4 @@ pub mod tools;
 pub use calibration::{lsq, paper as calibrate};
 pub use physics::{cooling, fluid, heat, hydraulics, losses, network, rig};
 pub use simulation::{equilibrium, fast, missions, model, plant, scenario, sim};
-pub use tools::{cli, measured, params_block, plot, reader_checks, reduce, uq};
+pub use tools::{cli, gendoc, measured, params_block, plot, reader_checks, reduce, uq};

@@ -51,6 +51,9 @@ enum Cmd {
     /// them (rig.toml, params.rs, firmware-params.bin, report.md, PNGs);
     /// `--check firmware-params.bin` runs the firmware's boot checks.
     Commission(eha_sim::calibration::cli::CommissionArgs),
+    /// Re-render the generated tables in docs/ from their committed JSON
+    /// (`--check`: fail on a difference instead; CI runs it).
+    Docs(eha_sim::gendoc::DocsArgs),
 }
 
 fn main() -> ExitCode {
@@ -65,6 +68,7 @@ fn main() -> ExitCode {
         Cmd::Faults(a) => eha_sim::faults::run(&a),
         Cmd::ParamsBlock(a) => eha_sim::params_block::run(&a),
         Cmd::Uq(a) => eha_sim::uq::run_cli(&a),
+        Cmd::Docs(a) => eha_sim::gendoc::run_cli(&a),
         // Own exit codes: 0 diagnosis made (none included), 2 bad input.
         Cmd::Diagnose(a) => return eha_sim::diagnosis::cli::run(&a),
         Cmd::DiagnoseSweep(a) => return eha_sim::diagnosis::sweep::run(&a),

@@ -322,6 +322,46 @@ pub fn over_product_limits(measured: &BTreeMap<String, ImageBudget>) -> Vec<Stri
         .collect()
 }
 
+/// What each figure is, for the rendered table.
+const FIELD_LABELS: [(&str, &str); 10] = [
+    ("instr_per_tick_mean", "`Guard::tick` instructions per 10 ms tick, mean (QEMU -icount)"),
+    ("instr_per_tick_max", "`Guard::tick` instructions, max (a model-step tick)"),
+    ("guard_new_instr", "`Guard::new` instructions (boot: block, bounds, checks, stability)"),
+    ("stack_boot_b", "stack high-water, boot + init, B (stack painting)"),
+    ("stack_tick_b", "stack high-water, tick loop, B"),
+    ("flash_b", "flash `.text` + `.rodata`, B"),
+    ("flash_total_b", "flash, whole load image, B"),
+    ("ram_static_b", "static RAM (`.data`, `.bss`, no-init), B"),
+    ("loop_instr_per_tick_mean", "product loop (`App::tick`) instructions per tick, mean"),
+    ("loop_instr_per_tick_max", "product loop instructions per tick, max"),
+];
+
+/// Every image's figures as a Markdown table (rows: figures, columns:
+/// images; `–` where an image does not measure a figure).
+pub fn markdown(budgets: &BTreeMap<String, ImageBudget>) -> String {
+    let mut s = String::from("| figure |");
+    for name in budgets.keys() {
+        s.push_str(&format!(" {name} |"));
+    }
+    s.push_str("\n|---|");
+    s.push_str(&"---:|".repeat(budgets.len()));
+    s.push('\n');
+    for (k, (key, label)) in FIELD_LABELS.iter().enumerate() {
+        s.push_str(&format!("| {label} |"));
+        for b in budgets.values() {
+            let (f, v) = b.fields()[k];
+            debug_assert_eq!(f, *key);
+            match v {
+                Some(x) if x.fract() == 0.0 => s.push_str(&format!(" {x:.0} |")),
+                Some(x) => s.push_str(&format!(" {x:.1} |")),
+                None => s.push_str(" – |"),
+            }
+        }
+        s.push('\n');
+    }
+    s
+}
+
 /// Arguments of `eha-sim fw-budget`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct BudgetArgs {

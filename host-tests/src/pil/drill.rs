@@ -22,8 +22,8 @@
 use eha_guard::protocol::Request;
 
 /// Motor current of the reference plant, A rms: `|D dp + sign(w) T_f| / Kt` with
-/// the friction torque of the extended eq. (8), `T_f = T0 + C_v mu(T)/mu(40) D |w|
-/// + eta_m D |dp|` at the case oil `case_oil_c`, degC
+/// the friction torque of the extended eq. (8),
+/// `T_f = T0 + C_v mu(T)/mu(40) D |w| + eta_m D |dp|` at the case oil `case_oil_c`, degC
 /// (`eha_sim::hydraulics::shaft_torque`, |w| >= 1 rad/s), with the firmware's
 /// own parameters.
 pub fn motor_current(p_a_bar: f32, p_b_bar: f32, speed_rpm: f32, case_oil_c: f64) -> f32 {

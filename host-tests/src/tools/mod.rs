@@ -9,6 +9,7 @@
 //! - [`uq`]: uncertainty bands over the rig's documented parameter ranges.
 
 pub mod cli;
+pub mod gendoc;
 pub mod measured;
 pub mod params_block;
 pub mod plot;

@@ -176,7 +176,7 @@ pub fn quantile(v: &mut [f64], q: f64) -> f64 {
 }
 
 /// One paper number against its band.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PaperCheck {
     /// What it is.
     pub name: String,
@@ -316,8 +316,14 @@ pub fn upper_margin(uq: &Uq, channel: &str) -> Option<f64> {
 
 /// The paper checks as a Markdown table.
 pub fn checks_markdown(uq: &Uq, samples: usize) -> String {
+    checks_table(&uq.checks, samples)
+}
+
+/// The paper numbers against their bands as a Markdown table (`samples`:
+/// how many the bands came from).
+pub fn checks_table(checks: &[PaperCheck], samples: usize) -> String {
     let mut s = format!("| paper number | paper | nominal | 5 % | 50 % | 95 % | 90 % band width | position ({samples} samples) |\n|---|---|---|---|---|---|---|---|\n");
-    for c in &uq.checks {
+    for c in checks {
         let pos = if c.inside { "inside".to_string() } else { format!("outside by {:+.2} {}", c.outside_by, c.unit) };
         s.push_str(&format!(
             "| {} | {:.2} {u} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} {u} | {pos} |\n",
