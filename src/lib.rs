@@ -41,7 +41,7 @@ pub mod validate;
 #[cfg(all(target_os = "none", not(feature = "board-stm32f4")))]
 mod vectors;
 
-pub use guard::{faults, ClearResult, Faults, Guard, GuardConfig, GuardOf, Output, Real, Sample};
+pub use guard::{faults, ClearResult, Faults, Guard, GuardConfig, GuardOf, Output, Real, Reports, Sample};
 pub use memory::{Restore, ThermalRecord};
 
 #[cfg(test)]
