@@ -44,6 +44,9 @@ mod vectors;
 pub use guard::{faults, ClearResult, Faults, Guard, GuardConfig, GuardOf, Output, Real, Reports, Sample};
 pub use memory::{Restore, ThermalRecord};
 
+/// This firmware library's version (the crate's, `MAJOR.MINOR.PATCH`).
+pub const VERSION: &str = env!("CARGO_PKG_VERSION");
+
 #[cfg(test)]
 mod build_checks {
     extern crate std;

@@ -222,6 +222,46 @@ pub fn boot_state(ram: Restore, nv: NvLoad, params: ParamSource, model: &ModelCo
     boot_restore(ram, nv, &NvPolicy::DEFAULT, cool.as_ref(), now_s, alive_s, nv_failing)
 }
 
+/// What [`boot_guard`] found.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Booted {
+    /// Where the model constants come from.
+    pub params: ParamSource,
+    /// The parameter block's rig id (all zero without a block): the key of
+    /// the armed commands ([`CommandRules`]).
+    pub rig_id: [u8; 16],
+    /// How the thermal state started.
+    pub restore: RestoreKind,
+}
+
+/// Boots the guard in place at `slot` as the product does: the model
+/// constants of `block` ([`boot_params`]: `cfg.model` without one, CONFIG
+/// and fail-safe for an invalid one), the thermal state of the RAM records
+/// `ram` (A, B) and the non-volatile load `nv` ([`boot_state`]; `rtc_s`, the
+/// clock's seconds, is read only when `nv` holds something).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub fn boot_guard<N: Num>(
+    slot: &mut core::mem::MaybeUninit<GuardOf<N>>,
+    cfg: &GuardConfig,
+    block: Option<&[u8; BLOCK_LEN]>,
+    ram: (&ThermalRecord, &ThermalRecord),
+    nv: NvLoad,
+    rtc_s: impl FnOnce() -> Option<u32>,
+    alive_s: Option<u32>,
+    nv_failing: bool,
+) -> Booted {
+    let (model, params, rig_id) = boot_params(block, cfg.model);
+    let now_s = if nv != NvLoad::Empty { rtc_s() } else { None };
+    let restore = boot_state(slots::restore_from(ram.0, ram.1), nv, params, model, now_s, alive_s, nv_failing);
+    let cfg = GuardConfig { model, ..*cfg };
+    let guard = GuardOf::<N>::new_in(slot, &cfg, restore);
+    if let ParamSource::Invalid(_) = params {
+        guard.refuse_config();
+    }
+    Booted { params, rig_id, restore: restore_kind(&restore) }
+}
+
 /// Accounts `lost` timer periods that had no tick of their own: those a
 /// non-volatile save `stalled` are blind ticks ([`GuardOf::tick_blind`],
 /// at most [`MAX_STALL_TICKS`]), the others missing ticks
@@ -301,15 +341,12 @@ impl<N: Num> AppOf<N> {
         let (reset_cause, boots, running) = reset::at_boot(&mem.cause, mem.hw_hint);
         board.store_cause(&running);
         let (a, b) = &mem.records;
-        let (model, params, rig_id) = boot_params(board.param_block(), cfg.model);
-        let now_s = if mem.nv != NvLoad::Empty { board.rtc_s() } else { None };
-        let restore = boot_state(slots::restore_from(a, b), mem.nv, params, model, now_s, mem.alive_s, mem.nv_failing);
-        let cfg = GuardConfig { model, ..*cfg };
         let p = slot.as_mut_ptr();
         // SAFETY: `p` points to `slot`, valid for writes; every field is written
         // exactly once below before the reference is created.
         let app = unsafe {
-            GuardOf::<N>::new_in(&mut *core::ptr::addr_of_mut!((*p).guard).cast::<core::mem::MaybeUninit<GuardOf<N>>>(), &cfg, restore);
+            let guard = &mut *core::ptr::addr_of_mut!((*p).guard).cast::<core::mem::MaybeUninit<GuardOf<N>>>();
+            let booted = boot_guard(guard, cfg, board.param_block(), (a, b), mem.nv, || board.rtc_s(), mem.alive_s, mem.nv_failing);
             core::ptr::addr_of_mut!((*p).lng).write(cfg.lng);
             core::ptr::addr_of_mut!((*p).rx).write(Deframer::new());
             core::ptr::addr_of_mut!((*p).rx_buf).write([0; RX_READ]);
@@ -322,20 +359,17 @@ impl<N: Num> AppOf<N> {
             core::ptr::addr_of_mut!((*p).alive_at).write(0);
             core::ptr::addr_of_mut!((*p).stalled).write(0);
             core::ptr::addr_of_mut!((*p).tick).write(0);
-            core::ptr::addr_of_mut!((*p).restore).write(restore_kind(&restore));
+            core::ptr::addr_of_mut!((*p).restore).write(booted.restore);
             core::ptr::addr_of_mut!((*p).reset_cause).write(reset_cause);
             core::ptr::addr_of_mut!((*p).boots).write(boots);
             core::ptr::addr_of_mut!((*p).worst_tick_cycles).write(0);
             core::ptr::addr_of_mut!((*p).dump).write(None);
-            core::ptr::addr_of_mut!((*p).params).write(params);
-            core::ptr::addr_of_mut!((*p).rules).write(CommandRules::new(rig_id, u32::from(boots)));
+            core::ptr::addr_of_mut!((*p).params).write(booted.params);
+            core::ptr::addr_of_mut!((*p).rules).write(CommandRules::new(booted.rig_id, u32::from(boots)));
             &mut *p
         };
-        if let ParamSource::Invalid(_) = params {
-            app.guard.refuse_config();
-        }
         app.guard.trace_event(Trace::Reset { tick: 0, cause: reset_cause as u8 });
-        app.guard.trace_event(Trace::Params { tick: 0, source: params.code() });
+        app.guard.trace_event(Trace::Params { tick: 0, source: app.params.code() });
         let out = app.guard.output();
         let _ = board.set_pins(Pins::for_outputs(out.valve_open, out.alarm || out.derate));
         app
