@@ -113,7 +113,8 @@
 // A valid parameter block.
 #define EHA_PARAMS_BLOCK 1
 
-// The block was refused: CONFIG, fail-safe.
+// The block was refused (its header, CRC or alignment, or values the
+// model rejects): CONFIG, fail-safe.
 #define EHA_PARAMS_INVALID 2
 
 // Fault bit: an input outside its plausible range.

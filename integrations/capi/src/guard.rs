@@ -240,7 +240,9 @@ pub unsafe extern "C" fn eha_guard_init(storage: *mut c_void, storage_size: usiz
             RestoreKind::Corrupt => EHA_RESTORE_CORRUPT,
             RestoreKind::PowerLoss => EHA_RESTORE_POWER_LOSS,
         };
+        // A block whose values the model refuses is invalid too (CONFIG).
         let params = match s.params {
+            _ if s.guard.faults().contains(faults::CONFIG) => EHA_PARAMS_INVALID,
             ParamSource::Default => EHA_PARAMS_DEFAULT,
             ParamSource::Block => EHA_PARAMS_BLOCK,
             ParamSource::Invalid(_) => EHA_PARAMS_INVALID,

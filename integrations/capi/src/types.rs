@@ -318,7 +318,8 @@ pub const EHA_RESTORE_POWER_LOSS: i32 = 3;
 pub const EHA_PARAMS_DEFAULT: i32 = 0;
 /// A valid parameter block.
 pub const EHA_PARAMS_BLOCK: i32 = 1;
-/// The block was refused: CONFIG, fail-safe.
+/// The block was refused (its header, CRC or alignment, or values the
+/// model rejects): CONFIG, fail-safe.
 pub const EHA_PARAMS_INVALID: i32 = 2;
 
 /// What `eha_guard_init` did.
