@@ -35,6 +35,11 @@ fn c_example_in_qemu_equals_the_rust_application_bit_for_bit_on_fig15() {
     let size = common::run(Command::new("arm-none-eabi-size").arg(&elf), "arm-none-eabi-size");
     let lib_bytes = std::fs::metadata(&lib).map(|m| m.len()).unwrap_or(0);
     eprintln!("C example (arm-none-eabi-gcc, libeha_guard_capi.a {lib_bytes} B with debug info):\n{size}");
+    // No panicking path of the Rust core is linked into the C image (the
+    // core's denied lints leave none; the panic handler would fault).
+    let syms = common::run(Command::new("arm-none-eabi-nm").arg("-C").arg(&elf), "arm-none-eabi-nm");
+    let panics: Vec<&str> = syms.lines().filter(|l| l.contains("panic")).collect();
+    assert!(panics.is_empty(), "the C image links panicking code: {panics:?}");
 
     // The C image in closed loop with the plant (-icount: instruction counts).
     let opts = LoopOptions { tick_s: eha_guard::params::S_PER_TICK, duration_s: DURATION_S };
