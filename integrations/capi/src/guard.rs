@@ -610,3 +610,33 @@ pub unsafe extern "C" fn eha_record_from_bytes(bytes: *const u8, len: usize, rec
 pub extern "C" fn eha_guard_storage_need() -> usize {
     size_of::<Shim>()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[repr(C, align(8))]
+    struct Storage([u8; EHA_GUARD_STORAGE_SIZE]);
+
+    /// A panic inside a call (none is reachable in the core: forced here)
+    /// is caught at the boundary: the status says so, the outputs are the
+    /// fail-safe ones and the storage is poisoned for every later call.
+    #[test]
+    fn a_caught_panic_poisons_the_storage() {
+        let mut s = Box::new(Storage([0; EHA_GUARD_STORAGE_SIZE]));
+        let p = s.0.as_mut_ptr().cast::<c_void>();
+        // SAFETY: the storage is valid, aligned and large enough.
+        unsafe {
+            let st = eha_guard_init(p, EHA_GUARD_STORAGE_SIZE, core::ptr::null(), 0, core::ptr::null(), core::ptr::null_mut());
+            assert_eq!(st, EhaStatus::EhaErrNull, "a NULL block: CONFIG fail-safe, initialised");
+            let mut o = EhaOutput::default();
+            assert_eq!(eha_guard_tick_missing(p, &mut o), EhaStatus::EhaOk);
+            let st = with_guard(p, &mut o, |_| panic!("forced by the test"));
+            assert_eq!(st, EhaStatus::EhaErrPanic);
+            assert_eq!(o, EhaOutput::FAIL_SAFE);
+            o = EhaOutput::default();
+            assert_eq!(eha_guard_tick_missing(p, &mut o), EhaStatus::EhaErrState);
+            assert_eq!(o, EhaOutput::FAIL_SAFE);
+        }
+    }
+}
