@@ -4,7 +4,8 @@
  * Link libeha_guard_capi.a (cargo build --release -p eha-guard-capi
  * --target thumbv7em-none-eabihf), keep one guard in caller-owned storage
  * (EHA_GUARD_STORAGE_SIZE bytes, aligned to EHA_GUARD_STORAGE_ALIGN), call
- * eha_guard_init once at boot and eha_guard_tick every 10 ms.
+ * eha_guard_init once at boot and eha_guard_tick every 10 ms. Not
+ * reentrant: call a guard's functions from one context (the 10 ms task).
  * docs/integration.md ("C") shows the loop; docs/firmware.md the rules.
  */
 
