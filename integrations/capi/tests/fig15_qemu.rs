@@ -55,6 +55,10 @@ fn c_example_in_qemu_equals_the_rust_application_bit_for_bit_on_fig15() {
     };
     let end = c.finish(n).unwrap_or_else(|e| panic!("{e}"));
     let wall_c = t0.elapsed().as_secs_f64();
+    // The C image's stack high-water mark (painted at reset), on its stdout.
+    let stdout = String::from_utf8_lossy(&end.defmt);
+    let stack_b: u32 = stdout.lines().find_map(|l| l.strip_prefix("stack_high_water_b=")).and_then(|v| v.trim().parse().ok()).unwrap_or_else(|| panic!("no stack report on the C image's stdout: {stdout:?}"));
+    assert!(stack_b > 0 && stack_b < 16 * 1024, "stack high-water {stack_b} B");
     assert_eq!(records.len() as u64, n);
     assert_eq!(end.done.accepted as u64, n, "the C loop accepted every sample frame");
     assert_eq!((end.done.missing, end.done.rejected_crc, end.done.rejected_framing, end.done.rejected_sequence), (0, 0, 0, 0));
@@ -98,7 +102,7 @@ fn c_example_in_qemu_equals_the_rust_application_bit_for_bit_on_fig15() {
     eprintln!(
         "Fig. 15, {n} ticks: C image vs Rust image {}/{} bit-identical, vs host SIL {}/{}; valve events {:?}; LNG used {:.4} kg; \
          instructions per tick (whole loop, -icount): C {c_mean:.0} mean {c_max:.0} max, Rust eha-fw {r_mean:.0} mean {r_max:.0} max; \
-         wall: C closed loop {wall_c:.1} s, Rust replay {wall_rust:.1} s",
+         C stack high-water {stack_b} B; wall: C closed loop {wall_c:.1} s, Rust replay {wall_rust:.1} s",
         vs_image.identical, vs_image.ticks, vs_sil.identical, vs_sil.ticks, s.valve_events, s.lng_used_kg
     );
     assert_eq!(vs_image.ticks as u64, n);

@@ -10,7 +10,8 @@
  * (eha_guard::protocol::lockstep): per tick, a little-endian u16 length and
  * that many received bytes on semihosting stdin; the tick's reply and an
  * end-of-tick frame on semihosting ":tt" (append: the host's stderr); at
- * end of input a completion marker, then exit 0. The host runs it in closed
+ * end of input a completion marker and the stack's high-water mark (painted
+ * at reset) on semihosting stdout, then exit 0. The host runs it in closed
  * loop with the reference plant and compares every reply with the Rust
  * application's, bit for bit (integrations/capi/tests/fig15_qemu.rs).
  *
@@ -81,6 +82,28 @@ static void tx_flush(int32_t fd)
         sh_exit(EXIT_WRITE);
     }
     tx_len = 0;
+}
+
+uint32_t stack_high_water_b(void);
+
+/* "stack_high_water_b=N\n" on semihosting stdout (the harness reads it). */
+static void report_stack(void)
+{
+    char line[32] = "stack_high_water_b=";
+    char digits[10];
+    uint32_t v = stack_high_water_b(), n = 0, at = 19;
+    do {
+        digits[n++] = (char)('0' + v % 10);
+        v /= 10;
+    } while (v != 0);
+    while (n > 0) {
+        line[at++] = digits[--n];
+    }
+    line[at++] = '\n';
+    int32_t fd = sh_open_tt(4);
+    if (fd < 0 || sh_write(fd, (const uint8_t *)line, at) != 0) {
+        sh_exit(EXIT_WRITE);
+    }
 }
 
 static uint16_t sat_add16(uint16_t a, uint16_t b)
@@ -242,5 +265,6 @@ int main(void)
     tx_frame(eha_wire_lockstep_done(&done, tx, sizeof tx, &len), len);
     tx_frame(eha_wire_lockstep_tick_end(0, tx + tx_len, sizeof tx - tx_len, &len), len);
     tx_flush(out);
+    report_stack();
     return 0;
 }

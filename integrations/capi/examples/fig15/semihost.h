@@ -5,7 +5,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
-/* Opens ":tt": mode 0 = stdin, 8 = append (QEMU: stderr). -1 on failure. */
+/* Opens ":tt": mode 0 = stdin, 4 = write (stdout), 8 = append (QEMU:
+   stderr). -1 on failure. */
 int32_t sh_open_tt(uint32_t mode);
 /* Reads up to len bytes; returns the bytes read (0 at end of input), -1 on error. */
 int32_t sh_read(int32_t fd, uint8_t *buf, uint32_t len);

@@ -3,13 +3,32 @@
 #include <stdint.h>
 #include "semihost.h"
 
-extern uint32_t __stack_top, __data_start, __data_end, __data_load, __bss_start, __bss_end;
+extern uint32_t __stack_top, __data_start, __data_end, __data_load, __bss_start, __bss_end, __noinit_end;
+
+/* Stack painting: the free RAM between the statics and the stack is filled
+   with this word at reset; stack_high_water_b() finds the deepest word the
+   stack overwrote. */
+#define PAINT 0x5AC3A55Cu
+
+uint32_t stack_high_water_b(void)
+{
+    const uint32_t *p = &__noinit_end;
+    while (p < &__stack_top && *p == PAINT) {
+        p++;
+    }
+    return (uint32_t)((uintptr_t)&__stack_top - (uintptr_t)p);
+}
 int main(void);
 
 enum { EXIT_HARDFAULT = 3, EXIT_EXCEPTION = 4 };
 
 void reset_handler(void)
 {
+    uint32_t sp;
+    __asm__ volatile("mov %0, sp" : "=r"(sp));
+    for (uint32_t *p = &__noinit_end; (uintptr_t)p < sp - 64; p++) {
+        *p = PAINT;
+    }
     /* The FPU first (CPACR: CP10 and CP11 full access): the guard is f32. */
     *(volatile uint32_t *)0xE000ED88u |= 0xFu << 20;
     __asm__ volatile("dsb\n isb" ::: "memory");
