@@ -41,8 +41,11 @@ pub mod validate;
 #[cfg(all(target_os = "none", not(feature = "board-stm32f4")))]
 mod vectors;
 
-pub use guard::{faults, ClearResult, Faults, Guard, GuardConfig, GuardOf, Output, Real, Sample};
+pub use guard::{faults, ClearResult, Faults, Guard, GuardConfig, GuardOf, Output, Real, Reports, Sample};
 pub use memory::{Restore, ThermalRecord};
+
+/// This firmware library's version (the crate's, `MAJOR.MINOR.PATCH`).
+pub const VERSION: &str = env!("CARGO_PKG_VERSION");
 
 #[cfg(test)]
 mod build_checks {

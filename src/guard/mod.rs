@@ -13,7 +13,7 @@ mod tick;
 mod types;
 pub mod faults;
 pub use faults::Faults;
-pub use types::{GuardConfig, Output, Sample, DRAIN_C_UNKNOWN};
+pub use types::{GuardConfig, Output, Reports, Sample, DRAIN_C_UNKNOWN};
 // `ClearResult`, `recovery_ticks` and the trust constants are defined below.
 
 use crate::crosscheck::{CrossCheck, Verdict};

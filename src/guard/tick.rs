@@ -6,6 +6,19 @@
 use super::*;
 
 impl<N: Num> GuardOf<N> {
+    /// One 10 ms tick with a new sample and the controller's reports, in the
+    /// product loop's order: the valve position (when reported), the LNG
+    /// supply, the speed plausibility, then [`GuardOf::tick`].
+    #[inline(always)]
+    pub fn tick_reported(&mut self, s: &Sample, r: &Reports) -> Output {
+        if let Some(open) = r.valve_fb {
+            self.valve_feedback(open);
+        }
+        self.lng_supply(r.lng_supply_bar);
+        self.check_speed(s, r.elec_hz);
+        self.tick(s)
+    }
+
     /// One 10 ms tick with a new sample. Never panics; any invalid channel latches a
     /// fault, opens the valve in this same tick and is replaced by its worst case.
     #[inline(never)]

@@ -43,6 +43,21 @@ pub struct Output {
     pub lng_seconds_left: f32,
 }
 
+/// What the controller reports beside the sample, once per tick, each
+/// optional: the valve position read back ([`super::GuardOf::valve_feedback`]),
+/// the LNG supply pressure ([`super::GuardOf::lng_supply`]) and the motor's
+/// electrical frequency ([`super::GuardOf::check_speed`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Reports {
+    /// LNG valve position read back (`Some(true)` open), `None` when not reported.
+    pub valve_fb: Option<bool>,
+    /// LNG supply pressure at the valve, bar gauge; `None` when not reported.
+    pub lng_supply_bar: Option<f32>,
+    /// The motor drive's electrical frequency, Hz (signed like the speed);
+    /// `None` when not reported.
+    pub elec_hz: Option<f32>,
+}
+
 /// Drain temperature reported when no model is available (CONFIG fault), degC.
 pub const DRAIN_C_UNKNOWN: f32 = 1.0e6;
 

@@ -6,6 +6,8 @@ use super::wire::{self, command_key, Ack, AckResult, Cmd, Command, Refusal, Stat
 use crate::guard::ClearResult;
 use super::{AppOf, Board, TRACE_EVENTS_PER_TICK};
 use crate::num::Num;
+use crate::protection::LngConfig;
+use crate::GuardOf;
 use crate::protocol::{DecodeError, Request};
 use crate::trace::Trace;
 
@@ -18,6 +20,93 @@ impl ConcatFixed for [[u8; 4]; 2] {
     fn concat_fixed(&self) -> [u8; 8] {
         let [a, b] = *self;
         [a[0], a[1], a[2], a[3], b[0], b[1], b[2], b[3]]
+    }
+}
+
+/// The rules of the keyed commands (clear and refill), apart from the
+/// transport that carries them: each is armed, then confirmed within
+/// [`ARM_WINDOW_TICKS`] with the [`command_key`] of the arm's nonce and the
+/// parameter block's rig id, at most once per [`COMMAND_INTERVAL_TICKS`],
+/// then done under the guard's own rule (a clear: [`GuardOf::clear_faults`];
+/// a refill: refused with the valve open or in alarm). The product loop
+/// ([`AppOf`]) and the C API (`integrations/capi`) both use it.
+#[derive(Clone, Copy, Debug)]
+pub struct CommandRules {
+    /// The parameter block's rig id (all zero for the compiled-in
+    /// default): the key of armed commands.
+    rig_id: [u8; 16],
+    /// The armed clear or refill: (the arm, its nonce, its tick).
+    armed: Option<(Cmd, u32, u32)>,
+    /// The last nonce handed out.
+    nonce: u32,
+    /// Tick of the last confirmed clear (0) and refill (1).
+    confirmed: [Option<u32>; 2],
+}
+
+impl CommandRules {
+    /// No command armed; `rig_id` keys the confirmations, `seed` (the boot
+    /// count on the boards) starts the nonces.
+    pub fn new(rig_id: [u8; 16], seed: u32) -> Self {
+        CommandRules { rig_id, armed: None, nonce: seed, confirmed: [None; 2] }
+    }
+
+    /// The rig id that keys the confirmations.
+    pub fn rig_id(&self) -> &[u8; 16] {
+        &self.rig_id
+    }
+
+    /// Arms a clear or a refill (`cmd`: [`Cmd::ClearArm`] or
+    /// [`Cmd::RefillArm`]) at `tick`: a fresh nonce (from the tick counter and
+    /// the last one; not secret: the key guards against accidents, not
+    /// attacks), returned.
+    pub fn arm(&mut self, cmd: Cmd, tick: u32) -> u32 {
+        let nonce = crate::memory::crc32(&[tick.to_le_bytes(), self.nonce.to_le_bytes()].concat_fixed()) | 1;
+        self.nonce = nonce;
+        self.armed = Some((cmd, nonce, tick));
+        nonce
+    }
+
+    /// A confirmation ([`Cmd::ClearConfirm`] or [`Cmd::RefillConfirm`] with
+    /// its `key`) at `tick`: the matching arm within its window, the key, the
+    /// interval since the last one, then the guard's own rule. A confirmed
+    /// clear answers the seconds UNTRUSTED still holds (0: trust restored);
+    /// a refill restores `lng`'s full budget.
+    pub fn confirm<N: Num>(&mut self, cmd: Cmd, key: u32, tick: u32, guard: &mut GuardOf<N>, lng: &LngConfig) -> Result<u32, Refusal> {
+        let (want, slot) = match cmd {
+            Cmd::ClearConfirm => (Cmd::ClearArm, 0),
+            _ => (Cmd::RefillArm, 1),
+        };
+        let (armed, nonce, at) = self.armed.take().ok_or(Refusal::NotArmed)?;
+        if armed != want || tick.wrapping_sub(at) > ARM_WINDOW_TICKS {
+            return Err(Refusal::NotArmed);
+        }
+        if key != command_key(&self.rig_id, nonce, cmd) {
+            return Err(Refusal::Key);
+        }
+        let last = self.confirmed.get(slot).copied().flatten();
+        if last.is_some_and(|t| tick.wrapping_sub(t) < COMMAND_INTERVAL_TICKS) {
+            return Err(Refusal::TooSoon);
+        }
+        if let Some(t) = self.confirmed.get_mut(slot) {
+            *t = Some(tick);
+        }
+        match cmd {
+            Cmd::ClearConfirm => match guard.clear_faults() {
+                ClearResult::Cleared => Ok(0),
+                ClearResult::TrustHeld(left) => Ok(left.div_ceil(100).max(1)),
+                ClearResult::Refused => Err(Refusal::Rule),
+            },
+            _ => {
+                // A refill with the valve open or in alarm would undo the
+                // empty-tank and corrupt-boot rules while they protect.
+                let o = guard.output();
+                if o.valve_open || o.alarm {
+                    return Err(Refusal::Rule);
+                }
+                guard.refill_lng(lng);
+                Ok(0)
+            }
+        }
     }
 }
 
@@ -85,8 +174,8 @@ impl<N: Num> AppOf<N> {
     pub(super) fn execute<B: Board>(&mut self, board: &mut B, c: Command) {
         self.counters.commands = self.counters.commands.saturating_add(1);
         let (result, value) = match c.cmd {
-            Cmd::ClearArm | Cmd::RefillArm => (AckResult::Done, self.arm(c.cmd)),
-            Cmd::ClearConfirm | Cmd::RefillConfirm => match self.confirm(c) {
+            Cmd::ClearArm | Cmd::RefillArm => (AckResult::Done, self.rules.arm(c.cmd, self.tick)),
+            Cmd::ClearConfirm | Cmd::RefillConfirm => match self.rules.confirm(c.cmd, c.arg, self.tick, &mut self.guard, &self.lng) {
                 Ok(v) => (AckResult::Done, v),
                 Err(r) => (AckResult::Refused, r as u32),
             },
@@ -104,57 +193,6 @@ impl<N: Num> AppOf<N> {
         let code = if result == AckResult::Done { 0 } else { u8::try_from(value).unwrap_or(u8::MAX) };
         self.guard.trace_event(Trace::Command { tick: self.guard.ticks(), code: c.cmd.code(), result: code });
         board.write_tx(&Ack { token: c.token, cmd: c.cmd, result, value }.encode());
-    }
-
-    /// Arms a clear or a refill: a fresh nonce (from the tick counter and the
-    /// last one; not secret: the key guards against accidents, not attacks).
-    fn arm(&mut self, cmd: Cmd) -> u32 {
-        let nonce = crate::memory::crc32(&[self.tick.to_le_bytes(), self.nonce.to_le_bytes()].concat_fixed()) | 1;
-        self.nonce = nonce;
-        self.armed = Some((cmd, nonce, self.tick));
-        nonce
-    }
-
-    /// A confirmation: the matching arm within its window, the key, the
-    /// interval since the last one, then the guard's own rule. A confirmed
-    /// clear answers the seconds UNTRUSTED still holds (0: trust restored).
-    fn confirm(&mut self, c: Command) -> Result<u32, Refusal> {
-        let (want, slot) = match c.cmd {
-            Cmd::ClearConfirm => (Cmd::ClearArm, 0),
-            _ => (Cmd::RefillArm, 1),
-        };
-        let (armed, nonce, at) = self.armed.take().ok_or(Refusal::NotArmed)?;
-        if armed != want || self.tick.wrapping_sub(at) > ARM_WINDOW_TICKS {
-            return Err(Refusal::NotArmed);
-        }
-        if c.arg != command_key(&self.rig_id, nonce, c.cmd) {
-            return Err(Refusal::Key);
-        }
-        let last = self.confirmed.get(slot).copied().flatten();
-        if last.is_some_and(|t| self.tick.wrapping_sub(t) < COMMAND_INTERVAL_TICKS) {
-            return Err(Refusal::TooSoon);
-        }
-        if let Some(t) = self.confirmed.get_mut(slot) {
-            *t = Some(self.tick);
-        }
-        match c.cmd {
-            Cmd::ClearConfirm => match self.guard.clear_faults() {
-                ClearResult::Cleared => Ok(0),
-                ClearResult::TrustHeld(left) => Ok(left.div_ceil(100).max(1)),
-                ClearResult::Refused => Err(Refusal::Rule),
-            },
-            _ => {
-                // A refill with the valve open or in alarm would undo the
-                // empty-tank and corrupt-boot rules while they protect.
-                let o = self.guard.output();
-                if o.valve_open || o.alarm {
-                    return Err(Refusal::Rule);
-                }
-                let lng = self.lng;
-                self.guard.refill_lng(&lng);
-                Ok(0)
-            }
-        }
     }
 
     #[cfg(feature = "fault-inject")]

@@ -20,14 +20,19 @@
 pub mod clock;
 mod commands;
 pub mod mem_board;
+mod records;
 pub mod reset;
 pub mod wire;
 
+pub use commands::CommandRules;
+pub use records::RecordKeeper;
+
 use crate::memory::nv::{NvLoad, NvPolicy};
 use crate::protection::LngConfig;
-use crate::memory::slots::{self, AbWriter};
+use crate::memory::slots;
 use crate::memory::cooling::RestCooling;
 use crate::memory::{boot_restore, Restore, ThermalRecord};
+use crate::model::ModelConsts;
 use crate::num::Num;
 use crate::protocol::{Deframer, Request};
 use crate::trace::{RestoreKind, Trace};
@@ -179,6 +184,96 @@ impl Counters {
     }
 }
 
+/// The model constants of a boot and where they come from: a valid
+/// parameter block (and its rig id, the key of the armed commands), else
+/// `default` (the compiled-in paper rig on the boards: NOT_COMMISSIONED,
+/// rig id all zero); an invalid block gives [`ParamSource::Invalid`], on
+/// which the caller refuses the configuration
+/// ([`GuardOf::refuse_config`]: CONFIG, fail-safe).
+#[inline(always)]
+pub fn boot_params<'a>(block: Option<&'a [u8; BLOCK_LEN]>, default: &'a ModelConsts<f32>) -> (&'a ModelConsts<f32>, ParamSource, [u8; 16]) {
+    let (model, params) = match block.map(params_block::view) {
+        None | Some(Ok(None)) => (default, ParamSource::Default),
+        Some(Ok(Some(c))) => (c, ParamSource::Block),
+        Some(Err(e)) => (default, ParamSource::Invalid(e)),
+    };
+    let mut rig_id = [0u8; 16];
+    if let (ParamSource::Block, Some(b)) = (params, block) {
+        let id = params_block::rig_id(b).as_bytes();
+        for (d, s) in rig_id.iter_mut().zip(id) {
+            *d = *s;
+        }
+    }
+    (model, params, rig_id)
+}
+
+/// The thermal state of a boot ([`boot_restore`] under the default
+/// non-volatile write policy): the RAM records' rule `ram`, else the
+/// non-volatile record `nv` after a power loss, cooled over the off-time
+/// (`now_s` and `alive_s`, the clock's seconds now and at the last-alive
+/// stamp) by the model's bound at rest (none under an invalid block).
+#[inline(always)]
+pub fn boot_state(ram: Restore, nv: NvLoad, params: ParamSource, model: &ModelConsts<f32>, now_s: Option<u32>, alive_s: Option<u32>, nv_failing: bool) -> Restore {
+    // The cooling bound at rest of the model in use (none under CONFIG).
+    let cool = match params {
+        ParamSource::Invalid(_) => None,
+        _ => RestCooling::from_consts(model),
+    };
+    boot_restore(ram, nv, &NvPolicy::DEFAULT, cool.as_ref(), now_s, alive_s, nv_failing)
+}
+
+/// What [`boot_guard`] found.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Booted {
+    /// Where the model constants come from.
+    pub params: ParamSource,
+    /// The parameter block's rig id (all zero without a block): the key of
+    /// the armed commands ([`CommandRules`]).
+    pub rig_id: [u8; 16],
+    /// How the thermal state started.
+    pub restore: RestoreKind,
+}
+
+/// Boots the guard in place at `slot` as the product does: the model
+/// constants of `block` ([`boot_params`]: `cfg.model` without one, CONFIG
+/// and fail-safe for an invalid one), the thermal state of the RAM records
+/// `ram` (A, B) and the non-volatile load `nv` ([`boot_state`]; `rtc_s`, the
+/// clock's seconds, is read only when `nv` holds something).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub fn boot_guard<N: Num>(
+    slot: &mut core::mem::MaybeUninit<GuardOf<N>>,
+    cfg: &GuardConfig,
+    block: Option<&[u8; BLOCK_LEN]>,
+    ram: (&ThermalRecord, &ThermalRecord),
+    nv: NvLoad,
+    rtc_s: impl FnOnce() -> Option<u32>,
+    alive_s: Option<u32>,
+    nv_failing: bool,
+) -> Booted {
+    let (model, params, rig_id) = boot_params(block, cfg.model);
+    let now_s = if nv != NvLoad::Empty { rtc_s() } else { None };
+    let restore = boot_state(slots::restore_from(ram.0, ram.1), nv, params, model, now_s, alive_s, nv_failing);
+    let cfg = GuardConfig { model, ..*cfg };
+    let guard = GuardOf::<N>::new_in(slot, &cfg, restore);
+    if let ParamSource::Invalid(_) = params {
+        guard.refuse_config();
+    }
+    Booted { params, rig_id, restore: restore_kind(&restore) }
+}
+
+/// Accounts `lost` timer periods that had no tick of their own: those a
+/// non-volatile save `stalled` are blind ticks ([`GuardOf::tick_blind`],
+/// at most [`MAX_STALL_TICKS`]), the others missing ticks
+/// ([`GuardOf::tick_missing`], at most [`MAX_MISSED_TICKS`]).
+pub fn catch_up<N: Num>(guard: &mut GuardOf<N>, lost: u32, stalled: u32) {
+    let blind = lost.min(stalled);
+    let _ = guard.tick_blind(blind.min(MAX_STALL_TICKS));
+    for _ in 0..(lost - blind).min(MAX_MISSED_TICKS) {
+        let _ = guard.tick_missing();
+    }
+}
+
 /// The product application of the firmware build's number type.
 pub type App = AppOf<Real>;
 
@@ -199,18 +294,10 @@ pub struct AppOf<N: Num> {
     sample: Option<Request>,
     commands: Deque<Command, COMMAND_QUEUE>,
     counters: Counters,
-    records: AbWriter,
-    /// The guard's [`GuardOf::epoch`] when the A/B record was last written
-    /// (the record is rewritten only when the state it holds changed).
-    record_epoch: Option<u32>,
-    nv_policy: NvPolicy,
-    nv_last: Option<ThermalRecord>,
+    /// The thermal record's write rules (A/B slots, non-volatile policy).
+    records: RecordKeeper,
     /// Tick of the last last-alive stamp ([`Board::rtc_alive`]).
     alive_at: u32,
-    /// Tick of the last failed non-volatile save: no attempt for
-    /// [`NV_RETRY_TICKS`] after it (compared by wrapping difference, so the
-    /// 497-day wrap of the tick counter does not stop the saves).
-    nv_failed_at: Option<u32>,
     /// Timer periods the last non-volatile save stalled the core (the
     /// next tick accounts them as blind, not missing).
     stalled: u32,
@@ -223,15 +310,8 @@ pub struct AppOf<N: Num> {
     dump: Option<(u16, u8, u8)>,
     /// Where the model constants of this boot come from.
     params: ParamSource,
-    /// The parameter block's rig id (all zero for the compiled-in
-    /// default): the key of armed commands.
-    rig_id: [u8; 16],
-    /// The armed clear or refill: (the arm, its nonce, its tick).
-    armed: Option<(wire::Cmd, u32, u32)>,
-    /// The last nonce handed out.
-    nonce: u32,
-    /// Tick of the last confirmed clear (0) and refill (1).
-    confirmed: [Option<u32>; 2],
+    /// The keyed commands' rules (clear, refill).
+    rules: CommandRules,
 }
 
 fn restore_kind(r: &Restore) -> RestoreKind {
@@ -261,35 +341,12 @@ impl<N: Num> AppOf<N> {
         let (reset_cause, boots, running) = reset::at_boot(&mem.cause, mem.hw_hint);
         board.store_cause(&running);
         let (a, b) = &mem.records;
-        // The model constants: a valid parameter block, else `cfg`'s own (the
-        // compiled-in paper rig on the boards: NOT_COMMISSIONED); an invalid
-        // block refuses the configuration (CONFIG, fail-safe).
-        let (model, params) = match board.param_block().map(params_block::view) {
-            None | Some(Ok(None)) => (cfg.model, ParamSource::Default),
-            Some(Ok(Some(c))) => (c, ParamSource::Block),
-            Some(Err(e)) => (cfg.model, ParamSource::Invalid(e)),
-        };
-        let mut rig_id = [0u8; 16];
-        if let (ParamSource::Block, Some(b)) = (params, board.param_block()) {
-            let id = params_block::rig_id(b).as_bytes();
-            for (d, s) in rig_id.iter_mut().zip(id) {
-                *d = *s;
-            }
-        }
-        let nv_policy = NvPolicy::DEFAULT;
-        // The cooling bound at rest of the model in use (none under CONFIG).
-        let cool = match params {
-            ParamSource::Invalid(_) => None,
-            _ => RestCooling::from_consts(model),
-        };
-        let now_s = if mem.nv != NvLoad::Empty { board.rtc_s() } else { None };
-        let restore = boot_restore(slots::restore_from(a, b), mem.nv, &nv_policy, cool.as_ref(), now_s, mem.alive_s, mem.nv_failing);
-        let cfg = GuardConfig { model, ..*cfg };
         let p = slot.as_mut_ptr();
         // SAFETY: `p` points to `slot`, valid for writes; every field is written
         // exactly once below before the reference is created.
         let app = unsafe {
-            GuardOf::<N>::new_in(&mut *core::ptr::addr_of_mut!((*p).guard).cast::<core::mem::MaybeUninit<GuardOf<N>>>(), &cfg, restore);
+            let guard = &mut *core::ptr::addr_of_mut!((*p).guard).cast::<core::mem::MaybeUninit<GuardOf<N>>>();
+            let booted = boot_guard(guard, cfg, board.param_block(), (a, b), mem.nv, || board.rtc_s(), mem.alive_s, mem.nv_failing);
             core::ptr::addr_of_mut!((*p).lng).write(cfg.lng);
             core::ptr::addr_of_mut!((*p).rx).write(Deframer::new());
             core::ptr::addr_of_mut!((*p).rx_buf).write([0; RX_READ]);
@@ -298,31 +355,21 @@ impl<N: Num> AppOf<N> {
             core::ptr::addr_of_mut!((*p).sample).write(None);
             core::ptr::addr_of_mut!((*p).commands).write(Deque::new());
             core::ptr::addr_of_mut!((*p).counters).write(Counters::default());
-            core::ptr::addr_of_mut!((*p).records).write(AbWriter::after_boot(a, b));
-            core::ptr::addr_of_mut!((*p).nv_policy).write(nv_policy);
-            core::ptr::addr_of_mut!((*p).nv_last).write(mem.nv.valid());
+            core::ptr::addr_of_mut!((*p).records).write(RecordKeeper::after_boot(a, b, &mem.nv));
             core::ptr::addr_of_mut!((*p).alive_at).write(0);
-            core::ptr::addr_of_mut!((*p).record_epoch).write(None);
-            core::ptr::addr_of_mut!((*p).nv_failed_at).write(None);
             core::ptr::addr_of_mut!((*p).stalled).write(0);
             core::ptr::addr_of_mut!((*p).tick).write(0);
-            core::ptr::addr_of_mut!((*p).restore).write(restore_kind(&restore));
+            core::ptr::addr_of_mut!((*p).restore).write(booted.restore);
             core::ptr::addr_of_mut!((*p).reset_cause).write(reset_cause);
             core::ptr::addr_of_mut!((*p).boots).write(boots);
             core::ptr::addr_of_mut!((*p).worst_tick_cycles).write(0);
             core::ptr::addr_of_mut!((*p).dump).write(None);
-            core::ptr::addr_of_mut!((*p).params).write(params);
-            core::ptr::addr_of_mut!((*p).rig_id).write(rig_id);
-            core::ptr::addr_of_mut!((*p).armed).write(None);
-            core::ptr::addr_of_mut!((*p).nonce).write(u32::from(boots));
-            core::ptr::addr_of_mut!((*p).confirmed).write([None; 2]);
+            core::ptr::addr_of_mut!((*p).params).write(booted.params);
+            core::ptr::addr_of_mut!((*p).rules).write(CommandRules::new(booted.rig_id, u32::from(boots)));
             &mut *p
         };
-        if let ParamSource::Invalid(_) = params {
-            app.guard.refuse_config();
-        }
         app.guard.trace_event(Trace::Reset { tick: 0, cause: reset_cause as u8 });
-        app.guard.trace_event(Trace::Params { tick: 0, source: params.code() });
+        app.guard.trace_event(Trace::Params { tick: 0, source: app.params.code() });
         let out = app.guard.output();
         let _ = board.set_pins(Pins::for_outputs(out.valve_open, out.alarm || out.derate));
         app
@@ -393,15 +440,7 @@ impl<N: Num> AppOf<N> {
         }
         let fresh = self.sample.take();
         let out = match &fresh {
-            Some(req) => {
-                let s = req.sample();
-                if let Some(open) = req.valve_fb {
-                    self.guard.valve_feedback(open);
-                }
-                self.guard.lng_supply(req.lng_supply_bar);
-                self.guard.check_speed(&s, req.elec_hz);
-                self.guard.tick(&s)
-            }
+            Some(req) => self.guard.tick_reported(&req.sample(), &req.reports()),
             None => {
                 self.counters.missing = self.counters.missing.saturating_add(1);
                 self.guard.tick_missing()
@@ -410,7 +449,7 @@ impl<N: Num> AppOf<N> {
 
         // 3. outputs: the thermal record first (a failed save changes the
         // outputs: derate), then the pins and the reply
-        let out = if self.record_epoch != Some(self.guard.epoch()) {
+        let out = if self.records.changed(&self.guard) {
             self.save(board);
             self.guard.output()
         } else {
@@ -450,11 +489,7 @@ impl<N: Num> AppOf<N> {
     #[cold]
     #[inline(never)]
     fn catch_up(&mut self, lost: u32) {
-        let blind = lost.min(core::mem::replace(&mut self.stalled, 0));
-        let _ = self.guard.tick_blind(blind.min(MAX_STALL_TICKS));
-        for _ in 0..(lost - blind).min(MAX_MISSED_TICKS) {
-            let _ = self.guard.tick_missing();
-        }
+        catch_up(&mut self.guard, lost, core::mem::replace(&mut self.stalled, 0));
     }
 
     /// The thermal record, written when the state it holds has changed
@@ -463,29 +498,18 @@ impl<N: Num> AppOf<N> {
     /// non-volatile store when its policy says so.
     #[inline(never)]
     fn save<B: Board>(&mut self, board: &mut B) {
-        self.record_epoch = Some(self.guard.epoch());
-        let rec = self.records.write(&self.guard.snapshot_unsealed(), |slot, r| board.store_record(slot, r));
-        let retry = self.nv_failed_at.is_none_or(|t| self.tick.wrapping_sub(t) >= NV_RETRY_TICKS);
-        if retry && self.nv_policy.due(self.nv_last.as_ref(), &rec) {
+        let rec = self.records.write_ram(&self.guard, |slot, r| board.store_record(slot, r));
+        if self.records.nv_due(self.tick, &rec) {
             let rec = rec.with_rtc(board.rtc_s());
             let t0 = board.ticks();
             let saved = board.nv_save(&rec);
             // A flash erase stalls the core: the periods it took are
             // accounted at the next tick, without STALE.
             self.stalled = board.ticks().wrapping_sub(t0);
-            match saved {
-                None => {}
-                Some(true) => {
-                    self.nv_last = Some(rec);
-                    self.nv_failed_at = None;
-                    self.guard.report_nv_save(true);
-                }
-                Some(false) => {
-                    self.counters.nv_failures = self.counters.nv_failures.saturating_add(1);
-                    self.nv_failed_at = Some(self.tick);
-                    self.guard.report_nv_save(false);
-                }
+            if saved == Some(false) {
+                self.counters.nv_failures = self.counters.nv_failures.saturating_add(1);
             }
+            self.records.nv_result(self.tick, &rec, saved, &mut self.guard);
         }
     }
 
@@ -494,7 +518,7 @@ impl<N: Num> AppOf<N> {
     fn stamp_alive<B: Board>(&mut self, board: &mut B) {
         self.alive_at = self.tick;
         if let Some(s) = board.rtc_s() {
-            board.rtc_alive(crate::memory::alive_word(s, self.nv_failed_at.is_some()));
+            board.rtc_alive(crate::memory::alive_word(s, self.records.nv_failing()));
         }
     }
 

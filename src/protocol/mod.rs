@@ -224,6 +224,11 @@ impl Request {
             ambient_c: self.ambient_c,
         }
     }
+
+    /// The controller's reports carried by this frame.
+    pub fn reports(&self) -> crate::Reports {
+        crate::Reports { valve_fb: self.valve_fb, lng_supply_bar: self.lng_supply_bar, elec_hz: self.elec_hz }
+    }
 }
 
 impl GuardOutput {
