@@ -81,14 +81,7 @@ pub fn requests() -> Vec<Option<Request>> {
         if lost {
             oil.tick_missing();
         } else {
-            oil.tick(&eha_guard::Sample {
-                current_a: r.current_a,
-                p_a_bar: r.p_a_bar,
-                p_b_bar: r.p_b_bar,
-                speed_rpm: r.speed_rpm,
-                position_mm: r.position_mm,
-                ambient_c: r.ambient_c,
-            });
+            oil.tick(&r.sample());
         }
         v.push((!lost).then_some(r));
         seq = seq.wrapping_add(1);
