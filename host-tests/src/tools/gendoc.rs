@@ -31,9 +31,10 @@ pub struct Section {
 }
 
 /// Every generated section.
-pub const SECTIONS: [Section; 2] = [
+pub const SECTIONS: [Section; 3] = [
     Section { doc: "docs/results.md", tag: "uq-paper", source: "docs/data/uq-paper.json", render: render_uq_paper },
     Section { doc: "docs/results.md", tag: "fw-budget", source: ".ci/fw-budget.json", render: render_fw_budget },
+    Section { doc: "docs/rig-file.md", tag: "rig-file", source: "host-tests/src/physics/rig.rs", render: crate::tools::rigdoc::render },
 ];
 
 /// The paper numbers against their bands (`eha-sim uq --table5`, 200

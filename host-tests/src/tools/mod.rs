@@ -15,6 +15,7 @@ pub mod params_block;
 pub mod plot;
 pub mod reader_checks;
 pub mod reduce;
+pub mod rigdoc;
 pub mod uq;
 
 #[cfg(test)]
