@@ -882,10 +882,11 @@ pub struct FaultsArgs {
     /// Do not run: write the failure-mode table from this `faults.json`.
     #[arg(long)]
     pub from: Option<PathBuf>,
-    /// Where the failure-mode table goes (after a run of the whole
-    /// campaign, or with `--from`).
-    #[arg(long, default_value = "docs/failure-modes.md")]
-    pub modes: PathBuf,
+    /// Where the whole campaign's results are committed (after a run of
+    /// the whole campaign, or with `--from`), relative to the workspace
+    /// root; `docs/failure-modes.md` is then re-rendered from it.
+    #[arg(long, default_value = "docs/data/faults.json")]
+    pub data: PathBuf,
 }
 
 /// `eha-sim faults`: run the campaign, write `faults.json` and `faults.md`
@@ -895,16 +896,14 @@ pub fn run(a: &FaultsArgs) -> Result<()> {
     if let Some(json) = &a.from {
         let text = std::fs::read_to_string(json).with_context(|| format!("reading {}", json.display()))?;
         let rows: Vec<FaultResult> = serde_json::from_str(&text).context("parsing faults.json")?;
-        std::fs::write(&a.modes, modes::document(&rows, &json.display().to_string())).with_context(|| format!("writing {}", a.modes.display()))?;
-        println!("wrote {} from {} runs", a.modes.display(), rows.len());
-        return Ok(());
+        return commit_data(a, &rows);
     }
     let t0 = std::time::Instant::now();
     let rows = if a.fast { fast_campaign()? } else { campaign()? };
     write(&a.out, &rows)?;
     print!("{}", table(&rows));
     if !a.fast {
-        std::fs::write(&a.modes, modes::document(&rows, "out/faults/faults.json")).with_context(|| format!("writing {}", a.modes.display()))?;
+        commit_data(a, &rows)?;
     }
     let passing = rows.iter().filter(|r| r.pass).count();
     let limited = rows.iter().filter(|r| !r.pass && r.limit.is_some()).count();
@@ -917,6 +916,19 @@ pub fn run(a: &FaultsArgs) -> Result<()> {
     let bad = unlisted_failures(&rows);
     if !bad.is_empty() {
         bail!("{} runs fail that are not listed design limits:\n{}", bad.len(), bad.join("\n"));
+    }
+    Ok(())
+}
+
+/// The whole campaign's rows to `docs/data/faults.json` (or `a.data`) and
+/// the documents re-rendered from it (`eha-sim docs`).
+fn commit_data(a: &FaultsArgs, rows: &[FaultResult]) -> Result<()> {
+    let root = crate::pil::firmware::workspace_root();
+    let path = root.join(&a.data);
+    std::fs::write(&path, modes::data_json(rows)?).with_context(|| format!("writing {}", path.display()))?;
+    println!("wrote {} ({} runs)", path.display(), rows.len());
+    for p in crate::gendoc::run(&root, false)? {
+        println!("rewrote {}", p.display());
     }
     Ok(())
 }

@@ -31,11 +31,18 @@ pub struct Section {
 }
 
 /// Every generated section.
-pub const SECTIONS: [Section; 3] = [
+pub const SECTIONS: [Section; 4] = [
     Section { doc: "docs/results.md", tag: "uq-paper", source: "docs/data/uq-paper.json", render: render_uq_paper },
     Section { doc: "docs/results.md", tag: "fw-budget", source: ".ci/fw-budget.json", render: render_fw_budget },
     Section { doc: "docs/rig-file.md", tag: "rig-file", source: "host-tests/src/physics/rig.rs", render: crate::tools::rigdoc::render },
+    Section { doc: "docs/failure-modes.md", tag: "failure-modes", source: "docs/data/faults.json", render: render_failure_modes },
 ];
+
+/// The fault campaign's table (`eha-sim faults`, the whole campaign).
+fn render_failure_modes(json: &str) -> Result<String> {
+    let rows: Vec<crate::faults::FaultResult> = serde_json::from_str(json)?;
+    Ok(crate::faults::modes::document(&rows))
+}
 
 /// The paper numbers against their bands (`eha-sim uq --table5`, 200
 /// samples, its `paper.json`).
