@@ -65,7 +65,12 @@ fn main() -> ExitCode {
         Cmd::Rig => cli::run_rig(),
         Cmd::Pil(a) => eha_sim::pil::cli::run(&a),
         Cmd::FwBudget(a) => eha_sim::pil::budget::run(&a),
-        Cmd::Faults(a) => eha_sim::faults::run(&a),
+        Cmd::Faults(a) => {
+            let res = eha_sim::faults::run(&a);
+            // the whole campaign (or --from) committed its data: the docs follow it
+            let docs = if a.fast { Ok(()) } else { eha_sim::gendoc::run_cli(&eha_sim::gendoc::DocsArgs { check: false }) };
+            res.and(docs)
+        }
         Cmd::ParamsBlock(a) => eha_sim::params_block::run(&a),
         Cmd::Uq(a) => eha_sim::uq::run_cli(&a),
         Cmd::Docs(a) => eha_sim::gendoc::run_cli(&a),

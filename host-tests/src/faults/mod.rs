@@ -920,17 +920,40 @@ pub fn run(a: &FaultsArgs) -> Result<()> {
     Ok(())
 }
 
-/// The whole campaign's rows to `docs/data/faults.json` (or `a.data`) and
-/// the documents re-rendered from it (`eha-sim docs`).
+/// The whole campaign's rows to `docs/data/faults.json` (or `a.data`);
+/// the command line then re-renders the documents from it (`eha-sim docs`).
 fn commit_data(a: &FaultsArgs, rows: &[FaultResult]) -> Result<()> {
-    let root = crate::pil::firmware::workspace_root();
-    let path = root.join(&a.data);
-    std::fs::write(&path, modes::data_json(rows)?).with_context(|| format!("writing {}", path.display()))?;
+    let path = crate::pil::firmware::workspace_root().join(&a.data);
+    std::fs::write(&path, data_json(rows)?).with_context(|| format!("writing {}", path.display()))?;
     println!("wrote {} ({} runs)", path.display(), rows.len());
-    for p in crate::gendoc::run(&root, false)? {
-        println!("rewrote {}", p.display());
-    }
     Ok(())
+}
+
+/// `rows` as committed in `docs/data/faults.json`: one run per line, every
+/// non-integer number rounded to 1e-4 (the table prints two decimals), so
+/// a re-run that changes nothing the table shows changes little in git.
+pub fn data_json(rows: &[FaultResult]) -> Result<String> {
+    fn round(v: &mut serde_json::Value) {
+        match v {
+            serde_json::Value::Number(n) => {
+                if let Some(x) = n.as_f64().filter(|x| x.fract() != 0.0) {
+                    if let Some(r) = serde_json::Number::from_f64((x * 1e4).round() / 1e4) {
+                        *n = r;
+                    }
+                }
+            }
+            serde_json::Value::Object(m) => m.values_mut().for_each(round),
+            serde_json::Value::Array(a) => a.iter_mut().for_each(round),
+            _ => {}
+        }
+    }
+    let mut lines = Vec::with_capacity(rows.len());
+    for r in rows {
+        let mut v = serde_json::to_value(r)?;
+        round(&mut v);
+        lines.push(serde_json::to_string(&v)?);
+    }
+    Ok(format!("[\n{}\n]\n", lines.join(",\n")))
 }
 
 /// Write `faults.json` and `faults.md` to `dir`.

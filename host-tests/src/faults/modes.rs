@@ -129,29 +129,3 @@ pub fn document(rows: &[FaultResult]) -> String {
     s
 }
 
-/// `rows` as committed in `docs/data/faults.json`: one run per line, every
-/// non-integer number rounded to 1e-4 (the table prints two decimals), so
-/// a re-run that changes nothing the table shows changes little in git.
-pub fn data_json(rows: &[FaultResult]) -> anyhow::Result<String> {
-    fn round(v: &mut serde_json::Value) {
-        match v {
-            serde_json::Value::Number(n) => {
-                if let Some(x) = n.as_f64().filter(|x| x.fract() != 0.0) {
-                    if let Some(r) = serde_json::Number::from_f64((x * 1e4).round() / 1e4) {
-                        *n = r;
-                    }
-                }
-            }
-            serde_json::Value::Object(m) => m.values_mut().for_each(round),
-            serde_json::Value::Array(a) => a.iter_mut().for_each(round),
-            _ => {}
-        }
-    }
-    let mut lines = Vec::with_capacity(rows.len());
-    for r in rows {
-        let mut v = serde_json::to_value(r)?;
-        round(&mut v);
-        lines.push(serde_json::to_string(&v)?);
-    }
-    Ok(format!("[\n{}\n]\n", lines.join(",\n")))
-}

@@ -3,7 +3,7 @@
 //! modulus, relief and check valves, the position loop of Case 2.
 
 use crate::rig::Rig;
-use crate::scenario::{Circuit, Mission};
+use crate::physics::mission::{Circuit, Mission};
 use std::f64::consts::PI;
 
 /// Index of the hydraulic states in the state vector.

@@ -15,5 +15,6 @@ pub mod fluid;
 pub mod heat;
 pub mod hydraulics;
 pub mod losses;
+pub mod mission;
 pub mod network;
 pub mod rig;

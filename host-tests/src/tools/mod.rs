@@ -10,6 +10,7 @@
 
 pub mod cli;
 pub mod gendoc;
+pub mod layers;
 pub mod measured;
 pub mod params_block;
 pub mod plot;

@@ -64,7 +64,7 @@ fn slow_fault_campaign_passes_except_the_listed_design_limits() {
     // is rendered from) give this run's table
     let data = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/data/faults.json");
     let committed: Vec<FaultResult> = serde_json::from_str(&std::fs::read_to_string(&data).unwrap_or_default()).unwrap_or_default();
-    let this_run: Vec<FaultResult> = serde_json::from_str(&modes::data_json(&rows).expect("serialises")).expect("parses");
+    let this_run: Vec<FaultResult> = serde_json::from_str(&eha_sim::faults::data_json(&rows).expect("serialises")).expect("parses");
     if modes::document(&committed) != modes::document(&this_run) {
         problems.push("docs/data/faults.json is not this run's: commit it with `eha-sim faults --from out/faults/faults.json`".into());
     }
