@@ -3,7 +3,9 @@
 //! Electro-Hydrostatic Actuator": the oracle for the `eha-guard` firmware and
 //! a desk tool for thermal engineers.
 //!
-//! Layers, one folder each:
+//! Layers, one folder each, bottom to top (`tools::layers` and its test keep
+//! imports running downwards):
+//! - [`data`]: the measured-data format and plots;
 //! - [`physics`]: the paper's equations (losses, heat transfer, fluid,
 //!   hydraulics, cooling) and the rig's parameters;
 //! - [`simulation`]: the model's right-hand side, the stiff solver, the
@@ -12,8 +14,8 @@
 //!   or to a user's logs, identifiability, commissioning;
 //! - [`diagnosis`]: what the model gets wrong on a log, the cause, the gain;
 //!   [`emulator`]: the independent truth model of its tests;
-//! - [`tools`]: the measured-data format, command line, plots, firmware
-//!   parameters; [`pil`] and [`faults`]: the firmware in QEMU against the
+//! - [`tools`]: command line, firmware parameters, uncertainty bands,
+//!   generated docs; [`pil`] and [`faults`]: the firmware in QEMU against the
 //!   plant.
 //!
 //! The modules are also re-exported at the crate root under their short
@@ -23,6 +25,7 @@
 #![warn(missing_docs)]
 
 pub mod calibration;
+pub mod data;
 pub mod diagnosis;
 pub mod emulator;
 pub mod faults;
@@ -34,4 +37,5 @@ pub mod tools;
 pub use calibration::{lsq, paper as calibrate};
 pub use physics::{cooling, fluid, heat, hydraulics, losses, network, rig};
 pub use simulation::{equilibrium, fast, missions, model, plant, scenario, sim};
-pub use tools::{cli, gendoc, measured, params_block, plot, reader_checks, reduce, uq};
+pub use data::{measured, plot};
+pub use tools::{cli, gendoc, params_block, reader_checks, reduce, uq};

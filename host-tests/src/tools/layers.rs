@@ -506,7 +506,7 @@ mod tests {
     fn host_rank(p: &ModPath) -> Option<u32> {
         let s: Vec<&str> = p.iter().map(String::as_str).collect();
         Some(match s.as_slice() {
-            ["tools", "measured", ..] | ["tools", "plot"] => 0,
+            ["data", ..] => 0,
             ["physics", ..] => 1,
             ["simulation", ..] | ["tools", "reduce"] => 2,
             [_, "cli"] | ["tools", "gendoc" | "rigdoc" | "layers"] => 7,
