@@ -31,7 +31,7 @@ pub const KNOWN_LIMITS: &[Limit] = &[
         fault: "speed/stuck-zero+no-elec",
         scenario: None,
         start: None,
-        reason: "without the drive's electrical frequency a speed stuck at zero under load is seen by the stall rule after 2 s (the rule's time, to let a load be held at standstill briefly), not within the 1 s of the pass rule; the estimate runs up to 2.5 K low meanwhile (hot starts too since the oil follows its viscosity line, issue 34), then the speed's worst case takes over",
+        reason: "without the drive's electrical frequency a speed stuck at zero under load is seen by the stall rule after 2 s (the rule's time, to let a load be held at standstill briefly), not within the 1 s of the pass rule; the estimate runs up to 2.5 K low meanwhile (hot starts too, the oil following its viscosity line), then the speed's worst case takes over",
     },
     Limit { fault: "lng-empty-physical", scenario: None, start: None, reason: NO_SUPPLY_PRESSURE },
     Limit {
@@ -44,7 +44,7 @@ pub const KNOWN_LIMITS: &[Limit] = &[
         fault: "power-loss-machine-running",
         scenario: None,
         start: None,
-        reason: "the guard's MCU unpowered while the pump runs on without LNG: the heat of the off-time is not seen (the power-off cooling assumes the machine stopped with its guard: one supply; docs/firmware.md, residual risk); in cold oil the pump's viscous friction is up to twice its 40 degC value (issue 34), so an early power loss on the LNG case fails too",
+        reason: "the guard's MCU unpowered while the pump runs on without LNG: the heat of the off-time is not seen (the power-off cooling assumes the machine stopped with its guard: one supply; docs/firmware.md, residual risk); in cold oil the pump's viscous friction is up to twice its 40 degC value, so an early power loss on the LNG case fails too",
     },
 ];
 

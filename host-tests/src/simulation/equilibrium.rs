@@ -1,5 +1,5 @@
 //! Thermal equilibrium of the reference model at a held operating point:
-//! where a long run is heading (issue 16: "beyond 600 s nothing is checked").
+//! where a long run is heading (so that runs beyond 600 s are checked too).
 //!
 //! The hydraulic state is frozen at the given instant and the twelve node
 //! temperatures are solved for zero net heat flow by Newton's method with a

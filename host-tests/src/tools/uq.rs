@@ -1,4 +1,4 @@
-//! Uncertainty bands (issue 34, `eha-sim uq`): Monte Carlo over the rig's
+//! Uncertainty bands (`eha-sim uq`): Monte Carlo over the rig's
 //! documented uncertain parameters ([`crate::rig::Uncertain`], `[[uncertain]]` in
 //! the rig file), Latin hypercube in the log of each factor, the samples run in
 //! parallel (rayon). For Case 1 (600 s, the needle at `needle_bar`, still air)
