@@ -7,15 +7,14 @@ use heapless::Vec;
 
 // ---------------------------------------------------------------- CRC-16
 
-/// CRC-16/CCITT-FALSE lookup tables, built at compile time (const
+/// CRC-16/CCITT-FALSE lookup table, built at compile time (const
 /// evaluation: an out-of-range index would be a compile error, never a
 /// runtime panic). `CRC_TABLE[i]` is the register after one byte `i` from
-/// zero (`i << 16 mod P`); `CRC_TABLE2[i]` the same shifted by one byte more
-/// (`i << 24 mod P`), so two bytes cost two lookups
-/// ([`crc16`]; 512 B of flash for about 2.5 instructions per byte fewer on
-/// the ~60 bytes framed per tick, measured with the bench).
+/// zero (`i << 16 mod P`). (A second table for two bytes per step saved
+/// about 2.5 instructions per byte for 512 B of flash: not kept, for the
+/// product image's flash limit.)
 #[allow(clippy::indexing_slicing)]
-const CRC_TABLES: ([u16; 256], [u16; 256]) = {
+static CRC_TABLE: [u16; 256] = {
     let mut t = [0u16; 256];
     let mut i = 0;
     while i < 256 {
@@ -28,16 +27,8 @@ const CRC_TABLES: ([u16; 256], [u16; 256]) = {
         t[i] = crc;
         i += 1;
     }
-    let mut t2 = [0u16; 256];
-    let mut i = 0;
-    while i < 256 {
-        t2[i] = (t[i] << 8) ^ t[(t[i] >> 8) as usize];
-        i += 1;
-    }
-    (t, t2)
+    t
 };
-static CRC_TABLE: [u16; 256] = CRC_TABLES.0;
-static CRC_TABLE2: [u16; 256] = CRC_TABLES.1;
 
 /// One byte of CRC-16/CCITT-FALSE.
 #[inline(always)]
@@ -49,20 +40,7 @@ pub(crate) fn crc16_byte(crc: u16, b: u8) -> u16 {
 /// CRC-16/CCITT-FALSE of `data`.
 #[inline(never)]
 pub fn crc16(data: &[u8]) -> u16 {
-    let mut crc: u16 = 0xFFFF;
-    let mut pairs = data.chunks_exact(2);
-    for p in &mut pairs {
-        if let [b0, b1] = *p {
-            let x = crc ^ u16::from_be_bytes([b0, b1]);
-            // the indices are < 256 by construction; `get` keeps the tick
-            // path free of panicking indexing
-            crc = CRC_TABLE2.get(usize::from(x >> 8)).copied().unwrap_or(0) ^ CRC_TABLE.get(usize::from(x & 0xFF)).copied().unwrap_or(0);
-        }
-    }
-    for &b in pairs.remainder() {
-        crc = crc16_byte(crc, b);
-    }
-    crc
+    data.iter().fold(0xFFFF, |crc, b| crc16_byte(crc, *b))
 }
 
 // ------------------------------------------------------------------ COBS
