@@ -146,9 +146,15 @@ pub fn view(b: &[u8; BLOCK_LEN]) -> Result<Option<&ModelConsts<f32>>, BlockError
 
 /// The rig id of a block (up to the first zero byte; non-ASCII bytes end it).
 pub fn rig_id(b: &[u8; BLOCK_LEN]) -> &str {
+    core::str::from_utf8(rig_id_bytes(b)).unwrap_or("")
+}
+
+/// [`rig_id`] as bytes, all ASCII (the firmware's command key: no UTF-8
+/// validation, which took 0.5 KB of the product image's flash).
+pub fn rig_id_bytes(b: &[u8; BLOCK_LEN]) -> &[u8] {
     let id = b.get(ID_AT..ID_AT + ID_LEN).unwrap_or(&[]);
     let n = id.iter().position(|c| *c == 0 || !c.is_ascii()).unwrap_or(id.len());
-    core::str::from_utf8(id.get(..n).unwrap_or(&[])).unwrap_or("")
+    id.get(..n).unwrap_or(&[])
 }
 
 /// The `PARAMS` region of the flash (the symbol `__eha_params` of the board's

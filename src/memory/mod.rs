@@ -121,6 +121,21 @@ pub fn crc32_update(mut crc: u32, data: &[u8]) -> u32 {
     crc
 }
 
+/// [`crc32_update`] over the little-endian bytes of `words`: the whole word
+/// is XORed in and shifted through eight nibble steps (the same register
+/// as four bytes of two steps each, the CRC being linear).
+#[inline(never)]
+fn crc32_words(mut crc: u32, words: &[u32]) -> u32 {
+    for w in words {
+        crc ^= *w;
+        for _ in 0..8 {
+            let idx = (crc & 0xf) as usize;
+            crc = (crc >> 4) ^ CRC_NIBBLE.get(idx).copied().unwrap_or(0);
+        }
+    }
+    crc
+}
+
 /// CRC-32 of `data` (init and final xor 0xFFFFFFFF).
 pub fn crc32(data: &[u8]) -> u32 {
     !crc32_update(0xFFFF_FFFF, data)
@@ -142,21 +157,29 @@ impl ThermalRecord {
         crc: 0,
     };
 
+    /// CRC-32 of the record's bytes before `crc` (its fields in order,
+    /// little-endian), a word at a time: one call, no per-field calls (the
+    /// product loop seals a record at every model step).
+    #[inline(never)]
     fn body_crc(&self) -> u32 {
-        let mut c = 0xFFFF_FFFF;
-        c = crc32_update(c, &self.lng_used_cj.to_le_bytes());
-        c = crc32_update(c, &self.tick.to_le_bytes());
-        c = crc32_update(c, &self.magic.to_le_bytes());
-        c = crc32_update(c, &self.version.to_le_bytes());
-        c = crc32_update(c, &self.reserved.to_le_bytes());
-        c = crc32_update(c, &self.faults.to_le_bytes());
-        for t in self.temps_c.iter() {
-            c = crc32_update(c, &t.to_bits().to_le_bytes());
-        }
-        c = crc32_update(c, &self.ambient_c.to_bits().to_le_bytes());
-        c = crc32_update(c, &self.seq_flags.to_le_bytes());
-        c = crc32_update(c, &self.rtc_s.to_le_bytes());
-        !c
+        let [t0, t1, t2, t3, t4, t5] = self.temps_c.map(f32::to_bits);
+        let words = [
+            self.lng_used_cj,
+            self.tick,
+            self.magic,
+            u32::from(self.version) | (u32::from(self.reserved) << 16),
+            self.faults,
+            t0,
+            t1,
+            t2,
+            t3,
+            t4,
+            t5,
+            self.ambient_c.to_bits(),
+            self.seq_flags,
+            self.rtc_s,
+        ];
+        !crc32_words(0xFFFF_FFFF, &words)
     }
 
     /// Builds a sealed record (magic, version, CRC filled in).
@@ -421,11 +444,36 @@ pub fn seq_newer(a: u32, b: u32) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+    extern crate std;
 
     #[test]
     fn crc32_check_value() {
         // The standard CRC-32 check value of "123456789" is 0xCBF43926.
         assert_eq!(crc32(b"123456789"), 0xCBF4_3926);
+    }
+
+    /// The word-wise record CRC is the CRC-32 of the record's bytes before
+    /// its `crc` field (the format's definition).
+    #[test]
+    fn record_crc_is_the_crc32_of_its_bytes() {
+        let mut r = ThermalRecord::new([1.5, -2.25, 40.0, 61.75, 0.0, f32::MIN_POSITIVE], 21.0, 123_456, 0x8000_0001, 0xDEAD_BEEF);
+        r.seq_flags = 0x0102_0304;
+        r.rtc_s = 77;
+        let mut bytes = std::vec::Vec::new();
+        for w in [r.lng_used_cj, r.tick, r.magic] {
+            bytes.extend_from_slice(&w.to_le_bytes());
+        }
+        bytes.extend_from_slice(&r.version.to_le_bytes());
+        bytes.extend_from_slice(&r.reserved.to_le_bytes());
+        bytes.extend_from_slice(&r.faults.to_le_bytes());
+        for t in r.temps_c {
+            bytes.extend_from_slice(&t.to_le_bytes());
+        }
+        for w in [r.ambient_c.to_bits(), r.seq_flags, r.rtc_s] {
+            bytes.extend_from_slice(&w.to_le_bytes());
+        }
+        assert_eq!(bytes.len(), RECORD_BYTES - 4);
+        assert_eq!(r.body_crc(), crc32(&bytes));
     }
 
     #[test]

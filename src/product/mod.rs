@@ -199,7 +199,7 @@ pub fn boot_params<'a>(block: Option<&'a [u8; BLOCK_LEN]>, default: &'a ModelCon
     };
     let mut rig_id = [0u8; 16];
     if let (ParamSource::Block, Some(b)) = (params, block) {
-        let id = params_block::rig_id(b).as_bytes();
+        let id = params_block::rig_id_bytes(b);
         for (d, s) in rig_id.iter_mut().zip(id) {
             *d = *s;
         }

@@ -7,15 +7,14 @@ use heapless::Vec;
 
 // ---------------------------------------------------------------- CRC-16
 
-/// CRC-16/CCITT-FALSE lookup tables, built at compile time (const
+/// CRC-16/CCITT-FALSE lookup table, built at compile time (const
 /// evaluation: an out-of-range index would be a compile error, never a
 /// runtime panic). `CRC_TABLE[i]` is the register after one byte `i` from
-/// zero (`i << 16 mod P`); `CRC_TABLE2[i]` the same shifted by one byte more
-/// (`i << 24 mod P`), so two bytes cost two lookups
-/// ([`crc16`]; 512 B of flash for about 2.5 instructions per byte fewer on
-/// the ~60 bytes framed per tick, measured with the bench).
+/// zero (`i << 16 mod P`). (A second table for two bytes per step saved
+/// about 2.5 instructions per byte for 512 B of flash: not kept, for the
+/// product image's flash limit.)
 #[allow(clippy::indexing_slicing)]
-const CRC_TABLES: ([u16; 256], [u16; 256]) = {
+static CRC_TABLE: [u16; 256] = {
     let mut t = [0u16; 256];
     let mut i = 0;
     while i < 256 {
@@ -28,16 +27,8 @@ const CRC_TABLES: ([u16; 256], [u16; 256]) = {
         t[i] = crc;
         i += 1;
     }
-    let mut t2 = [0u16; 256];
-    let mut i = 0;
-    while i < 256 {
-        t2[i] = (t[i] << 8) ^ t[(t[i] >> 8) as usize];
-        i += 1;
-    }
-    (t, t2)
+    t
 };
-static CRC_TABLE: [u16; 256] = CRC_TABLES.0;
-static CRC_TABLE2: [u16; 256] = CRC_TABLES.1;
 
 /// One byte of CRC-16/CCITT-FALSE.
 #[inline(always)]
@@ -49,20 +40,7 @@ pub(crate) fn crc16_byte(crc: u16, b: u8) -> u16 {
 /// CRC-16/CCITT-FALSE of `data`.
 #[inline(never)]
 pub fn crc16(data: &[u8]) -> u16 {
-    let mut crc: u16 = 0xFFFF;
-    let mut pairs = data.chunks_exact(2);
-    for p in &mut pairs {
-        if let [b0, b1] = *p {
-            let x = crc ^ u16::from_be_bytes([b0, b1]);
-            // the indices are < 256 by construction; `get` keeps the tick
-            // path free of panicking indexing
-            crc = CRC_TABLE2.get(usize::from(x >> 8)).copied().unwrap_or(0) ^ CRC_TABLE.get(usize::from(x & 0xFF)).copied().unwrap_or(0);
-        }
-    }
-    for &b in pairs.remainder() {
-        crc = crc16_byte(crc, b);
-    }
-    crc
+    data.iter().fold(0xFFFF, |crc, b| crc16_byte(crc, *b))
 }
 
 // ------------------------------------------------------------------ COBS
@@ -189,24 +167,24 @@ pub fn frame(payload: &[u8], lead: bool) -> WireFrame {
 
 // ------------------------------------------------------------ deframing
 
-/// Splits a byte stream at `0x00` delimiters, COBS-decodes the bytes as they
-/// arrive and CRC-checks each frame at its delimiter. Fixed memory (one
-/// decoded frame, [`MAX_RAW`] bytes); garbage of any length is consumed
+/// Splits a byte stream at `0x00` delimiters, COBS-decodes each frame and
+/// CRC-checks it at its delimiter. Fixed memory (one frame, [`MAX_RAW`]
+/// bytes and its code byte and delimiter); garbage of any length is consumed
 /// without panicking.
 #[derive(Clone, Debug)]
 pub struct Deframer {
-    buf: [u8; MAX_RAW],
+    /// The decoded frame; while a frame arrives in pieces, its encoded
+    /// bytes up to and including its delimiter (decoded there in place).
+    buf: [u8; RAW_CAP],
+    /// Encoded bytes in `buf`; non-zero: inside a frame.
     len: usize,
-    /// Data bytes left in the open COBS block (0: the next byte is a code).
-    left: usize,
-    /// The open block ends in a zero (its code was below 0xFF), owed when
-    /// another block follows.
-    zero: bool,
-    /// Inside a frame (a byte other than a delimiter has arrived).
-    active: bool,
     /// The frame is longer than any frame: refused at its delimiter.
     overflow: bool,
 }
+
+/// A frame's encoded bytes and delimiter: the code byte, [`MAX_RAW`] bytes
+/// (no frame here reaches a 0xFF block) and the delimiter.
+const RAW_CAP: usize = MAX_RAW + 2;
 
 impl Default for Deframer {
     fn default() -> Self {
@@ -217,7 +195,7 @@ impl Default for Deframer {
 impl Deframer {
     /// An idle deframer.
     pub const fn new() -> Self {
-        Self { buf: [0; MAX_RAW], len: 0, left: 0, zero: false, active: false, overflow: false }
+        Self { buf: [0; RAW_CAP], len: 0, overflow: false }
     }
 
     /// Feed one byte. Returns `Some` at the end of a non-empty frame: the
@@ -229,102 +207,53 @@ impl Deframer {
     /// Feeds bytes up to and including the first delimiter that ends a
     /// non-empty frame. Returns how many bytes were taken and, if a frame
     /// ended, its payload (valid until the next call) or why it was refused.
-    /// The decoder's state stays in locals over the run, and a data byte
-    /// costs one compare more than a copy (the product loop decodes a sample
-    /// frame every tick: this is on its hot path).
+    /// A whole frame in `bytes` (the usual case: the product loop reads one
+    /// sample frame per tick at once) is decoded straight from them; a
+    /// frame in pieces is gathered up to its delimiter and decoded in place.
     #[inline(never)]
     pub fn feed(&mut self, bytes: &[u8]) -> (usize, Option<Result<&[u8], DecodeError>>) {
-        if !self.active {
-            // A whole frame in `bytes` (the usual case: one sample frame per
-            // tick, read at once), decoded straight from them in one pass
-            // that stops at the delimiter. A frame not complete in `bytes`
-            // goes the byte-wise way.
-            if let Some((taken, res)) = decode_whole(bytes, &mut self.buf) {
-                return (taken, res.map(|r| r.and_then(|n| Self::check(self.buf.get(..n).unwrap_or(&[])))));
+        if self.len == 0 {
+            if let Some(out) = self.buf.first_chunk_mut::<MAX_RAW>() {
+                if let Some((taken, res)) = decode_whole(bytes, out) {
+                    return (taken, res.map(|r| r.and_then(|n| Self::check(self.buf.get(..n).unwrap_or(&[])))));
+                }
             }
         }
-        self.feed_bytes(bytes)
+        let (i, ended) = self.gather(bytes);
+        if !ended {
+            return (i, None);
+        }
+        let n = core::mem::replace(&mut self.len, 0);
+        if core::mem::replace(&mut self.overflow, false) {
+            return (i, Some(Err(DecodeError::Overflow)));
+        }
+        let res = decode_in_place(&mut self.buf, n);
+        (i, Some(res.and_then(|n| Self::check(self.buf.get(..n).unwrap_or(&[])))))
     }
 
-    /// [`Deframer::feed`] byte by byte (a frame split across calls).
-    fn feed_bytes(&mut self, bytes: &[u8]) -> (usize, Option<Result<&[u8], DecodeError>>) {
-        let (mut len, mut left, mut zero, mut active, mut overflow) = (self.len, self.left, self.zero, self.active, self.overflow);
-        let buf = &mut self.buf;
-        let n = bytes.len();
+    /// Appends the bytes of `bytes` up to and including the first delimiter
+    /// that ends a frame to `buf` (delimiters before a frame are skipped;
+    /// bytes past `buf`'s end set `overflow`). Returns how many were taken
+    /// and whether the delimiter was among them.
+    fn gather(&mut self, bytes: &[u8]) -> (usize, bool) {
         let mut i = 0;
-        let mut ended = false;
-        while i < n {
-            if left != 0 && !overflow {
-                // up to `left` data bytes in one run, up to a zero (a
-                // delimiter inside a block: the frame is refused at it)
-                let src = bytes.get(i..).unwrap_or(&[]);
-                let dst = buf.get_mut(len..).unwrap_or(&mut []);
-                let run = left.min(src.len());
-                if dst.len() < run {
-                    overflow = true;
-                    continue;
-                }
-                let mut k = 0;
-                for (d, &x) in dst.iter_mut().zip(src).take(run) {
-                    if x == 0 {
-                        break;
-                    }
-                    *d = x;
-                    k += 1;
-                }
-                len += k;
-                left -= k;
-                i += k;
-                if i >= n {
-                    break;
-                }
-            }
-            let b = bytes.get(i).copied().unwrap_or(0);
+        while let Some(&b) = bytes.get(i) {
             i += 1;
-            if b == 0 {
-                if active {
-                    ended = true;
-                    break;
-                }
+            if b == 0 && self.len == 0 {
                 continue; // empty frame: resync idiom, ignored
             }
-            active = true;
-            if overflow {
-                continue;
-            }
-            // a code byte: the previous block's zero (if owed), then `b - 1`
-            // data bytes
-            if zero {
-                match buf.get_mut(len) {
-                    Some(d) => {
-                        *d = 0;
-                        len += 1;
-                    }
-                    None => overflow = true,
+            match self.buf.get_mut(self.len) {
+                Some(d) => {
+                    *d = b;
+                    self.len += 1;
                 }
+                None => self.overflow = true,
             }
-            zero = b != 0xFF;
-            left = usize::from(b) - 1;
+            if b == 0 {
+                return (i, true);
+            }
         }
-        (self.len, self.left, self.zero, self.active, self.overflow) = (len, left, zero, active, overflow);
-        (i, if ended { self.end() } else { None })
-    }
-
-    fn end(&mut self) -> Option<Result<&[u8], DecodeError>> {
-        let (len, left, overflow) = (self.len, self.left, self.overflow);
-        self.len = 0;
-        self.left = 0;
-        self.zero = false;
-        self.active = false;
-        self.overflow = false;
-        if overflow {
-            return Some(Err(DecodeError::Overflow));
-        }
-        // a block running past the delimiter, or no room for a CRC
-        if left != 0 || len < 3 {
-            return Some(Err(DecodeError::Cobs));
-        }
-        Some(Self::check(self.buf.get(..len).unwrap_or(&[])))
+        (i, false)
     }
 
     /// The payload of a decoded frame after its CRC check.
@@ -343,16 +272,25 @@ impl Deframer {
 
     /// True while a partial frame is buffered (bytes received, no delimiter yet).
     pub fn pending(&self) -> bool {
-        self.active
+        self.len != 0
     }
 }
 
 /// Decodes the first frame of `src` into `out` when `src` holds all of it:
 /// leading delimiters are skipped; `Some((taken, Some(Ok(n))))` for `n`
 /// decoded bytes up to and including the delimiter, `Some((taken,
-/// Some(Err)))` for a damaged frame (a zero inside a block, or one longer
-/// than any frame, `taken` up to its delimiter), `Some((taken, None))` when
-/// `src` is only delimiters, `None` when the frame is not complete in `src`.
+/// Some(Err)))` for a damaged frame (a block running past the delimiter, or
+/// one longer than any frame, `taken` up to its delimiter), `Some((taken,
+/// None))` when `src` is only delimiters, `None` when the frame is not
+/// complete in `src`.
+///
+/// Between delimiters no byte is zero (that is what COBS is for), so the
+/// bytes after the first code are copied up to the delimiter a word at a
+/// time (the first word that holds a zero byte holds the delimiter), and
+/// then the chain of codes is walked in `out`: each code stands where its
+/// block's owed zero goes. A code of 0xFF (a block of 254 bytes, owing no
+/// zero) runs past the delimiter of any frame here ([`MAX_RAW`] < 254), so
+/// it is refused as such.
 #[inline(always)]
 fn decode_whole(src: &[u8], out: &mut [u8; MAX_RAW]) -> Option<(usize, Option<Result<usize, DecodeError>>)> {
     let n = src.len();
@@ -363,39 +301,68 @@ fn decode_whole(src: &[u8], out: &mut [u8; MAX_RAW]) -> Option<(usize, Option<Re
     if i == n {
         return Some((i, None));
     }
-    // `i` is at a code byte: the zero the previous block owes (not after a
-    // 0xFF block), then `code - 1` data bytes copied in one run. Plain
-    // indices and one bounds check per block: float payloads have many
-    // short blocks.
-    let mut j = 0usize;
-    let mut owed = false;
-    loop {
-        let code = usize::from(*src.get(i)?);
-        if code == 0 {
-            // the delimiter right after a whole block
-            return Some((i + 1, Some(Ok(j))));
+    let first = usize::from(*src.get(i)?);
+    let body = src.get(i + 1..)?;
+    // copy up to the delimiter: whole words while none of their bytes is zero
+    let mut k = 0usize;
+    while let (Some(s), Some(d)) = (body.get(k..k + 4), out.get_mut(k..k + 4)) {
+        let w = u32::from_le_bytes(<[u8; 4]>::try_from(s).ok()?);
+        if w.wrapping_sub(0x0101_0101) & !w & 0x8080_8080 != 0 {
+            break;
         }
-        if owed {
-            let Some(d) = out.get_mut(j) else { return skip_to_delimiter(src, i, DecodeError::Overflow) };
-            *d = 0;
-            j += 1;
-        }
-        owed = code != 0xFF;
-        let (from, to) = (i + 1, i + code);
-        let block = src.get(from..to)?;
-        let Some(dst) = out.get_mut(j..j + (code - 1)) else { return skip_to_delimiter(src, from, DecodeError::Overflow) };
-        let mut k = 0;
-        while let (Some(&x), Some(d)) = (block.get(k), dst.get_mut(k)) {
-            if x == 0 {
-                // a delimiter inside a block: the frame ends short
-                return Some((from + k + 1, Some(Err(DecodeError::Cobs))));
-            }
-            *d = x;
-            k += 1;
-        }
-        j += code - 1;
-        i = to;
+        d.copy_from_slice(s);
+        k += 4;
     }
+    loop {
+        match *body.get(k)? {
+            0 => break,
+            x => {
+                let Some(d) = out.get_mut(k) else { return skip_to_delimiter(src, i + 1 + k, DecodeError::Overflow) };
+                *d = x;
+                k += 1;
+            }
+        }
+    }
+    let taken = i + 1 + k + 1;
+    // the chain of codes: each one's position gets its owed zero
+    let mut at = first - 1;
+    while at < k {
+        let Some(c) = out.get_mut(at) else { break };
+        let code = usize::from(*c);
+        *c = 0;
+        at += code;
+    }
+    if at != k {
+        return Some((taken, Some(Err(DecodeError::Cobs))));
+    }
+    Some((taken, Some(Ok(k))))
+}
+
+/// Decodes the `n` encoded bytes at the start of `buf` (a frame and its
+/// delimiter, `n` ≤ [`RAW_CAP`]) in place, as [`decode_whole`] does: the
+/// bytes after the first code move down by one, each code of the chain
+/// becomes its block's owed zero. Returns the decoded length.
+fn decode_in_place(buf: &mut [u8; RAW_CAP], n: usize) -> Result<usize, DecodeError> {
+    let first = usize::from(buf.first().copied().unwrap_or(0));
+    // the decoded bytes: all but the code byte and the delimiter
+    let m = n.saturating_sub(2);
+    for k in 0..m {
+        let x = buf.get(k + 1).copied().unwrap_or(0);
+        if let Some(d) = buf.get_mut(k) {
+            *d = x;
+        }
+    }
+    let mut at = first.wrapping_sub(1);
+    while at < m {
+        let Some(c) = buf.get_mut(at) else { break };
+        let code = usize::from(*c);
+        *c = 0;
+        at += code;
+    }
+    if at != m || first == 0 {
+        return Err(DecodeError::Cobs);
+    }
+    Ok(m)
 }
 
 /// The rest of a refused frame up to its delimiter, if `src` holds it.

@@ -164,3 +164,81 @@ fn frame_equals_the_reference_encoding() {
         }
     }
 }
+
+/// What a deframer makes of a byte stream: each frame's payload, or its
+/// refusal as damaged framing or as a CRC mismatch (the two counters the
+/// product keeps).
+fn deframe_all(bytes: &[u8], whole: bool) -> std::vec::Vec<Result<std::vec::Vec<u8>, bool>> {
+    let mut d = Deframer::new();
+    let mut got = std::vec::Vec::new();
+    let mut keep = |r: Result<&[u8], DecodeError>| got.push(r.map(|p| p.to_vec()).map_err(|e| e == DecodeError::Crc));
+    if whole {
+        let mut rest = bytes;
+        while !rest.is_empty() {
+            let (n, r) = d.feed(rest);
+            assert!(n > 0 && n <= rest.len());
+            if let Some(r) = r {
+                keep(r);
+            }
+            rest = &rest[n..];
+        }
+    } else {
+        for &b in bytes {
+            if let Some(r) = d.push(b) {
+                keep(r);
+            }
+        }
+    }
+    got
+}
+
+proptest::proptest! {
+    /// The whole-frame decoder and the byte-wise one agree on any stream:
+    /// valid frames, frames with bytes changed, zeros dropped in or taken
+    /// out, garbage and over-long runs.
+    #[test]
+    fn whole_frame_and_bytewise_decoding_agree(
+        seqs in proptest::collection::vec(0u16..4, 1..4),
+        edits in proptest::collection::vec((0usize..200, 0u8..=255), 0..6),
+        garbage in proptest::collection::vec(proptest::prelude::any::<u8>(), 0..80),
+    ) {
+        let mut bytes = std::vec::Vec::new();
+        for s in &seqs {
+            bytes.extend_from_slice(&req(*s).encode());
+        }
+        for (at, v) in &edits {
+            let at = at % bytes.len();
+            bytes[at] = *v;
+        }
+        bytes.extend_from_slice(&garbage);
+        bytes.push(0);
+        let whole = deframe_all(&bytes, true);
+        proptest::prop_assert_eq!(&whole, &deframe_all(&bytes, false));
+        proptest::prop_assert_eq!(&whole, &reference_deframe(&bytes));
+    }
+}
+
+/// [`deframe_all`] by the reference COBS decoder: split at the zeros, decode
+/// each non-empty piece, refuse it as framing when it does not decode or is
+/// shorter than a CRC and a byte or longer than any frame, as CRC when the
+/// CRC differs.
+fn reference_deframe(bytes: &[u8]) -> std::vec::Vec<Result<std::vec::Vec<u8>, bool>> {
+    let mut got = std::vec::Vec::new();
+    let end = bytes.iter().rposition(|b| *b == 0).map_or(0, |z| z + 1);
+    for piece in bytes[..end].split(|b| *b == 0).filter(|p| !p.is_empty()) {
+        let mut raw: Vec<u8, 1024> = Vec::new();
+        let r = match cobs_decode(piece, &mut raw) {
+            Some(()) if raw.len() >= 3 && raw.len() <= MAX_RAW => {
+                let (body, c) = raw.split_at(raw.len() - 2);
+                if u16::from_le_bytes([c[0], c[1]]) == crc16(body) {
+                    Ok(body.to_vec())
+                } else {
+                    Err(true)
+                }
+            }
+            _ => Err(false),
+        };
+        got.push(r);
+    }
+    got
+}

@@ -19,6 +19,8 @@ struct Cobs {
     crc: u16,
 }
 
+const _: () = assert!(MAX_WIRE < 0xFF);
+
 impl Cobs {
     #[inline(always)]
     fn push(&mut self, buf: &mut [u8; MAX_WIRE], b: u8) {
@@ -36,10 +38,8 @@ impl Cobs {
             *x = b;
         }
         self.at += 1;
-        self.code += 1;
-        if self.code == 0xFF {
-            self.close(buf);
-        }
+        // (no block fills to a 0xFF code: a reply is shorter than 254 bytes)
+        self.code = self.code.wrapping_add(1);
     }
 
     #[inline(always)]
