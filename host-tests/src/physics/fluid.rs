@@ -5,7 +5,7 @@
 //! source. Temperatures are in °C, pressures in Pa, SI everywhere else.
 
 use serde::{Deserialize, Serialize};
-use std::cell::Cell;
+use std::cell::{Cell, RefCell};
 
 /// Kelvin offset, K.
 pub const KELVIN_OFFSET: f64 = 273.15;
@@ -40,6 +40,17 @@ impl Walther {
         let x = (t_c + KELVIN_OFFSET).log10();
         10f64.powf(10f64.powf(self.a - self.b * x)) - 0.7
     }
+}
+
+/// Viscosities kept per thread by [`Oil::nu_m2_per_s`] (a model has 5 oil nodes).
+const NU_MEMO: usize = 8;
+
+/// The last viscosities of one oil: (grade points' bits), temperatures' bits, values.
+struct NuMemo {
+    grade: (u64, u64),
+    t: [u64; NU_MEMO],
+    nu: [f64; NU_MEMO],
+    next: usize,
 }
 
 /// Largest kinematic viscosity at which the oil laws are used, cSt: the
@@ -111,8 +122,29 @@ impl Oil {
     }
 
     /// Kinematic viscosity at `t_c`, m²/s (ASTM D341 Walther relation).
+    ///
+    /// The last few values are kept per thread, keyed by the oil's grade
+    /// points and `t_c` to the bit (the answer is the value computed): one
+    /// evaluation of the model's right-hand side asks 12–14 times for the
+    /// viscosity of its 5 oil nodes, each a `log10` and two `pow`.
     pub fn nu_m2_per_s(&self, t_c: f64) -> f64 {
-        self.walther().nu_cst(t_c) * 1e-6
+        thread_local! {
+            static MEMO: RefCell<NuMemo> = const { RefCell::new(NuMemo { grade: (u64::MAX, u64::MAX), t: [u64::MAX; NU_MEMO], nu: [f64::NAN; NU_MEMO], next: 0 }) };
+        }
+        let grade = (self.nu40_cst.to_bits(), self.nu100_cst.to_bits());
+        let key = t_c.to_bits();
+        MEMO.with_borrow_mut(|m| {
+            if m.grade != grade {
+                *m = NuMemo { grade, t: [u64::MAX; NU_MEMO], nu: [f64::NAN; NU_MEMO], next: 0 };
+            } else if let Some(i) = m.t.iter().position(|&k| k == key) {
+                return m.nu[i];
+            }
+            let nu = self.walther().nu_cst(t_c) * 1e-6;
+            let i = m.next;
+            (m.t[i], m.nu[i]) = (key, nu);
+            m.next = (i + 1) % NU_MEMO;
+            nu
+        })
     }
 
     /// Density at `t_c` °C and gauge pressure `p_pa`, kg/m³

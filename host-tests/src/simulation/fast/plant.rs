@@ -339,7 +339,7 @@ impl FastPlant {
             // branch switch of the heat balances inside ends the step there.
             let mut switch = None;
             if !replay {
-                self.hyd.set_path(TempPath::line(self.t, th.z, t1, zp));
+                self.hyd.set_path(TempPath::line(&self.model, self.t, th.z, t1, zp));
                 self.hyd.cover(&self.model, t1, seg_end).map_err(hyd_error)?;
                 if let Some((lo, hi)) = self.hyd.first_switch(&self.model, scan_from.max(self.t), t1) {
                     scan_from = hi;
