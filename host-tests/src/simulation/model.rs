@@ -345,13 +345,15 @@ impl Model {
             let t_ball = y[t_ix(Node::BallOil)];
             (self.rig.oil.rho(t_ball, 0.0), self.nu(t_ball))
         };
-        self.op_hydraulic_with(t, y, ball)
+        self.op_hydraulic_with(t, y, true, ball)
     }
 
     /// [`Model::op_hydraulic`] with the ball-valve oil's (density kg/m³,
     /// kinematic viscosity m²/s) from `ball` (asked for in a throttle
-    /// mission only) instead of from its temperature in `y`.
-    fn op_hydraulic_with(&self, t: f64, y: &[f64], ball: impl FnOnce() -> (f64, f64)) -> OpPoint {
+    /// mission only) instead of from its temperature in `y`; without
+    /// `surroundings`, a mission's ambient temperature and air speed are
+    /// left at 0 (the hydraulic derivatives do not read them).
+    fn op_hydraulic_with(&self, t: f64, y: &[f64], surroundings: bool, ball: impl FnOnce() -> (f64, f64)) -> OpPoint {
         match &self.drive {
             Drive::Replay(r) => {
                 let mut op = r.op(&self.rig, t);
@@ -374,9 +376,13 @@ impl Model {
                     q_path: 0.0,
                     current_a: 0.0,
                     circuit: m.circuit,
-                    ambient_c: m.ambient_c.at(t),
-                    air_mps: m.air_speed_mps.at(t) + self.rig.ext.forced_convection.unwrap_or(0.0),
+                    ambient_c: 0.0,
+                    air_mps: 0.0,
                 };
+                if surroundings {
+                    op.ambient_c = m.ambient_c.at(t);
+                    op.air_mps = m.air_speed_mps.at(t) + self.rig.ext.forced_convection.unwrap_or(0.0);
+                }
                 if m.circuit == Circuit::Throttle {
                     let needle = hydraulics::needle_k(&self.rig, m.needle_bar.at(t));
                     let (rho, nu) = ball();
@@ -691,7 +697,7 @@ impl Model {
     pub fn hydraulic_rhs_oil(&self, t: f64, yh: &[f64], oil: &HydraulicOil, dy: &mut [f64]) {
         match &self.drive {
             Drive::Mission(m) => {
-                let op = self.op_hydraulic_with(t, yh, || (oil.rho_ball, oil.nu_ball));
+                let op = self.op_hydraulic_with(t, yh, false, || (oil.rho_ball, oil.nu_ball));
                 let f = hydraulics::flows(&self.rig, &op, oil.k_leak);
                 hydraulics::derivatives(&self.rig, m, t, &op, &f, dy);
             }

@@ -126,17 +126,24 @@ impl<const N: usize> Lu<N> {
     pub fn new(mut a: Mat<N>) -> Option<Self> {
         let mut piv = [0usize; N];
         for k in 0..N {
-            let p = (k..N).max_by(|&i, &j| a[i][k].abs().total_cmp(&a[j][k].abs())).unwrap_or(k);
+            // The last of the largest pivots (as `Iterator::max_by` chose it).
+            let mut p = k;
+            for i in k + 1..N {
+                if a[i][k].abs().total_cmp(&a[p][k].abs()).is_ge() {
+                    p = i;
+                }
+            }
             piv[k] = p;
-            a.swap(k, p);
+            if p != k {
+                a.swap(k, p);
+            }
             let d = a[k][k];
             if d == 0.0 || !d.is_finite() {
                 return None;
             }
             let inv = 1.0 / d;
-            let (top, bottom) = a.split_at_mut(k + 1);
-            let rk = &top[k];
-            for ri in bottom.iter_mut() {
+            let rk = a[k];
+            for ri in a.iter_mut().skip(k + 1) {
                 let f = ri[k] * inv;
                 ri[k] = f;
                 for j in k + 1..N {

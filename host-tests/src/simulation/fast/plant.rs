@@ -376,6 +376,11 @@ impl FastPlant {
             if err.is_nan() || err > 1.0 {
                 self.stats.rejected += 1;
                 self.hyd.reject(self.t);
+                // One level down (dropping by the levels the error asks for,
+                // local error ∝ h⁴, saved 10 % of Case 2's rejections but
+                // took Fig. 15's ball-valve oil from 1.7e-3 to 7.8e-3 K off
+                // after a valve switch: the estimate is not to be trusted
+                // that far).
                 level = if odd { start_level(h / 2.0) } else { level - 1 };
                 if level <= LEVEL_MIN {
                     return Err(SimError::Solver { t: self.t, message: format!("thermal step underflow (error {:.2e} K)", trial.err_k) });

@@ -140,6 +140,8 @@ pub struct RosStats {
     pub rejected: u64,
     /// Right-hand-side evaluations (stages, Jacobian columns, ∂f/∂t).
     pub evals: u64,
+    /// Jacobians taken (N evaluations each).
+    pub jacobians: u64,
 }
 
 /// Why a Rosenbrock integration stopped.
@@ -223,6 +225,12 @@ impl<const N: usize> Rosenbrock<N> {
         let mut h = h_try.min(t_max - t);
         if t + 1.05 * h >= t_max {
             h = t_max - t;
+        } else if t + 2.0 * h > t_max {
+            // Two even steps rather than a full one and a remnant: a remnant
+            // far below the kept Jacobian's step takes a new Jacobian, and
+            // so does the full step after it (measured on Case 2: 9.2 k
+            // Jacobians for 28.6 k steps, 6.9 k of them for the step ratio).
+            h = 0.5 * (t_max - t);
         }
         // ∂f/∂t anew every step (forward difference, backwards at the
         // interval's end: a schedule may step there). Kept with the
@@ -350,6 +358,7 @@ impl<const N: usize> Rosenbrock<N> {
             yp[j] = y[j];
         }
         self.stats.evals += N as u64;
+        self.stats.jacobians += 1;
         jac
     }
 }
