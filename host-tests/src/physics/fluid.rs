@@ -255,9 +255,25 @@ pub const P_SEA_LEVEL_PA: f64 = 101_325.0;
 /// Static pressure of the ICAO standard atmosphere at `altitude_m`
 /// (troposphere, 0–11 km: p = p₀(1 − 2.25577e-5·h)^5.25588), Pa; held at the
 /// tropopause value above 11 km (the ram-air cases of the paper fly lower).
+///
+/// The last altitude's value is kept per thread (keyed by its bits: the
+/// answer is the value computed): every outer surface of every heat
+/// balance asks for it, a `pow` each time.
 pub fn isa_pressure_pa(altitude_m: f64) -> f64 {
-    let h = altitude_m.clamp(-500.0, 11_000.0);
-    P_SEA_LEVEL_PA * (1.0 - 2.25577e-5 * h).powf(5.25588)
+    thread_local! {
+        static LAST: Cell<(u64, f64)> = const { Cell::new((u64::MAX, f64::NAN)) };
+    }
+    let key = altitude_m.to_bits();
+    LAST.with(|c| {
+        let (k, p) = c.get();
+        if k == key {
+            return p;
+        }
+        let h = altitude_m.clamp(-500.0, 11_000.0);
+        let p = P_SEA_LEVEL_PA * (1.0 - 2.25577e-5 * h).powf(5.25588);
+        c.set((key, p));
+        p
+    })
 }
 
 /// Air properties at film temperature `t_c` °C and 101325 Pa (sea level).

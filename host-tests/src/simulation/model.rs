@@ -687,6 +687,14 @@ impl Model {
         HydraulicOil { k_leak: self.k_leak(temps[Node::Case as usize]), rho_ball: self.rig.oil.rho(t_ball, 0.0), nu_ball: self.nu(t_ball) }
     }
 
+    /// The hydraulic operating point of a mission at the hydraulic states
+    /// `yh` with the oil properties `oil` ([`Model::hydraulic_rhs_oil`]);
+    /// its ambient temperature and air speed are left at 0. Not for a
+    /// replay (whose operating point is the log's: [`Model::op_hydraulic`]).
+    pub fn op_hydraulic_oil(&self, t: f64, yh: &[f64], oil: &HydraulicOil) -> OpPoint {
+        self.op_hydraulic_with(t, yh, false, || (oil.rho_ball, oil.nu_ball))
+    }
+
     /// The hydraulic derivatives of a mission (`dy[..ix::N]`, zero in a
     /// replay) at the hydraulic states `yh` with the oil properties `oil`
     /// given instead of the temperatures: with `oil` from

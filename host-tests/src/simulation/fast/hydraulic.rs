@@ -64,11 +64,6 @@ impl TempPath {
         Self { t0: 0.0, z0: z, t1: 1.0, z1: z, oil0: oil, oil1: oil }
     }
 
-    /// The line through (t0, z0) and (t1, z1).
-    pub fn line(model: &Model, t0: f64, z0: [f64; N_NODES], t1: f64, z1: [f64; N_NODES]) -> Self {
-        Self { t0, z0, t1, z1, oil0: model.hydraulic_oil(&z0), oil1: model.hydraulic_oil(&z1) }
-    }
-
     /// Weight of the second point at `t` (held beyond the points: a
     /// hydraulic step past the thermal step must not extrapolate a transient).
     fn weight(&self, t: f64) -> f64 {
@@ -130,9 +125,12 @@ impl HydTrack {
         }
     }
 
-    /// The temperatures the hydraulics see from now on.
-    pub fn set_path(&mut self, path: TempPath) {
-        self.path = path;
+    /// The temperatures the hydraulics see from now on: the line through
+    /// (t0, z0) and (t1, z1) (the properties at z0 kept from the last path
+    /// when it ended there).
+    pub fn set_line(&mut self, model: &Model, t0: f64, z0: [f64; N_NODES], t1: f64, z1: [f64; N_NODES]) {
+        let oil0 = if self.path.z1 == z0 { self.path.oil1 } else { model.hydraulic_oil(&z0) };
+        self.path = TempPath { t0, z0, t1, z1, oil0, oil1: model.hydraulic_oil(&z1) };
     }
 
     /// Integrates until the track covers `t` (at most up to `t_max`, a
@@ -214,11 +212,8 @@ impl HydTrack {
 /// ring (the upwind direction) and the shaft speed (the friction torque's
 /// sign in the motor current). Values below the thresholds (1 Pa,
 /// 1e-10 m³/s, 1e-4 rad/s) are a machine at rest, not a reversal.
-fn branch_values(model: &Model, z: &[f64; N_NODES], t: f64, yh: &[f64; NH]) -> [f64; 3] {
-    let mut y = [0.0; N_STATE];
-    y[..NH].copy_from_slice(yh);
-    y[T0..T0 + N_NODES].copy_from_slice(z);
-    let op = model.op_hydraulic(t, &y);
+fn branch_values(model: &Model, oil: &HydraulicOil, t: f64, yh: &[f64; NH]) -> [f64; 3] {
+    let op = model.op_hydraulic_oil(t, yh, oil);
     [op.p_a - op.p_b, op.circulation(&model.rig), op.omega]
 }
 
@@ -234,7 +229,7 @@ impl HydTrack {
     /// (relative to t), or None.
     pub fn first_switch(&mut self, model: &Model, t0: f64, t1: f64) -> Option<(f64, f64)> {
         let path = self.path;
-        let val = |t: f64| branch_values(model, &path.at(t), t, &self.at(t));
+        let val = |t: f64| branch_values(model, &path.oil_at(t), t, &self.at(t));
         let mut ta = t0;
         let mut va = match self.last_branch {
             Some((t, v)) if t == t0 => v,

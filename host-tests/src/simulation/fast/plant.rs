@@ -24,7 +24,7 @@
 //!   temperatures' and the hydraulic track's); a valve change there
 //!   continues from the callback time.
 
-use super::hydraulic::{hermite, left_of, HydTrack, TempPath, NH};
+use super::hydraulic::{hermite, left_of, HydTrack, NH};
 use super::phi::{Phi, VECTOR_NORM_MAX};
 use super::rosenbrock::{RosError, RosStats, Rosenbrock, Tableau};
 use super::thermal::{Thermal, NE, NT};
@@ -339,7 +339,7 @@ impl FastPlant {
             // branch switch of the heat balances inside ends the step there.
             let mut switch = None;
             if !replay {
-                self.hyd.set_path(TempPath::line(&self.model, self.t, th.z, t1, zp));
+                self.hyd.set_line(&self.model, self.t, th.z, t1, zp);
                 self.hyd.cover(&self.model, t1, seg_end).map_err(hyd_error)?;
                 if let Some((lo, hi)) = self.hyd.first_switch(&self.model, scan_from.max(self.t), t1) {
                     scan_from = hi;
