@@ -669,6 +669,19 @@ impl Model {
         dy[E_LNG] = q_lng;
     }
 
+    /// [`Model::rhs`] without the hydraulic derivatives (`dy[..ix::N]` is
+    /// left as it is): the node temperatures' derivatives and the energy
+    /// rates, the same to the last bit.
+    pub fn thermal_rhs(&self, t: f64, y: &[f64], dy: &mut [f64]) {
+        let op = self.op_point(t, y);
+        let temps = &y[T0..T0 + N_NODES];
+        let l = self.losses(t, &op, temps);
+        let (q_in, q_amb, q_lng) = self.thermal(&op, &l, temps, &mut dy[T0..T0 + N_NODES]);
+        dy[E_LOSS] = q_in;
+        dy[E_AMB] = q_amb;
+        dy[E_LNG] = q_lng;
+    }
+
     /// The hydraulic part of [`Model::rhs`]: fills `dy[..ix::N]` (zero in a
     /// replay, whose operating point is imposed) and returns the operating
     /// point at (t, y) without a mission's motor current

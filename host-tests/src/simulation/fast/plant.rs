@@ -241,7 +241,7 @@ impl FastPlant {
         y[..NH].copy_from_slice(yh);
         y[T0..T0 + NT].copy_from_slice(z);
         let mut dy = [0.0; N_STATE];
-        model.rhs(t, &y, &mut dy);
+        model.thermal_rhs(t, &y, &mut dy);
         stats.rhs_evals += 1;
         fz.copy_from_slice(&dy[T0..T0 + NT]);
         q.copy_from_slice(&dy[T0 + NT..]);
