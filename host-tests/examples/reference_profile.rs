@@ -40,8 +40,8 @@ fn main() {
             p.run(opt.control_interval_s.min(opt.output_interval_s), sc.duration_s(), |_| Ok(Default::default())).expect("runs");
             let (s, f) = (p.stats(), p.fast_stats());
             println!(
-                "case {key} fast: {} thermal steps ({} rejected), {} model evaluations ({} for {} Jacobians), {} hydraulic steps ({} rejected, {} hydraulic evaluations)",
-                s.steps, f.rejected, s.rhs_evals, s.jacobian_evals, s.factorizations, f.hydraulics.steps, f.hydraulics.rejected, f.hydraulics.evals
+                "case {key} fast: {} thermal steps ({} rejected), {} model evaluations ({} for {} Jacobians), {} hydraulic steps ({} rejected, {} hydraulic evaluations, {} Jacobians)",
+                s.steps, f.rejected, s.rhs_evals, s.jacobian_evals, s.factorizations, f.hydraulics.steps, f.hydraulics.rejected, f.hydraulics.evals, f.hydraulics.jacobians
             );
         }
     }

@@ -118,9 +118,13 @@ pub fn path_dp(rig: &Rig, q: f64, t_oil: f64, needle: Option<f64>) -> (f64, f64)
 /// flows (Re ≈ 500 at 9.5 L/min); the line heat itself is evaluated by eq. (10)
 /// with the regime-dependent friction factor.
 pub fn path_flow(rig: &Rig, dp: f64, t_oil: f64, needle: Option<f64>) -> f64 {
+    path_flow_props(rig, dp, rig.oil.rho(t_oil, 0.0), rig.oil.nu_m2_per_s(t_oil), needle)
+}
+
+/// [`path_flow`] with the oil's density `rho` (kg/m³) and kinematic
+/// viscosity `nu` (m²/s) given instead of its temperature, m³/s.
+pub fn path_flow_props(rig: &Rig, dp: f64, rho: f64, nu: f64, needle: Option<f64>) -> f64 {
     let line = &rig.hydraulics.path;
-    let rho = rig.oil.rho(t_oil, 0.0);
-    let nu = rig.oil.nu_m2_per_s(t_oil);
     let a = line.area_m2();
     let r1 = 128.0 * nu * rho * line.length_m / (PI * line.diameter_m.powi(4));
     let r2 = rho * line.local_loss_coeff / (2.0 * a * a) + needle.map_or(0.0, |k| 1.0 / (k * k));

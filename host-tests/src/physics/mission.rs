@@ -4,6 +4,7 @@
 //! simulation's scenarios (`crate::scenario`) build missions.
 
 use serde::{Deserialize, Serialize};
+use std::cell::Cell;
 
 /// Hydraulic configuration of the rig (paper, Section III.A).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -72,8 +73,24 @@ impl PositionRef {
     pub fn at(&self, t: f64) -> (f64, f64) {
         match self {
             PositionRef::Sine { amplitude_m, freq_hz, offset_m } => {
-                let w = 2.0 * std::f64::consts::PI * freq_hz;
-                (offset_m + amplitude_m * (w * t).sin(), amplitude_m * w * (w * t).cos())
+                // The last answer is kept per thread, keyed by the bits of
+                // the sine and of t (the answer is the value computed): the
+                // hydraulic integration asks at the same t for a Jacobian's
+                // columns and for a step's last stage and end point.
+                thread_local! {
+                    static LAST: Cell<([u64; 4], (f64, f64))> = const { Cell::new(([u64::MAX; 4], (f64::NAN, f64::NAN))) };
+                }
+                let key = [amplitude_m.to_bits(), freq_hz.to_bits(), offset_m.to_bits(), t.to_bits()];
+                LAST.with(|c| {
+                    let (k, v) = c.get();
+                    if k == key {
+                        return v;
+                    }
+                    let w = 2.0 * std::f64::consts::PI * freq_hz;
+                    let v = (offset_m + amplitude_m * (w * t).sin(), amplitude_m * w * (w * t).cos());
+                    c.set((key, v));
+                    v
+                })
             }
             PositionRef::Profile(s) => {
                 let h = 1e-3;

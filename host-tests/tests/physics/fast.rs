@@ -48,7 +48,7 @@ fn check(rig: &Rig, sc: &Scenario, opt: &SimOptions, regression_k: f64) -> SimOu
 
 /// Case 1 at 60 bar, 600 s, with the benchmark's 10 s outputs and with the
 /// default 1 s outputs (0.1 s callbacks, read from the interpolants).
-/// Measured 4.7e-4 K and 4.6e-4 K with the oil on its viscosity line
+/// Measured 4.7e-4 K and 3.0e-4 K with the oil on its viscosity line
 /// (issue 34; 1.5e-4 and 1.1e-3 K before).
 #[test]
 fn case1_within_a_hundredth_of_a_kelvin() {
@@ -58,7 +58,7 @@ fn case1_within_a_hundredth_of_a_kelvin() {
     check(&rig, &sc, &SimOptions::default(), 3e-3);
 }
 
-/// Case 2 (servo, 0.2 Hz), 600 s, 1 s outputs. Measured 6.5e-3 K (6.8e-3
+/// Case 2 (servo, 0.2 Hz), 600 s, 1 s outputs. Measured 6.4e-3 K (6.8e-3
 /// before issue 34; the
 /// winding, whose copper loss the steps integrate over 120 cycles).
 #[test]
@@ -133,7 +133,7 @@ fn fig15_switches_with_the_bdf() {
 }
 
 /// The firmware suite's five random missions (throttle and servo), 600 s.
-/// Measured 4.2e-4, 2.3e-3, 2.4e-4, 3.4e-4, 1.9e-3 K (issue 34's oil;
+/// Measured 4.1e-4, 2.3e-3, 2.3e-4, 3.4e-4, 1.8e-3 K (issue 34's oil;
 /// 1.2e-3, 2.7e-3, 4.8e-4, 1.4e-3, 2.3e-3 K before).
 #[test]
 fn random_missions_within_a_hundredth_of_a_kelvin() {
@@ -190,6 +190,6 @@ fn slow_twenty_long_random_missions_within_a_hundredth_of_a_kelvin() {
 /// The missions of the slow test where the fast path or the shipped BDF is
 /// more than 0.01 K from the BDF at rtol 1e-9, both at a stop or rest with
 /// the needle open. Measured with the oil on its viscosity line (issue 34),
-/// fast / shipped BDF: seed 13 7.5e-3 / 1.06e-2 K, seed 21 1.07e-2 /
-/// 1.49e-2 K; the other 18 within 8.2e-3 K (fast) and 9.9e-3 K (shipped).
+/// fast / shipped BDF: seed 13 8.0e-3 / 1.06e-2 K, seed 21 4.6e-3 /
+/// 1.49e-2 K; the other 18 within 5.5e-3 K (fast) and 9.9e-3 K (shipped).
 const DEGENERATE: [u64; 2] = [13, 21];

@@ -98,6 +98,53 @@ fn mul_vec_add_portable<const N: usize>(a: &Mat<N>, x: &[f64; N], y: &mut [f64; 
     }
 }
 
+/// The transpose: the columns of `a` as rows.
+pub fn transpose<const N: usize>(a: &Mat<N>) -> Mat<N> {
+    std::array::from_fn(|j| std::array::from_fn(|i| a[i][j]))
+}
+
+/// y += a·x with `cols` = aᵀ (a's columns as rows): the same sums in the
+/// same order as [`mul_vec_add`], but each column is contiguous, so the
+/// column updates y += x_j·a[·][j] are vector operations (measured on the
+/// 13-node network with AVX2: ~330 → ~130 instructions per product, the
+/// thermal step's nine products per try).
+pub fn mul_vec_add_cols<const N: usize>(cols: &Mat<N>, x: &[f64; N], y: &mut [f64; N]) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU supports AVX2, checked just above.
+            return unsafe { mul_vec_add_cols_avx2(cols, x, y) };
+        }
+    }
+    mul_vec_add_cols_portable(cols, x, y)
+}
+
+/// a·x with `cols` = aᵀ ([`mul_vec_add_cols`]).
+pub fn mul_vec_cols<const N: usize>(cols: &Mat<N>, x: &[f64; N]) -> [f64; N] {
+    let mut y = [0.0; N];
+    mul_vec_add_cols(cols, x, &mut y);
+    y
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn mul_vec_add_cols_avx2<const N: usize>(cols: &Mat<N>, x: &[f64; N], y: &mut [f64; N]) {
+    mul_vec_add_cols_portable(cols, x, y)
+}
+
+#[inline(always)]
+fn mul_vec_add_cols_portable<const N: usize>(cols: &Mat<N>, x: &[f64; N], y: &mut [f64; N]) {
+    let mut acc = [0.0; N];
+    for (xj, cj) in x.iter().zip(cols) {
+        for (acc_i, cij) in acc.iter_mut().zip(cj) {
+            *acc_i += cij * xj;
+        }
+    }
+    for (yi, s) in y.iter_mut().zip(acc) {
+        *yi += s;
+    }
+}
+
 /// The 1-norm (largest column sum of absolute values).
 pub fn norm1<const N: usize>(a: &Mat<N>) -> f64 {
     (0..N).map(|j| a.iter().map(|r| r[j].abs()).sum::<f64>()).fold(0.0, f64::max)
@@ -126,17 +173,24 @@ impl<const N: usize> Lu<N> {
     pub fn new(mut a: Mat<N>) -> Option<Self> {
         let mut piv = [0usize; N];
         for k in 0..N {
-            let p = (k..N).max_by(|&i, &j| a[i][k].abs().total_cmp(&a[j][k].abs())).unwrap_or(k);
+            // The last of the largest pivots (as `Iterator::max_by` chose it).
+            let mut p = k;
+            for i in k + 1..N {
+                if a[i][k].abs().total_cmp(&a[p][k].abs()).is_ge() {
+                    p = i;
+                }
+            }
             piv[k] = p;
-            a.swap(k, p);
+            if p != k {
+                a.swap(k, p);
+            }
             let d = a[k][k];
             if d == 0.0 || !d.is_finite() {
                 return None;
             }
             let inv = 1.0 / d;
-            let (top, bottom) = a.split_at_mut(k + 1);
-            let rk = &top[k];
-            for ri in bottom.iter_mut() {
+            let rk = a[k];
+            for ri in a.iter_mut().skip(k + 1) {
                 let f = ri[k] * inv;
                 ri[k] = f;
                 for j in k + 1..N {

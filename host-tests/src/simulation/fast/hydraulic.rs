@@ -6,7 +6,7 @@
 
 use super::rosenbrock::{RosError, Rosenbrock};
 use crate::hydraulics::ix;
-use crate::model::{Model, N_STATE, T0};
+use crate::model::{HydraulicOil, Model, N_STATE, T0};
 use crate::network::N_NODES;
 
 /// Hydraulic states.
@@ -40,38 +40,57 @@ pub struct HydTrack {
     checks: u32,
 }
 
-/// Node temperatures linear in time through two points.
+/// Node temperatures linear in time through two points, and the oil
+/// properties the hydraulics see through them, linear in time between
+/// their values at the two points. (Interpolating the properties rather
+/// than evaluating them at the interpolated temperatures: the difference
+/// is their curvature over a thermal step's few millikelvin, ~1e-9
+/// relative; evaluated, they were half of a hydraulic evaluation's cost,
+/// a `log10` and two `pow` each.)
 #[derive(Debug, Clone, Copy)]
 pub struct TempPath {
     t0: f64,
     z0: [f64; N_NODES],
     t1: f64,
     z1: [f64; N_NODES],
+    oil0: HydraulicOil,
+    oil1: HydraulicOil,
 }
 
 impl TempPath {
     /// Constant temperatures `z`.
-    pub fn constant(z: [f64; N_NODES]) -> Self {
-        Self { t0: 0.0, z0: z, t1: 1.0, z1: z }
+    pub fn constant(model: &Model, z: [f64; N_NODES]) -> Self {
+        let oil = model.hydraulic_oil(&z);
+        Self { t0: 0.0, z0: z, t1: 1.0, z1: z, oil0: oil, oil1: oil }
     }
 
-    /// The line through (t0, z0) and (t1, z1).
-    pub fn line(t0: f64, z0: [f64; N_NODES], t1: f64, z1: [f64; N_NODES]) -> Self {
-        Self { t0, z0, t1, z1 }
+    /// Weight of the second point at `t` (held beyond the points: a
+    /// hydraulic step past the thermal step must not extrapolate a transient).
+    fn weight(&self, t: f64) -> f64 {
+        if self.t1 > self.t0 {
+            ((t - self.t0) / (self.t1 - self.t0)).clamp(0.0, 1.0)
+        } else {
+            0.0
+        }
     }
 
-    /// Temperatures at `t` (held beyond the points: a hydraulic step past
-    /// the thermal step must not extrapolate a transient).
+    /// Temperatures at `t`.
     pub fn at(&self, t: f64) -> [f64; N_NODES] {
-        let w = if self.t1 > self.t0 { ((t - self.t0) / (self.t1 - self.t0)).clamp(0.0, 1.0) } else { 0.0 };
+        let w = self.weight(t);
         std::array::from_fn(|i| self.z0[i] + w * (self.z1[i] - self.z0[i]))
+    }
+
+    /// The hydraulics' oil properties at `t`.
+    pub fn oil_at(&self, t: f64) -> HydraulicOil {
+        self.oil0.lerp(&self.oil1, self.weight(t))
     }
 }
 
 impl HydTrack {
     /// A track with `ros` as integrator, starting at (t, y).
     pub fn new(ros: Rosenbrock<NH>, t: f64, y: [f64; NH]) -> Self {
-        Self { ros, pts: vec![(t, y, [0.0; NH])], last_branch: None, path: TempPath::constant([0.0; N_NODES]), coupled: false, checks: 0 }
+        let path = TempPath { t0: 0.0, z0: [0.0; N_NODES], t1: 1.0, z1: [0.0; N_NODES], oil0: HydraulicOil::default(), oil1: HydraulicOil::default() };
+        Self { ros, pts: vec![(t, y, [0.0; NH])], last_branch: None, path, coupled: false, checks: 0 }
     }
 
     /// Restart at (t, y) with step `h0`: the first point's f is computed
@@ -81,7 +100,7 @@ impl HydTrack {
         rhs(model, z, t, &y, &mut f);
         self.ros.stats.evals += 1;
         self.check_coupling(model, z, t, &y, &f);
-        self.path = TempPath::constant(*z);
+        self.path = TempPath::constant(model, *z);
         self.pts.clear();
         self.pts.push((t, y, f));
         self.last_branch = None;
@@ -106,9 +125,12 @@ impl HydTrack {
         }
     }
 
-    /// The temperatures the hydraulics see from now on.
-    pub fn set_path(&mut self, path: TempPath) {
-        self.path = path;
+    /// The temperatures the hydraulics see from now on: the line through
+    /// (t0, z0) and (t1, z1) (the properties at z0 kept from the last path
+    /// when it ended there).
+    pub fn set_line(&mut self, model: &Model, t0: f64, z0: [f64; N_NODES], t1: f64, z1: [f64; N_NODES]) {
+        let oil0 = if self.path.z1 == z0 { self.path.oil1 } else { model.hydraulic_oil(&z0) };
+        self.path = TempPath { t0, z0, t1, z1, oil0, oil1: model.hydraulic_oil(&z1) };
     }
 
     /// Integrates until the track covers `t` (at most up to `t_max`, a
@@ -120,7 +142,7 @@ impl HydTrack {
         let t_left = left_of(t_max);
         let t_stop = if self.coupled { t.min(t_max) } else { t_max };
         let path = self.path;
-        let mut fun = |t: f64, y: &[f64; NH], d: &mut [f64; NH]| rhs(model, &path.at(t), t.min(t_left), y, d);
+        let mut fun = |t: f64, y: &[f64; NH], d: &mut [f64; NH]| model.hydraulic_rhs_oil(t.min(t_left), y, &path.oil_at(t), d);
         while tt < t - 1e-12 * t.abs().max(1.0) && tt < t_stop {
             tt = self.ros.step(&mut fun, tt, &mut y, &mut f, t_stop)?;
             self.pts.push((tt, y, f));
@@ -169,7 +191,7 @@ impl HydTrack {
             self.pts.push((t, y, f));
             self.last_branch = None;
         }
-        self.path = TempPath::constant(*z);
+        self.path = TempPath::constant(model, *z);
         let i = self.pts.partition_point(|p| p.0 <= t);
         if i > 1 {
             self.pts.drain(..i - 1);
@@ -190,11 +212,8 @@ impl HydTrack {
 /// ring (the upwind direction) and the shaft speed (the friction torque's
 /// sign in the motor current). Values below the thresholds (1 Pa,
 /// 1e-10 m³/s, 1e-4 rad/s) are a machine at rest, not a reversal.
-fn branch_values(model: &Model, z: &[f64; N_NODES], t: f64, yh: &[f64; NH]) -> [f64; 3] {
-    let mut y = [0.0; N_STATE];
-    y[..NH].copy_from_slice(yh);
-    y[T0..T0 + N_NODES].copy_from_slice(z);
-    let op = model.op_hydraulic(t, &y);
+fn branch_values(model: &Model, oil: &HydraulicOil, t: f64, yh: &[f64; NH]) -> [f64; 3] {
+    let op = model.op_hydraulic_oil(t, yh, oil);
     [op.p_a - op.p_b, op.circulation(&model.rig), op.omega]
 }
 
@@ -210,7 +229,7 @@ impl HydTrack {
     /// (relative to t), or None.
     pub fn first_switch(&mut self, model: &Model, t0: f64, t1: f64) -> Option<(f64, f64)> {
         let path = self.path;
-        let val = |t: f64| branch_values(model, &path.at(t), t, &self.at(t));
+        let val = |t: f64| branch_values(model, &path.oil_at(t), t, &self.at(t));
         let mut ta = t0;
         let mut va = match self.last_branch {
             Some((t, v)) if t == t0 => v,

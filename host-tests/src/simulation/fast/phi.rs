@@ -13,7 +13,7 @@
 //! which follow from splitting ∫₀^{2h} at h. Doubling is also how a stepper
 //! moves to twice the step at the cost of four products.
 
-use super::dense::{identity, lin2, mul, mul_vec, norm1, zeros, Mat};
+use super::dense::{identity, lin2, mul, mul_vec, norm1, transpose, zeros, Mat};
 
 /// Degree of the Taylor polynomial of φ₃.
 const TAYLOR_DEGREE: usize = 11;
@@ -33,6 +33,9 @@ pub struct Phi<const N: usize> {
     pub p2: Mat<N>,
     /// h·φ₃(hA), s.
     pub p3: Mat<N>,
+    /// The transposes of p1, p2, p3 (their columns as rows), for
+    /// matrix–vector products ([`super::dense::mul_vec_add_cols`]).
+    pub cols: [Mat<N>; 3],
 }
 
 impl<const N: usize> Phi<N> {
@@ -42,7 +45,7 @@ impl<const N: usize> Phi<N> {
         if norm == 0.0 {
             // A = 0 (no Jacobian yet): E = I, Φ_k = h/k!·I.
             let id: Mat<N> = identity();
-            return Self { h, e: id, p1: lin2(&id, h, &id, 0.0), p2: lin2(&id, h / 2.0, &id, 0.0), p3: lin2(&id, h / 6.0, &id, 0.0) };
+            return Self::with_cols(h, id, lin2(&id, h, &id, 0.0), lin2(&id, h / 2.0, &id, 0.0), lin2(&id, h / 6.0, &id, 0.0));
         }
         let s = if norm > TAYLOR_NORM { (norm / TAYLOR_NORM).log2().ceil() as i32 } else { 0 };
         let h0 = h / 2f64.powi(s);
@@ -77,7 +80,7 @@ impl<const N: usize> Phi<N> {
         let p2 = lin2(&mul(&z, &p3), 1.0, &id, 0.5);
         let p1 = lin2(&mul(&z, &p2), 1.0, &id, 1.0);
         let e = lin2(&mul(&z, &p1), 1.0, &id, 1.0);
-        Self { h, e, p1: lin2(&p1, h, &id, 0.0), p2: lin2(&p2, h, &id, 0.0), p3: lin2(&p3, h, &id, 0.0) }
+        Self::with_cols(h, e, lin2(&p1, h, &id, 0.0), lin2(&p2, h, &id, 0.0), lin2(&p3, h, &id, 0.0))
     }
 
     /// The same functions at twice the step (four matrix products).
@@ -88,7 +91,11 @@ impl<const N: usize> Phi<N> {
         let p2 = lin2(&mul(&ep, &self.p2), 0.5, &self.p1, 0.5);
         let mut p3 = lin2(&mul(&ep, &self.p3), 0.25, &self.p2, 0.25);
         p3 = lin2(&p3, 1.0, &self.p1, 0.125);
-        Self { h: 2.0 * self.h, e: mul(&self.e, &self.e), p1, p2, p3 }
+        Self::with_cols(2.0 * self.h, mul(&self.e, &self.e), p1, p2, p3)
+    }
+
+    fn with_cols(h: f64, e: Mat<N>, p1: Mat<N>, p2: Mat<N>, p3: Mat<N>) -> Self {
+        Self { h, e, p1, p2, p3, cols: [transpose(&p1), transpose(&p2), transpose(&p3)] }
     }
 }
 

@@ -140,6 +140,8 @@ pub struct RosStats {
     pub rejected: u64,
     /// Right-hand-side evaluations (stages, Jacobian columns, ∂f/∂t).
     pub evals: u64,
+    /// Jacobians taken (N evaluations each).
+    pub jacobians: u64,
 }
 
 /// Why a Rosenbrock integration stopped.
@@ -217,12 +219,18 @@ impl<const N: usize> Rosenbrock<N> {
     where
         F: FnMut(f64, &[f64; N], &mut [f64; N]),
     {
-        let tab = self.tab;
+        let tab = &self.tab;
         let h_min = 1e-14 * t_max.abs().max(1.0);
         let h_try = self.h;
         let mut h = h_try.min(t_max - t);
         if t + 1.05 * h >= t_max {
             h = t_max - t;
+        } else if t + 2.0 * h > t_max {
+            // Two even steps rather than a full one and a remnant: a remnant
+            // far below the kept Jacobian's step takes a new Jacobian, and
+            // so does the full step after it (measured on Case 2: 9.2 k
+            // Jacobians for 28.6 k steps, 6.9 k of them for the step ratio).
+            h = 0.5 * (t_max - t);
         }
         // ∂f/∂t anew every step (forward difference, backwards at the
         // interval's end: a schedule may step there). Kept with the
@@ -244,7 +252,7 @@ impl<const N: usize> Rosenbrock<N> {
             let jac = match self.jac {
                 Some((j, age, hj)) if age < self.jac_max_age && h <= 4.0 * hj && hj <= 4.0 * h => j,
                 _ => {
-                    let j = self.jacobian(f, t, y, f0);
+                    let j = jacobian(f, t, y, f0, &self.scale, &mut self.stats);
                     self.jac = Some((j, 0, h));
                     j
                 }
@@ -299,7 +307,13 @@ impl<const N: usize> Rosenbrock<N> {
                 err += (e / sc).powi(2);
             }
             let err = (err / N as f64).sqrt();
-            let fac = (0.9 / err.powf(1.0 / tab.elo)).clamp(0.2, 6.0);
+            // err^(1/elo), without a `pow` for the two tableaus here.
+            let root = match tab.elo {
+                3.0 => err.cbrt(),
+                4.0 => err.sqrt().sqrt(),
+                e => err.powf(1.0 / e),
+            };
+            let fac = (0.9 / root).clamp(0.2, 6.0);
             if err <= 1.0 && err.is_finite() {
                 let t1 = if h == t_max - t { t_max } else { t + h };
                 *y = y1;
@@ -332,26 +346,29 @@ impl<const N: usize> Rosenbrock<N> {
         }
     }
 
-    /// The Jacobian at (t, y) by forward differences, `f0` = f(t, y).
-    fn jacobian<F>(&mut self, f: &mut F, t: f64, y: &[f64; N], f0: &[f64; N]) -> Mat<N>
-    where
-        F: FnMut(f64, &[f64; N], &mut [f64; N]),
-    {
-        let mut jac: Mat<N> = [[0.0; N]; N];
-        let mut yp = *y;
-        let mut fp = [0.0; N];
-        for j in 0..N {
-            let d = 1e-7 * (y[j].abs() + self.scale[j]);
-            yp[j] = y[j] + d;
-            f(t, &yp, &mut fp);
-            for i in 0..N {
-                jac[i][j] = (fp[i] - f0[i]) / d;
-            }
-            yp[j] = y[j];
+}
+
+/// The Jacobian at (t, y) by forward differences, `f0` = f(t, y), with
+/// increments relative to the states' magnitudes `scale`.
+fn jacobian<const N: usize, F>(f: &mut F, t: f64, y: &[f64; N], f0: &[f64; N], scale: &[f64; N], stats: &mut RosStats) -> Mat<N>
+where
+    F: FnMut(f64, &[f64; N], &mut [f64; N]),
+{
+    let mut jac: Mat<N> = [[0.0; N]; N];
+    let mut yp = *y;
+    let mut fp = [0.0; N];
+    for j in 0..N {
+        let d = 1e-7 * (y[j].abs() + scale[j]);
+        yp[j] = y[j] + d;
+        f(t, &yp, &mut fp);
+        for i in 0..N {
+            jac[i][j] = (fp[i] - f0[i]) / d;
         }
-        self.stats.evals += N as u64;
-        jac
+        yp[j] = y[j];
     }
+    stats.evals += N as u64;
+    stats.jacobians += 1;
+    jac
 }
 
 #[cfg(test)]

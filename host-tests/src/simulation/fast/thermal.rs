@@ -27,7 +27,7 @@
 //! an odd step, from the vector solution of [`super::phi::solve_linear`].
 //! The energy integrals follow by the trapezoidal rule on the heat rates.
 
-use super::dense::{mul_vec, mul_vec_add, Mat};
+use super::dense::{mul_vec_add_cols, mul_vec_cols, transpose, Mat};
 use super::phi::{solve_linear, Phi};
 use crate::model::{N_STATE, T0};
 use crate::network::N_NODES;
@@ -59,6 +59,8 @@ pub struct Thermal {
     hist: Vec<(f64, [f64; NT], [f64; NT])>,
     /// ∂(dz/dt)/∂z, 1/s.
     pub a: Mat<NT>,
+    /// Aᵀ, for products A·v ([`mul_vec_cols`]).
+    a_cols: Mat<NT>,
     /// ∂q/∂z, W/K.
     pub a_e: [[f64; NT]; NE],
 }
@@ -86,7 +88,7 @@ impl Thermal {
     /// A state at time `t`, temperatures `z` and energies `e` (call
     /// [`Thermal::jacobian`] first).
     pub fn new(t: f64, z: [f64; NT], e: [f64; NE]) -> Self {
-        Self { z, e, fz: [0.0; NT], q: [0.0; NE], t, hist: Vec::with_capacity(3), a: [[0.0; NT]; NT], a_e: [[0.0; NT]; NE] }
+        Self { z, e, fz: [0.0; NT], q: [0.0; NE], t, hist: Vec::with_capacity(3), a: [[0.0; NT]; NT], a_cols: [[0.0; NT]; NT], a_e: [[0.0; NT]; NE] }
     }
 
     /// Whether A is zero (no Jacobian taken yet).
@@ -114,6 +116,7 @@ impl Thermal {
                 self.a_e[i][j] = (qp[i] - q[i]) / d;
             }
         }
+        self.a_cols = transpose(&self.a);
         if keep_history {
             for (_, g, z) in self.hist.iter_mut() {
                 for (i, gi) in g.iter_mut().enumerate() {
@@ -151,9 +154,9 @@ impl Thermal {
             Some(p) => {
                 // z₀ + Φ₁·f₀ + h·Φ₂·g' + h²·Φ₃·g''
                 let mut z = self.z;
-                mul_vec_add(&p.p1, &self.fz, &mut z);
-                mul_vec_add(&p.p2, &d.0.map(|x| x * h), &mut z);
-                mul_vec_add(&p.p3, &d.1.map(|x| x * h * h), &mut z);
+                mul_vec_add_cols(&p.cols[0], &self.fz, &mut z);
+                mul_vec_add_cols(&p.cols[1], &d.0.map(|x| x * h), &mut z);
+                mul_vec_add_cols(&p.cols[2], &d.1.map(|x| x * h * h), &mut z);
                 z
             }
             None => solve_linear(&self.a, h, &self.z, [g0, &d.0, &d.1]),
@@ -163,7 +166,7 @@ impl Thermal {
     /// The predictor of a step of `h` s (`phi`: the level's matrices, None:
     /// an odd step): z* and g₀.
     pub fn predict(&self, phi: Option<&Phi<NT>>, h: f64) -> ([f64; NT], [f64; NT]) {
-        let az0 = mul_vec(&self.a, &self.z);
+        let az0 = mul_vec_cols(&self.a_cols, &self.z);
         let g0: [f64; NT] = std::array::from_fn(|i| self.fz[i] - az0[i]);
         // The polynomial through the stored g and g₀.
         let mut pts: [(f64, &[f64; NT]); 3] = [(0.0, &g0); 3];
@@ -178,7 +181,7 @@ impl Thermal {
     /// The corrector of the step predicted by [`Thermal::predict`] (`zp`,
     /// `g0`), given the model's rates `fp`, `qp` at the predicted end.
     pub fn correct(&self, phi: Option<&Phi<NT>>, h: f64, zp: &[f64; NT], g0: &[f64; NT], fp: &[f64; NT], qp: &[f64; NE]) -> Trial {
-        let azp = mul_vec(&self.a, zp);
+        let azp = mul_vec_cols(&self.a_cols, zp);
         let gp: [f64; NT] = std::array::from_fn(|i| fp[i] - azp[i]);
         // The polynomial through the latest stored g, g₀ and g*.
         let mut pts: [(f64, &[f64; NT]); 3] = [(0.0, g0); 3];
@@ -190,7 +193,7 @@ impl Thermal {
         pts[m + 1] = (h, &gp);
         let z1 = self.linear(phi, h, g0, &derivatives(&pts[..m + 2]));
         let dz: [f64; NT] = std::array::from_fn(|i| z1[i] - zp[i]);
-        let adz = mul_vec(&self.a, &dz);
+        let adz = mul_vec_cols(&self.a_cols, &dz);
         let f1 = std::array::from_fn(|i| fp[i] + adz[i]);
         let q1 = std::array::from_fn(|i| qp[i] + self.a_e[i].iter().zip(&dz).map(|(p, q)| p * q).sum::<f64>());
         let milne = if m == 1 { 10.0 } else { 6.0 };
