@@ -4,7 +4,8 @@
 
 use super::wire::{self, command_key, Ack, AckResult, Cmd, Command, Refusal, Status, TraceReply, ARM_WINDOW_TICKS, COMMAND_INTERVAL_TICKS, KIND_COMMAND};
 use crate::guard::ClearResult;
-use super::{AppOf, Board, TRACE_EVENTS_PER_TICK};
+use super::{AppOf, Board, Counters, COMMAND_QUEUE, TRACE_EVENTS_PER_TICK};
+use heapless::Deque;
 use crate::num::Num;
 use crate::protection::LngConfig;
 use crate::GuardOf;
@@ -130,45 +131,49 @@ impl Incoming {
     }
 }
 
-impl<N: Num> AppOf<N> {
+impl Counters {
     // cold path, kept out of the tick loop's code (flash)
     #[inline(never)]
     pub(super) fn reject(&mut self, e: DecodeError) {
-        let c = &mut self.counters;
         let slot = match e {
-            DecodeError::Crc => &mut c.rejected_crc,
-            _ => &mut c.rejected_framing,
+            DecodeError::Crc => &mut self.rejected_crc,
+            _ => &mut self.rejected_framing,
         };
         *slot = slot.saturating_add(1);
     }
+}
 
-    /// One received frame: a sample (sequence rule: newer than the last
-    /// accepted, within half the u16 range) or a command.
-    pub(super) fn accept(&mut self, frame: Result<Incoming, DecodeError>) {
-        let req = match frame {
-            Ok(Incoming::Sample(r)) => r,
-            Ok(Incoming::Command(c)) => {
-                if self.commands.push_back(c).is_err() {
-                    self.reject(DecodeError::Overflow);
-                }
-                return;
+/// One received frame: a sample (sequence rule: newer than the last
+/// accepted `last_seq`, within half the u16 range; the tick's `sample`, a
+/// newer one supersedes it) or a command (queued). Takes the application's
+/// fields apart from the receive buffer the frame is decoded from.
+#[inline(always)]
+pub(super) fn accept(c: &mut Counters, last_seq: &mut Option<u16>, sample: &mut Option<Request>, commands: &mut Deque<Command, COMMAND_QUEUE>, frame: Result<Incoming, DecodeError>) {
+    let req = match frame {
+        Ok(Incoming::Sample(r)) => r,
+        Ok(Incoming::Command(cmd)) => {
+            if commands.push_back(cmd).is_err() {
+                c.reject(DecodeError::Overflow);
             }
-            Err(e) => return self.reject(e),
-        };
-        if let Some(last) = self.last_seq {
-            let ahead = req.seq.wrapping_sub(last);
-            if ahead == 0 || ahead > 0x8000 {
-                self.counters.rejected_sequence = self.counters.rejected_sequence.saturating_add(1);
-                return;
-            }
+            return;
         }
-        self.last_seq = Some(req.seq);
-        self.counters.accepted = self.counters.accepted.saturating_add(1);
-        if self.sample.replace(req).is_some() {
-            self.counters.superseded = self.counters.superseded.saturating_add(1);
+        Err(e) => return c.reject(e),
+    };
+    if let Some(last) = *last_seq {
+        let ahead = req.seq.wrapping_sub(last);
+        if ahead == 0 || ahead > 0x8000 {
+            c.rejected_sequence = c.rejected_sequence.saturating_add(1);
+            return;
         }
     }
+    *last_seq = Some(req.seq);
+    c.accepted = c.accepted.saturating_add(1);
+    if sample.replace(req).is_some() {
+        c.superseded = c.superseded.saturating_add(1);
+    }
+}
 
+impl<N: Num> AppOf<N> {
     // cold path, kept out of the tick loop's code (flash)
     #[inline(never)]
     pub(super) fn execute<B: Board>(&mut self, board: &mut B, c: Command) {

@@ -17,6 +17,7 @@ use super::{Board, BootMemory};
 use crate::memory::nv::{Blocking, NvStore, RamFlash};
 use crate::memory::ThermalRecord;
 use crate::params_block::BLOCK_LEN;
+use crate::protocol::MAX_WIRE;
 
 /// Receive buffer, bytes (more than a tick's traffic at any baud rate the
 /// product uses; the excess is counted as dropped, as a UART ring would).
@@ -37,7 +38,8 @@ pub struct MemBoard {
     rx_len: usize,
     rx_at: usize,
     rx_dropped: u32,
-    tx: heapless::Vec<u8, MEM_TX>,
+    tx: [u8; MEM_TX],
+    tx_len: usize,
     /// Bytes that did not fit the transmit buffer.
     pub tx_dropped: u32,
     /// The pin levels as last written (and read back).
@@ -88,7 +90,8 @@ impl MemBoard {
             rx_len: 0,
             rx_at: 0,
             rx_dropped: 0,
-            tx: heapless::Vec::new(),
+            tx: [0; MEM_TX],
+            tx_len: 0,
             tx_dropped: 0,
             pins: Pins { valve_pin: false, ok_pin: false },
             stuck_valve_pin: None,
@@ -153,17 +156,19 @@ impl MemBoard {
 
     /// The bytes sent since the last [`MemBoard::take_tx`] / [`MemBoard::clear_tx`].
     pub fn tx(&self) -> &[u8] {
-        &self.tx
+        self.tx.get(..self.tx_len).unwrap_or(&[])
     }
 
     /// Forgets the bytes sent so far.
     pub fn clear_tx(&mut self) {
-        self.tx.clear();
+        self.tx_len = 0;
     }
 
     /// The bytes sent so far, and forgets them.
     pub fn take_tx(&mut self) -> heapless::Vec<u8, MEM_TX> {
-        core::mem::take(&mut self.tx)
+        let v = heapless::Vec::from_slice(self.tx()).unwrap_or_default();
+        self.tx_len = 0;
+        v
     }
 
     /// What the board finds in its memories at boot (the non-volatile
@@ -186,7 +191,7 @@ impl MemBoard {
     pub fn warm_reset(&mut self) {
         self.rx_len = 0;
         self.rx_at = 0;
-        self.tx.clear();
+        self.tx_len = 0;
         self.ticks = 0;
         self.pins = Pins::default();
     }
@@ -211,13 +216,37 @@ impl Board for MemBoard {
         0
     }
 
+    /// The received bytes in place, no copy.
+    #[inline(always)]
+    fn rx_bytes<'a>(&'a mut self, _scratch: &'a mut [u8; super::RX_READ]) -> &'a [u8] {
+        let (at, len) = (self.rx_at, self.rx_len);
+        self.rx_at = len;
+        self.rx.get(at..len).unwrap_or(&[])
+    }
+
     fn rx_dropped(&self) -> u32 {
         self.rx_dropped
     }
 
     fn write_tx(&mut self, bytes: &[u8]) {
-        if self.tx.extend_from_slice(bytes).is_err() {
-            self.tx_dropped = self.tx_dropped.saturating_add(u32::try_from(bytes.len()).unwrap_or(u32::MAX));
+        match self.tx.get_mut(self.tx_len..self.tx_len + bytes.len()) {
+            Some(dst) => {
+                dst.copy_from_slice(bytes);
+                self.tx_len += bytes.len();
+            }
+            None => self.tx_dropped = self.tx_dropped.saturating_add(u32::try_from(bytes.len()).unwrap_or(u32::MAX)),
+        }
+    }
+
+    /// Written in place when a whole [`MAX_WIRE`] fits, no copy.
+    #[inline(always)]
+    fn write_tx_with(&mut self, scratch: &mut [u8; MAX_WIRE], fill: impl FnOnce(&mut [u8; MAX_WIRE]) -> usize) {
+        match self.tx.get_mut(self.tx_len..).and_then(|t| t.first_chunk_mut::<MAX_WIRE>()) {
+            Some(dst) => self.tx_len += fill(dst).min(MAX_WIRE),
+            None => {
+                let n = fill(scratch);
+                self.write_tx(scratch.get(..n).unwrap_or(&[]));
+            }
         }
     }
 

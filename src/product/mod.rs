@@ -34,7 +34,7 @@ use crate::memory::cooling::RestCooling;
 use crate::memory::{boot_restore, Restore, ThermalRecord};
 use crate::model::ModelConsts;
 use crate::num::Num;
-use crate::protocol::{Deframer, Request};
+use crate::protocol::{Deframer, Request, MAX_WIRE};
 use crate::trace::{RestoreKind, Trace};
 use crate::params_block::{self, ParamSource, BLOCK_LEN};
 use crate::{GuardConfig, GuardOf, Output, Real};
@@ -69,10 +69,30 @@ pub trait Board {
     /// Moves bytes received since the last call into `buf`; never blocks.
     /// Returns how many were written.
     fn read_rx(&mut self, buf: &mut [u8]) -> usize;
+    /// The bytes received since the last call, taken from the board:
+    /// borrowed from the board's own receive buffer where it keeps them in
+    /// one piece (the in-memory board: no copy), else read into `scratch`
+    /// ([`Board::read_rx`], the default). Empty when nothing is left; the
+    /// caller calls again until then.
+    #[inline(always)]
+    fn rx_bytes<'a>(&'a mut self, scratch: &'a mut [u8; RX_READ]) -> &'a [u8] {
+        let n = self.read_rx(scratch);
+        scratch.get(..n).unwrap_or(&[])
+    }
     /// Received bytes dropped because the receive buffer was full, since boot.
     fn rx_dropped(&self) -> u32;
     /// Sends bytes to the controller (returns when they are queued or sent).
     fn write_tx(&mut self, bytes: &[u8]);
+    /// Sends one frame that `fill` writes at the start of a buffer of
+    /// [`MAX_WIRE`] bytes (returning its length): straight into the board's
+    /// own transmit buffer where it keeps one with room (the in-memory
+    /// board: no copy), else into `scratch` and on by [`Board::write_tx`]
+    /// (the default).
+    #[inline(always)]
+    fn write_tx_with(&mut self, scratch: &mut [u8; MAX_WIRE], fill: impl FnOnce(&mut [u8; MAX_WIRE]) -> usize) {
+        let n = fill(scratch);
+        self.write_tx(scratch.get(..n).unwrap_or(&[]));
+    }
     /// Drives the valve and OK pins and returns the levels read back from
     /// the output register.
     fn set_pins(&mut self, pins: Pins) -> Pins;
@@ -290,6 +310,9 @@ pub struct AppOf<N: Num> {
     /// The tick reply's encoder (re-frames only the per-tick tail while
     /// the outputs, pins and counters hold).
     reply: ReplyEncoder,
+    /// The tick reply's bytes on a board that takes them by
+    /// [`Board::write_tx`].
+    tx_buf: [u8; MAX_WIRE],
     last_seq: Option<u16>,
     sample: Option<Request>,
     commands: Deque<Command, COMMAND_QUEUE>,
@@ -351,6 +374,7 @@ impl<N: Num> AppOf<N> {
             core::ptr::addr_of_mut!((*p).rx).write(Deframer::new());
             core::ptr::addr_of_mut!((*p).rx_buf).write([0; RX_READ]);
             core::ptr::addr_of_mut!((*p).reply).write(ReplyEncoder::new());
+            core::ptr::addr_of_mut!((*p).tx_buf).write([0; MAX_WIRE]);
             core::ptr::addr_of_mut!((*p).last_seq).write(None);
             core::ptr::addr_of_mut!((*p).sample).write(None);
             core::ptr::addr_of_mut!((*p).commands).write(Deque::new());
@@ -419,18 +443,16 @@ impl<N: Num> AppOf<N> {
 
         // 1. transport
         loop {
-            let n = board.read_rx(&mut self.rx_buf);
-            if n == 0 {
+            let mut rest = board.rx_bytes(&mut self.rx_buf);
+            if rest.is_empty() {
                 break;
             }
-            let mut at = 0;
-            while at < n {
-                let (k, res) = self.rx.feed(self.rx_buf.get(at..n).unwrap_or(&[]));
-                let frame = res.map(commands::Incoming::parse);
-                at += k;
-                if let Some(frame) = frame {
-                    self.accept(frame);
+            while !rest.is_empty() {
+                let (k, res) = self.rx.feed(rest);
+                if let Some(frame) = res.map(commands::Incoming::parse) {
+                    commands::accept(&mut self.counters, &mut self.last_seq, &mut self.sample, &mut self.commands, frame);
                 }
+                rest = rest.get(k..).unwrap_or(&[]);
             }
         }
 
@@ -468,7 +490,8 @@ impl<N: Num> AppOf<N> {
             restore: self.restore,
             reset_cause: self.reset_cause,
         };
-        board.write_tx(self.reply.frame(&reply, self.guard.epoch()));
+        let (enc, epoch) = (&mut self.reply, self.guard.epoch());
+        board.write_tx_with(&mut self.tx_buf, |out| enc.frame_into(&reply, epoch, out));
         while let Some(c) = self.commands.pop_front() {
             self.execute(board, c);
         }

@@ -23,6 +23,16 @@ fn req(seq: u16) -> Request {
 fn crc_check_value() {
     assert_eq!(crc16(b"123456789"), 0x29B1);
     assert_eq!(crc16(b""), 0xFFFF);
+    // the word-at-a-time CRC is the byte-at-a-time one at every length
+    // and alignment
+    let data: std::vec::Vec<u8> = (0..64u32).map(|k| (k.wrapping_mul(0x9E37_79B9) >> 13) as u8).collect();
+    for start in 0..4 {
+        for end in start..data.len() {
+            let bytes = &data[start..end];
+            let bytewise = bytes.iter().fold(0xFFFF, |c, b| super::framing::crc16_byte(c, *b));
+            assert_eq!(crc16(bytes), bytewise, "{start}..{end}");
+        }
+    }
 }
 
 #[test]

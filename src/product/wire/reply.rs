@@ -23,13 +23,13 @@ const _: () = assert!(MAX_WIRE < 0xFF);
 
 impl Cobs {
     #[inline(always)]
-    fn push(&mut self, buf: &mut [u8; MAX_WIRE], b: u8) {
+    fn push(&mut self, buf: &mut [u8], b: u8) {
         self.crc = crc16_byte(self.crc, b);
         self.put(buf, b);
     }
 
     #[inline(always)]
-    fn put(&mut self, buf: &mut [u8; MAX_WIRE], b: u8) {
+    fn put(&mut self, buf: &mut [u8], b: u8) {
         if b == 0 {
             self.close(buf);
             return;
@@ -43,7 +43,7 @@ impl Cobs {
     }
 
     #[inline(always)]
-    fn close(&mut self, buf: &mut [u8; MAX_WIRE]) {
+    fn close(&mut self, buf: &mut [u8]) {
         if let Some(x) = buf.get_mut(self.code_at) {
             *x = self.code;
         }
@@ -53,12 +53,22 @@ impl Cobs {
     }
 }
 
+/// Words of the framed head: the leading delimiter, the first code byte
+/// and the head's bytes (a zero among them becomes a code in its place).
+const HEAD_WORDS: usize = (2 + TICK_LEN - TICK_TAIL_LEN).div_ceil(4);
+const _: () = assert!(HEAD_WORDS == 7 && HEAD_WORDS * 4 <= MAX_WIRE);
+
 /// The product loop's tick-reply encoder (see the module docs). Its head is
 /// keyed by whatever the caller says changes it (the guard's output epoch,
-/// the pins and the counters).
+/// the pins and the counters). It writes into a buffer the caller gives
+/// (the board's own transmit buffer where it has one): the framed head is
+/// copied whole, a fixed-size copy, and the tail encoded after it.
 #[derive(Clone, Debug)]
 pub struct ReplyEncoder {
-    buf: [u8; MAX_WIRE],
+    /// The framed head, as words: copied a word at a time whatever the
+    /// alignment of the buffer it goes to (a library `memcpy` of its
+    /// unknown alignment costs about 80 instructions).
+    head_buf: [[u8; 4]; HEAD_WORDS],
     /// The encoder's state after the head.
     head: Cobs,
     key: Option<(u32, u8, u16, u16)>,
@@ -73,42 +83,57 @@ impl Default for ReplyEncoder {
 impl ReplyEncoder {
     /// An encoder with no head yet.
     pub const fn new() -> Self {
-        ReplyEncoder { buf: [0; MAX_WIRE], head: Cobs { at: 0, code_at: 0, code: 1, crc: 0xFFFF }, key: None }
+        ReplyEncoder { head_buf: [[0; 4]; HEAD_WORDS], head: Cobs { at: 0, code_at: 0, code: 1, crc: 0xFFFF }, key: None }
     }
 
-    /// The wire bytes of `r` (leading and trailing delimiter); `epoch`
-    /// changes whenever the outputs in `r` change.
+    /// The wire bytes of `r` (leading and trailing delimiter) written at
+    /// the start of `out`; returns their count. `epoch` changes whenever
+    /// the outputs in `r` change.
     #[inline(never)]
-    pub fn frame(&mut self, r: &TickReply, epoch: u32) -> &[u8] {
+    pub fn frame_into(&mut self, r: &TickReply, epoch: u32, out: &mut [u8; MAX_WIRE]) -> usize {
         let pins = u8::from(r.pins.valve_pin) | (u8::from(r.pins.ok_pin) << 1);
         let key = Some((epoch, pins, r.overruns, r.rejected));
         if self.key != key {
             self.key = key;
             let mut head = [0u8; TICK_LEN - TICK_TAIL_LEN];
             r.head(&mut PutAt::new(&mut head));
-            let mut c = Cobs { at: 2, code_at: 1, code: 1, crc: 0xFFFF };
-            if let Some(x) = self.buf.first_mut() {
+            let framed = self.head_buf.as_flattened_mut();
+            if let Some(x) = framed.first_mut() {
                 *x = 0; // the leading delimiter
             }
+            let mut c = Cobs { at: 2, code_at: 1, code: 1, crc: 0xFFFF };
             for b in head {
-                c.push(&mut self.buf, b);
+                c.push(framed, b);
             }
             self.head = c;
         }
+        if let Some([w0, w1, w2, w3, w4, w5, w6]) = out.as_chunks_mut::<4>().0.first_chunk_mut::<HEAD_WORDS>() {
+            // word by word, not in a loop (which LLVM turns back into a
+            // library `memcpy` call)
+            let [h0, h1, h2, h3, h4, h5, h6] = self.head_buf;
+            (*w0, *w1, *w2, *w3, *w4, *w5, *w6) = (h0, h1, h2, h3, h4, h5, h6);
+        }
         let mut c = self.head;
         for b in r.tail() {
-            c.push(&mut self.buf, b);
+            c.push(out, b);
         }
         for b in c.crc.to_le_bytes() {
-            c.put(&mut self.buf, b);
+            c.put(out, b);
         }
-        if let Some(x) = self.buf.get_mut(c.code_at) {
+        if let Some(x) = out.get_mut(c.code_at) {
             *x = c.code;
         }
-        if let Some(x) = self.buf.get_mut(c.at) {
+        if let Some(x) = out.get_mut(c.at) {
             *x = 0; // the trailing delimiter
         }
-        self.buf.get(..c.at + 1).unwrap_or(&[])
+        (c.at + 1).min(MAX_WIRE)
+    }
+
+    /// [`ReplyEncoder::frame_into`] a buffer of its own (tests, hosts).
+    pub fn frame(&mut self, r: &TickReply, epoch: u32) -> heapless::Vec<u8, MAX_WIRE> {
+        let mut out = [0u8; MAX_WIRE];
+        let n = self.frame_into(r, epoch, &mut out);
+        heapless::Vec::from_slice(out.get(..n).unwrap_or(&[])).unwrap_or_default()
     }
 }
 
@@ -142,7 +167,7 @@ mod tests {
         for k in 0..300u32 {
             let r = reply(k);
             // the epoch changes with the outputs (every 4 ticks here)
-            assert_eq!(e.frame(&r, k / 4 * 2 + k % 2), &r.encode()[..], "tick {k}");
+            assert_eq!(&e.frame(&r, k / 4 * 2 + k % 2)[..], &r.encode()[..], "tick {k}");
         }
     }
 }
