@@ -271,9 +271,9 @@ impl<N: Num> GuardOf<N> {
     /// start-up timeout): the machine may have run meanwhile, unseen. They
     /// are replayed at the first sample with its inputs (no piston work:
     /// the first sample has no position derivative), no cooling credit:
-    /// the machine is taken to have done then what it does now. Before
-    /// issue 33 they were not counted: a controller starting 5 s late on a
-    /// machine at 60 bar left the estimate 1.2 K low.
+    /// the machine is taken to have done then what it does now. Not
+    /// counting them, a controller starting 5 s late on a machine at 60 bar
+    /// would leave the estimate 1.2 K low.
     #[cold]
     #[inline(never)]
     fn replay_wait(&mut self) {

@@ -1,4 +1,4 @@
-//! Cooling over a measured off-time (issue 15 §5): after a power loss on a
+//! Cooling over a measured off-time: after a power loss on a
 //! board with a battery-backed real-time clock, the saved temperatures are
 //! cooled by an upper bound of the model's own cooling at rest, so the
 //! restore stays on the hot side while a machine that was off for hours does

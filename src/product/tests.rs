@@ -413,7 +413,7 @@ fn an_invalid_block_latches_config_and_opens_the_valve() {
     }
 }
 
-/// Power loss on a board with a real-time clock (issue 15 §5): the
+/// Power loss on a board with a real-time clock: the
 /// non-volatile record carries the clock reading; after 24 h off the restore
 /// is cooled by the model's rest bound (never below the air), on a board
 /// without a clock it stays at the saved temperatures plus the write

@@ -20,7 +20,7 @@
 //! every double-bit and every burst error up to 16 bits in frames of this size.
 //!
 //! CRC and COBS are written here (≈80 lines) instead of taken from the `crc`
-//! and `cobs` crates, for the product image's budgets (measured, session 18,
+//! and `cobs` crates, for the product image's budgets (measured,
 //! docs/firmware-numbers.md): with both crates it is 33 368 B, past its
 //! 32 KiB; with `crc` for the CRC-16 alone it fits (+100 B) but the product
 //! loop costs 91 instructions more per tick (the CRC runs on every frame in
