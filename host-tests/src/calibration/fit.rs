@@ -185,6 +185,9 @@ pub fn calibrate(base: &Rig, logs: &[CalLog], o: &CalOptions) -> Result<Calibrat
             Needs::Sensor(ch) if !logs.iter().any(|l| l.has(ch)) => {
                 Some(format!("no log carries `{}`; would need: {}", ch.name(), d.excitation))
             }
+            Needs::Input(ch) if !logs.iter().any(|l| super::log::input_above_zero(&l.run, ch)) => {
+                Some(format!("no log has `{}` above 0; would need: {}", ch.name(), d.excitation))
+            }
             _ => None,
         })
         .collect();

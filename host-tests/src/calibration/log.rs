@@ -37,6 +37,12 @@ pub fn scored_channels(run: &MeasuredRun) -> Vec<Channel> {
         .collect()
 }
 
+/// Whether `run` logs input `ch` above zero at some sample (a ram-air
+/// column of zeros carries no forced convection to calibrate).
+pub fn input_above_zero(run: &MeasuredRun, ch: Channel) -> bool {
+    run.get(ch).is_some_and(|v| v.iter().flatten().any(|&x| x > 0.0))
+}
+
 impl CalLog {
     /// Prepares `run` (named `name`) with at most `points_per_channel` fit
     /// points per channel. Errors when an input column is empty.

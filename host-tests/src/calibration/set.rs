@@ -19,6 +19,9 @@ pub enum Needs {
     Nothing,
     /// A logged temperature channel on that node.
     Sensor(Channel),
+    /// A logged input column that is above zero somewhere (the ram air:
+    /// without a logged stream its coefficient acts on nothing).
+    Input(Channel),
 }
 
 /// One parameter of the calibration set.
@@ -34,8 +37,11 @@ pub struct ParamDef {
     pub lo: f64,
     /// Upper bound of the multiplier.
     pub hi: f64,
-    /// Standard deviation of the prior on ln θ (centre ln 1 = the rig file).
+    /// Standard deviation of the prior on ln θ; the prior's centre is θ = 1,
+    /// which is [`ParamDef::centre`].
     pub prior_sigma_ln: f64,
+    /// What θ = 1 (the prior's centre) is, with its source.
+    pub centre: &'static str,
     /// Why these bounds and this prior width.
     pub why: &'static str,
     /// Sensor the logs must carry for this parameter to be fitted.
@@ -60,13 +66,20 @@ pub enum Stage {
 /// `commission`, freed by `--fit-oil-probe`).
 pub const PROBE_OIL: &str = "probe_oil";
 
+/// The prior centre of a multiplier on a rig-file value: the rig file.
+pub const RIG_FILE: &str = "the rig file's value";
+
+/// Name of the forced-convection (ram-air) coefficient's parameter.
+pub const H_FORCED: &str = "h_forced";
+
 /// The calibration set, in fit order.
-pub const PARAMS: [ParamDef; 20] = [
+pub const PARAMS: [ParamDef; 21] = [
     ParamDef {
         name: "h_out_motor",
         what: "outer heat transfer of the motor housing (free convection + radiation)",
         fields: "motor.area_m2",
         lo: 0.25, hi: 4.0, prior_sigma_ln: 0.5,
+        centre: RIG_FILE,
         why: "still-air h of painted housings is 3–15 W/(m²·K) against the correlation's 6–9; exposed area 50–100 % of Table 2's",
         needs: Needs::Sensor(Channel::TMotorC),
         excitation: "a long soak (> 20 min) with the motor loaded, then a cool-down with the shaft stopped",
@@ -77,6 +90,7 @@ pub const PARAMS: [ParamDef; 20] = [
         what: "outer heat transfer of the pump housing",
         fields: "pump.area_m2",
         lo: 0.25, hi: 4.0, prior_sigma_ln: 0.5,
+        centre: RIG_FILE,
         why: "as h_out_motor; the pump's mounting can shield or add area",
         needs: Needs::Sensor(Channel::TPumpC),
         excitation: "a soak to near steady state and a cool-down at 0 rpm",
@@ -87,6 +101,7 @@ pub const PARAMS: [ParamDef; 20] = [
         what: "outer heat transfer of the main valve block (also scales its wall conduction area)",
         fields: "blocks.main_area_m2",
         lo: 0.25, hi: 4.0, prior_sigma_ln: 0.5,
+        centre: RIG_FILE,
         why: "Table 2 gives 0.44 m² for both blocks; the split and the exposed fraction are assumed",
         needs: Needs::Sensor(Channel::TBlockC),
         excitation: "a long soak (the main block's time constant is hours) and a cool-down",
@@ -97,9 +112,21 @@ pub const PARAMS: [ParamDef; 20] = [
         what: "outer heat transfer of the ball/needle-valve block (also scales its wall conduction area)",
         fields: "blocks.ball_area_m2",
         lo: 0.25, hi: 4.0, prior_sigma_ln: 0.5,
+        centre: RIG_FILE,
         why: "split of Table 2's block area assumed",
         needs: Needs::Sensor(Channel::TBallvalveC),
         excitation: "throttling through the needle for > 20 min, then a cool-down",
+        stage: Stage::Thermal,
+    },
+    ParamDef {
+        name: H_FORCED,
+        what: "forced-convection (ram-air) coefficient of every housing, as a factor on the rig's flat-plate law",
+        fields: "outside.ram_run_length_m (×θ^-5: the turbulent flat-plate h ∝ L^-0.2, so h_forced ×θ exactly)",
+        lo: 0.25, hi: 4.0, prior_sigma_ln: 0.4,
+        centre: "the rig file's law: turbulent flat plate with the run length that gives Table 5's 66.1 W/(m²·K) at 15 m/s",
+        why: "the paper's coefficient is one flat-plate law for every housing; cross-flow correlations for cylinders and blocks of these sizes (Churchill–Bernstein, Hilpert) give 0.6–0.8 of it, and ducting, blockage and shielding on a real bench move it by ±30 %: σ 0.4 in ln covers ×0.45…×2.2 at 2σ",
+        needs: Needs::Input(Channel::AirSpeedMps),
+        excitation: "ram-air steps (0 and 5–25 m/s) with the housings well above the air",
         stage: Stage::Thermal,
     },
     ParamDef {
@@ -107,6 +134,7 @@ pub const PARAMS: [ParamDef; 20] = [
         what: "oil-to-metal film, loop oil ↔ main block (eqs. 12–14)",
         fields: "blocks.loop_area_scale",
         lo: 0.2, hi: 5.0, prior_sigma_ln: 0.7,
+        centre: RIG_FILE,
         why: "duct correlations scatter ±30 %; the wetted area of drilled passages is unknown within a factor 3",
         needs: Needs::Sensor(Channel::TBlockC),
         excitation: "flow steps (shaft speed) while the oil is tens of kelvin above the block",
@@ -117,6 +145,7 @@ pub const PARAMS: [ParamDef; 20] = [
         what: "oil-to-metal film, pump port passages ↔ pump housing",
         fields: "pump.port_area_scale",
         lo: 0.2, hi: 5.0, prior_sigma_ln: 0.7,
+        centre: RIG_FILE,
         why: "port geometry assumed",
         needs: Needs::Sensor(Channel::TPumpC),
         excitation: "speed steps at a constant pressure drop",
@@ -127,6 +156,7 @@ pub const PARAMS: [ParamDef; 20] = [
         what: "oil-to-metal film, ball-valve oil ↔ ball block",
         fields: "nuisance.inner_scale (×θ) with blocks.loop_area_scale, pump.port_area_scale, pump.case_inner_area_m2 (÷θ, so only the ball film changes)",
         lo: 0.2, hi: 5.0, prior_sigma_ln: 0.7,
+        centre: RIG_FILE,
         why: "ball-block passage geometry assumed",
         needs: Needs::Sensor(Channel::TBallvalveC),
         excitation: "needle throttling at several flows",
@@ -137,6 +167,7 @@ pub const PARAMS: [ParamDef; 20] = [
         what: "case-oil film on the pump housing (rotating group)",
         fields: "pump.case_inner_area_m2",
         lo: 0.1, hi: 10.0, prior_sigma_ln: 1.0,
+        centre: RIG_FILE,
         why: "the reference takes the case flow as laminar Taylor–Couette flow (Nu = 2 below the instability, a lower bound: slippers, pistons and the leakage jets churn a real case) on an assumed inner area",
         needs: Needs::Sensor(Channel::TPumpC),
         excitation: "speed steps with a drain thermocouple (t_drain_c) or a pump-surface sensor",
@@ -147,6 +178,7 @@ pub const PARAMS: [ParamDef; 20] = [
         what: "heat capacity of the motor housing (mass without the winding)",
         fields: "motor.mass_kg (the part above motor.winding_mass_kg)",
         lo: 0.4, hi: 2.5, prior_sigma_ln: 0.3,
+        centre: RIG_FILE,
         why: "Table 2 gives the total mass; the part that follows the surface sensor within minutes is 50–100 %",
         needs: Needs::Sensor(Channel::TMotorC),
         excitation: "load steps: the motor's heating rate right after a current step",
@@ -157,6 +189,7 @@ pub const PARAMS: [ParamDef; 20] = [
         what: "heat capacity of the pump housing",
         fields: "pump.mass_kg",
         lo: 0.4, hi: 2.5, prior_sigma_ln: 0.3,
+        centre: RIG_FILE,
         why: "Table 2 mass; participating fraction and cp (steel/aluminium) uncertain",
         needs: Needs::Sensor(Channel::TPumpC),
         excitation: "pressure or speed steps: the pump's heating rate after a step",
@@ -167,6 +200,7 @@ pub const PARAMS: [ParamDef; 20] = [
         what: "heat capacity of the main valve block",
         fields: "blocks.main_mass_kg",
         lo: 0.4, hi: 2.5, prior_sigma_ln: 0.4,
+        centre: RIG_FILE,
         why: "split of Table 2's 190 kg assumed",
         needs: Needs::Sensor(Channel::TBlockC),
         excitation: "a load step held for > 20 min",
@@ -177,6 +211,7 @@ pub const PARAMS: [ParamDef; 20] = [
         what: "heat capacity of the ball/needle-valve block",
         fields: "blocks.ball_mass_kg",
         lo: 0.4, hi: 2.5, prior_sigma_ln: 0.4,
+        centre: RIG_FILE,
         why: "split of Table 2's 190 kg assumed",
         needs: Needs::Sensor(Channel::TBallvalveC),
         excitation: "needle pressure steps",
@@ -187,6 +222,7 @@ pub const PARAMS: [ParamDef; 20] = [
         what: "circulating-oil volume (main-block passages, hoses, accumulator side)",
         fields: "blocks.loop_oil_m3",
         lo: 0.3, hi: 3.0, prior_sigma_ln: 0.5,
+        centre: RIG_FILE,
         why: "hose lengths and accumulator volume differ between rigs",
         needs: Needs::Sensor(Channel::TOilC),
         excitation: "load steps: the oil sensor's rate right after a step",
@@ -197,6 +233,7 @@ pub const PARAMS: [ParamDef; 20] = [
         what: "oil volume of the pump case",
         fields: "pump.case_oil_m3",
         lo: 0.3, hi: 3.0, prior_sigma_ln: 0.5,
+        centre: RIG_FILE,
         why: "pump design; not in the paper",
         needs: Needs::Sensor(Channel::TDrainC),
         excitation: "a drain thermocouple (t_drain_c) and pressure steps",
@@ -207,6 +244,7 @@ pub const PARAMS: [ParamDef; 20] = [
         what: "response time of the manifold oil probe in the flowing oil (thermowell, sheath)",
         fields: "blocks.sensor_tau_s",
         lo: 0.25, hi: 5.0, prior_sigma_ln: 1.0,
+        centre: RIG_FILE,
         why: "sheathed probes in thermowells in flowing oil answer in 1–20 s (t63); the rig file's 2 s is assumed. Longer lags belong to a dead-end pocket (candidate sensor-lag)",
         needs: Needs::Sensor(Channel::TOilC),
         excitation: "load or speed steps: the oil channel's delay right after a step",
@@ -217,6 +255,7 @@ pub const PARAMS: [ParamDef; 20] = [
         what: "pump friction torque of the extended eq. (8), T0 + C_v·μ·D·ω + η_m·D·Δp, as a whole",
         fields: "pump.no_load_torque_nm, pump.viscous_torque_coeff, pump.eta_m",
         lo: 0.1, hi: 2.0, prior_sigma_ln: 0.5,
+        centre: RIG_FILE,
         why: "hydro-mechanical efficiency 70–95 % (the rig file's η_m 0.28 is calibrated on one rig)",
         needs: Needs::Nothing,
         excitation: "pressure steps at constant speed and speed steps at constant pressure (separates it from leakage)",
@@ -227,6 +266,7 @@ pub const PARAMS: [ParamDef; 20] = [
         what: "pump leakage gap height (pistons, slippers, valve plate; leakage ∝ gap³)",
         fields: "pump.gaps.piston_gap_m, pump.gaps.slipper_gap_m, pump.gaps.port_gap_m",
         lo: 0.33, hi: 2.5, prior_sigma_ln: 0.3,
+        centre: RIG_FILE,
         why: "gaps of 4–30 µm for the rig file's 12 µm",
         needs: Needs::Nothing,
         excitation: "pressure steps at a low speed (leakage heat ∝ Δp² does not scale with ω)",
@@ -237,6 +277,7 @@ pub const PARAMS: [ParamDef; 20] = [
         what: "winding resistance at 25 °C (eq. 1)",
         fields: "motor.r25_ohm",
         lo: 0.5, hi: 2.0, prior_sigma_ln: 0.15,
+        centre: RIG_FILE,
         why: "Table 2 gives 0.074 Ω; cables, connectors and the measurement temperature move it by tens of %",
         needs: Needs::Nothing,
         excitation: "current steps (pressure steps) with the motor sensor logged; or measure R with a 4-wire meter",
@@ -247,6 +288,7 @@ pub const PARAMS: [ParamDef; 20] = [
         what: "stator iron-loss coefficients k_h, k_c, k_e of eq. (2)",
         fields: "motor.iron.k_h, motor.iron.k_c, motor.iron.k_e",
         lo: 0.2, hi: 5.0, prior_sigma_ln: 0.7,
+        centre: RIG_FILE,
         why: "Bertotti coefficients of electrical steels span an order of magnitude; not in the paper",
         needs: Needs::Nothing,
         excitation: "speed steps at a low pressure drop (iron loss follows ω, copper loss the current)",
@@ -257,6 +299,7 @@ pub const PARAMS: [ParamDef; 20] = [
         what: "share of the throttling heat released in the line/hoses (loop oil) rather than at the needle (ball-valve oil)",
         fields: "hydraulics.path.length_m, hydraulics.path.local_loss_coeff",
         lo: 0.1, hi: 5.0, prior_sigma_ln: 0.7,
+        centre: RIG_FILE,
         why: "hose lengths and fittings of the throttle path are assumed",
         needs: Needs::Sensor(Channel::TBallvalveC),
         excitation: "needle throttling at several flows (line loss ∝ q², needle heat = the rest)",
@@ -281,6 +324,7 @@ pub fn apply(base: &Rig, theta: &[f64]) -> Rig {
             "h_out_pump" => r.pump.area_m2 *= t,
             "h_out_main_block" => r.blocks.main_area_m2 *= t,
             "h_out_ball_block" => r.blocks.ball_area_m2 *= t,
+            H_FORCED => r.outside.ram_run_length_m *= t.powi(-5),
             "film_loop" => r.blocks.loop_area_scale *= t,
             "film_port" => r.pump.port_area_scale *= t,
             "film_ball" => {

@@ -123,6 +123,13 @@ fn emulator_machine_held_out_error_falls() {
 /// emulator's structure floor, ~0.5 K, plus margin), the families'
 /// calibration at least 1.1 K off on the identification run (a miss more
 /// than twice the floor: the finding itself).
+///
+/// With both oils on their viscosity lines this test fails (measured:
+/// families 0.84 / 2.44 K, identification runs 1.87 / 1.56 K; with the
+/// forced-convection coefficient `h_forced` in the set, identification runs
+/// 1.07 / 1.17 K, families unchanged). The bound is kept: the remaining miss
+/// is the oil channel and the main block (docs/calibration.md, "Rig-level
+/// structure in the commissioning and diagnosis calibration set").
 #[test]
 #[ignore = "slow tier: two calibrations on emulator logs"]
 fn slow_identification_runs_commission_across_regimes() {
