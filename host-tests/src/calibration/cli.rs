@@ -1,5 +1,5 @@
 //! `eha-sim commission`: from a team's rig logs to firmware parameters for
-//! their EHA (issue 18). Writes `rig.toml`, `params.rs`, `firmware-params.bin`
+//! their EHA. Writes `rig.toml`, `params.rs`, `firmware-params.bin`
 //! (only when the reduced model holds), `report.md` and `holdout-*.png` into
 //! `--out`; `--check firmware-params.bin` runs the firmware's boot checks; exit 0 when the reduced model meets the
 //! 0.2 K bound on every log, 1 when it does not (the report says why), 2 on

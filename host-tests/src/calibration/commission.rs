@@ -1,4 +1,4 @@
-//! Commissioning (issue 18): calibrate the reference model to a team's
+//! Commissioning: calibrate the reference model to a team's
 //! training logs, validate on held-out logs, reduce the commissioned rig to
 //! firmware parameters and check the reduced model against the
 //! commissioned reference, and against the measured drain temperature when
@@ -15,7 +15,7 @@ use crate::scenario::Scenario;
 use eha_guard::model::{Model, ModelInputN, ReducedParams};
 
 /// Bound of the reduced model against the commissioned reference on every
-/// log's inputs, drain max |e|, K (issue 18).
+/// log's inputs, drain max |e|, K.
 pub const REDUCED_BOUND_K: f64 = 0.2;
 
 /// The reduced model (firmware parameters `p`, f64) on one log's inputs.
@@ -129,7 +129,7 @@ pub struct Commissioning {
 impl Commissioning {
     /// Whether the firmware parameter block may be flashed: the reduced model
     /// holds every log and the training logs separate the loss coefficients.
-    /// Measured (issue 16): commissioned from one operating point, the other
+    /// Measured: commissioned from one operating point, the other
     /// EHA's firmware under-predicted a held-out high-pressure mission by
     /// 1.8 K with every reduced check passing.
     pub fn flashable(&self) -> bool {
@@ -228,7 +228,7 @@ pub fn commission(base: &Rig, train: &[CalLog], holdout: &[CalLog], o: &CalOptio
 /// reads it: its drain thermocouple, else its manifold oil sensor (a few kelvin
 /// colder than the case oil), else 40 °C. (At 40 °C throughout, the viscous
 /// friction of oil at 20 °C, 2.2 times its 40 °C value, went into `eta_m`, and the
-/// firmware, whose friction follows the oil since issue 34, saw its own
+/// firmware, whose friction follows the oil, saw its own
 /// cross-check disagree within a second.)
 /// `(eta_m, rows)`; `None` without current or load, or outside 0.01..2.
 pub fn eta_m_from_current(rig: &Rig, logs: &[CalLog]) -> Option<(f64, usize)> {

@@ -2,7 +2,7 @@
 //! and commissioning tests and examples): a few mission kinds, the sensors
 //! of the measured-data format with σ = 0.1 K noise, 12-bit quantisation,
 //! ~1 % dropped rows and ~0.5 % empty cells, optionally a drain-port
-//! thermocouple; and a synthetic "other EHA" (issue 18 §4).
+//! thermocouple; and a synthetic "other EHA".
 
 use crate::diagnosis::synth::quantise;
 use crate::measured::{Channel, MeasuredRun};

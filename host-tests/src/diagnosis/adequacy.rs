@@ -1,4 +1,4 @@
-//! Is the calibrated baseline good enough to judge? (issue 17, the
+//! Is the calibrated baseline good enough to judge? (the
 //! `unexplained` answer.) Compares every channel's held-out error of the
 //! calibrated baseline with the channel's own noise floor, estimated from
 //! the measured samples, and with how far the channel moved; lists the

@@ -1,4 +1,4 @@
-//! The diagnosis procedure of issue 5: baseline, calibration on the
+//! The diagnosis procedure: baseline, calibration on the
 //! training window, residual analysis, candidate fits ranked by BIC with
 //! held-out improvement, and the winner's before/after errors.
 
@@ -41,8 +41,8 @@ pub const MISFIT_ABS_K: f64 = 3.0;
 /// those, that excuse is gone; what the set still leaves is reported.
 pub const PHYSICAL_MISFIT_RISE_FRACTION: f64 = 0.1;
 /// Absolute bound of the default [`DiagnoseOptions::physical_misfit`]: 1 K, the firmware's
-/// drain accuracy bound on a commissioned machine (issue 18: max error
-/// ≤ 1 K): a model that misses a held-out channel by more than that after
+/// drain accuracy bound on a commissioned machine (max error ≤ 1 K): a
+/// model that misses a held-out channel by more than that after
 /// the full physical calibration is not good enough to judge by.
 pub const PHYSICAL_MISFIT_ABS_K: f64 = 1.0;
 
@@ -377,11 +377,11 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
     // and its gain would then be the basin's, not the effect's; the better
     // baseline (training residual) is the one candidates are judged
     // against. In the global tier only then (restarting every global
-    // baseline turned the servo `none` log 1717 `unexplained`, session 13);
+    // baseline turned the servo `none` log 1717 `unexplained`);
     // in the physical tier always: whether a candidate first qualifies there
     // is itself path-dependent (a semantically neutral refactor moved
     // emulator log 1708 across it, and its baseline from 0.38 to 0.41 K held
-    // out; session 17), and the baseline should not depend on it.
+    // out), and the baseline should not depend on it.
     if ranking.iter().any(|r| r.qualifies) || !escalate {
         let mut by_rss: Vec<&FitResult> = fits.iter().collect();
         by_rss.sort_by(|a, b| a.rss.total_cmp(&b.rss));
@@ -395,7 +395,7 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
             // the new baseline (nearly off), the better fit kept. Without
             // it a candidate, which contains the baseline as its limit,
             // could rank far below it (measured: emulator seed 1701, every
-            // candidate ΔBIC −290 to −420, session 17).
+            // candidate ΔBIC −290 to −420).
             let refits: Vec<Option<FitResult>> = fits.par_iter().map(|f| fit_from(sim, run, &pts, f.candidate, &base, o)).collect();
             extra_sims += refits.iter().flatten().map(|f| f.sims).sum::<usize>();
             for (f, r) in fits.iter_mut().zip(refits) {
@@ -532,7 +532,7 @@ pub fn unconfuse_housing_paths(ranking: &mut [RankEntry]) {
 /// (emulator seed 1710, hidden conduction: forced convection had the lower
 /// BIC by 36 and the higher held-out error, 0.297 against 0.272 K); no
 /// synthetic test and no other emulator log has two qualifying candidates
-/// (docs/diagnosis.md, session 15).
+/// (docs/diagnosis.md).
 pub fn choose(ranking: &[RankEntry]) -> Option<&RankEntry> {
     ranking.iter().filter(|r| r.qualifies).min_by(|a, b| a.heldout_rmse_k.total_cmp(&b.heldout_rmse_k).then(a.bic.total_cmp(&b.bic)))
 }

@@ -30,7 +30,7 @@ pub const HOUSING_OUTER_PREFIX: &str = "h_out_";
 ///   air speed the stream is a constant change of each housing's outer
 ///   coefficient, which that set carries; only a varying logged air speed
 ///   (the same 20 % span rule) shows its v^0.8 law. In the physical tier
-///   of session 12's emulator sweep a hidden motor–pump conduction on a
+///   of an earlier emulator sweep a hidden motor–pump conduction on a
 ///   constant-throttle log (seed 1710) was named forced convection, and a
 ///   hidden forced convection (seed 1712) gained 1 % (docs/diagnosis.md).
 ///   Under the four global multipliers (one outer scale for every housing)
@@ -39,7 +39,7 @@ pub const HOUSING_OUTER_PREFIX: &str = "h_out_";
 ///   point (`calibration::ident::one_point`): the path cools the pump and
 ///   warms the motor by a nearly constant heat, which the per-housing outer
 ///   transfer, films and capacities carry like the stream above; the two
-///   candidates then explain each other (session 16: a hidden forced
+///   candidates then explain each other (measured: a hidden forced
 ///   convection on a constant-throttle log, seed 1812, was named
 ///   conduction with 73 % on t_pump_c; seed 1710 the mirror image under
 ///   the global set). Speed or pressure steps change the pump's heat and

@@ -1,4 +1,4 @@
-//! Diagnosis of a measured run against the reference model (issue 5):
+//! Diagnosis of a measured run against the reference model:
 //! drive the model with the measured inputs, calibrate a nuisance set on a
 //! training window, show where and how the residuals are structured, fit
 //! every candidate extension, name the cause by BIC plus held-out gain, and

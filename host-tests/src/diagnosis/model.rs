@@ -5,8 +5,8 @@
 use crate::measured::Channel;
 use std::collections::BTreeMap;
 
-/// A candidate model extension (issue 2, "Model extensions"); `None` is the
-/// baseline. Names are the exact strings of issue 5. `viscosity-temperature`
+/// A candidate model extension (the rig file's `[ext]` section); `None` is
+/// the baseline. Names are the strings `diagnosis.json` reports. `viscosity-temperature`
 /// is retired: the oil's viscosity follows its Walther line in the baseline
 /// of the reference and of the emulator, so there is nothing left to find.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]

@@ -5,14 +5,14 @@
 use super::model::SimSeries;
 use crate::measured::{Channel, MeasuredRun};
 
-/// Pump displacement, m³/rad (19 cm³/rev, issue 2 / paper Table 3).
+/// Pump displacement, m³/rad (19 cm³/rev, paper Table 3).
 const D_RAD: f64 = 19e-6 / (2.0 * std::f64::consts::PI);
 /// Ram area, m² (1526.81 mm², paper Table 3).
 const A_RAM: f64 = 1526.81e-6;
 
 /// Kinematic viscosity of ISO VG 46 oil, cSt, by the ASTM D341 (Walther)
 /// relation log10 log10(ν+0.7) = A − B log10(T\[K\]) through 46 cSt at 40 °C
-/// and 6.8 cSt at 100 °C (issue 2, Fluids). Used only as the μ(T) of the
+/// and 6.8 cSt at 100 °C (ISO VG 46). Used only as the μ(T) of the
 /// Δp²/μ(T) leakage regressor (paper eqs. 5–7: leakage loss ∝ Δp²/μ).
 pub fn vg46_viscosity_cst(t_c: f64) -> f64 {
     let w = |nu: f64| (nu + 0.7f64).log10().log10();

@@ -1,5 +1,5 @@
 //! Writing a diagnosis: `diagnosis.json` (the machine-readable verdict with
-//! exactly the keys of issue 5) and `report.md` (the evidence, with PNGs).
+//! its documented keys) and `report.md` (the evidence, with PNGs).
 
 use super::analysis::{Diagnosis, Metrics, RankEntry};
 use std::fmt::Write as _;
@@ -16,7 +16,7 @@ pub struct RankingJson {
     pub heldout_rmse_k: f64,
 }
 
-/// `diagnosis.json`: exactly the top-level keys of issue 5. RMSEs are pooled
+/// `diagnosis.json`: exactly its documented top-level keys. RMSEs are pooled
 /// over every measured temperature channel, K; "before" is the calibrated
 /// baseline, "after" the model with `cause` switched on (equal to "before"
 /// when `cause` is `none`).
@@ -39,7 +39,7 @@ pub struct DiagnosisJson {
     /// Every candidate and `none`, best BIC first.
     pub ranking: Vec<RankingJson>,
     /// Present only when `cause` is `unexplained`: what misfits and what
-    /// to check (issue 17).
+    /// to check.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub unexplained: Option<UnexplainedJson>,
 }

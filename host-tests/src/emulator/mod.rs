@@ -1,4 +1,4 @@
-//! An independent rig emulator (issue 17): a second "truth" for the
+//! An independent rig emulator: a second "truth" for the
 //! diagnosis tests, written from the paper (Liu et al., eqs. 1–19, Tables
 //! 2–3) without the reference model's code (`model.rs`, `network.rs`,
 //! `losses.rs`, `heat.rs`, `fluid.rs` are not called). It differs from the
@@ -18,8 +18,8 @@
 //!   loop oil, the needle's the ball-block oil. In the throttle runs the
 //!   oil obeys the first law: the pressure work's α·T share (α from the
 //!   emulator's own density law) heats the delivered oil on compression,
-//!   the needle, hoses and leakage get the (1 − α·T) rest (session 15;
-//!   before, the expansions took it all, as the paper's eqs. do).
+//!   the needle, hoses and leakage get the (1 − α·T) rest (the paper's
+//!   eqs. give the expansions all of it).
 //! - **Correlations** ([`props`]): Churchill–Chu vertical + McAdams faces
 //!   for free convection, Churchill–Bernstein for the air flow, Churchill's
 //!   Nu³ mixing; Hausen/Gnielinski duct films; a rotating-cylinder film for

@@ -110,3 +110,54 @@ fn c_example_in_qemu_equals_the_rust_application_bit_for_bit_on_fig15() {
         vs_image.first_difference, vs_image.first_difference.map(|k| c_replies[k]), vs_image.first_difference.map(|k| rust[k]));
     assert_eq!(vs_sil.identical, vs_sil.ticks, "C image differs from the host SIL first at tick {:?}", vs_sil.first_difference);
 }
+
+/// The same C example built for the Cortex-M3 (`EHA_CPU=cortex-m3`: no FPU,
+/// the library's f32 in soft-float, `thumbv7m-none-eabi`) in QEMU
+/// mps2-an385, in closed loop on Fig. 15: every tick reply bit-identical to
+/// the Rust application on the host (SIL) on the same frames, which the test
+/// above shows equal to the Cortex-M4F image. Tolerance: none — IEEE single
+/// precision is the same arithmetic with or without the FPU (correctly
+/// rounded operations, no fused multiply-add, the same libm code).
+#[test]
+fn c_example_for_the_cortex_m3_equals_the_rust_application_bit_for_bit_on_fig15() {
+    require_qemu();
+    let lib = common::staticlib(Some("thumbv7m-none-eabi"));
+    let elf = common::scratch("fig15-m3").join("fig15.elf");
+    common::run(
+        Command::new(common::crate_dir().join("examples/fig15/build.sh")).arg(&elf).arg(&lib).env("EHA_CPU", "cortex-m3"),
+        "building the C example for the Cortex-M3",
+    );
+    let size = common::run(Command::new("arm-none-eabi-size").arg(&elf), "arm-none-eabi-size");
+    eprintln!("C example for the Cortex-M3:\n{size}");
+    let opts = LoopOptions { tick_s: eha_guard::params::S_PER_TICK, duration_s: DURATION_S };
+    let n = opts.ticks();
+    let mut q = QemuOptions::new(Build::F32, &elf);
+    q.machine = "mps2-an385".into();
+    q.cpu = "cortex-m3".into();
+    q.icount = true;
+    let t0 = std::time::Instant::now();
+    let mut c = QemuSession::spawn(&q).unwrap_or_else(|e| panic!("{e}"));
+    let mut plant = Plant::new(&Rig::default(), &Scenario::Lng { duration_s: DURATION_S }).unwrap_or_else(|e| panic!("plant: {e}"));
+    let records = match run_closed_loop(&mut plant, &mut c, &opts) {
+        Ok(r) => r,
+        Err(f) => panic!("Cortex-M3 C image closed loop failed after {} ticks: {:#}", f.records.len(), f.error),
+    };
+    let end = c.finish(n).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(records.len() as u64, n);
+    assert_eq!(end.done.accepted as u64, n, "the C loop accepted every sample frame");
+    let c_replies: Vec<TickReply> = records.iter().map(|r| r.reply).collect();
+    let s = Summary::of(&records, true);
+    assert!(s.valve_events.iter().any(|(_, o)| *o), "the Fig. 15 run must open the LNG valve: {:?}", s.valve_events);
+    let mut sil = SilTarget::new(Build::F32);
+    let host = replay(&records, &mut sil).unwrap_or_else(|e| panic!("{e}"));
+    let vs_sil = compare(&c_replies, &host);
+    let mean_instr = records.iter().map(|r| f64::from(r.cycles)).sum::<f64>() / records.len().max(1) as f64 / eha_sim::pil::qemu::TICKS_PER_INSTRUCTION;
+    eprintln!(
+        "Fig. 15 on the Cortex-M3, {n} ticks: C image vs host SIL {}/{} bit-identical; valve events {:?}; {mean_instr:.0} instructions per tick (soft-float); wall {:.1} s",
+        vs_sil.identical,
+        vs_sil.ticks,
+        s.valve_events,
+        t0.elapsed().as_secs_f64()
+    );
+    assert_eq!(vs_sil.identical, vs_sil.ticks, "Cortex-M3 C image differs from the host SIL first at tick {:?}", vs_sil.first_difference);
+}

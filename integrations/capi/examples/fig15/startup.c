@@ -29,9 +29,12 @@ void reset_handler(void)
     for (uint32_t *p = &__noinit_end; (uintptr_t)p < sp - 64; p++) {
         *p = PAINT;
     }
-    /* The FPU first (CPACR: CP10 and CP11 full access): the guard is f32. */
+#if defined(__ARM_FP)
+    /* The FPU first (CPACR: CP10 and CP11 full access): the guard is f32.
+       (A Cortex-M3 build has no FPU: its f32 is soft-float.) */
     *(volatile uint32_t *)0xE000ED88u |= 0xFu << 20;
     __asm__ volatile("dsb\n isb" ::: "memory");
+#endif
     const uint32_t *src = &__data_load;
     for (uint32_t *dst = &__data_start; dst < &__data_end;) {
         *dst++ = *src++;
