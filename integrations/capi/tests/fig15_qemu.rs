@@ -19,12 +19,39 @@ use std::process::Command;
 use eha_guard::product::wire::TickReply;
 use eha_sim::pil::report::{compare, Summary};
 use eha_sim::pil::sil::SilTarget;
-use eha_sim::pil::{firmware_for_tests, replay, require_qemu, run_closed_loop, Build, LoopOptions, QemuOptions, QemuSession};
+use eha_sim::pil::qemu::SessionEnd;
+use eha_sim::pil::{firmware_for_tests, replay, require_qemu, run_closed_loop, Build, LoopOptions, QemuOptions, QemuSession, TickRecord};
 use eha_sim::plant::Plant;
 use eha_sim::rig::Rig;
 use eha_sim::scenario::Scenario;
 
 const DURATION_S: f64 = 600.0;
+
+/// Instructions per tick, mean and max, from SysTick cycles under -icount.
+fn instructions(cycles: &[u32]) -> (f64, f64) {
+    let v: Vec<f64> = cycles.iter().map(|c| f64::from(*c) / eha_sim::pil::qemu::TICKS_PER_INSTRUCTION).collect();
+    (v.iter().sum::<f64>() / v.len().max(1) as f64, v.iter().cloned().fold(0.0, f64::max))
+}
+
+/// A C image (`q`, with -icount) in closed loop with the reference plant on
+/// Fig. 15 for `DURATION_S`: its tick records, its end-of-run report and the
+/// wall time, s. Every tick ran and every sample frame was accepted.
+fn c_image_on_fig15(mut q: QemuOptions) -> (Vec<TickRecord>, SessionEnd, f64) {
+    let opts = LoopOptions { tick_s: eha_guard::params::S_PER_TICK, duration_s: DURATION_S };
+    let n = opts.ticks();
+    q.icount = true;
+    let t0 = std::time::Instant::now();
+    let mut c = QemuSession::spawn(&q).unwrap_or_else(|e| panic!("{e}"));
+    let mut plant = Plant::new(&Rig::default(), &Scenario::Lng { duration_s: DURATION_S }).unwrap_or_else(|e| panic!("plant: {e}"));
+    let records = match run_closed_loop(&mut plant, &mut c, &opts) {
+        Ok(r) => r,
+        Err(f) => panic!("C image ({}) closed loop failed after {} ticks: {:#}", q.machine, f.records.len(), f.error),
+    };
+    let end = c.finish(n).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(records.len() as u64, n);
+    assert_eq!(end.done.accepted as u64, n, "the C loop accepted every sample frame");
+    (records, end, t0.elapsed().as_secs_f64())
+}
 
 #[test]
 fn c_example_in_qemu_equals_the_rust_application_bit_for_bit_on_fig15() {
@@ -42,25 +69,12 @@ fn c_example_in_qemu_equals_the_rust_application_bit_for_bit_on_fig15() {
     assert!(panics.is_empty(), "the C image links panicking code: {panics:?}");
 
     // The C image in closed loop with the plant (-icount: instruction counts).
-    let opts = LoopOptions { tick_s: eha_guard::params::S_PER_TICK, duration_s: DURATION_S };
-    let n = opts.ticks();
-    let mut q = QemuOptions::new(Build::F32, &elf);
-    q.icount = true;
-    let t0 = std::time::Instant::now();
-    let mut c = QemuSession::spawn(&q).unwrap_or_else(|e| panic!("{e}"));
-    let mut plant = Plant::new(&Rig::default(), &Scenario::Lng { duration_s: DURATION_S }).unwrap_or_else(|e| panic!("plant: {e}"));
-    let records = match run_closed_loop(&mut plant, &mut c, &opts) {
-        Ok(r) => r,
-        Err(f) => panic!("C image closed loop failed after {} ticks: {:#}", f.records.len(), f.error),
-    };
-    let end = c.finish(n).unwrap_or_else(|e| panic!("{e}"));
-    let wall_c = t0.elapsed().as_secs_f64();
+    let (records, end, wall_c) = c_image_on_fig15(QemuOptions::new(Build::F32, &elf));
+    let n = records.len() as u64;
     // The C image's stack high-water mark (painted at reset), on its stdout.
     let stdout = String::from_utf8_lossy(&end.defmt);
     let stack_b: u32 = stdout.lines().find_map(|l| l.strip_prefix("stack_high_water_b=")).and_then(|v| v.trim().parse().ok()).unwrap_or_else(|| panic!("no stack report on the C image's stdout: {stdout:?}"));
     assert!(stack_b > 0 && stack_b < 16 * 1024, "stack high-water {stack_b} B");
-    assert_eq!(records.len() as u64, n);
-    assert_eq!(end.done.accepted as u64, n, "the C loop accepted every sample frame");
     assert_eq!((end.done.missing, end.done.rejected_crc, end.done.rejected_framing, end.done.rejected_sequence), (0, 0, 0, 0));
     let c_replies: Vec<TickReply> = records.iter().map(|r| r.reply).collect();
 
@@ -93,12 +107,8 @@ fn c_example_in_qemu_equals_the_rust_application_bit_for_bit_on_fig15() {
     let wall_rust = t1.elapsed().as_secs_f64();
     let vs_image = compare(&c_replies, &rust);
 
-    let instr = |cy: &[u32]| {
-        let v: Vec<f64> = cy.iter().map(|c| f64::from(*c) / eha_sim::pil::qemu::TICKS_PER_INSTRUCTION).collect();
-        (v.iter().sum::<f64>() / v.len().max(1) as f64, v.iter().cloned().fold(0.0, f64::max))
-    };
-    let (c_mean, c_max) = instr(&records.iter().map(|r| r.cycles).collect::<Vec<_>>());
-    let (r_mean, r_max) = instr(&rust_cycles);
+    let (c_mean, c_max) = instructions(&records.iter().map(|r| r.cycles).collect::<Vec<_>>());
+    let (r_mean, r_max) = instructions(&rust_cycles);
     eprintln!(
         "Fig. 15, {n} ticks: C image vs Rust image {}/{} bit-identical, vs host SIL {}/{}; valve events {:?}; LNG used {:.4} kg; \
          instructions per tick (whole loop, -icount): C {c_mean:.0} mean {c_max:.0} max, Rust eha-fw {r_mean:.0} mean {r_max:.0} max; \
@@ -129,35 +139,24 @@ fn c_example_for_the_cortex_m3_equals_the_rust_application_bit_for_bit_on_fig15(
     );
     let size = common::run(Command::new("arm-none-eabi-size").arg(&elf), "arm-none-eabi-size");
     eprintln!("C example for the Cortex-M3:\n{size}");
-    let opts = LoopOptions { tick_s: eha_guard::params::S_PER_TICK, duration_s: DURATION_S };
-    let n = opts.ticks();
     let mut q = QemuOptions::new(Build::F32, &elf);
     q.machine = "mps2-an385".into();
     q.cpu = "cortex-m3".into();
-    q.icount = true;
-    let t0 = std::time::Instant::now();
-    let mut c = QemuSession::spawn(&q).unwrap_or_else(|e| panic!("{e}"));
-    let mut plant = Plant::new(&Rig::default(), &Scenario::Lng { duration_s: DURATION_S }).unwrap_or_else(|e| panic!("plant: {e}"));
-    let records = match run_closed_loop(&mut plant, &mut c, &opts) {
-        Ok(r) => r,
-        Err(f) => panic!("Cortex-M3 C image closed loop failed after {} ticks: {:#}", f.records.len(), f.error),
-    };
-    let end = c.finish(n).unwrap_or_else(|e| panic!("{e}"));
-    assert_eq!(records.len() as u64, n);
-    assert_eq!(end.done.accepted as u64, n, "the C loop accepted every sample frame");
+    let (records, _, wall) = c_image_on_fig15(q);
+    let n = records.len() as u64;
     let c_replies: Vec<TickReply> = records.iter().map(|r| r.reply).collect();
     let s = Summary::of(&records, true);
     assert!(s.valve_events.iter().any(|(_, o)| *o), "the Fig. 15 run must open the LNG valve: {:?}", s.valve_events);
     let mut sil = SilTarget::new(Build::F32);
     let host = replay(&records, &mut sil).unwrap_or_else(|e| panic!("{e}"));
     let vs_sil = compare(&c_replies, &host);
-    let mean_instr = records.iter().map(|r| f64::from(r.cycles)).sum::<f64>() / records.len().max(1) as f64 / eha_sim::pil::qemu::TICKS_PER_INSTRUCTION;
+    let (mean_instr, _) = instructions(&records.iter().map(|r| r.cycles).collect::<Vec<_>>());
     eprintln!(
         "Fig. 15 on the Cortex-M3, {n} ticks: C image vs host SIL {}/{} bit-identical; valve events {:?}; {mean_instr:.0} instructions per tick (soft-float); wall {:.1} s",
         vs_sil.identical,
         vs_sil.ticks,
         s.valve_events,
-        t0.elapsed().as_secs_f64()
+        wall
     );
     assert_eq!(vs_sil.identical, vs_sil.ticks, "Cortex-M3 C image differs from the host SIL first at tick {:?}", vs_sil.first_difference);
 }
