@@ -491,8 +491,9 @@ pub const CONFUSABLE_SHARE: f64 = 0.5;
 /// 75 / 59 %, conduction 53 / 18 %) and conduction (seed 61) keep their
 /// names. The share was set with these cases in view.
 pub fn unconfuse_housing_paths(ranking: &mut [RankEntry]) {
-    let base: Vec<(String, f64)> = ranking.iter().find(|r| r.cause == "none").map(|r| r.channel_heldout_k.clone()).unwrap_or_default();
-    let none_k = ranking.iter().find(|r| r.cause == "none").map_or(0.0, |r| r.heldout_rmse_k);
+    let (base, none_k): (Vec<(String, f64)>, f64) =
+        ranking.iter().find(|r| r.cause == "none").map_or((Vec::new(), 0.0), |r| (r.channel_heldout_k.clone(), r.heldout_rmse_k));
+    let pooled = |r: &RankEntry| if none_k > 0.0 { 1.0 - r.heldout_rmse_k / none_k } else { 0.0 };
     let gain_on = |r: &RankEntry, ch: &str| -> Option<f64> {
         let b = base.iter().find(|c| c.0 == ch)?.1;
         let a = r.channel_heldout_k.iter().find(|c| c.0 == ch)?.1;
@@ -504,7 +505,6 @@ pub fn unconfuse_housing_paths(ranking: &mut [RankEntry]) {
             continue;
         }
         let Some(other) = ranking.iter().find(|o| o.cause != w.cause && HOUSING_PATHS.contains(&o.cause.as_str())) else { continue };
-        let pooled = |r: &RankEntry| if none_k > 0.0 { 1.0 - r.heldout_rmse_k / none_k } else { 0.0 };
         if let Some(g) = gain_on(other, &w.gain_channel) {
             let (gp, wp) = (pooled(other), pooled(w));
             if g >= CONFUSABLE_SHARE * w.heldout_gain && gp >= CONFUSABLE_SHARE * wp {
