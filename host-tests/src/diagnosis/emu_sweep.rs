@@ -15,7 +15,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 /// Outcome of one emulated log.
-#[derive(Debug, Clone, serde::Serialize)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct EmuResult {
     /// The case.
     pub case: EmuCase,
@@ -54,7 +54,7 @@ pub struct EmuResult {
 
 /// How the hidden effect's own candidate fared when fitted jointly with the
 /// calibration set (the "oracle" structure, known only to the sweep).
-#[derive(Debug, Clone, serde::Serialize)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct HiddenFit {
     /// BIC decrease against the calibrated baseline.
     pub delta_bic: f64,
@@ -316,50 +316,22 @@ pub struct EmuSweepArgs {
     pub logs: bool,
 }
 
-/// Runs the emulator sweep; exit 0 always unless the outputs cannot be
-/// written (it is a measurement, not a test).
-pub fn run(a: &EmuSweepArgs) -> ExitCode {
-    let cases: Vec<EmuCase> = (0..a.seeds)
-        .flat_map(|k| match a.cases {
-            CaseSet::Ident => ident_cases(a.duration, 2700 + 100 * k),
-            CaseSet::Original => default_cases(a.duration, 1700 + 100 * k),
-        })
-        .filter(|c| !(a.no_servo && c.scenario.is_servo()))
-        .filter(|c| a.only.is_empty() || a.only.contains(&c.seed))
-        .collect();
-    let bar = indicatif::ProgressBar::new(cases.len() as u64);
-    let res: Vec<Result<EmuResult, String>> = cases
-        .par_iter()
-        .map(|c| {
-            if a.logs {
-                if let Ok((run, _)) = generate(c) {
-                    let dir = a.out.join("logs");
-                    let _ = std::fs::create_dir_all(&dir);
-                    let _ = run.write_file(dir.join(format!("{}-{:?}-{}.csv", c.hidden.name(), c.scenario, c.seed)));
-                }
-            }
-            let r = run_emu_case(*c, &DiagnoseOptions::default());
-            bar.inc(1);
-            r
-        })
-        .collect();
-    bar.finish_and_clear();
+/// The sweep's Markdown (`emulator-sweep.md`): the answer table, its
+/// summary line, the hidden effects' own fits and their classes. Also what
+/// `eha-sim docs` renders into docs/diagnosis.md from the committed JSON.
+pub fn document(ok: &[EmuResult]) -> String {
     let mut md = String::from(
         "| scenario (seed) | hidden | magnitude | answer | affected channel (imprint) | its held-out RMSE before → after (K) | pooled held-out RMSE nominal / calibrated → after (K) | calibrated held-out per channel, K (× noise σ, % of rise; **misfit**) | nuisance on a bound | s |\n|---|---|---|---|---|---|---|---|---|---:|\n",
     );
-    let ok: Vec<&EmuResult> = res.iter().flatten().collect();
-    for r in &ok {
+    for r in ok {
         md += &table_row(r);
         md.push('\n');
-    }
-    for e in res.iter().filter_map(|r| r.as_ref().err()) {
-        let _ = writeln!(md, "\nerror: {e}");
     }
     let with = ok.iter().filter(|r| r.case.hidden != Candidate::None).count();
     let hits = ok.iter().filter(|r| r.case.hidden != Candidate::None && r.hit()).count();
     let gain = ok.iter().filter(|r| r.case.hidden != Candidate::None && r.hit() && r.affected_gain().is_some_and(|g| g >= 0.5)).count();
     let count = |s: &str| ok.iter().filter(|r| r.answer == s).count();
-    let nones: Vec<&&EmuResult> = ok.iter().filter(|r| r.case.hidden == Candidate::None).collect();
+    let nones: Vec<&EmuResult> = ok.iter().filter(|r| r.case.hidden == Candidate::None).collect();
     let false_disc = nones.iter().filter(|r| r.answer != "none" && r.answer != "unexplained").count();
     let _ = writeln!(
         md,
@@ -389,6 +361,42 @@ pub fn run(a: &EmuSweepArgs) -> ExitCode {
         class("oracle ≥ 50 %"),
         class("oracle < 50 %"),
     );
+    md
+}
+
+/// Runs the emulator sweep; exit 0 always unless the outputs cannot be
+/// written (it is a measurement, not a test).
+pub fn run(a: &EmuSweepArgs) -> ExitCode {
+    let cases: Vec<EmuCase> = (0..a.seeds)
+        .flat_map(|k| match a.cases {
+            CaseSet::Ident => ident_cases(a.duration, 2700 + 100 * k),
+            CaseSet::Original => default_cases(a.duration, 1700 + 100 * k),
+        })
+        .filter(|c| !(a.no_servo && c.scenario.is_servo()))
+        .filter(|c| a.only.is_empty() || a.only.contains(&c.seed))
+        .collect();
+    let bar = indicatif::ProgressBar::new(cases.len() as u64);
+    let res: Vec<Result<EmuResult, String>> = cases
+        .par_iter()
+        .map(|c| {
+            if a.logs {
+                if let Ok((run, _)) = generate(c) {
+                    let dir = a.out.join("logs");
+                    let _ = std::fs::create_dir_all(&dir);
+                    let _ = run.write_file(dir.join(format!("{}-{:?}-{}.csv", c.hidden.name(), c.scenario, c.seed)));
+                }
+            }
+            let r = run_emu_case(*c, &DiagnoseOptions::default());
+            bar.inc(1);
+            r
+        })
+        .collect();
+    bar.finish_and_clear();
+    let ok: Vec<EmuResult> = res.iter().flatten().cloned().collect();
+    let mut md = document(&ok);
+    for e in res.iter().filter_map(|r| r.as_ref().err()) {
+        let _ = writeln!(md, "\nerror: {e}");
+    }
     print!("{md}");
     let write = || -> std::io::Result<()> {
         std::fs::create_dir_all(&a.out)?;

@@ -62,10 +62,10 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 /// One emulated log to generate.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct EmuCase {
     /// The hidden effect (`Candidate::None` for none).
-    #[serde(serialize_with = "ser_candidate")]
+    #[serde(serialize_with = "ser_candidate", deserialize_with = "de_candidate")]
     pub hidden: Candidate,
     /// Operating scenario.
     pub scenario: EmuScenario,
@@ -77,6 +77,11 @@ pub struct EmuCase {
 
 fn ser_candidate<S: serde::Serializer>(c: &Candidate, s: S) -> Result<S::Ok, S::Error> {
     s.serialize_str(c.name())
+}
+
+fn de_candidate<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Candidate, D::Error> {
+    let name = <String as serde::Deserialize>::deserialize(d)?;
+    Candidate::from_name(&name).ok_or_else(|| serde::de::Error::custom(format!("unknown candidate `{name}`")))
 }
 
 /// What the emulator did (never shown to the diagnosis).
