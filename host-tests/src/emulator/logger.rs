@@ -8,19 +8,8 @@
 
 use super::plant::{Op, NN, NS};
 use crate::measured::{Channel, MeasuredRun};
+pub use crate::data::acquisition::{gauss, quantise};
 use rand::Rng;
-
-/// Standard normal draw (Box–Muller).
-pub fn gauss(rng: &mut impl Rng) -> f64 {
-    let (u1, u2): (f64, f64) = (rng.random::<f64>().max(1e-300), rng.random());
-    (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
-}
-
-/// 12-bit quantisation over 0…200 °C (LSB 0.049 K).
-pub fn quantise(t_c: f64) -> f64 {
-    let lsb = 200.0 / 4095.0;
-    ((t_c / lsb).round() * lsb).clamp(0.0, 200.0)
-}
 
 /// The sensor readings (°C, noise-free) of the five logged temperature
 /// channels in a plant state, in [`Channel::TEMPERATURES`] order.

@@ -53,8 +53,7 @@ pub mod params;
 pub mod plant;
 pub mod props;
 
-use crate::diagnosis::synth::magnitude_range;
-use crate::diagnosis::Candidate;
+use crate::physics::candidates::{magnitude_range, Candidate};
 use crate::measured::{Channel, MeasuredRun};
 use missions::{step_at, EmuScenario};
 use plant::{Hidden, Plant};
