@@ -98,7 +98,15 @@ pub struct EmuTruth {
 
 /// Generates the log of `c`.
 pub fn generate(c: &EmuCase) -> Result<(MeasuredRun, EmuTruth), String> {
-    generate_on(c, None)
+    generate_on(c, None, false)
+}
+
+/// The effect-free twin of case `c`: the same machine, mission, sensor
+/// noise and dropouts as [`generate`]'s log, with nothing hidden (its
+/// `affected` is `None`, its magnitude the one the log hides). The
+/// diagnosis's misfit on the twin is the structure floor of that very log.
+pub fn generate_twin(c: &EmuCase) -> Result<(MeasuredRun, EmuTruth), String> {
+    generate_on(c, None, true)
 }
 
 /// The log of case `c` flown by another case's machine: `machine` is that
@@ -106,10 +114,10 @@ pub fn generate(c: &EmuCase) -> Result<(MeasuredRun, EmuTruth), String> {
 /// noise and dropouts are `c`'s. Two logs of one machine in two scenarios,
 /// as a test campaign would take them.
 pub fn generate_on_machine(c: &EmuCase, machine: &EmuTruth) -> Result<(MeasuredRun, EmuTruth), String> {
-    generate_on(c, Some((&machine.params, machine.magnitude)))
+    generate_on(c, Some((&machine.params, machine.magnitude)), false)
 }
 
-fn generate_on(c: &EmuCase, machine: Option<(&params::EmuParams, f64)>) -> Result<(MeasuredRun, EmuTruth), String> {
+fn generate_on(c: &EmuCase, machine: Option<(&params::EmuParams, f64)>, twin: bool) -> Result<(MeasuredRun, EmuTruth), String> {
     let mut rng = ChaCha8Rng::seed_from_u64(c.seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ 0x17);
     let m = missions::draw(c.scenario, c.duration_s, &mut rng);
     let p = params::EmuParams::draw(&mut rng);
@@ -121,12 +129,13 @@ fn generate_on(c: &EmuCase, machine: Option<(&params::EmuParams, f64)>) -> Resul
         None => (p, magnitude),
     };
     let dt = c.scenario.log_interval_s();
-    let plant = Plant { p: &p, m: &m, h: Hidden { effect: c.hidden, magnitude } };
+    let hidden = if twin { Candidate::None } else { c.hidden };
+    let plant = Plant { p: &p, m: &m, h: Hidden { effect: hidden, magnitude } };
     let trace = plant.run(dt);
     if trace.iter().any(|r| r.1.iter().any(|v| !v.is_finite())) {
         return Err(format!("emulator diverged on {c:?}"));
     }
-    let affected = if c.hidden == Candidate::None {
+    let affected = if hidden == Candidate::None {
         None
     } else {
         let off = Plant { p: &p, m: &m, h: Hidden { effect: Candidate::None, magnitude: 0.0 } }.run(dt);
