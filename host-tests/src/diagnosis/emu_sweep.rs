@@ -445,8 +445,20 @@ fn ratio_bands(ok: &[EmuResult]) -> String {
             if seeds.is_empty() { "–".into() } else { seeds.join(", ") },
         );
     }
-    let twins_false = with.iter().filter(|(r, _)| r.twin.as_ref().is_some_and(|t| t.twin_answer != "none" && t.twin_answer != "unexplained")).count();
-    let _ = writeln!(md, "\nThe {} twins (effect-free): {twins_false} false discoveries.", with.len());
+    let false_twins: Vec<String> = with
+        .iter()
+        .filter_map(|(r, _)| {
+            let t = r.twin.as_ref()?;
+            (t.twin_answer != "none" && t.twin_answer != "unexplained").then(|| format!("{}'s twin: `{}`", r.case.seed, t.twin_answer))
+        })
+        .collect();
+    let _ = writeln!(
+        md,
+        "\nThe {} twins (effect-free): {} false discoveries{}.",
+        with.len(),
+        false_twins.len(),
+        if false_twins.is_empty() { String::new() } else { format!(" ({})", false_twins.join(", ")) }
+    );
     md
 }
 
