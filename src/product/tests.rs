@@ -378,6 +378,39 @@ fn a_valid_block_runs_its_own_rig() {
     assert!(app.guard().trace().iter().any(|e| matches!(e, Trace::Params { source: 1, .. })));
 }
 
+/// A block with a commissioning margin: the tick replies carry the model's
+/// drain plus the margin (the f32 sum, exactly), the valve and alarm follow
+/// that estimate (bit-identical to a bare guard with the block's constants),
+/// and the thermal record keeps the model's own temperatures.
+#[test]
+fn a_blocks_margin_reaches_the_replies_not_the_record() {
+    let with = crate::model::ModelConsts { drain_margin_k: 2.5, ..other_rig() };
+    let without = other_rig();
+    let mut b = board();
+    b.block = Some(flash_block(params_block::encode(&with, "margin")));
+    let mem = b.boot_memory();
+    let mut app = App::boot(&mut *b, &GuardConfig::DEFAULT, &mem);
+    assert_eq!(app.params(), ParamSource::Block);
+    let mut bare = Guard::new(&GuardConfig { model: &with, ..GuardConfig::DEFAULT }, Restore::Cold);
+    let mut plain = Guard::new(&GuardConfig { model: &without, ..GuardConfig::DEFAULT }, Restore::Cold);
+    let mut known = 0;
+    for k in 0..300u16 {
+        let s = sample(k, 30.0, 60.0);
+        b.push_rx(&s.encode());
+        app.tick(&mut *b, 0);
+        let want = bare.tick(&s.sample());
+        let model = plain.tick(&s.sample()).drain_c;
+        let t = ticks(&replies(&mut b));
+        assert!(crate::protocol::GuardOutput::bit_eq(&t[0].out, &want), "tick {k}: {:?} vs {want:?}", t[0].out);
+        if model != crate::guard::DRAIN_C_UNKNOWN {
+            assert_eq!(t[0].out.drain_c.to_bits(), (model + 2.5).to_bits(), "tick {k}");
+            known += 1;
+        }
+    }
+    assert!(known >= 290, "{known} ticks with an estimate");
+    assert_eq!(app.guard().snapshot().temps_c, plain.snapshot().temps_c);
+}
+
 /// A block that fails its checks (a flipped bit: CRC; or constants whose Phi
 /// belongs to another rig: stability) latches CONFIG and opens the valve from
 /// the first tick, and CONFIG cannot be cleared.
@@ -389,9 +422,14 @@ fn an_invalid_block_latches_config_and_opens_the_valve() {
     for g in wrong_phi.g_loop.iter_mut() {
         *g *= 1.5;
     }
+    // the commissioning margin on the cold side, not a number, over its 10 K
+    let margin = |m: f32| params_block::encode(&crate::model::ModelConsts { drain_margin_k: m, ..other_rig() }, "bad-margin");
     for (name, bytes, source) in [
         ("torn", torn, ParamSource::Invalid(params_block::BlockError::Crc)),
         ("phi of another rig", params_block::encode(&wrong_phi, "bad-phi"), ParamSource::Block),
+        ("negative margin", margin(-0.5), ParamSource::Block),
+        ("NaN margin", margin(f32::NAN), ParamSource::Block),
+        ("margin over 10 K", margin(10.5), ParamSource::Block),
     ] {
         let mut b = board();
         b.block = Some(flash_block(bytes));
