@@ -322,9 +322,17 @@ pub(super) fn flash_block(bytes: [u8; BLOCK_LEN]) -> &'static [u8; BLOCK_LEN] {
 }
 
 /// Another EHA's constants: the pump's mechanical loss 1.5× the paper rig's
-/// (eq. 8; Phi does not depend on it, so the block stays consistent).
+/// (eq. 8), with its own Phi (the exact ZOH of its own nominal Jacobian, as
+/// the reduction computes it: the friction heat depends on the oil's
+/// temperature through the pump's shares, so the paper rig's Phi fails the
+/// stability check's 1e-7 s and the block would be refused). Checked to build.
 pub(super) fn other_rig() -> crate::model::ModelConsts<f32> {
-    crate::model::ModelConsts { k_mech: crate::params::DEFAULT_CONSTS.k_mech * 1.5, ..crate::params::DEFAULT_CONSTS }
+    use crate::model::{etd_matrix, Model};
+    let mut c = crate::model::ModelConsts { k_mech: crate::params::DEFAULT_CONSTS.k_mech * 1.5, ..crate::params::DEFAULT_CONSTS };
+    let j = Model::<f32>::for_linearisation(&c).map(|m| m.nominal_jacobian_f32().map(|r| r.map(f64::from)));
+    c.phi = etd_matrix(&j.unwrap_or_default(), crate::params::S_PER_STEP).map(|r| r.map(|x| x as f32));
+    assert_eq!(Model::<f32>::from_consts(&c).err(), None, "the other rig's constants must build a model");
+    c
 }
 
 /// No block (erased flash, or a board without the region): the compiled-in
