@@ -32,10 +32,10 @@
 
 // Format version of the parameter block this library reads
 // (`eha_guard::params_block::VERSION`); another version is refused (CONFIG).
-#define EHA_PARAMS_FORMAT_VERSION 6
+#define EHA_PARAMS_FORMAT_VERSION 7
 
 // Size of a parameter block, bytes (`eha_guard::params_block::BLOCK_LEN`).
-#define EHA_PARAMS_BLOCK_LEN 2484
+#define EHA_PARAMS_BLOCK_LEN 2488
 
 // Format version of the thermal record (`eha_guard::memory::VERSION`); a
 // record of another version restores as damaged (conservative start).
