@@ -330,8 +330,9 @@ typedef struct {
 // One tick's result. Always finite except `lng_seconds_left` (infinite
 // with no dissipation).
 typedef struct {
-  // Predicted pump drain-port oil temperature, degC
-  // ([`EHA_DRAIN_C_UNKNOWN`] without a model: CONFIG).
+  // Predicted pump drain-port oil temperature, degC, with the parameter
+  // block's commissioning margin added (the value the valve and alarm act
+  // on; [`EHA_DRAIN_C_UNKNOWN`] without a model: CONFIG).
   float drain_c;
   // LNG remaining, kg.
   float lng_remaining_kg;
