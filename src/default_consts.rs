@@ -46,6 +46,7 @@ pub const DEFAULT_CONSTS: ModelConsts<f32> = ModelConsts {
     alpha_t0: 0.1775475,
     lng_in: -162.0,
     pole_pairs: 4.0,
+    drain_margin_k: 0.0,
     inv_c: [
         0.10869565,
         0.0,

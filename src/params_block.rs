@@ -3,7 +3,7 @@
 //! matrix included), with a header and a CRC, flashed into its own region (the
 //! `PARAMS` region of the board's `memory.x`) and read at boot.
 //!
-//! Layout (little-endian, [`BLOCK_LEN`] = 2484 bytes):
+//! Layout (little-endian, [`BLOCK_LEN`] = 2488 bytes):
 //!
 //! | offset | size | field |
 //! |---|---|---|
@@ -12,7 +12,7 @@
 //! | 6 | 2 | number of words ([`N_WORDS`]) |
 //! | 8 | 16 | rig id, ASCII, zero-padded |
 //! | 24 | 4 × N_WORDS | the words of [`ModelConsts`] in field order |
-//! | 2480 | 4 | CRC-32 (IEEE) of bytes 0..2480 |
+//! | 2484 | 4 | CRC-32 (IEEE) of bytes 0..2484 |
 //!
 //! Erased flash (`0xFF…`) or empty memory (`0x00…`, QEMU) at the magic means
 //! *absent*: the firmware runs the compiled-in [`crate::params::DEFAULT_CONSTS`]
@@ -29,7 +29,10 @@ use crate::model::ModelConsts;
 pub const BLOCK_LEN: usize = WORDS_AT + 4 * N_WORDS + 4;
 /// `"EHAP"` little-endian.
 pub const MAGIC: u32 = u32::from_le_bytes(*b"EHAP");
-/// Format version of this firmware. 6: both of the following (614 words,
+/// Format version of this firmware. 7: the commissioning margin on the
+/// drain estimate (`drain_margin_k`, K, 0..10, added by the guard to the
+/// model's case oil for its decisions and reports; 615 words, 2488 bytes).
+/// 6: both of the following (614 words,
 /// 2484 bytes). 5 (oil): the oil over temperature (613 words,
 /// 2480 bytes): the tables over the case-oil temperature (`leak_ratio`,
 /// `visc_ratio`, `tc_speed`: each 1 at 40 degC and monotonic, checked in
@@ -43,7 +46,7 @@ pub const MAGIC: u32 = u32::from_le_bytes(*b"EHAP");
 /// `alpha_t0`, `g_case_slope`; 264 words, 1084 bytes). 3: without `irc0`/`irc1` (the oil
 /// capacity's inverse is exact; 259 words, 1064 bytes). 2: the rest-cooling
 /// words (`rest_rate`, `rest_mode`). Older blocks are refused.
-pub const VERSION: u16 = 6;
+pub const VERSION: u16 = 7;
 /// Offset of the rig id.
 const ID_AT: usize = 8;
 /// Length of the rig id, bytes.

@@ -105,11 +105,23 @@ struct Core<N: Num> {
     scales: InputScales<N>,
     limits: LimitsN<N>,
     th: Thresholds<N>,
+    /// The commissioning margin added to the model's case oil, K
+    /// ([`crate::model::ModelConsts::drain_margin_k`], within its bounds).
+    margin: N,
     /// Sensor cross-check; `None` without a torque constant (disabled).
     cc: Option<CrossCheck<N>>,
 }
 
 impl<N: Num> Core<N> {
+    /// The drain-oil estimate of every decision and report (valve, alarm,
+    /// trace, outputs), degC: the model's case oil plus the commissioning
+    /// margin, on the hot side. The model's own state stays physical: the
+    /// margin never feeds back into it (nor into the thermal record).
+    #[inline(always)]
+    fn drain_c(&self) -> N {
+        self.model.drain_c().add(self.margin)
+    }
+
     /// Builds the core in place at `dst`; `false` (and an all-zero core, a
     /// valid value by the [`Num`] contract, never read) when the
     /// configuration cannot be built.
@@ -165,6 +177,7 @@ impl<N: Num> Core<N> {
             core::ptr::addr_of_mut!((*dst).scales).write(scales);
             core::ptr::addr_of_mut!((*dst).limits).write(limits);
             core::ptr::addr_of_mut!((*dst).th).write(th);
+            core::ptr::addr_of_mut!((*dst).margin).write(N::from_f32(config.model.drain_margin_k));
             core::ptr::addr_of_mut!((*dst).cc).write(cc);
         }
         true
@@ -399,7 +412,7 @@ impl<N: Num> GuardOf<N> {
     fn boot_outputs(&mut self) {
         match self.core_ok.then_some(&self.core) {
             Some(c) if !self.cold => {
-                let d = c.model.drain_c();
+                let d = c.drain_c();
                 let f = d.to_f32();
                 self.out.drain_c = if f.is_finite() { f } else { DRAIN_C_UNKNOWN };
                 let raised = if self.untrusted {

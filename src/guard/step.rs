@@ -37,7 +37,7 @@ impl<N: Num> GuardOf<N> {
                 c.model.set_temperatures(&t, ambient_c.to_f32());
             }
         }
-        let d = c.model.drain_c();
+        let d = c.drain_c();
         if self.latched.is_empty() && d < c.th.close && self.valve.is_open() {
             self.valve.set(false);
             self.trace.write(Trace::ValveClose {
@@ -137,7 +137,7 @@ impl<N: Num> GuardOf<N> {
             return;
         };
         let force = !self.latched.is_empty();
-        let d = c.model.drain_c();
+        let d = c.drain_c();
         let th = &c.th;
         let valve_ev = self
             .valve

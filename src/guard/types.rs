@@ -27,7 +27,10 @@ pub struct Sample {
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[cfg_attr(any(target_os = "none", feature = "defmt"), derive(defmt::Format))]
 pub struct Output {
-    /// Predicted drain-oil temperature, degC ([`DRAIN_C_UNKNOWN`] if the model is disabled).
+    /// Predicted drain-oil temperature, degC: the model's case oil plus the
+    /// parameter block's commissioning margin (`drain_margin_k`, 0 for the
+    /// paper rig), the value the valve and alarm act on ([`DRAIN_C_UNKNOWN`]
+    /// if the model is disabled).
     pub drain_c: f32,
     /// LNG valve command (`true` = open).
     pub valve_open: bool,

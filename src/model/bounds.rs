@@ -87,6 +87,7 @@ bounds! {
     alpha_t0: 1, [0.109, 0.274], "alpha x 273.15 (checked)";
     lng_in: 1, [-200.0, -100.0], "LNG inlet temperature, degC (Table 6: -162)";
     pole_pairs: 1, [1.0, 50.0], "motor pole pairs (rig 4): the drive's electrical frequency is pole pairs x rev/s, the speed check's second source";
+    drain_margin_k: 1, [0.0, 10.0], "commissioning margin added to the drain estimate, K (paper rig 0): negative would lower the estimate below the model (the cold side); above 10 K the valve would open at 30 degC and the model is not fit to protect the machine: recommission instead";
     inv_c: 1, [1.0e-4, 10.0], "1 / pump housing capacity, K/kJ: 0.1-10 000 kJ/K (rig 9.2 kJ/K)";
     inv_c: 2, [0.0, 0.0], "oil nodes: their capacity comes from rho c_p and the volume, this word must be 0";
     inv_c: 3, [1.0e-4, 10.0], "1 / capacity of the main block, ball-valve block and actuator, K/kJ";

@@ -95,6 +95,10 @@ pub struct ModelConsts<S> {
     pub lng_in: S,
     /// Motor pole pairs (the speed check's electrical frequency, `crate::speedcheck`).
     pub pole_pairs: S,
+    /// Commissioning safety margin on the drain-oil estimate, K: added by the
+    /// guard to the model's case oil for every decision and report, never fed
+    /// back into the model ([`ReducedParams::drain_margin_k`]).
+    pub drain_margin_k: S,
     /// 1 / capacity of the metal states, K/kJ (oil nodes 0).
     pub inv_c: [S; N_STATES],
     /// Outer surfaces, constant conductance, kW/K (eqs. 15-16).
@@ -186,8 +190,8 @@ impl Word for f64 {
     }
 }
 
-/// Scalar words at the head of a [`ModelConsts`] (`p_case` .. `pole_pairs`).
-pub const N_SCALARS: usize = 38;
+/// Scalar words at the head of a [`ModelConsts`] (`p_case` .. `drain_margin_k`).
+pub const N_SCALARS: usize = 39;
 /// Number of words in a [`ModelConsts`].
 pub const N_WORDS: usize =
     N_SCALARS + N_STATES + 3 * N_OUTER + 5 * N_TABLE + 3 * N_TEMP + N_DUCTS + 2 + N_RE * N_DUCTS * N_COARSE + 2 * N_NODES + N_PHI * N_PHI;
@@ -242,6 +246,7 @@ impl<S: Copy> ModelConsts<S> {
             alpha_t0: f(c.alpha_t0),
             lng_in: f(c.lng_in),
             pole_pairs: f(c.pole_pairs),
+            drain_margin_k: f(c.drain_margin_k),
             inv_c: c.inv_c.map(&mut f),
             ga: c.ga.map(&mut f),
             gb: c.gb.map(&mut f),
@@ -316,6 +321,7 @@ impl ModelConsts<()> {
         alpha_t0: (),
         lng_in: (),
         pole_pairs: (),
+        drain_margin_k: (),
         inv_c: [(); N_STATES],
         ga: [(); N_OUTER],
         gb: [(); N_OUTER],
@@ -518,6 +524,7 @@ pub fn derive(p: &ReducedParams) -> Result<ModelConsts<f64>, ConfigError> {
         alpha_t0: p.expansion_per_k * 273.15,
         lng_in: p.lng_inlet_c,
         pole_pairs: p.pole_pairs,
+        drain_margin_k: p.drain_margin_k,
         inv_c,
         ga: p.outer_w_per_k.map(|x| x * KW_PER_W),
         gb: p.outer_quarter_w_per_k125.map(|x| x * KW_PER_W),

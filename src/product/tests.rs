@@ -322,9 +322,17 @@ pub(super) fn flash_block(bytes: [u8; BLOCK_LEN]) -> &'static [u8; BLOCK_LEN] {
 }
 
 /// Another EHA's constants: the pump's mechanical loss 1.5× the paper rig's
-/// (eq. 8; Phi does not depend on it, so the block stays consistent).
+/// (eq. 8), with its own Phi (the exact ZOH of its own nominal Jacobian, as
+/// the reduction computes it: the friction heat depends on the oil's
+/// temperature through the pump's shares, so the paper rig's Phi fails the
+/// stability check's 1e-7 s and the block would be refused). Checked to build.
 pub(super) fn other_rig() -> crate::model::ModelConsts<f32> {
-    crate::model::ModelConsts { k_mech: crate::params::DEFAULT_CONSTS.k_mech * 1.5, ..crate::params::DEFAULT_CONSTS }
+    use crate::model::{etd_matrix, Model};
+    let mut c = crate::model::ModelConsts { k_mech: crate::params::DEFAULT_CONSTS.k_mech * 1.5, ..crate::params::DEFAULT_CONSTS };
+    let j = Model::<f32>::for_linearisation(&c).map(|m| m.nominal_jacobian_f32().map(|r| r.map(f64::from)));
+    c.phi = etd_matrix(&j.unwrap_or_default(), crate::params::S_PER_STEP).map(|r| r.map(|x| x as f32));
+    assert_eq!(Model::<f32>::from_consts(&c).err(), None, "the other rig's constants must build a model");
+    c
 }
 
 /// No block (erased flash, or a board without the region): the compiled-in
@@ -378,6 +386,39 @@ fn a_valid_block_runs_its_own_rig() {
     assert!(app.guard().trace().iter().any(|e| matches!(e, Trace::Params { source: 1, .. })));
 }
 
+/// A block with a commissioning margin: the tick replies carry the model's
+/// drain plus the margin (the f32 sum, exactly), the valve and alarm follow
+/// that estimate (bit-identical to a bare guard with the block's constants),
+/// and the thermal record keeps the model's own temperatures.
+#[test]
+fn a_blocks_margin_reaches_the_replies_not_the_record() {
+    let with = crate::model::ModelConsts { drain_margin_k: 2.5, ..other_rig() };
+    let without = other_rig();
+    let mut b = board();
+    b.block = Some(flash_block(params_block::encode(&with, "margin")));
+    let mem = b.boot_memory();
+    let mut app = App::boot(&mut *b, &GuardConfig::DEFAULT, &mem);
+    assert_eq!(app.params(), ParamSource::Block);
+    let mut bare = Guard::new(&GuardConfig { model: &with, ..GuardConfig::DEFAULT }, Restore::Cold);
+    let mut plain = Guard::new(&GuardConfig { model: &without, ..GuardConfig::DEFAULT }, Restore::Cold);
+    let mut known = 0;
+    for k in 0..300u16 {
+        let s = sample(k, 30.0, 60.0);
+        b.push_rx(&s.encode());
+        app.tick(&mut *b, 0);
+        let want = bare.tick(&s.sample());
+        let model = plain.tick(&s.sample()).drain_c;
+        let t = ticks(&replies(&mut b));
+        assert!(crate::protocol::GuardOutput::bit_eq(&t[0].out, &want), "tick {k}: {:?} vs {want:?}", t[0].out);
+        if model != crate::guard::DRAIN_C_UNKNOWN {
+            assert_eq!(t[0].out.drain_c.to_bits(), (model + 2.5).to_bits(), "tick {k}");
+            known += 1;
+        }
+    }
+    assert!(known >= 290, "{known} ticks with an estimate");
+    assert_eq!(app.guard().snapshot().temps_c, plain.snapshot().temps_c);
+}
+
 /// A block that fails its checks (a flipped bit: CRC; or constants whose Phi
 /// belongs to another rig: stability) latches CONFIG and opens the valve from
 /// the first tick, and CONFIG cannot be cleared.
@@ -389,9 +430,14 @@ fn an_invalid_block_latches_config_and_opens_the_valve() {
     for g in wrong_phi.g_loop.iter_mut() {
         *g *= 1.5;
     }
+    // the commissioning margin on the cold side, not a number, over its 10 K
+    let margin = |m: f32| params_block::encode(&crate::model::ModelConsts { drain_margin_k: m, ..other_rig() }, "bad-margin");
     for (name, bytes, source) in [
         ("torn", torn, ParamSource::Invalid(params_block::BlockError::Crc)),
         ("phi of another rig", params_block::encode(&wrong_phi, "bad-phi"), ParamSource::Block),
+        ("negative margin", margin(-0.5), ParamSource::Block),
+        ("NaN margin", margin(f32::NAN), ParamSource::Block),
+        ("margin over 10 K", margin(10.5), ParamSource::Block),
     ] {
         let mut b = board();
         b.block = Some(flash_block(bytes));

@@ -5,6 +5,7 @@
 mod alarm;
 mod crosscheck;
 mod lng_credit;
+mod margin;
 mod model_accuracy;
 mod plant;
 mod protection_props;

@@ -25,7 +25,7 @@ pub struct ParamsBlockArgs {
 #[derive(Subcommand, Debug)]
 enum BlockCmd {
     /// Reduce a rig file to the firmware's model constants and write the
-    /// parameter block (2484 bytes) to flash at the PARAMS region
+    /// parameter block (2488 bytes) to flash at the PARAMS region
     /// (STM32F411: 0x0802_0000; QEMU mps2: 0x0003_F000).
     Write {
         /// Rig file (TOML, as `host-tests/rig/liu2024.toml`).
@@ -101,10 +101,11 @@ pub fn check_bytes(bytes: &[u8; BLOCK_LEN]) -> Result<String> {
     let mismatch = eha_guard::model::stability::phi_mismatch_s(&c.phi, &j);
     let gain = eha_guard::model::stability::step_gain(&c.phi, &j);
     Ok(format!(
-        "block ok: rig id \"{}\", format v{}, {} words; Phi mismatch {mismatch:.2e} s (limit {:.0e} s); step gain |M^1024| {gain:.5} (limit 1.001)",
+        "block ok: rig id \"{}\", format v{}, {} words; drain margin {} K (added to the drain estimate); Phi mismatch {mismatch:.2e} s (limit {:.0e} s); step gain |M^1024| {gain:.5} (limit 1.001)",
         params_block::rig_id(bytes),
         params_block::VERSION,
         consts::N_WORDS,
+        c.drain_margin_k,
         eha_guard::model::stability::PHI_TOL_S,
     ))
 }
@@ -114,7 +115,7 @@ fn block_error_text(e: BlockError) -> String {
         BlockError::Magic => "bytes 0..4: not the parameter-block magic \"EHAP\" (and not erased)".into(),
         BlockError::Version => format!("bytes 4..6: format version is not {} (this firmware's)", params_block::VERSION),
         BlockError::Words => format!("bytes 6..8: word count is not {} (another model structure)", consts::N_WORDS),
-        BlockError::Crc => "bytes 1084..1088: CRC-32 mismatch (torn or corrupted block)".into(),
+        BlockError::Crc => format!("bytes {}..{BLOCK_LEN}: CRC-32 mismatch (torn or corrupted block)", BLOCK_LEN - 4),
         BlockError::Alignment => "block not 4-byte aligned".into(),
     }
 }

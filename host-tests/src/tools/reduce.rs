@@ -250,6 +250,8 @@ pub fn reduce_without_jacobian(rig: &Rig) -> ReducedParams {
         phi_step_s: eha_guard::model::etd_matrix(&[[0.0; N_PHI]; N_PHI], eha_guard::params::S_PER_STEP),
         rest_rate_per_s: [0.0; N_NODES],
         rest_mode: [0.0; N_NODES],
+        // a rig file has no validation logs: commissioning sets the margin
+        drain_margin_k: 0.0,
     }
 }
 
@@ -444,7 +446,7 @@ fn row(r: &[f64]) -> String {
 
 /// The scalar fields of `p` by name, in `DEFAULT`'s order (the renderer writes
 /// them; the acceptance test compares them with the reduction).
-pub fn scalar_fields(p: &ReducedParams) -> [(&'static str, f64); 37] {
+pub fn scalar_fields(p: &ReducedParams) -> [(&'static str, f64); 38] {
     [
         ("pump_j_per_k", p.pump_j_per_k),
         ("main_block_j_per_k", p.main_block_j_per_k),
@@ -483,6 +485,7 @@ pub fn scalar_fields(p: &ReducedParams) -> [(&'static str, f64); 37] {
         ("speed_table_max_rad_s", p.speed_table_max_rad_s),
         ("flow_table_max_m3_per_s", p.flow_table_max_m3_per_s),
         ("lng_inlet_c", p.lng_inlet_c),
+        ("drain_margin_k", p.drain_margin_k),
     ]
 }
 

@@ -498,9 +498,11 @@ fn parameter_block_in_flash_runs_its_rig_and_an_invalid_one_is_refused() {
 /// `Err` on a host stall during the 30 s closed loop.
 fn params_attempt() -> Result<(), String> {
     // Another EHA: 30 % more pump friction (eta_m), a 30 % lighter pump
-    // housing, a 30 % better case-oil film; Phi recomputed for it.
+    // housing, a 30 % better case-oil film; Phi recomputed for it; and a
+    // commissioning margin of 1.5 K (the image adds it as the host does).
     let mut other = eha_guard::params::DEFAULT;
     other.eta_m *= 1.3;
+    other.drain_margin_k = 1.5;
     other.pump_j_per_k *= 0.7;
     for g in other.g_case_w_per_k.iter_mut() {
         *g *= 1.3;

@@ -32,10 +32,10 @@
 
 // Format version of the parameter block this library reads
 // (`eha_guard::params_block::VERSION`); another version is refused (CONFIG).
-#define EHA_PARAMS_FORMAT_VERSION 6
+#define EHA_PARAMS_FORMAT_VERSION 7
 
 // Size of a parameter block, bytes (`eha_guard::params_block::BLOCK_LEN`).
-#define EHA_PARAMS_BLOCK_LEN 2484
+#define EHA_PARAMS_BLOCK_LEN 2488
 
 // Format version of the thermal record (`eha_guard::memory::VERSION`); a
 // record of another version restores as damaged (conservative start).
@@ -330,8 +330,9 @@ typedef struct {
 // One tick's result. Always finite except `lng_seconds_left` (infinite
 // with no dissipation).
 typedef struct {
-  // Predicted pump drain-port oil temperature, degC
-  // ([`EHA_DRAIN_C_UNKNOWN`] without a model: CONFIG).
+  // Predicted pump drain-port oil temperature, degC, with the parameter
+  // block's commissioning margin added (the value the valve and alarm act
+  // on; [`EHA_DRAIN_C_UNKNOWN`] without a model: CONFIG).
   float drain_c;
   // LNG remaining, kg.
   float lng_remaining_kg;

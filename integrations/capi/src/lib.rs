@@ -43,9 +43,9 @@ pub const EHA_GUARD_VERSION_PATCH: u32 = 0;
 pub const EHA_GUARD_VERSION: u32 = (EHA_GUARD_VERSION_MAJOR << 16) | (EHA_GUARD_VERSION_MINOR << 8) | EHA_GUARD_VERSION_PATCH;
 /// Format version of the parameter block this library reads
 /// (`eha_guard::params_block::VERSION`); another version is refused (CONFIG).
-pub const EHA_PARAMS_FORMAT_VERSION: u32 = 6;
+pub const EHA_PARAMS_FORMAT_VERSION: u32 = 7;
 /// Size of a parameter block, bytes (`eha_guard::params_block::BLOCK_LEN`).
-pub const EHA_PARAMS_BLOCK_LEN: usize = 2484;
+pub const EHA_PARAMS_BLOCK_LEN: usize = 2488;
 /// Format version of the thermal record (`eha_guard::memory::VERSION`); a
 /// record of another version restores as damaged (conservative start).
 pub const EHA_RECORD_FORMAT_VERSION: u32 = 5;

@@ -126,8 +126,9 @@ impl EhaSample {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct EhaOutput {
-    /// Predicted pump drain-port oil temperature, degC
-    /// ([`EHA_DRAIN_C_UNKNOWN`] without a model: CONFIG).
+    /// Predicted pump drain-port oil temperature, degC, with the parameter
+    /// block's commissioning margin added (the value the valve and alarm act
+    /// on; [`EHA_DRAIN_C_UNKNOWN`] without a model: CONFIG).
     pub drain_c: f32,
     /// LNG remaining, kg.
     pub lng_remaining_kg: f32,

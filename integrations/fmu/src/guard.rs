@@ -40,7 +40,7 @@ static VARS: [Var; 15] = [
     Var::real_input(vr::POSITION, "position_mm", "mm", 0.0, "Piston position from the linear encoder"),
     Var::real_input(vr::AMBIENT, "ambient_c", "degC", 20.0, "Ambient air temperature near the actuator"),
     Var::new(vr::VALVE_FB, "valve_feedback", Causality::Input, VarType::Integer { start: Some(-1) }, "LNG valve position switch: -1 = not wired, 0 = shut, 1 = open"),
-    Var::real_output(vr::DRAIN, "drain_c", "degC", "Estimated pump drain-port oil temperature (1e6 when the model is refused: CONFIG fault)"),
+    Var::real_output(vr::DRAIN, "drain_c", "degC", "Estimated pump drain-port oil temperature with the parameter block's commissioning margin, the value the valve and alarm act on (1e6 when the model is refused: CONFIG fault)"),
     Var::new(vr::VALVE, "valve_open", Causality::Output, BOOL_OUT, "LNG cooling valve command (true = open)"),
     Var::new(vr::ALARM, "alarm", Causality::Output, BOOL_OUT, "Over-temperature alarm (drain above 60 degC, cleared below 58 degC) or untrusted estimate"),
     Var::new(vr::DERATE, "derate", Causality::Output, BOOL_OUT, "Derate request to the actuator controller"),
