@@ -208,6 +208,7 @@ pub fn nuisance_set(run: &MeasuredRun) -> Vec<usize> {
         .filter(|(_, d)| match d.needs {
             Needs::Sensor(ch) => logged(ch),
             Needs::Input(ch) => calibration::log::input_above_zero(run, ch),
+            Needs::SensorWithJointExcitation(ch) => logged(ch) && calibration::ident::independent_speed_and_load(run),
             Needs::Nothing => true,
         })
         .filter(|(_, d)| !(one_point && ["leak_gap", "iron_loss", "winding_r", "needle_split"].contains(&d.name)))
