@@ -226,10 +226,41 @@ fn conductances() {
     }
 }
 
+/// `commission` on the identification runs (its own options: probe held,
+/// η_m from the current; `--hold-wall` holds `block_wall` too): the fitted
+/// wall, and the firmware's six-state reduction against the commissioned
+/// reference on every log.
+fn commission_ident(hold_wall: bool) {
+    use eha_sim::calibration::commission::commission;
+    let p = EmuParams::default();
+    let t0 = Instant::now();
+    let train = [emu_log(&p, EmuScenario::IdentRun, 44).0, emu_log(&p, EmuScenario::IdentRun, 45).0];
+    let holds = [emu_log(&p, EmuScenario::PressureSpeedSteps, 43).0, emu_log(&p, EmuScenario::IdentRun, 46).0];
+    let mut o = CalOptions::default();
+    if hold_wall {
+        o.hold.push(("block_wall", "held for the comparison".into()));
+    }
+    let c = commission(&Rig::default(), &train, &holds, &o).expect("commission");
+    println!("commission: {} model runs, {:.1} s; flashable {}", c.cal.model_runs, t0.elapsed().as_secs_f64(), c.flashable());
+    for q in c.cal.params.iter().filter(|q| ["block_wall", "pump_friction", "probe_oil"].contains(&q.name.as_str())) {
+        println!("  {} {:.3} {:?}", q.name, q.value, q.status);
+    }
+    for h in &c.holdout {
+        println!("  held out {}: pooled {:.3} K", h.log, pooled(&h.commissioned));
+    }
+    for r in &c.reduced {
+        println!("  reduced vs reference drain, {}: max {:.3} K, under {:.3} K", r.log, r.vs_reference_max_k, r.vs_reference_under_k);
+    }
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     if args.iter().any(|a| a == "--conductances") {
         conductances();
+        return;
+    }
+    if args.iter().any(|a| a == "--commission") {
+        commission_ident(args.iter().any(|a| a == "--hold-wall"));
         return;
     }
     let anatomy = args.iter().any(|a| a == "--anatomy");
