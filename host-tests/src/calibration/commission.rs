@@ -158,9 +158,9 @@ pub enum CommissionError {
     /// The calibration failed.
     #[error(transparent)]
     Cal(#[from] CalError),
-    /// The commissioned rig cannot be reduced to firmware parameters.
-    #[error("the commissioned rig gives firmware parameters the firmware model rejects")]
-    Reduce,
+    /// The commissioned rig cannot be reduced to firmware parameters (why).
+    #[error("the commissioned rig cannot be flashed: {0}")]
+    Reduce(String),
     /// A model run failed.
     #[error("{0}")]
     Run(String),
@@ -200,7 +200,11 @@ pub fn commission(base: &Rig, train: &[CalLog], holdout: &[CalLog], o: &CalOptio
         let b = l.simulate(&cal.rig).map_err(CommissionError::Run)?;
         scores.push(HoldoutScore { log: l.name.clone(), as_given: channel_errors(l, &a), commissioned: channel_errors(l, &b) });
     }
-    let params = reduce(&cal.rig).ok_or(CommissionError::Reduce)?;
+    if let Some(why) = crate::reduce::unsupported_structure(&cal.rig) {
+        return Err(CommissionError::Reduce(why.into()));
+    }
+    let params = reduce(&cal.rig)
+        .ok_or_else(|| CommissionError::Reduce("it gives firmware parameters the firmware model rejects".into()))?;
     let reduced: Vec<ReducedCheck> = train
         .iter()
         .chain(holdout)

@@ -188,6 +188,11 @@ pub fn calibrate(base: &Rig, logs: &[CalLog], o: &CalOptions) -> Result<Calibrat
             Needs::Input(ch) if !logs.iter().any(|l| super::log::input_above_zero(&l.run, ch)) => {
                 Some(format!("no log has `{}` above 0; would need: {}", ch.name(), d.excitation))
             }
+            Needs::SensorWithJointExcitation(ch)
+                if !logs.iter().any(|l| l.has(ch) && super::ident::independent_speed_and_load(&l.run)) =>
+            {
+                Some(format!("no log with `{}` moves speed and load independently; would need: {}", ch.name(), d.excitation))
+            }
             _ => None,
         })
         .collect();

@@ -22,6 +22,12 @@ pub enum Needs {
     /// A logged input column that is above zero somewhere (the ram air:
     /// without a logged stream its coefficient acts on nothing).
     Input(Channel),
+    /// A logged temperature channel in a log that moves shaft speed and
+    /// pressure drop independently
+    /// ([`super::ident::independent_speed_and_load`]): a parameter that the
+    /// data separate from its neighbours only through how flow and heat
+    /// input combine.
+    SensorWithJointExcitation(Channel),
 }
 
 /// One parameter of the calibration set.
@@ -69,11 +75,14 @@ pub const PROBE_OIL: &str = "probe_oil";
 /// The prior centre of a multiplier on a rig-file value: the rig file.
 pub const RIG_FILE: &str = "the rig file's value";
 
+/// Name of the valve blocks' wall-conduction parameter.
+pub const BLOCK_WALL: &str = "block_wall";
+
 /// Name of the forced-convection (ram-air) coefficient's parameter.
 pub const H_FORCED: &str = "h_forced";
 
 /// The calibration set, in fit order.
-pub const PARAMS: [ParamDef; 21] = [
+pub const PARAMS: [ParamDef; 22] = [
     ParamDef {
         name: "h_out_motor",
         what: "outer heat transfer of the motor housing (free convection + radiation)",
@@ -171,6 +180,17 @@ pub const PARAMS: [ParamDef; 21] = [
         why: "the reference takes the case flow as laminar Taylor–Couette flow (Nu = 2 below the instability, a lower bound: slippers, pistons and the leakage jets churn a real case) on an assumed inner area",
         needs: Needs::Sensor(Channel::TPumpC),
         excitation: "speed steps with a drain thermocouple (t_drain_c) or a pump-surface sensor",
+        stage: Stage::Thermal,
+    },
+    ParamDef {
+        name: BLOCK_WALL,
+        what: "conduction from the oil passages' wall into the valve blocks' lumped metal, in series with the loop and ball-valve films",
+        fields: "blocks.wall_m (÷θ: the wall conductance k·a²/wall_m ×θ)",
+        lo: 0.25, hi: 100.0, prior_sigma_ln: 1.5,
+        centre: "the rig file's plane wall: one sixth of the block's outer area, 30 mm of steel (90 W/K for the main block)",
+        why: "how a lumped block's temperature connects to its passages is a modelling choice, not a measured value: a plane wall of a sixth of the block's face gives 90 W/K; the conduction shape factor of drilled passages (2πkL/ln(r_o/r_i), 1–2 m of Ø10 mm bores with r_o/r_i 3–10) 120–500 W/K; a block lumped with its passage walls none (θ → ∞). In series with a film that grows with flow and falls with viscosity, the wall caps the oil's coupling to the block at high flow and hot oil (measured on the rig emulator: 68 W/K at 2000 rpm and 70 °C against its 216 W/K of films). σ 1.5 in ln covers ×0.05…×20 at 2σ; the bound ×100 is the no-wall limit",
+        needs: Needs::SensorWithJointExcitation(Channel::TBlockC),
+        excitation: "an identification run: speed (flow) and needle drop (heat input) stepped independently, the oil tens of kelvin above the block, hot and cold (the film changes with flow and viscosity, the wall does not)",
         stage: Stage::Thermal,
     },
     ParamDef {
@@ -334,6 +354,7 @@ pub fn apply(base: &Rig, theta: &[f64]) -> Rig {
                 r.pump.case_inner_area_m2 /= t;
             }
             "film_case" => r.pump.case_inner_area_m2 *= t,
+            BLOCK_WALL => r.blocks.wall_m /= t,
             "cap_motor" => {
                 let w = r.motor.winding_mass_kg;
                 r.motor.mass_kg = w + t * (r.motor.mass_kg - w);

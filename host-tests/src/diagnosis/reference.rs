@@ -121,8 +121,10 @@ impl ReferenceModel {
 /// diagnosis calibrates on `run`: those whose sensor is among the
 /// diagnosis's channels ([`Channel::TEMPERATURES`], logged), without the
 /// loss coefficients that only speed and pressure steps separate when the
-/// run has one operating point (the calibration's rule), and without the
-/// needle split on servo runs (no throttling).
+/// run has one operating point (the calibration's rule), without the
+/// needle split on servo runs (no throttling), and without `block_wall`
+/// unless the run moves speed and load independently (its
+/// [`Needs::SensorWithJointExcitation`]).
 pub fn nuisance_set(run: &MeasuredRun) -> Vec<usize> {
     let logged = |ch: Channel| Channel::TEMPERATURES.contains(&ch) && run.get(ch).is_some_and(|v| v.iter().any(Option::is_some));
     let one_point = calibration::ident::one_point(run);
@@ -133,6 +135,7 @@ pub fn nuisance_set(run: &MeasuredRun) -> Vec<usize> {
         .filter(|(_, d)| match d.needs {
             Needs::Sensor(ch) => logged(ch),
             Needs::Input(ch) => calibration::log::input_above_zero(run, ch),
+            Needs::SensorWithJointExcitation(ch) => logged(ch) && calibration::ident::independent_speed_and_load(run),
             Needs::Nothing => true,
         })
         .filter(|(_, d)| !(one_point && ["leak_gap", "iron_loss", "winding_r", "needle_split"].contains(&d.name)))

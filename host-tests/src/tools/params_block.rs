@@ -52,6 +52,9 @@ pub fn run(a: &ParamsBlockArgs) -> Result<()> {
     match &a.cmd {
         BlockCmd::Write { rig, out, id } => {
             let r = Rig::from_toml_file(rig).map_err(|e| anyhow::anyhow!("{e}"))?;
+            if let Some(why) = crate::reduce::unsupported_structure(&r) {
+                anyhow::bail!("{}: cannot be reduced to a parameter block: {why}", rig.display());
+            }
             let p = reduce(&r).context("the reduced parameters are rejected by the firmware model")?;
             let id = id.clone().unwrap_or_else(|| rig.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default());
             let block = block_for(&p, &id)?;

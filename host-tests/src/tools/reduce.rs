@@ -407,12 +407,32 @@ fn perron_by_group(a: &[[f64; N_STATES]; N_STATES], group: &[usize; N_STATES]) -
     v.iter().all(|x| *x > 1e-6 && *x <= 1.0).then_some(v)
 }
 
+/// Why the firmware's six-state model cannot carry `rig`'s structure, or
+/// `None` when it can: the optional pump-as-built structure
+/// ([`crate::rig::Pump::split`], [`Rig::joints`]). The parameter block has no
+/// word for it; the words it would need are named.
+pub fn unsupported_structure(rig: &Rig) -> Option<&'static str> {
+    if rig.joints.is_some() {
+        Some(
+            "the rig has metal joints from the pump housing (`joints`: pump → motor flange, pump → manifold/main block); \
+             the firmware's six states have no conductance between the pump housing and the motor or the main block. \
+             It would need two parameter-block words, `g_pump_motor_w_per_k` and `g_pump_main_block_w_per_k` \
+             (f32, W/K, a conduction link in the pump and main-block (and motor) heat balances), in a new block format version",
+        )
+    } else if rig.pump.split.is_some() {
+        Some(
+            "the rig splits the pump into internals and housing (`pump.split`); the firmware's six states have one pump node",
+        )
+    } else {
+        None
+    }
+}
+
 /// The whole reduction (steps 1-6). `None` if the rig gives parameters the firmware
-/// model rejects, or has the optional pump-as-built structure
-/// ([`crate::rig::Pump::split`], [`Rig::joints`]): the firmware's six states follow
-/// the baseline's one pump node with no path to the motor.
+/// model rejects, or has a structure the six states do not carry
+/// ([`unsupported_structure`] says which).
 pub fn reduce(rig: &Rig) -> Option<ReducedParams> {
-    if rig.pump.split.is_some() || rig.joints.is_some() {
+    if unsupported_structure(rig).is_some() {
         return None;
     }
     let p = rediscretise(&reduce_without_jacobian(rig))?;
@@ -584,4 +604,29 @@ pub fn splice_params_rs(file: &str, rendered: &str) -> Option<String> {
     }
     let end = item + file[item..].find("\n};\n")? + 4;
     Some(format!("{}{}{}", &file[..start], rendered, &file[end..]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A rig with the pump's metal joints is refused with the reason and the
+    /// parameter-block words it would need; the split pump alone with its
+    /// own reason; the rig file and the calibration's block wall (an
+    /// existing word) reduce.
+    #[test]
+    fn joints_are_refused_with_the_words_they_need() {
+        let rig = Rig::default();
+        assert!(unsupported_structure(&rig).is_none());
+        let mut walled = rig.clone();
+        walled.blocks.wall_m /= 50.0;
+        assert!(reduce(&walled).is_some(), "the block wall is carried by duct_wall_w_per_k");
+        let built = rig.clone().with_pump_as_built();
+        let why = unsupported_structure(&built).expect("joints refused");
+        assert!(why.contains("g_pump_main_block_w_per_k") && why.contains("g_pump_motor_w_per_k"), "{why}");
+        assert!(reduce(&built).is_none());
+        let mut split = built.clone();
+        split.joints = None;
+        assert!(unsupported_structure(&split).is_some_and(|w| w.contains("pump.split")));
+    }
 }

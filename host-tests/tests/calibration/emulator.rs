@@ -50,7 +50,9 @@ fn pooled(e: &[eha_sim::calibration::ChannelError]) -> f64 {
 ///   `leak_gap` left its ×2.5 bound (1.41): the hot oil's lower viscosity
 ///   supplies the leakage the wider gap gave before.
 /// - Calibrated on two identification runs instead, the same held-out log
-///   misses by 1.87 K (the slow test below asserts that case).
+///   misses by 0.65 K (the slow test below asserts that case; with the
+///   `block_wall` parameter those logs free, held here: no training log
+///   moves speed and load independently).
 /// `film_case` 8.7 where the emulator's case-oil wetted area is ×5.3
 /// (another film correlation); `cap_case_oil` held (no drain sensor).
 #[test]
@@ -109,7 +111,7 @@ fn emulator_machine_held_out_error_falls() {
     assert_eq!(p.status, eha_sim::calibration::Status::Fitted, "probe_oil fitted");
 }
 
-/// Which logs to commission with (session 19). The same emulated machine
+/// Which logs to commission with. The same emulated machine
 /// calibrated on two logs of the operating families (load cycles, speed
 /// steps) or on two identification runs (speed, load and ram air stepped
 /// independently, `EmuScenario::IdentRun`), each checked on a held-out log
@@ -124,12 +126,26 @@ fn emulator_machine_held_out_error_falls() {
 /// calibration at least 1.1 K off on the identification run (a miss more
 /// than twice the floor: the finding itself).
 ///
-/// With both oils on their viscosity lines this test fails (measured:
-/// families 0.84 / 2.44 K, identification runs 1.87 / 1.56 K; with the
-/// forced-convection coefficient `h_forced` in the set, identification runs
-/// 1.07 / 1.17 K, families unchanged). The bound is kept: the remaining miss
-/// is the oil channel and the main block (docs/calibration.md, "Rig-level
-/// structure in the commissioning and diagnosis calibration set").
+/// With both oils on their viscosity lines the identification runs held
+/// out 1.87 / 1.56 K, 1.07 / 1.17 K with the forced-convection coefficient
+/// `h_forced` in the set (this test failed). The rest was the oil channel
+/// (1.5–2.1 K on every log, training included). Measured with the example
+/// `ident_structure` (docs/calibration.md, "Rig-level structure in the
+/// commissioning and diagnosis calibration set"): the calibrated oil
+/// residual regresses on speed and drop (+2…+7 K per 1000 rpm, +4…+6 K per
+/// 100 bar, R² 0.55–0.85: too warm at high flow and high heat input); each
+/// emulator path switched off alone (pump → manifold joint, the plate's
+/// film, the port-plate friction heat, the ball-block joint, probe lags,
+/// hoses) left the oil at 1.3–2.4 K; the cause is the reference's block
+/// wall in series with the loop film, which caps the oil's coupling to the
+/// block at 68 W/K at 2000 rpm and 70 °C where the emulator's films (no
+/// wall) reach 216 W/K. With that wall a calibration parameter
+/// (`block_wall`, fitted at ×54.3) the identification runs hold out
+/// **0.650 / 0.695 K** (oil 1.12 / 1.14 K, training 0.64 / 0.64 K; 1236
+/// model runs, ~50 s for both calibrations on 2 cores); the families are
+/// unchanged at 0.839 / 2.441 K (`block_wall` needs a log that moves speed
+/// and load independently: freed on the families it went to ×25 against
+/// three parameters on bounds and worsened their held-out pump channel).
 #[test]
 #[ignore = "slow tier: two calibrations on emulator logs"]
 fn slow_identification_runs_commission_across_regimes() {
@@ -146,8 +162,8 @@ fn slow_identification_runs_commission_across_regimes() {
         .expect("calibration on identification runs");
     let (f, i) = (held(&fam), held(&ident));
     eprintln!("held out (pressure-speed steps, identification run): families {f:.3?} K, identification runs {i:.3?} K");
-    assert!(i.iter().all(|&e| e <= 0.75), "identification-run calibration held out {i:.3?} K (measured 0.54, 0.53)");
-    assert!(f[1] >= 1.1, "families' calibration on the identification run {:.3} K (measured 1.47)", f[1]);
+    assert!(i.iter().all(|&e| e <= 0.75), "identification-run calibration held out {i:.3?} K (measured 0.650, 0.695)");
+    assert!(f[1] >= 1.1, "families' calibration on the identification run {:.3} K (measured 2.441)", f[1]);
 }
 
 /// The identification run is recognised as moving speed and load
