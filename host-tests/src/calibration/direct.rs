@@ -87,10 +87,10 @@ pub struct DirectParam {
 /// well-conditioned where a log says little.
 pub const DIRECT_PARAMS: [DirectParam; 16] = [
     DirectParam { name: "loss_pressure", target: Target::LossPressure, lo: 0.33, hi: 3.0, prior_sigma_ln: 0.4, why: "eta_m of another pump: 0.15-1.3 about the rig's 0.44" },
-    DirectParam { name: "loss_speed", target: Target::LossSpeed, lo: 0.25, hi: 4.0, prior_sigma_ln: 0.5, why: "bearing/seal drag and viscous friction: not in the paper, a factor 2 either way" },
+    DirectParam { name: "loss_speed", target: Target::LossSpeed, lo: 0.1, hi: 4.0, prior_sigma_ln: 0.5, why: "bearing/seal drag and viscous friction: not in the paper (a pump built to it has next to none: the rig emulator's fit went to a 0.25 bound), a factor 2 either way" },
     DirectParam { name: "leak", target: Target::Leak, lo: 0.33, hi: 3.0, prior_sigma_ln: 0.4, why: "gap conductance ∝ gap^3: ±40 % in the gaps" },
     DirectParam { name: "split_case", target: Target::SplitCase, lo: 0.33, hi: 3.0, prior_sigma_ln: 0.4, why: "share of the sliding pairs' friction heating the case oil (the rest of the non-delivered share heats the housing)" },
-    DirectParam { name: "film_case", target: Target::FilmCase, lo: 0.2, hi: 5.0, prior_sigma_ln: 0.5, why: "Taylor-Couette film of a case gap whose geometry the rig file guesses" },
+    DirectParam { name: "film_case", target: Target::FilmCase, lo: 0.2, hi: 20.0, prior_sigma_ln: 0.5, why: "Taylor-Couette film of a case gap whose geometry the rig file guesses (the rig emulator's case film is another correlation on 5.3 times the wetted area: its fit went to a 5 and then a 10 bound)" },
     DirectParam { name: "film_port", target: Target::FilmPort, lo: 0.25, hi: 4.0, prior_sigma_ln: 0.5, why: "duct film correlations ±30 %, passage areas unknown" },
     DirectParam { name: "film_loop", target: Target::FilmLoop, lo: 0.25, hi: 4.0, prior_sigma_ln: 0.5, why: "block passages' film and wall" },
     DirectParam { name: "film_ball", target: Target::FilmBall, lo: 0.25, hi: 4.0, prior_sigma_ln: 0.5, why: "ball-valve passage film and wall" },

@@ -9,7 +9,6 @@
 //! times.
 
 use super::log::{CalLog, ChannelError};
-use crate::diagnosis::reference::replay_inputs;
 use crate::measured::Channel;
 use crate::scenario::Circuit;
 use eha_guard::model::{Model, ModelInputN, ReducedParams};
@@ -70,10 +69,9 @@ fn lerp(v: &[f64], i: usize, f: f64) -> f64 {
 impl TickInputs {
     /// The inputs of `log` at the ticks `t0 + k 10 ms` up to its last row
     /// (the times of `Plant::run` at 10 ms). The piston moves only on the
-    /// servo circuit (the reference's replay rule). Errors when a required
-    /// input column is empty.
+    /// servo circuit (the reference's replay rule).
     pub fn of(log: &CalLog) -> Result<Self, String> {
-        let r = replay_inputs(&log.run, &log.name).map_err(|e| e.to_string())?;
+        let r = log.replay_inputs().ok_or_else(|| format!("{}: not a replay", log.name))?;
         let ts = &r.time_s;
         let (t0, t_end) = (ts[0], ts[ts.len() - 1]);
         let servo = r.circuit == Circuit::Servo;

@@ -247,3 +247,29 @@ fn direct_fit_is_reproducible_at_the_last_digit() {
     eprintln!("held-out drain max {:.6} / {:.6}, under {:.6} / {:.6}, rmse {:.6} / {:.6}; max |d ln theta| {dtheta:.2e}", a.max_abs_k, b.max_abs_k, a.max_under_k, b.max_under_k, a.rmse_k, b.rmse_k);
     assert!(moved.iter().all(|m| *m <= 0.05), "headline moved by {moved:?} K");
 }
+
+/// The path `commission` would take on the other EHA: the reference
+/// calibrated to the training logs, reduced (`c.params`, the reduction
+/// path), then the direct fit from that reduction. Both against the true
+/// drain of the held-out mission. Measured: see the eprintln.
+#[test]
+#[ignore = "slow tier: commissioning (~30 s) and a direct fit from its reduction"]
+fn other_eha_direct_fit_from_the_commissioned_reduction() {
+    let (train, hold) = other_logs();
+    let t0 = Instant::now();
+    let c = eha_sim::calibration::commission::commission(&other_rig_file(), &train, &hold, &eha_sim::calibration::CalOptions::default()).expect("commissioning");
+    eprintln!("commissioning {:.1} s, {} reference runs", t0.elapsed().as_secs_f64(), c.cal.model_runs);
+    let t0 = Instant::now();
+    let f = identify_direct(&c.params, &train, &DirectOptions::default()).expect("direct fit");
+    print_fit(&f, t0.elapsed().as_secs_f64());
+    print_scores("train", &f.train);
+    let s = score(&c.params, &f.params, &hold).expect("held-out scores");
+    print_scores("held-out", &s);
+    let truth = other_rig_truth();
+    let a = check_reduced(&truth, &c.params, &hold[0]).expect("reduction on the truth");
+    let b = check_reduced(&truth, &f.params, &hold[0]).expect("direct on the truth");
+    eprintln!(
+        "held-out true drain: commissioned reduction max {:.3} under {:.3} K; direct from it max {:.3} under {:.3} K",
+        a.vs_reference_max_k, a.vs_reference_under_k, b.vs_reference_max_k, b.vs_reference_under_k
+    );
+}
