@@ -161,7 +161,7 @@ fn direct_multipliers_keep_the_block_consistent() {
 /// reduction (not from a commissioned rig: this tests the direct path
 /// alone) against the true (noise-free) drain of the held-out mission.
 ///
-/// Measured (one run, 2 cores under load ~9 from other builds: 28 s, 384
+/// Measured (one run, 2 cores under load ~9 from other builds: 24 s, 345
 /// model runs of a 30 min log; held `split_case`, `cap_case_oil`,
 /// `cap_ball`): held-out true drain max |e| 4.54 → 0.39 K, under-prediction
 /// 0.002 → 0.35 K (the reduction of the rig file runs hot on this
@@ -174,7 +174,7 @@ fn direct_multipliers_keep_the_block_consistent() {
 /// 0.39/0.35 K plus the spread between fits with other held sets,
 /// 0.39-0.64 K); each asserted multiplier within 10 % of the truth.
 #[test]
-#[ignore = "slow tier: direct fit on three 30 min logs (~30 s)"]
+#[ignore = "slow tier: direct fit on three 30 min logs (~25 s)"]
 fn other_eha_direct_fit_on_held_out_drain() {
     let (train, hold) = other_logs();
     let p0 = eha_sim::reduce::reduce(&other_rig_file()).expect("reduction");
@@ -207,9 +207,23 @@ fn other_eha_direct_fit_on_held_out_drain() {
 /// 1200 s each; the drain truth is the emulator's case-oil node (its logger
 /// has no drain column yet) with the logger's noise.
 ///
-/// Measured: see the eprintln (numbers in the assertion comments).
+/// Measured (one run, 15 s, 406 model runs of a 1200 s log): the paper
+/// reduction runs 33 K hot on this machine's drain (the emulator's case
+/// film is another correlation on 5.3 times the wetted area); the fit takes
+/// film_case to 14.3 and loss_speed to its 0.1 bound (the emulator, written
+/// from the paper, has no no-load or viscous pump friction), largest
+/// |ρ| 0.83. Held out, drain: pressure-speed steps max |e| 33.22 → 2.32 K,
+/// RMSE 23.5 → 0.97 K, but under-prediction 0.08 → 2.32 K; servo hold/move
+/// max 2.69 → 2.42 K, under-prediction 0.35 → 2.42 K. Trained on throttle
+/// runs only, the direct model under-predicts the servo mission by more
+/// than the paper reduction did: the reason `commission` must choose a path
+/// by held-out error, under-prediction included, and count a margin.
+/// Tolerances: max |e| ≤ 3.0 K on both (measured 2.32/2.42 K, ~25 % for the
+/// fit's sensitivity to the emulator's structure), RMSE ≤ 1.3 K on the
+/// throttle mix; the servo under-prediction asserted as the measured miss
+/// (1.5-3.0 K) so that a change shows.
 #[test]
-#[ignore = "slow tier: direct fit on emulator logs (~20 s)"]
+#[ignore = "slow tier: direct fit on emulator logs (~15 s)"]
 fn emulator_direct_fit_on_held_out_drain() {
     let train = [emu_log(EmuScenario::LoadCycles, 41), emu_log(EmuScenario::SpeedSteps, 42)];
     let hold = [emu_log(EmuScenario::PressureSpeedSteps, 43), emu_log(EmuScenario::ServoHoldMove, 44)];
@@ -222,13 +236,20 @@ fn emulator_direct_fit_on_held_out_drain() {
     for l in &s {
         let (a, b) = (l.drain_before().expect("drain"), l.drain_after().expect("drain"));
         eprintln!("{}: drain max {:.3} -> {:.3}, under {:.3} -> {:.3}", l.log, a.max_abs_k, b.max_abs_k, a.max_under_k, b.max_under_k);
+        assert!(b.max_abs_k <= 3.0, "{}: direct drain max |e| {:.3} K", l.log, b.max_abs_k);
     }
+    let (mix_before, mix) = (s[0].drain_before().expect("drain"), s[0].drain_after().expect("drain"));
+    assert!(mix_before.max_abs_k > 20.0, "paper reduction on the emulator {:.3} K", mix_before.max_abs_k);
+    assert!(mix.rmse_k <= 1.3, "throttle mix drain RMSE {:.3} K", mix.rmse_k);
+    let servo = s[1].drain_after().expect("drain");
+    assert!((1.5..=3.0).contains(&servo.max_under_k), "servo under-prediction {:.3} K (measured 2.42 K)", servo.max_under_k);
 }
 
 /// Reproducible at the last digit: every logged temperature moved by
 /// ±1e-9 K (alternating by row) moves the headline numbers (held-out
 /// measured drain max |e|, under-prediction, RMSE; the multipliers) by at
-/// most 0.05 K (the bound). Measured: see the eprintln.
+/// most 0.05 K (the bound). Measured: identical to 6 decimals
+/// (held-out max 0.686196 K both), max |Δ ln θ| 2.5e-10.
 #[test]
 #[ignore = "slow tier: two direct fits on three 30 min logs (~60 s)"]
 fn direct_fit_is_reproducible_at_the_last_digit() {
@@ -251,9 +272,16 @@ fn direct_fit_is_reproducible_at_the_last_digit() {
 /// The path `commission` would take on the other EHA: the reference
 /// calibrated to the training logs, reduced (`c.params`, the reduction
 /// path), then the direct fit from that reduction. Both against the true
-/// drain of the held-out mission. Measured: see the eprintln.
+/// drain of the held-out mission. Measured (commissioning 13.5 s, 789
+/// reference runs; the direct fit 21 s, 342 model runs): commissioned
+/// reduction max |e| 0.229 K, under-prediction 0.154 K; direct from it
+/// 0.325 K and 0.061 K (measured drain RMSE 0.218 → 0.171 K; multipliers
+/// within 2 % of 1 except those of the main block). On a machine built like
+/// our model the reduction already holds and the two paths are within
+/// 0.1 K. Tolerances: both ≤ 0.5 K max |e| (the other-EHA bound),
+/// under-prediction ≤ 0.3 K.
 #[test]
-#[ignore = "slow tier: commissioning (~30 s) and a direct fit from its reduction"]
+#[ignore = "slow tier: commissioning (~15 s) and a direct fit from its reduction (~20 s)"]
 fn other_eha_direct_fit_from_the_commissioned_reduction() {
     let (train, hold) = other_logs();
     let t0 = Instant::now();
@@ -272,4 +300,7 @@ fn other_eha_direct_fit_from_the_commissioned_reduction() {
         "held-out true drain: commissioned reduction max {:.3} under {:.3} K; direct from it max {:.3} under {:.3} K",
         a.vs_reference_max_k, a.vs_reference_under_k, b.vs_reference_max_k, b.vs_reference_under_k
     );
+    for (path, r) in [("commissioned reduction", &a), ("direct", &b)] {
+        assert!(r.vs_reference_max_k <= 0.5 && r.vs_reference_under_k <= 0.3, "{path}: max {:.3} under {:.3} K", r.vs_reference_max_k, r.vs_reference_under_k);
+    }
 }
