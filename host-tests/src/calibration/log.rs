@@ -86,6 +86,15 @@ impl CalLog {
             .collect()
     }
 
+    /// The log's inputs as the reference replays them (every row, empty
+    /// cells interpolated; the circuit).
+    pub fn replay_inputs(&self) -> Option<&crate::scenario::ReplayInputs> {
+        match &self.scenario {
+            Scenario::Replay(r) => Some(r),
+            _ => None,
+        }
+    }
+
     /// Whether the log carries channel `ch`.
     pub fn has(&self, ch: Channel) -> bool {
         self.channels.contains(&ch)

@@ -6,6 +6,9 @@
 //!   the single table mapping them onto rig fields;
 //! - [`log`]: a measured log prepared for replay and scoring;
 //! - [`fit`]: joint fit over several logs with prior rows;
+//! - [`direct`]: the firmware model's own parameters fitted directly to
+//!   the logs from a reduction, with [`replay`] (the reduced model on a
+//!   log's inputs at the 10 ms tick);
 //! - [`ident`]: identifiability (singular values, intervals, correlated
 //!   pairs) and the one-operating-point warning;
 //! - [`synthetic`]: logs generated from a rig (tests and examples);
@@ -14,11 +17,13 @@
 
 pub mod cli;
 pub mod commission;
+pub mod direct;
 pub mod fit;
 pub mod ident;
 pub mod log;
 pub mod lsq;
 pub mod paper;
+pub mod replay;
 pub mod set;
 pub mod synthetic;
 

@@ -4,5 +4,6 @@
 
 mod cli;
 mod commission;
+mod direct;
 mod emulator;
 mod recovery;
