@@ -5,4 +5,5 @@
 mod cli;
 mod commission;
 mod emulator;
+mod foreign;
 mod recovery;
