@@ -41,6 +41,9 @@ pub struct CalOptions {
     /// (e.g. `pump_friction` when `commission` took it from the current).
     /// Default: the oil probe's response time ([`PROBE_HELD`]).
     pub hold: Vec<(&'static str, String)>,
+    /// Weight of the `t_drain_c` residuals relative to the other channels
+    /// (their σ divided by it); 1: the same σ as every channel.
+    pub drain_weight: f64,
 }
 
 impl Default for CalOptions {
@@ -52,6 +55,7 @@ impl Default for CalOptions {
             hold_ratio: 0.7,
             corr_threshold: 0.9,
             hold: vec![(PROBE_OIL, PROBE_HELD.into())],
+            drain_weight: 1.0,
         }
     }
 }
@@ -129,8 +133,17 @@ fn to_z(ln: f64, d: &super::set::ParamDef) -> f64 {
     (2.0 * u - 1.0).asin().clamp(-1.5, 1.5)
 }
 
+/// Data σ: the common one, and the drain channel's weight on it.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Sigma {
+    /// σ of every channel, K.
+    pub(crate) data_k: f64,
+    /// `t_drain_c` residuals are multiplied by this as well.
+    pub(crate) drain_weight: f64,
+}
+
 /// Scaled data residuals of every log at full multiplier vector `theta`.
-fn data_residuals(base: &Rig, logs: &[CalLog], theta: &[f64], sigma: f64, runs: &AtomicUsize) -> Option<Vec<f64>> {
+fn data_residuals(base: &Rig, logs: &[CalLog], theta: &[f64], sigma: Sigma, runs: &AtomicUsize) -> Option<Vec<f64>> {
     let rig = apply(base, theta);
     let parts: Option<Vec<Vec<f64>>> = logs
         .par_iter()
@@ -138,7 +151,8 @@ fn data_residuals(base: &Rig, logs: &[CalLog], theta: &[f64], sigma: f64, runs: 
             runs.fetch_add(1, Ordering::Relaxed);
             let s = l.simulate(&rig).ok()?;
             let r = l.residuals(&s);
-            r.iter().all(|x| x.is_finite()).then(|| r.into_iter().map(|x| x / sigma).collect())
+            let w = |ch: crate::measured::Channel| if ch == crate::measured::Channel::TDrainC { sigma.drain_weight } else { 1.0 };
+            r.iter().all(|x| x.is_finite()).then(|| r.into_iter().zip(&l.points).map(|(x, p)| x * w(p.0) / sigma.data_k).collect())
         })
         .collect();
     Some(parts?.concat())
@@ -147,7 +161,7 @@ fn data_residuals(base: &Rig, logs: &[CalLog], theta: &[f64], sigma: f64, runs: 
 /// Jacobian of the scaled data residuals with respect to ln θ of the
 /// parameters `idx`, at `theta` (forward differences of 0.05 in ln θ,
 /// stepping inwards from an upper bound).
-pub(crate) fn jacobian_ln(base: &Rig, logs: &[CalLog], theta: &[f64], idx: &[usize], sigma: f64, runs: &AtomicUsize) -> Option<(DVector<f64>, DMatrix<f64>)> {
+pub(crate) fn jacobian_ln(base: &Rig, logs: &[CalLog], theta: &[f64], idx: &[usize], sigma: Sigma, runs: &AtomicUsize) -> Option<(DVector<f64>, DMatrix<f64>)> {
     let r0 = DVector::from_vec(data_residuals(base, logs, theta, sigma, runs)?);
     let cols: Option<Vec<DVector<f64>>> = idx
         .par_iter()
@@ -173,7 +187,7 @@ pub fn calibrate(base: &Rig, logs: &[CalLog], o: &CalOptions) -> Result<Calibrat
         return Err(CalError::NoLogs);
     }
     let runs = AtomicUsize::new(0);
-    let sigma = o.sigma_data_k;
+    let sigma = Sigma { data_k: o.sigma_data_k, drain_weight: o.drain_weight };
     let ones = super::set::nominal();
     for l in logs {
         l.simulate(base).map_err(|e| CalError::Model(l.name.clone(), e))?;
