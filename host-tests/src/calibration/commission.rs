@@ -6,7 +6,7 @@
 
 use super::fit::{calibrate, CalError, CalOptions, Calibration};
 use super::log::{channel_errors, CalLog, ChannelError};
-use crate::diagnosis::reference::replay_inputs;
+use crate::simulation::replay::replay_inputs;
 use crate::measured::Channel;
 use crate::plant::{Control, Plant, Sensors};
 use crate::reduce::reduce;

@@ -2,7 +2,7 @@
 //! inputs, the channels it can be scored on (the five temperatures plus
 //! `t_drain_c` when logged) and the thinned fit points.
 
-use crate::diagnosis::reference::{replay_inputs, REPLAY_RTOL};
+use crate::simulation::replay::{replay_inputs, REPLAY_RTOL};
 use crate::measured::{Channel, MeasuredRun};
 use crate::rig::Rig;
 use crate::scenario::Scenario;

@@ -4,7 +4,7 @@
 //! ~1 % dropped rows and ~0.5 % empty cells, optionally a drain-port
 //! thermocouple; and a synthetic "other EHA".
 
-use crate::diagnosis::synth::quantise;
+use crate::data::acquisition::quantise;
 use crate::measured::{Channel, MeasuredRun};
 use crate::rig::Rig;
 use crate::scenario::{Circuit, Mission, PositionRef, Scenario, Schedule, ValveRule};
@@ -140,7 +140,7 @@ pub fn log(rig: &Rig, m: &Mission, sample_s: f64, seed: u64, drain: bool) -> Res
             .iter()
             .map(|&i| {
                 if ch.is_temperature() {
-                    let g: f64 = crate::emulator::logger::gauss(&mut rng);
+                    let g: f64 = crate::data::acquisition::gauss(&mut rng);
                     let y = quantise(v[i] + 0.1 * g);
                     (!rng.random_bool(0.005)).then_some(y)
                 } else {

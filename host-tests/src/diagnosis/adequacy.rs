@@ -5,7 +5,7 @@
 //! regressors its residual correlates with, the calibrated parameters that
 //! sit on a bound, and what to check or measure.
 
-use super::analysis::{Metrics, XCorr};
+use super::stats::{Metrics, XCorr};
 use super::model::ParamSpec;
 use crate::measured::{Channel, MeasuredRun};
 

@@ -7,7 +7,8 @@ use super::fit::{fit, FitOptions, FitResult, Point};
 use super::identify::{identifiable, HOUSING_OUTER_PREFIX};
 use super::model::{Candidate, SimSeries, Simulator};
 use super::regressors::regressors;
-use super::stats::{bias, bic, cross_correlation, ljung_box, max_abs, rmse, LjungBox};
+pub use super::stats::{ChannelMetrics, Metrics, XCorr};
+use super::stats::{bias, bic, cross_correlation, ljung_box, max_abs, rmse};
 use crate::measured::{Channel, MeasuredRun};
 use rayon::prelude::*;
 
@@ -115,41 +116,6 @@ impl Default for DiagnoseOptions {
     }
 }
 
-/// Errors of one channel, K (simulated − measured).
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
-pub struct ChannelMetrics {
-    /// Channel name.
-    pub channel: String,
-    /// RMSE on the training window, K.
-    pub train_rmse_k: f64,
-    /// RMSE on the held-out window, K.
-    pub heldout_rmse_k: f64,
-    /// Mean residual over the run, K.
-    pub bias_k: f64,
-    /// Largest absolute residual over the run, K.
-    pub max_error_k: f64,
-    /// Ljung–Box test of the residuals over the run.
-    pub ljung_box: LjungBox,
-}
-
-/// Errors of one model over every measured temperature channel.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
-pub struct Metrics {
-    /// Per channel.
-    pub channels: Vec<ChannelMetrics>,
-    /// Pooled RMSE over all channels, training window, K.
-    pub train_rmse_k: f64,
-    /// Pooled RMSE over all channels, held-out window, K.
-    pub heldout_rmse_k: f64,
-}
-
-impl Metrics {
-    /// The metrics of channel `name`.
-    pub fn channel(&self, name: &str) -> Option<&ChannelMetrics> {
-        self.channels.iter().find(|c| c.channel == name)
-    }
-}
-
 /// One row of the ranking: a candidate's fit and its evidence.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct RankEntry {
@@ -177,21 +143,6 @@ pub struct RankEntry {
     /// Why the candidate cannot be named in this run whatever its fit
     /// (empty when it can): see [`identifiable`].
     pub note: String,
-}
-
-/// Peak cross-correlation of one channel's residual with one regressor.
-#[derive(Debug, Clone, serde::Serialize)]
-pub struct XCorr {
-    /// Residual channel.
-    pub channel: String,
-    /// Regressor name.
-    pub regressor: String,
-    /// Correlation at lag 0.
-    pub rho0: f64,
-    /// Largest |correlation| over the lags (signed).
-    pub peak_rho: f64,
-    /// Lag of the peak, s (regressor leading the residual).
-    pub peak_lag_s: f64,
 }
 
 /// The full result of a diagnosis.

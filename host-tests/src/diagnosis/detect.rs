@@ -24,7 +24,7 @@ use rayon::prelude::*;
 use std::fmt::Write as _;
 
 /// One candidate's detectability on one log.
-#[derive(Debug, Clone, serde::Serialize)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct Detectability {
     /// Candidate name.
     pub candidate: String,

@@ -15,7 +15,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 /// Outcome of one emulated log.
-#[derive(Debug, Clone, serde::Serialize)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct EmuResult {
     /// The case.
     pub case: EmuCase,
@@ -48,13 +48,40 @@ pub struct EmuResult {
     /// Below 50 %, this log cannot show the effect whatever the rules; at or
     /// above, and the oracle under it, the emulator's structure decides.
     pub hidden_detect: Option<super::detect::Detectability>,
+    /// The imprint ratio against the log's effect-free twin (only when the
+    /// sweep ran twins; `None` for the `none` cases).
+    #[serde(default)]
+    pub twin: Option<TwinCheck>,
     /// Wall time of the diagnosis, s.
     pub seconds: f64,
 }
 
+/// The hidden effect's log against its effect-free twin
+/// ([`crate::emulator::generate_twin`]: same machine, mission and noise,
+/// nothing hidden), both diagnosed blind.
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+pub struct TwinCheck {
+    /// Held-out RMSE of the calibrated baseline on the affected channel,
+    /// the log, K.
+    pub misfit_k: f64,
+    /// The same on the twin: the structure floor of this log, K.
+    pub twin_misfit_k: f64,
+    /// The twin's answer (anything but `none`/`unexplained` is a false
+    /// discovery).
+    pub twin_answer: String,
+}
+
+impl TwinCheck {
+    /// Imprint ratio r = misfit / twin misfit: the effect stands clear of
+    /// the floor at r ≥ 2, where a diagnosis must name it.
+    pub fn ratio(&self) -> f64 {
+        self.misfit_k / self.twin_misfit_k.max(1e-9)
+    }
+}
+
 /// How the hidden effect's own candidate fared when fitted jointly with the
 /// calibration set (the "oracle" structure, known only to the sweep).
-#[derive(Debug, Clone, serde::Serialize)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct HiddenFit {
     /// BIC decrease against the calibrated baseline.
     pub delta_bic: f64,
@@ -90,6 +117,12 @@ impl EmuResult {
 
 /// Generates and diagnoses `case` with the rig file as baseline.
 pub fn run_emu_case(case: EmuCase, o: &DiagnoseOptions) -> Result<EmuResult, String> {
+    run_emu_case_twin(case, o, false)
+}
+
+/// [`run_emu_case`], and with `twin` (for a hidden effect) its effect-free
+/// twin diagnosed too, for the imprint ratio ([`TwinCheck`]).
+pub fn run_emu_case_twin(case: EmuCase, o: &DiagnoseOptions, twin: bool) -> Result<EmuResult, String> {
     let (run, truth) = generate(&case)?;
     let t = std::time::Instant::now();
     let model = ReferenceModel::new(Rig::default(), &run).map_err(|e| e.to_string())?;
@@ -117,9 +150,25 @@ pub fn run_emu_case(case: EmuCase, o: &DiagnoseOptions) -> Result<EmuResult, Str
             })
         })
         .flatten();
+    let seconds = t.elapsed().as_secs_f64();
+    let twin = match (&affected, twin) {
+        (Some((c, _)), true) => {
+            let (trun, _) = crate::emulator::generate_twin(&case)?;
+            let tmodel = ReferenceModel::new(Rig::default(), &trun).map_err(|e| e.to_string())?;
+            let td = diagnose(&trun, &tmodel, o).map_err(|e| e.to_string())?;
+            let misfit = |m: &super::stats::Metrics| m.channel(c).map(|x| x.heldout_rmse_k);
+            misfit(&d.before).zip(misfit(&td.before)).map(|(a, b)| TwinCheck {
+                misfit_k: a,
+                twin_misfit_k: b,
+                twin_answer: td.answer().into(),
+            })
+        }
+        _ => None,
+    };
     Ok(EmuResult {
         case,
         magnitude: truth.magnitude,
+        twin,
         answer: d.answer().into(),
         affected,
         affected_heldout_k,
@@ -134,7 +183,7 @@ pub fn run_emu_case(case: EmuCase, o: &DiagnoseOptions) -> Result<EmuResult, Str
         best_candidate: best,
         hidden_fit,
         hidden_detect,
-        seconds: t.elapsed().as_secs_f64(),
+        seconds,
     })
 }
 
@@ -314,52 +363,27 @@ pub struct EmuSweepArgs {
     /// Also write every generated log to OUT/logs/ (measured-data format).
     #[arg(long)]
     pub logs: bool,
+    /// Skip the effect-free twins (no imprint ratios; half the time).
+    #[arg(long)]
+    pub no_twins: bool,
 }
 
-/// Runs the emulator sweep; exit 0 always unless the outputs cannot be
-/// written (it is a measurement, not a test).
-pub fn run(a: &EmuSweepArgs) -> ExitCode {
-    let cases: Vec<EmuCase> = (0..a.seeds)
-        .flat_map(|k| match a.cases {
-            CaseSet::Ident => ident_cases(a.duration, 2700 + 100 * k),
-            CaseSet::Original => default_cases(a.duration, 1700 + 100 * k),
-        })
-        .filter(|c| !(a.no_servo && c.scenario.is_servo()))
-        .filter(|c| a.only.is_empty() || a.only.contains(&c.seed))
-        .collect();
-    let bar = indicatif::ProgressBar::new(cases.len() as u64);
-    let res: Vec<Result<EmuResult, String>> = cases
-        .par_iter()
-        .map(|c| {
-            if a.logs {
-                if let Ok((run, _)) = generate(c) {
-                    let dir = a.out.join("logs");
-                    let _ = std::fs::create_dir_all(&dir);
-                    let _ = run.write_file(dir.join(format!("{}-{:?}-{}.csv", c.hidden.name(), c.scenario, c.seed)));
-                }
-            }
-            let r = run_emu_case(*c, &DiagnoseOptions::default());
-            bar.inc(1);
-            r
-        })
-        .collect();
-    bar.finish_and_clear();
+/// The sweep's Markdown (`emulator-sweep.md`): the answer table, its
+/// summary line, the hidden effects' own fits and their classes. Also what
+/// `eha-sim docs` renders into docs/diagnosis.md from the committed JSON.
+pub fn document(ok: &[EmuResult]) -> String {
     let mut md = String::from(
         "| scenario (seed) | hidden | magnitude | answer | affected channel (imprint) | its held-out RMSE before → after (K) | pooled held-out RMSE nominal / calibrated → after (K) | calibrated held-out per channel, K (× noise σ, % of rise; **misfit**) | nuisance on a bound | s |\n|---|---|---|---|---|---|---|---|---|---:|\n",
     );
-    let ok: Vec<&EmuResult> = res.iter().flatten().collect();
-    for r in &ok {
+    for r in ok {
         md += &table_row(r);
         md.push('\n');
-    }
-    for e in res.iter().filter_map(|r| r.as_ref().err()) {
-        let _ = writeln!(md, "\nerror: {e}");
     }
     let with = ok.iter().filter(|r| r.case.hidden != Candidate::None).count();
     let hits = ok.iter().filter(|r| r.case.hidden != Candidate::None && r.hit()).count();
     let gain = ok.iter().filter(|r| r.case.hidden != Candidate::None && r.hit() && r.affected_gain().is_some_and(|g| g >= 0.5)).count();
     let count = |s: &str| ok.iter().filter(|r| r.answer == s).count();
-    let nones: Vec<&&EmuResult> = ok.iter().filter(|r| r.case.hidden == Candidate::None).collect();
+    let nones: Vec<&EmuResult> = ok.iter().filter(|r| r.case.hidden == Candidate::None).collect();
     let false_disc = nones.iter().filter(|r| r.answer != "none" && r.answer != "unexplained").count();
     let _ = writeln!(
         md,
@@ -389,6 +413,76 @@ pub fn run(a: &EmuSweepArgs) -> ExitCode {
         class("oracle ≥ 50 %"),
         class("oracle < 50 %"),
     );
+    md += &ratio_bands(ok);
+    md
+}
+
+/// The table by imprint-ratio band (r against each log's effect-free twin):
+/// where a diagnosis must name the cause (r ≥ 2) and how it did; empty when
+/// the sweep ran no twins.
+fn ratio_bands(ok: &[EmuResult]) -> String {
+    let with: Vec<(&EmuResult, f64)> = ok.iter().filter_map(|r| Some((r, r.twin.as_ref()?.ratio()))).collect();
+    if with.is_empty() {
+        return String::new();
+    }
+    let mut md = String::from(
+        "\n**By imprint ratio** r = the calibrated baseline's held-out misfit on the affected channel over the same on the \
+         log's effect-free twin (same machine, mission and noise):\n\n\
+         | r | cases | named | wrong cause | `none` | `unexplained` | seeds |\n|---|---:|---:|---:|---:|---:|---|\n",
+    );
+    for (label, lo, hi) in [("< 1", 0.0, 1.0), ("1–2", 1.0, 2.0), ("2–3", 2.0, 3.0), ("≥ 3", 3.0, f64::INFINITY)] {
+        let band: Vec<&(&EmuResult, f64)> = with.iter().filter(|(_, r)| *r >= lo && *r < hi).collect();
+        let n = |f: &dyn Fn(&EmuResult) -> bool| band.iter().filter(|(r, _)| f(r)).count();
+        let seeds: Vec<String> = band.iter().map(|(r, x)| format!("{} ({x:.1})", r.case.seed)).collect();
+        let _ = writeln!(
+            md,
+            "| {label} | {} | {} | {} | {} | {} | {} |",
+            band.len(),
+            n(&|r| r.hit()),
+            n(&|r| !r.hit() && r.answer != "none" && r.answer != "unexplained"),
+            n(&|r| r.answer == "none"),
+            n(&|r| r.answer == "unexplained"),
+            if seeds.is_empty() { "–".into() } else { seeds.join(", ") },
+        );
+    }
+    let twins_false = with.iter().filter(|(r, _)| r.twin.as_ref().is_some_and(|t| t.twin_answer != "none" && t.twin_answer != "unexplained")).count();
+    let _ = writeln!(md, "\nThe {} twins (effect-free): {twins_false} false discoveries.", with.len());
+    md
+}
+
+/// Runs the emulator sweep; exit 0 always unless the outputs cannot be
+/// written (it is a measurement, not a test).
+pub fn run(a: &EmuSweepArgs) -> ExitCode {
+    let cases: Vec<EmuCase> = (0..a.seeds)
+        .flat_map(|k| match a.cases {
+            CaseSet::Ident => ident_cases(a.duration, 2700 + 100 * k),
+            CaseSet::Original => default_cases(a.duration, 1700 + 100 * k),
+        })
+        .filter(|c| !(a.no_servo && c.scenario.is_servo()))
+        .filter(|c| a.only.is_empty() || a.only.contains(&c.seed))
+        .collect();
+    let bar = indicatif::ProgressBar::new(cases.len() as u64);
+    let res: Vec<Result<EmuResult, String>> = cases
+        .par_iter()
+        .map(|c| {
+            if a.logs {
+                if let Ok((run, _)) = generate(c) {
+                    let dir = a.out.join("logs");
+                    let _ = std::fs::create_dir_all(&dir);
+                    let _ = run.write_file(dir.join(format!("{}-{:?}-{}.csv", c.hidden.name(), c.scenario, c.seed)));
+                }
+            }
+            let r = run_emu_case_twin(*c, &DiagnoseOptions::default(), !a.no_twins);
+            bar.inc(1);
+            r
+        })
+        .collect();
+    bar.finish_and_clear();
+    let ok: Vec<EmuResult> = res.iter().flatten().cloned().collect();
+    let mut md = document(&ok);
+    for e in res.iter().filter_map(|r| r.as_ref().err()) {
+        let _ = writeln!(md, "\nerror: {e}");
+    }
     print!("{md}");
     let write = || -> std::io::Result<()> {
         std::fs::create_dir_all(&a.out)?;

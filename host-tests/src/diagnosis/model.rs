@@ -5,63 +5,7 @@
 use crate::measured::Channel;
 use std::collections::BTreeMap;
 
-/// A candidate model extension (the rig file's `[ext]` section); `None` is
-/// the baseline. Names are the strings `diagnosis.json` reports. `viscosity-temperature`
-/// is retired: the oil's viscosity follows its Walther line in the baseline
-/// of the reference and of the emulator, so there is nothing left to find.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
-pub enum Candidate {
-    /// Copper resistance rising with winding temperature, R = R0(1+α(T−T0)) (eq. 1).
-    WindingResistanceTemperature,
-    /// Manifold oil sensor in a dead-end pocket, first-order lag (paper Figs. 9–10).
-    SensorLag,
-    /// Non-linear (Coulomb) actuator friction (paper Case 2).
-    CoulombFriction,
-    /// Pump churning loss ∝ ω^2.5 (eq. 8 mechanical-loss term).
-    ChurningLoss,
-    /// Direct conduction between motor and pump housings (Point 2 joint).
-    MotorPumpConduction,
-    /// Unlogged forced convection over the housings (eqs. 17–19, Table 5).
-    ForcedConvection,
-    /// No extension: the baseline.
-    None,
-}
-
-impl Candidate {
-    /// The extensions tried by the diagnosis, in report order.
-    pub const EXTENSIONS: [Candidate; 6] = [
-        Candidate::WindingResistanceTemperature,
-        Candidate::SensorLag,
-        Candidate::CoulombFriction,
-        Candidate::ChurningLoss,
-        Candidate::MotorPumpConduction,
-        Candidate::ForcedConvection,
-    ];
-
-    /// Exact name used in reports, JSON and tests.
-    pub fn name(self) -> &'static str {
-        match self {
-            Candidate::WindingResistanceTemperature => "winding-resistance-temperature",
-            Candidate::SensorLag => "sensor-lag",
-            Candidate::CoulombFriction => "coulomb-friction",
-            Candidate::ChurningLoss => "churning-loss",
-            Candidate::MotorPumpConduction => "motor-pump-conduction",
-            Candidate::ForcedConvection => "forced-convection",
-            Candidate::None => "none",
-        }
-    }
-
-    /// The candidate with exact name `s`.
-    pub fn from_name(s: &str) -> Option<Candidate> {
-        Candidate::EXTENSIONS.into_iter().chain([Candidate::None]).find(|c| c.name() == s)
-    }
-}
-
-impl std::fmt::Display for Candidate {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
+pub use crate::physics::candidates::Candidate;
 
 /// A fitted parameter: strictly positive, fitted in log space between
 /// `lo` and `hi`, starting from `start`.

@@ -172,3 +172,53 @@ pub fn bic(rss: f64, n: usize, k: usize) -> f64 {
     let n = n as f64;
     n * (rss.max(1e-300) / n).ln() + k as f64 * n.ln()
 }
+
+/// Errors of one channel, K (simulated − measured).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct ChannelMetrics {
+    /// Channel name.
+    pub channel: String,
+    /// RMSE on the training window, K.
+    pub train_rmse_k: f64,
+    /// RMSE on the held-out window, K.
+    pub heldout_rmse_k: f64,
+    /// Mean residual over the run, K.
+    pub bias_k: f64,
+    /// Largest absolute residual over the run, K.
+    pub max_error_k: f64,
+    /// Ljung–Box test of the residuals over the run.
+    pub ljung_box: LjungBox,
+}
+
+/// Errors of one model over every measured temperature channel.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Metrics {
+    /// Per channel.
+    pub channels: Vec<ChannelMetrics>,
+    /// Pooled RMSE over all channels, training window, K.
+    pub train_rmse_k: f64,
+    /// Pooled RMSE over all channels, held-out window, K.
+    pub heldout_rmse_k: f64,
+}
+
+impl Metrics {
+    /// The metrics of channel `name`.
+    pub fn channel(&self, name: &str) -> Option<&ChannelMetrics> {
+        self.channels.iter().find(|c| c.channel == name)
+    }
+}
+
+/// Peak cross-correlation of one channel's residual with one regressor.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct XCorr {
+    /// Residual channel.
+    pub channel: String,
+    /// Regressor name.
+    pub regressor: String,
+    /// Correlation at lag 0.
+    pub rho0: f64,
+    /// Largest |correlation| over the lags (signed).
+    pub peak_rho: f64,
+    /// Lag of the peak, s (regressor leading the residual).
+    pub peak_lag_s: f64,
+}

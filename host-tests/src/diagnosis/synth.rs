@@ -6,6 +6,8 @@
 //! samples. Used by the diagnosis tests and the `diagnose-sweep` command.
 
 use super::model::Candidate;
+use crate::data::acquisition::{gauss, quantise};
+pub use crate::physics::candidates::magnitude_range;
 use crate::measured::{Channel, MeasuredRun};
 use crate::rig::Rig;
 use crate::scenario::{Circuit, Mission, PositionRef, Schedule, Scenario, ValveRule};
@@ -171,32 +173,6 @@ pub struct Truth {
     /// the generator with and without the effect over the last 30 % of the
     /// run), with that RMS difference, K. `None` for clean runs.
     pub affected: Option<(Channel, f64)>,
-}
-
-/// Realistic magnitude range of each extension (its parameter's unit in
-/// `eha_sim::rig::Extensions`).
-pub fn magnitude_range(c: Candidate) -> (f64, f64) {
-    match c {
-        // copper: 3.9e-3 1/K; alloys and winding hot spots 3e-3…4.3e-3
-        Candidate::WindingResistanceTemperature => (3.0e-3, 4.3e-3),
-        // dead-end pocket (Figs. 9–10): minutes
-        Candidate::SensorLag => (60.0, 240.0),
-        // piston-seal Coulomb friction of a 1527 mm² ram, N (2–4 % of
-        // its 30 kN force at 200 bar)
-        Candidate::CoulombFriction => (500.0, 1200.0),
-        // churning ∝ ω^2.5, 60–150 W at 1500 rpm (ω^2.5 ≈ 3.2e5)
-        Candidate::ChurningLoss => (2.0e-4, 5.0e-4),
-        // flange conduction, W/K
-        Candidate::MotorPumpConduction => (3.0, 8.0),
-        // unlogged fan / draught, m/s (Table 5 ram air is 15–50 m/s)
-        Candidate::ForcedConvection => (5.0, 12.0),
-        Candidate::None => (1.0, 1.0),
-    }
-}
-
-fn gauss(rng: &mut ChaCha8Rng) -> f64 {
-    let (u1, u2): (f64, f64) = (rng.random::<f64>().max(1e-300), rng.random());
-    (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
 }
 
 fn perturb(rng: &mut ChaCha8Rng) -> f64 {
@@ -432,12 +408,6 @@ pub fn truth_rig(c: &SynthCase, rng: &mut ChaCha8Rng) -> (Rig, f64) {
     (r, m)
 }
 
-/// 12-bit quantisation of a temperature over the sensor span 0…200 °C
-/// (LSB 0.049 K).
-pub fn quantise(t_c: f64) -> f64 {
-    let lsb = 200.0 / 4095.0;
-    ((t_c / lsb).round() * lsb).clamp(0.0, 200.0)
-}
 
 /// Generates the measured run of case `c`.
 pub fn generate(c: &SynthCase) -> Result<(MeasuredRun, Truth), String> {

@@ -7,7 +7,7 @@
 use rand::Rng;
 
 /// Operating scenario of an emulated log.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum EmuScenario {
     /// Case 1: constant 500 rpm, needle set for 20, 40 or 60 bar.
     ConstantThrottle,

@@ -54,8 +54,7 @@ pub mod params;
 pub mod plant;
 pub mod props;
 
-use crate::diagnosis::synth::magnitude_range;
-use crate::diagnosis::Candidate;
+use crate::physics::candidates::{magnitude_range, Candidate};
 use crate::measured::{Channel, MeasuredRun};
 use missions::{step_at, EmuScenario};
 use plant::{Hidden, Plant};
@@ -63,10 +62,10 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 /// One emulated log to generate.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct EmuCase {
     /// The hidden effect (`Candidate::None` for none).
-    #[serde(serialize_with = "ser_candidate")]
+    #[serde(serialize_with = "ser_candidate", deserialize_with = "de_candidate")]
     pub hidden: Candidate,
     /// Operating scenario.
     pub scenario: EmuScenario,
@@ -78,6 +77,11 @@ pub struct EmuCase {
 
 fn ser_candidate<S: serde::Serializer>(c: &Candidate, s: S) -> Result<S::Ok, S::Error> {
     s.serialize_str(c.name())
+}
+
+fn de_candidate<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Candidate, D::Error> {
+    let name = <String as serde::Deserialize>::deserialize(d)?;
+    Candidate::from_name(&name).ok_or_else(|| serde::de::Error::custom(format!("unknown candidate `{name}`")))
 }
 
 /// What the emulator did (never shown to the diagnosis).
@@ -95,7 +99,15 @@ pub struct EmuTruth {
 
 /// Generates the log of `c`.
 pub fn generate(c: &EmuCase) -> Result<(MeasuredRun, EmuTruth), String> {
-    generate_on(c, None)
+    generate_on(c, None, false)
+}
+
+/// The effect-free twin of case `c`: the same machine, mission, sensor
+/// noise and dropouts as [`generate`]'s log, with nothing hidden (its
+/// `affected` is `None`, its magnitude the one the log hides). The
+/// diagnosis's misfit on the twin is the structure floor of that very log.
+pub fn generate_twin(c: &EmuCase) -> Result<(MeasuredRun, EmuTruth), String> {
+    generate_on(c, None, true)
 }
 
 /// The log of case `c` flown by another case's machine: `machine` is that
@@ -103,10 +115,10 @@ pub fn generate(c: &EmuCase) -> Result<(MeasuredRun, EmuTruth), String> {
 /// noise and dropouts are `c`'s. Two logs of one machine in two scenarios,
 /// as a test campaign would take them.
 pub fn generate_on_machine(c: &EmuCase, machine: &EmuTruth) -> Result<(MeasuredRun, EmuTruth), String> {
-    generate_on(c, Some((&machine.params, machine.magnitude)))
+    generate_on(c, Some((&machine.params, machine.magnitude)), false)
 }
 
-fn generate_on(c: &EmuCase, machine: Option<(&params::EmuParams, f64)>) -> Result<(MeasuredRun, EmuTruth), String> {
+fn generate_on(c: &EmuCase, machine: Option<(&params::EmuParams, f64)>, twin: bool) -> Result<(MeasuredRun, EmuTruth), String> {
     let mut rng = ChaCha8Rng::seed_from_u64(c.seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ 0x17);
     let m = missions::draw(c.scenario, c.duration_s, &mut rng);
     let p = params::EmuParams::draw(&mut rng);
@@ -118,12 +130,13 @@ fn generate_on(c: &EmuCase, machine: Option<(&params::EmuParams, f64)>) -> Resul
         None => (p, magnitude),
     };
     let dt = c.scenario.log_interval_s();
-    let plant = Plant { p: &p, m: &m, h: Hidden { effect: c.hidden, magnitude } };
+    let hidden = if twin { Candidate::None } else { c.hidden };
+    let plant = Plant { p: &p, m: &m, h: Hidden { effect: hidden, magnitude } };
     let trace = plant.run(dt);
     if trace.iter().any(|r| r.1.iter().any(|v| !v.is_finite())) {
         return Err(format!("emulator diverged on {c:?}"));
     }
-    let affected = if c.hidden == Candidate::None {
+    let affected = if hidden == Candidate::None {
         None
     } else {
         let off = Plant { p: &p, m: &m, h: Hidden { effect: Candidate::None, magnitude: 0.0 } }.run(dt);

@@ -7,7 +7,7 @@
 use super::missions::{linear_at, step_at, EmuMission};
 use super::params::EmuParams;
 use super::props::{self, oil_cp, oil_nu, oil_rho};
-use crate::diagnosis::Candidate;
+use crate::physics::candidates::Candidate;
 use std::f64::consts::PI;
 
 /// Thermal nodes of the emulator (the reference model has 12 others).

@@ -8,8 +8,11 @@
 //! - [`heat`]: film, convection and radiation correlations, eqs. (12)–(19);
 //! - [`network`]: nodes, capacities and conductances;
 //! - [`hydraulics`]: pump, valves, lines, cylinder, position loop;
-//! - [`cooling`]: the LNG exchanger, eqs. (20)–(25).
+//! - [`cooling`]: the LNG exchanger, eqs. (20)–(25);
+//! - [`candidates`]: the model extensions a diagnosis tries, with their
+//!   realistic magnitudes.
 
+pub mod candidates;
 pub mod cooling;
 pub mod fluid;
 pub mod heat;

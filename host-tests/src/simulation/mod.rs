@@ -6,12 +6,14 @@
 //! - [`scenario`], [`missions`]: the paper's cases and mission profiles;
 //! - [`sim`]: runs and their outputs (shared log format plus internal
 //!   channels);
-//! - [`equilibrium`]: the steady state of the node balances (Newton).
+//! - [`equilibrium`]: the steady state of the node balances (Newton);
+//! - [`replay`]: a measured log's inputs as a replay scenario.
 
 pub mod equilibrium;
 pub mod fast;
 pub mod missions;
 pub mod model;
 pub mod plant;
+pub mod replay;
 pub mod scenario;
 pub mod sim;

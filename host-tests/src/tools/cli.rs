@@ -112,7 +112,7 @@ pub fn scenario_of(a: &SimulateArgs) -> Result<Scenario> {
     if let Some(p) = &a.replay {
         let run = crate::measured::MeasuredRun::read_file(p)?;
         let name = p.file_stem().map_or("replay".into(), |s| format!("replay-{}", s.to_string_lossy()));
-        return Ok(Scenario::Replay(crate::diagnosis::reference::replay_inputs(&run, &name)?));
+        return Ok(Scenario::Replay(crate::simulation::replay::replay_inputs(&run, &name)?));
     }
     Ok(a.case.scenario.scenario(a.case.needle_bar, a.case.duration_s))
 }

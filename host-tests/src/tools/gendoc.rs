@@ -31,12 +31,25 @@ pub struct Section {
 }
 
 /// Every generated section.
-pub const SECTIONS: [Section; 4] = [
+pub const SECTIONS: [Section; 5] = [
     Section { doc: "docs/results.md", tag: "uq-paper", source: "docs/data/uq-paper.json", render: render_uq_paper },
     Section { doc: "docs/results.md", tag: "fw-budget", source: ".ci/fw-budget.json", render: render_fw_budget },
     Section { doc: "docs/rig-file.md", tag: "rig-file", source: "host-tests/src/physics/rig.rs", render: crate::tools::rigdoc::render },
     Section { doc: "docs/failure-modes.md", tag: "failure-modes", source: "docs/data/faults.json", render: render_failure_modes },
+    Section {
+        doc: "docs/diagnosis.md",
+        tag: "emulator-sweep",
+        source: "docs/data/emulator-sweep-1700.json",
+        render: render_emulator_sweep,
+    },
 ];
+
+/// The emulator sweep's tables (`eha-sim emulator-sweep`, seeds
+/// 1700–1717, its `emulator-sweep.json`).
+fn render_emulator_sweep(json: &str) -> Result<String> {
+    let rows: Vec<crate::diagnosis::emu_sweep::EmuResult> = serde_json::from_str(json)?;
+    Ok(crate::diagnosis::emu_sweep::document(&rows))
+}
 
 /// The fault campaign's table (`eha-sim faults`, the whole campaign).
 fn render_failure_modes(json: &str) -> Result<String> {

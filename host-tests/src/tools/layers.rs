@@ -519,17 +519,9 @@ mod tests {
     }
 
     /// Violations that stand (see the test above): the firmware's constants
-    /// and its guard types, the calibration's use of the diagnosis's replay
-    /// and synthetic logs, the emulator's use of the diagnosis's candidates.
+    /// and its guard types.
     const KNOWN: &[&str] = &[
         "firmware cycle: default_consts ↔ model ↔ model::consts ↔ model::input ↔ num ↔ params",
         "firmware cycle: guard::types ↔ speedcheck ↔ validate",
-        "host cycle: diagnosis::adequacy ↔ diagnosis::analysis",
-        "host upward: calibration::commission → diagnosis::reference",
-        "host upward: calibration::log → diagnosis::reference",
-        "host upward: calibration::synthetic → diagnosis::synth",
-        "host upward: emulator → diagnosis::model",
-        "host upward: emulator → diagnosis::synth",
-        "host upward: emulator::plant → diagnosis::model",
     ];
 }
