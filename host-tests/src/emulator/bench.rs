@@ -9,7 +9,7 @@
 use super::missions::{draw, EmuScenario};
 use super::params::EmuParams;
 use super::plant::{Hidden, Plant, N};
-use crate::diagnosis::Candidate;
+use crate::physics::candidates::Candidate;
 use crate::measured::{Channel, MeasuredRun};
 use crate::rig::Rig;
 use rand::SeedableRng;
