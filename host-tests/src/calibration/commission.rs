@@ -444,13 +444,15 @@ fn head_of(log: &CalLog, frac: f64, points_per_channel: usize) -> Result<CalLog,
 /// reduced, and scored against each log's measured drain after the split
 /// (replayed from the start). `None` when a training log has no
 /// `t_drain_c`, or when the validation fit gives parameters the firmware
-/// model rejects.
-pub fn validate_margin(base: &Rig, train: &[CalLog], o: &CalOptions) -> Result<Option<MarginValidation>, CommissionError> {
+/// model rejects. `start`: the multipliers the validation fit starts from
+/// (the commissioning's; its priors stay at the rig file).
+pub fn validate_margin(base: &Rig, train: &[CalLog], o: &CalOptions, start: Option<&[f64]>) -> Result<Option<MarginValidation>, CommissionError> {
     if train.is_empty() || !train.iter().all(|l| l.has(Channel::TDrainC)) {
         return Ok(None);
     }
     let heads: Vec<CalLog> = train.iter().map(|l| head_of(l, SPLIT_FRACTION, o.points_per_channel)).collect::<Result<_, _>>().map_err(CommissionError::Run)?;
-    let (_, cal, _) = fit(base, &heads, o)?;
+    let o = CalOptions { start: start.map(<[f64]>::to_vec), ..o.clone() };
+    let (_, cal, _) = fit(base, &heads, &o)?;
     let Some(p) = reduce(&cal.rig) else { return Ok(None) };
     let mut folds = Vec::new();
     for (l, h) in train.iter().zip(&heads) {
@@ -505,7 +507,11 @@ pub fn commission_with(base: &Rig, train: &[CalLog], holdout: &[CalLog], o: &Cal
         .map_err(CommissionError::Run)?;
     let reduced_ok = reduced.iter().all(|r| r.vs_reference_max_k <= REDUCED_BOUND_K);
     let excitation_ok = !cal.warnings.iter().any(|w| w.starts_with(crate::calibration::ident::NO_EXCITATION));
-    let margin = if with_margin { validate_margin(base, train, o)? } else { None };
+    // The validation fit starts from the commissioning's multipliers: from
+    // the rig file, a 1e-9 K nudge of the logs moved big-pump's margin by
+    // 0.17 K (the heads fit wanders along its ill-determined directions);
+    // from there, by 0.043 K.
+    let margin = if with_margin { validate_margin(base, train, o, Some(&cal.theta))? } else { None };
     if with_margin && margin.is_none() {
         cal.warnings.push("no drain margin: it needs `t_drain_c` in every training log, and a validation fit (first 60 % of every training log) that the firmware model accepts".into());
     }

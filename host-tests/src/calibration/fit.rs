@@ -44,6 +44,10 @@ pub struct CalOptions {
     /// Weight of the `t_drain_c` residuals relative to the other channels
     /// (their σ divided by it); 1: the same σ as every channel.
     pub drain_weight: f64,
+    /// Multipliers (one per [`PARAMS`] entry) the LM fit starts from; the
+    /// rig file's (all 1) when `None`. Screening and priors stay at the rig
+    /// file; held parameters stay at 1.
+    pub start: Option<Vec<f64>>,
 }
 
 impl Default for CalOptions {
@@ -56,6 +60,7 @@ impl Default for CalOptions {
             corr_threshold: 0.9,
             hold: vec![(PROBE_OIL, PROBE_HELD.into())],
             drain_weight: 1.0,
+            start: None,
         }
     }
 }
@@ -236,7 +241,11 @@ pub fn calibrate(base: &Rig, logs: &[CalLog], o: &CalOptions) -> Result<Calibrat
     }
     let free: Vec<usize> = (0..PARAMS.len()).filter(|&k| held[k].is_none()).collect();
     // 3. LM on the free parameters (internal z), data rows + prior rows.
-    let best: Mutex<(f64, Vec<f64>)> = Mutex::new((f64::INFINITY, ones.clone()));
+    let start: Vec<f64> = match &o.start {
+        Some(th) if th.len() == PARAMS.len() => (0..PARAMS.len()).map(|k| if held[k].is_none() { th[k] } else { 1.0 }).collect(),
+        _ => ones.clone(),
+    };
+    let best: Mutex<(f64, Vec<f64>)> = Mutex::new((f64::INFINITY, start.clone()));
     // LM's evaluation budget, counted in its sequential calls
     // (`FdProblem::with_budget`) so that the fit is reproducible.
     let evals = std::sync::Arc::new(AtomicUsize::new(0));
@@ -276,7 +285,7 @@ pub fn calibrate(base: &Rig, logs: &[CalLog], o: &CalOptions) -> Result<Calibrat
     // minimum: it restarts from the best point while a restart gains > 1 %.
     let thermal: Vec<usize> = free.iter().copied().filter(|&k| PARAMS[k].stage == Stage::Thermal).collect();
     if !thermal.is_empty() && thermal.len() < free.len() {
-        lm_run(&thermal, &ones);
+        lm_run(&thermal, &start);
     }
     let starts = if free.is_empty() { 0 } else { MAX_LM_STARTS };
     for _ in 0..starts {

@@ -84,35 +84,84 @@ fn report(m: &EmuMachine, c: &Commissioning, secs: f64) {
     }
 }
 
-/// The commissioning path without the margin, on both machines.
+/// Tolerance on a measured headline number, K: a 1e-9 K nudge of every
+/// temperature moved them by up to 0.051 K
+/// (`slow_commissioning_is_reproducible_at_the_last_digit`).
+const AS_MEASURED_K: f64 = 0.15;
+
+fn near(what: &str, got: f64, measured: f64) {
+    assert!((got - measured).abs() <= AS_MEASURED_K, "{what}: {got:.3} K, measured {measured:.3} K (±{AS_MEASURED_K})");
+}
+
+/// The commissioning path without the margin, on both machines. Measured
+/// (held-out servo, throttle mix; firmware drain vs the thermocouple, max
+/// |e| / under-prediction): big-pump flashable, 2.27 / 2.27 K and 3.78 /
+/// 2.32 K (vs the true drain 1.97 / 1.97, 3.85 / 2.37 K); leaky-heavy
+/// refused, the six-state model 0.608 K off the commissioned reference on
+/// the servo log, 3.12 / 3.12 K and 2.42 / 2.42 K. The training logs
+/// themselves are missed too (big-pump soak then idle: 2.77 K under, in the
+/// idle phase): the commissioned reference does not follow these machines'
+/// drain, the reduction does (≤ 0.19 K on every throttle log).
 #[test]
 #[ignore = "slow tier: two commissionings on emulator bench logs (~40 s each)"]
 fn slow_commissioning_without_margin_on_foreign_machines() {
-    for m in machines() {
+    let measured = [(true, [(2.273, 2.273), (3.781, 2.324)]), (false, [(3.115, 3.115), (2.420, 2.420)])];
+    for (m, (flash, want)) in machines().into_iter().zip(measured) {
         let s = bench_set(&m, 3600).expect("bench");
         let train: Vec<CalLog> = s.train.iter().map(cal).collect();
         let hold: Vec<CalLog> = s.holdout.iter().map(cal).collect();
         let t0 = std::time::Instant::now();
-        let w: f64 = std::env::var("EHA_DRAIN_WEIGHT").ok().and_then(|v| v.parse().ok()).unwrap_or(1.0);
-        let c = commission_with(&m.rig_file(), &train, &hold, &CalOptions { drain_weight: w, ..CalOptions::default() }, false).expect("commissioning");
+        let c = commission_with(&m.rig_file(), &train, &hold, &CalOptions::default(), false).expect("commissioning");
         report(&m, &c, t0.elapsed().as_secs_f64());
-        headline(&m, &c, &s.holdout);
+        let h = headline(&m, &c, &s.holdout);
+        assert_eq!(c.flashable(), flash, "{}: flashable", m.name);
+        for (got, want) in h.measured.iter().zip(want) {
+            near(&format!("{} held-out max |e|", m.name), got.0, want.0);
+            near(&format!("{} held-out under-prediction", m.name), got.1, want.1);
+        }
     }
 }
 
 /// The commissioning path with the drain margin (validated on a split of the
-/// training missions), on both machines.
+/// training missions), on both machines: the acceptance is 1.0 K max
+/// |e| and ≤ 0.3 K under-prediction on the held-out logs with the margin
+/// counted. Measured (max |e| / under vs the thermocouple; servo, throttle
+/// mix):
+/// - big-pump: margin 2.15 K (after the split the soak log's idle phase is
+///   under-predicted by 1.95 K); 2.35 / 0.12 K and 5.93 / 0.17 K: the
+///   under-prediction bound met, max |e| not (the mix is over-predicted by
+///   3.78 K before the margin).
+/// - leaky-heavy: margin 2.50 K (1.45 and 2.30 K after the split); 2.74 /
+///   0.62 K and 3.45 / 0.00 K: the servo log still 0.62 K under (3.12 K
+///   without margin, more than the split saw); refused for the reduction
+///   (0.608 K on the servo log), written only with `--accept-with-margin`.
+/// - Cost on the throttle mix (open loop): valve open 1486 → 1508 s, LNG
+///   2.96 → 3.01 kg (big-pump); 1540 → 1562 s, 2.09 → 2.13 kg
+///   (leaky-heavy); the servo logs stay below 40 °C.
+/// - 33–48 s per commissioning (four logs: two 1800 s training, a 1200 s
+///   servo and a 1800 s mix held out) on the shared 2 cores.
 #[test]
-#[ignore = "slow tier: two commissionings with margin validation on emulator bench logs (~1.5 min each)"]
+#[ignore = "slow tier: two commissionings with margin validation on emulator bench logs (~1 min each)"]
 fn slow_commissioning_with_margin_on_foreign_machines() {
-    for m in machines() {
+    let measured = [(2.152, [(2.345, 0.120), (5.933, 0.172)], [1486.0, 1508.0]), (2.500, [(2.735, 0.616), (3.452, 0.0)], [1540.0, 1562.0])];
+    for (m, (margin, want, open_s)) in machines().into_iter().zip(measured) {
         let s = bench_set(&m, 3600).expect("bench");
         let train: Vec<CalLog> = s.train.iter().map(cal).collect();
         let hold: Vec<CalLog> = s.holdout.iter().map(cal).collect();
         let t0 = std::time::Instant::now();
         let c = commission(&m.rig_file(), &train, &hold, &CalOptions::default()).expect("commissioning");
         report(&m, &c, t0.elapsed().as_secs_f64());
-        headline(&m, &c, &s.holdout);
+        let h = headline(&m, &c, &s.holdout);
+        near(&format!("{} margin", m.name), h.margin_k, margin);
+        for (got, want) in h.measured.iter().zip(want) {
+            near(&format!("{} held-out max |e| with margin", m.name), got.0, want.0);
+            near(&format!("{} held-out under-prediction with margin", m.name), got.1, want.1);
+        }
+        // The margin opens the valve earlier, never later (open loop).
+        let n = c.reduced.len() - c.holdout.len();
+        let (a, b) = (&c.reduced[n + 1], &c.holdout_with_margin[1]);
+        assert!(b.valve_open_s >= a.valve_open_s && b.lng_kg >= a.lng_kg, "{}: margin cost negative", m.name);
+        assert!((a.valve_open_s - open_s[0]).abs() <= 20.0 && (b.valve_open_s - open_s[1]).abs() <= 20.0, "{}: valve open {:.0} -> {:.0} s", m.name, a.valve_open_s, b.valve_open_s);
     }
 }
 
@@ -137,8 +186,15 @@ fn one_operating_point_is_refused_with_log_region_channel_and_bench_run() {
 
 /// Every temperature of every log moved by 1e-9 K: the headline numbers
 /// (held-out max |e| and under-prediction, margin) move by at most 0.05 K.
+/// Measured: big-pump 0.043 K (margin 2.152 → 2.196 K); leaky-heavy 0.051 K
+/// (the servo log's under-prediction with margin 0.616 → 0.565 K; margin
+/// 2.500 → 2.504 K): fails by 0.001 K. The servo log is extrapolation (no
+/// training log moves the piston) and the commissioning's fit moves along
+/// its ill-determined directions; with the validation fit started from the
+/// rig file instead of the commissioning's multipliers, big-pump's margin
+/// moved 0.17 K.
 #[test]
-#[ignore = "slow tier: four commissionings with margin validation (~8 min)"]
+#[ignore = "slow tier: four commissionings with margin validation (~4 min)"]
 fn slow_commissioning_is_reproducible_at_the_last_digit() {
     let nudge = |l: &BenchLog| -> BenchLog {
         let mut l = l.clone();
@@ -153,7 +209,10 @@ fn slow_commissioning_is_reproducible_at_the_last_digit() {
         let run = |logs: &[BenchLog], hold: &[BenchLog]| {
             let train: Vec<CalLog> = logs.iter().map(cal).collect();
             let h: Vec<CalLog> = hold.iter().map(cal).collect();
+            let t0 = std::time::Instant::now();
             let c = commission(&m.rig_file(), &train, &h, &CalOptions::default()).expect("commissioning");
+            eprintln!("{}: {:.1} s, flashable {}", m.name, t0.elapsed().as_secs_f64(), c.flashable());
+            report(&m, &c, t0.elapsed().as_secs_f64());
             headline(&m, &c, hold)
         };
         let a = run(&s.train, &s.holdout);
@@ -168,3 +227,4 @@ fn slow_commissioning_is_reproducible_at_the_last_digit() {
         assert!(worst <= 0.05, "{}: a 1e-9 K nudge moved the headline by {worst:.3} K", m.name);
     }
 }
+
