@@ -41,6 +41,13 @@ pub struct CalOptions {
     /// (e.g. `pump_friction` when `commission` took it from the current).
     /// Default: the oil probe's response time ([`PROBE_HELD`]).
     pub hold: Vec<(&'static str, String)>,
+    /// Weight of the `t_drain_c` residuals relative to the other channels
+    /// (their σ divided by it); 1: the same σ as every channel.
+    pub drain_weight: f64,
+    /// Multipliers (one per [`PARAMS`] entry) the LM fit starts from; the
+    /// rig file's (all 1) when `None`. Screening and priors stay at the rig
+    /// file; held parameters stay at 1.
+    pub start: Option<Vec<f64>>,
 }
 
 impl Default for CalOptions {
@@ -52,6 +59,8 @@ impl Default for CalOptions {
             hold_ratio: 0.7,
             corr_threshold: 0.9,
             hold: vec![(PROBE_OIL, PROBE_HELD.into())],
+            drain_weight: 1.0,
+            start: None,
         }
     }
 }
@@ -129,8 +138,17 @@ fn to_z(ln: f64, d: &super::set::ParamDef) -> f64 {
     (2.0 * u - 1.0).asin().clamp(-1.5, 1.5)
 }
 
+/// Data σ: the common one, and the drain channel's weight on it.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Sigma {
+    /// σ of every channel, K.
+    pub(crate) data_k: f64,
+    /// `t_drain_c` residuals are multiplied by this as well.
+    pub(crate) drain_weight: f64,
+}
+
 /// Scaled data residuals of every log at full multiplier vector `theta`.
-fn data_residuals(base: &Rig, logs: &[CalLog], theta: &[f64], sigma: f64, runs: &AtomicUsize) -> Option<Vec<f64>> {
+fn data_residuals(base: &Rig, logs: &[CalLog], theta: &[f64], sigma: Sigma, runs: &AtomicUsize) -> Option<Vec<f64>> {
     let rig = apply(base, theta);
     let parts: Option<Vec<Vec<f64>>> = logs
         .par_iter()
@@ -138,7 +156,8 @@ fn data_residuals(base: &Rig, logs: &[CalLog], theta: &[f64], sigma: f64, runs: 
             runs.fetch_add(1, Ordering::Relaxed);
             let s = l.simulate(&rig).ok()?;
             let r = l.residuals(&s);
-            r.iter().all(|x| x.is_finite()).then(|| r.into_iter().map(|x| x / sigma).collect())
+            let w = |ch: crate::measured::Channel| if ch == crate::measured::Channel::TDrainC { sigma.drain_weight } else { 1.0 };
+            r.iter().all(|x| x.is_finite()).then(|| r.into_iter().zip(&l.points).map(|(x, p)| x * w(p.0) / sigma.data_k).collect())
         })
         .collect();
     Some(parts?.concat())
@@ -147,7 +166,7 @@ fn data_residuals(base: &Rig, logs: &[CalLog], theta: &[f64], sigma: f64, runs: 
 /// Jacobian of the scaled data residuals with respect to ln θ of the
 /// parameters `idx`, at `theta` (forward differences of 0.05 in ln θ,
 /// stepping inwards from an upper bound).
-pub(crate) fn jacobian_ln(base: &Rig, logs: &[CalLog], theta: &[f64], idx: &[usize], sigma: f64, runs: &AtomicUsize) -> Option<(DVector<f64>, DMatrix<f64>)> {
+pub(crate) fn jacobian_ln(base: &Rig, logs: &[CalLog], theta: &[f64], idx: &[usize], sigma: Sigma, runs: &AtomicUsize) -> Option<(DVector<f64>, DMatrix<f64>)> {
     let r0 = DVector::from_vec(data_residuals(base, logs, theta, sigma, runs)?);
     let cols: Option<Vec<DVector<f64>>> = idx
         .par_iter()
@@ -173,7 +192,7 @@ pub fn calibrate(base: &Rig, logs: &[CalLog], o: &CalOptions) -> Result<Calibrat
         return Err(CalError::NoLogs);
     }
     let runs = AtomicUsize::new(0);
-    let sigma = o.sigma_data_k;
+    let sigma = Sigma { data_k: o.sigma_data_k, drain_weight: o.drain_weight };
     let ones = super::set::nominal();
     for l in logs {
         l.simulate(base).map_err(|e| CalError::Model(l.name.clone(), e))?;
@@ -227,7 +246,11 @@ pub fn calibrate(base: &Rig, logs: &[CalLog], o: &CalOptions) -> Result<Calibrat
     }
     let free: Vec<usize> = (0..PARAMS.len()).filter(|&k| held[k].is_none()).collect();
     // 3. LM on the free parameters (internal z), data rows + prior rows.
-    let best: Mutex<(f64, Vec<f64>)> = Mutex::new((f64::INFINITY, ones.clone()));
+    let start: Vec<f64> = match &o.start {
+        Some(th) if th.len() == PARAMS.len() => (0..PARAMS.len()).map(|k| if held[k].is_none() { th[k] } else { 1.0 }).collect(),
+        _ => ones.clone(),
+    };
+    let best: Mutex<(f64, Vec<f64>)> = Mutex::new((f64::INFINITY, start.clone()));
     // LM's evaluation budget, counted in its sequential calls
     // (`FdProblem::with_budget`) so that the fit is reproducible.
     let evals = std::sync::Arc::new(AtomicUsize::new(0));
@@ -267,7 +290,7 @@ pub fn calibrate(base: &Rig, logs: &[CalLog], o: &CalOptions) -> Result<Calibrat
     // minimum: it restarts from the best point while a restart gains > 1 %.
     let thermal: Vec<usize> = free.iter().copied().filter(|&k| PARAMS[k].stage == Stage::Thermal).collect();
     if !thermal.is_empty() && thermal.len() < free.len() {
-        lm_run(&thermal, &ones);
+        lm_run(&thermal, &start);
     }
     let starts = if free.is_empty() { 0 } else { MAX_LM_STARTS };
     for _ in 0..starts {

@@ -4,9 +4,12 @@
 //! current, 1 rpm on speed, 0.05 K on ambient), 12-bit quantisation of the
 //! temperatures over 0…200 °C, ~1 % of rows lost and ~0.5 % of temperature
 //! cells empty. The sensor lags and placements are plant states
-//! ([`super::plant`]).
+//! ([`super::plant`]). On request the drain-port thermocouple is logged as
+//! `t_drain_c` like the other temperatures (σ = 0.1 K, 12-bit, ~0.5 % cells
+//! empty; its 3 s lag is the plant state [`DRAIN_SENSOR`]), its noise drawn
+//! after every other channel's so that the other columns do not change.
 
-use super::plant::{Op, NN, NS};
+use super::plant::{Op, DRAIN_SENSOR, NN, NS};
 use crate::measured::{Channel, MeasuredRun};
 pub use crate::data::acquisition::{gauss, quantise};
 use rand::Rng;
@@ -22,12 +25,14 @@ pub type Row = (f64, Vec<f64>, Op);
 
 /// Logs `trace` (time, state, operating point) as a measured run.
 /// `ram_air` gives the logged ram-air speed at a time when the run logs it
-/// (never the hidden draught); `servo` adds `position_mm`.
+/// (never the hidden draught); `servo` adds `position_mm`; `drain` adds
+/// `t_drain_c` (the drain-port thermocouple).
 pub fn log<R: Rng>(
     trace: &[Row],
     ambient: impl Fn(f64) -> f64,
     ram_air: Option<&dyn Fn(f64) -> f64>,
     servo: bool,
+    drain: bool,
     rng: &mut R,
 ) -> MeasuredRun {
     let keep: Vec<&Row> = trace.iter().enumerate().filter(|(i, _)| *i == 0 || !rng.random_bool(0.01)).map(|x| x.1).collect();
@@ -64,6 +69,16 @@ pub fn log<R: Rng>(
             })
             .collect();
         run.set(ch, v);
+    }
+    if drain {
+        let v: Vec<Option<f64>> = keep
+            .iter()
+            .map(|r| {
+                let y = quantise(r.1[DRAIN_SENSOR] + 0.1 * gauss(rng));
+                (!rng.random_bool(0.005)).then_some(y)
+            })
+            .collect();
+        run.set(Channel::TDrainC, v);
     }
     run
 }

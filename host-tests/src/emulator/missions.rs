@@ -30,6 +30,16 @@ pub enum EmuScenario {
     /// (10–100 bar) and logged ram air (0 or 5–25 m/s) each stepped on its
     /// own schedule (every 60–240 s), so that no two inputs move together.
     IdentRun,
+    /// A bench's one-at-a-time throttle run: speed steps (400–1200 rpm every
+    /// 150–250 s) at a needle set for 20 bar for the first half, then needle
+    /// steps (10–50 bar every 150–250 s) at 700 rpm.
+    SpeedThenNeedleSteps,
+    /// A long soak (600–800 rpm at 40–55 bar) for 60 % of the run, then
+    /// idle (300 rpm, needle open to 5 bar).
+    SoakThenIdle,
+    /// A throttle mix: speed (400–1200 rpm) and needle (10–60 bar) drawn
+    /// afresh together at every step, every 90–200 s.
+    ThrottleMix,
 }
 
 impl EmuScenario {
@@ -135,6 +145,24 @@ pub fn draw(scenario: EmuScenario, duration_s: f64, rng: &mut impl Rng) -> EmuMi
             m.speed = steps(rng, d, 60.0, 240.0, |r, _| r(500.0, 2000.0));
             m.dp_bar = steps(rng, d, 60.0, 240.0, |r, _| r(10.0, 100.0));
             m.air = steps(rng, d, 60.0, 240.0, |r, _| if r(0.0, 1.0) < 0.35 { 0.0 } else { r(5.0, 25.0) });
+        }
+        EmuScenario::SpeedThenNeedleSteps => {
+            let half = 0.5 * d;
+            m.speed = steps(rng, half, 150.0, 250.0, |r, _| r(400.0, 1200.0));
+            m.dp_bar = vec![(0.0, 20.0)];
+            let needle = steps(rng, d - half, 150.0, 250.0, |r, _| r(10.0, 50.0));
+            m.speed.push((half, 700.0));
+            m.dp_bar.extend(needle.into_iter().map(|(t, v)| (half + t, v)));
+        }
+        EmuScenario::SoakThenIdle => {
+            let soak = 0.6 * d;
+            m.speed = vec![(0.0, rng.random_range(600.0..800.0)), (soak, 300.0)];
+            m.dp_bar = vec![(0.0, rng.random_range(40.0..55.0)), (soak, 5.0)];
+        }
+        EmuScenario::ThrottleMix => {
+            let times = steps(rng, d, 90.0, 200.0, |_, _| 0.0);
+            m.speed = times.iter().map(|&(t, _)| (t, rng.random_range(400.0..1200.0))).collect();
+            m.dp_bar = times.iter().map(|&(t, _)| (t, rng.random_range(10.0..60.0))).collect();
         }
         EmuScenario::ServoHoldMove => {
             let (mut pts, mut t, mut hold) = (vec![(0.0, 0.0)], 0.0, rng.random_bool(0.5));

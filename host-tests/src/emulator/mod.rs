@@ -47,6 +47,7 @@
 //! a motor-housing ↔ pump-barrel conductance; an unlogged draught over all
 //! housings.
 
+pub mod bench;
 pub mod logger;
 pub mod missions;
 pub mod params;
@@ -163,9 +164,15 @@ fn generate_on(c: &EmuCase, machine: Option<(&params::EmuParams, f64)>, twin: bo
 /// mission's ambient, its ram air where the scenario logs it, the servo
 /// columns on servo runs, the sensors' noise and dropouts from `rng`.
 pub fn log_mission(trace: &[logger::Row], m: &missions::EmuMission, rng: &mut impl Rng) -> MeasuredRun {
+    log_mission_as(trace, m, false, rng)
+}
+
+/// [`log_mission`], with the drain-port thermocouple logged as `t_drain_c`
+/// when `drain` (a commissioning bench).
+pub fn log_mission_as(trace: &[logger::Row], m: &missions::EmuMission, drain: bool, rng: &mut impl Rng) -> MeasuredRun {
     let air = |t: f64| step_at(&m.air, t);
     let ram: Option<&dyn Fn(f64) -> f64> = if m.scenario.logs_air() { Some(&air) } else { None };
-    logger::log(trace, |t| m.ambient_c(t), ram, m.scenario.is_servo(), rng)
+    logger::log(trace, |t| m.ambient_c(t), ram, m.scenario.is_servo(), drain, rng)
 }
 
 #[cfg(test)]

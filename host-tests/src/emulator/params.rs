@@ -99,6 +99,9 @@ pub struct EmuParams {
     pub emissivity: f64,
     /// Sensor time constants: motor, pump, block, ball block, oil, s.
     pub sensor_tau: [f64; 5],
+    /// Drain-port thermocouple (logged as `t_drain_c` when asked): its
+    /// response time to the case (drain) oil, s.
+    pub drain_tau_s: f64,
     /// Fraction by which a surface probe reads towards ambient (probe
     /// stem and contact resistance).
     pub probe_ambient_frac: f64,
@@ -174,6 +177,7 @@ impl Default for EmuParams {
             ],
             emissivity: 0.92,
             sensor_tau: [8.0, 8.0, 10.0, 10.0, 6.0],
+            drain_tau_s: 3.0,
             probe_ambient_frac: 0.04,
             pump_probe_barrel: 0.65,
             pocket: [5e-6, 0.03],

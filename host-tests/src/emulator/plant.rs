@@ -46,8 +46,12 @@ pub enum N {
 
 /// Number of nodes.
 pub const NN: usize = 14;
-/// State: node temperatures, five sensor states, piston position.
-pub const NS: usize = NN + 6;
+/// State: node temperatures, five sensor states, the drain-port
+/// thermocouple ([`DRAIN_SENSOR`]), piston position.
+pub const NS: usize = NN + 7;
+/// Index of the drain-port thermocouple's state: the case (drain) oil
+/// through a first-order lag of `EmuParams::drain_tau_s`.
+pub const DRAIN_SENSOR: usize = NN + 5;
 
 /// Heat flows and conductance sums being assembled, per node.
 struct Acc {
@@ -354,6 +358,8 @@ impl Plant<'_> {
         for k in 0..5 {
             dy[NN + k] = (targets[k] - y[NN + k]) / p.sensor_tau[k];
         }
+        // Drain-port thermocouple in the case-drain flow.
+        dy[DRAIN_SENSOR] = (tn(N::CaseOil) - y[DRAIN_SENSOR]) / p.drain_tau_s;
         dy[NS - 1] = o.v;
         rate
     }

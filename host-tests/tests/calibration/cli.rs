@@ -39,6 +39,8 @@ fn commission_cli_writes_outputs_and_a_block_that_checks() {
     assert_eq!(chk.status.code(), Some(0), "the written block passes the firmware's boot checks");
     let report = std::fs::read_to_string(out.join("report.md")).expect("report");
     assert!(report.contains("Headline") && report.contains("c.csv"), "headline on the held-out log");
+    // The drain margin from the split of the training missions, with its cost.
+    assert!(report.contains("## Drain margin") && report.contains("Margin **") && report.contains("valve open s"), "margin section in the report");
     let params = std::fs::read_to_string(out.join("params.rs")).expect("params");
     assert!(params.contains("pub const DEFAULT: ReducedParams"), "params.rs renders the firmware parameters");
     // A bad value: file:line:column from the reader, exit 2.

@@ -5,12 +5,18 @@
 //! drain thermocouple; three training missions (one with the LNG valve on
 //! the bench thermostat), one held-out mission of another kind.
 
-use eha_sim::calibration::commission::{check_reduced, commission, NO_COOLING};
+use eha_sim::calibration::commission::{check_reduced, commission_with, NO_COOLING};
 use eha_sim::calibration::synthetic::{log, mission, other_rig_file, other_rig_truth, Kind};
 use eha_sim::calibration::{CalLog, CalOptions};
 
 fn cal_log(kind: Kind, seed: u64) -> CalLog {
     CalLog::new(&format!("{kind:?}-{seed}"), log(&other_rig_truth(), &mission(kind, 1800.0, seed), 2.0, seed, true).expect("log"), 120).expect("cal log")
+}
+
+/// Without the margin validation (three more calibrations; the margin is
+/// tested on the emulator machines, tests/calibration/foreign.rs).
+fn commission(base: &eha_sim::rig::Rig, train: &[CalLog], hold: &[CalLog], o: &CalOptions) -> Result<eha_sim::calibration::commission::Commissioning, eha_sim::calibration::commission::CommissionError> {
+    commission_with(base, train, hold, o, false)
 }
 
 /// Three training logs (pressure steps, speed steps, and needle steps with

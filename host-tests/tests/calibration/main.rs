@@ -6,4 +6,5 @@ mod cli;
 mod commission;
 mod direct;
 mod emulator;
+mod foreign;
 mod recovery;

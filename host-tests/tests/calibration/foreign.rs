@@ -1,0 +1,230 @@
+//! Commissioning machines built otherwise: two emulated machines far from
+//! the paper rig (`eha_sim::emulator::bench`: big-pump, leaky-heavy),
+//! trained on two one-at-a-time throttle missions, held out on a servo
+//! mission and a throttle mix, every log with a drain-port thermocouple.
+//! The user's rig file is the paper rig with the nameplate values.
+
+use eha_sim::calibration::commission::{check_reduced_with, commission, commission_with, Commissioning};
+use eha_sim::calibration::{CalLog, CalOptions};
+use eha_sim::emulator::bench::{bench_log, bench_set, big_pump, machines, BenchLog, EmuMachine};
+use eha_sim::emulator::missions::EmuScenario;
+use eha_sim::measured::Channel;
+
+fn cal(l: &BenchLog) -> CalLog {
+    CalLog::new(&l.name, l.run.clone(), 120).expect("cal log")
+}
+
+fn truth(l: &BenchLog) -> CalLog {
+    CalLog::new(&l.name, l.truth.clone(), 120).expect("cal log")
+}
+
+/// The bench logs carry the drain thermocouple: within its lag and noise of
+/// the true case oil (3 s / 5 s lag, σ 0.1 K, 12-bit; measured worst 0.40–0.89
+/// K on big-pump, 2.47 K on leaky-heavy's soak log, whose drain rises ~0.5 K/s
+/// after the load step against the 5 s probe), and the drain crosses the
+/// 40 °C valve threshold on the throttle logs.
+#[test]
+fn bench_logs_carry_the_drain_thermocouple() {
+    for m in machines() {
+        let s = bench_set(&m, 3600).expect("bench");
+        for l in s.train.iter().chain(&s.holdout) {
+            let d = l.run.get(Channel::TDrainC).expect("t_drain_c");
+            let t = l.truth.get(Channel::TDrainC).expect("truth");
+            let worst = d.iter().zip(t).filter_map(|(d, t)| Some((d.as_ref()? - t.as_ref()?).abs())).fold(0.0, f64::max);
+            let top = t.iter().flatten().copied().fold(f64::MIN, f64::max);
+            eprintln!("{}: {} rows, drain max {top:.1} °C, |thermocouple − true| max {worst:.2} K", l.name, l.run.len());
+            assert!(worst < 3.0, "{}: thermocouple off the true drain by {worst:.2} K", l.name);
+            if !l.name.contains("Servo") {
+                assert!(top > 45.0, "{}: drain max {top:.1} °C", l.name);
+            }
+        }
+    }
+}
+
+/// Headline numbers of one commissioning: per held-out log (firmware with
+/// the margin counted) max |e| and under-prediction against the measured
+/// drain and against the true drain; the margin.
+struct Headline {
+    measured: Vec<(f64, f64)>,
+    truth: Vec<(f64, f64)>,
+    margin_k: f64,
+}
+
+fn headline(m: &EmuMachine, c: &Commissioning, hold: &[BenchLog]) -> Headline {
+    let margin_k = c.margin_k();
+    let measured = c.holdout_with_margin.iter().map(|r| (r.vs_measured_max_k.expect("drain"), r.vs_measured_under_k.expect("drain"))).collect();
+    let truth = hold
+        .iter()
+        .map(|l| {
+            let r = check_reduced_with(&c.cal.rig, &c.params, &truth(l), margin_k).expect("check on truth");
+            (r.vs_measured_max_k.expect("truth"), r.vs_measured_under_k.expect("truth"))
+        })
+        .collect();
+    let h = Headline { measured, truth, margin_k };
+    eprintln!("{}: margin {:.3} K; held out (max |e|, under) vs measured {:.3?}, vs true drain {:.3?}", m.name, h.margin_k, h.measured, h.truth);
+    h
+}
+
+fn report(m: &EmuMachine, c: &Commissioning, secs: f64) {
+    eprintln!("{}: {:.1} s, {} model runs, flashable {}, refusal {:?}", m.name, secs, c.cal.model_runs, c.flashable(), c.refusal().map(|r| r.to_string()));
+    for p in c.cal.params.iter().filter(|p| p.at_bound) {
+        eprintln!("  on a bound: {} {:.3}", p.name, p.value);
+    }
+    for r in &c.reduced {
+        eprintln!("  reduced {:40} vs ref max {:.3} | vs measured max {:?} under {:?}", r.log, r.vs_reference_max_k, r.vs_measured_max_k, r.vs_measured_under_k);
+    }
+    if let Some(v) = &c.margin {
+        for f in &v.folds {
+            eprintln!("  after the split: {}: max {:?} under {:?} at {:?}", f.log, f.vs_measured_max_k, f.vs_measured_under_k, f.vs_measured_region.as_ref().map(|g| g.to_string()));
+        }
+    }
+    let n = c.reduced.len() - c.holdout.len();
+    for (a, b) in c.reduced[n..].iter().zip(&c.holdout_with_margin) {
+        eprintln!("  cost {}: valve open {:.0} -> {:.0} s, LNG {:.3} -> {:.3} kg", a.log, a.valve_open_s, b.valve_open_s, a.lng_kg, b.lng_kg);
+    }
+}
+
+/// Tolerance on a measured headline number, K: a 1e-9 K nudge of every
+/// temperature moved them by up to 0.051 K
+/// (`slow_commissioning_is_reproducible_at_the_last_digit`).
+const AS_MEASURED_K: f64 = 0.15;
+
+fn near(what: &str, got: f64, measured: f64) {
+    assert!((got - measured).abs() <= AS_MEASURED_K, "{what}: {got:.3} K, measured {measured:.3} K (±{AS_MEASURED_K})");
+}
+
+/// The commissioning path without the margin, on both machines. Measured
+/// (held-out servo, throttle mix; firmware drain vs the thermocouple, max
+/// |e| / under-prediction): big-pump flashable, 2.27 / 2.27 K and 3.78 /
+/// 2.32 K (vs the true drain 1.97 / 1.97, 3.85 / 2.37 K); leaky-heavy
+/// refused, the six-state model 0.608 K off the commissioned reference on
+/// the servo log, 3.12 / 3.12 K and 2.42 / 2.42 K. The training logs
+/// themselves are missed too (big-pump soak then idle: 2.77 K under, in the
+/// idle phase): the commissioned reference does not follow these machines'
+/// drain, the reduction does (≤ 0.19 K on every throttle log).
+#[test]
+#[ignore = "slow tier: two commissionings on emulator bench logs (~40 s each)"]
+fn slow_commissioning_without_margin_on_foreign_machines() {
+    let measured = [(true, [(2.273, 2.273), (3.781, 2.324)]), (false, [(3.115, 3.115), (2.420, 2.420)])];
+    for (m, (flash, want)) in machines().into_iter().zip(measured) {
+        let s = bench_set(&m, 3600).expect("bench");
+        let train: Vec<CalLog> = s.train.iter().map(cal).collect();
+        let hold: Vec<CalLog> = s.holdout.iter().map(cal).collect();
+        let t0 = std::time::Instant::now();
+        let c = commission_with(&m.rig_file(), &train, &hold, &CalOptions::default(), false).expect("commissioning");
+        report(&m, &c, t0.elapsed().as_secs_f64());
+        let h = headline(&m, &c, &s.holdout);
+        assert_eq!(c.flashable(), flash, "{}: flashable", m.name);
+        for (got, want) in h.measured.iter().zip(want) {
+            near(&format!("{} held-out max |e|", m.name), got.0, want.0);
+            near(&format!("{} held-out under-prediction", m.name), got.1, want.1);
+        }
+    }
+}
+
+/// The commissioning path with the drain margin (validated on a split of the
+/// training missions), on both machines: the acceptance is 1.0 K max
+/// |e| and ≤ 0.3 K under-prediction on the held-out logs with the margin
+/// counted. Measured (max |e| / under vs the thermocouple; servo, throttle
+/// mix):
+/// - big-pump: margin 2.15 K (after the split the soak log's idle phase is
+///   under-predicted by 1.95 K); 2.35 / 0.12 K and 5.93 / 0.17 K: the
+///   under-prediction bound met, max |e| not (the mix is over-predicted by
+///   3.78 K before the margin).
+/// - leaky-heavy: margin 2.50 K (1.45 and 2.30 K after the split); 2.74 /
+///   0.62 K and 3.45 / 0.00 K: the servo log still 0.62 K under (3.12 K
+///   without margin, more than the split saw); refused for the reduction
+///   (0.608 K on the servo log), written only with `--accept-with-margin`.
+/// - Cost on the throttle mix (open loop): valve open 1486 → 1508 s, LNG
+///   2.96 → 3.01 kg (big-pump); 1540 → 1562 s, 2.09 → 2.13 kg
+///   (leaky-heavy); the servo logs stay below 40 °C.
+/// - 33–48 s per commissioning (four logs: two 1800 s training, a 1200 s
+///   servo and a 1800 s mix held out) on the shared 2 cores.
+#[test]
+#[ignore = "slow tier: two commissionings with margin validation on emulator bench logs (~1 min each)"]
+fn slow_commissioning_with_margin_on_foreign_machines() {
+    let measured = [(2.152, [(2.345, 0.120), (5.933, 0.172)], [1486.0, 1508.0]), (2.500, [(2.735, 0.616), (3.452, 0.0)], [1540.0, 1562.0])];
+    for (m, (margin, want, open_s)) in machines().into_iter().zip(measured) {
+        let s = bench_set(&m, 3600).expect("bench");
+        let train: Vec<CalLog> = s.train.iter().map(cal).collect();
+        let hold: Vec<CalLog> = s.holdout.iter().map(cal).collect();
+        let t0 = std::time::Instant::now();
+        let c = commission(&m.rig_file(), &train, &hold, &CalOptions::default()).expect("commissioning");
+        report(&m, &c, t0.elapsed().as_secs_f64());
+        let h = headline(&m, &c, &s.holdout);
+        near(&format!("{} margin", m.name), h.margin_k, margin);
+        for (got, want) in h.measured.iter().zip(want) {
+            near(&format!("{} held-out max |e| with margin", m.name), got.0, want.0);
+            near(&format!("{} held-out under-prediction with margin", m.name), got.1, want.1);
+        }
+        // The margin opens the valve earlier, never later (open loop).
+        let n = c.reduced.len() - c.holdout.len();
+        let (a, b) = (&c.reduced[n + 1], &c.holdout_with_margin[1]);
+        assert!(b.valve_open_s >= a.valve_open_s && b.lng_kg >= a.lng_kg, "{}: margin cost negative", m.name);
+        assert!((a.valve_open_s - open_s[0]).abs() <= 20.0 && (b.valve_open_s - open_s[1]).abs() <= 20.0, "{}: valve open {:.0} -> {:.0} s", m.name, a.valve_open_s, b.valve_open_s);
+    }
+}
+
+/// A training set that cannot identify the machine: one operating point
+/// (500 rpm, one needle setting, 20 min) on big-pump. Refused, and the
+/// refusal names the log, its operating region, the channel and the bench
+/// run that would fix it.
+#[test]
+fn one_operating_point_is_refused_with_log_region_channel_and_bench_run() {
+    let m = big_pump();
+    let l = bench_log(&m, EmuScenario::ConstantThrottle, 1200.0, 3700).expect("bench log");
+    let c = commission(&m.rig_file(), &[cal(&l)], &[], &CalOptions::default()).expect("commissioning");
+    let r = c.refusal().expect("refused");
+    eprintln!("{r}");
+    assert!(!c.flashable());
+    assert!(r.reason.contains("one operating point"), "{}", r.reason);
+    assert_eq!(r.log, l.name);
+    assert!(r.region.contains("one operating point") && r.region.contains("rpm") && r.region.contains("bar") && r.region.contains("°C"), "{}", r.region);
+    assert!(r.channel.contains("temperature"), "{}", r.channel);
+    assert!(r.bench_run.contains("speed steps") && r.bench_run.contains("needle steps") && r.bench_run.contains("t_drain_c"), "{}", r.bench_run);
+}
+
+/// Every temperature of every log moved by 1e-9 K: the headline numbers
+/// (held-out max |e| and under-prediction, margin) move by at most 0.05 K.
+/// Measured: big-pump 0.043 K (margin 2.152 → 2.196 K); leaky-heavy 0.051 K
+/// (the servo log's under-prediction with margin 0.616 → 0.565 K; margin
+/// 2.500 → 2.504 K): fails by 0.001 K. The servo log is extrapolation (no
+/// training log moves the piston) and the commissioning's fit moves along
+/// its ill-determined directions; with the validation fit started from the
+/// rig file instead of the commissioning's multipliers, big-pump's margin
+/// moved 0.17 K.
+#[test]
+#[ignore = "slow tier: four commissionings with margin validation (~4 min)"]
+fn slow_commissioning_is_reproducible_at_the_last_digit() {
+    let nudge = |l: &BenchLog| -> BenchLog {
+        let mut l = l.clone();
+        for ch in Channel::TEMPERATURES.into_iter().chain([Channel::TDrainC]) {
+            let v: Vec<Option<f64>> = l.run.get(ch).expect("channel").iter().map(|x| x.map(|x| x + 1e-9)).collect();
+            l.run.set(ch, v);
+        }
+        l
+    };
+    for m in machines() {
+        let s = bench_set(&m, 3600).expect("bench");
+        let run = |logs: &[BenchLog], hold: &[BenchLog]| {
+            let train: Vec<CalLog> = logs.iter().map(cal).collect();
+            let h: Vec<CalLog> = hold.iter().map(cal).collect();
+            let t0 = std::time::Instant::now();
+            let c = commission(&m.rig_file(), &train, &h, &CalOptions::default()).expect("commissioning");
+            eprintln!("{}: {:.1} s, flashable {}", m.name, t0.elapsed().as_secs_f64(), c.flashable());
+            report(&m, &c, t0.elapsed().as_secs_f64());
+            headline(&m, &c, hold)
+        };
+        let a = run(&s.train, &s.holdout);
+        let tn: Vec<BenchLog> = s.train.iter().map(nudge).collect();
+        let hn: Vec<BenchLog> = s.holdout.iter().map(nudge).collect();
+        let b = run(&tn, &hn);
+        let mut worst = (a.margin_k - b.margin_k).abs();
+        for (x, y) in a.measured.iter().zip(&b.measured).chain(a.truth.iter().zip(&b.truth)) {
+            worst = worst.max((x.0 - y.0).abs()).max((x.1 - y.1).abs());
+        }
+        eprintln!("{}: headline numbers moved by at most {worst:.4} K", m.name);
+        assert!(worst <= 0.05, "{}: a 1e-9 K nudge moved the headline by {worst:.3} K", m.name);
+    }
+}
+
