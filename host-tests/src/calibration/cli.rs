@@ -114,7 +114,7 @@ pub fn run(args: &CommissionArgs) -> ExitCode {
             if c.flashable() {
                 ExitCode::SUCCESS
             } else if accepted(args, &c) {
-                eprintln!("warning: refused ({}); firmware-params.bin written as asked (--accept-with-margin); the block has no margin word: lower the valve threshold by the drain margin {:.2} K", reduced_failure(&c), c.margin_k());
+                eprintln!("warning: refused ({}); firmware-params.bin written as asked (--accept-with-margin); the block carries the drain margin {:.2} K", reduced_failure(&c), c.params.drain_margin_k);
                 ExitCode::SUCCESS
             } else {
                 eprintln!("error: {}", reduced_failure(&c));
@@ -272,7 +272,7 @@ fn report(args: &CommissionArgs, c: &Commissioning) -> String {
     if !c.flashable() {
         let _ = writeln!(s, "\n**REFUSED:** {}\n", reduced_failure(c));
         if accepted(args, c) {
-            let _ = writeln!(s, "`firmware-params.bin` written as asked (`--accept-with-margin`). The block has no margin word: lower the guard's valve threshold by the drain margin {:.2} K.\n", c.margin_k());
+            let _ = writeln!(s, "`firmware-params.bin` written as asked (`--accept-with-margin`); the block carries the drain margin {:.2} K (`drain_margin_k`), which the guard adds to its drain estimate.\n", c.params.drain_margin_k);
         }
     }
     let _ = writeln!(s, "\n## Held-out validation of the reference model\n\n| log | channel | RMSE as given K | RMSE commissioned K | max as given K | max commissioned K |\n|---|---|---:|---:|---:|---:|");

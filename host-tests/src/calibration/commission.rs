@@ -14,6 +14,10 @@ use crate::rig::Rig;
 use crate::scenario::Scenario;
 use eha_guard::model::{Model, ModelInputN, ReducedParams};
 
+/// Largest drain margin the parameter block accepts, K (the firmware's
+/// bounds table, `drain_margin_k`).
+pub const MARGIN_MAX_K: f64 = 10.0;
+
 /// Bound of the reduced model against the commissioned reference on every
 /// log's inputs, drain max |e|, K.
 pub const REDUCED_BOUND_K: f64 = 0.2;
@@ -496,7 +500,7 @@ pub fn commission_with(base: &Rig, train: &[CalLog], holdout: &[CalLog], o: &Cal
     if let Some(why) = crate::reduce::unsupported_structure(&cal.rig) {
         return Err(CommissionError::Reduce(why.into()));
     }
-    let params = reduce(&cal.rig)
+    let mut params = reduce(&cal.rig)
         .ok_or_else(|| CommissionError::Reduce("it gives firmware parameters the firmware model rejects".into()))?;
     let reduced: Vec<ReducedCheck> = train
         .iter()
@@ -518,6 +522,16 @@ pub fn commission_with(base: &Rig, train: &[CalLog], holdout: &[CalLog], o: &Cal
     let margin = if with_margin { validate_margin(base, train, o, Some(&cal.theta))? } else { None };
     if with_margin && margin.is_none() {
         cal.warnings.push("no drain margin: it needs `t_drain_c` in every training log, and a validation fit (first 60 % of every training log) that the firmware model accepts".into());
+    }
+    // The validated margin goes into the block (the guard adds it to the
+    // estimate it decides on); beyond the block's bound it is refused.
+    match &margin {
+        Some(m) if m.margin_k <= MARGIN_MAX_K => params.drain_margin_k = m.margin_k,
+        Some(m) => cal.warnings.push(format!(
+            "drain margin {:.2} K exceeds the parameter block's {MARGIN_MAX_K} K bound: the model does not fit this machine well enough to protect it; the block carries no margin",
+            m.margin_k
+        )),
+        None => {}
     }
     let holdout_with_margin = match &margin {
         Some(m) => holdout

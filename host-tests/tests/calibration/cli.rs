@@ -41,6 +41,15 @@ fn commission_cli_writes_outputs_and_a_block_that_checks() {
     assert!(report.contains("Headline") && report.contains("c.csv"), "headline on the held-out log");
     // The drain margin from the split of the training missions, with its cost.
     assert!(report.contains("## Drain margin") && report.contains("Margin **") && report.contains("valve open s"), "margin section in the report");
+    // ... and the block carries it (`drain_margin_k`, what the guard adds to
+    // its estimate): the report's margin, printed to 0.01 K, is the block's.
+    let num_after = |text: &str, key: &str| -> f64 {
+        let rest = &text[text.find(key).unwrap_or_else(|| panic!("`{key}` in {text}")) + key.len()..];
+        rest.split_whitespace().next().and_then(|w| w.trim_matches('*').parse().ok()).unwrap_or_else(|| panic!("a number after `{key}`"))
+    };
+    let in_report = num_after(&report, "Margin **");
+    let in_block = num_after(&String::from_utf8_lossy(&chk.stdout), "drain margin ");
+    assert!(in_report > 0.0 && (in_block - in_report).abs() <= 0.006, "block margin {in_block} K, report {in_report} K");
     let params = std::fs::read_to_string(out.join("params.rs")).expect("params");
     assert!(params.contains("pub const DEFAULT: ReducedParams"), "params.rs renders the firmware parameters");
     // A bad value: file:line:column from the reader, exit 2.
