@@ -533,13 +533,16 @@ pub fn commission_with(base: &Rig, train: &[CalLog], holdout: &[CalLog], o: &Cal
         )),
         None => {}
     }
-    let holdout_with_margin = match &margin {
-        Some(m) => holdout
+    // Scored with the margin the block carries (none when it exceeds the
+    // block's bound), so the report and the flashed block cannot disagree.
+    let holdout_with_margin = if params.drain_margin_k > 0.0 {
+        holdout
             .iter()
-            .map(|l| check_reduced_with(&cal.rig, &params, l, m.margin_k))
+            .map(|l| check_reduced_with(&cal.rig, &params, l, params.drain_margin_k))
             .collect::<Result<_, _>>()
-            .map_err(CommissionError::Run)?,
-        None => reduced[train.len()..].to_vec(),
+            .map_err(CommissionError::Run)?
+    } else {
+        reduced[train.len()..].to_vec()
     };
     let train_regions = train.iter().map(log_region).collect();
     Ok(Commissioning {
