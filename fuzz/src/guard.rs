@@ -125,7 +125,7 @@ impl<N: Num> Run<N> {
             assert!(o.valve_open, "{what}: latched fault {:#x} but valve closed: {o:?}", o.faults);
         }
         // derate: the alarm, a valve that does not follow its command, or a
-        // failed non-volatile save (issue 33); never without one of them
+        // failed non-volatile save; never without one of them
         let derate = o.alarm || o.faults.intersects(faults::ACTUATOR | faults::NV_FAILED);
         assert_eq!(o.derate, derate, "{what}: derate must follow the alarm, ACTUATOR or NV_FAILED: {o:?}");
         assert!(

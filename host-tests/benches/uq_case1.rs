@@ -1,5 +1,5 @@
 //! Benchmark: `eha-sim uq` on Case 1 at 60 bar, 200 Latin-hypercube samples of
-//! the paper rig's uncertain parameters in parallel (issue 34 acceptance:
+//! the paper rig's uncertain parameters in parallel (target:
 //! ≤ 5 s on 2 cores). Prints the threads used.
 
 use criterion::{criterion_group, criterion_main, Criterion};

@@ -41,8 +41,8 @@ const HIDDEN_TAU_S: f64 = 213.590;
 /// compared (the τ, the kept rows, the empty cells); the temperatures follow
 /// the physics, which may change after the example was frozen (they were
 /// identical to the last digit when this test was written). `EXAMPLE_BLESS=1`
-/// re-freezes the example from the generator (done after issue 16's pump
-/// energy balance and after issue 34's oil on its viscosity line).
+/// re-freezes the example from the generator (done after each change of the
+/// reference physics that moves the temperatures).
 #[test]
 fn worked_example_is_the_generators_seed_5() {
     let case = SynthCase {
@@ -75,9 +75,8 @@ fn worked_example_is_the_generators_seed_5() {
 /// within 15 % of the hidden value: the nuisance set it is fitted with
 /// (conductances and capacities the generator moved by 10–20 %) trades off
 /// against τ, so the magnitude is indicative, not exact (docs/diagnosis.md).
-/// Measured: 221.94 s, +3.9 % (re-frozen after issue 34, the oil on its
-/// viscosity line; 234.85 s, +10.0 %, after issue 16; 227.43 s, +6.5 %,
-/// before it; 149 s, −30 %, before the two-start fits).
+/// Measured: 221.94 s, +3.9 % (it has moved between +3.9 and +10 % with
+/// changes of the reference physics; −30 % before the two-start fits).
 #[test]
 fn worked_example_is_diagnosed_as_sensor_lag() {
     let dir = std::env::temp_dir().join(format!("diag-ex-{}", std::process::id()));
@@ -97,7 +96,8 @@ fn worked_example_is_diagnosed_as_sensor_lag() {
     let (b, a) = (j["heldout_rmse_before_k"].as_f64().unwrap(), j["heldout_rmse_after_k"].as_f64().unwrap());
     assert!(a < 0.5 * b, "held-out {b} -> {a}");
     let ranking = j["ranking"].as_array().unwrap();
-    // seven candidates (the viscosity–temperature one retired in issue 34)
+    // seven candidates (no viscosity–temperature one: the oil follows its
+    // viscosity line in the baseline)
     assert_eq!(ranking.len(), 7);
     assert_eq!(ranking[0]["cause"], "sensor-lag");
     for f in ["report.md", "temperatures.png", "residuals.png"] {

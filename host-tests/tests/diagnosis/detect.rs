@@ -51,8 +51,8 @@ fn find<'a>(rows: &'a [Detectability], c: &str, k: usize) -> &'a Detectability {
 #[test]
 fn detectability_follows_the_physics_of_a_constant_throttle_log() {
     let rows = rows();
-    // (the viscosity–temperature row is gone: the oil follows its viscosity line
-    // in the baseline since issue 34, the candidate is retired)
+    // (no viscosity–temperature row: the oil follows its viscosity line in
+    // the baseline, so there is no such candidate)
     assert_eq!(rows.len(), 18, "6 candidates × 3 magnitudes");
     for k in 0..3 {
         let c = find(&rows, "coulomb-friction", k);

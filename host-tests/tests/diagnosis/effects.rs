@@ -1,4 +1,4 @@
-//! Hidden-effect tests of the diagnosis (issue 5). Each case: the reference
+//! Hidden-effect tests of the diagnosis. Each case: the reference
 //! simulation with one extension switched on at a random realistic
 //! magnitude (`eha_sim::diagnosis::synth::magnitude_range`), nuisance
 //! multipliers perturbed ±10–20 % (and, in the `Structure` cases, every node
@@ -10,12 +10,12 @@
 //!
 //! Assertions and why:
 //! - the named cause equals the hidden one — every candidate in at least
-//!   two scenarios, chosen to excite it (issue 5); `none` for runs without a
+//!   two scenarios, chosen to excite it; `none` for runs without a
 //!   hidden effect, with the nuisance physics as in the rig file or
 //!   different from it (no false discovery);
 //! - the held-out RMSE of the channel the effect changes most (measured on
 //!   the generator: with vs without the effect over the last 30 %) falls by
-//!   at least 50 % once the named extension is switched on (issue 5).
+//!   at least 50 % once the named extension is switched on.
 //!
 //! Tiers: the fast tier (the README's test command) holds one case per
 //! candidate that a throttle run can show and the `none` guards against false
@@ -101,20 +101,10 @@ use SynthScenario::{
 // ---- fast tier: one case per candidate (throttle runs), and the none guards.
 
 /// Dead-end oil sensor: a lag of minutes on t_oil_c, visible in any run.
-/// **Measured since the replay tolerances (session 14)**: named (ΔBIC
-/// 1827), but the held-out RMSE of t_oil_c goes 0.152 → 0.232 K (−53 %):
-/// the calibrated baseline already fits t_oil_c to 1.3σ (a lag on a
-/// monotonic warm-up looks like more oil capacity), the gain is on the
-/// other channels (pooled 0.205 → 0.163 K). It gained 53 % with the replay
-/// error control of before; with both tolerances ten times tighter it is
-/// answered `none`: this case's gain is within what the integration error
-/// moves (docs/diagnosis.md, "Replay tolerances"). The named sensor lags
-/// with ≥ 50 % are the worked example (seed 5) and the emulator's 1704 and
-/// 1705; seed 32 (slow tier) gains 29 % since the probe response time.
-/// Since then (session 16) this case gained −38 % on t_oil_c; since issue 34
-/// (the oil on its viscosity line in the baseline and the generator) it is
-/// named and gains 62 % on t_oil_c (held out 0.361 → 0.107 K, measured), so it
-/// is a pass again, checked as one.
+/// Measured: named, 62 % on t_oil_c (held out 0.361 → 0.107 K). A lag on a
+/// monotonic warm-up looks like more oil capacity, so this case's gain has
+/// been near the bar and moved with the replay tolerances
+/// (docs/diagnosis.md, "Replay tolerances"): checked as a pass.
 #[test]
 fn hidden_sensor_lag_is_named() {
     check(&[case("sensor-lag", Case1Pressure, Nuisance, 31)]);
@@ -127,13 +117,12 @@ fn hidden_winding_resistance_temperature_is_named() {
     check(&[case("winding-resistance-temperature", Case1Pressure, Nuisance, 11)]);
 }
 
-// (The viscosity–temperature candidate is retired since issue 34: the oil
-// follows its Walther line in the baseline, so there is nothing hidden to name;
-// its cases, seeds 21–26, are gone with it.)
+// (No viscosity–temperature candidate: the oil follows its Walther line in
+// the baseline, so there is nothing hidden to name.)
 
 /// Churning ∝ ω^2.5: needs shaft-speed changes (a constant-speed run cannot
 /// tell it from a pump capacity error, so the diagnosis does not name it
-/// there). **Measured miss since issue 16**: named, but the held-out gain on
+/// there). **Measured miss**: named, but the held-out gain on
 /// the pump shell is 7 % (0.204 → 0.162 K), under the 50 % bar: the
 /// baseline's own viscous pump friction (C_v·μ·D·ω², extended eq. 8, scaled
 /// with the nuisance set) already takes most of an ω^2.5 loss, so little is
@@ -191,33 +180,25 @@ fn slow_second_scenario_per_candidate_is_named() {
         case("winding-resistance-temperature", ThrottleSteps, Structure, 12),
         case("churning-loss", SpeedSweep, Structure, 52),
     ]);
-    // Measured since the replay tolerances (session 14): the draught under
-    // logged ram-air steps (seed 71) is named, t_pump_c held out
-    // 0.274 → 0.176 K pooled, 41 % on t_pump_c (77 % before), under the bar.
-    // Re-measured with the oils on their viscosity lines: 50 % on t_pump_c,
-    // on the bar; asserted named with the gain under 60 %.
+    // Measured: the draught under logged ram-air steps (seed 71) is named
+    // with 50 % on t_pump_c, on the bar; asserted named with the gain under
+    // 60 %.
     check_miss(&[(case("forced-convection", AirSteps, Nuisance, 71), "forced-convection", Some(0.6))]);
-    // Measured since the oil probe's response time joined the physical set
-    // (session 16): the 185 s dead-end pocket (seed 32) is named (ΔBIC 1500,
-    // pooled held out 0.32 → 0.19 K), but the calibrated baseline's probe
-    // (up to 10 s) already takes up part of the lag: t_oil_c gains 29 %
-    // (68 % against the baseline without a probe), under the bar.
-    // Re-measured with the oils on their viscosity lines: named with 82 %
-    // on t_oil_c (held out 0.94 -> 0.21 K pooled): a pass again, checked as one.
+    // Measured: the 185 s dead-end pocket (seed 32) is named with 82 % on
+    // t_oil_c (held out 0.94 -> 0.21 K pooled), although the calibrated
+    // baseline's probe (up to 10 s) takes up part of the lag: a pass.
     check(&[case("sensor-lag", ThrottleSteps, Structure, 32)]);
 }
 
-/// Measured miss since issue 16's pump energy balance: the motor → pump
-/// flange conduction in throttle steps with per-node capacities off
-/// (seed 62) is answered `none` (it was named): a quarter of the pump's
-/// friction now heats the housing directly, which takes up the imprint of a
-/// warm flange (affected t_pump_c, held-out 0.327 K unchanged).
+/// Measured miss: the motor → pump flange conduction in throttle steps with
+/// per-node capacities off (seed 62). With the pump's energy balance a
+/// quarter of the pump's friction heats the housing directly, which takes
+/// up the imprint of a warm flange.
 #[test]
 #[ignore = "slow tier: measured miss"]
 fn slow_measured_miss_motor_pump_conduction_with_structure_mismatch() {
-    // Re-measured with the oils on their viscosity lines: `unexplained`
-    // (t_pump_c held out 0.73 K; no cause named): still a miss, no longer
-    // silent.
+    // Measured: `unexplained` (t_pump_c held out 0.73 K; no cause named): a
+    // miss, not a silent one.
     check_miss(&[(case("motor-pump-conduction", ThrottleSteps, Structure, 62), "unexplained", None)]);
 }
 
@@ -230,16 +211,11 @@ fn slow_measured_miss_motor_pump_conduction_with_structure_mismatch() {
 #[test]
 #[ignore = "slow tier: servo replays"]
 fn slow_hidden_coulomb_friction_is_named() {
-    // Since the replay tolerances (session 14) hold/move (seed 45) gains
-    // 60 % on t_oil_c (0.207 → 0.126 K; 38 % before, a measured miss since
-    // issue 16) and the gusts (seed 47) 41 % (0.228 → 0.182 K pooled; 59 %
-    // before), under the 50 % bar: both named, one measured short.
-    // Measured since the oils are on their viscosity lines: hold/move
-    // (seed 45) is answered `none` (t_oil_c held out 0.14 K, the calibrated
+    // Measured: hold/move (seed 45) is answered `none` (t_oil_c held out 0.14 K, the calibrated
     // baseline already near the noise; imprint 0.59 K absorbed): a measured
     // miss, asserted as measured.
     check_miss(&[(case("coulomb-friction", ServoHoldMove, Nuisance, 45), "none", None)]);
-    // Gusts (seed 47), re-measured likewise: `none` (t_oil_c held out
+    // Gusts (seed 47): `none` (t_oil_c held out
     // 0.20 K, imprint 0.85 K absorbed): a measured miss.
     check_miss(&[(case("coulomb-friction", ServoGust, Nuisance, 47), "none", None)]);
 }

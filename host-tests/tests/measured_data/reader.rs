@@ -149,7 +149,7 @@ fn round_trip_is_lossless() {
     assert!(bad.write(Vec::new()).is_err());
 }
 
-/// The optional bench column `t_drain_c` (issue 18): read as
+/// The optional bench column `t_drain_c`: read as
 /// `Channel::TDrainC`, range-checked like every temperature (−60…250 °C,
 /// error naming file, line and column) and written back in the format's
 /// column order.

@@ -2,7 +2,7 @@
 //! source, plus the pump's work on the oil, minus the actuator's; the
 //! leakage, line and needle losses appear through the oil's h(T, p)) equals
 //! the energy stored in the nodes plus the heat to ambient plus the heat to
-//! the LNG, within 1e-6 (issue 16's **spec** bound, pressure work included).
+//! the LNG, within 1e-6 (the specified bound, pressure work included).
 //! A failure means a conductance, advection, pressure-work or source term
 //! that does not conserve energy.
 //!
@@ -23,7 +23,7 @@ fn check(rig: &Rig, sc: Scenario, reg: f64) {
     let (loss, stored, amb, lng) = (g("e_loss_j"), g("e_stored_j"), g("e_ambient_j"), g("e_lng_j"));
     let rel = (loss - stored - amb - lng).abs() / loss;
     println!("{}: losses {loss:.0} J = stored {stored:.0} + ambient {amb:.0} + LNG {lng:.0} (rel. mismatch {rel:.2e})", out.name);
-    // Spec (issue 16): 1e-6.
+    // Specified bound: 1e-6.
     assert!(rel < 1e-6, "{}: mismatch {rel}", out.name);
     // Regression: 2-3x the measured mismatch of this run.
     assert!(rel < reg, "{}: mismatch {rel:.2e} > regression bound {reg:.0e}", out.name);

@@ -33,7 +33,7 @@ fn case1(rig: &Rig, bar: f64) -> SimOutput {
 }
 
 /// Table 4 (600 s, 60 bar): inlet 53.00, outlet 54.17, drain 59.67 °C, each
-/// within ±0.5 K (issue 16's bound: a tenth of the paper's own
+/// within ±0.5 K (the specified bound: a tenth of the paper's own
 /// simulation-vs-test scatter in Fig. 8, and twice the 0.25 K reading
 /// uncertainty the fit assumes).
 ///
@@ -154,9 +154,10 @@ fn lng_sizing_reproduces_the_paper_fitted() {
 /// **The opening is fitted, reproduces the fit**: the valve follows the
 /// circulating oil at 40 °C, whose 110 s crossing is a calibration target
 /// (measured: opens at 110.0 s, the thermostat sampled every 0.1 s). The
-/// drain below 50 °C is a prediction since issue 16's refit: the LNG flow
-/// (3 g/s) was chosen on the previous fit as the smallest round value that
-/// kept the drain below 50 °C (then 49.97 °C max); measured now 46.83 °C max.
+/// drain below 50 °C is a prediction: the LNG flow (3 g/s) was chosen on an
+/// earlier fit, before the pump's energy balance, as the smallest round value
+/// that kept the drain below 50 °C (then 49.97 °C max); measured now
+/// 46.83 °C max.
 #[test]
 fn fig15_lng_valve_opens_near_110s_and_drain_stays_below_50c_fitted() {
     let out = simulate(&Rig::default(), &Scenario::Lng { duration_s: 600.0 }, &SimOptions::default()).expect("runs");
@@ -235,7 +236,7 @@ fn balance_from(ratios: &[(f64, f64)], eps: f64) -> Option<f64> {
 /// films' heat into the pump's metal (`p_mech_metal_w`), which the oil never
 /// receives. Counting all of eq. (8) as oil heat (the earlier accounting)
 /// overstated the oil's input by that much and gave 305.0 / 212.5 / 212.5 s,
-/// an upper bound, not a balance time (before issue 16's energy balance:
+/// an upper bound, not a balance time (without the pump's energy balance:
 /// 390 / 382.5 / 382.5 / 517.5 s). Printed beside: the 20 % and 5 % crossings.
 /// Asserted: each time within ±15 s of the measured (three periods: near the
 /// crossing the ratio falls ≈ 0.001 per 15 s and scatters ≈ ±0.0005 between

@@ -1,4 +1,4 @@
-//! Issue 16: the pump's energy from the first law (compression heat from the
+//! The pump's energy from the first law (compression heat from the
 //! oil's h(T, p), the extended friction law of eq. 8), the speed limiter and
 //! where long runs are heading. docs/calibration.md has the numbers.
 
@@ -72,7 +72,7 @@ fn fitted_hydro_mechanical_efficiency_known_miss() {
     let t_f = p.no_load_torque_nm + p.viscous_torque_coeff * mu * d * w + p.eta_m * d * dp;
     let eta = d * dp / (d * dp + t_f);
     println!("eta_hm {:.2} % (ideal torque {:.2} N m, friction {:.3} N m: T0 {:.2}, viscous {:.3}, pressure {:.3})", eta * 100.0, d * dp, t_f, p.no_load_torque_nm, p.viscous_torque_coeff * mu * d * w, p.eta_m * d * dp);
-    assert!((eta - 0.6762).abs() <= 0.002, "eta_hm {eta:.4}: re-measure (issue 16's bound 0.75)");
+    assert!((eta - 0.6762).abs() <= 0.002, "eta_hm {eta:.4}: re-measure (the specified bound is 0.75)");
 }
 
 /// The speed limiter leaves the nominal operating points alone: a 500 rpm
@@ -158,10 +158,10 @@ fn table5_with_ram_air_drains_within_0_3_k_shells_known_miss() {
     assert!(failures.is_empty(), "{failures:?}");
 }
 
-/// The pump as it is built (issue 34 item 2; optional, off by default:
+/// The pump as it is built (optional, off by default:
 /// [`Rig::with_pump_as_built`]): internals, seats and joints a priori
 /// (docs/calibration.md, committed in 8971154 before any run), Table 4's
-/// three calibrated values refitted with it (1fb1418). The issue's targets,
+/// three calibrated values refitted with it (1fb1418). The targets,
 /// each a prediction, each asserted as measured (±0.05 K, deterministic runs)
 /// and printed against its bound:
 ///

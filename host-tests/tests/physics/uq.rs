@@ -1,4 +1,4 @@
-//! Uncertainty bands (issue 34 item 3, `eha-sim uq`): the paper's numbers
+//! Uncertainty bands (`eha-sim uq`): the paper's numbers
 //! against the 90 % bands of 200 Latin-hypercube samples of the rig's
 //! documented uncertain parameters (`[[uncertain]]`, docs/calibration.md),
 //! Table 5 with ram air included.

@@ -426,7 +426,7 @@ fn garbage_and_bursts_on_the_uart_are_rejected_without_a_hang() {
 /// The OK (alarm) pin follows the 60 °C alarm: the MCU boots with a warm
 /// thermal record at 59.8 °C put in no-init RAM (through QEMU's gdb stub), as
 /// after a reset on a hot machine; in closed loop at 60 bar the estimate
-/// rises through 60 °C and the alarm is raised (measured after issue 16: from
+/// rises through 60 °C and the alarm is raised (measured with the pump's energy balance: from
 /// 59 °C the estimate peaked at 59.32 °C after 6 s with the exchanger on,
 /// then fell; from 59.8 °C it crosses 60 °C on the way up). In every tick reply the OK
 /// pin read back is the inverse of the alarm, before and after the edge.
