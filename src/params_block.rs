@@ -59,7 +59,7 @@ const _: () = assert!(WORDS_AT + 4 * N_WORDS == CRC_AT);
 
 /// Why a block is refused.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(any(target_os = "none", feature = "defmt"), derive(defmt::Format))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum BlockError {
     /// Not erased and not [`MAGIC`].
     Magic,
@@ -75,7 +75,7 @@ pub enum BlockError {
 
 /// Where the model constants of this boot come from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(any(target_os = "none", feature = "defmt"), derive(defmt::Format))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum ParamSource {
     /// No block: the compiled-in paper rig (NOT_COMMISSIONED).
     Default,

@@ -8,7 +8,7 @@ pub const TRACE_LEN: usize = 32;
 
 /// How the thermal state was initialised at boot (see [`crate::memory`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(any(target_os = "none", feature = "defmt"), derive(defmt::Format))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum RestoreKind {
     /// Cold boot: every node starts at the first ambient sample.
     Cold,
@@ -25,7 +25,7 @@ pub enum RestoreKind {
 /// One protection event. `tick` is the guard's tick counter (10 ms) at the event;
 /// temperatures are the predicted drain temperature in degC.
 #[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(any(target_os = "none", feature = "defmt"), derive(defmt::Format))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Trace {
     /// Thermal state initialised (cold / warm / corrupt record).
     Restore {

@@ -14,7 +14,7 @@ use core::ops::{BitAnd, BitAndAssign, BitOr, BitOrAssign, Not};
 pub struct Faults(u32);
 
 /// In the defmt log: the word in hex, as on the wire.
-#[cfg(any(target_os = "none", feature = "defmt"))]
+#[cfg(feature = "defmt")]
 impl defmt::Format for Faults {
     fn format(&self, f: defmt::Formatter) {
         defmt::write!(f, "{=u32:#010x}", self.0)

@@ -7,7 +7,7 @@ use crate::validate::InputLimits;
 
 /// One input sample, wire units (f32).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-#[cfg_attr(any(target_os = "none", feature = "defmt"), derive(defmt::Format))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Sample {
     /// Motor phase current, A rms.
     pub current_a: f32,
@@ -25,7 +25,7 @@ pub struct Sample {
 
 /// One tick's result, wire units. Always finite.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-#[cfg_attr(any(target_os = "none", feature = "defmt"), derive(defmt::Format))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Output {
     /// Predicted drain-oil temperature, degC: the model's case oil plus the
     /// parameter block's commissioning margin (`drain_margin_k`, 0 for the

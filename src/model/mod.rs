@@ -63,7 +63,7 @@ const MAX_DELAY_STEPS: i32 = 31;
 
 /// Why a parameter set cannot be turned into a model of the chosen number type.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(any(target_os = "none", feature = "defmt"), derive(defmt::Format))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum ConfigError {
     /// [`ReducedParams::is_plausible`] failed.
     Implausible,

@@ -2,7 +2,7 @@
 //! ([`crate::memory::cooling`]): the board reads its calendar registers (BCD,
 //! the STM32 RTC's `TR`/`DR` layout) and turns them into seconds since
 //! 2000-01-01 00:00 with [`calendar_s`]. Pure and host-tested; the register
-//! access lives in the board (`src/bin/eha-stm32f4/rtc.rs`).
+//! access lives in the board (`boards/stm32f411/src/rtc.rs`).
 
 /// Seconds since 2000-01-01 00:00:00 of the STM32 RTC's time register `tr`
 /// (24-hour format: SU 0-3, ST 4-6, MNU 8-11, MNT 12-14, HU 16-19, HT 20-21)

@@ -15,7 +15,7 @@
 //!
 //! A board ([`Board`]) supplies the UART bytes, pins, timer, watchdog and
 //! memories; the QEMU `mps2-an386` board and the STM32F411 board differ only
-//! there (`src/bin/eha-mps2/`, `src/bin/eha-stm32f4/`).
+//! there (`boards/mps2/`, `boards/stm32f411/`).
 
 pub mod clock;
 mod commands;

@@ -1,4 +1,4 @@
-//! The lockstep transport of the QEMU PIL image (`src/bin/eha-fw.rs`): the
+//! The lockstep transport of the QEMU PIL image (`boards/mps2/src/bin/eha-fw.rs`): the
 //! product application ([`crate::product::App`]) ticks once per chunk of
 //! received bytes the host sends, so a run is deterministic and as fast as
 //! the emulator.

@@ -1,6 +1,6 @@
 //! Firmware resource budgets: `eha-sim fw-budget` runs the benchmark image
 //! in QEMU under `-icount` (instruction counts, stack painting; see
-//! `src/bin/eha-bench.rs`), reads the flash and static RAM of every image
+//! `boards/mps2/src/bin/eha-bench.rs`), reads the flash and static RAM of every image
 //! from its ELF, writes `out/fw-budget.json` and compares each figure with
 //! the committed budgets (`.ci/fw-budget.json`): a figure more than
 //! [`REGRESSION_MARGIN`] above its budget fails.
@@ -17,7 +17,7 @@ use anyhow::{bail, Context, Result};
 use object::{Object, ObjectSection, SectionFlags};
 use serde::{Deserialize, Serialize};
 
-use super::firmware::{build_bin, workspace_root, Build};
+use super::firmware::{build_bin, workspace_root, Build, MPS2, STM32F4};
 
 /// Allowed growth over a committed budget (fraction): 10 %.
 pub const REGRESSION_MARGIN: f64 = 0.10;
@@ -73,6 +73,8 @@ impl ImageBudget {
 struct Image {
     name: &'static str,
     build: Build,
+    /// The board crate and its binary.
+    package: &'static str,
     bin: &'static str,
     features: &'static [&'static str],
     /// How the image is run in QEMU, if at all.
@@ -92,10 +94,10 @@ enum Run {
 }
 
 const IMAGES: [Image; 4] = [
-    Image { name: "bench-f32", build: Build::F32, bin: "eha-bench", features: &[], run: Run::Bench },
-    Image { name: "bench-fixed", build: Build::Fixed, bin: "eha-bench", features: &[], run: Run::Bench },
-    Image { name: "product-mps2", build: Build::F32, bin: "eha-mps2", features: &["fault-inject"], run: Run::Product },
-    Image { name: "stm32f411", build: Build::F32, bin: "eha-stm32f4", features: &["board-stm32f4"], run: Run::No },
+    Image { name: "bench-f32", build: Build::F32, package: MPS2, bin: "eha-bench", features: &[], run: Run::Bench },
+    Image { name: "bench-fixed", build: Build::Fixed, package: MPS2, bin: "eha-bench", features: &[], run: Run::Bench },
+    Image { name: "product-mps2", build: Build::F32, package: MPS2, bin: "eha-mps2", features: &["fault-inject"], run: Run::Product },
+    Image { name: "stm32f411", build: Build::F32, package: STM32F4, bin: "eha-stm32f4", features: &[], run: Run::No },
 ];
 
 /// Boot and tick-loop stack of the product image: 3 s of the drill's
@@ -237,7 +239,7 @@ pub fn measure() -> Result<BTreeMap<String, ImageBudget>> {
     let mut app_tick = None;
     let mut bench_f32 = ImageBudget::default();
     for im in &IMAGES {
-        let elf = build_bin(im.build, im.bin, im.features)?;
+        let elf = build_bin(im.build, im.package, im.bin, im.features)?;
         let mut b = match im.run {
             Run::Bench => {
                 let text = run_bench(im.build, &elf)?;

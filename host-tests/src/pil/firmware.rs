@@ -1,5 +1,7 @@
 //! Building the firmware ELF with a nested `cargo build` (the same commands
-//! as the `cargo fw-build` / `cargo fw-build-m3` aliases).
+//! as the `cargo fw-build` / `cargo fw-build-m3` aliases). The images are
+//! the binaries of the board crates: [`MPS2`] (QEMU: `eha-fw`, `eha-bench`,
+//! `eha-mps2`) and [`STM32F4`] (`eha-stm32f4`).
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -57,6 +59,11 @@ impl std::str::FromStr for Build {
     }
 }
 
+/// The board crate of the QEMU mps2 images (`boards/mps2`).
+pub const MPS2: &str = "eha-mps2";
+/// The board crate of the flashed STM32F411 image (`boards/stm32f411`).
+pub const STM32F4: &str = "eha-stm32f4";
+
 /// The workspace root (the firmware crate's directory).
 pub fn workspace_root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).parent().map(Path::to_path_buf).unwrap_or_else(|| PathBuf::from(".."))
@@ -68,13 +75,13 @@ pub fn workspace_root() -> PathBuf {
 /// When the image was built beforehand (`.ci/run` builds every image before
 /// the tests), this is cargo's up-to-date check, about a second.
 pub fn build_firmware(build: Build) -> Result<PathBuf> {
-    build_bin(build, "eha-fw", &[])
+    build_bin(build, MPS2, "eha-fw", &[])
 }
 
-/// Build firmware binary `bin` of the root crate for `build` (release
-/// profile, LTO, the flashed configuration) with the extra cargo `features`
-/// (e.g. `board-stm32f4`), and return the ELF path.
-pub fn build_bin(build: Build, bin: &str, features: &[&str]) -> Result<PathBuf> {
+/// Build firmware binary `bin` of the board crate `package` for `build`
+/// (release profile, LTO, the flashed configuration) with the extra cargo
+/// `features` of that crate (e.g. `fault-inject`), and return the ELF path.
+pub fn build_bin(build: Build, package: &str, bin: &str, features: &[&str]) -> Result<PathBuf> {
     ensure_target(build)?;
     let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
     let root = workspace_root();
@@ -85,7 +92,7 @@ pub fn build_bin(build: Build, bin: &str, features: &[&str]) -> Result<PathBuf> 
     let feat_args: Vec<String> = if feats.is_empty() { vec![] } else { vec!["--features".into(), feats.join(",")] };
     let mut cmd = Command::new(&cargo);
     cmd.current_dir(&root)
-        .args(["build", "--release", "-p", "eha-guard", "--bin", bin, "--target", build.target()])
+        .args(["build", "--release", "-p", package, "--bin", bin, "--target", build.target()])
         .args(&feat_args)
         .args(["--message-format", "json-render-diagnostics"])
         .stdin(Stdio::null())
@@ -96,7 +103,7 @@ pub fn build_bin(build: Build, bin: &str, features: &[&str]) -> Result<PathBuf> 
     let out = cmd.output().with_context(|| format!("running {cargo:?} to build the firmware in {}", root.display()))?;
     if !out.status.success() {
         bail!(
-            "firmware build failed ({}): cargo build --release -p eha-guard --bin {bin} --target {} {} (see the compiler output above)",
+            "firmware build failed ({}): cargo build --release -p {package} --bin {bin} --target {} {} (see the compiler output above)",
             out.status,
             build.target(),
             feat_args.join(" ")

@@ -34,7 +34,7 @@ pub fn product_elf() -> Result<PathBuf> {
     if let Some(p) = g.as_ref() {
         return Ok(p.clone());
     }
-    let p = build_bin(Build::F32, "eha-mps2", &["fault-inject"])?;
+    let p = build_bin(Build::F32, super::firmware::MPS2, "eha-mps2", &["fault-inject"])?;
     *g = Some(p.clone());
     Ok(p)
 }

@@ -1,6 +1,6 @@
 //! Running the PIL image in `qemu-system-arm` and talking to it in lockstep.
 //!
-//! Channels (see `src/bin/eha-fw.rs`, `eha_guard::protocol::lockstep`):
+//! Channels (see `boards/mps2/src/bin/eha-fw.rs`, `eha_guard::protocol::lockstep`):
 //! per-tick chunks of received bytes → QEMU stdin; the tick's frames and its
 //! end-of-tick frame ← QEMU stderr (semihosting `:tt` append); defmt log ←
 //! QEMU stdout. Both output pipes are drained by threads so the emulator
@@ -20,7 +20,7 @@ use eha_guard::protocol::Deframer;
 
 use super::firmware::Build;
 
-/// Exit codes of the firmware (`src/bin/eha-fw.rs`).
+/// Exit codes of the firmware (`boards/mps2/src/bin/eha-fw.rs`).
 pub fn exit_meaning(code: i32) -> &'static str {
     match code {
         0 => "clean exit",

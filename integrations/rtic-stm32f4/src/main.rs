@@ -158,7 +158,7 @@ mod app {
             Err(_) => (&eha_guard::params::DEFAULT_CONSTS, true),
         };
         let config = GuardConfig { model, ..GuardConfig::DEFAULT };
-        // A cold start; the product image (src/bin/eha-stm32f4) adds the
+        // A cold start; the product image (boards/stm32f411) adds the
         // thermal record in no-init RAM and flash (Restore::Warm/PowerLoss).
         let guard = Guard::new_in(cx.local.slot, &config, Restore::Cold);
         if refused {

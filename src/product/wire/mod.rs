@@ -52,7 +52,7 @@ pub const TRACE_LEN: usize = 18;
 /// valve open or the guard in alarm; a clear never restores trust in the
 /// estimate before it can have recovered (docs/firmware.md, "Commands").
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(any(target_os = "none", feature = "defmt"), derive(defmt::Format))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Cmd {
     /// Arm a clear of the latched faults; the ack carries the nonce.
     ClearArm,
@@ -200,7 +200,7 @@ impl Pins {
 /// Why the MCU last reset (kept in no-init RAM across the reset, see
 /// [`super::reset`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(any(target_os = "none", feature = "defmt"), derive(defmt::Format))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum ResetCause {
     /// Power-on (no-init RAM held no cause record).
     PowerOn = 0,

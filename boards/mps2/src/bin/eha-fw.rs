@@ -29,22 +29,24 @@
 //! | 5 | semihosting read (stdin) failed, or a chunk was cut short |
 //! | 6 | semihosting write (replies) failed |
 //! | 7 | semihosting open of stdin/stderr failed |
-#![cfg_attr(target_os = "none", no_std, no_main)]
+#![no_std]
+#![no_main]
 
-#[cfg(not(target_os = "none"))]
-fn main() {}
+// The mps2 vector table (shared with the product image).
+#[path = "../vectors.rs"]
+mod vectors;
 
-#[cfg(target_os = "none")]
 mod fw {
     use core::mem::MaybeUninit;
     use cortex_m::peripheral::{syst::SystClkSource, SYST};
     use cortex_m_rt::{entry, exception, ExceptionFrame};
     use defmt_semihosting as _;
-    use eha_guard::memory::slots::noinit;
+    use eha_cortex_m::noinit;
+    use eha_guard::memory::nv::NvLoad;
     use eha_guard::memory::ThermalRecord;
-    use eha_guard::product::reset::{self, CauseRecord};
+    use eha_guard::product::reset::CauseRecord;
     use eha_guard::product::wire::Pins;
-    use eha_guard::product::{App, Board, BootMemory};
+    use eha_guard::product::{App, Board};
     use eha_guard::protocol::lockstep::{tick_end, DONE_TOKEN};
     use eha_guard::{GuardConfig, Output};
     use semihosting::io::{Stderr, Stdin};
@@ -165,10 +167,10 @@ mod fw {
             self.ticks = self.ticks.wrapping_add(1);
         }
         fn store_record(&mut self, slot: usize, rec: &ThermalRecord) {
-            noinit::store(slot, rec);
+            noinit::store_record(slot, rec);
         }
         fn store_cause(&mut self, rec: &CauseRecord) {
-            reset::noinit::store(rec);
+            noinit::store_cause(rec);
         }
     }
 
@@ -200,8 +202,7 @@ mod fw {
             tx_lost: 0,
             ticks: 0,
         });
-        let (a, b) = noinit::load();
-        let mem = BootMemory { records: (a, b), nv: eha_guard::memory::nv::NvLoad::Empty, alive_s: None, nv_failing: false, cause: reset::noinit::load(), hw_hint: None };
+        let mem = noinit::boot_memory(NvLoad::Empty, None, false, None);
         // The application state lives in .bss, not on the stack.
         static mut APP: MaybeUninit<App> = MaybeUninit::uninit();
         // SAFETY: `main` runs once; this is the only reference to APP.

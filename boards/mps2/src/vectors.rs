@@ -1,5 +1,5 @@
-//! Device interrupt vectors of the QEMU `mps2` images (the STM32F411's come with
-//! its PAC). cortex-m-rt's default table holds 240 entries (960 bytes of flash);
+//! Device interrupt vectors of the QEMU `mps2` images, included by each of
+//! them (the STM32F411's come with its PAC). cortex-m-rt's default table holds 240 entries (960 bytes of flash);
 //! these images unmask only UART0 RX (IRQ 0) and timer 0 (IRQ 8), so the table
 //! stops after IRQ 31. Every entry is `DefaultHandler`, which the boards dispatch
 //! by the active IRQ number. An IRQ above 31 is never unmasked here.

@@ -7,21 +7,21 @@
 //! valve), bit 1 = OK pin (high = no alarm). Reset level 0 = valve open,
 //! alarm: the safe state.
 //!
-//! Interrupts (no PAC: the vector table of `src/vectors.rs` sends every IRQ
+//! Interrupts (no PAC: the vector table of `vectors.rs` sends every IRQ
 //! to `DefaultHandler`, which dispatches by number): UART0 RX = IRQ 0,
 //! timer 0 = IRQ 8; the watchdog's warning goes to NMI.
+//!
+//! Tick counter, receive queue, no-init records and stack painting:
+//! `eha_cortex_m` (shared with the STM32F411 board).
 
-use core::cell::RefCell;
-use core::sync::atomic::{AtomicU32, Ordering::Relaxed};
-use cortex_m::interrupt::{self as irq, Mutex};
 use cortex_m::peripheral::{syst::SystClkSource, NVIC, SCB, SYST};
 use cortex_m_rt::{exception, ExceptionFrame};
-use eha_guard::memory::slots::noinit;
+use eha_cortex_m::{noinit, rx, stack, tick};
+use eha_guard::memory::nv::NvLoad;
 use eha_guard::memory::ThermalRecord;
-use eha_guard::product::reset::{self, CauseRecord};
+use eha_guard::product::reset::CauseRecord;
 use eha_guard::product::wire::{Pins, ResetCause};
 use eha_guard::product::{Board, BootMemory};
-use heapless::Deque;
 
 const SYSCLK_HZ: u32 = 25_000_000;
 /// Tick period: 10 ms of the 25 MHz APB clock.
@@ -57,10 +57,6 @@ unsafe impl cortex_m::interrupt::InterruptNumber for Irq {
     }
 }
 
-static TICKS: AtomicU32 = AtomicU32::new(0);
-static RX_DROPPED: AtomicU32 = AtomicU32::new(0);
-static RX: Mutex<RefCell<Deque<u8, 256>>> = Mutex::new(RefCell::new(Deque::new()));
-
 /// Puts the outputs in their safe state with one register write: valve
 /// pin low (valve open), OK pin low (alarm). Used by the fault handlers.
 fn safe_outputs() {
@@ -70,12 +66,12 @@ fn safe_outputs() {
 /// Records `cause`, makes the outputs safe and resets the MCU.
 fn fail(cause: ResetCause) -> ! {
     safe_outputs();
-    reset::noinit::record(cause);
+    noinit::record_cause(cause);
     SCB::sys_reset()
 }
 
-/// The board's peripherals (all MMIO; the statics above are shared with the
-/// interrupt handlers).
+/// The board's peripherals (all MMIO; the tick counter and the receive
+/// queue are shared with the interrupt handlers).
 pub struct Mps2 {
     syst: SYST,
     boot_stack_b: u32,
@@ -86,7 +82,7 @@ impl Mps2 {
     /// Safe outputs, stack paint, watchdog armed, and what the memories hold.
     pub fn init() -> (Mps2, BootMemory) {
         safe_outputs();
-        eha_guard::stack::paint();
+        stack::paint();
         let Some(cp) = cortex_m::Peripherals::take() else { fail(ResetCause::Other) };
         let mut syst = cp.SYST;
         syst.set_clock_source(SystClkSource::Core);
@@ -98,17 +94,14 @@ impl Mps2 {
         wr(WDOG, WDOG_LOAD);
         wr(WDOG + 0x008, 0b11);
         wr(WDOG + 0xC00, 0);
-        let (a, b) = noinit::load();
-        let mem = BootMemory { records: (a, b), nv: eha_guard::memory::nv::NvLoad::Empty, alive_s: None, nv_failing: false, cause: reset::noinit::load(), hw_hint: None };
+        let mem = noinit::boot_memory(NvLoad::Empty, None, false, None);
         (Mps2 { syst, boot_stack_b: 0 }, mem)
     }
 
     /// Called after `App::boot`: the boot stack is measured, then repainted so
     /// that the status reply reports the tick loop's own high-water mark.
     pub fn boot_done(&mut self) {
-        self.boot_stack_b = eha_guard::stack::high_water();
-        eha_guard::stack::paint();
-        defmt::info!("boot stack {=u32} B", self.boot_stack_b);
+        self.boot_stack_b = stack::boot_done();
     }
 }
 
@@ -119,8 +112,8 @@ pub fn start(_b: &mut Mps2) {
     wr(TIMER0 + 0x008, TICK_RELOAD); // RELOAD
     wr(TIMER0 + 0x004, TICK_RELOAD); // VALUE
     wr(TIMER0, 0b1001); // enable, interrupt enable
-    // SAFETY: the handlers only touch the statics above, through atomics or
-    // a critical section.
+    // SAFETY: the handlers only touch their peripheral's registers and the
+    // tick counter and receive queue (atomics or a critical section).
     unsafe {
         NVIC::unmask(Irq(IRQ_UART0_RX));
         NVIC::unmask(Irq(IRQ_TIMER0));
@@ -129,20 +122,11 @@ pub fn start(_b: &mut Mps2) {
 
 impl Board for Mps2 {
     fn read_rx(&mut self, buf: &mut [u8]) -> usize {
-        irq::free(|cs| {
-            let mut q = RX.borrow(cs).borrow_mut();
-            let mut n = 0;
-            for slot in buf.iter_mut() {
-                let Some(b) = q.pop_front() else { break };
-                *slot = b;
-                n += 1;
-            }
-            n
-        })
+        rx::read(buf)
     }
 
     fn rx_dropped(&self) -> u32 {
-        RX_DROPPED.load(Relaxed)
+        rx::dropped()
     }
 
     fn write_tx(&mut self, bytes: &[u8]) {
@@ -165,27 +149,19 @@ impl Board for Mps2 {
     }
 
     fn ticks(&self) -> u32 {
-        TICKS.load(Relaxed)
+        tick::count()
     }
 
     fn wait_tick(&mut self, seen: u32) {
-        while TICKS.load(Relaxed) == seen {
-            // WFI with interrupts masked: a tick that fires between the check
-            // and the WFI still wakes it (pending), and runs after `free`.
-            irq::free(|_| {
-                if TICKS.load(Relaxed) == seen {
-                    cortex_m::asm::wfi();
-                }
-            });
-        }
+        tick::wait(seen);
     }
 
     fn store_record(&mut self, slot: usize, rec: &ThermalRecord) {
-        noinit::store(slot, rec);
+        noinit::store_record(slot, rec);
     }
 
     fn store_cause(&mut self, rec: &CauseRecord) {
-        reset::noinit::store(rec);
+        noinit::store_cause(rec);
     }
 
     fn cycle_stamp(&self) -> u32 {
@@ -198,7 +174,7 @@ impl Board for Mps2 {
     }
 
     fn stack_high_water_b(&self) -> u32 {
-        eha_guard::stack::high_water()
+        stack::high_water()
     }
 
     fn boot_stack_b(&self) -> u32 {
@@ -217,18 +193,13 @@ fn uart0_rx() {
     // UART takes no more bytes while the buffer is full.)
     wr(UART0 + 0x00C, 0b1010); // clear RX and RX-overrun interrupts
     while rd(UART0 + 0x004) & 2 != 0 {
-        let b = rd(UART0) as u8;
-        irq::free(|cs| {
-            if RX.borrow(cs).borrow_mut().push_back(b).is_err() {
-                RX_DROPPED.fetch_add(1, Relaxed);
-            }
-        });
+        rx::push(rd(UART0) as u8);
     }
 }
 
 fn timer0() {
     wr(TIMER0 + 0x00C, 1);
-    TICKS.fetch_add(1, Relaxed);
+    tick::advance();
 }
 
 #[exception]

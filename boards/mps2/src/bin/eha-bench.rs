@@ -3,18 +3,19 @@
 //! `Model::update` in QEMU, stack high-water mark, init cost. Run with `cargo fw-bench` (M4F, f32) or
 //! `cargo fw-bench-m3` (M3, fixed point); see `docs/firmware-numbers.md`.
 //!
-//! Method (../shared/toolchain-notes.md): QEMU `-icount shift=10,align=off,sleep=off`
+//! Method (docs/toolchain.md): QEMU `-icount shift=10,align=off,sleep=off`
 //! makes every instruction 1.024 us of virtual time; SysTick runs on the 25 MHz core
 //! clock, so instructions = SysTick ticks / 25.6. The timing overhead (two SysTick
 //! reads) is measured on an empty region and subtracted. Report on semihosting
 //! stderr; completion marker `EHA-BENCH-DONE`; exit codes: 0 ok, 101 panic,
 //! 102 HardFault, 103 other exception, 104 no peripherals.
-#![cfg_attr(target_os = "none", no_std, no_main)]
+#![no_std]
+#![no_main]
 
-#[cfg(not(target_os = "none"))]
-fn main() {}
+// The mps2 vector table (shared with the product image).
+#[path = "../vectors.rs"]
+mod vectors;
 
-#[cfg(target_os = "none")]
 mod fw {
     use core::sync::atomic::{AtomicU32, Ordering};
     use cortex_m::peripheral::{syst::SystClkSource, SYST};
@@ -245,8 +246,8 @@ mod fw {
         let mut nv_stats = Stats::new();
         // (after the stack figures above: its own high-water mark, from
         // this frame down)
-        let depth = eha_guard::stack::depth();
-        eha_guard::stack::paint();
+        let depth = eha_cortex_m::stack::depth();
+        eha_cortex_m::stack::paint();
         if let Ok(store) = eha_guard::memory::nv::NvStore::new(eha_guard::memory::nv::Blocking(eha_guard::memory::nv::RamFlash::<4096>::new()), 0..4096) {
             let nv = nv.write(store);
             let rec = guard.snapshot();
@@ -263,12 +264,12 @@ mod fw {
         }
 
         nv_stats.report("non-volatile save on the in-memory flash (max: a page erase and move)", ovh);
-        eprintln!("non-volatile save stack: {} bytes below its caller", eha_guard::stack::high_water().saturating_sub(depth));
+        eprintln!("non-volatile save stack: {} bytes below its caller", eha_cortex_m::stack::high_water().saturating_sub(depth));
     }
 
     #[entry]
     fn main() -> ! {
-        eha_guard::stack::paint();
+        eha_cortex_m::stack::paint();
         let Some(mut p) = cortex_m::Peripherals::take() else {
             semihosting::process::exit(104)
         };
@@ -307,8 +308,8 @@ mod fw {
 
         // Stack used by boot + init (f64 matrix exponential), then repaint to measure
         // the tick loop alone (its figure includes main's own frame).
-        let init_stack = eha_guard::stack::high_water();
-        eha_guard::stack::paint();
+        let init_stack = eha_cortex_m::stack::high_water();
+        eha_cortex_m::stack::paint();
         let Some(limits) = LimitsN::<Real>::new(&GuardConfig::DEFAULT.limits, &scales) else {
             semihosting::process::exit(107)
         };
@@ -584,7 +585,7 @@ mod fw {
         eprintln!(
             "stack high-water mark: boot+init {} bytes, tick loop {} bytes",
             init_stack,
-            eha_guard::stack::high_water()
+            eha_cortex_m::stack::high_water()
         );
         nv_saves(&guard, ovh);
         let dc = (last.drain_c * 1000.0) as i32;

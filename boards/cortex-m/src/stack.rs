@@ -1,6 +1,6 @@
-//! Stack painting (target only): fill the unused stack with a pattern, later
-//! find the lowest overwritten word. Used by the product boards (boot and
-//! tick-loop high-water marks in the status reply) and the benchmark.
+//! Stack painting: fill the unused stack with a pattern, later find the
+//! lowest overwritten word. Used by the product boards (boot and tick-loop
+//! high-water marks in the status reply) and the benchmark image.
 
 const PAINT: u32 = 0xDEAD_BEEF;
 
@@ -42,4 +42,15 @@ pub fn high_water() -> u32 {
         p += 4;
     }
     (hi - p) as u32
+}
+
+/// At the end of boot: the boot's high-water mark (returned, and logged),
+/// then the stack painted again so that later readings are the tick
+/// loop's own.
+#[inline]
+pub fn boot_done() -> u32 {
+    let b = high_water();
+    paint();
+    defmt::info!("boot stack {=u32} B", b);
+    b
 }

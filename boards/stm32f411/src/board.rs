@@ -18,20 +18,22 @@
 //! The HAL configures every peripheral; the two interrupt handlers and the
 //! fault handlers touch registers through the PAC directly (a flag clear, a
 //! data register read, one BSRR write), so they own no HAL object.
+//!
+//! Tick counter, receive queue, no-init records and stack painting:
+//! `eha_cortex_m` (shared with the QEMU board).
 
 use core::cell::RefCell;
 use core::sync::atomic::{AtomicU32, Ordering::Relaxed};
 use cortex_m::interrupt::{self as irq, Mutex};
 use cortex_m::peripheral::{DWT, NVIC, SCB};
 use cortex_m_rt::{exception, ExceptionFrame};
+use eha_cortex_m::{noinit, rx, stack, tick};
 use eha_guard::memory::nv::{Blocking, NvLoad, NvStore};
-use eha_guard::memory::slots::noinit;
 use eha_guard::memory::ThermalRecord;
-use eha_guard::product::reset::{self, CauseRecord};
+use eha_guard::product::reset::CauseRecord;
 use eha_guard::product::wire::{Pins, ResetCause};
 use eha_guard::product::{Board, BootMemory};
 use embedded_storage::nor_flash::{ErrorType, NorFlash, ReadNorFlash};
-use heapless::Deque;
 use stm32f4xx_hal::flash::{FlashExt, LockedFlash};
 use stm32f4xx_hal::gpio::{Output, PinState, PushPull, PA5, PA6};
 use stm32f4xx_hal::pac::{self, interrupt, Interrupt};
@@ -73,9 +75,6 @@ const SECTOR: u32 = 128 * 1024;
 /// half (bits 16..32) of the set/reset register, one bit per pin.
 const SAFE_BSRR: u32 = (1 << (16 + 5)) | (1 << (16 + 6));
 
-static TICKS: AtomicU32 = AtomicU32::new(0);
-static RX_DROPPED: AtomicU32 = AtomicU32::new(0);
-static RX: Mutex<RefCell<Deque<u8, 256>>> = Mutex::new(RefCell::new(Deque::new()));
 /// The IWDG, shared by `feed_watchdog` and the flash erase (both thread
 /// mode; no interrupt handler touches it).
 static WDT: Mutex<RefCell<Option<IndependentWatchdog>>> = Mutex::new(RefCell::new(None));
@@ -96,7 +95,7 @@ fn safe_outputs() {
 fn fail(cause: ResetCause) -> ! {
     irq::disable();
     safe_outputs();
-    reset::noinit::record(cause);
+    noinit::record_cause(cause);
     SCB::sys_reset()
 }
 
@@ -168,8 +167,8 @@ impl NorFlash for Flash {
 }
 
 
-/// The board's peripherals (the statics above are shared with the
-/// interrupt handlers).
+/// The board's peripherals (the tick counter and the receive queue are
+/// shared with the interrupt handlers).
 pub struct F411 {
     valve: PA5<Output<PushPull>>,
     ok: PA6<Output<PushPull>>,
@@ -208,7 +207,7 @@ impl F411 {
         let gpioa = dp.GPIOA.split(&mut rcc);
         let valve = gpioa.pa5.into_push_pull_output_in_state(PinState::Low);
         let ok = gpioa.pa6.into_push_pull_output_in_state(PinState::Low);
-        eha_guard::stack::paint();
+        stack::paint();
         // 2. Watchdog (LSI, independent of the clock tree below): a boot that
         // hangs, e.g. on a crystal that never starts, is reset.
         // With a probe attached, the IWDG stops while the core is halted, and
@@ -231,20 +230,12 @@ impl F411 {
         let (tx, rx) = serial.split();
         let tick = dp.TIM2.counter_us(&mut rcc);
         // 5. Memories: no-init RAM records, the non-volatile record, the cause.
-        let (a, b) = noinit::load();
         let mut nv = NvStore::new(Blocking(Flash(LockedFlash::new(dp.FLASH))), NV_RANGE).ok();
         // A store that cannot be opened is a damaged record, not an empty
         // one: the machine may be hot (conservative start).
         let nv_rec = nv.as_mut().map_or(NvLoad::Damaged, |n| n.load());
         let alive = crate::rtc::alive_load().and_then(eha_guard::memory::alive_from_word);
-        let mem = BootMemory {
-            records: (a, b),
-            nv: nv_rec,
-            alive_s: alive.map(|a| a.0),
-            nv_failing: alive.is_some_and(|a| a.1),
-            cause: reset::noinit::load(),
-            hw_hint: hw_hint(csr),
-        };
+        let mem: BootMemory = noinit::boot_memory(nv_rec, alive.map(|a| a.0), alive.is_some_and(|a| a.1), hw_hint(csr));
         defmt::info!(
             "RCC_CSR {=u32:#010x}, sysclk {=u32} Hz, NV store {}, NV record {}",
             csr,
@@ -262,9 +253,7 @@ impl F411 {
     /// Called after `App::boot`: the boot stack is measured, then repainted so
     /// that the status reply reports the tick loop's own high-water mark.
     pub fn boot_done(&mut self) {
-        self.boot_stack_b = eha_guard::stack::high_water();
-        eha_guard::stack::paint();
-        defmt::info!("boot stack {=u32} B", self.boot_stack_b);
+        self.boot_stack_b = stack::boot_done();
     }
 }
 
@@ -278,8 +267,9 @@ pub fn start(b: &mut F411) {
     b.tick.listen(Event::Update);
     WDT_BASE_MS.store(WDT_RUN_MS, Relaxed);
     watchdog_window(WDT_RUN_MS);
-    // SAFETY: the handlers only touch the statics above (atomics or a
-    // critical section) and their own peripheral's flag/data registers.
+    // SAFETY: the handlers only touch the tick counter and the receive queue
+    // (atomics or a critical section) and their own peripheral's flag/data
+    // registers.
     unsafe {
         NVIC::unmask(Interrupt::USART1);
         NVIC::unmask(Interrupt::TIM2);
@@ -288,20 +278,11 @@ pub fn start(b: &mut F411) {
 
 impl Board for F411 {
     fn read_rx(&mut self, buf: &mut [u8]) -> usize {
-        irq::free(|cs| {
-            let mut q = RX.borrow(cs).borrow_mut();
-            let mut n = 0;
-            for slot in buf.iter_mut() {
-                let Some(b) = q.pop_front() else { break };
-                *slot = b;
-                n += 1;
-            }
-            n
-        })
+        rx::read(buf)
     }
 
     fn rx_dropped(&self) -> u32 {
-        RX_DROPPED.load(Relaxed)
+        rx::dropped()
     }
 
     fn write_tx(&mut self, bytes: &[u8]) {
@@ -323,27 +304,19 @@ impl Board for F411 {
     }
 
     fn ticks(&self) -> u32 {
-        TICKS.load(Relaxed)
+        tick::count()
     }
 
     fn wait_tick(&mut self, seen: u32) {
-        while TICKS.load(Relaxed) == seen {
-            // WFI with interrupts masked: a tick that fires between the check
-            // and the WFI still wakes it (pending), and runs after `free`.
-            irq::free(|_| {
-                if TICKS.load(Relaxed) == seen {
-                    cortex_m::asm::wfi();
-                }
-            });
-        }
+        tick::wait(seen);
     }
 
     fn store_record(&mut self, slot: usize, rec: &ThermalRecord) {
-        noinit::store(slot, rec);
+        noinit::store_record(slot, rec);
     }
 
     fn store_cause(&mut self, rec: &CauseRecord) {
-        reset::noinit::store(rec);
+        noinit::store_cause(rec);
     }
 
     /// Appends the record to flash. A sector erase stalls the CPU (and the
@@ -353,12 +326,12 @@ impl Board for F411 {
     /// application sees them as an overrun and missing steps.
     fn nv_save(&mut self, rec: &ThermalRecord) -> Option<bool> {
         let nv = self.nv.as_mut()?;
-        let (t0, c0) = (TICKS.load(Relaxed), DWT::cycle_count());
+        let (t0, c0) = (tick::count(), DWT::cycle_count());
         let ok = nv.save(rec).is_ok();
         let elapsed = DWT::cycle_count().wrapping_sub(c0) / CYCLES_PER_TICK;
-        let counted = TICKS.load(Relaxed).wrapping_sub(t0);
+        let counted = tick::count().wrapping_sub(t0);
         if elapsed > counted {
-            TICKS.fetch_add(elapsed - counted, Relaxed);
+            tick::catch_up(elapsed - counted);
         }
         if !ok {
             self.nv_errors = self.nv_errors.saturating_add(1);
@@ -378,7 +351,7 @@ impl Board for F411 {
     }
 
     fn stack_high_water_b(&self) -> u32 {
-        eha_guard::stack::high_water()
+        stack::high_water()
     }
 
     fn boot_stack_b(&self) -> u32 {
@@ -412,14 +385,10 @@ fn USART1() {
         }
         let b = usart.dr().read().bits() as u8;
         if ore {
-            RX_DROPPED.fetch_add(1, Relaxed);
+            rx::lost();
         }
         if rxne {
-            irq::free(|cs| {
-                if RX.borrow(cs).borrow_mut().push_back(b).is_err() {
-                    RX_DROPPED.fetch_add(1, Relaxed);
-                }
-            });
+            rx::push(b);
         }
     }
 }
@@ -430,7 +399,7 @@ fn TIM2() {
     // SAFETY: TIM2_SR flags are rc_w0: writing 1 leaves a flag, 0 clears it;
     // this clears UIF only.
     unsafe { (*pac::TIM2::ptr()).sr().write(|w| w.bits(0xFFFF & !1)) };
-    TICKS.fetch_add(1, Relaxed);
+    tick::advance();
 }
 
 /// Any other interrupt or exception (NMI included): none is expected.

@@ -1,0 +1,27 @@
+//! The Cortex-M parts both product boards share (`boards/mps2`,
+//! `boards/stm32f411`): what a board module needs beyond its own
+//! peripherals to run [`eha_guard::product::App`].
+//!
+//! - [`tick`]: the tick counter that the board's 10 ms timer interrupt
+//!   advances, and the low-power wait for the next tick;
+//! - [`rx`]: the controller link's receive queue, filled by the board's
+//!   UART interrupt;
+//! - [`noinit`]: the thermal and reset-cause records in no-init RAM (what a
+//!   warm reset keeps) and the [`eha_guard::product::BootMemory`] they give;
+//! - [`stack`]: stack painting (boot and tick-loop high-water marks).
+//!
+//! Target only (`target_os = "none"`): a host build of this crate is empty.
+//! The functions that were each board's own code are `#[inline]`: they
+//! compile into the board's image as they did there (the product image's
+//! flash budget has no room for a different inlining).
+#![no_std]
+#![warn(missing_docs)]
+
+#[cfg(target_os = "none")]
+pub mod noinit;
+#[cfg(target_os = "none")]
+pub mod rx;
+#[cfg(target_os = "none")]
+pub mod stack;
+#[cfg(target_os = "none")]
+pub mod tick;
