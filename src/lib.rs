@@ -22,8 +22,8 @@
 compile_error!("`fault-inject` is for the QEMU test images only: never in the flashed STM32F411 image (`board-stm32f4`)");
 
 pub mod crosscheck;
-mod default_consts;
 pub mod guard;
+pub mod interface;
 pub mod linalg;
 pub mod memory;
 pub mod model;

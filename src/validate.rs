@@ -8,7 +8,7 @@
 //! bit and, while the fault is latched, replaced by its *worst-case* value (maximum
 //! loss), so the thermal estimate keeps rising conservatively.
 
-use crate::guard::Sample;
+use crate::interface::Sample;
 use crate::model::{InputScales, ModelInputN};
 use crate::num::Num;
 

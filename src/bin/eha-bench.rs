@@ -297,7 +297,7 @@ mod fw {
         let wraps = WRAPS.load(Ordering::Relaxed) - w0;
         let init_ticks = wraps as u64 * 0x0100_0000 + (t0.wrapping_sub(t1) & 0x00FF_FFFF) as u64;
 
-        let Ok(mut model) = Model::<Real>::from_consts(&eha_guard::params::DEFAULT_CONSTS) else {
+        let Ok(mut model) = Model::<Real>::from_consts(&eha_guard::model::DEFAULT_CONSTS) else {
             semihosting::process::exit(105)
         };
         let Some(scales) = InputScales::<Real>::new() else {

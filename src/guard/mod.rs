@@ -13,7 +13,8 @@ mod tick;
 mod types;
 pub mod faults;
 pub use faults::Faults;
-pub use types::{GuardConfig, Output, Reports, Sample, DRAIN_C_UNKNOWN};
+pub use crate::interface::{Output, Reports, Sample, DRAIN_C_UNKNOWN};
+pub use types::GuardConfig;
 // `ClearResult`, `recovery_ticks` and the trust constants are defined below.
 
 use crate::crosscheck::{CrossCheck, Verdict};

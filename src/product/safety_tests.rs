@@ -212,7 +212,7 @@ fn rediscretised(mut c: crate::model::ModelConsts<f32>) -> crate::model::ModelCo
 /// rate (the minimum-heating check).
 #[test]
 fn a_block_whose_model_cannot_heat_is_refused() {
-    let mut zero = crate::params::DEFAULT_CONSTS;
+    let mut zero = crate::model::DEFAULT_CONSTS;
     let mut tiny = zero;
     for (z, t) in [
         (&mut zero.k_lf, &mut tiny.k_lf),
@@ -244,7 +244,7 @@ fn a_block_whose_model_cannot_heat_is_refused() {
 /// `k_sh = 0` switched the sensor cross-check off without a word: refused.
 #[test]
 fn a_block_without_a_torque_constant_is_refused() {
-    let c = crate::model::ModelConsts { k_sh: 0.0, ..crate::params::DEFAULT_CONSTS };
+    let c = crate::model::ModelConsts { k_sh: 0.0, ..crate::model::DEFAULT_CONSTS };
     let (src, f, _) = boot_with_block(&c);
     assert!(f.contains(faults::CONFIG), "k_sh = 0 accepted: source {src:?}, faults {f:?}");
 }
@@ -253,7 +253,7 @@ fn a_block_without_a_torque_constant_is_refused() {
 /// bound claiming 100 times the cooling is refused, not trusted.
 #[test]
 fn a_block_claiming_more_cooling_at_rest_than_its_model_is_refused() {
-    let mut c = crate::params::DEFAULT_CONSTS;
+    let mut c = crate::model::DEFAULT_CONSTS;
     for r in c.rest_rate.iter_mut() {
         *r *= 100.0;
     }
@@ -266,7 +266,7 @@ fn a_block_claiming_more_cooling_at_rest_than_its_model_is_refused() {
 /// sample, up to 10 s later).
 #[test]
 fn a_refused_block_shows_the_alarm_from_the_first_instant() {
-    let mut torn = params_block::encode(&crate::params::DEFAULT_CONSTS, "torn");
+    let mut torn = params_block::encode(&crate::model::DEFAULT_CONSTS, "torn");
     torn[500] ^= 0x10;
     let mut b = board();
     b.block = Some(super::tests::flash_block(torn));

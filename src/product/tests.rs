@@ -328,7 +328,7 @@ pub(super) fn flash_block(bytes: [u8; BLOCK_LEN]) -> &'static [u8; BLOCK_LEN] {
 /// stability check's 1e-7 s and the block would be refused). Checked to build.
 pub(super) fn other_rig() -> crate::model::ModelConsts<f32> {
     use crate::model::{etd_matrix, Model};
-    let mut c = crate::model::ModelConsts { k_mech: crate::params::DEFAULT_CONSTS.k_mech * 1.5, ..crate::params::DEFAULT_CONSTS };
+    let mut c = crate::model::ModelConsts { k_mech: crate::model::DEFAULT_CONSTS.k_mech * 1.5, ..crate::model::DEFAULT_CONSTS };
     let j = Model::<f32>::for_linearisation(&c).map(|m| m.nominal_jacobian_f32().map(|r| r.map(f64::from)));
     c.phi = etd_matrix(&j.unwrap_or_default(), crate::params::S_PER_STEP).map(|r| r.map(|x| x as f32));
     assert_eq!(Model::<f32>::from_consts(&c).err(), None, "the other rig's constants must build a model");

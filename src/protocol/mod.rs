@@ -209,13 +209,13 @@ pub struct Request {
     pub lng_supply_bar: Option<f32>,
 }
 
-/// What the guard reports after a tick: the guard's own [`crate::Output`].
-pub type GuardOutput = crate::Output;
+/// What the guard reports after a tick: the guard's own [`crate::interface::Output`].
+pub type GuardOutput = crate::interface::Output;
 
 impl Request {
     /// The guard's sample carried by this frame.
-    pub fn sample(&self) -> crate::Sample {
-        crate::Sample {
+    pub fn sample(&self) -> crate::interface::Sample {
+        crate::interface::Sample {
             current_a: self.current_a,
             p_a_bar: self.p_a_bar,
             p_b_bar: self.p_b_bar,
@@ -226,8 +226,8 @@ impl Request {
     }
 
     /// The controller's reports carried by this frame.
-    pub fn reports(&self) -> crate::Reports {
-        crate::Reports { valve_fb: self.valve_fb, lng_supply_bar: self.lng_supply_bar, elec_hz: self.elec_hz }
+    pub fn reports(&self) -> crate::interface::Reports {
+        crate::interface::Reports { valve_fb: self.valve_fb, lng_supply_bar: self.lng_supply_bar, elec_hz: self.elec_hz }
     }
 }
 

@@ -670,7 +670,8 @@ fn trace_ring_keeps_newest_32() {
 /// `mu(40) / mu(T)` as the guard reads it: its `f32` table over the oil
 /// temperature (`DEFAULT_CONSTS.leak_ratio`), linear between points, end values held.
 fn leak_ratio(t_c: f64) -> f64 {
-    use eha_guard::params::{DEFAULT_CONSTS, N_TEMP, TEMP_TABLE_MIN_C, TEMP_TABLE_STEP_K};
+    use eha_guard::model::DEFAULT_CONSTS;
+    use eha_guard::params::{N_TEMP, TEMP_TABLE_MIN_C, TEMP_TABLE_STEP_K};
     let u = (t_c - TEMP_TABLE_MIN_C) * (1.0 / TEMP_TABLE_STEP_K);
     let (j, f) = match u.floor() {
         x if x < 0.0 => (0, 0.0),

@@ -11,7 +11,7 @@
 
 use crate::protocol::{DecodeError, PutAt, Rd, WireFrame};
 use crate::trace::{RestoreKind, Trace};
-use crate::Output;
+use crate::interface::Output;
 
 mod codec;
 mod reply;
