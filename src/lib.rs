@@ -22,6 +22,7 @@
 compile_error!("`fault-inject` is for the QEMU test images only: never in the flashed STM32F411 image (`board-stm32f4`)");
 
 pub mod crosscheck;
+pub mod faults;
 pub mod guard;
 pub mod interface;
 pub mod linalg;
@@ -41,7 +42,9 @@ pub mod validate;
 #[cfg(all(target_os = "none", not(feature = "board-stm32f4")))]
 mod vectors;
 
-pub use guard::{faults, ClearResult, Faults, Guard, GuardConfig, GuardOf, Output, Real, Reports, Sample};
+pub use faults::{ChannelSet, Faults};
+pub use guard::{ClearResult, Guard, GuardConfig, GuardOf, Real};
+pub use interface::{Output, Reports, Sample};
 pub use memory::{Restore, ThermalRecord};
 
 /// This firmware library's version (the crate's, `MAJOR.MINOR.PATCH`).

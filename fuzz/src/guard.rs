@@ -214,7 +214,7 @@ fn restore(u: &mut Unstructured<'_>, variant: u8) -> Restore {
             }
             let amb = -20.0 + 0.25 * f32::from(byte(u));
             let used = u.arbitrary::<u32>().unwrap_or(0);
-            let fb = u.arbitrary::<u32>().unwrap_or(0) & (faults::LATCHED | eha_guard::Faults::channels(0x3F)).bits();
+            let fb = u.arbitrary::<u32>().unwrap_or(0) & (faults::LATCHED | eha_guard::Faults::channels(eha_guard::ChannelSet::ALL)).bits();
             let fb = if byte(u) & 1 == 0 { 0 } else { fb };
             Restore::from_record(&ThermalRecord::new(temps, amb, used, fb, 0))
         }

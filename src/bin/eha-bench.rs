@@ -22,7 +22,7 @@ mod fw {
     use defmt_semihosting as _;
     use eha_guard::model::{InputScales, Model, ModelInputN};
     use eha_guard::num::Num;
-    use eha_guard::validate::{self, Channels, LimitsN, CH_ALL};
+    use eha_guard::validate::{self, Channels, LimitsN};
     use eha_guard::product::mem_board::MemBoard;
     use eha_guard::{Guard, GuardConfig, Real, Restore, Sample};
     use semihosting::eprintln;
@@ -173,7 +173,7 @@ mod fw {
         lim: &LimitsN<Real>,
     ) -> ModelInputN<Real> {
         let (v, nf) = validate::convert(s, sc);
-        let c = validate::check(&v, nf, prev, CH_ALL, lim);
+        let c = validate::check(&v, nf, prev, eha_guard::ChannelSet::ALL, lim);
         validate::substitute(&v, c.bad, Some(v[4]), lim)
     }
 

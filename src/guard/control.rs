@@ -79,12 +79,12 @@ impl<N: Num> GuardOf<N> {
     #[inline(never)]
     fn latch_speed(&mut self) {
         self.settle(self.tick);
-        let newly = !self.latched.contains(faults::SENSOR_DISAGREE) || self.bad_ch & crate::validate::CH_SPEED == 0;
+        let newly = !self.latched.contains(faults::SENSOR_DISAGREE) || !self.bad_ch.intersects(ChannelSet::SPEED);
         self.latched |= faults::SENSOR_DISAGREE;
-        self.bad_ch |= crate::validate::CH_SPEED;
+        self.bad_ch |= ChannelSet::SPEED;
         self.untrusted = true;
         if newly {
-            self.trace.write(Trace::Fault { tick: self.tick, new_bits: faults::SENSOR_DISAGREE | Faults::channels(crate::validate::CH_SPEED) });
+            self.trace.write(Trace::Fault { tick: self.tick, new_bits: faults::SENSOR_DISAGREE | Faults::channels(ChannelSet::SPEED) });
         }
         if self.valve.force_open() {
             self.trace.write(Trace::ValveOpen { tick: self.tick, drain_c: self.out.drain_c, forced: true });
@@ -124,7 +124,7 @@ impl<N: Num> GuardOf<N> {
         let bits = (self.latched & !faults::CONFIG) | Faults::channels(self.bad_ch);
         self.settle(self.tick);
         self.latched &= faults::CONFIG;
-        self.bad_ch = 0;
+        self.bad_ch = ChannelSet::NONE;
         // A valve still disagreeing with its command latches again after the full time;
         // so do sensors that still disagree.
         self.fb_mismatch = 0;

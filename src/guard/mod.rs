@@ -11,8 +11,6 @@ mod control;
 mod step;
 mod tick;
 mod types;
-pub mod faults;
-pub use faults::Faults;
 pub use crate::interface::{Output, Reports, Sample, DRAIN_C_UNKNOWN};
 pub use types::GuardConfig;
 // `ClearResult`, `recovery_ticks` and the trust constants are defined below.
@@ -24,11 +22,12 @@ use crate::num::Num;
 use crate::params::{N_NODES, TICKS_PER_STEP};
 use crate::protection::{alarm_update_with, LngBudget, LngConfig, Valve};
 use crate::trace::{RestoreKind, Trace, TraceBuf};
-use crate::validate::{self, Channels, LimitsN, CH_ALL, CH_CURRENT, CH_POSITION, CH_P_A, CH_P_B, CH_SPEED};
+use crate::faults::{self, ChannelSet, Faults};
+use crate::validate::{self, Channels, LimitsN};
 
 /// Channels the sensor cross-check compares: a window with any of them substituted
 /// by its worst case is not evaluated.
-const CROSS_CHANNELS: u8 = CH_CURRENT | CH_P_A | CH_P_B | CH_SPEED;
+const CROSS_CHANNELS: ChannelSet = ChannelSet::CURRENT.union(ChannelSet::P_A).union(ChannelSet::P_B).union(ChannelSet::SPEED);
 
 /// Number type of the firmware build: `f32`, or [`crate::num::Fx`] with `fixed-point`.
 #[cfg(not(feature = "fixed-point"))]
@@ -198,12 +197,14 @@ pub struct GuardOf<N: Num> {
     startup_timeout_ticks: u32,
     clear_valid_ticks: u32,
     latched: Faults,
-    bad_ch: u8,
+    /// Channels latched bad: at their worst case until a clear.
+    bad_ch: ChannelSet,
     prev: Channels<N>,
-    prev_ok: u8,
+    /// Channels whose previous value is valid (the rate check's reference).
+    prev_ok: ChannelSet,
     /// `prev_ok` before the missing ticks since the last sample: the rate
     /// check of the next sample over the gap.
-    gap_ok: u8,
+    gap_ok: ChannelSet,
     /// Inside [`GuardOf::tick_blind`] or the replay of the wait: no
     /// cooling credit.
     blind: bool,
@@ -314,10 +315,10 @@ impl<N: Num> GuardOf<N> {
             stale_ticks: config.stale_ticks,
             startup_timeout_ticks: config.startup_timeout_ticks,
             clear_valid_ticks: config.clear_valid_ticks,
-            bad_ch: 0,
+            bad_ch: ChannelSet::NONE,
             prev: [N::ZERO; 6],
-            prev_ok: 0,
-            gap_ok: 0,
+            prev_ok: ChannelSet::NONE,
+            gap_ok: ChannelSet::NONE,
             blind: false,
             waited: 0,
             replay_u: ModelInputN { current_ha: N::ZERO, p_a_hbar: N::ZERO, p_b_hbar: N::ZERO, speed_hrads: N::ZERO, dpos_mm: N::ZERO, ambient_c: N::ZERO },
@@ -369,7 +370,7 @@ impl<N: Num> GuardOf<N> {
                 g.lng.set_used_cj(r.lng_used_cj);
                 let saved = Faults::from_bits(r.faults);
                 g.latched |= saved & faults::LATCHED & !faults::CONFIG;
-                g.bad_ch = saved.channel_mask() & CH_ALL;
+                g.bad_ch = saved.channel_set();
                 if r.valve_open() {
                     // The valve was open: it stays open for at least its dwell.
                     g.valve.force_open();

@@ -90,7 +90,7 @@ impl<N: Num> GuardOf<N> {
         let cj = c.model.last_total_kw().round_times(1000).max(0) as u32;
         if let Some(cc) = c.cc.as_mut() {
             let (from_p, from_i) = c.model.last_mech_pair_kw();
-            match cc.step(from_p, from_i, self.bad_ch & CROSS_CHANNELS == 0) {
+            match cc.step(from_p, from_i, !self.bad_ch.intersects(CROSS_CHANNELS)) {
                 Verdict::None => {}
                 // While they disagree (and once latched) the model heats with the
                 // larger of the two losses.

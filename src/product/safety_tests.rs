@@ -327,7 +327,7 @@ fn ticks_of(b: &mut MemBoard) -> std::vec::Vec<TickReply> {
 
 /// The first tick with SENSOR_DISAGREE and the speed channel latched bad.
 fn speed_fault_at(t: &[TickReply]) -> Option<u32> {
-    t.iter().position(|r| r.out.faults.contains(faults::SENSOR_DISAGREE | crate::Faults::channels(crate::validate::CH_SPEED)) && r.out.valve_open).map(|k| k as u32)
+    t.iter().position(|r| r.out.faults.contains(faults::SENSOR_DISAGREE | crate::Faults::channels(crate::ChannelSet::SPEED)) && r.out.valve_open).map(|k| k as u32)
 }
 
 /// With the drive's electrical frequency as a second speed source, a speed

@@ -453,7 +453,7 @@ fn an_invalid_block_latches_config_and_opens_the_valve() {
         app.tick(&mut *b, 0);
         let t = ticks(&replies(&mut b));
         assert!(
-            t.iter().all(|r| r.out.faults.intersects(crate::guard::faults::CONFIG) && r.out.valve_open && !r.pins.valve_pin && r.out.alarm),
+            t.iter().all(|r| r.out.faults.intersects(crate::faults::CONFIG) && r.out.valve_open && !r.pins.valve_pin && r.out.alarm),
             "{name}: {t:?}"
         );
     }

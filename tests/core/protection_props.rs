@@ -310,7 +310,7 @@ fn run_valid<N: eha_guard::num::Num>(ticks: &[(Tick, Option<Fault>)], clear_ever
                 may_latch = true;
                 let class = if matches!(f, Some(Fault::NonFinite { .. })) { faults::NON_FINITE } else { faults::RANGE };
                 prop_assert!(o.valve_open && o.faults.intersects(class), "tick {}: {:?} not latched: {:?}", k, f, o);
-                prop_assert!(o.faults.channel_mask() & (1 << ch) != 0, "tick {}: channel bit of {:?} missing: {:?}", k, f, o);
+                prop_assert!(o.faults.channel_set().contains(eha_guard::ChannelSet::channel(*ch)), "tick {}: channel bit of {:?} missing: {:?}", k, f, o);
             }
             Some(Fault::Rate { .. }) => may_latch = true,
             _ => {}
@@ -403,7 +403,7 @@ proptest! {
         prop_assert!(o.valve_open, "valve must open in the faulting step");
         let class = if bad.is_finite() { faults::RANGE } else { faults::NON_FINITE };
         prop_assert!(o.faults.intersects(class), "fault bits {:#x}", o.faults);
-        prop_assert!(o.faults.channel_mask() & (1 << ch) != 0, "channel bit missing {:#x}", o.faults);
+        prop_assert!(o.faults.channel_set().contains(eha_guard::ChannelSet::channel(ch)), "channel bit missing {:#x}", o.faults);
     }
 
     #[test]

@@ -432,8 +432,8 @@ pub fn bit_names(f: Faults) -> String {
     let inner = dbg.trim_start_matches("Faults(").trim_end_matches(')');
     let mut out: Vec<String> = inner.split(" | ").filter(|p| !p.starts_with("channels")).map(str::to_string).collect();
     for c in Channel::ALL {
-        let bit = 1u8 << (Channel::ALL.iter().position(|x| *x == c).unwrap_or(0));
-        if f.channel_mask() & bit != 0 {
+        let ch = eha_guard::ChannelSet::channel(Channel::ALL.iter().position(|x| *x == c).unwrap_or(0));
+        if f.channel_set().contains(ch) {
             out.push(format!("ch:{}", c.name()));
         }
     }

@@ -147,7 +147,7 @@ fn fig15_attempt() -> Result<(), String> {
     let stale_ticks = eha_guard::guard::GuardConfig::DEFAULT.stale_ticks as usize;
     if gap_len >= stale_ticks {
         let wall_ms = 1e3 * (run.ticks[first + gap_at + gap_len - 1].0 - run.ticks[(first + gap_at).saturating_sub(1)].0);
-        let stale = eha_guard::guard::faults::STALE;
+        let stale = eha_guard::faults::STALE;
         let latched = guard_ticks.iter().position(|t| t.out.faults.contains(stale)).unwrap_or(guard_ticks.len());
         assert!(latched >= gap_at + stale_ticks - 1, "STALE at guard tick {latched}, before the {stale_ticks}th miss of the stall at {gap_at}");
         assert!(
@@ -289,7 +289,7 @@ fn check_fault_reset(name: &str, cmd: Cmd, at_sample: u16, cause: ResetCause, ma
     })
     .unwrap_or_else(|e| panic!("{name}: {e:#}"));
     let before: eha_guard::guard::Output = before.unwrap_or_else(|| panic!("{name}: the fault was never injected"));
-    if before.faults.contains(eha_guard::guard::faults::STALE) {
+    if before.faults.contains(eha_guard::faults::STALE) {
         // The host stalled the loop before the injection: the guard was in
         // its controller-silent fail-safe (valve open, estimate at the hot
         // side) when the fault hit, which is not the case under test.
@@ -470,7 +470,7 @@ fn alarm_attempt() -> Result<(), String> {
 /// ticks in a row without a sample), with its fail-safe checked: valve
 /// open from there on.
 fn stale_tick(run: &eha_sim::pil::product::ProductRun) -> Option<u32> {
-    let stale = eha_guard::guard::faults::STALE;
+    let stale = eha_guard::faults::STALE;
     let k = run.ticks.iter().position(|(_, t)| t.out.faults.contains(stale))?;
     assert!(run.ticks[k..].iter().all(|(_, t)| t.out.valve_open), "STALE without the valve open after tick {}", run.ticks[k].1.tick);
     Some(run.ticks[k].1.tick)
@@ -548,7 +548,7 @@ fn params_attempt() -> Result<(), String> {
     let pins = s.pins().unwrap_or_else(|e| panic!("{e:#}"));
     assert!(!seen.is_empty());
     for t in &seen {
-        assert!(t.out.faults.intersects(eha_guard::guard::faults::CONFIG) && t.out.valve_open && !t.pins.valve_pin, "torn block: {t:?}");
+        assert!(t.out.faults.intersects(eha_guard::faults::CONFIG) && t.out.valve_open && !t.pins.valve_pin, "torn block: {t:?}");
     }
     assert!(!pins.valve_pin && !pins.ok_pin, "torn block: valve open and alarm on the pins, read {pins:?}");
     Ok(())
