@@ -128,7 +128,7 @@ impl<N: Num> GuardOf<N> {
         // A valve still disagreeing with its command latches again after the full time;
         // so do sensors that still disagree.
         self.fb_mismatch = 0;
-        if let Some(c) = self.core_ok.then_some(&mut self.core) {
+        if let Some(c) = self.core.get_mut() {
             if let Some(cc) = c.cc.as_mut() {
                 cc.restart_count();
                 c.model.set_loss_max(cc.disagrees());
@@ -235,7 +235,7 @@ impl<N: Num> GuardOf<N> {
     pub fn snapshot_unsealed(&self) -> ThermalRecord {
         let mut temps = [0.0f32; N_NODES];
         let mut amb = 0.0;
-        if let Some(c) = self.core_ok.then_some(&self.core) {
+        if let Some(c) = self.core.get() {
             for (o, t) in temps.iter_mut().zip(c.model.temperatures_c().iter()) {
                 *o = t.to_f32();
             }
@@ -268,7 +268,7 @@ impl<N: Num> GuardOf<N> {
     /// rejects at init: valve open, alarm, drain reported as
     /// [`DRAIN_C_UNKNOWN`]. CONFIG is never cleared.
     pub fn refuse_config(&mut self) {
-        self.core_ok = false;
+        self.core.ok = false;
         self.latched |= faults::CONFIG;
         // fail-safe outputs from this instant: valve open, alarm (OK pin low),
         // no estimate
@@ -280,7 +280,7 @@ impl<N: Num> GuardOf<N> {
 
     /// The model, when the parameters were usable.
     pub fn model(&self) -> Option<&Model<N>> {
-        self.core_ok.then_some(&self.core).map(|c| &c.model)
+        self.core.get().map(|c| &c.model)
     }
 
     /// Ticks taken since boot (10 ms each, wraps after 497 days).

@@ -184,13 +184,49 @@ impl<N: Num> Core<N> {
     }
 }
 
+/// The core, and whether the configuration built it: the one way to reach it
+/// ([`CoreSlot::get`]), so no code can use a core that was not built.
+#[derive(Clone, Copy, Debug)]
+struct CoreSlot<N: Num> {
+    core: Core<N>,
+    /// The configuration built into a model (else CONFIG, fail-safe).
+    ok: bool,
+}
+
+impl<N: Num> CoreSlot<N> {
+    /// The core, when the configuration built it.
+    #[inline(always)]
+    fn get(&self) -> Option<&Core<N>> {
+        self.ok.then_some(&self.core)
+    }
+
+    /// [`CoreSlot::get`], mutable.
+    #[inline(always)]
+    fn get_mut(&mut self) -> Option<&mut Core<N>> {
+        self.ok.then_some(&mut self.core)
+    }
+
+    /// Builds the slot in place at `dst` ([`Core::init_in`]); whether the
+    /// core was built.
+    ///
+    /// # Safety
+    /// `dst` must be valid for writes of a `CoreSlot<N>`.
+    #[inline(always)]
+    unsafe fn init_in(dst: *mut Self, config: &GuardConfig) -> bool {
+        // SAFETY: `dst` is valid for writes (caller): so are its fields.
+        unsafe {
+            let ok = Core::<N>::init_in(core::ptr::addr_of_mut!((*dst).core), config);
+            core::ptr::addr_of_mut!((*dst).ok).write(ok);
+            ok
+        }
+    }
+}
+
 /// The guard, generic over the model number type (`f64` for host tests).
 #[derive(Clone, Debug)]
 pub struct GuardOf<N: Num> {
-    /// The model and its constants; used only when `core_ok`.
-    core: Core<N>,
-    /// The configuration built into a model (else CONFIG, fail-safe).
-    core_ok: bool,
+    /// The model and its constants, when the configuration built them.
+    core: CoreSlot<N>,
     /// Valve dwell in model steps (the configured ticks, rounded up).
     dwell_model_steps: u32,
     stale_ticks: u32,
@@ -307,9 +343,8 @@ impl<N: Num> GuardOf<N> {
         // SAFETY: `p` points to `slot`, valid for writes; `Core::init_in` and
         // `put!` write every field exactly once before the reference is made.
         let g = unsafe {
-            let ok = Core::<N>::init_in(core::ptr::addr_of_mut!((*p).core), config);
+            let ok = CoreSlot::<N>::init_in(core::ptr::addr_of_mut!((*p).core), config);
             put!(p,
-            core_ok: ok,
             latched: if ok { Faults::NONE } else { faults::CONFIG },
             dwell_model_steps: config.valve.dwell_ticks.div_ceil(TICKS_PER_STEP),
             stale_ticks: config.stale_ticks,
@@ -363,7 +398,7 @@ impl<N: Num> GuardOf<N> {
             Restore::Cold => RestoreKind::Cold,
             Restore::Warm(r) | Restore::PowerLoss(r) => {
                 g.after_power_loss = matches!(restore, Restore::PowerLoss(_));
-                if let Some(c) = g.core_ok.then_some(&mut g.core) {
+                if let Some(c) = g.core.get_mut() {
                     c.model.set_temperatures(&r.temps_c, r.ambient_c);
                 }
                 g.cold = false;
@@ -379,7 +414,7 @@ impl<N: Num> GuardOf<N> {
                 // while recovering from an unknown start: the hold starts again.
                 g.untrusted = saved.contains(faults::UNTRUSTED);
                 g.hold_pending = saved.contains(faults::RECOVERING);
-                if let Some(c) = g.core_ok.then_some(&mut g.core) {
+                if let Some(c) = g.core.get_mut() {
                     c.model.set_loss_max(g.latched.contains(faults::SENSOR_DISAGREE));
                 }
                 if g.after_power_loss {
@@ -390,7 +425,7 @@ impl<N: Num> GuardOf<N> {
             }
             Restore::Corrupt => {
                 let t = config.alarm.alarm_c;
-                if let Some(c) = g.core_ok.then_some(&mut g.core) {
+                if let Some(c) = g.core.get_mut() {
                     c.model.set_temperatures(&[t; N_NODES], t);
                 }
                 g.cold = false;
@@ -412,7 +447,7 @@ impl<N: Num> GuardOf<N> {
     #[cold]
     #[inline(never)]
     fn boot_outputs(&mut self) {
-        match self.core_ok.then_some(&self.core) {
+        match self.core.get() {
             Some(c) if !self.cold => {
                 let d = c.drain_c();
                 let f = d.to_f32();

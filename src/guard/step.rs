@@ -22,7 +22,7 @@ impl<N: Num> GuardOf<N> {
         self.mark = self.tick;
         self.open_acc = 0;
         self.credit_acc = 0;
-        let Some(c) = self.core_ok.then_some(&mut self.core) else {
+        let Some(c) = self.core.get_mut() else {
             return;
         };
         if self.cold {
@@ -82,7 +82,7 @@ impl<N: Num> GuardOf<N> {
         let (open_ticks, credit_ticks) = (self.open_acc, self.credit_acc);
         self.open_acc = 0;
         self.credit_acc = 0;
-        let Some(c) = self.core_ok.then_some(&mut self.core) else {
+        let Some(c) = self.core.get_mut() else {
             return;
         };
         c.model.update(credit_ticks);
@@ -133,7 +133,7 @@ impl<N: Num> GuardOf<N> {
     /// step with the valve open, at `cj` centijoules per tick) and the outputs that
     /// change only here.
     fn protect(&mut self, cj: u32, open_ticks: u32) {
-        let Some(c) = self.core_ok.then_some(&self.core) else {
+        let Some(c) = self.core.get() else {
             return;
         };
         let force = !self.latched.is_empty();

@@ -23,7 +23,7 @@ impl<N: Num> GuardOf<N> {
     /// fault, opens the valve in this same tick and is replaced by its worst case.
     #[inline(never)]
     pub fn tick(&mut self, s: &Sample) -> Output {
-        if let Some(core) = self.core_ok.then_some(&self.core) {
+        if let Some(core) = self.core.get() {
             // Fast path: every channel in range and within its rate and every previous
             // value valid (so this is not the first tick). Nothing to latch, the valve
             // is not forced by this tick (an earlier latched fault has already opened
@@ -62,7 +62,7 @@ impl<N: Num> GuardOf<N> {
     fn tick_slow(&mut self, s: &Sample) -> Output {
         let gap = core::mem::replace(&mut self.missing, 0);
         let first = !self.started;
-        let Some(core) = self.core_ok.then_some(&self.core) else {
+        let Some(core) = self.core.get() else {
             return self.slow_tail(None, Faults::NONE, N::ZERO);
         };
         let (v, nonfinite) = validate::convert(s, &core.scales);
@@ -136,7 +136,7 @@ impl<N: Num> GuardOf<N> {
             self.bad_ch = ChannelSet::ALL;
             self.stale_alarm();
         }
-        let u = self.core_ok.then(|| Self::subst(&self.prev, self.bad_ch, None, &self.core.limits));
+        let u = self.core.get().map(|c| Self::subst(&self.prev, self.bad_ch, None, &c.limits));
         self.slow_tail(u.as_ref(), new_bits, N::ZERO)
     }
 
@@ -167,7 +167,7 @@ impl<N: Num> GuardOf<N> {
             self.valid_since = self.tick.wrapping_add(1);
             self.prev_ok = ChannelSet::NONE;
             self.gap_ok = ChannelSet::NONE;
-            let u = self.core_ok.then(|| Self::subst(&self.prev, self.bad_ch, None, &self.core.limits));
+            let u = self.core.get().map(|c| Self::subst(&self.prev, self.bad_ch, None, &c.limits));
             self.slow_tail(u.as_ref(), Faults::NONE, N::ZERO);
         }
         self.settle(self.tick);
@@ -248,7 +248,7 @@ impl<N: Num> GuardOf<N> {
             });
         }
         match u {
-            Some(u) if self.core_ok => {
+            Some(u) if self.core.get().is_some() => {
                 if !self.started {
                     self.start(start_amb);
                     self.replay_wait();
@@ -305,7 +305,7 @@ impl<N: Num> GuardOf<N> {
     /// every `TICKS_PER_STEP` ticks the model step with the protection.
     #[inline(always)]
     fn advance(&mut self, u: &ModelInputN<N>) -> Output {
-        let full = match self.core_ok.then_some(&mut self.core) {
+        let full = match self.core.get_mut() {
             Some(c) => c.model.tick_n(u),
             None => false,
         };
