@@ -16,7 +16,7 @@ impl<N: Num> GuardOf<N> {
             | Faults::channels(self.bad_ch)
             | Faults::when(self.lng_low, faults::LNG_LOW)
             | Faults::when(self.untrusted, faults::UNTRUSTED)
-            | Faults::when(self.nv_failed, faults::NV_FAILED)
+            | Faults::when(self.nv.failed(), faults::NV_FAILED)
             | Faults::when(self.recovering(), faults::RECOVERING)
             | self.cooling_status()
     }
@@ -25,10 +25,10 @@ impl<N: Num> GuardOf<N> {
     /// has, or it started from a known state). Before the first sample an
     /// unknown start has not begun to recover.
     pub fn recovery_left(&self) -> u32 {
-        match self.hold_from {
-            _ if self.hold_pending => self.recovery_ticks,
-            Some(t) => self.recovery_ticks.saturating_sub(self.tick.wrapping_sub(t)),
-            None => 0,
+        match self.hold {
+            Hold::Pending => self.recovery_ticks,
+            Hold::From(t) => self.recovery_ticks.saturating_sub(self.tick.wrapping_sub(t)),
+            Hold::None => 0,
         }
     }
 
@@ -42,7 +42,7 @@ impl<N: Num> GuardOf<N> {
     /// (the tank is empty: no credit, LNG_LOW).
     fn cooling_status(&self) -> Faults {
         let open = self.valve.is_open();
-        Faults::when(open && self.started && self.fb.is_none(), faults::NO_VALVE_FEEDBACK)
+        Faults::when(open && self.phase.started() && self.fb.is_none(), faults::NO_VALVE_FEEDBACK)
             | Faults::when(open && self.fb == Some(true) && self.supply.is_none() && self.credited(), faults::LNG_UNCONFIRMED)
             | Faults::when(self.supply == Some(false), faults::LNG_LOW)
     }
@@ -97,11 +97,15 @@ impl<N: Num> GuardOf<N> {
     /// restore could be older than the write policy promises); it clears
     /// at the next clear that follows a good save.
     pub fn report_nv_save(&mut self, ok: bool) {
-        self.nv_ok = ok;
-        if !ok && !self.nv_failed {
-            self.nv_failed = true;
-            self.trace.write(Trace::Fault { tick: self.tick, new_bits: faults::NV_FAILED });
-            self.refresh_out();
+        match (ok, self.nv) {
+            (true, NvHealth::Failed) => self.nv = NvHealth::SavedSince,
+            (true, _) => {}
+            (false, NvHealth::Good) => {
+                self.nv = NvHealth::Failed;
+                self.trace.write(Trace::Fault { tick: self.tick, new_bits: faults::NV_FAILED });
+                self.refresh_out();
+            }
+            (false, _) => self.nv = NvHealth::Failed,
         }
     }
 
@@ -141,19 +145,19 @@ impl<N: Num> GuardOf<N> {
         // follows it again from the next model step — unless it is still recovering
         // from an unknown state: after a disagreement that recovery starts now,
         // with the inputs good again.
-        if self.hold_pending && self.started {
-            self.hold_pending = false;
-            self.hold_from = Some(self.tick);
+        if self.hold == Hold::Pending && self.phase.started() {
+            self.hold = Hold::From(self.tick);
         }
         let left = self.recovery_left();
         let trust = left == 0 && self.untrusted;
-        let bits = bits | Faults::when(trust, faults::UNTRUSTED) | Faults::when(self.nv_failed && self.nv_ok, faults::NV_FAILED);
+        let bits = bits | Faults::when(trust, faults::UNTRUSTED) | Faults::when(self.nv == NvHealth::SavedSince, faults::NV_FAILED);
         if left == 0 {
             self.untrusted = false;
-            self.hold_pending = false;
-            self.hold_from = None;
+            self.hold = Hold::None;
         }
-        self.nv_failed &= !self.nv_ok;
+        if self.nv == NvHealth::SavedSince {
+            self.nv = NvHealth::Good;
+        }
         if !bits.is_empty() {
             self.trace.write(Trace::FaultsCleared {
                 tick: self.tick,

@@ -12,11 +12,10 @@ impl<N: Num> GuardOf<N> {
     #[cold]
     #[inline(never)]
     pub(super) fn start(&mut self, ambient_c: N) {
-        self.started = true;
-        if self.hold_pending {
+        let from = core::mem::replace(&mut self.phase, Phase::Running);
+        if self.hold == Hold::Pending {
             // The estimate starts to forget its unknown start from here.
-            self.hold_pending = false;
-            self.hold_from = Some(self.tick);
+            self.hold = Hold::From(self.tick);
         }
         // Nothing of the waiting time is counted: no model ran, no credit, no LNG booked.
         self.mark = self.tick;
@@ -25,9 +24,9 @@ impl<N: Num> GuardOf<N> {
         let Some(c) = self.core.get_mut() else {
             return;
         };
-        if self.cold {
+        if from == Phase::WaitingCold {
             c.model.set_uniform(ambient_c);
-        } else if self.after_power_loss {
+        } else if from == Phase::WaitingAfterPowerLoss {
             // The air may have been warmer during the off-time than at the save:
             // every node is raised by the first sample's excess over the saved
             // ambient (the cooling bound assumes the larger of the two).
@@ -126,7 +125,7 @@ impl<N: Num> GuardOf<N> {
         // The estimate ran on inputs that disagree (the larger shaft loss
         // covers the shaft, not the throttling heat a wrong pressure hides):
         // its state is unknown until it has recovered on good inputs.
-        self.hold_pending = true;
+        self.hold = Hold::Pending;
     }
 
     /// Valve hysteresis and dwell, alarm, LNG budget (`open_ticks` ticks of the model
@@ -207,7 +206,7 @@ impl<N: Num> GuardOf<N> {
         // Derate: the alarm, and whatever leaves the protection weaker than
         // the estimate says (a valve not following its command, a thermal
         // record that could not be saved).
-        let derate = self.alarm || self.nv_failed || self.latched.contains(faults::ACTUATOR);
+        let derate = self.alarm || self.nv.failed() || self.latched.contains(faults::ACTUATOR);
         self.out = Output {
             drain_c: self.out.drain_c,
             valve_open: self.valve.is_open(),

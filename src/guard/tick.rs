@@ -61,7 +61,7 @@ impl<N: Num> GuardOf<N> {
     #[cold]
     fn tick_slow(&mut self, s: &Sample) -> Output {
         let gap = core::mem::replace(&mut self.missing, 0);
-        let first = !self.started;
+        let first = !self.phase.started();
         let Some(core) = self.core.get() else {
             return self.slow_tail(None, Faults::NONE, N::ZERO);
         };
@@ -121,7 +121,7 @@ impl<N: Num> GuardOf<N> {
     /// channel takes its worst case. Before the first sample the guard waits instead
     /// (`wait_tick`).
     pub fn tick_missing(&mut self) -> Output {
-        if !self.started {
+        if !self.phase.started() {
             return self.wait_tick();
         }
         self.missing = self.missing.saturating_add(1);
@@ -155,7 +155,7 @@ impl<N: Num> GuardOf<N> {
     #[cold]
     #[inline(never)]
     pub fn tick_blind(&mut self, n: u32) -> Output {
-        if !self.started {
+        if !self.phase.started() {
             for _ in 0..n {
                 self.wait_tick();
             }
@@ -210,7 +210,7 @@ impl<N: Num> GuardOf<N> {
             // No estimate and no input: alarm and derate until a clear, and
             // the machine may have run unseen: the start state is unknown.
             self.untrusted = true;
-            self.hold_pending = true;
+            self.hold = Hold::Pending;
             if !self.alarm {
                 self.alarm = true;
                 self.trace.write(Trace::Alarm {
@@ -249,7 +249,7 @@ impl<N: Num> GuardOf<N> {
         }
         match u {
             Some(u) if self.core.get().is_some() => {
-                if !self.started {
+                if !self.phase.started() {
                     self.start(start_amb);
                     self.replay_wait();
                 }

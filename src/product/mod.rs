@@ -300,41 +300,45 @@ pub type App = AppOf<Real>;
 /// The product application state (one per board, lives for the whole run),
 /// generic over the guard's number type (the boards run [`App`]; the host
 /// runs the fixed-point build's too, as the twin of the M3 PIL image).
+/// `repr(C)`: the fields in their declared order, the guard first (its
+/// model's addresses are immediates of the hot code: a reshuffle of the
+/// fields around it changed the product image by hundreds of bytes).
 #[derive(Clone)]
+#[repr(C)]
 pub struct AppOf<N: Num> {
-    lng: LngConfig,
     guard: GuardOf<N>,
-    rx: Deframer,
-    /// The bytes of one read from the board's receive buffer.
-    rx_buf: [u8; RX_READ],
     /// The tick reply's encoder (re-frames only the per-tick tail while
     /// the outputs, pins and counters hold).
     reply: ReplyEncoder,
-    /// The tick reply's bytes on a board that takes them by
-    /// [`Board::write_tx`].
-    tx_buf: [u8; MAX_WIRE],
-    last_seq: Option<u16>,
-    sample: Option<Request>,
-    commands: Deque<Command, COMMAND_QUEUE>,
-    counters: Counters,
     /// The thermal record's write rules (A/B slots, non-volatile policy).
     records: RecordKeeper,
+    /// The keyed commands' rules (clear, refill).
+    rules: CommandRules,
+    sample: Option<Request>,
+    last_seq: Option<u16>,
+    commands: Deque<Command, COMMAND_QUEUE>,
+    rx: Deframer,
+    lng: LngConfig,
+    /// The bytes of one read from the board's receive buffer.
+    rx_buf: [u8; RX_READ],
+    counters: Counters,
     /// Tick of the last last-alive stamp ([`Board::rtc_alive`]).
     alive_at: u32,
     /// Timer periods the last non-volatile save stalled the core (the
     /// next tick accounts them as blind, not missing).
     stalled: u32,
     tick: u32,
-    restore: RestoreKind,
-    reset_cause: ResetCause,
-    boots: u16,
     worst_tick_cycles: u32,
     /// Trace dump in progress: token, next index, events in the dump.
     dump: Option<(u16, u8, u8)>,
+    boots: u16,
+    restore: RestoreKind,
+    reset_cause: ResetCause,
     /// Where the model constants of this boot come from.
     params: ParamSource,
-    /// The keyed commands' rules (clear, refill).
-    rules: CommandRules,
+    /// The tick reply's bytes on a board that takes them by
+    /// [`Board::write_tx`].
+    tx_buf: [u8; MAX_WIRE],
 }
 
 fn restore_kind(r: &Restore) -> RestoreKind {
