@@ -33,7 +33,10 @@ pub struct Output {
     pub valve_open: bool,
     /// Over-temperature alarm (drain > 60 degC, cleared below 58 degC).
     pub alarm: bool,
-    /// Derate request to the actuator controller (= alarm).
+    /// Derate request to the actuator controller: the alarm, or a protection
+    /// weaker than the estimate says (ACTUATOR: the valve does not follow
+    /// its command; NV_FAILED: the thermal record could not be saved). Equal
+    /// to [`Output::alarm`] while neither fault stands.
     pub derate: bool,
     /// The faults ([`crate::faults`]; on the wire as their 32-bit word).
     pub faults: crate::faults::Faults,

@@ -24,7 +24,7 @@
 //!
 //! Checked at every tick: no panic (overflow checks and debug assertions are
 //! on in the fuzz build), finite outputs, a latched fault implies the valve
-//! open, derate = alarm, LNG remaining within [0, full charge].
+//! open, derate = alarm or ACTUATOR or NV_FAILED, LNG remaining within [0, full charge].
 
 use crate::stats;
 use eha_guard::faults;
