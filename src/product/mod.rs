@@ -26,6 +26,7 @@ pub mod wire;
 
 pub use commands::CommandRules;
 pub use records::RecordKeeper;
+pub use wire::Counters;
 
 use crate::memory::nv::{NvLoad, NvPolicy};
 use crate::protection::LngConfig;
@@ -172,36 +173,6 @@ pub struct BootMemory {
     pub cause: CauseRecord,
     /// The board's hardware reset flag, if it names a cause (e.g. IWDG).
     pub hw_hint: Option<ResetCause>,
-}
-
-/// Frame and tick counters of the product loop (saturating).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Counters {
-    /// Frames with a CRC mismatch.
-    pub rejected_crc: u16,
-    /// Frames with bad COBS, length, kind, or a full command queue.
-    pub rejected_framing: u16,
-    /// Samples that were duplicates or older than the last accepted one.
-    pub rejected_sequence: u16,
-    /// Samples replaced by a newer one within the same tick.
-    pub superseded: u16,
-    /// Samples accepted.
-    pub accepted: u32,
-    /// Ticks without a new sample.
-    pub missing: u32,
-    /// Timer periods lost to ticks that overran.
-    pub overruns: u32,
-    /// Commands executed.
-    pub commands: u16,
-    /// Non-volatile saves that failed (each followed by [`NV_RETRY_TICKS`]
-    /// without an attempt).
-    pub nv_failures: u16,
-}
-
-impl Counters {
-    fn rejected(&self) -> u16 {
-        self.rejected_crc.saturating_add(self.rejected_framing).saturating_add(self.rejected_sequence)
-    }
 }
 
 /// The model constants of a boot and where they come from: a valid

@@ -641,5 +641,5 @@ fn a_flash_erase_stall_is_accounted_without_stale() {
     assert!(erased >= 1 && stalls >= 1, "{erased} erases, {stalls} stalls");
     assert!(!worst.intersects(faults::STALE | faults::LATCHED), "an erase stall latched {worst:?}");
     let st = app.status(&*b, 0);
-    assert!(st.overruns >= 300 * erased, "the stalls are counted as overruns: {}", st.overruns);
+    assert!(st.counters.overruns >= 300 * erased, "the stalls are counted as overruns: {}", st.counters.overruns);
 }

@@ -192,7 +192,7 @@ fn commands_status_refill_clear_trace() {
     app.tick(&mut *b, 0);
     let r = replies(&mut b);
     let st = r.iter().find_map(|f| if let FromGuard::Status(s) = f { Some(*s) } else { None }).expect("status");
-    assert_eq!((st.token, st.tick, st.missing, st.faults.intersects(crate::faults::NON_FINITE)), (9, 2, 1, true));
+    assert_eq!((st.token, st.tick, st.counters.missing, st.faults.intersects(crate::faults::NON_FINITE)), (9, 2, 1, true));
     let a = arm_confirm(&mut app, &mut b, 7, Cmd::ClearArm, Cmd::ClearConfirm, 2, &rest(2));
     assert_eq!((a.cmd, a.result, a.value), (Cmd::ClearConfirm, AckResult::Refused, wire::Refusal::Rule as u32), "clear rule not met");
     // 100 valid ticks, then the clear succeeds (the interval counts

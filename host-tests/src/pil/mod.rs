@@ -267,8 +267,8 @@ pub fn run_pil(plant: &mut dyn PlantModel, qemu: &QemuOptions, opts: &LoopOption
                 Ok(end) => {
                     let log = defmt_log::decode(&qemu.elf, &end.defmt)
                         .map_err(|e| PilFailure::new(records.clone(), Vec::new(), e.context("decoding the defmt log")))?;
-                    if end.done.accepted != ticks as u32 {
-                        let what = format!("firmware accepted {} frames, host sent {ticks}", end.done.accepted);
+                    if end.done.counters.accepted != ticks as u32 {
+                        let what = format!("firmware accepted {} frames, host sent {ticks}", end.done.counters.accepted);
                         return Err(PilFailure::new(records, log, PilError::Protocol { tick: ticks, what }.into()));
                     }
                     Ok(PilRun { build: qemu.build, records, done: end.done, log, wall: start.elapsed(), icount: qemu.icount })

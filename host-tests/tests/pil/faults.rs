@@ -115,7 +115,7 @@ fn corrupted_truncated_out_of_order_and_garbage_frames_are_rejected_and_counted(
     // finishes with its completion marker and exit code 0.
     let _ = s.tick(&good[..5], 7000).unwrap_or_else(|e| panic!("{e}"));
     let end = s.finish(7001).unwrap_or_else(|e| panic!("{e}"));
-    assert_eq!(end.done.accepted, 4);
+    assert_eq!(end.done.counters.accepted, 4);
     eprintln!("fault injection: {expected_rejects} rejected frames handled in {:.2} s", t0.elapsed().as_secs_f64());
 }
 

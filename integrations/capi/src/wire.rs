@@ -8,7 +8,7 @@
 use core::ffi::c_void;
 use core::mem::{align_of, size_of};
 
-use eha_guard::product::wire::{restore_from_code, Pins, ResetCause, Status, TickReply};
+use eha_guard::product::wire::{restore_from_code, Counters, Pins, ResetCause, Status, TickReply};
 use eha_guard::protocol::lockstep::{tick_end, DONE_TOKEN};
 use eha_guard::protocol::{Deframer, DecodeError, Request, WireFrame, MAX_WIRE, PROTOCOL_VERSION};
 use eha_guard::Faults;
@@ -321,11 +321,14 @@ pub unsafe extern "C" fn eha_wire_lockstep_done(done: *const EhaLockstepDone, bu
         token: DONE_TOKEN,
         tick: d.tick,
         boots: d.boots,
-        rejected_crc: d.rejected_crc,
-        rejected_framing: d.rejected_framing,
-        rejected_sequence: d.rejected_sequence,
-        accepted: d.accepted,
-        missing: d.missing,
+        counters: Counters {
+            rejected_crc: d.rejected_crc,
+            rejected_framing: d.rejected_framing,
+            rejected_sequence: d.rejected_sequence,
+            accepted: d.accepted,
+            missing: d.missing,
+            ..Counters::default()
+        },
         faults: Faults::from_bits(d.faults),
         protocol: PROTOCOL_VERSION,
         ..Status::default()
