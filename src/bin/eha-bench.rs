@@ -437,18 +437,7 @@ mod fw {
         let mut noise_a = 1u32;
         for k in 0..TICKS {
             let s = sample(k, &mut noise_a);
-            let req = eha_guard::protocol::Request {
-                seq: (k & 0xFFFF) as u16,
-                current_a: s.current_a,
-                p_a_bar: s.p_a_bar,
-                p_b_bar: s.p_b_bar,
-                speed_rpm: s.speed_rpm,
-                position_mm: s.position_mm,
-                ambient_c: s.ambient_c,
-                valve_fb: None,
-                elec_hz: None,
-                lng_supply_bar: None,
-            };
+            let req = eha_guard::protocol::Request { seq: (k & 0xFFFF) as u16, sample: s, reports: eha_guard::Reports::default() };
             board.push_rx(&req.encode());
             let w0 = WRAPS.load(Ordering::Relaxed);
             let t0 = now();
@@ -474,10 +463,7 @@ mod fw {
         let mut writer = eha_guard::memory::slots::AbWriter::after_boot(&eha_guard::ThermalRecord::EMPTY, &eha_guard::ThermalRecord::EMPTY);
         for k in 0..600u32 {
             let s = sample(k, &mut noise_p);
-            let req = eha_guard::protocol::Request {
-                seq: (k & 0xFFFF) as u16, current_a: s.current_a, p_a_bar: s.p_a_bar, p_b_bar: s.p_b_bar,
-                speed_rpm: s.speed_rpm, position_mm: s.position_mm, ambient_c: s.ambient_c, valve_fb: None, elec_hz: None, lng_supply_bar: None,
-            };
+            let req = eha_guard::protocol::Request { seq: (k & 0xFFFF) as u16, sample: s, reports: eha_guard::Reports::default() };
             let wire = req.encode();
             let w0 = WRAPS.load(Ordering::Relaxed);
             let t0 = now();

@@ -437,7 +437,7 @@ impl<N: Num> AppOf<N> {
         }
         let fresh = self.sample.take();
         let out = match &fresh {
-            Some(req) => self.guard.tick_reported(&req.sample(), &req.reports()),
+            Some(req) => self.guard.tick_reported(&req.sample, &req.reports),
             None => {
                 self.counters.missing = self.counters.missing.saturating_add(1);
                 self.guard.tick_missing()

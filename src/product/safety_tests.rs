@@ -178,7 +178,7 @@ fn a_detected_actuator_fault_derates() {
     for k in 1..100u16 {
         // the valve reports open while commanded shut (cold oil; pump at
         // rest, so the sensor cross-check has nothing to compare)
-        b.push_rx(&Request { valve_fb: Some(true), speed_rpm: 0.0, ..sample(k, 0.0, 5.0) }.encode());
+        b.push_rx(&Request { reports: crate::Reports { valve_fb: Some(true), ..crate::Reports::default() }, ..super::tests::at_rest(k, 0.0, 5.0) }.encode());
         app.tick(&mut *b, 0);
         last = *ticks(&replies(&mut b)).last().expect("a tick reply");
     }
@@ -301,15 +301,8 @@ fn run_case1(ticks: u32, speed: impl Fn(u32) -> f32, elec: bool) -> std::vec::Ve
     for k in 0..ticks {
         let r = Request {
             seq: (k & 0xFFFF) as u16,
-            current_a: current_a(65.0, 5.0, 500.0, oil_c),
-            p_a_bar: 65.0,
-            p_b_bar: 5.0,
-            speed_rpm: speed(k),
-            position_mm: 0.0,
-            ambient_c: 20.0,
-            valve_fb: Some(open),
-            elec_hz: elec.then_some(500.0 / 60.0 * 4.0),
-            lng_supply_bar: None,
+            sample: crate::Sample { current_a: current_a(65.0, 5.0, 500.0, oil_c), p_a_bar: 65.0, p_b_bar: 5.0, speed_rpm: speed(k), position_mm: 0.0, ambient_c: 20.0 },
+            reports: crate::Reports { valve_fb: Some(open), elec_hz: elec.then_some(500.0 / 60.0 * 4.0), lng_supply_bar: None },
         };
         b.push_rx(&r.encode());
         app.tick(&mut *b, 0);
@@ -429,7 +422,7 @@ fn settle(app: &mut App, b: &mut MemBoard, from: u16, n: u16, cmds: &[&[u8]]) ->
                 b.push_rx(c);
             }
         }
-        b.push_rx(&Request { speed_rpm: 0.0, ..sample(from.wrapping_add(k), 0.0, 5.0) }.encode());
+        b.push_rx(&super::tests::at_rest(from.wrapping_add(k), 0.0, 5.0).encode());
         app.tick(b, 0);
         last = ticks_of(b).last().copied();
     }
@@ -442,7 +435,7 @@ fn settle(app: &mut App, b: &mut MemBoard, from: u16, n: u16, cmds: &[&[u8]]) ->
 fn one_crc_valid_frame_does_not_clear_faults() {
     let mut b = board();
     let mut app = boot(&mut b);
-    b.push_rx(&Request { current_a: f32::NAN, ..sample(0, 0.0, 5.0) }.encode());
+    b.push_rx(&super::tests::sample(0, f32::NAN, 5.0).encode());
     app.tick(&mut *b, 0);
     let r = settle(&mut app, &mut b, 1, 150, &[]);
     assert!(r.out.faults.contains(faults::NON_FINITE));
@@ -483,7 +476,7 @@ fn a_refill_while_the_valve_is_open_is_refused() {
     let r = settle(&mut app, &mut b, 50, 5, &[&refill]);
     assert_eq!(r.out.lng_remaining_kg, 0.0, "refilled with the valve open and the alarm on");
     // armed and keyed: refused by the rule
-    let a = super::tests::arm_confirm(&mut app, &mut b, 9, wire::Cmd::RefillArm, wire::Cmd::RefillConfirm, 55, &Request { speed_rpm: 0.0, ..sample(0, 0.0, 5.0) });
+    let a = super::tests::arm_confirm(&mut app, &mut b, 9, wire::Cmd::RefillArm, wire::Cmd::RefillConfirm, 55, &super::tests::at_rest(0, 0.0, 5.0));
     assert_eq!((a.result, a.value), (wire::AckResult::Refused, wire::Refusal::Rule as u32), "{a:?}");
     assert_eq!(app.guard.output().lng_remaining_kg, 0.0);
 }
@@ -497,7 +490,7 @@ fn armed_commands_need_the_key_the_window_and_the_interval() {
     use wire::{Ack, AckResult, Cmd, Command, FromGuard, Refusal};
     let mut b = board();
     let mut app = boot(&mut b);
-    let rest = |k: u16| Request { speed_rpm: 0.0, ..sample(k, 0.0, 5.0) };
+    let rest = |k: u16| super::tests::at_rest(k, 0.0, 5.0);
     settle(&mut app, &mut b, 0, 200, &[]);
     let ack = |b: &mut MemBoard, token: u16| -> Ack {
         replies(b).iter().find_map(|f| match f {
@@ -573,7 +566,7 @@ fn a_controller_clearing_in_a_loop_clears_at_most_every_ten_seconds() {
             None => Command { token: k, cmd: Cmd::ClearArm, arg: 0 },
         };
         b.push_rx(&c.encode());
-        b.push_rx(&Request { speed_rpm: 0.0, ..sample(k, 0.0, 5.0) }.encode());
+        b.push_rx(&super::tests::at_rest(k, 0.0, 5.0).encode());
         app.tick(&mut *b, 0);
         for f in replies(&mut b) {
             if let FromGuard::Ack(a) = f {
@@ -617,15 +610,8 @@ fn a_flash_erase_stall_is_accounted_without_stale() {
     for k in 0..60_000u32 {
         let r = Request {
             seq: (k & 0xFFFF) as u16,
-            current_a: current_a(65.0, 5.0, 500.0, oil_c),
-            p_a_bar: 65.0,
-            p_b_bar: 5.0,
-            speed_rpm: 500.0,
-            position_mm: 0.0,
-            ambient_c: 20.0,
-            valve_fb: Some(open),
-            elec_hz: None,
-            lng_supply_bar: None,
+            sample: crate::Sample { current_a: current_a(65.0, 5.0, 500.0, oil_c), p_a_bar: 65.0, p_b_bar: 5.0, speed_rpm: 500.0, position_mm: 0.0, ambient_c: 20.0 },
+            reports: crate::Reports { valve_fb: Some(open), elec_hz: None, lng_supply_bar: None },
         };
         b.push_rx(&r.encode());
         let before = b.ticks;
