@@ -435,14 +435,16 @@ impl<N: Num> AppOf<N> {
         if lost > 0 {
             self.catch_up(lost);
         }
-        let fresh = self.sample.take();
-        let out = match &fresh {
+        // (the request is used where it is stored: no copy on the stack)
+        let fresh = self.sample.is_some();
+        let out = match &self.sample {
             Some(req) => self.guard.tick_reported(&req.sample, &req.reports),
             None => {
                 self.counters.missing = self.counters.missing.saturating_add(1);
                 self.guard.tick_missing()
             }
         };
+        self.sample = None;
 
         // 3. outputs: the thermal record first (a failed save changes the
         // outputs: derate), then the pins and the reply
@@ -456,7 +458,7 @@ impl<N: Num> AppOf<N> {
         let reply = TickReply {
             tick: self.tick,
             sample_seq: self.last_seq.unwrap_or(0),
-            fresh: fresh.is_some(),
+            fresh,
             not_commissioned: self.params == ParamSource::Default,
             out,
             pins,
