@@ -91,8 +91,9 @@
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing))]
 
 pub mod crosscheck;
-mod default_consts;
+pub mod faults;
 pub mod guard;
+pub mod interface;
 pub mod linalg;
 pub mod memory;
 pub mod model;
@@ -106,7 +107,9 @@ pub mod speedcheck;
 pub mod trace;
 pub mod validate;
 
-pub use guard::{faults, ClearResult, Faults, Guard, GuardConfig, GuardOf, Output, Real, Reports, Sample};
+pub use faults::{ChannelSet, Faults};
+pub use guard::{ClearResult, Guard, GuardConfig, GuardOf, Real};
+pub use interface::{Output, Reports, Sample};
 pub use memory::{Restore, ThermalRecord};
 
 /// This firmware library's version (the crate's, `MAJOR.MINOR.PATCH`).

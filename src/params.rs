@@ -10,8 +10,6 @@
 //! valve block, 4 ball/needle-valve block, 5 actuator body` ([`NODE_PUMP`] ...):
 //! every state is a contract node, saved in the thermal record and reported.
 
-pub use crate::default_consts::DEFAULT_CONSTS;
-
 /// Number of thermal states of the reduced model, all of them contract nodes: the
 /// thermal record saves them and the model reports them
 /// ([`crate::model::Model::temperatures_c`]).

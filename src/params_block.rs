@@ -15,7 +15,7 @@
 //! | 2484 | 4 | CRC-32 (IEEE) of bytes 0..2484 |
 //!
 //! Erased flash (`0xFF…`) or empty memory (`0x00…`, QEMU) at the magic means
-//! *absent*: the firmware runs the compiled-in [`crate::params::DEFAULT_CONSTS`]
+//! *absent*: the firmware runs the compiled-in [`crate::model::DEFAULT_CONSTS`]
 //! (the paper rig) and reports NOT_COMMISSIONED. Anything else that fails a
 //! check is *invalid*: CONFIG fault, valve open. The values and the stability
 //! of the discretisation are checked when the model is built from the block
@@ -201,7 +201,7 @@ pub fn encode(c: &ModelConsts<f32>, rig_id: &str) -> [u8; BLOCK_LEN] {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::params::DEFAULT_CONSTS;
+    use crate::model::DEFAULT_CONSTS;
 
     /// 4-byte aligned block storage (as the linker places the region).
     #[repr(C, align(4))]

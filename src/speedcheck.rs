@@ -28,7 +28,7 @@
 //! product builds have an FPU; a handful of operations per tick).
 
 use crate::model::{ModelConsts, HRADS_PER_RPM};
-use crate::Sample;
+use crate::interface::Sample;
 
 /// Speed-check settings.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -64,7 +64,7 @@ pub enum Trace {
         /// Predicted drain temperature, degC.
         drain_c: f32,
     },
-    /// New fault bits latched (see [`crate::guard::faults`]).
+    /// New fault bits latched (see [`crate::faults`]).
     Fault {
         /// Tick counter (10 ms).
         tick: u32,

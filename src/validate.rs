@@ -8,24 +8,10 @@
 //! bit and, while the fault is latched, replaced by its *worst-case* value (maximum
 //! loss), so the thermal estimate keeps rising conservatively.
 
-use crate::guard::Sample;
+use crate::faults::ChannelSet;
+use crate::interface::Sample;
 use crate::model::{InputScales, ModelInputN};
 use crate::num::Num;
-
-/// Channel bit: motor current.
-pub const CH_CURRENT: u8 = 1 << 0;
-/// Channel bit: port A pressure.
-pub const CH_P_A: u8 = 1 << 1;
-/// Channel bit: port B pressure.
-pub const CH_P_B: u8 = 1 << 2;
-/// Channel bit: motor speed.
-pub const CH_SPEED: u8 = 1 << 3;
-/// Channel bit: piston position.
-pub const CH_POSITION: u8 = 1 << 4;
-/// Channel bit: ambient temperature.
-pub const CH_AMBIENT: u8 = 1 << 5;
-/// All six channels.
-pub const CH_ALL: u8 = 0x3f;
 
 /// Plausible ranges and per-tick (10 ms) rates of the inputs, wire units.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -79,7 +65,7 @@ impl InputLimits {
 }
 
 /// The six channels in model units, order `[current hA, p_A hbar, p_B hbar,
-/// speed hrad/s, position mm, ambient degC]` (bit `i` of the `CH_*` masks).
+/// speed hrad/s, position mm, ambient degC]` (channel `i` of a [`ChannelSet`]).
 pub type Channels<N> = [N; 6];
 
 /// [`InputLimits`] converted once to model units.
@@ -171,14 +157,14 @@ pub struct Check {
     pub range: bool,
     /// Some channel changed faster than its rate limit.
     pub rate: bool,
-    /// Channels that failed any check (`CH_*` bits).
-    pub bad: u8,
+    /// Channels that failed any check.
+    pub bad: ChannelSet,
 }
 
-/// Converts a sample to model units; returns the values and the mask of channels
+/// Converts a sample to model units; returns the values and the channels
 /// whose `f32` is NaN or infinite (tested on the bits: exponent all ones).
 #[inline(always)]
-pub fn convert<N: Num>(s: &Sample, sc: &InputScales<N>) -> (Channels<N>, u8) {
+pub fn convert<N: Num>(s: &Sample, sc: &InputScales<N>) -> (Channels<N>, ChannelSet) {
     let raw = [
         s.current_a,
         s.p_a_bar,
@@ -189,10 +175,10 @@ pub fn convert<N: Num>(s: &Sample, sc: &InputScales<N>) -> (Channels<N>, u8) {
     ];
     let scale = sc.per_channel();
     let mut v = [N::ZERO; 6];
-    let mut nonfinite = 0u8;
+    let mut nonfinite = ChannelSet::NONE;
     for (i, ((o, x), k)) in v.iter_mut().zip(raw.iter()).zip(scale.iter()).enumerate() {
         if x.to_bits() & 0x7f80_0000 == 0x7f80_0000 {
-            nonfinite |= 1 << i;
+            nonfinite |= ChannelSet::channel(i);
         } else {
             *o = N::from_f32_scaled(*x, *k);
         }
@@ -204,7 +190,7 @@ pub fn convert<N: Num>(s: &Sample, sc: &InputScales<N>) -> (Channels<N>, u8) {
 /// become values that fail the range test, [`Num::from_sample`]) and checks every
 /// channel's range and its rate against `prev` in one combined test, without
 /// classifying. Returns the channels and `true` when all twelve tests pass. Only
-/// meaningful when every previous value is valid (`prev_ok == CH_ALL`); on `false`
+/// meaningful when every previous value is valid (`prev_ok == ChannelSet::ALL`); on `false`
 /// the caller classifies the sample with [`convert`] and [`check`] (the distinct
 /// fault bits and channel bits), which give the same verdict.
 #[inline(always)]
@@ -262,18 +248,18 @@ fn check_one<N: Num>(
     lo: N,
     hi: N,
     r: N,
-    bit: u8,
-    skip: u8,
-    prev_ok: u8,
+    bit: ChannelSet,
+    skip: ChannelSet,
+    prev_ok: ChannelSet,
     c: &mut Check,
 ) {
-    if skip & bit != 0 {
+    if skip.intersects(bit) {
         return;
     }
     if !(x >= lo && x <= hi) {
         c.range = true;
         c.bad |= bit;
-    } else if prev_ok & bit != 0 {
+    } else if prev_ok.intersects(bit) {
         let d = x.sub(p);
         if !(d.abs() <= r) {
             c.rate = true;
@@ -288,13 +274,13 @@ fn check_one<N: Num>(
 #[inline(always)]
 pub fn check<N: Num>(
     v: &Channels<N>,
-    nonfinite: u8,
+    nonfinite: ChannelSet,
     prev: &Channels<N>,
-    prev_ok: u8,
+    prev_ok: ChannelSet,
     lim: &LimitsN<N>,
 ) -> Check {
     let mut c = Check {
-        non_finite: nonfinite != 0,
+        non_finite: !nonfinite.is_empty(),
         bad: nonfinite,
         ..Check::default()
     };
@@ -304,12 +290,12 @@ pub fn check<N: Num>(
     let [h0, h1, h2, h3, h4, h5] = lim.hi;
     let [r0, r1, r2, r3, r4, r5] = lim.rate;
     let (nf, ok) = (nonfinite, prev_ok);
-    check_one(x0, p0, l0, h0, r0, CH_CURRENT, nf, ok, &mut c);
-    check_one(x1, p1, l1, h1, r1, CH_P_A, nf, ok, &mut c);
-    check_one(x2, p2, l2, h2, r2, CH_P_B, nf, ok, &mut c);
-    check_one(x3, p3, l3, h3, r3, CH_SPEED, nf, ok, &mut c);
-    check_one(x4, p4, l4, h4, r4, CH_POSITION, nf, ok, &mut c);
-    check_one(x5, p5, l5, h5, r5, CH_AMBIENT, nf, ok, &mut c);
+    check_one(x0, p0, l0, h0, r0, ChannelSet::CURRENT, nf, ok, &mut c);
+    check_one(x1, p1, l1, h1, r1, ChannelSet::P_A, nf, ok, &mut c);
+    check_one(x2, p2, l2, h2, r2, ChannelSet::P_B, nf, ok, &mut c);
+    check_one(x3, p3, l3, h3, r3, ChannelSet::SPEED, nf, ok, &mut c);
+    check_one(x4, p4, l4, h4, r4, ChannelSet::POSITION, nf, ok, &mut c);
+    check_one(x5, p5, l5, h5, r5, ChannelSet::AMBIENT, nf, ok, &mut c);
     c
 }
 
@@ -325,7 +311,7 @@ pub fn check<N: Num>(
 #[inline(always)]
 pub fn substitute<N: Num>(
     v: &Channels<N>,
-    bad: u8,
+    bad: ChannelSet,
     prev_pos: Option<N>,
     lim: &LimitsN<N>,
 ) -> ModelInputN<N> {
@@ -333,9 +319,9 @@ pub fn substitute<N: Num>(
     let [_, _, _, _, _, amb_max] = lim.hi;
     let [i_max, p_max, _, w_max, _, _] = lim.hi;
     let [_, p_min, _, _, _, _] = lim.lo;
-    let current = if bad & CH_CURRENT != 0 { i_max } else { i };
-    let speed_ok = bad & CH_SPEED == 0;
-    let (pa, pb) = if bad & (CH_P_A | CH_P_B) != 0 {
+    let current = if bad.intersects(ChannelSet::CURRENT) { i_max } else { i };
+    let speed_ok = !bad.intersects(ChannelSet::SPEED);
+    let (pa, pb) = if bad.intersects(ChannelSet::P_A | ChannelSet::P_B) {
         if speed_ok && w < N::ZERO {
             (p_min, p_max)
         } else {
@@ -353,10 +339,10 @@ pub fn substitute<N: Num>(
         w_max
     };
     let dpos = match prev_pos {
-        Some(p) if bad & CH_POSITION == 0 => x.sub(p),
+        Some(p) if !bad.intersects(ChannelSet::POSITION) => x.sub(p),
         _ => N::ZERO,
     };
-    let ambient = if bad & CH_AMBIENT != 0 { amb_max } else { amb };
+    let ambient = if bad.intersects(ChannelSet::AMBIENT) { amb_max } else { amb };
     ModelInputN {
         current_ha: current,
         p_a_hbar: pa,

@@ -8,9 +8,9 @@
 #![no_main]
 use eha_guard::model::consts::N_WORDS;
 use eha_guard::model::ModelConsts;
-use eha_guard::params::DEFAULT_CONSTS;
+use eha_guard::model::DEFAULT_CONSTS;
 use eha_guard::params_block::{encode, view, BLOCK_LEN};
-use eha_guard::{guard::faults, GuardConfig, GuardOf, Restore, Sample};
+use eha_guard::{faults, GuardConfig, GuardOf, Restore, Sample};
 use libfuzzer_sys::fuzz_target;
 
 #[repr(C, align(8))]

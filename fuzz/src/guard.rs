@@ -24,7 +24,7 @@
 //!
 //! Checked at every tick: no panic (overflow checks and debug assertions are
 //! on in the fuzz build), finite outputs, a latched fault implies the valve
-//! open, derate = alarm, LNG remaining within [0, full charge].
+//! open, derate = alarm or ACTUATOR or NV_FAILED, LNG remaining within [0, full charge].
 
 use crate::stats;
 use eha_guard::faults;
@@ -214,7 +214,7 @@ fn restore(u: &mut Unstructured<'_>, variant: u8) -> Restore {
             }
             let amb = -20.0 + 0.25 * f32::from(byte(u));
             let used = u.arbitrary::<u32>().unwrap_or(0);
-            let fb = u.arbitrary::<u32>().unwrap_or(0) & (faults::LATCHED | eha_guard::Faults::channels(0x3F)).bits();
+            let fb = u.arbitrary::<u32>().unwrap_or(0) & (faults::LATCHED | eha_guard::Faults::channels(eha_guard::ChannelSet::ALL)).bits();
             let fb = if byte(u) & 1 == 0 { 0 } else { fb };
             Restore::from_record(&ThermalRecord::new(temps, amb, used, fb, 0))
         }

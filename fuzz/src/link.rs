@@ -117,14 +117,16 @@ pub fn structured(data: &[u8]) -> Vec<u8> {
                 nominal + span * f32::from(byte(u) as i8) / 128.0
             }
         };
-        let req = Request {
-            seq,
+        // (fields in the order the input bytes are read)
+        let sample = eha_guard::Sample {
             current_a: v(&mut u, 30.0, 30.0),
             p_a_bar: v(&mut u, 65.0, 60.0),
             p_b_bar: v(&mut u, 5.0, 5.0),
             speed_rpm: v(&mut u, 500.0, 500.0),
             position_mm: v(&mut u, 0.0, 10.0),
             ambient_c: v(&mut u, 16.0, 1.0),
+        };
+        let reports = eha_guard::Reports {
             // The valve-position flags byte: absent, reported shut, reported open.
             valve_fb: match byte(&mut u) % 3 {
                 0 => None,
@@ -135,6 +137,7 @@ pub fn structured(data: &[u8]) -> Vec<u8> {
             elec_hz: (sel & 0x20 != 0).then(|| v(&mut u, 83.0, 80.0)),
             lng_supply_bar: (sel & 0x40 != 0).then(|| v(&mut u, 3.0, 3.0)),
         };
+        let req = Request { seq, sample, reports };
         let wire = req.encode();
         let corrupt = if sel & 0x10 != 0 { byte(&mut u) % 10 } else { 255 };
         match corrupt {

@@ -1,5 +1,5 @@
 //! Regenerates `DEFAULT` in `src/params.rs` (and its model constants,
-//! `src/default_consts.rs`) from `Rig::default()` by the
+//! `src/model/default_consts.rs`) from `Rig::default()` by the
 //! reduction of `eha_sim::reduce` (docs/reduction.md).
 //!
 //! `cargo run --release -p eha-sim --example reduce [-- --consts-only]`
@@ -8,7 +8,7 @@ use eha_sim::reduce::{reduce, render_default_consts_rs, render_params_rs, splice
 use eha_sim::rig::Rig;
 
 fn main() -> anyhow::Result<()> {
-    // `--consts-only`: only `src/default_consts.rs`, from the `DEFAULT` compiled in
+    // `--consts-only`: only `src/model/default_consts.rs`, from the `DEFAULT` compiled in
     // (after editing `DEFAULT` by hand, or to check that the two agree).
     if std::env::args().any(|a| a == "--consts-only") {
         return write_consts(&eha_guard::params::DEFAULT);
@@ -25,7 +25,7 @@ fn main() -> anyhow::Result<()> {
 
 fn write_consts(p: &eha_guard::params::ReducedParams) -> anyhow::Result<()> {
     let consts = render_default_consts_rs(p).map_err(|e| anyhow::anyhow!("model constants rejected: {e:?}"))?;
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../src/default_consts.rs");
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../src/model/default_consts.rs");
     std::fs::write(&path, consts)?;
     println!("wrote {}", path.display());
     Ok(())

@@ -16,7 +16,7 @@ impl<N: Num> GuardOf<N> {
             | Faults::channels(self.bad_ch)
             | Faults::when(self.lng_low, faults::LNG_LOW)
             | Faults::when(self.untrusted, faults::UNTRUSTED)
-            | Faults::when(self.nv_failed, faults::NV_FAILED)
+            | Faults::when(self.nv.failed(), faults::NV_FAILED)
             | Faults::when(self.recovering(), faults::RECOVERING)
             | self.cooling_status()
     }
@@ -25,10 +25,10 @@ impl<N: Num> GuardOf<N> {
     /// has, or it started from a known state). Before the first sample an
     /// unknown start has not begun to recover.
     pub fn recovery_left(&self) -> u32 {
-        match self.hold_from {
-            _ if self.hold_pending => self.recovery_ticks,
-            Some(t) => self.recovery_ticks.saturating_sub(self.tick.wrapping_sub(t)),
-            None => 0,
+        match self.hold {
+            Hold::Pending => self.recovery_ticks,
+            Hold::From(t) => self.recovery_ticks.saturating_sub(self.tick.wrapping_sub(t)),
+            Hold::None => 0,
         }
     }
 
@@ -42,7 +42,7 @@ impl<N: Num> GuardOf<N> {
     /// (the tank is empty: no credit, LNG_LOW).
     fn cooling_status(&self) -> Faults {
         let open = self.valve.is_open();
-        Faults::when(open && self.started && self.fb.is_none(), faults::NO_VALVE_FEEDBACK)
+        Faults::when(open && self.phase.started() && self.fb.is_none(), faults::NO_VALVE_FEEDBACK)
             | Faults::when(open && self.fb == Some(true) && self.supply.is_none() && self.credited(), faults::LNG_UNCONFIRMED)
             | Faults::when(self.supply == Some(false), faults::LNG_LOW)
     }
@@ -79,12 +79,12 @@ impl<N: Num> GuardOf<N> {
     #[inline(never)]
     fn latch_speed(&mut self) {
         self.settle(self.tick);
-        let newly = !self.latched.contains(faults::SENSOR_DISAGREE) || self.bad_ch & crate::validate::CH_SPEED == 0;
+        let newly = !self.latched.contains(faults::SENSOR_DISAGREE) || !self.bad_ch.intersects(ChannelSet::SPEED);
         self.latched |= faults::SENSOR_DISAGREE;
-        self.bad_ch |= crate::validate::CH_SPEED;
+        self.bad_ch |= ChannelSet::SPEED;
         self.untrusted = true;
         if newly {
-            self.trace.write(Trace::Fault { tick: self.tick, new_bits: faults::SENSOR_DISAGREE | Faults::channels(crate::validate::CH_SPEED) });
+            self.trace.write(Trace::Fault { tick: self.tick, new_bits: faults::SENSOR_DISAGREE | Faults::channels(ChannelSet::SPEED) });
         }
         if self.valve.force_open() {
             self.trace.write(Trace::ValveOpen { tick: self.tick, drain_c: self.out.drain_c, forced: true });
@@ -97,11 +97,15 @@ impl<N: Num> GuardOf<N> {
     /// restore could be older than the write policy promises); it clears
     /// at the next clear that follows a good save.
     pub fn report_nv_save(&mut self, ok: bool) {
-        self.nv_ok = ok;
-        if !ok && !self.nv_failed {
-            self.nv_failed = true;
-            self.trace.write(Trace::Fault { tick: self.tick, new_bits: faults::NV_FAILED });
-            self.refresh_out();
+        match (ok, self.nv) {
+            (true, NvHealth::Failed) => self.nv = NvHealth::SavedSince,
+            (true, _) => {}
+            (false, NvHealth::Good) => {
+                self.nv = NvHealth::Failed;
+                self.trace.write(Trace::Fault { tick: self.tick, new_bits: faults::NV_FAILED });
+                self.refresh_out();
+            }
+            (false, _) => self.nv = NvHealth::Failed,
         }
     }
 
@@ -124,11 +128,11 @@ impl<N: Num> GuardOf<N> {
         let bits = (self.latched & !faults::CONFIG) | Faults::channels(self.bad_ch);
         self.settle(self.tick);
         self.latched &= faults::CONFIG;
-        self.bad_ch = 0;
+        self.bad_ch = ChannelSet::NONE;
         // A valve still disagreeing with its command latches again after the full time;
         // so do sensors that still disagree.
         self.fb_mismatch = 0;
-        if let Some(c) = self.core_ok.then_some(&mut self.core) {
+        if let Some(c) = self.core.get_mut() {
             if let Some(cc) = c.cc.as_mut() {
                 cc.restart_count();
                 c.model.set_loss_max(cc.disagrees());
@@ -141,19 +145,19 @@ impl<N: Num> GuardOf<N> {
         // follows it again from the next model step — unless it is still recovering
         // from an unknown state: after a disagreement that recovery starts now,
         // with the inputs good again.
-        if self.hold_pending && self.started {
-            self.hold_pending = false;
-            self.hold_from = Some(self.tick);
+        if self.hold == Hold::Pending && self.phase.started() {
+            self.hold = Hold::From(self.tick);
         }
         let left = self.recovery_left();
         let trust = left == 0 && self.untrusted;
-        let bits = bits | Faults::when(trust, faults::UNTRUSTED) | Faults::when(self.nv_failed && self.nv_ok, faults::NV_FAILED);
+        let bits = bits | Faults::when(trust, faults::UNTRUSTED) | Faults::when(self.nv == NvHealth::SavedSince, faults::NV_FAILED);
         if left == 0 {
             self.untrusted = false;
-            self.hold_pending = false;
-            self.hold_from = None;
+            self.hold = Hold::None;
         }
-        self.nv_failed &= !self.nv_ok;
+        if self.nv == NvHealth::SavedSince {
+            self.nv = NvHealth::Good;
+        }
         if !bits.is_empty() {
             self.trace.write(Trace::FaultsCleared {
                 tick: self.tick,
@@ -235,7 +239,7 @@ impl<N: Num> GuardOf<N> {
     pub fn snapshot_unsealed(&self) -> ThermalRecord {
         let mut temps = [0.0f32; N_NODES];
         let mut amb = 0.0;
-        if let Some(c) = self.core_ok.then_some(&self.core) {
+        if let Some(c) = self.core.get() {
             for (o, t) in temps.iter_mut().zip(c.model.temperatures_c().iter()) {
                 *o = t.to_f32();
             }
@@ -268,7 +272,7 @@ impl<N: Num> GuardOf<N> {
     /// rejects at init: valve open, alarm, drain reported as
     /// [`DRAIN_C_UNKNOWN`]. CONFIG is never cleared.
     pub fn refuse_config(&mut self) {
-        self.core_ok = false;
+        self.core.ok = false;
         self.latched |= faults::CONFIG;
         // fail-safe outputs from this instant: valve open, alarm (OK pin low),
         // no estimate
@@ -280,7 +284,7 @@ impl<N: Num> GuardOf<N> {
 
     /// The model, when the parameters were usable.
     pub fn model(&self) -> Option<&Model<N>> {
-        self.core_ok.then_some(&self.core).map(|c| &c.model)
+        self.core.get().map(|c| &c.model)
     }
 
     /// Ticks taken since boot (10 ms each, wraps after 497 days).

@@ -8,12 +8,12 @@
 //! valve/alarm hysteresis, dwell, LNG budget and trace run on the new estimate.
 
 mod control;
+mod state;
 mod step;
 mod tick;
 mod types;
-pub mod faults;
-pub use faults::Faults;
-pub use types::{GuardConfig, Output, Reports, Sample, DRAIN_C_UNKNOWN};
+pub use crate::interface::{Output, Reports, Sample, DRAIN_C_UNKNOWN};
+pub use types::GuardConfig;
 // `ClearResult`, `recovery_ticks` and the trust constants are defined below.
 
 use crate::crosscheck::{CrossCheck, Verdict};
@@ -23,11 +23,13 @@ use crate::num::Num;
 use crate::params::{N_NODES, TICKS_PER_STEP};
 use crate::protection::{alarm_update_with, LngBudget, LngConfig, Valve};
 use crate::trace::{RestoreKind, Trace, TraceBuf};
-use crate::validate::{self, Channels, LimitsN, CH_ALL, CH_CURRENT, CH_POSITION, CH_P_A, CH_P_B, CH_SPEED};
+use crate::faults::{self, ChannelSet, Faults};
+use state::{Hold, NvHealth, Phase};
+use crate::validate::{self, Channels, LimitsN};
 
 /// Channels the sensor cross-check compares: a window with any of them substituted
 /// by its worst case is not evaluated.
-const CROSS_CHANNELS: u8 = CH_CURRENT | CH_P_A | CH_P_B | CH_SPEED;
+const CROSS_CHANNELS: ChannelSet = ChannelSet::CURRENT.union(ChannelSet::P_A).union(ChannelSet::P_B).union(ChannelSet::SPEED);
 
 /// Number type of the firmware build: `f32`, or [`crate::num::Fx`] with `fixed-point`.
 #[cfg(not(feature = "fixed-point"))]
@@ -184,28 +186,77 @@ impl<N: Num> Core<N> {
     }
 }
 
-/// The guard, generic over the model number type (`f64` for host tests).
-#[derive(Clone, Debug)]
-pub struct GuardOf<N: Num> {
-    /// The model and its constants; used only when `core_ok`.
+/// The core, and whether the configuration built it: the one way to reach it
+/// ([`CoreSlot::get`]), so no code can use a core that was not built.
+#[derive(Clone, Copy, Debug)]
+struct CoreSlot<N: Num> {
     core: Core<N>,
     /// The configuration built into a model (else CONFIG, fail-safe).
-    core_ok: bool,
+    ok: bool,
+}
+
+impl<N: Num> CoreSlot<N> {
+    /// The core, when the configuration built it.
+    #[inline(always)]
+    fn get(&self) -> Option<&Core<N>> {
+        self.ok.then_some(&self.core)
+    }
+
+    /// [`CoreSlot::get`], mutable.
+    #[inline(always)]
+    fn get_mut(&mut self) -> Option<&mut Core<N>> {
+        self.ok.then_some(&mut self.core)
+    }
+
+    /// Builds the slot in place at `dst` ([`Core::init_in`]); whether the
+    /// core was built.
+    ///
+    /// # Safety
+    /// `dst` must be valid for writes of a `CoreSlot<N>`.
+    #[inline(always)]
+    unsafe fn init_in(dst: *mut Self, config: &GuardConfig) -> bool {
+        // SAFETY: `dst` is valid for writes (caller): so are its fields.
+        unsafe {
+            let ok = Core::<N>::init_in(core::ptr::addr_of_mut!((*dst).core), config);
+            core::ptr::addr_of_mut!((*dst).ok).write(ok);
+            ok
+        }
+    }
+}
+
+/// The guard, generic over the model number type (`f64` for host tests).
+/// `repr(C)`: the fields in their declared order, which a change of the
+/// small state then does not reshuffle. Where the model and the hot fields
+/// sit decides the size and cost of the firmware's code (their offsets are
+/// immediates of its instructions): this order, rustc's own before the
+/// state was typed, gave the product image 40 868 B, rustc's new choice
+/// 41 148 B.
+#[derive(Clone, Debug)]
+#[repr(C)]
+pub struct GuardOf<N: Num> {
+    /// The trust hold of an estimate whose state was unknown: a corrupt or
+    /// damaged record, no sample by the start-up timeout, a record saved
+    /// while recovering (pending until the first sample), or inputs found to
+    /// disagree (SENSOR_DISAGREE: pending until the clear, when the inputs
+    /// are good again).
+    hold: Hold,
+    /// Speed plausibility (`None`: no usable constants, CONFIG).
+    speed: Option<crate::speedcheck::SpeedCheck>,
+    valve: Valve,
+    trace: TraceBuf,
+    /// The outputs, refreshed whenever one of them changes (fault latching, the
+    /// fail-safe opening, a model step, clear/refill): a tick on the fast path
+    /// returns them as they are.
+    out: Output,
+    /// The model and its constants, when the configuration built them.
+    core: CoreSlot<N>,
     /// Valve dwell in model steps (the configured ticks, rounded up).
     dwell_model_steps: u32,
     stale_ticks: u32,
     startup_timeout_ticks: u32,
     clear_valid_ticks: u32,
     latched: Faults,
-    bad_ch: u8,
     prev: Channels<N>,
-    prev_ok: u8,
-    /// `prev_ok` before the missing ticks since the last sample: the rate
-    /// check of the next sample over the gap.
-    gap_ok: u8,
-    /// Inside [`GuardOf::tick_blind`] or the replay of the wait: no
-    /// cooling credit.
-    blind: bool,
     /// Ticks waited for the first sample (replayed at the start).
     waited: u32,
     /// The first sample's own inputs, for that replay.
@@ -214,15 +265,6 @@ pub struct GuardOf<N: Num> {
     /// Tick index from which every sample was present and valid (the run of valid
     /// samples of the clear rule is `tick - valid_since`).
     valid_since: u32,
-    /// `false` until the first sample: until then the guard waits (valve open, model
-    /// not started, STALE only after `startup_timeout_ticks`). A cold start takes
-    /// the first sample's ambient, and the protection is evaluated once on the
-    /// initial (or restored) estimate.
-    started: bool,
-    cold: bool,
-    /// Restored from the non-volatile record after a power loss: the first
-    /// sample's ambient, if warmer than the saved one, raises every node.
-    after_power_loss: bool,
     /// Tick from which the present valve and credit state hold in this model step.
     mark: u32,
     /// Ticks of this model step before `mark` with the valve commanded open (LNG
@@ -232,52 +274,49 @@ pub struct GuardOf<N: Num> {
     credit_acc: u32,
     /// Mean loss of the last model step, cJ per tick (= W).
     last_cj: u32,
-    valve: Valve,
-    /// Last valve position reported by [`GuardOf::valve_feedback`] (None: no feedback).
-    fb: Option<bool>,
-    /// The LNG supply pressure says the tank has LNG (None: not reported,
-    /// [`GuardOf::lng_supply`]).
-    supply: Option<bool>,
     /// Least supply pressure that says the tank has LNG, bar.
     min_supply_bar: f32,
-    /// Speed plausibility (`None`: no usable constants, CONFIG).
-    speed: Option<crate::speedcheck::SpeedCheck>,
     /// Consecutive reports differing from the command.
     fb_mismatch: u32,
     /// Reports differing from the command that latch ACTUATOR.
     mismatch_ticks: u32,
+    /// Ticks the estimate needs to forget an unknown start
+    /// ([`recovery_ticks`]).
+    recovery_ticks: u32,
+    lng: LngBudget,
+    tick: u32,
+    /// Changes of the outputs and of the recorded state ([`GuardOf::epoch`]).
+    epoch: u32,
+    // One-byte state last (no padding).
+    /// Inside [`GuardOf::tick_blind`] or the replay of the wait: no
+    /// cooling credit.
+    blind: bool,
+    /// Waiting until the first sample (valve open, model not started, STALE
+    /// only after `startup_timeout_ticks`), then running; at the first sample
+    /// the protection is evaluated once on the initial (or restored) estimate.
+    phase: Phase,
     /// The LNG budget is used up: no exchanger credit.
     lng_empty: bool,
     alarm: bool,
     /// The estimate is not trusted (corrupt record at boot, no sample by the start-up
     /// timeout): alarm and derate held until a successful `clear_faults`.
     untrusted: bool,
-    /// The estimate's state is unknown: a corrupt or damaged record, no
-    /// sample by the start-up timeout, a record saved while recovering (the
-    /// trust hold starts with the first sample), or inputs found to
-    /// disagree (SENSOR_DISAGREE: the hold starts at the clear, when the
-    /// inputs are good again).
-    hold_pending: bool,
-    /// Tick the estimate started from an unknown state (`None`: it did not).
-    hold_from: Option<u32>,
-    /// Ticks the estimate needs to forget an unknown start
-    /// ([`recovery_ticks`]).
-    recovery_ticks: u32,
-    lng: LngBudget,
     lng_low: bool,
-    tick: u32,
-    /// The outputs, refreshed whenever one of them changes (fault latching, the
-    /// fail-safe opening, a model step, clear/refill): a tick on the fast path
-    /// returns them as they are.
-    out: Output,
-    /// Changes of the outputs and of the recorded state ([`GuardOf::epoch`]).
-    epoch: u32,
     /// A non-volatile save failed (`faults::NV_FAILED`, derate) and no
-    /// clear has seen a good save since.
-    nv_failed: bool,
-    /// The last non-volatile save succeeded.
-    nv_ok: bool,
-    trace: TraceBuf,
+    /// clear has seen a good save since, or not.
+    nv: NvHealth,
+    /// Last valve position reported by [`GuardOf::valve_feedback`] (None: no feedback).
+    fb: Option<bool>,
+    /// The LNG supply pressure says the tank has LNG (None: not reported,
+    /// [`GuardOf::lng_supply`]).
+    supply: Option<bool>,
+    /// Channels latched bad: at their worst case until a clear.
+    bad_ch: ChannelSet,
+    /// Channels whose previous value is valid (the rate check's reference).
+    prev_ok: ChannelSet,
+    /// `prev_ok` before the missing ticks since the last sample: the rate
+    /// check of the next sample over the gap.
+    gap_ok: ChannelSet,
 }
 
 /// Invariant kept by every place that latches a fault: `latched != 0` implies the
@@ -305,26 +344,23 @@ impl<N: Num> GuardOf<N> {
         // SAFETY: `p` points to `slot`, valid for writes; `Core::init_in` and
         // `put!` write every field exactly once before the reference is made.
         let g = unsafe {
-            let ok = Core::<N>::init_in(core::ptr::addr_of_mut!((*p).core), config);
+            let ok = CoreSlot::<N>::init_in(core::ptr::addr_of_mut!((*p).core), config);
             put!(p,
-            core_ok: ok,
             latched: if ok { Faults::NONE } else { faults::CONFIG },
             dwell_model_steps: config.valve.dwell_ticks.div_ceil(TICKS_PER_STEP),
             stale_ticks: config.stale_ticks,
             startup_timeout_ticks: config.startup_timeout_ticks,
             clear_valid_ticks: config.clear_valid_ticks,
-            bad_ch: 0,
+            bad_ch: ChannelSet::NONE,
             prev: [N::ZERO; 6],
-            prev_ok: 0,
-            gap_ok: 0,
+            prev_ok: ChannelSet::NONE,
+            gap_ok: ChannelSet::NONE,
             blind: false,
             waited: 0,
             replay_u: ModelInputN { current_ha: N::ZERO, p_a_hbar: N::ZERO, p_b_hbar: N::ZERO, speed_hrads: N::ZERO, dpos_mm: N::ZERO, ambient_c: N::ZERO },
             missing: 0,
             valid_since: 0,
-            started: false,
-            cold: true,
-            after_power_loss: false,
+            phase: Phase::WaitingCold,
             mark: 0,
             open_acc: 0,
             credit_acc: 0,
@@ -340,8 +376,7 @@ impl<N: Num> GuardOf<N> {
             lng_empty: false,
             alarm: false,
             untrusted: false,
-            hold_pending: false,
-            hold_from: None,
+            hold: Hold::None,
             recovery_ticks: recovery_ticks(config.model),
             lng: LngBudget::new(&config.lng),
             lng_low: false,
@@ -351,8 +386,7 @@ impl<N: Num> GuardOf<N> {
                 ..Output::default()
             },
             epoch: 0,
-            nv_failed: false,
-            nv_ok: true,
+            nv: NvHealth::Good,
             trace: TraceBuf::new(),
             );
             &mut *p
@@ -360,15 +394,15 @@ impl<N: Num> GuardOf<N> {
         let kind = match restore {
             Restore::Cold => RestoreKind::Cold,
             Restore::Warm(r) | Restore::PowerLoss(r) => {
-                g.after_power_loss = matches!(restore, Restore::PowerLoss(_));
-                if let Some(c) = g.core_ok.then_some(&mut g.core) {
+                let power_loss = matches!(restore, Restore::PowerLoss(_));
+                g.phase = if power_loss { Phase::WaitingAfterPowerLoss } else { Phase::WaitingRestored };
+                if let Some(c) = g.core.get_mut() {
                     c.model.set_temperatures(&r.temps_c, r.ambient_c);
                 }
-                g.cold = false;
                 g.lng.set_used_cj(r.lng_used_cj);
                 let saved = Faults::from_bits(r.faults);
                 g.latched |= saved & faults::LATCHED & !faults::CONFIG;
-                g.bad_ch = saved.channel_mask() & CH_ALL;
+                g.bad_ch = saved.channel_set();
                 if r.valve_open() {
                     // The valve was open: it stays open for at least its dwell.
                     g.valve.force_open();
@@ -376,11 +410,13 @@ impl<N: Num> GuardOf<N> {
                 // Saved before a clear restored trust: still not trusted; saved
                 // while recovering from an unknown start: the hold starts again.
                 g.untrusted = saved.contains(faults::UNTRUSTED);
-                g.hold_pending = saved.contains(faults::RECOVERING);
-                if let Some(c) = g.core_ok.then_some(&mut g.core) {
+                if saved.contains(faults::RECOVERING) {
+                    g.hold = Hold::Pending;
+                }
+                if let Some(c) = g.core.get_mut() {
                     c.model.set_loss_max(g.latched.contains(faults::SENSOR_DISAGREE));
                 }
-                if g.after_power_loss {
+                if power_loss {
                     RestoreKind::PowerLoss
                 } else {
                     RestoreKind::Warm
@@ -388,14 +424,14 @@ impl<N: Num> GuardOf<N> {
             }
             Restore::Corrupt => {
                 let t = config.alarm.alarm_c;
-                if let Some(c) = g.core_ok.then_some(&mut g.core) {
+                if let Some(c) = g.core.get_mut() {
                     c.model.set_temperatures(&[t; N_NODES], t);
                 }
-                g.cold = false;
+                g.phase = Phase::WaitingRestored;
                 g.lng.set_used_cj(u32::MAX);
                 g.latched |= faults::MEMORY_CORRUPT;
                 g.untrusted = true;
-                g.hold_pending = true;
+                g.hold = Hold::Pending;
                 RestoreKind::Corrupt
             }
         };
@@ -410,8 +446,8 @@ impl<N: Num> GuardOf<N> {
     #[cold]
     #[inline(never)]
     fn boot_outputs(&mut self) {
-        match self.core_ok.then_some(&self.core) {
-            Some(c) if !self.cold => {
+        match self.core.get() {
+            Some(c) if self.phase != Phase::WaitingCold => {
                 let d = c.drain_c();
                 let f = d.to_f32();
                 self.out.drain_c = if f.is_finite() { f } else { DRAIN_C_UNKNOWN };

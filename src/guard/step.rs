@@ -12,22 +12,21 @@ impl<N: Num> GuardOf<N> {
     #[cold]
     #[inline(never)]
     pub(super) fn start(&mut self, ambient_c: N) {
-        self.started = true;
-        if self.hold_pending {
+        let from = core::mem::replace(&mut self.phase, Phase::Running);
+        if self.hold == Hold::Pending {
             // The estimate starts to forget its unknown start from here.
-            self.hold_pending = false;
-            self.hold_from = Some(self.tick);
+            self.hold = Hold::From(self.tick);
         }
         // Nothing of the waiting time is counted: no model ran, no credit, no LNG booked.
         self.mark = self.tick;
         self.open_acc = 0;
         self.credit_acc = 0;
-        let Some(c) = self.core_ok.then_some(&mut self.core) else {
+        let Some(c) = self.core.get_mut() else {
             return;
         };
-        if self.cold {
+        if from == Phase::WaitingCold {
             c.model.set_uniform(ambient_c);
-        } else if self.after_power_loss {
+        } else if from == Phase::WaitingAfterPowerLoss {
             // The air may have been warmer during the off-time than at the save:
             // every node is raised by the first sample's excess over the saved
             // ambient (the cooling bound assumes the larger of the two).
@@ -82,7 +81,7 @@ impl<N: Num> GuardOf<N> {
         let (open_ticks, credit_ticks) = (self.open_acc, self.credit_acc);
         self.open_acc = 0;
         self.credit_acc = 0;
-        let Some(c) = self.core_ok.then_some(&mut self.core) else {
+        let Some(c) = self.core.get_mut() else {
             return;
         };
         c.model.update(credit_ticks);
@@ -90,7 +89,7 @@ impl<N: Num> GuardOf<N> {
         let cj = c.model.last_total_kw().round_times(1000).max(0) as u32;
         if let Some(cc) = c.cc.as_mut() {
             let (from_p, from_i) = c.model.last_mech_pair_kw();
-            match cc.step(from_p, from_i, self.bad_ch & CROSS_CHANNELS == 0) {
+            match cc.step(from_p, from_i, !self.bad_ch.intersects(CROSS_CHANNELS)) {
                 Verdict::None => {}
                 // While they disagree (and once latched) the model heats with the
                 // larger of the two losses.
@@ -126,14 +125,14 @@ impl<N: Num> GuardOf<N> {
         // The estimate ran on inputs that disagree (the larger shaft loss
         // covers the shaft, not the throttling heat a wrong pressure hides):
         // its state is unknown until it has recovered on good inputs.
-        self.hold_pending = true;
+        self.hold = Hold::Pending;
     }
 
     /// Valve hysteresis and dwell, alarm, LNG budget (`open_ticks` ticks of the model
     /// step with the valve open, at `cj` centijoules per tick) and the outputs that
     /// change only here.
     fn protect(&mut self, cj: u32, open_ticks: u32) {
-        let Some(c) = self.core_ok.then_some(&self.core) else {
+        let Some(c) = self.core.get() else {
             return;
         };
         let force = !self.latched.is_empty();
@@ -207,7 +206,7 @@ impl<N: Num> GuardOf<N> {
         // Derate: the alarm, and whatever leaves the protection weaker than
         // the estimate says (a valve not following its command, a thermal
         // record that could not be saved).
-        let derate = self.alarm || self.nv_failed || self.latched.contains(faults::ACTUATOR);
+        let derate = self.alarm || self.nv.failed() || self.latched.contains(faults::ACTUATOR);
         self.out = Output {
             drain_c: self.out.drain_c,
             valve_open: self.valve.is_open(),

@@ -23,7 +23,7 @@ impl<N: Num> GuardOf<N> {
     /// fault, opens the valve in this same tick and is replaced by its worst case.
     #[inline(never)]
     pub fn tick(&mut self, s: &Sample) -> Output {
-        if let Some(core) = self.core_ok.then_some(&self.core) {
+        if let Some(core) = self.core.get() {
             // Fast path: every channel in range and within its rate and every previous
             // value valid (so this is not the first tick). Nothing to latch, the valve
             // is not forced by this tick (an earlier latched fault has already opened
@@ -31,9 +31,9 @@ impl<N: Num> GuardOf<N> {
             // earlier fault still take their worst case. Anything else is classified
             // by `tick_slow`.
             let (v, ok) = validate::convert_check(s, &self.prev, &core.scales, &core.limits);
-            if ok & (self.prev_ok == CH_ALL) {
+            if ok & (self.prev_ok == ChannelSet::ALL) {
                 // `missing` is 0 here: a missing tick clears `prev_ok`.
-                let u = if self.bad_ch == 0 {
+                let u = if self.bad_ch.is_empty() {
                     validate::direct(&v, &self.prev)
                 } else {
                     let [_, _, _, _, prev_pos, _] = self.prev;
@@ -51,7 +51,7 @@ impl<N: Num> GuardOf<N> {
     /// at their worst case.
     #[inline(never)]
     #[cold]
-    fn subst(v: &Channels<N>, bad: u8, prev_pos: Option<N>, limits: &LimitsN<N>) -> ModelInputN<N> {
+    fn subst(v: &Channels<N>, bad: ChannelSet, prev_pos: Option<N>, limits: &LimitsN<N>) -> ModelInputN<N> {
         validate::substitute(v, bad, prev_pos, limits)
     }
 
@@ -61,8 +61,8 @@ impl<N: Num> GuardOf<N> {
     #[cold]
     fn tick_slow(&mut self, s: &Sample) -> Output {
         let gap = core::mem::replace(&mut self.missing, 0);
-        let first = !self.started;
-        let Some(core) = self.core_ok.then_some(&self.core) else {
+        let first = !self.phase.started();
+        let Some(core) = self.core.get() else {
             return self.slow_tail(None, Faults::NONE, N::ZERO);
         };
         let (v, nonfinite) = validate::convert(s, &core.scales);
@@ -88,11 +88,11 @@ impl<N: Num> GuardOf<N> {
             new_bits |= faults::NON_FINITE;
         }
         self.bad_ch |= c.bad;
-        if c.bad != 0 {
+        if !c.bad.is_empty() {
             self.valid_since = self.tick.wrapping_add(1);
         }
         let [_, _, _, _, prev_pos, _] = self.prev;
-        let prev_pos = if self.prev_ok & CH_POSITION != 0 {
+        let prev_pos = if self.prev_ok.intersects(ChannelSet::POSITION) {
             Some(prev_pos)
         } else {
             None
@@ -110,9 +110,9 @@ impl<N: Num> GuardOf<N> {
         // an earlier STALE makes the model run on the worst case from now on), else
         // the worst case.
         let [_, _, _, _, _, amb] = v;
-        let start_amb = if c.bad & validate::CH_AMBIENT == 0 { amb } else { u.ambient_c };
+        let start_amb = if !c.bad.intersects(ChannelSet::AMBIENT) { amb } else { u.ambient_c };
         self.prev = v;
-        self.prev_ok = !c.bad & CH_ALL;
+        self.prev_ok = !c.bad;
         self.slow_tail(Some(&u), new_bits, start_amb)
     }
 
@@ -121,7 +121,7 @@ impl<N: Num> GuardOf<N> {
     /// channel takes its worst case. Before the first sample the guard waits instead
     /// (`wait_tick`).
     pub fn tick_missing(&mut self) -> Output {
-        if !self.started {
+        if !self.phase.started() {
             return self.wait_tick();
         }
         self.missing = self.missing.saturating_add(1);
@@ -129,14 +129,14 @@ impl<N: Num> GuardOf<N> {
         if self.missing == 1 {
             self.gap_ok = self.prev_ok;
         }
-        self.prev_ok = 0;
+        self.prev_ok = ChannelSet::NONE;
         let mut new_bits = Faults::NONE;
         if self.missing >= self.stale_ticks {
             new_bits |= faults::STALE;
-            self.bad_ch = CH_ALL;
+            self.bad_ch = ChannelSet::ALL;
             self.stale_alarm();
         }
-        let u = self.core_ok.then(|| Self::subst(&self.prev, self.bad_ch, None, &self.core.limits));
+        let u = self.core.get().map(|c| Self::subst(&self.prev, self.bad_ch, None, &c.limits));
         self.slow_tail(u.as_ref(), new_bits, N::ZERO)
     }
 
@@ -155,7 +155,7 @@ impl<N: Num> GuardOf<N> {
     #[cold]
     #[inline(never)]
     pub fn tick_blind(&mut self, n: u32) -> Output {
-        if !self.started {
+        if !self.phase.started() {
             for _ in 0..n {
                 self.wait_tick();
             }
@@ -165,9 +165,9 @@ impl<N: Num> GuardOf<N> {
         self.blind = true;
         for _ in 0..n {
             self.valid_since = self.tick.wrapping_add(1);
-            self.prev_ok = 0;
-            self.gap_ok = 0;
-            let u = self.core_ok.then(|| Self::subst(&self.prev, self.bad_ch, None, &self.core.limits));
+            self.prev_ok = ChannelSet::NONE;
+            self.gap_ok = ChannelSet::NONE;
+            let u = self.core.get().map(|c| Self::subst(&self.prev, self.bad_ch, None, &c.limits));
             self.slow_tail(u.as_ref(), Faults::NONE, N::ZERO);
         }
         self.settle(self.tick);
@@ -202,15 +202,15 @@ impl<N: Num> GuardOf<N> {
             if !self.latched.contains(faults::STALE) {
                 self.trace.write(Trace::Fault {
                     tick: self.tick,
-                    new_bits: faults::STALE | Faults::channels(CH_ALL),
+                    new_bits: faults::STALE | Faults::channels(ChannelSet::ALL),
                 });
             }
             self.latched |= faults::STALE;
-            self.bad_ch = CH_ALL;
+            self.bad_ch = ChannelSet::ALL;
             // No estimate and no input: alarm and derate until a clear, and
             // the machine may have run unseen: the start state is unknown.
             self.untrusted = true;
-            self.hold_pending = true;
+            self.hold = Hold::Pending;
             if !self.alarm {
                 self.alarm = true;
                 self.trace.write(Trace::Alarm {
@@ -248,8 +248,8 @@ impl<N: Num> GuardOf<N> {
             });
         }
         match u {
-            Some(u) if self.core_ok => {
-                if !self.started {
+            Some(u) if self.core.get().is_some() => {
+                if !self.phase.started() {
                     self.start(start_amb);
                     self.replay_wait();
                 }
@@ -305,7 +305,7 @@ impl<N: Num> GuardOf<N> {
     /// every `TICKS_PER_STEP` ticks the model step with the protection.
     #[inline(always)]
     fn advance(&mut self, u: &ModelInputN<N>) -> Output {
-        let full = match self.core_ok.then_some(&mut self.core) {
+        let full = match self.core.get_mut() {
             Some(c) => c.model.tick_n(u),
             None => false,
         };

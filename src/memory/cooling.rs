@@ -61,7 +61,7 @@ impl RestCooling {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::params::DEFAULT_CONSTS;
+    use crate::model::DEFAULT_CONSTS;
 
     fn bound() -> RestCooling {
         RestCooling::from_consts(&DEFAULT_CONSTS).expect("the default constants carry a bound")

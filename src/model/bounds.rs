@@ -187,7 +187,7 @@ mod tests {
     /// The fields of `ModelConsts` in order with their word counts, read
     /// from its `Debug` output (every word printed as `0`).
     fn fields_in_order() -> Vec<(String, usize)> {
-        let zero = crate::params::DEFAULT_CONSTS.map(|_| 0u8);
+        let zero = crate::model::DEFAULT_CONSTS.map(|_| 0u8);
         let text = std::format!("{zero:?}");
         let body = text.trim_start_matches("ModelConsts {").trim_end_matches('}');
         let mut out: Vec<(String, usize)> = Vec::new();
@@ -225,19 +225,19 @@ mod tests {
 
     #[test]
     fn the_compiled_in_constants_are_within_their_bounds() {
-        assert_eq!(crate::params::DEFAULT_CONSTS.check_bounds(), Ok(()));
+        assert_eq!(crate::model::DEFAULT_CONSTS.check_bounds(), Ok(()));
     }
 
     #[test]
     fn an_out_of_range_word_is_named() {
-        let c = ModelConsts { k_sh: 0.0, ..crate::params::DEFAULT_CONSTS };
+        let c = ModelConsts { k_sh: 0.0, ..crate::model::DEFAULT_CONSTS };
         let Err(ConfigError::OutOfBounds(w)) = c.check_bounds() else { panic!("k_sh = 0 accepted") };
         assert_eq!(word_bound(usize::from(w)).map(|b| b.0), Some("k_sh"));
-        let mut c = crate::params::DEFAULT_CONSTS;
+        let mut c = crate::model::DEFAULT_CONSTS;
         c.inv_c[2] = 0.1;
         let Err(ConfigError::OutOfBounds(w)) = c.check_bounds() else { panic!("an oil capacity word accepted") };
         assert_eq!(word_bound(usize::from(w)).map(|b| (b.0, b.1)), Some(("inv_c", 2)));
-        let c = ModelConsts { k_lp: crate::params::DEFAULT_CONSTS.k_lp * 1.01, ..crate::params::DEFAULT_CONSTS };
+        let c = ModelConsts { k_lp: crate::model::DEFAULT_CONSTS.k_lp * 1.01, ..crate::model::DEFAULT_CONSTS };
         assert_eq!(c.check_bounds(), Err(ConfigError::Inconsistent));
     }
 }

@@ -1,7 +1,7 @@
 //! The model's constants in model units (kW, L/s, hbar, hrad/s, degC): what the
 //! firmware needs to run the reduced model, derived once from the SI
 //! [`ReducedParams`] on the host ([`derive()`], `f64`) and carried to the target as
-//! `f32` (the compiled-in [`crate::params::DEFAULT_CONSTS`] or a parameter block
+//! `f32` (the compiled-in [`crate::model::DEFAULT_CONSTS`] or a parameter block
 //! in flash, [`crate::params_block`]). The target does no `f64` arithmetic and no
 //! matrix exponential: it converts these values into its number type and checks them.
 
@@ -12,138 +12,192 @@ use crate::params::{
     N_TABLE, N_TEMP, S_PER_STEP, S_PER_TICK, TEMP_TABLE_MIN_C, TEMP_TABLE_STEP_K,
 };
 
-/// Constants of the reduced model in model units, scalar type `S` (`f64` on the
-/// host, `f32` in a parameter block). Field order is the block's word order.
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[repr(C)]
-pub struct ModelConsts<S> {
-    /// Case pressure, hbar.
-    pub p_case: S,
-    /// Pump leakage flow per port, L/s per hbar (eqs. 5-7).
-    pub k_lf: S,
-    /// Half of [`Self::k_lf`] (the case receives the mean of both ports' leakage).
-    pub k_lf_half: S,
-    /// Pump leakage heat, kW per hbar^2 (eqs. 5-7).
-    pub k_lp: S,
-    /// Pump mechanical loss, kW per (hbar hrad/s) (eq. 8).
-    pub k_mech: S,
-    /// Pump flow, L/s per hrad/s.
-    pub k_q: S,
-    /// Piston flow, L/s per (mm per tick).
-    pub k_a: S,
-    /// Throttling power, kW per (hbar L/s).
-    pub k_dpq: S,
-    /// Line loss, kW per (L/s)^2 (eq. 10, laminar part).
-    pub r1: S,
-    /// Line loss, kW per (L/s)^3 (eq. 10, local losses).
-    pub r2: S,
-    /// Actuator heat weight of `dp^2` (eq. 11), of [`Self::k_act`] (≤ 1).
-    pub w_dp: S,
-    /// Actuator heat weight of `dx^2` (seal friction), of [`Self::k_act`] (≤ 1).
-    pub w_dx: S,
-    /// Actuator heat scale, kW: `k_act (w_dp dp^2 + w_dx dx^2)` per tick.
-    pub k_act: S,
-    /// Copper loss, kW per hA^2 (eq. 1).
-    pub k_cu: S,
-    /// Shaft power from the current, kW per (hA hrad/s) (cross-check); 0 disables it.
-    pub k_sh: S,
-    /// Hydraulic power of the displacement, kW per (hbar hrad/s) (cross-check).
-    pub k_hyd: S,
-    /// Iron loss, hysteresis, kW per hrad/s (eq. 2).
-    pub fe1: S,
-    /// Iron loss, eddy, kW per (hrad/s)^2 (eq. 2).
-    pub fe2: S,
-    /// Iron loss, excess, kW per (hrad/s)^1.5 (eq. 2).
-    pub fe15: S,
-    /// Flow-table index scale `(N_TABLE - 1) / sqrt(q_max)`, per sqrt(L/s).
-    pub q_scale: S,
-    /// Speed-table index scale `(N_TABLE - 1) / sqrt(w_max)`, per sqrt(hrad/s).
-    pub w_scale: S,
-    /// Oil `rho c_p` at 0 degC, kJ/(L K).
-    pub rc0: S,
-    /// Slope of `rho c_p`, kJ/(L K^2).
-    pub rc1: S,
-    /// Curvature of `rho c_p`, kJ/(L K^3) (density and specific heat both linear).
-    pub rc2: S,
-    /// 1 / case oil volume, 1/L.
-    pub inv_v_case: S,
-    /// 1 / loop oil volume, 1/L.
-    pub inv_v_loop: S,
-    /// One port passage's oil volume, L.
-    pub v_port: S,
-    /// Ball-valve passage oil volume, L.
-    pub v_ball: S,
-    /// 1 / ring oil volume, 1/L.
-    pub inv_v_ring: S,
-    /// Share of the pump's viscous and pressure friction into the delivered oil.
-    pub f_out: S,
-    /// Share of the pump's viscous and pressure friction into the case oil;
-    /// `1 - f_out - f_case` heats the pump housing (with the no-load friction).
-    pub f_case: S,
-    /// Pump no-load friction, kW per hrad/s (extended eq. 8).
-    pub k_m0: S,
-    /// Pump viscous friction at 40 degC, kW per (hrad/s)^2 (extended eq. 8).
-    pub k_mv: S,
-    /// Oil expansion coefficient alpha, 1/K (compression and throttling, h(T, p)).
-    pub alpha: S,
-    /// Relative slope of the case film conductance with the case-oil temperature,
-    /// 1/K, about `FILM_PROPERTY_C` (may be negative).
-    pub g_case_slope: S,
-    /// `alpha * 273.15`: `alpha T` with T in kelvin is `alpha_t0 + alpha t_degC`.
-    pub alpha_t0: S,
-    /// LNG inlet temperature, degC (eqs. 20-22).
-    pub lng_in: S,
-    /// Motor pole pairs (the speed check's electrical frequency, `crate::speedcheck`).
-    pub pole_pairs: S,
-    /// Commissioning safety margin on the drain-oil estimate, K: added by the
-    /// guard to the model's case oil for every decision and report, never fed
-    /// back into the model ([`ReducedParams::drain_margin_k`]).
-    pub drain_margin_k: S,
-    /// 1 / capacity of the metal states, K/kJ (oil nodes 0).
-    pub inv_c: [S; N_STATES],
-    /// Outer surfaces, constant conductance, kW/K (eqs. 15-16).
-    pub ga: [S; N_OUTER],
-    /// Outer surfaces, `|dT|^(1/4)` conductance, kW/K^1.25.
-    pub gb: [S; N_OUTER],
-    /// Outer surfaces, radiation `4 eps sigma A (300 K)^3`, kW/K (eq. 19).
-    pub gr: [S; N_OUTER],
-    /// Case oil <-> pump housing over `sqrt` speed grid, kW/K.
-    pub g_case: [S; N_TABLE],
-    /// Port passage <-> pump housing over flow, kW/K.
-    pub g_port: [S; N_TABLE],
-    /// Loop oil <-> main block over flow, kW/K.
-    pub g_loop: [S; N_TABLE],
-    /// Ball-valve oil <-> its block over flow, kW/K.
-    pub g_ball: [S; N_TABLE],
-    /// LNG exchanger `eps C_min` over flow, kW/K (eqs. 20-22).
-    pub g_lng: [S; N_TABLE],
-    /// Leakage ratio `mu(40) / mu(T)` over the temperature grid (1 at 40 degC,
-    /// non-decreasing).
-    pub leak_ratio: [S; N_TEMP],
-    /// Viscous friction ratio `mu(T) / mu(40)` over the temperature grid (1 at
-    /// 40 degC, non-increasing).
-    pub visc_ratio: [S; N_TEMP],
-    /// Case-gap speed factor `nu(40) / nu(T)` over the temperature grid (1 at
-    /// 40 degC, non-decreasing).
-    pub tc_speed: [S; N_TEMP],
-    /// Reynolds number of each duct (port, loop, ball) over 1e4 per L/s of flow at
-    /// the 40 degC viscosity.
-    pub re_q: [S; N_DUCTS],
-    /// Block walls behind the loop's and the ball-valve passage's films, kW/K.
-    pub g_wall: [S; 2],
-    /// The ducts' films at the Reynolds numbers of `params::DUCT_RE` (2300, 1e4,
-    /// 3e4, 1e5) on the coarse temperature grid, kW/K: per point `[port 2300, port
-    /// 1e4, port 3e4, port 1e5, loop ..., ball ...]`.
-    pub g_trans: [[S; N_RE * N_DUCTS]; N_COARSE],
-    /// Cooling at rest: decay rate of each node's bound on its excess over
-    /// the air, 1/s (all 0: no bound; [`ReducedParams::rest_rate_per_s`]).
-    pub rest_rate: [S; N_NODES],
-    /// Cooling at rest: the bound's mode shape, node order, in (0, 1]
-    /// ([`ReducedParams::rest_mode`]).
-    pub rest_mode: [S; N_NODES],
-    /// Exact-ZOH matrix `Phi = h phi1(h A)` of the model step over the first
-    /// [`N_PHI`] states, s.
-    pub phi: [[S; N_PHI]; N_PHI],
+/// Defines [`ModelConsts`] from one list of its fields (in word order, the
+/// only listing of them) with the walks over every field: [`ModelConsts::map`]
+/// and the field skeleton (`ModelConsts::<()>::UNIT`). A field's type is `S`,
+/// `[S; n]` or `[[S; n]; m]`.
+macro_rules! model_consts {
+    ($(#[$sm:meta])* pub struct ModelConsts<S> { $( $(#[$fm:meta])* $name:ident : $ty:tt, )* }) => {
+        $(#[$sm])*
+        pub struct ModelConsts<S> {
+            $( $(#[$fm])* pub $name: $ty, )*
+        }
+
+        impl<S: Copy> ModelConsts<S> {
+            /// Applies `f` to every word, in word order.
+            pub fn map<T: Copy>(&self, mut f: impl FnMut(S) -> T) -> ModelConsts<T> {
+                let c = self;
+                ModelConsts { $( $name: map_field!(f, c.$name, $ty), )* }
+            }
+        }
+
+        impl ModelConsts<()> {
+            /// The field skeleton (for [`ModelConsts::from_words`]).
+            const UNIT: Self = ModelConsts { $( $name: unit_field!($ty), )* };
+        }
+    };
+}
+
+/// One field of [`ModelConsts::map`]: `f` applied to each of its words.
+macro_rules! map_field {
+    ($f:ident, $x:expr, [[S; $n:expr]; $m:expr]) => {
+        $x.map(|r| r.map(&mut $f))
+    };
+    ($f:ident, $x:expr, [S; $n:expr]) => {
+        $x.map(&mut $f)
+    };
+    ($f:ident, $x:expr, S) => {
+        $f($x)
+    };
+}
+
+/// One field of the skeleton `ModelConsts::<()>::UNIT`.
+macro_rules! unit_field {
+    ([[S; $n:expr]; $m:expr]) => {
+        [[(); $n]; $m]
+    };
+    ([S; $n:expr]) => {
+        [(); $n]
+    };
+    (S) => {
+        ()
+    };
+}
+
+model_consts! {
+    /// Constants of the reduced model in model units, scalar type `S` (`f64` on the
+    /// host, `f32` in a parameter block). Field order is the block's word order.
+    #[derive(Clone, Copy, Debug, PartialEq)]
+    #[repr(C)]
+    pub struct ModelConsts<S> {
+        /// Case pressure, hbar.
+        p_case: S,
+        /// Pump leakage flow per port, L/s per hbar (eqs. 5-7).
+        k_lf: S,
+        /// Half of [`Self::k_lf`] (the case receives the mean of both ports' leakage).
+        k_lf_half: S,
+        /// Pump leakage heat, kW per hbar^2 (eqs. 5-7).
+        k_lp: S,
+        /// Pump mechanical loss, kW per (hbar hrad/s) (eq. 8).
+        k_mech: S,
+        /// Pump flow, L/s per hrad/s.
+        k_q: S,
+        /// Piston flow, L/s per (mm per tick).
+        k_a: S,
+        /// Throttling power, kW per (hbar L/s).
+        k_dpq: S,
+        /// Line loss, kW per (L/s)^2 (eq. 10, laminar part).
+        r1: S,
+        /// Line loss, kW per (L/s)^3 (eq. 10, local losses).
+        r2: S,
+        /// Actuator heat weight of `dp^2` (eq. 11), of [`Self::k_act`] (≤ 1).
+        w_dp: S,
+        /// Actuator heat weight of `dx^2` (seal friction), of [`Self::k_act`] (≤ 1).
+        w_dx: S,
+        /// Actuator heat scale, kW: `k_act (w_dp dp^2 + w_dx dx^2)` per tick.
+        k_act: S,
+        /// Copper loss, kW per hA^2 (eq. 1).
+        k_cu: S,
+        /// Shaft power from the current, kW per (hA hrad/s) (cross-check); 0 disables it.
+        k_sh: S,
+        /// Hydraulic power of the displacement, kW per (hbar hrad/s) (cross-check).
+        k_hyd: S,
+        /// Iron loss, hysteresis, kW per hrad/s (eq. 2).
+        fe1: S,
+        /// Iron loss, eddy, kW per (hrad/s)^2 (eq. 2).
+        fe2: S,
+        /// Iron loss, excess, kW per (hrad/s)^1.5 (eq. 2).
+        fe15: S,
+        /// Flow-table index scale `(N_TABLE - 1) / sqrt(q_max)`, per sqrt(L/s).
+        q_scale: S,
+        /// Speed-table index scale `(N_TABLE - 1) / sqrt(w_max)`, per sqrt(hrad/s).
+        w_scale: S,
+        /// Oil `rho c_p` at 0 degC, kJ/(L K).
+        rc0: S,
+        /// Slope of `rho c_p`, kJ/(L K^2).
+        rc1: S,
+        /// Curvature of `rho c_p`, kJ/(L K^3) (density and specific heat both linear).
+        rc2: S,
+        /// 1 / case oil volume, 1/L.
+        inv_v_case: S,
+        /// 1 / loop oil volume, 1/L.
+        inv_v_loop: S,
+        /// One port passage's oil volume, L.
+        v_port: S,
+        /// Ball-valve passage oil volume, L.
+        v_ball: S,
+        /// 1 / ring oil volume, 1/L.
+        inv_v_ring: S,
+        /// Share of the pump's viscous and pressure friction into the delivered oil.
+        f_out: S,
+        /// Share of the pump's viscous and pressure friction into the case oil;
+        /// `1 - f_out - f_case` heats the pump housing (with the no-load friction).
+        f_case: S,
+        /// Pump no-load friction, kW per hrad/s (extended eq. 8).
+        k_m0: S,
+        /// Pump viscous friction at 40 degC, kW per (hrad/s)^2 (extended eq. 8).
+        k_mv: S,
+        /// Oil expansion coefficient alpha, 1/K (compression and throttling, h(T, p)).
+        alpha: S,
+        /// Relative slope of the case film conductance with the case-oil temperature,
+        /// 1/K, about `FILM_PROPERTY_C` (may be negative).
+        g_case_slope: S,
+        /// `alpha * 273.15`: `alpha T` with T in kelvin is `alpha_t0 + alpha t_degC`.
+        alpha_t0: S,
+        /// LNG inlet temperature, degC (eqs. 20-22).
+        lng_in: S,
+        /// Motor pole pairs (the speed check's electrical frequency, `crate::speedcheck`).
+        pole_pairs: S,
+        /// Commissioning safety margin on the drain-oil estimate, K: added by the
+        /// guard to the model's case oil for every decision and report, never fed
+        /// back into the model ([`ReducedParams::drain_margin_k`]).
+        drain_margin_k: S,
+        /// 1 / capacity of the metal states, K/kJ (oil nodes 0).
+        inv_c: [S; N_STATES],
+        /// Outer surfaces, constant conductance, kW/K (eqs. 15-16).
+        ga: [S; N_OUTER],
+        /// Outer surfaces, `|dT|^(1/4)` conductance, kW/K^1.25.
+        gb: [S; N_OUTER],
+        /// Outer surfaces, radiation `4 eps sigma A (300 K)^3`, kW/K (eq. 19).
+        gr: [S; N_OUTER],
+        /// Case oil <-> pump housing over `sqrt` speed grid, kW/K.
+        g_case: [S; N_TABLE],
+        /// Port passage <-> pump housing over flow, kW/K.
+        g_port: [S; N_TABLE],
+        /// Loop oil <-> main block over flow, kW/K.
+        g_loop: [S; N_TABLE],
+        /// Ball-valve oil <-> its block over flow, kW/K.
+        g_ball: [S; N_TABLE],
+        /// LNG exchanger `eps C_min` over flow, kW/K (eqs. 20-22).
+        g_lng: [S; N_TABLE],
+        /// Leakage ratio `mu(40) / mu(T)` over the temperature grid (1 at 40 degC,
+        /// non-decreasing).
+        leak_ratio: [S; N_TEMP],
+        /// Viscous friction ratio `mu(T) / mu(40)` over the temperature grid (1 at
+        /// 40 degC, non-increasing).
+        visc_ratio: [S; N_TEMP],
+        /// Case-gap speed factor `nu(40) / nu(T)` over the temperature grid (1 at
+        /// 40 degC, non-decreasing).
+        tc_speed: [S; N_TEMP],
+        /// Reynolds number of each duct (port, loop, ball) over 1e4 per L/s of flow at
+        /// the 40 degC viscosity.
+        re_q: [S; N_DUCTS],
+        /// Block walls behind the loop's and the ball-valve passage's films, kW/K.
+        g_wall: [S; 2],
+        /// The ducts' films at the Reynolds numbers of `params::DUCT_RE` (2300, 1e4,
+        /// 3e4, 1e5) on the coarse temperature grid, kW/K: per point `[port 2300, port
+        /// 1e4, port 3e4, port 1e5, loop ..., ball ...]`.
+        g_trans: [[S; N_RE * N_DUCTS]; N_COARSE],
+        /// Cooling at rest: decay rate of each node's bound on its excess over
+        /// the air, 1/s (all 0: no bound; [`ReducedParams::rest_rate_per_s`]).
+        rest_rate: [S; N_NODES],
+        /// Cooling at rest: the bound's mode shape, node order, in (0, 1]
+        /// ([`ReducedParams::rest_mode`]).
+        rest_mode: [S; N_NODES],
+        /// Exact-ZOH matrix `Phi = h phi1(h A)` of the model step over the first
+        /// [`N_PHI`] states, s.
+        phi: [[S; N_PHI]; N_PHI],
+    }
 }
 
 mod sealed {
@@ -204,70 +258,6 @@ const _: () = assert!(core::mem::size_of::<ModelConsts<f64>>() == 8 * N_WORDS);
 pub const MAX_ABS: f32 = 250.0;
 
 impl<S: Copy> ModelConsts<S> {
-    /// Applies `f` to every word, in word order (the only listing of the fields).
-    pub fn map<T: Copy>(&self, mut f: impl FnMut(S) -> T) -> ModelConsts<T> {
-        let c = self;
-        ModelConsts {
-            p_case: f(c.p_case),
-            k_lf: f(c.k_lf),
-            k_lf_half: f(c.k_lf_half),
-            k_lp: f(c.k_lp),
-            k_mech: f(c.k_mech),
-            k_q: f(c.k_q),
-            k_a: f(c.k_a),
-            k_dpq: f(c.k_dpq),
-            r1: f(c.r1),
-            r2: f(c.r2),
-            w_dp: f(c.w_dp),
-            w_dx: f(c.w_dx),
-            k_act: f(c.k_act),
-            k_cu: f(c.k_cu),
-            k_sh: f(c.k_sh),
-            k_hyd: f(c.k_hyd),
-            fe1: f(c.fe1),
-            fe2: f(c.fe2),
-            fe15: f(c.fe15),
-            q_scale: f(c.q_scale),
-            w_scale: f(c.w_scale),
-            rc0: f(c.rc0),
-            rc1: f(c.rc1),
-            rc2: f(c.rc2),
-            inv_v_case: f(c.inv_v_case),
-            inv_v_loop: f(c.inv_v_loop),
-            v_port: f(c.v_port),
-            v_ball: f(c.v_ball),
-            inv_v_ring: f(c.inv_v_ring),
-            f_out: f(c.f_out),
-            f_case: f(c.f_case),
-            k_m0: f(c.k_m0),
-            k_mv: f(c.k_mv),
-            alpha: f(c.alpha),
-            g_case_slope: f(c.g_case_slope),
-            alpha_t0: f(c.alpha_t0),
-            lng_in: f(c.lng_in),
-            pole_pairs: f(c.pole_pairs),
-            drain_margin_k: f(c.drain_margin_k),
-            inv_c: c.inv_c.map(&mut f),
-            ga: c.ga.map(&mut f),
-            gb: c.gb.map(&mut f),
-            gr: c.gr.map(&mut f),
-            g_case: c.g_case.map(&mut f),
-            g_port: c.g_port.map(&mut f),
-            g_loop: c.g_loop.map(&mut f),
-            g_ball: c.g_ball.map(&mut f),
-            g_lng: c.g_lng.map(&mut f),
-            leak_ratio: c.leak_ratio.map(&mut f),
-            visc_ratio: c.visc_ratio.map(&mut f),
-            tc_speed: c.tc_speed.map(&mut f),
-            re_q: c.re_q.map(&mut f),
-            g_wall: c.g_wall.map(&mut f),
-            g_trans: c.g_trans.map(|r| r.map(&mut f)),
-            rest_rate: c.rest_rate.map(&mut f),
-            rest_mode: c.rest_mode.map(&mut f),
-            phi: c.phi.map(|r| r.map(&mut f)),
-        }
-    }
-
     /// Calls `f` on every word in word order.
     pub fn for_each(&self, f: impl FnMut(S)) {
         let _ = self.map(f);
@@ -278,69 +268,6 @@ impl<S: Copy> ModelConsts<S> {
     pub fn from_words(mut next: impl FnMut() -> S) -> Self {
         ModelConsts::<()>::UNIT.map(|()| next())
     }
-}
-
-impl ModelConsts<()> {
-    /// The field skeleton (for [`ModelConsts::from_words`]).
-    const UNIT: Self = ModelConsts {
-        p_case: (),
-        k_lf: (),
-        k_lf_half: (),
-        k_lp: (),
-        k_mech: (),
-        k_q: (),
-        k_a: (),
-        k_dpq: (),
-        r1: (),
-        r2: (),
-        w_dp: (),
-        w_dx: (),
-        k_act: (),
-        k_cu: (),
-        k_sh: (),
-        k_hyd: (),
-        fe1: (),
-        fe2: (),
-        fe15: (),
-        q_scale: (),
-        w_scale: (),
-        rc0: (),
-        rc1: (),
-        rc2: (),
-        inv_v_case: (),
-        inv_v_loop: (),
-        v_port: (),
-        v_ball: (),
-        inv_v_ring: (),
-        f_out: (),
-        f_case: (),
-        k_m0: (),
-        k_mv: (),
-        alpha: (),
-        g_case_slope: (),
-        alpha_t0: (),
-        lng_in: (),
-        pole_pairs: (),
-        drain_margin_k: (),
-        inv_c: [(); N_STATES],
-        ga: [(); N_OUTER],
-        gb: [(); N_OUTER],
-        gr: [(); N_OUTER],
-        g_case: [(); N_TABLE],
-        g_port: [(); N_TABLE],
-        g_loop: [(); N_TABLE],
-        g_ball: [(); N_TABLE],
-        g_lng: [(); N_TABLE],
-        leak_ratio: [(); N_TEMP],
-        visc_ratio: [(); N_TEMP],
-        tc_speed: [(); N_TEMP],
-        re_q: [(); N_DUCTS],
-        g_wall: [(); 2],
-        g_trans: [[(); N_RE * N_DUCTS]; N_COARSE],
-        rest_rate: [(); N_NODES],
-        rest_mode: [(); N_NODES],
-        phi: [[(); N_PHI]; N_PHI],
-    };
 }
 
 impl ModelConsts<f64> {
@@ -561,66 +488,5 @@ pub fn derive(p: &ReducedParams) -> Result<ModelConsts<f64>, ConfigError> {
         Ok(c)
     } else {
         Err(ConfigError::ConstantRange)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    extern crate std;
-    use crate::params::{DEFAULT, DEFAULT_CONSTS};
-
-    /// `src/default_consts.rs` is `derive(&DEFAULT)` rounded to f32, bit for bit
-    /// (regenerate with `cargo run --release -p eha-sim --example reduce -- --consts-only`).
-    #[test]
-    fn default_consts_are_derived_from_default() {
-        let d = derive(&DEFAULT).unwrap().to_f32();
-        let (mut a, mut b) = (std::vec::Vec::new(), std::vec::Vec::new());
-        d.for_each(|x| a.push(x.to_bits()));
-        DEFAULT_CONSTS.for_each(|x| b.push(x.to_bits()));
-        assert_eq!(a.len(), N_WORDS);
-        assert_eq!(a, b);
-    }
-
-    /// Words round-trip in order through `for_each` / `from_words`.
-    #[test]
-    fn words_round_trip() {
-        let mut w = std::vec::Vec::new();
-        DEFAULT_CONSTS.for_each(|x| w.push(x));
-        let mut it = w.iter();
-        let back = ModelConsts::from_words(|| it.next().copied().unwrap_or(f32::NAN));
-        assert_eq!(back, DEFAULT_CONSTS);
-    }
-
-    /// Implausible words are refused by the value check.
-    #[test]
-    fn bad_words_are_refused() {
-        let mut c = DEFAULT_CONSTS;
-        c.g_case[3] = -0.1;
-        assert_eq!(c.check_values(), Err(ConfigError::Implausible));
-        let mut c = DEFAULT_CONSTS;
-        c.k_mech = f32::NAN;
-        assert_eq!(c.check_values(), Err(ConfigError::ConstantRange));
-        let mut c = DEFAULT_CONSTS;
-        c.rc1 = 300.0;
-        assert_eq!(c.check_values(), Err(ConfigError::ConstantRange));
-        // the new words' bounds: a temperature table not referred to 40 degC or
-        // not monotonic, shares over 1
-        let mut c = DEFAULT_CONSTS;
-        c.leak_ratio = c.leak_ratio.map(|x| x * 1.01);
-        assert_eq!(c.check_values(), Err(ConfigError::Implausible));
-        let mut c = DEFAULT_CONSTS;
-        c.visc_ratio.swap(0, 1);
-        assert_eq!(c.check_values(), Err(ConfigError::Implausible));
-        let mut c = DEFAULT_CONSTS;
-        c.f_out = 0.9;
-        assert_eq!(c.check_values(), Err(ConfigError::Implausible));
-        // an Euler state with a capacity so small against its conductance that its
-        // step would overshoot (the actuator at 1/20 of its capacity: its tidal
-        // exchange at 1 m/s piston speed then gives h G / C = 0.9)
-        let mut c = DEFAULT_CONSTS;
-        c.inv_c[crate::params::NODE_ACTUATOR] *= 20.0;
-        assert_eq!(c.check_values(), Err(ConfigError::Implausible));
-        assert_eq!(DEFAULT_CONSTS.check_values(), Ok(()));
     }
 }

@@ -30,6 +30,9 @@
 
 pub mod bounds;
 pub mod consts;
+#[cfg(test)]
+mod consts_tests;
+mod default_consts;
 pub mod physics_checks;
 mod init;
 mod input;
@@ -42,6 +45,7 @@ pub mod table;
 use crate::linalg::expm1m;
 use crate::num::Num;
 pub use consts::{ModelConsts, Word};
+pub use default_consts::DEFAULT_CONSTS;
 pub use crate::params::{
     ReducedParams, N_NODES, N_OUTER, N_PHI, N_STATES, N_TABLE, N_TEMP, NODE_ACTUATOR, NODE_BALL_BLOCK, NODE_DRAIN, NODE_LOOP,
     NODE_MAIN_BLOCK, NODE_PUMP, OUTER_NODES, S_PER_STEP, S_PER_TICK, TICKS_PER_STEP,

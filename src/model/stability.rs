@@ -173,7 +173,7 @@ fn mat_mul(a: &[[f32; N_PHI]; N_PHI], b: &[[f32; N_PHI]; N_PHI]) -> [[f32; N_PHI
 mod tests {
     use super::*;
     use crate::num::Fx;
-    use crate::params::DEFAULT_CONSTS;
+    use crate::model::DEFAULT_CONSTS;
     extern crate std;
     use std::println;
 

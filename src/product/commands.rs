@@ -243,26 +243,17 @@ impl<N: Num> AppOf<N> {
     // cold path, kept out of the tick loop's code (flash)
     #[inline(never)]
     pub fn status<B: Board>(&self, board: &B, token: u16) -> Status {
-        let c = &self.counters;
         Status {
             token,
             tick: self.tick,
-            overruns: c.overruns,
+            counters: self.counters,
             worst_tick_cycles: self.worst_tick_cycles,
             stack_high_water_b: u16::try_from(board.stack_high_water_b()).unwrap_or(u16::MAX),
             boot_stack_b: u16::try_from(board.boot_stack_b()).unwrap_or(u16::MAX),
             reset_cause: self.reset_cause as u8,
             restore: wire::restore_code(self.restore),
             boots: self.boots,
-            rejected_crc: c.rejected_crc,
-            rejected_framing: c.rejected_framing,
-            rejected_sequence: c.rejected_sequence,
-            superseded: c.superseded,
-            accepted: c.accepted,
-            missing: c.missing,
             rx_overflow: u16::try_from(board.rx_dropped()).unwrap_or(u16::MAX),
-            commands: c.commands,
-            nv_failures: c.nv_failures,
             faults: self.guard.faults(),
             protocol: crate::protocol::PROTOCOL_VERSION,
         }

@@ -26,6 +26,7 @@ pub mod wire;
 
 pub use commands::CommandRules;
 pub use records::RecordKeeper;
+pub use wire::Counters;
 
 use crate::memory::nv::{NvLoad, NvPolicy};
 use crate::protection::LngConfig;
@@ -174,36 +175,6 @@ pub struct BootMemory {
     pub hw_hint: Option<ResetCause>,
 }
 
-/// Frame and tick counters of the product loop (saturating).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Counters {
-    /// Frames with a CRC mismatch.
-    pub rejected_crc: u16,
-    /// Frames with bad COBS, length, kind, or a full command queue.
-    pub rejected_framing: u16,
-    /// Samples that were duplicates or older than the last accepted one.
-    pub rejected_sequence: u16,
-    /// Samples replaced by a newer one within the same tick.
-    pub superseded: u16,
-    /// Samples accepted.
-    pub accepted: u32,
-    /// Ticks without a new sample.
-    pub missing: u32,
-    /// Timer periods lost to ticks that overran.
-    pub overruns: u32,
-    /// Commands executed.
-    pub commands: u16,
-    /// Non-volatile saves that failed (each followed by [`NV_RETRY_TICKS`]
-    /// without an attempt).
-    pub nv_failures: u16,
-}
-
-impl Counters {
-    fn rejected(&self) -> u16 {
-        self.rejected_crc.saturating_add(self.rejected_framing).saturating_add(self.rejected_sequence)
-    }
-}
-
 /// The model constants of a boot and where they come from: a valid
 /// parameter block (and its rig id, the key of the armed commands), else
 /// `default` (the compiled-in paper rig on the boards: NOT_COMMISSIONED,
@@ -300,41 +271,45 @@ pub type App = AppOf<Real>;
 /// The product application state (one per board, lives for the whole run),
 /// generic over the guard's number type (the boards run [`App`]; the host
 /// runs the fixed-point build's too, as the twin of the M3 PIL image).
+/// `repr(C)`: the fields in their declared order, the guard first (its
+/// model's addresses are immediates of the hot code: a reshuffle of the
+/// fields around it changed the product image by hundreds of bytes).
 #[derive(Clone)]
+#[repr(C)]
 pub struct AppOf<N: Num> {
-    lng: LngConfig,
     guard: GuardOf<N>,
-    rx: Deframer,
-    /// The bytes of one read from the board's receive buffer.
-    rx_buf: [u8; RX_READ],
     /// The tick reply's encoder (re-frames only the per-tick tail while
     /// the outputs, pins and counters hold).
     reply: ReplyEncoder,
-    /// The tick reply's bytes on a board that takes them by
-    /// [`Board::write_tx`].
-    tx_buf: [u8; MAX_WIRE],
-    last_seq: Option<u16>,
-    sample: Option<Request>,
-    commands: Deque<Command, COMMAND_QUEUE>,
-    counters: Counters,
     /// The thermal record's write rules (A/B slots, non-volatile policy).
     records: RecordKeeper,
+    /// The keyed commands' rules (clear, refill).
+    rules: CommandRules,
+    sample: Option<Request>,
+    last_seq: Option<u16>,
+    commands: Deque<Command, COMMAND_QUEUE>,
+    rx: Deframer,
+    lng: LngConfig,
+    /// The bytes of one read from the board's receive buffer.
+    rx_buf: [u8; RX_READ],
+    counters: Counters,
     /// Tick of the last last-alive stamp ([`Board::rtc_alive`]).
     alive_at: u32,
     /// Timer periods the last non-volatile save stalled the core (the
     /// next tick accounts them as blind, not missing).
     stalled: u32,
     tick: u32,
-    restore: RestoreKind,
-    reset_cause: ResetCause,
-    boots: u16,
     worst_tick_cycles: u32,
     /// Trace dump in progress: token, next index, events in the dump.
     dump: Option<(u16, u8, u8)>,
+    boots: u16,
+    restore: RestoreKind,
+    reset_cause: ResetCause,
     /// Where the model constants of this boot come from.
     params: ParamSource,
-    /// The keyed commands' rules (clear, refill).
-    rules: CommandRules,
+    /// The tick reply's bytes on a board that takes them by
+    /// [`Board::write_tx`].
+    tx_buf: [u8; MAX_WIRE],
 }
 
 fn restore_kind(r: &Restore) -> RestoreKind {
@@ -460,14 +435,16 @@ impl<N: Num> AppOf<N> {
         if lost > 0 {
             self.catch_up(lost);
         }
-        let fresh = self.sample.take();
-        let out = match &fresh {
-            Some(req) => self.guard.tick_reported(&req.sample(), &req.reports()),
+        // (the request is used where it is stored: no copy on the stack)
+        let fresh = self.sample.is_some();
+        let out = match &self.sample {
+            Some(req) => self.guard.tick_reported(&req.sample, &req.reports),
             None => {
                 self.counters.missing = self.counters.missing.saturating_add(1);
                 self.guard.tick_missing()
             }
         };
+        self.sample = None;
 
         // 3. outputs: the thermal record first (a failed save changes the
         // outputs: derate), then the pins and the reply
@@ -481,7 +458,7 @@ impl<N: Num> AppOf<N> {
         let reply = TickReply {
             tick: self.tick,
             sample_seq: self.last_seq.unwrap_or(0),
-            fresh: fresh.is_some(),
+            fresh,
             not_commissioned: self.params == ParamSource::Default,
             out,
             pins,

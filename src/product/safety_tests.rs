@@ -178,7 +178,7 @@ fn a_detected_actuator_fault_derates() {
     for k in 1..100u16 {
         // the valve reports open while commanded shut (cold oil; pump at
         // rest, so the sensor cross-check has nothing to compare)
-        b.push_rx(&Request { valve_fb: Some(true), speed_rpm: 0.0, ..sample(k, 0.0, 5.0) }.encode());
+        b.push_rx(&Request { reports: crate::Reports { valve_fb: Some(true), ..crate::Reports::default() }, ..super::tests::at_rest(k, 0.0, 5.0) }.encode());
         app.tick(&mut *b, 0);
         last = *ticks(&replies(&mut b)).last().expect("a tick reply");
     }
@@ -212,7 +212,7 @@ fn rediscretised(mut c: crate::model::ModelConsts<f32>) -> crate::model::ModelCo
 /// rate (the minimum-heating check).
 #[test]
 fn a_block_whose_model_cannot_heat_is_refused() {
-    let mut zero = crate::params::DEFAULT_CONSTS;
+    let mut zero = crate::model::DEFAULT_CONSTS;
     let mut tiny = zero;
     for (z, t) in [
         (&mut zero.k_lf, &mut tiny.k_lf),
@@ -244,7 +244,7 @@ fn a_block_whose_model_cannot_heat_is_refused() {
 /// `k_sh = 0` switched the sensor cross-check off without a word: refused.
 #[test]
 fn a_block_without_a_torque_constant_is_refused() {
-    let c = crate::model::ModelConsts { k_sh: 0.0, ..crate::params::DEFAULT_CONSTS };
+    let c = crate::model::ModelConsts { k_sh: 0.0, ..crate::model::DEFAULT_CONSTS };
     let (src, f, _) = boot_with_block(&c);
     assert!(f.contains(faults::CONFIG), "k_sh = 0 accepted: source {src:?}, faults {f:?}");
 }
@@ -253,7 +253,7 @@ fn a_block_without_a_torque_constant_is_refused() {
 /// bound claiming 100 times the cooling is refused, not trusted.
 #[test]
 fn a_block_claiming_more_cooling_at_rest_than_its_model_is_refused() {
-    let mut c = crate::params::DEFAULT_CONSTS;
+    let mut c = crate::model::DEFAULT_CONSTS;
     for r in c.rest_rate.iter_mut() {
         *r *= 100.0;
     }
@@ -266,7 +266,7 @@ fn a_block_claiming_more_cooling_at_rest_than_its_model_is_refused() {
 /// sample, up to 10 s later).
 #[test]
 fn a_refused_block_shows_the_alarm_from_the_first_instant() {
-    let mut torn = params_block::encode(&crate::params::DEFAULT_CONSTS, "torn");
+    let mut torn = params_block::encode(&crate::model::DEFAULT_CONSTS, "torn");
     torn[500] ^= 0x10;
     let mut b = board();
     b.block = Some(super::tests::flash_block(torn));
@@ -301,15 +301,8 @@ fn run_case1(ticks: u32, speed: impl Fn(u32) -> f32, elec: bool) -> std::vec::Ve
     for k in 0..ticks {
         let r = Request {
             seq: (k & 0xFFFF) as u16,
-            current_a: current_a(65.0, 5.0, 500.0, oil_c),
-            p_a_bar: 65.0,
-            p_b_bar: 5.0,
-            speed_rpm: speed(k),
-            position_mm: 0.0,
-            ambient_c: 20.0,
-            valve_fb: Some(open),
-            elec_hz: elec.then_some(500.0 / 60.0 * 4.0),
-            lng_supply_bar: None,
+            sample: crate::Sample { current_a: current_a(65.0, 5.0, 500.0, oil_c), p_a_bar: 65.0, p_b_bar: 5.0, speed_rpm: speed(k), position_mm: 0.0, ambient_c: 20.0 },
+            reports: crate::Reports { valve_fb: Some(open), elec_hz: elec.then_some(500.0 / 60.0 * 4.0), lng_supply_bar: None },
         };
         b.push_rx(&r.encode());
         app.tick(&mut *b, 0);
@@ -327,7 +320,7 @@ fn ticks_of(b: &mut MemBoard) -> std::vec::Vec<TickReply> {
 
 /// The first tick with SENSOR_DISAGREE and the speed channel latched bad.
 fn speed_fault_at(t: &[TickReply]) -> Option<u32> {
-    t.iter().position(|r| r.out.faults.contains(faults::SENSOR_DISAGREE | crate::Faults::channels(crate::validate::CH_SPEED)) && r.out.valve_open).map(|k| k as u32)
+    t.iter().position(|r| r.out.faults.contains(faults::SENSOR_DISAGREE | crate::Faults::channels(crate::ChannelSet::SPEED)) && r.out.valve_open).map(|k| k as u32)
 }
 
 /// With the drive's electrical frequency as a second speed source, a speed
@@ -429,7 +422,7 @@ fn settle(app: &mut App, b: &mut MemBoard, from: u16, n: u16, cmds: &[&[u8]]) ->
                 b.push_rx(c);
             }
         }
-        b.push_rx(&Request { speed_rpm: 0.0, ..sample(from.wrapping_add(k), 0.0, 5.0) }.encode());
+        b.push_rx(&super::tests::at_rest(from.wrapping_add(k), 0.0, 5.0).encode());
         app.tick(b, 0);
         last = ticks_of(b).last().copied();
     }
@@ -442,7 +435,7 @@ fn settle(app: &mut App, b: &mut MemBoard, from: u16, n: u16, cmds: &[&[u8]]) ->
 fn one_crc_valid_frame_does_not_clear_faults() {
     let mut b = board();
     let mut app = boot(&mut b);
-    b.push_rx(&Request { current_a: f32::NAN, ..sample(0, 0.0, 5.0) }.encode());
+    b.push_rx(&super::tests::sample(0, f32::NAN, 5.0).encode());
     app.tick(&mut *b, 0);
     let r = settle(&mut app, &mut b, 1, 150, &[]);
     assert!(r.out.faults.contains(faults::NON_FINITE));
@@ -483,7 +476,7 @@ fn a_refill_while_the_valve_is_open_is_refused() {
     let r = settle(&mut app, &mut b, 50, 5, &[&refill]);
     assert_eq!(r.out.lng_remaining_kg, 0.0, "refilled with the valve open and the alarm on");
     // armed and keyed: refused by the rule
-    let a = super::tests::arm_confirm(&mut app, &mut b, 9, wire::Cmd::RefillArm, wire::Cmd::RefillConfirm, 55, &Request { speed_rpm: 0.0, ..sample(0, 0.0, 5.0) });
+    let a = super::tests::arm_confirm(&mut app, &mut b, 9, wire::Cmd::RefillArm, wire::Cmd::RefillConfirm, 55, &super::tests::at_rest(0, 0.0, 5.0));
     assert_eq!((a.result, a.value), (wire::AckResult::Refused, wire::Refusal::Rule as u32), "{a:?}");
     assert_eq!(app.guard.output().lng_remaining_kg, 0.0);
 }
@@ -497,7 +490,7 @@ fn armed_commands_need_the_key_the_window_and_the_interval() {
     use wire::{Ack, AckResult, Cmd, Command, FromGuard, Refusal};
     let mut b = board();
     let mut app = boot(&mut b);
-    let rest = |k: u16| Request { speed_rpm: 0.0, ..sample(k, 0.0, 5.0) };
+    let rest = |k: u16| super::tests::at_rest(k, 0.0, 5.0);
     settle(&mut app, &mut b, 0, 200, &[]);
     let ack = |b: &mut MemBoard, token: u16| -> Ack {
         replies(b).iter().find_map(|f| match f {
@@ -573,7 +566,7 @@ fn a_controller_clearing_in_a_loop_clears_at_most_every_ten_seconds() {
             None => Command { token: k, cmd: Cmd::ClearArm, arg: 0 },
         };
         b.push_rx(&c.encode());
-        b.push_rx(&Request { speed_rpm: 0.0, ..sample(k, 0.0, 5.0) }.encode());
+        b.push_rx(&super::tests::at_rest(k, 0.0, 5.0).encode());
         app.tick(&mut *b, 0);
         for f in replies(&mut b) {
             if let FromGuard::Ack(a) = f {
@@ -617,15 +610,8 @@ fn a_flash_erase_stall_is_accounted_without_stale() {
     for k in 0..60_000u32 {
         let r = Request {
             seq: (k & 0xFFFF) as u16,
-            current_a: current_a(65.0, 5.0, 500.0, oil_c),
-            p_a_bar: 65.0,
-            p_b_bar: 5.0,
-            speed_rpm: 500.0,
-            position_mm: 0.0,
-            ambient_c: 20.0,
-            valve_fb: Some(open),
-            elec_hz: None,
-            lng_supply_bar: None,
+            sample: crate::Sample { current_a: current_a(65.0, 5.0, 500.0, oil_c), p_a_bar: 65.0, p_b_bar: 5.0, speed_rpm: 500.0, position_mm: 0.0, ambient_c: 20.0 },
+            reports: crate::Reports { valve_fb: Some(open), elec_hz: None, lng_supply_bar: None },
         };
         b.push_rx(&r.encode());
         let before = b.ticks;
@@ -641,5 +627,5 @@ fn a_flash_erase_stall_is_accounted_without_stale() {
     assert!(erased >= 1 && stalls >= 1, "{erased} erases, {stalls} stalls");
     assert!(!worst.intersects(faults::STALE | faults::LATCHED), "an erase stall latched {worst:?}");
     let st = app.status(&*b, 0);
-    assert!(st.overruns >= 300 * erased, "the stalls are counted as overruns: {}", st.overruns);
+    assert!(st.counters.overruns >= 300 * erased, "the stalls are counted as overruns: {}", st.counters.overruns);
 }

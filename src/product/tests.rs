@@ -30,16 +30,16 @@ pub(super) fn board() -> std::boxed::Box<MemBoard> {
 pub(super) fn sample(seq: u16, current_a: f32, p_a_bar: f32) -> Request {
     Request {
         seq,
-        current_a,
-        p_a_bar,
-        p_b_bar: 3.0,
-        speed_rpm: 500.0,
-        position_mm: 0.0,
-        ambient_c: 30.0,
-        valve_fb: None,
-        elec_hz: None,
-        lng_supply_bar: None,
+        sample: crate::Sample { current_a, p_a_bar, p_b_bar: 3.0, speed_rpm: 500.0, position_mm: 0.0, ambient_c: 30.0 },
+        reports: crate::Reports::default(),
     }
+}
+
+/// [`sample`] at rest (speed 0).
+pub(super) fn at_rest(seq: u16, current_a: f32, p_a_bar: f32) -> Request {
+    let mut r = sample(seq, current_a, p_a_bar);
+    r.sample.speed_rpm = 0.0;
+    r
 }
 
 pub(super) fn ticks(r: &[FromGuard]) -> StdVec<TickReply> {
@@ -76,7 +76,7 @@ fn one_sample_per_tick_matches_the_bare_guard() {
         let s = sample(k, 20.0 + f32::from(k % 7), 60.0);
         b.push_rx(&s.encode());
         app.tick(&mut *b, 0);
-        let want = bare.tick(&s.sample());
+        let want = bare.tick(&s.sample);
         let t = ticks(&replies(&mut b));
         assert_eq!(t.len(), 1);
         assert!(t[0].fresh && t[0].sample_seq == k);
@@ -187,12 +187,12 @@ fn commands_status_refill_clear_trace() {
     app.tick(&mut *b, 0);
     let cmd = |token, cmd| Command { token, cmd, arg: 0 }.encode();
     // the pump at rest, consistent sensors
-    let rest = |k| Request { speed_rpm: 0.0, ..sample(k, 0.0, 5.0) };
+    let rest = |k| at_rest(k, 0.0, 5.0);
     b.push_rx(&cmd(9, Cmd::Status));
     app.tick(&mut *b, 0);
     let r = replies(&mut b);
     let st = r.iter().find_map(|f| if let FromGuard::Status(s) = f { Some(*s) } else { None }).expect("status");
-    assert_eq!((st.token, st.tick, st.missing, st.faults.intersects(crate::faults::NON_FINITE)), (9, 2, 1, true));
+    assert_eq!((st.token, st.tick, st.counters.missing, st.faults.intersects(crate::faults::NON_FINITE)), (9, 2, 1, true));
     let a = arm_confirm(&mut app, &mut b, 7, Cmd::ClearArm, Cmd::ClearConfirm, 2, &rest(2));
     assert_eq!((a.cmd, a.result, a.value), (Cmd::ClearConfirm, AckResult::Refused, wire::Refusal::Rule as u32), "clear rule not met");
     // 100 valid ticks, then the clear succeeds (the interval counts
@@ -328,7 +328,7 @@ pub(super) fn flash_block(bytes: [u8; BLOCK_LEN]) -> &'static [u8; BLOCK_LEN] {
 /// stability check's 1e-7 s and the block would be refused). Checked to build.
 pub(super) fn other_rig() -> crate::model::ModelConsts<f32> {
     use crate::model::{etd_matrix, Model};
-    let mut c = crate::model::ModelConsts { k_mech: crate::params::DEFAULT_CONSTS.k_mech * 1.5, ..crate::params::DEFAULT_CONSTS };
+    let mut c = crate::model::ModelConsts { k_mech: crate::model::DEFAULT_CONSTS.k_mech * 1.5, ..crate::model::DEFAULT_CONSTS };
     let j = Model::<f32>::for_linearisation(&c).map(|m| m.nominal_jacobian_f32().map(|r| r.map(f64::from)));
     c.phi = etd_matrix(&j.unwrap_or_default(), crate::params::S_PER_STEP).map(|r| r.map(|x| x as f32));
     assert_eq!(Model::<f32>::from_consts(&c).err(), None, "the other rig's constants must build a model");
@@ -374,8 +374,8 @@ fn a_valid_block_runs_its_own_rig() {
         let s = sample(k, 30.0, 60.0);
         b.push_rx(&s.encode());
         app.tick(&mut *b, 0);
-        let want = bare.tick(&s.sample());
-        last_paper = paper.tick(&s.sample()).drain_c;
+        let want = bare.tick(&s.sample);
+        last_paper = paper.tick(&s.sample).drain_c;
         let t = ticks(&replies(&mut b));
         assert!(!t[0].not_commissioned);
         assert!(crate::protocol::GuardOutput::bit_eq(&t[0].out, &want), "tick {k}: {:?} vs {want:?}", t[0].out);
@@ -406,8 +406,8 @@ fn a_blocks_margin_reaches_the_replies_not_the_record() {
         let s = sample(k, 30.0, 60.0);
         b.push_rx(&s.encode());
         app.tick(&mut *b, 0);
-        let want = bare.tick(&s.sample());
-        let model = plain.tick(&s.sample()).drain_c;
+        let want = bare.tick(&s.sample);
+        let model = plain.tick(&s.sample).drain_c;
         let t = ticks(&replies(&mut b));
         assert!(crate::protocol::GuardOutput::bit_eq(&t[0].out, &want), "tick {k}: {:?} vs {want:?}", t[0].out);
         if model != crate::guard::DRAIN_C_UNKNOWN {
@@ -453,7 +453,7 @@ fn an_invalid_block_latches_config_and_opens_the_valve() {
         app.tick(&mut *b, 0);
         let t = ticks(&replies(&mut b));
         assert!(
-            t.iter().all(|r| r.out.faults.intersects(crate::guard::faults::CONFIG) && r.out.valve_open && !r.pins.valve_pin && r.out.alarm),
+            t.iter().all(|r| r.out.faults.intersects(crate::faults::CONFIG) && r.out.valve_open && !r.pins.valve_pin && r.out.alarm),
             "{name}: {t:?}"
         );
     }
@@ -484,8 +484,8 @@ fn power_loss_restore_is_cooled_over_the_clocks_off_time() {
         let mem = BootMemory { nv: crate::memory::nv::NvLoad::Valid(hot), alive_s: rtc.map(|_| 5_000), nv_failing: false, ..b.boot_memory() };
         let mut app = App::boot(&mut *b, &GuardConfig::DEFAULT, &mem);
         let mut s = sample(1, 0.0, 3.0);
-        s.speed_rpm = 0.0;
-        s.ambient_c = ambient_c;
+        s.sample.speed_rpm = 0.0;
+        s.sample.ambient_c = ambient_c;
         b.push_rx(&s.encode());
         app.tick(&mut *b, 0);
         let t = ticks(&replies(&mut b));

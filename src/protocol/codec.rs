@@ -32,22 +32,23 @@ impl Request {
         let mut p = Vec::new();
         let _ = p.push(KIND_SAMPLE);
         let _ = p.extend_from_slice(&self.seq.to_le_bytes());
-        for v in [self.current_a, self.p_a_bar, self.p_b_bar, self.speed_rpm, self.position_mm, self.ambient_c] {
+        let (s, r) = (&self.sample, &self.reports);
+        for v in [s.current_a, s.p_a_bar, s.p_b_bar, s.speed_rpm, s.position_mm, s.ambient_c] {
             let _ = p.extend_from_slice(&v.to_le_bytes());
         }
-        let mut flags = match self.valve_fb {
+        let mut flags = match r.valve_fb {
             None => 0,
             Some(false) => FLAG_VALVE_FB,
             Some(true) => FLAG_VALVE_FB | FLAG_VALVE_FB_OPEN,
         };
-        if self.elec_hz.is_some() {
+        if r.elec_hz.is_some() {
             flags |= FLAG_ELEC_HZ;
         }
-        if self.lng_supply_bar.is_some() {
+        if r.lng_supply_bar.is_some() {
             flags |= FLAG_LNG_SUPPLY;
         }
         let _ = p.push(flags);
-        for v in [self.elec_hz, self.lng_supply_bar].into_iter().flatten() {
+        for v in [r.elec_hz, r.lng_supply_bar].into_iter().flatten() {
             let _ = p.extend_from_slice(&v.to_le_bytes());
         }
         p
@@ -67,27 +68,24 @@ impl Request {
         if p.len() != want {
             return Err(DecodeError::Length);
         }
-        let mut q = Request {
-            seq: r.u16()?,
+        let seq = r.u16()?;
+        let sample = Sample {
             current_a: r.f32()?,
             p_a_bar: r.f32()?,
             p_b_bar: r.f32()?,
             speed_rpm: r.f32()?,
             position_mm: r.f32()?,
             ambient_c: r.f32()?,
-            valve_fb: None,
-            elec_hz: None,
-            lng_supply_bar: None,
         };
         let _ = r.u8()?;
-        q.valve_fb = (flags & FLAG_VALVE_FB != 0).then_some(flags & FLAG_VALVE_FB_OPEN != 0);
+        let mut reports = Reports { valve_fb: (flags & FLAG_VALVE_FB != 0).then_some(flags & FLAG_VALVE_FB_OPEN != 0), ..Reports::default() };
         if flags & FLAG_ELEC_HZ != 0 {
-            q.elec_hz = Some(r.f32()?);
+            reports.elec_hz = Some(r.f32()?);
         }
         if flags & FLAG_LNG_SUPPLY != 0 {
-            q.lng_supply_bar = Some(r.f32()?);
+            reports.lng_supply_bar = Some(r.f32()?);
         }
-        Ok(q)
+        Ok(Request { seq, sample, reports })
     }
 
     /// Wire bytes: COBS frame terminated by `0x00` (no leading delimiter).

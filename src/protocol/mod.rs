@@ -57,6 +57,7 @@
 //! are the product frames of [`crate::product::wire`]; the sequence rule
 //! and the counters live in the one application loop, [`crate::product`].
 
+use crate::interface::{Reports, Sample};
 use heapless::Vec;
 
 /// Version of the controller protocol (the sample request and the product
@@ -183,53 +184,22 @@ pub use framing::{cobs_decode, cobs_encode, crc16, Deframer};
 
 // ------------------------------------------------------------- messages
 
-/// One sensor sample for one guard tick (the wire form of the guard's `Sample`).
+/// One request frame: the guard's sample for one tick and the controller's
+/// reports beside it, as the guard takes them
+/// ([`crate::GuardOf::tick_reported`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Request {
     /// Sequence number (wrapping).
     pub seq: u16,
-    /// Motor phase current, A rms.
-    pub current_a: f32,
-    /// Pump port A pressure, bar (gauge).
-    pub p_a_bar: f32,
-    /// Pump port B pressure, bar (gauge).
-    pub p_b_bar: f32,
-    /// Motor/pump speed, rpm (signed).
-    pub speed_rpm: f32,
-    /// Piston position, mm.
-    pub position_mm: f32,
-    /// Ambient air temperature, degC.
-    pub ambient_c: f32,
-    /// LNG valve position read back (`Some(true)` open), `None` when not reported.
-    pub valve_fb: Option<bool>,
-    /// The motor drive's electrical (commutation) frequency, Hz, signed like
-    /// the speed; `None` when not reported.
-    pub elec_hz: Option<f32>,
-    /// LNG supply pressure at the valve, bar gauge; `None` when not reported.
-    pub lng_supply_bar: Option<f32>,
+    /// The sensor sample, wire units.
+    pub sample: Sample,
+    /// The valve position read back, the motor's electrical frequency and
+    /// the LNG supply pressure, each when reported.
+    pub reports: Reports,
 }
 
-/// What the guard reports after a tick: the guard's own [`crate::Output`].
-pub type GuardOutput = crate::Output;
-
-impl Request {
-    /// The guard's sample carried by this frame.
-    pub fn sample(&self) -> crate::Sample {
-        crate::Sample {
-            current_a: self.current_a,
-            p_a_bar: self.p_a_bar,
-            p_b_bar: self.p_b_bar,
-            speed_rpm: self.speed_rpm,
-            position_mm: self.position_mm,
-            ambient_c: self.ambient_c,
-        }
-    }
-
-    /// The controller's reports carried by this frame.
-    pub fn reports(&self) -> crate::Reports {
-        crate::Reports { valve_fb: self.valve_fb, lng_supply_bar: self.lng_supply_bar, elec_hz: self.elec_hz }
-    }
-}
+/// What the guard reports after a tick: the guard's own [`crate::interface::Output`].
+pub type GuardOutput = crate::interface::Output;
 
 impl GuardOutput {
     /// Flags byte: bit0 valve, bit1 alarm, bit2 derate.

@@ -7,15 +7,8 @@ use super::*;
 fn req(seq: u16) -> Request {
     Request {
         seq,
-        current_a: 12.5,
-        p_a_bar: 80.0,
-        p_b_bar: 3.25,
-        speed_rpm: -1500.0,
-        position_mm: 42.0,
-        ambient_c: 21.0,
-        valve_fb: None,
-        elec_hz: None,
-        lng_supply_bar: None,
+        sample: Sample { current_a: 12.5, p_a_bar: 80.0, p_b_bar: 3.25, speed_rpm: -1500.0, position_mm: 42.0, ambient_c: 21.0 },
+        reports: Reports::default(),
     }
 }
 
@@ -87,7 +80,7 @@ fn request_round_trip_and_size() {
 fn request_valve_feedback_flags() {
     // None / shut / open round-trip through the flags byte (offset 27).
     for fb in [None, Some(false), Some(true)] {
-        let r = Request { valve_fb: fb, ..req(3) };
+        let r = Request { reports: Reports { valve_fb: fb, ..Reports::default() }, ..req(3) };
         let p = r.to_payload();
         assert_eq!(p.len(), REQUEST_LEN);
         assert_eq!(p[27], match fb { None => 0, Some(false) => 1, Some(true) => 3 });
@@ -107,7 +100,7 @@ fn request_valve_feedback_flags() {
     }
     // The optional fields round-trip, each alone and both.
     for (hz, lng) in [(Some(33.5), None), (None, Some(4.5)), (Some(-12.0), Some(0.0))] {
-        let r = Request { elec_hz: hz, lng_supply_bar: lng, valve_fb: Some(true), ..req(4) };
+        let r = Request { reports: Reports { elec_hz: hz, lng_supply_bar: lng, valve_fb: Some(true) }, ..req(4) };
         let p = r.to_payload();
         assert_eq!(p.len(), REQUEST_LEN + 4 * usize::from(hz.is_some()) + 4 * usize::from(lng.is_some()));
         assert_eq!(Request::from_payload(&p), Ok(r));

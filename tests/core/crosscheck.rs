@@ -188,7 +188,7 @@ fn blind_at_zero_speed() {
 #[test]
 fn refused_without_a_torque_constant() {
     let mut cfg = GuardConfig::DEFAULT;
-    let off_model = eha_guard::model::ModelConsts { k_sh: 0.0, ..eha_guard::params::DEFAULT_CONSTS };
+    let off_model = eha_guard::model::ModelConsts { k_sh: 0.0, ..eha_guard::model::DEFAULT_CONSTS };
     cfg.model = &off_model;
     let mut g = GuardOf::<f32>::new(&cfg, Restore::Cold);
     let out = run(&mut g, 10, |_| Sample { current_a: 5.0, ..sample(65.0, 5.0, 500.0) });

@@ -5,7 +5,8 @@
 
 use eha_guard::model::ModelConsts;
 use eha_guard::num::Num;
-use eha_guard::params::{DEFAULT_CONSTS, TICKS_PER_STEP};
+use eha_guard::model::DEFAULT_CONSTS;
+use eha_guard::params::TICKS_PER_STEP;
 use eha_guard::trace::Trace;
 use eha_guard::{faults, GuardConfig, GuardOf, Restore, Sample};
 

@@ -310,7 +310,7 @@ fn run_valid<N: eha_guard::num::Num>(ticks: &[(Tick, Option<Fault>)], clear_ever
                 may_latch = true;
                 let class = if matches!(f, Some(Fault::NonFinite { .. })) { faults::NON_FINITE } else { faults::RANGE };
                 prop_assert!(o.valve_open && o.faults.intersects(class), "tick {}: {:?} not latched: {:?}", k, f, o);
-                prop_assert!(o.faults.channel_mask() & (1 << ch) != 0, "tick {}: channel bit of {:?} missing: {:?}", k, f, o);
+                prop_assert!(o.faults.channel_set().contains(eha_guard::ChannelSet::channel(*ch)), "tick {}: channel bit of {:?} missing: {:?}", k, f, o);
             }
             Some(Fault::Rate { .. }) => may_latch = true,
             _ => {}
@@ -403,7 +403,7 @@ proptest! {
         prop_assert!(o.valve_open, "valve must open in the faulting step");
         let class = if bad.is_finite() { faults::RANGE } else { faults::NON_FINITE };
         prop_assert!(o.faults.intersects(class), "fault bits {:#x}", o.faults);
-        prop_assert!(o.faults.channel_mask() & (1 << ch) != 0, "channel bit missing {:#x}", o.faults);
+        prop_assert!(o.faults.channel_set().contains(eha_guard::ChannelSet::channel(ch)), "channel bit missing {:#x}", o.faults);
     }
 
     #[test]
@@ -670,7 +670,8 @@ fn trace_ring_keeps_newest_32() {
 /// `mu(40) / mu(T)` as the guard reads it: its `f32` table over the oil
 /// temperature (`DEFAULT_CONSTS.leak_ratio`), linear between points, end values held.
 fn leak_ratio(t_c: f64) -> f64 {
-    use eha_guard::params::{DEFAULT_CONSTS, N_TEMP, TEMP_TABLE_MIN_C, TEMP_TABLE_STEP_K};
+    use eha_guard::model::DEFAULT_CONSTS;
+    use eha_guard::params::{N_TEMP, TEMP_TABLE_MIN_C, TEMP_TABLE_STEP_K};
     let u = (t_c - TEMP_TABLE_MIN_C) * (1.0 / TEMP_TABLE_STEP_K);
     let (j, f) = match u.floor() {
         x if x < 0.0 => (0, 0.0),

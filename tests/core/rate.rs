@@ -29,9 +29,9 @@ fn run(every: u32, step_k: f32) -> eha_guard::Faults {
 fn samples_slower_than_the_tick_are_rate_checked_over_the_gap() {
     // 1 K per 10 ms: a 3 K step is too fast for one tick, for two (20 ms)
     // and fine over three
-    assert!(run(1, 3.0).contains(faults::RATE | faults::Faults::channels(eha_guard::validate::CH_AMBIENT)));
+    assert!(run(1, 3.0).contains(faults::RATE | faults::Faults::channels(eha_guard::ChannelSet::AMBIENT)));
     let f = run(2, 3.0);
-    assert!(f.contains(faults::RATE | faults::Faults::channels(eha_guard::validate::CH_AMBIENT)), "a 3 K step in 20 ms passed: {f:?}");
+    assert!(f.contains(faults::RATE | faults::Faults::channels(eha_guard::ChannelSet::AMBIENT)), "a 3 K step in 20 ms passed: {f:?}");
     let f = run(4, 3.0);
     assert!(!f.intersects(faults::RATE), "3 K in 40 ms is within the rate: {f:?}");
     let f = run(2, 1.5);

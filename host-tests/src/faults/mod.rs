@@ -432,8 +432,8 @@ pub fn bit_names(f: Faults) -> String {
     let inner = dbg.trim_start_matches("Faults(").trim_end_matches(')');
     let mut out: Vec<String> = inner.split(" | ").filter(|p| !p.starts_with("channels")).map(str::to_string).collect();
     for c in Channel::ALL {
-        let bit = 1u8 << (Channel::ALL.iter().position(|x| *x == c).unwrap_or(0));
-        if f.channel_mask() & bit != 0 {
+        let ch = eha_guard::ChannelSet::channel(Channel::ALL.iter().position(|x| *x == c).unwrap_or(0));
+        if f.channel_set().contains(ch) {
             out.push(format!("ch:{}", c.name()));
         }
     }
@@ -603,19 +603,13 @@ pub fn run_case(case: Case, spec: &ScenarioSpec, start: Start, mut target: Optio
                 _ => true,
             };
             let fb = !(active && fault == Fault::NoValveFeedback);
-            let req = Request {
-                seq,
+            let reports = eha_guard::Reports {
                 // The valve's position switch: where the valve really is.
                 valve_fb: fb.then_some(valve_position),
                 elec_hz: (case.inputs != Inputs::NoElec).then(|| (f64::from(truth.speed_rpm) * POLE_PAIRS / 60.0) as f32),
                 lng_supply_bar: (case.inputs == Inputs::Supply).then_some(if tank_empty { 0.0 } else { 5.0 }),
-                current_a: sample.current_a,
-                p_a_bar: sample.p_a_bar,
-                p_b_bar: sample.p_b_bar,
-                speed_rpm: sample.speed_rpm,
-                position_mm: sample.position_mm,
-                ambient_c: sample.ambient_c,
             };
+            let req = Request { seq, sample, reports };
             seq = seq.wrapping_add(1);
             if let Some(m) = mcu.as_mut() {
                 let mut wire: Vec<u8> = Vec::new();

@@ -20,6 +20,7 @@
 //! harness passes the last tick reply's command; a valve that follows).
 
 use eha_guard::protocol::Request;
+use eha_guard::{Reports, Sample};
 
 /// Motor current of the reference plant, A rms: `|D dp + sign(w) T_f| / Kt` with
 /// the friction torque of the extended eq. (8),
@@ -42,7 +43,7 @@ pub const STEPS: u32 = 60_000;
 /// The bytes of tick `k` of the drill (empty: the frame was lost), with the
 /// valve's position as the last tick commanded it (`last_open`).
 pub fn bytes(r: &Option<Request>, last_open: bool) -> Vec<u8> {
-    r.map_or_else(Vec::new, |r| Request { valve_fb: Some(last_open), ..r }.encode().to_vec())
+    r.map_or_else(Vec::new, |r| Request { reports: Reports { valve_fb: Some(last_open), ..r.reports }, ..r }.encode().to_vec())
 }
 
 /// Per tick, the sample the controller sent (`None`: lost on the way).
@@ -58,30 +59,27 @@ pub fn requests() -> Vec<Option<Request>> {
         let hot = t < 100.0;
         let dp = if hot { 140.0 } else { 10.0 };
         let sensor_gain = if t < 300.0 { 1.0 } else { 0.7 };
-        let mut r = Request {
-            seq,
+        let mut sample = Sample {
             current_a: sensor_gain * motor_current(2.0 + dp, 2.0, 500.0, oil_c),
             p_a_bar: 2.0 + dp,
             p_b_bar: 2.0,
             speed_rpm: 500.0,
             position_mm: 20.0 * (0.05 * t).sin(),
             ambient_c: 16.0,
-            valve_fb: None,
-        elec_hz: None,
-        lng_supply_bar: None,
         };
         if k == 50_000 {
-            r.current_a = f32::NAN;
+            sample.current_a = f32::NAN;
         }
         if k == 55_000 {
-            r.p_a_bar = 5000.0;
+            sample.p_a_bar = 5000.0;
         }
+        let r = Request { seq, sample, reports: Reports::default() };
         let lost = (10_001..10_004).contains(&k) || (45_001..45_011).contains(&k);
         oil.valve_feedback(oil.output().valve_open);
         if lost {
             oil.tick_missing();
         } else {
-            oil.tick(&r.sample());
+            oil.tick(&r.sample);
         }
         v.push((!lost).then_some(r));
         seq = seq.wrapping_add(1);

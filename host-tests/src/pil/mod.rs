@@ -62,18 +62,16 @@ pub struct PlantSensors {
 impl PlantSensors {
     /// The request frame for this sample.
     pub fn request(&self, seq: u16) -> Request {
-        Request {
-            seq,
+        let sample = eha_guard::Sample {
             current_a: self.current_a as f32,
             p_a_bar: self.p_a_bar as f32,
             p_b_bar: self.p_b_bar as f32,
             speed_rpm: self.speed_rpm as f32,
             position_mm: self.position_mm as f32,
             ambient_c: self.ambient_c as f32,
-            valve_fb: self.valve_fb,
-            elec_hz: self.elec_hz,
-            lng_supply_bar: self.lng_supply_bar,
-        }
+        };
+        let reports = eha_guard::Reports { valve_fb: self.valve_fb, elec_hz: self.elec_hz, lng_supply_bar: self.lng_supply_bar };
+        Request { seq, sample, reports }
     }
 }
 
@@ -267,8 +265,8 @@ pub fn run_pil(plant: &mut dyn PlantModel, qemu: &QemuOptions, opts: &LoopOption
                 Ok(end) => {
                     let log = defmt_log::decode(&qemu.elf, &end.defmt)
                         .map_err(|e| PilFailure::new(records.clone(), Vec::new(), e.context("decoding the defmt log")))?;
-                    if end.done.accepted != ticks as u32 {
-                        let what = format!("firmware accepted {} frames, host sent {ticks}", end.done.accepted);
+                    if end.done.counters.accepted != ticks as u32 {
+                        let what = format!("firmware accepted {} frames, host sent {ticks}", end.done.counters.accepted);
                         return Err(PilFailure::new(records, log, PilError::Protocol { tick: ticks, what }.into()));
                     }
                     Ok(PilRun { build: qemu.build, records, done: end.done, log, wall: start.elapsed(), icount: qemu.icount })

@@ -113,7 +113,7 @@ pub fn table(records: &[TickRecord], every_s: f64) -> String {
 /// Human summary lines.
 pub fn summary_text(run: &PilRun, s: &Summary) -> String {
     let mut t = String::new();
-    let c = run.done;
+    let c = run.done.counters;
     let _ = writeln!(t, "firmware build      : {} ({} in QEMU)", run.build.name(), run.build.machine());
     let _ = writeln!(t, "ticks               : {} ({:.1} s of plant time)", s.ticks, s.plant_time_s);
     let _ = writeln!(t, "frames              : accepted {}, rejected crc {} framing {} sequence {}, missing ticks {}", c.accepted, c.rejected_crc, c.rejected_framing, c.rejected_sequence, c.missing);
@@ -144,7 +144,7 @@ pub fn summary_text(run: &PilRun, s: &Summary) -> String {
 pub fn transcript(run: &PilRun, every_s: f64) -> String {
     let s = Summary::of(&run.records, run.icount);
     let mut t = String::new();
-    let c = run.done;
+    let c = run.done.counters;
     let _ = writeln!(t, "build {} machine {}", run.build.name(), run.build.machine());
     let rejected = u32::from(c.rejected_crc) + u32::from(c.rejected_framing) + u32::from(c.rejected_sequence);
     let _ = writeln!(t, "ticks {} accepted {} rejected {} missing {}", s.ticks, c.accepted, rejected, c.missing);
@@ -315,7 +315,7 @@ pub fn open_loop_transcript(run: &super::OpenLoopRun, tick_s: f64, every: usize)
         }
         prev = Some(r);
     }
-    let c = run.done;
+    let c = run.done.counters;
     let _ = writeln!(t, "done: accepted {} missing {} rejected crc {} framing {} sequence {}", c.accepted, c.missing, c.rejected_crc, c.rejected_framing, c.rejected_sequence);
     t.push_str("defmt log:\n");
     for l in &run.log {

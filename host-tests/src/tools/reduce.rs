@@ -570,7 +570,7 @@ pub fn render_params_rs(p: &ReducedParams) -> String {
     s
 }
 
-/// The whole text of `src/default_consts.rs`: `DEFAULT_CONSTS`, the model
+/// The whole text of `src/model/default_consts.rs`: `DEFAULT_CONSTS`, the model
 /// constants of `p` in model units as `f32` words (the compiled-in parameter
 /// block of the firmware), `Err` if the firmware model rejects `p`.
 pub fn render_default_consts_rs(p: &ReducedParams) -> Result<String, eha_guard::model::ConfigError> {

@@ -155,7 +155,7 @@ fn commissioned_block_in_closed_loop_on_the_held_out_mission() {
     // The electrical balance is commissioned (eta_m from the current), so the
     // sensor cross-check agrees with this machine: the only fault is LNG_LOW.
     assert!(
-        fw.fault.is_none_or(|(_, bits)| !bits.intersects(eha_guard::guard::faults::SENSOR_DISAGREE)),
+        fw.fault.is_none_or(|(_, bits)| !bits.intersects(eha_guard::faults::SENSOR_DISAGREE)),
         "cross-check fault with the commissioned block: {:?}",
         fw.fault
     );
@@ -163,7 +163,7 @@ fn commissioned_block_in_closed_loop_on_the_held_out_mission() {
     // machine within a second (SENSOR_DISAGREE, fail-safe), so it never
     // under-predicts here, but its estimate is useless: the reason to commission.
     let (t_fault, bits) = paper.fault.expect("measured: the paper default's cross-check latches");
-    assert!(t_fault <= 1.5 && bits.intersects(eha_guard::guard::faults::SENSOR_DISAGREE), "first fault {:?}", paper.fault);
+    assert!(t_fault <= 1.5 && bits.intersects(eha_guard::faults::SENSOR_DISAGREE), "first fault {:?}", paper.fault);
     assert!(paper.max_lng > 5.0, "paper default: max |e| {:.3} K", paper.max_lng);
 }
 

@@ -34,8 +34,8 @@ fn run_qemu(build: Build, samples: &[Option<eha_guard::protocol::Request>]) -> (
     let replies: Vec<TickReply> = run_drill(&mut s, samples).unwrap_or_else(|e| panic!("{e}")).into_iter().map(|o| o.reply).collect();
     let secs = t0.elapsed().as_secs_f64();
     let end = s.finish(samples.len() as u64).unwrap_or_else(|e| panic!("{e}"));
-    assert_eq!(end.done.accepted, samples.len() as u32 - 13);
-    assert_eq!(end.done.missing, 3 + 10);
+    assert_eq!(end.done.counters.accepted, samples.len() as u32 - 13);
+    assert_eq!(end.done.counters.missing, 3 + 10);
     (replies, secs)
 }
 

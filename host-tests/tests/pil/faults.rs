@@ -13,7 +13,8 @@ use eha_sim::pil::{firmware_for_tests, require_qemu, Build, PilError, QemuOption
 fn sample(seq: u16) -> Request {
     // (the viscous friction at 40 degC: these tests are about frames, not heat)
     let current_a = eha_sim::pil::drill::motor_current(60.0, 5.0, 1500.0, 40.0);
-    Request { seq, current_a, p_a_bar: 60.0, p_b_bar: 5.0, speed_rpm: 1500.0, position_mm: 10.0, ambient_c: 22.0, valve_fb: None, elec_hz: None, lng_supply_bar: None }
+    let sample = eha_guard::Sample { current_a, p_a_bar: 60.0, p_b_bar: 5.0, speed_rpm: 1500.0, position_mm: 10.0, ambient_c: 22.0 };
+    Request { seq, sample, reports: eha_guard::Reports::default() }
 }
 
 /// Number of non-empty frames (segments ended by 0x00) in `bytes`, given
@@ -115,7 +116,7 @@ fn corrupted_truncated_out_of_order_and_garbage_frames_are_rejected_and_counted(
     // finishes with its completion marker and exit code 0.
     let _ = s.tick(&good[..5], 7000).unwrap_or_else(|e| panic!("{e}"));
     let end = s.finish(7001).unwrap_or_else(|e| panic!("{e}"));
-    assert_eq!(end.done.accepted, 4);
+    assert_eq!(end.done.counters.accepted, 4);
     eprintln!("fault injection: {expected_rejects} rejected frames handled in {:.2} s", t0.elapsed().as_secs_f64());
 }
 

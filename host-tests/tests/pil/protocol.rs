@@ -20,7 +20,8 @@ fn any_f32() -> impl Strategy<Value = f32> {
 prop_compose! {
     fn any_request()(seq in any::<u16>(), v in proptest::array::uniform6(any_f32()), fb in proptest::option::of(any::<bool>()),
                      hz in proptest::option::of(any_f32()), lng in proptest::option::of(any_f32())) -> Request {
-        Request { seq, current_a: v[0], p_a_bar: v[1], p_b_bar: v[2], speed_rpm: v[3], position_mm: v[4], ambient_c: v[5], valve_fb: fb, elec_hz: hz, lng_supply_bar: lng }
+        let sample = eha_guard::Sample { current_a: v[0], p_a_bar: v[1], p_b_bar: v[2], speed_rpm: v[3], position_mm: v[4], ambient_c: v[5] };
+        Request { seq, sample, reports: eha_guard::Reports { valve_fb: fb, elec_hz: hz, lng_supply_bar: lng } }
     }
 }
 
@@ -46,7 +47,8 @@ prop_compose! {
 }
 
 fn bits(r: &Request) -> [u32; 6] {
-    [r.current_a, r.p_a_bar, r.p_b_bar, r.speed_rpm, r.position_mm, r.ambient_c].map(f32::to_bits)
+    let s = &r.sample;
+    [s.current_a, s.p_a_bar, s.p_b_bar, s.speed_rpm, s.position_mm, s.ambient_c].map(f32::to_bits)
 }
 
 fn decode_all(bytes: &[u8]) -> Vec<Result<Vec<u8>, eha_guard::protocol::DecodeError>> {
@@ -77,9 +79,9 @@ proptest! {
         let back = Request::from_payload(got[0].as_ref().unwrap()).unwrap();
         prop_assert_eq!(back.seq, r.seq);
         prop_assert_eq!(bits(&back), bits(&r));
-        prop_assert_eq!(back.valve_fb, r.valve_fb);
-        prop_assert_eq!(back.elec_hz.map(f32::to_bits), r.elec_hz.map(f32::to_bits));
-        prop_assert_eq!(back.lng_supply_bar.map(f32::to_bits), r.lng_supply_bar.map(f32::to_bits));
+        prop_assert_eq!(back.reports.valve_fb, r.reports.valve_fb);
+        prop_assert_eq!(back.reports.elec_hz.map(f32::to_bits), r.reports.elec_hz.map(f32::to_bits));
+        prop_assert_eq!(back.reports.lng_supply_bar.map(f32::to_bits), r.reports.lng_supply_bar.map(f32::to_bits));
     }
 
     #[test]

@@ -33,8 +33,8 @@ fn run(scenario: Scenario, duration_s: f64) -> PilRun {
     let opts = LoopOptions { tick_s: eha_guard::params::S_PER_TICK, duration_s };
     let run = run_pil(&mut plant, &q, &opts).unwrap_or_else(|f| panic!("{f}"));
     assert_eq!(run.records.len() as u64, opts.ticks());
-    assert_eq!(run.done.accepted as usize, run.records.len());
-    assert_eq!((run.done.rejected_crc, run.done.rejected_framing, run.done.rejected_sequence, run.done.missing), (0, 0, 0, 0));
+    assert_eq!(run.done.counters.accepted as usize, run.records.len());
+    assert_eq!((run.done.counters.rejected_crc, run.done.counters.rejected_framing, run.done.counters.rejected_sequence, run.done.counters.missing), (0, 0, 0, 0));
     run
 }
 

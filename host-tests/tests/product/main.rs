@@ -147,7 +147,7 @@ fn fig15_attempt() -> Result<(), String> {
     let stale_ticks = eha_guard::guard::GuardConfig::DEFAULT.stale_ticks as usize;
     if gap_len >= stale_ticks {
         let wall_ms = 1e3 * (run.ticks[first + gap_at + gap_len - 1].0 - run.ticks[(first + gap_at).saturating_sub(1)].0);
-        let stale = eha_guard::guard::faults::STALE;
+        let stale = eha_guard::faults::STALE;
         let latched = guard_ticks.iter().position(|t| t.out.faults.contains(stale)).unwrap_or(guard_ticks.len());
         assert!(latched >= gap_at + stale_ticks - 1, "STALE at guard tick {latched}, before the {stale_ticks}th miss of the stall at {gap_at}");
         assert!(
@@ -181,7 +181,7 @@ fn fig15_attempt() -> Result<(), String> {
          max |drain diff| {max_diff:.3e} K; overruns {}; worst tick {} cycles; stack boot {} B tick {} B",
         run.samples.len(),
         run.ticks.len(),
-        st.overruns,
+        st.counters.overruns,
         st.worst_tick_cycles,
         st.boot_stack_b,
         st.stack_high_water_b
@@ -212,16 +212,16 @@ fn fig15_attempt() -> Result<(), String> {
     // UART takes one byte per QEMU main-loop pass, and on a 2-core VM most
     // misses have the sample sent ~9 ms before the tick that lacked it
     // (docs/firmware.md); the count is printed, not asserted.
-    assert_eq!(st.superseded, 0, "a sample was overwritten before a tick used it");
+    assert_eq!(st.counters.superseded, 0, "a sample was overwritten before a tick used it");
     for p in &run.samples {
         assert_eq!(p.tick.pins, Pins::for_outputs(p.tick.out.valve_open, p.tick.out.alarm), "pins at sample {}", p.request.seq);
     }
-    assert!(st.overruns as usize * 100 <= run.samples.len(), "more than 1 % of ticks overran: {}", st.overruns);
+    assert!(st.counters.overruns as usize * 100 <= run.samples.len(), "more than 1 % of ticks overran: {}", st.counters.overruns);
     // A clean link garbles nothing; a sample the harness sent again after it
     // came late (every 5 ticks without it) may arrive twice: the duplicate is
     // rejected by the sequence rule.
-    assert_eq!(st.rejected_crc + st.rejected_framing, 0);
-    assert!(usize::from(st.rejected_sequence) <= missed, "{} duplicates for {missed} late samples", st.rejected_sequence);
+    assert_eq!(st.counters.rejected_crc + st.counters.rejected_framing, 0);
+    assert!(usize::from(st.counters.rejected_sequence) <= missed, "{} duplicates for {missed} late samples", st.counters.rejected_sequence);
     assert!(st.boot_stack_b > 0 && st.boot_stack_b <= 4096, "boot stack {} B > 4 KiB", st.boot_stack_b);
     assert!(st.stack_high_water_b > 0 && st.stack_high_water_b <= 2048, "tick stack {} B > 2 KiB", st.stack_high_water_b);
     assert_eq!(run.samples[0].tick.reset_cause, ResetCause::PowerOn);
@@ -289,7 +289,7 @@ fn check_fault_reset(name: &str, cmd: Cmd, at_sample: u16, cause: ResetCause, ma
     })
     .unwrap_or_else(|e| panic!("{name}: {e:#}"));
     let before: eha_guard::guard::Output = before.unwrap_or_else(|| panic!("{name}: the fault was never injected"));
-    if before.faults.contains(eha_guard::guard::faults::STALE) {
+    if before.faults.contains(eha_guard::faults::STALE) {
         // The host stalled the loop before the injection: the guard was in
         // its controller-silent fail-safe (valve open, estimate at the hot
         // side) when the fault hit, which is not the case under test.
@@ -393,9 +393,9 @@ fn garbage_and_bursts_on_the_uart_are_rejected_without_a_hang() {
     let rate = (run.ticks.len() - 1) as f64 / (t_last - t_first);
     eprintln!("garbage: {} ticks at {rate:.1} Hz; status {st:?}", run.ticks.len());
     assert_eq!(run.samples.len(), 1000, "every sample eventually got its tick");
-    assert!(st.rejected_crc + st.rejected_framing >= 20, "20 junk bursts and 20 truncated frames: {st:?}");
+    assert!(st.counters.rejected_crc + st.counters.rejected_framing >= 20, "20 junk bursts and 20 truncated frames: {st:?}");
     assert!((90.0..=110.0).contains(&rate), "tick rate {rate} Hz");
-    assert!(st.overruns * 100 <= 1000, "more than 1 % of ticks overran (host descheduling QEMU): {}", st.overruns);
+    assert!(st.counters.overruns * 100 <= 1000, "more than 1 % of ticks overran (host descheduling QEMU): {}", st.counters.overruns);
     // Junk never reaches the guard as data: no range, rate or non-finite
     // fault. (A sample stuck behind a long burst arrives late; more than
     // 50 ms late is STALE, which is what STALE is for, so it may latch.)
@@ -416,10 +416,10 @@ fn garbage_and_bursts_on_the_uart_are_rejected_without_a_hang() {
     // still ends before the status command.
     s.send(&[0]).unwrap_or_else(|e| panic!("{e:#}"));
     let st2 = s.status(6, &mut ticks).unwrap_or_else(|e| panic!("{e:#}"));
-    eprintln!("garbage: after a 4 KiB frame: rejected_framing {} -> {}, rx_overflow {}", st.rejected_framing, st2.rejected_framing, st2.rx_overflow);
-    assert!(st2.rejected_framing > st.rejected_framing, "the 4 KiB frame is rejected and counted: {st2:?}");
+    eprintln!("garbage: after a 4 KiB frame: rejected_framing {} -> {}, rx_overflow {}", st.counters.rejected_framing, st2.counters.rejected_framing, st2.rx_overflow);
+    assert!(st2.counters.rejected_framing > st.counters.rejected_framing, "the 4 KiB frame is rejected and counted: {st2:?}");
     if st2.rx_overflow == 0 {
-        assert_eq!(st2.rejected_framing, st.rejected_framing + 1, "no byte dropped, so exactly one framing reject: {st2:?}");
+        assert_eq!(st2.counters.rejected_framing, st.counters.rejected_framing + 1, "no byte dropped, so exactly one framing reject: {st2:?}");
     }
 }
 
@@ -470,7 +470,7 @@ fn alarm_attempt() -> Result<(), String> {
 /// ticks in a row without a sample), with its fail-safe checked: valve
 /// open from there on.
 fn stale_tick(run: &eha_sim::pil::product::ProductRun) -> Option<u32> {
-    let stale = eha_guard::guard::faults::STALE;
+    let stale = eha_guard::faults::STALE;
     let k = run.ticks.iter().position(|(_, t)| t.out.faults.contains(stale))?;
     assert!(run.ticks[k..].iter().all(|(_, t)| t.out.valve_open), "STALE without the valve open after tick {}", run.ticks[k].1.tick);
     Some(run.ticks[k].1.tick)
@@ -548,7 +548,7 @@ fn params_attempt() -> Result<(), String> {
     let pins = s.pins().unwrap_or_else(|e| panic!("{e:#}"));
     assert!(!seen.is_empty());
     for t in &seen {
-        assert!(t.out.faults.intersects(eha_guard::guard::faults::CONFIG) && t.out.valve_open && !t.pins.valve_pin, "torn block: {t:?}");
+        assert!(t.out.faults.intersects(eha_guard::faults::CONFIG) && t.out.valve_open && !t.pins.valve_pin, "torn block: {t:?}");
     }
     assert!(!pins.valve_pin && !pins.ok_pin, "torn block: valve open and alarm on the pins, read {pins:?}");
     Ok(())

@@ -8,7 +8,7 @@
 use core::ffi::c_void;
 use core::mem::{align_of, size_of};
 
-use eha_guard::product::wire::{restore_from_code, Pins, ResetCause, Status, TickReply};
+use eha_guard::product::wire::{restore_from_code, Counters, Pins, ResetCause, Status, TickReply};
 use eha_guard::protocol::lockstep::{tick_end, DONE_TOKEN};
 use eha_guard::protocol::{Deframer, DecodeError, Request, WireFrame, MAX_WIRE, PROTOCOL_VERSION};
 use eha_guard::Faults;
@@ -155,14 +155,15 @@ pub unsafe extern "C" fn eha_wire_feed(deframer: *mut c_void, bytes: *const u8, 
 }
 
 /// The C sample of a request frame.
-fn sample_of(r: &Request) -> EhaSample {
+fn sample_of(req: &Request) -> EhaSample {
+    let (s, r) = (&req.sample, &req.reports);
     EhaSample {
-        current_a: r.current_a,
-        p_a_bar: r.p_a_bar,
-        p_b_bar: r.p_b_bar,
-        speed_rpm: r.speed_rpm,
-        position_mm: r.position_mm,
-        ambient_c: r.ambient_c,
+        current_a: s.current_a,
+        p_a_bar: s.p_a_bar,
+        p_b_bar: s.p_b_bar,
+        speed_rpm: s.speed_rpm,
+        position_mm: s.position_mm,
+        ambient_c: s.ambient_c,
         lng_supply_bar: r.lng_supply_bar.unwrap_or(0.0),
         elec_hz: r.elec_hz.unwrap_or(0.0),
         valve_feedback: match r.valve_fb {
@@ -321,11 +322,14 @@ pub unsafe extern "C" fn eha_wire_lockstep_done(done: *const EhaLockstepDone, bu
         token: DONE_TOKEN,
         tick: d.tick,
         boots: d.boots,
-        rejected_crc: d.rejected_crc,
-        rejected_framing: d.rejected_framing,
-        rejected_sequence: d.rejected_sequence,
-        accepted: d.accepted,
-        missing: d.missing,
+        counters: Counters {
+            rejected_crc: d.rejected_crc,
+            rejected_framing: d.rejected_framing,
+            rejected_sequence: d.rejected_sequence,
+            accepted: d.accepted,
+            missing: d.missing,
+            ..Counters::default()
+        },
         faults: Faults::from_bits(d.faults),
         protocol: PROTOCOL_VERSION,
         ..Status::default()

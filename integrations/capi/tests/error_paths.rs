@@ -10,7 +10,7 @@ mod common;
 
 use std::process::Command;
 
-use eha_guard::params::DEFAULT_CONSTS;
+use eha_guard::model::DEFAULT_CONSTS;
 use eha_guard::params_block;
 
 /// Native libraries a Rust `std` static library needs on Linux

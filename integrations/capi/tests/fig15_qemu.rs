@@ -49,7 +49,7 @@ fn c_image_on_fig15(mut q: QemuOptions) -> (Vec<TickRecord>, SessionEnd, f64) {
     };
     let end = c.finish(n).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(records.len() as u64, n);
-    assert_eq!(end.done.accepted as u64, n, "the C loop accepted every sample frame");
+    assert_eq!(end.done.counters.accepted as u64, n, "the C loop accepted every sample frame");
     (records, end, t0.elapsed().as_secs_f64())
 }
 
@@ -75,7 +75,7 @@ fn c_example_in_qemu_equals_the_rust_application_bit_for_bit_on_fig15() {
     let stdout = String::from_utf8_lossy(&end.defmt);
     let stack_b: u32 = stdout.lines().find_map(|l| l.strip_prefix("stack_high_water_b=")).and_then(|v| v.trim().parse().ok()).unwrap_or_else(|| panic!("no stack report on the C image's stdout: {stdout:?}"));
     assert!(stack_b > 0 && stack_b < 16 * 1024, "stack high-water {stack_b} B");
-    assert_eq!((end.done.missing, end.done.rejected_crc, end.done.rejected_framing, end.done.rejected_sequence), (0, 0, 0, 0));
+    assert_eq!((end.done.counters.missing, end.done.counters.rejected_crc, end.done.counters.rejected_framing, end.done.counters.rejected_sequence), (0, 0, 0, 0));
     let c_replies: Vec<TickReply> = records.iter().map(|r| r.reply).collect();
 
     // The run is the Fig. 15 case: the valve opened on temperature and closed.

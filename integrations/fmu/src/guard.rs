@@ -159,7 +159,7 @@ impl Model for GuardFmu {
         }
         let model: &ModelConsts<f32> = match &self.consts {
             Some(c) => c,
-            None => &eha_guard::params::DEFAULT_CONSTS,
+            None => &eha_guard::model::DEFAULT_CONSTS,
         };
         // A cold boot, as the QEMU image and the SIL run start (zeroed RAM:
         // no thermal record).

@@ -154,8 +154,8 @@ mod app {
         let region = params_block::flash_region();
         let (model, refused) = match params_block::view(region) {
             Ok(Some(c)) => (c, false),
-            Ok(None) => (&eha_guard::params::DEFAULT_CONSTS, false),
-            Err(_) => (&eha_guard::params::DEFAULT_CONSTS, true),
+            Ok(None) => (&eha_guard::model::DEFAULT_CONSTS, false),
+            Err(_) => (&eha_guard::model::DEFAULT_CONSTS, true),
         };
         let config = GuardConfig { model, ..GuardConfig::DEFAULT };
         // A cold start; the product image (boards/stm32f411) adds the

@@ -149,19 +149,20 @@ impl Status {
         framed(true, |p| {
             p.u8(KIND_STATUS);
             p.u16(self.token);
+            let c = &self.counters;
             p.u32(self.tick);
-            p.u32(self.overruns);
+            p.u32(c.overruns);
             p.u32(self.worst_tick_cycles);
             p.u16(self.stack_high_water_b);
             p.u16(self.boot_stack_b);
             p.u8(self.reset_cause);
             p.u8(self.restore);
-            for v in [self.boots, self.rejected_crc, self.rejected_framing, self.rejected_sequence, self.superseded] {
+            for v in [self.boots, c.rejected_crc, c.rejected_framing, c.rejected_sequence, c.superseded] {
                 p.u16(v);
             }
-            p.u32(self.accepted);
-            p.u32(self.missing);
-            for v in [self.rx_overflow, self.commands, self.nv_failures] {
+            p.u32(c.accepted);
+            p.u32(c.missing);
+            for v in [self.rx_overflow, c.commands, c.nv_failures] {
                 p.u16(v);
             }
             p.u32(self.faults.bits());
@@ -172,25 +173,37 @@ impl Status {
     /// Parses a payload (host side).
     pub fn from_payload(p: &[u8]) -> Result<Status, DecodeError> {
         let mut r = expect(p, KIND_STATUS, STATUS_LEN)?;
+        // In wire order: the counters interleave with the other fields.
+        let token = r.u16()?;
+        let tick = r.u32()?;
+        let overruns = r.u32()?;
+        let worst_tick_cycles = r.u32()?;
+        let stack_high_water_b = r.u16()?;
+        let boot_stack_b = r.u16()?;
+        let reset_cause = r.u8()?;
+        let restore = r.u8()?;
+        let boots = r.u16()?;
+        let rejected_crc = r.u16()?;
+        let rejected_framing = r.u16()?;
+        let rejected_sequence = r.u16()?;
+        let superseded = r.u16()?;
+        let accepted = r.u32()?;
+        let missing = r.u32()?;
+        let rx_overflow = r.u16()?;
+        let commands = r.u16()?;
+        let nv_failures = r.u16()?;
+        let counters = Counters { rejected_crc, rejected_framing, rejected_sequence, superseded, accepted, missing, overruns, commands, nv_failures };
         Ok(Status {
-            token: r.u16()?,
-            tick: r.u32()?,
-            overruns: r.u32()?,
-            worst_tick_cycles: r.u32()?,
-            stack_high_water_b: r.u16()?,
-            boot_stack_b: r.u16()?,
-            reset_cause: r.u8()?,
-            restore: r.u8()?,
-            boots: r.u16()?,
-            rejected_crc: r.u16()?,
-            rejected_framing: r.u16()?,
-            rejected_sequence: r.u16()?,
-            superseded: r.u16()?,
-            accepted: r.u32()?,
-            missing: r.u32()?,
-            rx_overflow: r.u16()?,
-            commands: r.u16()?,
-            nv_failures: r.u16()?,
+            token,
+            tick,
+            counters,
+            worst_tick_cycles,
+            stack_high_water_b,
+            boot_stack_b,
+            reset_cause,
+            restore,
+            boots,
+            rx_overflow,
             faults: crate::faults::Faults::from_bits(r.u32()?),
             protocol: r.u8()?,
         })

@@ -11,7 +11,7 @@
 
 use crate::protocol::{DecodeError, PutAt, Rd, WireFrame};
 use crate::trace::{RestoreKind, Trace};
-use crate::Output;
+use crate::interface::Output;
 
 mod codec;
 mod reply;
@@ -278,6 +278,37 @@ pub struct TickReply {
     pub reset_cause: ResetCause,
 }
 
+/// Frame and tick counters of the product loop (saturating).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Counters {
+    /// Frames with a CRC mismatch.
+    pub rejected_crc: u16,
+    /// Frames with bad COBS, length, kind, or a full command queue.
+    pub rejected_framing: u16,
+    /// Samples that were duplicates or older than the last accepted one.
+    pub rejected_sequence: u16,
+    /// Samples replaced by a newer one within the same tick.
+    pub superseded: u16,
+    /// Samples accepted.
+    pub accepted: u32,
+    /// Ticks without a new sample.
+    pub missing: u32,
+    /// Timer periods lost to ticks that overran.
+    pub overruns: u32,
+    /// Commands executed.
+    pub commands: u16,
+    /// Non-volatile saves that failed (each followed by [`super::NV_RETRY_TICKS`]
+    /// without an attempt).
+    pub nv_failures: u16,
+}
+
+impl Counters {
+    /// Frames rejected for any reason (saturating).
+    pub(crate) fn rejected(&self) -> u16 {
+        self.rejected_crc.saturating_add(self.rejected_framing).saturating_add(self.rejected_sequence)
+    }
+}
+
 /// Counters and health, on request.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Status {
@@ -285,8 +316,8 @@ pub struct Status {
     pub token: u16,
     /// Tick counter since boot.
     pub tick: u32,
-    /// Overrun ticks since boot.
-    pub overruns: u32,
+    /// The product loop's frame and tick counters.
+    pub counters: Counters,
     /// Longest tick, core-clock cycles (0 when the board cannot measure it).
     pub worst_tick_cycles: u32,
     /// Stack high-water mark of the tick loop, bytes (0 when not measured).
@@ -299,24 +330,8 @@ pub struct Status {
     pub restore: u8,
     /// Boots since power-on (from no-init RAM).
     pub boots: u16,
-    /// Frames rejected for a CRC mismatch.
-    pub rejected_crc: u16,
-    /// Frames rejected for framing (COBS, length, overflow, unknown kind).
-    pub rejected_framing: u16,
-    /// Samples rejected as duplicate or older.
-    pub rejected_sequence: u16,
-    /// Samples that arrived within a tick after another and were replaced by it.
-    pub superseded: u16,
-    /// Samples accepted.
-    pub accepted: u32,
-    /// Ticks without a new sample.
-    pub missing: u32,
     /// Received bytes lost to a full receive buffer.
     pub rx_overflow: u16,
-    /// Commands executed.
-    pub commands: u16,
-    /// Non-volatile record saves that failed.
-    pub nv_failures: u16,
     /// Faults now.
     pub faults: crate::faults::Faults,
     /// Protocol version of this firmware ([`crate::protocol::PROTOCOL_VERSION`]).

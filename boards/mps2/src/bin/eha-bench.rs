@@ -23,7 +23,7 @@ mod fw {
     use defmt_semihosting as _;
     use eha_guard::model::{InputScales, Model, ModelInputN};
     use eha_guard::num::Num;
-    use eha_guard::validate::{self, Channels, LimitsN, CH_ALL};
+    use eha_guard::validate::{self, Channels, LimitsN};
     use eha_guard::product::mem_board::MemBoard;
     use eha_guard::{Guard, GuardConfig, Real, Restore, Sample};
     use semihosting::eprintln;
@@ -174,7 +174,7 @@ mod fw {
         lim: &LimitsN<Real>,
     ) -> ModelInputN<Real> {
         let (v, nf) = validate::convert(s, sc);
-        let c = validate::check(&v, nf, prev, CH_ALL, lim);
+        let c = validate::check(&v, nf, prev, eha_guard::ChannelSet::ALL, lim);
         validate::substitute(&v, c.bad, Some(v[4]), lim)
     }
 
@@ -298,7 +298,7 @@ mod fw {
         let wraps = WRAPS.load(Ordering::Relaxed) - w0;
         let init_ticks = wraps as u64 * 0x0100_0000 + (t0.wrapping_sub(t1) & 0x00FF_FFFF) as u64;
 
-        let Ok(mut model) = Model::<Real>::from_consts(&eha_guard::params::DEFAULT_CONSTS) else {
+        let Ok(mut model) = Model::<Real>::from_consts(&eha_guard::model::DEFAULT_CONSTS) else {
             semihosting::process::exit(105)
         };
         let Some(scales) = InputScales::<Real>::new() else {
@@ -438,18 +438,7 @@ mod fw {
         let mut noise_a = 1u32;
         for k in 0..TICKS {
             let s = sample(k, &mut noise_a);
-            let req = eha_guard::protocol::Request {
-                seq: (k & 0xFFFF) as u16,
-                current_a: s.current_a,
-                p_a_bar: s.p_a_bar,
-                p_b_bar: s.p_b_bar,
-                speed_rpm: s.speed_rpm,
-                position_mm: s.position_mm,
-                ambient_c: s.ambient_c,
-                valve_fb: None,
-                elec_hz: None,
-                lng_supply_bar: None,
-            };
+            let req = eha_guard::protocol::Request { seq: (k & 0xFFFF) as u16, sample: s, reports: eha_guard::Reports::default() };
             board.push_rx(&req.encode());
             let w0 = WRAPS.load(Ordering::Relaxed);
             let t0 = now();
@@ -475,10 +464,7 @@ mod fw {
         let mut writer = eha_guard::memory::slots::AbWriter::after_boot(&eha_guard::ThermalRecord::EMPTY, &eha_guard::ThermalRecord::EMPTY);
         for k in 0..600u32 {
             let s = sample(k, &mut noise_p);
-            let req = eha_guard::protocol::Request {
-                seq: (k & 0xFFFF) as u16, current_a: s.current_a, p_a_bar: s.p_a_bar, p_b_bar: s.p_b_bar,
-                speed_rpm: s.speed_rpm, position_mm: s.position_mm, ambient_c: s.ambient_c, valve_fb: None, elec_hz: None, lng_supply_bar: None,
-            };
+            let req = eha_guard::protocol::Request { seq: (k & 0xFFFF) as u16, sample: s, reports: eha_guard::Reports::default() };
             let wire = req.encode();
             let w0 = WRAPS.load(Ordering::Relaxed);
             let t0 = now();

@@ -1,13 +1,133 @@
 //! The fault word as a typed set ([`Faults`]) and its named members
-//! (`faults::RANGE`, …). Bits 0-6 and 14 latch until the clear rule
-//! ([`super::GuardOf::clear_faults`]); bits 7 and 15 are live status; bits
-//! 8-13 name the latched bad input channels (`validate::CH_*` shifted by
+//! (`faults::RANGE`, …), and the set of input channels ([`ChannelSet`]).
+//! Bits 0-6 and 14 latch until the clear rule
+//! ([`crate::GuardOf::clear_faults`]); bits 7 and 15 are live status; bits
+//! 8-13 name the latched bad input channels (a [`ChannelSet`] shifted by
 //! [`CH_SHIFT`]); bits 16.. are the status bits added with the safety case
 //! (non-volatile save failed, cooling not confirmed). The same 32 bits go
 //! on the wire ([`Faults::bits`], `crate::product::wire`) and into the
 //! thermal record.
 
 use core::ops::{BitAnd, BitAndAssign, BitOr, BitOrAssign, Not};
+
+/// A set of the six input channels of a [`crate::Sample`], bit `i` for
+/// channel `i` in the sample's order (current, port A, port B, speed,
+/// position, ambient): the channels a check found bad, the channels whose
+/// previous value is valid, the latched bad channels.
+#[derive(Clone, Copy, Default, PartialEq, Eq)]
+#[repr(transparent)]
+pub struct ChannelSet(u8);
+
+impl ChannelSet {
+    /// No channel.
+    pub const NONE: ChannelSet = ChannelSet(0);
+    /// Motor current.
+    pub const CURRENT: ChannelSet = ChannelSet(1 << 0);
+    /// Port A pressure.
+    pub const P_A: ChannelSet = ChannelSet(1 << 1);
+    /// Port B pressure.
+    pub const P_B: ChannelSet = ChannelSet(1 << 2);
+    /// Motor speed.
+    pub const SPEED: ChannelSet = ChannelSet(1 << 3);
+    /// Piston position.
+    pub const POSITION: ChannelSet = ChannelSet(1 << 4);
+    /// Ambient temperature.
+    pub const AMBIENT: ChannelSet = ChannelSet(1 << 5);
+    /// All six channels.
+    pub const ALL: ChannelSet = ChannelSet(0x3F);
+
+    /// The set of a channel mask (bits above the six channels dropped).
+    #[inline(always)]
+    pub const fn from_bits(bits: u8) -> ChannelSet {
+        ChannelSet(bits & 0x3F)
+    }
+
+    /// The mask (bit `i` = channel `i`).
+    #[inline(always)]
+    pub const fn bits(self) -> u8 {
+        self.0
+    }
+
+    /// Channel `i` alone (0 current .. 5 ambient; none for `i` ≥ 6).
+    #[inline(always)]
+    pub const fn channel(i: usize) -> ChannelSet {
+        if i < 6 {
+            ChannelSet(1 << i)
+        } else {
+            ChannelSet::NONE
+        }
+    }
+
+    /// The channels of both sets (`|` in a `const`).
+    #[inline(always)]
+    pub const fn union(self, other: ChannelSet) -> ChannelSet {
+        ChannelSet(self.0 | other.0)
+    }
+
+    /// No channel in the set.
+    #[inline(always)]
+    pub const fn is_empty(self) -> bool {
+        self.0 == 0
+    }
+
+    /// Every channel of `other` is in the set.
+    #[inline(always)]
+    pub const fn contains(self, other: ChannelSet) -> bool {
+        self.0 & other.0 == other.0
+    }
+
+    /// Some channel of `other` is in the set.
+    #[inline(always)]
+    pub const fn intersects(self, other: ChannelSet) -> bool {
+        self.0 & other.0 != 0
+    }
+}
+
+impl BitOr for ChannelSet {
+    type Output = ChannelSet;
+    #[inline(always)]
+    fn bitor(self, o: ChannelSet) -> ChannelSet {
+        ChannelSet(self.0 | o.0)
+    }
+}
+
+impl BitOrAssign for ChannelSet {
+    #[inline(always)]
+    fn bitor_assign(&mut self, o: ChannelSet) {
+        self.0 |= o.0;
+    }
+}
+
+impl BitAnd for ChannelSet {
+    type Output = ChannelSet;
+    #[inline(always)]
+    fn bitand(self, o: ChannelSet) -> ChannelSet {
+        ChannelSet(self.0 & o.0)
+    }
+}
+
+/// The other channels (the complement within the six).
+impl Not for ChannelSet {
+    type Output = ChannelSet;
+    #[inline(always)]
+    fn not(self) -> ChannelSet {
+        ChannelSet(!self.0 & 0x3F)
+    }
+}
+
+impl core::fmt::Debug for ChannelSet {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(f, "ChannelSet({:#08b})", self.0)
+    }
+}
+
+/// In the defmt log: the mask in binary.
+#[cfg(feature = "defmt")]
+impl defmt::Format for ChannelSet {
+    fn format(&self, f: defmt::Formatter) {
+        defmt::write!(f, "{=u8:#08b}", self.0)
+    }
+}
 
 /// A set of guard faults (the 16-bit fault word).
 #[derive(Clone, Copy, Default, PartialEq, Eq)]
@@ -35,14 +155,16 @@ impl Faults {
         Faults(bits)
     }
 
-    /// The latched bad-channel mask `ch` (`validate::CH_*`) as fault bits.
-    pub const fn channels(ch: u8) -> Faults {
-        Faults(((ch & 0x3F) as u32) << CH_SHIFT)
+    /// The latched bad channels `ch` as fault bits.
+    #[inline(always)]
+    pub const fn channels(ch: ChannelSet) -> Faults {
+        Faults((ch.0 as u32) << CH_SHIFT)
     }
 
-    /// The bad-channel mask in this set (`validate::CH_*`).
-    pub const fn channel_mask(self) -> u8 {
-        ((self.0 >> CH_SHIFT) & 0x3F) as u8
+    /// The bad channels in this set.
+    #[inline(always)]
+    pub const fn channel_set(self) -> ChannelSet {
+        ChannelSet(((self.0 >> CH_SHIFT) & 0x3F) as u8)
     }
 
     /// No fault in the set.
@@ -137,8 +259,8 @@ impl core::fmt::Debug for Faults {
                 first = false;
             }
         }
-        if self.channel_mask() != 0 {
-            write!(f, "{}channels {:#08b}", if first { "" } else { " | " }, self.channel_mask())?;
+        if !self.channel_set().is_empty() {
+            write!(f, "{}channels {:#08b}", if first { "" } else { " | " }, self.channel_set().bits())?;
             first = false;
         }
         if first {
@@ -212,13 +334,16 @@ mod tests {
 
     #[test]
     fn set_operations_and_names() {
-        let f = STALE | Faults::channels(0b101) | UNTRUSTED;
+        let f = STALE | Faults::channels(ChannelSet::CURRENT | ChannelSet::P_B) | UNTRUSTED;
         assert!(f.contains(STALE) && f.intersects(UNTRUSTED | RANGE) && !f.contains(STALE | RANGE));
-        assert_eq!(f.channel_mask(), 0b101);
+        assert_eq!(f.channel_set().bits(), 0b101);
         assert_eq!(Faults::from_bits(f.bits()), f);
         assert_eq!((f & !UNTRUSTED) & UNTRUSTED, Faults::NONE);
         assert_eq!(std::format!("{:?}", f), "Faults(STALE | UNTRUSTED | channels 0b000101)");
         assert_eq!(std::format!("{:?}", Faults::NONE), "Faults(none)");
-        assert_eq!(ALL_NAMED.bits() & Faults::channels(0x3F).bits(), 0);
+        assert_eq!(ALL_NAMED.bits() & Faults::channels(ChannelSet::ALL).bits(), 0);
+        assert_eq!(!ChannelSet::SPEED, ChannelSet::from_bits(0b110111));
+        assert_eq!(ChannelSet::channel(5), ChannelSet::AMBIENT);
+        assert_eq!(ChannelSet::channel(6), ChannelSet::NONE);
     }
 }
