@@ -83,7 +83,7 @@ impl OuterGrid {
         };
         let x = t_wall / self.step_k;
         let Some(cell) = self.cells.get(i) else { return exact(t_wall) };
-        if !(x.abs() < 1e12) {
+        if x.is_nan() || x.abs() >= 1e12 {
             return exact(t_wall);
         }
         let key = [area.to_bits(), t_air.to_bits(), air_mps.to_bits(), ram_share.to_bits()];
@@ -140,7 +140,7 @@ impl NuGrid {
     pub fn nu(&self, oil: &Oil, t_c: f64) -> f64 {
         let x = t_c * self.per_step;
         // Beyond ±1e12 cells (and NaN): exact.
-        if !(x.abs() < 1e12) {
+        if x.is_nan() || x.abs() >= 1e12 {
             return oil.nu_m2_per_s(t_c);
         }
         let grade = (oil.nu40_cst.to_bits(), oil.nu100_cst.to_bits());
