@@ -43,6 +43,8 @@ fn main() {
                 "case {key} fast: {} thermal steps ({} rejected), {} model evaluations ({} for {} Jacobians), {} hydraulic steps ({} rejected, {} hydraulic evaluations, {} Jacobians)",
                 s.steps, f.rejected, s.rhs_evals, s.jacobian_evals, s.factorizations, f.hydraulics.steps, f.hydraulics.rejected, f.hydraulics.evals, f.hydraulics.jacobians
             );
+            let (outer, nu) = p.model().grid_evals();
+            println!("case {key} fast: exact evaluations behind the temperature grids: {outer} outer-surface heat flows, {nu} viscosities");
         }
     }
 }

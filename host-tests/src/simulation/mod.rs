@@ -7,10 +7,13 @@
 //! - [`sim`]: runs and their outputs (shared log format plus internal
 //!   channels);
 //! - [`equilibrium`]: the steady state of the node balances (Newton);
-//! - [`replay`]: a measured log's inputs as a replay scenario.
+//! - [`replay`]: a measured log's inputs as a replay scenario;
+//! - [`grids`]: the outer surfaces' heat flows and the oil's viscosity
+//!   interpolated on a temperature grid (the fast plant's heat balances).
 
 pub mod equilibrium;
 pub mod fast;
+pub mod grids;
 pub mod missions;
 pub mod model;
 pub mod plant;

@@ -5,6 +5,7 @@
 use crate::hydraulics::{self, ix, OpPoint};
 use crate::losses;
 use crate::network::{self, Node, N_NODES, NODES};
+use crate::simulation::grids::{NuGrid, OuterGrid};
 use crate::rig::Rig;
 use crate::scenario::{Circuit, Mission, ReplayInputs, ValveRule};
 use std::cell::Cell;
@@ -276,24 +277,51 @@ pub struct Model {
     /// LNG valve open (set between solver segments).
     pub lng_open: Cell<bool>,
     contents: [(f64, f64); N_NODES],
+    /// The outer surfaces' heat flows and the oil's viscosity on a
+    /// temperature grid (the fast plant's; None: the exact correlations).
+    outer_grid: Option<OuterGrid>,
+    nu_grid: Option<NuGrid>,
 }
 
 impl Model {
     /// Build a model.
     pub fn new(rig: Rig, drive: Drive) -> Self {
         let contents = network::contents(&rig);
-        Self { rig, drive, lng_open: Cell::new(false), contents }
+        Self { rig, drive, lng_open: Cell::new(false), contents, outer_grid: None, nu_grid: None }
+    }
+
+    /// Interpolate the outer surfaces' heat flows and the oil's viscosity
+    /// on a grid of `step_k` kelvin from now on ([`crate::simulation::grids`]),
+    /// or (None) evaluate them exactly.
+    pub fn set_grids(&mut self, step_k: Option<f64>) {
+        let step = step_k.filter(|&s| s > 0.0 && s.is_finite());
+        self.outer_grid = step.map(OuterGrid::new);
+        self.nu_grid = step.map(NuGrid::new);
+    }
+
+    /// Exact evaluations behind the grids so far: (outer surfaces, viscosities).
+    pub fn grid_evals(&self) -> (u64, u64) {
+        (self.outer_grid.as_ref().map_or(0, |g| g.evals.get()), self.nu_grid.as_ref().map_or(0, |g| g.evals.get()))
     }
 
     /// Kinematic viscosity of the oil at `t_oil` (its Walther line), m²/s.
     pub fn nu(&self, t_oil: f64) -> f64 {
-        self.rig.oil.nu_m2_per_s(t_oil)
+        match &self.nu_grid {
+            Some(g) => g.nu(&self.rig.oil, t_oil),
+            None => self.rig.oil.nu_m2_per_s(t_oil),
+        }
+    }
+
+    /// Dynamic viscosity of the oil at `t_oil` and 0 bar, Pa·s (ν·ρ, as
+    /// [`crate::fluid::Oil::mu_pa_s`]).
+    pub fn mu(&self, t_oil: f64) -> f64 {
+        self.nu(t_oil) * self.rig.oil.rho(t_oil, 0.0)
     }
 
     /// Pump leakage conductance of eqs. (5)–(7) at the case-oil temperature
     /// (the films' viscosity), m³/(s·Pa).
     pub fn k_leak(&self, t_case: f64) -> f64 {
-        self.rig.pump.gaps.conductance(self.rig.oil.mu_pa_s(t_case))
+        self.rig.pump.gaps.conductance(self.mu(t_case))
     }
 
     /// Heat capacity of node `n` at `t_c`, J/K (oil: V·ρ(T)·c_p(T)).
@@ -407,7 +435,7 @@ impl Model {
     /// viscosity at the case-oil temperature `t_case`, W.
     pub fn pump_friction(&self, op: &OpPoint, t_case: f64) -> losses::PumpFriction {
         let p = &self.rig.pump;
-        let mu = self.rig.oil.mu_pa_s(t_case);
+        let mu = self.mu(t_case);
         losses::PumpFriction::new(p.no_load_torque_nm, p.viscous_torque_coeff, p.eta_m, self.rig.displacement_m3_per_rad(), mu, op.p_a - op.p_b, op.omega)
     }
 
@@ -636,8 +664,11 @@ impl Model {
         // Outer surfaces: convection (eqs. 15/16, ram air) + radiation (eq. 19),
         // and the main block's mounting to the bench (held at the air temperature).
         let mut q_amb = 0.0;
-        for (n, area, shape, ram_share) in network::surfaces(rig) {
-            let w = network::q_outer_exposed(rig, area, shape, tc(n), op.ambient_c, op.air_mps, ram_share);
+        for (i, (n, area, shape, ram_share)) in network::surfaces(rig).into_iter().enumerate() {
+            let w = match &self.outer_grid {
+                Some(g) => g.q(i, rig, area, shape, tc(n), op.ambient_c, op.air_mps, ram_share),
+                None => network::q_outer_exposed(rig, area, shape, tc(n), op.ambient_c, op.air_mps, ram_share),
+            };
             q[n as usize] -= w;
             q_amb += w;
         }

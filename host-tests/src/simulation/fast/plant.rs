@@ -82,6 +82,10 @@ pub struct FastOptions {
     pub h_max_s: f64,
     /// First thermal step after a start or a schedule breakpoint, s.
     pub h_start_s: f64,
+    /// Grid of temperatures on which the heat balances interpolate the
+    /// outer surfaces' heat flows and the oil's viscosity, K (0: exact;
+    /// see [`crate::simulation::grids`]).
+    pub grid_k: f64,
 }
 
 impl Default for FastOptions {
@@ -90,7 +94,7 @@ impl Default for FastOptions {
     /// 1e-4 K per thermal step, hydraulics at 1e-4 of their typical
     /// magnitudes (3e-4 gave 1.25e-2 K on a servo mission's loop oil).
     fn default() -> Self {
-        Self { tol_k: 1e-4, hyd_rtol: 1e-4, alias_ratio: 8.0, h_max_s: 60.0, h_start_s: 1e-3 }
+        Self { tol_k: 1e-4, hyd_rtol: 1e-4, alias_ratio: 8.0, h_max_s: 60.0, h_start_s: 1e-3, grid_k: 0.1 }
     }
 }
 
@@ -155,7 +159,8 @@ impl FastPlant {
 
     /// [`FastPlant::new`] with explicit accuracy settings.
     pub fn with_options(rig: &Rig, scenario: &Scenario, opts: FastOptions) -> Result<Self, SimError> {
-        let (model, t) = model_for(rig, scenario)?;
+        let (mut model, t) = model_for(rig, scenario)?;
+        model.set_grids(Some(opts.grid_k));
         let mut y = [0.0; N_STATE];
         y.copy_from_slice(&model.initial_state());
         // Errors relative to the states' typical magnitudes (1 MPa, 1 cm,
