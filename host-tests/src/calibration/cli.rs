@@ -215,7 +215,7 @@ fn plot_log(dir: &Path, base: &Rig, c: &Commissioning, l: &CalLog) -> anyhow::Re
 /// The two paths (reduction, direct identification): which was flashed
 /// and why, and both paths' numbers after the split and on the held-out logs.
 fn paths_section(s: &mut String, c: &Commissioning) {
-    let _ = writeln!(s, "## Path: {}\n\nChosen because {}.\n", c.choice.chosen.name(), c.choice.why);
+    let _ = writeln!(s, "## Path: {}\n\nChosen because {}. (The held-out logs decide between two blocks, each fitted without them.)\n", c.choice.chosen.name(), c.choice.why);
     let f = |x: Option<f64>| x.map_or("–".into(), |v| format!("{v:.3}"));
     let _ = writeln!(s, "| path | margin K | after the split, margin counted: max \\|e\\| K | held out, margin counted: worst max \\|e\\| K | worst under K |\n|---|---:|---:|---:|---:|");
     for p in std::iter::once(&c.reduction_path).chain(c.direct_path.as_ref().ok()) {

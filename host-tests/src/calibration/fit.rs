@@ -445,7 +445,7 @@ fn polish(base: &Rig, logs: &[CalLog], mut theta: Vec<f64>, free: &[usize], sigm
     // times √s², s² the reduced χ² at LM's end (at least 1). A model that
     // cannot follow the machine (χ² per point ≫ 1) then leaves the
     // directions its logs barely inform to the priors, instead of to the
-    // path LM took; a model that fits (s² = 1) is unchanged.
+    // path LM took; a model that fits (s² = 1) keeps σ_d.
     let Some(r0) = data_residuals(base, logs, &theta, sigma, runs) else { return (theta, out) };
     let s2 = (r0.iter().map(|x| x * x).sum::<f64>() / r0.len().saturating_sub(free.len()).max(1) as f64).max(1.0);
     out.s2 = s2;

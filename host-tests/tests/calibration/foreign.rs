@@ -5,6 +5,7 @@
 //! The user's rig file is the paper rig with the nameplate values.
 
 use eha_sim::calibration::commission::{check_reduced_with, commission, commission_with, Commissioning};
+use eha_sim::calibration::paths::PathKind;
 use eha_sim::calibration::{CalLog, CalOptions};
 use eha_sim::emulator::bench::{bench_log, bench_set, big_pump, leaky_heavy, machines, BenchLog, EmuMachine};
 use eha_sim::emulator::missions::EmuScenario;
@@ -101,27 +102,29 @@ fn report(m: &EmuMachine, c: &Commissioning, secs: f64) {
 }
 
 /// Tolerance on a measured headline number, K: a 1e-9 K nudge of every
-/// temperature moved them by up to 0.051 K
-/// (`slow_commissioning_is_reproducible_at_the_last_digit`).
+/// temperature moved them by up to 0.039 K
+/// (`slow_commissioning_is_reproducible_at_the_last_digit_*`); the
+/// commissioning is not converged to better than that (the polish stops
+/// after 8 steps with a predicted decrease of a few units of χ²).
 const AS_MEASURED_K: f64 = 0.15;
 
 fn near(what: &str, got: f64, measured: f64) {
     assert!((got - measured).abs() <= AS_MEASURED_K, "{what}: {got:.3} K, measured {measured:.3} K (±{AS_MEASURED_K})");
 }
 
-/// The commissioning path without the margin, on both machines. Measured
-/// (held-out servo, throttle mix; firmware drain vs the thermocouple, max
-/// |e| / under-prediction): big-pump flashable, 2.27 / 2.27 K and 3.78 /
-/// 2.32 K (vs the true drain 1.97 / 1.97, 3.85 / 2.37 K); leaky-heavy
-/// refused, the six-state model 0.608 K off the commissioned reference on
-/// the servo log, 3.12 / 3.12 K and 2.42 / 2.42 K. The training logs
-/// themselves are missed too (big-pump soak then idle: 2.77 K under, in the
+/// The reduction path without the margin (no validation, no direct
+/// path), on both machines. Measured (held-out servo, throttle mix;
+/// firmware drain vs the thermocouple, max |e| / under-prediction):
+/// big-pump flashable, 2.25 / 2.25 K and 3.87 / 2.29 K; leaky-heavy
+/// refused, the six-state model 0.626 K off the commissioned reference on
+/// the servo log, 3.10 / 3.10 K and 2.44 / 2.44 K. The training logs
+/// themselves are missed too (big-pump soak then idle: 2.7 K under, in the
 /// idle phase): the commissioned reference does not follow these machines'
-/// drain, the reduction does (≤ 0.19 K on every throttle log).
+/// drain, the reduction does (≤ 0.2 K on every throttle log).
 #[test]
 #[ignore = "slow tier: two commissionings on emulator bench logs (~40 s each)"]
 fn slow_commissioning_without_margin_on_foreign_machines() {
-    let measured = [(true, [(2.273, 2.273), (3.781, 2.324)]), (false, [(3.115, 3.115), (2.420, 2.420)])];
+    let measured = [(true, [(2.246, 2.246), (3.866, 2.292)]), (false, [(3.095, 3.095), (2.441, 2.441)])];
     for (m, (flash, want)) in machines().into_iter().zip(measured) {
         let s = bench_set(&m, 3600).expect("bench");
         let train: Vec<CalLog> = s.train.iter().map(cal).collect();
@@ -138,28 +141,33 @@ fn slow_commissioning_without_margin_on_foreign_machines() {
     }
 }
 
-/// The commissioning path with the drain margin (validated on a split of the
-/// training missions), on both machines: the acceptance is 1.0 K max
-/// |e| and ≤ 0.3 K under-prediction on the held-out logs with the margin
-/// counted. Measured (max |e| / under vs the thermocouple; servo, throttle
-/// mix):
-/// - big-pump: margin 2.15 K (after the split the soak log's idle phase is
-///   under-predicted by 1.95 K); 2.35 / 0.12 K and 5.93 / 0.17 K: the
-///   under-prediction bound met, max |e| not (the mix is over-predicted by
-///   3.78 K before the margin).
-/// - leaky-heavy: margin 2.50 K (1.45 and 2.30 K after the split); 2.74 /
-///   0.62 K and 3.45 / 0.00 K: the servo log still 0.62 K under (3.12 K
-///   without margin, more than the split saw); refused for the reduction
-///   (0.608 K on the servo log), written only with `--accept-with-margin`.
-/// - Cost on the throttle mix (open loop): valve open 1486 → 1508 s, LNG
-///   2.96 → 3.01 kg (big-pump); 1540 → 1562 s, 2.09 → 2.13 kg
-///   (leaky-heavy); the servo logs stay below 40 °C.
-/// - 33–48 s per commissioning (four logs: two 1800 s training, a 1200 s
-///   servo and a 1800 s mix held out) on the shared 2 cores.
+/// Commissioning as the user runs it: both paths (the reduction, the
+/// direct identification), each with its drain margin validated on a split
+/// of the training missions, and the safer on the held-out logs flashed.
+/// The acceptance is 1.0 K max |e| and ≤ 0.3 K under-prediction on
+/// the held-out logs with the margin counted. Measured (max |e| / under vs
+/// the thermocouple, margin counted; servo, throttle mix):
+/// - big-pump: reduction chosen (the direct path under-predicts by 1.59 K
+///   with its 1.23 K margin); margin 2.12 K (after the split the soak log's
+///   idle phase is under-predicted by 1.92 K); 2.31 / 0.13 K and 5.98 /
+///   0.18 K: the under-prediction bound met, max |e| not (the mix is
+///   over-predicted by 3.87 K before the margin). Direct path: 1.43 / 1.18 K
+///   and 2.39 / 1.59 K.
+/// - leaky-heavy: reduction chosen (the direct path under-predicts the
+///   servo log by 2.29 K with its 1.10 K margin, although the split
+///   preferred it, 2.23 K against 2.43 K); margin 2.43 K; 2.66 / 0.67 K and
+///   3.35 / 0.01 K; refused for the reduction (0.626 K on the servo log),
+///   written only with `--accept-with-margin`. Direct path: 2.29 / 2.29 K
+///   and 2.12 / 1.37 K.
+/// - Cost on the throttle mix (open loop): valve open 1490 → 1511 s, LNG
+///   3.01 → 3.06 kg (big-pump); the servo logs stay below 40 °C.
+/// - 250–440 s per commissioning (four logs) on 2 cores shared with three
+///   other builds (load 8–13); 32 s before the polish and the direct path,
+///   at a lighter load.
 #[test]
 #[ignore = "slow tier: two commissionings with margin validation on emulator bench logs (~1 min each)"]
 fn slow_commissioning_with_margin_on_foreign_machines() {
-    let measured = [(2.152, [(2.345, 0.120), (5.933, 0.172)], [1486.0, 1508.0]), (2.500, [(2.735, 0.616), (3.452, 0.0)], [1540.0, 1562.0])];
+    let measured = [(2.115, [(2.308, 0.131), (5.981, 0.177)], [1490.0, 1511.0]), (2.430, [(2.661, 0.666), (3.353, 0.011)], [1540.0, 1562.0])];
     for (m, (margin, want, open_s)) in machines().into_iter().zip(measured) {
         let s = bench_set(&m, 3600).expect("bench");
         let train: Vec<CalLog> = s.train.iter().map(cal).collect();
@@ -169,6 +177,8 @@ fn slow_commissioning_with_margin_on_foreign_machines() {
         report(&m, &c, t0.elapsed().as_secs_f64());
         let h = headline(&m, &c, &s.holdout);
         near(&format!("{} margin", m.name), h.margin_k, margin);
+        assert!(c.direct_path.is_ok(), "{}: the direct path did not run: {:?}", m.name, c.direct_path.as_ref().err());
+        assert_eq!(c.choice.chosen, PathKind::Reduction, "{}: {}", m.name, c.choice.why);
         for (got, want) in h.measured.iter().zip(want) {
             near(&format!("{} held-out max |e| with margin", m.name), got.0, want.0);
             near(&format!("{} held-out under-prediction with margin", m.name), got.1, want.1);
