@@ -135,9 +135,9 @@ pub const UNDER_OK_K: f64 = 0.3;
 /// [`PathOutcome::validation_max_k`] after the split (where the margin
 /// covers the under-prediction by construction). The reduction when the
 /// direct path has no margin within the block's bound, or on a tie.
-/// Measured on leaky-heavy: the split preferred the direct path (2.23 K
+/// Measured on leaky-heavy: the split preferred the direct path (2.13 K
 /// against 2.43 K) while it under-predicted the held-out servo log by
-/// 2.29 K with its margin, the reduction by 0.67 K.
+/// 2.24 K with its margin, the reduction by 0.67 K.
 pub fn choose(reduction: &PathOutcome, direct: Result<&PathOutcome, &str>) -> Choice {
     let keep = |why: String| Choice { chosen: PathKind::Reduction, why };
     let d = match direct {
