@@ -212,6 +212,26 @@ fn plot_log(dir: &Path, base: &Rig, c: &Commissioning, l: &CalLog) -> anyhow::Re
     lines(&dir.join(format!("holdout-{stem}.png")), &format!("held out: {}", l.name), &panels)
 }
 
+/// The two paths (reduction, direct identification): which was flashed
+/// and why, and both paths' numbers after the split and on the held-out logs.
+fn paths_section(s: &mut String, c: &Commissioning) {
+    let _ = writeln!(s, "## Path: {}\n\nChosen because {}. (The held-out logs decide between two blocks, each fitted without them.)\n", c.choice.chosen.name(), c.choice.why);
+    let f = |x: Option<f64>| x.map_or("–".into(), |v| format!("{v:.3}"));
+    let _ = writeln!(s, "| path | margin K | after the split, margin counted: max \\|e\\| K | held out, margin counted: worst max \\|e\\| K | worst under K |\n|---|---:|---:|---:|---:|");
+    for p in std::iter::once(&c.reduction_path).chain(c.direct_path.as_ref().ok()) {
+        let w = p.holdout_worst();
+        let _ = writeln!(s, "| {} | {} | {} | {} | {} |", p.kind.name(), f(p.margin_k()), f(p.validation_max_k()), f(w.map(|w| w.0)), f(w.map(|w| w.1)));
+    }
+    if let Err(e) = &c.direct_path {
+        let _ = writeln!(s, "\nThe direct path did not run: {e}.");
+    }
+    if let Some(d) = &c.direct_fit {
+        let _ = writeln!(s, "\nDirect identification (fitted, not a validation): χ² {:.0} → {:.0} over {} points, {} model runs; multipliers on the reduction: {}.", d.chi2_before_after.0, d.chi2_before_after.1, d.n_points, d.model_runs,
+            d.results.iter().filter(|r| r.held.is_none()).map(|r| format!("`{}` {:.3}{}", r.name, r.value, if r.at_bound { " (on a bound)" } else { "" })).collect::<Vec<_>>().join(", "));
+    }
+    let _ = writeln!(s);
+}
+
 /// The drain margin: how it was validated, what it costs on the held-out
 /// logs, and which bench run would shrink it.
 fn margin_section(s: &mut String, c: &Commissioning) {
@@ -220,13 +240,13 @@ fn margin_section(s: &mut String, c: &Commissioning) {
         let _ = writeln!(s, "Not computed: it needs `t_drain_c` in every training log and a validation fit the firmware model accepts.\n");
         return;
     };
-    let _ = writeln!(s, "Calibrated on the first {:.0} % of every training log, reduced, and scored on the rest:\n\n| training log | firmware after the split: max \\|e\\| K | under K | where the under-prediction is largest |\n|---|---:|---:|---|", 100.0 * super::commission::SPLIT_FRACTION);
+    let _ = writeln!(s, "Fitted on the first {:.0} % of every training log (the chosen path), and scored on the rest:\n\n| training log | firmware after the split: max \\|e\\| K | under K | where the under-prediction is largest |\n|---|---:|---:|---|", 100.0 * super::commission::SPLIT_FRACTION);
     let f = |x: Option<f64>| x.map_or("–".into(), |v| format!("{v:.3}"));
     for r in &m.folds {
         let _ = writeln!(s, "| {} | {} | {} | {} |", r.log, f(r.vs_measured_max_k), f(r.vs_measured_under_k), r.vs_measured_region.as_ref().map_or("–".into(), |g| g.to_string()));
     }
     let _ = writeln!(s, "\nMargin **{:.2} K** = largest under-prediction {:.2} K + allowance {:.2} K (twice the thermocouple noise σ).\n", m.margin_k, m.margin_k - m.allowance_k, m.allowance_k);
-    let held = &c.reduced[c.reduced.len() - c.holdout.len()..];
+    let held = c.holdout_without_margin();
     let _ = writeln!(s, "Cost on the held-out logs (the guard's valve on the estimate, open loop):\n\n| log | valve open s, no margin | with margin | LNG kg, no margin | with margin |\n|---|---:|---:|---:|---:|");
     for (a, b) in held.iter().zip(&c.holdout_with_margin) {
         let _ = writeln!(s, "| {} | {:.0} | {:.0} | {:.3} | {:.3} |", a.log, a.valve_open_s, b.valve_open_s, a.lng_kg, b.lng_kg);
@@ -257,6 +277,7 @@ fn report(args: &CommissionArgs, c: &Commissioning) -> String {
         let _ = writeln!(s, "| {} | {} | {} | {} | {} | {} |", r.log, f(r.vs_measured_max_k), f(r.vs_measured_under_k), f(r.vs_measured_rmse_k), f(d.vs_measured_max_k), f(d.vs_measured_under_k));
     }
     let _ = writeln!(s, "\n(Against the measured `t_drain_c`, which carries the thermocouple's noise; open loop: the logged LNG valve, if any, drives the exchanger; the commissioned firmware with the drain margin below added. Held-out logs without `t_drain_c` show –.)\n");
+    paths_section(&mut s, c);
     margin_section(&mut s, c);
     if !c.cal.warnings.is_empty() {
         let _ = writeln!(s, "## Warnings\n");

@@ -12,6 +12,7 @@ use crate::plant::{Control, Plant, Sensors};
 use crate::reduce::reduce;
 use crate::rig::Rig;
 use crate::scenario::Scenario;
+use super::paths::{Choice, PathKind, PathOutcome};
 use eha_guard::model::{Model, ModelInputN, ReducedParams};
 
 /// Largest drain margin the parameter block accepts, K (the firmware's
@@ -40,6 +41,8 @@ pub struct ReducedCheck {
     pub vs_measured_max_k: Option<f64>,
     /// Largest under-prediction of the measured drain (measured − reduced), K.
     pub vs_measured_under_k: Option<f64>,
+    /// Largest over-prediction of the measured drain (reduced − measured), K.
+    pub vs_measured_over_k: Option<f64>,
     /// RMSE against the measured drain, K.
     pub vs_measured_rmse_k: Option<f64>,
     /// Where the under-prediction of the measured drain is largest (the
@@ -144,13 +147,13 @@ pub fn check_reduced_with(rig: &Rig, p: &ReducedParams, log: &CalLog, margin_k: 
 }
 
 /// [`check_reduced_with`], the measured drain scored from `score_from_s` on.
-fn check_reduced_core(rig: &Rig, p: &ReducedParams, log: &CalLog, margin_k: f64, score_from_s: f64) -> Result<ReducedCheck, String> {
+pub(crate) fn check_reduced_core(rig: &Rig, p: &ReducedParams, log: &CalLog, margin_k: f64, score_from_s: f64) -> Result<ReducedCheck, String> {
     let inputs = replay_inputs(&log.run, &log.name).map_err(|e| e.to_string())?;
     let t_end = log.run.time_s[log.run.len() - 1];
     let mut plant = Plant::new(rig, &Scenario::Replay(inputs)).map_err(|e| e.to_string())?;
     let mut m = Model::<f64>::new(p).map_err(|e| format!("reduced model rejects the parameters: {e:?}"))?;
     let (mut k, mut prev_x, mut max_ref, mut under_ref) = (0usize, 0.0, 0.0f64, 0.0f64);
-    let (mut max_meas, mut under, mut ss, mut n) = (0.0f64, 0.0f64, 0.0, 0usize);
+    let (mut max_meas, mut under, mut over, mut ss, mut n) = (0.0f64, 0.0f64, 0.0f64, 0.0, 0usize);
     let has_drain = log.has(Channel::TDrainC);
     let servo = log.run.get(Channel::PositionMm).is_some_and(|v| v.iter().any(Option::is_some));
     let valve = eha_guard::protection::ValveConfig::DEFAULT;
@@ -175,6 +178,7 @@ fn check_reduced_core(rig: &Rig, p: &ReducedParams, log: &CalLog, margin_k: f64,
                     let e = est - meas;
                     max_meas = max_meas.max(e.abs());
                     under = under.max(-e);
+                    over = over.max(e);
                     eu = -e;
                     ss += e * e;
                     n += 1;
@@ -214,6 +218,7 @@ fn check_reduced_core(rig: &Rig, p: &ReducedParams, log: &CalLog, margin_k: f64,
         vs_reference_region: region_of(&rows, &e_ref, servo),
         vs_measured_max_k: meas(max_meas),
         vs_measured_under_k: meas(under),
+        vs_measured_over_k: meas(over),
         vs_measured_rmse_k: meas((ss / n.max(1) as f64).sqrt()),
         vs_measured_region: (has_drain && under > 0.0).then(|| region_of(&rows, &e_under, servo)),
         valve_open_s: open_ticks as f64 * 0.01,
@@ -264,6 +269,15 @@ pub struct Commissioning {
     /// (the margin's accuracy and cost; equal to the held-out part of
     /// `reduced` when there is no margin).
     pub holdout_with_margin: Vec<ReducedCheck>,
+    /// The reduction path's firmware, validated and held out.
+    pub reduction_path: PathOutcome,
+    /// The direct path's firmware, or why it did not run.
+    pub direct_path: Result<PathOutcome, String>,
+    /// The direct identification behind `direct_path`.
+    pub direct_fit: Option<super::direct::DirectFit>,
+    /// Which path the block (`params`, `margin`, `holdout_with_margin`)
+    /// comes from, and why.
+    pub choice: Choice,
 }
 
 /// Allowance added to the validation's largest under-prediction, K: twice
@@ -336,13 +350,23 @@ pub fn log_region(log: &CalLog) -> Region {
 }
 
 impl Commissioning {
-    /// Whether the firmware parameter block may be flashed: the reduced model
-    /// holds every log and the training logs separate the loss coefficients.
+    /// Whether the firmware parameter block may be flashed: the training
+    /// logs separate the loss coefficients, and the block is either the
+    /// direct identification (judged on the logs themselves) or a reduction
+    /// that holds the commissioned reference on every log.
     /// Measured: commissioned from one operating point, the other
     /// EHA's firmware under-predicted a held-out high-pressure mission by
     /// 1.8 K with every reduced check passing.
     pub fn flashable(&self) -> bool {
-        self.reduced_ok && self.excitation_ok
+        self.excitation_ok && (self.reduced_ok || self.choice.chosen == PathKind::Direct)
+    }
+
+    /// The chosen path's firmware on the held-out logs without the margin.
+    pub fn holdout_without_margin(&self) -> &[ReducedCheck] {
+        match (&self.choice.chosen, &self.direct_path) {
+            (PathKind::Direct, Ok(d)) => &d.holdout,
+            _ => &self.reduction_path.holdout,
+        }
     }
 
     /// The margin written into an accepted block, K (0 without validation).
@@ -363,7 +387,7 @@ impl Commissioning {
                 bench_run: "speed steps at one needle setting (e.g. 400–1200 rpm every 3–4 min at 20 bar) and needle steps at one speed (e.g. 10–50 bar every 3–4 min at 700 rpm), 30 min each, with `t_drain_c` logged".into(),
             });
         }
-        if !self.reduced_ok {
+        if !self.reduced_ok && self.choice.chosen == PathKind::Reduction {
             let r = self.reduced.iter().max_by(|a, b| a.vs_reference_max_k.total_cmp(&b.vs_reference_max_k))?;
             return Some(Refusal {
                 reason: format!("the six-state firmware model departs from the commissioned reference by {:.3} K (bound {REDUCED_BOUND_K} K)", r.vs_reference_max_k),
@@ -443,28 +467,53 @@ fn head_of(log: &CalLog, frac: f64, points_per_channel: usize) -> Result<CalLog,
     CalLog::new(&log.name, head, points_per_channel)
 }
 
-/// Validation of the firmware drain over a split of the training missions:
-/// the calibration on the first [`SPLIT_FRACTION`] of every training log,
-/// reduced, and scored against each log's measured drain after the split
-/// (replayed from the start). `None` when a training log has no
-/// `t_drain_c`, or when the validation fit gives parameters the firmware
-/// model rejects. `start`: the multipliers the validation fit starts from
-/// (the commissioning's; its priors stay at the rig file).
-pub fn validate_margin(base: &Rig, train: &[CalLog], o: &CalOptions, start: Option<&[f64]>) -> Result<Option<MarginValidation>, CommissionError> {
+/// The split of the training missions that validates a margin: the first
+/// [`SPLIT_FRACTION`] of every training log, the reference calibrated on
+/// them and its reduction.
+#[derive(Debug, Clone)]
+pub struct Split {
+    /// The heads of the training logs.
+    pub heads: Vec<CalLog>,
+    /// The reference calibrated on the heads.
+    pub rig: Rig,
+    /// Its reduction.
+    pub reduction: ReducedParams,
+}
+
+/// The calibration on the first [`SPLIT_FRACTION`] of every training log
+/// and its reduction. `None` when a training log has no `t_drain_c`, or the
+/// reduction gives parameters the firmware model rejects. `start`: the
+/// multipliers the fit starts from (the commissioning's; its priors stay at
+/// the rig file).
+pub fn split_fit(base: &Rig, train: &[CalLog], o: &CalOptions, start: Option<&[f64]>) -> Result<Option<Split>, CommissionError> {
     if train.is_empty() || !train.iter().all(|l| l.has(Channel::TDrainC)) {
         return Ok(None);
     }
     let heads: Vec<CalLog> = train.iter().map(|l| head_of(l, SPLIT_FRACTION, o.points_per_channel)).collect::<Result<_, _>>().map_err(CommissionError::Run)?;
     let o = CalOptions { start: start.map(<[f64]>::to_vec), ..o.clone() };
     let (_, cal, _) = fit(base, &heads, &o)?;
-    let Some(p) = reduce(&cal.rig) else { return Ok(None) };
+    Ok(reduce(&cal.rig).map(|reduction| Split { heads, rig: cal.rig, reduction }))
+}
+
+/// The firmware parameters `p` fitted on the split's heads, replayed over
+/// each whole training log (from the start) and scored against its measured
+/// drain after the split; the margin is the largest under-prediction there
+/// plus [`MARGIN_ALLOWANCE_K`].
+pub fn score_split(split: &Split, train: &[CalLog], p: &ReducedParams) -> Result<MarginValidation, CommissionError> {
     let mut folds = Vec::new();
-    for (l, h) in train.iter().zip(&heads) {
+    for (l, h) in train.iter().zip(&split.heads) {
         let t_split = h.run.time_s[h.run.len() - 1];
-        folds.push(check_reduced_core(&cal.rig, &p, l, 0.0, t_split).map_err(CommissionError::Run)?);
+        folds.push(check_reduced_core(&split.rig, p, l, 0.0, t_split).map_err(CommissionError::Run)?);
     }
     let worst = folds.iter().filter_map(|f| f.vs_measured_under_k).fold(0.0, f64::max);
-    Ok(Some(MarginValidation { folds, allowance_k: MARGIN_ALLOWANCE_K, margin_k: worst + MARGIN_ALLOWANCE_K }))
+    Ok(MarginValidation { folds, allowance_k: MARGIN_ALLOWANCE_K, margin_k: worst + MARGIN_ALLOWANCE_K })
+}
+
+/// Validation of the reduction path's firmware drain over a split of the
+/// training missions ([`split_fit`], [`score_split`] of its reduction).
+pub fn validate_margin(base: &Rig, train: &[CalLog], o: &CalOptions, start: Option<&[f64]>) -> Result<Option<MarginValidation>, CommissionError> {
+    let Some(split) = split_fit(base, train, o, start)? else { return Ok(None) };
+    score_split(&split, train, &split.reduction).map(Some)
 }
 
 /// Commissions `base` on `train`, validates on `holdout`, with the drain
@@ -519,13 +568,32 @@ pub fn commission_with(base: &Rig, train: &[CalLog], holdout: &[CalLog], o: &Cal
     // the rig file, a 1e-9 K nudge of the logs moved big-pump's margin by
     // 0.17 K (the heads fit wanders along its ill-determined directions);
     // from there, by 0.043 K.
-    let margin = if with_margin { validate_margin(base, train, o, Some(&cal.theta))? } else { None };
+    let split = if with_margin { split_fit(base, train, o, Some(&cal.theta))? } else { None };
+    let margin = split.as_ref().map(|s| score_split(s, train, &s.reduction)).transpose()?;
     if with_margin && margin.is_none() {
         cal.warnings.push("no drain margin: it needs `t_drain_c` in every training log, and a validation fit (first 60 % of every training log) that the firmware model accepts".into());
     }
+    let reduction = super::paths::PathOutcome::new(PathKind::Reduction, &cal.rig, params, margin, holdout)?;
+    // The second path: the firmware model's own parameters identified from
+    // the logs, from the reduction; validated on the same split.
+    let direct = match (&o.direct, with_margin) {
+        (Some(d), true) => super::paths::direct_path(&cal.rig, &params, train, holdout, split.as_ref(), d),
+        (Some(_), false) => Err("not asked: no margin validation to compare the paths on".into()),
+        (None, _) => Err("switched off".into()),
+    };
+    let choice = super::paths::choose(&reduction, direct.as_ref().map(|d| &d.1).map_err(String::as_str));
+    let (direct_fit, direct_path) = match direct {
+        Ok((f, p)) => (Some(f), Ok(p)),
+        Err(e) => (None, Err(e)),
+    };
+    let chosen = match (&choice.chosen, &direct_path) {
+        (PathKind::Direct, Ok(d)) => d,
+        _ => &reduction,
+    };
+    params = chosen.params;
     // The validated margin goes into the block (the guard adds it to the
     // estimate it decides on); beyond the block's bound it is refused.
-    match &margin {
+    match &chosen.validation {
         Some(m) if m.margin_k <= MARGIN_MAX_K => params.drain_margin_k = m.margin_k,
         Some(m) => cal.warnings.push(format!(
             "drain margin {:.2} K exceeds the parameter block's {MARGIN_MAX_K} K bound: the model does not fit this machine well enough to protect it; the block carries no margin",
@@ -535,15 +603,8 @@ pub fn commission_with(base: &Rig, train: &[CalLog], holdout: &[CalLog], o: &Cal
     }
     // Scored with the margin the block carries (none when it exceeds the
     // block's bound), so the report and the flashed block cannot disagree.
-    let holdout_with_margin = if params.drain_margin_k > 0.0 {
-        holdout
-            .iter()
-            .map(|l| check_reduced_with(&cal.rig, &params, l, params.drain_margin_k))
-            .collect::<Result<_, _>>()
-            .map_err(CommissionError::Run)?
-    } else {
-        reduced[train.len()..].to_vec()
-    };
+    let holdout_with_margin = chosen.holdout_with_margin.clone();
+    let margin = chosen.validation.clone();
     let train_regions = train.iter().map(log_region).collect();
     Ok(Commissioning {
         cal,
@@ -557,6 +618,10 @@ pub fn commission_with(base: &Rig, train: &[CalLog], holdout: &[CalLog], o: &Cal
         eta_m_from_current: eta_e,
         margin,
         holdout_with_margin,
+        reduction_path: reduction,
+        direct_path,
+        direct_fit,
+        choice,
     })
 }
 

@@ -23,6 +23,7 @@ pub mod ident;
 pub mod log;
 pub mod lsq;
 pub mod paper;
+pub mod paths;
 pub mod replay;
 pub mod set;
 pub mod synthetic;

@@ -5,8 +5,9 @@
 //! The user's rig file is the paper rig with the nameplate values.
 
 use eha_sim::calibration::commission::{check_reduced_with, commission, commission_with, Commissioning};
+use eha_sim::calibration::paths::PathKind;
 use eha_sim::calibration::{CalLog, CalOptions};
-use eha_sim::emulator::bench::{bench_log, bench_set, big_pump, machines, BenchLog, EmuMachine};
+use eha_sim::emulator::bench::{bench_log, bench_set, big_pump, leaky_heavy, machines, BenchLog, EmuMachine};
 use eha_sim::emulator::missions::EmuScenario;
 use eha_sim::measured::Channel;
 
@@ -70,6 +71,9 @@ fn report(m: &EmuMachine, c: &Commissioning, secs: f64) {
     for p in c.cal.params.iter().filter(|p| p.at_bound) {
         eprintln!("  on a bound: {} {:.3}", p.name, p.value);
     }
+    let fitted: Vec<String> = c.cal.params.iter().filter(|p| p.status == eha_sim::calibration::Status::Fitted).map(|p| format!("{} {:.4}", p.name, p.value)).collect();
+    eprintln!("  fitted: {}", fitted.join(", "));
+    eprintln!("  polish: objective {:.3?} decrement {:?} converged {} on bound {:?}", c.cal.polish.objective, c.cal.polish.decrement, c.cal.polish.converged, c.cal.polish.on_bound);
     for r in &c.reduced {
         eprintln!("  reduced {:40} vs ref max {:.3} | vs measured max {:?} under {:?}", r.log, r.vs_reference_max_k, r.vs_measured_max_k, r.vs_measured_under_k);
     }
@@ -78,34 +82,49 @@ fn report(m: &EmuMachine, c: &Commissioning, secs: f64) {
             eprintln!("  after the split: {}: max {:?} under {:?} at {:?}", f.log, f.vs_measured_max_k, f.vs_measured_under_k, f.vs_measured_region.as_ref().map(|g| g.to_string()));
         }
     }
-    let n = c.reduced.len() - c.holdout.len();
-    for (a, b) in c.reduced[n..].iter().zip(&c.holdout_with_margin) {
+    eprintln!("  chosen: {:?}: {}", c.choice.chosen, c.choice.why);
+    for p in std::iter::once(&c.reduction_path).chain(c.direct_path.as_ref().ok()) {
+        eprintln!("  path {:?}: margin {:?}, validation max {:?}, held out with margin (max, under) {:?}", p.kind, p.margin_k(), p.validation_max_k(), p.holdout_with_margin.iter().map(|r| (r.vs_measured_max_k, r.vs_measured_under_k)).collect::<Vec<_>>());
+        for f in p.validation.iter().flat_map(|v| &v.folds) {
+            eprintln!("    fold {}: over {:?} under {:?} at {:?}", f.log, f.vs_measured_over_k, f.vs_measured_under_k, f.vs_measured_region.as_ref().map(|g| g.to_string()));
+        }
+    }
+    if let Err(e) = &c.direct_path {
+        eprintln!("  direct path: {e}");
+    }
+    if let Some(f) = &c.direct_fit {
+        let v: Vec<String> = f.results.iter().filter(|r| r.held.is_none()).map(|r| format!("{} {:.3}{}", r.name, r.value, if r.at_bound { "*" } else { "" })).collect();
+        eprintln!("  direct fit: {} runs, chi2 {:.0} -> {:.0}; {}", f.model_runs, f.chi2_before_after.0, f.chi2_before_after.1, v.join(", "));
+    }
+    for (a, b) in c.holdout_without_margin().iter().zip(&c.holdout_with_margin) {
         eprintln!("  cost {}: valve open {:.0} -> {:.0} s, LNG {:.3} -> {:.3} kg", a.log, a.valve_open_s, b.valve_open_s, a.lng_kg, b.lng_kg);
     }
 }
 
 /// Tolerance on a measured headline number, K: a 1e-9 K nudge of every
-/// temperature moved them by up to 0.051 K
-/// (`slow_commissioning_is_reproducible_at_the_last_digit`).
+/// temperature moved them by up to 0.039 K
+/// (`slow_commissioning_is_reproducible_at_the_last_digit_*`); the
+/// commissioning is not converged to better than that (the polish stops
+/// after 8 steps with a predicted decrease of a few units of χ²).
 const AS_MEASURED_K: f64 = 0.15;
 
 fn near(what: &str, got: f64, measured: f64) {
     assert!((got - measured).abs() <= AS_MEASURED_K, "{what}: {got:.3} K, measured {measured:.3} K (±{AS_MEASURED_K})");
 }
 
-/// The commissioning path without the margin, on both machines. Measured
-/// (held-out servo, throttle mix; firmware drain vs the thermocouple, max
-/// |e| / under-prediction): big-pump flashable, 2.27 / 2.27 K and 3.78 /
-/// 2.32 K (vs the true drain 1.97 / 1.97, 3.85 / 2.37 K); leaky-heavy
-/// refused, the six-state model 0.608 K off the commissioned reference on
-/// the servo log, 3.12 / 3.12 K and 2.42 / 2.42 K. The training logs
-/// themselves are missed too (big-pump soak then idle: 2.77 K under, in the
+/// The reduction path without the margin (no validation, no direct
+/// path), on both machines. Measured (held-out servo, throttle mix;
+/// firmware drain vs the thermocouple, max |e| / under-prediction):
+/// big-pump flashable, 2.25 / 2.25 K and 3.87 / 2.29 K; leaky-heavy
+/// refused, the six-state model 0.626 K off the commissioned reference on
+/// the servo log, 3.10 / 3.10 K and 2.44 / 2.44 K. The training logs
+/// themselves are missed too (big-pump soak then idle: 2.7 K under, in the
 /// idle phase): the commissioned reference does not follow these machines'
-/// drain, the reduction does (≤ 0.19 K on every throttle log).
+/// drain, the reduction does (≤ 0.2 K on every throttle log).
 #[test]
 #[ignore = "slow tier: two commissionings on emulator bench logs (~40 s each)"]
 fn slow_commissioning_without_margin_on_foreign_machines() {
-    let measured = [(true, [(2.273, 2.273), (3.781, 2.324)]), (false, [(3.115, 3.115), (2.420, 2.420)])];
+    let measured = [(true, [(2.246, 2.246), (3.866, 2.292)]), (false, [(3.095, 3.095), (2.441, 2.441)])];
     for (m, (flash, want)) in machines().into_iter().zip(measured) {
         let s = bench_set(&m, 3600).expect("bench");
         let train: Vec<CalLog> = s.train.iter().map(cal).collect();
@@ -122,28 +141,34 @@ fn slow_commissioning_without_margin_on_foreign_machines() {
     }
 }
 
-/// The commissioning path with the drain margin (validated on a split of the
-/// training missions), on both machines: the acceptance is 1.0 K max
-/// |e| and ≤ 0.3 K under-prediction on the held-out logs with the margin
-/// counted. Measured (max |e| / under vs the thermocouple; servo, throttle
-/// mix):
-/// - big-pump: margin 2.15 K (after the split the soak log's idle phase is
-///   under-predicted by 1.95 K); 2.35 / 0.12 K and 5.93 / 0.17 K: the
-///   under-prediction bound met, max |e| not (the mix is over-predicted by
-///   3.78 K before the margin).
-/// - leaky-heavy: margin 2.50 K (1.45 and 2.30 K after the split); 2.74 /
-///   0.62 K and 3.45 / 0.00 K: the servo log still 0.62 K under (3.12 K
-///   without margin, more than the split saw); refused for the reduction
-///   (0.608 K on the servo log), written only with `--accept-with-margin`.
-/// - Cost on the throttle mix (open loop): valve open 1486 → 1508 s, LNG
-///   2.96 → 3.01 kg (big-pump); 1540 → 1562 s, 2.09 → 2.13 kg
+/// Commissioning as the user runs it: both paths (the reduction, the
+/// direct identification), each with its drain margin validated on a split
+/// of the training missions, and the safer on the held-out logs flashed.
+/// The acceptance is 1.0 K max |e| and ≤ 0.3 K under-prediction on
+/// the held-out logs with the margin counted. Measured (max |e| / under vs
+/// the thermocouple, margin counted; servo, throttle mix):
+/// - big-pump: reduction chosen (the direct path under-predicts by 1.33 K
+///   with its 0.91 K margin); margin 2.12 K (after the split the soak log's
+///   idle phase is under-predicted by 1.92 K); 2.31 / 0.13 K and 5.98 /
+///   0.18 K: the under-prediction bound met, max |e| not (the mix is
+///   over-predicted by 3.87 K before the margin). Direct path: 1.33 / 1.33 K
+///   and 2.33 / 1.31 K.
+/// - leaky-heavy: reduction chosen (the direct path under-predicts the
+///   servo log by 2.24 K with its 1.04 K margin, although the split
+///   preferred it, 2.13 K against 2.43 K); margin 2.43 K; 2.66 / 0.67 K and
+///   3.35 / 0.01 K; refused for the reduction (0.626 K on the servo log),
+///   written only with `--accept-with-margin`. Direct path: 2.24 / 2.24 K
+///   and 2.09 / 1.11 K.
+/// - Cost on the throttle mix (open loop): valve open 1490 → 1511 s, LNG
+///   3.01 → 3.06 kg (big-pump); 1541 → 1561 s, 1.98 → 2.01 kg
 ///   (leaky-heavy); the servo logs stay below 40 °C.
-/// - 33–48 s per commissioning (four logs: two 1800 s training, a 1200 s
-///   servo and a 1800 s mix held out) on the shared 2 cores.
+/// - 108–440 s per commissioning (four logs) on 2 cores shared with three
+///   other helpers' builds and tests (load 8–13); 32 s before the polish
+///   and the direct path, at a lighter load. Not a timing test.
 #[test]
 #[ignore = "slow tier: two commissionings with margin validation on emulator bench logs (~1 min each)"]
 fn slow_commissioning_with_margin_on_foreign_machines() {
-    let measured = [(2.152, [(2.345, 0.120), (5.933, 0.172)], [1486.0, 1508.0]), (2.500, [(2.735, 0.616), (3.452, 0.0)], [1540.0, 1562.0])];
+    let measured = [(2.115, [(2.308, 0.131), (5.981, 0.177)], [1490.0, 1511.0]), (2.430, [(2.661, 0.666), (3.353, 0.011)], [1541.0, 1561.0])];
     for (m, (margin, want, open_s)) in machines().into_iter().zip(measured) {
         let s = bench_set(&m, 3600).expect("bench");
         let train: Vec<CalLog> = s.train.iter().map(cal).collect();
@@ -153,13 +178,14 @@ fn slow_commissioning_with_margin_on_foreign_machines() {
         report(&m, &c, t0.elapsed().as_secs_f64());
         let h = headline(&m, &c, &s.holdout);
         near(&format!("{} margin", m.name), h.margin_k, margin);
+        assert!(c.direct_path.is_ok(), "{}: the direct path did not run: {:?}", m.name, c.direct_path.as_ref().err());
+        assert_eq!(c.choice.chosen, PathKind::Reduction, "{}: {}", m.name, c.choice.why);
         for (got, want) in h.measured.iter().zip(want) {
             near(&format!("{} held-out max |e| with margin", m.name), got.0, want.0);
             near(&format!("{} held-out under-prediction with margin", m.name), got.1, want.1);
         }
         // The margin opens the valve earlier, never later (open loop).
-        let n = c.reduced.len() - c.holdout.len();
-        let (a, b) = (&c.reduced[n + 1], &c.holdout_with_margin[1]);
+        let (a, b) = (&c.holdout_without_margin()[1], &c.holdout_with_margin[1]);
         assert!(b.valve_open_s >= a.valve_open_s && b.lng_kg >= a.lng_kg, "{}: margin cost negative", m.name);
         assert!((a.valve_open_s - open_s[0]).abs() <= 20.0 && (b.valve_open_s - open_s[1]).abs() <= 20.0, "{}: valve open {:.0} -> {:.0} s", m.name, a.valve_open_s, b.valve_open_s);
     }
@@ -185,17 +211,30 @@ fn one_operating_point_is_refused_with_log_region_channel_and_bench_run() {
 }
 
 /// Every temperature of every log moved by 1e-9 K: the headline numbers
-/// (held-out max |e| and under-prediction, margin) move by at most 0.05 K.
-/// Measured: big-pump 0.043 K (margin 2.152 → 2.196 K); leaky-heavy 0.051 K
-/// (the servo log's under-prediction with margin 0.616 → 0.565 K; margin
-/// 2.500 → 2.504 K): fails by 0.001 K. The servo log is extrapolation (no
-/// training log moves the piston) and the commissioning's fit moves along
-/// its ill-determined directions; with the validation fit started from the
-/// rig file instead of the commissioning's multipliers, big-pump's margin
-/// moved 0.17 K.
+/// (held-out max |e| and under-prediction of the flashed path, margin) move
+/// by at most 0.05 K. Measured with the calibration's final polish
+/// (Gauss–Newton with the priors, data σ inflated by the reduced χ²):
+/// big-pump 0.039 K (margin 2.115 → 2.084 K; 0.092 K before the polish),
+/// a pass, although multipliers the drain barely sees still moved
+/// (`h_out_motor` 1.48 → 0.93). leaky-heavy 0.10 K (the reduction's servo
+/// under-prediction 0.666 → 0.563 K, margin 2.430 → 2.517 K): the nudged
+/// LM ended in another basin of the ball-valve block (film ×3.28 → ×0.58,
+/// capacity ×2.46 → ×0.46), which the polish does not choose between; a
+/// miss, asserted as the bound.
 #[test]
-#[ignore = "slow tier: four commissionings with margin validation (~4 min)"]
-fn slow_commissioning_is_reproducible_at_the_last_digit() {
+#[ignore = "slow tier: two commissionings with margin validation and the direct path (~2 min)"]
+fn slow_commissioning_is_reproducible_at_the_last_digit_big_pump() {
+    reproducible(big_pump());
+}
+
+/// [`slow_commissioning_is_reproducible_at_the_last_digit_big_pump`] on leaky-heavy.
+#[test]
+#[ignore = "slow tier: two commissionings with margin validation and the direct path (~2 min)"]
+fn slow_commissioning_is_reproducible_at_the_last_digit_leaky_heavy() {
+    reproducible(leaky_heavy());
+}
+
+fn reproducible(m: EmuMachine) {
     let nudge = |l: &BenchLog| -> BenchLog {
         let mut l = l.clone();
         for ch in Channel::TEMPERATURES.into_iter().chain([Channel::TDrainC]) {
@@ -204,7 +243,7 @@ fn slow_commissioning_is_reproducible_at_the_last_digit() {
         }
         l
     };
-    for m in machines() {
+    {
         let s = bench_set(&m, 3600).expect("bench");
         let run = |logs: &[BenchLog], hold: &[BenchLog]| {
             let train: Vec<CalLog> = logs.iter().map(cal).collect();
