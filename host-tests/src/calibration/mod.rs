@@ -15,6 +15,7 @@
 //! - [`paper`]: the reference's own calibration to the paper's Table 4,
 //!   Table 5 and Fig. 15 (`eha-sim calibrate`), with [`lsq`].
 
+pub mod check;
 pub mod cli;
 pub mod commission;
 pub mod direct;

@@ -3,13 +3,13 @@
 //! (`reduce`), and the firmware model's own parameters identified directly
 //! from the logs, starting from that reduction ([`super::direct`]). Each
 //! path's firmware is validated on the split of the training missions
-//! (fitted on the first [`super::commission::SPLIT_FRACTION`] of every
+//! (fitted on the first [`super::check::SPLIT_FRACTION`] of every
 //! training log, scored against the measured drain after it) with its own
 //! margin, and both are scored on the held-out logs with that margin; the
 //! block comes from the path that is safer there ([`choose`]), and the
 //! report gives both paths' numbers.
 
-use super::commission::{check_reduced_with, score_split, CommissionError, MarginValidation, ReducedCheck, Split, MARGIN_MAX_K};
+use super::check::{check_reduced_with, score_split, CommissionError, MarginValidation, ReducedCheck, Split, MARGIN_MAX_K};
 use super::direct::{identify_direct, DirectFit, DirectOptions};
 use super::log::CalLog;
 use crate::rig::Rig;

@@ -1,0 +1,294 @@
+//! The reduced model's checks shared by both commissioning paths: the
+//! firmware model (f64) replayed on a log against the commissioned reference
+//! and the measured drain, the operating region of its largest errors, and
+//! the margin from a split of the training missions.
+
+use super::fit::CalError;
+use super::log::CalLog;
+use crate::measured::Channel;
+use crate::plant::{Control, Plant, Sensors};
+use crate::rig::Rig;
+use crate::scenario::Scenario;
+use crate::simulation::replay::replay_inputs;
+use eha_guard::model::{Model, ModelInputN, ReducedParams};
+
+/// Largest drain margin the parameter block accepts, K (the firmware's
+/// bounds table, `drain_margin_k`).
+pub const MARGIN_MAX_K: f64 = 10.0;
+
+/// Bound of the reduced model against the commissioned reference on every
+/// log's inputs, drain max |e|, K.
+pub const REDUCED_BOUND_K: f64 = 0.2;
+
+/// The reduced model (firmware parameters `p`, f64) on one log's inputs.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct ReducedCheck {
+    /// Log name.
+    pub log: String,
+    /// Drain margin added to the estimate in this check, K (0: none).
+    pub margin_k: f64,
+    /// Max |reduced − reference| drain, K (reference = the rig it was reduced from).
+    pub vs_reference_max_k: f64,
+    /// Largest under-prediction of the reference drain (reference − reduced), K.
+    pub vs_reference_under_k: f64,
+    /// Where the departure from the reference is largest (the ticks within
+    /// half of `vs_reference_max_k`).
+    pub vs_reference_region: Region,
+    /// Max |reduced − measured| drain, K, when the log has `t_drain_c`.
+    pub vs_measured_max_k: Option<f64>,
+    /// Largest under-prediction of the measured drain (measured − reduced), K.
+    pub vs_measured_under_k: Option<f64>,
+    /// Largest over-prediction of the measured drain (reduced − measured), K.
+    pub vs_measured_over_k: Option<f64>,
+    /// RMSE against the measured drain, K.
+    pub vs_measured_rmse_k: Option<f64>,
+    /// Where the under-prediction of the measured drain is largest (the
+    /// ticks within half of `vs_measured_under_k`), when there is one.
+    pub vs_measured_region: Option<Region>,
+    /// Seconds the guard's valve would be open on this estimate (open
+    /// loop: opens above 40 °C, closes after 2 s below 38 °C; the decision
+    /// is not fed back into the replay).
+    pub valve_open_s: f64,
+    /// LNG the guard would book for those seconds (the model's total loss
+    /// while open, eq. 23, Table 6 latent and sensible heat), kg.
+    pub lng_kg: f64,
+}
+
+/// An operating region of a log: ranges over the ticks that matter.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Region {
+    /// Time, s.
+    pub t_s: (f64, f64),
+    /// Shaft speed (absolute), rpm.
+    pub speed_rpm: (f64, f64),
+    /// Port pressure difference (absolute), bar.
+    pub dp_bar: (f64, f64),
+    /// Drain temperature of the reference, °C.
+    pub drain_c: (f64, f64),
+    /// Whether the log is a servo run (`position_mm` logged).
+    pub servo: bool,
+}
+
+impl std::fmt::Display for Region {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} run, t {:.0}–{:.0} s, {:.0}–{:.0} rpm, Δp {:.0}–{:.0} bar, drain {:.1}–{:.1} °C",
+            if self.servo { "servo" } else { "throttle" },
+            self.t_s.0,
+            self.t_s.1,
+            self.speed_rpm.0,
+            self.speed_rpm.1,
+            self.dp_bar.0,
+            self.dp_bar.1,
+            self.drain_c.0,
+            self.drain_c.1
+        )
+    }
+}
+
+impl Region {
+    /// The bench run that would put this region into the training set with
+    /// the drain logged.
+    pub fn bench_run(&self) -> String {
+        if self.servo {
+            format!(
+                "a 30-min servo hold/manoeuvre mission in the training set (holds and triangles reaching Δp {:.0}–{:.0} bar), with `t_drain_c` logged",
+                self.dp_bar.0, self.dp_bar.1
+            )
+        } else {
+            format!(
+                "a 30-min throttle run holding {:.0} rpm at {:.0} bar until the drain passes {:.0} °C, then speed and needle stepped one at a time around that point, with `t_drain_c` logged",
+                0.5 * (self.speed_rpm.0 + self.speed_rpm.1),
+                0.5 * (self.dp_bar.0 + self.dp_bar.1),
+                self.drain_c.1
+            )
+        }
+    }
+}
+
+/// One replay tick kept for the regions: t, speed, Δp, reference drain.
+type TickRow = (f64, f64, f64, f64);
+
+/// Ranges of the rows whose `e` is at least half of the largest (all rows
+/// when the largest is not positive).
+fn region_of(rows: &[TickRow], e: &[f64], servo: bool) -> Region {
+    let top = e.iter().copied().fold(0.0, f64::max);
+    let mut r = Region { t_s: (f64::MAX, f64::MIN), speed_rpm: (f64::MAX, f64::MIN), dp_bar: (f64::MAX, f64::MIN), drain_c: (f64::MAX, f64::MIN), servo };
+    let widen = |a: &mut (f64, f64), x: f64| *a = (a.0.min(x), a.1.max(x));
+    for (row, &ek) in rows.iter().zip(e) {
+        if top <= 0.0 || ek >= 0.5 * top {
+            widen(&mut r.t_s, row.0);
+            widen(&mut r.speed_rpm, row.1);
+            widen(&mut r.dp_bar, row.2);
+            widen(&mut r.drain_c, row.3);
+        }
+    }
+    r
+}
+
+/// [`check_reduced_with`] without a margin.
+pub fn check_reduced(rig: &Rig, p: &ReducedParams, log: &CalLog) -> Result<ReducedCheck, String> {
+    check_reduced_with(rig, p, log, 0.0)
+}
+
+/// Runs the reference on `rig` replaying `log`'s inputs at the firmware's
+/// 10 ms tick and feeds the same signals to the reduced model `p` exactly as
+/// the guard does (tick accumulation, 100 ms model step; the logged LNG
+/// valve, if any, is the exchanger command). The drain estimate is the
+/// model's plus `margin_k` (the drain margin, K). Errors compare it with
+/// the reference's case-oil node and with the measured `t_drain_c`
+/// (interpolated to the tick; only where samples exist).
+pub fn check_reduced_with(rig: &Rig, p: &ReducedParams, log: &CalLog, margin_k: f64) -> Result<ReducedCheck, String> {
+    check_reduced_core(rig, p, log, margin_k, f64::NEG_INFINITY)
+}
+
+/// [`check_reduced_with`], the measured drain scored from `score_from_s` on.
+pub(crate) fn check_reduced_core(rig: &Rig, p: &ReducedParams, log: &CalLog, margin_k: f64, score_from_s: f64) -> Result<ReducedCheck, String> {
+    let inputs = replay_inputs(&log.run, &log.name).map_err(|e| e.to_string())?;
+    let t_end = log.run.time_s[log.run.len() - 1];
+    let mut plant = Plant::new(rig, &Scenario::Replay(inputs)).map_err(|e| e.to_string())?;
+    let mut m = Model::<f64>::new(p).map_err(|e| format!("reduced model rejects the parameters: {e:?}"))?;
+    let (mut k, mut prev_x, mut max_ref, mut under_ref) = (0usize, 0.0, 0.0f64, 0.0f64);
+    let (mut max_meas, mut under, mut over, mut ss, mut n) = (0.0f64, 0.0f64, 0.0f64, 0.0, 0usize);
+    let has_drain = log.has(Channel::TDrainC);
+    let servo = log.run.get(Channel::PositionMm).is_some_and(|v| v.iter().any(Option::is_some));
+    let valve = eha_guard::protection::ValveConfig::DEFAULT;
+    let (mut guard_open, mut below_ticks, mut open_ticks, mut open_j) = (false, 0u32, 0usize, 0.0f64);
+    let (mut rows, mut e_ref, mut e_under): (Vec<TickRow>, Vec<f64>, Vec<f64>) = (Vec::new(), Vec::new(), Vec::new());
+    let mut open = false;
+    plant
+        .run(0.01, t_end, |snap| {
+            let s = Sensors::from(snap);
+            if k == 0 {
+                m.set_uniform(s.ambient_c);
+                prev_x = s.position_mm;
+            }
+            let est = m.drain_c() + margin_k;
+            max_ref = max_ref.max((est - s.t_drain_c).abs());
+            under_ref = under_ref.max(s.t_drain_c - est);
+            rows.push((s.t, s.speed_rpm.abs(), (s.p_a_bar - s.p_b_bar).abs(), s.t_drain_c));
+            e_ref.push((est - s.t_drain_c).abs());
+            let mut eu = f64::NEG_INFINITY;
+            if has_drain && k > 0 && s.t >= score_from_s {
+                if let Some(meas) = log.run.value_at(Channel::TDrainC, s.t) {
+                    let e = est - meas;
+                    max_meas = max_meas.max(e.abs());
+                    under = under.max(-e);
+                    over = over.max(e);
+                    eu = -e;
+                    ss += e * e;
+                    n += 1;
+                }
+            }
+            e_under.push(eu);
+            // The guard's valve on this estimate (open loop).
+            if est > f64::from(valve.open_c) {
+                guard_open = true;
+                below_ticks = 0;
+            } else if guard_open {
+                below_ticks = if est < f64::from(valve.close_c) { below_ticks + 1 } else { 0 };
+                if below_ticks >= valve.dwell_ticks {
+                    guard_open = false;
+                }
+            }
+            if guard_open {
+                open_ticks += 1;
+                open_j += m.last_total_kw() * 1e3 * 0.01;
+            }
+            let u = ModelInputN::from_wire_f64(s.current_a, s.p_a_bar, s.p_b_bar, s.speed_rpm, s.position_mm - prev_x, s.ambient_c);
+            prev_x = s.position_mm;
+            if m.tick_n(&u) {
+                m.update(if open { 10 } else { 0 });
+            }
+            open = log.run.value_at(Channel::LngValve, s.t).is_some_and(|v| v >= 0.5);
+            k += 1;
+            Ok(Control { lng_valve: Some(open), stop: false })
+        })
+        .map_err(|e| e.to_string())?;
+    let meas = |x: f64| has_drain.then_some(x);
+    Ok(ReducedCheck {
+        log: log.name.clone(),
+        margin_k,
+        vs_reference_max_k: max_ref,
+        vs_reference_under_k: under_ref,
+        vs_reference_region: region_of(&rows, &e_ref, servo),
+        vs_measured_max_k: meas(max_meas),
+        vs_measured_under_k: meas(under),
+        vs_measured_over_k: meas(over),
+        vs_measured_rmse_k: meas((ss / n.max(1) as f64).sqrt()),
+        vs_measured_region: (has_drain && under > 0.0).then(|| region_of(&rows, &e_under, servo)),
+        valve_open_s: open_ticks as f64 * 0.01,
+        lng_kg: open_j / f64::from(eha_guard::protection::LngConfig::DEFAULT.j_per_kg()),
+    })
+}
+
+/// Allowance added to the validation's largest under-prediction, K: twice
+/// the drain thermocouple's noise σ (0.1 K), by which a new log's noise
+/// extremes can exceed the validation's.
+pub const MARGIN_ALLOWANCE_K: f64 = 0.2;
+
+/// The drain margin from validation on a split of the training missions
+/// ([`super::commission::validate_margin`]).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct MarginValidation {
+    /// One check per training log, scored after the split (margin 0).
+    pub folds: Vec<ReducedCheck>,
+    /// Allowance added, K ([`MARGIN_ALLOWANCE_K`]).
+    pub allowance_k: f64,
+    /// The margin: the folds' largest under-prediction of the measured
+    /// drain plus the allowance, K (≥ 0).
+    pub margin_k: f64,
+}
+
+impl MarginValidation {
+    /// The fold with the largest under-prediction.
+    pub fn worst(&self) -> Option<&ReducedCheck> {
+        self.folds.iter().max_by(|a, b| a.vs_measured_under_k.unwrap_or(0.0).total_cmp(&b.vs_measured_under_k.unwrap_or(0.0)))
+    }
+}
+
+/// Errors of commissioning.
+#[derive(Debug, thiserror::Error)]
+pub enum CommissionError {
+    /// The calibration failed.
+    #[error(transparent)]
+    Cal(#[from] CalError),
+    /// The commissioned rig cannot be reduced to firmware parameters (why).
+    #[error("the commissioned rig cannot be flashed: {0}")]
+    Reduce(String),
+    /// A model run failed.
+    #[error("{0}")]
+    Run(String),
+}
+
+/// Share of every training log the margin validation's fit sees; the
+/// firmware from that fit is scored on the rest.
+pub const SPLIT_FRACTION: f64 = 0.6;
+
+/// The split of the training missions that validates a margin: the first
+/// [`SPLIT_FRACTION`] of every training log, the reference calibrated on
+/// them and its reduction.
+#[derive(Debug, Clone)]
+pub struct Split {
+    /// The heads of the training logs.
+    pub heads: Vec<CalLog>,
+    /// The reference calibrated on the heads.
+    pub rig: Rig,
+    /// Its reduction.
+    pub reduction: ReducedParams,
+}
+
+/// The firmware parameters `p` fitted on the split's heads, replayed over
+/// each whole training log (from the start) and scored against its measured
+/// drain after the split; the margin is the largest under-prediction there
+/// plus [`MARGIN_ALLOWANCE_K`].
+pub fn score_split(split: &Split, train: &[CalLog], p: &ReducedParams) -> Result<MarginValidation, CommissionError> {
+    let mut folds = Vec::new();
+    for (l, h) in train.iter().zip(&split.heads) {
+        let t_split = h.run.time_s[h.run.len() - 1];
+        folds.push(check_reduced_core(&split.rig, p, l, 0.0, t_split).map_err(CommissionError::Run)?);
+    }
+    let worst = folds.iter().filter_map(|f| f.vs_measured_under_k).fold(0.0, f64::max);
+    Ok(MarginValidation { folds, allowance_k: MARGIN_ALLOWANCE_K, margin_k: worst + MARGIN_ALLOWANCE_K })
+}
