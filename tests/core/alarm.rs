@@ -94,9 +94,9 @@ fn fixed_point_thresholds_are_exact() {
 }
 
 /// Heating load: Case-1-like at higher loss (155 bar across the pump, 700 rpm,
-/// ambient 20 degC, the consistent motor current; 100 bar at 600 rpm no longer
-/// reaches 60 degC since the pump's friction heat is shared with the housing,
-/// issue 16). From the 56 degC warm start below it lifts the drain by
+/// ambient 20 degC, the consistent motor current; 100 bar at 600 rpm does not
+/// reach 60 degC, the pump's friction heat being shared with the housing).
+/// From the 56 degC warm start below it lifts the drain by
 /// ≈ 0.1 K per 100 ms model step (measured, f32), so the estimate passes through the
 /// 58-60 band in several model steps and the first step above 60 is unambiguous;
 /// it stays far inside every input range.

@@ -208,7 +208,7 @@ fn clear_after_the_sensors_agree_again() {
     assert!(out[2999].faults.intersects(faults::SENSOR_DISAGREE));
     // The estimate ran on inputs that disagreed: the clear clears the latch,
     // and trust returns only when the estimate has recovered on good inputs
-    // (the hold counts from the clear; issue 33).
+    // (the hold counts from the clear).
     let hold = eha_guard::guard::recovery_ticks(GuardConfig::DEFAULT.model);
     assert_eq!(g.clear_faults(), eha_guard::ClearResult::TrustHeld(hold));
     let out = run(&mut g, 3000, |_| sample(65.0, 5.0, 500.0));

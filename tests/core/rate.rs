@@ -1,5 +1,5 @@
-//! The rate check with samples slower than the tick (issue 33): a missing
-//! tick dropped the previous values, so with a sample every 20 ms no sample
+//! The rate check with samples slower than the tick: a missing tick had
+//! dropped the previous values, so with a sample every 20 ms no sample
 //! was ever rate-checked (`tick.rs`, "samples slower than 10 ms disable the
 //! rate check"). The next sample is now checked against the last one over
 //! the gap: the per-tick rates times the ticks between them.

@@ -1,5 +1,5 @@
 //! Ticks the MCU never saw (a flash erase stalls the core for up to 4 s on
-//! the STM32F411; issue 33, item 7): `tick_blind` accounts them with the
+//! the STM32F411): `tick_blind` accounts them with the
 //! last inputs held, no piston work and no cooling credit, without STALE.
 //! (Every channel at its worst case instead heated the drain estimate by
 //! 35.8 K in a 1 s gap from 34 degC: every erase would be an alarm.)
@@ -25,8 +25,7 @@ fn a_stalled_gap_heats_the_estimate_without_stale() {
         println!("gap {gap}: drain {} -> {} degC, {:?}", before.drain_c, o.drain_c, o.faults);
         assert!(!o.faults.intersects(faults::STALE | faults::LATCHED), "{o:?}");
         // Case 1 heats the drain 0.25 K/s at 37 degC with the valve shut
-        // (measured 0.2525; 0.21 before the oil followed its viscosity line,
-        // issue 34): the gap keeps heating at that rate
+        // (measured 0.2525 with the oil on its viscosity line): the gap keeps heating at that rate
         let rise = o.drain_c - before.drain_c;
         assert!(rise >= 0.23 * gap as f32 / 100.0 && rise <= 0.28 * gap as f32 / 100.0, "gap {gap}: {rise} K");
         // and the next sample is taken without a fault

@@ -79,7 +79,7 @@ fn guard_waits_for_the_first_sample_valve_open_no_stale() {
     assert_eq!(o.faults, eha_guard::Faults::NONE, "{o:?}");
     assert!(!o.valve_open, "the valve closes at the first sample of a cold start: {o:?}");
     // Cold start at the first sample's ambient, then the 3 s waited replayed
-    // with its inputs (issue 33: the machine may have run unseen): idle, +0.03 K.
+    // with its inputs (the machine may have run unseen): idle, +0.03 K.
     assert!(o.drain_c > 30.0 && o.drain_c < 30.1, "cold start at the first sample's ambient, the wait replayed: {o:?}");
     // The closing is in the trace at the first sample's tick.
     assert!(g.trace().iter().any(|e| matches!(e, Trace::ValveClose { tick: 300, .. })), "{:?}", g.trace().iter().collect::<Vec<_>>());
@@ -151,8 +151,8 @@ fn warm_restore_waits_and_starts_from_the_record() {
 
 /// A controller that starts 5 s after the guard while the machine already
 /// runs at 60 bar: the wait is replayed with the first sample's inputs.
-/// Before issue 33 the estimate started at the ambient as if nothing had
-/// happened: 1.2 K low in the campaign (late-start, hot-60).
+/// Starting at the ambient as if nothing had happened was measured
+/// 1.2 K low in the campaign (late-start, hot-60).
 #[test]
 fn the_wait_for_the_first_sample_is_replayed_with_its_inputs() {
     let cfg = GuardConfig::DEFAULT;

@@ -8,7 +8,7 @@
 //! more than 0.5 K after 20 000 s of valid samples (docs/firmware.md).
 //! The live status bit `faults::UNTRUSTED` says why the alarm is on.
 //!
-//! Issue 33 (item 6): a clear restored trust at once, however new the
+//! A clear used to restore trust at once, however new the
 //! unknown start; it now clears the latched faults and holds UNTRUSTED until
 //! the estimate has run `recovery_ticks` (ln(40 K / 0.5 K) over the slowest
 //! rest cooling rate: 56.2 h for the paper rig) since its first sample
@@ -115,8 +115,7 @@ fn trust_returns_when_the_estimate_has_recovered() {
     let cfg = GuardConfig::DEFAULT;
     let hold = eha_guard::guard::recovery_ticks(cfg.model);
     let hours = f64::from(hold) / 360_000.0;
-    // 55.86 h with the rest rates of the oil on its viscosity line (issue 34;
-    // 56.0-56.5 h before): ln(80) over the slowest rest rate
+    // 55.86 h with the rest rates of the oil on its viscosity line: ln(80) over the slowest rest rate
     assert!((55.8..56.0).contains(&hours), "{hours} h");
     // ln(40 / 0.5) as the guard's constant
     let ln = (eha_guard::guard::TRUST_START_ERROR_K / eha_guard::guard::TRUST_TOLERANCE_K).ln();

@@ -160,8 +160,8 @@ fn sample(p_a: f32, rpm: f32) -> Sample {
 fn guard_opens_at_the_first_model_step_above_40_also_right_after_a_closing() {
     // Warm restore at 45 degC (valve open), idle with the pump turning: the open
     // exchanger cools the drain below 38 degC and the valve closes; right after the
-    // closing a hard load (340 bar at 2500 rpm; 300 bar at 1500 rpm no longer does it
-    // since issue 16 shares the pump's friction with the housing) lifts the estimate
+    // closing a hard load (340 bar at 2500 rpm; 300 bar at 1500 rpm does not, since the
+    // pump's friction heat is shared with the housing) lifts the estimate
     // back above 40 degC within two seconds. At every model step the valve
     // must be open whenever the estimate is above 40 degC, in that same tick (f32,
     // Fx and f64).

@@ -1,4 +1,4 @@
-//! Commissioning an EHA that is not the paper's (issue 18 §4): a synthetic
+//! Commissioning an EHA that is not the paper's: a synthetic
 //! other rig (1.5× displacement, other masses and areas in its rig file;
 //! the true machine with films 30 % off and per-node deviations no global
 //! multiplier represents), logs with noise, quantisation and dropouts and a
@@ -46,9 +46,8 @@ fn other_rig_commissioned_firmware_meets_drain_bounds_on_held_out_mission() {
     }
     // The cooling run is in the training set: no warning about the exchanger.
     assert!(!c.cal.warnings.iter().any(|w| w.starts_with(NO_COOLING)), "{:?}", c.cal.warnings);
-    // Issue 18: the reduced model within 0.2 K of the commissioned reference
-    // on every log's inputs (measured worst 0.136 K since the oil follows its
-    // viscosity line, issue 34; 0.117 K before).
+    // The reduced model within 0.2 K of the commissioned reference on every
+    // log's inputs (measured worst 0.136 K).
     let worst = c.reduced.iter().map(|r| r.vs_reference_max_k).fold(0.0, f64::max);
     assert!(c.reduced_ok && worst <= eha_sim::calibration::commission::REDUCED_BOUND_K, "worst reduced-vs-reference {worst:.3} K");
     // Against the true (noise-free) drain of the machine: the reduced model
@@ -62,7 +61,7 @@ fn other_rig_commissioned_firmware_meets_drain_bounds_on_held_out_mission() {
         fw.vs_reference_max_k, fw.vs_reference_under_k, paper.vs_reference_max_k, paper.vs_reference_under_k
     );
     eprintln!("held-out measured drain: commissioned under {:?}, paper default under {:?}", fw.vs_measured_under_k, paper.vs_measured_under_k);
-    // Issue 18 §4 bounds on the held-out mission: max |e| ≤ 1.0 K against
+    // Specified bounds on the held-out mission: max |e| ≤ 1.0 K against
     // the true drain.
     assert!(fw.vs_reference_max_k <= 1.0, "commissioned firmware max |e| {:.3} K", fw.vs_reference_max_k);
     assert!(fw.vs_reference_under_k <= 0.5, "commissioned firmware under-predicts by {:.3} K", fw.vs_reference_under_k);
@@ -71,7 +70,7 @@ fn other_rig_commissioned_firmware_meets_drain_bounds_on_held_out_mission() {
     assert!(paper.vs_reference_max_k > 5.0, "paper default {:.3} K", paper.vs_reference_max_k);
 }
 
-/// Issue 18 §4 in closed loop, through the flash block: the commissioned
+/// Commissioning in closed loop, through the flash block: the commissioned
 /// parameters written as `firmware-params.bin`, read back in place as the
 /// firmware reads its PARAMS region, run the f32 guard against the true
 /// machine on the held-out mission (30 min; the guard's valve acts on the
@@ -138,11 +137,11 @@ fn commissioned_block_in_closed_loop_on_the_held_out_mission() {
         );
     }
     eprintln!("eta_m from the current: {:?}", c.eta_m_from_current);
-    // Issue 18 §4 bounds with the block as flashed (cross-check on): max |e|
+    // Specified bounds with the block as flashed (cross-check on): max |e|
     // ≤ 1.0 K while the guard's cooling model holds, under-prediction ≤ 0.5 K
-    // over the whole mission (measured 0.173 / 0.086 K; 0.179 / 0.179 K before
-    // issue 34, whose eta_m from the current takes the viscous friction at the
-    // log's oil temperature: 0.3325 against the truth's 0.3327). The third training
+    // over the whole mission (measured 0.173 / 0.086 K; eta_m from the
+    // current takes the viscous friction at the log's oil temperature:
+    // 0.3325 against the truth's 0.3327). The third training
     // log (valve on the bench thermostat) is what holds the bound: trained
     // without it, the commissioned reference matched the true machine open
     // loop but the exchanger's cycling exposed ball-block and port-film values
@@ -167,7 +166,7 @@ fn commissioned_block_in_closed_loop_on_the_held_out_mission() {
     assert!(paper.max_lng > 5.0, "paper default: max |e| {:.3} K", paper.max_lng);
 }
 
-/// Issue 18 §4, second case: logs that lack excitation. The other EHA
+/// Commissioning, second case: logs that lack excitation. The other EHA
 /// commissioned from one operating point only (500 rpm, 40 bar, 30 min): the
 /// warning names the log and the parameters held for lack of excitation, and
 /// the result is refused by `commission` (reduced model off the commissioned
@@ -178,8 +177,8 @@ fn commissioned_block_in_closed_loop_on_the_held_out_mission() {
 /// refused parameters would under-predict the held-out true drain by 1.81 K
 /// (eta_m comes exactly from the current, 0.2074; the leak gaps, ×1.15 on
 /// this machine, are held at the rig file and one operating point cannot
-/// tell leakage from the films). Before issue 16's pump energy balance the
-/// same parameters under-predicted by 0.28 K and were accepted.
+/// tell leakage from the films). Without the pump's energy balance the same
+/// parameters under-predicted by 0.28 K and were accepted.
 #[test]
 fn low_excitation_commissioning_warns_and_is_refused_or_conservative() {
     let train = [cal_log(Kind::Constant { rpm: 500.0, bar: 40.0 }, 41)];
@@ -206,8 +205,7 @@ fn low_excitation_commissioning_warns_and_is_refused_or_conservative() {
         c.eta_m_from_current
     );
     assert!(!c.flashable() || fw.vs_reference_under_k <= 0.5, "accepted and under-predicts by {:.3} K", fw.vs_reference_under_k);
-    // Measured since issue 16: the reduced checks pass (0.137 K since issue 34,
-    // 0.096 K before) but the block is refused for the excitation; flashed anyway
-    // it would under-predict by 1.4 K (1.8 K before issue 34).
+    // Measured: the reduced checks pass (0.137 K) but the block is refused
+    // for the excitation; flashed anyway it would under-predict by 1.4 K.
     assert!(!c.flashable() && c.reduced_ok, "measured: refused for the excitation alone");
 }

@@ -92,10 +92,10 @@ fn emulator_machine_held_out_error_falls() {
     // The deviation that maps one to one, within the range the emulator's own
     // structure allows: case film ×5.3 (another correlation: > 2; measured 8.70).
     assert!(v("film_case") > 2.0, "film_case {:.3}", v("film_case"));
-    // No longer one to one since issue 16 (was 0.695 for the emulator's η_m
-    // ×0.72): the reference's pump now has no-load and viscous friction, a
-    // housing share, the emulator (written from the paper) none of them
-    // (compression heat both have since session 15), and the fit trades
+    // Not one to one with the emulator's η_m ×0.72: the reference's pump has
+    // no-load and viscous friction and a housing share, the emulator
+    // (written from the paper) none of them (both have the compression
+    // heat), and the fit trades
     // the friction against the leakage (leak_gap 1.41; on its ×2.5 bound
     // while the oils had a constant viscosity).
     // Asserted as measured (0.105 before the emulator's compression heat,

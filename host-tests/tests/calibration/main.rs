@@ -1,4 +1,4 @@
-//! Calibration set (issue 17 item 1, issue 18): recovery on synthetic
+//! Calibration set: recovery on synthetic
 //! data of the reference, a truth written independently (the rig
 //! emulator), and the one-operating-point warning.
 

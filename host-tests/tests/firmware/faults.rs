@@ -4,7 +4,7 @@
 //! fault in three scenarios at up to three start times (early, after the
 //! valve first opened, hot).
 //!
-//! Pass rule (issue 33): whenever the guard is not protecting (a latched
+//! Pass rule: whenever the guard is not protecting (a latched
 //! fault with the valve commanded open, or the estimate untrusted), its
 //! estimate is at most 1 K below the true drain and the true drain at most
 //! 42 °C with the valve closed; a protected detection within 1 s exempts
@@ -12,7 +12,7 @@
 //! (`eha_sim::faults::limits::KNOWN_LIMITS`, with its reason).
 //!
 //! Fast tier: a representative subset (about 20 runs, one per kind of fault,
-//! the hot starts and every new fault of issue 33). Slow tier: the whole
+//! the hot starts and the faults of the product loop's safety review). Slow tier: the whole
 //! campaign (751 runs, ~1.5 min on two cores), which also checks that every
 //! listed limit still fails somewhere, that with the drive's electrical
 //! frequency no speed fault fails, and that `docs/failure-modes.md` is the
@@ -36,7 +36,7 @@ fn fault_campaign_subset_passes_except_the_listed_design_limits() {
     report(&rows, "out/faults-fast");
     let bad = unlisted_failures(&rows);
     assert!(bad.is_empty(), "{}", bad.join("\n"));
-    // the subset's new faults of issue 33 are not limits: they pass
+    // the subset's faults of the safety review are not limits: they pass
     for f in ["clear-spam", "corrupt-start-clear", "flash-write-fail", "flash-read-fail", "power-loss", "warm-reset", "no-valve-feedback", "lng-empty-physical+supply"] {
         assert!(rows.iter().filter(|r| r.fault == f).all(|r| r.pass), "{f}: {:?}", rows.iter().find(|r| r.fault == f));
     }

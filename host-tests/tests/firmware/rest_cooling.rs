@@ -1,4 +1,4 @@
-//! Cooling over a measured off-time (issue 15 §5): the guard runs the paper
+//! Cooling over a measured off-time: the guard runs the paper
 //! rig hot in closed loop with the reference (40 bar, 500 rpm, 900 s), the
 //! power is cut, and the reference plant cools at rest (pump stopped, 20 °C
 //! air) for 1, 6 and 24 hours. The restore of the product's boot rule
@@ -59,10 +59,9 @@ fn model_at_rest(temps: &[f32; N_NODES], air: f32, off_s: u32) -> [f64; N_NODES]
     m.temperatures_c()
 }
 
-/// Measured (one run, the oil on its viscosity line since issue 34, the
-/// product loop of issue 33): restored after 1 / 6 / 24 h off: 38.16 / 31.75
-/// / 22.45 °C (uncooled 39.81; 38.97 / 32.27 / 22.56 on the guard alone,
-/// 40.13 / 33.03 / 22.72 of 41.03 before issue 34), reference 26.54 / 21.57
+/// Measured (one run, the oil on its viscosity line, the product loop):
+/// restored after 1 / 6 / 24 h off: 38.16 / 31.75 / 22.45 °C (uncooled
+/// 39.81; 38.97 / 32.27 / 22.56 on the guard alone), reference 26.54 / 21.57
 /// / 20.02, the firmware model at rest 26.74 / 21.56 / 20.02.
 #[test]
 fn restore_after_a_measured_off_time_is_cooled_and_never_below_the_reference() {
@@ -75,8 +74,8 @@ fn restore_after_a_measured_off_time_is_cooled_and_never_below_the_reference() {
     let last = rec.last().expect("steps");
     let saved = guard.snapshot().with_rtc(Some(T0_S));
     // a clean hot run: nothing the record keeps (LNG_UNCONFIRMED is a live
-    // status: the valve opened since the oil follows its viscosity line,
-    // issue 34, and no supply pressure is sent)
+    // status: the valve opens with the oil on its viscosity line, and no
+    // supply pressure is sent)
     assert!(!guard.faults().intersects(eha_guard::faults::RECORDED), "a clean hot run: {:?}", guard.faults());
     let ref_at_save = last.sensors.t_drain_c;
     eprintln!("save: estimate {:.2} degC, reference {:.2} degC", saved.temps_c[1], ref_at_save);

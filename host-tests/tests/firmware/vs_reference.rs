@@ -1,4 +1,4 @@
-//! Acceptance of the firmware's reduced model (issue 3, "Host tests") against
+//! Acceptance of the firmware's reduced model against
 //! the full reference simulation: Case 1 at 0/20/40/60 bar, Case 2, the LNG case,
 //! five random missions (`missions::TEST_SEEDS`), a long hot run (Case 1 at 60 bar
 //! for an hour on a rig without LNG: the drain passes 60 °C, the oil thins to
@@ -35,12 +35,12 @@ use std::sync::OnceLock;
 
 /// Duration of every acceptance run, s (the paper's 600 s).
 const DURATION_S: f64 = 600.0;
-/// Issue bound on max |drain error|, K (issue 3).
+/// Specified bound on max |drain error|, K.
 const MAX_ABS_K: f64 = 1.0;
-/// Bound on max |drain error| once the oil follows its viscosity line (issue 34),
+/// Tighter bound on max |drain error| with the oil on its viscosity line,
 /// K: the firmware stays within 0.1 K of the reference on every acceptance run,
 /// the hour-long hot run and the 0 °C cold start included.
-const MAX_ABS_34_K: f64 = 0.1;
+const MAX_ABS_TIGHT_K: f64 = 0.1;
 /// Issue goal on max |drain error|, K (reported, not asserted).
 const GOAL_K: f64 = 0.5;
 /// Issue bound on drain under-prediction, K.
@@ -49,24 +49,24 @@ const MAX_UNDER_K: f64 = 0.5;
 const MAX_SWITCH_S: f64 = 2.0;
 /// Regression bound on max |drain error| over every run, K: measured worst
 /// 0.098 K (the pump stopped with the valve open), 1.5×; 0.063 K on the
-/// acceptance runs (random-2), 2.4× (issue 34; before, 0.070 K, random-1).
+/// acceptance runs (random-2), 2.4×.
 const REG_MAX_ABS_K: f64 = 0.15;
 /// Regression bound on drain under-prediction over every run, K: measured worst
-/// 0.059 K (random-5), 2.5× (issue 34; before, 0.057 K, random-1).
+/// 0.059 K (random-5), 2.5×.
 const REG_MAX_UNDER_K: f64 = 0.15;
 /// Regression bound on |f32 − f64| drain, K: measured 3.81e-6 K (Case 1 60 bar
 /// and LNG), 2.6×. (The fixed-point spec bound, 0.1 K, is itself 2.2× the
 /// measured 4.47e-2 K, so it serves as that type's regression bound too.)
 const REG_F32_K: f64 = 1e-5;
 /// Regression bound on any switching-time difference, s. Measured worst 1.90 s
-/// since the oil follows its viscosity line (issue 34; 0.54 s before): random-2
+/// with the oil on its viscosity line (0.54 s with a constant viscosity): random-2
 /// event 5, a closing at 575.7 s where the drain falls slowly (≈ 0.03 K/s), so the
 /// estimate's +0.06 K there shows as 1.9 s; the next worst 0.71 s (random-1 event
 /// 1). No margin is left for a regression bound above the issue's 2 s: it is the
 /// issue's bound ([`MAX_SWITCH_S`]).
 const REG_SWITCH_S: f64 = MAX_SWITCH_S;
 /// Regression bound on a first-opening difference, s: measured worst 0.08 s
-/// (Case 1 40 bar; 0.14 s before issue 34), 3.75×.
+/// (Case 1 40 bar), 3.75×.
 const REG_FIRST_OPEN_S: f64 = 0.3;
 
 /// One run of the suite: its name, its scenario, and whether the rig has an LNG
@@ -262,8 +262,8 @@ fn assert_bounds(rows: &[(String, ErrorStats, eha_guard::Faults)]) {
         assert!(!f.intersects(faults::LATCHED), "{n}: guard faulted on reference signals");
         // Issue: max |drain error| <= 1.0 K.
         assert!(e.max_abs <= MAX_ABS_K, "{n}: max |error| {:.3} K > {MAX_ABS_K} K", e.max_abs);
-        // Issue 34: within 0.1 K of the reference on every acceptance run.
-        assert!(e.max_abs <= MAX_ABS_34_K, "{n}: max |error| {:.3} K > {MAX_ABS_34_K} K", e.max_abs);
+        // Within 0.1 K of the reference on every acceptance run.
+        assert!(e.max_abs <= MAX_ABS_TIGHT_K, "{n}: max |error| {:.3} K > {MAX_ABS_TIGHT_K} K", e.max_abs);
         // Issue: under-prediction is the unsafe side, never more than 0.5 K.
         assert!(e.max_under <= MAX_UNDER_K, "{n}: under-prediction {:.3} K > {MAX_UNDER_K} K", e.max_under);
         // Regression bounds (2-3x the measured worst; the spec bounds above are what the issue demands).
@@ -399,8 +399,8 @@ fn load_then_idle() -> Scenario {
 }
 
 /// The LNG case's 60 bar load with the pump stopped at 310 s, while the guard's valve
-/// is open (it opens at 297.8 s and would close at 323.8 s; 285 s until issue 34,
-/// when the oil on its viscosity line moved the openings): the drain bounds of the
+/// is open (it opens at 297.8 s and would close at 323.8 s; 285 s with a constant
+/// viscosity, before the oil on its viscosity line moved the openings): the drain bounds of the
 /// acceptance runs over the 290 s after the stop (the exchanger stays commanded open
 /// with no oil through it).
 fn stop_with_valve_open() -> Scenario {

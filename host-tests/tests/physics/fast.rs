@@ -3,8 +3,8 @@
 //! node temperature the output logs (12 channels, not only the five of the
 //! measured format): the paper's Case 1 and Case 2, Fig. 15 with its LNG
 //! thermostat and the five random missions of the firmware suite, with the
-//! oil on its viscosity line (the reference's default since issue 34: the
-//! hydraulics see the temperatures). Spec: 0.01 K (issue acceptance). Each test also has a
+//! oil on its viscosity line (the reference's default: the
+//! hydraulics see the temperatures). Spec: 0.01 K. Each test also has a
 //! regression bound at 2-3x the deviation measured when it was written, so
 //! that a change of the scheme that costs accuracy shows here first.
 
@@ -48,8 +48,7 @@ fn check(rig: &Rig, sc: &Scenario, opt: &SimOptions, regression_k: f64) -> SimOu
 
 /// Case 1 at 60 bar, 600 s, with the benchmark's 10 s outputs and with the
 /// default 1 s outputs (0.1 s callbacks, read from the interpolants).
-/// Measured 4.7e-4 K and 3.0e-4 K with the oil on its viscosity line
-/// (issue 34; 1.5e-4 and 1.1e-3 K before).
+/// Measured 4.7e-4 K and 3.0e-4 K with the oil on its viscosity line.
 #[test]
 fn case1_within_a_hundredth_of_a_kelvin() {
     let rig = Rig::default();
@@ -58,8 +57,7 @@ fn case1_within_a_hundredth_of_a_kelvin() {
     check(&rig, &sc, &SimOptions::default(), 3e-3);
 }
 
-/// Case 2 (servo, 0.2 Hz), 600 s, 1 s outputs. Measured 6.4e-3 K (6.8e-3
-/// before issue 34; the
+/// Case 2 (servo, 0.2 Hz), 600 s, 1 s outputs. Measured 6.4e-3 K (the
 /// winding, whose copper loss the steps integrate over 120 cycles).
 #[test]
 fn case2_within_a_hundredth_of_a_kelvin() {
@@ -77,7 +75,7 @@ fn case2_within_a_hundredth_of_a_kelvin() {
 /// The switching: the free-running fast path with its own thermostat opens
 /// and closes as often as the BDF, each switch within 1 s of the BDF's
 /// (measured 0.70 s at most).
-/// Not at the same callback: with the oil on its viscosity line (issue 34)
+/// Not at the same callback: with the oil on its viscosity line
 /// the BDF's loop oil crosses 40 °C at 613.4 s by 5e-6 K, the fast path's
 /// (7.5e-5 K low, at any of its tolerances from 1e-5 to 1e-7 K per step)
 /// one callback later; a thermostat limit cycle has no restoring force on
@@ -133,8 +131,7 @@ fn fig15_switches_with_the_bdf() {
 }
 
 /// The firmware suite's five random missions (throttle and servo), 600 s.
-/// Measured 4.1e-4, 2.3e-3, 2.3e-4, 3.4e-4, 1.8e-3 K (issue 34's oil;
-/// 1.2e-3, 2.7e-3, 4.8e-4, 1.4e-3, 2.3e-3 K before).
+/// Measured 4.1e-4, 2.3e-3, 2.3e-4, 3.4e-4, 1.8e-3 K.
 #[test]
 fn random_missions_within_a_hundredth_of_a_kelvin() {
     let rig = Rig::default();
@@ -189,7 +186,7 @@ fn slow_twenty_long_random_missions_within_a_hundredth_of_a_kelvin() {
 
 /// The missions of the slow test where the fast path or the shipped BDF is
 /// more than 0.01 K from the BDF at rtol 1e-9, both at a stop or rest with
-/// the needle open. Measured with the oil on its viscosity line (issue 34),
+/// the needle open. Measured with the oil on its viscosity line,
 /// fast / shipped BDF: seed 13 8.0e-3 / 1.06e-2 K, seed 21 4.6e-3 /
 /// 1.49e-2 K; the other 18 within 5.5e-3 K (fast) and 9.9e-3 K (shipped).
 const DEGENERATE: [u64; 2] = [13, 21];
