@@ -314,8 +314,8 @@ pub fn posterior(log_z: &[f64], prior: &[f64]) -> Vec<f64> {
 /// Time constant of the discrepancy process, s: the structure floor of the
 /// emulator's effect-free logs varies over minutes (warm-ups, steps).
 /// Chosen among 60, 120, 300 and 600 s with two cases in view: the
-/// synthetic winding case (seed 11) is named at 60 and 120 s (P 0.98,
-/// 0.92) and not at 300 or 600 s (0.81, 0.74, conduction second); the
+/// synthetic winding case (seed 11) is named at 60 and 120 s (P ≈ 0.98,
+/// 0.92) and not at 300 or 600 s (≈ 0.80, 0.71, conduction second); the
 /// emulator twin of 1700 is `unexplained` at all four.
 pub const DISCREPANCY_TAU_S: f64 = 120.0;
 
