@@ -212,6 +212,7 @@ fn prior_terms(specs: &[ParamSpec], values: &[f64]) -> (f64, Vec<f64>) {
 /// then extension) with the discrepancy amplitude `amp(channel)` of every
 /// channel and time constant `tau_s`; `noise(channel)` the channel's σ.
 /// `None` when the fit has no Jacobian.
+#[allow(clippy::too_many_arguments)]
 pub fn log_evidence(
     run: &MeasuredRun,
     pts: &[Point],
