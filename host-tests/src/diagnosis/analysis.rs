@@ -3,6 +3,7 @@
 //! held-out improvement, and the winner's before/after errors.
 
 use super::adequacy::{assess, Adequacy, MisfitRule};
+use super::evidence::{posterior_of, Posterior, DISCREPANCY_TAU_S};
 use super::fit::{fit, FitOptions, FitResult, Point};
 use super::identify::{identifiable, HOUSING_OUTER_PREFIX};
 use super::model::{Candidate, SimSeries, Simulator};
@@ -138,7 +139,9 @@ pub struct RankEntry {
     pub channel_heldout_k: Vec<(String, f64)>,
     /// Fitted extension parameters (name, value, unit).
     pub params: Vec<(String, f64, String)>,
-    /// Whether it passes both the BIC and the held-out test.
+    /// Whether it passes the BIC and the held-out checks and the log can
+    /// identify it: only then is it admitted to the posterior
+    /// ([`super::evidence::posterior_of`]), which names it at P ≥ 0.9.
     pub qualifies: bool,
     /// Why the candidate cannot be named in this run whatever its fit
     /// (empty when it can): see [`identifiable`].
@@ -182,6 +185,9 @@ pub struct Diagnosis {
     pub series: [SimSeries; 3],
     /// Model runs spent.
     pub sims: usize,
+    /// Probabilities of `none`, `unexplained` and every candidate, and the
+    /// per-channel numbers behind them ([`super::evidence`]).
+    pub posterior: Posterior,
 }
 
 impl Diagnosis {
@@ -241,6 +247,23 @@ pub fn fit_points(run: &MeasuredRun, split: f64, per_channel: usize) -> Vec<Poin
         let rows: Vec<usize> = (0..run.len()).filter(|&i| run.time_s[i] < split && m[i].is_some()).collect();
         let step = rows.len().div_ceil(per_channel.max(1)).max(1);
         pts.extend(rows.iter().step_by(step).map(|&i| (ch, i)));
+    }
+    pts
+}
+
+/// The points the evidence is computed on: per channel, the training fit
+/// points ([`fit_points`]) followed by the held-out samples thinned with the
+/// same step; the held-out part enters as the predictive likelihood of the
+/// fitted structure.
+pub fn evidence_points(run: &MeasuredRun, split: f64, per_channel: usize) -> Vec<Point> {
+    let mut pts = Vec::new();
+    for ch in Channel::TEMPERATURES {
+        let Some(m) = run.get(ch) else { continue };
+        let rows: Vec<usize> = (0..run.len()).filter(|&i| run.time_s[i] < split && m[i].is_some()).collect();
+        let step = rows.len().div_ceil(per_channel.max(1)).max(1);
+        pts.extend(rows.iter().step_by(step).map(|&i| (ch, i)));
+        let held: Vec<usize> = (0..run.len()).filter(|&i| run.time_s[i] >= split && m[i].is_some()).collect();
+        pts.extend(held.iter().step_by(step).map(|&i| (ch, i)));
     }
     pts
 }
@@ -360,9 +383,23 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
         }
     }
     let sims = 1 + base_sims + extra_sims;
-    unconfuse_housing_paths(&mut ranking);
     ranking.sort_by(|a, b| a.bic.total_cmp(&b.bic));
-    let winner = choose(&ranking).and_then(|r| Candidate::from_name(&r.cause));
+    let adequacy = assess(run, split, &m_before, &xcorr, (&nuis_specs, &base.nuisance), rule);
+    let chan: Vec<(Channel, f64, f64)> =
+        adequacy.channels.iter().filter_map(|c| Some((Channel::from_name(&c.channel)?, c.noise_k, c.rise_k))).collect();
+    let posterior = posterior_of(
+        run,
+        &pts,
+        &evidence_points(run, split, o.points_per_channel),
+        &base,
+        &fits,
+        &nuis_specs,
+        &|c| sim.extension_params(c),
+        &chan,
+        &|c| ranking.iter().any(|r| r.qualifies && r.cause == c.name()),
+        DISCREPANCY_TAU_S,
+    );
+    let winner = posterior.named().and_then(|r| Candidate::from_name(&r.cause));
     let (cause, after_fit, m_after) = match winner.and_then(|w| fits.iter().zip(&fit_metrics).find(|(f, _)| f.candidate == w)) {
         Some((f, m)) => (f.candidate, f.clone(), m.clone()),
         None => (Candidate::None, base.clone(), m_before.clone()),
@@ -381,7 +418,6 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
         }
     }
     let m_nominal = metrics(run, &nominal, split, o.ljung_box_lags);
-    let adequacy = assess(run, split, &m_before, &xcorr, (&nuis_specs, &base.nuisance), rule);
     Ok(Diagnosis {
         nuisance_set: sim.nuisance_set_name().into(),
         cause,
@@ -398,6 +434,7 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
         split_time_s: split,
         series: [nominal, base.series.clone(), after_fit.series],
         sims,
+        posterior,
     })
 }
 
@@ -415,77 +452,6 @@ pub fn fit_from(sim: &dyn Simulator, run: &MeasuredRun, pts: &[Point], c: Candid
 pub(crate) fn identifiable_here(c: Candidate, run: &MeasuredRun, split: f64, sim: &dyn Simulator) -> Result<(), &'static str> {
     let housing_outer_calibrated = sim.nuisance().iter().any(|p| p.name.starts_with(HOUSING_OUTER_PREFIX));
     identifiable(c, run, split, housing_outer_calibrated)
-}
-
-/// The two candidates that act on the pump housing's heat balance alone:
-/// a metal path to the motor, and an unlogged air stream over the housings.
-pub const HOUSING_PATHS: [&str; 2] = ["motor-pump-conduction", "forced-convection"];
-
-/// Share of a housing-path candidate's held-out gains (on its gain channel
-/// and pooled) that the other housing-path candidate reaching both makes
-/// the two confusable on this log ([`unconfuse_housing_paths`]).
-pub const CONFUSABLE_SHARE: f64 = 0.5;
-
-/// A qualifying housing-path candidate ([`HOUSING_PATHS`]) is not named when
-/// the other one, fitted on the same log, gains at least
-/// [`CONFUSABLE_SHARE`] of its held-out gain both on the same channel and
-/// pooled over all channels: both cool the pump housing (one into the
-/// motor, one into the air), and a log that either of them mends about as
-/// well does not tell them apart. The pooled condition keeps the name where
-/// the other mends the pump only by making another channel worse (a path
-/// into the motor warms the motor channel, an air stream cools it). The
-/// entry stays in the ranking with the reason; the answer is then
-/// `unexplained` or `none` by the usual rule. Measured: on the emulator
-/// sweep a hidden draught was named motor–pump conduction on two logs
-/// (1712: conduction 86 % on t_pump_c and 21 % pooled, the draught 50 % and
-/// 13 %; 1713: 46 / 30 % and 45 / 20 %); the synthetic draught (seed 71:
-/// 75 / 59 %, conduction 53 / 18 %) and conduction (seed 61) keep their
-/// names. The share was set with these cases in view.
-pub fn unconfuse_housing_paths(ranking: &mut [RankEntry]) {
-    let (base, none_k): (Vec<(String, f64)>, f64) =
-        ranking.iter().find(|r| r.cause == "none").map_or((Vec::new(), 0.0), |r| (r.channel_heldout_k.clone(), r.heldout_rmse_k));
-    let pooled = |r: &RankEntry| if none_k > 0.0 { 1.0 - r.heldout_rmse_k / none_k } else { 0.0 };
-    let gain_on = |r: &RankEntry, ch: &str| -> Option<f64> {
-        let b = base.iter().find(|c| c.0 == ch)?.1;
-        let a = r.channel_heldout_k.iter().find(|c| c.0 == ch)?.1;
-        (b > 0.0).then(|| 1.0 - a / b)
-    };
-    let mut notes = Vec::new();
-    for (i, w) in ranking.iter().enumerate() {
-        if !w.qualifies || !HOUSING_PATHS.contains(&w.cause.as_str()) {
-            continue;
-        }
-        let Some(other) = ranking.iter().find(|o| o.cause != w.cause && HOUSING_PATHS.contains(&o.cause.as_str())) else { continue };
-        if let Some(g) = gain_on(other, &w.gain_channel) {
-            let (gp, wp) = (pooled(other), pooled(w));
-            if g >= CONFUSABLE_SHARE * w.heldout_gain && gp >= CONFUSABLE_SHARE * wp {
-                notes.push((i, format!(
-                    "confusable with {} ({:.0} % against {:.0} % on {}, {:.0} % against {:.0} % pooled): this log does not tell the two apart",
-                    other.cause, 100.0 * g, 100.0 * w.heldout_gain, w.gain_channel, 100.0 * gp, 100.0 * wp
-                )));
-            }
-        }
-    }
-    for (i, note) in notes {
-        ranking[i].qualifies = false;
-        ranking[i].note = note;
-    }
-}
-
-/// The named cause among the qualifying entries of `ranking` (sorted by
-/// BIC): the one with the lowest pooled held-out RMSE, BIC breaking ties;
-/// `None` when nothing qualifies. Not the lowest BIC: the residuals of these
-/// fits are strongly autocorrelated (Ljung–Box p ≈ 0 on every log), so
-/// the BIC's independent-sample penalty overstates a training-window
-/// difference, while the held-out window is the independent check. Where
-/// two candidates qualify they have one parameter each, and their BIC
-/// difference is the training residual alone. Chosen with one case in view
-/// (emulator seed 1710, hidden conduction: forced convection had the lower
-/// BIC by 36 and the higher held-out error, 0.297 against 0.272 K); no
-/// synthetic test and no other emulator log has two qualifying candidates
-/// (docs/diagnosis.md).
-pub fn choose(ranking: &[RankEntry]) -> Option<&RankEntry> {
-    ranking.iter().filter(|r| r.qualifies).min_by(|a, b| a.heldout_rmse_k.total_cmp(&b.heldout_rmse_k).then(a.bic.total_cmp(&b.bic)))
 }
 
 /// The diagnosis made again with `sim`'s physical calibration set, its model
@@ -592,78 +558,4 @@ fn cross_correlations(run: &MeasuredRun, base: &SimSeries, max_lag_s: f64) -> Ve
             XCorr { channel: ch.name().into(), regressor: name.clone(), rho0: cc[0], peak_rho: peak, peak_lag_s: k as f64 * dt }
         })
         .collect()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn entry(cause: &str, bic: f64, heldout_rmse_k: f64, qualifies: bool) -> RankEntry {
-        RankEntry {
-            cause: cause.into(),
-            bic,
-            heldout_rmse_k,
-            train_rmse_k: 0.0,
-            delta_bic: 0.0,
-            heldout_gain: 0.0,
-            gain_channel: String::new(),
-            channel_heldout_k: vec![],
-            params: vec![],
-            qualifies,
-            note: String::new(),
-        }
-    }
-
-    /// The named cause is the qualifying candidate with the lowest held-out
-    /// error (the numbers of emulator seed 1710), whatever the BIC order; a
-    /// non-qualifying one is never named however well it predicts.
-    #[test]
-    fn the_qualifying_candidate_with_the_lowest_heldout_error_is_named() {
-        let ranking = [
-            entry("forced-convection", -2602.6, 0.297, true),
-            entry("motor-pump-conduction", -2566.9, 0.272, true),
-            entry("none", -2394.9, 0.433, false),
-            entry("sensor-lag", -2379.2, 0.100, false),
-        ];
-        assert_eq!(choose(&ranking).map(|r| r.cause.as_str()), Some("motor-pump-conduction"));
-        // Equal held-out error: the lower BIC.
-        let tie = [entry("a", -10.0, 0.2, true), entry("b", -20.0, 0.2, true)];
-        assert_eq!(choose(&tie).map(|r| r.cause.as_str()), Some("b"));
-        assert!(choose(&ranking[2..]).is_none());
-    }
-
-    /// A housing-path candidate is not named when the other one mends the
-    /// same channel and the pooled error by at least half as much (the
-    /// numbers of emulator seed 1712: conduction 86 / 21 %, the draught
-    /// 50 / 13 % on t_pump_c / pooled); it is when the other gains less on
-    /// either, and other candidates are untouched.
-    #[test]
-    fn confusable_housing_path_candidates_are_not_named() {
-        let with = |mut e: RankEntry, gain: f64, pump_k: f64| {
-            e.heldout_gain = gain;
-            e.gain_channel = "t_pump_c".into();
-            e.channel_heldout_k = vec![("t_pump_c".into(), pump_k)];
-            e
-        };
-        let mut ranking = vec![
-            with(entry("none", 0.0, 0.61, false), 0.0, 0.78),
-            with(entry("motor-pump-conduction", -10.0, 0.48, true), 0.86, 0.11),
-            with(entry("forced-convection", -5.0, 0.53, false), 0.50, 0.39),
-            with(entry("sensor-lag", -1.0, 0.50, true), 0.40, 0.70),
-        ];
-        unconfuse_housing_paths(&mut ranking);
-        assert!(!ranking[1].qualifies && ranking[1].note.contains("confusable with forced-convection"), "{}", ranking[1].note);
-        assert!(ranking[3].qualifies, "other candidates untouched");
-        // The draught mends t_pump_c by 30 % only (0.78 -> 0.55 K): conduction stays named.
-        ranking[1].qualifies = true;
-        ranking[2].channel_heldout_k = vec![("t_pump_c".into(), 0.55)];
-        unconfuse_housing_paths(&mut ranking);
-        assert!(ranking[1].qualifies);
-        // As much on t_pump_c, but 5 % pooled against 21 % (it makes
-        // another channel worse): still named.
-        ranking[2].channel_heldout_k = vec![("t_pump_c".into(), 0.39)];
-        ranking[2].heldout_rmse_k = 0.58;
-        unconfuse_housing_paths(&mut ranking);
-        assert!(ranking[1].qualifies);
-    }
 }

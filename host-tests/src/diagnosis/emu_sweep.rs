@@ -360,7 +360,8 @@ pub struct EmuSweepArgs {
     /// Output directory for emulator-sweep.md and emulator-sweep.json.
     #[arg(long, default_value = "emulator-sweep-out")]
     pub out: PathBuf,
-    /// Also write every generated log to OUT/logs/ (measured-data format).
+    /// Also write every generated log to OUT/logs/ (measured-data format),
+    /// the effect-free twins as `…-twin.csv`.
     #[arg(long)]
     pub logs: bool,
     /// Skip the effect-free twins (no imprint ratios; half the time).
@@ -482,6 +483,9 @@ pub fn run(a: &EmuSweepArgs) -> ExitCode {
                     let dir = a.out.join("logs");
                     let _ = std::fs::create_dir_all(&dir);
                     let _ = run.write_file(dir.join(format!("{}-{:?}-{}.csv", c.hidden.name(), c.scenario, c.seed)));
+                }
+                if let (false, false, Ok((twin, _))) = (a.no_twins, c.hidden == Candidate::None, crate::emulator::generate_twin(c)) {
+                    let _ = twin.write_file(a.out.join("logs").join(format!("{}-{:?}-{}-twin.csv", c.hidden.name(), c.scenario, c.seed)));
                 }
             }
             let r = run_emu_case_twin(*c, &DiagnoseOptions::default(), !a.no_twins);

@@ -56,6 +56,12 @@ pub struct FitResult {
     pub sims: usize,
     /// Model series at the best parameters (all measured times).
     pub series: SimSeries,
+    /// Jacobian of the data residuals (rows: the fit points) with respect
+    /// to the logarithms of the parameters (columns: nuisance, then
+    /// extension) at the best parameters, K per unit of ln value: the
+    /// curvature of the evidence ([`super::evidence`]). `None` when the
+    /// model failed there.
+    pub jac_ln: Option<DMatrix<f64>>,
 }
 
 /// Residuals (simulated − measured, K) of `s` at `points`; `None` when the
@@ -82,6 +88,8 @@ struct Problem<'a> {
     opts: FitOptions,
     sims: std::sync::atomic::AtomicUsize,
     best: Option<(f64, DVector<f64>, SimSeries)>,
+    /// The last Jacobian's point and its data rows in ln-parameter space.
+    last_jac_ln: std::sync::Mutex<Option<(DVector<f64>, DMatrix<f64>)>>,
 }
 
 impl Problem<'_> {
@@ -134,9 +142,23 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
     }
 
     fn jacobian(&self) -> Option<DMatrix<f64>> {
+        let (jz, jln) = self.jacobians()?;
+        if let Ok(mut l) = self.last_jac_ln.lock() {
+            *l = Some((self.x.clone(), jln));
+        }
+        Some(jz)
+    }
+}
+
+impl Problem<'_> {
+    /// Forward-difference Jacobians at `self.x`: with respect to the
+    /// internal variables (all rows, for the iteration) and to the ln
+    /// values (data rows only, for the evidence), from the same model runs.
+    fn jacobians(&self) -> Option<(DMatrix<f64>, DMatrix<f64>)> {
         let r0 = self.r.as_ref()?;
         let h = self.opts.fd_step;
-        let cols: Vec<Option<DVector<f64>>> = (0..self.x.len())
+        let n_data = self.points.len();
+        let cols: Vec<Option<(DVector<f64>, DVector<f64>)>> = (0..self.x.len())
             .into_par_iter()
             .map(|j| {
                 let mut xp = self.x.clone();
@@ -149,11 +171,15 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
                 let step = inward * (h / half).min(0.5);
                 xp[j] += step;
                 let (rp, _) = self.eval(&xp)?;
-                Some((rp - r0) / step)
+                let d_ln = from_internal(xp[j], s).ln() - from_internal(self.x[j], s).ln();
+                let dr = rp - r0;
+                let ln_col = DVector::from_iterator(n_data, dr.iter().take(n_data).map(|v| v / d_ln));
+                Some((dr / step, ln_col))
             })
             .collect();
-        let cols: Option<Vec<DVector<f64>>> = cols.into_iter().collect();
-        Some(DMatrix::from_columns(&cols?))
+        let cols: Option<Vec<(DVector<f64>, DVector<f64>)>> = cols.into_iter().collect();
+        let (jz, jln): (Vec<_>, Vec<_>) = cols?.into_iter().unzip();
+        Some((DMatrix::from_columns(&jz), DMatrix::from_columns(&jln)))
     }
 }
 
@@ -211,15 +237,32 @@ pub fn fit(
         opts,
         sims: 0.into(),
         best: None,
+        last_jac_ln: std::sync::Mutex::new(None),
     };
     p.set_params(&DVector::from_vec(x0));
     p.r.as_ref()?;
-    let (p, _report) = LevenbergMarquardt::new()
+    let (mut p, _report) = LevenbergMarquardt::new()
         .with_ftol(opts.ftol)
         .with_xtol(1e-4)
         .with_patience(opts.max_sims.max(1))
         .minimize(p);
     let (_, x, series) = p.best.clone()?;
+    // The ln-space Jacobian at the best point: the iteration's last one when
+    // it was taken there, else one more (p + 1 model runs, outside the fit's
+    // budget).
+    let stored = p.last_jac_ln.lock().ok().and_then(|mut l| l.take()).filter(|(xj, _)| *xj == x).map(|(_, j)| j);
+    let mut sims = p.sims.load(std::sync::atomic::Ordering::Relaxed).min(opts.max_sims);
+    let jac_ln = match stored {
+        Some(j) => Some(j),
+        None => {
+            p.opts.max_sims = usize::MAX;
+            p.sims.store(0, std::sync::atomic::Ordering::Relaxed);
+            p.set_params(&x);
+            let j = p.jacobians().map(|(_, j)| j);
+            sims += p.sims.load(std::sync::atomic::Ordering::Relaxed);
+            j
+        }
+    };
     let v = p.values(&x);
     // The data part only (BIC and RMSEs compare fits on the data).
     let rss = residuals_at(run, &series, points)?.iter().map(|e| e * e).sum();
@@ -229,7 +272,8 @@ pub fn fit(
         ext: v[n_nuis..].to_vec(),
         rss,
         n: points.len(),
-        sims: p.sims.load(std::sync::atomic::Ordering::Relaxed).min(opts.max_sims),
+        sims,
         series,
+        jac_ln,
     })
 }

@@ -7,6 +7,7 @@
 pub mod adequacy;
 pub mod analysis;
 pub mod detect;
+pub mod evidence;
 pub mod fit;
 pub mod identify;
 pub mod model;

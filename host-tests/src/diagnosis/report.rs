@@ -16,6 +16,19 @@ pub struct RankingJson {
     pub heldout_rmse_k: f64,
 }
 
+/// One structure's probability in `diagnosis.json`.
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize, PartialEq)]
+pub struct ProbabilityJson {
+    /// `none`, `unexplained` or a candidate name.
+    pub cause: String,
+    /// Posterior probability.
+    pub probability: f64,
+    /// ln Bayes factor against `none`.
+    pub log_bayes_factor: f64,
+    /// Prior probability (0: the log cannot identify the candidate).
+    pub prior: f64,
+}
+
 /// `diagnosis.json`: exactly its documented top-level keys. RMSEs are pooled
 /// over every measured temperature channel, K; "before" is the calibrated
 /// baseline, "after" the model with `cause` switched on (equal to "before"
@@ -38,6 +51,14 @@ pub struct DiagnosisJson {
     pub heldout_rmse_after_k: f64,
     /// Every candidate and `none`, best BIC first.
     pub ranking: Vec<RankingJson>,
+    /// Posterior probability of `none`, `unexplained` and every candidate,
+    /// most probable first (a cause is named at ≥ 0.9; otherwise the first
+    /// two are the answer's top two).
+    pub probabilities: Vec<ProbabilityJson>,
+    /// Per channel: the calibrated baseline's misfit on the training
+    /// window, the structure floor estimated from the other channels, their
+    /// ratio, the noise (K) and the Ljung–Box p before and after whitening.
+    pub channels: Vec<super::evidence::ChannelEvidence>,
     /// Present only when `cause` is `unexplained`: what misfits and what
     /// to check.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -85,6 +106,13 @@ impl DiagnosisJson {
                 .iter()
                 .map(|r| RankingJson { cause: r.cause.clone(), bic: r.bic, heldout_rmse_k: r.heldout_rmse_k })
                 .collect(),
+            probabilities: d
+                .posterior
+                .causes
+                .iter()
+                .map(|c| ProbabilityJson { cause: c.cause.clone(), probability: c.probability, log_bayes_factor: c.log_bayes_factor, prior: c.prior })
+                .collect(),
+            channels: d.posterior.channels.clone(),
             unexplained: d.unexplained.then(|| UnexplainedJson {
                 misfit_channels: d
                     .adequacy
@@ -103,6 +131,35 @@ impl DiagnosisJson {
                 check: d.adequacy.advice.clone(),
             }),
         }
+    }
+}
+
+/// The probabilities of the structures and the per-channel floor numbers.
+fn probability_section(s: &mut String, d: &Diagnosis) {
+    let p = &d.posterior;
+    let c = &p.causes;
+    if c.is_empty() {
+        return;
+    }
+    if p.named().is_none() && c.len() > 1 {
+        let _ = writeln!(
+            s,
+            "\nNo cause reaches P ≥ {:.1}. Most probable: `{}` (P = {:.2}), then `{}` (P = {:.2}).",
+            super::evidence::NAME_PROBABILITY, c[0].cause, c[0].probability, c[1].cause, c[1].probability
+        );
+    }
+    let _ = writeln!(s, "\n## Probabilities (discrepancy of floor size, time constant {:.0} s)\n", p.tau_s);
+    let _ = writeln!(s, "| structure | prior | ln Bayes factor vs `none` | probability |\n|---|---:|---:|---:|");
+    for x in c {
+        let _ = writeln!(s, "| `{}` | {:.3} | {:.1} | {:.3} |", x.cause, x.prior, x.log_bayes_factor, x.probability);
+    }
+    let _ = writeln!(s, "\n| channel | misfit, training (K) | floor from the other channels (K) | ratio | noise σ (K) | Ljung–Box p raw | whitened |\n|---|---:|---:|---:|---:|---:|---:|");
+    for x in &p.channels {
+        let _ = writeln!(
+            s,
+            "| `{}` | {:.3} | {:.3} | {:.1} | {:.3} | {:.1e} | {:.1e} |",
+            x.channel, x.misfit_k, x.floor_k, x.imprint_ratio, x.noise_k, x.ljung_box_p_raw, x.ljung_box_p_whitened
+        );
     }
 }
 
@@ -167,6 +224,7 @@ pub fn report_markdown(d: &Diagnosis, source: &str, pngs: &[String]) -> String {
     for (n, v, u) in &d.params {
         let _ = writeln!(s, "- fitted `{n}` = {} {u}", num(*v));
     }
+    probability_section(&mut s, d);
     adequacy_section(&mut s, d);
     let _ = writeln!(
         s,

@@ -87,9 +87,18 @@ fn worked_example_is_diagnosed_as_sensor_lag() {
     keys.sort();
     assert_eq!(
         keys,
-        ["cause", "heldout_rmse_after_k", "heldout_rmse_before_k", "parameters", "ranking", "rmse_after_k", "rmse_before_k"]
+        ["cause", "channels", "heldout_rmse_after_k", "heldout_rmse_before_k", "parameters", "probabilities", "ranking", "rmse_after_k", "rmse_before_k"]
     );
     assert_eq!(j["cause"], "sensor-lag");
+    // The probabilities: none, unexplained and the six candidates, summing
+    // to one, the named cause first at P >= 0.9.
+    let p = j["probabilities"].as_array().unwrap();
+    assert_eq!(p.len(), 8);
+    let sum: f64 = p.iter().map(|x| x["probability"].as_f64().unwrap()).sum();
+    assert!((sum - 1.0).abs() < 1e-9, "probabilities sum to {sum}");
+    assert_eq!(p[0]["cause"], "sensor-lag");
+    assert!(p[0]["probability"].as_f64().unwrap() >= 0.9, "{}", p[0]);
+    assert_eq!(j["channels"].as_array().unwrap().len(), 5);
     let tau = j["parameters"]["sensor_tau_s"].as_f64().unwrap();
     println!("fitted sensor_tau_s {tau:.2} s, hidden {HIDDEN_TAU_S} s ({:+.1} %)", 100.0 * (tau / HIDDEN_TAU_S - 1.0));
     assert!((tau - HIDDEN_TAU_S).abs() <= 0.15 * HIDDEN_TAU_S, "fitted τ {tau:.1} s vs hidden {HIDDEN_TAU_S} s");

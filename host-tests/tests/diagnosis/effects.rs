@@ -122,14 +122,20 @@ fn hidden_winding_resistance_temperature_is_named() {
 
 /// Churning ∝ ω^2.5: needs shaft-speed changes (a constant-speed run cannot
 /// tell it from a pump capacity error, so the diagnosis does not name it
-/// there). **Measured miss**: named, but the held-out gain on
-/// the pump shell is 7 % (0.204 → 0.162 K), under the 50 % bar: the
-/// baseline's own viscous pump friction (C_v·μ·D·ω², extended eq. 8, scaled
-/// with the nuisance set) already takes most of an ω^2.5 loss, so little is
-/// left for the candidate to explain. Asserted: named, gain below 15 %.
+/// there). **Measured miss**: `none`. The baseline's own viscous pump
+/// friction (C_v·μ·D·ω², extended eq. 8, scaled with the nuisance set)
+/// takes most of an ω^2.5 loss: the calibrated baseline leaves t_pump_c,
+/// the channel the loss heats, at 0.136 K held out (1.1σ), and the churning
+/// fit moves it to 0.132 K; what it mends is t_block_c (0.256 → 0.102 K),
+/// which its physics reaches only through the oil and where the block's own
+/// misfit is the discrepancy it is judged against. Its Bayes factor against
+/// `none` is e^−2.7 (P 0.03): on its own channel the log does not show the
+/// effect, and `none` is what the imprint-ratio rule allows there. (It was
+/// named, 7 % on t_pump_c, when the lowest held-out error among the
+/// qualifying candidates decided.) Asserted: `none`.
 #[test]
-fn hidden_churning_loss_is_named_measured_low_gain() {
-    check_miss(&[(case("churning-loss", ThrottleSteps, Nuisance, 51), "churning-loss", Some(0.15))]);
+fn hidden_churning_loss_is_a_measured_miss() {
+    check_miss(&[(case("churning-loss", ThrottleSteps, Nuisance, 51), "none", None)]);
 }
 
 /// Flange conduction motor → pump: the pump follows the motor.

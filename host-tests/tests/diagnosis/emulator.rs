@@ -64,7 +64,13 @@ fn emulator_none_case1_log_is_none() {
     let d = diagnose(&log, &model, &DiagnoseOptions::default()).expect("diagnosis");
     let j = DiagnosisJson::from_diagnosis(&d);
     eprintln!("cause {} set {} held-out {:.3} K", j.cause, d.nuisance_set, d.before.heldout_rmse_k);
+    eprintln!("probabilities {:?}", j.probabilities.iter().map(|p| (p.cause.as_str(), p.probability)).collect::<Vec<_>>());
     assert_eq!(j.cause, "none");
+    // An effect-free log: no cause at P >= 0.9, and the probabilities
+    // (none, unexplained, six candidates) sum to one.
+    assert!(d.posterior.named().is_none(), "{:?}", j.probabilities);
+    assert_eq!(j.probabilities.len(), 8);
+    assert!((j.probabilities.iter().map(|p| p.probability).sum::<f64>() - 1.0).abs() < 1e-9);
     assert!(j.unexplained.is_none());
     assert!(d.before.heldout_rmse_k <= 0.3, "pooled held-out {:.3} K", d.before.heldout_rmse_k);
     let block = d.adequacy.channels.iter().find(|c| c.channel == "t_block_c").expect("t_block_c");
@@ -86,11 +92,11 @@ fn slow_emulator_sensor_lag_is_named() {
     assert!((0.35..0.5).contains(&g), "held-out gain {:.0} % (measured 46 %)", 100.0 * g);
 }
 
-/// Motor–pump conduction (4.0 W/K) on a Case 1 log (seed 1710). Where two
-/// candidates qualify, the one with the lowest held-out error is named
-/// (`diagnosis::analysis::choose`), not the lower BIC; this log once showed
-/// the difference (forced convection with the lower BIC, conduction with
-/// the lower held-out error). Its answer now is `none` (below).
+/// Motor–pump conduction (4.0 W/K) on a Case 1 log (seed 1710). This log
+/// once had two qualifying candidates (forced convection with the lower
+/// BIC, conduction with the lower held-out error); where two qualify, the
+/// posterior probability decides (`diagnosis::evidence`). Its answer now is
+/// `none` (below).
 #[test]
 #[ignore = "slow tier: emulator case"]
 fn slow_emulator_conduction_is_named_over_a_qualifying_forced_convection() {

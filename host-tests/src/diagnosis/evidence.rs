@@ -1,0 +1,636 @@
+//! Probabilities for causes: the Laplace evidence of each structure
+//! (`none`, every candidate, `unexplained`) with a model discrepancy term
+//! per channel, in the spirit of Kennedy & O'Hagan (2001).
+//!
+//! Each channel's residual (simulated − measured at the training fit
+//! points) is modelled as a slowly varying discrepancy δ(t) plus white
+//! sensor noise: δ is a stationary AR(1) (Ornstein–Uhlenbeck) process of
+//! amplitude `s` and time constant τ (minutes), the noise has the channel's
+//! own σ. A Kalman filter over the (irregular) sample times gives the exact
+//! Gaussian log-likelihood and the whitened innovations; the same linear
+//! filter whitens the Jacobian's columns, so the curvature JᵀJ of the
+//! evidence counts independent information, not autocorrelated samples
+//! (the BIC's assumption, false here: Ljung–Box p ≈ 0 on every channel).
+//!
+//! The structures differ in what the discrepancy may be:
+//! - `none` and each candidate: the discrepancy is held at the **floor**
+//!   of this log — what the rig-level structure error of a machine that is
+//!   not our model leaves; a candidate has to beat a discrepancy of that
+//!   size, not the sensor noise;
+//! - `unexplained`: the calibrated baseline with the discrepancy amplitude
+//!   of every channel free (log-uniform prior from the floor to
+//!   [`MAX_DISCREPANCY_K`]), marginalised numerically.
+//!
+//! The floor of a channel a candidate's physics touches
+//! ([`touched_channels`]) is estimated from the channels it does not
+//! touch (see [`floor_for`]); a channel that misfits far more than the
+//! others is then judged with its own misfit as its discrepancy and does
+//! not veto a decision on the others.
+
+use super::fit::{FitResult, Point};
+use super::model::{Candidate, ParamSpec};
+use crate::measured::{Channel, MeasuredRun};
+use nalgebra::DMatrix;
+
+/// Largest discrepancy amplitude of the `unexplained` structure's prior, K.
+pub const MAX_DISCREPANCY_K: f64 = 20.0;
+
+/// Kalman whitening of one channel's residual under an AR(1) discrepancy of
+/// amplitude `amp_k` and time constant `tau_s` plus white noise `noise_k`,
+/// at the sample times: a linear, data-independent filter.
+#[derive(Debug, Clone)]
+pub struct Whitener {
+    phi: Vec<f64>,
+    gain: Vec<f64>,
+    sd: Vec<f64>,
+}
+
+impl Whitener {
+    /// The filter for samples at `times_s` (increasing).
+    pub fn new(times_s: &[f64], amp_k: f64, noise_k: f64, tau_s: f64) -> Self {
+        let (s2, r) = (amp_k * amp_k, noise_k * noise_k);
+        let (mut phi, mut gain, mut sd) = (Vec::new(), Vec::new(), Vec::new());
+        let mut p = s2;
+        for (i, t) in times_s.iter().enumerate() {
+            let f = if i == 0 { 0.0 } else { (-(t - times_s[i - 1]).max(0.0) / tau_s).exp() };
+            let pp = if i == 0 { s2 } else { f * f * p + s2 * (1.0 - f * f) };
+            let s = pp + r;
+            let k = pp / s;
+            p = (1.0 - k) * pp;
+            phi.push(f);
+            gain.push(k);
+            sd.push(s.sqrt());
+        }
+        Whitener { phi, gain, sd }
+    }
+
+    /// Whitened innovations of `y` (each N(0, 1) under the model).
+    pub fn whiten(&self, y: &[f64]) -> Vec<f64> {
+        let mut x = 0.0;
+        y.iter()
+            .enumerate()
+            .map(|(i, v)| {
+                let xp = self.phi[i] * x;
+                let nu = v - xp;
+                x = xp + self.gain[i] * nu;
+                nu / self.sd[i]
+            })
+            .collect()
+    }
+
+    /// Gaussian log-likelihood of `y`.
+    pub fn log_lik(&self, y: &[f64]) -> f64 {
+        let w = self.whiten(y);
+        -0.5 * w.iter().map(|x| x * x).sum::<f64>()
+            - self.sd.iter().map(|s| s.ln()).sum::<f64>()
+            - 0.5 * w.len() as f64 * (2.0 * std::f64::consts::PI).ln()
+    }
+}
+
+/// The channels a candidate's physics acts on directly: where its heat
+/// enters (or, for the probe lag, the probe).
+pub fn touched_channels(c: Candidate) -> &'static [Channel] {
+    use Candidate::*;
+    use Channel::*;
+    match c {
+        WindingResistanceTemperature => &[TMotorC],
+        SensorLag | CoulombFriction => &[TOilC],
+        ChurningLoss => &[TPumpC],
+        MotorPumpConduction | ForcedConvection => &[TMotorC, TPumpC],
+        None => &[],
+    }
+}
+
+/// One channel's numbers for the evidence: noise, rise, the calibrated
+/// baseline's misfit on the training points.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct ChannelFloor {
+    /// Channel name.
+    pub channel: String,
+    /// Noise σ estimated from its samples, K.
+    pub noise_k: f64,
+    /// RMS rise above ambient, K.
+    pub rise_k: f64,
+    /// RMS residual of the calibrated baseline on the training fit points, K.
+    pub misfit_k: f64,
+}
+
+/// The floor of channel `c` when the channels in `touched` are judged:
+/// `c`'s rise times the median over the untouched channels of their
+/// misfit per rise — rig-level structure errors (a film, a capacity, a
+/// heat path off by some per cent) scale with how far a channel rises — but
+/// never less than `c`'s noise; an untouched channel's floor is its own
+/// misfit. With every channel touched (or one channel only), the floor is
+/// the noise.
+pub fn floor_for(c: &ChannelFloor, all: &[ChannelFloor], touched: &[String]) -> f64 {
+    floor_rule(c, all, touched, FloorRule::Rise)
+}
+
+/// How the floor of a touched channel is scaled from the others.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum FloorRule {
+    /// Misfit per rise.
+    Rise,
+    /// Misfit per noise σ.
+    Noise,
+    /// The channel's own misfit.
+    Own,
+    /// The noise only.
+    Bare,
+}
+
+/// [`floor_for`] with the scaling `rule`.
+pub fn floor_rule(c: &ChannelFloor, all: &[ChannelFloor], touched: &[String], rule: FloorRule) -> f64 {
+    if !touched.contains(&c.channel) || rule == FloorRule::Own {
+        return c.misfit_k.max(c.noise_k);
+    }
+    if rule == FloorRule::Bare {
+        return c.noise_k;
+    }
+    let scale = |o: &ChannelFloor| if rule == FloorRule::Rise { o.rise_k.max(1e-6) } else { o.noise_k };
+    let mut rel: Vec<f64> = all.iter().filter(|o| !touched.contains(&o.channel)).map(|o| o.misfit_k / scale(o)).collect();
+    if rel.is_empty() {
+        return c.noise_k;
+    }
+    rel.sort_by(f64::total_cmp);
+    let med = if rel.len() % 2 == 1 { rel[rel.len() / 2] } else { 0.5 * (rel[rel.len() / 2 - 1] + rel[rel.len() / 2]) };
+    (med * scale(c)).max(c.noise_k)
+}
+
+/// The evidence of one structure, nats.
+#[derive(Debug, Clone, Default, serde::Serialize)]
+pub struct Evidence {
+    /// Log-likelihood of the data at the fitted parameters.
+    pub log_lik: f64,
+    /// Log prior density of the fitted parameters (ln-value space).
+    pub log_prior: f64,
+    /// (p/2) ln 2π − ½ ln det H: the posterior volume (with `log_prior`,
+    /// the Occam factor).
+    pub log_volume: f64,
+    /// ln Z = sum of the three.
+    pub log_z: f64,
+}
+
+/// Channel runs of `pts` (grouped by channel, rows increasing, as
+/// [`super::analysis::fit_points`] makes them): (channel, index range).
+fn channel_runs(pts: &[Point]) -> Vec<(Channel, std::ops::Range<usize>)> {
+    let mut out: Vec<(Channel, std::ops::Range<usize>)> = Vec::new();
+    for (i, (ch, _)) in pts.iter().enumerate() {
+        match out.last_mut() {
+            Some((c, r)) if c == ch => r.end = i + 1,
+            _ => out.push((*ch, i..i + 1)),
+        }
+    }
+    out
+}
+
+/// Log prior density and prior precision of each parameter in ln-value
+/// space: Gaussian where the spec has a prior; otherwise uniform between
+/// the bounds, with the uniform's precision (12/range²) standing in for
+/// its curvature so that a parameter the data do not inform costs nothing.
+fn prior_terms(specs: &[ParamSpec], values: &[f64]) -> (f64, Vec<f64>) {
+    let mut lp = 0.0;
+    let mut prec = Vec::with_capacity(specs.len());
+    for (s, v) in specs.iter().zip(values) {
+        match s.prior_sigma_ln {
+            Some(sig) => {
+                let z = (v / s.start).ln() / sig;
+                lp += -0.5 * z * z - (sig * (2.0 * std::f64::consts::PI).sqrt()).ln();
+                prec.push(1.0 / (sig * sig));
+            }
+            None => {
+                let range = (s.hi / s.lo).ln().max(1e-9);
+                lp -= range.ln();
+                prec.push(12.0 / (range * range));
+            }
+        }
+    }
+    (lp, prec)
+}
+
+/// Laplace evidence of the structure `fit` (parameters `specs`, nuisance
+/// then extension) with the discrepancy amplitude `amp(channel)` of every
+/// channel and time constant `tau_s`; `noise(channel)` the channel's σ.
+/// `None` when the fit has no Jacobian.
+#[allow(clippy::too_many_arguments)]
+pub fn log_evidence(
+    run: &MeasuredRun,
+    pts: &[Point],
+    all_pts: &[Point],
+    fit: &FitResult,
+    specs: &[ParamSpec],
+    amp: &dyn Fn(Channel) -> f64,
+    noise: &dyn Fn(Channel) -> f64,
+    tau_s: f64,
+) -> Option<Evidence> {
+    let log_lik = log_lik_at(run, all_pts, fit, amp, noise, tau_s)?;
+    let j = fit.jac_ln.as_ref()?;
+    let p = j.ncols();
+    let mut h = DMatrix::<f64>::zeros(p, p);
+    for (ch, range) in channel_runs(pts) {
+        let times: Vec<f64> = pts[range.clone()].iter().map(|(_, i)| run.time_s[*i]).collect();
+        let w = Whitener::new(&times, amp(ch), noise(ch), tau_s);
+        let cols: Vec<Vec<f64>> = (0..p).map(|k| w.whiten(&j.column(k).rows(range.start, range.len()).iter().copied().collect::<Vec<_>>())).collect();
+        for a in 0..p {
+            for b in a..p {
+                let v: f64 = cols[a].iter().zip(&cols[b]).map(|(x, y)| x * y).sum();
+                h[(a, b)] += v;
+                if a != b {
+                    h[(b, a)] += v;
+                }
+            }
+        }
+    }
+    let values: Vec<f64> = fit.nuisance.iter().chain(&fit.ext).copied().collect();
+    let (log_prior, prec) = prior_terms(specs, &values);
+    for (k, q) in prec.iter().enumerate() {
+        h[(k, k)] += q;
+    }
+    let ln_det = h.clone().cholesky().map(|c| 2.0 * c.l().diagonal().iter().map(|d| d.ln()).sum::<f64>()).unwrap_or_else(|| {
+        h.symmetric_eigenvalues().iter().map(|e| e.max(1e-12).ln()).sum()
+    });
+    let log_volume = 0.5 * p as f64 * (2.0 * std::f64::consts::PI).ln() - 0.5 * ln_det;
+    Some(Evidence { log_lik, log_prior, log_volume, log_z: log_lik + log_prior + log_volume })
+}
+
+/// Log-likelihood of the residual of `fit` at `pts` (every channel's
+/// discrepancy amplitude `amp(channel)`).
+pub fn log_lik_at(run: &MeasuredRun, pts: &[Point], fit: &FitResult, amp: &dyn Fn(Channel) -> f64, noise: &dyn Fn(Channel) -> f64, tau_s: f64) -> Option<f64> {
+    let r = super::fit::residuals_at(run, &fit.series, pts)?;
+    Some(
+        channel_runs(pts)
+            .into_iter()
+            .map(|(ch, range)| {
+                let times: Vec<f64> = pts[range.clone()].iter().map(|(_, i)| run.time_s[*i]).collect();
+                Whitener::new(&times, amp(ch), noise(ch), tau_s).log_lik(&r[range])
+            })
+            .sum(),
+    )
+}
+
+/// Log marginal likelihood of one channel's residual `y` at `times_s` with
+/// the discrepancy amplitude free: log-uniform prior on [`lo_k`,
+/// [`MAX_DISCREPANCY_K`]], integrated on a grid in ln s.
+pub fn log_lik_free_amplitude(times_s: &[f64], y: &[f64], lo_k: f64, noise_k: f64, tau_s: f64) -> f64 {
+    let (a, b) = (lo_k.ln(), MAX_DISCREPANCY_K.ln().max(lo_k.ln() + 1e-6));
+    let n = 48;
+    let d = (b - a) / n as f64;
+    let ls: Vec<f64> = (0..n).map(|i| Whitener::new(times_s, (a + (i as f64 + 0.5) * d).exp(), noise_k, tau_s).log_lik(y)).collect();
+    let m = ls.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    m + (ls.iter().map(|l| (l - m).exp()).sum::<f64>() * d / (b - a)).ln()
+}
+
+/// Log-likelihood of the residual of `fit` at `pts` with every channel's
+/// discrepancy amplitude free above `lo(channel)` ([`log_lik_free_amplitude`]).
+pub fn log_lik_unexplained(
+    run: &MeasuredRun,
+    pts: &[Point],
+    fit: &FitResult,
+    lo: &dyn Fn(Channel) -> f64,
+    noise: &dyn Fn(Channel) -> f64,
+    tau_s: f64,
+) -> Option<f64> {
+    let r = super::fit::residuals_at(run, &fit.series, pts)?;
+    Some(
+        channel_runs(pts)
+            .into_iter()
+            .map(|(ch, range)| {
+                let times: Vec<f64> = pts[range.clone()].iter().map(|(_, i)| run.time_s[*i]).collect();
+                log_lik_free_amplitude(&times, &r[range], lo(ch), noise(ch), tau_s)
+            })
+            .sum(),
+    )
+}
+
+/// Posterior probabilities from log evidences and prior probabilities
+/// (same order), normalised.
+pub fn posterior(log_z: &[f64], prior: &[f64]) -> Vec<f64> {
+    let l: Vec<f64> = log_z.iter().zip(prior).map(|(z, p)| z + p.max(1e-300).ln()).collect();
+    let m = l.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let e: Vec<f64> = l.iter().map(|x| (x - m).exp()).collect();
+    let s: f64 = e.iter().sum();
+    e.iter().map(|x| x / s).collect()
+}
+
+/// Time constant of the discrepancy process, s: the structure floor of the
+/// emulator's effect-free logs varies over minutes (warm-ups, steps).
+/// Chosen among 60, 120, 300 and 600 s with two cases in view: the
+/// synthetic winding case (seed 11) is named at 60 and 120 s (P ≈ 0.98,
+/// 0.92) and not at 300 or 600 s (≈ 0.80, 0.71, conduction second); the
+/// emulator twin of 1700 is `unexplained` at all four.
+pub const DISCREPANCY_TAU_S: f64 = 120.0;
+
+/// Probability at which a cause is named.
+pub const NAME_PROBABILITY: f64 = 0.9;
+
+/// Prior probability of `none` and of `unexplained`; each of the six
+/// candidates has a sixth of the rest when admitted, 0 otherwise (the
+/// posterior is normalised over what is admitted).
+pub const PRIOR_NO_CAUSE: f64 = 0.25;
+
+/// One structure's posterior.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct CauseProbability {
+    /// `none`, `unexplained` or a candidate name.
+    pub cause: String,
+    /// Prior probability (0 for a candidate the log cannot identify).
+    pub prior: f64,
+    /// ln of the Bayes factor against `none`, each judged with the
+    /// discrepancy of its own channels' floor.
+    pub log_bayes_factor: f64,
+    /// Posterior probability.
+    pub probability: f64,
+}
+
+/// One channel's numbers behind the probabilities.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ChannelEvidence {
+    /// Channel name.
+    pub channel: String,
+    /// Noise σ estimated from its samples, K.
+    pub noise_k: f64,
+    /// RMS rise above ambient, K.
+    pub rise_k: f64,
+    /// RMS residual of the calibrated baseline on the training points, K.
+    pub misfit_k: f64,
+    /// Structure floor of this channel estimated from the others, K
+    /// ([`floor_for`]).
+    pub floor_k: f64,
+    /// Imprint ratio: misfit over floor (≥ 2: something stands clear of
+    /// the floor on this channel).
+    pub imprint_ratio: f64,
+    /// Ljung–Box p of the raw baseline residual (training points).
+    pub ljung_box_p_raw: f64,
+    /// Ljung–Box p of the same residual whitened with the floor-sized
+    /// discrepancy.
+    pub ljung_box_p_whitened: f64,
+}
+
+/// Probabilities over the structures and the channel numbers behind them.
+#[derive(Debug, Clone, Default, serde::Serialize)]
+pub struct Posterior {
+    /// `none`, `unexplained` and every candidate, most probable first.
+    pub causes: Vec<CauseProbability>,
+    /// Per channel.
+    pub channels: Vec<ChannelEvidence>,
+    /// Discrepancy time constant used, s.
+    pub tau_s: f64,
+}
+
+impl Posterior {
+    /// The candidate named at [`NAME_PROBABILITY`], if any.
+    pub fn named(&self) -> Option<&CauseProbability> {
+        self.causes.iter().find(|c| c.probability >= NAME_PROBABILITY && c.cause != "none" && c.cause != "unexplained")
+    }
+
+    /// Probability of `cause` (0 when absent).
+    pub fn of(&self, cause: &str) -> f64 {
+        self.causes.iter().find(|c| c.cause == cause).map_or(0.0, |c| c.probability)
+    }
+}
+
+/// The posterior over `none`, `unexplained` and the candidates `fits`
+/// against the calibrated baseline `base`, on the training points `pts`.
+/// `chan` gives each channel's (noise σ, rise) in K; `admitted` says
+/// whether a candidate is admitted (else its prior is 0): in the diagnosis,
+/// whether the log can tell it apart and its fit passes the held-out checks.
+/// `nuisance` and `ext` are the parameter specs of the model.
+#[allow(clippy::too_many_arguments)]
+pub fn posterior_of(
+    run: &MeasuredRun,
+    pts: &[Point],
+    all_pts: &[Point],
+    base: &FitResult,
+    fits: &[FitResult],
+    nuisance: &[ParamSpec],
+    ext: &dyn Fn(Candidate) -> Vec<ParamSpec>,
+    chan: &[(Channel, f64, f64)],
+    admitted: &dyn Fn(Candidate) -> bool,
+    tau_s: f64,
+) -> Posterior {
+    let r = super::fit::residuals_at(run, &base.series, pts).unwrap_or_default();
+    let runs = channel_runs(pts);
+    let floors: Vec<ChannelFloor> = runs
+        .iter()
+        .filter_map(|(ch, range)| {
+            let (_, noise, rise) = chan.iter().find(|c| c.0 == *ch)?;
+            let e = r.get(range.clone())?;
+            let m = (e.iter().map(|x| x * x).sum::<f64>() / e.len().max(1) as f64).sqrt();
+            Some(ChannelFloor { channel: ch.name().into(), noise_k: *noise, rise_k: *rise, misfit_k: m })
+        })
+        .collect();
+    let find = |ch: Channel| floors.iter().find(|f| f.channel == ch.name());
+    let noise = |ch: Channel| find(ch).map_or(0.1, |f| f.noise_k);
+    // Each channel judged on its own: its floor from the other channels.
+    let own_floor = |ch: Channel| find(ch).map_or(0.1, |f| floor_for(f, &floors, std::slice::from_ref(&f.channel)));
+    let channels: Vec<ChannelEvidence> = runs
+        .iter()
+        .filter_map(|(ch, range)| {
+            let f = find(*ch)?;
+            let e = r.get(range.clone())?;
+            let times: Vec<f64> = pts[range.clone()].iter().map(|(_, i)| run.time_s[*i]).collect();
+            let floor = own_floor(*ch);
+            let w = Whitener::new(&times, floor, f.noise_k, tau_s).whiten(e);
+            let lags = 20.min(e.len() / 4).max(1);
+            let lb = |v: &[f64]| super::stats::ljung_box(&v.iter().map(|x| Some(*x)).collect::<Vec<_>>(), lags).p_value;
+            Some(ChannelEvidence {
+                channel: f.channel.clone(),
+                noise_k: f.noise_k,
+                rise_k: f.rise_k,
+                misfit_k: f.misfit_k,
+                floor_k: floor,
+                imprint_ratio: f.misfit_k / floor,
+                ljung_box_p_raw: lb(e),
+                ljung_box_p_whitened: lb(&w),
+            })
+        })
+        .collect();
+    let mut causes = Vec::new();
+    // `unexplained`: the baseline with every channel's discrepancy free
+    // above its floor, against `none` with each at its floor.
+    let unexplained = log_lik_at(run, all_pts, base, &own_floor, &noise, tau_s)
+        .zip(log_lik_unexplained(run, all_pts, base, &own_floor, &noise, tau_s))
+        .map_or(f64::NEG_INFINITY, |(l0, lu)| lu - l0);
+    causes.push(("unexplained".to_string(), PRIOR_NO_CAUSE, unexplained));
+    for f in fits {
+        let touched: Vec<String> = touched_channels(f.candidate).iter().map(|c| c.name().to_string()).collect();
+        let amp = |ch: Channel| find(ch).map_or(0.1, |x| floor_for(x, &floors, &touched));
+        let mut specs = nuisance.to_vec();
+        specs.extend(ext(f.candidate));
+        let b = log_evidence(run, pts, all_pts, f, &specs, &amp, &noise, tau_s)
+            .zip(log_evidence(run, pts, all_pts, base, nuisance, &amp, &noise, tau_s))
+            .map_or(f64::NEG_INFINITY, |(a, b)| a.log_z - b.log_z);
+        let prior = if admitted(f.candidate) { (1.0 - 2.0 * PRIOR_NO_CAUSE) / Candidate::EXTENSIONS.len() as f64 } else { 0.0 };
+        causes.push((f.candidate.name().to_string(), prior, b));
+    }
+    causes.push(("none".to_string(), PRIOR_NO_CAUSE, 0.0));
+    let p = posterior(&causes.iter().map(|c| c.2).collect::<Vec<_>>(), &causes.iter().map(|c| c.1).collect::<Vec<_>>());
+    let mut causes: Vec<CauseProbability> = causes
+        .into_iter()
+        .zip(p)
+        .map(|((cause, prior, log_bayes_factor), probability)| CauseProbability { cause, prior, log_bayes_factor, probability })
+        .collect();
+    causes.sort_by(|a, b| b.probability.total_cmp(&a.probability));
+    Posterior { causes, channels, tau_s }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::diagnosis::model::SimSeries;
+    use rand::{Rng, SeedableRng};
+
+    /// Dense Gaussian log-likelihood of `y` with covariance
+    /// s²·exp(−|Δt|/τ) + σ²·I (Cholesky), the definition the filter must match.
+    fn dense_log_lik(t: &[f64], y: &[f64], s: f64, sigma: f64, tau: f64) -> f64 {
+        let n = t.len();
+        let k = DMatrix::from_fn(n, n, |i, j| s * s * (-(t[i] - t[j]).abs() / tau).exp() + if i == j { sigma * sigma } else { 0.0 });
+        let c = k.cholesky().unwrap();
+        let a = c.solve(&nalgebra::DVector::from_column_slice(y));
+        let ln_det = 2.0 * c.l().diagonal().iter().map(|d| d.ln()).sum::<f64>();
+        -0.5 * (y.iter().zip(a.iter()).map(|(x, z)| x * z).sum::<f64>() + ln_det + n as f64 * (2.0 * std::f64::consts::PI).ln())
+    }
+
+    /// AR(1) discrepancy of amplitude `s`, time constant `tau` at `t`, plus
+    /// white noise `sigma` (exact discretisation on irregular times).
+    fn ar1(rng: &mut impl Rng, t: &[f64], s: f64, tau: f64, sigma: f64) -> Vec<f64> {
+        let mut g = || -> f64 { (0..12).map(|_| rng.random::<f64>()).sum::<f64>() - 6.0 };
+        let mut x = s * g();
+        let mut out = Vec::new();
+        for (i, ti) in t.iter().enumerate() {
+            if i > 0 {
+                let f = (-(ti - t[i - 1]) / tau).exp();
+                x = f * x + s * (1.0 - f * f).sqrt() * g();
+            }
+            out.push(x + sigma * g());
+        }
+        out
+    }
+
+    /// The Kalman filter is the exact likelihood of the AR(1)-plus-noise
+    /// model on irregular times (samples missing), to rounding; and the
+    /// whitening it gives turns a residual that the Ljung–Box test rejects
+    /// outright (p < 1e-6, as every channel of every log does today) into
+    /// one it accepts (p > 0.01).
+    #[test]
+    fn the_discrepancy_filter_is_the_exact_likelihood_and_whitens() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let t: Vec<f64> = (0..40).filter(|i| i % 7 != 3).map(|i| 6.0 * i as f64).collect();
+        let y = ar1(&mut rng, &t, 0.4, 300.0, 0.1);
+        let w = Whitener::new(&t, 0.4, 0.1, 300.0);
+        let (a, b) = (w.log_lik(&y), dense_log_lik(&t, &y, 0.4, 0.1, 300.0));
+        assert!((a - b).abs() < 1e-9 * b.abs().max(1.0), "filter {a} against dense {b}");
+        let t: Vec<f64> = (0..600).map(|i| 2.0 * i as f64).collect();
+        let y = ar1(&mut rng, &t, 0.4, 300.0, 0.1);
+        let lb = |v: &[f64]| crate::diagnosis::stats::ljung_box(&v.iter().map(|x| Some(*x)).collect::<Vec<_>>(), 20).p_value;
+        let raw = lb(&y);
+        let white = lb(&Whitener::new(&t, 0.4, 0.1, 300.0).whiten(&y));
+        assert!(raw < 1e-6 && white > 0.01, "Ljung–Box p raw {raw:.2e}, whitened {white:.3}");
+    }
+
+    const CHANNELS: [(Channel, f64); 5] =
+        [(Channel::TMotorC, 5.0), (Channel::TPumpC, 10.0), (Channel::TBlockC, 8.0), (Channel::TBallvalveC, 8.0), (Channel::TOilC, 10.0)];
+
+    /// A toy diagnosis on the training window (0–840 s, 6 s points): every
+    /// channel's calibrated-baseline residual is a structure floor of 2 % of
+    /// its rise (AR(1), τ 5 min; the evidence's own τ is [`DISCREPANCY_TAU_S`]) plus σ 0.1 K noise; the oil channel also
+    /// carries a lag-like imprint of `imprint_k` (1 − e^(−t/200 s)) that the
+    /// `sensor-lag` fit removes; `block_extra_k` adds a smooth misfit to
+    /// t_block_c that nothing explains. Returns the posterior.
+    fn toy(imprint_k: f64, block_extra_k: f64, seed: u64) -> Posterior {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let rows: Vec<f64> = (0..141).map(|i| 6.0 * i as f64).collect();
+        let mut run = MeasuredRun::new(rows.clone());
+        let (mut base, mut cand) = (SimSeries::default(), SimSeries::default());
+        let mut pts = Vec::new();
+        let g: Vec<f64> = rows.iter().map(|t| 1.0 - (-t / 200.0).exp()).collect();
+        for (ch, rise) in CHANNELS {
+            run.set(ch, vec![Some(30.0); rows.len()]);
+            let floor = ar1(&mut rng, &rows, 0.02 * rise, 300.0, 0.1);
+            let extra: Vec<f64> = match ch {
+                Channel::TOilC => g.iter().map(|x| imprint_k * x).collect(),
+                Channel::TBlockC => rows.iter().map(|t| block_extra_k * (t / 300.0).sin()).collect(),
+                _ => vec![0.0; rows.len()],
+            };
+            let explained = ch == Channel::TOilC;
+            base.channels.insert(ch, floor.iter().zip(&extra).map(|(f, e)| 30.0 + f + e).collect());
+            cand.channels.insert(ch, floor.iter().zip(&extra).map(|(f, e)| 30.0 + f + if explained { 0.0 } else { *e }).collect());
+            pts.extend((0..rows.len()).map(|i| (ch, i)));
+        }
+        // Jacobians: one nuisance multiplier moving every channel along a
+        // ramp; the candidate's parameter moving the oil along the imprint.
+        let n = pts.len();
+        let ramp = |i: usize| 0.5 * rows[pts[i].1] / 840.0;
+        let j_base = DMatrix::from_fn(n, 1, |i, _| ramp(i));
+        let j_cand = DMatrix::from_fn(n, 2, |i, k| if k == 0 { ramp(i) } else if pts[i].0 == Channel::TOilC { 0.5 * g[pts[i].1] } else { 0.0 });
+        let fit = |c: Candidate, series: SimSeries, ext: Vec<f64>, j: DMatrix<f64>| FitResult {
+            candidate: c,
+            nuisance: vec![1.0],
+            ext,
+            rss: 0.0,
+            n,
+            sims: 0,
+            series,
+            jac_ln: Some(j),
+        };
+        let nuisance = [ParamSpec::new("scale", "1", 1.0, 0.5, 2.0)];
+        let b = fit(Candidate::None, base, vec![], j_base);
+        let c = fit(Candidate::SensorLag, cand, vec![100.0], j_cand);
+        let chan: Vec<(Channel, f64, f64)> = CHANNELS.iter().map(|(ch, rise)| (*ch, 0.1, *rise)).collect();
+        posterior_of(
+            &run,
+            &pts,
+            &pts,
+            &b,
+            std::slice::from_ref(&c),
+            &nuisance,
+            &|_| vec![ParamSpec::new("sensor_tau_s", "s", 100.0, 10.0, 1000.0)],
+            &chan,
+            &|_| true,
+            DISCREPANCY_TAU_S,
+        )
+    }
+
+    /// Item "a candidate has to beat a discrepancy of floor size": an
+    /// imprint on the oil channel as large as the floor the other channels
+    /// show (2 % of its 10 K rise, 0.2 K) gets no name at P ≥ 0.9, on each
+    /// of five draws of the floor; the same imprint at five times the floor
+    /// (1 K) is named with P ≥ 0.9 on each.
+    #[test]
+    fn a_candidate_must_beat_a_discrepancy_of_floor_size() {
+        for seed in 1..=5 {
+            let small = toy(0.2, 0.0, seed);
+            assert!(small.named().is_none(), "seed {seed}: floor-size imprint named: {:?}", small.causes);
+            let clear = toy(1.0, 0.0, seed);
+            assert!(clear.of("sensor-lag") >= NAME_PROBABILITY, "seed {seed}: clear imprint: {:?}", clear.causes);
+            let oil = clear.channels.iter().find(|c| c.channel == "t_oil_c").unwrap();
+            assert!(oil.imprint_ratio >= 2.0, "seed {seed}: oil imprint ratio {:.1}", oil.imprint_ratio);
+        }
+    }
+
+    /// Per-channel evidence: each candidate's Bayes factor against `none`
+    /// is taken on the channels its physics touches at the floor, every
+    /// other channel at its own misfit, so a channel that misfits far more
+    /// than the others (t_block_c off by 3 K, fifteen times its floor)
+    /// leaves the lag's Bayes factor decisive (measured ln BF 11–31 with it,
+    /// 11–39 without, five draws; asserted > 5: the oil's floor, a median
+    /// over the other channels, moves a little with the block).
+    /// **Measured limit**: the `unexplained` structure (every channel's
+    /// discrepancy free) then takes the probability, P ≥ 0.99, so the lag is
+    /// not named: the big misfit still vetoes the decision through
+    /// `unexplained`. A per-channel mixture (floor or free on each channel,
+    /// for every structure) removed that veto in this test but named
+    /// `sensor-lag` on the emulator twin of 1700 (ln BF 45.6): not adopted.
+    #[test]
+    fn a_channel_that_misfits_far_more_leaves_the_candidates_bayes_factor() {
+        for seed in 1..=5 {
+            let bf = |p: &Posterior| p.causes.iter().find(|c| c.cause == "sensor-lag").unwrap().log_bayes_factor;
+            let (clean, vetoed) = (toy(1.0, 0.0, seed), toy(1.0, 3.0, seed));
+            eprintln!("seed {seed}: ln BF {:.1} clean, {:.1} with the block misfit", bf(&clean), bf(&vetoed));
+            assert!(bf(&vetoed) > 5.0, "seed {seed}: ln BF {:.1} against {:.1}", bf(&clean), bf(&vetoed));
+            assert!(vetoed.of("unexplained") >= 0.99, "seed {seed}: measured limit changed: {:?}", vetoed.causes);
+            let block = vetoed.channels.iter().find(|c| c.channel == "t_block_c").unwrap();
+            assert!(block.misfit_k > 1.5, "seed {seed}: block misfit {:.2}", block.misfit_k);
+        }
+    }
+}
