@@ -129,7 +129,8 @@ impl defmt::Format for ChannelSet {
     }
 }
 
-/// A set of guard faults (the 16-bit fault word).
+/// A set of guard faults (the fault word: 32 bits on the wire and in the
+/// thermal record).
 #[derive(Clone, Copy, Default, PartialEq, Eq)]
 pub struct Faults(u32);
 

@@ -153,8 +153,10 @@ pub(crate) fn check_reduced_core(rig: &Rig, p: &ReducedParams, log: &CalLog, mar
     let (mut max_meas, mut under, mut over, mut ss, mut n) = (0.0f64, 0.0f64, 0.0f64, 0.0, 0usize);
     let has_drain = log.has(Channel::TDrainC);
     let servo = log.run.get(Channel::PositionMm).is_some_and(|v| v.iter().any(Option::is_some));
-    let valve = eha_guard::protection::ValveConfig::DEFAULT;
-    let (mut guard_open, mut below_ticks, mut open_ticks, mut open_j) = (false, 0u32, 0usize, 0.0f64);
+    let cfg = eha_guard::protection::ValveConfig::DEFAULT;
+    let (open_c, close_c) = (f64::from(cfg.open_c), f64::from(cfg.close_c));
+    let mut valve = eha_guard::protection::Valve::new();
+    let (mut open_ticks, mut open_j) = (0usize, 0.0f64);
     let (mut rows, mut e_ref, mut e_under): (Vec<TickRow>, Vec<f64>, Vec<f64>) = (Vec::new(), Vec::new(), Vec::new());
     let mut open = false;
     plant
@@ -182,17 +184,10 @@ pub(crate) fn check_reduced_core(rig: &Rig, p: &ReducedParams, log: &CalLog, mar
                 }
             }
             e_under.push(eu);
-            // The guard's valve on this estimate (open loop).
-            if est > f64::from(valve.open_c) {
-                guard_open = true;
-                below_ticks = 0;
-            } else if guard_open {
-                below_ticks = if est < f64::from(valve.close_c) { below_ticks + 1 } else { 0 };
-                if below_ticks >= valve.dwell_ticks {
-                    guard_open = false;
-                }
-            }
-            if guard_open {
+            // The guard's valve on this estimate (open loop), decided every
+            // tick with the dwell in ticks.
+            valve.update_with(est, false, open_c, close_c, cfg.dwell_ticks);
+            if valve.is_open() {
                 open_ticks += 1;
                 open_j += m.last_total_kw() * 1e3 * 0.01;
             }

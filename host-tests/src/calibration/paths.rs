@@ -147,7 +147,8 @@ pub fn choose(reduction: &PathOutcome, direct: Result<&PathOutcome, &str>) -> Ch
     let (Some(ma), Some(mb)) = (reduction.margin_k(), d.margin_k()) else {
         return keep("the paths cannot be compared: no margin validated within the block's bound on one of them (it needs `t_drain_c` in every training log)".into());
     };
-    let split = match (reduction.validation_max_k(), d.validation_max_k()) {
+    let after_split = (reduction.validation_max_k(), d.validation_max_k());
+    let split = match after_split {
         (Some(a), Some(b)) => format!("; after the split, margin counted, max |e| {a:.2} K (reduction, margin {ma:.2} K) and {b:.2} K (direct, margin {mb:.2} K)"),
         _ => String::new(),
     };
@@ -162,7 +163,7 @@ pub fn choose(reduction: &PathOutcome, direct: Result<&PathOutcome, &str>) -> Ch
             };
             (wins, why)
         }
-        _ => match (reduction.validation_max_k(), d.validation_max_k()) {
+        _ => match after_split {
             (Some(a), Some(b)) => (b < a, format!("no held-out log with `t_drain_c`: the smaller max |e| after the split{split}")),
             _ => (false, "the paths cannot be compared".into()),
         },

@@ -241,14 +241,7 @@ fn metrics(run: &MeasuredRun, s: &SimSeries, split: f64, lb_lags: usize) -> Metr
 /// Training fit points: present temperature samples before `split`, thinned
 /// uniformly to at most `per_channel` per channel.
 pub fn fit_points(run: &MeasuredRun, split: f64, per_channel: usize) -> Vec<Point> {
-    let mut pts = Vec::new();
-    for ch in Channel::TEMPERATURES {
-        let Some(m) = run.get(ch) else { continue };
-        let rows: Vec<usize> = (0..run.len()).filter(|&i| run.time_s[i] < split && m[i].is_some()).collect();
-        let step = rows.len().div_ceil(per_channel.max(1)).max(1);
-        pts.extend(rows.iter().step_by(step).map(|&i| (ch, i)));
-    }
-    pts
+    points(run, split, per_channel, false)
 }
 
 /// The points the evidence is computed on: per channel, the training fit
@@ -256,14 +249,23 @@ pub fn fit_points(run: &MeasuredRun, split: f64, per_channel: usize) -> Vec<Poin
 /// same step; the held-out part enters as the predictive likelihood of the
 /// fitted structure.
 pub fn evidence_points(run: &MeasuredRun, split: f64, per_channel: usize) -> Vec<Point> {
+    points(run, split, per_channel, true)
+}
+
+/// Per channel: the present samples before `split` thinned to at most
+/// `per_channel`, then (with `held_out`) those from `split` on, thinned with
+/// the same step.
+fn points(run: &MeasuredRun, split: f64, per_channel: usize, held_out: bool) -> Vec<Point> {
     let mut pts = Vec::new();
     for ch in Channel::TEMPERATURES {
         let Some(m) = run.get(ch) else { continue };
         let rows: Vec<usize> = (0..run.len()).filter(|&i| run.time_s[i] < split && m[i].is_some()).collect();
         let step = rows.len().div_ceil(per_channel.max(1)).max(1);
         pts.extend(rows.iter().step_by(step).map(|&i| (ch, i)));
-        let held: Vec<usize> = (0..run.len()).filter(|&i| run.time_s[i] >= split && m[i].is_some()).collect();
-        pts.extend(held.iter().step_by(step).map(|&i| (ch, i)));
+        if held_out {
+            let held: Vec<usize> = (0..run.len()).filter(|&i| run.time_s[i] >= split && m[i].is_some()).collect();
+            pts.extend(held.iter().step_by(step).map(|&i| (ch, i)));
+        }
     }
     pts
 }

@@ -256,13 +256,19 @@ pub fn log_evidence(
 /// Log-likelihood of the residual of `fit` at `pts` (every channel's
 /// discrepancy amplitude `amp(channel)`).
 pub fn log_lik_at(run: &MeasuredRun, pts: &[Point], fit: &FitResult, amp: &dyn Fn(Channel) -> f64, noise: &dyn Fn(Channel) -> f64, tau_s: f64) -> Option<f64> {
+    sum_over_channels(run, pts, fit, |ch, times, y| Whitener::new(times, amp(ch), noise(ch), tau_s).log_lik(y))
+}
+
+/// The sum over the channels of `pts` of `f(channel, times_s, residual)`,
+/// the residual of `fit` at those points.
+fn sum_over_channels(run: &MeasuredRun, pts: &[Point], fit: &FitResult, f: impl Fn(Channel, &[f64], &[f64]) -> f64) -> Option<f64> {
     let r = super::fit::residuals_at(run, &fit.series, pts)?;
     Some(
         channel_runs(pts)
             .into_iter()
             .map(|(ch, range)| {
                 let times: Vec<f64> = pts[range.clone()].iter().map(|(_, i)| run.time_s[*i]).collect();
-                Whitener::new(&times, amp(ch), noise(ch), tau_s).log_lik(&r[range])
+                f(ch, &times, &r[range])
             })
             .sum(),
     )
@@ -290,16 +296,7 @@ pub fn log_lik_unexplained(
     noise: &dyn Fn(Channel) -> f64,
     tau_s: f64,
 ) -> Option<f64> {
-    let r = super::fit::residuals_at(run, &fit.series, pts)?;
-    Some(
-        channel_runs(pts)
-            .into_iter()
-            .map(|(ch, range)| {
-                let times: Vec<f64> = pts[range.clone()].iter().map(|(_, i)| run.time_s[*i]).collect();
-                log_lik_free_amplitude(&times, &r[range], lo(ch), noise(ch), tau_s)
-            })
-            .sum(),
-    )
+    sum_over_channels(run, pts, fit, |ch, times, y| log_lik_free_amplitude(times, y, lo(ch), noise(ch), tau_s))
 }
 
 /// Posterior probabilities from log evidences and prior probabilities
