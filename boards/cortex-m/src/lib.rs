@@ -25,3 +25,38 @@ pub mod rx;
 pub mod stack;
 #[cfg(target_os = "none")]
 pub mod tick;
+
+/// The [`eha_guard::product::Board`] methods every board answers from this
+/// crate alone (receive queue, tick counter, no-init records): expands, inside
+/// a board's `impl Board for …` block, to `read_rx`, `rx_dropped`, `ticks`,
+/// `wait_tick`, `store_record` and `store_cause`. The board writes the
+/// methods that touch its own peripherals (pins, UART transmit, watchdog,
+/// non-volatile store, clocks).
+#[macro_export]
+macro_rules! shared_board_methods {
+    () => {
+        fn read_rx(&mut self, buf: &mut [u8]) -> usize {
+            $crate::rx::read(buf)
+        }
+
+        fn rx_dropped(&self) -> u32 {
+            $crate::rx::dropped()
+        }
+
+        fn ticks(&self) -> u32 {
+            $crate::tick::count()
+        }
+
+        fn wait_tick(&mut self, seen: u32) {
+            $crate::tick::wait(seen);
+        }
+
+        fn store_record(&mut self, slot: usize, rec: &::eha_guard::memory::ThermalRecord) {
+            $crate::noinit::store_record(slot, rec);
+        }
+
+        fn store_cause(&mut self, rec: &::eha_guard::product::reset::CauseRecord) {
+            $crate::noinit::store_cause(rec);
+        }
+    };
+}

@@ -18,8 +18,6 @@ use cortex_m::peripheral::{syst::SystClkSource, NVIC, SCB, SYST};
 use cortex_m_rt::{exception, ExceptionFrame};
 use eha_cortex_m::{noinit, rx, stack, tick};
 use eha_guard::memory::nv::NvLoad;
-use eha_guard::memory::ThermalRecord;
-use eha_guard::product::reset::CauseRecord;
 use eha_guard::product::wire::{Pins, ResetCause};
 use eha_guard::product::{Board, BootMemory};
 
@@ -121,13 +119,7 @@ pub fn start(_b: &mut Mps2) {
 }
 
 impl Board for Mps2 {
-    fn read_rx(&mut self, buf: &mut [u8]) -> usize {
-        rx::read(buf)
-    }
-
-    fn rx_dropped(&self) -> u32 {
-        rx::dropped()
-    }
+    eha_cortex_m::shared_board_methods!();
 
     fn write_tx(&mut self, bytes: &[u8]) {
         for &b in bytes {
@@ -146,22 +138,6 @@ impl Board for Mps2 {
         wr(WDOG + 0xC00, 0x1ACC_E551);
         wr(WDOG + 0x00C, 1); // INTCLR: clears the warning and reloads the count
         wr(WDOG + 0xC00, 0);
-    }
-
-    fn ticks(&self) -> u32 {
-        tick::count()
-    }
-
-    fn wait_tick(&mut self, seen: u32) {
-        tick::wait(seen);
-    }
-
-    fn store_record(&mut self, slot: usize, rec: &ThermalRecord) {
-        noinit::store_record(slot, rec);
-    }
-
-    fn store_cause(&mut self, rec: &CauseRecord) {
-        noinit::store_cause(rec);
     }
 
     fn cycle_stamp(&self) -> u32 {

@@ -30,7 +30,6 @@ use cortex_m_rt::{exception, ExceptionFrame};
 use eha_cortex_m::{noinit, rx, stack, tick};
 use eha_guard::memory::nv::{Blocking, NvLoad, NvStore};
 use eha_guard::memory::ThermalRecord;
-use eha_guard::product::reset::CauseRecord;
 use eha_guard::product::wire::{Pins, ResetCause};
 use eha_guard::product::{Board, BootMemory};
 use embedded_storage::nor_flash::{ErrorType, NorFlash, ReadNorFlash};
@@ -277,13 +276,7 @@ pub fn start(b: &mut F411) {
 }
 
 impl Board for F411 {
-    fn read_rx(&mut self, buf: &mut [u8]) -> usize {
-        rx::read(buf)
-    }
-
-    fn rx_dropped(&self) -> u32 {
-        rx::dropped()
-    }
+    eha_cortex_m::shared_board_methods!();
 
     fn write_tx(&mut self, bytes: &[u8]) {
         // Blocking per byte: a 36-byte tick reply takes 0.8 ms at 460800 baud.
@@ -301,22 +294,6 @@ impl Board for F411 {
 
     fn feed_watchdog(&mut self) {
         with_wdt(|w| w.feed());
-    }
-
-    fn ticks(&self) -> u32 {
-        tick::count()
-    }
-
-    fn wait_tick(&mut self, seen: u32) {
-        tick::wait(seen);
-    }
-
-    fn store_record(&mut self, slot: usize, rec: &ThermalRecord) {
-        noinit::store_record(slot, rec);
-    }
-
-    fn store_cause(&mut self, rec: &CauseRecord) {
-        noinit::store_cause(rec);
     }
 
     /// Appends the record to flash. A sector erase stalls the CPU (and the
