@@ -60,3 +60,22 @@ macro_rules! shared_board_methods {
         }
     };
 }
+
+/// The two fatal handlers every board has, both ending in the board's own
+/// `fail` (safe outputs, the reset cause in no-init RAM, a reset): the
+/// HardFault exception and the panic handler. `fail` is a function
+/// `fn(ResetCause) -> !` of the board module.
+#[macro_export]
+macro_rules! fatal_handlers {
+    ($fail:ident) => {
+        #[cortex_m_rt::exception]
+        unsafe fn HardFault(_ef: &cortex_m_rt::ExceptionFrame) -> ! {
+            $fail(::eha_guard::product::wire::ResetCause::HardFault)
+        }
+
+        #[panic_handler]
+        fn panic(_info: &core::panic::PanicInfo) -> ! {
+            $fail(::eha_guard::product::wire::ResetCause::Panic)
+        }
+    };
+}

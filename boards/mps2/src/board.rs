@@ -15,7 +15,7 @@
 //! `eha_cortex_m` (shared with the STM32F411 board).
 
 use cortex_m::peripheral::{syst::SystClkSource, NVIC, SCB, SYST};
-use cortex_m_rt::{exception, ExceptionFrame};
+use cortex_m_rt::exception;
 use eha_cortex_m::{noinit, rx, stack, tick};
 use eha_guard::memory::nv::NvLoad;
 use eha_guard::product::wire::{Pins, ResetCause};
@@ -194,12 +194,4 @@ unsafe fn NonMaskableInt() {
     fail(ResetCause::Watchdog)
 }
 
-#[exception]
-unsafe fn HardFault(_ef: &ExceptionFrame) -> ! {
-    fail(ResetCause::HardFault)
-}
-
-#[panic_handler]
-fn panic(_info: &core::panic::PanicInfo) -> ! {
-    fail(ResetCause::Panic)
-}
+eha_cortex_m::fatal_handlers!(fail);

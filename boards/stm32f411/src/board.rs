@@ -26,7 +26,7 @@ use core::cell::RefCell;
 use core::sync::atomic::{AtomicU32, Ordering::Relaxed};
 use cortex_m::interrupt::{self as irq, Mutex};
 use cortex_m::peripheral::{DWT, NVIC, SCB};
-use cortex_m_rt::{exception, ExceptionFrame};
+use cortex_m_rt::exception;
 use eha_cortex_m::{noinit, rx, stack, tick};
 use eha_guard::memory::nv::{Blocking, NvLoad, NvStore};
 use eha_guard::memory::ThermalRecord;
@@ -385,12 +385,4 @@ unsafe fn DefaultHandler(_irqn: i16) {
     fail(ResetCause::Exception)
 }
 
-#[exception]
-unsafe fn HardFault(_ef: &ExceptionFrame) -> ! {
-    fail(ResetCause::HardFault)
-}
-
-#[panic_handler]
-fn panic(_info: &core::panic::PanicInfo) -> ! {
-    fail(ResetCause::Panic)
-}
+eha_cortex_m::fatal_handlers!(fail);
