@@ -8,8 +8,8 @@ use super::log::CalLog;
 use crate::measured::Channel;
 use crate::plant::{Control, Plant, Sensors};
 use crate::rig::Rig;
-use crate::scenario::Scenario;
-use crate::simulation::replay::replay_inputs;
+use crate::scenario::{Circuit, Scenario};
+use crate::simulation::replay::{circuit_of, replay_inputs};
 use eha_guard::model::{Model, ModelInputN, ReducedParams};
 
 /// Largest drain margin the parameter block accepts, K (the firmware's
@@ -65,7 +65,8 @@ pub struct Region {
     pub dp_bar: (f64, f64),
     /// Drain temperature of the reference, °C.
     pub drain_c: (f64, f64),
-    /// Whether the log is a servo run (`position_mm` logged).
+    /// Whether the log is a servo run (its circuit by
+    /// [`crate::simulation::replay::circuit_of`]).
     pub servo: bool,
 }
 
@@ -152,7 +153,7 @@ pub(crate) fn check_reduced_core(rig: &Rig, p: &ReducedParams, log: &CalLog, mar
     let (mut k, mut prev_x, mut max_ref, mut under_ref) = (0usize, 0.0, 0.0f64, 0.0f64);
     let (mut max_meas, mut under, mut over, mut ss, mut n) = (0.0f64, 0.0f64, 0.0f64, 0.0, 0usize);
     let has_drain = log.has(Channel::TDrainC);
-    let servo = log.run.get(Channel::PositionMm).is_some_and(|v| v.iter().any(Option::is_some));
+    let servo = matches!(circuit_of(&log.run), Ok(Circuit::Servo));
     let cfg = eha_guard::protection::ValveConfig::DEFAULT;
     let (open_c, close_c) = (f64::from(cfg.open_c), f64::from(cfg.close_c));
     let mut valve = eha_guard::protection::Valve::new();

@@ -9,6 +9,8 @@ use super::log::{channel_errors, CalLog, ChannelError};
 use crate::measured::Channel;
 use crate::reduce::reduce;
 use crate::rig::Rig;
+use crate::scenario::Circuit;
+use crate::simulation::replay::circuit_of;
 use super::paths::{Choice, PathKind, PathOutcome};
 pub use super::check::{
     check_reduced, check_reduced_with, score_split, CommissionError, MarginValidation, ReducedCheck, Region, Split, MARGIN_ALLOWANCE_K,
@@ -110,7 +112,7 @@ pub fn log_region(log: &CalLog) -> Region {
     let dp = pct(pa.iter().zip(&pb).map(|(a, b)| (a - b).abs()).collect());
     let t = if log.has(Channel::TDrainC) { col(Channel::TDrainC) } else { col(Channel::TOilC) };
     let drain = (t.iter().copied().fold(f64::MAX, f64::min), t.iter().copied().fold(f64::MIN, f64::max));
-    let servo = r.get(Channel::PositionMm).is_some_and(|v| v.iter().any(Option::is_some));
+    let servo = matches!(circuit_of(r), Ok(Circuit::Servo));
     Region { t_s: (r.time_s[0], r.time_s[r.len() - 1]), speed_rpm: speed, dp_bar: dp, drain_c: drain, servo }
 }
 

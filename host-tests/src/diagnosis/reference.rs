@@ -122,13 +122,16 @@ impl ReferenceModel {
 /// diagnosis's channels ([`Channel::TEMPERATURES`], logged), without the
 /// loss coefficients that only speed and pressure steps separate when the
 /// run has one operating point (the calibration's rule), without the
-/// needle split on servo runs (no throttling), and without `block_wall`
+/// needle split on servo runs (no throttling; the circuit by
+/// [`circuit_of`]), and without `block_wall`
 /// unless the run moves speed and load independently (its
 /// [`Needs::SensorWithJointExcitation`]).
 pub fn nuisance_set(run: &MeasuredRun) -> Vec<usize> {
     let logged = |ch: Channel| Channel::TEMPERATURES.contains(&ch) && run.get(ch).is_some_and(|v| v.iter().any(Option::is_some));
     let one_point = calibration::ident::one_point(run);
-    let servo = run.get(Channel::PositionMm).is_some();
+    // The circuit by the log's rule (stated, or the piston's travel), never
+    // by whether a position column exists.
+    let servo = matches!(circuit_of(run), Ok(crate::scenario::Circuit::Servo));
     calibration::PARAMS
         .iter()
         .enumerate()

@@ -97,6 +97,12 @@ fn a_logged_stationary_piston_does_not_change_the_circuit() {
     let a = replay_inputs(&plain, "plain").expect("inputs");
     let b = replay_inputs(&with_piston, "piston").expect("inputs");
     assert_eq!((a.circuit, b.circuit), (Circuit::Throttle, Circuit::Throttle));
+    // The diagnosis's calibration set by the same rule: the needle split
+    // (throttling only) stays free on the throttle log with its piston.
+    let set = eha_sim::diagnosis::reference::nuisance_set;
+    let needle = eha_sim::calibration::PARAMS.iter().position(|d| d.name == "needle_split").expect("needle_split");
+    assert!(set(&plain).contains(&needle), "the throttle steps calibrate the needle split");
+    assert_eq!(set(&plain), set(&with_piston), "the position column changed the calibration set");
     let opts = SimOptions { output_interval_s: 10.0, control_interval_s: 10.0 };
     let rig = eha_sim::rig::Rig::default();
     let ya = simulate_budget(&rig, &Scenario::Replay(a), &opts, 1e-6, None).expect("replay");
