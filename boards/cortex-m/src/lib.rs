@@ -29,7 +29,10 @@ pub mod tick;
 /// The [`eha_guard::product::Board`] methods every board answers from this
 /// crate alone (receive queue, tick counter, no-init records): expands, inside
 /// a board's `impl Board for …` block, to `read_rx`, `rx_dropped`, `ticks`,
-/// `wait_tick`, `store_record` and `store_cause`. The board writes the
+/// `wait_tick`, `store_record`, `store_cause`, `stack_high_water_b`,
+/// `boot_stack_b` (the board struct's `boot_stack_b: u32` field, which its
+/// `boot_done` sets from [`stack::boot_done`]) and `param_block` (the
+/// linker's PARAMS region). The board writes the
 /// methods that touch its own peripherals (pins, UART transmit, watchdog,
 /// non-volatile store, clocks).
 #[macro_export]
@@ -57,6 +60,18 @@ macro_rules! shared_board_methods {
 
         fn store_cause(&mut self, rec: &::eha_guard::product::reset::CauseRecord) {
             $crate::noinit::store_cause(rec);
+        }
+
+        fn stack_high_water_b(&self) -> u32 {
+            $crate::stack::high_water()
+        }
+
+        fn boot_stack_b(&self) -> u32 {
+            self.boot_stack_b
+        }
+
+        fn param_block(&self) -> Option<&'static [u8; ::eha_guard::params_block::BLOCK_LEN]> {
+            Some(::eha_guard::params_block::flash_region())
         }
     };
 }

@@ -148,18 +148,6 @@ impl Board for Mps2 {
         let _ = &self.syst;
         stamp.wrapping_sub(SYST::get_current()) & 0x00FF_FFFF
     }
-
-    fn stack_high_water_b(&self) -> u32 {
-        stack::high_water()
-    }
-
-    fn boot_stack_b(&self) -> u32 {
-        self.boot_stack_b
-    }
-
-    fn param_block(&self) -> Option<&'static [u8; eha_guard::params_block::BLOCK_LEN]> {
-        Some(eha_guard::params_block::flash_region())
-    }
 }
 
 fn uart0_rx() {

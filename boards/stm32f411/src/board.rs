@@ -327,17 +327,6 @@ impl Board for F411 {
         DWT::cycle_count().wrapping_sub(stamp)
     }
 
-    fn stack_high_water_b(&self) -> u32 {
-        stack::high_water()
-    }
-
-    fn boot_stack_b(&self) -> u32 {
-        self.boot_stack_b
-    }
-
-    fn param_block(&self) -> Option<&'static [u8; eha_guard::params_block::BLOCK_LEN]> {
-        Some(eha_guard::params_block::flash_region())
-    }
     fn rtc_s(&mut self) -> Option<u32> {
         self.rtc.seconds()
     }
