@@ -171,6 +171,15 @@ pub struct Rosenbrock<const N: usize> {
     jac_max_age: u32,
     /// The kept Jacobian, the steps it has served and the step it was taken at.
     jac: Option<(Mat<N>, u32, f64)>,
+    /// The factorised iteration matrix 1/(γh) − W of the kept Jacobian
+    /// and the step h it was built for: a step of the same length reuses
+    /// it (the same matrix, so the same bits). Steps of equal length are
+    /// frequent here (steps cut at thermal step ends on a power-of-two
+    /// ladder, halved remnants): measured, Case 2 221.6 → 213.1 M
+    /// instructions, outputs bit-identical. Reused for steps within 1.2×,
+    /// 1.5× or 2× of h (a W-method keeps its order with W = J + δ·I),
+    /// the rejections rose 1.7–2.8-fold and Case 2 took 223–273 M.
+    lu: Option<(Lu<N>, f64)>,
 }
 
 impl<const N: usize> Rosenbrock<N> {
@@ -183,12 +192,13 @@ impl<const N: usize> Rosenbrock<N> {
     /// An integrator with the method `tab`, keeping a Jacobian for up to
     /// `jac_max_age` steps (only a W-method keeps its order so).
     pub fn with_method(tab: Tableau, jac_max_age: u32, rtol: f64, atol: [f64; N], scale: [f64; N], h0: f64) -> Self {
-        Self { rtol, atol, scale, h: h0, stats: RosStats::default(), tab, jac_max_age, jac: None }
+        Self { rtol, atol, scale, h: h0, stats: RosStats::default(), tab, jac_max_age, jac: None, lu: None }
     }
 
     /// Forgets the kept Jacobian (the right-hand side changed: a breakpoint).
     pub fn forget_jacobian(&mut self) {
         self.jac = None;
+        self.lu = None;
     }
 
     /// Integrates y' = f(t, y) from `t0` to `t1` with RODAS4, calling
@@ -254,17 +264,25 @@ impl<const N: usize> Rosenbrock<N> {
                 _ => {
                     let j = jacobian(f, t, y, f0, &self.scale, &mut self.stats);
                     self.jac = Some((j, 0, h));
+                    self.lu = None;
                     j
                 }
             };
-            let mut g = jac;
-            for (i, row) in g.iter_mut().enumerate() {
-                for x in row.iter_mut() {
-                    *x = -*x;
+            let lu = match self.lu {
+                Some((lu, hl)) if h == hl => lu,
+                _ => {
+                    let mut g = jac;
+                    for (i, row) in g.iter_mut().enumerate() {
+                        for x in row.iter_mut() {
+                            *x = -*x;
+                        }
+                        row[i] += 1.0 / (tab.gamma[0] * h);
+                    }
+                    let lu = Lu::new(g).ok_or(RosError::Singular(t))?;
+                    self.lu = Some((lu, h));
+                    lu
                 }
-                row[i] += 1.0 / (tab.gamma[0] * h);
-            }
-            let lu = Lu::new(g).ok_or(RosError::Singular(t))?;
+            };
             let mut k = [[0.0; N]; S_MAX];
             let mut fs = *f0;
             for s in 0..tab.s {
@@ -338,6 +356,7 @@ impl<const N: usize> Rosenbrock<N> {
             // A kept Jacobian may be what failed: take a fresh one.
             if self.jac.is_some_and(|(_, age, _)| age > 0) {
                 self.jac = None;
+                self.lu = None;
             }
             h *= if err.is_finite() { fac.min(0.5) } else { 0.1 };
             if h < h_min {
