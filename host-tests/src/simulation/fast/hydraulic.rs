@@ -179,6 +179,9 @@ impl HydTrack {
     /// temperatures): the track goes on from its interpolant at `t`, with
     /// f taken anew at the temperatures `z` of the step's end.
     pub fn advance(&mut self, model: &Model, t: f64, z: &[f64; N_NODES], t_max: f64) {
+        // The oil properties at z once, for f and for the path (the same
+        // bits as `rhs`, which computes them from z).
+        let oil = model.hydraulic_oil(z);
         if self.coupled {
             // The track ends at t (or past it before a callback's rewind):
             // f there anew with the step's end temperatures.
@@ -186,12 +189,12 @@ impl HydTrack {
             let i = self.pts.partition_point(|p| p.0 < t);
             self.pts.truncate(i);
             let mut f = [0.0; NH];
-            rhs(model, z, t.min(left_of(t_max)), &y, &mut f);
+            model.hydraulic_rhs_oil(t.min(left_of(t_max)), &y, &oil, &mut f);
             self.ros.stats.evals += 1;
             self.pts.push((t, y, f));
             self.last_branch = None;
         }
-        self.path = TempPath::constant(model, *z);
+        self.path = TempPath { t0: 0.0, z0: *z, t1: 1.0, z1: *z, oil0: oil, oil1: oil };
         let i = self.pts.partition_point(|p| p.0 <= t);
         if i > 1 {
             self.pts.drain(..i - 1);
