@@ -1,0 +1,154 @@
+//! Test plans (`eha_sim::diagnosis::plan`, `eha-sim plan`): the command's
+//! contract (fast tier) and, on the independent rig emulator, whether the
+//! planned run lifts effects that the original log left below r = 2 (slow
+//! tier).
+
+use eha_sim::diagnosis::emu_sweep::default_cases;
+use eha_sim::diagnosis::plan::{plan, Design, Limits, Plan};
+use eha_sim::diagnosis::reference::ReferenceModel;
+use eha_sim::diagnosis::{diagnose, Candidate, DiagnoseOptions, Simulator};
+use eha_sim::emulator::plant::{Hidden, Plant};
+use eha_sim::emulator::{generate, generate_twin, log_mission, logger, EmuCase, EmuTruth};
+use eha_sim::measured::{Channel, MeasuredRun};
+use eha_sim::rig::Rig;
+use eha_sim::scenario::{read_mission_str, ValveRule};
+use rand::SeedableRng;
+
+/// The emulator case of `seed` in the original case set (1200 s logs).
+fn case(seed: u64) -> EmuCase {
+    default_cases(1200.0, 1700).into_iter().find(|c| c.seed == seed).expect("case")
+}
+
+/// The planned mission flown by the emulated machine of `truth`, with the
+/// case's hidden effect and without (its twin: same mission and noise), and
+/// the channel the effect changes most on it (held-out window).
+fn fly(d: &Design, c: &EmuCase, truth: &EmuTruth, ambient_c: f64) -> (MeasuredRun, MeasuredRun, Channel) {
+    let m = d.emu_mission([ambient_c, 0.3, 0.0]);
+    let dt = m.scenario.log_interval_s();
+    let with = Plant { p: &truth.params, m: &m, h: Hidden { effect: c.hidden, magnitude: truth.magnitude } }.run(dt);
+    let without = Plant { p: &truth.params, m: &m, h: Hidden { effect: Candidate::None, magnitude: 0.0 } }.run(dt);
+    let log = |tr: &[logger::Row]| log_mission(tr, &m, &mut rand_chacha::ChaCha8Rng::seed_from_u64(c.seed ^ 0x91A4));
+    let split = 0.7 * d.duration_s;
+    let affected = Channel::TEMPERATURES
+        .into_iter()
+        .enumerate()
+        .map(|(k, ch)| {
+            let e: f64 = with
+                .iter()
+                .zip(&without)
+                .filter(|(a, _)| a.0 >= split)
+                .map(|(a, b)| (logger::sensor_readings(&a.1)[k] - logger::sensor_readings(&b.1)[k]).powi(2))
+                .sum();
+            (ch, e)
+        })
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|x| x.0)
+        .expect("channels");
+    (log(&with), log(&without), affected)
+}
+
+/// Imprint ratio (calibrated baseline's held-out misfit on `ch`, log over
+/// twin) and the log's answer.
+fn ratio(log: &MeasuredRun, twin: &MeasuredRun, ch: Channel) -> (f64, String, String) {
+    let o = DiagnoseOptions::default();
+    let d = diagnose(log, &ReferenceModel::new(Rig::default(), log).expect("model"), &o).expect("diagnosis");
+    let t = diagnose(twin, &ReferenceModel::new(Rig::default(), twin).expect("model"), &o).expect("twin diagnosis");
+    let m = |x: &eha_sim::diagnosis::Diagnosis| x.before.channel(ch.name()).map(|c| c.heldout_rmse_k).expect("channel");
+    (m(&d) / m(&t), d.answer().to_string(), t.answer().to_string())
+}
+
+/// Every throttle-circuit candidate at its typical magnitude (a blind plan).
+fn throttle_candidates(log: &MeasuredRun) -> Vec<(Candidate, f64)> {
+    let model = ReferenceModel::new(Rig::default(), log).expect("model");
+    Candidate::EXTENSIONS
+        .into_iter()
+        .filter(|c| *c != Candidate::CoulombFriction)
+        .map(|c| (c, model.extension_params(c)[0].start))
+        .collect()
+}
+
+fn mean_ambient(log: &MeasuredRun) -> f64 {
+    let v: Vec<f64> = log.get(Channel::AmbientC).expect("ambient").iter().flatten().copied().collect();
+    v.iter().sum::<f64>() / v.len() as f64
+}
+
+/// One case: the original log's ratio, the plan, the planned run's ratio
+/// and answer.
+fn planned_case(seed: u64) -> (f64, f64, String, Plan) {
+    let c = case(seed);
+    let (log, truth) = generate(&c).expect("log");
+    let (twin, _) = generate_twin(&c).expect("twin");
+    let ch = truth.affected.expect("affected").0;
+    let (r0, a0, _) = ratio(&log, &twin, ch);
+    let t = std::time::Instant::now();
+    let p = plan(&Rig::default(), &log, &throttle_candidates(&log), Limits::for_rig(&Rig::default(), &log), 1200.0).expect("plan");
+    let secs = t.elapsed().as_secs_f64();
+    let (plog, ptwin, pch) = fly(&p.design, &c, &truth, mean_ambient(&log));
+    let (r1, a1, t1) = ratio(&plog, &ptwin, pch);
+    let exp = p.expected.iter().find(|e| e.planned.candidate == c.hidden.name()).map(|e| (e.planned.best.1, e.on_log.as_ref().map(|r| r.best.1)));
+    eprintln!(
+        "{seed} {}: original r {r0:.2} on {} ({a0}); plan {:.0} s: {} (D_s {:.3}); expected r̂ for the hidden candidate {exp:?}; planned r {r1:.2} on {} ({a1}; twin {t1})",
+        c.hidden.name(),
+        ch.name(),
+        secs,
+        p.design.name,
+        p.d_s,
+        pch.name()
+    );
+    (r0, r1, a1, p)
+}
+
+/// The command's contract on a short emulator log (Case 1, sensor lag
+/// hidden): the mission stays within the limits, its CSV is read back by
+/// the project's mission reader as the same mission (levels, steps,
+/// duration), every family member's D_s is finite and the chosen one is the
+/// largest admissible; the expected ratios are ≥ 1 by construction.
+#[test]
+fn plan_contract_mission_within_limits_and_readable() {
+    let c = EmuCase { hidden: Candidate::SensorLag, scenario: eha_sim::emulator::missions::EmuScenario::ConstantThrottle, seed: 1704, duration_s: 600.0 };
+    let (log, _) = generate(&c).expect("log");
+    let mut limits = Limits::for_rig(&Rig::default(), &log);
+    limits.speed_rpm = (500.0, 1500.0);
+    limits.drop_bar = (10.0, 60.0);
+    let t = std::time::Instant::now();
+    let p = plan(&Rig::default(), &log, &[(Candidate::SensorLag, 120.0)], limits, 600.0).expect("plan");
+    eprintln!("plan in {:.1} s: {} (D_s {:.3}); {:?}", t.elapsed().as_secs_f64(), p.design.name, p.d_s, p.expected.iter().map(|e| (e.planned.best.clone(), e.on_log.as_ref().map(|r| r.best.1))).collect::<Vec<_>>());
+    assert!(p.design.segments.iter().all(|l| limits.contains(l)), "{:?}", p.design.segments);
+    assert!(p.family.iter().all(|f| f.d_s.is_finite()), "{:?}", p.family);
+    let best = p.family.iter().filter(|f| f.admissible).map(|f| f.d_s).fold(f64::NEG_INFINITY, f64::max);
+    assert_eq!(p.d_s, best);
+    let m = read_mission_str(&p.design.csv(), "mission.csv", "plan", ValveRule::None).expect("mission reader");
+    let want = p.design.mission();
+    assert_eq!(m.duration_s, 600.0);
+    for t in (0..=600).step_by(5).map(f64::from) {
+        for (a, b, what) in [(m.speed_rpm.at(t), want.speed_rpm.at(t), "speed"), (m.needle_bar.at(t), want.needle_bar.at(t), "needle"), (m.air_speed_mps.at(t), want.air_speed_mps.at(t), "air")] {
+            assert!((a - b).abs() < 1e-2, "{what} at {t} s: {a} read back, {b} planned");
+        }
+    }
+    for e in &p.expected {
+        assert!(e.planned.best.1 >= 1.0 && e.planned_separated >= 1.0);
+    }
+}
+
+/// On the emulator: effects the original 1200 s log left below r = 2,
+/// planned blind (every throttle candidate at its typical magnitude), the
+/// planned mission flown by the same machine with the same hidden effect,
+/// and its twin without. Measured: see the assertion message.
+#[test]
+#[ignore]
+fn slow_planned_runs_lift_effects_above_the_floor() {
+    let seeds = [1708, 1710, 1712, 1709, 1700, 1713];
+    let mut rows = Vec::new();
+    for s in seeds {
+        let (r0, r1, answer, p) = planned_case(s);
+        rows.push((s, r0, r1, answer, p.design.name.clone()));
+    }
+    let below: Vec<_> = rows.iter().filter(|r| r.1 < 2.0).collect();
+    let lifted: Vec<_> = below.iter().filter(|r| r.2 >= 2.0).collect();
+    let named: Vec<_> = lifted.iter().filter(|r| r.3 == case(r.0).hidden.name()).collect();
+    let msg = format!("{rows:?}");
+    eprintln!("{} of {} below r 2 lifted to ≥ 2, {} of those named: {msg}", lifted.len(), below.len(), named.len());
+    assert!(below.len() >= 4, "{msg}");
+    assert!(2 * lifted.len() >= below.len(), "{msg}");
+    assert_eq!(named.len(), lifted.len(), "{msg}");
+}
