@@ -496,6 +496,35 @@ impl Plan {
     }
 }
 
+/// The leading candidates of a diagnosis a throttle-circuit plan can
+/// excite: the `n` most probable, ties (a candidate the log could not admit
+/// has probability 0) broken by the Bayes factor against `none`. `causes`
+/// is (cause, probability, ln Bayes factor), as `diagnosis.json`'s
+/// `probabilities` lists them.
+pub fn leading(causes: &[(String, f64, f64)], n: usize) -> Vec<Candidate> {
+    let mut c: Vec<(Candidate, f64, f64)> = causes
+        .iter()
+        .filter_map(|(name, p, bf)| Some((Candidate::from_name(name)?, *p, if bf.is_finite() { *bf } else { f64::NEG_INFINITY })))
+        .filter(|(c, _, _)| *c != Candidate::None && *c != Candidate::CoulombFriction)
+        .collect();
+    c.sort_by(|a, b| b.1.total_cmp(&a.1).then(b.2.total_cmp(&a.2)));
+    c.into_iter().take(n).map(|x| x.0).collect()
+}
+
+/// (cause, probability, ln Bayes factor) of every structure in a
+/// `diagnosis.json` file.
+pub fn read_probabilities(path: &std::path::Path) -> anyhow::Result<Vec<(String, f64, f64)>> {
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(path)?).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    let list = v.get("probabilities").and_then(|p| p.as_array()).ok_or_else(|| anyhow::anyhow!("{}: no `probabilities` array", path.display()))?;
+    list.iter()
+        .map(|e| {
+            let cause = e.get("cause").and_then(|c| c.as_str()).ok_or_else(|| anyhow::anyhow!("{}: a probability without `cause`", path.display()))?;
+            let num = |k: &str| e.get(k).and_then(|x| x.as_f64()).unwrap_or(f64::NEG_INFINITY);
+            Ok((cause.to_string(), num("probability"), num("log_bayes_factor")))
+        })
+        .collect()
+}
+
 /// Arguments of `plan`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct PlanArgs {
@@ -506,10 +535,14 @@ pub struct PlanArgs {
     #[arg(long)]
     pub log: std::path::PathBuf,
     /// Leading candidates, `name` or `name=magnitude` (the parameter's unit),
-    /// comma-separated; default: every candidate a throttle run can excite,
-    /// at its typical magnitude.
+    /// comma-separated; default: the two leading ones of `--diagnosis`, else
+    /// every candidate a throttle run can excite, at typical magnitudes.
     #[arg(long, value_delimiter = ',')]
     pub candidates: Vec<String>,
+    /// `diagnosis.json` of the log (`eha-sim diagnose`): its two leading
+    /// candidates are planned for when `--candidates` is not given.
+    #[arg(long)]
+    pub diagnosis: Option<std::path::PathBuf>,
     /// Output directory for mission.csv, plan.md and plan.json.
     #[arg(long, default_value = "plan-out")]
     pub out: std::path::PathBuf,
@@ -559,7 +592,9 @@ pub fn run(a: &PlanArgs) -> anyhow::Result<()> {
         None => Rig::default(),
     };
     let model = ReferenceModel::new(rig.clone(), &log)?;
-    let cands: Vec<(Candidate, f64)> = if a.candidates.is_empty() {
+    let cands: Vec<(Candidate, f64)> = if let (true, Some(p)) = (a.candidates.is_empty(), &a.diagnosis) {
+        leading(&read_probabilities(p)?, 2).iter().map(|c| parse_candidate(c.name(), &model)).collect::<Result<_, _>>()
+    } else if a.candidates.is_empty() {
         Candidate::EXTENSIONS.iter().filter(|c| **c != Candidate::CoulombFriction).map(|c| parse_candidate(c.name(), &model)).collect::<Result<_, _>>()
     } else {
         a.candidates.iter().map(|s| parse_candidate(s, &model)).collect::<Result<_, _>>()

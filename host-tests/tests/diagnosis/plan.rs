@@ -4,7 +4,7 @@
 //! tier).
 
 use eha_sim::diagnosis::emu_sweep::default_cases;
-use eha_sim::diagnosis::plan::{plan, Design, Limits, Plan};
+use eha_sim::diagnosis::plan::{leading, plan, Design, Limits, Plan};
 use eha_sim::diagnosis::reference::ReferenceModel;
 use eha_sim::diagnosis::{diagnose, Candidate, DiagnoseOptions, Simulator};
 use eha_sim::emulator::plant::{Hidden, Plant};
@@ -48,23 +48,21 @@ fn fly(d: &Design, c: &EmuCase, truth: &EmuTruth, ambient_c: f64) -> (MeasuredRu
 }
 
 /// Imprint ratio (calibrated baseline's held-out misfit on `ch`, log over
-/// twin) and the log's answer.
-fn ratio(log: &MeasuredRun, twin: &MeasuredRun, ch: Channel) -> (f64, String, String) {
+/// twin), the log's answer, the twin's, and the log's leading candidates
+/// ([`leading`], two).
+fn ratio(log: &MeasuredRun, twin: &MeasuredRun, ch: Channel) -> (f64, String, String, Vec<Candidate>) {
     let o = DiagnoseOptions::default();
     let d = diagnose(log, &ReferenceModel::new(Rig::default(), log).expect("model"), &o).expect("diagnosis");
     let t = diagnose(twin, &ReferenceModel::new(Rig::default(), twin).expect("model"), &o).expect("twin diagnosis");
     let m = |x: &eha_sim::diagnosis::Diagnosis| x.before.channel(ch.name()).map(|c| c.heldout_rmse_k).expect("channel");
-    (m(&d) / m(&t), d.answer().to_string(), t.answer().to_string())
+    let causes: Vec<(String, f64, f64)> = d.posterior.causes.iter().map(|c| (c.cause.clone(), c.probability, c.log_bayes_factor)).collect();
+    (m(&d) / m(&t), d.answer().to_string(), t.answer().to_string(), leading(&causes, 2))
 }
 
-/// Every throttle-circuit candidate at its typical magnitude (a blind plan).
-fn throttle_candidates(log: &MeasuredRun) -> Vec<(Candidate, f64)> {
+/// The candidates at their typical magnitudes.
+fn typical(log: &MeasuredRun, cands: &[Candidate]) -> Vec<(Candidate, f64)> {
     let model = ReferenceModel::new(Rig::default(), log).expect("model");
-    Candidate::EXTENSIONS
-        .into_iter()
-        .filter(|c| *c != Candidate::CoulombFriction)
-        .map(|c| (c, model.extension_params(c)[0].start))
-        .collect()
+    cands.iter().map(|&c| (c, model.extension_params(c)[0].start)).collect()
 }
 
 fn mean_ambient(log: &MeasuredRun) -> f64 {
@@ -79,15 +77,15 @@ fn planned_case(seed: u64) -> (f64, f64, String, Plan) {
     let (log, truth) = generate(&c).expect("log");
     let (twin, _) = generate_twin(&c).expect("twin");
     let ch = truth.affected.expect("affected").0;
-    let (r0, a0, _) = ratio(&log, &twin, ch);
+    let (r0, a0, _, lead) = ratio(&log, &twin, ch);
     let t = std::time::Instant::now();
-    let p = plan(&Rig::default(), &log, &throttle_candidates(&log), Limits::for_rig(&Rig::default(), &log), 1200.0).expect("plan");
+    let p = plan(&Rig::default(), &log, &typical(&log, &lead), Limits::for_rig(&Rig::default(), &log), 1200.0).expect("plan");
     let secs = t.elapsed().as_secs_f64();
     let (plog, ptwin, pch) = fly(&p.design, &c, &truth, mean_ambient(&log));
-    let (r1, a1, t1) = ratio(&plog, &ptwin, pch);
+    let (r1, a1, t1, _) = ratio(&plog, &ptwin, pch);
     let exp = p.expected.iter().find(|e| e.planned.candidate == c.hidden.name()).map(|e| (e.planned.best.1, e.on_log.as_ref().map(|r| r.best.1)));
     eprintln!(
-        "{seed} {}: original r {r0:.2} on {} ({a0}); plan {:.0} s: {} (D_s {:.3}); expected r̂ for the hidden candidate {exp:?}; planned r {r1:.2} on {} ({a1}; twin {t1})",
+        "{seed} {}: original r {r0:.2} on {} ({a0}; leading {lead:?}); plan {:.0} s: {} (D_s {:.3}); expected r̂ for the hidden candidate {exp:?}; planned r {r1:.2} on {} ({a1}; twin {t1})",
         c.hidden.name(),
         ch.name(),
         secs,
@@ -131,7 +129,8 @@ fn plan_contract_mission_within_limits_and_readable() {
 }
 
 /// On the emulator: effects the original 1200 s log left below r = 2,
-/// planned blind (every throttle candidate at its typical magnitude), the
+/// planned for the log's two leading candidates ([`leading`], at typical
+/// magnitudes; the hidden one is not told), the
 /// planned mission flown by the same machine with the same hidden effect,
 /// and its twin without. Measured: see the assertion message.
 #[test]
