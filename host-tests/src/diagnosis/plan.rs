@@ -154,7 +154,7 @@ impl Design {
         s.push_str("time_s,speed_rpm,needle_bar,position_mm,ambient_c,air_speed_mps\n");
         let mut prev: Option<&Level> = None;
         let row = |s: &mut String, t: f64, l: &Level| {
-            let _ = writeln!(s, "{t:.1},{:.1},{:.3},,{:.2},{:.2}", l.speed_rpm, l.needle_setting_bar(), self.ambient_c, l.air_mps);
+            let _ = writeln!(s, "{t:.1},{:.1},{:.6},,{:.2},{:.2}", l.speed_rpm, l.needle_setting_bar(), self.ambient_c, l.air_mps);
         };
         for (t, l) in self.starts() {
             if let Some(p) = prev {
@@ -550,11 +550,11 @@ pub struct PlanArgs {
     #[arg(long)]
     pub duration_s: Option<f64>,
     /// Shaft speed range, rpm (`lo,hi`; default 500 to 2000 within the rig's limit).
-    #[arg(long, value_delimiter = ',', num_args = 2)]
+    #[arg(long, value_delimiter = ',')]
     pub speed_rpm: Option<Vec<f64>>,
     /// Needle drop range at the running speed, bar (`lo,hi`; default 10 to
     /// 100 within half the relief pressure).
-    #[arg(long, value_delimiter = ',', num_args = 2)]
+    #[arg(long, value_delimiter = ',')]
     pub drop_bar: Option<Vec<f64>>,
     /// Largest ram air, m/s (used only when the log logs ram air).
     #[arg(long, default_value_t = DEFAULT_AIR_MPS)]
@@ -601,11 +601,19 @@ pub fn run(a: &PlanArgs) -> anyhow::Result<()> {
     }
     .map_err(|e| anyhow::anyhow!(e))?;
     let mut limits = Limits::for_rig(&rig, &log);
+    let pair = |v: &[f64], what: &str| -> anyhow::Result<(f64, f64)> {
+        match v {
+            [a, b] => Ok((*a, *b)),
+            _ => anyhow::bail!("--{what}: expected two values `lo,hi`, got {}", v.len()),
+        }
+    };
     if let Some(v) = &a.speed_rpm {
-        limits.speed_rpm = (v[0], v[1].min(rig.motor.max_speed_rpm));
+        let (lo, hi) = pair(v, "speed-rpm")?;
+        limits.speed_rpm = (lo, hi.min(rig.motor.max_speed_rpm));
     }
     if let Some(v) = &a.drop_bar {
-        limits.drop_bar = (v[0], v[1].min(rig.hydraulics.relief_crack_pa / 1e5));
+        let (lo, hi) = pair(v, "drop-bar")?;
+        limits.drop_bar = (lo, hi.min(rig.hydraulics.relief_crack_pa / 1e5));
     }
     limits.air_mps = limits.air_mps.map(|_| a.max_air_mps);
     limits.max_temp_c = a.max_temp_c;
