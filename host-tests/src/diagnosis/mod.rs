@@ -12,6 +12,7 @@ pub mod fit;
 pub mod identify;
 pub mod model;
 pub mod plan;
+pub mod plan_cli;
 pub mod plot;
 pub mod projection;
 pub mod regressors;
