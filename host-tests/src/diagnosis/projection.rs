@@ -289,7 +289,9 @@ pub fn floor_detectability(sim: &dyn Simulator, run: &MeasuredRun, nuisance: &[f
             seen.into_iter().map(move |e| (c, e))
         })
         .collect();
-    let imprints: Vec<Option<(Candidate, Vec<f64>, DVector<f64>, DVector<f64>)>> = jobs
+    // (candidate, parameters, imprint, left), in the order of `jobs`.
+    type Job = (Candidate, Vec<f64>, DVector<f64>, DVector<f64>);
+    let imprints: Vec<Option<Job>> = jobs
         .par_iter()
         .map(|(c, e)| {
             let s = sens.imprint(sim, nuisance, *c, e).ok()?;
@@ -297,7 +299,7 @@ pub fn floor_detectability(sim: &dyn Simulator, run: &MeasuredRun, nuisance: &[f
             Some((*c, e.clone(), s, l))
         })
         .collect();
-    let imprints: Vec<_> = imprints.into_iter().flatten().collect();
+    let imprints: Vec<Job> = imprints.into_iter().flatten().collect();
     let named = |c: Candidate, e: &[f64]| -> Vec<(String, f64, String)> { sim.extension_params(c).iter().zip(e).map(|(s, v)| (s.name.clone(), *v, s.unit.clone())).collect() };
     let rows: Vec<ProjectedRow> = imprints.iter().map(|(c, e, s, l)| row(&sens, &floors, *c, &named(*c, e), s, l)).collect();
     // The largest magnitude of each candidate for the angles.

@@ -178,10 +178,14 @@ fn slow_planned_runs_lift_effects_above_the_floor() {
     }
 }
 
-/// The same for one case with a planned run twice as long (2400 s).
+/// The same for one case with a planned run twice as long (2400 s):
+/// **measured miss**, 1708 churning r 1.40 → 1.35 (`unexplained`; twin
+/// `unexplained`; 5 min). Asserted as measured.
 #[test]
 #[ignore]
 fn slow_planned_run_twice_as_long() {
     let (r0, r1, answer, p) = planned_case(1708, 2400.0);
     eprintln!("1708, 2400 s plan: r {r0:.2} -> {r1:.2} ({answer}), {}", p.design.name);
+    assert!(r1 < 2.0, "measured miss changed: r {r1:.2}");
+    assert!(["none", "unexplained", "churning-loss"].contains(&answer.as_str()), "wrong cause: {answer}");
 }
