@@ -51,6 +51,10 @@ enum Cmd {
     /// them (rig.toml, params.rs, firmware-params.bin, report.md, PNGs);
     /// `--check firmware-params.bin` runs the firmware's boot checks.
     Commission(eha_sim::calibration::cli::CommissionArgs),
+    /// Test plan: a bench mission (mission.csv) that makes the leading
+    /// candidates of a log showable against its structure floor, with the
+    /// expected imprint ratio per candidate.
+    Plan(eha_sim::diagnosis::plan_cli::PlanArgs),
     /// Re-render the generated tables in docs/ from their committed JSON
     /// (`--check`: fail on a difference instead; CI runs it).
     Docs(eha_sim::gendoc::DocsArgs),
@@ -74,6 +78,7 @@ fn main() -> ExitCode {
         Cmd::ParamsBlock(a) => eha_sim::params_block::run(&a),
         Cmd::Uq(a) => eha_sim::uq::run_cli(&a),
         Cmd::Docs(a) => eha_sim::gendoc::run_cli(&a),
+        Cmd::Plan(a) => eha_sim::diagnosis::plan_cli::run(&a),
         // Own exit codes: 0 diagnosis made (none included), 2 bad input.
         Cmd::Diagnose(a) => return eha_sim::diagnosis::cli::run(&a),
         Cmd::DiagnoseSweep(a) => return eha_sim::diagnosis::sweep::run(&a),

@@ -31,9 +31,12 @@ pub struct DiagnoseArgs {
     /// Model runs allowed per least-squares fit.
     #[arg(long, default_value_t = 80)]
     pub max_sims: usize,
-    /// Also report what this log could show: each candidate's imprint at its
-    /// typical magnitude and how much of it the calibration takes up
-    /// (report.md section, detectability.json; one more fit per candidate).
+    /// Also report what this log can show against its structure floor: each
+    /// candidate's imprint at 1, 4 and 16 times its typical magnitude
+    /// projected off the calibration's sensitivities, the expected imprint
+    /// ratio per channel and the angles between candidates (report.md
+    /// section, detectability.json; one model run per calibration parameter
+    /// and per row).
     #[arg(long)]
     pub detectability: bool,
 }
@@ -130,12 +133,12 @@ fn run_inner(args: &DiagnoseArgs) -> anyhow::Result<String> {
     write_outputs(&d, &run, &args.measured.display().to_string(), &args.out)?;
     let mut detect_line = None;
     if args.detectability {
-        let rows = super::detect::with_answer_tier(&model, &d, |a| super::detect::detectability(&run, a, &o));
+        let fd = detectability_against_floor(&model, &d, &run, &o)?;
         // A section appended to the report just written.
         use std::io::Write as _;
-        std::fs::OpenOptions::new().append(true).open(args.out.join("report.md"))?.write_all(super::detect::markdown(&rows).as_bytes())?;
-        std::fs::write(args.out.join("detectability.json"), serde_json::to_string_pretty(&rows)? + "\n")?;
-        detect_line = Some(super::detect::summary(&rows));
+        std::fs::OpenOptions::new().append(true).open(args.out.join("report.md"))?.write_all(fd.markdown().as_bytes())?;
+        std::fs::write(args.out.join("detectability.json"), serde_json::to_string_pretty(&fd)? + "\n")?;
+        detect_line = Some(fd.summary());
     }
     let verdict = format!(
         "cause: {} | held-out RMSE {:.3} -> {:.3} K | training {:.3} -> {:.3} K | {} model runs, {:.1} s | {}",
@@ -152,4 +155,24 @@ fn run_inner(args: &DiagnoseArgs) -> anyhow::Result<String> {
         Some(l) => format!("{verdict}\n{l}"),
         None => verdict,
     })
+}
+
+/// The detectability of `run` against its structure floor around the
+/// calibrated point of the tier whose answer stands in `d`: the floors are
+/// the diagnosis's own channel numbers, the points the evidence's.
+pub fn detectability_against_floor(
+    model: &dyn Simulator,
+    d: &super::Diagnosis,
+    run: &MeasuredRun,
+    o: &DiagnoseOptions,
+) -> anyhow::Result<super::projection::FloorDetectability> {
+    let floors: Vec<super::evidence::ChannelFloor> = d
+        .posterior
+        .channels
+        .iter()
+        .map(|c| super::evidence::ChannelFloor { channel: c.channel.clone(), noise_k: c.noise_k, rise_k: c.rise_k, misfit_k: c.misfit_k })
+        .collect();
+    let pts = super::analysis::evidence_points(run, d.split_time_s, o.points_per_channel);
+    super::detect::with_answer_tier(model, d, |a| super::projection::floor_detectability(a.sim, run, a.nuisance, pts, a.split, floors))
+        .map_err(|e| anyhow::anyhow!("detectability: {e}"))
 }

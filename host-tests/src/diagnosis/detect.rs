@@ -1,8 +1,8 @@
-//! What a log could have shown (`diagnose --detectability`): for each
-//! candidate at its typical magnitude and at 4× and 16× it (within its
-//! bounds), the imprint it would leave on the
-//! logged channels and how much of that imprint the calibration set takes
-//! up. The calibrated model plus the candidate is simulated over the log's
+//! What a candidate at a given magnitude would leave on a log after a
+//! nonlinear recalibration (the emulator sweep's oracle column; the
+//! `--detectability` report is the linearised, floor-based
+//! [`super::projection`]): the imprint it would leave on the logged
+//! channels and how much of that imprint the calibration set takes up. The calibrated model plus the candidate is simulated over the log's
 //! own inputs (noise-free), the baseline is refitted to that output on the
 //! training window, and what it cannot follow on the held-out window is the
 //! imprint "left". With sensor noise σ on that channel, the best held-out
@@ -20,8 +20,6 @@ use super::analysis::{fit_points, identifiable_here, DiagnoseOptions, Diagnosis}
 use super::fit::{fit, residuals_at, Point};
 use super::model::{Candidate, SimSeries, Simulator};
 use crate::measured::{Channel, MeasuredRun};
-use rayon::prelude::*;
-use std::fmt::Write as _;
 
 /// One candidate's detectability on one log.
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
@@ -84,30 +82,6 @@ pub fn with_answer_tier<R>(model: &dyn Simulator, d: &Diagnosis, f: impl FnOnce(
     f(&Around { sim, nuisance: &values, base: &d.series[1], split: d.split_time_s })
 }
 
-/// The detectability of every candidate on `run` around `a`. Candidates
-/// whose injected run fails are left out.
-pub fn detectability(run: &MeasuredRun, a: &Around, o: &DiagnoseOptions) -> Vec<Detectability> {
-    // (candidate, index into MULTIPLES): a structural candidate has one form
-    // only; a multiple is left out once the previous one sat on the bound.
-    let jobs: Vec<(Candidate, usize)> = Candidate::EXTENSIONS
-        .iter()
-        .flat_map(|&c| {
-            let specs = a.sim.extension_params(c);
-            (0..MULTIPLES.len())
-                .filter(|&j| if specs.is_empty() { j == 0 } else { j == 0 || specs.iter().any(|s| MULTIPLES[j - 1] * s.start < s.hi) })
-                .map(move |j| (c, j))
-                .collect::<Vec<_>>()
-        })
-        .collect();
-    let pts = fit_points(run, a.split, o.points_per_channel);
-    jobs.par_iter()
-        .filter_map(|&(c, j)| {
-            let ext: Vec<f64> = a.sim.extension_params(c).iter().map(|s| (MULTIPLES[j] * s.start).min(s.hi)).collect();
-            inject(run, a, &pts, o, c, &ext)
-        })
-        .collect()
-}
-
 /// The detectability of candidate `c` at parameters `ext` around `a` (one
 /// fit); `None` when a run fails.
 pub fn detect_one(run: &MeasuredRun, a: &Around, o: &DiagnoseOptions, c: Candidate, ext: &[f64]) -> Option<Detectability> {
@@ -147,61 +121,4 @@ fn inject(run: &MeasuredRun, a: &Around, pts: &[Point], o: &DiagnoseOptions, c: 
         best_gain: 1.0 - noise / (noise * noise + left * left).sqrt(),
         note: identifiable_here(c, run, split, sim).err().unwrap_or_default().into(),
     })
-}
-
-/// One line: per candidate, the smallest magnitude tried whose best gain
-/// reaches 50 % (and whether the log lets it be named at all), or that
-/// none does.
-pub fn summary(rows: &[Detectability]) -> String {
-    let mut shown = Vec::new();
-    let mut hidden = Vec::new();
-    for c in Candidate::EXTENSIONS {
-        let mine: Vec<&Detectability> = rows.iter().filter(|r| r.candidate == c.name()).collect();
-        if mine.is_empty() {
-            continue;
-        }
-        match mine.iter().find(|r| r.best_gain >= 0.5) {
-            Some(r) => {
-                let mag = r.magnitude.first().map_or(String::new(), |(_, v, u)| format!(" from {v:.3e} {u}"));
-                let ident = if r.note.is_empty() { "" } else { ", not identifiable here" };
-                shown.push(format!("{}{mag}{ident}", c.name()));
-            }
-            None => hidden.push(c.name().to_string()),
-        }
-    }
-    format!(
-        "could show on this log (best gain ≥ 50 %, an upper bound): {}; not at any magnitude tried: {}",
-        if shown.is_empty() { "nothing".to_string() } else { shown.join(", ") },
-        if hidden.is_empty() { "–".to_string() } else { hidden.join(", ") }
-    )
-}
-
-/// The Markdown section of `report.md`.
-pub fn markdown(rows: &[Detectability]) -> String {
-    let mut s = String::from(
-        "\n## What this log could show (detectability)\n\n\
-         Each candidate at its typical magnitude, injected into the calibrated model over this log's inputs \
-         (noise-free); the baseline recalibrated to that output; what it cannot follow on the held-out window \
-         is the imprint left. Best gain = 1 − σ/√(σ² + left²): the most any diagnosis could show on that \
-         channel if the model's structure were right (50 % needs left ≥ 1.73 σ).\n\n\
-         | candidate | magnitude | imprint (K, channel) | left after calibration (K) | noise σ (K) | best held-out gain | identifiable here |\n\
-         |---|---|---|---:|---:|---:|---|\n",
-    );
-    for r in rows {
-        let mag: Vec<String> = r.magnitude.iter().map(|(n, v, u)| format!("{n}={v:.3e} {u}")).collect();
-        let _ = writeln!(
-            s,
-            "| `{}` | {} | {:.3} ({}) | {:.3} | {:.3} | {:.0} % | {} |",
-            r.candidate,
-            if mag.is_empty() { "–".into() } else { mag.join(", ") },
-            r.imprint_k.1,
-            r.imprint_k.0,
-            r.left_k,
-            r.noise_k,
-            100.0 * r.best_gain,
-            if r.note.is_empty() { "yes".to_string() } else { format!("no ({})", r.note) },
-        );
-    }
-    let _ = writeln!(s, "\n{}.", summary(rows));
-    s
 }

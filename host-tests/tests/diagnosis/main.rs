@@ -7,5 +7,6 @@ mod cli;
 mod detect;
 mod effects;
 mod emulator;
+mod plan;
 mod replay;
 mod stats;
