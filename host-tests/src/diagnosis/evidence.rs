@@ -372,6 +372,69 @@ pub struct Posterior {
     pub channels: Vec<ChannelEvidence>,
     /// Discrepancy time constant used, s.
     pub tau_s: f64,
+    /// The terms behind the evidence of every fitted structure (the
+    /// baseline first), so that other decision rules can be measured on a
+    /// sweep without refitting.
+    #[serde(skip)]
+    pub terms: Vec<StructureTerms>,
+}
+
+/// Discrepancy amplitudes of [`ChannelTerms::log_lik`], K: 72 points
+/// log-spaced from 5 mK to [`MAX_DISCREPANCY_K`].
+pub fn amplitude_grid() -> Vec<f64> {
+    let (a, b) = (0.005f64.ln(), MAX_DISCREPANCY_K.ln());
+    (0..72).map(|i| (a + (b - a) * i as f64 / 71.0).exp()).collect()
+}
+
+/// One channel's log-likelihood under one structure's fit, on the
+/// amplitude grid ([`amplitude_grid`]) of its discrepancy.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ChannelTerms {
+    /// Channel name.
+    pub channel: String,
+    /// Noise σ, K.
+    pub noise_k: f64,
+    /// The discrepancy amplitude the structure's evidence used, K.
+    pub amp_k: f64,
+    /// Log-likelihood of the residual (training and held-out evidence
+    /// points) at each grid amplitude.
+    pub log_lik: Vec<f64>,
+}
+
+/// What a structure's evidence is made of.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct StructureTerms {
+    /// `none` (the calibrated baseline) or a candidate name.
+    pub cause: String,
+    /// Prior probability.
+    pub prior: f64,
+    /// ln prior density + ln posterior volume of the fitted parameters
+    /// (the Occam factor), with the structure's amplitudes.
+    pub occam: f64,
+    /// The same for the baseline with this structure's amplitudes.
+    pub base_occam: f64,
+    /// Per channel.
+    pub channels: Vec<ChannelTerms>,
+}
+
+/// [`StructureTerms::channels`] of `fit`: every channel's log-likelihood on
+/// the amplitude grid, with the amplitude `amp(channel)` noted.
+fn channel_terms(run: &MeasuredRun, pts: &[Point], fit: &FitResult, amp: &dyn Fn(Channel) -> f64, noise: &dyn Fn(Channel) -> f64, tau_s: f64) -> Vec<ChannelTerms> {
+    let Some(r) = super::fit::residuals_at(run, &fit.series, pts) else { return Vec::new() };
+    let grid = amplitude_grid();
+    channel_runs(pts)
+        .into_iter()
+        .map(|(ch, range)| {
+            let times: Vec<f64> = pts[range.clone()].iter().map(|(_, i)| run.time_s[*i]).collect();
+            let y = &r[range];
+            ChannelTerms {
+                channel: ch.name().into(),
+                noise_k: noise(ch),
+                amp_k: amp(ch),
+                log_lik: grid.iter().map(|a| Whitener::new(&times, *a, noise(ch), tau_s).log_lik(y)).collect(),
+            }
+        })
+        .collect()
 }
 
 impl Posterior {
@@ -449,16 +512,24 @@ pub fn posterior_of(
         .zip(log_lik_unexplained(run, all_pts, base, &own_floor, &noise, tau_s))
         .map_or(f64::NEG_INFINITY, |(l0, lu)| lu - l0);
     causes.push(("unexplained".to_string(), PRIOR_NO_CAUSE, unexplained));
+    let mut terms =
+        vec![StructureTerms { cause: "none".into(), prior: PRIOR_NO_CAUSE, occam: 0.0, base_occam: 0.0, channels: channel_terms(run, all_pts, base, &own_floor, &noise, tau_s) }];
     for f in fits {
         let touched: Vec<String> = touched_channels(f.candidate).iter().map(|c| c.name().to_string()).collect();
         let amp = |ch: Channel| find(ch).map_or(0.1, |x| floor_for(x, &floors, &touched));
         let mut specs = nuisance.to_vec();
         specs.extend(ext(f.candidate));
-        let b = log_evidence(run, pts, all_pts, f, &specs, &amp, &noise, tau_s)
-            .zip(log_evidence(run, pts, all_pts, base, nuisance, &amp, &noise, tau_s))
-            .map_or(f64::NEG_INFINITY, |(a, b)| a.log_z - b.log_z);
+        let (ec, eb) = (log_evidence(run, pts, all_pts, f, &specs, &amp, &noise, tau_s), log_evidence(run, pts, all_pts, base, nuisance, &amp, &noise, tau_s));
+        let b = ec.as_ref().zip(eb.as_ref()).map_or(f64::NEG_INFINITY, |(a, b)| a.log_z - b.log_z);
         let prior = if admitted(f.candidate) { (1.0 - 2.0 * PRIOR_NO_CAUSE) / Candidate::EXTENSIONS.len() as f64 } else { 0.0 };
         causes.push((f.candidate.name().to_string(), prior, b));
+        terms.push(StructureTerms {
+            cause: f.candidate.name().into(),
+            prior,
+            occam: ec.as_ref().map_or(f64::NEG_INFINITY, |e| e.log_prior + e.log_volume),
+            base_occam: eb.as_ref().map_or(f64::NEG_INFINITY, |e| e.log_prior + e.log_volume),
+            channels: channel_terms(run, all_pts, f, &amp, &noise, tau_s),
+        });
     }
     causes.push(("none".to_string(), PRIOR_NO_CAUSE, 0.0));
     let p = posterior(&causes.iter().map(|c| c.2).collect::<Vec<_>>(), &causes.iter().map(|c| c.1).collect::<Vec<_>>());
@@ -468,7 +539,7 @@ pub fn posterior_of(
         .map(|((cause, prior, log_bayes_factor), probability)| CauseProbability { cause, prior, log_bayes_factor, probability })
         .collect();
     causes.sort_by(|a, b| b.probability.total_cmp(&a.probability));
-    Posterior { causes, channels, tau_s }
+    Posterior { causes, channels, tau_s, terms }
 }
 
 #[cfg(test)]
