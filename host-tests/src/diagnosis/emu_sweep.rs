@@ -486,52 +486,8 @@ pub fn document(ok: &[EmuResult]) -> String {
         class("oracle ≥ 50 %"),
         class("oracle < 50 %"),
     );
-    md += &ratio_bands(ok);
-    md
-}
-
-/// The table by imprint-ratio band (r against each log's effect-free twin):
-/// where a diagnosis must name the cause (r ≥ 2) and how it did; empty when
-/// the sweep ran no twins.
-fn ratio_bands(ok: &[EmuResult]) -> String {
-    let with: Vec<(&EmuResult, f64)> = ok.iter().filter_map(|r| Some((r, r.twin.as_ref()?.ratio()))).collect();
-    if with.is_empty() {
-        return String::new();
-    }
-    let mut md = String::from(
-        "\n**By imprint ratio** r = the calibrated baseline's held-out misfit on the affected channel over the same on the \
-         log's effect-free twin (same machine, mission and noise):\n\n\
-         | r | cases | named | wrong cause | `none` | `unexplained` | seeds |\n|---|---:|---:|---:|---:|---:|---|\n",
-    );
-    for (label, lo, hi) in [("< 1", 0.0, 1.0), ("1–2", 1.0, 2.0), ("2–3", 2.0, 3.0), ("≥ 3", 3.0, f64::INFINITY)] {
-        let band: Vec<&(&EmuResult, f64)> = with.iter().filter(|(_, r)| *r >= lo && *r < hi).collect();
-        let n = |f: &dyn Fn(&EmuResult) -> bool| band.iter().filter(|(r, _)| f(r)).count();
-        let seeds: Vec<String> = band.iter().map(|(r, x)| format!("{} ({x:.1})", r.case.seed)).collect();
-        let _ = writeln!(
-            md,
-            "| {label} | {} | {} | {} | {} | {} | {} |",
-            band.len(),
-            n(&|r| r.hit()),
-            n(&|r| !r.hit() && r.answer != "none" && r.answer != "unexplained"),
-            n(&|r| r.answer == "none"),
-            n(&|r| r.answer == "unexplained"),
-            if seeds.is_empty() { "–".into() } else { seeds.join(", ") },
-        );
-    }
-    let false_twins: Vec<String> = with
-        .iter()
-        .filter_map(|(r, _)| {
-            let t = r.twin.as_ref()?;
-            (t.twin_answer != "none" && t.twin_answer != "unexplained").then(|| format!("{}'s twin: `{}`", r.case.seed, t.twin_answer))
-        })
-        .collect();
-    let _ = writeln!(
-        md,
-        "\nThe {} twins (effect-free): {} false discoveries{}.",
-        with.len(),
-        false_twins.len(),
-        if false_twins.is_empty() { String::new() } else { format!(" ({})", false_twins.join(", ")) }
-    );
+    md += &super::emu_tables::ratio_table(ok);
+    md += &super::emu_tables::reliability_table(ok);
     md
 }
 
@@ -609,7 +565,19 @@ pub fn run(a: &EmuSweepArgs) -> ExitCode {
     print!("{md}");
     let write = || -> std::io::Result<()> {
         std::fs::write(a.out.join("emulator-sweep.md"), &md)?;
-        let j = serde_json::to_string_pretty(&ok).map_err(std::io::Error::other)?;
+        // The evidence terms stay in the JSONL (they are most of its size).
+        let lean: Vec<EmuResult> = ok
+            .iter()
+            .cloned()
+            .map(|mut r| {
+                r.evidence_terms.clear();
+                if let Some(t) = r.twin.as_mut() {
+                    t.twin_terms.clear();
+                }
+                r
+            })
+            .collect();
+        let j = serde_json::to_string_pretty(&lean).map_err(std::io::Error::other)?;
         std::fs::write(a.out.join("emulator-sweep.json"), j + "\n")
     };
     match write() {

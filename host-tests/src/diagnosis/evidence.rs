@@ -12,20 +12,21 @@
 //! evidence counts independent information, not autocorrelated samples
 //! (the BIC's assumption, false here: Ljung–Box p ≈ 0 on every channel).
 //!
-//! The structures differ in what the discrepancy may be:
-//! - `none` and each candidate: the discrepancy is held at the **floor**
-//!   of this log — what the rig-level structure error of a machine that is
-//!   not our model leaves; a candidate has to beat a discrepancy of that
-//!   size, not the sensor noise;
-//! - `unexplained`: the calibrated baseline with the discrepancy amplitude
-//!   of every channel free (log-uniform prior from the floor to
-//!   [`MAX_DISCREPANCY_K`]), marginalised numerically.
-//!
-//! The floor of a channel a candidate's physics touches
-//! ([`touched_channels`]) is estimated from the channels it does not
-//! touch (see [`floor_for`]); a channel that misfits far more than the
-//! others is then judged with its own misfit as its discrepancy and does
-//! not veto a decision on the others.
+//! The structures differ in what the discrepancy may be. On each channel
+//! it is either at the **floor** of this log — what the rig-level structure
+//! error of a machine that is not our model leaves — or, with prior
+//! probability [`ANOMALY_PRIOR`], beyond it (amplitude free, log-uniform
+//! from the floor to [`MAX_DISCREPANCY_K`], marginalised numerically):
+//! - `none`: every channel at its floor;
+//! - `unexplained`: the calibrated baseline with at least one channel
+//!   beyond its floor;
+//! - a candidate: the channels its physics touches ([`touched_channels`])
+//!   at the floor estimated from the untouched ones ([`floor_for`]) — a
+//!   candidate has to beat a discrepancy of floor size there, not the
+//!   sensor noise — and every other channel at its floor or beyond, as
+//!   for the baseline. A channel that misfits far more than the others
+//!   costs a candidate what it costs `unexplained`, so it does not veto the
+//!   decision on the candidate's own channels.
 
 use super::fit::{FitResult, Point};
 use super::model::{Candidate, ParamSpec};
@@ -286,17 +287,62 @@ pub fn log_lik_free_amplitude(times_s: &[f64], y: &[f64], lo_k: f64, noise_k: f6
     m + (ls.iter().map(|l| (l - m).exp()).sum::<f64>() * d / (b - a)).ln()
 }
 
-/// Log-likelihood of the residual of `fit` at `pts` with every channel's
-/// discrepancy amplitude free above `lo(channel)` ([`log_lik_free_amplitude`]).
-pub fn log_lik_unexplained(
-    run: &MeasuredRun,
-    pts: &[Point],
-    fit: &FitResult,
-    lo: &dyn Fn(Channel) -> f64,
-    noise: &dyn Fn(Channel) -> f64,
-    tau_s: f64,
-) -> Option<f64> {
-    sum_over_channels(run, pts, fit, |ch, times, y| log_lik_free_amplitude(times, y, lo(ch), noise(ch), tau_s))
+/// The log-likelihood on the amplitude grid at amplitude `a_k`: quadratic
+/// through the three nearest grid points in ln a (linear left 0.16 nats
+/// on a 700-point residual); clamped to the grid's ends.
+fn grid_at(l: &[f64], a_k: f64) -> f64 {
+    let g: Vec<f64> = amplitude_grid().iter().map(|v| v.ln()).collect();
+    let x = a_k.ln().clamp(g[0], g[g.len() - 1]);
+    let i = g.iter().rposition(|v| *v <= x).unwrap_or(0).clamp(1, g.len() - 2);
+    let (x0, x1, x2) = (g[i - 1], g[i], g[i + 1]);
+    l[i - 1] * (x - x1) * (x - x2) / ((x0 - x1) * (x0 - x2))
+        + l[i] * (x - x0) * (x - x2) / ((x1 - x0) * (x1 - x2))
+        + l[i + 1] * (x - x0) * (x - x1) / ((x2 - x0) * (x2 - x1))
+}
+
+/// [`log_lik_free_amplitude`] from the amplitude grid.
+fn grid_free(l: &[f64], lo_k: f64) -> f64 {
+    let (a, b) = (lo_k.ln(), MAX_DISCREPANCY_K.ln().max(lo_k.ln() + 1e-6));
+    let n = 48;
+    let d = (b - a) / n as f64;
+    let ls: Vec<f64> = (0..n).map(|i| grid_at(l, (a + (i as f64 + 0.5) * d).exp())).collect();
+    let m = ls.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    m + (ls.iter().map(|v| (v - m).exp()).sum::<f64>() * d / (b - a)).ln()
+}
+
+/// The posterior of [`posterior_of`] recomputed from its stored terms (the
+/// likelihoods interpolated on the amplitude grid): how a sweep measures
+/// the decision rule of this build on fits it stored. `terms[0]` is the
+/// baseline (its amplitudes are the channels' floors).
+pub fn posterior_from_terms(terms: &[StructureTerms]) -> Vec<CauseProbability> {
+    let Some(base) = terms.first() else { return Vec::new() };
+    let q = ANOMALY_PRIOR;
+    let floor = |k: &str| base.channels.iter().find(|c| c.channel == k).map_or(0.1, |c| c.amp_k);
+    let floor_or_beyond = |c: &ChannelTerms| {
+        log_sum_exp((1.0 - q).ln() + grid_at(&c.log_lik, floor(&c.channel)), q.ln() + grid_free(&c.log_lik, floor(&c.channel)))
+    };
+    let l_none: f64 = base.channels.iter().map(|c| (1.0 - q).ln() + grid_at(&c.log_lik, c.amp_k)).sum();
+    let l_any: f64 = base.channels.iter().map(floor_or_beyond).sum();
+    let mut causes = vec![("unexplained".to_string(), PRIOR_NO_CAUSE, l_any + (-(l_none - l_any).exp()).ln_1p().max(-700.0) - l_none)];
+    for t in &terms[1..] {
+        let touched: Vec<&str> = Candidate::from_name(&t.cause).map_or(vec![], |c| touched_channels(c).iter().map(|c| c.name()).collect());
+        let l: f64 = t
+            .channels
+            .iter()
+            .map(|c| if touched.contains(&c.channel.as_str()) { grid_at(&c.log_lik, c.amp_k) } else { floor_or_beyond(c) })
+            .sum();
+        let b = l + t.occam - t.base_occam - l_none;
+        causes.push((t.cause.clone(), t.prior, if b.is_nan() { f64::NEG_INFINITY } else { b }));
+    }
+    causes.push(("none".to_string(), PRIOR_NO_CAUSE, 0.0));
+    let p = posterior(&causes.iter().map(|c| c.2).collect::<Vec<_>>(), &causes.iter().map(|c| c.1).collect::<Vec<_>>());
+    let mut out: Vec<CauseProbability> = causes
+        .into_iter()
+        .zip(p)
+        .map(|((cause, prior, log_bayes_factor), probability)| CauseProbability { cause, prior, log_bayes_factor, probability })
+        .collect();
+    out.sort_by(|a, b| b.probability.total_cmp(&a.probability));
+    out
 }
 
 /// Posterior probabilities from log evidences and prior probabilities
@@ -317,6 +363,19 @@ pub fn posterior(log_z: &[f64], prior: &[f64]) -> Vec<f64> {
 /// emulator twin of 1700 is `unexplained` at all four.
 pub const DISCREPANCY_TAU_S: f64 = 120.0;
 
+/// Prior probability that a channel carries a discrepancy beyond its floor
+/// (something no candidate and no calibration parameter explains).
+pub const ANOMALY_PRIOR: f64 = 0.1;
+
+/// ln(eᵃ + eᵇ).
+fn log_sum_exp(a: f64, b: f64) -> f64 {
+    let m = a.max(b);
+    if m == f64::NEG_INFINITY {
+        return m;
+    }
+    m + ((a - m).exp() + (b - m).exp()).ln()
+}
+
 /// Probability at which a cause is named.
 pub const NAME_PROBABILITY: f64 = 0.9;
 
@@ -332,8 +391,7 @@ pub struct CauseProbability {
     pub cause: String,
     /// Prior probability (0 for a candidate the log cannot identify).
     pub prior: f64,
-    /// ln of the Bayes factor against `none`, each judged with the
-    /// discrepancy of its own channels' floor.
+    /// ln of the Bayes factor against `none` (every channel at its floor).
     pub log_bayes_factor: f64,
     /// Posterior probability.
     pub probability: f64,
@@ -505,13 +563,29 @@ pub fn posterior_of(
             })
         })
         .collect();
-    let mut causes = Vec::new();
-    // `unexplained`: the baseline with every channel's discrepancy free
-    // above its floor, against `none` with each at its floor.
-    let unexplained = log_lik_at(run, all_pts, base, &own_floor, &noise, tau_s)
-        .zip(log_lik_unexplained(run, all_pts, base, &own_floor, &noise, tau_s))
-        .map_or(f64::NEG_INFINITY, |(l0, lu)| lu - l0);
-    causes.push(("unexplained".to_string(), PRIOR_NO_CAUSE, unexplained));
+    // Per channel k, either the discrepancy is at the floor (prior 1 − q)
+    // or something beyond the candidates sits there (free amplitude above
+    // the floor, prior q = [`ANOMALY_PRIOR`]). `none`: every channel at its
+    // floor. `unexplained`: the baseline with at least one channel beyond
+    // it. A candidate: its touched channels at the floor its physics leaves
+    // (estimated from the untouched ones), every other channel floor or
+    // beyond as for the baseline — so a channel that misfits far more than
+    // the others costs the candidate what it costs `unexplained`, and does
+    // not veto the decision on the candidate's own channels.
+    let q = ANOMALY_PRIOR;
+    let channel_of = |fit: &FitResult, f: &dyn Fn(Channel, &[f64], &[f64]) -> f64| sum_over_channels(run, all_pts, fit, f);
+    let floor_or_beyond = |ch: Channel, times: &[f64], y: &[f64]| {
+        let fl = own_floor(ch);
+        let at = (1.0 - q).ln() + Whitener::new(times, fl, noise(ch), tau_s).log_lik(y);
+        let beyond = q.ln() + log_lik_free_amplitude(times, y, fl, noise(ch), tau_s);
+        log_sum_exp(at, beyond)
+    };
+    let at_floor = |ch: Channel, times: &[f64], y: &[f64]| (1.0 - q).ln() + Whitener::new(times, own_floor(ch), noise(ch), tau_s).log_lik(y);
+    let l_none = channel_of(base, &at_floor).unwrap_or(f64::NEG_INFINITY);
+    let l_any = channel_of(base, &floor_or_beyond).unwrap_or(f64::NEG_INFINITY);
+    // ln(Z_any − Z_none): the mixture without its all-at-floor term.
+    let unexplained = l_any + (-(l_none - l_any).exp()).ln_1p().max(-700.0) - l_none;
+    let mut causes = vec![("unexplained".to_string(), PRIOR_NO_CAUSE, unexplained)];
     let mut terms =
         vec![StructureTerms { cause: "none".into(), prior: PRIOR_NO_CAUSE, occam: 0.0, base_occam: 0.0, channels: channel_terms(run, all_pts, base, &own_floor, &noise, tau_s) }];
     for f in fits {
@@ -520,14 +594,24 @@ pub fn posterior_of(
         let mut specs = nuisance.to_vec();
         specs.extend(ext(f.candidate));
         let (ec, eb) = (log_evidence(run, pts, all_pts, f, &specs, &amp, &noise, tau_s), log_evidence(run, pts, all_pts, base, nuisance, &amp, &noise, tau_s));
-        let b = ec.as_ref().zip(eb.as_ref()).map_or(f64::NEG_INFINITY, |(a, b)| a.log_z - b.log_z);
+        let occam = |e: &Option<Evidence>| e.as_ref().map_or(f64::NEG_INFINITY, |e| e.log_prior + e.log_volume);
+        let l_c = channel_of(f, &|ch, times, y| {
+            if touched_channels(f.candidate).contains(&ch) {
+                Whitener::new(times, amp(ch), noise(ch), tau_s).log_lik(y)
+            } else {
+                floor_or_beyond(ch, times, y)
+            }
+        })
+        .unwrap_or(f64::NEG_INFINITY);
+        let b = l_c + occam(&ec) - occam(&eb) - l_none;
+        let b = if b.is_nan() { f64::NEG_INFINITY } else { b };
         let prior = if admitted(f.candidate) { (1.0 - 2.0 * PRIOR_NO_CAUSE) / Candidate::EXTENSIONS.len() as f64 } else { 0.0 };
         causes.push((f.candidate.name().to_string(), prior, b));
         terms.push(StructureTerms {
             cause: f.candidate.name().into(),
             prior,
-            occam: ec.as_ref().map_or(f64::NEG_INFINITY, |e| e.log_prior + e.log_volume),
-            base_occam: eb.as_ref().map_or(f64::NEG_INFINITY, |e| e.log_prior + e.log_volume),
+            occam: occam(&ec),
+            base_occam: occam(&eb),
             channels: channel_terms(run, all_pts, f, &amp, &noise, tau_s),
         });
     }
@@ -676,28 +760,41 @@ mod tests {
         }
     }
 
-    /// Per-channel evidence: each candidate's Bayes factor against `none`
-    /// is taken on the channels its physics touches at the floor, every
-    /// other channel at its own misfit, so a channel that misfits far more
-    /// than the others (t_block_c off by 3 K, fifteen times its floor)
-    /// leaves the lag's Bayes factor decisive (measured ln BF 11–31 with it,
-    /// 11–39 without, five draws; asserted > 5: the oil's floor, a median
-    /// over the other channels, moves a little with the block).
-    /// **Measured limit**: the `unexplained` structure (every channel's
-    /// discrepancy free) then takes the probability, P ≥ 0.99, so the lag is
-    /// not named: the big misfit still vetoes the decision through
-    /// `unexplained`. A per-channel mixture (floor or free on each channel,
-    /// for every structure) removed that veto in this test but named
-    /// `sensor-lag` on the emulator twin of 1700 (ln BF 45.6): not adopted.
+    /// The posterior recomputed from the stored terms (the sweep's offline
+    /// decision) is the diagnosis's own, to the grid's interpolation: ln
+    /// Bayes factors within 0.1 nats + 0.1 % (measured: 0.16 of 303 nats
+    /// with the block misfit), probabilities within 0.01, on the toy with
+    /// and without the block misfit.
+    #[test]
+    fn the_posterior_from_stored_terms_is_the_diagnosis_own() {
+        for (imprint, block) in [(1.0, 0.0), (0.2, 3.0), (1.0, 3.0), (0.5, 0.0)] {
+            let p = toy(imprint, block, 3);
+            let q = posterior_from_terms(&p.terms);
+            for c in &p.causes {
+                let d = q.iter().find(|x| x.cause == c.cause).unwrap();
+                assert!((d.log_bayes_factor - c.log_bayes_factor).abs() < 0.1 + 1e-3 * c.log_bayes_factor.abs(), "{imprint}/{block} {}: {} against {}", c.cause, d.log_bayes_factor, c.log_bayes_factor);
+                assert!((d.probability - c.probability).abs() < 0.01, "{imprint}/{block} {}: {} against {}", c.cause, d.probability, c.probability);
+            }
+        }
+    }
+
+    /// Per-channel evidence: a channel that misfits far more than the
+    /// others (t_block_c off by a 3 K sine that nothing explains, fifteen
+    /// times its floor) does not veto the decision on the oil channel: the
+    /// clear lag imprint (1 K) is still named at P ≥ 0.9 on each of five
+    /// draws, and the floor-size imprint (0.2 K) still is not; there the
+    /// block makes the answer `unexplained`, never `none`. (Before the
+    /// per-channel structures, the block sent P(`unexplained`) to ≥ 0.99
+    /// and the lag was not named.)
     #[test]
     fn a_channel_that_misfits_far_more_leaves_the_candidates_bayes_factor() {
         for seed in 1..=5 {
-            let bf = |p: &Posterior| p.causes.iter().find(|c| c.cause == "sensor-lag").unwrap().log_bayes_factor;
-            let (clean, vetoed) = (toy(1.0, 0.0, seed), toy(1.0, 3.0, seed));
-            eprintln!("seed {seed}: ln BF {:.1} clean, {:.1} with the block misfit", bf(&clean), bf(&vetoed));
-            assert!(bf(&vetoed) > 5.0, "seed {seed}: ln BF {:.1} against {:.1}", bf(&clean), bf(&vetoed));
-            assert!(vetoed.of("unexplained") >= 0.99, "seed {seed}: measured limit changed: {:?}", vetoed.causes);
-            let block = vetoed.channels.iter().find(|c| c.channel == "t_block_c").unwrap();
+            let (clear, faint) = (toy(1.0, 3.0, seed), toy(0.2, 3.0, seed));
+            eprintln!("seed {seed}: {:?}", clear.causes.iter().map(|c| (&c.cause, c.probability)).collect::<Vec<_>>());
+            assert!(clear.of("sensor-lag") >= NAME_PROBABILITY, "seed {seed}: clear lag beside a 3 K block misfit: {:?}", clear.causes);
+            assert!(faint.named().is_none(), "seed {seed}: floor-size lag named: {:?}", faint.causes);
+            assert!(faint.of("unexplained") > faint.of("none"), "seed {seed}: the block's misfit must not read `none`: {:?}", faint.causes);
+            let block = clear.channels.iter().find(|c| c.channel == "t_block_c").unwrap();
             assert!(block.misfit_k > 1.5, "seed {seed}: block misfit {:.2}", block.misfit_k);
         }
     }
