@@ -4,7 +4,7 @@
 //! the whole table (`emulator-sweep.md`, `emulator-sweep.json`).
 
 use super::analysis::{diagnose, DiagnoseOptions, Diagnosis};
-use super::evidence::{ChannelEvidence, StructureTerms};
+use super::evidence::{ChannelEvidence, DecisionRule, StructureTerms};
 use super::report::ProbabilityJson;
 use super::model::Candidate;
 use super::reference::ReferenceModel;
@@ -439,6 +439,46 @@ pub struct EmuSweepArgs {
     /// Keep the cases already in OUT/emulator-sweep.jsonl and run the rest.
     #[arg(long)]
     pub resume: bool,
+    /// Run nothing: render the cases already in OUT/emulator-sweep.jsonl.
+    #[arg(long)]
+    pub render_only: bool,
+    /// Decide again from the stored evidence terms with this rule
+    /// ([`redecide`]) before rendering.
+    #[arg(long, value_enum)]
+    pub redecide: Option<DecisionRule>,
+}
+
+/// `r` decided again from its stored evidence terms with `rule`
+/// ([`super::evidence::posterior_from_terms`]): new
+/// probabilities; the answer is the cause named at P ≥ 0.9, else the old
+/// answer when it named nothing, else `unexplained` when a channel misfits
+/// (for a twin, whose adequacy flags are not stored: a channel at imprint
+/// ratio ≥ 2 against its floor) and `none` otherwise. Exact for the tier the sweep's answer came from;
+/// an answer that would have changed the escalation path is not replayed.
+/// Results without terms are left as they are.
+pub fn redecide(r: &mut EmuResult, rule: DecisionRule) {
+    let again = |terms: &[StructureTerms], answer: &mut String, probs: &mut Vec<ProbabilityJson>, misfits: bool| {
+        if terms.is_empty() {
+            return;
+        }
+        let p = super::evidence::posterior_from_terms(terms, rule);
+        *probs = p
+            .iter()
+            .map(|c| ProbabilityJson { cause: c.cause.clone(), probability: c.probability, log_bayes_factor: c.log_bayes_factor, prior: c.prior })
+            .collect();
+        let named = p.iter().find(|c| c.probability >= super::evidence::NAME_PROBABILITY && super::emu_tables::names_a_cause(&c.cause));
+        *answer = match named {
+            Some(c) => c.cause.clone(),
+            None if super::emu_tables::names_a_cause(answer) => (if misfits { "unexplained" } else { "none" }).into(),
+            None => answer.clone(),
+        };
+    };
+    let misfits = r.channels.iter().any(|c| c.4);
+    again(&r.evidence_terms, &mut r.answer, &mut r.probabilities, misfits);
+    if let Some(t) = r.twin.as_mut() {
+        let twin_misfits = t.twin_channels.iter().any(|c| c.imprint_ratio >= 2.0);
+        again(&t.twin_terms, &mut t.twin_answer, &mut t.twin_probabilities, twin_misfits);
+    }
 }
 
 /// The sweep's Markdown (`emulator-sweep.md`): the answer table, its
@@ -512,7 +552,7 @@ pub fn run(a: &EmuSweepArgs) -> ExitCode {
     }
     let lines = a.out.join("emulator-sweep.jsonl");
     let mut ok: Vec<EmuResult> = Vec::new();
-    if a.resume {
+    if a.resume || a.render_only {
         if let Ok(text) = std::fs::read_to_string(&lines) {
             for (n, l) in text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty()) {
                 match serde_json::from_str::<EmuResult>(l) {
@@ -527,7 +567,8 @@ pub fn run(a: &EmuSweepArgs) -> ExitCode {
     } else {
         let _ = std::fs::remove_file(&lines);
     }
-    let todo: Vec<EmuCase> = cases.into_iter().filter(|c| !ok.iter().any(|r| r.case.seed == c.seed)).collect();
+    let todo: Vec<EmuCase> =
+        if a.render_only { Vec::new() } else { cases.into_iter().filter(|c| !ok.iter().any(|r| r.case.seed == c.seed)).collect() };
     let bar = indicatif::ProgressBar::new(todo.len() as u64);
     let mut errors = Vec::new();
     for c in &todo {
@@ -558,6 +599,10 @@ pub fn run(a: &EmuSweepArgs) -> ExitCode {
         bar.inc(1);
     }
     bar.finish_and_clear();
+    if let Some(rule) = a.redecide {
+        ok.iter_mut().for_each(|r| redecide(r, rule));
+    }
+    ok.sort_by_key(|r| r.case.seed);
     let mut md = document(&ok);
     for e in &errors {
         let _ = writeln!(md, "\nerror: {e}");

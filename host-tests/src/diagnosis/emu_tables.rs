@@ -117,7 +117,7 @@ pub fn statements(probabilities: &[ProbabilityJson]) -> Vec<(String, f64)> {
         }
     }
     merged.sort_by(|a, b| b.1.total_cmp(&a.1));
-    let named = names_a_cause(&merged[0].0) && merged[0].1 >= super::evidence::NAME_PROBABILITY;
+    let named = merged[0].0 != "no cause" && merged[0].1 >= super::evidence::NAME_PROBABILITY;
     merged.truncate(if named { 1 } else { 2 });
     merged
 }
@@ -214,6 +214,9 @@ mod tests {
     fn statements_merge_no_cause_and_keep_the_top_two() {
         let s = statements(&[p("sensor-lag", 0.95), p("none", 0.03), p("unexplained", 0.02)]);
         assert_eq!(s, vec![("sensor-lag".to_string(), 0.95)]);
+        let s = statements(&[p("none", 0.95), p("unexplained", 0.04), p("churning-loss", 0.01)]);
+        assert_eq!((s.len(), s[0].0.as_str(), s[1].0.as_str()), (2, "no cause", "churning-loss"), "a `none` report states its top two");
+        assert!((s[0].1 - 0.99).abs() < 1e-12);
         let s = statements(&[p("sensor-lag", 0.5), p("none", 0.3), p("unexplained", 0.15), p("churning-loss", 0.05)]);
         assert_eq!(s.len(), 2);
         assert_eq!(s[0].0, "sensor-lag");
