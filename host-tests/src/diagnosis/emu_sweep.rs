@@ -3,13 +3,14 @@
 //! the tests (a small subset) and by `eha-sim emulator-sweep`, which writes
 //! the whole table (`emulator-sweep.md`, `emulator-sweep.json`).
 
-use super::analysis::{diagnose, DiagnoseOptions};
+use super::analysis::{diagnose, DiagnoseOptions, Diagnosis};
+use super::evidence::{ChannelEvidence, DecisionRule, StructureTerms};
+use super::report::ProbabilityJson;
 use super::model::Candidate;
 use super::reference::ReferenceModel;
 use crate::emulator::missions::EmuScenario;
 use crate::emulator::{generate, EmuCase};
 use crate::rig::Rig;
-use rayon::prelude::*;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -52,6 +53,23 @@ pub struct EmuResult {
     /// sweep ran twins; `None` for the `none` cases).
     #[serde(default)]
     pub twin: Option<TwinCheck>,
+    /// The posterior over every structure, most probable first.
+    #[serde(default)]
+    pub probabilities: Vec<ProbabilityJson>,
+    /// Every candidate's fit: (name, ΔBIC, best-channel held-out gain,
+    /// whether it qualified), best BIC first.
+    #[serde(default)]
+    pub ranking: Vec<(String, f64, f64, bool)>,
+    /// The evidence's per-channel numbers (misfit, floor, ratio).
+    #[serde(default)]
+    pub evidence_channels: Vec<ChannelEvidence>,
+    /// The calibration set whose answer stands (global or physical tier).
+    #[serde(default)]
+    pub tier: String,
+    /// The evidence's terms per structure (for measuring other decision
+    /// rules offline); left out of the committed JSON.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub evidence_terms: Vec<StructureTerms>,
     /// Wall time of the diagnosis, s.
     pub seconds: f64,
 }
@@ -69,6 +87,15 @@ pub struct TwinCheck {
     /// The twin's answer (anything but `none`/`unexplained` is a false
     /// discovery).
     pub twin_answer: String,
+    /// The twin's posterior, most probable first.
+    #[serde(default)]
+    pub twin_probabilities: Vec<ProbabilityJson>,
+    /// The twin's per-channel evidence numbers.
+    #[serde(default)]
+    pub twin_channels: Vec<ChannelEvidence>,
+    /// The twin's evidence terms per structure.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub twin_terms: Vec<StructureTerms>,
 }
 
 impl TwinCheck {
@@ -123,10 +150,42 @@ pub fn run_emu_case(case: EmuCase, o: &DiagnoseOptions) -> Result<EmuResult, Str
 /// [`run_emu_case`], and with `twin` (for a hidden effect) its effect-free
 /// twin diagnosed too, for the imprint ratio ([`TwinCheck`]).
 pub fn run_emu_case_twin(case: EmuCase, o: &DiagnoseOptions, twin: bool) -> Result<EmuResult, String> {
+    run_emu_case_with(case, o, twin, true)
+}
+
+/// The posterior of `d` as `diagnosis.json` writes it.
+fn probabilities(d: &Diagnosis) -> Vec<ProbabilityJson> {
+    d.posterior
+        .causes
+        .iter()
+        .map(|c| ProbabilityJson { cause: c.cause.clone(), probability: c.probability, log_bayes_factor: c.log_bayes_factor, prior: c.prior })
+        .collect()
+}
+
+/// [`run_emu_case_twin`]; with `oracle`, also the hidden effect injected
+/// into the calibrated reference model ([`EmuResult::hidden_detect`]). The
+/// log and its twin are diagnosed in parallel.
+pub fn run_emu_case_with(case: EmuCase, o: &DiagnoseOptions, twin: bool, oracle: bool) -> Result<EmuResult, String> {
     let (run, truth) = generate(&case)?;
+    let want_twin = twin && truth.affected.is_some();
     let t = std::time::Instant::now();
-    let model = ReferenceModel::new(Rig::default(), &run).map_err(|e| e.to_string())?;
-    let d = diagnose(&run, &model, o).map_err(|e| e.to_string())?;
+    let (main, twin_d) = rayon::join(
+        || -> Result<(ReferenceModel, Diagnosis), String> {
+            let model = ReferenceModel::new(Rig::default(), &run).map_err(|e| e.to_string())?;
+            let d = diagnose(&run, &model, o).map_err(|e| e.to_string())?;
+            Ok((model, d))
+        },
+        || -> Result<Option<Diagnosis>, String> {
+            if !want_twin {
+                return Ok(None);
+            }
+            let (trun, _) = crate::emulator::generate_twin(&case)?;
+            let tmodel = ReferenceModel::new(Rig::default(), &trun).map_err(|e| e.to_string())?;
+            diagnose(&trun, &tmodel, o).map(Some).map_err(|e| e.to_string())
+        },
+    );
+    let (model, d) = main?;
+    let td = twin_d?;
     let affected = truth.affected.map(|(c, v)| (c.name().to_string(), v));
     let affected_heldout_k =
         affected.as_ref().and_then(|(c, _)| Some((d.before.channel(c)?.heldout_rmse_k, d.after.channel(c)?.heldout_rmse_k)));
@@ -142,7 +201,7 @@ pub fn run_emu_case_twin(case: EmuCase, o: &DiagnoseOptions, twin: bool) -> Resu
             note: e.note.clone(),
         }
     });
-    let hidden_detect = (case.hidden != Candidate::None)
+    let hidden_detect = (oracle && case.hidden != Candidate::None)
         .then(|| {
             super::detect::with_answer_tier(&model, &d, |a| {
                 let ext: Vec<f64> = a.sim.extension_params(case.hidden).iter().map(|_| truth.magnitude).collect();
@@ -151,16 +210,16 @@ pub fn run_emu_case_twin(case: EmuCase, o: &DiagnoseOptions, twin: bool) -> Resu
         })
         .flatten();
     let seconds = t.elapsed().as_secs_f64();
-    let twin = match (&affected, twin) {
-        (Some((c, _)), true) => {
-            let (trun, _) = crate::emulator::generate_twin(&case)?;
-            let tmodel = ReferenceModel::new(Rig::default(), &trun).map_err(|e| e.to_string())?;
-            let td = diagnose(&trun, &tmodel, o).map_err(|e| e.to_string())?;
+    let twin = match (&affected, td) {
+        (Some((c, _)), Some(td)) => {
             let misfit = |m: &super::stats::Metrics| m.channel(c).map(|x| x.heldout_rmse_k);
             misfit(&d.before).zip(misfit(&td.before)).map(|(a, b)| TwinCheck {
                 misfit_k: a,
                 twin_misfit_k: b,
                 twin_answer: td.answer().into(),
+                twin_probabilities: probabilities(&td),
+                twin_channels: td.posterior.channels.clone(),
+                twin_terms: td.posterior.terms.clone(),
             })
         }
         _ => None,
@@ -183,6 +242,11 @@ pub fn run_emu_case_twin(case: EmuCase, o: &DiagnoseOptions, twin: bool) -> Resu
         best_candidate: best,
         hidden_fit,
         hidden_detect,
+        probabilities: probabilities(&d),
+        ranking: d.ranking.iter().map(|r| (r.cause.clone(), r.delta_bic, r.heldout_gain, r.qualifies)).collect(),
+        evidence_channels: d.posterior.channels.clone(),
+        tier: d.nuisance_set.clone(),
+        evidence_terms: d.posterior.terms.clone(),
         seconds,
     })
 }
@@ -345,19 +409,20 @@ pub struct EmuSweepArgs {
     /// Log duration, s.
     #[arg(long, default_value_t = 1200.0)]
     pub duration: f64,
-    /// Repetitions of the case set (seeds 1700 + 100·k + case index).
+    /// Repetitions of each case set (seeds 1700 or 2700 + 100·k + case index).
     #[arg(long, default_value_t = 1)]
     pub seeds: u64,
-    /// Case set.
-    #[arg(long, value_enum, default_value_t = CaseSet::Original)]
-    pub cases: CaseSet,
+    /// Case sets (comma-separated), run in this order within each repetition.
+    #[arg(long, value_enum, value_delimiter = ',', default_values_t = [CaseSet::Original])]
+    pub cases: Vec<CaseSet>,
     /// Run only the cases with these seeds (comma-separated).
     #[arg(long, value_delimiter = ',')]
     pub only: Vec<u64>,
     /// Leave out the servo cases (slow replays, and with them coulomb-friction).
     #[arg(long)]
     pub no_servo: bool,
-    /// Output directory for emulator-sweep.md and emulator-sweep.json.
+    /// Output directory for emulator-sweep.md and emulator-sweep.json (and
+    /// emulator-sweep.jsonl, one line per case as it finishes).
     #[arg(long, default_value = "emulator-sweep-out")]
     pub out: PathBuf,
     /// Also write every generated log to OUT/logs/ (measured-data format),
@@ -367,6 +432,53 @@ pub struct EmuSweepArgs {
     /// Skip the effect-free twins (no imprint ratios; half the time).
     #[arg(long)]
     pub no_twins: bool,
+    /// Skip the oracle (the hidden effect injected into the calibrated
+    /// reference model; the "in the model's structure" column).
+    #[arg(long)]
+    pub no_oracle: bool,
+    /// Keep the cases already in OUT/emulator-sweep.jsonl and run the rest.
+    #[arg(long)]
+    pub resume: bool,
+    /// Run nothing: render the cases already in OUT/emulator-sweep.jsonl.
+    #[arg(long)]
+    pub render_only: bool,
+    /// Decide again from the stored evidence terms with this rule
+    /// ([`redecide`]) before rendering.
+    #[arg(long, value_enum)]
+    pub redecide: Option<DecisionRule>,
+}
+
+/// `r` decided again from its stored evidence terms with `rule`
+/// ([`super::evidence::posterior_from_terms`]): new
+/// probabilities; the answer is the cause named at P ≥ 0.9, else the old
+/// answer when it named nothing, else `unexplained` when a channel misfits
+/// (for a twin, whose adequacy flags are not stored: a channel at imprint
+/// ratio ≥ 2 against its floor) and `none` otherwise. Exact for the tier the sweep's answer came from;
+/// an answer that would have changed the escalation path is not replayed.
+/// Results without terms are left as they are.
+pub fn redecide(r: &mut EmuResult, rule: DecisionRule) {
+    let again = |terms: &[StructureTerms], answer: &mut String, probs: &mut Vec<ProbabilityJson>, misfits: bool| {
+        if terms.is_empty() {
+            return;
+        }
+        let p = super::evidence::posterior_from_terms(terms, rule);
+        *probs = p
+            .iter()
+            .map(|c| ProbabilityJson { cause: c.cause.clone(), probability: c.probability, log_bayes_factor: c.log_bayes_factor, prior: c.prior })
+            .collect();
+        let named = p.iter().find(|c| c.probability >= super::evidence::NAME_PROBABILITY && super::emu_tables::names_a_cause(&c.cause));
+        *answer = match named {
+            Some(c) => c.cause.clone(),
+            None if super::emu_tables::names_a_cause(answer) => (if misfits { "unexplained" } else { "none" }).into(),
+            None => answer.clone(),
+        };
+    };
+    let misfits = r.channels.iter().any(|c| c.4);
+    again(&r.evidence_terms, &mut r.answer, &mut r.probabilities, misfits);
+    if let Some(t) = r.twin.as_mut() {
+        let twin_misfits = t.twin_channels.iter().any(|c| c.imprint_ratio >= 2.0);
+        again(&t.twin_terms, &mut t.twin_answer, &mut t.twin_probabilities, twin_misfits);
+    }
 }
 
 /// The sweep's Markdown (`emulator-sweep.md`): the answer table, its
@@ -414,96 +526,103 @@ pub fn document(ok: &[EmuResult]) -> String {
         class("oracle ≥ 50 %"),
         class("oracle < 50 %"),
     );
-    md += &ratio_bands(ok);
-    md
-}
-
-/// The table by imprint-ratio band (r against each log's effect-free twin):
-/// where a diagnosis must name the cause (r ≥ 2) and how it did; empty when
-/// the sweep ran no twins.
-fn ratio_bands(ok: &[EmuResult]) -> String {
-    let with: Vec<(&EmuResult, f64)> = ok.iter().filter_map(|r| Some((r, r.twin.as_ref()?.ratio()))).collect();
-    if with.is_empty() {
-        return String::new();
-    }
-    let mut md = String::from(
-        "\n**By imprint ratio** r = the calibrated baseline's held-out misfit on the affected channel over the same on the \
-         log's effect-free twin (same machine, mission and noise):\n\n\
-         | r | cases | named | wrong cause | `none` | `unexplained` | seeds |\n|---|---:|---:|---:|---:|---:|---|\n",
-    );
-    for (label, lo, hi) in [("< 1", 0.0, 1.0), ("1–2", 1.0, 2.0), ("2–3", 2.0, 3.0), ("≥ 3", 3.0, f64::INFINITY)] {
-        let band: Vec<&(&EmuResult, f64)> = with.iter().filter(|(_, r)| *r >= lo && *r < hi).collect();
-        let n = |f: &dyn Fn(&EmuResult) -> bool| band.iter().filter(|(r, _)| f(r)).count();
-        let seeds: Vec<String> = band.iter().map(|(r, x)| format!("{} ({x:.1})", r.case.seed)).collect();
-        let _ = writeln!(
-            md,
-            "| {label} | {} | {} | {} | {} | {} | {} |",
-            band.len(),
-            n(&|r| r.hit()),
-            n(&|r| !r.hit() && r.answer != "none" && r.answer != "unexplained"),
-            n(&|r| r.answer == "none"),
-            n(&|r| r.answer == "unexplained"),
-            if seeds.is_empty() { "–".into() } else { seeds.join(", ") },
-        );
-    }
-    let false_twins: Vec<String> = with
-        .iter()
-        .filter_map(|(r, _)| {
-            let t = r.twin.as_ref()?;
-            (t.twin_answer != "none" && t.twin_answer != "unexplained").then(|| format!("{}'s twin: `{}`", r.case.seed, t.twin_answer))
-        })
-        .collect();
-    let _ = writeln!(
-        md,
-        "\nThe {} twins (effect-free): {} false discoveries{}.",
-        with.len(),
-        false_twins.len(),
-        if false_twins.is_empty() { String::new() } else { format!(" ({})", false_twins.join(", ")) }
-    );
+    md += &super::emu_tables::ratio_table(ok);
+    md += &super::emu_tables::reliability_table(ok);
     md
 }
 
 /// Runs the emulator sweep; exit 0 always unless the outputs cannot be
-/// written (it is a measurement, not a test).
+/// written (it is a measurement, not a test). Cases run one after another
+/// (each log and its twin in parallel, every diagnosis's fits in parallel),
+/// each appended to `emulator-sweep.jsonl` as it finishes.
 pub fn run(a: &EmuSweepArgs) -> ExitCode {
     let cases: Vec<EmuCase> = (0..a.seeds)
-        .flat_map(|k| match a.cases {
-            CaseSet::Ident => ident_cases(a.duration, 2700 + 100 * k),
-            CaseSet::Original => default_cases(a.duration, 1700 + 100 * k),
+        .flat_map(|k| {
+            a.cases.iter().flat_map(move |set| match set {
+                CaseSet::Ident => ident_cases(a.duration, 2700 + 100 * k),
+                CaseSet::Original => default_cases(a.duration, 1700 + 100 * k),
+            })
         })
         .filter(|c| !(a.no_servo && c.scenario.is_servo()))
         .filter(|c| a.only.is_empty() || a.only.contains(&c.seed))
         .collect();
-    let bar = indicatif::ProgressBar::new(cases.len() as u64);
-    let res: Vec<Result<EmuResult, String>> = cases
-        .par_iter()
-        .map(|c| {
-            if a.logs {
-                if let Ok((run, _)) = generate(c) {
-                    let dir = a.out.join("logs");
-                    let _ = std::fs::create_dir_all(&dir);
-                    let _ = run.write_file(dir.join(format!("{}-{:?}-{}.csv", c.hidden.name(), c.scenario, c.seed)));
-                }
-                if let (false, false, Ok((twin, _))) = (a.no_twins, c.hidden == Candidate::None, crate::emulator::generate_twin(c)) {
-                    let _ = twin.write_file(a.out.join("logs").join(format!("{}-{:?}-{}-twin.csv", c.hidden.name(), c.scenario, c.seed)));
+    if let Err(e) = std::fs::create_dir_all(&a.out) {
+        eprintln!("error: {}: {e}", a.out.display());
+        return ExitCode::from(2);
+    }
+    let lines = a.out.join("emulator-sweep.jsonl");
+    let mut ok: Vec<EmuResult> = Vec::new();
+    if a.resume || a.render_only {
+        if let Ok(text) = std::fs::read_to_string(&lines) {
+            for (n, l) in text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty()) {
+                match serde_json::from_str::<EmuResult>(l) {
+                    Ok(r) => ok.push(r),
+                    Err(e) => {
+                        eprintln!("error: {}:{}: {e}", lines.display(), n + 1);
+                        return ExitCode::from(2);
+                    }
                 }
             }
-            let r = run_emu_case_twin(*c, &DiagnoseOptions::default(), !a.no_twins);
-            bar.inc(1);
-            r
-        })
-        .collect();
+        }
+    } else {
+        let _ = std::fs::remove_file(&lines);
+    }
+    let todo: Vec<EmuCase> =
+        if a.render_only { Vec::new() } else { cases.into_iter().filter(|c| !ok.iter().any(|r| r.case.seed == c.seed)).collect() };
+    let bar = indicatif::ProgressBar::new(todo.len() as u64);
+    let mut errors = Vec::new();
+    for c in &todo {
+        if a.logs {
+            let dir = a.out.join("logs");
+            let _ = std::fs::create_dir_all(&dir);
+            if let Ok((run, _)) = generate(c) {
+                let _ = run.write_file(dir.join(format!("{}-{:?}-{}.csv", c.hidden.name(), c.scenario, c.seed)));
+            }
+            if let (false, false, Ok((twin, _))) = (a.no_twins, c.hidden == Candidate::None, crate::emulator::generate_twin(c)) {
+                let _ = twin.write_file(dir.join(format!("{}-{:?}-{}-twin.csv", c.hidden.name(), c.scenario, c.seed)));
+            }
+        }
+        match run_emu_case_with(*c, &DiagnoseOptions::default(), !a.no_twins, !a.no_oracle) {
+            Ok(r) => {
+                let line = serde_json::to_string(&r).unwrap_or_default() + "\n";
+                let appended = std::fs::OpenOptions::new().create(true).append(true).open(&lines).and_then(|mut f| {
+                    use std::io::Write as _;
+                    f.write_all(line.as_bytes())
+                });
+                if let Err(e) = appended {
+                    eprintln!("error: {}: {e}", lines.display());
+                }
+                ok.push(r);
+            }
+            Err(e) => errors.push(format!("seed {}: {e}", c.seed)),
+        }
+        bar.inc(1);
+    }
     bar.finish_and_clear();
-    let ok: Vec<EmuResult> = res.iter().flatten().cloned().collect();
+    if let Some(rule) = a.redecide {
+        ok.iter_mut().for_each(|r| redecide(r, rule));
+    }
+    ok.sort_by_key(|r| r.case.seed);
     let mut md = document(&ok);
-    for e in res.iter().filter_map(|r| r.as_ref().err()) {
+    for e in &errors {
         let _ = writeln!(md, "\nerror: {e}");
     }
     print!("{md}");
     let write = || -> std::io::Result<()> {
-        std::fs::create_dir_all(&a.out)?;
         std::fs::write(a.out.join("emulator-sweep.md"), &md)?;
-        let j = serde_json::to_string_pretty(&ok).map_err(std::io::Error::other)?;
+        // The evidence terms stay in the JSONL (they are most of its size).
+        let lean: Vec<EmuResult> = ok
+            .iter()
+            .cloned()
+            .map(|mut r| {
+                r.evidence_terms.clear();
+                if let Some(t) = r.twin.as_mut() {
+                    t.twin_terms.clear();
+                }
+                r
+            })
+            .collect();
+        let j = serde_json::to_string_pretty(&lean).map_err(std::io::Error::other)?;
         std::fs::write(a.out.join("emulator-sweep.json"), j + "\n")
     };
     match write() {

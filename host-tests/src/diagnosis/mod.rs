@@ -23,6 +23,7 @@ pub mod sweep;
 pub mod synth;
 pub mod cli;
 pub mod emu_sweep;
+pub mod emu_tables;
 
 pub use analysis::{diagnose, DiagnoseError, DiagnoseOptions, Diagnosis};
 pub use model::{Candidate, ParamSpec, SimSeries, Simulator};

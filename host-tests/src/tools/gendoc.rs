@@ -39,13 +39,13 @@ pub const SECTIONS: [Section; 5] = [
     Section {
         doc: "docs/diagnosis.md",
         tag: "emulator-sweep",
-        source: "docs/data/emulator-sweep-1700.json",
+        source: "docs/data/emulator-sweep.json",
         render: render_emulator_sweep,
     },
 ];
 
-/// The emulator sweep's tables (`eha-sim emulator-sweep`, seeds
-/// 1700–1717, its `emulator-sweep.json`).
+/// The emulator sweep's tables (`eha-sim emulator-sweep`, the case sets
+/// it ran, its `emulator-sweep.json`).
 fn render_emulator_sweep(json: &str) -> Result<String> {
     let rows: Vec<crate::diagnosis::emu_sweep::EmuResult> = serde_json::from_str(json)?;
     Ok(crate::diagnosis::emu_sweep::document(&rows))

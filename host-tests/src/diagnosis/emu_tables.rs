@@ -1,0 +1,226 @@
+//! The emulator sweep's summary tables: answers by imprint-ratio band (r
+//! against each log's effect-free twin) and the reliability of the stated
+//! probabilities (stated probability against observed frequency).
+
+use super::emu_sweep::EmuResult;
+use super::model::Candidate;
+use super::report::ProbabilityJson;
+use std::fmt::Write as _;
+
+/// One diagnosed log of the sweep: a case log or an effect-free twin.
+#[derive(Debug, Clone)]
+pub struct Diagnosed<'a> {
+    /// Seed of the case.
+    pub seed: u64,
+    /// Whether this is the effect-free twin of a case.
+    pub twin: bool,
+    /// The hidden effect in this log (`none` for twins and effect-free cases).
+    pub truth: &'static str,
+    /// Imprint ratio of the case's effect (`None` for effect-free logs).
+    pub ratio: Option<f64>,
+    /// The answer.
+    pub answer: &'a str,
+    /// Its posterior.
+    pub probabilities: &'a [ProbabilityJson],
+}
+
+/// Every diagnosed log of `ok`, the twins after their cases.
+pub fn diagnosed(ok: &[EmuResult]) -> Vec<Diagnosed<'_>> {
+    let mut out = Vec::new();
+    for r in ok {
+        let ratio = r.twin.as_ref().map(|t| t.ratio());
+        out.push(Diagnosed { seed: r.case.seed, twin: false, truth: r.case.hidden.name(), ratio, answer: &r.answer, probabilities: &r.probabilities });
+        if let Some(t) = &r.twin {
+            out.push(Diagnosed {
+                seed: r.case.seed,
+                twin: true,
+                truth: Candidate::None.name(),
+                ratio: None,
+                answer: &t.twin_answer,
+                probabilities: &t.twin_probabilities,
+            });
+        }
+    }
+    out
+}
+
+/// Whether `answer` names a cause (not `none`, not `unexplained`).
+pub fn names_a_cause(answer: &str) -> bool {
+    answer != "none" && answer != "unexplained"
+}
+
+/// The answers on logs with a hidden effect by imprint-ratio band (named,
+/// right, wrong cause, `none`, `unexplained`), and on the effect-free logs
+/// (the case set's and the twins) the false discoveries. Empty without
+/// twins.
+pub fn ratio_table(ok: &[EmuResult]) -> String {
+    let all = diagnosed(ok);
+    let with: Vec<(&Diagnosed, f64)> = all.iter().filter_map(|d| Some((d, d.ratio?))).filter(|(d, _)| d.truth != "none").collect();
+    if with.is_empty() {
+        return String::new();
+    }
+    let mut md = String::from(
+        "\n**By imprint ratio** r = the calibrated baseline's held-out misfit on the affected channel over the same on the \
+         log's effect-free twin (same machine, mission and noise); a cause must be named at r ≥ 2, a wrong cause is wrong at any r:\n\n\
+         | r | logs | named | right | wrong cause | `none` | `unexplained` | seeds (r) |\n|---|---:|---:|---:|---:|---:|---:|---|\n",
+    );
+    for (label, lo, hi) in [("< 1", 0.0, 1.0), ("1–2", 1.0, 2.0), ("2–3", 2.0, 3.0), ("≥ 3", 3.0, f64::INFINITY)] {
+        let band: Vec<&(&Diagnosed, f64)> = with.iter().filter(|(_, r)| *r >= lo && *r < hi).collect();
+        let n = |f: &dyn Fn(&Diagnosed) -> bool| band.iter().filter(|(d, _)| f(d)).count();
+        let seeds: Vec<String> = band
+            .iter()
+            .map(|(d, x)| {
+                let mark = if d.answer == d.truth { "✓" } else if names_a_cause(d.answer) { "✗" } else { "" };
+                format!("{}{mark} ({x:.1})", d.seed)
+            })
+            .collect();
+        let _ = writeln!(
+            md,
+            "| {label} | {} | {} | {} | {} | {} | {} | {} |",
+            band.len(),
+            n(&|d| names_a_cause(d.answer)),
+            n(&|d| d.answer == d.truth),
+            n(&|d| names_a_cause(d.answer) && d.answer != d.truth),
+            n(&|d| d.answer == "none"),
+            n(&|d| d.answer == "unexplained"),
+            if seeds.is_empty() { "–".into() } else { seeds.join(", ") },
+        );
+    }
+    let free: Vec<&Diagnosed> = all.iter().filter(|d| d.truth == "none").collect();
+    let wrong: Vec<String> =
+        free.iter().filter(|d| names_a_cause(d.answer)).map(|d| format!("{}{}: `{}`", d.seed, if d.twin { "'s twin" } else { "" }, d.answer)).collect();
+    let _ = writeln!(
+        md,
+        "\nEffect-free logs ({} of the case sets, {} twins): {} `none`, {} `unexplained`, **{} false discoveries**{}.",
+        free.iter().filter(|d| !d.twin).count(),
+        free.iter().filter(|d| d.twin).count(),
+        free.iter().filter(|d| d.answer == "none").count(),
+        free.iter().filter(|d| d.answer == "unexplained").count(),
+        wrong.len(),
+        if wrong.is_empty() { String::new() } else { format!(" ({})", wrong.join(", ")) }
+    );
+    md
+}
+
+/// The statements a report makes about one log, on the posterior with
+/// `none` and `unexplained` merged into "no cause" (the emulator knows
+/// only whether an effect is hidden, not which of the two a foreign
+/// machine deserves): the named cause when one reaches the naming
+/// probability, else the two most probable. (statement, probability).
+pub fn statements(probabilities: &[ProbabilityJson]) -> Vec<(String, f64)> {
+    let mut merged: Vec<(String, f64)> = vec![("no cause".into(), 0.0)];
+    for p in probabilities {
+        if names_a_cause(&p.cause) {
+            merged.push((p.cause.clone(), p.probability));
+        } else {
+            merged[0].1 += p.probability;
+        }
+    }
+    merged.sort_by(|a, b| b.1.total_cmp(&a.1));
+    let named = merged[0].0 != "no cause" && merged[0].1 >= super::evidence::NAME_PROBABILITY;
+    merged.truncate(if named { 1 } else { 2 });
+    merged
+}
+
+/// Probability bins of the reliability table.
+pub const BINS: [(f64, f64); 7] = [(0.0, 0.1), (0.1, 0.3), (0.3, 0.5), (0.5, 0.7), (0.7, 0.9), (0.9, 0.99), (0.99, 1.0 + 1e-9)];
+
+/// One bin of the reliability table.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Bin {
+    /// Bin bounds.
+    pub range: (f64, f64),
+    /// Statements in the bin.
+    pub n: usize,
+    /// Mean stated probability.
+    pub stated: f64,
+    /// Fraction of the statements that are true (the hidden effect, or no
+    /// cause on an effect-free log).
+    pub observed: f64,
+    /// The same with "no cause" also counted true on a log whose effect
+    /// stays below r = 2 (the rule by which the answer is judged).
+    pub observed_lenient: f64,
+}
+
+/// The reliability bins over every diagnosed log of `ok`.
+pub fn reliability(ok: &[EmuResult]) -> Vec<Bin> {
+    let mut st: Vec<(f64, bool, bool)> = Vec::new();
+    for d in diagnosed(ok) {
+        let truth = if d.truth == "none" { "no cause" } else { d.truth };
+        let faint = d.ratio.is_some_and(|r| r < 2.0);
+        for (s, p) in statements(d.probabilities) {
+            st.push((p, s == truth, s == truth || (faint && s == "no cause")));
+        }
+    }
+    BINS.iter()
+        .map(|&(lo, hi)| {
+            let b: Vec<&(f64, bool, bool)> = st.iter().filter(|(p, _, _)| *p >= lo && *p < hi).collect();
+            let n = b.len();
+            let mean = |f: &dyn Fn(&(f64, bool, bool)) -> f64| if n == 0 { f64::NAN } else { b.iter().map(|x| f(x)).sum::<f64>() / n as f64 };
+            Bin {
+                range: (lo, hi.min(1.0)),
+                n,
+                stated: mean(&|x| x.0),
+                observed: mean(&|x| f64::from(u8::from(x.1))),
+                observed_lenient: mean(&|x| f64::from(u8::from(x.2))),
+            }
+        })
+        .collect()
+}
+
+/// The reliability table in Markdown (empty when no log carries
+/// probabilities).
+pub fn reliability_table(ok: &[EmuResult]) -> String {
+    let bins = reliability(ok);
+    if bins.iter().all(|b| b.n == 0) {
+        return String::new();
+    }
+    let mut md = String::from(
+        "\n**Reliability of the stated probabilities** over every diagnosed log (case logs and twins): each report's \
+         statements — the named cause, or else the two most probable, with `none` and `unexplained` merged into \
+         \"no cause\" — binned by stated probability; observed = the fraction that is true (the hidden effect; \
+         \"no cause\" on an effect-free log), and the same counting \"no cause\" right also on a log whose effect \
+         stays below r = 2. Calibrated: within 10 points in every bin with ≥ 5 statements.\n\n\
+         | stated P | statements | mean stated | observed | observed, r < 2 effects as no cause | within 10 points |\n|---|---:|---:|---:|---:|---|\n",
+    );
+    for b in &bins {
+        let pct = |x: f64| if x.is_nan() { "–".to_string() } else { format!("{:.0} %", 100.0 * x) };
+        let ok = if b.n < 5 { "(< 5)".to_string() } else if (b.stated - b.observed).abs() <= 0.1 { "yes".into() } else { "**no**".into() };
+        let _ = writeln!(
+            md,
+            "| {:.2}–{:.2} | {} | {} | {} | {} | {ok} |",
+            b.range.0,
+            b.range.1,
+            b.n,
+            pct(b.stated),
+            pct(b.observed),
+            pct(b.observed_lenient)
+        );
+    }
+    md
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn p(c: &str, x: f64) -> ProbabilityJson {
+        ProbabilityJson { cause: c.into(), probability: x, log_bayes_factor: 0.0, prior: 0.25 }
+    }
+
+    /// A named cause is one statement; otherwise the two most probable,
+    /// with `none` and `unexplained` summed into "no cause".
+    #[test]
+    fn statements_merge_no_cause_and_keep_the_top_two() {
+        let s = statements(&[p("sensor-lag", 0.95), p("none", 0.03), p("unexplained", 0.02)]);
+        assert_eq!(s, vec![("sensor-lag".to_string(), 0.95)]);
+        let s = statements(&[p("none", 0.95), p("unexplained", 0.04), p("churning-loss", 0.01)]);
+        assert_eq!((s.len(), s[0].0.as_str(), s[1].0.as_str()), (2, "no cause", "churning-loss"), "a `none` report states its top two");
+        assert!((s[0].1 - 0.99).abs() < 1e-12);
+        let s = statements(&[p("sensor-lag", 0.5), p("none", 0.3), p("unexplained", 0.15), p("churning-loss", 0.05)]);
+        assert_eq!(s.len(), 2);
+        assert_eq!(s[0].0, "sensor-lag");
+        assert_eq!(s[1].0, "no cause");
+        assert!((s[1].1 - 0.45).abs() < 1e-12);
+    }
+}
