@@ -2,7 +2,7 @@
 //! against each log's effect-free twin) and the reliability of the stated
 //! probabilities (stated probability against observed frequency).
 
-use super::emu_sweep::EmuResult;
+use super::emu_result::EmuResult;
 use super::model::Candidate;
 use super::report::ProbabilityJson;
 use std::fmt::Write as _;
@@ -44,11 +44,6 @@ pub fn diagnosed(ok: &[EmuResult]) -> Vec<Diagnosed<'_>> {
     out
 }
 
-/// Whether `answer` names a cause (not `none`, not `unexplained`).
-pub fn names_a_cause(answer: &str) -> bool {
-    answer != "none" && answer != "unexplained"
-}
-
 /// The answers on logs with a hidden effect by imprint-ratio band (named,
 /// right, wrong cause, `none`, `unexplained`), and on the effect-free logs
 /// (the case set's and the twins) the false discoveries. Empty without
@@ -70,7 +65,7 @@ pub fn ratio_table(ok: &[EmuResult]) -> String {
         let seeds: Vec<String> = band
             .iter()
             .map(|(d, x)| {
-                let mark = if d.answer == d.truth { "✓" } else if names_a_cause(d.answer) { "✗" } else { "" };
+                let mark = if d.answer == d.truth { "✓" } else if super::evidence::names_a_cause(d.answer) { "✗" } else { "" };
                 format!("{}{mark} ({x:.1})", d.seed)
             })
             .collect();
@@ -78,9 +73,9 @@ pub fn ratio_table(ok: &[EmuResult]) -> String {
             md,
             "| {label} | {} | {} | {} | {} | {} | {} | {} |",
             band.len(),
-            n(&|d| names_a_cause(d.answer)),
+            n(&|d| super::evidence::names_a_cause(d.answer)),
             n(&|d| d.answer == d.truth),
-            n(&|d| names_a_cause(d.answer) && d.answer != d.truth),
+            n(&|d| super::evidence::names_a_cause(d.answer) && d.answer != d.truth),
             n(&|d| d.answer == "none"),
             n(&|d| d.answer == "unexplained"),
             if seeds.is_empty() { "–".into() } else { seeds.join(", ") },
@@ -88,7 +83,7 @@ pub fn ratio_table(ok: &[EmuResult]) -> String {
     }
     let free: Vec<&Diagnosed> = all.iter().filter(|d| d.truth == "none").collect();
     let wrong: Vec<String> =
-        free.iter().filter(|d| names_a_cause(d.answer)).map(|d| format!("{}{}: `{}`", d.seed, if d.twin { "'s twin" } else { "" }, d.answer)).collect();
+        free.iter().filter(|d| super::evidence::names_a_cause(d.answer)).map(|d| format!("{}{}: `{}`", d.seed, if d.twin { "'s twin" } else { "" }, d.answer)).collect();
     let _ = writeln!(
         md,
         "\nEffect-free logs ({} of the case sets, {} twins): {} `none`, {} `unexplained`, **{} false discoveries**{}.",
@@ -110,7 +105,7 @@ pub fn ratio_table(ok: &[EmuResult]) -> String {
 pub fn statements(probabilities: &[ProbabilityJson]) -> Vec<(String, f64)> {
     let mut merged: Vec<(String, f64)> = vec![("no cause".into(), 0.0)];
     for p in probabilities {
-        if names_a_cause(&p.cause) {
+        if super::evidence::names_a_cause(&p.cause) {
             merged.push((p.cause.clone(), p.probability));
         } else {
             merged[0].1 += p.probability;

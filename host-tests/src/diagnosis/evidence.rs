@@ -622,6 +622,11 @@ pub fn posterior_of(
     Posterior { causes, channels, tau_s, terms }
 }
 
+/// Whether `answer` names a cause (not `none`, not `unexplained`).
+pub fn names_a_cause(answer: &str) -> bool {
+    answer != "none" && answer != "unexplained"
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -22,6 +22,7 @@ pub mod stats;
 pub mod sweep;
 pub mod synth;
 pub mod cli;
+pub mod emu_result;
 pub mod emu_sweep;
 pub mod emu_tables;
 
