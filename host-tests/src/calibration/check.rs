@@ -146,77 +146,133 @@ pub fn check_reduced_with(rig: &Rig, p: &ReducedParams, log: &CalLog, margin_k: 
 
 /// [`check_reduced_with`], the measured drain scored from `score_from_s` on.
 pub(crate) fn check_reduced_core(rig: &Rig, p: &ReducedParams, log: &CalLog, margin_k: f64, score_from_s: f64) -> Result<ReducedCheck, String> {
+    let mut out = check_reduced_many(rig, log, &[(p, &[margin_k])], score_from_s)?;
+    Ok(out.remove(0).remove(0))
+}
+
+/// One firmware model in [`check_reduced_many`] and its running scores per margin.
+struct Probe {
+    model: Model<f64>,
+    margins: Vec<f64>,
+    valves: Vec<eha_guard::protection::Valve>,
+    /// Per margin: max |e| and under-prediction vs the reference, vs the
+    /// measured max |e|, under, over, Σe², open ticks, open J.
+    acc: Vec<[f64; 8]>,
+    /// Per margin, per tick: |est − reference| and the under-prediction of
+    /// the measured drain (−∞ where not scored), for the regions.
+    e_ref: Vec<Vec<f64>>,
+    e_under: Vec<Vec<f64>>,
+}
+
+/// [`check_reduced_with`] for several firmware models on one replay of the
+/// reference: `models` pairs each parameter set with the margins to score
+/// it with (the margin is added to the estimate only, the model's state is
+/// the same for every margin, so one model run serves them all). One
+/// result per model, one [`ReducedCheck`] per margin, each equal to its own
+/// [`check_reduced_with`] run. The reference replay is the expensive part:
+/// commissioning scores up to three models with two margins on each
+/// held-out log.
+pub fn check_reduced_many(rig: &Rig, log: &CalLog, models: &[(&ReducedParams, &[f64])], score_from_s: f64) -> Result<Vec<Vec<ReducedCheck>>, String> {
     let inputs = replay_inputs(&log.run, &log.name).map_err(|e| e.to_string())?;
     let t_end = log.run.time_s[log.run.len() - 1];
     let mut plant = Plant::new(rig, &Scenario::Replay(inputs)).map_err(|e| e.to_string())?;
-    let mut m = Model::<f64>::new(p).map_err(|e| format!("reduced model rejects the parameters: {e:?}"))?;
-    let (mut k, mut prev_x, mut max_ref, mut under_ref) = (0usize, 0.0, 0.0f64, 0.0f64);
-    let (mut max_meas, mut under, mut over, mut ss, mut n) = (0.0f64, 0.0f64, 0.0f64, 0.0, 0usize);
+    let mut probes = models
+        .iter()
+        .map(|(p, margins)| {
+            let model = Model::<f64>::new(p).map_err(|e| format!("reduced model rejects the parameters: {e:?}"))?;
+            let n = margins.len();
+            Ok(Probe {
+                model,
+                margins: margins.to_vec(),
+                valves: vec![eha_guard::protection::Valve::new(); n],
+                acc: vec![[0.0; 8]; n],
+                e_ref: vec![Vec::new(); n],
+                e_under: vec![Vec::new(); n],
+            })
+        })
+        .collect::<Result<Vec<_>, String>>()?;
+    let (mut k, mut prev_x) = (0usize, 0.0);
+    let mut rows: Vec<TickRow> = Vec::new();
     let has_drain = log.has(Channel::TDrainC);
     let servo = matches!(circuit_of(&log.run), Ok(Circuit::Servo));
     let cfg = eha_guard::protection::ValveConfig::DEFAULT;
     let (open_c, close_c) = (f64::from(cfg.open_c), f64::from(cfg.close_c));
-    let mut valve = eha_guard::protection::Valve::new();
-    let (mut open_ticks, mut open_j) = (0usize, 0.0f64);
-    let (mut rows, mut e_ref, mut e_under): (Vec<TickRow>, Vec<f64>, Vec<f64>) = (Vec::new(), Vec::new(), Vec::new());
     let mut open = false;
     plant
         .run(0.01, t_end, |snap| {
             let s = Sensors::from(snap);
             if k == 0 {
-                m.set_uniform(s.ambient_c);
+                probes.iter_mut().for_each(|pr| pr.model.set_uniform(s.ambient_c));
                 prev_x = s.position_mm;
             }
-            let est = m.drain_c() + margin_k;
-            max_ref = max_ref.max((est - s.t_drain_c).abs());
-            under_ref = under_ref.max(s.t_drain_c - est);
             rows.push((s.t, s.speed_rpm.abs(), (s.p_a_bar - s.p_b_bar).abs(), s.t_drain_c));
-            e_ref.push((est - s.t_drain_c).abs());
-            let mut eu = f64::NEG_INFINITY;
-            if has_drain && k > 0 && s.t >= score_from_s {
-                if let Some(meas) = log.run.value_at(Channel::TDrainC, s.t) {
-                    let e = est - meas;
-                    max_meas = max_meas.max(e.abs());
-                    under = under.max(-e);
-                    over = over.max(e);
-                    eu = -e;
-                    ss += e * e;
-                    n += 1;
+            let meas = if has_drain && k > 0 && s.t >= score_from_s { log.run.value_at(Channel::TDrainC, s.t) } else { None };
+            let u = ModelInputN::from_wire_f64(s.current_a, s.p_a_bar, s.p_b_bar, s.speed_rpm, s.position_mm - prev_x, s.ambient_c);
+            for pr in &mut probes {
+                let drain = pr.model.drain_c();
+                let total_kw = pr.model.last_total_kw();
+                for (j, &margin_k) in pr.margins.iter().enumerate() {
+                    let est = drain + margin_k;
+                    let a = &mut pr.acc[j];
+                    a[0] = a[0].max((est - s.t_drain_c).abs());
+                    a[1] = a[1].max(s.t_drain_c - est);
+                    pr.e_ref[j].push((est - s.t_drain_c).abs());
+                    let mut eu = f64::NEG_INFINITY;
+                    if let Some(m) = meas {
+                        let e = est - m;
+                        a[2] = a[2].max(e.abs());
+                        a[3] = a[3].max(-e);
+                        a[4] = a[4].max(e);
+                        a[5] += e * e;
+                        eu = -e;
+                    }
+                    pr.e_under[j].push(eu);
+                    // The guard's valve on this estimate (open loop), decided
+                    // every tick with the dwell in ticks.
+                    let v = &mut pr.valves[j];
+                    v.update_with(est, false, open_c, close_c, cfg.dwell_ticks);
+                    if v.is_open() {
+                        a[6] += 1.0;
+                        a[7] += total_kw * 1e3 * 0.01;
+                    }
+                }
+                if pr.model.tick_n(&u) {
+                    pr.model.update(if open { 10 } else { 0 });
                 }
             }
-            e_under.push(eu);
-            // The guard's valve on this estimate (open loop), decided every
-            // tick with the dwell in ticks.
-            valve.update_with(est, false, open_c, close_c, cfg.dwell_ticks);
-            if valve.is_open() {
-                open_ticks += 1;
-                open_j += m.last_total_kw() * 1e3 * 0.01;
-            }
-            let u = ModelInputN::from_wire_f64(s.current_a, s.p_a_bar, s.p_b_bar, s.speed_rpm, s.position_mm - prev_x, s.ambient_c);
             prev_x = s.position_mm;
-            if m.tick_n(&u) {
-                m.update(if open { 10 } else { 0 });
-            }
             open = log.run.value_at(Channel::LngValve, s.t).is_some_and(|v| v >= 0.5);
             k += 1;
             Ok(Control { lng_valve: Some(open), stop: false })
         })
         .map_err(|e| e.to_string())?;
+    let j_per_kg = f64::from(eha_guard::protection::LngConfig::DEFAULT.j_per_kg());
     let meas = |x: f64| has_drain.then_some(x);
-    Ok(ReducedCheck {
-        log: log.name.clone(),
-        margin_k,
-        vs_reference_max_k: max_ref,
-        vs_reference_under_k: under_ref,
-        vs_reference_region: region_of(&rows, &e_ref, servo),
-        vs_measured_max_k: meas(max_meas),
-        vs_measured_under_k: meas(under),
-        vs_measured_over_k: meas(over),
-        vs_measured_rmse_k: meas((ss / n.max(1) as f64).sqrt()),
-        vs_measured_region: (has_drain && under > 0.0).then(|| region_of(&rows, &e_under, servo)),
-        valve_open_s: open_ticks as f64 * 0.01,
-        lng_kg: open_j / f64::from(eha_guard::protection::LngConfig::DEFAULT.j_per_kg()),
-    })
+    Ok(probes
+        .into_iter()
+        .map(|pr| {
+            (0..pr.margins.len())
+                .map(|j| {
+                    let a = pr.acc[j];
+                    let n = pr.e_under[j].iter().filter(|x| x.is_finite()).count();
+                    ReducedCheck {
+                        log: log.name.clone(),
+                        margin_k: pr.margins[j],
+                        vs_reference_max_k: a[0],
+                        vs_reference_under_k: a[1],
+                        vs_reference_region: region_of(&rows, &pr.e_ref[j], servo),
+                        vs_measured_max_k: meas(a[2]),
+                        vs_measured_under_k: meas(a[3]),
+                        vs_measured_over_k: meas(a[4]),
+                        vs_measured_rmse_k: meas((a[5] / n.max(1) as f64).sqrt()),
+                        vs_measured_region: (has_drain && a[3] > 0.0).then(|| region_of(&rows, &pr.e_under[j], servo)),
+                        valve_open_s: a[6] * 0.01,
+                        lng_kg: a[7] / j_per_kg,
+                    }
+                })
+                .collect()
+        })
+        .collect())
 }
 
 /// Allowance added to the validation's largest under-prediction, K: twice
@@ -280,11 +336,26 @@ pub struct Split {
 /// drain after the split; the margin is the largest under-prediction there
 /// plus [`MARGIN_ALLOWANCE_K`].
 pub fn score_split(split: &Split, train: &[CalLog], p: &ReducedParams) -> Result<MarginValidation, CommissionError> {
-    let mut folds = Vec::new();
+    Ok(score_split_many(split, train, &[p])?.remove(0))
+}
+
+/// [`score_split`] for several firmware parameter sets on one replay of
+/// `split.rig` per training log; one validation per set, in order.
+pub fn score_split_many(split: &Split, train: &[CalLog], ps: &[&ReducedParams]) -> Result<Vec<MarginValidation>, CommissionError> {
+    let mut folds: Vec<Vec<ReducedCheck>> = vec![Vec::new(); ps.len()];
+    let models: Vec<(&ReducedParams, &[f64])> = ps.iter().map(|&p| (p, &[0.0][..])).collect();
     for (l, h) in train.iter().zip(&split.heads) {
         let t_split = h.run.time_s[h.run.len() - 1];
-        folds.push(check_reduced_core(&split.rig, p, l, 0.0, t_split).map_err(CommissionError::Run)?);
+        let checks = check_reduced_many(&split.rig, l, &models, t_split).map_err(CommissionError::Run)?;
+        for (f, mut c) in folds.iter_mut().zip(checks) {
+            f.push(c.remove(0));
+        }
     }
-    let worst = folds.iter().filter_map(|f| f.vs_measured_under_k).fold(0.0, f64::max);
-    Ok(MarginValidation { folds, allowance_k: MARGIN_ALLOWANCE_K, margin_k: worst + MARGIN_ALLOWANCE_K })
+    Ok(folds
+        .into_iter()
+        .map(|folds| {
+            let worst = folds.iter().filter_map(|f| f.vs_measured_under_k).fold(0.0, f64::max);
+            MarginValidation { folds, allowance_k: MARGIN_ALLOWANCE_K, margin_k: worst + MARGIN_ALLOWANCE_K }
+        })
+        .collect())
 }

@@ -13,7 +13,8 @@ use crate::scenario::Circuit;
 use crate::simulation::replay::circuit_of;
 use super::paths::{Choice, PathKind, PathOutcome};
 pub use super::check::{
-    check_reduced, check_reduced_with, score_split, CommissionError, MarginValidation, ReducedCheck, Region, Split, MARGIN_ALLOWANCE_K,
+    check_reduced_many,
+    check_reduced, check_reduced_with, score_split, score_split_many, CommissionError, MarginValidation, ReducedCheck, Region, Split, MARGIN_ALLOWANCE_K,
     MARGIN_MAX_K, REDUCED_BOUND_K, SPLIT_FRACTION,
 };
 use eha_guard::model::ReducedParams;
@@ -273,36 +274,65 @@ pub fn commission_with(base: &Rig, train: &[CalLog], holdout: &[CalLog], o: &Cal
     }
     let mut params = reduce(&cal.rig)
         .ok_or_else(|| CommissionError::Reduce("it gives firmware parameters the firmware model rejects".into()))?;
-    let reduced: Vec<ReducedCheck> = train
-        .iter()
-        .chain(holdout)
-        .map(|l| check_reduced(&cal.rig, &params, l))
-        .collect::<Result<_, _>>()
-        .map_err(CommissionError::Run)?;
-    let default_on_holdout = holdout
-        .iter()
-        .map(|l| check_reduced(&cal.rig, &eha_guard::params::DEFAULT, l))
-        .collect::<Result<_, _>>()
-        .map_err(CommissionError::Run)?;
-    let reduced_ok = reduced.iter().all(|r| r.vs_reference_max_k <= REDUCED_BOUND_K);
+    let mut reduced: Vec<ReducedCheck> = train.iter().map(|l| check_reduced(&cal.rig, &params, l)).collect::<Result<_, _>>().map_err(CommissionError::Run)?;
     let excitation_ok = !cal.warnings.iter().any(|w| w.starts_with(crate::calibration::ident::NO_EXCITATION));
     // The validation fit starts from the commissioning's multipliers: from
     // the rig file, a 1e-9 K nudge of the logs moved big-pump's margin by
     // 0.17 K (the heads fit wanders along its ill-determined directions);
     // from there, by 0.043 K.
     let split = if with_margin { split_fit(base, train, o, Some(&cal.theta))? } else { None };
-    let margin = split.as_ref().map(|s| score_split(s, train, &s.reduction)).transpose()?;
-    if with_margin && margin.is_none() {
-        cal.warnings.push("no drain margin: it needs `t_drain_c` in every training log, and a validation fit (first 60 % of every training log) that the firmware model accepts".into());
-    }
-    let reduction = super::paths::PathOutcome::new(PathKind::Reduction, &cal.rig, params, margin, holdout)?;
     // The second path: the firmware model's own parameters identified from
     // the logs, from the reduction; validated on the same split.
     let direct = match (&o.direct, with_margin) {
-        (Some(d), true) => super::paths::direct_path(&cal.rig, &params, train, holdout, split.as_ref(), d),
+        (Some(d), true) => super::paths::direct_fits(&params, train, split.as_ref(), d),
         (Some(_), false) => Err("not asked: no margin validation to compare the paths on".into()),
         (None, _) => Err("switched off".into()),
     };
+    // Both paths' folds after the split on one replay of each training log.
+    let (margin, direct_validation) = match &split {
+        Some(s) => {
+            let mut ps = vec![&s.reduction];
+            if let Ok((_, Some(h))) = &direct {
+                ps.push(h);
+            }
+            let mut v = score_split_many(s, train, &ps)?.into_iter();
+            (v.next(), v.next())
+        }
+        None => (None, None),
+    };
+    if with_margin && margin.is_none() {
+        cal.warnings.push("no drain margin: it needs `t_drain_c` in every training log, and a validation fit (first 60 % of every training log) that the firmware model accepts".into());
+    }
+    // Every held-out log on one replay of the commissioned reference: the
+    // reduction without and with its margin, the paper default, the direct
+    // path without and with its margin.
+    let red_m = super::paths::checked_margins(margin.as_ref());
+    let dir_m = super::paths::checked_margins(direct_validation.as_ref());
+    let default_params = eha_guard::params::DEFAULT;
+    let mut models: Vec<(&ReducedParams, &[f64])> = vec![(&params, &red_m), (&default_params, &[0.0])];
+    if let Ok((f, _)) = &direct {
+        models.push((&f.params, &dir_m));
+    }
+    let (mut red_plain, mut red_with, mut default_on_holdout, mut dir_plain, mut dir_with) = (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for l in holdout {
+        let mut c = check_reduced_many(&cal.rig, l, &models, f64::NEG_INFINITY).map_err(CommissionError::Run)?.into_iter();
+        let mut r = c.next().expect("the reduction's checks");
+        red_with.push(r.pop().expect("one check per margin"));
+        red_plain.push(if r.is_empty() { red_with[red_with.len() - 1].clone() } else { r.remove(0) });
+        default_on_holdout.push(c.next().expect("the default's check").remove(0));
+        if let Some(mut d) = c.next() {
+            dir_with.push(d.pop().expect("one check per margin"));
+            dir_plain.push(if d.is_empty() { dir_with[dir_with.len() - 1].clone() } else { d.remove(0) });
+        }
+    }
+    reduced.extend(red_plain.iter().cloned());
+    let reduced_ok = reduced.iter().all(|r| r.vs_reference_max_k <= REDUCED_BOUND_K);
+    let reduction = PathOutcome::from_checks(PathKind::Reduction, params, margin, red_plain, red_with);
+    let direct: Result<(super::direct::DirectFit, PathOutcome), String> =
+        direct.map(|(f, _)| {
+            let p = f.params;
+            (f, PathOutcome::from_checks(PathKind::Direct, p, direct_validation, dir_plain, dir_with))
+        });
     let choice = super::paths::choose(&reduction, direct.as_ref().map(|d| &d.1).map_err(String::as_str));
     let (direct_fit, direct_path) = match direct {
         Ok((f, p)) => (Some(f), Ok(p)),

@@ -9,7 +9,7 @@
 //! block comes from the path that is safer there ([`choose`]), and the
 //! report gives both paths' numbers.
 
-use super::check::{check_reduced_with, score_split, CommissionError, MarginValidation, ReducedCheck, Split, MARGIN_MAX_K};
+use super::check::{check_reduced_many, CommissionError, MarginValidation, ReducedCheck, Split, MARGIN_MAX_K};
 use super::direct::{identify_direct, DirectFit, DirectOptions};
 use super::log::CalLog;
 use crate::rig::Rig;
@@ -54,15 +54,24 @@ pub struct PathOutcome {
 
 impl PathOutcome {
     /// Runs the held-out checks of `params` (reference `rig` replays the
-    /// logs' inputs; the scores are against the measured drain).
+    /// logs' inputs; the scores are against the measured drain), with and
+    /// without the validated margin in one replay per log.
     pub fn new(kind: PathKind, rig: &Rig, params: ReducedParams, validation: Option<MarginValidation>, holdout: &[CalLog]) -> Result<Self, CommissionError> {
-        let check = |m: f64| -> Result<Vec<ReducedCheck>, CommissionError> {
-            holdout.iter().map(|l| check_reduced_with(rig, &params, l, m)).collect::<Result<_, _>>().map_err(CommissionError::Run)
-        };
-        let plain = check(0.0)?;
-        let m = validation.as_ref().map_or(0.0, |v| v.margin_k);
-        let with = if m > 0.0 && m <= MARGIN_MAX_K { check(m)? } else { plain.clone() };
-        Ok(PathOutcome { kind, params, validation, holdout: plain, holdout_with_margin: with })
+        let margins = checked_margins(validation.as_ref());
+        let mut plain = Vec::new();
+        let mut with = Vec::new();
+        for l in holdout {
+            let mut c = check_reduced_many(rig, l, &[(&params, &margins)], f64::NEG_INFINITY).map_err(CommissionError::Run)?.remove(0);
+            with.push(c.pop().expect("one check per margin"));
+            plain.push(c.pop().unwrap_or_else(|| with[with.len() - 1].clone()));
+        }
+        Ok(Self::from_checks(kind, params, validation, plain, with))
+    }
+
+    /// The outcome from held-out checks already run: `plain` without a
+    /// margin, `with` with [`checked_margins`]' last margin.
+    pub fn from_checks(kind: PathKind, params: ReducedParams, validation: Option<MarginValidation>, plain: Vec<ReducedCheck>, with: Vec<ReducedCheck>) -> Self {
+        PathOutcome { kind, params, validation, holdout: plain, holdout_with_margin: with }
     }
 
     /// The validated margin, K, when validated and within the block's bound.
@@ -89,27 +98,30 @@ impl PathOutcome {
     }
 }
 
-/// The direct path: identified on the training logs from the reduction
-/// `p0`, validated by the same identification on the split's heads from the
-/// split's reduction.
-pub fn direct_path(
-    rig: &Rig,
-    p0: &ReducedParams,
-    train: &[CalLog],
-    holdout: &[CalLog],
-    split: Option<&Split>,
-    o: &DirectOptions,
-) -> Result<(DirectFit, PathOutcome), String> {
+/// The margins a path's held-out logs are checked with: 0, and the
+/// validated margin when there is one within the block's bound (the
+/// block's own margin; beyond the bound the block carries none).
+pub fn checked_margins(validation: Option<&MarginValidation>) -> Vec<f64> {
+    match validation.map(|v| v.margin_k) {
+        Some(m) if m > 0.0 && m <= MARGIN_MAX_K => vec![0.0, m],
+        _ => vec![0.0],
+    }
+}
+
+/// The direct path's identifications: on the training logs from the
+/// reduction `p0`, and (with a split) on the split's heads from the split's
+/// reduction, whose parameters the split then scores. `Err`: why it did
+/// not run, or the firmware model rejects what it found.
+pub fn direct_fits(p0: &ReducedParams, train: &[CalLog], split: Option<&Split>, o: &DirectOptions) -> Result<(DirectFit, Option<ReducedParams>), String> {
     let fit = identify_direct(p0, train, o).map_err(|e| e.to_string())?;
-    let validation = match split {
-        Some(s) => {
-            let h = identify_direct(&s.reduction, &s.heads, o).map_err(|e| format!("on the split's heads: {e}"))?;
-            Some(score_split(s, train, &h.params).map_err(|e| e.to_string())?)
-        }
+    let heads = match split {
+        Some(s) => Some(identify_direct(&s.reduction, &s.heads, o).map_err(|e| format!("on the split's heads: {e}"))?.params),
         None => None,
     };
-    let out = PathOutcome::new(PathKind::Direct, rig, fit.params, validation, holdout).map_err(|e| e.to_string())?;
-    Ok((fit, out))
+    for p in std::iter::once(&fit.params).chain(heads.as_ref()) {
+        eha_guard::model::Model::<f64>::new(p).map_err(|e| format!("the firmware model rejects the identified parameters: {e:?}"))?;
+    }
+    Ok((fit, heads))
 }
 
 /// Which path is flashed, and why.

@@ -209,3 +209,22 @@ fn low_excitation_commissioning_warns_and_is_refused_or_conservative() {
     // for the excitation; flashed anyway it would under-predict by 1.4 K.
     assert!(!c.flashable() && c.reduced_ok, "measured: refused for the excitation alone");
 }
+
+/// One replay of the reference carrying several firmware models and
+/// margins (`check_reduced_many`, how commissioning scores the held-out
+/// logs) gives each model and margin exactly what its own replay gives:
+/// the margin is added to the estimate only and the models do not share
+/// state. Exact equality: the same operations in the same order.
+#[test]
+fn one_replay_scores_several_models_and_margins_as_separate_replays() {
+    use eha_sim::calibration::commission::{check_reduced_many, check_reduced_with};
+    let l = CalLog::new("soak-33", log(&other_rig_truth(), &mission(Kind::SoakThenMixed, 600.0, 33), 2.0, 33, true).expect("log"), 120).expect("cal log");
+    let rig = other_rig_file();
+    let p = eha_sim::reduce::reduce(&rig).expect("reduction");
+    let d = eha_guard::params::DEFAULT;
+    let many = check_reduced_many(&rig, &l, &[(&p, &[0.0, 1.5]), (&d, &[0.0])], f64::NEG_INFINITY).expect("one replay");
+    assert_eq!(many[0][0], check_reduced_with(&rig, &p, &l, 0.0).expect("replay"));
+    assert_eq!(many[0][1], check_reduced_with(&rig, &p, &l, 1.5).expect("replay"));
+    assert_eq!(many[1][0], check_reduced(&rig, &d, &l).expect("replay"));
+    assert!(many[0][1].valve_open_s >= many[0][0].valve_open_s, "the margin opens the valve earlier");
+}
