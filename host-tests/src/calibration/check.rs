@@ -150,14 +150,30 @@ pub(crate) fn check_reduced_core(rig: &Rig, p: &ReducedParams, log: &CalLog, mar
     Ok(out.remove(0).remove(0))
 }
 
+/// The running scores of one model and margin in [`check_reduced_many`].
+#[derive(Debug, Clone, Copy, Default)]
+struct Scores {
+    /// Largest |estimate − reference drain| and under-prediction of it, K.
+    max_ref: f64,
+    under_ref: f64,
+    /// Against the measured drain: largest |e|, under- and over-prediction,
+    /// K, and Σe², K².
+    max_meas: f64,
+    under: f64,
+    over: f64,
+    ss: f64,
+    /// Ticks with the valve open, and the cooling demand meanwhile, J.
+    open_ticks: f64,
+    open_j: f64,
+}
+
 /// One firmware model in [`check_reduced_many`] and its running scores per margin.
 struct Probe {
     model: Model<f64>,
     margins: Vec<f64>,
     valves: Vec<eha_guard::protection::Valve>,
-    /// Per margin: max |e| and under-prediction vs the reference, vs the
-    /// measured max |e|, under, over, Σe², open ticks, open J.
-    acc: Vec<[f64; 8]>,
+    /// Per margin, the running scores.
+    acc: Vec<Scores>,
     /// Per margin, per tick: |est − reference| and the under-prediction of
     /// the measured drain (−∞ where not scored), for the regions.
     e_ref: Vec<Vec<f64>>,
@@ -185,7 +201,7 @@ pub fn check_reduced_many(rig: &Rig, log: &CalLog, models: &[(&ReducedParams, &[
                 model,
                 margins: margins.to_vec(),
                 valves: vec![eha_guard::protection::Valve::new(); n],
-                acc: vec![[0.0; 8]; n],
+                acc: vec![Scores::default(); n],
                 e_ref: vec![Vec::new(); n],
                 e_under: vec![Vec::new(); n],
             })
@@ -214,16 +230,16 @@ pub fn check_reduced_many(rig: &Rig, log: &CalLog, models: &[(&ReducedParams, &[
                 for (j, &margin_k) in pr.margins.iter().enumerate() {
                     let est = drain + margin_k;
                     let a = &mut pr.acc[j];
-                    a[0] = a[0].max((est - s.t_drain_c).abs());
-                    a[1] = a[1].max(s.t_drain_c - est);
+                    a.max_ref = a.max_ref.max((est - s.t_drain_c).abs());
+                    a.under_ref = a.under_ref.max(s.t_drain_c - est);
                     pr.e_ref[j].push((est - s.t_drain_c).abs());
                     let mut eu = f64::NEG_INFINITY;
                     if let Some(m) = meas {
                         let e = est - m;
-                        a[2] = a[2].max(e.abs());
-                        a[3] = a[3].max(-e);
-                        a[4] = a[4].max(e);
-                        a[5] += e * e;
+                        a.max_meas = a.max_meas.max(e.abs());
+                        a.under = a.under.max(-e);
+                        a.over = a.over.max(e);
+                        a.ss += e * e;
                         eu = -e;
                     }
                     pr.e_under[j].push(eu);
@@ -232,8 +248,8 @@ pub fn check_reduced_many(rig: &Rig, log: &CalLog, models: &[(&ReducedParams, &[
                     let v = &mut pr.valves[j];
                     v.update_with(est, false, open_c, close_c, cfg.dwell_ticks);
                     if v.is_open() {
-                        a[6] += 1.0;
-                        a[7] += total_kw * 1e3 * 0.01;
+                        a.open_ticks += 1.0;
+                        a.open_j += total_kw * 1e3 * 0.01;
                     }
                 }
                 if pr.model.tick_n(&u) {
@@ -258,16 +274,16 @@ pub fn check_reduced_many(rig: &Rig, log: &CalLog, models: &[(&ReducedParams, &[
                     ReducedCheck {
                         log: log.name.clone(),
                         margin_k: pr.margins[j],
-                        vs_reference_max_k: a[0],
-                        vs_reference_under_k: a[1],
+                        vs_reference_max_k: a.max_ref,
+                        vs_reference_under_k: a.under_ref,
                         vs_reference_region: region_of(&rows, &pr.e_ref[j], servo),
-                        vs_measured_max_k: meas(a[2]),
-                        vs_measured_under_k: meas(a[3]),
-                        vs_measured_over_k: meas(a[4]),
-                        vs_measured_rmse_k: meas((a[5] / n.max(1) as f64).sqrt()),
-                        vs_measured_region: (has_drain && a[3] > 0.0).then(|| region_of(&rows, &pr.e_under[j], servo)),
-                        valve_open_s: a[6] * 0.01,
-                        lng_kg: a[7] / j_per_kg,
+                        vs_measured_max_k: meas(a.max_meas),
+                        vs_measured_under_k: meas(a.under),
+                        vs_measured_over_k: meas(a.over),
+                        vs_measured_rmse_k: meas((a.ss / n.max(1) as f64).sqrt()),
+                        vs_measured_region: (has_drain && a.under > 0.0).then(|| region_of(&rows, &pr.e_under[j], servo)),
+                        valve_open_s: a.open_ticks * 0.01,
+                        lng_kg: a.open_j / j_per_kg,
                     }
                 })
                 .collect()

@@ -316,13 +316,14 @@ pub fn commission_with(base: &Rig, train: &[CalLog], holdout: &[CalLog], o: &Cal
     let (mut red_plain, mut red_with, mut default_on_holdout, mut dir_plain, mut dir_with) = (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for l in holdout {
         let mut c = check_reduced_many(&cal.rig, l, &models, f64::NEG_INFINITY).map_err(CommissionError::Run)?.into_iter();
-        let mut r = c.next().expect("the reduction's checks");
-        red_with.push(r.pop().expect("one check per margin"));
-        red_plain.push(if r.is_empty() { red_with[red_with.len() - 1].clone() } else { r.remove(0) });
+        let (p, w) = super::paths::plain_and_with(c.next().expect("the reduction's checks"));
+        red_plain.push(p);
+        red_with.push(w);
         default_on_holdout.push(c.next().expect("the default's check").remove(0));
-        if let Some(mut d) = c.next() {
-            dir_with.push(d.pop().expect("one check per margin"));
-            dir_plain.push(if d.is_empty() { dir_with[dir_with.len() - 1].clone() } else { d.remove(0) });
+        if let Some(d) = c.next() {
+            let (p, w) = super::paths::plain_and_with(d);
+            dir_plain.push(p);
+            dir_with.push(w);
         }
     }
     reduced.extend(red_plain.iter().cloned());

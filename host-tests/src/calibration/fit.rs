@@ -314,7 +314,7 @@ pub fn calibrate(base: &Rig, logs: &[CalLog], o: &CalOptions) -> Result<Calibrat
     // (measured on big-pump: with the basin check and a central-difference
     // retry in the split fit too, the nudge test's margin moved 1.956 ->
     // 2.253 K, against 2.290 -> 2.118 K with the plain polish there).
-    let (theta, polish) = if o.start.is_some() { polish(base, logs, lm_theta, &free, sigma, &runs, None) } else { polish_basins(base, logs, lm_theta, &free, sigma, &runs) };
+    let (theta, polish) = if o.start.is_some() { polish(base, logs, lm_theta, &free, sigma, &runs) } else { polish_basins(base, logs, lm_theta, &free, sigma, &runs) };
     // 4. Identifiability at the optimum.
     let (r1, j1) = jacobian_ln(base, logs, &theta, &free, sigma, &runs)
         .ok_or_else(|| CalError::Model("the calibrated rig".into(), "model failed in the final Jacobian".into()))?;
@@ -446,7 +446,7 @@ fn objective(base: &Rig, logs: &[CalLog], theta: &[f64], free: &[usize], sigma: 
 /// stops where its evaluation budget or step tolerance stops it: measured
 /// on big-pump, a 1e-9 K nudge of the logs moved that point enough to move
 /// the held-out headline by 0.09 K.
-fn polish(base: &Rig, logs: &[CalLog], theta: Vec<f64>, free: &[usize], sigma: Sigma, runs: &AtomicUsize, s2: Option<f64>) -> (Vec<f64>, Polish) {
+fn polish(base: &Rig, logs: &[CalLog], theta: Vec<f64>, free: &[usize], sigma: Sigma, runs: &AtomicUsize) -> (Vec<f64>, Polish) {
     let mut out = Polish::default();
     if free.is_empty() {
         out.converged = true;
@@ -457,16 +457,9 @@ fn polish(base: &Rig, logs: &[CalLog], theta: Vec<f64>, free: &[usize], sigma: S
     // cannot follow the machine (χ² per point ≫ 1) then leaves the
     // directions its logs barely inform to the priors, instead of to the
     // path LM took; a model that fits (s² = 1) keeps σ_d.
-    let s2_given = s2.is_some();
-    let s2 = match s2 {
-        Some(s2) => s2,
-        None => {
-            let Some(r0) = data_residuals(base, logs, &theta, sigma, runs) else { return (theta, out) };
-            (r0.iter().map(|x| x * x).sum::<f64>() / r0.len().saturating_sub(free.len()).max(1) as f64).max(1.0)
-        }
-    };
-    out.s2 = s2;
-    polish_at(base, logs, theta, free, sigma, runs, out, s2_given)
+    let Some(r0) = data_residuals(base, logs, &theta, sigma, runs) else { return (theta, out) };
+    out.s2 = (r0.iter().map(|x| x * x).sum::<f64>() / r0.len().saturating_sub(free.len()).max(1) as f64).max(1.0);
+    polish_at(base, logs, theta, free, sigma, runs, out, false)
 }
 
 /// The ball-valve block's oil film and heat capacity: their ratio (the
@@ -486,7 +479,7 @@ pub const SCALE_PAIR: (&str, &str) = ("film_ball", "cap_ball_block");
 /// [`Polish::other_basin`].
 fn polish_basins(base: &Rig, logs: &[CalLog], lm_theta: Vec<f64>, free: &[usize], sigma: Sigma, runs: &AtomicUsize) -> (Vec<f64>, Polish) {
     let start = lm_theta.clone();
-    let (theta, p) = polish(base, logs, lm_theta, free, sigma, runs, None);
+    let (theta, p) = polish(base, logs, lm_theta, free, sigma, runs);
     let pair = (super::set::index(SCALE_PAIR.0), super::set::index(SCALE_PAIR.1));
     let (Some(a), Some(b)) = pair else { return (theta, p) };
     if !(free.contains(&a) && free.contains(&b)) {
@@ -498,7 +491,7 @@ fn polish_basins(base: &Rig, logs: &[CalLog], lm_theta: Vec<f64>, free: &[usize]
         let (lo, hi) = (PARAMS[k].lo.ln(), PARAMS[k].hi.ln());
         mirror[k] = (mirror[k].ln() - 2.0 * mean).clamp(lo, hi).exp();
     }
-    let (theta2, p2) = polish(base, logs, mirror, free, sigma, runs, Some(p.s2));
+    let (theta2, p2) = polish_at(base, logs, mirror, free, sigma, runs, Polish { s2: p.s2, ..Polish::default() }, true);
     let (f1, f2) = (p.objective.last().copied().unwrap_or(f64::INFINITY), p2.objective.last().copied().unwrap_or(f64::INFINITY));
     if f2 < f1 {
         (theta2, Polish { other_basin: Some(f1), ..p2 })
@@ -507,7 +500,9 @@ fn polish_basins(base: &Rig, logs: &[CalLog], lm_theta: Vec<f64>, free: &[usize]
     }
 }
 
-/// The Gauss–Newton iterations of [`polish`] with `out.s2` set.
+/// The Gauss–Newton iterations of [`polish`] with `out.s2` set; `far`: the
+/// start is far from an optimum (the reflected start of [`polish_basins`]),
+/// twice [`POLISH_MAX_ITERS`].
 #[allow(clippy::too_many_arguments)]
 fn polish_at(base: &Rig, logs: &[CalLog], mut theta: Vec<f64>, free: &[usize], sigma: Sigma, runs: &AtomicUsize, mut out: Polish, far: bool) -> (Vec<f64>, Polish) {
     let s2 = out.s2;

@@ -61,9 +61,10 @@ impl PathOutcome {
         let mut plain = Vec::new();
         let mut with = Vec::new();
         for l in holdout {
-            let mut c = check_reduced_many(rig, l, &[(&params, &margins)], f64::NEG_INFINITY).map_err(CommissionError::Run)?.remove(0);
-            with.push(c.pop().expect("one check per margin"));
-            plain.push(c.pop().unwrap_or_else(|| with[with.len() - 1].clone()));
+            let c = check_reduced_many(rig, l, &[(&params, &margins)], f64::NEG_INFINITY).map_err(CommissionError::Run)?.remove(0);
+            let (p, w) = plain_and_with(c);
+            plain.push(p);
+            with.push(w);
         }
         Ok(Self::from_checks(kind, params, validation, plain, with))
     }
@@ -106,6 +107,15 @@ pub fn checked_margins(validation: Option<&MarginValidation>) -> Vec<f64> {
         Some(m) if m > 0.0 && m <= MARGIN_MAX_K => vec![0.0, m],
         _ => vec![0.0],
     }
+}
+
+/// One held-out log's checks with [`checked_margins`] (from
+/// [`check_reduced_many`]): (without a margin, with the margin), the same
+/// check twice when there is no margin.
+pub fn plain_and_with(mut checks: Vec<ReducedCheck>) -> (ReducedCheck, ReducedCheck) {
+    let with = checks.pop().expect("one check per margin");
+    let plain = checks.pop().unwrap_or_else(|| with.clone());
+    (plain, with)
 }
 
 /// The direct path's identifications: on the training logs from the

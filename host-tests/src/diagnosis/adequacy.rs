@@ -9,6 +9,25 @@ use super::stats::{Metrics, XCorr};
 use super::model::ParamSpec;
 use crate::measured::{Channel, MeasuredRun};
 
+/// A channel's noise σ as the diagnosis takes it, K: [`noise_sigma`], 0.1 K
+/// when too few samples give it, at least 0.02 K.
+pub fn channel_noise_k(v: &[Option<f64>]) -> f64 {
+    noise_sigma(v).unwrap_or(0.1).max(0.02)
+}
+
+/// RMS rise of channel `ch` of `run` above the ambient over its samples at
+/// or after `split`, K (NaN without an ambient column).
+pub fn rms_rise_k(run: &MeasuredRun, ch: Channel, split: f64) -> f64 {
+    let Some(v) = run.get(ch) else { return 0.0 };
+    let rises: Vec<f64> = v
+        .iter()
+        .zip(&run.time_s)
+        .filter(|(x, t)| x.is_some() && **t >= split)
+        .map(|(x, t)| x.unwrap_or(0.0) - run.value_at(Channel::AmbientC, *t).unwrap_or(f64::NAN))
+        .collect();
+    (rises.iter().map(|r| r * r).sum::<f64>() / rises.len().max(1) as f64).sqrt()
+}
+
 /// Noise standard deviation of a sampled channel, K, from its second
 /// differences (a slowly varying signal plus white noise of σ gives
 /// differences y\[i+1\] − 2y\[i\] + y\[i−1\] of variance 6σ²), robustly:
@@ -135,15 +154,12 @@ impl MisfitRule {
 /// when a channel misfits.
 pub fn assess(run: &MeasuredRun, split: f64, m: &Metrics, xcorr: &[XCorr], nuisance: (&[ParamSpec], &[f64]), rule: MisfitRule) -> Adequacy {
     let (specs, values) = nuisance;
-    let amb: Vec<f64> = run.time_s.iter().map(|&t| run.value_at(Channel::AmbientC, t).unwrap_or(f64::NAN)).collect();
     let mut channels = Vec::new();
     for c in &m.channels {
         let Some(ch) = Channel::from_name(&c.channel) else { continue };
         let Some(v) = run.get(ch) else { continue };
-        let noise = noise_sigma(v).unwrap_or(0.1).max(0.02);
-        let rises: Vec<f64> =
-            v.iter().zip(&run.time_s).zip(&amb).filter(|((x, t), _)| x.is_some() && **t >= split).map(|((x, _), a)| x.unwrap_or(0.0) - a).collect();
-        let rise = (rises.iter().map(|r| r * r).sum::<f64>() / rises.len().max(1) as f64).sqrt();
+        let noise = channel_noise_k(v);
+        let rise = rms_rise_k(run, ch, split);
         let mut regs: Vec<(String, f64, f64)> =
             xcorr.iter().filter(|x| x.channel == c.channel).map(|x| (x.regressor.clone(), x.peak_rho, x.peak_lag_s)).collect();
         regs.sort_by(|a, b| b.1.abs().total_cmp(&a.1.abs()));

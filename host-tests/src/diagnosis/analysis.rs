@@ -238,6 +238,13 @@ fn metrics(run: &MeasuredRun, s: &SimSeries, split: f64, lb_lags: usize) -> Metr
     Metrics { channels, train_rmse_k: rmse(&tr).unwrap_or(f64::NAN), heldout_rmse_k: rmse(&ho).unwrap_or(f64::NAN) }
 }
 
+/// The time that splits `run` into training and held-out windows, s: a
+/// fraction `train_fraction` of its span (at most 0.7) from its start.
+pub fn split_time_s(run: &MeasuredRun, train_fraction: f64) -> f64 {
+    let (t0, t1) = (run.time_s[0], run.time_s[run.len() - 1]);
+    t0 + train_fraction.min(0.7) * (t1 - t0)
+}
+
 /// Training fit points: present temperature samples before `split`, thinned
 /// uniformly to at most `per_channel` per channel.
 pub fn fit_points(run: &MeasuredRun, split: f64, per_channel: usize) -> Vec<Point> {
@@ -301,8 +308,7 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
     if run.len() < 20 {
         return Err(DiagnoseError::TooShort(run.len()));
     }
-    let (t0, t1) = (run.time_s[0], run.time_s[run.len() - 1]);
-    let split = t0 + o.train_fraction.min(0.7) * (t1 - t0);
+    let split = split_time_s(run, o.train_fraction);
     let pts = fit_points(run, split, o.points_per_channel);
     let nuis_specs = sim.nuisance();
     let nominal_v: Vec<f64> = nuis_specs.iter().map(|s| s.start).collect();

@@ -30,11 +30,7 @@ pub fn run_emu_case_twin(case: EmuCase, o: &DiagnoseOptions, twin: bool) -> Resu
 
 /// The posterior of `d` as `diagnosis.json` writes it.
 fn probabilities(d: &Diagnosis) -> Vec<ProbabilityJson> {
-    d.posterior
-        .causes
-        .iter()
-        .map(|c| ProbabilityJson { cause: c.cause.clone(), probability: c.probability, log_bayes_factor: c.log_bayes_factor, prior: c.prior })
-        .collect()
+    d.posterior.causes.iter().map(ProbabilityJson::from).collect()
 }
 
 /// [`run_emu_case_twin`]; with `oracle`, also the hidden effect injected
@@ -337,12 +333,8 @@ pub fn redecide(r: &mut EmuResult, rule: DecisionRule) {
             return;
         }
         let p = super::evidence::posterior_from_terms(terms, rule);
-        *probs = p
-            .iter()
-            .map(|c| ProbabilityJson { cause: c.cause.clone(), probability: c.probability, log_bayes_factor: c.log_bayes_factor, prior: c.prior })
-            .collect();
-        let named = p.iter().find(|c| c.probability >= super::evidence::NAME_PROBABILITY && super::evidence::names_a_cause(&c.cause));
-        *answer = match named {
+        *probs = p.iter().map(ProbabilityJson::from).collect();
+        *answer = match super::evidence::named_cause(&p) {
             Some(c) => c.cause.clone(),
             None if super::evidence::names_a_cause(answer) => (if misfits { "unexplained" } else { "none" }).into(),
             None => answer.clone(),
@@ -386,7 +378,7 @@ pub fn document(ok: &[EmuResult]) -> String {
     md += "\n**The hidden effect's own candidate, as fitted in the diagnosis** (known to the sweep only):\n\n\
            | scenario (seed) | hidden | answer | ΔBIC | affected channel held-out, baseline → with it (gain) | pooled held-out (K) | qualifies | in the model's structure: imprint left after calibration (best gain) | class |\n\
            |---|---|---|---:|---|---|---|---|---|\n";
-    for row in ok.iter().filter_map(|r| oracle_row(r)) {
+    for row in ok.iter().filter_map(oracle_row) {
         md += &row;
         md.push('\n');
     }

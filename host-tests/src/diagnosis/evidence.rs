@@ -12,21 +12,24 @@
 //! evidence counts independent information, not autocorrelated samples
 //! (the BIC's assumption, false here: Ljung–Box p ≈ 0 on every channel).
 //!
-//! The structures differ in what the discrepancy may be. On each channel
-//! it is either at the **floor** of this log — what the rig-level structure
-//! error of a machine that is not our model leaves — or, with prior
-//! probability [`ANOMALY_PRIOR`], beyond it (amplitude free, log-uniform
-//! from the floor to [`MAX_DISCREPANCY_K`], marginalised numerically):
-//! - `none`: every channel at its floor;
-//! - `unexplained`: the calibrated baseline with at least one channel
-//!   beyond its floor;
+//! The structures differ in what the discrepancy may be ([`DecisionRule`]).
+//! Under the product's rule ([`DecisionRule::Pooled`], [`DECISION_RULE`]):
+//! - `none`: every channel's discrepancy at the **floor** of this log —
+//!   what the rig-level structure error of a machine that is not our model
+//!   leaves, each channel's estimated from the others ([`floor_for`]);
+//! - `unexplained`: the calibrated baseline with every channel's amplitude
+//!   free (log-uniform from its floor to [`MAX_DISCREPANCY_K`],
+//!   marginalised numerically);
 //! - a candidate: the channels its physics touches ([`touched_channels`])
 //!   at the floor estimated from the untouched ones ([`floor_for`]) — a
 //!   candidate has to beat a discrepancy of floor size there, not the
-//!   sensor noise — and every other channel at its floor or beyond, as
-//!   for the baseline. A channel that misfits far more than the others
-//!   costs a candidate what it costs `unexplained`, so it does not veto the
-//!   decision on the candidate's own channels.
+//!   sensor noise — and every other channel at its own misfit.
+//!
+//! A channel that misfits far more than the others then sends the
+//! probability to `unexplained` (a measured limit). The alternative
+//! [`DecisionRule::PerChannel`] — each channel at its floor or, with prior
+//! probability [`ANOMALY_PRIOR`], beyond it — removes that veto but makes
+//! a false discovery on an emulator log; it is measured, not adopted.
 
 use super::fit::{FitResult, Point};
 use super::model::{Candidate, ParamSpec};
@@ -158,20 +161,6 @@ pub fn floor_rule(c: &ChannelFloor, all: &[ChannelFloor], touched: &[String], ru
     (med * scale(c)).max(c.noise_k)
 }
 
-/// The evidence of one structure, nats.
-#[derive(Debug, Clone, Default, serde::Serialize)]
-pub struct Evidence {
-    /// Log-likelihood of the data at the fitted parameters.
-    pub log_lik: f64,
-    /// Log prior density of the fitted parameters (ln-value space).
-    pub log_prior: f64,
-    /// (p/2) ln 2π − ½ ln det H: the posterior volume (with `log_prior`,
-    /// the Occam factor).
-    pub log_volume: f64,
-    /// ln Z = sum of the three.
-    pub log_z: f64,
-}
-
 /// Channel runs of `pts` (grouped by channel, rows increasing, as
 /// [`super::analysis::fit_points`] makes them): (channel, index range).
 fn channel_runs(pts: &[Point]) -> Vec<(Channel, std::ops::Range<usize>)> {
@@ -209,12 +198,14 @@ fn prior_terms(specs: &[ParamSpec], values: &[f64]) -> (f64, Vec<f64>) {
     (lp, prec)
 }
 
-/// Laplace evidence of the structure `fit` (parameters `specs`, nuisance
-/// then extension) with the discrepancy amplitude `amp(channel)` of every
-/// channel and time constant `tau_s`; `noise(channel)` the channel's σ.
-/// `None` when the fit has no Jacobian.
+/// The Occam factor of the Laplace evidence of the structure `fit`
+/// (parameters `specs`, nuisance then extension), nats: ln prior density +
+/// ln posterior volume, with the discrepancy amplitude `amp(channel)` of
+/// every channel and time constant `tau_s`; `noise(channel)` the channel's
+/// σ. (The likelihood part is [`ChannelTerms::log_lik`].) `None` when the
+/// fit has no Jacobian or no residual at `all_pts`.
 #[allow(clippy::too_many_arguments)]
-pub fn log_evidence(
+pub fn log_occam(
     run: &MeasuredRun,
     pts: &[Point],
     all_pts: &[Point],
@@ -223,8 +214,8 @@ pub fn log_evidence(
     amp: &dyn Fn(Channel) -> f64,
     noise: &dyn Fn(Channel) -> f64,
     tau_s: f64,
-) -> Option<Evidence> {
-    let log_lik = log_lik_at(run, all_pts, fit, amp, noise, tau_s)?;
+) -> Option<f64> {
+    super::fit::residuals_at(run, &fit.series, all_pts)?;
     let j = fit.jac_ln.as_ref()?;
     let p = j.ncols();
     let mut h = DMatrix::<f64>::zeros(p, p);
@@ -251,47 +242,14 @@ pub fn log_evidence(
         h.symmetric_eigenvalues().iter().map(|e| e.max(1e-12).ln()).sum()
     });
     let log_volume = 0.5 * p as f64 * (2.0 * std::f64::consts::PI).ln() - 0.5 * ln_det;
-    Some(Evidence { log_lik, log_prior, log_volume, log_z: log_lik + log_prior + log_volume })
-}
-
-/// Log-likelihood of the residual of `fit` at `pts` (every channel's
-/// discrepancy amplitude `amp(channel)`).
-pub fn log_lik_at(run: &MeasuredRun, pts: &[Point], fit: &FitResult, amp: &dyn Fn(Channel) -> f64, noise: &dyn Fn(Channel) -> f64, tau_s: f64) -> Option<f64> {
-    sum_over_channels(run, pts, fit, |ch, times, y| Whitener::new(times, amp(ch), noise(ch), tau_s).log_lik(y))
-}
-
-/// The sum over the channels of `pts` of `f(channel, times_s, residual)`,
-/// the residual of `fit` at those points.
-fn sum_over_channels(run: &MeasuredRun, pts: &[Point], fit: &FitResult, f: impl Fn(Channel, &[f64], &[f64]) -> f64) -> Option<f64> {
-    let r = super::fit::residuals_at(run, &fit.series, pts)?;
-    Some(
-        channel_runs(pts)
-            .into_iter()
-            .map(|(ch, range)| {
-                let times: Vec<f64> = pts[range.clone()].iter().map(|(_, i)| run.time_s[*i]).collect();
-                f(ch, &times, &r[range])
-            })
-            .sum(),
-    )
-}
-
-/// Log marginal likelihood of one channel's residual `y` at `times_s` with
-/// the discrepancy amplitude free: log-uniform prior on [`lo_k`,
-/// [`MAX_DISCREPANCY_K`]], integrated on a grid in ln s.
-pub fn log_lik_free_amplitude(times_s: &[f64], y: &[f64], lo_k: f64, noise_k: f64, tau_s: f64) -> f64 {
-    let (a, b) = (lo_k.ln(), MAX_DISCREPANCY_K.ln().max(lo_k.ln() + 1e-6));
-    let n = 48;
-    let d = (b - a) / n as f64;
-    let ls: Vec<f64> = (0..n).map(|i| Whitener::new(times_s, (a + (i as f64 + 0.5) * d).exp(), noise_k, tau_s).log_lik(y)).collect();
-    let m = ls.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    m + (ls.iter().map(|l| (l - m).exp()).sum::<f64>() * d / (b - a)).ln()
+    Some(log_prior + log_volume)
 }
 
 /// The log-likelihood on the amplitude grid at amplitude `a_k`: quadratic
 /// through the three nearest grid points in ln a (linear left 0.16 nats
 /// on a 700-point residual); clamped to the grid's ends.
 fn grid_at(l: &[f64], a_k: f64) -> f64 {
-    let g: Vec<f64> = amplitude_grid().iter().map(|v| v.ln()).collect();
+    let g: &[f64] = &LN_AMPLITUDE_GRID;
     let x = a_k.ln().clamp(g[0], g[g.len() - 1]);
     let i = g.iter().rposition(|v| *v <= x).unwrap_or(0).clamp(1, g.len() - 2);
     let (x0, x1, x2) = (g[i - 1], g[i], g[i + 1]);
@@ -300,7 +258,9 @@ fn grid_at(l: &[f64], a_k: f64) -> f64 {
         + l[i + 1] * (x - x0) * (x - x1) / ((x2 - x0) * (x2 - x1))
 }
 
-/// [`log_lik_free_amplitude`] from the amplitude grid.
+/// Log marginal likelihood of one channel with its discrepancy amplitude
+/// free: log-uniform prior on [`lo_k`, [`MAX_DISCREPANCY_K`]], integrated
+/// on 48 points in ln a of the amplitude grid's interpolant ([`grid_at`]).
 fn grid_free(l: &[f64], lo_k: f64) -> f64 {
     let (a, b) = (lo_k.ln(), MAX_DISCREPANCY_K.ln().max(lo_k.ln() + 1e-6));
     let n = 48;
@@ -483,6 +443,10 @@ pub fn amplitude_grid() -> Vec<f64> {
     (0..72).map(|i| (a + (b - a) * i as f64 / 71.0).exp()).collect()
 }
 
+/// ln of [`amplitude_grid`], computed once ([`grid_at`] reads it for every
+/// interpolated amplitude).
+static LN_AMPLITUDE_GRID: std::sync::LazyLock<Vec<f64>> = std::sync::LazyLock::new(|| amplitude_grid().iter().map(|v| v.ln()).collect());
+
 /// One channel's log-likelihood under one structure's fit, on the
 /// amplitude grid ([`amplitude_grid`]) of its discrepancy.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -537,7 +501,7 @@ fn channel_terms(run: &MeasuredRun, pts: &[Point], fit: &FitResult, amp: &dyn Fn
 impl Posterior {
     /// The candidate named at [`NAME_PROBABILITY`], if any.
     pub fn named(&self) -> Option<&CauseProbability> {
-        self.causes.iter().find(|c| c.probability >= NAME_PROBABILITY && c.cause != "none" && c.cause != "unexplained")
+        named_cause(&self.causes)
     }
 
     /// Probability of `cause` (0 when absent).
@@ -609,12 +573,12 @@ pub fn posterior_of(
         let amp = |ch: Channel| find(ch).map_or(0.1, |x| floor_for(x, &floors, &touched));
         let mut specs = nuisance.to_vec();
         specs.extend(ext(f.candidate));
-        let occam = |e: Option<Evidence>| e.map_or(f64::NEG_INFINITY, |e| e.log_prior + e.log_volume);
+        let occam = |o: Option<f64>| o.unwrap_or(f64::NEG_INFINITY);
         terms.push(StructureTerms {
             cause: f.candidate.name().into(),
             prior: if admitted(f.candidate) { (1.0 - 2.0 * PRIOR_NO_CAUSE) / Candidate::EXTENSIONS.len() as f64 } else { 0.0 },
-            occam: occam(log_evidence(run, pts, all_pts, f, &specs, &amp, &noise, tau_s)),
-            base_occam: occam(log_evidence(run, pts, all_pts, base, nuisance, &amp, &noise, tau_s)),
+            occam: occam(log_occam(run, pts, all_pts, f, &specs, &amp, &noise, tau_s)),
+            base_occam: occam(log_occam(run, pts, all_pts, base, nuisance, &amp, &noise, tau_s)),
             channels: channel_terms(run, all_pts, f, &amp, &noise, tau_s),
         });
     }
@@ -625,6 +589,11 @@ pub fn posterior_of(
 /// Whether `answer` names a cause (not `none`, not `unexplained`).
 pub fn names_a_cause(answer: &str) -> bool {
     answer != "none" && answer != "unexplained"
+}
+
+/// The candidate of `causes` named at [`NAME_PROBABILITY`], if any.
+pub fn named_cause(causes: &[CauseProbability]) -> Option<&CauseProbability> {
+    causes.iter().find(|c| c.probability >= NAME_PROBABILITY && names_a_cause(&c.cause))
 }
 
 #[cfg(test)]

@@ -17,11 +17,12 @@
 //! expected imprint ratio per candidate is reported alone and with the
 //! other candidates fitted too (separation).
 
-use super::analysis::{evidence_points, fit_points};
+use super::analysis::{evidence_points, fit_points, split_time_s, DiagnoseOptions};
 use super::evidence::{floor_for, ChannelFloor};
 use super::fit::{fit, FitOptions};
 use super::model::{Candidate, Simulator};
-use super::projection::{channel_floors, expected_ratio, rise, row, ProjectedRow, Sensitivities};
+use super::adequacy::rms_rise_k;
+use super::projection::{channel_floors, row, ProjectedRow, Sensitivities};
 use super::reference::{nuisance_set, ReferenceModel};
 use crate::emulator::missions::{EmuMission, EmuScenario};
 use crate::hydraulics::NEEDLE_SET_RPM;
@@ -289,7 +290,7 @@ struct Machine {
 
 /// Calibrates the physical set of the reference model on `log` (one fit on
 /// the training window).
-fn calibrate(rig: &Rig, log: &MeasuredRun, split: f64, per_channel: usize) -> Result<(Machine, Vec<f64>), String> {
+fn calibrate(rig: &Rig, log: &MeasuredRun, split: f64, per_channel: usize) -> Result<Machine, String> {
     let model = ReferenceModel::new(rig.clone(), log).map_err(|e| e.to_string())?;
     let phys = model.physical_set().ok_or("the model has no physical set")?;
     let specs = phys.nuisance();
@@ -302,12 +303,13 @@ fn calibrate(rig: &Rig, log: &MeasuredRun, split: f64, per_channel: usize) -> Re
     }
     let floors = channel_floors(log, &f.series, &pts, split);
     let values = specs.iter().zip(&f.nuisance).map(|(s, v)| (s.name.clone(), *v)).collect();
-    Ok((Machine { rig: rig.clone(), calibrated: crate::calibration::apply(rig, &theta), values, floors }, f.nuisance))
+    Ok(Machine { rig: rig.clone(), calibrated: crate::calibration::apply(rig, &theta), values, floors })
 }
 
-/// Training/held-out split of `run` (the diagnosis's 70 %).
+/// Training/held-out split of `run`: the diagnosis's, at its default
+/// training fraction.
 fn split_of(run: &MeasuredRun) -> f64 {
-    run.time_s[0] + 0.7 * (run.time_s[run.len() - 1] - run.time_s[0])
+    split_time_s(run, DiagnoseOptions::default().train_fraction)
 }
 
 /// Points per channel in the plan's projections (the diagnosis's default).
@@ -350,7 +352,7 @@ fn project(machine: &Machine, run: &MeasuredRun, cands: &[(Candidate, f64)]) -> 
         .into_iter()
         .filter_map(|ch| {
             let f = machine.floors.iter().find(|f| f.channel == ch.name())?;
-            let r = rise(run, ch, split);
+            let r = rms_rise_k(run, ch, split);
             Some(ChannelFloor { channel: f.channel.clone(), noise_k: f.noise_k, rise_k: r, misfit_k: f.misfit_k / f.rise_k.max(1e-6) * r })
         })
         .collect();
@@ -391,7 +393,7 @@ pub fn plan(rig: &Rig, log: &MeasuredRun, cands: &[(Candidate, f64)], limits: Li
         return Err(format!("`{}` cannot be excited by a throttle-circuit plan (the cylinder is isolated)", c.0.name()));
     }
     let split = split_of(log);
-    let (machine, _) = calibrate(rig, log, split, PER_CHANNEL)?;
+    let machine = calibrate(rig, log, split, PER_CHANNEL)?;
     let ambient_c = log.get(Channel::AmbientC).map_or(20.0, |v| {
         let x: Vec<f64> = v.iter().flatten().copied().collect();
         x.iter().sum::<f64>() / x.len().max(1) as f64
@@ -427,8 +429,10 @@ pub fn plan(rig: &Rig, log: &MeasuredRun, cands: &[(Candidate, f64)], limits: Li
     let (k, d_s) = best.ok_or("no mission of the family is within the limits")?;
     let p = projections[k].take().ok_or("the chosen mission has no projection")?;
     let on_log = project(&machine, log, cands).ok();
+    // The candidates' parameter names and units (one model of the log, not one per name).
+    let ext_model = ReferenceModel::new(rig.clone(), log).ok();
     let named = |c: Candidate, m: f64| -> Vec<(String, f64, String)> {
-        ReferenceModel::new(rig.clone(), log).map(|r| r.extension_params(c)).unwrap_or_default().iter().map(|s| (s.name.clone(), m, s.unit.clone())).collect()
+        ext_model.as_ref().map(|r| r.extension_params(c)).unwrap_or_default().iter().map(|s| (s.name.clone(), m, s.unit.clone())).collect()
     };
     let expected = cands
         .iter()
@@ -447,11 +451,6 @@ pub fn plan(rig: &Rig, log: &MeasuredRun, cands: &[(Candidate, f64)], limits: Li
         .collect();
     let candidates = cands.iter().flat_map(|&(c, m)| named(c, m).into_iter().map(move |(n, v, u)| (c.name().to_string(), n, v, u))).collect();
     Ok(Plan { design: designs[k].clone(), d_s, candidates, expected, family: family_rows, limits, log_floors: machine.floors })
-}
-
-/// The expected ratio of a planned row on `channel`, if present.
-pub fn ratio_on(r: &ProjectedRow, channel: &str) -> Option<f64> {
-    r.channels.iter().find(|c| c.channel == channel).map(|c| expected_ratio(c.left_k, c.floor_k))
 }
 
 impl Plan {

@@ -18,6 +18,7 @@
 //! √3·f) is where a diagnosis must name the cause. Bounds are ignored and
 //! the calibration is taken as linear, so r̂ is an estimate, not a bound.
 
+use super::adequacy::{channel_noise_k, rms_rise_k};
 use super::evidence::{floor_for, touched_channels, ChannelFloor};
 use super::fit::{residuals_at, Point, PRIOR_DATA_SIGMA_K};
 use super::model::{Candidate, ParamSpec, SimSeries, Simulator};
@@ -156,20 +157,9 @@ pub fn channel_floors(run: &MeasuredRun, base: &SimSeries, pts: &[Point], split:
             continue;
         }
         let misfit = (idx.iter().map(|&i| r[i] * r[i]).sum::<f64>() / idx.len() as f64).sqrt();
-        let noise = super::adequacy::noise_sigma(v).unwrap_or(0.1).max(0.02);
-        out.push(ChannelFloor { channel: ch.name().into(), noise_k: noise, rise_k: rise(run, ch, split), misfit_k: misfit });
+        out.push(ChannelFloor { channel: ch.name().into(), noise_k: channel_noise_k(v), rise_k: rms_rise_k(run, ch, split), misfit_k: misfit });
     }
     out
-}
-
-/// RMS rise of channel `ch` above ambient on the held-out window, K.
-pub fn rise(run: &MeasuredRun, ch: Channel, split: f64) -> f64 {
-    let Some(v) = run.get(ch) else { return 0.0 };
-    let r: Vec<f64> = (0..run.len())
-        .filter(|&i| run.time_s[i] >= split)
-        .filter_map(|i| Some(v[i]? - run.value_at(Channel::AmbientC, run.time_s[i])?))
-        .collect();
-    (r.iter().map(|x| x * x).sum::<f64>() / r.len().max(1) as f64).sqrt()
 }
 
 /// One channel's share of a candidate's projected imprint.

@@ -29,6 +29,12 @@ pub struct ProbabilityJson {
     pub prior: f64,
 }
 
+impl From<&super::evidence::CauseProbability> for ProbabilityJson {
+    fn from(c: &super::evidence::CauseProbability) -> Self {
+        ProbabilityJson { cause: c.cause.clone(), probability: c.probability, log_bayes_factor: c.log_bayes_factor, prior: c.prior }
+    }
+}
+
 /// `diagnosis.json`: exactly its documented top-level keys. RMSEs are pooled
 /// over every measured temperature channel, K; "before" is the calibrated
 /// baseline, "after" the model with `cause` switched on (equal to "before"
@@ -110,7 +116,7 @@ impl DiagnosisJson {
                 .posterior
                 .causes
                 .iter()
-                .map(|c| ProbabilityJson { cause: c.cause.clone(), probability: c.probability, log_bayes_factor: c.log_bayes_factor, prior: c.prior })
+                .map(ProbabilityJson::from)
                 .collect(),
             channels: d.posterior.channels.clone(),
             unexplained: d.unexplained.then(|| UnexplainedJson {

@@ -88,7 +88,7 @@ fn toy(omega: impl Fn(f64) -> f64) -> (Toy, MeasuredRun, f64) {
 fn floors(run: &MeasuredRun, split: f64) -> Vec<ChannelFloor> {
     [Channel::TPumpC, Channel::TMotorC]
         .iter()
-        .map(|ch| ChannelFloor { channel: ch.name().into(), noise_k: 0.1, rise_k: eha_sim::diagnosis::projection::rise(run, *ch, split), misfit_k: 0.2 })
+        .map(|ch| ChannelFloor { channel: ch.name().into(), noise_k: 0.1, rise_k: eha_sim::diagnosis::adequacy::rms_rise_k(run, *ch, split), misfit_k: 0.2 })
         .collect()
 }
 

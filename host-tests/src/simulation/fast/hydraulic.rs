@@ -58,9 +58,9 @@ pub struct TempPath {
 }
 
 impl TempPath {
-    /// Constant temperatures `z`.
-    pub fn constant(model: &Model, z: [f64; N_NODES]) -> Self {
-        let oil = model.hydraulic_oil(&z);
+    /// Constant temperatures `z`, with the oil's properties there
+    /// (`Model::hydraulic_oil(z)`).
+    pub fn constant(z: [f64; N_NODES], oil: HydraulicOil) -> Self {
         Self { t0: 0.0, z0: z, t1: 1.0, z1: z, oil0: oil, oil1: oil }
     }
 
@@ -100,7 +100,7 @@ impl HydTrack {
         rhs(model, z, t, &y, &mut f);
         self.ros.stats.evals += 1;
         self.check_coupling(model, z, t, &y, &f);
-        self.path = TempPath::constant(model, *z);
+        self.path = TempPath::constant(*z, model.hydraulic_oil(z));
         self.pts.clear();
         self.pts.push((t, y, f));
         self.last_branch = None;
@@ -194,7 +194,7 @@ impl HydTrack {
             self.pts.push((t, y, f));
             self.last_branch = None;
         }
-        self.path = TempPath { t0: 0.0, z0: *z, t1: 1.0, z1: *z, oil0: oil, oil1: oil };
+        self.path = TempPath::constant(*z, oil);
         let i = self.pts.partition_point(|p| p.0 <= t);
         if i > 1 {
             self.pts.drain(..i - 1);
