@@ -7,6 +7,9 @@
 //! an argument).
 //!
 //! `cargo run --profile fast -p eha-sim --example reference_profile -- 2`
+//!
+//! `DURATION_S=5` runs the fast path over the first 5 s only (the same
+//! plant and callbacks, ending there): where a run's work goes in time.
 
 use eha_sim::fast::{FastOptions, FastPlant};
 use eha_sim::rig::Rig;
@@ -22,6 +25,7 @@ fn main() {
     ];
     let fast_only = std::env::var_os("FAST_ONLY").is_some();
     let bdf_only = std::env::var_os("BDF_ONLY").is_some();
+    let duration: Option<f64> = std::env::var("DURATION_S").ok().map(|s| s.parse().expect("DURATION_S: seconds"));
     for (key, sc, opt) in cases {
         if which.as_deref().is_some_and(|w| w != key) {
             continue;
@@ -37,7 +41,8 @@ fn main() {
             // The plant itself (the same steps as `simulate_fast`, whose
             // callbacks only read the interpolants), for its own counters.
             let mut p = FastPlant::with_options(&rig, &sc, FastOptions::for_scenario(&sc)).expect("plant");
-            p.run(opt.control_interval_s.min(opt.output_interval_s), sc.duration_s(), |_| Ok(Default::default())).expect("runs");
+            let t_end = duration.unwrap_or(sc.duration_s());
+            p.run(opt.control_interval_s.min(opt.output_interval_s), t_end, |_| Ok(Default::default())).expect("runs");
             let (s, f) = (p.stats(), p.fast_stats());
             println!(
                 "case {key} fast: {} thermal steps ({} rejected), {} model evaluations ({} for {} Jacobians), {} hydraulic steps ({} rejected, {} hydraulic evaluations, {} Jacobians)",
