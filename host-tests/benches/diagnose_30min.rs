@@ -5,7 +5,8 @@
 //! manoeuvres). Prints the wall time, the model runs by phase and the
 //! verdict of each, and the time left the progress bar
 //! (`diagnosis::progress`, hidden here) showed at 25, 50 and 75 % against
-//! the time actually left; run with
+//! the time actually left (`DIAG30_ONLY=throttle|servo` runs one log,
+//! `DIAG30_XCORR_STEP_S` sets the cross-correlation's lag step); run with
 //! `cargo bench --profile fast -p eha-sim --bench diagnose_30min`.
 //! (One run per log: a diagnosis is a minute-scale job, so the statistics of
 //! criterion's repeated sampling would cost ten times that.)
@@ -16,6 +17,19 @@ use eha_sim::diagnosis::synth::{generate, Mismatch, SynthCase, SynthScenario};
 use eha_sim::diagnosis::{diagnose, Candidate, DiagnoseOptions};
 use eha_sim::rig::Rig;
 use std::time::Instant;
+
+/// CPU time of this process so far (user + system), s, from
+/// /proc/self/stat (Linux; 0 elsewhere): less sensitive to other
+/// processes' load than the wall time.
+fn cpu_s() -> f64 {
+    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
+    let after = stat.rsplit_once(')').map_or("", |x| x.1);
+    let f: Vec<&str> = after.split_whitespace().collect();
+    // Fields 14 and 15 of the file (clock ticks, 100 per s): the 12th and
+    // 13th after the `)`.
+    let tick = |k: usize| f.get(k).and_then(|x| x.parse::<f64>().ok()).unwrap_or(0.0);
+    (tick(11) + tick(12)) / 100.0
+}
 
 fn main() {
     let cases = [
@@ -29,16 +43,22 @@ fn main() {
         }
         let case = SynthCase { hidden, scenario, mismatch: Mismatch::Nuisance, seed: 7, duration_s: 1800.0, sample_s: 0.1 };
         let (run, _) = generate(&case).expect("generate");
-        let t = Instant::now();
+        let (t, cpu0) = (Instant::now(), cpu_s());
         let model = ReferenceModel::new(Rig::default(), &run).expect("model");
-        let o = DiagnoseOptions::default();
+        // DIAG30_XCORR_STEP_S: the cross-correlation's lag resolution
+        // (0 = every sample, the former cost), for before/after numbers.
+        let mut o = DiagnoseOptions::default();
+        if let Some(v) = std::env::var("DIAG30_XCORR_STEP_S").ok().and_then(|v| v.parse().ok()) {
+            o.xcorr_lag_step_s = v;
+        }
         let progress = Progress::new(&model, o.fit.max_sims, false);
         let d = diagnose(&run, &progress, &o).expect("diagnose");
         let crossings = progress.finish();
         let secs = t.elapsed().as_secs_f64();
         println!(
-            "{name}: {} rows, {secs:.1} s wall, {} model runs, cause {} (hidden {}), held-out {:.3} -> {:.3} K",
+            "{name}: {} rows, {secs:.1} s wall, {:.1} s CPU, {} model runs, cause {} (hidden {}), held-out {:.3} -> {:.3} K",
             run.len(),
+            cpu_s() - cpu0,
             d.sims,
             d.cause.name(),
             hidden.name(),

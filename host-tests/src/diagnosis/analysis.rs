@@ -9,7 +9,7 @@ use super::identify::{identifiable, HOUSING_OUTER_PREFIX};
 use super::model::{Candidate, Phase, SimSeries, Simulator};
 use super::regressors::regressors;
 pub use super::stats::{ChannelMetrics, Metrics, XCorr};
-use super::stats::{bias, bic, cross_correlation, ljung_box, max_abs, rmse};
+use super::stats::{bias, bic, cross_correlation_every, ljung_box, max_abs, rmse};
 use crate::measured::{Channel, MeasuredRun};
 use rayon::prelude::*;
 
@@ -48,6 +48,13 @@ pub const PHYSICAL_MISFIT_RISE_FRACTION: f64 = 0.1;
 /// the full physical calibration is not good enough to judge by.
 pub const PHYSICAL_MISFIT_ABS_K: f64 = 1.0;
 
+/// Default [`DiagnoseOptions::xcorr_lag_step_s`]: 1 s. The residuals and
+/// regressors of a thermal model move on minute scales, so a peak over
+/// 0…120 s is found on a 1 s grid; a log at 0.1 s then costs a tenth
+/// (measured on a 30-minute log at 0.1 s, bench `diagnose_30min`); logs
+/// sampled at 1 s or slower are unchanged.
+pub const XCORR_LAG_STEP_S: f64 = 1.0;
+
 /// Settings of one diagnosis.
 #[derive(Debug, Clone, Copy)]
 pub struct DiagnoseOptions {
@@ -82,6 +89,11 @@ pub struct DiagnoseOptions {
     pub min_pooled_gain: f64,
     /// Largest lag of the residual/regressor cross-correlation, s.
     pub max_lag_s: f64,
+    /// Lag resolution of that cross-correlation, s: lags at every sample
+    /// up to this spacing, then every k-th with k·dt ≈ this (0: every
+    /// sample). It only reports (the regressors a misfit follows, in
+    /// `report.md` and the `unexplained` advice), it decides nothing.
+    pub xcorr_lag_step_s: f64,
     /// Lags of the Ljung–Box test.
     pub ljung_box_lags: usize,
     /// When a channel of the calibrated baseline (global nuisance set)
@@ -106,6 +118,7 @@ impl Default for DiagnoseOptions {
             min_gain_k: 0.05,
             min_pooled_gain: 0.2,
             max_lag_s: 120.0,
+            xcorr_lag_step_s: XCORR_LAG_STEP_S,
             ljung_box_lags: 20,
             misfit: MisfitRule { noise_factor: MISFIT_NOISE_FACTOR, rise_fraction: MISFIT_RISE_FRACTION, abs_k: MISFIT_ABS_K },
             physical_misfit: MisfitRule {
@@ -352,9 +365,10 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
     let nominal = sim.simulate(&nominal_v, Candidate::None, &[]).map_err(DiagnoseError::Baseline)?;
     let base = fit(sim, run, &pts, Candidate::None, &nominal_v, None, o.fit)
         .ok_or_else(|| DiagnoseError::Baseline("no valid residuals at the nominal parameters".into()))?;
-    let m_before = metrics(run, &base.series, split, o.ljung_box_lags);
-    let xcorr = cross_correlations(run, &base.series, o.max_lag_s);
     log.mark("baseline", 1 + base.sims);
+    let m_before = metrics(run, &base.series, split, o.ljung_box_lags);
+    let xcorr = cross_correlations(run, &base.series, o.max_lag_s, o.xcorr_lag_step_s);
+    log.mark("residual analysis", 0);
     // `escalate` is false only in the physical tier (called from below).
     let rule = if escalate { o.misfit } else { o.physical_misfit };
     if escalate && assess(run, split, &m_before, &xcorr, (&nuis_specs, &base.nuisance), rule).misfits {
@@ -433,8 +447,9 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
                 }
             }
             m_before = metrics(run, &base.series, split, o.ljung_box_lags);
-            xcorr = cross_correlations(run, &base.series, o.max_lag_s);
+            xcorr = cross_correlations(run, &base.series, o.max_lag_s, o.xcorr_lag_step_s);
             (ranking, fit_metrics) = rank(run, sim, o, split, n, &base, &m_before, &fits);
+            log.mark("residual analysis", 0);
         }
     }
     let sims = 1 + base_sims + extra_sims;
@@ -454,6 +469,7 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
         &|c| ranking.iter().any(|r| r.qualifies && r.cause == c.name()),
         DISCREPANCY_TAU_S,
     );
+    log.mark("evidence", 0);
     let winner = posterior.named().and_then(|r| Candidate::from_name(&r.cause));
     let (cause, after_fit, m_after) = match winner.and_then(|w| fits.iter().zip(&fit_metrics).find(|(f, _)| f.candidate == w)) {
         Some((f, m)) => (f.candidate, f.clone(), m.clone()),
@@ -599,11 +615,13 @@ fn rank(
 }
 
 /// Cross-correlation of every channel's calibrated-baseline residual with
-/// every regressor of [`regressors`], lags 0…`max_lag_s`.
-fn cross_correlations(run: &MeasuredRun, base: &SimSeries, max_lag_s: f64) -> Vec<XCorr> {
+/// every regressor of [`regressors`], lags 0…`max_lag_s` every `step_s`
+/// (rounded to whole samples, at least one).
+fn cross_correlations(run: &MeasuredRun, base: &SimSeries, max_lag_s: f64, step_s: f64) -> Vec<XCorr> {
     let regs = regressors(run, base);
     let dt = (run.time_s[run.len() - 1] - run.time_s[0]) / (run.len() - 1) as f64;
     let max_lag = ((max_lag_s / dt).round() as usize).min(run.len() / 3);
+    let step = ((step_s / dt).round() as usize).max(1);
     type Residual = (Channel, Vec<Option<f64>>);
     let residuals: Vec<Residual> = Channel::TEMPERATURES
         .into_iter()
@@ -617,9 +635,9 @@ fn cross_correlations(run: &MeasuredRun, base: &SimSeries, max_lag_s: f64) -> Ve
     pairs
         .par_iter()
         .map(|((ch, r), (name, u))| {
-            let cc = cross_correlation(r, u, max_lag);
+            let cc = cross_correlation_every(r, u, max_lag, step);
             let (k, peak) = cc.iter().enumerate().fold((0, 0.0f64), |b, (k, v)| if v.abs() > b.1.abs() { (k, *v) } else { b });
-            XCorr { channel: ch.name().into(), regressor: name.clone(), rho0: cc[0], peak_rho: peak, peak_lag_s: k as f64 * dt }
+            XCorr { channel: ch.name().into(), regressor: name.clone(), rho0: cc[0], peak_rho: peak, peak_lag_s: (k * step) as f64 * dt }
         })
         .collect()
 }

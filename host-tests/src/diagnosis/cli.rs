@@ -105,6 +105,9 @@ fn run_inner(args: &DiagnoseArgs) -> anyhow::Result<String> {
             (&runs[0], &single as &dyn Simulator)
         }
     };
+    if joint.is_some() {
+        o = super::multi::options_for(&o, runs.len());
+    }
     let progress = Progress::new(model, o.fit.max_sims, true);
     let d = diagnose(run, &progress, &o);
     if d.is_err() {

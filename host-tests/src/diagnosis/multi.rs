@@ -108,6 +108,14 @@ pub fn combine(runs: &[&MeasuredRun], train_fraction: f64) -> Result<(MeasuredRu
     Ok((run, Layout { rows, log_rows, log_splits_s, split_s }))
 }
 
+/// The options of a joint diagnosis of `logs` logs: `o` with
+/// [`DiagnoseOptions::points_per_channel`] per log (the fit and evidence
+/// points are thinned over the combined table: each log keeps the
+/// resolution it has alone).
+pub fn options_for(o: &DiagnoseOptions, logs: usize) -> DiagnoseOptions {
+    DiagnoseOptions { points_per_channel: o.points_per_channel * logs.max(1), ..*o }
+}
+
 /// One model per log sharing one parameter vector: [`Simulator::simulate`]
 /// runs every log's model with the same nuisance and candidate values (in
 /// parallel) and places each log's series on the combined table of
