@@ -69,7 +69,15 @@ fn main() {
             println!("  phase {:22} {:5} runs {:7.1} s", p.name, p.runs, p.secs);
         }
         for c in crossings {
-            println!("  bar at {:3.0} % after {:6.1} s: showed {:6.1} s left, actually {:6.1} s", 100.0 * c.fraction, c.at_s, c.eta_s, secs - c.at_s);
+            println!(
+                "  bar at {:3.0} % ({} of {} runs) after {:6.1} s: showed {:6.1} s left, actually {:6.1} s",
+                100.0 * c.fraction,
+                c.runs.0,
+                c.runs.1,
+                c.at_s,
+                c.eta_s,
+                secs - c.at_s
+            );
         }
     }
 }

@@ -9,10 +9,15 @@
 //! The estimate, renewed at every phase ([`Phase`]): a fit costs its whole
 //! budget until a fit of the tier has been measured, then what the tier's
 //! baseline fit cost (scaled by (p + 2)/(p + 1) for a candidate's extra
-//! parameter), then what the candidate fits cost on average. The phases ahead: the candidates (two
-//! starts each); in the physical tier the two restarts and the refits; and,
-//! when the global baseline fails the strict rule (the diagnosis says so),
-//! the whole physical tier.
+//! parameter, at least [`CANDIDATE_SHARE`] of the budget), then what the
+//! candidate fits cost on average. The phases ahead: the candidates (two
+//! starts each), the two restarts and the refits ([`REFIT_SHARE`] of a
+//! candidate fit each; the physical tier always restarts, the global tier
+//! when a candidate qualifies, which both 30-minute bench logs did); and,
+//! while the global baseline fails the strict rule (the diagnosis says
+//! so), [`ESCALATION_WEIGHT`] of the physical tier. The residual analysis
+//! and the evidence are not counted (0.2–3 s of a 30-minute log's
+//! diagnosis, bench `diagnose_30min`).
 
 use super::model::{Candidate, ParamSpec, Phase, SimSeries, Simulator};
 use std::sync::{Arc, Mutex};
@@ -27,6 +32,8 @@ pub struct Crossing {
     pub at_s: f64,
     /// Time left the bar showed then, s.
     pub eta_s: f64,
+    /// Model runs done then, and the bar's length (runs done + estimated).
+    pub runs: (u64, u64),
 }
 
 /// Least share of its budget a candidate fit is expected to take before
@@ -49,7 +56,6 @@ pub const ESCALATION_WEIGHT: f64 = 0.5;
 
 struct Est {
     max_sims: usize,
-    physical: bool,
     params: usize,
     phase_start: u64,
     cand_fits: usize,
@@ -80,11 +86,12 @@ impl Est {
             self.base_fit.map_or(prior, |b| (b * (self.params + 2) as f64 / (self.params + 1) as f64).clamp(CANDIDATE_SHARE * prior, prior))
         })
     }
-    /// Runs of a whole tier with `p` nuisance parameters, by the prior.
-    fn tier(&self, p: usize, physical: bool) -> f64 {
+    /// Runs of a whole tier with `p` nuisance parameters, by the prior
+    /// (restarts and refits included).
+    fn tier(&self, p: usize) -> f64 {
         let (b, c) = (self.prior(p), self.prior(p + 1));
         let n = (2 * Candidate::EXTENSIONS.len()) as f64;
-        1.0 + b + n * c + if physical { 2.0 * b + Candidate::EXTENSIONS.len() as f64 * REFIT_SHARE * c } else { 0.0 }
+        1.0 + b + n * c + 2.0 * b + Candidate::EXTENSIONS.len() as f64 * REFIT_SHARE * c
     }
 }
 
@@ -119,7 +126,7 @@ impl<'a> Progress<'a> {
         if visible {
             bar.enable_steady_tick(std::time::Duration::from_millis(200));
         }
-        let est = Est { max_sims, physical: false, params: 0, phase_start: 0, cand_fits: 0, base_fit: None, cand_fit: None, crossings: Vec::new() };
+        let est = Est { max_sims, params: 0, phase_start: 0, cand_fits: 0, base_fit: None, cand_fit: None, crossings: Vec::new() };
         Progress { inner: Inner::Borrowed(inner), shared: Arc::new(Shared { bar, est: Mutex::new(est), start: Instant::now() }), physical: false }
     }
 
@@ -178,7 +185,7 @@ impl Simulator for Progress<'_> {
             for frac in [0.25, 0.5, 0.75] {
                 if f >= frac && !e.crossings.iter().any(|x| x.fraction == frac) {
                     let at_s = self.shared.start.elapsed().as_secs_f64();
-                    e.crossings.push(Crossing { fraction: frac, at_s, eta_s: b.eta().as_secs_f64() });
+                    e.crossings.push(Crossing { fraction: frac, at_s, eta_s: b.eta().as_secs_f64(), runs: (pos, len) });
                 }
             }
         }
@@ -193,16 +200,16 @@ impl Simulator for Progress<'_> {
         let ext = Candidate::EXTENSIONS.len() as f64;
         let (ahead, msg) = match p {
             Phase::Baseline { params } => {
-                (e.physical, e.params, e.base_fit, e.cand_fit) = (self.physical, params, None, None);
-                (e.tier(params, self.physical), format!("{tier}: baseline ({params} parameters)"))
+                (e.params, e.base_fit, e.cand_fit) = (params, None, None);
+                (e.tier(params), format!("{tier}: baseline ({params} parameters)"))
             }
             Phase::Candidates { fits, may_escalate } => {
                 e.base_fit = Some((done - 1.0).max(1.0));
                 e.cand_fits = fits;
-                let mut ahead = fits as f64 * e.cand() + if e.physical { 2.0 * e.base() + ext * REFIT_SHARE * e.cand() } else { 0.0 };
+                let mut ahead = fits as f64 * e.cand() + 2.0 * e.base() + ext * REFIT_SHARE * e.cand();
                 if may_escalate {
                     let pp = self.inner().physical_set().map_or(e.params, |s| s.nuisance().len());
-                    ahead += ESCALATION_WEIGHT * e.tier(pp, true);
+                    ahead += ESCALATION_WEIGHT * e.tier(pp);
                 }
                 (ahead, format!("{tier}: {fits} candidate fits"))
             }
