@@ -217,8 +217,10 @@ impl Diagnosis {
 /// The cost of one phase of a diagnosis.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct PhaseCost {
-    /// `global` or `physical`, then the phase (`baseline`, `candidates`,
-    /// `restarts`, `refits`).
+    /// `global` or `physical`, then the phase: `baseline` (the nominal run
+    /// and the baseline fit), `residual analysis` (metrics and
+    /// cross-correlations, no model runs), `candidates`, `restarts`,
+    /// `refits`, `evidence` (the posterior, no model runs).
     pub name: String,
     /// Model runs (fits' Jacobians included).
     pub runs: usize,
