@@ -86,14 +86,7 @@ fn run_inner(args: &DiagnoseArgs) -> anyhow::Result<String> {
     // and one model per log sharing the parameters.
     let refs: Vec<&MeasuredRun> = runs.iter().collect();
     let joint = if runs.len() > 1 {
-        let (rows, layout) = super::multi::combine(&refs, o.train_fraction).map_err(|e| anyhow::anyhow!(e))?;
-        let free = super::reference::nuisance_set_of(&rows, &refs);
-        let mut models: Vec<Box<dyn Simulator>> = Vec::with_capacity(runs.len());
-        for (run, f) in runs.iter().zip(&files) {
-            let m = ReferenceModel::new(rig.clone(), run).map_err(|e| anyhow::anyhow!("{f}: {e}"))?;
-            models.push(Box::new(m.with_nuisance_set(free.clone())));
-        }
-        Some((rows, super::multi::MultiModel::new(models, layout).map_err(|e| anyhow::anyhow!(e))?))
+        Some(super::multi::joint_reference(&rig, &refs, &files, o.train_fraction).map_err(|e| anyhow::anyhow!(e))?)
     } else {
         None
     };

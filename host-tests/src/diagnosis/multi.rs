@@ -190,6 +190,27 @@ impl Simulator for MultiModel<'_> {
     }
 }
 
+/// The reference model of one machine's logs `runs` on `rig`: the logs on
+/// one table ([`combine`] at `train_fraction`), one replay model per log
+/// calibrating the parameters the logs share
+/// ([`super::reference::nuisance_set_of`]). Errors name the log (`files`).
+pub fn joint_reference(
+    rig: &crate::rig::Rig,
+    runs: &[&MeasuredRun],
+    files: &[String],
+    train_fraction: f64,
+) -> Result<(MeasuredRun, MultiModel<'static>), String> {
+    let (rows, layout) = combine(runs, train_fraction)?;
+    let free = super::reference::nuisance_set_of(&rows, runs);
+    let mut models: Vec<Box<dyn Simulator>> = Vec::with_capacity(runs.len());
+    for (k, run) in runs.iter().enumerate() {
+        let name = files.get(k).cloned().unwrap_or_else(|| format!("log {}", k + 1));
+        let m = super::reference::ReferenceModel::new(rig.clone(), run).map_err(|e| format!("{name}: {e}"))?;
+        models.push(Box::new(m.with_nuisance_set(free.clone())));
+    }
+    Ok((rows, MultiModel::new(models, layout)?))
+}
+
 /// One log's share of a joint diagnosis: its rows of the nominal, calibrated
 /// ("before") and extended ("after") series, and their errors against its
 /// own training and held-out windows.

@@ -1,11 +1,11 @@
 //! Several logs of one machine diagnosed together
 //! (`eha_sim::diagnosis::multi`): the shared-parameter plumbing on a toy
 //! machine whose two parameters only the two logs together determine, the
-//! command line with several files, and (slow tier) two emulator logs of one
-//! machine with a hidden effect and without.
+//! command line with several files, and (slow tier, 6–7 min each at load
+//! ~20) two emulator logs of one machine with a hidden effect and without.
 
 use eha_sim::diagnosis::fit::{fit, FitOptions};
-use eha_sim::diagnosis::multi::{combine, log_parts, options_for, write_outputs, MultiModel};
+use eha_sim::diagnosis::multi::{combine, joint_reference, log_parts, options_for, write_outputs, MultiModel};
 use eha_sim::diagnosis::report::DiagnosisJson;
 use eha_sim::diagnosis::{diagnose, Candidate, DiagnoseOptions, ParamSpec, SimSeries, Simulator};
 use eha_sim::measured::{Channel, MeasuredRun};
@@ -130,17 +130,12 @@ fn several_files_on_the_command_line_each_checked() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// The joint diagnosis of `logs` (one machine) with the reference model.
+/// The joint diagnosis of `logs` (one machine) with the reference model,
+/// as `eha-sim diagnose a.csv b.csv` makes it.
 fn diagnose_together(logs: &[&MeasuredRun]) -> eha_sim::diagnosis::Diagnosis {
-    use eha_sim::diagnosis::reference::{nuisance_set_of, ReferenceModel};
     let o = options_for(&DiagnoseOptions::default(), logs.len());
-    let (rows, layout) = combine(logs, o.train_fraction).expect("combine");
-    let free = nuisance_set_of(&rows, logs);
-    let models: Vec<Box<dyn Simulator>> = logs
-        .iter()
-        .map(|r| Box::new(ReferenceModel::new(eha_sim::rig::Rig::default(), r).expect("model").with_nuisance_set(free.clone())) as Box<dyn Simulator>)
-        .collect();
-    let joint = MultiModel::new(models, layout).expect("joint model");
+    let files: Vec<String> = (1..=logs.len()).map(|k| format!("log {k}")).collect();
+    let (rows, joint) = joint_reference(&eha_sim::rig::Rig::default(), logs, &files, o.train_fraction).expect("joint model");
     let d = diagnose(&rows, &joint, &o).expect("joint diagnosis");
     for p in log_parts(&d, logs, joint.layout(), &o) {
         let ch: Vec<String> =
@@ -178,16 +173,19 @@ fn summary(label: &str, d: &eha_sim::diagnosis::Diagnosis) -> String {
 /// oil pocket hidden, τ ≈ 200 s): its Case 1 log and the same machine
 /// flown through speed steps (seed 1705's mission, noise and dropouts).
 /// The joint diagnosis is at least as right as each log alone: it names
-/// `sensor-lag` when either log alone does, and never another cause. An
-/// effect-free machine (seed 1714's, Case 1 and speed steps of seed 1716's
-/// mission) gives no discovery together either.
+/// `sensor-lag` when either log alone does, and never another cause.
+/// Measured: each alone and together `sensor-lag` at P 1.00 (pooled
+/// held-out 0.239 -> 0.172 K, 0.746 -> 0.547 K, together 0.526 -> 0.299 K).
 #[test]
 #[ignore = "slow tier: three emulator diagnoses, minutes"]
 fn slow_two_logs_of_one_emulated_machine_with_a_lag_are_at_least_as_right_together() {
     two_logs_of_one_machine(Candidate::SensorLag, (1704, 1705));
 }
 
-/// The effect-free pair of the test above.
+/// The effect-free pair: the machine of seed 1714 (nothing hidden) at
+/// Case 1 and through seed 1716's speed steps gives no discovery together,
+/// nor a wrong cause. Measured: `none` alone (0.149, 0.267 K) and together
+/// (P 1.00, 0.296 K).
 #[test]
 #[ignore = "slow tier: three emulator diagnoses, minutes"]
 fn slow_two_effect_free_logs_of_one_emulated_machine_give_no_discovery() {
