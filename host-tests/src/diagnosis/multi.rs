@@ -298,7 +298,7 @@ mod tests {
             assert_eq!(c.get(Channel::TOilC).unwrap()[row].is_some(), i == 1);
         }
         assert!(c.time_s.windows(2).all(|w| w[1] > w[0]), "times increase");
-        assert_eq!(l.gather(&c.get(Channel::TPumpC).unwrap().to_vec(), 1), b.get(Channel::TPumpC).unwrap().to_vec());
+        assert_eq!(l.gather(c.get(Channel::TPumpC).unwrap(), 1), b.get(Channel::TPumpC).unwrap().to_vec());
         assert!(combine(&[&a], 0.7).is_err());
     }
 }
