@@ -16,8 +16,8 @@
 //! when a candidate qualifies, which both 30-minute bench logs did); and,
 //! while the global baseline fails the strict rule (the diagnosis says
 //! so), [`ESCALATION_WEIGHT`] of the physical tier. The residual analysis
-//! and the evidence are not counted (0.2–3 s of a 30-minute log's
-//! diagnosis, bench `diagnose_30min`).
+//! and the evidence are not counted (0.5 s of a 30-minute log's
+//! diagnosis on a quiet machine, bench `diagnose_30min`).
 
 use super::model::{Candidate, ParamSpec, Phase, SimSeries, Simulator};
 use std::sync::{Arc, Mutex};
