@@ -2,10 +2,12 @@
 //! ≤ 30 s wall on 2 cores). Two logs from the hidden-effect generator: a
 //! throttle mission with speed and pressure steps and a gust-rejection servo
 //! mission (the slowest replay: the fast oil nodes follow the 1 Hz
-//! manoeuvres). Prints the wall time, the model runs by phase and the
+//! manoeuvres), and a 30-minute log of the independent rig emulator
+//! (speed steps at 2 s, nothing hidden: escalates to the physical set).
+//! Prints the wall time, the model runs by phase and the
 //! verdict of each, and the time left the progress bar
 //! (`diagnosis::progress`, hidden here) showed at 25, 50 and 75 % against
-//! the time actually left (`DIAG30_ONLY=throttle|servo` runs one log,
+//! the time actually left (`DIAG30_ONLY=throttle|servo|emulator` runs one log,
 //! `DIAG30_XCORR_STEP_S` sets the cross-correlation's lag step); run with
 //! `cargo bench --profile fast -p eha-sim --bench diagnose_30min`.
 //! (One run per log: a diagnosis is a minute-scale job, so the statistics of
@@ -33,16 +35,27 @@ fn cpu_s() -> f64 {
 
 fn main() {
     let cases = [
-        ("throttle steps, 30 min at 0.1 s", SynthScenario::ThrottleSteps, Candidate::SensorLag),
-        ("servo gusts, 30 min at 0.1 s", SynthScenario::ServoGust, Candidate::CoulombFriction),
+        ("throttle steps, 30 min at 0.1 s", Some(SynthScenario::ThrottleSteps), Candidate::SensorLag),
+        ("servo gusts, 30 min at 0.1 s", Some(SynthScenario::ServoGust), Candidate::CoulombFriction),
+        ("emulator speed steps, 30 min at 2 s", None, Candidate::None),
     ];
     let only = std::env::var("DIAG30_ONLY").ok();
     for (name, scenario, hidden) in cases {
         if only.as_deref().is_some_and(|o| !name.starts_with(o)) {
             continue;
         }
-        let case = SynthCase { hidden, scenario, mismatch: Mismatch::Nuisance, seed: 7, duration_s: 1800.0, sample_s: 0.1 };
-        let (run, _) = generate(&case).expect("generate");
+        // The emulator's log (not our model: the diagnosis escalates to
+        // the physical set), effect-free machine of seed 1716.
+        let run = match scenario {
+            Some(scenario) => {
+                let case = SynthCase { hidden, scenario, mismatch: Mismatch::Nuisance, seed: 7, duration_s: 1800.0, sample_s: 0.1 };
+                generate(&case).expect("generate").0
+            }
+            None => {
+                use eha_sim::emulator::{generate, missions::EmuScenario, EmuCase};
+                generate(&EmuCase { hidden, scenario: EmuScenario::SpeedSteps, seed: 1716, duration_s: 1800.0 }).expect("emulate").0
+            }
+        };
         let (t, cpu0) = (Instant::now(), cpu_s());
         let model = ReferenceModel::new(Rig::default(), &run).expect("model");
         // DIAG30_XCORR_STEP_S: the cross-correlation's lag resolution
