@@ -31,6 +31,18 @@ fn replay_30min(c: &mut Criterion) {
             "{name}: diagnosis replay {} steps, {} evaluations; every state controlled {} steps, {} evaluations",
             fast.stats.steps, fast.stats.rhs_evals, full.stats.steps, full.stats.rhs_evals
         );
+        // The multirate fast path on the same replay, timed against the
+        // diagnosis's replay, alternating (5 each; a quick look, not criterion).
+        let (mut t_bdf, mut t_fast) = (0.0, 0.0);
+        for _ in 0..5 {
+            let t = std::time::Instant::now();
+            black_box(simulate_budget(&rig, &sc, &opt, REPLAY_RTOL, None).expect("replay"));
+            t_bdf += t.elapsed().as_secs_f64() / 5.0;
+            let t = std::time::Instant::now();
+            black_box(eha_sim::sim::simulate_fast(&rig, &sc, &opt).expect("fast replay"));
+            t_fast += t.elapsed().as_secs_f64() / 5.0;
+        }
+        eprintln!("{name}: diagnosis replay {:.1} ms, fast path {:.1} ms (mean of 5, alternating)", 1e3 * t_bdf, 1e3 * t_fast);
         g.bench_function(format!("{name}_diagnosis"), |b| {
             b.iter(|| simulate_budget(black_box(&rig), black_box(&sc), &opt, REPLAY_RTOL, None).expect("replay"))
         });

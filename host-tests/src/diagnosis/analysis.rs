@@ -6,10 +6,10 @@ use super::adequacy::{assess, Adequacy, MisfitRule};
 use super::evidence::{posterior_of, Posterior, DISCREPANCY_TAU_S};
 use super::fit::{fit, FitOptions, FitResult, Point};
 use super::identify::{identifiable, HOUSING_OUTER_PREFIX};
-use super::model::{Candidate, SimSeries, Simulator};
+use super::model::{Candidate, Phase, SimSeries, Simulator};
 use super::regressors::regressors;
 pub use super::stats::{ChannelMetrics, Metrics, XCorr};
-use super::stats::{bias, bic, cross_correlation, ljung_box, max_abs, rmse};
+use super::stats::{bias, bic, cross_correlation_every, ljung_box, max_abs, rmse};
 use crate::measured::{Channel, MeasuredRun};
 use rayon::prelude::*;
 
@@ -48,6 +48,13 @@ pub const PHYSICAL_MISFIT_RISE_FRACTION: f64 = 0.1;
 /// the full physical calibration is not good enough to judge by.
 pub const PHYSICAL_MISFIT_ABS_K: f64 = 1.0;
 
+/// Default [`DiagnoseOptions::xcorr_lag_step_s`]: 1 s. The residuals and
+/// regressors of a thermal model move on minute scales, so a peak over
+/// 0…120 s is found on a 1 s grid; a log at 0.1 s then costs a tenth
+/// (measured on a 30-minute log at 0.1 s, bench `diagnose_30min`); logs
+/// sampled at 1 s or slower are unchanged.
+pub const XCORR_LAG_STEP_S: f64 = 1.0;
+
 /// Settings of one diagnosis.
 #[derive(Debug, Clone, Copy)]
 pub struct DiagnoseOptions {
@@ -82,6 +89,11 @@ pub struct DiagnoseOptions {
     pub min_pooled_gain: f64,
     /// Largest lag of the residual/regressor cross-correlation, s.
     pub max_lag_s: f64,
+    /// Lag resolution of that cross-correlation, s: lags at every sample
+    /// up to this spacing, then every k-th with k·dt ≈ this (0: every
+    /// sample). It only reports (the regressors a misfit follows, in
+    /// `report.md` and the `unexplained` advice), it decides nothing.
+    pub xcorr_lag_step_s: f64,
     /// Lags of the Ljung–Box test.
     pub ljung_box_lags: usize,
     /// When a channel of the calibrated baseline (global nuisance set)
@@ -106,6 +118,7 @@ impl Default for DiagnoseOptions {
             min_gain_k: 0.05,
             min_pooled_gain: 0.2,
             max_lag_s: 120.0,
+            xcorr_lag_step_s: XCORR_LAG_STEP_S,
             ljung_box_lags: 20,
             misfit: MisfitRule { noise_factor: MISFIT_NOISE_FACTOR, rise_fraction: MISFIT_RISE_FRACTION, abs_k: MISFIT_ABS_K },
             physical_misfit: MisfitRule {
@@ -185,6 +198,9 @@ pub struct Diagnosis {
     pub series: [SimSeries; 3],
     /// Model runs spent.
     pub sims: usize,
+    /// Model runs and wall time by phase, in order (the global tier's
+    /// first when the diagnosis escalated).
+    pub phases: Vec<PhaseCost>,
     /// Probabilities of `none`, `unexplained` and every candidate, and the
     /// per-channel numbers behind them ([`super::evidence`]).
     pub posterior: Posterior,
@@ -195,6 +211,38 @@ impl Diagnosis {
     /// calibrated model explains the data to the noise level).
     pub fn answer(&self) -> &'static str {
         if self.unexplained { "unexplained" } else { self.cause.name() }
+    }
+}
+
+/// The cost of one phase of a diagnosis.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct PhaseCost {
+    /// `global` or `physical`, then the phase: `baseline` (the nominal run
+    /// and the baseline fit), `residual analysis` (metrics and
+    /// cross-correlations, no model runs), `candidates`, `restarts`,
+    /// `refits`, `evidence` (the posterior, no model runs).
+    pub name: String,
+    /// Model runs (fits' Jacobians included).
+    pub runs: usize,
+    /// Wall time, s.
+    pub secs: f64,
+}
+
+/// Records phases of one tier: the runs and the time since the last mark.
+struct PhaseLog {
+    tier: &'static str,
+    t: std::time::Instant,
+    phases: Vec<PhaseCost>,
+}
+
+impl PhaseLog {
+    fn new(tier: &'static str) -> Self {
+        PhaseLog { tier, t: std::time::Instant::now(), phases: Vec::new() }
+    }
+    fn mark(&mut self, name: &str, runs: usize) {
+        let secs = self.t.elapsed().as_secs_f64();
+        self.t = std::time::Instant::now();
+        self.phases.push(PhaseCost { name: format!("{} {name}", self.tier), runs, secs });
     }
 }
 
@@ -212,7 +260,9 @@ pub enum DiagnoseError {
     Baseline(String),
 }
 
-fn metrics(run: &MeasuredRun, s: &SimSeries, split: f64, lb_lags: usize) -> Metrics {
+/// Per-channel and pooled errors of `s` against `run`, training rows
+/// before `split`, held out from it.
+pub(crate) fn metrics(run: &MeasuredRun, s: &SimSeries, split: f64, lb_lags: usize) -> Metrics {
     let mut channels = Vec::new();
     let (mut tr, mut ho) = (Vec::new(), Vec::new());
     for ch in Channel::TEMPERATURES {
@@ -311,19 +361,24 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
     let split = split_time_s(run, o.train_fraction);
     let pts = fit_points(run, split, o.points_per_channel);
     let nuis_specs = sim.nuisance();
+    let mut log = PhaseLog::new(sim.nuisance_set_name());
+    sim.phase(Phase::Baseline { params: nuis_specs.len() });
     let nominal_v: Vec<f64> = nuis_specs.iter().map(|s| s.start).collect();
     let nominal = sim.simulate(&nominal_v, Candidate::None, &[]).map_err(DiagnoseError::Baseline)?;
     let base = fit(sim, run, &pts, Candidate::None, &nominal_v, None, o.fit)
         .ok_or_else(|| DiagnoseError::Baseline("no valid residuals at the nominal parameters".into()))?;
+    log.mark("baseline", 1 + base.sims);
     let m_before = metrics(run, &base.series, split, o.ljung_box_lags);
-    let xcorr = cross_correlations(run, &base.series, o.max_lag_s);
+    let xcorr = cross_correlations(run, &base.series, o.max_lag_s, o.xcorr_lag_step_s);
+    log.mark("residual analysis", 0);
     // `escalate` is false only in the physical tier (called from below).
     let rule = if escalate { o.misfit } else { o.physical_misfit };
     if escalate && assess(run, split, &m_before, &xcorr, (&nuis_specs, &base.nuisance), rule).misfits {
-        if let Some(d) = in_physical_tier(run, sim, o, 1 + base.sims) {
+        if let Some(d) = in_physical_tier(run, sim, o, 1 + base.sims, &log.phases) {
             return d;
         }
     }
+    let may_escalate = escalate && assess(run, split, &m_before, &xcorr, (&nuis_specs, &base.nuisance), o.physical_misfit).misfits;
     // Every candidate is fitted jointly with the nuisance set from two
     // starts, keeping the better: (a) the nominal nuisance values with the
     // candidate's typical magnitude — starting from the calibrated baseline
@@ -333,6 +388,7 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
     // limit) never ends up with a worse fit than the baseline.
     let starts: Vec<(Candidate, bool)> =
         Candidate::EXTENSIONS.iter().flat_map(|&c| [(c, false), (c, true)]).collect();
+    sim.phase(Phase::Candidates { fits: starts.len(), may_escalate: may_escalate && sim.physical_set().is_some() });
     let all: Vec<Option<FitResult>> = starts
         .par_iter()
         .map(|&(c, from_base)| if from_base { fit_from(sim, run, &pts, c, &base, o) } else { fit(sim, run, &pts, c, &nominal_v, None, o.fit) })
@@ -348,6 +404,7 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
             }
         })
         .collect();
+    log.mark("candidates", extra_sims);
     let n = pts.len();
     let mut fits: Vec<FitResult> = fits.into_iter().flatten().collect();
     let base_sims = base.sims;
@@ -368,9 +425,12 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
         let mut by_rss: Vec<&FitResult> = fits.iter().collect();
         by_rss.sort_by(|a, b| a.rss.total_cmp(&b.rss));
         let starts: Vec<Vec<f64>> = by_rss.iter().take(2).map(|f| f.nuisance.clone()).collect();
+        sim.phase(Phase::Restarts { fits: starts.len() });
         let restarts: Vec<FitResult> =
             starts.par_iter().filter_map(|v| fit(sim, run, &pts, Candidate::None, v, None, o.fit)).collect();
-        extra_sims += restarts.iter().map(|f| f.sims).sum::<usize>();
+        let r_sims = restarts.iter().map(|f| f.sims).sum::<usize>();
+        extra_sims += r_sims;
+        log.mark("restarts", r_sims);
         if let Some(better) = restarts.into_iter().filter(|r| r.rss < base.rss).min_by(|a, b| a.rss.total_cmp(&b.rss)) {
             base = better;
             // The candidates get the same chance: each is fitted again from
@@ -378,16 +438,20 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
             // it a candidate, which contains the baseline as its limit,
             // could rank far below it (measured: emulator seed 1701, every
             // candidate ΔBIC −290 to −420).
+            sim.phase(Phase::Refits { fits: fits.len() });
             let refits: Vec<Option<FitResult>> = fits.par_iter().map(|f| fit_from(sim, run, &pts, f.candidate, &base, o)).collect();
-            extra_sims += refits.iter().flatten().map(|f| f.sims).sum::<usize>();
+            let r_sims = refits.iter().flatten().map(|f| f.sims).sum::<usize>();
+            extra_sims += r_sims;
+            log.mark("refits", r_sims);
             for (f, r) in fits.iter_mut().zip(refits) {
                 if let Some(r) = r.filter(|r| r.rss < f.rss) {
                     *f = r;
                 }
             }
             m_before = metrics(run, &base.series, split, o.ljung_box_lags);
-            xcorr = cross_correlations(run, &base.series, o.max_lag_s);
+            xcorr = cross_correlations(run, &base.series, o.max_lag_s, o.xcorr_lag_step_s);
             (ranking, fit_metrics) = rank(run, sim, o, split, n, &base, &m_before, &fits);
+            log.mark("residual analysis", 0);
         }
     }
     let sims = 1 + base_sims + extra_sims;
@@ -407,6 +471,7 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
         &|c| ranking.iter().any(|r| r.qualifies && r.cause == c.name()),
         DISCREPANCY_TAU_S,
     );
+    log.mark("evidence", 0);
     let winner = posterior.named().and_then(|r| Candidate::from_name(&r.cause));
     let (cause, after_fit, m_after) = match winner.and_then(|w| fits.iter().zip(&fit_metrics).find(|(f, _)| f.candidate == w)) {
         Some((f, m)) => (f.candidate, f.clone(), m.clone()),
@@ -421,10 +486,11 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
     // them lets the physical set absorb effects the global set leaves to be
     // named (see [`diagnose`]).
     if escalate && winner.is_none() && assess(run, split, &m_before, &xcorr, (&nuis_specs, &base.nuisance), o.physical_misfit).misfits {
-        if let Some(d) = in_physical_tier(run, sim, o, sims) {
+        if let Some(d) = in_physical_tier(run, sim, o, sims, &log.phases) {
             return d;
         }
     }
+    sim.phase(Phase::Done);
     let m_nominal = metrics(run, &nominal, split, o.ljung_box_lags);
     Ok(Diagnosis {
         nuisance_set: sim.nuisance_set_name().into(),
@@ -442,6 +508,7 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
         split_time_s: split,
         series: [nominal, base.series.clone(), after_fit.series],
         sims,
+        phases: log.phases,
         posterior,
     })
 }
@@ -465,10 +532,17 @@ pub(crate) fn identifiable_here(c: Candidate, run: &MeasuredRun, split: f64, sim
 /// The diagnosis made again with `sim`'s physical calibration set, its model
 /// runs counting the `spent` ones of the global tier; `None` when the model
 /// has no physical set.
-fn in_physical_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, spent: usize) -> Option<Result<Diagnosis, DiagnoseError>> {
+fn in_physical_tier(
+    run: &MeasuredRun,
+    sim: &dyn Simulator,
+    o: &DiagnoseOptions,
+    spent: usize,
+    phases: &[PhaseCost],
+) -> Option<Result<Diagnosis, DiagnoseError>> {
     let p = sim.physical_set()?;
     Some(diagnose_tier(run, &*p, o, false).map(|mut d| {
         d.sims += spent;
+        d.phases.splice(0..0, phases.iter().cloned());
         d
     }))
 }
@@ -543,11 +617,13 @@ fn rank(
 }
 
 /// Cross-correlation of every channel's calibrated-baseline residual with
-/// every regressor of [`regressors`], lags 0…`max_lag_s`.
-fn cross_correlations(run: &MeasuredRun, base: &SimSeries, max_lag_s: f64) -> Vec<XCorr> {
+/// every regressor of [`regressors`], lags 0…`max_lag_s` every `step_s`
+/// (rounded to whole samples, at least one).
+fn cross_correlations(run: &MeasuredRun, base: &SimSeries, max_lag_s: f64, step_s: f64) -> Vec<XCorr> {
     let regs = regressors(run, base);
     let dt = (run.time_s[run.len() - 1] - run.time_s[0]) / (run.len() - 1) as f64;
     let max_lag = ((max_lag_s / dt).round() as usize).min(run.len() / 3);
+    let step = ((step_s / dt).round() as usize).max(1);
     type Residual = (Channel, Vec<Option<f64>>);
     let residuals: Vec<Residual> = Channel::TEMPERATURES
         .into_iter()
@@ -561,9 +637,9 @@ fn cross_correlations(run: &MeasuredRun, base: &SimSeries, max_lag_s: f64) -> Ve
     pairs
         .par_iter()
         .map(|((ch, r), (name, u))| {
-            let cc = cross_correlation(r, u, max_lag);
+            let cc = cross_correlation_every(r, u, max_lag, step);
             let (k, peak) = cc.iter().enumerate().fold((0, 0.0f64), |b, (k, v)| if v.abs() > b.1.abs() { (k, *v) } else { b });
-            XCorr { channel: ch.name().into(), regressor: name.clone(), rho0: cc[0], peak_rho: peak, peak_lag_s: k as f64 * dt }
+            XCorr { channel: ch.name().into(), regressor: name.clone(), rho0: cc[0], peak_rho: peak, peak_lag_s: (k * step) as f64 * dt }
         })
         .collect()
 }

@@ -1,12 +1,15 @@
-//! The `diagnose` subcommand: `eha-sim diagnose <measured.csv> [--rig
-//! rig.toml] [--set key=value]... [--out DIR]`. Exit 0 when a diagnosis was
-//! made (`none` and `unexplained` included), 2 on bad input (file, rig, or a baseline that
+//! The `diagnose` subcommand: `eha-sim diagnose <measured.csv>... [--rig
+//! rig.toml] [--set key=value]... [--out DIR]`. Several logs are several
+//! runs of one machine: one calibration shared by all, one answer
+//! ([`super::multi`]). Exit 0 when a diagnosis was made (`none` and
+//! `unexplained` included), 2 on bad input (file, rig, or a baseline that
 //! cannot run on the inputs).
 
 use super::analysis::{diagnose, DiagnoseOptions};
 use super::reference::ReferenceModel;
 use super::report::write_outputs;
-use super::Simulator;
+use super::progress::Progress;
+use super::{Candidate, Simulator};
 use crate::measured::MeasuredRun;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -14,8 +17,11 @@ use std::process::ExitCode;
 /// Arguments of `diagnose`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct DiagnoseArgs {
-    /// Measured run in the shared measured-data format.
-    pub measured: PathBuf,
+    /// Measured runs in the shared measured-data format. Several files are
+    /// logs of one machine: calibrated together (one parameter vector, each
+    /// log replayed with its own inputs and circuit) and diagnosed once.
+    #[arg(required = true)]
+    pub measured: Vec<PathBuf>,
     /// Rig parameter file (TOML); default: the built-in paper rig.
     #[arg(long)]
     pub rig: Option<PathBuf>,
@@ -41,58 +47,6 @@ pub struct DiagnoseArgs {
     pub detectability: bool,
 }
 
-/// The model with a progress bar on the terminal (hidden when stderr is not
-/// one): the stage (baseline calibration, then the candidates' fits) and the
-/// model runs done of the budget (the baseline fit plus two starts per
-/// candidate, each at most `max_sims` runs; fits that converge earlier leave
-/// part of the budget unused, so the time left is an upper bound).
-struct Progress<'a> {
-    inner: &'a dyn Simulator,
-    bar: indicatif::ProgressBar,
-    candidates: std::sync::atomic::AtomicBool,
-}
-
-impl<'a> Progress<'a> {
-    fn new(inner: &'a dyn Simulator, max_sims: usize) -> Self {
-        let fits = 1 + 2 * super::Candidate::EXTENSIONS.len() as u64;
-        let budget = 1 + fits * max_sims as u64;
-        let bar = indicatif::ProgressBar::new(budget);
-        bar.set_style(
-            indicatif::ProgressStyle::with_template("{msg:28} [{bar:30}] {pos}/{len} model runs, {elapsed} elapsed, ≤ {eta} left")
-                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
-                .progress_chars("=> "),
-        );
-        bar.set_message("calibrating the baseline");
-        bar.enable_steady_tick(std::time::Duration::from_millis(200));
-        Progress { inner, bar, candidates: std::sync::atomic::AtomicBool::new(false) }
-    }
-}
-
-impl Simulator for Progress<'_> {
-    fn nuisance(&self) -> Vec<super::ParamSpec> {
-        self.inner.nuisance()
-    }
-    fn extension_params(&self, c: super::Candidate) -> Vec<super::ParamSpec> {
-        self.inner.extension_params(c)
-    }
-    fn physical_set(&self) -> Option<Box<dyn Simulator + '_>> {
-        // The escalated diagnosis runs without the progress bar's counts.
-        self.inner.physical_set()
-    }
-
-    fn nuisance_set_name(&self) -> &'static str {
-        self.inner.nuisance_set_name()
-    }
-
-    fn simulate(&self, nuisance: &[f64], c: super::Candidate, ext: &[f64]) -> Result<super::SimSeries, String> {
-        if c != super::Candidate::None && !self.candidates.swap(true, std::sync::atomic::Ordering::Relaxed) {
-            self.bar.set_message("fitting 7 candidates × 2 starts");
-        }
-        self.bar.inc(1);
-        self.inner.simulate(nuisance, c, ext)
-    }
-}
-
 /// Runs `diagnose` and prints a one-line verdict; see the module doc for the
 /// exit codes.
 pub fn run(args: &DiagnoseArgs) -> ExitCode {
@@ -109,9 +63,13 @@ pub fn run(args: &DiagnoseArgs) -> ExitCode {
 }
 
 fn run_inner(args: &DiagnoseArgs) -> anyhow::Result<String> {
-    let run = MeasuredRun::read_file(&args.measured)?;
-    for n in &run.notes {
-        eprintln!("note: {n}");
+    let mut runs = Vec::with_capacity(args.measured.len());
+    for f in &args.measured {
+        let run = MeasuredRun::read_file(f)?;
+        for n in &run.notes {
+            eprintln!("note: {}: {n}", f.display());
+        }
+        runs.push(run);
     }
     let mut rig = match &args.rig {
         Some(p) => crate::rig::Rig::from_toml_file(p)?,
@@ -120,26 +78,60 @@ fn run_inner(args: &DiagnoseArgs) -> anyhow::Result<String> {
     for s in &args.set {
         rig.set_override(s)?;
     }
-    let model = ReferenceModel::new(rig, &run)?;
     let mut o = DiagnoseOptions { train_fraction: args.train_fraction.clamp(0.1, 0.7), ..Default::default() };
     o.fit.max_sims = args.max_sims.max(4);
+    let files: Vec<String> = args.measured.iter().map(|f| f.display().to_string()).collect();
     let t = std::time::Instant::now();
-    let progress = Progress::new(&model, o.fit.max_sims);
-    let d = diagnose(&run, &progress, &o);
-    progress.bar.finish_and_clear();
+    // One log: its own table and model; several: the logs on one table
+    // and one model per log sharing the parameters.
+    let refs: Vec<&MeasuredRun> = runs.iter().collect();
+    let joint = if runs.len() > 1 {
+        Some(super::multi::joint_reference(&rig, &refs, &files, o.train_fraction).map_err(|e| anyhow::anyhow!(e))?)
+    } else {
+        None
+    };
+    let single;
+    let (run, model): (&MeasuredRun, &dyn Simulator) = match &joint {
+        Some((rows, m)) => (rows as &MeasuredRun, m as &dyn Simulator),
+        None => {
+            single = ReferenceModel::new(rig, &runs[0]).map_err(|e| anyhow::anyhow!("{}: {e}", files[0]))?;
+            (&runs[0], &single as &dyn Simulator)
+        }
+    };
+    if joint.is_some() {
+        o = super::multi::options_for(&o, runs.len());
+    }
+    let progress = Progress::new(model, o.fit.max_sims, true);
+    let d = diagnose(run, &progress, &o);
+    if d.is_err() {
+        progress.finish();
+    }
     let d = d?;
     // The diagnosis's own time (the detectability pass comes after).
     let secs = t.elapsed().as_secs_f64();
-    write_outputs(&d, &run, &args.measured.display().to_string(), &args.out)?;
+    match &joint {
+        Some((_, m)) => {
+            let parts = super::multi::log_parts(&d, &refs, m.layout(), &o);
+            super::multi::write_outputs(&d, &parts, &refs, &files, &args.out)?;
+        }
+        None => write_outputs(&d, run, &files[0], &args.out)?,
+    }
     let mut detect_line = None;
     if args.detectability {
-        let fd = detectability_against_floor(&model, &d, &run, &o)?;
+        // One run per calibration parameter and per candidate row, around
+        // the answer's tier.
+        let p = d.nuisance_before.len();
+        progress.extend((1 + p + super::detect::MULTIPLES.len() * Candidate::EXTENSIONS.len()) as u64, "detectability");
+        let fd = detectability_against_floor(&progress, &d, run, &o);
+        progress.finish();
+        let fd = fd?;
         // A section appended to the report just written.
         use std::io::Write as _;
         std::fs::OpenOptions::new().append(true).open(args.out.join("report.md"))?.write_all(fd.markdown().as_bytes())?;
         std::fs::write(args.out.join("detectability.json"), serde_json::to_string_pretty(&fd)? + "\n")?;
         detect_line = Some(fd.summary());
     }
+    progress.finish();
     let verdict = format!(
         "cause: {} | held-out RMSE {:.3} -> {:.3} K | training {:.3} -> {:.3} K | {} model runs, {:.1} s | {}",
         d.answer(),

@@ -11,9 +11,11 @@ pub mod evidence;
 pub mod fit;
 pub mod identify;
 pub mod model;
+pub mod multi;
 pub mod plan;
 pub mod plan_cli;
 pub mod plot;
+pub mod progress;
 pub mod projection;
 pub mod regressors;
 pub mod report;
@@ -27,4 +29,4 @@ pub mod emu_sweep;
 pub mod emu_tables;
 
 pub use analysis::{diagnose, DiagnoseError, DiagnoseOptions, Diagnosis};
-pub use model::{Candidate, ParamSpec, SimSeries, Simulator};
+pub use model::{Candidate, ParamSpec, Phase, SimSeries, Simulator};

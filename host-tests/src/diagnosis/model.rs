@@ -72,4 +72,42 @@ pub trait Simulator: Sync {
     fn nuisance_set_name(&self) -> &'static str {
         "global"
     }
+    /// Told by the diagnosis before each of its phases starts (for a
+    /// progress display that counts the model runs ahead); the models
+    /// themselves ignore it.
+    fn phase(&self, _p: Phase) {}
+}
+
+/// A phase of the diagnosis of one tier (nuisance set), announced to the
+/// model before it starts ([`Simulator::phase`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Phase {
+    /// The nominal run and the baseline calibration: one fit of `params`
+    /// nuisance parameters.
+    Baseline {
+        /// Nuisance parameters.
+        params: usize,
+    },
+    /// `fits` candidate fits (two starts per candidate, in parallel), each
+    /// of the nuisance set plus the candidate's parameters. `may_escalate`:
+    /// the global baseline fails the strict rule, so the physical tier
+    /// follows unless a cause is named.
+    Candidates {
+        /// Fits in the phase.
+        fits: usize,
+        /// Whether the physical tier is likely to follow.
+        may_escalate: bool,
+    },
+    /// `fits` baseline fits from the best candidates' nuisance values.
+    Restarts {
+        /// Fits in the phase.
+        fits: usize,
+    },
+    /// `fits` candidate fits again from a better baseline.
+    Refits {
+        /// Fits in the phase.
+        fits: usize,
+    },
+    /// This tier's answer stands (no escalation follows).
+    Done,
 }

@@ -77,6 +77,15 @@ impl ReferenceModel {
         Ok(m)
     }
 
+    /// The same model calibrating the physical-set parameters `free`
+    /// (indices into [`crate::calibration::PARAMS`]) instead of this log's
+    /// own [`nuisance_set`]: one machine's logs share one set
+    /// ([`nuisance_set_of`]).
+    pub fn with_nuisance_set(mut self, free: Vec<usize>) -> Self {
+        self.free = free;
+        self
+    }
+
     /// Solver-step budget of one replay of this log ([`REPLAY_STEPS_PER_S`]).
     fn step_budget(&self) -> u64 {
         let span = match (self.times.first(), self.times.last()) {
@@ -127,11 +136,20 @@ impl ReferenceModel {
 /// unless the run moves speed and load independently (its
 /// [`Needs::SensorWithJointExcitation`]).
 pub fn nuisance_set(run: &MeasuredRun) -> Vec<usize> {
+    nuisance_set_of(run, &[run])
+}
+
+/// The calibration parameters one machine's logs share ([`nuisance_set`]
+/// for several logs): sensors, inputs and excitation judged on `rows`
+/// (every log's rows on one table, e.g. [`super::multi::combine`]'s), the
+/// needle split left out only when every log in `logs` is a servo circuit.
+pub fn nuisance_set_of(rows: &MeasuredRun, logs: &[&MeasuredRun]) -> Vec<usize> {
+    let run = rows;
     let logged = |ch: Channel| Channel::TEMPERATURES.contains(&ch) && run.get(ch).is_some_and(|v| v.iter().any(Option::is_some));
     let one_point = calibration::ident::one_point(run);
     // The circuit by the log's rule (stated, or the piston's travel), never
     // by whether a position column exists.
-    let servo = matches!(circuit_of(run), Ok(crate::scenario::Circuit::Servo));
+    let servo = !logs.is_empty() && logs.iter().all(|l| matches!(circuit_of(l), Ok(crate::scenario::Circuit::Servo)));
     calibration::PARAMS
         .iter()
         .enumerate()

@@ -69,6 +69,71 @@ pub struct DiagnosisJson {
     /// to check.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub unexplained: Option<UnexplainedJson>,
+    /// Present only when several logs of one machine were diagnosed
+    /// together: each log's errors before and after, on its own training
+    /// and held-out windows (the top-level RMSEs pool every log).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub logs: Vec<LogJson>,
+}
+
+/// One log of a joint diagnosis in `diagnosis.json`.
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize, PartialEq)]
+pub struct LogJson {
+    /// The log's file as given.
+    pub file: String,
+    /// Rows in the log.
+    pub rows: usize,
+    /// Start of its held-out window, s (the log's own time).
+    pub heldout_from_s: f64,
+    /// Training-window RMSE before / after, pooled over its temperature channels, K.
+    pub rmse_before_k: f64,
+    /// Training-window RMSE after, K.
+    pub rmse_after_k: f64,
+    /// Held-out RMSE before, K.
+    pub heldout_rmse_before_k: f64,
+    /// Held-out RMSE after, K.
+    pub heldout_rmse_after_k: f64,
+    /// Per channel: held-out RMSE before and after, bias before, K.
+    pub channels: Vec<LogChannelJson>,
+}
+
+/// One channel of one log of a joint diagnosis.
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize, PartialEq)]
+pub struct LogChannelJson {
+    /// Channel name.
+    pub channel: String,
+    /// Held-out RMSE of the calibrated baseline, K.
+    pub heldout_rmse_before_k: f64,
+    /// Held-out RMSE with the cause, K.
+    pub heldout_rmse_after_k: f64,
+    /// Mean residual of the calibrated baseline (simulated − measured), K.
+    pub bias_before_k: f64,
+}
+
+impl LogJson {
+    /// The numbers of one log's part ([`super::multi::LogPart`]) of a joint diagnosis.
+    pub fn of(file: &str, rows: usize, d: &Diagnosis) -> Self {
+        LogJson {
+            file: file.into(),
+            rows,
+            heldout_from_s: d.split_time_s,
+            rmse_before_k: d.before.train_rmse_k,
+            rmse_after_k: d.after.train_rmse_k,
+            heldout_rmse_before_k: d.before.heldout_rmse_k,
+            heldout_rmse_after_k: d.after.heldout_rmse_k,
+            channels: d
+                .before
+                .channels
+                .iter()
+                .map(|b| LogChannelJson {
+                    channel: b.channel.clone(),
+                    heldout_rmse_before_k: b.heldout_rmse_k,
+                    heldout_rmse_after_k: d.after.channel(&b.channel).map_or(f64::NAN, |a| a.heldout_rmse_k),
+                    bias_before_k: b.bias_k,
+                })
+                .collect(),
+        }
+    }
 }
 
 /// One misfitting channel in `diagnosis.json`.
@@ -136,6 +201,7 @@ impl DiagnosisJson {
                 parameters_at_bounds: d.adequacy.at_bounds.iter().map(|b| (b.name.clone(), b.value)).collect(),
                 check: d.adequacy.advice.clone(),
             }),
+            logs: Vec::new(),
         }
     }
 }
@@ -224,21 +290,56 @@ fn adequacy_section(s: &mut String, d: &Diagnosis) {
 /// The Markdown report of `d` for the measured file `source`; `pngs` are
 /// the plot file names (relative to the report) to embed.
 pub fn report_markdown(d: &Diagnosis, source: &str, pngs: &[String]) -> String {
+    report_markdown_logs(d, source, pngs, &[])
+}
+
+/// Each log's errors of a joint diagnosis.
+fn logs_section(s: &mut String, logs: &[LogJson]) {
+    let _ = writeln!(s, "\n## Logs (one machine, one calibration)\n");
+    let _ = writeln!(s, "| log | rows | held out from (s) | RMSE train before → after (K) | held-out before → after (K) | held-out per channel, before → after (K) |");
+    let _ = writeln!(s, "|---|---:|---:|---|---|---|");
+    for l in logs {
+        let ch: Vec<String> =
+            l.channels.iter().map(|c| format!("{} {:.2} → {:.2}", c.channel, c.heldout_rmse_before_k, c.heldout_rmse_after_k)).collect();
+        let _ = writeln!(
+            s,
+            "| `{}` | {} | {:.0} | {:.3} → {:.3} | {:.3} → {:.3} | {} |",
+            l.file, l.rows, l.heldout_from_s, l.rmse_before_k, l.rmse_after_k, l.heldout_rmse_before_k, l.heldout_rmse_after_k, ch.join(", ")
+        );
+    }
+}
+
+/// [`report_markdown`] of a joint diagnosis of several logs (`logs`, one
+/// entry per log; empty for one log): the windows are each log's own and
+/// the per-log errors get their own section.
+pub fn report_markdown_logs(d: &Diagnosis, source: &str, pngs: &[String], logs: &[LogJson]) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "# Diagnosis of `{source}`\n");
     let _ = writeln!(s, "**Cause: `{}`**", d.answer());
     for (n, v, u) in &d.params {
         let _ = writeln!(s, "- fitted `{n}` = {} {u}", num(*v));
     }
+    if !logs.is_empty() {
+        logs_section(&mut s, logs);
+    }
     probability_section(&mut s, d);
     adequacy_section(&mut s, d);
+    let window = if logs.is_empty() {
+        format!("Training window: before {:.2} s; held-out window: from {:.2} s (last ≥ 30 % of the run).", d.split_time_s, d.split_time_s)
+    } else {
+        "Training window: the first part of each log, held-out window: the rest (last ≥ 30 % of each log; times under \"Logs\").".to_string()
+    };
     let _ = writeln!(
         s,
-        "\nTraining window: before {:.2} s; held-out window: from {:.2} s (last ≥ 30 % of the run). \
+        "\n{window} \
          RMSE pooled over temperature channels: training {:.3} → {:.3} K, held-out {:.3} → {:.3} K ({} model runs).",
-        d.split_time_s, d.split_time_s, d.before.train_rmse_k, d.after.train_rmse_k, d.before.heldout_rmse_k,
+        d.before.train_rmse_k, d.after.train_rmse_k, d.before.heldout_rmse_k,
         d.after.heldout_rmse_k, d.sims
     );
+    if !d.phases.is_empty() {
+        let p: Vec<String> = d.phases.iter().map(|p| format!("{} {} ({:.1} s)", p.name, p.runs, p.secs)).collect();
+        let _ = writeln!(s, "\nModel runs by phase: {}.", p.join(", "));
+    }
     let _ = writeln!(s, "\n## Ranking (BIC on the training window, held-out check)\n");
     let _ = writeln!(s, "| cause | BIC | ΔBIC vs none | RMSE train (K) | RMSE held-out (K) | best channel gain | qualifies | fitted |");
     let _ = writeln!(s, "|---|---:|---:|---:|---:|---|---|---|");

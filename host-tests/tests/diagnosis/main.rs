@@ -7,6 +7,7 @@ mod cli;
 mod detect;
 mod effects;
 mod emulator;
+mod multi;
 mod plan;
 mod replay;
 mod stats;
