@@ -83,9 +83,7 @@ pub fn measured_rule_section(ok: &[EmuResult]) -> String {
     let fd: Vec<String> =
         all.iter().filter(|d| d.truth == "none" && names(d)).map(|d| format!("{}{}: `{}`", d.seed, if d.twin { "'s twin" } else { "" }, d.answer)).collect();
     let mut md = format!(
-        "
-**Under the `{rule}` rule** (decided again from the stored evidence terms of {} logs, `emulator-sweep --measure {rule}`):          named at r ≥ 2: {} of {} ({} right); wrong causes: {}{}; false discoveries: {} of {} effect-free{}.
-",
+        "\n**Under the `{rule}` rule** (decided again from the stored evidence terms of {} logs, `emulator-sweep --measure {rule}`): named at r ≥ 2: {} of {} ({} right); wrong causes: {}{}; false discoveries: {} of {} effect-free{}.\n",
         all.len(),
         must.iter().filter(|d| names(d)).count(),
         must.len(),
@@ -106,9 +104,7 @@ pub fn measured_rule_section(ok: &[EmuResult]) -> String {
         if set.is_empty() {
             continue;
         }
-        let _ = write!(md, "
-Reliability under `{rule}`, {label} ({} logs):
-", set.len());
+        let _ = write!(md, "\nReliability under `{rule}`, {label} ({} logs):\n", set.len());
         md += &bins_markdown(&reliability_of(set));
     }
     md
