@@ -57,6 +57,10 @@ pub struct EmuResult {
     /// The calibration set whose answer stands (global or physical tier).
     #[serde(default)]
     pub tier: String,
+    /// The posterior under another decision rule ([`MeasuredRule`]),
+    /// computed from the stored terms by `emulator-sweep --measure`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub measured: Option<MeasuredRule>,
     /// The evidence's terms per structure (for measuring other decision
     /// rules offline); left out of the committed JSON.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -84,6 +88,10 @@ pub struct TwinCheck {
     /// The twin's per-channel evidence numbers.
     #[serde(default)]
     pub twin_channels: Vec<ChannelEvidence>,
+    /// The twin's posterior under the measured rule (see
+    /// [`EmuResult::measured`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub twin_measured: Option<MeasuredRule>,
     /// The twin's evidence terms per structure.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub twin_terms: Vec<StructureTerms>,
@@ -95,6 +103,18 @@ impl TwinCheck {
     pub fn ratio(&self) -> f64 {
         self.misfit_k / self.twin_misfit_k.max(1e-9)
     }
+}
+
+/// A log's posterior and answer under a decision rule other than the one
+/// the sweep ran with, decided again from its stored evidence terms.
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+pub struct MeasuredRule {
+    /// The rule's name (`tempered`, `per-channel`, ...).
+    pub rule: String,
+    /// The answer under it (see [`super::emu_sweep::redecide`]).
+    pub answer: String,
+    /// The posterior under it, most probable first.
+    pub probabilities: Vec<ProbabilityJson>,
 }
 
 /// How the hidden effect's own candidate fared when fitted jointly with the

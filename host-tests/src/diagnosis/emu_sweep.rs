@@ -15,7 +15,7 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-pub use super::emu_result::{EmuResult, HiddenFit, TwinCheck};
+pub use super::emu_result::{EmuResult, HiddenFit, MeasuredRule, TwinCheck};
 
 /// Generates and diagnoses `case` with the rig file as baseline.
 pub fn run_emu_case(case: EmuCase, o: &DiagnoseOptions) -> Result<EmuResult, String> {
@@ -91,6 +91,7 @@ pub fn run_emu_case_with(case: EmuCase, o: &DiagnoseOptions, twin: bool, oracle:
                 twin_probabilities: probabilities(&td),
                 twin_channels: td.posterior.channels.clone(),
                 twin_terms: td.posterior.terms.clone(),
+                twin_measured: None,
             })
         }
         _ => None,
@@ -117,6 +118,7 @@ pub fn run_emu_case_with(case: EmuCase, o: &DiagnoseOptions, twin: bool, oracle:
         ranking: d.ranking.iter().map(|r| (r.cause.clone(), r.delta_bic, r.heldout_gain, r.qualifies)).collect(),
         evidence_channels: d.posterior.channels.clone(),
         tier: d.nuisance_set.clone(),
+        measured: None,
         evidence_terms: d.posterior.terms.clone(),
         seconds,
     })
@@ -317,6 +319,28 @@ pub struct EmuSweepArgs {
     /// ([`redecide`]) before rendering.
     #[arg(long, value_enum)]
     pub redecide: Option<DecisionRule>,
+    /// Also decide with this rule from the stored terms and keep its
+    /// posterior beside the sweep's own ([`measure`]): the document adds
+    /// its reliability table and counts.
+    #[arg(long, value_enum)]
+    pub measure: Option<DecisionRule>,
+}
+
+/// `r` (and its twin) with the posterior and answer under `rule` stored
+/// beside its own ([`EmuResult::measured`]), as [`redecide`] would make
+/// them. Results without terms are left as they are.
+pub fn measure(r: &mut EmuResult, rule: DecisionRule) {
+    let name = clap::ValueEnum::to_possible_value(&rule).map_or_else(|| format!("{rule:?}"), |v| v.get_name().to_string());
+    let mut again = r.clone();
+    redecide(&mut again, rule);
+    if !r.evidence_terms.is_empty() {
+        r.measured = Some(MeasuredRule { rule: name.clone(), answer: again.answer.clone(), probabilities: again.probabilities.clone() });
+    }
+    if let (Some(t), Some(a)) = (r.twin.as_mut(), again.twin.as_ref()) {
+        if !t.twin_terms.is_empty() {
+            t.twin_measured = Some(MeasuredRule { rule: name, answer: a.twin_answer.clone(), probabilities: a.twin_probabilities.clone() });
+        }
+    }
 }
 
 /// `r` decided again from its stored evidence terms with `rule`
@@ -395,6 +419,7 @@ pub fn document(ok: &[EmuResult]) -> String {
     );
     md += &super::emu_tables::ratio_table(ok);
     md += &super::emu_tables::reliability_table(ok);
+    md += &super::emu_tables::measured_rule_section(ok);
     md
 }
 
@@ -468,6 +493,9 @@ pub fn run(a: &EmuSweepArgs) -> ExitCode {
     bar.finish_and_clear();
     if let Some(rule) = a.redecide {
         ok.iter_mut().for_each(|r| redecide(r, rule));
+    }
+    if let Some(rule) = a.measure {
+        ok.iter_mut().for_each(|r| measure(r, rule));
     }
     ok.sort_by_key(|r| r.case.seed);
     let mut md = document(&ok);

@@ -272,3 +272,51 @@ fn slow_measured_miss_forced_convection_with_structure_mismatch() {
 fn slow_measured_false_discovery_in_high_pressure_speed_steps_with_structure_mismatch() {
     check_miss(&[(case("none", PressureSpeedSteps, Structure, 93), "churning-loss", None)]);
 }
+
+/// The tempered decision rule (`DecisionRule::Tempered`, measured on the
+/// emulator sweep, not the product's) re-decided on the fast tier's
+/// synthetic cases from their stored evidence terms. **Measured**: it names
+/// none of the four causes the product names here (P of the hidden cause
+/// 0.67 lag, 0.21 winding, 0.63 conduction, 0.39 draught: η 0.1, fitted
+/// where a structure floor swamps the evidence, throws away most of it on
+/// logs of our own model's structure) and names `sensor-lag` on the `none`
+/// log 92 (a candidate that failed the held-out checks, let back in by the
+/// leak): a false discovery. Asserted as measured (the named cause, or
+/// none, per case), so it fails when either changes.
+#[test]
+#[ignore = "slow tier: measurement of a rule that is not the product's"]
+fn slow_tempered_rule_on_the_fast_tier_synthetic_cases() {
+    use eha_sim::diagnosis::evidence::{named_cause, posterior_from_terms, DecisionRule};
+    let expected = ["–", "–", "–", "–", "–", "–", "–", "–", "sensor-lag", "–", "–", "–"];
+    let cases = [
+        case("sensor-lag", Case1Pressure, Nuisance, 31),
+        case("winding-resistance-temperature", Case1Pressure, Nuisance, 11),
+        case("churning-loss", ThrottleSteps, Nuisance, 51),
+        case("motor-pump-conduction", Case1Pressure, Nuisance, 61),
+        case("forced-convection", Case1Pressure, Nuisance, 71),
+        case("none", Case1Pressure, Nuisance, 81),
+        case("none", ThrottleSteps, Nuisance, 82),
+        case("none", LoadCycles, Nuisance, 85),
+        case("none", PressureSpeedSteps, Nuisance, 92),
+        case("none", SpeedSweep, Structure, 84),
+        case("none", LoadCycles, Structure, 86),
+        case("none", AirSteps, Structure, 88),
+    ];
+    let out: Vec<(String, String, f64, String)> = cases
+        .par_iter()
+        .map(|c| {
+            let (run, _) = eha_sim::diagnosis::synth::generate(c).expect("generates");
+            let model = eha_sim::diagnosis::reference::ReferenceModel::new(eha_sim::rig::Rig::default(), &run).expect("model");
+            let d = eha_sim::diagnosis::diagnose(&run, &model, &DiagnoseOptions::default()).expect("diagnoses");
+            let p = posterior_from_terms(&d.posterior.terms, DecisionRule::Tempered);
+            let named = named_cause(&p).map_or("–".to_string(), |x| x.cause.clone());
+            let top = p.iter().find(|x| x.cause == c.hidden.name()).map_or(0.0, |x| x.probability);
+            (c.hidden.name().to_string(), d.answer().to_string(), top, named)
+        })
+        .collect();
+    for (h, a, p, n) in &out {
+        eprintln!("hidden {h}: product answer {a}; tempered: P(hidden) {p:.3}, named {n}");
+    }
+    let named: Vec<&str> = out.iter().map(|o| o.3.as_str()).collect();
+    assert_eq!(named, expected, "named under the tempered rule, case by case, changed");
+}
