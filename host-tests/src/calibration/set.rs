@@ -88,12 +88,8 @@ pub const CASE_CHURN: &str = "case_churn";
 /// ([`crate::rig::Pump::case_churn_speed_exp`]).
 pub const CASE_CHURN_SPEED: &str = "case_churn_speed";
 
-/// Name of the case oil's share of the pump friction heat
-/// ([`crate::rig::FrictionPairs::case_share_scale`]).
-pub const FRICTION_CASE: &str = "friction_case";
-
 /// The calibration set, in fit order.
-pub const PARAMS: [ParamDef; 25] = [
+pub const PARAMS: [ParamDef; 24] = [
     ParamDef {
         name: "h_out_motor",
         what: "outer heat transfer of the motor housing (free convection + radiation)",
@@ -315,17 +311,6 @@ pub const PARAMS: [ParamDef; 25] = [
         stage: Stage::Thermal,
     },
     ParamDef {
-        name: FRICTION_CASE,
-        what: "share of the pump's viscous and pressure friction heat that enters the case oil, as a factor on the sliding-pair rule's 0.15 (the delivered oil's and the housing's shares scaled down together)",
-        fields: "pump.friction_pairs.case_share_scale",
-        lo: 0.3, hi: 4.0, prior_sigma_ln: 0.7,
-        centre: "the rig file's sliding-pair rule: half the slipper film's heat to the case oil, none of the piston/bore or valve-plate films' (0.15 of the friction heat)",
-        why: "the leakage through the piston/bore and slipper gaps carries their films' heat into the case, and the rotating group's churning heats the case oil itself; the rule counts neither. 0.05–0.6 of the friction heat (×0.3–4): the upper end a pump whose pistons' film heat leaves with their leakage, the lower a case flushed from outside",
-        needs: Needs::Sensor(Channel::TDrainC),
-        excitation: "pressure steps at two or more speeds with a drain thermocouple (t_drain_c): the drain's rise against the pump housing's per watt of friction",
-        stage: Stage::Thermal,
-    },
-    ParamDef {
         name: "leak_gap",
         what: "pump leakage gap height (pistons, slippers, valve plate; leakage ∝ gap³)",
         fields: "pump.gaps.piston_gap_m, pump.gaps.slipper_gap_m, pump.gaps.port_gap_m",
@@ -418,7 +403,6 @@ pub fn apply(base: &Rig, theta: &[f64]) -> Rig {
                 r.pump.no_load_torque_nm *= t;
                 r.pump.viscous_torque_coeff *= t;
             }
-            FRICTION_CASE => r.pump.friction_pairs.case_share_scale *= t,
             "leak_gap" => {
                 r.pump.gaps.piston_gap_m *= t;
                 r.pump.gaps.slipper_gap_m *= t;

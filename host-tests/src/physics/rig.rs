@@ -177,28 +177,15 @@ pub struct FrictionPairs {
     pub slipper_swash: f64,
     /// Valve-plate share (assumed 0.2).
     pub valve_plate: f64,
-    /// Factor on the case oil's share of the rule above (the delivered oil's
-    /// and the housing's scaled down together so that the shares still add
-    /// up to 1): the leakage through the piston and slipper gaps carries
-    /// their films' heat into the case, which the rule does not count.
-    /// 1: the rule alone (the rig file; calibrated by `friction_case` from a
-    /// drain thermocouple).
-    #[serde(default = "one")]
-    pub case_share_scale: f64,
 }
 
 impl FrictionPairs {
     /// Shares of the C_v and C_p friction heat that enter (delivered oil,
-    /// case oil, housing metal); they add up to 1. The case oil's share of
-    /// the pairs' rule times [`FrictionPairs::case_share_scale`] (at most
-    /// 0.95).
+    /// case oil, housing metal); they add up to 1.
     pub fn shares(&self) -> (f64, f64, f64) {
         let sum = self.piston_bore + self.slipper_swash + self.valve_plate;
         let (p, s, v) = (self.piston_bore / sum, self.slipper_swash / sum, self.valve_plate / sum);
-        let (del, case, metal) = (p + 0.5 * v, 0.5 * s, 0.5 * s + 0.5 * v);
-        let case_k = (case * self.case_share_scale).min(0.95);
-        let rest = (1.0 - case_k) / (1.0 - case);
-        (del * rest, case_k, metal * rest)
+        (p + 0.5 * v, 0.5 * s, 0.5 * s + 0.5 * v)
     }
 }
 
@@ -627,7 +614,7 @@ impl Default for Rig {
                 eta_m: 0.443_590,
                 no_load_torque_nm: 0.3,
                 viscous_torque_coeff: 5.0e4,
-                friction_pairs: FrictionPairs { piston_bore: 0.5, slipper_swash: 0.3, valve_plate: 0.2, case_share_scale: 1.0 },
+                friction_pairs: FrictionPairs { piston_bore: 0.5, slipper_swash: 0.3, valve_plate: 0.2 },
                 split: None,
                 mass_kg: 20.0,
                 cp: 460.0,
@@ -768,10 +755,6 @@ impl Rig {
             if !(v.is_finite() && v > 0.0) {
                 return Err(RigError::Invalid(name, format!("must be > 0, got {v}")));
             }
-        }
-        let cs = self.pump.friction_pairs.case_share_scale;
-        if !(cs.is_finite() && cs > 0.0) {
-            return Err(RigError::Invalid("pump.friction_pairs.case_share_scale", format!("must be > 0 (1: the sliding-pair rule alone), got {cs}")));
         }
         if !(self.pump.case_churn.is_finite() && self.pump.case_churn > 0.0) {
             return Err(RigError::Invalid("pump.case_churn", format!("must be > 0 (1: the gap law alone), got {}", self.pump.case_churn)));
