@@ -6,6 +6,7 @@
 
 use eha_sim::calibration::commission::{check_reduced_with, commission, commission_with, Commissioning};
 use eha_sim::calibration::paths::PathKind;
+use eha_sim::calibration::ident::{case_film_speed_range, drain_time_low_and_high_speed_s};
 use eha_sim::calibration::{CalLog, CalOptions};
 use eha_sim::emulator::bench::{bench_log, bench_set, big_pump, leaky_heavy, machines, BenchLog, EmuMachine};
 use eha_sim::emulator::missions::EmuScenario;
@@ -23,11 +24,19 @@ fn truth(l: &BenchLog) -> CalLog {
 /// the true case oil (3 s / 5 s lag, σ 0.1 K, 12-bit; measured worst 0.40–0.89
 /// K on big-pump, 2.47 K on leaky-heavy's soak log, whose drain rises ~0.5 K/s
 /// after the load step against the 5 s probe), and the drain crosses the
-/// 40 °C valve threshold on the throttle logs.
+/// 40 °C valve threshold on the throttle logs. The training logs never
+/// hold the pump below 100 rpm, so the churned case film is held
+/// (`case_film_speed_range`); the servo log (0–150 rpm) added frees it.
 #[test]
 fn bench_logs_carry_the_drain_thermocouple() {
     for m in machines() {
         let s = bench_set(&m, 3600).expect("bench");
+        let mut train: Vec<CalLog> = s.train.iter().map(cal).collect();
+        let (low, high) = drain_time_low_and_high_speed_s(&train);
+        eprintln!("{}: training drain logs {low:.0} s below 100 rpm, {high:.0} s above 300 rpm", m.name);
+        assert!(!case_film_speed_range(&train), "{}: the churned case film freed by throttle logs alone", m.name);
+        train.push(cal(&s.holdout[0]));
+        assert!(case_film_speed_range(&train), "{}: the servo log does not free the churned case film", m.name);
         for l in s.train.iter().chain(&s.holdout) {
             let d = l.run.get(Channel::TDrainC).expect("t_drain_c");
             let t = l.truth.get(Channel::TDrainC).expect("truth");
