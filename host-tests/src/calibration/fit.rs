@@ -230,6 +230,23 @@ pub fn calibrate(base: &Rig, logs: &[CalLog], o: &CalOptions) -> Result<Calibrat
             held[k].get_or_insert_with(|| format!("every log has one operating point; would need: {}", PARAMS[k].excitation));
         }
     }
+    // 1c. The churned case film needs the drain both near rest and at
+    // speed: without, its level and the gap's floor trade freely.
+    if !super::ident::case_film_speed_range(logs) {
+        let (low, high) = super::ident::drain_time_low_and_high_speed_s(logs);
+        for name in [super::set::CASE_CHURN, super::set::CASE_CHURN_SPEED] {
+            let k = super::set::index(name).expect("calibration parameter");
+            held[k].get_or_insert_with(|| {
+                format!(
+                    "the logs with `t_drain_c` spend {low:.0} s below {:.0} rpm and {high:.0} s above {:.0} rpm (needs {:.0} s of each); would need: {}",
+                    super::ident::CASE_FILM_LOW_RPM,
+                    super::ident::CASE_FILM_HIGH_RPM,
+                    super::ident::CASE_FILM_MIN_S,
+                    PARAMS[k].excitation
+                )
+            });
+        }
+    }
     for (name, why) in &o.hold {
         if let Some(k) = super::set::index(name) {
             held[k].get_or_insert_with(|| why.clone());

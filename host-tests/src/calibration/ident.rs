@@ -179,3 +179,47 @@ pub fn independent_speed_and_load(run: &crate::measured::MeasuredRun) -> bool {
     let (s_speed, s_dp, rho) = speed_load_excitation(run);
     s_speed >= ONE_POINT_SPREAD && s_dp >= ONE_POINT_SPREAD && rho.abs() < JOINT_MAX_CORRELATION
 }
+
+/// Shaft speed below which the churned case film has blended out (about
+/// [`crate::network::CASE_CHURN_ONSET_RAD_S`]), rpm.
+pub const CASE_FILM_LOW_RPM: f64 = 100.0;
+
+/// Shaft speed above which the churned case film has blended in, rpm.
+pub const CASE_FILM_HIGH_RPM: f64 = 300.0;
+
+/// Time the drain-logged training set must spend below
+/// [`CASE_FILM_LOW_RPM`] and above [`CASE_FILM_HIGH_RPM`] (each) to
+/// separate the case film's floor from its churned level, s.
+pub const CASE_FILM_MIN_S: f64 = 120.0;
+
+/// Seconds the logs carrying `t_drain_c` spend below [`CASE_FILM_LOW_RPM`]
+/// and above [`CASE_FILM_HIGH_RPM`] (|speed|, each row weighted by the time
+/// to the next).
+pub fn drain_time_low_and_high_speed_s(logs: &[CalLog]) -> (f64, f64) {
+    let (mut low, mut high) = (0.0, 0.0);
+    for l in logs.iter().filter(|l| l.has(Channel::TDrainC)) {
+        let x = Inputs::of(&l.run);
+        let t = &l.run.time_s;
+        for i in 0..t.len().saturating_sub(1) {
+            let Some(w) = x.speed(i).map(f64::abs) else { continue };
+            let dt = t[i + 1] - t[i];
+            if w < CASE_FILM_LOW_RPM {
+                low += dt;
+            } else if w > CASE_FILM_HIGH_RPM {
+                high += dt;
+            }
+        }
+    }
+    (low, high)
+}
+
+/// Whether the logs carrying `t_drain_c` show the case film both near rest
+/// and at speed ([`CASE_FILM_MIN_S`] each): otherwise the churned film's
+/// level and the gap's floor are seen only in their product
+/// (`set::CASE_CHURN`, `film_case`), and the fit picks between basins by
+/// the last digit (measured on the emulator's big-pump, trained above
+/// 300 rpm: film ×1.9 with churn ×13, or film ×6.1 with churn ×4.5).
+pub fn case_film_speed_range(logs: &[CalLog]) -> bool {
+    let (low, high) = drain_time_low_and_high_speed_s(logs);
+    low >= CASE_FILM_MIN_S && high >= CASE_FILM_MIN_S
+}

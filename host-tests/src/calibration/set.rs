@@ -81,8 +81,15 @@ pub const BLOCK_WALL: &str = "block_wall";
 /// Name of the forced-convection (ram-air) coefficient's parameter.
 pub const H_FORCED: &str = "h_forced";
 
+/// Name of the churned case film's level ([`crate::rig::Pump::case_churn`]).
+pub const CASE_CHURN: &str = "case_churn";
+
+/// Name of the churned case film's speed exponent
+/// ([`crate::rig::Pump::case_churn_speed_exp`]).
+pub const CASE_CHURN_SPEED: &str = "case_churn_speed";
+
 /// The calibration set, in fit order.
-pub const PARAMS: [ParamDef; 22] = [
+pub const PARAMS: [ParamDef; 24] = [
     ParamDef {
         name: "h_out_motor",
         what: "outer heat transfer of the motor housing (free convection + radiation)",
@@ -180,6 +187,28 @@ pub const PARAMS: [ParamDef; 22] = [
         why: "the reference takes the case flow as laminar Taylor–Couette flow (Nu = 2 below the instability, a lower bound: slippers, pistons and the leakage jets churn a real case) on an assumed inner area",
         needs: Needs::Sensor(Channel::TPumpC),
         excitation: "speed steps with a drain thermocouple (t_drain_c) or a pump-surface sensor",
+        stage: Stage::Thermal,
+    },
+    ParamDef {
+        name: CASE_CHURN,
+        what: "the case film churned by the rotating group: factor on the case gap's laminar film at 955 rpm (oil at 40 °C), blended in above ~100 rpm; the gap film stays the floor at rest (network::case_churn_factor)",
+        fields: "pump.case_churn",
+        lo: 0.5, hi: 100.0, prior_sigma_ln: 2.0,
+        centre: "the rig file's law: laminar Taylor–Couette flow across the 3 mm case gap (Nu = 2 below the instability), nothing churned",
+        why: "Nu = 2 across the gap is conduction, a lower bound: the slippers, pistons and leakage jets of a rotating group churn its case. A rotating cylinder of this size in oil (Becker's Nu = 0.133·Re^⅔·Pr^⅓ on the 60 mm barrel at 955 rpm, 40 °C: h ≈ 600 W/(m²·K)) gives 10 times the gap law there (58 W/(m²·K)), the slippers and jets a few times more; ×100 (h ≈ 6 kW/(m²·K), oil jets impinging) is the upper end. Below 1: a case not full of oil (drained, aerated at speed). σ 2 in ln: the rig file's law is a floor, not an estimate; the logs decide",
+        needs: Needs::Sensor(Channel::TDrainC),
+        excitation: "speed steps (300–1500 rpm) and holds at a low speed (servo holds, the shaft stopped) with a drain thermocouple (t_drain_c)",
+        stage: Stage::Thermal,
+    },
+    ParamDef {
+        name: CASE_CHURN_SPEED,
+        what: "speed exponent added to the churned case film (pump.case_churn_speed_exp = ln θ)",
+        fields: "pump.case_churn_speed_exp (+ ln θ)",
+        lo: 0.5, hi: 2.7, prior_sigma_ln: 0.5,
+        centre: "the gap law's own speed dependence (exponent added 0)",
+        why: "churned films go as Re^0.5 (laminar boundary layers on slippers) to Re^0.8 (turbulent), a rotating cylinder as Re^⅔; the gap law over 300–1500 rpm goes as Re^0 below the Taylor instability to Re^0.7 above it: an added exponent −0.7…+1 (θ 0.5–2.7) covers the difference, σ 0.5 its likely half",
+        needs: Needs::Sensor(Channel::TDrainC),
+        excitation: "speed steps (300–1500 rpm) with a drain thermocouple (t_drain_c)",
         stage: Stage::Thermal,
     },
     ParamDef {
@@ -354,6 +383,8 @@ pub fn apply(base: &Rig, theta: &[f64]) -> Rig {
                 r.pump.case_inner_area_m2 /= t;
             }
             "film_case" => r.pump.case_inner_area_m2 *= t,
+            CASE_CHURN => r.pump.case_churn *= t,
+            CASE_CHURN_SPEED => r.pump.case_churn_speed_exp += t.ln(),
             BLOCK_WALL => r.blocks.wall_m /= t,
             "cap_motor" => {
                 let w = r.motor.winding_mass_kg;

@@ -145,14 +145,52 @@ pub fn duct_conductance(rig: &Rig, q_m3_per_s: f64, d: f64, len: f64, area_scale
 /// Film coefficient of the oil between the pump case and the rotating
 /// cylinder barrel (Taylor–Couette flow in the radial gap), W/(m²·K):
 /// h = Nu·k/(2e) with Nu from [`heat::nu_taylor_couette`] at the barrel's
-/// speed `omega` (rad/s, either sign); it holds on both walls of the gap.
-/// `t_oil` °C and `nu` m²/s are the case oil's.
+/// speed `omega` (rad/s, either sign), times the churned case's
+/// [`case_churn_factor`]; it holds on both walls of the gap. `t_oil` °C and
+/// `nu` m²/s are the case oil's.
 pub fn case_gap_h(rig: &Rig, omega: f64, t_oil: f64, nu: f64) -> f64 {
     let p = &rig.pump;
     let e = p.case_gap_m;
     let r_mean = p.rotor_radius_m + 0.5 * e;
     let ta = omega * omega * r_mean * e.powi(3) / (nu * nu);
-    heat::nu_taylor_couette(ta) * rig.oil.k(t_oil) / (2.0 * e)
+    heat::nu_taylor_couette(ta) * rig.oil.k(t_oil) / (2.0 * e) * case_churn_factor(rig, omega, nu)
+}
+
+/// Reference speed of the churned case film ([`crate::rig::Pump::case_churn`]
+/// is its factor there), rad/s (≈ 955 rpm, inside a 300–1500 rpm bench),
+/// with the oil at [`CASE_CHURN_REF_C`].
+pub const CASE_CHURN_REF_RAD_S: f64 = 100.0;
+
+/// Speed at which the churned film is half blended in, rad/s (≈ 95 rpm,
+/// oil at [`CASE_CHURN_REF_C`]): below it the rim of a 30 mm barrel moves
+/// < 0.3 m/s and the stirring Reynolds numbers (~100 on a 15 mm slipper)
+/// are far from churned flow; conduction across the gap takes over.
+pub const CASE_CHURN_ONSET_RAD_S: f64 = 10.0;
+
+/// Oil temperature of the churned film's reference speeds, °C.
+pub const CASE_CHURN_REF_C: f64 = 40.0;
+
+/// Factor of the churned case on the gap's film: 1 + s·(θ·rⁿ − 1), with
+/// θ = [`crate::rig::Pump::case_churn`], n =
+/// [`crate::rig::Pump::case_churn_speed_exp`], r the gap's Reynolds number
+/// ω·r·e/ν over its value at [`CASE_CHURN_REF_RAD_S`] with the oil at
+/// [`CASE_CHURN_REF_C`], and the blend s = r²/(r² + r₀²), r₀ the same ratio
+/// at [`CASE_CHURN_ONSET_RAD_S`]: the churned law θ·rⁿ on the gap law at
+/// speed, the gap law (Nu = 2 across the gap, conduction: a lower bound) at
+/// rest. Exactly 1 for the rig file's θ = 1, n = 0. A function of ω/ν alone,
+/// as the gap law is (the reduction tabulates it over speed at 40 °C).
+pub fn case_churn_factor(rig: &Rig, omega: f64, nu: f64) -> f64 {
+    let p = &rig.pump;
+    if p.case_churn == 1.0 && p.case_churn_speed_exp == 0.0 {
+        return 1.0;
+    }
+    let r = omega.abs() * rig.oil.nu_m2_per_s(CASE_CHURN_REF_C) / (CASE_CHURN_REF_RAD_S * nu);
+    if r == 0.0 {
+        return 1.0;
+    }
+    let r0 = CASE_CHURN_ONSET_RAD_S / CASE_CHURN_REF_RAD_S;
+    let s = r * r / (r * r + r0 * r0);
+    1.0 + s * (p.case_churn * r.powf(p.case_churn_speed_exp) - 1.0)
 }
 
 /// Case-oil film to the pump housing: [`case_gap_h`] on the case's inner
@@ -255,4 +293,27 @@ pub fn q_outer(rig: &Rig, area: f64, shape: Shape, t_wall: f64, t_air: f64, air_
 pub fn block_path(rig: &Rig, film_w_per_k: f64, block_area_m2: f64) -> f64 {
     let a = (block_area_m2 / 6.0).sqrt();
     series(film_w_per_k, heat::g_plane_wall(rig.blocks.steel_k, a, rig.blocks.wall_m))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The churned case film: exactly the gap law for the rig file and at
+    /// rest; θ at the reference speed with the oil at 40 °C (to the blend,
+    /// 1 %); a function of ω/ν alone.
+    #[test]
+    fn case_churn_is_the_gap_law_at_the_centre_and_at_rest() {
+        let mut rig = Rig::default();
+        let nu40 = rig.oil.nu_m2_per_s(CASE_CHURN_REF_C);
+        assert_eq!(case_churn_factor(&rig, CASE_CHURN_REF_RAD_S, nu40), 1.0);
+        rig.pump.case_churn = 30.0;
+        rig.pump.case_churn_speed_exp = 0.6;
+        assert_eq!(case_churn_factor(&rig, 0.0, nu40), 1.0);
+        let at_ref = case_churn_factor(&rig, CASE_CHURN_REF_RAD_S, nu40);
+        assert!((at_ref / 30.0 - 1.0).abs() < 0.011, "{at_ref}");
+        let (a, b) = (case_churn_factor(&rig, 50.0, nu40), case_churn_factor(&rig, 25.0, nu40 / 2.0));
+        assert!((a - b).abs() < 1e-12 * a);
+        assert!(case_churn_factor(&rig, 1.0, nu40) < 1.1);
+    }
 }

@@ -81,6 +81,11 @@ pub struct Motor {
     pub max_speed_rpm: f64,
 }
 
+/// Serde default of a factor that is 1 unless the rig file says otherwise.
+fn one() -> f64 {
+    1.0
+}
+
 /// Piston pump and its housing.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -129,6 +134,20 @@ pub struct Pump {
     pub case_inner_area_m2: f64,
     /// Radial gap between the rotating cylinder barrel and the case, m (assumed).
     pub case_gap_m: f64,
+    /// The case film churned by the rotating group: factor on the gap's
+    /// laminar Taylor–Couette film at [`crate::network::CASE_CHURN_REF_RAD_S`]
+    /// (oil at 40 °C), blended in above
+    /// [`crate::network::CASE_CHURN_ONSET_RAD_S`]; the gap law stays the
+    /// floor at rest (`crate::network::case_churn_factor`). 1: the gap law
+    /// alone (the rig file; calibrated by `case_churn` from a drain
+    /// thermocouple).
+    #[serde(default = "one")]
+    pub case_churn: f64,
+    /// Speed exponent added to the churned case film's law (in the gap's
+    /// Reynolds number ω·r·e/ν): 0, the gap law's own (the rig file;
+    /// calibrated by `case_churn_speed`).
+    #[serde(default)]
+    pub case_churn_speed_exp: f64,
     /// Outer radius of the rotating cylinder barrel, m (assumed).
     pub rotor_radius_m: f64,
     /// Port passage diameter, m (assumed).
@@ -605,6 +624,8 @@ impl Default for Rig {
                 port_oil_m3: 0.05e-3,
                 case_inner_area_m2: 0.02,
                 case_gap_m: 0.003,
+                case_churn: 1.0,
+                case_churn_speed_exp: 0.0,
                 rotor_radius_m: 0.03,
                 port_d_m: 0.012,
                 port_len_m: 0.05,
@@ -734,6 +755,12 @@ impl Rig {
             if !(v.is_finite() && v > 0.0) {
                 return Err(RigError::Invalid(name, format!("must be > 0, got {v}")));
             }
+        }
+        if !(self.pump.case_churn.is_finite() && self.pump.case_churn > 0.0) {
+            return Err(RigError::Invalid("pump.case_churn", format!("must be > 0 (1: the gap law alone), got {}", self.pump.case_churn)));
+        }
+        if !(self.pump.case_churn_speed_exp.is_finite() && self.pump.case_churn_speed_exp.abs() <= 2.0) {
+            return Err(RigError::Invalid("pump.case_churn_speed_exp", format!("must be within -2..2 (0: the gap law's own), got {}", self.pump.case_churn_speed_exp)));
         }
         if self.ext.viscosity_temperature.is_some() {
             return Err(RigError::Invalid(

@@ -6,6 +6,7 @@
 
 use eha_sim::calibration::commission::{check_reduced_with, commission, commission_with, Commissioning};
 use eha_sim::calibration::paths::PathKind;
+use eha_sim::calibration::ident::{case_film_speed_range, drain_time_low_and_high_speed_s};
 use eha_sim::calibration::{CalLog, CalOptions};
 use eha_sim::emulator::bench::{bench_log, bench_set, big_pump, leaky_heavy, machines, BenchLog, EmuMachine};
 use eha_sim::emulator::missions::EmuScenario;
@@ -23,11 +24,19 @@ fn truth(l: &BenchLog) -> CalLog {
 /// the true case oil (3 s / 5 s lag, σ 0.1 K, 12-bit; measured worst 0.40–0.89
 /// K on big-pump, 2.47 K on leaky-heavy's soak log, whose drain rises ~0.5 K/s
 /// after the load step against the 5 s probe), and the drain crosses the
-/// 40 °C valve threshold on the throttle logs.
+/// 40 °C valve threshold on the throttle logs. The training logs never
+/// hold the pump below 100 rpm, so the churned case film is held
+/// (`case_film_speed_range`); the servo log (0–150 rpm) added frees it.
 #[test]
 fn bench_logs_carry_the_drain_thermocouple() {
     for m in machines() {
         let s = bench_set(&m, 3600).expect("bench");
+        let mut train: Vec<CalLog> = s.train.iter().map(cal).collect();
+        let (low, high) = drain_time_low_and_high_speed_s(&train);
+        eprintln!("{}: training drain logs {low:.0} s below 100 rpm, {high:.0} s above 300 rpm", m.name);
+        assert!(!case_film_speed_range(&train), "{}: the churned case film freed by throttle logs alone", m.name);
+        train.push(cal(&s.holdout[0]));
+        assert!(case_film_speed_range(&train), "{}: the servo log does not free the churned case film", m.name);
         for l in s.train.iter().chain(&s.holdout) {
             let d = l.run.get(Channel::TDrainC).expect("t_drain_c");
             let t = l.truth.get(Channel::TDrainC).expect("truth");
@@ -267,3 +276,51 @@ fn reproducible(m: EmuMachine) {
     }
 }
 
+
+/// The churned case film where the training set frees it: big-pump trained
+/// on its two throttle logs and the servo log (0–150 rpm holds), held out
+/// on the throttle mix; the same commissioning with the churned film held
+/// (the gap law) beside it. Measured (firmware drain vs the thermocouple,
+/// max |e| / under-prediction, without the margin): churned film fitted
+/// (film ×1.11, churn ×22.5, exponent −0.13), mix 2.446 / 2.446 K, the servo
+/// log (training) 0.947 K under; gap law 3.835 / 2.342 K, servo 2.284 K
+/// under. Max |e| falls, the under-prediction does not. Not settled at
+/// the last digit: with every temperature nudged by 1e-9 K the churned fit
+/// ended at film ×0.80, churn ×33.0 and the mix at 2.682 / 2.682 K.
+#[test]
+#[ignore = "slow tier: two commissionings on emulator bench logs (~1 min each)"]
+fn slow_churned_case_film_with_a_low_speed_training_log() {
+    let m = big_pump();
+    let s = bench_set(&m, 3600).expect("bench");
+    let mut train: Vec<CalLog> = s.train.iter().map(cal).collect();
+    train.push(cal(&s.holdout[0]));
+    let hold = [cal(&s.holdout[1])];
+    let churn = eha_sim::calibration::set::CASE_CHURN;
+    let mut got = Vec::new();
+    for held in [false, true] {
+        let mut o = CalOptions::default();
+        if held {
+            o.hold.push((churn, "the gap law, for comparison".into()));
+            o.hold.push((eha_sim::calibration::set::CASE_CHURN_SPEED, "the gap law, for comparison".into()));
+        }
+        let t0 = std::time::Instant::now();
+        let c = commission_with(&m.rig_file(), &train, &hold, &o, false).expect("commissioning");
+        report(&m, &c, t0.elapsed().as_secs_f64());
+        let fitted = c.cal.params.iter().any(|p| p.name == churn && p.status == eha_sim::calibration::Status::Fitted);
+        assert_eq!(fitted, !held, "case_churn fitted");
+        let mix = &c.holdout_with_margin[0];
+        let servo = c.reduced.iter().find(|r| r.log.contains("Servo")).expect("servo log");
+        got.push((mix.vs_measured_max_k.expect("drain"), mix.vs_measured_under_k.expect("drain"), servo.vs_measured_under_k.expect("drain")));
+    }
+    eprintln!("churned film / gap law: mix (max, under), servo under: {got:.3?}");
+    // The churned fit moved 0.24 K under the last-digit nudge: its numbers
+    // within 0.3 K; the gap law's within AS_MEASURED_K.
+    let want = [(2.446, 2.446, 0.947, 0.3), (3.835, 2.342, 2.284, AS_MEASURED_K)];
+    for (g, w) in got.iter().zip(want) {
+        for (what, x, y) in [("mix max |e|", g.0, w.0), ("mix under-prediction", g.1, w.1), ("servo (training) under-prediction", g.2, w.2)] {
+            assert!((x - y).abs() <= w.3, "{what}: {x:.3} K, measured {y:.3} K (±{})", w.3);
+        }
+    }
+    // The churned film's gain on the held-out mix's max |e|: ≥ 1 K.
+    assert!(got[1].0 - got[0].0 >= 1.0, "mix max |e| {:.3} K churned, {:.3} K gap law", got[0].0, got[1].0);
+}
