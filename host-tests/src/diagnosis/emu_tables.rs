@@ -2,7 +2,7 @@
 //! against each log's effect-free twin) and the reliability of the stated
 //! probabilities (stated probability against observed frequency).
 
-use super::emu_result::EmuResult;
+use super::emu_result::{EmuResult, TwinCheck};
 use super::model::Candidate;
 use super::report::ProbabilityJson;
 use std::fmt::Write as _;
@@ -24,40 +24,42 @@ pub struct Diagnosed<'a> {
     pub probabilities: &'a [ProbabilityJson],
 }
 
-/// Every diagnosed log of `ok`, the twins after their cases.
-pub fn diagnosed(ok: &[EmuResult]) -> Vec<Diagnosed<'_>> {
+/// An answer and its posterior.
+type Answer<'a> = (&'a str, &'a [ProbabilityJson]);
+
+/// Every log of `ok` that `case` (a case log) or `twin` (its effect-free
+/// twin) gives an answer for, the twins after their cases.
+fn diagnosed_by<'a>(
+    ok: &'a [EmuResult],
+    case: impl Fn(&'a EmuResult) -> Option<Answer<'a>>,
+    twin: impl Fn(&'a TwinCheck) -> Option<Answer<'a>>,
+) -> Vec<Diagnosed<'a>> {
     let mut out = Vec::new();
     for r in ok {
         let ratio = r.twin.as_ref().map(|t| t.ratio());
-        out.push(Diagnosed { seed: r.case.seed, twin: false, truth: r.case.hidden.name(), ratio, answer: &r.answer, probabilities: &r.probabilities });
-        if let Some(t) = &r.twin {
-            out.push(Diagnosed {
-                seed: r.case.seed,
-                twin: true,
-                truth: Candidate::None.name(),
-                ratio: None,
-                answer: &t.twin_answer,
-                probabilities: &t.twin_probabilities,
-            });
+        if let Some((answer, probabilities)) = case(r) {
+            out.push(Diagnosed { seed: r.case.seed, twin: false, truth: r.case.hidden.name(), ratio, answer, probabilities });
+        }
+        if let Some((answer, probabilities)) = r.twin.as_ref().and_then(&twin) {
+            out.push(Diagnosed { seed: r.case.seed, twin: true, truth: Candidate::None.name(), ratio: None, answer, probabilities });
         }
     }
     out
 }
 
+/// Every diagnosed log of `ok`, the twins after their cases.
+pub fn diagnosed(ok: &[EmuResult]) -> Vec<Diagnosed<'_>> {
+    diagnosed_by(ok, |r| Some((&r.answer, &r.probabilities)), |t| Some((&t.twin_answer, &t.twin_probabilities)))
+}
+
 /// Every log of `ok` with a posterior under the measured rule
 /// ([`EmuResult::measured`]), its answer and probabilities under it.
 pub fn diagnosed_measured(ok: &[EmuResult]) -> Vec<Diagnosed<'_>> {
-    let mut out = Vec::new();
-    for r in ok {
-        let ratio = r.twin.as_ref().map(|t| t.ratio());
-        if let Some(m) = &r.measured {
-            out.push(Diagnosed { seed: r.case.seed, twin: false, truth: r.case.hidden.name(), ratio, answer: &m.answer, probabilities: &m.probabilities });
-        }
-        if let Some(m) = r.twin.as_ref().and_then(|t| t.twin_measured.as_ref()) {
-            out.push(Diagnosed { seed: r.case.seed, twin: true, truth: Candidate::None.name(), ratio: None, answer: &m.answer, probabilities: &m.probabilities });
-        }
-    }
-    out
+    diagnosed_by(
+        ok,
+        |r| r.measured.as_ref().map(|m| (m.answer.as_str(), m.probabilities.as_slice())),
+        |t| t.twin_measured.as_ref().map(|m| (m.answer.as_str(), m.probabilities.as_slice())),
+    )
 }
 
 /// Seeds of the original case set (seeds 1700 + 100·k + index, k < 10):

@@ -381,11 +381,6 @@ pub const LEARNING_RATE: f64 = 0.1;
 /// candidate is never the cause).
 pub const LEAK: f64 = 0.1;
 
-/// Whether [`DecisionRule::Tempered`] adds the Laplace Occam factor's
-/// difference (candidate against baseline, both at the own-misfit
-/// amplitudes) to the likelihood ratio.
-pub const TEMPERED_OCCAM: bool = true;
-
 /// The weight of one channel in [`DecisionRule::Tempered`]: its
 /// amplitude (the baseline's own training misfit, at least the noise) and
 /// the effective sample fraction of the baseline's residual whitened at it.
@@ -435,11 +430,9 @@ pub fn tempered_causes(terms: &[StructureTerms]) -> Vec<(String, f64, f64)> {
                 None => f64::NEG_INFINITY,
             })
             .sum();
-        let occam = match (TEMPERED_OCCAM, t.occam_own != 0.0 || t.base_occam_own != 0.0) {
-            (false, _) => 0.0,
-            (true, true) => t.occam_own - t.base_occam_own,
-            (true, false) => t.occam - t.base_occam,
-        };
+        // The Laplace Occam factors' difference at the own-misfit
+        // amplitudes (at the structure's own where a stored sweep lacks them).
+        let occam = if t.occam_own != 0.0 || t.base_occam_own != 0.0 { t.occam_own - t.base_occam_own } else { t.occam - t.base_occam };
         let b = LEARNING_RATE * (l + occam);
         let prior = if t.prior > 0.0 { t.prior } else { LEAK * cand_prior };
         // Against `none`, whose evidence is 2·pn of the no-cause block's.
@@ -771,6 +764,9 @@ pub fn posterior_of(
         })
         .collect();
     let own = |ch: Channel| find(ch).map_or(0.1, |f| f.misfit_k.max(f.noise_k));
+    let occam = |o: Option<f64>| o.unwrap_or(f64::NEG_INFINITY);
+    // The baseline's at the own-misfit amplitudes: the same for every candidate.
+    let base_occam_own = occam(log_occam(run, pts, all_pts, base, nuisance, &own, &noise, tau_s));
     let mut terms = vec![StructureTerms {
         cause: "none".into(),
         prior: PRIOR_NO_CAUSE,
@@ -786,7 +782,6 @@ pub fn posterior_of(
         let amp = |ch: Channel| find(ch).map_or(0.1, |x| floor_for(x, &floors, &touched));
         let mut specs = nuisance.to_vec();
         specs.extend(ext(f.candidate));
-        let occam = |o: Option<f64>| o.unwrap_or(f64::NEG_INFINITY);
         terms.push(StructureTerms {
             cause: f.candidate.name().into(),
             prior: if admitted(f.candidate) { (1.0 - 2.0 * PRIOR_NO_CAUSE) / Candidate::EXTENSIONS.len() as f64 } else { 0.0 },
@@ -794,7 +789,7 @@ pub fn posterior_of(
             occam: occam(log_occam(run, pts, all_pts, f, &specs, &amp, &noise, tau_s)),
             base_occam: occam(log_occam(run, pts, all_pts, base, nuisance, &amp, &noise, tau_s)),
             occam_own: occam(log_occam(run, pts, all_pts, f, &specs, &own, &noise, tau_s)),
-            base_occam_own: occam(log_occam(run, pts, all_pts, base, nuisance, &own, &noise, tau_s)),
+            base_occam_own,
             channels: channel_terms(run, all_pts, f, &amp, &noise, &own, tau_s),
         });
     }

@@ -211,19 +211,12 @@ pub fn joint_reference(
     Ok((rows, MultiModel::new(models, layout)?))
 }
 
-/// One log's share of a joint diagnosis: its rows of the nominal, calibrated
-/// ("before") and extended ("after") series, and their errors against its
-/// own training and held-out windows.
-#[derive(Debug, Clone)]
-pub struct LogPart {
-    /// The joint diagnosis seen on this log alone: `series`, `nominal`,
-    /// `before`, `after` and `split_time_s` are this log's; the answer,
-    /// ranking, posterior and parameters the joint ones (for plots).
-    pub diagnosis: Diagnosis,
-}
-
-/// Each log's part of the joint diagnosis `d` of `runs` laid out by `layout`.
-pub fn log_parts(d: &Diagnosis, runs: &[&MeasuredRun], layout: &Layout, o: &DiagnoseOptions) -> Vec<LogPart> {
+/// Each log's part of the joint diagnosis `d` of `runs` laid out by
+/// `layout`: the joint diagnosis seen on that log alone — `series`,
+/// `nominal`, `before`, `after` and `split_time_s` are the log's (its rows,
+/// its own training and held-out windows); the answer, ranking, posterior
+/// and parameters the joint ones (for plots).
+pub fn log_parts(d: &Diagnosis, runs: &[&MeasuredRun], layout: &Layout, o: &DiagnoseOptions) -> Vec<Diagnosis> {
     runs.iter()
         .enumerate()
         .map(|(i, run)| {
@@ -239,7 +232,7 @@ pub fn log_parts(d: &Diagnosis, runs: &[&MeasuredRun], layout: &Layout, o: &Diag
             di.after = m(&series[2]);
             di.split_time_s = split;
             di.series = series;
-            LogPart { diagnosis: di }
+            di
         })
         .collect()
 }
@@ -247,17 +240,17 @@ pub fn log_parts(d: &Diagnosis, runs: &[&MeasuredRun], layout: &Layout, o: &Diag
 /// Writes a joint diagnosis: `report.md` (with the per-log section),
 /// `diagnosis.json` (with its `logs` key) and each log's PNGs under
 /// `log-1/`, `log-2/`, … in `out`; `files` names the logs.
-pub fn write_outputs(d: &Diagnosis, parts: &[LogPart], runs: &[&MeasuredRun], files: &[String], out: &std::path::Path) -> std::io::Result<()> {
+pub fn write_outputs(d: &Diagnosis, parts: &[Diagnosis], runs: &[&MeasuredRun], files: &[String], out: &std::path::Path) -> std::io::Result<()> {
     use super::report::{report_markdown_logs, DiagnosisJson, LogJson};
     std::fs::create_dir_all(out)?;
     let mut pngs = Vec::new();
     for (i, (p, run)) in parts.iter().zip(runs).enumerate() {
         let sub = format!("log-{}", i + 1);
         std::fs::create_dir_all(out.join(&sub))?;
-        let names = super::plot::write_plots(&p.diagnosis, run, &out.join(&sub)).map_err(|e| std::io::Error::other(e.to_string()))?;
+        let names = super::plot::write_plots(p, run, &out.join(&sub)).map_err(|e| std::io::Error::other(e.to_string()))?;
         pngs.extend(names.iter().map(|n| format!("{sub}/{n}")));
     }
-    let logs: Vec<LogJson> = parts.iter().zip(runs).zip(files).map(|((p, r), f)| LogJson::of(f, r.len(), &p.diagnosis)).collect();
+    let logs: Vec<LogJson> = parts.iter().zip(runs).zip(files).map(|((p, r), f)| LogJson::of(f, r.len(), p)).collect();
     std::fs::write(out.join("report.md"), report_markdown_logs(d, &files.join("` + `"), &pngs, &logs))?;
     let mut j = DiagnosisJson::from_diagnosis(d);
     j.logs = logs;

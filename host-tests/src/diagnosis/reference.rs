@@ -140,11 +140,10 @@ pub fn nuisance_set(run: &MeasuredRun) -> Vec<usize> {
 }
 
 /// The calibration parameters one machine's logs share ([`nuisance_set`]
-/// for several logs): sensors, inputs and excitation judged on `rows`
+/// for several logs): sensors, inputs and excitation judged on `run`
 /// (every log's rows on one table, e.g. [`super::multi::combine`]'s), the
 /// needle split left out only when every log in `logs` is a servo circuit.
-pub fn nuisance_set_of(rows: &MeasuredRun, logs: &[&MeasuredRun]) -> Vec<usize> {
-    let run = rows;
+pub fn nuisance_set_of(run: &MeasuredRun, logs: &[&MeasuredRun]) -> Vec<usize> {
     let logged = |ch: Channel| Channel::TEMPERATURES.contains(&ch) && run.get(ch).is_some_and(|v| v.iter().any(Option::is_some));
     let one_point = calibration::ident::one_point(run);
     // The circuit by the log's rule (stated, or the piston's travel), never

@@ -111,7 +111,7 @@ pub struct LogChannelJson {
 }
 
 impl LogJson {
-    /// The numbers of one log's part ([`super::multi::LogPart`]) of a joint diagnosis.
+    /// The numbers of one log's part ([`super::multi::log_parts`]) of a joint diagnosis.
     pub fn of(file: &str, rows: usize, d: &Diagnosis) -> Self {
         LogJson {
             file: file.into(),

@@ -91,8 +91,8 @@ fn logs_share_one_parameter_vector_and_one_answer() {
     assert_eq!(parts.len(), 2);
     for (p, run) in parts.iter().zip([&a, &b]) {
         let split = eha_sim::diagnosis::analysis::split_time_s(run, 0.7);
-        assert_eq!(p.diagnosis.split_time_s, split);
-        assert!(p.diagnosis.before.heldout_rmse_k < 0.01, "held out {:.4} K", p.diagnosis.before.heldout_rmse_k);
+        assert_eq!(p.split_time_s, split);
+        assert!(p.before.heldout_rmse_k < 0.01, "held out {:.4} K", p.before.heldout_rmse_k);
     }
     let out = std::env::temp_dir().join(format!("diag-multi-{}", std::process::id()));
     write_outputs(&d, &parts, &[&a, &b], &["a.csv".into(), "b.csv".into()], &out).expect("outputs");
@@ -139,8 +139,8 @@ fn diagnose_together(logs: &[&MeasuredRun]) -> eha_sim::diagnosis::Diagnosis {
     let d = diagnose(&rows, &joint, &o).expect("joint diagnosis");
     for p in log_parts(&d, logs, joint.layout(), &o) {
         let ch: Vec<String> =
-            p.diagnosis.before.channels.iter().map(|c| format!("{} {:.2}", c.channel, c.heldout_rmse_k)).collect();
-        eprintln!("  joint, one log: held-out {:.3} -> {:.3} K; {}", p.diagnosis.before.heldout_rmse_k, p.diagnosis.after.heldout_rmse_k, ch.join(", "));
+            p.before.channels.iter().map(|c| format!("{} {:.2}", c.channel, c.heldout_rmse_k)).collect();
+        eprintln!("  joint, one log: held-out {:.3} -> {:.3} K; {}", p.before.heldout_rmse_k, p.after.heldout_rmse_k, ch.join(", "));
     }
     d
 }
