@@ -129,6 +129,15 @@ impl EmuMachine {
     }
 }
 
+/// The emulator's own trace behind [`bench_log`] (same mission draw for
+/// the same seed), with the mission: for audits of its internal heat flows.
+pub fn bench_trace(machine: &EmuMachine, scenario: EmuScenario, duration_s: f64, seed: u64) -> (super::missions::EmuMission, Vec<super::logger::Row>) {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let m = draw(scenario, duration_s, &mut rng);
+    let trace = Plant { p: &machine.params, m: &m, h: Hidden { effect: Candidate::None, magnitude: 0.0 } }.run(scenario.log_interval_s());
+    (m, trace)
+}
+
 /// One bench log with the machine's true drain.
 #[derive(Debug, Clone)]
 pub struct BenchLog {

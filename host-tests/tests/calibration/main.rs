@@ -7,4 +7,5 @@ mod commission;
 mod direct;
 mod emulator;
 mod foreign;
+mod mix_audit;
 mod recovery;

@@ -1,0 +1,231 @@
+//! Heat-source audit of the throttle mix: the emulator machine's case-oil
+//! heat balance (its own laws, `Plant::case_budget`) beside the commissioned
+//! reference's on the same logged inputs, binned by operating point, on the
+//! training logs and the held-out mix, and the reference's largest
+//! under-predictions of the drain with where they sit. A measurement
+//! printed, not a test of a number: run by hand (`-- --ignored --nocapture
+//! slow_mix_heat_audit`; `MIXAUDIT_SERIES=1` prints the mix's time series,
+//! the commissioned rig is cached in the temp dir, `MIXAUDIT_FRESH=1`
+//! commissions again; the machine variants of [`slow_mix_experiment`] apply).
+
+use eha_sim::calibration::commission::commission_with;
+use eha_sim::calibration::{CalLog, CalOptions};
+use eha_sim::emulator::bench::{bench_log, bench_trace, machines, EmuMachine};
+use eha_sim::emulator::missions::EmuScenario;
+use eha_sim::emulator::plant::{Hidden, Plant};
+use eha_sim::model::{Drive, Model, ReplayDrive};
+use eha_sim::network::{self, Node};
+use eha_sim::physics::candidates::Candidate;
+use eha_sim::rig::Rig;
+use eha_sim::scenario::Scenario;
+use eha_sim::sim::{simulate_rtol, SimOptions};
+
+fn commissioned(m: &EmuMachine) -> Rig {
+    let holds = std::env::var("EXP_HOLD").unwrap_or_default();
+    let tag = std::env::var("MIXAUDIT_TAG").unwrap_or_default();
+    let path = std::env::temp_dir().join(format!("mixaudit-{}{}{}.toml", m.name, holds, tag));
+    if std::env::var("MIXAUDIT_FRESH").is_err() {
+        if let Ok(r) = Rig::from_toml_file(&path) {
+            return r;
+        }
+    }
+    let s = eha_sim::emulator::bench::bench_set(m, 3600).expect("bench");
+    let train: Vec<CalLog> = s.train.iter().map(|l| CalLog::new(&l.name, l.run.clone(), 120).expect("log")).collect();
+    let mut o = CalOptions::default();
+    for name in holds.split(',').filter(|n| !n.is_empty()) {
+        let k = eha_sim::calibration::set::index(name).expect("parameter");
+        o.hold.push((eha_sim::calibration::set::PARAMS[k].name, "experiment".into()));
+    }
+    let c = commission_with(&m.rig_file(), &train, &[], &o, false).expect("commission");
+    std::fs::write(&path, c.cal.rig.to_toml()).expect("write rig");
+    c.cal.rig
+}
+
+#[derive(Default, Clone, Copy)]
+struct Acc {
+    n: f64,
+    v: [f64; 14],
+}
+
+/// Columns of one bin.
+const COLS: [&str; 14] = [
+    "err", "emuΔT", "refΔT", "emuQ", "refQ", "emuG", "refG", "emuMech", "refFric", "emuLeak", "refLeak", "emuIn", "refIn", "refVisc",
+];
+
+fn audit(m: &EmuMachine, rig: &Rig, scenario: EmuScenario, dur: f64, seed: u64) {
+    let (mission, trace) = bench_trace(m, scenario, dur, seed);
+    let log = bench_log(m, scenario, dur, seed).expect("log");
+    let cal = CalLog::new(&log.name, log.run.clone(), 120).expect("cal");
+    let inputs = cal.replay_inputs().expect("replay").clone();
+    let out = simulate_rtol(rig, &Scenario::Replay(inputs.clone()), &SimOptions { output_interval_s: 2.0, control_interval_s: 2.0 }, 1e-6).expect("sim");
+    let model = Model::new(rig.clone(), Drive::Replay(ReplayDrive::new(inputs.clone())));
+    let drive = ReplayDrive::new(inputs);
+    let plant = Plant { p: &m.params, m: &mission, h: Hidden { effect: Candidate::None, magnitude: 0.0 } };
+    let oil = &rig.oil;
+    let mut bins = vec![Acc::default(); 16];
+    let mut series = Vec::new();
+    let sb = |rpm: f64| if rpm < 550.0 { 0 } else if rpm < 850.0 { 1 } else if rpm < 1050.0 { 2 } else { 3 };
+    let pb = |bar: f64| if bar < 25.0 { 0 } else if bar < 40.0 { 1 } else if bar < 50.0 { 2 } else { 3 };
+    for (t, y, _) in &trace {
+        let e = plant.case_budget(*t, y);
+        let at = |name: &str| out.at(name, *t).expect(name);
+        let (tc, tp, tout) = (at("t_drain_c"), at("t_pump_c"), at("t_outlet_c"));
+        let op = drive.op(rig, *t);
+        let fh = model.friction_heat(&op, tc);
+        let fr = model.pump_friction(&op, tc);
+        let (_, fcase, _) = rig.pump.friction_pairs.shares();
+        let ql = model.k_leak(tc) * (op.p_a - op.p_case);
+        let rho = oil.rho(at("t_loop_oil_c"), 0.0);
+        let leak = ql * rho * (oil.enthalpy_tp(tc, op.p_a) - oil.enthalpy_tp(tc, op.p_case));
+        let inflow = ql * rho * (oil.enthalpy_tp(tout, op.p_a) - oil.enthalpy_tp(tc, op.p_a));
+        let g = network::case_film_w_per_k(rig, op.omega, tc, model.nu(tc));
+        let rpm = op.omega * 30.0 / std::f64::consts::PI;
+        let bar = (op.p_a - op.p_b) * 1e-5;
+        let k = sb(rpm) * 4 + pb(bar);
+        let b = &mut bins[if *t < 300.0 { 15 } else { k }];
+        b.n += 1.0;
+        let row = [
+            tc - e.case_c,
+            e.case_c - e.wall_c,
+            tc - tp,
+            e.mech_w + e.leak_w + e.inflow_w,
+            fh.case + leak + inflow,
+            e.film_w_per_k,
+            g,
+            e.mech_w,
+            fh.case,
+            e.leak_w,
+            leak,
+            e.inflow_w,
+            inflow,
+            fcase * fr.viscous_w,
+        ];
+        for (a, x) in b.v.iter_mut().zip(row) {
+            *a += x;
+        }
+        let _ = Node::Case;
+        if scenario == EmuScenario::ThrottleMix && (*t as i64) % if *t < 300.0 { 4 } else { 10 } == 0 {
+            let cap = model.capacity(Node::Case, tc);
+            series.push(format!(
+                "{t:6.0} {rpm:6.0} {bar:5.1} emu case {:6.2} wall {:6.2} barrel {:6.2} end {:6.2} | ref case {tc:6.2} pump {tp:6.2} meas_pump {:6.2} | err {:6.2} | Q {:6.1}/{:6.1} G {:5.1}/{:5.1} tau_case {:5.1}/{:5.1}",
+                e.case_c, e.wall_c, y[2], y[3], log.run.value_at(eha_sim::measured::Channel::TPumpC, *t).unwrap_or(f64::NAN), tc - e.case_c,
+                e.mech_w + e.leak_w + e.inflow_w, fh.case + leak + inflow, e.film_w_per_k, g, plant.capacities(y)[4] / e.film_w_per_k, cap / g
+            ));
+        }
+    }
+    // The reference's drain against the thermocouple and the true drain at
+    // every logged row: the largest under-predictions.
+    let tc_log = log.run.get(eha_sim::measured::Channel::TDrainC).expect("drain");
+    let tr_log = log.truth.get(eha_sim::measured::Channel::TDrainC).expect("truth");
+    let mut rows: Vec<(f64, f64, f64, f64)> = Vec::new();
+    for (k, &t) in log.run.time_s.iter().enumerate() {
+        if let (Some(m), Some(tr)) = (tc_log[k], tr_log[k]) {
+            rows.push((t, out.at("t_drain_c", t).expect("drain"), m, tr));
+        }
+    }
+    rows.sort_by(|a, b| (a.1 - a.2).total_cmp(&(b.1 - b.2)));
+    for r in rows.iter().take(4) {
+        eprintln!("  worst under vs thermocouple: t {:.0} s ref {:.2} thermocouple {:.2} true {:.2}: {:.2} K (vs true {:.2} K)", r.0, r.1, r.2, r.3, r.1 - r.2, r.1 - r.3);
+    }
+    if std::env::var("MIXAUDIT_SERIES").is_ok() {
+        for l in &series {
+            eprintln!("{l}");
+        }
+    }
+    eprintln!("== {} {:?} (t > 300 s; bins rpm <550/550-850/850-1050/>1050 × bar <25/25-40/40-50/>50)", m.name, scenario);
+    eprintln!("{:>10} {:>5} {}", "bin", "n", COLS.iter().map(|c| format!("{c:>8}")).collect::<String>());
+    for (k, b) in bins.iter().enumerate() {
+        if b.n < 5.0 {
+            continue;
+        }
+        let row: String = b.v.iter().map(|x| format!("{:>8.2}", x / b.n)).collect();
+        eprintln!("{:>10} {:>5} {}", format!("s{} p{}", k / 4, k % 4), b.n, row);
+    }
+}
+
+#[test]
+#[ignore = "measurement by hand: a commissioning (cached in the temp dir) and replays"]
+fn slow_mix_heat_audit() {
+    for mut m in machines() {
+        if std::env::var("EXP_MACHINE").is_ok_and(|n| n != m.name) {
+            continue;
+        }
+        variant(&mut m);
+        let rig = commissioned(&m);
+        audit(&m, &rig, EmuScenario::SpeedThenNeedleSteps, 1800.0, 3600);
+        audit(&m, &rig, EmuScenario::SoakThenIdle, 1800.0, 3601);
+        audit(&m, &rig, EmuScenario::ThrottleMix, 1800.0, 3603);
+    }
+}
+
+/// Emulator-side and calibration-side experiments on the mix's miss, by
+/// environment (docs/commissioning.md, "Where the throttle mix's
+/// under-prediction comes from"): on the emulator machines
+/// `EXP_MECH_RULE=1` places the mechanical loss by the reference's
+/// sliding-pair rule (delivered 0.6, case 0.15, metal 0.25);
+/// `EXP_G_BARREL_END=W/K`, `EXP_PROBE_AMBIENT=frac`, `EXP_PROBE_BARREL=w`
+/// set those fields; `EXP_A_CASE=k`, `EXP_GAP=k` scale the case wetted area
+/// and the leakage gap; on the user's rig file `EXP_RIG_CV=k`,
+/// `EXP_RIG_T0=k` scale the viscous and no-load friction torques;
+/// `EXP_HOLD=a,b` holds calibration parameters at the rig file;
+/// `EXP_MACHINE` picks one machine. Prints the held-out numbers without the
+/// margin (firmware drain vs thermocouple).
+#[test]
+#[ignore = "measurement by hand: one commissioning per machine"]
+fn slow_mix_experiment() {
+    for mut m in machines() {
+        if std::env::var("EXP_MACHINE").is_ok_and(|n| n != m.name) {
+            continue;
+        }
+        variant(&mut m);
+        let s = eha_sim::emulator::bench::bench_set(&m, 3600).expect("bench");
+        let train: Vec<CalLog> = s.train.iter().map(|l| CalLog::new(&l.name, l.run.clone(), 120).expect("log")).collect();
+        let hold: Vec<CalLog> = s.holdout.iter().map(|l| CalLog::new(&l.name, l.run.clone(), 120).expect("log")).collect();
+        let mut o = CalOptions::default();
+        for name in std::env::var("EXP_HOLD").unwrap_or_default().split(',').filter(|n| !n.is_empty()) {
+            let k = eha_sim::calibration::set::index(name).expect("parameter");
+            o.hold.push((eha_sim::calibration::set::PARAMS[k].name, "experiment".into()));
+        }
+        let env = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<f64>().ok());
+        let mut base = m.rig_file();
+        if let Some(k) = env("EXP_RIG_CV") {
+            base.pump.viscous_torque_coeff *= k;
+        }
+        if let Some(k) = env("EXP_RIG_T0") {
+            base.pump.no_load_torque_nm *= k;
+        }
+        let t0 = std::time::Instant::now();
+        let c = commission_with(&base, &train, &hold, &o, false).expect("commission");
+        let fitted: Vec<String> = c.cal.params.iter().filter(|p| p.status == eha_sim::calibration::Status::Fitted).map(|p| format!("{} {:.3}{}", p.name, p.value, if p.at_bound { "*" } else { "" })).collect();
+        eprintln!("{} ({:.0} s): fitted {}", m.name, t0.elapsed().as_secs_f64(), fitted.join(", "));
+        for r in c.reduced.iter() {
+            eprintln!("  {:45} reduced vs ref {:.3} | vs measured max {:.3?} under {:.3?}", r.log, r.vs_reference_max_k, r.vs_measured_max_k, r.vs_measured_under_k);
+        }
+        for r in &c.holdout_with_margin {
+            eprintln!("  held out {:36} max {:.3?} under {:.3?} over {:.3?} at {}", r.log, r.vs_measured_max_k, r.vs_measured_under_k, r.vs_measured_over_k, r.vs_measured_region.as_ref().map(|g| g.to_string()).unwrap_or_default());
+        }
+    }
+}
+
+/// The emulator machine with the experiment's changes (environment).
+fn variant(m: &mut EmuMachine) {
+    if std::env::var("EXP_MECH_RULE").is_ok() {
+        m.params.mech_split = [0.6, 0.15, 0.25];
+    }
+    let env = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<f64>().ok());
+    if let Some(g) = env("EXP_G_BARREL_END") {
+        m.params.g_barrel_end = g;
+    }
+    if let Some(f) = env("EXP_PROBE_AMBIENT") {
+        m.params.probe_ambient_frac = f;
+    }
+    if let Some(w) = env("EXP_PROBE_BARREL") {
+        m.params.pump_probe_barrel = w;
+    }
+    if let Some(k) = env("EXP_A_CASE") {
+        m.params.a_case.iter_mut().for_each(|a| *a *= k);
+    }
+    if let Some(k) = env("EXP_GAP") {
+        m.params.gap_m *= k;
+    }
+}
