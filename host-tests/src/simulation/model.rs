@@ -5,7 +5,7 @@
 use crate::hydraulics::{self, ix, OpPoint};
 use crate::losses;
 use crate::network::{self, Node, N_NODES, NODES};
-use crate::simulation::grids::{NuGrid, OuterGrid};
+use crate::simulation::grids::{NuGrid, OuterGrid, NU_GRID_FACTOR};
 use crate::rig::Rig;
 use crate::scenario::{Circuit, Mission, ReplayInputs, ValveRule};
 use std::cell::Cell;
@@ -290,13 +290,14 @@ impl Model {
         Self { rig, drive, lng_open: Cell::new(false), contents, outer_grid: None, nu_grid: None }
     }
 
-    /// Interpolate the outer surfaces' heat flows and the oil's viscosity
-    /// on a grid of `step_k` kelvin from now on ([`crate::simulation::grids`]),
-    /// or (None) evaluate them exactly.
+    /// Interpolate the outer surfaces' heat flows on a grid of `step_k`
+    /// kelvin and the oil's viscosity on one `NU_GRID_FACTOR` times coarser
+    /// from now on ([`crate::simulation::grids`]), or (None) evaluate them
+    /// exactly.
     pub fn set_grids(&mut self, step_k: Option<f64>) {
         let step = step_k.filter(|&s| s > 0.0 && s.is_finite());
         self.outer_grid = step.map(OuterGrid::new);
-        self.nu_grid = step.map(NuGrid::new);
+        self.nu_grid = step.map(|s| NuGrid::new(s * NU_GRID_FACTOR));
     }
 
     /// Exact evaluations behind the grids so far: (outer surfaces, viscosities).
