@@ -43,6 +43,7 @@
 //! with them the oracle's outputs, are the exact correlations.
 
 use crate::fluid::Oil;
+use crate::heat::nu_laminar_x;
 use crate::network::{q_outer_exposed, Shape};
 use crate::rig::Rig;
 use std::cell::Cell;
@@ -251,6 +252,93 @@ impl NuGrid {
 
 const _: () = assert!(NU_SLOTS.is_power_of_two(), "slots are indexed by a mask");
 
+/// Low bits of X's representation dropped for the laminar grid's index:
+/// 16 cells a binade (X's relative spacing 1/32–1/16).
+const LAM_SHIFT: u32 = 52 - 4;
+/// Cells and points kept by [`LaminarGrid`] (direct-mapped by index).
+const LAM_SLOTS: usize = 1024;
+/// Below this X the laminar law is evaluated exactly (at X ≤ 0.081 it is
+/// its constant, the developing-flow term gone).
+const LAM_EXACT_BELOW: f64 = 0.1;
+
+/// The laminar duct Nusselt number (eq. 13) as a function of its one
+/// argument X = Re·Pr·d/L ([`nu_laminar_x`]: two `cbrt`, ~340 instructions,
+/// eight times in a heat balance) on a grid of X: the grid points are the
+/// values of X whose representation ends in `LAM_SHIFT` zero bits (16 a
+/// binade, uniform within it), and in the cell [X_k, X_k+1] the cubic
+/// through the exact values at X_k−1 … X_k+2 (Newton's form, the nodes
+/// non-uniform across a binade's edge). Measured within 2.6e-7 relative
+/// from X = 0.1 to 1e6 (test below).
+#[derive(Debug)]
+pub struct LaminarGrid {
+    /// (k, Newton coefficients, the node t of X_k−1, X_k, 1/(X_k+1 − X_k)) at slot k mod LAM_SLOTS; k = u64::MAX: empty.
+    cells: Box<[Cell<(u64, [f64; 4], f64, f64, f64)>]>,
+    /// (k, the law at X_k) at slot k mod LAM_SLOTS; k = u64::MAX: empty.
+    points: Box<[Cell<(u64, f64)>]>,
+    /// Exact evaluations so far.
+    pub evals: Cell<u64>,
+}
+
+impl Default for LaminarGrid {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl LaminarGrid {
+    /// An empty grid.
+    pub fn new() -> Self {
+        let cells = (0..LAM_SLOTS).map(|_| Cell::new((u64::MAX, [0.0; 4], 0.0, 0.0, 0.0))).collect();
+        let points = (0..LAM_SLOTS).map(|_| Cell::new((u64::MAX, 0.0))).collect();
+        Self { cells, points, evals: Cell::new(0) }
+    }
+
+    /// The laminar Nusselt number at X = Re·Pr·d/L, interpolated.
+    pub fn nu(&self, x: f64) -> f64 {
+        if !(x >= LAM_EXACT_BELOW && x < 1e300) {
+            return nu_laminar_x(x);
+        }
+        let k = x.to_bits() >> LAM_SHIFT;
+        let slot = &self.cells[(k as usize) & (LAM_SLOTS - 1)];
+        let (mut kk, mut a, mut tm, mut x0, mut inv_w) = slot.get();
+        if kk != k {
+            let at = |j: u64| f64::from_bits(j << LAM_SHIFT);
+            let (xm, x1, x2) = (at(k - 1), at(k + 1), at(k + 2));
+            x0 = at(k);
+            inv_w = 1.0 / (x1 - x0);
+            tm = (xm - x0) * inv_w;
+            let t2 = (x2 - x0) * inv_w;
+            let (fm, f0, f1, f2) = (self.point(k - 1), self.point(k), self.point(k + 1), self.point(k + 2));
+            // Divided differences on the nodes 0, 1, tm, t2.
+            let d01 = f1 - f0;
+            let d1m = (fm - f1) / (tm - 1.0);
+            let d01m = (d1m - d01) / tm;
+            let dm2 = (f2 - fm) / (t2 - tm);
+            let d1m2 = (dm2 - d1m) / (t2 - 1.0);
+            let d01m2 = (d1m2 - d01m) / t2;
+            a = [f0, d01, d01m, d01m2];
+            kk = k;
+            slot.set((kk, a, tm, x0, inv_w));
+        }
+        let t = (x - x0) * inv_w;
+        a[0] + t * (a[1] + (t - 1.0) * (a[2] + (t - tm) * a[3]))
+    }
+
+    fn point(&self, k: u64) -> f64 {
+        let slot = &self.points[(k as usize) & (LAM_SLOTS - 1)];
+        let (kk, v) = slot.get();
+        if kk == k {
+            return v;
+        }
+        self.evals.set(self.evals.get() + 1);
+        let v = nu_laminar_x(f64::from_bits(k << LAM_SHIFT));
+        slot.set((k, v));
+        v
+    }
+}
+
+const _: () = assert!(LAM_SLOTS.is_power_of_two(), "slots are indexed by a mask");
+
 /// ⌊x⌋ for |x| < 2⁶³ (a truncation and a correction: `f64::floor` is a
 /// library call on the baseline x86-64 target).
 fn floor_i64(x: f64) -> i64 {
@@ -304,6 +392,24 @@ mod tests {
         let (tw, ta) = std::hint::black_box((31.0, 21.0));
         let (q, e) = (g.q(0, &rig, area, shape, tw, ta, 0.0, share), q_outer_exposed(&rig, area, shape, tw, ta, 0.0, share));
         assert_eq!(q, e, "a new air state is exact");
+    }
+
+    /// The laminar Nusselt number on its grid from X = 0.1 to 1e6 (a
+    /// cell's nodes across a binade's edge included) against the law:
+    /// within 5e-7 relative (measured 2.52e-7), and exact below X = 0.1.
+    #[test]
+    fn laminar_nusselt_error_is_bounded() {
+        let g = LaminarGrid::new();
+        let mut worst: f64 = 0.0;
+        for j in 0..70_000 {
+            let x = 10f64.powf(-1.0 + j as f64 * 1e-4);
+            let (v, e) = (g.nu(x), nu_laminar_x(x));
+            worst = worst.max((v / e - 1.0).abs());
+        }
+        println!("largest relative error {worst:.3e}");
+        assert!(worst < 5e-7 && worst > 0.0, "largest relative error {worst:.3e}");
+        assert_eq!(g.nu(0.05), nu_laminar_x(0.05));
+        assert_eq!(g.nu(0.0), nu_laminar_x(0.0));
     }
 
     /// The viscosity on the 1 K grid (cubic) from −20 to 150 °C, against

@@ -5,7 +5,7 @@
 use crate::hydraulics::{self, ix, OpPoint};
 use crate::losses;
 use crate::network::{self, Node, N_NODES, NODES};
-use crate::simulation::grids::{NuGrid, OuterGrid, NU_GRID_FACTOR};
+use crate::simulation::grids::{LaminarGrid, NuGrid, OuterGrid, NU_GRID_FACTOR};
 use crate::rig::Rig;
 use crate::scenario::{Circuit, Mission, ReplayInputs, ValveRule};
 use std::cell::Cell;
@@ -281,13 +281,14 @@ pub struct Model {
     /// temperature grid (the fast plant's; None: the exact correlations).
     outer_grid: Option<OuterGrid>,
     nu_grid: Option<NuGrid>,
+    lam_grid: Option<LaminarGrid>,
 }
 
 impl Model {
     /// Build a model.
     pub fn new(rig: Rig, drive: Drive) -> Self {
         let contents = network::contents(&rig);
-        Self { rig, drive, lng_open: Cell::new(false), contents, outer_grid: None, nu_grid: None }
+        Self { rig, drive, lng_open: Cell::new(false), contents, outer_grid: None, nu_grid: None, lam_grid: None }
     }
 
     /// Interpolate the outer surfaces' heat flows on a grid of `step_k`
@@ -298,11 +299,21 @@ impl Model {
         let step = step_k.filter(|&s| s > 0.0 && s.is_finite());
         self.outer_grid = step.map(OuterGrid::new);
         self.nu_grid = step.map(|s| NuGrid::new(s * NU_GRID_FACTOR));
+        self.lam_grid = step.map(|_| LaminarGrid::new());
     }
 
     /// Exact evaluations behind the grids so far: (outer surfaces, viscosities).
     pub fn grid_evals(&self) -> (u64, u64) {
         (self.outer_grid.as_ref().map_or(0, |g| g.evals.get()), self.nu_grid.as_ref().map_or(0, |g| g.evals.get()))
+    }
+
+    /// Oil-to-metal conductance of a duct ([`network::duct_conductance`]),
+    /// W/K, the laminar Nusselt number on its grid when the grids are set.
+    fn duct_conductance(&self, q_m3_per_s: f64, d: f64, len: f64, area_scale: f64, t_oil: f64, nu: f64) -> f64 {
+        match &self.lam_grid {
+            Some(g) => network::duct_conductance_with(&self.rig, q_m3_per_s, d, len, area_scale, t_oil, nu, |x| g.nu(x)),
+            None => network::duct_conductance(&self.rig, q_m3_per_s, d, len, area_scale, t_oil, nu),
+        }
     }
 
     /// Kinematic viscosity of the oil at `t_oil` (its Walther line), m²/s.
@@ -561,7 +572,7 @@ impl Model {
         let nu_case = self.nu(tc(Node::Case));
         link(&mut q, Node::Case, Node::Pump, network::case_film_w_per_k(rig, op.omega, tc(Node::Case), nu_case));
         for port in [Node::Inlet, Node::Outlet] {
-            let g = network::duct_conductance(rig, qc, p.port_d_m, p.port_len_m, p.port_area_scale, tc(port), self.nu(tc(port)));
+            let g = self.duct_conductance(qc, p.port_d_m, p.port_len_m, p.port_area_scale, tc(port), self.nu(tc(port)));
             link(&mut q, port, Node::Pump, g);
         }
         if let Some(s) = &p.split {
@@ -580,9 +591,9 @@ impl Model {
             link(&mut q, Node::Pump, Node::Motor, j.pump_motor.conductance_w_per_k());
             link(&mut q, Node::Pump, Node::MainBlock, j.pump_manifold.conductance_w_per_k());
         }
-        let g_loop = network::duct_conductance(rig, qc, b.loop_d_m, b.loop_len_m, b.loop_area_scale, tc(Node::Loop), self.nu(tc(Node::Loop)));
+        let g_loop = self.duct_conductance(qc, b.loop_d_m, b.loop_len_m, b.loop_area_scale, tc(Node::Loop), self.nu(tc(Node::Loop)));
         link(&mut q, Node::Loop, Node::MainBlock, network::block_path(rig, g_loop, b.main_area_m2));
-        let g_ball = network::duct_conductance(rig, qc, b.ball_d_m, b.ball_len_m, 1.0, tc(Node::BallOil), self.nu(tc(Node::BallOil)));
+        let g_ball = self.duct_conductance(qc, b.ball_d_m, b.ball_len_m, 1.0, tc(Node::BallOil), self.nu(tc(Node::BallOil)));
         link(&mut q, Node::BallOil, Node::BallBlock, network::block_path(rig, g_ball, b.ball_area_m2));
         // Manifold sensor pocket: in the flowing manifold in the baseline; in
         // a dead-end branch (Figs. 9–10) with `sensor-lag`.
