@@ -316,6 +316,13 @@ impl Model {
         }
     }
 
+    /// Pressure drops of the throttle path ([`hydraulics::path_dp`]) with
+    /// the oil at `t_oil`: its viscosity from [`Model::nu`] (on the grid
+    /// when the grids are set), Pa.
+    fn path_dp(&self, q: f64, t_oil: f64, needle: Option<f64>) -> (f64, f64) {
+        hydraulics::path_dp_props(&self.rig, q, self.rig.oil.rho(t_oil, 0.0), self.nu(t_oil), needle)
+    }
+
     /// Kinematic viscosity of the oil at `t_oil` (its Walther line), m²/s.
     pub fn nu(&self, t_oil: f64) -> f64 {
         match &self.nu_grid {
@@ -488,11 +495,11 @@ impl Model {
         let (line, needle) = match (&self.drive, op.circuit) {
             (Drive::Mission(m), Circuit::Throttle) => {
                 let nk = hydraulics::needle_k(rig, m.needle_bar.at(t));
-                let (l, n) = hydraulics::path_dp(rig, op.q_path, tc(Node::BallOil), nk);
+                let (l, n) = self.path_dp(op.q_path, tc(Node::BallOil), nk);
                 (l * op.q_path, n * op.q_path)
             }
             (Drive::Replay(_), Circuit::Throttle) => {
-                let (l, _) = hydraulics::path_dp(rig, op.q_path, tc(Node::BallOil), None);
+                let (l, _) = self.path_dp(op.q_path, tc(Node::BallOil), None);
                 let line = l * op.q_path;
                 (line, losses::throttle_w(dp, op.q_path) - line)
             }
@@ -630,7 +637,7 @@ impl Model {
         // loop at the pump's suction pressure (the actuator does the work between).
         let p_suction = if forward { op.p_b } else { op.p_a };
         let line_dp = match op.circuit {
-            Circuit::Throttle => hydraulics::path_dp(rig, op.q_path.abs(), tc(Node::BallOil), None).0.max(0.0),
+            Circuit::Throttle => self.path_dp(op.q_path.abs(), tc(Node::BallOil), None).0.max(0.0),
             Circuit::Servo => 0.0,
         };
         let (p_loop, p_ball) = match (op.circuit, forward) {
