@@ -292,9 +292,10 @@ impl Model {
     }
 
     /// Interpolate the outer surfaces' heat flows on a grid of `step_k`
-    /// kelvin and the oil's viscosity on one `NU_GRID_FACTOR` times coarser
-    /// from now on ([`crate::simulation::grids`]), or (None) evaluate them
-    /// exactly.
+    /// kelvin (a cubic on a coarser one away from the air), the oil's
+    /// viscosity on one `NU_GRID_FACTOR` times coarser and the ducts'
+    /// laminar Nusselt number on a grid of its argument from now on
+    /// ([`crate::simulation::grids`]), or (None) evaluate them exactly.
     pub fn set_grids(&mut self, step_k: Option<f64>) {
         let step = step_k.filter(|&s| s > 0.0 && s.is_finite());
         self.outer_grid = step.map(OuterGrid::new);

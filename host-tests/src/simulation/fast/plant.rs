@@ -83,8 +83,10 @@ pub struct FastOptions {
     /// First thermal step after a start or a schedule breakpoint, s.
     pub h_start_s: f64,
     /// Grid of temperatures on which the heat balances interpolate the
-    /// outer surfaces' heat flows (linear), K; the oil's viscosity on one
-    /// ten times coarser (cubic). 0: exact (see [`crate::simulation::grids`]).
+    /// outer surfaces' heat flows (linear; cubic on one five times coarser
+    /// away from the air), K; the oil's viscosity on one ten times coarser
+    /// (cubic), the ducts' laminar Nusselt number on its own grid. 0: exact
+    /// (see [`crate::simulation::grids`]).
     pub grid_k: f64,
 }
 
