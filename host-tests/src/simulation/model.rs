@@ -282,13 +282,16 @@ pub struct Model {
     outer_grid: Option<OuterGrid>,
     nu_grid: Option<NuGrid>,
     lam_grid: Option<LaminarGrid>,
+    /// The pump gaps' conductance times viscosity (eqs. 5–7 are ∝ 1/μ),
+    /// m³·Pa⁻¹·s⁻¹·Pa·s, taken once with the grids (the fast plant's).
+    leak_geom: Option<f64>,
 }
 
 impl Model {
     /// Build a model.
     pub fn new(rig: Rig, drive: Drive) -> Self {
         let contents = network::contents(&rig);
-        Self { rig, drive, lng_open: Cell::new(false), contents, outer_grid: None, nu_grid: None, lam_grid: None }
+        Self { rig, drive, lng_open: Cell::new(false), contents, outer_grid: None, nu_grid: None, lam_grid: None, leak_geom: None }
     }
 
     /// Interpolate the outer surfaces' heat flows on a grid of `step_k`
@@ -301,6 +304,7 @@ impl Model {
         self.outer_grid = step.map(OuterGrid::new);
         self.nu_grid = step.map(|s| NuGrid::new(s * NU_GRID_FACTOR));
         self.lam_grid = step.map(|_| LaminarGrid::new());
+        self.leak_geom = step.map(|_| self.rig.pump.gaps.conductance(1.0));
     }
 
     /// Exact evaluations behind the grids so far: (outer surfaces, viscosities).
@@ -341,7 +345,12 @@ impl Model {
     /// Pump leakage conductance of eqs. (5)–(7) at the case-oil temperature
     /// (the films' viscosity), m³/(s·Pa).
     pub fn k_leak(&self, t_case: f64) -> f64 {
-        self.rig.pump.gaps.conductance(self.mu(t_case))
+        match self.leak_geom {
+            // The fast plant: the geometric factor over μ (a division, not
+            // three and a logarithm).
+            Some(g) => g / self.mu(t_case),
+            None => self.rig.pump.gaps.conductance(self.mu(t_case)),
+        }
     }
 
     /// Heat capacity of node `n` at `t_c`, J/K (oil: V·ρ(T)·c_p(T)).
