@@ -25,7 +25,12 @@ pub fn reynolds(q_m3_per_s: f64, d_m: f64, nu: f64) -> f64 {
 /// The (Pr/Pr_w)^0.11 viscosity correction is taken as 1 (wall and bulk
 /// temperatures differ by tens of K at most; the correction is below 5 %).
 pub fn nu_laminar(re: f64, pr: f64, d_over_l: f64) -> f64 {
-    let g = 1.615 * (re * pr * d_over_l).max(0.0).cbrt() - 0.7;
+    nu_laminar_x(re * pr * d_over_l)
+}
+
+/// [`nu_laminar`] as a function of its one argument X = Re·Pr·d/L.
+pub fn nu_laminar_x(x: f64) -> f64 {
+    let g = 1.615 * x.max(0.0).cbrt() - 0.7;
     (3.66f64.powi(3) + 0.7f64.powi(3) + g.max(0.0).powi(3)).cbrt()
 }
 
@@ -48,13 +53,19 @@ pub fn nu_turbulent(re: f64, pr: f64, d_over_l: f64) -> f64 {
 /// Re = 2300, eq. (14) above 10⁴, and Gnielinski's (1995) linear blend in
 /// between, so the coefficient is continuous (important for the stiff solver).
 pub fn nu_tube(re: f64, pr: f64, d_over_l: f64) -> f64 {
+    nu_tube_with(re, pr, d_over_l, nu_laminar_x)
+}
+
+/// [`nu_tube`] with the laminar Nusselt number of X = Re·Pr·d/L given
+/// (exact: [`nu_laminar_x`]; the fast plant's interpolation of it).
+pub fn nu_tube_with(re: f64, pr: f64, d_over_l: f64, laminar: impl Fn(f64) -> f64) -> f64 {
     if re <= 2300.0 {
-        nu_laminar(re, pr, d_over_l)
+        laminar(re * pr * d_over_l)
     } else if re >= 1e4 {
         nu_turbulent(re, pr, d_over_l)
     } else {
         let gamma = (re - 2300.0) / (1e4 - 2300.0);
-        (1.0 - gamma) * nu_laminar(2300.0, pr, d_over_l) + gamma * nu_turbulent(1e4, pr, d_over_l)
+        (1.0 - gamma) * laminar(2300.0 * pr * d_over_l) + gamma * nu_turbulent(1e4, pr, d_over_l)
     }
 }
 

@@ -105,8 +105,13 @@ pub fn needle_k(rig: &Rig, bar: f64) -> Option<f64> {
 /// (its viscosity and density): line friction and local losses (eq. 10) plus
 /// the needle orifice, Pa. Returns (line part, needle part).
 pub fn path_dp(rig: &Rig, q: f64, t_oil: f64, needle: Option<f64>) -> (f64, f64) {
-    let rho = rig.oil.rho(t_oil, 0.0);
-    let line = rig.hydraulics.path.dp_pa(q, rig.oil.nu_m2_per_s(t_oil), rho);
+    path_dp_props(rig, q, rig.oil.rho(t_oil, 0.0), rig.oil.nu_m2_per_s(t_oil), needle)
+}
+
+/// [`path_dp`] with the oil's density `rho` (kg/m³) and kinematic
+/// viscosity `nu` (m²/s) given instead of its temperature, Pa.
+pub fn path_dp_props(rig: &Rig, q: f64, rho: f64, nu: f64, needle: Option<f64>) -> (f64, f64) {
+    let line = rig.hydraulics.path.dp_pa(q, nu, rho);
     let needle_dp = needle.map_or(0.0, |k| q * q.abs() / (k * k));
     (line, needle_dp)
 }

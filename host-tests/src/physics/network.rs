@@ -136,9 +136,16 @@ pub fn stored_j(rig: &Rig, n: Node, content: (f64, f64), t_c: f64) -> f64 {
 /// Oil-to-metal conductance of a duct: forced convection by eqs. (13)/(14)
 /// (h = Nu·k/d, eq. 12) on the wetted area π·d·L·scale, W/K.
 pub fn duct_conductance(rig: &Rig, q_m3_per_s: f64, d: f64, len: f64, area_scale: f64, t_oil: f64, nu: f64) -> f64 {
+    duct_conductance_with(rig, q_m3_per_s, d, len, area_scale, t_oil, nu, heat::nu_laminar_x)
+}
+
+/// [`duct_conductance`] with the laminar Nusselt number of X = Re·Pr·d/L
+/// given ([`heat::nu_tube_with`]).
+#[allow(clippy::too_many_arguments)] // duct_conductance's arguments and the laminar law
+pub fn duct_conductance_with(rig: &Rig, q_m3_per_s: f64, d: f64, len: f64, area_scale: f64, t_oil: f64, nu: f64, laminar: impl Fn(f64) -> f64) -> f64 {
     let re = heat::reynolds(q_m3_per_s, d, nu);
     let pr = rig.oil.prandtl(t_oil, nu);
-    let h = heat::nu_tube(re, pr, d / len) * rig.oil.k(t_oil) / d;
+    let h = heat::nu_tube_with(re, pr, d / len, laminar) * rig.oil.k(t_oil) / d;
     h * std::f64::consts::PI * d * len * area_scale * rig.nuisance.inner_scale
 }
 

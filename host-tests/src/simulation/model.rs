@@ -5,7 +5,7 @@
 use crate::hydraulics::{self, ix, OpPoint};
 use crate::losses;
 use crate::network::{self, Node, N_NODES, NODES};
-use crate::simulation::grids::{NuGrid, OuterGrid};
+use crate::simulation::grids::{LaminarGrid, NuGrid, OuterGrid, NU_GRID_FACTOR};
 use crate::rig::Rig;
 use crate::scenario::{Circuit, Mission, ReplayInputs, ValveRule};
 use std::cell::Cell;
@@ -281,27 +281,51 @@ pub struct Model {
     /// temperature grid (the fast plant's; None: the exact correlations).
     outer_grid: Option<OuterGrid>,
     nu_grid: Option<NuGrid>,
+    lam_grid: Option<LaminarGrid>,
+    /// The pump gaps' conductance times viscosity (eqs. 5–7 are ∝ 1/μ),
+    /// m³·Pa⁻¹·s⁻¹·Pa·s, taken once with the grids (the fast plant's).
+    leak_geom: Option<f64>,
 }
 
 impl Model {
     /// Build a model.
     pub fn new(rig: Rig, drive: Drive) -> Self {
         let contents = network::contents(&rig);
-        Self { rig, drive, lng_open: Cell::new(false), contents, outer_grid: None, nu_grid: None }
+        Self { rig, drive, lng_open: Cell::new(false), contents, outer_grid: None, nu_grid: None, lam_grid: None, leak_geom: None }
     }
 
-    /// Interpolate the outer surfaces' heat flows and the oil's viscosity
-    /// on a grid of `step_k` kelvin from now on ([`crate::simulation::grids`]),
-    /// or (None) evaluate them exactly.
+    /// Interpolate the outer surfaces' heat flows on a grid of `step_k`
+    /// kelvin (a cubic on a coarser one away from the air), the oil's
+    /// viscosity on one `NU_GRID_FACTOR` times coarser and the ducts'
+    /// laminar Nusselt number on a grid of its argument from now on
+    /// ([`crate::simulation::grids`]), or (None) evaluate them exactly.
     pub fn set_grids(&mut self, step_k: Option<f64>) {
         let step = step_k.filter(|&s| s > 0.0 && s.is_finite());
         self.outer_grid = step.map(OuterGrid::new);
-        self.nu_grid = step.map(NuGrid::new);
+        self.nu_grid = step.map(|s| NuGrid::new(s * NU_GRID_FACTOR));
+        self.lam_grid = step.map(|_| LaminarGrid::new());
+        self.leak_geom = step.map(|_| self.rig.pump.gaps.conductance(1.0));
     }
 
     /// Exact evaluations behind the grids so far: (outer surfaces, viscosities).
     pub fn grid_evals(&self) -> (u64, u64) {
         (self.outer_grid.as_ref().map_or(0, |g| g.evals.get()), self.nu_grid.as_ref().map_or(0, |g| g.evals.get()))
+    }
+
+    /// Oil-to-metal conductance of a duct ([`network::duct_conductance`]),
+    /// W/K, the laminar Nusselt number on its grid when the grids are set.
+    fn duct_conductance(&self, q_m3_per_s: f64, d: f64, len: f64, area_scale: f64, t_oil: f64, nu: f64) -> f64 {
+        match &self.lam_grid {
+            Some(g) => network::duct_conductance_with(&self.rig, q_m3_per_s, d, len, area_scale, t_oil, nu, |x| g.nu(x)),
+            None => network::duct_conductance(&self.rig, q_m3_per_s, d, len, area_scale, t_oil, nu),
+        }
+    }
+
+    /// Pressure drops of the throttle path ([`hydraulics::path_dp`]) with
+    /// the oil at `t_oil`: its viscosity from [`Model::nu`] (on the grid
+    /// when the grids are set), Pa.
+    fn path_dp(&self, q: f64, t_oil: f64, needle: Option<f64>) -> (f64, f64) {
+        hydraulics::path_dp_props(&self.rig, q, self.rig.oil.rho(t_oil, 0.0), self.nu(t_oil), needle)
     }
 
     /// Kinematic viscosity of the oil at `t_oil` (its Walther line), m²/s.
@@ -321,7 +345,12 @@ impl Model {
     /// Pump leakage conductance of eqs. (5)–(7) at the case-oil temperature
     /// (the films' viscosity), m³/(s·Pa).
     pub fn k_leak(&self, t_case: f64) -> f64 {
-        self.rig.pump.gaps.conductance(self.mu(t_case))
+        match self.leak_geom {
+            // The fast plant: the geometric factor over μ (a division, not
+            // three and a logarithm).
+            Some(g) => g / self.mu(t_case),
+            None => self.rig.pump.gaps.conductance(self.mu(t_case)),
+        }
     }
 
     /// Heat capacity of node `n` at `t_c`, J/K (oil: V·ρ(T)·c_p(T)).
@@ -476,11 +505,11 @@ impl Model {
         let (line, needle) = match (&self.drive, op.circuit) {
             (Drive::Mission(m), Circuit::Throttle) => {
                 let nk = hydraulics::needle_k(rig, m.needle_bar.at(t));
-                let (l, n) = hydraulics::path_dp(rig, op.q_path, tc(Node::BallOil), nk);
+                let (l, n) = self.path_dp(op.q_path, tc(Node::BallOil), nk);
                 (l * op.q_path, n * op.q_path)
             }
             (Drive::Replay(_), Circuit::Throttle) => {
-                let (l, _) = hydraulics::path_dp(rig, op.q_path, tc(Node::BallOil), None);
+                let (l, _) = self.path_dp(op.q_path, tc(Node::BallOil), None);
                 let line = l * op.q_path;
                 (line, losses::throttle_w(dp, op.q_path) - line)
             }
@@ -560,7 +589,7 @@ impl Model {
         let nu_case = self.nu(tc(Node::Case));
         link(&mut q, Node::Case, Node::Pump, network::case_film_w_per_k(rig, op.omega, tc(Node::Case), nu_case));
         for port in [Node::Inlet, Node::Outlet] {
-            let g = network::duct_conductance(rig, qc, p.port_d_m, p.port_len_m, p.port_area_scale, tc(port), self.nu(tc(port)));
+            let g = self.duct_conductance(qc, p.port_d_m, p.port_len_m, p.port_area_scale, tc(port), self.nu(tc(port)));
             link(&mut q, port, Node::Pump, g);
         }
         if let Some(s) = &p.split {
@@ -579,9 +608,9 @@ impl Model {
             link(&mut q, Node::Pump, Node::Motor, j.pump_motor.conductance_w_per_k());
             link(&mut q, Node::Pump, Node::MainBlock, j.pump_manifold.conductance_w_per_k());
         }
-        let g_loop = network::duct_conductance(rig, qc, b.loop_d_m, b.loop_len_m, b.loop_area_scale, tc(Node::Loop), self.nu(tc(Node::Loop)));
+        let g_loop = self.duct_conductance(qc, b.loop_d_m, b.loop_len_m, b.loop_area_scale, tc(Node::Loop), self.nu(tc(Node::Loop)));
         link(&mut q, Node::Loop, Node::MainBlock, network::block_path(rig, g_loop, b.main_area_m2));
-        let g_ball = network::duct_conductance(rig, qc, b.ball_d_m, b.ball_len_m, 1.0, tc(Node::BallOil), self.nu(tc(Node::BallOil)));
+        let g_ball = self.duct_conductance(qc, b.ball_d_m, b.ball_len_m, 1.0, tc(Node::BallOil), self.nu(tc(Node::BallOil)));
         link(&mut q, Node::BallOil, Node::BallBlock, network::block_path(rig, g_ball, b.ball_area_m2));
         // Manifold sensor pocket: in the flowing manifold in the baseline; in
         // a dead-end branch (Figs. 9–10) with `sensor-lag`.
@@ -618,7 +647,7 @@ impl Model {
         // loop at the pump's suction pressure (the actuator does the work between).
         let p_suction = if forward { op.p_b } else { op.p_a };
         let line_dp = match op.circuit {
-            Circuit::Throttle => hydraulics::path_dp(rig, op.q_path.abs(), tc(Node::BallOil), None).0.max(0.0),
+            Circuit::Throttle => self.path_dp(op.q_path.abs(), tc(Node::BallOil), None).0.max(0.0),
             Circuit::Servo => 0.0,
         };
         let (p_loop, p_ball) = match (op.circuit, forward) {

@@ -83,8 +83,10 @@ pub struct FastOptions {
     /// First thermal step after a start or a schedule breakpoint, s.
     pub h_start_s: f64,
     /// Grid of temperatures on which the heat balances interpolate the
-    /// outer surfaces' heat flows and the oil's viscosity, K (0: exact;
-    /// see [`crate::simulation::grids`]).
+    /// outer surfaces' heat flows (linear; cubic on one five times coarser
+    /// away from the air), K; the oil's viscosity on one ten times coarser
+    /// (cubic), the ducts' laminar Nusselt number on its own grid. 0: exact
+    /// (see [`crate::simulation::grids`]).
     pub grid_k: f64,
 }
 
@@ -349,7 +351,10 @@ impl FastPlant {
             let mut odd = partial;
             let (odd_phi, odd_phi2);
             let mut h = t1 - self.t;
-            let mut phi = if !odd {
+            // While A = 0 (the first run's explicit start) the step is a
+            // polynomial in closed form (`Thermal::linear`): no level's
+            // matrices (7 of them, 9.5 kB, built and boxed per level).
+            let mut phi = if !odd && !th.is_zero() {
                 Some(self.phi(&mut ladder, &th, level, dt_s))
             } else if norm1(&th.a) * h > VECTOR_NORM_MAX {
                 self.stats.phi_builds += 1;

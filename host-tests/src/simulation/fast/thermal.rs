@@ -63,6 +63,8 @@ pub struct Thermal {
     a_cols: Mat<NT>,
     /// ∂q/∂z, W/K.
     pub a_e: [[f64; NT]; NE],
+    /// Whether A is zero (no Jacobian taken yet).
+    a_zero: bool,
 }
 
 /// A step tried from the current state.
@@ -88,12 +90,12 @@ impl Thermal {
     /// A state at time `t`, temperatures `z` and energies `e` (call
     /// [`Thermal::jacobian`] first).
     pub fn new(t: f64, z: [f64; NT], e: [f64; NE]) -> Self {
-        Self { z, e, fz: [0.0; NT], q: [0.0; NE], t, hist: Vec::with_capacity(3), a: [[0.0; NT]; NT], a_cols: [[0.0; NT]; NT], a_e: [[0.0; NT]; NE] }
+        Self { z, e, fz: [0.0; NT], q: [0.0; NE], t, hist: Vec::with_capacity(3), a: [[0.0; NT]; NT], a_cols: [[0.0; NT]; NT], a_e: [[0.0; NT]; NE], a_zero: true }
     }
 
     /// Whether A is zero (no Jacobian taken yet).
     pub fn is_zero(&self) -> bool {
-        self.a.iter().all(|r| r.iter().all(|&x| x == 0.0))
+        self.a_zero
     }
 
     /// f anew at z, and A by forward differences (N_NODES more
@@ -117,6 +119,7 @@ impl Thermal {
             }
         }
         self.a_cols = transpose(&self.a);
+        self.a_zero = self.a.iter().all(|r| r.iter().all(|&x| x == 0.0));
         if keep_history {
             for (_, g, z) in self.hist.iter_mut() {
                 for (i, gi) in g.iter_mut().enumerate() {
@@ -150,6 +153,11 @@ impl Thermal {
     /// z(h) of z' = A·z + g₀ + g'·s + g''·s²/2 from z₀ (A·z₀ + g₀ = f₀),
     /// by the level's matrices or the vector solution.
     fn linear(&self, phi: Option<&Phi<NT>>, h: f64, g0: &[f64; NT], d: &([f64; NT], [f64; NT])) -> [f64; NT] {
+        if self.a_zero {
+            // A = 0: Φ_k = h/k!·I, f₀ = g₀.
+            let (c1, c2) = (h * h / 2.0, h * h * h / 6.0);
+            return std::array::from_fn(|i| self.z[i] + h * self.fz[i] + c1 * d.0[i] + c2 * d.1[i]);
+        }
         match phi {
             Some(p) => {
                 // z₀ + Φ₁·f₀ + h·Φ₂·g' + h²·Φ₃·g''
