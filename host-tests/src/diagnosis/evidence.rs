@@ -905,6 +905,7 @@ mod tests {
             sims: 0,
             series,
             jac_ln: Some(j),
+            jac_owed: None,
         };
         let nuisance = [ParamSpec::new("scale", "1", 1.0, 0.5, 2.0)];
         let b = fit(Candidate::None, base, vec![], j_base);
