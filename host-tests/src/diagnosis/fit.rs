@@ -167,6 +167,15 @@ impl Problem<'_> {
     /// values (data rows only, for the evidence), from the same model runs.
     fn jacobians(&self) -> Option<(DMatrix<f64>, DMatrix<f64>)> {
         let r0 = self.r.as_ref()?;
+        // A Jacobian after which the budget has no run left for the step
+        // it is for ends the fit unrun: the fit ends there anyway (a
+        // Jacobian the budget cannot finish fails, a step it cannot run
+        // fails), and a Jacobian at the best point is computed again only
+        // for a fit that is kept ([`settle_jacobian`], the same matrix).
+        let used = self.sims.load(std::sync::atomic::Ordering::Relaxed);
+        if self.opts.max_sims.saturating_sub(used) < self.x.len() + 1 {
+            return None;
+        }
         let h = self.opts.fd_step;
         let n_data = self.points.len();
         let cols: Vec<Option<(DVector<f64>, DVector<f64>)>> = (0..self.x.len())
