@@ -463,6 +463,8 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
     // in parallel; the results do not depend on the order).
     let settle_sims = {
         let mut kept: Vec<&mut FitResult> = std::iter::once(&mut base).chain(fits.iter_mut()).collect();
+        let owed = kept.iter().filter_map(|f| f.jac_owed.as_ref().map(|(x, _)| x.len())).sum();
+        sim.phase(Phase::Jacobians { runs: owed });
         let before: usize = kept.iter().map(|f| f.sims).sum();
         kept.par_iter_mut().for_each(|f| settle_jacobian(sim, run, &pts, f));
         kept.iter().map(|f| f.sims).sum::<usize>() - before
