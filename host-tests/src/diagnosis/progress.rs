@@ -17,14 +17,18 @@
 //! fails the strict rule (the diagnosis says so), [`ESCALATION_WEIGHT`] of
 //! the physical tier.
 //!
-//! The time left is the diagnosis's own estimate, not indicatif's (which
-//! follows the recent run rate, and so showed 20–40 % short where the later
-//! phases' runs are slower): the runs ahead of each phase times that
-//! phase's wall time per run — measured once the phase has run (the
-//! current phase's own rate after [`MIN_RATE_RUNS`] runs), before that the
-//! diagnosis's mean time per run weighted by [`RUN_COST`]. The residual
-//! analysis and the evidence are not counted (0.5 s of a 30-minute log's
-//! diagnosis on a quiet machine, bench `diagnose_30min`).
+//! The time left is the diagnosis's own estimate, not indicatif's (its
+//! smoothed recent rate showed 20–40 % short on the 30-minute emulator
+//! log): the runs ahead of each phase times that phase's wall time per
+//! run, as measured in this tier once the phase has run; the current
+//! phase's own mean rate after [`MIN_RATE_RUNS`] runs; phases not yet run
+//! at the current phase's rate (else the mean so far). A fixed ratio of
+//! cost per run between phases was tried and not kept: measured twice on
+//! the emulator log, the physical tier's candidates against its baseline
+//! fit ran at 1.35 and at 0.85 times its runs' wall time, the refits
+//! against the candidates at 1.3 and 1.0. The residual analysis and the
+//! evidence are not counted (0.5 s of a 30-minute log's diagnosis on a
+//! quiet machine, bench `diagnose_30min`).
 
 use super::model::{Candidate, ParamSpec, Phase, SimSeries, Simulator};
 use std::sync::{Arc, Mutex};
@@ -72,16 +76,6 @@ enum Kind {
     Detectability,
 }
 
-/// Wall time per model run of each kind of phase relative to the baseline
-/// fit's (baseline, candidates, restarts, refits, Jacobians,
-/// detectability), before the phase has been measured in this diagnosis.
-/// The escalated tier of the 30-minute emulator log (bench
-/// `diagnose_30min`): its candidate runs took 1.35–1.4 times the baseline
-/// fit's wall time per run (quiet machine, and under load 5–6), its
-/// restarts 1.45, its refits 1.8 and 0.96 (the same two runs): the
-/// candidates' ratio stands for every phase after the baseline.
-pub const RUN_COST: [f64; 6] = [1.0, 1.35, 1.35, 1.35, 1.35, 1.0];
-
 /// Runs of the current phase after which its own wall time per run is used
 /// for its remaining runs.
 pub const MIN_RATE_RUNS: f64 = 20.0;
@@ -102,7 +96,7 @@ struct Est {
     plan: Vec<(Kind, f64)>,
     /// Wall time and runs of this tier's finished phases, by kind.
     spent: [(f64, f64); 6],
-    /// Wall time and [`RUN_COST`]-weighted runs of every finished phase.
+    /// Wall time and runs of every finished phase.
     all: (f64, f64),
 }
 
@@ -153,30 +147,28 @@ impl Est {
         self.spent[k].0 += secs;
         self.spent[k].1 += done;
         self.all.0 += secs;
-        self.all.1 += done * RUN_COST[k];
+        self.all.1 += done;
         self.phase_t = now;
     }
     /// Wall time left, s, with `done` runs of the current phase done:
     /// `None` before any run has been timed.
     fn left_s(&self, done: f64, now: Instant) -> Option<f64> {
         let el = now.duration_since(self.phase_t).as_secs_f64();
-        let (secs, units) = (self.all.0 + el, self.all.1 + done * RUN_COST[self.kind as usize]);
-        if units <= 0.0 || secs <= 0.0 {
+        let (secs, runs) = (self.all.0 + el, self.all.1 + done);
+        if runs <= 0.0 || secs <= 0.0 {
             return None;
         }
-        let unit = secs / units;
+        // A phase not yet run: the current phase's rate once measured,
+        // else the mean so far.
+        let current = (done >= MIN_RATE_RUNS).then(|| el / done);
+        let fallback = current.unwrap_or(secs / runs);
         let per_run = |k: Kind| {
             let (s, n) = self.spent[k as usize];
-            if n >= MIN_RATE_RUNS { s / n } else { unit * RUN_COST[k as usize] }
+            if n >= MIN_RATE_RUNS { s / n } else { fallback }
         };
         let mut left = 0.0;
-        for (i, (k, runs)) in self.plan.iter().enumerate() {
-            left += if i == 0 {
-                let rate = if done >= MIN_RATE_RUNS { el / done } else { per_run(*k) };
-                (runs - done).max(0.0) * rate
-            } else {
-                runs * per_run(*k)
-            };
+        for (i, (k, n)) in self.plan.iter().enumerate() {
+            left += if i == 0 { (n - done).max(0.0) * current.unwrap_or_else(|| per_run(*k)) } else { n * per_run(*k) };
         }
         Some(left)
     }
