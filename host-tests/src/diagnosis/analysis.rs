@@ -4,7 +4,7 @@
 
 use super::adequacy::{assess, Adequacy, MisfitRule};
 use super::evidence::{posterior_of, Posterior, DISCREPANCY_TAU_S};
-use super::fit::{fit, FitOptions, FitResult, Point};
+use super::fit::{fit_deferred, settle_jacobian, FitOptions, FitResult, Point};
 use super::identify::{identifiable, HOUSING_OUTER_PREFIX};
 use super::model::{Candidate, Phase, SimSeries, Simulator};
 use super::regressors::regressors;
@@ -365,7 +365,9 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
     sim.phase(Phase::Baseline { params: nuis_specs.len() });
     let nominal_v: Vec<f64> = nuis_specs.iter().map(|s| s.start).collect();
     let nominal = sim.simulate(&nominal_v, Candidate::None, &[]).map_err(DiagnoseError::Baseline)?;
-    let base = fit(sim, run, &pts, Candidate::None, &nominal_v, None, o.fit)
+    // Fits are made without their Jacobian at the best point (owed, see
+    // `fit_deferred`): only the kept ones pay it, before the evidence.
+    let base = fit_deferred(sim, run, &pts, Candidate::None, &nominal_v, None, o.fit)
         .ok_or_else(|| DiagnoseError::Baseline("no valid residuals at the nominal parameters".into()))?;
     log.mark("baseline", 1 + base.sims);
     let m_before = metrics(run, &base.series, split, o.ljung_box_lags);
@@ -391,7 +393,7 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
     sim.phase(Phase::Candidates { fits: starts.len(), may_escalate: may_escalate && sim.physical_set().is_some() });
     let all: Vec<Option<FitResult>> = starts
         .par_iter()
-        .map(|&(c, from_base)| if from_base { fit_from(sim, run, &pts, c, &base, o) } else { fit(sim, run, &pts, c, &nominal_v, None, o.fit) })
+        .map(|&(c, from_base)| if from_base { fit_from(sim, run, &pts, c, &base, o) } else { fit_deferred(sim, run, &pts, c, &nominal_v, None, o.fit) })
         .collect();
     let mut extra_sims = 0;
     let fits: Vec<Option<FitResult>> = all
@@ -427,7 +429,7 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
         let starts: Vec<Vec<f64>> = by_rss.iter().take(2).map(|f| f.nuisance.clone()).collect();
         sim.phase(Phase::Restarts { fits: starts.len() });
         let restarts: Vec<FitResult> =
-            starts.par_iter().filter_map(|v| fit(sim, run, &pts, Candidate::None, v, None, o.fit)).collect();
+            starts.par_iter().filter_map(|v| fit_deferred(sim, run, &pts, Candidate::None, v, None, o.fit)).collect();
         let r_sims = restarts.iter().map(|f| f.sims).sum::<usize>();
         extra_sims += r_sims;
         log.mark("restarts", r_sims);
@@ -457,6 +459,18 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
     let sims = 1 + base_sims + extra_sims;
     ranking.sort_by(|a, b| a.bic.total_cmp(&b.bic));
     let adequacy = assess(run, split, &m_before, &xcorr, (&nuis_specs, &base.nuisance), rule);
+    // The kept fits' owed Jacobians, for the evidence (each fit's own runs,
+    // in parallel; the results do not depend on the order).
+    let settle_sims = {
+        let mut kept: Vec<&mut FitResult> = std::iter::once(&mut base).chain(fits.iter_mut()).collect();
+        let owed = kept.iter().filter_map(|f| f.jac_owed.as_ref().map(|(x, _)| x.len())).sum();
+        sim.phase(Phase::Jacobians { runs: owed });
+        let before: usize = kept.iter().map(|f| f.sims).sum();
+        kept.par_iter_mut().for_each(|f| settle_jacobian(sim, run, &pts, f));
+        kept.iter().map(|f| f.sims).sum::<usize>() - before
+    };
+    let sims = sims + settle_sims;
+    log.mark("jacobians", settle_sims);
     let chan: Vec<(Channel, f64, f64)> =
         adequacy.channels.iter().filter_map(|c| Some((Channel::from_name(&c.channel)?, c.noise_k, c.rise_k))).collect();
     let posterior = posterior_of(
@@ -469,7 +483,6 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
         &|c| sim.extension_params(c),
         &chan,
         &|c| ranking.iter().any(|r| r.qualifies && r.cause == c.name()),
-        &|c| ranking.iter().any(|r| r.note.is_empty() && r.cause == c.name()),
         DISCREPANCY_TAU_S,
     );
     log.mark("evidence", 0);
@@ -516,10 +529,11 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
 
 /// Candidate `c` fitted jointly with the nuisance set from the baseline
 /// `base`, with `c`'s parameters nearly off (a tenth of their log range
-/// above the lower bound).
+/// above the lower bound); its Jacobian at the best point owed
+/// ([`fit_deferred`], [`settle_jacobian`]).
 pub fn fit_from(sim: &dyn Simulator, run: &MeasuredRun, pts: &[Point], c: Candidate, base: &FitResult, o: &DiagnoseOptions) -> Option<FitResult> {
     let off: Vec<f64> = sim.extension_params(c).iter().map(|s| s.lo * (s.hi / s.lo).powf(0.1)).collect();
-    fit(sim, run, pts, c, &base.nuisance, Some(&off), o.fit)
+    fit_deferred(sim, run, pts, c, &base.nuisance, Some(&off), o.fit)
 }
 
 /// Whether candidate `c` can be named on `run` (training window before

@@ -102,51 +102,51 @@ fn run_inner(args: &DiagnoseArgs) -> anyhow::Result<String> {
         o = super::multi::options_for(&o, runs.len());
     }
     let progress = Progress::new(model, o.fit.max_sims, true);
-    let d = diagnose(run, &progress, &o);
-    if d.is_err() {
-        progress.finish();
-    }
-    let d = d?;
-    // The diagnosis's own time (the detectability pass comes after).
-    let secs = t.elapsed().as_secs_f64();
-    match &joint {
-        Some((_, m)) => {
-            let parts = super::multi::log_parts(&d, &refs, m.layout(), &o);
-            super::multi::write_outputs(&d, &parts, &refs, &files, &args.out)?;
+    // The diagnosis, its outputs and the detectability under one bar,
+    // cleared once on every path (before the verdict or the error prints).
+    let work = || -> anyhow::Result<String> {
+        let d = diagnose(run, &progress, &o)?;
+        // The diagnosis's own time (the detectability pass comes after).
+        let secs = t.elapsed().as_secs_f64();
+        match &joint {
+            Some((_, m)) => {
+                let parts = super::multi::log_parts(&d, &refs, m.layout(), &o);
+                super::multi::write_outputs(&d, &parts, &refs, &files, &args.out)?;
+            }
+            None => write_outputs(&d, run, &files[0], &args.out)?,
         }
-        None => write_outputs(&d, run, &files[0], &args.out)?,
-    }
-    let mut detect_line = None;
-    if args.detectability {
-        // One run per calibration parameter and per candidate row, around
-        // the answer's tier.
-        let p = d.nuisance_before.len();
-        progress.extend((1 + p + super::detect::MULTIPLES.len() * Candidate::EXTENSIONS.len()) as u64, "detectability");
-        let fd = detectability_against_floor(&progress, &d, run, &o);
-        progress.finish();
-        let fd = fd?;
-        // A section appended to the report just written.
-        use std::io::Write as _;
-        std::fs::OpenOptions::new().append(true).open(args.out.join("report.md"))?.write_all(fd.markdown().as_bytes())?;
-        std::fs::write(args.out.join("detectability.json"), serde_json::to_string_pretty(&fd)? + "\n")?;
-        detect_line = Some(fd.summary());
-    }
+        let mut detect_line = None;
+        if args.detectability {
+            // One run per calibration parameter and per candidate row, around
+            // the answer's tier.
+            let p = d.nuisance_before.len();
+            progress.extend((1 + p + super::detect::MULTIPLES.len() * Candidate::EXTENSIONS.len()) as u64, "detectability");
+            let fd = detectability_against_floor(&progress, &d, run, &o)?;
+            // A section appended to the report just written.
+            use std::io::Write as _;
+            std::fs::OpenOptions::new().append(true).open(args.out.join("report.md"))?.write_all(fd.markdown().as_bytes())?;
+            std::fs::write(args.out.join("detectability.json"), serde_json::to_string_pretty(&fd)? + "\n")?;
+            detect_line = Some(fd.summary());
+        }
+        let verdict = format!(
+            "cause: {} | held-out RMSE {:.3} -> {:.3} K | training {:.3} -> {:.3} K | {} model runs, {:.1} s | {}",
+            d.answer(),
+            d.before.heldout_rmse_k,
+            d.after.heldout_rmse_k,
+            d.before.train_rmse_k,
+            d.after.train_rmse_k,
+            d.sims,
+            secs,
+            args.out.join("report.md").display()
+        );
+        Ok(match detect_line {
+            Some(l) => format!("{verdict}\n{l}"),
+            None => verdict,
+        })
+    };
+    let outcome = work();
     progress.finish();
-    let verdict = format!(
-        "cause: {} | held-out RMSE {:.3} -> {:.3} K | training {:.3} -> {:.3} K | {} model runs, {:.1} s | {}",
-        d.answer(),
-        d.before.heldout_rmse_k,
-        d.after.heldout_rmse_k,
-        d.before.train_rmse_k,
-        d.after.train_rmse_k,
-        d.sims,
-        secs,
-        args.out.join("report.md").display()
-    );
-    Ok(match detect_line {
-        Some(l) => format!("{verdict}\n{l}"),
-        None => verdict,
-    })
+    outcome
 }
 
 /// The detectability of `run` against its structure floor around the

@@ -564,35 +564,10 @@ pub struct ChannelTerms {
     /// training points (at least the noise), K.
     #[serde(default)]
     pub own_k: f64,
-    /// Evidence points of the channel.
-    #[serde(default)]
-    pub n: usize,
-    /// RMS of this structure's residual at the evidence points, K.
-    #[serde(default)]
-    pub rms_k: f64,
     /// Lag-1 autocorrelation of the whitened residual at each grid
     /// amplitude: what the AR(1) discrepancy leaves unexplained
     /// ([`effective_fraction`]).
     #[serde(default)]
-    pub rho: Vec<f64>,
-    /// The same log-likelihood and autocorrelation under other time
-    /// constants of the discrepancy ([`ALT_TAU_S`]).
-    #[serde(default)]
-    pub alt: Vec<TauTerms>,
-}
-
-/// Time constants of the discrepancy, s, at which [`ChannelTerms::alt`]
-/// is also stored (for measuring the choice on a sweep).
-pub const ALT_TAU_S: [f64; 3] = [30.0, 600.0, 1800.0];
-
-/// One channel's terms under another discrepancy time constant.
-#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct TauTerms {
-    /// Time constant, s.
-    pub tau_s: f64,
-    /// Log-likelihood on the amplitude grid.
-    pub log_lik: Vec<f64>,
-    /// Lag-1 autocorrelation of the whitened residual on the grid.
     pub rho: Vec<f64>,
 }
 
@@ -624,11 +599,6 @@ pub struct StructureTerms {
     pub cause: String,
     /// Prior probability.
     pub prior: f64,
-    /// Whether the log carries the excitation that tells this candidate
-    /// apart from the nuisance physics ([`super::identify`]); a candidate
-    /// can be identifiable and still not admitted (held-out checks).
-    #[serde(default)]
-    pub identifiable: bool,
     /// ln prior density + ln posterior volume of the fitted parameters
     /// (the Occam factor), with the structure's amplitudes.
     pub occam: f64,
@@ -645,51 +615,55 @@ pub struct StructureTerms {
     pub channels: Vec<ChannelTerms>,
 }
 
-/// [`StructureTerms::channels`] of `fit`: every channel's log-likelihood on
-/// the amplitude grid, with the amplitude `amp(channel)` noted.
-fn channel_terms(
-    run: &MeasuredRun,
-    pts: &[Point],
-    fit: &FitResult,
-    amp: &dyn Fn(Channel) -> f64,
-    noise: &dyn Fn(Channel) -> f64,
-    own: &dyn Fn(Channel) -> f64,
-    tau_s: f64,
-) -> Vec<ChannelTerms> {
-    let Some(r) = super::fit::residuals_at(run, &fit.series, pts) else { return Vec::new() };
+/// One channel's whitening filters on the amplitude grid
+/// ([`amplitude_grid`]): they depend on the channel's sample times, noise
+/// and the discrepancy's time constant, not on the structure, so they are
+/// built once per diagnosis and applied to every structure's residual.
+struct GridWhiteners {
+    channel: Channel,
+    range: std::ops::Range<usize>,
+    noise_k: f64,
+    filters: Vec<Whitener>,
+}
+
+/// [`GridWhiteners`] of every channel of `pts`.
+fn grid_whiteners(run: &MeasuredRun, pts: &[Point], noise: &dyn Fn(Channel) -> f64, tau_s: f64) -> Vec<GridWhiteners> {
     let grid = amplitude_grid();
     channel_runs(pts)
         .into_iter()
         .map(|(ch, range)| {
             let times: Vec<f64> = pts[range.clone()].iter().map(|(_, i)| run.time_s[*i]).collect();
-            let y = &r[range];
-            let on_grid = |tau: f64| -> (Vec<f64>, Vec<f64>) {
-                grid.iter()
-                    .map(|a| {
-                        let w = Whitener::new(&times, *a, noise(ch), tau);
-                        let v = w.whiten(y);
-                        (w.log_lik_of_whitened(&v), lag1(&v))
-                    })
-                    .unzip()
-            };
-            let (log_lik, rho) = on_grid(tau_s);
-            ChannelTerms {
-                channel: ch.name().into(),
-                noise_k: noise(ch),
-                amp_k: amp(ch),
-                own_k: own(ch),
-                log_lik,
-                n: y.len(),
-                rms_k: (y.iter().map(|x| x * x).sum::<f64>() / y.len().max(1) as f64).sqrt(),
-                rho,
-                alt: ALT_TAU_S
-                    .iter()
-                    .map(|t| {
-                        let (log_lik, rho) = on_grid(*t);
-                        TauTerms { tau_s: *t, log_lik, rho }
-                    })
-                    .collect(),
-            }
+            let noise_k = noise(ch);
+            let filters = grid.iter().map(|a| Whitener::new(&times, *a, noise_k, tau_s)).collect();
+            GridWhiteners { channel: ch, range, noise_k, filters }
+        })
+        .collect()
+}
+
+/// [`StructureTerms::channels`] of `fit` at the points the filters `grid`
+/// were built for: every channel's log-likelihood on the amplitude grid,
+/// with the amplitude `amp(channel)` noted.
+fn channel_terms(
+    run: &MeasuredRun,
+    pts: &[Point],
+    fit: &FitResult,
+    amp: &dyn Fn(Channel) -> f64,
+    own: &dyn Fn(Channel) -> f64,
+    grid: &[GridWhiteners],
+) -> Vec<ChannelTerms> {
+    let Some(r) = super::fit::residuals_at(run, &fit.series, pts) else { return Vec::new() };
+    grid.iter()
+        .map(|g| {
+            let y = &r[g.range.clone()];
+            let (log_lik, rho) = g
+                .filters
+                .iter()
+                .map(|w| {
+                    let v = w.whiten(y);
+                    (w.log_lik_of_whitened(&v), lag1(&v))
+                })
+                .unzip();
+            ChannelTerms { channel: g.channel.name().into(), noise_k: g.noise_k, amp_k: amp(g.channel), own_k: own(g.channel), log_lik, rho }
         })
         .collect()
 }
@@ -723,7 +697,6 @@ pub fn posterior_of(
     ext: &dyn Fn(Candidate) -> Vec<ParamSpec>,
     chan: &[(Channel, f64, f64)],
     admitted: &dyn Fn(Candidate) -> bool,
-    identifiable: &dyn Fn(Candidate) -> bool,
     tau_s: f64,
 ) -> Posterior {
     let r = super::fit::residuals_at(run, &base.series, pts).unwrap_or_default();
@@ -767,15 +740,15 @@ pub fn posterior_of(
     let occam = |o: Option<f64>| o.unwrap_or(f64::NEG_INFINITY);
     // The baseline's at the own-misfit amplitudes: the same for every candidate.
     let base_occam_own = occam(log_occam(run, pts, all_pts, base, nuisance, &own, &noise, tau_s));
+    let grid = grid_whiteners(run, all_pts, &noise, tau_s);
     let mut terms = vec![StructureTerms {
         cause: "none".into(),
         prior: PRIOR_NO_CAUSE,
-        identifiable: true,
         occam: 0.0,
         base_occam: 0.0,
         occam_own: 0.0,
         base_occam_own: 0.0,
-        channels: channel_terms(run, all_pts, base, &own_floor, &noise, &own, tau_s),
+        channels: channel_terms(run, all_pts, base, &own_floor, &own, &grid),
     }];
     for f in fits {
         let touched: Vec<String> = touched_channels(f.candidate).iter().map(|c| c.name().to_string()).collect();
@@ -785,12 +758,11 @@ pub fn posterior_of(
         terms.push(StructureTerms {
             cause: f.candidate.name().into(),
             prior: if admitted(f.candidate) { (1.0 - 2.0 * PRIOR_NO_CAUSE) / Candidate::EXTENSIONS.len() as f64 } else { 0.0 },
-            identifiable: identifiable(f.candidate),
             occam: occam(log_occam(run, pts, all_pts, f, &specs, &amp, &noise, tau_s)),
             base_occam: occam(log_occam(run, pts, all_pts, base, nuisance, &amp, &noise, tau_s)),
             occam_own: occam(log_occam(run, pts, all_pts, f, &specs, &own, &noise, tau_s)),
             base_occam_own,
-            channels: channel_terms(run, all_pts, f, &amp, &noise, &own, tau_s),
+            channels: channel_terms(run, all_pts, f, &amp, &own, &grid),
         });
     }
     let causes = posterior_from_terms(&terms, DECISION_RULE);
@@ -905,6 +877,7 @@ mod tests {
             sims: 0,
             series,
             jac_ln: Some(j),
+            jac_owed: None,
         };
         let nuisance = [ParamSpec::new("scale", "1", 1.0, 0.5, 2.0)];
         let b = fit(Candidate::None, base, vec![], j_base);
@@ -919,7 +892,6 @@ mod tests {
             &nuisance,
             &|_| vec![ParamSpec::new("sensor_tau_s", "s", 100.0, 10.0, 1000.0)],
             &chan,
-            &|_| true,
             &|_| true,
             DISCREPANCY_TAU_S,
         )

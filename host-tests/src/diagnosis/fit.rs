@@ -60,8 +60,12 @@ pub struct FitResult {
     /// to the logarithms of the parameters (columns: nuisance, then
     /// extension) at the best parameters, K per unit of ln value: the
     /// curvature of the evidence ([`super::evidence`]). `None` when the
-    /// model failed there.
+    /// model failed there, or while it is still owed (see [`fit_deferred`]).
     pub jac_ln: Option<DMatrix<f64>>,
+    /// The internal variables of the best point and the difference step
+    /// while its Jacobian is owed ([`fit_deferred`]); `None` once it is in
+    /// [`Self::jac_ln`] or failed.
+    pub(crate) jac_owed: Option<(DVector<f64>, f64)>,
 }
 
 /// Residuals (simulated − measured, K) of `s` at `points`; `None` when the
@@ -104,13 +108,20 @@ impl Problem<'_> {
         }
         let v = self.values(x);
         let s = self.sim.simulate(&v[..self.n_nuis], self.cand, &v[self.n_nuis..]).ok()?;
-        let mut r = residuals_at(self.run, &s, self.points)?;
+        Some((self.residual_vector(x, &s)?, s))
+    }
+
+    /// The fit's residuals at internal point `x` whose model series is
+    /// `s`: the data rows, then the prior rows; `None` unless all finite.
+    fn residual_vector(&self, x: &DVector<f64>, s: &SimSeries) -> Option<DVector<f64>> {
+        let v = self.values(x);
+        let mut r = residuals_at(self.run, s, self.points)?;
         for (v, sp) in v.iter().zip(&self.specs) {
             if let Some(sig) = sp.prior_sigma_ln {
                 r.push(PRIOR_DATA_SIGMA_K * (v / sp.start).ln() / sig);
             }
         }
-        r.iter().all(|x| x.is_finite()).then(|| (DVector::from_vec(r), s))
+        r.iter().all(|x| x.is_finite()).then(|| DVector::from_vec(r))
     }
 }
 
@@ -156,6 +167,15 @@ impl Problem<'_> {
     /// values (data rows only, for the evidence), from the same model runs.
     fn jacobians(&self) -> Option<(DMatrix<f64>, DMatrix<f64>)> {
         let r0 = self.r.as_ref()?;
+        // A Jacobian after which the budget has no run left for the step
+        // it is for ends the fit unrun: the fit ends there anyway (a
+        // Jacobian the budget cannot finish fails, a step it cannot run
+        // fails), and a Jacobian at the best point is computed again only
+        // for a fit that is kept ([`settle_jacobian`], the same matrix).
+        let used = self.sims.load(std::sync::atomic::Ordering::Relaxed);
+        if self.opts.max_sims.saturating_sub(used) < self.x.len() + 1 {
+            return None;
+        }
         let h = self.opts.fd_step;
         let n_data = self.points.len();
         let cols: Vec<Option<(DVector<f64>, DVector<f64>)>> = (0..self.x.len())
@@ -207,11 +227,27 @@ pub fn fit(
     ext0: Option<&[f64]>,
     opts: FitOptions,
 ) -> Option<FitResult> {
-    let nuis_specs = sim.nuisance();
-    let ext_specs = sim.extension_params(cand);
-    let n_nuis = nuis_specs.len();
-    let mut specs = nuis_specs;
-    specs.extend(ext_specs.iter().cloned());
+    let mut f = fit_deferred(sim, run, points, cand, nuis0, ext0, opts)?;
+    settle_jacobian(sim, run, points, &mut f);
+    Some(f)
+}
+
+/// [`fit`] without the Jacobian at the best point when the iteration did
+/// not end there ([`FitResult::jac_ln`] is then owed: p model runs that
+/// [`settle_jacobian`] spends). The diagnosis fits several starts and
+/// keeps one; the Jacobian is only wanted of the fit it keeps.
+pub fn fit_deferred(
+    sim: &dyn Simulator,
+    run: &MeasuredRun,
+    points: &[Point],
+    cand: Candidate,
+    nuis0: &[f64],
+    ext0: Option<&[f64]>,
+    opts: FitOptions,
+) -> Option<FitResult> {
+    let specs = specs_of(sim, cand);
+    let n_nuis = sim.nuisance().len();
+    let ext_specs = &specs[n_nuis..];
     let starts: Vec<f64> = match ext0 {
         Some(e) => nuis0.iter().chain(e).copied().collect(),
         None => nuis0.iter().copied().chain(ext_specs.iter().map(|s| s.start)).collect(),
@@ -241,28 +277,17 @@ pub fn fit(
     };
     p.set_params(&DVector::from_vec(x0));
     p.r.as_ref()?;
-    let (mut p, _report) = LevenbergMarquardt::new()
+    let (p, _report) = LevenbergMarquardt::new()
         .with_ftol(opts.ftol)
         .with_xtol(1e-4)
         .with_patience(opts.max_sims.max(1))
         .minimize(p);
     let (_, x, series) = p.best.clone()?;
     // The ln-space Jacobian at the best point: the iteration's last one when
-    // it was taken there, else one more (p + 1 model runs, outside the fit's
-    // budget).
+    // it was taken there, else owed ([`settle_jacobian`]).
     let stored = p.last_jac_ln.lock().ok().and_then(|mut l| l.take()).filter(|(xj, _)| *xj == x).map(|(_, j)| j);
-    let mut sims = p.sims.load(std::sync::atomic::Ordering::Relaxed).min(opts.max_sims);
-    let jac_ln = match stored {
-        Some(j) => Some(j),
-        None => {
-            p.opts.max_sims = usize::MAX;
-            p.sims.store(0, std::sync::atomic::Ordering::Relaxed);
-            p.set_params(&x);
-            let j = p.jacobians().map(|(_, j)| j);
-            sims += p.sims.load(std::sync::atomic::Ordering::Relaxed);
-            j
-        }
-    };
+    let sims = p.sims.load(std::sync::atomic::Ordering::Relaxed).min(opts.max_sims);
+    let jac_owed = stored.is_none().then(|| (x.clone(), opts.fd_step));
     let v = p.values(&x);
     // The data part only (BIC and RMSEs compare fits on the data).
     let rss = residuals_at(run, &series, points)?.iter().map(|e| e * e).sum();
@@ -274,6 +299,41 @@ pub fn fit(
         n: points.len(),
         sims,
         series,
-        jac_ln,
+        jac_ln: stored,
+        jac_owed,
     })
+}
+
+/// The fitted parameters' specs of candidate `cand`: the nuisance set, then
+/// the candidate's.
+fn specs_of(sim: &dyn Simulator, cand: Candidate) -> Vec<ParamSpec> {
+    let mut specs = sim.nuisance();
+    specs.extend(sim.extension_params(cand));
+    specs
+}
+
+/// Pays a [`fit_deferred`] fit's owed Jacobian at its best point: p model
+/// runs (the residual there comes from the stored series, the model being
+/// deterministic), added to [`FitResult::sims`]. The same matrix [`fit`]
+/// returns; nothing to do when it is not owed.
+pub fn settle_jacobian(sim: &dyn Simulator, run: &MeasuredRun, points: &[Point], f: &mut FitResult) {
+    let Some((x, fd_step)) = f.jac_owed.take() else { return };
+    let specs = specs_of(sim, f.candidate);
+    let p = Problem {
+        sim,
+        run,
+        points,
+        cand: f.candidate,
+        n_nuis: f.nuisance.len(),
+        r: None,
+        specs,
+        x,
+        opts: FitOptions { max_sims: usize::MAX, fd_step, ftol: 0.0 },
+        sims: 0.into(),
+        best: None,
+        last_jac_ln: std::sync::Mutex::new(None),
+    };
+    let p = Problem { r: p.residual_vector(&p.x, &f.series), ..p };
+    f.jac_ln = p.jacobians().map(|(_, j)| j);
+    f.sims += p.sims.load(std::sync::atomic::Ordering::Relaxed);
 }

@@ -108,6 +108,12 @@ pub enum Phase {
         /// Fits in the phase.
         fits: usize,
     },
+    /// The Jacobians at the best points of the kept fits, for the evidence
+    /// (`diagnosis::fit::settle_jacobian`): `runs` model runs.
+    Jacobians {
+        /// Model runs in the phase.
+        runs: usize,
+    },
     /// This tier's answer stands (no escalation follows).
     Done,
 }
