@@ -166,7 +166,8 @@ fn slow_mix_heat_audit() {
 /// `EXP_G_BARREL_END=W/K`, `EXP_PROBE_AMBIENT=frac`, `EXP_PROBE_BARREL=w`
 /// set those fields; `EXP_A_CASE=k`, `EXP_GAP=k` scale the case wetted area
 /// and the leakage gap; on the user's rig file `EXP_RIG_CV=k`,
-/// `EXP_RIG_T0=k` scale the viscous and no-load friction torques;
+/// `EXP_RIG_T0=k` scale the viscous and no-load friction torques,
+/// `EXP_RIG_CASE_OIL=k` the case-oil volume (a volume the user measured);
 /// `EXP_HOLD=a,b` holds calibration parameters at the rig file;
 /// `EXP_MACHINE` picks one machine. Prints the held-out numbers without the
 /// margin (firmware drain vs thermocouple).
@@ -193,6 +194,9 @@ fn slow_mix_experiment() {
         }
         if let Some(k) = env("EXP_RIG_T0") {
             base.pump.no_load_torque_nm *= k;
+        }
+        if let Some(k) = env("EXP_RIG_CASE_OIL") {
+            base.pump.case_oil_m3 *= k;
         }
         let t0 = std::time::Instant::now();
         let c = commission_with(&base, &train, &hold, &o, false).expect("commission");
