@@ -111,10 +111,12 @@ fn report(m: &EmuMachine, c: &Commissioning, secs: f64) {
 }
 
 /// Tolerance on a measured headline number, K: a 1e-9 K nudge of every
-/// temperature moved them by up to 0.039 K
-/// (`slow_commissioning_is_reproducible_at_the_last_digit_*`); the
-/// commissioning is not converged to better than that (the polish stops
-/// after 8 steps with a predicted decrease of a few units of χ²).
+/// temperature moved them by 0.031 K on leaky-heavy and 0.172 K on
+/// big-pump (`slow_commissioning_is_reproducible_at_the_last_digit_*`,
+/// this build); the commissioning is not converged to better than that
+/// (the polish stops after 8 steps with a predicted decrease of a few units
+/// of χ²). Big-pump's spread is above this tolerance: on another build its
+/// numbers may fall outside it (one did: margin 2.115 against 2.290 K).
 const AS_MEASURED_K: f64 = 0.15;
 
 fn near(what: &str, got: f64, measured: f64) {
@@ -154,30 +156,34 @@ fn slow_commissioning_without_margin_on_foreign_machines() {
 /// direct identification), each with its drain margin validated on a split
 /// of the training missions, and the safer on the held-out logs flashed.
 /// The issue's acceptance is 1.0 K max |e| and ≤ 0.3 K under-prediction on
-/// the held-out logs with the margin counted. Measured (max |e| / under vs
-/// the thermocouple, margin counted; servo, throttle mix):
-/// - big-pump: reduction chosen (the direct path under-predicts by 1.33 K
-///   with its 0.91 K margin); margin 2.12 K (after the split the soak log's
-///   idle phase is under-predicted by 1.92 K); 2.31 / 0.13 K and 5.98 /
-///   0.18 K: the under-prediction bound met, max |e| not (the mix is
-///   over-predicted by 3.87 K before the margin). Direct path: 1.33 / 1.33 K
-///   and 2.33 / 1.31 K.
-/// - leaky-heavy: reduction chosen (the direct path under-predicts the
-///   servo log by 2.24 K with its 1.04 K margin, although the split
-///   preferred it, 2.13 K against 2.43 K); margin 2.43 K; 2.66 / 0.67 K and
-///   3.35 / 0.01 K; refused for the reduction (0.626 K on the servo log),
-///   written only with `--accept-with-margin`. Direct path: 2.24 / 2.24 K
-///   and 2.09 / 1.11 K.
-/// - Cost on the throttle mix (open loop): valve open 1490 → 1511 s, LNG
-///   3.01 → 3.06 kg (big-pump); 1541 → 1561 s, 1.98 → 2.01 kg
+/// the held-out logs with the margin counted. Measured at 4783c7b (max |e|
+/// / under vs the thermocouple, margin counted; servo, throttle mix):
+/// - big-pump: reduction chosen (the direct path under-predicts by 1.34 K
+///   with its 0.89 K margin); margin 2.29 K (after the split the soak log's
+///   idle phase is under-predicted by 2.09 K); 2.48 / 0.00 K and 6.04 /
+///   0.02 K: the under-prediction bound met, max |e| not. Direct path:
+///   1.34 / 1.34 K and 2.37 / 1.31 K.
+/// - leaky-heavy: reduction chosen (the direct path under-predicts by
+///   2.20 K with its 1.09 K margin, although the split preferred it, 2.04 K
+///   against 2.52 K); margin 2.52 K; 2.75 / 0.55 K and 3.47 / 0.00 K;
+///   refused for the reduction (0.567 K off the reference on the servo
+///   log), written only with `--accept-with-margin`.
+/// - Cost on the throttle mix (open loop): valve open 1488 → 1511 s, LNG
+///   3.01 → 3.07 kg (big-pump); 1541 → 1562 s, 1.94 → 1.97 kg
 ///   (leaky-heavy); the servo logs stay below 40 °C.
-/// - 108–440 s per commissioning (four logs) on 2 cores shared with three
-///   other helpers' builds and tests (load 8–13); 32 s before the polish
-///   and the direct path, at a lighter load. Not a timing test.
+/// - Time (four logs: two 30-min training, a 20-min servo and a 30-min
+///   mix held out; both paths, the split's margins) with nothing else
+///   running on the 2 cores: big-pump 36.3 and 37.4 s (1 696 reference
+///   runs), leaky-heavy 41.2 s (1 898). Not a timing test.
+/// The values asserted before (big-pump margin 2.115 K, 2.31 / 0.13 and
+/// 5.98 / 0.18 K) were one build's of an earlier commit; a 1e-9 K nudge of
+/// the logs moves big-pump by 0.17 K on this build
+/// (`slow_commissioning_is_reproducible_at_the_last_digit_big_pump`, which
+/// asserts the issue's 0.05 K and fails here: issue 36 open).
 #[test]
 #[ignore = "slow tier: two commissionings with margin validation on emulator bench logs (~1 min each)"]
 fn slow_commissioning_with_margin_on_foreign_machines() {
-    let measured = [(2.115, [(2.308, 0.131), (5.981, 0.177)], [1490.0, 1511.0]), (2.430, [(2.661, 0.666), (3.353, 0.011)], [1541.0, 1561.0])];
+    let measured = [(2.290, [(2.483, 0.000), (6.044, 0.016)], [1488.0, 1511.0]), (2.516, [(2.748, 0.548), (3.466, 0.000)], [1541.0, 1562.0])];
     for (m, (margin, want, open_s)) in machines().into_iter().zip(measured) {
         let s = bench_set(&m, 3600).expect("bench");
         let train: Vec<CalLog> = s.train.iter().map(cal).collect();
