@@ -309,6 +309,32 @@ pub const DECISION_RULE: DecisionRule = DecisionRule::Pooled;
 /// with it, and a sweep re-decides stored fits with it. `terms[0]` is the
 /// baseline (its amplitudes are the channels' floors).
 pub fn posterior_from_terms(terms: &[StructureTerms], rule: DecisionRule) -> Vec<CauseProbability> {
+    if terms.is_empty() {
+        return Vec::new();
+    }
+    match rule {
+        DecisionRule::Pooled => finish(gated_causes(terms, false)),
+        DecisionRule::PerChannel => finish(gated_causes(terms, true)),
+        DecisionRule::Tempered => finish(tempered_causes(terms)),
+    }
+}
+
+/// The names of the channels candidate `cause`'s physics touches
+/// ([`touched_channels`]; none for a name that is not a candidate).
+fn touched_names(cause: &str) -> Vec<&'static str> {
+    Candidate::from_name(cause).map_or(vec![], |c| touched_channels(c).iter().map(|c| c.name()).collect())
+}
+
+/// ln Bayes factor of a free discrepancy amplitude against the baseline's
+/// floors, summed over the baseline's channels: `unexplained` against `none`.
+fn free_amplitude_gain(base: &StructureTerms) -> f64 {
+    base.channels.iter().map(|c| grid_free(&c.log_lik, c.amp_k) - grid_at(&c.log_lik, c.amp_k)).sum()
+}
+
+/// (cause, prior, ln Bayes factor against `none`) of every structure under
+/// the gated rules: [`DecisionRule::Pooled`], or with `per_channel`
+/// [`DecisionRule::PerChannel`].
+fn gated_causes(terms: &[StructureTerms], per_channel: bool) -> Vec<(String, f64, f64)> {
     let Some(base) = terms.first() else { return Vec::new() };
     let q = ANOMALY_PRIOR;
     let bch = |k: &str| base.channels.iter().find(|c| c.channel == k);
@@ -316,41 +342,32 @@ pub fn posterior_from_terms(terms: &[StructureTerms], rule: DecisionRule) -> Vec
     let floor_or_beyond = |c: &ChannelTerms| {
         log_sum_exp((1.0 - q).ln() + grid_at(&c.log_lik, floor(&c.channel)), q.ln() + grid_free(&c.log_lik, floor(&c.channel)))
     };
-    if rule == DecisionRule::Tempered {
-        return finish(tempered_causes(terms));
-    }
     let mut causes = Vec::new();
-    let l_none = match rule {
-        DecisionRule::Pooled => {
-            let u: f64 = base.channels.iter().map(|c| grid_free(&c.log_lik, c.amp_k) - grid_at(&c.log_lik, c.amp_k)).sum();
-            causes.push(("unexplained".to_string(), PRIOR_NO_CAUSE, u));
-            0.0
-        }
-        DecisionRule::PerChannel => {
-            let l_none: f64 = base.channels.iter().map(|c| (1.0 - q).ln() + grid_at(&c.log_lik, c.amp_k)).sum();
-            let l_any: f64 = base.channels.iter().map(floor_or_beyond).sum();
-            causes.push(("unexplained".to_string(), PRIOR_NO_CAUSE, l_any + (-(l_none - l_any).exp()).ln_1p().max(-700.0) - l_none));
-            l_none
-        }
-        DecisionRule::Tempered => unreachable!("decided above"),
+    let l_none = if per_channel {
+        let l_none: f64 = base.channels.iter().map(|c| (1.0 - q).ln() + grid_at(&c.log_lik, c.amp_k)).sum();
+        let l_any: f64 = base.channels.iter().map(floor_or_beyond).sum();
+        causes.push(("unexplained".to_string(), PRIOR_NO_CAUSE, l_any + (-(l_none - l_any).exp()).ln_1p().max(-700.0) - l_none));
+        l_none
+    } else {
+        causes.push(("unexplained".to_string(), PRIOR_NO_CAUSE, free_amplitude_gain(base)));
+        0.0
     };
     for t in &terms[1..] {
-        let touched: Vec<&str> = Candidate::from_name(&t.cause).map_or(vec![], |c| touched_channels(c).iter().map(|c| c.name()).collect());
+        let touched = touched_names(&t.cause);
         let l: f64 = t
             .channels
             .iter()
-            .map(|c| match rule {
-                DecisionRule::Pooled => grid_at(&c.log_lik, c.amp_k) - bch(&c.channel).map_or(f64::NEG_INFINITY, |b| grid_at(&b.log_lik, c.amp_k)),
-                DecisionRule::PerChannel if touched.contains(&c.channel.as_str()) => grid_at(&c.log_lik, c.amp_k),
-                DecisionRule::PerChannel => floor_or_beyond(c),
-                DecisionRule::Tempered => 0.0,
+            .map(|c| match per_channel {
+                false => grid_at(&c.log_lik, c.amp_k) - bch(&c.channel).map_or(f64::NEG_INFINITY, |b| grid_at(&b.log_lik, c.amp_k)),
+                true if touched.contains(&c.channel.as_str()) => grid_at(&c.log_lik, c.amp_k),
+                true => floor_or_beyond(c),
             })
             .sum();
         let b = l + t.occam - t.base_occam - l_none;
         causes.push((t.cause.clone(), t.prior, if b.is_nan() { f64::NEG_INFINITY } else { b }));
     }
     causes.push(("none".to_string(), PRIOR_NO_CAUSE, 0.0));
-    finish(causes)
+    causes
 }
 
 /// (cause, prior, ln Bayes factor against `none`) → the posterior, most
@@ -410,14 +427,14 @@ fn own_and_weight(b: &ChannelTerms) -> (f64, f64) {
 pub fn tempered_causes(terms: &[StructureTerms]) -> Vec<(String, f64, f64)> {
     let Some(base) = terms.first() else { return Vec::new() };
     let bch = |k: &str| base.channels.iter().find(|c| c.channel == k);
-    let u: f64 = base.channels.iter().map(|c| grid_free(&c.log_lik, c.amp_k) - grid_at(&c.log_lik, c.amp_k)).sum();
+    let u = free_amplitude_gain(base);
     // No cause = none ∪ unexplained, with ln Z_no-cause = 0 the reference.
     // ln of `none`'s share of the no-cause block: −ln(1 + e^(ηu)).
     let ln_pn = -log_sum_exp(0.0, LEARNING_RATE * u);
     let mut causes = Vec::new();
     let cand_prior = (1.0 - 2.0 * PRIOR_NO_CAUSE) / Candidate::EXTENSIONS.len() as f64;
     for t in &terms[1..] {
-        let touched: Vec<&str> = Candidate::from_name(&t.cause).map_or(vec![], |c| touched_channels(c).iter().map(|c| c.name()).collect());
+        let touched = touched_names(&t.cause);
         let l: f64 = t
             .channels
             .iter()

@@ -319,7 +319,7 @@ fn specs_of(sim: &dyn Simulator, cand: Candidate) -> Vec<ParamSpec> {
 pub fn settle_jacobian(sim: &dyn Simulator, run: &MeasuredRun, points: &[Point], f: &mut FitResult) {
     let Some((x, fd_step)) = f.jac_owed.take() else { return };
     let specs = specs_of(sim, f.candidate);
-    let p = Problem {
+    let mut p = Problem {
         sim,
         run,
         points,
@@ -333,7 +333,7 @@ pub fn settle_jacobian(sim: &dyn Simulator, run: &MeasuredRun, points: &[Point],
         best: None,
         last_jac_ln: std::sync::Mutex::new(None),
     };
-    let p = Problem { r: p.residual_vector(&p.x, &f.series), ..p };
+    p.r = p.residual_vector(&p.x, &f.series);
     f.jac_ln = p.jacobians().map(|(_, j)| j);
     f.sims += p.sims.load(std::sync::atomic::Ordering::Relaxed);
 }

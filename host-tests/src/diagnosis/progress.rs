@@ -248,7 +248,7 @@ impl<'a> Progress<'a> {
     /// Announces `runs` more model runs of a pass after the diagnosis (the
     /// detectability), under `msg`.
     pub fn extend(&self, runs: u64, msg: &str) {
-        self.start_phase(Kind::Detectability, vec![(Kind::Detectability, runs as f64)], None, msg.to_string());
+        self.start_phase(Kind::Detectability, &|_, _| vec![(Kind::Detectability, runs as f64)], msg.to_string());
     }
 
     /// Clears the bar; returns the time left it showed at 25, 50 and 75 %.
@@ -257,20 +257,17 @@ impl<'a> Progress<'a> {
         self.shared.est.lock().map(|e| e.crossings.clone()).unwrap_or_default()
     }
 
-    /// Closes the current phase and starts one of `kind` with `plan` ahead
-    /// (`plan` computed from the estimate by `make` when given, after the
-    /// close), the bar's length following.
-    fn start_phase(&self, kind: Kind, plan: Vec<(Kind, f64)>, make: Option<&dyn Fn(&mut Est, f64) -> Vec<(Kind, f64)>>, msg: String) {
+    /// Closes the current phase and starts one of `kind` with the plan
+    /// `make` computes from the estimate (after the close; given the runs
+    /// the closed phase took) ahead, the bar's length following.
+    fn start_phase(&self, kind: Kind, make: &dyn Fn(&mut Est, f64) -> Vec<(Kind, f64)>, msg: String) {
         let b = &self.shared.bar;
         let pos = b.position();
         let ahead = {
             let Ok(mut e) = self.shared.est.lock() else { return };
             let done = (pos - e.phase_start) as f64;
             e.close_phase(done, Instant::now());
-            let plan = match make {
-                Some(f) => f(&mut e, done),
-                None => plan,
-            };
+            let plan = make(&mut e, done);
             e.kind = kind;
             e.phase_start = pos;
             let ahead: f64 = plan.iter().map(|x| x.1).sum();
@@ -368,6 +365,6 @@ impl Simulator for Progress<'_> {
                 Phase::Done => Vec::new(),
             }
         };
-        self.start_phase(kind, Vec::new(), Some(&make), msg);
+        self.start_phase(kind, &make, msg);
     }
 }

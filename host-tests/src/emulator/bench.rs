@@ -132,8 +132,13 @@ impl EmuMachine {
 /// The emulator's own trace behind [`bench_log`] (same mission draw for
 /// the same seed), with the mission: for audits of its internal heat flows.
 pub fn bench_trace(machine: &EmuMachine, scenario: EmuScenario, duration_s: f64, seed: u64) -> (super::missions::EmuMission, Vec<super::logger::Row>) {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let m = draw(scenario, duration_s, &mut rng);
+    trace_with(machine, scenario, duration_s, &mut ChaCha8Rng::seed_from_u64(seed))
+}
+
+/// The mission drawn from `rng` and the machine's trace of it at the
+/// scenario's log interval (the rng goes on to the logger's noise).
+fn trace_with(machine: &EmuMachine, scenario: EmuScenario, duration_s: f64, rng: &mut ChaCha8Rng) -> (super::missions::EmuMission, Vec<super::logger::Row>) {
+    let m = draw(scenario, duration_s, rng);
     let trace = Plant { p: &machine.params, m: &m, h: Hidden { effect: Candidate::None, magnitude: 0.0 } }.run(scenario.log_interval_s());
     (m, trace)
 }
@@ -154,9 +159,8 @@ pub struct BenchLog {
 /// noise from `seed`), with the drain thermocouple.
 pub fn bench_log(machine: &EmuMachine, scenario: EmuScenario, duration_s: f64, seed: u64) -> Result<BenchLog, String> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let m = draw(scenario, duration_s, &mut rng);
+    let (m, trace) = trace_with(machine, scenario, duration_s, &mut rng);
     let dt = scenario.log_interval_s();
-    let trace = Plant { p: &machine.params, m: &m, h: Hidden { effect: Candidate::None, magnitude: 0.0 } }.run(dt);
     if trace.iter().any(|r| r.1.iter().any(|v| !v.is_finite())) {
         return Err(format!("emulator diverged on {} {scenario:?}", machine.name));
     }

@@ -149,13 +149,10 @@ impl OuterGrid {
                         exact(kj * step_c)
                     }
                 });
-                let [qm, q0, q1, q2] = q;
-                let c = [q0, -qm / 3.0 - q0 / 2.0 + q1 - q2 / 6.0, (qm + q1) / 2.0 - q0, (q2 - qm) / 6.0 + (q0 - q1) / 2.0];
-                cc = CoarseCell { key, built: true, k: kc, q, c };
+                cc = CoarseCell { key, built: true, k: kc, q, c: cubic_through(q) };
                 slot.set(cc);
             }
-            let u = t_wall / step_c - kc;
-            return cc.c[0] + u * (cc.c[1] + u * (cc.c[2] + u * cc.c[3]));
+            return horner(&cc.c, t_wall / step_c - kc);
         }
         let k = floor_i64(x) as f64;
         if !c.built || k != c.k {
@@ -229,12 +226,10 @@ impl NuGrid {
         let slot = &self.cells[(k as usize) & (NU_SLOTS - 1)];
         let (kk, mut c) = slot.get();
         if kk != k {
-            let (vm, v0, v1, v2) = (self.point(oil, k - 1), self.point(oil, k), self.point(oil, k + 1), self.point(oil, k + 2));
-            // The cubic through (−1, vm), (0, v0), (1, v1), (2, v2) in powers of u.
-            c = [v0, -vm / 3.0 - v0 / 2.0 + v1 - v2 / 6.0, (vm + v1) / 2.0 - v0, (v2 - vm) / 6.0 + (v0 - v1) / 2.0];
+            c = cubic_through([self.point(oil, k - 1), self.point(oil, k), self.point(oil, k + 1), self.point(oil, k + 2)]);
             slot.set((k, c));
         }
-        c[0] + u * (c[1] + u * (c[2] + u * c[3]))
+        horner(&c, u)
     }
 
     fn point(&self, oil: &Oil, k: i64) -> f64 {
@@ -338,6 +333,18 @@ impl LaminarGrid {
 }
 
 const _: () = assert!(LAM_SLOTS.is_power_of_two(), "slots are indexed by a mask");
+
+/// The cubic through (−1, v[0]), (0, v[1]), (1, v[2]), (2, v[3]) in powers
+/// of u (Lagrange on four uniform points).
+fn cubic_through(v: [f64; 4]) -> [f64; 4] {
+    let [vm, v0, v1, v2] = v;
+    [v0, -vm / 3.0 - v0 / 2.0 + v1 - v2 / 6.0, (vm + v1) / 2.0 - v0, (v2 - vm) / 6.0 + (v0 - v1) / 2.0]
+}
+
+/// The cubic with coefficients `c` (powers of u) at `u`.
+fn horner(c: &[f64; 4], u: f64) -> f64 {
+    c[0] + u * (c[1] + u * (c[2] + u * c[3]))
+}
 
 /// ⌊x⌋ for |x| < 2⁶³ (a truncation and a correction: `f64::floor` is a
 /// library call on the baseline x86-64 target).

@@ -181,6 +181,10 @@ impl HydTrack {
         // bits as `rhs`, which computes them from z).
         let oil = model.hydraulic_oil(z);
         let t_f = t.min(left_of(t_max));
+        // f at the track's point at t with the step's end temperatures:
+        // for the coupling check and, once coupled, the track's new end
+        // (taken once when the check sees the coupling at this step).
+        let mut at_t: Option<([f64; NH], [f64; NH])> = None;
         if !self.coupled {
             // Whether the temperatures matter now, at every thermal step:
             // while they do not, the track runs ahead of the thermal steps
@@ -193,16 +197,19 @@ impl HydTrack {
             model.hydraulic_rhs_oil(t_f, &y, &oil, &mut f);
             self.ros.stats.evals += 1;
             self.check_coupling(model, z, t_f, &y, &f);
+            at_t = Some((y, f));
         }
         if self.coupled {
             // The track ends at t (or past it before a callback's rewind):
             // f there anew with the step's end temperatures.
-            let y = self.at(t);
+            let (y, f) = at_t.unwrap_or_else(|| {
+                let (y, mut f) = (self.at(t), [0.0; NH]);
+                model.hydraulic_rhs_oil(t_f, &y, &oil, &mut f);
+                self.ros.stats.evals += 1;
+                (y, f)
+            });
             let i = self.pts.partition_point(|p| p.0 < t);
             self.pts.truncate(i);
-            let mut f = [0.0; NH];
-            model.hydraulic_rhs_oil(t_f, &y, &oil, &mut f);
-            self.ros.stats.evals += 1;
             self.pts.push((t, y, f));
             self.last_branch = None;
         }
