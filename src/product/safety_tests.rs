@@ -7,6 +7,9 @@ extern crate std;
 use super::tests::{board, replies, sample, ticks};
 use super::*;
 use crate::faults;
+use crate::memory::nv::NvPolicy;
+use crate::memory::Restore;
+use crate::params_block;
 use mem_board::MemBoard;
 use std::boxed::Box;
 
