@@ -24,8 +24,11 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use std::time::Instant;
 
+/// A variant: name, what it changes, the change.
+type Variant<T> = (&'static str, &'static str, fn(&mut T));
+
 /// Emulator variants: name, what is switched off, the change.
-const VARIANTS: [(&str, &str, fn(&mut EmuParams)); 8] = [
+const VARIANTS: [Variant<EmuParams>; 8] = [
     ("nominal", "nothing", |_| {}),
     ("no-pump-manifold", "pump end cap → manifold plate joint (g_end_manifold 10 → 0 W/K)", |p| p.g_end_manifold = 0.0),
     ("no-plate-film", "loop oil ↔ manifold plate film (plate wetted area → 0, block film area +0.03 m²)", |p| {
@@ -44,7 +47,7 @@ const VARIANTS: [(&str, &str, fn(&mut EmuParams)); 8] = [
 
 /// Reference-side variants (the base rig before the calibration): name,
 /// what changes, the change.
-const REF_VARIANTS: [(&str, &str, fn(&mut Rig)); 9] = [
+const REF_VARIANTS: [Variant<Rig>; 9] = [
     ("rig", "the rig file", |_| {}),
     ("no-speed-friction", "pump no-load and viscous friction (T0, C_v) off: η_m·D·Δp only, as the emulator", |r| {
         r.pump.no_load_torque_nm = 0.0;

@@ -187,10 +187,15 @@ fn cycles_valve(log: &CalLog) -> bool {
     open && closed
 }
 
+/// What [`fit`] gives: the rig it started from, the calibration, and η_m
+/// identified from the current with the number of samples it rests on
+/// (`None`: from the temperatures).
+type Fitted = (Rig, Calibration, Option<(f64, usize)>);
+
 /// The calibration of `base` on `train` with `eta_m` from the current when
 /// the logs carry it: the rig it started from, the calibration and that
 /// `eta_m`.
-fn fit(base: &Rig, train: &[CalLog], o: &CalOptions) -> Result<(Rig, Calibration, Option<(f64, usize)>), CommissionError> {
+fn fit(base: &Rig, train: &[CalLog], o: &CalOptions) -> Result<Fitted, CommissionError> {
     // The pump's friction coefficient from the electrical balance when the
     // logs carry current under load (identified directly, and the firmware's
     // sensor cross-check then agrees with this machine); else from the

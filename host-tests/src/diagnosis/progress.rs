@@ -34,6 +34,10 @@ use super::model::{Candidate, ParamSpec, Phase, SimSeries, Simulator};
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
+/// Makes the runs ahead by phase from the estimate, given the runs the
+/// closed phase took ([`Progress`]'s phases).
+type PlanMaker<'a> = dyn Fn(&mut Est, f64) -> Vec<(Kind, f64)> + 'a;
+
 /// The time left shown when the bar first reached a fraction of its length.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Crossing {
@@ -260,7 +264,7 @@ impl<'a> Progress<'a> {
     /// Closes the current phase and starts one of `kind` with the plan
     /// `make` computes from the estimate (after the close; given the runs
     /// the closed phase took) ahead, the bar's length following.
-    fn start_phase(&self, kind: Kind, make: &dyn Fn(&mut Est, f64) -> Vec<(Kind, f64)>, msg: String) {
+    fn start_phase(&self, kind: Kind, make: &PlanMaker<'_>, msg: String) {
         let b = &self.shared.bar;
         let pos = b.position();
         let ahead = {

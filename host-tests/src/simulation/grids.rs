@@ -177,6 +177,9 @@ pub const NU_GRID_FACTOR: f64 = 10.0;
 /// turns at one slot.
 const NU_SLOTS: usize = 1024;
 
+/// A memo slot of [`NuGrid`]: (cell index k, cubic coefficients in u = x − k).
+type NuCell = Cell<(i64, [f64; 4])>;
+
 /// The oil's kinematic viscosity on a temperature grid: in the cell
 /// [k, k+1]·step_k, the cubic through the exact values at the four grid
 /// points k−1 … k+2 (Lagrange; continuous, exact at the points), its
@@ -192,7 +195,7 @@ pub struct NuGrid {
     per_step: f64,
     grade: Cell<(u64, u64)>,
     /// (k, cubic coefficients in u = x − k) at slot k mod NU_SLOTS; k = i64::MIN: empty.
-    cells: Box<[Cell<(i64, [f64; 4])>]>,
+    cells: Box<[NuCell]>,
     /// (k, ν(k·step_k)) at slot k mod NU_SLOTS; k = i64::MIN: empty.
     points: Box<[Cell<(i64, f64)>]>,
     /// Exact evaluations so far.
@@ -256,6 +259,10 @@ const LAM_SLOTS: usize = 1024;
 /// its constant, the developing-flow term gone).
 const LAM_EXACT_BELOW: f64 = 0.1;
 
+/// A memo slot of [`LaminarGrid`]: (k, Newton coefficients, the node t of
+/// X_k−1, X_k, 1/(X_k+1 − X_k)).
+type LamCell = Cell<(u64, [f64; 4], f64, f64, f64)>;
+
 /// The laminar duct Nusselt number (eq. 13) as a function of its one
 /// argument X = Re·Pr·d/L ([`nu_laminar_x`]: two `cbrt`, ~340 instructions,
 /// eight times in a heat balance) on a grid of X: the grid points are the
@@ -267,7 +274,7 @@ const LAM_EXACT_BELOW: f64 = 0.1;
 #[derive(Debug)]
 pub struct LaminarGrid {
     /// (k, Newton coefficients, the node t of X_k−1, X_k, 1/(X_k+1 − X_k)) at slot k mod LAM_SLOTS; k = u64::MAX: empty.
-    cells: Box<[Cell<(u64, [f64; 4], f64, f64, f64)>]>,
+    cells: Box<[LamCell]>,
     /// (k, the law at X_k) at slot k mod LAM_SLOTS; k = u64::MAX: empty.
     points: Box<[Cell<(u64, f64)>]>,
     /// Exact evaluations so far.
@@ -290,7 +297,7 @@ impl LaminarGrid {
 
     /// The laminar Nusselt number at X = Re·Pr·d/L, interpolated.
     pub fn nu(&self, x: f64) -> f64 {
-        if !(x >= LAM_EXACT_BELOW && x < 1e300) {
+        if !(LAM_EXACT_BELOW..1e300).contains(&x) {
             return nu_laminar_x(x);
         }
         let k = x.to_bits() >> LAM_SHIFT;

@@ -53,6 +53,7 @@ fn pooled(e: &[eha_sim::calibration::ChannelError]) -> f64 {
 ///   misses by 0.65 K (the slow test below asserts that case; with the
 ///   `block_wall` parameter those logs free, held here: no training log
 ///   moves speed and load independently).
+///
 /// `film_case` 8.7 where the emulator's case-oil wetted area is ×5.3
 /// (another film correlation); `cap_case_oil` held (no drain sensor).
 #[test]

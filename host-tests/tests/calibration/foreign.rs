@@ -175,6 +175,7 @@ fn slow_commissioning_without_margin_on_foreign_machines() {
 ///   mix held out; both paths, the split's margins) with nothing else
 ///   running on the 2 cores: big-pump 36.3 and 37.4 s (1 696 reference
 ///   runs), leaky-heavy 41.2 s (1 898). Not a timing test.
+///
 /// The values asserted before (big-pump margin 2.115 K, 2.31 / 0.13 and
 /// 5.98 / 0.18 K) were one build's of an earlier commit; a 1e-9 K nudge of
 /// the logs moves big-pump by 0.17 K on this build

@@ -36,8 +36,12 @@ fn closed_loop(open_c: Option<f32>) -> (Vec<TickRecord>, Plant) {
     (records, plant)
 }
 
+/// One tick of a target: the received bytes and the tick number in, the
+/// tick's outputs out.
+type TickFn = dyn FnMut(&[u8], u64) -> Result<TickOut, PilError>;
+
 /// A target made of a closure.
-struct FnTarget<'a>(&'a mut dyn FnMut(&[u8], u64) -> Result<TickOut, PilError>);
+struct FnTarget<'a>(&'a mut TickFn);
 
 impl Target for FnTarget<'_> {
     fn tick(&mut self, rx: &[u8], tick: u64) -> Result<TickOut, PilError> {

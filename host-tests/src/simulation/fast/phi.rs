@@ -212,8 +212,8 @@ mod tests {
         let p = Phi::new(&a, h);
         let z0 = [20.0, 25.0];
         let mut exact = [0.0; 2];
-        for i in 0..2 {
-            exact[i] = (0..2)
+        for (i, x) in exact.iter_mut().enumerate() {
+            *x = (0..2)
                 .map(|j| p.e[i][j] * z0[j] + p.p1[i][j] * g0[j] + h * p.p2[i][j] * g1[j] + h * h * p.p3[i][j] * g2[j])
                 .sum();
         }

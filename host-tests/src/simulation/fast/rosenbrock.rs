@@ -332,9 +332,9 @@ impl<const N: usize> Rosenbrock<N> {
             let mut err = 0.0;
             for i in 0..N {
                 let mut e = 0.0;
-                for s in 0..tab.s {
-                    y1[i] += tab.m[s] * k[s][i];
-                    e += tab.e[s] * k[s][i];
+                for ((m, es), ks) in tab.m.iter().zip(&tab.e).zip(&k).take(tab.s) {
+                    y1[i] += m * ks[i];
+                    e += es * ks[i];
                 }
                 let sc = self.atol[i] + self.rtol * y[i].abs().max(y1[i].abs());
                 err += (e / sc).powi(2);
