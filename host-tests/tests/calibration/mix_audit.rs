@@ -169,7 +169,9 @@ fn slow_mix_heat_audit() {
 /// set those fields; `EXP_A_CASE=k`, `EXP_GAP=k` scale the case wetted area
 /// and the leakage gap; on the user's rig file `EXP_RIG_CV=k`,
 /// `EXP_RIG_T0=k` scale the viscous and no-load friction torques,
-/// `EXP_RIG_CASE_OIL=k` the case-oil volume (a volume the user measured);
+/// `EXP_RIG_CASE_OIL=k` the case-oil volume (a volume the user measured),
+/// `EXP_RIG_GAP=k` the three pump gaps (with `EXP_HOLD=leak_gap`: the
+/// machine's leakage conductance, ×1.414 big-pump, ×1.658 leaky-heavy);
 /// `EXP_HOLD=a,b` holds calibration parameters at the rig file;
 /// `EXP_DRAIN_WEIGHT=w` weights the drain residuals; `EXP_LIKE_REF=a,b`
 /// (or `all`) the structural switches of [`like_reference`];
@@ -206,6 +208,12 @@ fn slow_mix_experiment() {
         }
         if let Some(k) = env("EXP_RIG_CASE_OIL") {
             base.pump.case_oil_m3 *= k;
+        }
+        if let Some(k) = env("EXP_RIG_GAP") {
+            let g = &mut base.pump.gaps;
+            g.piston_gap_m *= k;
+            g.slipper_gap_m *= k;
+            g.port_gap_m *= k;
         }
         rig_like_reference(&mut base, &like_ref());
         let mut train = train;
