@@ -39,6 +39,10 @@
 //!   plus noise, 12-bit quantisation and dropouts ([`logger`]); the
 //!   ambient drifts slowly (±0.2–0.8 K, 40 min period).
 //!
+//! Experiment switches ([`params::EmuParams::like_reference`], 0 in every
+//! machine) replace one law at a time by the reference's, for the
+//! structural bisection of a commissioning miss (docs/commissioning.md).
+//!
 //! The hidden effects are the diagnosis candidates, implemented here from
 //! the paper: R(T) = R25(1 + α(T − 25 °C)) (eq. 1); the manifold oil sensor in a dead-end pocket
 //! (Figs. 9–10, τ to the loop plus 0.03 W/K to the manifold plate); seal

@@ -5,7 +5,7 @@
 //! step bounded by the network's fastest time constant.
 
 use super::missions::{linear_at, step_at, EmuMission};
-use super::params::EmuParams;
+use super::params::{like_reference, EmuParams};
 use super::props::{self, oil_cp, oil_nu, oil_rho};
 use crate::physics::candidates::Candidate;
 use std::f64::consts::PI;
@@ -170,6 +170,15 @@ impl Plant<'_> {
         kh * f * b * b + kc * f * f * b * b + ke * f.powf(1.5) * b.powf(1.5)
     }
 
+    /// Iron-loss drag on the shaft, N·m: eq. (2)'s loss over the speed (at
+    /// least 1 rad/s); none with [`like_reference::NO_IRON_DRAG`].
+    fn iron_drag_nm(&self, omega: f64) -> f64 {
+        if self.p.like_reference & like_reference::NO_IRON_DRAG != 0 {
+            return 0.0;
+        }
+        self.iron_w(omega) / omega.abs().max(1.0)
+    }
+
     /// Operating point at `t` with temperatures `y` and piston position `x`.
     pub fn op(&self, t: f64, y: &[f64], x: f64) -> Op {
         let p = self.p;
@@ -189,7 +198,7 @@ impl Plant<'_> {
             let q = 1526.81e-6 * v + p.act_leak * dp + q_leak * dp.signum();
             let omega = q / d_rad;
             let torque = d_rad * dp + p.eta_m * d_rad * dp.abs() * omega.signum() + churn(omega);
-            let drag = self.iron_w(omega) / omega.abs().max(1.0);
+            let drag = self.iron_drag_nm(omega);
             let (pa, pb) = (p.boost_pa + dp.max(0.0), p.boost_pa + (-dp).max(0.0));
             Op { omega, current_a: (torque.abs() + drag) / p.kt_nm_per_a, p_a: pa, p_b: pb, v, q_leak, q_path: 0.0, air }
         } else {
@@ -207,7 +216,7 @@ impl Plant<'_> {
                 dp = 0.5 * rho * (q_path / (p.needle_cd * area)).powi(2) + self.hose_dp(q_path, y[N::LoopOil as usize]);
             }
             let torque = d_rad * dp * (1.0 + p.eta_m) + churn(omega);
-            let drag = self.iron_w(omega) / omega.abs().max(1.0);
+            let drag = self.iron_drag_nm(omega);
             Op {
                 omega,
                 current_a: (torque + drag) / p.kt_nm_per_a,
@@ -219,6 +228,29 @@ impl Plant<'_> {
                 air,
             }
         }
+    }
+
+    /// Case-oil film on a wetted area `a` (m²) at shaft speed `omega`
+    /// (rad/s), oil at `t_c` °C with kinematic viscosity `nu`, W/K: the
+    /// rotating cylinder ([`props::case_film`]); with the experiment switch
+    /// [`like_reference::CASE_GAP_FILM`] the reference's law instead,
+    /// conduction across a 3 mm gap (Nu = 2 on the gap's hydraulic
+    /// diameter 2e) rising with the Taylor number ω²·r·e³/ν² above 1700
+    /// (0.128·Ta^0.367 to 1e4, then 0.409·Ta^0.241).
+    fn case_film(&self, omega: f64, a: f64, nu: f64, t_c: f64) -> f64 {
+        if self.p.like_reference & like_reference::CASE_FILM_OMEGA_NU != 0 {
+            let d = 2.0 * self.p.r_rotor;
+            let re = omega.abs() * d * d / nu;
+            let pr40 = oil_nu(40.0) * oil_rho(40.0) * oil_cp(40.0) / props::oil_k(40.0);
+            return (2.0 + 0.133 * re.powf(2.0 / 3.0) * pr40.powf(1.0 / 3.0)) * props::oil_k(t_c) / d * a;
+        }
+        if self.p.like_reference & like_reference::CASE_GAP_FILM == 0 {
+            return props::case_film(omega, self.p.r_rotor, a, nu, t_c);
+        }
+        let e = 0.003;
+        let ta = omega * omega * (self.p.r_rotor + 0.5 * e) * e.powi(3) / (nu * nu);
+        let nuss = if ta < 1700.0 { 2.0 } else if ta < 1e4 { (0.128 * ta.powf(0.367)).max(2.0) } else { 0.409 * ta.powf(0.241) };
+        nuss * props::oil_k(t_c) / (2.0 * e) * a
     }
 
     /// Pressure drop of the throttle hoses, eq. (10): Darcy friction
@@ -314,7 +346,7 @@ impl Plant<'_> {
         acc.link(y, N::Ball, N::Block, p.g_ball_block);
         let nu_case = self.nu(tn(N::CaseOil));
         for (wall, a) in [(N::Barrel, p.a_case[0]), (N::EndCap, p.a_case[1])] {
-            acc.link(y, N::CaseOil, wall, props::case_film(o.omega, p.r_rotor, a, nu_case, tn(N::CaseOil)));
+            acc.link(y, N::CaseOil, wall, self.case_film(o.omega, a, nu_case, tn(N::CaseOil)));
         }
         let q_geo = d_rad * o.omega.abs();
         let duct = |dct: [f64; 3], flow: f64, n: N| props::duct_film(flow.max(1e-7), dct[0], dct[1], dct[2], self.nu(tn(n)), tn(n));
@@ -398,7 +430,7 @@ impl Plant<'_> {
         let mech = p.eta_m * d_rad * dp.abs() * o.omega.abs();
         let at = if self.m.scenario.is_servo() { 0.0 } else { props::oil_alpha(tn(N::PortOil)) * (tn(N::PortOil) + 273.15) };
         let nu_case = self.nu(tn(N::CaseOil));
-        let film: f64 = p.a_case.iter().map(|&a| props::case_film(o.omega, p.r_rotor, a, nu_case, tn(N::CaseOil))).sum();
+        let film: f64 = p.a_case.iter().map(|&a| self.case_film(o.omega, a, nu_case, tn(N::CaseOil))).sum();
         let wall = p.a_case[0] * tn(N::Barrel) + p.a_case[1] * tn(N::EndCap);
         let wall = wall / (p.a_case[0] + p.a_case[1]);
         let rho_cp = oil_rho(tn(N::PortOil)) * oil_cp(tn(N::PortOil));

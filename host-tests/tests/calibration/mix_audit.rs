@@ -36,7 +36,9 @@ fn commissioned(m: &EmuMachine) -> Rig {
         let k = eha_sim::calibration::set::index(name).expect("parameter");
         o.hold.push((eha_sim::calibration::set::PARAMS[k].name, "experiment".into()));
     }
-    let c = commission_with(&m.rig_file(), &train, &[], &o, false).expect("commission");
+    let mut base = m.rig_file();
+    rig_like_reference(&mut base, &like_ref());
+    let c = commission_with(&base, &train, &[], &o, false).expect("commission");
     std::fs::write(&path, c.cal.rig.to_toml()).expect("write rig");
     c.cal.rig
 }
@@ -159,16 +161,22 @@ fn slow_mix_heat_audit() {
 }
 
 /// Emulator-side and calibration-side experiments on the mix's miss, by
-/// environment (docs/commissioning.md, "Where the throttle mix's
-/// under-prediction comes from"): on the emulator machines
+/// environment (docs/commissioning.md, "The held-out drain misses:
+/// structural bisection"): on the emulator machines
 /// `EXP_MECH_RULE=1` places the mechanical loss by the reference's
 /// sliding-pair rule (delivered 0.6, case 0.15, metal 0.25);
 /// `EXP_G_BARREL_END=W/K`, `EXP_PROBE_AMBIENT=frac`, `EXP_PROBE_BARREL=w`
 /// set those fields; `EXP_A_CASE=k`, `EXP_GAP=k` scale the case wetted area
 /// and the leakage gap; on the user's rig file `EXP_RIG_CV=k`,
 /// `EXP_RIG_T0=k` scale the viscous and no-load friction torques,
-/// `EXP_RIG_CASE_OIL=k` the case-oil volume (a volume the user measured);
+/// `EXP_RIG_CASE_OIL=k` the case-oil volume (a volume the user measured),
+/// `EXP_RIG_GAP=k` the three pump gaps (with `EXP_HOLD=leak_gap`: the
+/// machine's leakage conductance, ×1.414 big-pump, ×1.658 leaky-heavy);
 /// `EXP_HOLD=a,b` holds calibration parameters at the rig file;
+/// `EXP_DRAIN_WEIGHT=w` weights the drain residuals; `EXP_LIKE_REF=a,b`
+/// (or `all`) the structural switches of [`like_reference`];
+/// `EXP_TRAIN_MIX=1` / `EXP_TRAIN_SERVO=1` add the held-out mix / servo log
+/// to the training set (still scored: can the reference follow it at all?);
 /// `EXP_MACHINE` picks one machine. Prints the held-out numbers without the
 /// margin (firmware drain vs thermocouple).
 #[test]
@@ -188,6 +196,9 @@ fn slow_mix_experiment() {
             o.hold.push((eha_sim::calibration::set::PARAMS[k].name, "experiment".into()));
         }
         let env = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<f64>().ok());
+        if let Some(w) = env("EXP_DRAIN_WEIGHT") {
+            o.drain_weight = w;
+        }
         let mut base = m.rig_file();
         if let Some(k) = env("EXP_RIG_CV") {
             base.pump.viscous_torque_coeff *= k;
@@ -197,6 +208,22 @@ fn slow_mix_experiment() {
         }
         if let Some(k) = env("EXP_RIG_CASE_OIL") {
             base.pump.case_oil_m3 *= k;
+        }
+        if let Some(k) = env("EXP_RIG_GAP") {
+            let g = &mut base.pump.gaps;
+            g.piston_gap_m *= k;
+            g.slipper_gap_m *= k;
+            g.port_gap_m *= k;
+        }
+        rig_like_reference(&mut base, &like_ref());
+        let mut train = train;
+        if std::env::var("EXP_TRAIN_MIX").is_ok() {
+            // the held-out mix in the training set too: can the reference follow it at all?
+            train.push(hold[1].clone());
+        }
+        if std::env::var("EXP_TRAIN_SERVO").is_ok() {
+            // the held-out servo log in the training set too (frees the churned case film)
+            train.push(hold[0].clone());
         }
         let t0 = std::time::Instant::now();
         let c = commission_with(&base, &train, &hold, &o, false).expect("commission");
@@ -232,4 +259,130 @@ fn variant(m: &mut EmuMachine) {
     if let Some(k) = env("EXP_GAP") {
         m.params.gap_m *= k;
     }
+    like_reference(&mut m.params, &like_ref());
+}
+
+/// Every structural switch of the bisection (`EXP_LIKE_REF=all`).
+const ALL_SWITCHES: [&str; 10] = ["split", "onepump", "surface", "oilprobe", "drain", "flange", "blocks", "emiss", "gapfilm", "nofric"];
+
+/// The structural switches of `EXP_LIKE_REF` (comma-separated; `all`: every one).
+fn like_ref() -> Vec<String> {
+    parse_switches(&std::env::var("EXP_LIKE_REF").unwrap_or_default())
+}
+
+/// A comma-separated switch list (`all`: [`ALL_SWITCHES`]).
+fn parse_switches(v: &str) -> Vec<String> {
+    if v == "all" {
+        return ALL_SWITCHES.map(String::from).to_vec();
+    }
+    v.split(',').filter(|s| !s.is_empty()).map(String::from).collect()
+}
+
+/// Structural bisection: each named switch makes the emulator machine like
+/// the reference in one respect (docs/commissioning.md, "The held-out drain
+/// misses: structural bisection"): `split` the mechanical loss placed by the
+/// reference's sliding-pair rule (delivered oil 0.6, case 0.15, metal 0.25);
+/// `onepump` barrel and end cap one node (9 → 2000 W/K); `surface` the
+/// surface probes read their metal (4 % towards ambient → 0) within 0.5 s
+/// (8–14 s); `oilprobe` the oil probe's 2 s of the rig file; `drain` the
+/// drain thermocouple within 0.5 s (3–5 s); `flange` no end cap → manifold
+/// joint (the reference's pump housing has no metal path); `blocks` the
+/// manifold plate part of the main block (500 W/K) and no ball → main block
+/// joint; `emiss` the rig file's emissivity 0.85; `gapfilm` the case film
+/// by the reference's gap law (`like_reference::CASE_GAP_FILM`);
+/// `filmomeganu` the rotating cylinder's film as a function of ω/ν
+/// (`like_reference::CASE_FILM_OMEGA_NU`); `nodrag` no iron-loss drag in
+/// the motor current (`like_reference::NO_IRON_DRAG`); `nofric` and
+/// `nowall` act on the
+/// rig file ([`rig_like_reference`]).
+fn like_reference(p: &mut eha_sim::emulator::params::EmuParams, switches: &[String]) {
+    use eha_sim::emulator::params::like_reference as bits;
+    for s in switches {
+        match s.as_str() {
+            "split" => p.mech_split = [0.6, 0.15, 0.25],
+            "onepump" => p.g_barrel_end = 2000.0,
+            "surface" => {
+                p.probe_ambient_frac = 0.0;
+                p.sensor_tau[..4].iter_mut().for_each(|t| *t = 0.5);
+            }
+            "oilprobe" => p.sensor_tau[4] = 2.0,
+            "drain" => p.drain_tau_s = 0.5,
+            "flange" => p.g_end_manifold = 0.0,
+            "blocks" => {
+                p.g_manifold_block = 500.0;
+                p.g_ball_block = 0.0;
+            }
+            "emiss" => p.emissivity = 0.85,
+            "gapfilm" => p.like_reference |= bits::CASE_GAP_FILM,
+            "filmomeganu" => p.like_reference |= bits::CASE_FILM_OMEGA_NU,
+            "nodrag" => p.like_reference |= bits::NO_IRON_DRAG,
+            "nofric" | "nowall" => {}
+            other => panic!("unknown structural switch `{other}`"),
+        }
+    }
+}
+
+/// The user's rig file with the experiment's changes: `nofric` takes the
+/// no-load and viscous friction torques out (×1e-3; the emulator's
+/// mechanical loss is the η_m term alone); `nowall` the blocks' wall behind
+/// the loop and ball-valve films (`blocks.wall_m` ×0.1, `block_wall` then reaches ×1000; the emulator's
+/// films have none in series).
+fn rig_like_reference(r: &mut Rig, switches: &[String]) {
+    if switches.iter().any(|s| s == "nofric") {
+        r.pump.no_load_torque_nm *= 1e-3;
+        r.pump.viscous_torque_coeff *= 1e-3;
+    }
+    if switches.iter().any(|s| s == "nowall") {
+        r.blocks.wall_m *= 0.1;
+    }
+}
+
+/// Held-out numbers of one bisection step: the machine with `switches`,
+/// commissioned on its two training logs without the margin: (servo
+/// under-prediction, mix max |e|, mix under-prediction), K, firmware drain
+/// against the thermocouple.
+fn bisection_step(machine: &EmuMachine, switches: &[String]) -> (f64, f64, f64) {
+    let mut m = machine.clone();
+    like_reference(&mut m.params, switches);
+    let s = eha_sim::emulator::bench::bench_set(&m, 3600).expect("bench");
+    let train: Vec<CalLog> = s.train.iter().map(|l| CalLog::new(&l.name, l.run.clone(), 120).expect("log")).collect();
+    let hold: Vec<CalLog> = s.holdout.iter().map(|l| CalLog::new(&l.name, l.run.clone(), 120).expect("log")).collect();
+    let mut base = m.rig_file();
+    rig_like_reference(&mut base, switches);
+    let c = commission_with(&base, &train, &hold, &CalOptions::default(), false).expect("commission");
+    let h = &c.holdout_with_margin;
+    let v = |x: Option<f64>| x.expect("drain logged");
+    (v(h[0].vs_measured_under_k), v(h[1].vs_measured_max_k), v(h[1].vs_measured_under_k))
+}
+
+/// The structural bisection's headline steps (docs/commissioning.md, "The
+/// held-out drain misses: structural bisection"), measured at this commit
+/// on this build: servo under-prediction, mix max |e| and under-prediction
+/// per machine, K, without the margin. Asserted within 0.25 K of the
+/// measured: the fit's basin moves with last-digit differences between
+/// builds (0.17 K measured on big-pump's nudge test); the conclusions drawn
+/// rest on differences of ≥ 0.6 K between rows.
+#[test]
+#[ignore = "slow: ten commissionings, 277 s on 2 shared cores"]
+fn slow_structural_bisection_of_the_drain_misses() {
+    // switches, big-pump (servo under, mix max, mix under), leaky-heavy (same)
+    let rows: [(&str, [f64; 3], [f64; 3]); 5] = [
+        ("", [2.287, 3.754, 2.306], [3.063, 2.443, 2.443]),
+        ("gapfilm", [0.632, 1.488, 1.488], [1.762, 1.751, 1.751]),
+        ("split,nofric", [2.339, 4.034, 1.722], [3.151, 1.840, 1.840]),
+        ("split,nofric,onepump,surface,oilprobe,drain,flange,blocks,emiss", [2.291, 3.969, 0.469], [3.055, 1.700, 1.516]),
+        ("all", [0.614, 1.638, 1.345], [0.778, 0.793, 0.793]),
+    ];
+    let mut bad = Vec::new();
+    for (switches, bp, lh) in rows {
+        for (m, want) in machines().iter().zip([bp, lh]) {
+            let got = bisection_step(m, &parse_switches(switches));
+            let got = [got.0, got.1, got.2];
+            eprintln!("{} [{switches}]: servo under {:.3}, mix max {:.3} under {:.3} K (measured {want:?})", m.name, got[0], got[1], got[2]);
+            if got.iter().zip(want).any(|(g, w)| (g - w).abs() > 0.25) {
+                bad.push(format!("{} [{switches}]: {got:.3?} against {want:?}", m.name));
+            }
+        }
+    }
+    assert!(bad.is_empty(), "bisection steps off their measured numbers: {bad:#?}");
 }
