@@ -1,0 +1,234 @@
+//! The full lumped thermal-hydraulic model: state vector, operating point,
+//! losses (eqs. 1–11) assigned to the thermal nodes, the network (eqs.
+//! 12–19), the LNG exchanger (eqs. 20–22) and the energy bookkeeping.
+//!
+//! This file holds the state layout, the [`Model`] and its drive, the oil
+//! properties on the grids and the full right-hand side; the parts of the
+//! right-hand side live by topic in `loss_terms.rs` (the losses and where the
+//! pump's friction heat goes), `thermal.rs` (the node heat balances),
+//! `hydraulic.rs` (the operating point and the hydraulic derivatives) and
+//! `replay_drive.rs` (interpolation in measured inputs).
+
+mod hydraulic;
+mod loss_terms;
+mod replay_drive;
+mod thermal;
+
+pub use hydraulic::HydraulicOil;
+pub use loss_terms::{FrictionHeat, Losses};
+pub use replay_drive::ReplayDrive;
+
+use crate::hydraulics::{self, ix};
+use crate::network::{self, Node, N_NODES, NODES};
+use crate::simulation::grids::{LaminarGrid, NuGrid, OuterGrid, NU_GRID_FACTOR};
+use crate::rig::Rig;
+use crate::scenario::{Mission, ValveRule};
+use std::cell::Cell;
+
+/// Offset of the temperatures in the state vector.
+pub const T0: usize = ix::N;
+/// Index of the integrated energy input into the nodes, J: every loss that
+/// is a heat source plus the pump's work on the oil minus the actuator's
+/// (see [`Model::thermal`]); in a throttle run it equals the integrated
+/// losses but for the reversible compression terms.
+pub const E_LOSS: usize = T0 + N_NODES;
+/// Index of the integrated heat to ambient, J.
+pub const E_AMB: usize = E_LOSS + 1;
+/// Index of the integrated heat to the LNG, J.
+pub const E_LNG: usize = E_LOSS + 2;
+/// State dimension.
+pub const N_STATE: usize = E_LOSS + 3;
+
+/// Index of a node's temperature in the state vector.
+pub const fn t_ix(n: Node) -> usize {
+    T0 + n as usize
+}
+
+/// What drives the model.
+#[derive(Debug, Clone)]
+pub enum Drive {
+    /// A mission: the hydraulic states are integrated.
+    Mission(Mission),
+    /// Measured inputs: the hydraulic operating point is imposed.
+    Replay(ReplayDrive),
+}
+
+/// The model: rig, drive and the LNG valve state.
+#[derive(Debug)]
+pub struct Model {
+    /// Rig parameters.
+    pub rig: Rig,
+    /// Drive.
+    pub drive: Drive,
+    /// LNG valve open (set between solver segments).
+    pub lng_open: Cell<bool>,
+    contents: [(f64, f64); N_NODES],
+    /// The outer surfaces' heat flows and the oil's viscosity on a
+    /// temperature grid (the fast plant's; None: the exact correlations).
+    outer_grid: Option<OuterGrid>,
+    nu_grid: Option<NuGrid>,
+    lam_grid: Option<LaminarGrid>,
+    /// The pump gaps' conductance times viscosity (eqs. 5–7 are ∝ 1/μ),
+    /// m³·Pa⁻¹·s⁻¹·Pa·s, taken once with the grids (the fast plant's).
+    leak_geom: Option<f64>,
+}
+
+impl Model {
+    /// Build a model.
+    pub fn new(rig: Rig, drive: Drive) -> Self {
+        let contents = network::contents(&rig);
+        Self { rig, drive, lng_open: Cell::new(false), contents, outer_grid: None, nu_grid: None, lam_grid: None, leak_geom: None }
+    }
+
+    /// Interpolate the outer surfaces' heat flows on a grid of `step_k`
+    /// kelvin (a cubic on a coarser one away from the air), the oil's
+    /// viscosity on one `NU_GRID_FACTOR` times coarser and the ducts'
+    /// laminar Nusselt number on a grid of its argument from now on
+    /// ([`crate::simulation::grids`]), or (None) evaluate them exactly.
+    pub fn set_grids(&mut self, step_k: Option<f64>) {
+        let step = step_k.filter(|&s| s > 0.0 && s.is_finite());
+        self.outer_grid = step.map(OuterGrid::new);
+        self.nu_grid = step.map(|s| NuGrid::new(s * NU_GRID_FACTOR));
+        self.lam_grid = step.map(|_| LaminarGrid::new());
+        self.leak_geom = step.map(|_| self.rig.pump.gaps.conductance(1.0));
+    }
+
+    /// Exact evaluations behind the grids so far: (outer surfaces, viscosities).
+    pub fn grid_evals(&self) -> (u64, u64) {
+        (self.outer_grid.as_ref().map_or(0, |g| g.evals.get()), self.nu_grid.as_ref().map_or(0, |g| g.evals.get()))
+    }
+
+    /// Oil-to-metal conductance of a duct ([`network::duct_conductance`]),
+    /// W/K, the laminar Nusselt number on its grid when the grids are set.
+    fn duct_conductance(&self, q_m3_per_s: f64, d: f64, len: f64, area_scale: f64, t_oil: f64, nu: f64) -> f64 {
+        match &self.lam_grid {
+            Some(g) => network::duct_conductance_with(&self.rig, q_m3_per_s, d, len, area_scale, t_oil, nu, |x| g.nu(x)),
+            None => network::duct_conductance(&self.rig, q_m3_per_s, d, len, area_scale, t_oil, nu),
+        }
+    }
+
+    /// Pressure drops of the throttle path ([`hydraulics::path_dp`]) with
+    /// the oil at `t_oil`: its viscosity from [`Model::nu`] (on the grid
+    /// when the grids are set), Pa.
+    fn path_dp(&self, q: f64, t_oil: f64, needle: Option<f64>) -> (f64, f64) {
+        hydraulics::path_dp_props(&self.rig, q, self.rig.oil.rho(t_oil, 0.0), self.nu(t_oil), needle)
+    }
+
+    /// Kinematic viscosity of the oil at `t_oil` (its Walther line), m²/s.
+    pub fn nu(&self, t_oil: f64) -> f64 {
+        match &self.nu_grid {
+            Some(g) => g.nu(&self.rig.oil, t_oil),
+            None => self.rig.oil.nu_m2_per_s(t_oil),
+        }
+    }
+
+    /// Dynamic viscosity of the oil at `t_oil` and 0 bar, Pa·s (ν·ρ, as
+    /// [`crate::fluid::Oil::mu_pa_s`]).
+    pub fn mu(&self, t_oil: f64) -> f64 {
+        self.nu(t_oil) * self.rig.oil.rho(t_oil, 0.0)
+    }
+
+    /// Pump leakage conductance of eqs. (5)–(7) at the case-oil temperature
+    /// (the films' viscosity), m³/(s·Pa).
+    pub fn k_leak(&self, t_case: f64) -> f64 {
+        match self.leak_geom {
+            // The fast plant: the geometric factor over μ (a division, not
+            // three and a logarithm).
+            Some(g) => g / self.mu(t_case),
+            None => self.rig.pump.gaps.conductance(self.mu(t_case)),
+        }
+    }
+
+    /// Heat capacity of node `n` at `t_c`, J/K (oil: V·ρ(T)·c_p(T)).
+    pub fn capacity(&self, n: Node, t_c: f64) -> f64 {
+        network::capacity_j_per_k(&self.rig, n, self.contents[n as usize], t_c)
+    }
+
+    /// Mass flow of a volumetric flow `q` (m³/s) around the oil ring, kg/s:
+    /// at the density of the loop oil (the pump's suction side), one value
+    /// for every link of the ring so that the ring conserves mass.
+    fn ring_mass_flow(&self, q: f64, t_loop: f64) -> f64 {
+        self.rig.oil.rho(t_loop, 0.0) * q
+    }
+
+    /// Initial state: hydraulics at rest (lines at the accumulator pressure),
+    /// every node at the initial ambient (paper assumption 1).
+    pub fn initial_state(&self) -> Vec<f64> {
+        let mut y = vec![0.0; N_STATE];
+        let amb = self.ambient(0.0);
+        y[ix::PA] = self.rig.hydraulics.accumulator_pa;
+        y[ix::PB] = self.rig.hydraulics.accumulator_pa;
+        for n in NODES {
+            y[t_ix(n)] = amb;
+        }
+        y
+    }
+
+    /// Ambient temperature at `t`, °C.
+    pub fn ambient(&self, t: f64) -> f64 {
+        match &self.drive {
+            Drive::Mission(m) => m.ambient_c.at(t),
+            Drive::Replay(r) => r.op(&self.rig, t).ambient_c,
+        }
+    }
+
+    /// Full right-hand side dy/dt = f(t, y).
+    pub fn rhs(&self, t: f64, y: &[f64], dy: &mut [f64]) {
+        let op = self.op_point(t, y);
+        let temps = &y[T0..T0 + N_NODES];
+        let l = self.losses(t, &op, temps);
+        self.hydraulic_rhs_at(t, y, &op, dy);
+        let (q_in, q_amb, q_lng) = self.thermal(&op, &l, temps, &mut dy[T0..T0 + N_NODES]);
+        dy[E_LOSS] = q_in;
+        dy[E_AMB] = q_amb;
+        dy[E_LNG] = q_lng;
+    }
+
+    /// [`Model::rhs`] without the hydraulic derivatives (`dy[..ix::N]` is
+    /// left as it is): the node temperatures' derivatives and the energy
+    /// rates, the same to the last bit.
+    pub fn thermal_rhs(&self, t: f64, y: &[f64], dy: &mut [f64]) {
+        let op = self.op_point(t, y);
+        let temps = &y[T0..T0 + N_NODES];
+        let l = self.losses(t, &op, temps);
+        let (q_in, q_amb, q_lng) = self.thermal(&op, &l, temps, &mut dy[T0..T0 + N_NODES]);
+        dy[E_LOSS] = q_in;
+        dy[E_AMB] = q_amb;
+        dy[E_LNG] = q_lng;
+    }
+
+    /// The states no derivative of [`Model::rhs`] depends on: the energy
+    /// integrals always, and in a replay the hydraulic states too (the
+    /// operating point is imposed from the log). Their Jacobian columns are
+    /// zero.
+    pub fn inert_states(&self) -> [bool; N_STATE] {
+        let mut inert = [false; N_STATE];
+        for e in [E_LOSS, E_AMB, E_LNG] {
+            inert[e] = true;
+        }
+        if matches!(self.drive, Drive::Replay(_)) {
+            inert[..ix::N].iter_mut().for_each(|i| *i = true);
+        }
+        inert
+    }
+
+    /// Energy stored in the nodes relative to the state `y0`, J.
+    pub fn stored_energy(&self, y0: &[f64], y: &[f64]) -> f64 {
+        NODES
+            .iter()
+            .enumerate()
+            .map(|(i, n)| {
+                let c = self.contents[i];
+                network::stored_j(&self.rig, *n, c, y[T0 + i]) - network::stored_j(&self.rig, *n, c, y0[T0 + i])
+            })
+            .sum()
+    }
+
+    /// The LNG valve rule of the drive.
+    pub fn valve_rule(&self) -> ValveRule {
+        match &self.drive {
+            Drive::Mission(m) => m.valve,
+            Drive::Replay(_) => ValveRule::External,
+        }
+    }
+}
