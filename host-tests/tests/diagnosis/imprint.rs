@@ -82,11 +82,16 @@ fn slow_imprint_ratio_above_two_sensor_lag() {
 /// training window no better than at 0.4 W/K; churning's fit gains −6 % on
 /// t_pump_c against the baseline restarted from its own nuisance values):
 /// docs/diagnosis.md. Asserted as measured: no cause, no wrong cause, no
-/// discovery on the twins.
+/// discovery on the twins; and the twin of 2700, once a false discovery.
 #[test]
-#[ignore = "slow tier: emulator cases with twins (~4 min), measured misses"]
+#[ignore = "slow tier: emulator cases with twins (~5 min), measured misses"]
 fn slow_imprint_ratio_above_two_housing_paths_and_churning_missed() {
     assert_missed(&run("motor-pump-conduction", LoadCycles, 1711), "unexplained", 6.36);
     assert_missed(&run("motor-pump-conduction", IdentRun, 2711), "unexplained", 2.83);
     assert_missed(&run("churning-loss", IdentRun, 2709), "unexplained", 4.73);
+    // The former false discovery: the twin of 2700 (winding, r 1.4, an
+    // identification run) was named `sensor-lag` at P 1.00 with two
+    // starts; with three the lag no longer qualifies there (measured:
+    // `unexplained`, the case itself `unexplained` too, right below r = 2).
+    assert_missed(&run("winding-resistance-temperature", IdentRun, 2700), "unexplained", 1.37);
 }
