@@ -114,7 +114,7 @@ fn main() {
     line("cand from nominal", &run, &a, ch, split, &names);
     line("cand from base", &run, &b, ch, split, &names);
     let best = if a.rss <= b.rss { a } else { b };
-    let tm = [truth.magnitude];
+    let tm: Vec<f64> = ex.iter().enumerate().map(|(k, s)| if k == 0 { truth.magnitude } else { s.start }).collect();
     let (tru, long) = rayon::join(
         || (hid != Candidate::None).then(|| fit(&*sim, &run, &pts, c, &base.nuisance, Some(&tm), opts)).flatten(),
         || has("long").then(|| fit(&*sim, &run, &pts, c, &best.nuisance, Some(&best.ext), FitOptions { max_sims: 400, ..opts })).flatten(),
@@ -122,7 +122,7 @@ fn main() {
     // the calibrated baseline with the candidate at the middle of its
     // physical range (`magnitude_range`, geometric mean)
     let (lo, hi) = eha_sim::physics::candidates::magnitude_range(c);
-    let mid = [(lo * hi).sqrt()];
+    let mid: Vec<f64> = ex.iter().enumerate().map(|(k, s)| if k == 0 { (lo * hi).sqrt() } else { s.start }).collect();
     if let Some(f) = fit(&*sim, &run, &pts, c, &base.nuisance, Some(&mid), opts) {
         line("cand base+mid", &run, &f, ch, split, &names);
     }
