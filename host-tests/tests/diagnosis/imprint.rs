@@ -9,9 +9,9 @@
 //! asserted as a miss, so a change either way fails. Why each miss is
 //! missed: docs/diagnosis.md, "What it can and cannot see".
 //!
-//! Slow tier only: each case is a log and its twin diagnosed in parallel,
-//! 50–90 s on two shared cores (`emulator-sweep --only …`, 16:00 UTC,
-//! 2026-11-27).
+//! Slow tier only: each case is a log and its twin diagnosed in parallel
+//! (with the oracle), 50–90 s a case on two shared cores; the two tests
+//! together took 969 s at load 7–8 (2026-11-27).
 
 use eha_sim::diagnosis::emu_sweep::{run_emu_case_twin, EmuResult};
 use eha_sim::diagnosis::{Candidate, DiagnoseOptions};
@@ -62,7 +62,7 @@ fn assert_missed(r: &EmuResult, answer: &str, ratio: f64) {
 /// pooled held-out RMSE rises 2.12 → 2.22 K (the joint nuisance refit
 /// trades t_block_c's 3–4 K structure floor), a measured miss.
 #[test]
-#[ignore = "slow tier: emulator cases with twins (~5 min)"]
+#[ignore = "slow tier: emulator cases with twins (minutes)"]
 fn slow_imprint_ratio_above_two_sensor_lag() {
     assert_named(&run("sensor-lag", ConstantThrottle, 1704), 3.14, 0.24);
     assert_named(&run("sensor-lag", SpeedSteps, 1705), 2.60, 0.45);
@@ -84,7 +84,7 @@ fn slow_imprint_ratio_above_two_sensor_lag() {
 /// docs/diagnosis.md. Asserted as measured: no cause, no wrong cause, no
 /// discovery on the twins; and the twin of 2700, once a false discovery.
 #[test]
-#[ignore = "slow tier: emulator cases with twins (~5 min), measured misses"]
+#[ignore = "slow tier: emulator cases with twins (minutes), measured misses"]
 fn slow_imprint_ratio_above_two_housing_paths_and_churning_missed() {
     assert_missed(&run("motor-pump-conduction", LoadCycles, 1711), "unexplained", 6.36);
     assert_missed(&run("motor-pump-conduction", IdentRun, 2711), "unexplained", 2.83);
