@@ -381,29 +381,36 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
         }
     }
     let may_escalate = escalate && assess(run, split, &m_before, &xcorr, (&nuis_specs, &base.nuisance), o.physical_misfit).misfits;
-    // Every candidate is fitted jointly with the nuisance set from two
-    // starts, keeping the better: (a) the nominal nuisance values with the
-    // candidate's typical magnitude — starting from the calibrated baseline
-    // alone would inherit the distortions the nuisance set took on to mimic
-    // the missing effect; (b) the calibrated baseline with the candidate
-    // nearly off, so that a candidate (which contains the baseline as its
-    // limit) never ends up with a worse fit than the baseline.
-    let starts: Vec<(Candidate, bool)> =
-        Candidate::EXTENSIONS.iter().flat_map(|&c| [(c, false), (c, true)]).collect();
+    // Every candidate is fitted jointly with the nuisance set from
+    // [`STARTS_PER_CANDIDATE`] starts, keeping the best: (a) the nominal
+    // nuisance values with the candidate's spec start — starting from the
+    // calibrated baseline alone would inherit the distortions the nuisance
+    // set took on to mimic the missing effect; (b) the calibrated baseline
+    // with the candidate nearly off, so that a candidate (which contains the
+    // baseline as its limit) never ends up with a worse fit than the
+    // baseline; (c) the calibrated baseline with the candidate at the middle
+    // of its physical range ([`typical_magnitude`]): from (b) the fit often
+    // stays in the baseline's basin with the candidate off, from (a) the
+    // ~20-parameter physical set ends its budget far from the baseline's
+    // values (measured on emulator logs, issue 37: docs/diagnosis.md, "What
+    // it can and cannot see").
+    let starts: Vec<(Candidate, Start)> =
+        Candidate::EXTENSIONS.iter().flat_map(|&c| [(c, Start::Nominal), (c, Start::BaseOff), (c, Start::BaseTypical)]).collect();
     sim.phase(Phase::Candidates { fits: starts.len(), may_escalate: may_escalate && sim.physical_set().is_some() });
     let all: Vec<Option<FitResult>> = starts
         .par_iter()
-        .map(|&(c, from_base)| if from_base { fit_from(sim, run, &pts, c, &base, o) } else { fit_deferred(sim, run, &pts, c, &nominal_v, None, o.fit) })
+        .map(|&(c, start)| match start {
+            Start::Nominal => fit_deferred(sim, run, &pts, c, &nominal_v, None, o.fit),
+            Start::BaseOff => fit_from(sim, run, &pts, c, &base, o),
+            Start::BaseTypical => fit_typical(sim, run, &pts, c, &base, o),
+        })
         .collect();
     let mut extra_sims = 0;
     let fits: Vec<Option<FitResult>> = all
-        .chunks(2)
-        .map(|pair| {
-            extra_sims += pair.iter().flatten().map(|f| f.sims).sum::<usize>();
-            match (&pair[0], &pair[1]) {
-                (Some(a), Some(b)) => Some(if a.rss <= b.rss { a.clone() } else { b.clone() }),
-                (a, b) => a.clone().or_else(|| b.clone()),
-            }
+        .chunks(STARTS_PER_CANDIDATE)
+        .map(|group| {
+            extra_sims += group.iter().flatten().map(|f| f.sims).sum::<usize>();
+            group.iter().flatten().min_by(|a, b| a.rss.total_cmp(&b.rss)).cloned()
         })
         .collect();
     log.mark("candidates", extra_sims);
@@ -525,6 +532,42 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
         phases: log.phases,
         posterior,
     })
+}
+
+/// Starts per candidate fit in each tier (see [`diagnose`]'s body):
+/// nominal nuisance values, the calibrated baseline with the candidate
+/// nearly off, and the calibrated baseline with the candidate at its
+/// [`typical_magnitude`].
+pub const STARTS_PER_CANDIDATE: usize = 3;
+
+/// Where a candidate fit starts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Start {
+    /// Nominal nuisance values, the candidate at its spec start.
+    Nominal,
+    /// The calibrated baseline, the candidate nearly off ([`fit_from`]).
+    BaseOff,
+    /// The calibrated baseline, the candidate at [`typical_magnitude`].
+    BaseTypical,
+}
+
+/// The middle (geometric mean) of candidate `c`'s physically typical
+/// magnitude range ([`crate::physics::candidates::magnitude_range`]: copper
+/// α, a dead-end pocket's minutes, 2–4 % seal friction, 60–150 W churning at
+/// 1500 rpm, a flange's W/K, a draught's m/s), clamped into `spec`'s bounds;
+/// the spec's own start when the range is a placeholder. A prior value
+/// from physics, the same for every log.
+pub fn typical_magnitude(c: Candidate, spec: &super::model::ParamSpec) -> f64 {
+    let (lo, hi) = crate::physics::candidates::magnitude_range(c);
+    if hi > lo { (lo * hi).sqrt().clamp(spec.lo, spec.hi) } else { spec.start }
+}
+
+/// Candidate `c` fitted jointly with the nuisance set from the baseline
+/// `base`, with `c`'s first parameter at its [`typical_magnitude`] (any
+/// further ones at their spec starts); its Jacobian at the best point owed.
+pub fn fit_typical(sim: &dyn Simulator, run: &MeasuredRun, pts: &[Point], c: Candidate, base: &FitResult, o: &DiagnoseOptions) -> Option<FitResult> {
+    let e: Vec<f64> = sim.extension_params(c).iter().enumerate().map(|(k, s)| if k == 0 { typical_magnitude(c, s) } else { s.start }).collect();
+    fit_deferred(sim, run, pts, c, &base.nuisance, Some(&e), o.fit)
 }
 
 /// Candidate `c` fitted jointly with the nuisance set from the baseline

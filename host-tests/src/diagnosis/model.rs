@@ -88,7 +88,7 @@ pub enum Phase {
         /// Nuisance parameters.
         params: usize,
     },
-    /// `fits` candidate fits (two starts per candidate, in parallel), each
+    /// `fits` candidate fits (`analysis::STARTS_PER_CANDIDATE` starts per candidate, in parallel), each
     /// of the nuisance set plus the candidate's parameters. `may_escalate`:
     /// the global baseline fails the strict rule, so the physical tier
     /// follows unless a cause is named.

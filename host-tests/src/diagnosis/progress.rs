@@ -138,7 +138,7 @@ impl Est {
         let ext = Candidate::EXTENSIONS.len() as f64;
         vec![
             (Kind::Baseline, 1.0 + b),
-            (Kind::Candidates, 2.0 * ext * c),
+            (Kind::Candidates, super::analysis::STARTS_PER_CANDIDATE as f64 * ext * c),
             (Kind::Restarts, 2.0 * b),
             (Kind::Refits, ext * REFIT_SHARE * c),
             (Kind::Jacobians, self.jacobians(p)),

@@ -187,9 +187,10 @@ fn slow_second_scenario_per_candidate_is_named() {
         case("churning-loss", SpeedSweep, Structure, 52),
     ]);
     // Measured: the draught under logged ram-air steps (seed 71) is named
-    // with 50 % on t_pump_c, on the bar; asserted named with the gain under
-    // 60 %.
-    check_miss(&[(case("forced-convection", AirSteps, Nuisance, 71), "forced-convection", Some(0.6))]);
+    // with 80 % on t_pump_c (held out 0.350 -> 0.115 K pooled) since the
+    // third candidate start (50 %, on the bar, with two); asserted named
+    // with >= 50 %.
+    check(&[case("forced-convection", AirSteps, Nuisance, 71)]);
     // Measured: the 185 s dead-end pocket (seed 32) is named with 82 % on
     // t_oil_c (held out 0.94 -> 0.21 K pooled), although the calibrated
     // baseline's probe (up to 10 s) takes up part of the lag: a pass.
@@ -203,9 +204,10 @@ fn slow_second_scenario_per_candidate_is_named() {
 #[test]
 #[ignore = "slow tier: measured miss"]
 fn slow_measured_miss_motor_pump_conduction_with_structure_mismatch() {
-    // Measured: `unexplained` (t_pump_c held out 0.73 K; no cause named): a
-    // miss, not a silent one.
-    check_miss(&[(case("motor-pump-conduction", ThrottleSteps, Structure, 62), "unexplained", None)]);
+    // Measured with three candidate starts: `none` (pooled held out
+    // 0.420 K; with two starts `unexplained`, t_pump_c 0.73 K): a miss
+    // either way, no wrong cause.
+    check_miss(&[(case("motor-pump-conduction", ThrottleSteps, Structure, 62), "none", None)]);
 }
 
 /// Coulomb seal friction: heat F·|v| in the actuator body, carried to the
@@ -221,9 +223,11 @@ fn slow_hidden_coulomb_friction_is_named() {
     // baseline already near the noise; imprint 0.59 K absorbed): a measured
     // miss, asserted as measured.
     check_miss(&[(case("coulomb-friction", ServoHoldMove, Nuisance, 45), "none", None)]);
-    // Gusts (seed 47): `none` (t_oil_c held out
-    // 0.20 K, imprint 0.85 K absorbed): a measured miss.
-    check_miss(&[(case("coulomb-friction", ServoGust, Nuisance, 47), "none", None)]);
+    // Gusts (seed 47): named since the third candidate start (measured:
+    // 38 % on t_oil_c, pooled held out 0.191 -> 0.124 K; with two starts
+    // `none`, the 0.85 K imprint absorbed). Asserted named with the gain
+    // under 50 %, a measured shortfall of the 50 % bar.
+    check_miss(&[(case("coulomb-friction", ServoGust, Nuisance, 47), "coulomb-friction", Some(0.5))]);
 }
 
 /// The servo missions that name Coulomb friction, and the brisk/slow servo
@@ -263,14 +267,18 @@ fn slow_measured_miss_forced_convection_with_structure_mismatch() {
     check_miss(&[(case("forced-convection", AirSteps, Structure, 72), "none", None)]);
 }
 
-/// Measured false discovery: high-pressure speed steps with per-node
-/// capacities off the baseline and nothing hidden are named churning-loss:
-/// the oil and blocks warm by tens of kelvin, the capacity errors leave
-/// ~1 K on the housings, and a speed-dependent pump heat fits them.
+/// Former measured false discovery: high-pressure speed steps with
+/// per-node capacities off the baseline and nothing hidden were named
+/// churning-loss with two candidate starts (the oil and blocks warm by tens
+/// of kelvin, the capacity errors leave ~1 K on the housings, and a
+/// speed-dependent pump heat fitted them). With the third start (the
+/// calibrated baseline with each candidate at its typical magnitude) the
+/// answer is `none` (measured, pooled held out 0.111 K); asserted as
+/// measured.
 #[test]
 #[ignore = "slow tier: measured false discovery"]
 fn slow_measured_false_discovery_in_high_pressure_speed_steps_with_structure_mismatch() {
-    check_miss(&[(case("none", PressureSpeedSteps, Structure, 93), "churning-loss", None)]);
+    check_miss(&[(case("none", PressureSpeedSteps, Structure, 93), "none", None)]);
 }
 
 /// The tempered decision rule (`DecisionRule::Tempered`, measured on the

@@ -114,27 +114,32 @@ fn slow_emulator_conduction_is_named_over_a_qualifying_forced_convection() {
     assert_no_qualifying_candidate(&r);
 }
 
-/// Churning (4.8e-4 W/(rad/s)^2.5) in speed steps (seed 1708). **Measured
+/// Churning (4.8e-4 W/(rad/s)^2.5) in speed steps (seed 1708, r 1.4 against
+/// its twin, below the r = 2 at which it must be named). **Measured
 /// miss**: answered `none`. The baseline refitted from the best candidates'
-/// nuisance values fits t_pump_c to 0.32–0.36 K held out, its viscous pump
+/// nuisance values fits t_pump_c to 0.36 K held out, its viscous pump
 /// friction (C_v·μ·D·ω², scaled by `pump_friction`) taking up most of the
-/// ω^2.5 loss; the best candidate is sensor lag, not qualifying. Asserted:
-/// `none`, the best candidate does not qualify, t_pump_c calibrated
-/// ≤ 0.4 K held out (4σ of the 0.1 K noise: the 8.7 K churning imprint is
-/// absorbed, not missed by a misfit).
+/// ω^2.5 loss. With the third candidate start (the calibrated baseline with
+/// churning at its typical magnitude) the churning fit finds the effect:
+/// best candidate, ΔBIC 44.9, t_pump_c 0.36 → 0.17 K held out (53 %), but
+/// the pooled held-out RMSE falls only 0.448 → 0.407 K (9 %, under the
+/// 20 % pooled bar), so it does not qualify (with two starts it gained −3 %).
+/// Asserted: `none`, the best candidate churning and not qualifying, its
+/// gain on t_pump_c 40–65 % (measured 53 %), t_pump_c calibrated ≤ 0.4 K
+/// held out (4σ of the 0.1 K noise).
 #[test]
 #[ignore = "slow tier: emulator case, measured miss"]
 fn slow_emulator_churning_measured_miss() {
     let r = run(case("churning-loss", SpeedSteps, 1708));
     assert_eq!(r.answer, "none", "measured outcome changed");
     let (name, _, _, qualifies) = r.best_candidate.clone().expect("a best candidate");
-    assert!(!qualifies, "best candidate {name} qualifies (measured: sensor-lag, not qualifying)");
+    assert!(name == "churning-loss" && !qualifies, "best candidate {name} qualifies {qualifies} (measured: churning-loss, not qualifying)");
     let (before, _) = r.affected_heldout_k.expect("affected channel");
     assert!(before <= 0.4, "t_pump_c calibrated held-out {before:.3} K (measured 0.36)");
-    // Churning's own fit: −3 % on t_pump_c at the default fit
-    // budget, −6 % with 13 Jacobians instead of 6 (docs/diagnosis.md, "Why
-    // the misses are missed").
-    assert_oracle_under(&r, 0.3, "−3 %");
+    let h = r.hidden_fit.as_ref().expect("hidden candidate fitted");
+    let g = h.affected_gain().expect("affected channel");
+    assert!((0.4..0.65).contains(&g), "churning's own gain on t_pump_c {:.0} % (measured 53 %)", 100.0 * g);
+    assert!(h.pooled_heldout_k.1 > 0.8 * h.pooled_heldout_k.0, "pooled {:?} (measured 0.448 -> 0.407 K, under the 20 % bar)", h.pooled_heldout_k);
 }
 
 // (No viscosity case: the emulator's and the reference's oil both follow

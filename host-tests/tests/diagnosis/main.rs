@@ -7,6 +7,7 @@ mod cli;
 mod detect;
 mod effects;
 mod emulator;
+mod imprint;
 mod multi;
 mod plan;
 mod replay;

@@ -179,13 +179,17 @@ fn slow_planned_runs_lift_effects_above_the_floor() {
 }
 
 /// The same for one case with a planned run twice as long (2400 s):
-/// **measured miss**, 1708 churning r 1.40 → 1.35 (`unexplained`; twin
-/// `unexplained`; 5 min). Asserted as measured.
+/// 1708 churning r 1.40 → 3.44 on t_pump_c with the third candidate start
+/// (1.35 with two), answered `none` (twin `none`; 87 s): lifted above
+/// r = 2 and then a **measured miss**. Asserted as measured: r ≥ 2.5 (the
+/// ratio moves with both calibrated baselines' last digits; it was 1.35),
+/// `none`, and never a wrong cause.
 #[test]
 #[ignore]
 fn slow_planned_run_twice_as_long() {
     let (r0, r1, answer, p) = planned_case(1708, 2400.0);
     eprintln!("1708, 2400 s plan: r {r0:.2} -> {r1:.2} ({answer}), {}", p.design.name);
-    assert!(r1 < 2.0, "measured miss changed: r {r1:.2}");
+    assert!(r1 >= 2.5, "measured r changed: {r1:.2} (measured 3.44)");
     assert!(["none", "unexplained", "churning-loss"].contains(&answer.as_str()), "wrong cause: {answer}");
+    assert_eq!(answer, "none", "measured outcome changed (measured none at r 3.44)");
 }

@@ -1,0 +1,97 @@
+//! The seven emulator cases of the 2026-11-27 sweep whose imprint ratio r
+//! (the calibrated baseline's held-out misfit on the affected channel over
+//! the same on the log's effect-free twin) is at least 2, where issue 37
+//! asks the diagnosis to name the cause, each with its twin (same machine,
+//! mission and noise, nothing hidden), where it must not name one.
+//! Every assertion is the outcome measured with the third candidate start
+//! (the calibrated baseline with the candidate at its typical magnitude,
+//! `diagnosis::analysis::typical_magnitude`): named where named, a miss
+//! asserted as a miss, so a change either way fails. Why each miss is
+//! missed: docs/diagnosis.md, "What it can and cannot see".
+//!
+//! Slow tier only: each case is a log and its twin diagnosed in parallel
+//! (with the oracle), 50–90 s a case on two shared cores; the two tests
+//! together took 969 s at load 7–8 (2026-11-27).
+
+use eha_sim::diagnosis::emu_sweep::{run_emu_case_twin, EmuResult};
+use eha_sim::diagnosis::{Candidate, DiagnoseOptions};
+use eha_sim::emulator::missions::EmuScenario::{self, ConstantThrottle, IdentRun, LoadCycles, SpeedSteps};
+use eha_sim::emulator::EmuCase;
+
+fn run(hidden: &str, scenario: EmuScenario, seed: u64) -> EmuResult {
+    let c = EmuCase { hidden: Candidate::from_name(hidden).expect("candidate"), scenario, seed, duration_s: 1200.0 };
+    let r = run_emu_case_twin(c, &DiagnoseOptions::default(), true).expect("emulated log diagnoses");
+    eprintln!("{}", eha_sim::diagnosis::emu_sweep::table_row(&r));
+    r
+}
+
+/// The imprint ratio against the twin, and the twin's answer.
+fn twin(r: &EmuResult) -> (f64, String) {
+    let t = r.twin.as_ref().expect("twin diagnosed");
+    (t.misfit_k / t.twin_misfit_k, t.twin_answer.clone())
+}
+
+/// A hidden effect named: the answer, r within 20 % of the measured value
+/// (the calibrated baselines of log and twin move with the fits' last
+/// digits), the held-out RMSE on the affected channel within ±0.1 K of the
+/// measured after-value, and the twin names no cause.
+fn assert_named(r: &EmuResult, ratio: f64, after_k: f64) {
+    assert!(r.hit(), "answer {} (measured: named)", r.answer);
+    let (rr, ta) = twin(r);
+    assert!((rr / ratio - 1.0).abs() < 0.2, "r {rr:.2} (measured {ratio})");
+    let (_, a) = r.affected_heldout_k.expect("affected channel");
+    assert!((a - after_k).abs() <= 0.1, "affected held-out after {a:.2} K (measured {after_k})");
+    assert!(ta == "none" || ta == "unexplained", "twin answered {ta}: a false discovery");
+}
+
+/// A measured miss: no cause named (`unexplained` or `none`, as measured),
+/// in particular no wrong cause, and no discovery on the twin.
+fn assert_missed(r: &EmuResult, answer: &str, ratio: f64) {
+    assert_eq!(r.answer, answer, "measured outcome changed");
+    let (rr, ta) = twin(r);
+    assert!((rr / ratio - 1.0).abs() < 0.2, "r {rr:.2} (measured {ratio})");
+    assert!(ta == "none" || ta == "unexplained", "twin answered {ta}: a false discovery");
+}
+
+/// Dead-end oil pockets: 1704 (Case 1, τ 203 s, r 3.1), 1705 (speed
+/// steps, τ 117 s, r 2.6) and 2705 (identification run, τ 145 s, r 3.8)
+/// named `sensor-lag` at P 1.00 (t_oil_c held out 0.45 → 0.24, 0.94 →
+/// 0.45, 5.58 → 3.71 K); 1705 and 2705 were `none` and `unexplained` with
+/// two starts. 2704 (identification run, τ 69 s, r 2.1) stays
+/// `unexplained`: the lag gains 23 % on t_oil_c (3.04 → 2.35 K) but the
+/// pooled held-out RMSE rises 2.12 → 2.22 K (the joint nuisance refit
+/// trades t_block_c's 3–4 K structure floor), a measured miss.
+#[test]
+#[ignore = "slow tier: emulator cases with twins (minutes)"]
+fn slow_imprint_ratio_above_two_sensor_lag() {
+    assert_named(&run("sensor-lag", ConstantThrottle, 1704), 3.14, 0.24);
+    assert_named(&run("sensor-lag", SpeedSteps, 1705), 2.60, 0.45);
+    assert_named(&run("sensor-lag", IdentRun, 2705), 3.78, 3.71);
+    let r = run("sensor-lag", IdentRun, 2704);
+    assert_missed(&r, "unexplained", 2.10);
+    let h = r.hidden_fit.as_ref().expect("hidden candidate fitted");
+    assert!(!h.qualifies && h.pooled_heldout_k.1 > h.pooled_heldout_k.0, "lag fit {h:?} (measured pooled 2.12 -> 2.22 K)");
+}
+
+/// Motor–pump conduction (1711, load cycles, 5.3 W/K, r 6.4; 2711,
+/// identification run, 5.7 W/K, r 2.8) and churning (2709, identification
+/// run, 4.9e-4 W/(rad/s)^2.5, r 4.7): measured misses, `unexplained`.
+/// The training window does not prefer the effect over the per-housing
+/// outer transfer and the pump's friction and case film (with the
+/// nuisance refitted, the conduction held at its true value fits the
+/// training window no better than at 0.4 W/K; churning's fit gains −6 % on
+/// t_pump_c against the baseline restarted from its own nuisance values):
+/// docs/diagnosis.md. Asserted as measured: no cause, no wrong cause, no
+/// discovery on the twins; and the twin of 2700, once a false discovery.
+#[test]
+#[ignore = "slow tier: emulator cases with twins (minutes), measured misses"]
+fn slow_imprint_ratio_above_two_housing_paths_and_churning_missed() {
+    assert_missed(&run("motor-pump-conduction", LoadCycles, 1711), "unexplained", 6.36);
+    assert_missed(&run("motor-pump-conduction", IdentRun, 2711), "unexplained", 2.83);
+    assert_missed(&run("churning-loss", IdentRun, 2709), "unexplained", 4.73);
+    // The former false discovery: the twin of 2700 (winding, r 1.4, an
+    // identification run) was named `sensor-lag` at P 1.00 with two
+    // starts; with three the lag no longer qualifies there (measured:
+    // `unexplained`, the case itself `unexplained` too, right below r = 2).
+    assert_missed(&run("winding-resistance-temperature", IdentRun, 2700), "unexplained", 1.37);
+}
