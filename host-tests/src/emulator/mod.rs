@@ -39,8 +39,8 @@
 //!   plus noise, 12-bit quantisation and dropouts ([`logger`]); the
 //!   ambient drifts slowly (±0.2–0.8 K, 40 min period).
 //!
-//! Experiment switches ([`params::EmuParams::like_reference`], 0 in every
-//! machine) replace one law at a time by the reference's, for the
+//! Experiment switches ([`params::EmuParams::like_reference`], empty in
+//! every machine) replace one law at a time by the reference's, for the
 //! structural bisection of a commissioning miss (docs/commissioning.md).
 //!
 //! The hidden effects are the diagnosis candidates, implemented here from

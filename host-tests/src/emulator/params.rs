@@ -110,31 +110,46 @@ pub struct EmuParams {
     /// Dead-end sensor pocket (hidden `sensor-lag`): oil volume, m³, and its
     /// conductance to the manifold plate, W/K.
     pub pocket: [f64; 2],
-    /// Structural experiment switches, a set of [`like_reference`] bits
-    /// (0 in every machine: the emulator as built). Each bit makes one law
-    /// of the machine the reference model's; for the by-hand structural
-    /// bisection of a commissioning miss (docs/commissioning.md), never set
-    /// in a test's machine.
-    pub like_reference: u32,
+    /// Structural experiment switches: the laws of the machine replaced by
+    /// the reference model's (none in every machine: the emulator as
+    /// built). For the by-hand structural bisection of a commissioning miss
+    /// (docs/commissioning.md), never set in a test's machine.
+    pub like_reference: LikeReference,
 }
 
-/// Bits of [`EmuParams::like_reference`]: laws of the emulator replaced by
-/// the reference model's, one structural difference each (experiment knobs;
-/// the parameter-level differences are set on the parameters instead, by
-/// the experiment, `tests/calibration/mix_audit.rs`).
-pub mod like_reference {
+/// A law of the emulator an experiment can replace by the reference
+/// model's, one structural difference each (the parameter-level
+/// differences are set on the parameters instead, by the experiment,
+/// `tests/calibration/mix_audit.rs`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RefLaw {
     /// The case film is the reference's gap law (conduction across a 3 mm
     /// gap, Nu = 2, rising by the Taylor–Couette law above Ta = 1700) on
     /// the machine's own wetted areas, instead of the rotating cylinder.
-    pub const CASE_GAP_FILM: u32 = 1;
+    CaseGapFilm,
     /// The rotating cylinder's case film as a function of ω/ν alone, as the
     /// reference's churned film is: its Prandtl number at the 40 °C oil's
     /// (Nu = 2 + 0.133·Re^⅔·Pr₄₀^⅓), the Reynolds number and the
     /// conductivity at the oil's temperature.
-    pub const CASE_FILM_OMEGA_NU: u32 = 2;
+    CaseFilmOmegaNu,
     /// No iron-loss drag torque in the motor current (the reference's shaft
     /// torque has none: its iron loss heats the housing without a torque).
-    pub const NO_IRON_DRAG: u32 = 4;
+    NoIronDrag,
+}
+
+/// A set of [`RefLaw`]s ([`EmuParams::like_reference`]); empty by default.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct LikeReference(u8);
+
+impl LikeReference {
+    /// The set with `law` added.
+    pub fn with(self, law: RefLaw) -> Self {
+        Self(self.0 | 1 << law as u8)
+    }
+    /// Whether `law` is replaced by the reference's.
+    pub fn has(self, law: RefLaw) -> bool {
+        self.0 & 1 << law as u8 != 0
+    }
 }
 
 /// Names of the parameters drawn per log (see [`EmuParams::draw`]).
@@ -206,7 +221,7 @@ impl Default for EmuParams {
             probe_ambient_frac: 0.04,
             pump_probe_barrel: 0.65,
             pocket: [5e-6, 0.03],
-            like_reference: 0,
+            like_reference: LikeReference::default(),
         }
     }
 }

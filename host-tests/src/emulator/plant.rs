@@ -5,7 +5,7 @@
 //! step bounded by the network's fastest time constant.
 
 use super::missions::{linear_at, step_at, EmuMission};
-use super::params::{like_reference, EmuParams};
+use super::params::{EmuParams, RefLaw};
 use super::props::{self, oil_cp, oil_nu, oil_rho};
 use crate::physics::candidates::Candidate;
 use std::f64::consts::PI;
@@ -171,9 +171,9 @@ impl Plant<'_> {
     }
 
     /// Iron-loss drag on the shaft, N·m: eq. (2)'s loss over the speed (at
-    /// least 1 rad/s); none with [`like_reference::NO_IRON_DRAG`].
+    /// least 1 rad/s); none with [`RefLaw::NoIronDrag`].
     fn iron_drag_nm(&self, omega: f64) -> f64 {
-        if self.p.like_reference & like_reference::NO_IRON_DRAG != 0 {
+        if self.p.like_reference.has(RefLaw::NoIronDrag) {
             return 0.0;
         }
         self.iron_w(omega) / omega.abs().max(1.0)
@@ -233,18 +233,18 @@ impl Plant<'_> {
     /// Case-oil film on a wetted area `a` (m²) at shaft speed `omega`
     /// (rad/s), oil at `t_c` °C with kinematic viscosity `nu`, W/K: the
     /// rotating cylinder ([`props::case_film`]); with the experiment switch
-    /// [`like_reference::CASE_GAP_FILM`] the reference's law instead,
+    /// [`RefLaw::CaseGapFilm`] the reference's law instead,
     /// conduction across a 3 mm gap (Nu = 2 on the gap's hydraulic
     /// diameter 2e) rising with the Taylor number ω²·r·e³/ν² above 1700
     /// (0.128·Ta^0.367 to 1e4, then 0.409·Ta^0.241).
     fn case_film(&self, omega: f64, a: f64, nu: f64, t_c: f64) -> f64 {
-        if self.p.like_reference & like_reference::CASE_FILM_OMEGA_NU != 0 {
+        if self.p.like_reference.has(RefLaw::CaseFilmOmegaNu) {
             let d = 2.0 * self.p.r_rotor;
             let re = omega.abs() * d * d / nu;
             let pr40 = oil_nu(40.0) * oil_rho(40.0) * oil_cp(40.0) / props::oil_k(40.0);
             return (2.0 + 0.133 * re.powf(2.0 / 3.0) * pr40.powf(1.0 / 3.0)) * props::oil_k(t_c) / d * a;
         }
-        if self.p.like_reference & like_reference::CASE_GAP_FILM == 0 {
+        if !self.p.like_reference.has(RefLaw::CaseGapFilm) {
             return props::case_film(omega, self.p.r_rotor, a, nu, t_c);
         }
         let e = 0.003;

@@ -289,14 +289,14 @@ fn parse_switches(v: &str) -> Vec<String> {
 /// joint (the reference's pump housing has no metal path); `blocks` the
 /// manifold plate part of the main block (500 W/K) and no ball → main block
 /// joint; `emiss` the rig file's emissivity 0.85; `gapfilm` the case film
-/// by the reference's gap law (`like_reference::CASE_GAP_FILM`);
+/// by the reference's gap law (`RefLaw::CaseGapFilm`);
 /// `filmomeganu` the rotating cylinder's film as a function of ω/ν
-/// (`like_reference::CASE_FILM_OMEGA_NU`); `nodrag` no iron-loss drag in
-/// the motor current (`like_reference::NO_IRON_DRAG`); `nofric` and
+/// (`RefLaw::CaseFilmOmegaNu`); `nodrag` no iron-loss drag in
+/// the motor current (`RefLaw::NoIronDrag`); `nofric` and
 /// `nowall` act on the
 /// rig file ([`rig_like_reference`]).
 fn like_reference(p: &mut eha_sim::emulator::params::EmuParams, switches: &[String]) {
-    use eha_sim::emulator::params::like_reference as bits;
+    use eha_sim::emulator::params::RefLaw;
     for s in switches {
         match s.as_str() {
             "split" => p.mech_split = [0.6, 0.15, 0.25],
@@ -313,9 +313,9 @@ fn like_reference(p: &mut eha_sim::emulator::params::EmuParams, switches: &[Stri
                 p.g_ball_block = 0.0;
             }
             "emiss" => p.emissivity = 0.85,
-            "gapfilm" => p.like_reference |= bits::CASE_GAP_FILM,
-            "filmomeganu" => p.like_reference |= bits::CASE_FILM_OMEGA_NU,
-            "nodrag" => p.like_reference |= bits::NO_IRON_DRAG,
+            "gapfilm" => p.like_reference = p.like_reference.with(RefLaw::CaseGapFilm),
+            "filmomeganu" => p.like_reference = p.like_reference.with(RefLaw::CaseFilmOmegaNu),
+            "nodrag" => p.like_reference = p.like_reference.with(RefLaw::NoIronDrag),
             "nofric" | "nowall" => {}
             other => panic!("unknown structural switch `{other}`"),
         }
