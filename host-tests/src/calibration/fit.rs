@@ -388,7 +388,7 @@ pub fn calibrate(base: &Rig, logs: &[CalLog], o: &CalOptions) -> Result<Calibrat
 /// nudge then moved leaky-heavy's headline 0.057 K).
 const POLISH_MAX_ITERS: usize = 8;
 
-/// [`polish`] stops when the predicted decrease of the objective (the
+/// `polish` stops when the predicted decrease of the objective (the
 /// Newton decrement gᵀH⁻¹g, in χ² units of the polish's σ, σ_d √s²; one
 /// unit is one data point off by one σ) falls below this.
 pub const POLISH_TOL: f64 = 0.01;

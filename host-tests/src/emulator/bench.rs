@@ -54,7 +54,7 @@ const LEAKY_HEAVY: &[&str] = &[
 ];
 
 /// A machine with a pump 1.6× the paper's and a bigger motor, other masses,
-/// films and losses ([`BIG_PUMP`]).
+/// films and losses (`BIG_PUMP`).
 pub fn big_pump() -> EmuMachine {
     let mut p = EmuParams::default();
     p.displacement_m3 *= 1.6;
@@ -84,7 +84,7 @@ pub fn big_pump() -> EmuMachine {
 }
 
 /// A machine with a smaller, leakier pump on a faster motor, heavier blocks,
-/// an insulated pump flange and slower probes ([`LEAKY_HEAVY`]).
+/// an insulated pump flange and slower probes (`LEAKY_HEAVY`).
 pub fn leaky_heavy() -> EmuMachine {
     let mut p = EmuParams::default();
     p.displacement_m3 *= 0.8;

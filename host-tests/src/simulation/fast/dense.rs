@@ -64,7 +64,7 @@ pub fn mul_vec<const N: usize>(a: &Mat<N>, x: &[f64; N]) -> [f64; N] {
     y
 }
 
-/// y += a·x, as a sum of columns: y += x_j·a[·][j] runs along y, so the
+/// y += a·x, as a sum of columns: y += x_j·a\[·\]\[j\] runs along y, so the
 /// compiler vectorises it (a row-by-row dot product is one dependent chain
 /// of additions, measured 3× slower on the 12-node network); with AVX2
 /// where the CPU has it, as [`mul`].
@@ -105,7 +105,7 @@ pub fn transpose<const N: usize>(a: &Mat<N>) -> Mat<N> {
 
 /// y += a·x with `cols` = aᵀ (a's columns as rows): the same sums in the
 /// same order as [`mul_vec_add`], but each column is contiguous, so the
-/// column updates y += x_j·a[·][j] are vector operations (measured on the
+/// column updates y += x_j·a\[·\]\[j\] are vector operations (measured on the
 /// 13-node network with AVX2: ~330 → ~130 instructions per product, the
 /// thermal step's nine products per try).
 pub fn mul_vec_add_cols<const N: usize>(cols: &Mat<N>, x: &[f64; N], y: &mut [f64; N]) {
