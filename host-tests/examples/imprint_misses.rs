@@ -1,5 +1,5 @@
-//! Why the diagnosis misses the emulator cases whose imprint ratio r ≥ 2
-//! (issue 37): for one case, the physical-tier baseline and the hidden
+//! Why the diagnosis misses emulator cases whose imprint ratio r ≥ 2 (where
+//! it must name the cause): for one case, the physical-tier baseline and the hidden
 //! effect's own candidate fitted as the diagnosis fits it, from the true
 //! magnitude, with a larger budget, and with variants of the nuisance set;
 //! training and held-out RMSE on the affected channel and pooled.

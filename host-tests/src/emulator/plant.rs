@@ -247,10 +247,10 @@ impl Plant<'_> {
         if !self.p.like_reference.has(RefLaw::CaseGapFilm) {
             return props::case_film(omega, self.p.r_rotor, a, nu, t_c);
         }
+        // the paper rig's 3 mm gap, the reference's Nusselt law itself
         let e = 0.003;
         let ta = omega * omega * (self.p.r_rotor + 0.5 * e) * e.powi(3) / (nu * nu);
-        let nuss = if ta < 1700.0 { 2.0 } else if ta < 1e4 { (0.128 * ta.powf(0.367)).max(2.0) } else { 0.409 * ta.powf(0.241) };
-        nuss * props::oil_k(t_c) / (2.0 * e) * a
+        crate::physics::heat::nu_taylor_couette(ta) * props::oil_k(t_c) / (2.0 * e) * a
     }
 
     /// Pressure drop of the throttle hoses, eq. (10): Darcy friction

@@ -180,7 +180,7 @@ fn slow_commissioning_without_margin_on_foreign_machines() {
 /// 5.98 / 0.18 K) were one build's of an earlier commit; a 1e-9 K nudge of
 /// the logs moves big-pump by 0.17 K on this build
 /// (`slow_commissioning_is_reproducible_at_the_last_digit_big_pump`, which
-/// asserts the issue's 0.05 K and fails here: issue 36 open).
+/// asserts the 0.05 K a reproducible result needs, and fails here).
 #[test]
 #[ignore = "slow tier: two commissionings with margin validation on emulator bench logs (~1 min each)"]
 fn slow_commissioning_with_margin_on_foreign_machines() {

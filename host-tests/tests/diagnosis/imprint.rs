@@ -1,7 +1,7 @@
 //! The seven emulator cases of the 2026-11-27 sweep whose imprint ratio r
 //! (the calibrated baseline's held-out misfit on the affected channel over
-//! the same on the log's effect-free twin) is at least 2, where issue 37
-//! asks the diagnosis to name the cause, each with its twin (same machine,
+//! the same on the log's effect-free twin) is at least 2, where the
+//! diagnosis must name the cause, each with its twin (same machine,
 //! mission and noise, nothing hidden), where it must not name one.
 //! Every assertion is the outcome measured with the third candidate start
 //! (the calibrated baseline with the candidate at its typical magnitude,
