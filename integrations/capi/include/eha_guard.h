@@ -54,12 +54,6 @@
 // Alignment of the storage, bytes.
 #define EHA_GUARD_STORAGE_ALIGN 8
 
-// Command code: clear the latched faults.
-#define EHA_COMMAND_CLEAR 1
-
-// Refill the LNG budget (a new charge installed).
-#define EHA_COMMAND_REFILL 2
-
 // [`eha_record_check`]: no record (no magic): a cold start.
 #define EHA_RECORD_ABSENT 0
 
@@ -68,6 +62,12 @@
 
 // A damaged record (magic present; CRC, version or range bad).
 #define EHA_RECORD_DAMAGED 2
+
+// Command code: clear the latched faults.
+#define EHA_COMMAND_CLEAR 1
+
+// Refill the LNG budget (a new charge installed).
+#define EHA_COMMAND_REFILL 2
 
 // [`EhaSample::valve_feedback`]: no position switch is wired.
 #define EHA_FEEDBACK_NONE -1
@@ -465,6 +465,10 @@ eha_status_t eha_guard_init(void *storage,
                             const eha_boot_t *boot,
                             eha_boot_info_t *info);
 
+// The exact storage this build needs, bytes (at most
+// [`EHA_GUARD_STORAGE_SIZE`]).
+size_t eha_guard_storage_need(void);
+
 // One 10 ms tick with a new sample and the controller's reports (valve
 // position, LNG supply, electrical frequency), in the product loop's
 // order. A sample with a flag out of range is not used: the tick runs as
@@ -527,6 +531,32 @@ eha_status_t eha_guard_record(void *storage, eha_record_write_t *w);
 // As [`eha_guard_tick`]; `record` valid.
 eha_status_t eha_guard_nv_saved(void *storage, const eha_record_t *record, uint8_t saved);
 
+// Classifies a record by the boot rules: `EHA_RECORD_*` (a NULL record
+// is absent).
+//
+// # Safety
+// `record` NULL or valid.
+int32_t eha_record_check(const eha_record_t *record);
+
+// Stamps a record with the battery-backed clock's seconds (before its
+// non-volatile save) and reseals it.
+//
+// # Safety
+// `record` valid for reads and writes.
+eha_status_t eha_record_set_rtc(eha_record_t *record, uint32_t rtc_s);
+
+// The record's byte form (`EHA_RECORD_BYTES` bytes, little-endian).
+//
+// # Safety
+// `record` valid; `out` valid for writes of `out_len` bytes.
+eha_status_t eha_record_to_bytes(const eha_record_t *record, uint8_t *out, size_t out_len);
+
+// A record from its byte form (not checked: see `eha_record_check`).
+//
+// # Safety
+// `bytes` valid for reads of `len` bytes; `record` valid for a write.
+eha_status_t eha_record_from_bytes(const uint8_t *bytes, size_t len, eha_record_t *record);
+
 // Arms a clear or a refill (`EHA_COMMAND_*`): `nonce` receives the nonce
 // the confirmation's key is computed from (`eha_command_key`). A new arm
 // replaces an armed one.
@@ -567,36 +597,6 @@ eha_status_t eha_guard_rig_id(void *storage, uint8_t *out);
 // # Safety
 // As [`eha_guard_tick`]; `ticks` valid for a write.
 eha_status_t eha_guard_ticks(void *storage, uint32_t *ticks);
-
-// Classifies a record by the boot rules: `EHA_RECORD_*` (a NULL record
-// is absent).
-//
-// # Safety
-// `record` NULL or valid.
-int32_t eha_record_check(const eha_record_t *record);
-
-// Stamps a record with the battery-backed clock's seconds (before its
-// non-volatile save) and reseals it.
-//
-// # Safety
-// `record` valid for reads and writes.
-eha_status_t eha_record_set_rtc(eha_record_t *record, uint32_t rtc_s);
-
-// The record's byte form (`EHA_RECORD_BYTES` bytes, little-endian).
-//
-// # Safety
-// `record` valid; `out` valid for writes of `out_len` bytes.
-eha_status_t eha_record_to_bytes(const eha_record_t *record, uint8_t *out, size_t out_len);
-
-// A record from its byte form (not checked: see `eha_record_check`).
-//
-// # Safety
-// `bytes` valid for reads of `len` bytes; `record` valid for a write.
-eha_status_t eha_record_from_bytes(const uint8_t *bytes, size_t len, eha_record_t *record);
-
-// The exact storage this build needs, bytes (at most
-// [`EHA_GUARD_STORAGE_SIZE`]).
-size_t eha_guard_storage_need(void);
 
 // Initialises a deframer in `storage` (`size` bytes, aligned to
 // [`EHA_WIRE_DEFRAMER_ALIGN`]).

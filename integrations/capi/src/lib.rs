@@ -4,8 +4,8 @@
 //! A C firmware links the static library (`libeha_guard_capi.a`, built for
 //! its Cortex-M target) and calls the same Rust code the product image runs,
 //! through a thin shim that only converts types and checks pointers:
-//! - [`guard`]: the guard in caller-owned storage ([`EHA_GUARD_STORAGE_SIZE`]
-//!   bytes aligned to [`EHA_GUARD_STORAGE_ALIGN`]; no allocation), booted from
+//! - [`guard`]: the guard in caller-owned storage ([`EHA_GUARD_STORAGE_SIZE`](guard::EHA_GUARD_STORAGE_SIZE)
+//!   bytes aligned to [`EHA_GUARD_STORAGE_ALIGN`](guard::EHA_GUARD_STORAGE_ALIGN); no allocation), booted from
 //!   the parameter block and the thermal records as the product boots
 //!   (`eha_guard::product::boot_guard`); the tick with the controller's
 //!   reports (`GuardOf::tick_reported`), missed and stalled ticks
