@@ -4,12 +4,15 @@
 
 mod alarm;
 mod crosscheck;
+mod faulted_runs;
 mod lng_credit;
 mod margin;
 mod model_accuracy;
 mod plant;
+mod protection_cases;
 mod protection_props;
 mod rate;
+mod records;
 mod stall;
 mod startup;
 mod untrusted;
