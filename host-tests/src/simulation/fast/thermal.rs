@@ -385,10 +385,11 @@ fn solve_small(m: &mut [[f64; NT]; NT], b: &mut [f64; NT], n: usize) {
         let p = (c..n).max_by(|&i, &j| m[i][c].abs().total_cmp(&m[j][c].abs())).unwrap_or(c);
         m.swap(c, p);
         b.swap(c, p);
+        let pivot = m[c];
         for r in c + 1..n {
-            let f = m[r][c] / m[c][c];
-            for k in c..n {
-                m[r][k] -= f * m[c][k];
+            let f = m[r][c] / pivot[c];
+            for (x, p) in m[r][c..n].iter_mut().zip(&pivot[c..n]) {
+                *x -= f * p;
             }
             b[r] -= f * b[c];
         }
