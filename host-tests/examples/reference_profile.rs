@@ -45,8 +45,8 @@ fn main() {
             p.run(opt.control_interval_s.min(opt.output_interval_s), t_end, |_| Ok(Default::default())).expect("runs");
             let (s, f) = (p.stats(), p.fast_stats());
             println!(
-                "case {key} fast: {} thermal steps ({} rejected), {} model evaluations ({} for {} Jacobians), {} hydraulic steps ({} rejected, {} hydraulic evaluations, {} Jacobians)",
-                s.steps, f.rejected, s.rhs_evals, s.jacobian_evals, s.factorizations, f.hydraulics.steps, f.hydraulics.rejected, f.hydraulics.evals, f.hydraulics.jacobians
+                "case {key} fast: {} thermal steps ({} rejected), {} model evaluations ({} for {} Jacobians, {} drift refreshes), {} hydraulic steps ({} rejected, {} hydraulic evaluations, {} Jacobians)",
+                s.steps, f.rejected, s.rhs_evals, s.jacobian_evals, s.factorizations, f.drifts, f.hydraulics.steps, f.hydraulics.rejected, f.hydraulics.evals, f.hydraulics.jacobians
             );
             let (outer, nu) = p.model().grid_evals();
             println!("case {key} fast: exact evaluations behind the temperature grids: {outer} outer-surface heat flows, {nu} viscosities");

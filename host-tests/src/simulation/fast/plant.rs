@@ -68,6 +68,17 @@ const GROW_ERR_MIN: f64 = 0.01;
 /// ten on Case 2 (errors of 3–18 tolerances: the forcing's slope changes
 /// there). Two levels cost accuracy (Case 2's winding 6.4e-3 → 9.8e-3 K).
 const SWITCH_DROP: i32 = 1;
+/// Largest move of a node temperature, K, since the last thermal Jacobian
+/// or drift refresh after which the Jacobian's drifting columns are taken
+/// anew (`Thermal::drift`: the columns of the nodes that held the step,
+/// one model evaluation each and one at z; the φ-functions stay A's). The
+/// case oil's diagonal grows 4.3× from the start's A to 600 s on Case 1
+/// (viscosity: its gap film and the leakage), treated explicitly that held
+/// the steps by an error growing from step to step. Measured on Case 1
+/// (`docs/reference-speed.md` section 8): 119 → 105 thermal steps, 2.62 →
+/// 2.51 M instructions at 20 K; 30 K the same, a fixed 100 s or 250 s
+/// interval 2.52 / 2.47 M (two refreshes, at 65 s and 250 s, here).
+const DRIFT_MOVE_K: f64 = 20.0;
 
 /// Accuracy and step settings of the multirate scheme.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -130,6 +141,9 @@ pub struct FastStats {
     pub jacobians: u64,
     /// φ-function sets computed from scratch (doublings not counted).
     pub phi_builds: u64,
+    /// Drift refreshes of the thermal Jacobian's drifting columns
+    /// (`DRIFT_MOVE_K`; one model evaluation a column and one more).
+    pub drifts: u64,
     /// Full model evaluations (steps and Jacobian columns).
     pub rhs_evals: u64,
     /// The hydraulic integrator's counters.
@@ -307,6 +321,13 @@ impl FastPlant {
         let mut t_cb = t_start + dt_s;
         let steps_at_start = self.stats.steps;
         let debug = std::env::var_os("FAST_DEBUG").is_some();
+        // The drifting columns (see `DRIFT_MOVE_K`): the nodes that held
+        // the step when a drift refresh was due, and the node that held the
+        // last accepted step.
+        let mut drift_cols: Vec<usize> = Vec::new();
+        let mut last_worst = 0usize;
+        // Temperatures at the last Jacobian or drift refresh.
+        let mut drift_z = th.z;
         'outer: while !ctl.stop && self.t < t_end - 1e-9 {
             while stops.peek().is_some_and(|&s| s <= self.t + 1e-9) {
                 stops.next();
@@ -315,7 +336,7 @@ impl FastPlant {
             if todo.hydraulics && !replay {
                 self.hyd.restart(&self.model, &th.z, self.t, yh, self.opts.h_start_s);
             }
-            if todo.jacobian || todo.fresh || todo.switch.is_some() {
+            if todo.jacobian || todo.fresh || todo.switch.is_some() || todo.drift {
                 let (t, yy) = match todo.switch {
                     Some(ts) if !replay => (ts, self.hyd.at(ts)),
                     _ => (self.t, yh),
@@ -328,8 +349,22 @@ impl FastPlant {
                     ladder.iter_mut().for_each(|p| *p = None);
                     jac_level = level;
                     self.stats.jacobians += 1;
+                    drift_z = th.z;
                 } else {
-                    th.fresh(&mut rates, !todo.fresh);
+                    if todo.fresh || todo.switch.is_some() {
+                        th.fresh(&mut rates, !todo.fresh);
+                    }
+                    if todo.drift {
+                        if !drift_cols.contains(&last_worst) {
+                            drift_cols.push(last_worst);
+                        }
+                        th.drift(&mut rates, &drift_cols);
+                        drift_z = th.z;
+                        self.stats.drifts += 1;
+                        if debug {
+                            eprintln!("drift columns {drift_cols:?} at {:.3}", self.t);
+                        }
+                    }
                 }
             }
             todo = Todo::default();
@@ -424,6 +459,7 @@ impl FastPlant {
                 }
                 continue;
             }
+            last_worst = trial.worst;
             let (t0, z0, f0, e0, q0, yh0) = (self.t, th.z, th.fz, th.e, th.q, yh);
             th.accept(&trial);
             yh = yh1;
@@ -465,6 +501,14 @@ impl FastPlant {
                 if refresh_armed && (level >= jac_level + REFRESH_LEVELS || stalled >= STALL_STEPS) {
                     todo.jacobian = true;
                     refresh_armed = false;
+                }
+                // A node that has moved `DRIFT_MOVE_K` since the last Jacobian
+                // or drift refresh: the drifting columns anew.
+                if !refresh_armed && !th.is_zero() {
+                    let moved = th.z.iter().zip(&drift_z).fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
+                    if moved >= DRIFT_MOVE_K {
+                        todo.drift = true;
+                    }
                 }
             }
             self.write_state(&yh, &th);
@@ -567,6 +611,8 @@ struct Todo {
     hydraulics: bool,
     /// Take f anew on the far side of a branch switch at this time.
     switch: Option<f64>,
+    /// Take the drifting columns of the Jacobian anew (`Thermal::drift`).
+    drift: bool,
 }
 
 fn hyd_error(e: RosError) -> SimError {

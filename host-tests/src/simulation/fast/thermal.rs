@@ -17,6 +17,16 @@
 //!   of the difference of the two, 3/8 + 1/24), and f₁ = f* + A·(z₁ − z*)
 //!   without a second evaluation.
 //!
+//! The drift of A: A is taken once after a start (its φ-functions cost
+//! ~0.26 M instructions anew), and the network's self-derivatives move with
+//! the temperatures (Case 1's case oil: its diagonal 4.3× from the start to
+//! 600 s). Left in g, that difference is explicit, and the steps were held
+//! by its instability, an error growing from step to step at a fixed step.
+//! [`Thermal::drift`] takes a few columns of the Jacobian anew (Â) and keeps
+//! Â − A beside A; the corrector then solves g(z₁) = g* + (Â − A)·(z₁ − z*)
+//! for z₁ (a small system in the drifting columns: z₁ is affine in g*), so
+//! that part is implicit as in an Adams–Moulton corrector, and f₁ takes Â.
+//!
 //! Order 3 rather than 2: a forcing that is quadratic in time (a copper loss
 //! ∝ I² under a steady piston speed) is integrated exactly; the order-2
 //! corrector's error on it has one sign in every step and added up to
@@ -42,6 +52,14 @@ pub const NE: usize = N_STATE - T0 - N_NODES;
 pub trait Rates: FnMut(&[f64; NT], &mut [f64; NT], &mut [f64; NE]) {}
 impl<F: FnMut(&[f64; NT], &mut [f64; NT], &mut [f64; NE])> Rates for F {}
 
+/// h·max_j ‖(Â − A)_j‖₁ below which the drift stays in the explicit g
+/// (the explicit treatment is stable and accurate there, and the implicit
+/// solve costs two products a drifting column; Case 2's steps).
+const DRIFT_GATE: f64 = 0.05;
+/// Fixed-point iterations of the drift on an odd step solved by vectors
+/// (no level matrices for the exact solve), at most.
+const DRIFT_ITERS: u32 = 4;
+
 /// The scheme's state between steps.
 #[derive(Debug, Clone)]
 pub struct Thermal {
@@ -65,6 +83,14 @@ pub struct Thermal {
     pub a_e: [[f64; NT]; NE],
     /// Whether A is zero (no Jacobian taken yet).
     a_zero: bool,
+    /// Â − A by columns (Â a later Jacobian of some columns, the φ-functions
+    /// still of A): the drift the corrector treats implicitly.
+    da_cols: Option<Mat<NT>>,
+    /// The drifting columns (`da_n` of them).
+    da_idx: [usize; NT],
+    da_n: usize,
+    /// Largest ‖(Â − A)_j‖₁ of the kept drift, 1/s.
+    da_norm: f64,
 }
 
 /// A step tried from the current state.
@@ -90,7 +116,7 @@ impl Thermal {
     /// A state at time `t`, temperatures `z` and energies `e` (call
     /// [`Thermal::jacobian`] first).
     pub fn new(t: f64, z: [f64; NT], e: [f64; NE]) -> Self {
-        Self { z, e, fz: [0.0; NT], q: [0.0; NE], t, hist: Vec::with_capacity(3), a: [[0.0; NT]; NT], a_cols: [[0.0; NT]; NT], a_e: [[0.0; NT]; NE], a_zero: true }
+        Self { z, e, fz: [0.0; NT], q: [0.0; NE], t, hist: Vec::with_capacity(3), a: [[0.0; NT]; NT], a_cols: [[0.0; NT]; NT], a_e: [[0.0; NT]; NE], a_zero: true, da_cols: None, da_idx: [0; NT], da_n: 0, da_norm: 0.0 }
     }
 
     /// Whether A is zero (no Jacobian taken yet).
@@ -119,6 +145,8 @@ impl Thermal {
             }
         }
         self.a_cols = transpose(&self.a);
+        self.da_cols = None;
+        self.da_n = 0;
         self.a_zero = self.a.iter().all(|r| r.iter().all(|&x| x == 0.0));
         if keep_history {
             for (_, g, z) in self.hist.iter_mut() {
@@ -130,6 +158,34 @@ impl Thermal {
             self.hist.clear();
         }
         (self.fz, self.q) = (fz, q);
+    }
+
+    /// The columns `cols` of the Jacobian anew by forward differences
+    /// (1 + cols.len() evaluations), kept as Â − A beside A: the φ-functions
+    /// stay those of A, the corrector treats the difference implicitly.
+    pub fn drift(&mut self, rates: &mut impl Rates, cols: &[usize]) {
+        let (mut fz, mut q) = ([0.0; NT], [0.0; NE]);
+        rates(&self.z, &mut fz, &mut q);
+        let (mut fp, mut qp) = ([0.0; NT], [0.0; NE]);
+        let mut da = self.da_cols.unwrap_or([[0.0; NT]; NT]);
+        for &j in cols {
+            let mut zp = self.z;
+            let d = 1e-5 * (1.0 + self.z[j].abs());
+            zp[j] += d;
+            rates(&zp, &mut fp, &mut qp);
+            for i in 0..NT {
+                da[j][i] = (fp[i] - fz[i]) / d - self.a[i][j];
+            }
+            for i in 0..NE {
+                self.a_e[i][j] = (qp[i] - q[i]) / d;
+            }
+            if !self.da_idx[..self.da_n].contains(&j) {
+                self.da_idx[self.da_n] = j;
+                self.da_n += 1;
+            }
+        }
+        self.da_norm = da.iter().map(|c| c.iter().map(|x| x.abs()).sum::<f64>()).fold(0.0, f64::max);
+        self.da_cols = Some(da);
     }
 
     /// f anew at z (the forcing changed: a breakpoint, the far side of a
@@ -199,9 +255,66 @@ impl Thermal {
         }
         pts[m] = (0.0, g0);
         pts[m + 1] = (h, &gp);
-        let z1 = self.linear(phi, h, g0, &derivatives(&pts[..m + 2]));
+        let mut z1 = self.linear(phi, h, g0, &derivatives(&pts[..m + 2]));
+        if let Some(da) = self.da_cols.as_ref().filter(|_| h * self.da_norm >= DRIFT_GATE) {
+            // The corrector with g at its end linear in the drift:
+            // g(z₁) = g* + (Â − A)·(z₁ − z*). z₁ is affine in g*: a change δ
+            // of it moves z₁ by M·δ, M = c₁·h·Φ₂ + c₂·h²·Φ₃ (c₁, c₂ the
+            // weights of the end point in g', g''); with δ = Σ_k (Â − A)_k·dz_k
+            // over the drifting columns k, a k×k system.
+            let n = self.da_n;
+            let (c1, c2) = end_weights(&pts[..m + 2]);
+            let exact = self.a_zero || phi.is_some();
+            if exact {
+                let mut w = [[0.0; NT]; NT];
+                for k in 0..n {
+                    let v = &da[self.da_idx[k]];
+                    match phi {
+                        Some(p) if !self.a_zero => {
+                            mul_vec_add_cols(&p.cols[1], &v.map(|x| x * h * c1), &mut w[k]);
+                            mul_vec_add_cols(&p.cols[2], &v.map(|x| x * h * h * c2), &mut w[k]);
+                        }
+                        _ => {
+                            let s = h * h * c1 / 2.0 + h * h * h * c2 / 6.0;
+                            w[k] = v.map(|x| x * s);
+                        }
+                    }
+                }
+                let mut mat = [[0.0; NT]; NT];
+                let mut x = [0.0; NT];
+                for r in 0..n {
+                    for c in 0..n {
+                        mat[r][c] = f64::from(u8::from(r == c)) - w[c][self.da_idx[r]];
+                    }
+                    x[r] = z1[self.da_idx[r]] - zp[self.da_idx[r]];
+                }
+                solve_small(&mut mat, &mut x, n);
+                for k in 0..n {
+                    for i in 0..NT {
+                        z1[i] += w[k][i] * x[k];
+                    }
+                }
+            } else {
+                for _ in 0..DRIFT_ITERS {
+                    let dz: [f64; NT] = std::array::from_fn(|i| z1[i] - zp[i]);
+                    let c = mul_vec_cols(da, &dz);
+                    let ge: [f64; NT] = std::array::from_fn(|i| gp[i] + c[i]);
+                    let mut pe = pts;
+                    pe[m + 1] = (h, &ge);
+                    let zn = self.linear(phi, h, g0, &derivatives(&pe[..m + 2]));
+                    let moved = zn.iter().zip(&z1).fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
+                    z1 = zn;
+                    if moved < 1e-9 {
+                        break;
+                    }
+                }
+            }
+        }
         let dz: [f64; NT] = std::array::from_fn(|i| z1[i] - zp[i]);
-        let adz = mul_vec_cols(&self.a_cols, &dz);
+        let mut adz = mul_vec_cols(&self.a_cols, &dz);
+        if let Some(da) = &self.da_cols {
+            mul_vec_add_cols(da, &dz, &mut adz);
+        }
         let f1 = std::array::from_fn(|i| fp[i] + adz[i]);
         let q1 = std::array::from_fn(|i| qp[i] + self.a_e[i].iter().zip(&dz).map(|(p, q)| p * q).sum::<f64>());
         let milne = if m == 1 { 10.0 } else { 6.0 };
@@ -250,4 +363,39 @@ fn derivatives(pts: &[(f64, &[f64; NT])]) -> ([f64; NT], [f64; NT]) {
         _ => {}
     }
     (d1, d2)
+}
+
+/// The weights of the last point's value in g' and g'' at s = 0 of
+/// [`derivatives`].
+fn end_weights(pts: &[(f64, &[f64; NT])]) -> (f64, f64) {
+    match pts {
+        [(x0, _), (x1, _)] => (1.0 / (x1 - x0), 0.0),
+        [(x0, _), (x1, _), (x2, _)] => {
+            let d = 1.0 / ((x2 - x1) * (x2 - x0));
+            (-(x0 + x1) * d, 2.0 * d)
+        }
+        _ => (0.0, 0.0),
+    }
+}
+
+/// Solves the leading n×n system m·x = b in place (Gaussian elimination
+/// with partial pivoting; b becomes x).
+fn solve_small(m: &mut [[f64; NT]; NT], b: &mut [f64; NT], n: usize) {
+    for c in 0..n {
+        let p = (c..n).max_by(|&i, &j| m[i][c].abs().total_cmp(&m[j][c].abs())).unwrap_or(c);
+        m.swap(c, p);
+        b.swap(c, p);
+        let pivot = m[c];
+        for r in c + 1..n {
+            let f = m[r][c] / pivot[c];
+            for (x, p) in m[r][c..n].iter_mut().zip(&pivot[c..n]) {
+                *x -= f * p;
+            }
+            b[r] -= f * b[c];
+        }
+    }
+    for c in (0..n).rev() {
+        let s: f64 = (c + 1..n).map(|k| m[c][k] * b[k]).sum();
+        b[c] = (b[c] - s) / m[c][c];
+    }
 }
