@@ -128,13 +128,13 @@ fn report(m: &EmuMachine, c: &Commissioning, secs: f64) {
     }
 }
 
-/// Tolerance on a measured headline number, K: a 1e-9 K nudge of every
-/// temperature moved them by 0.031 K on leaky-heavy and 0.172 K on
-/// big-pump (`slow_commissioning_is_reproducible_at_the_last_digit_*`,
-/// this build); the commissioning is not converged to better than that
-/// (the polish stops after 8 steps with a predicted decrease of a few units
-/// of χ²). Big-pump's spread is above this tolerance: on another build its
-/// numbers may fall outside it (one did: margin 2.115 against 2.290 K).
+/// Tolerance on a measured headline number, K: the commissioning is not
+/// converged to better than that (the polish stalls after 8 steps with a
+/// predicted decrease of tens of units of χ²). Big-pump's spread under a
+/// 1e-9 K nudge of every temperature is far above it (0.51 K with the
+/// structural freedoms, 0.17 K before them:
+/// `slow_commissioning_is_reproducible_at_the_last_digit_big_pump`): on
+/// another build its numbers may fall outside this tolerance.
 const AS_MEASURED_K: f64 = 0.15;
 
 fn near(what: &str, got: f64, measured: f64) {
@@ -249,15 +249,21 @@ fn one_operating_point_is_refused_with_log_region_channel_and_bench_run() {
 
 /// Every temperature of every log moved by 1e-9 K: the headline numbers
 /// (held-out max |e| and under-prediction of the flashed path, margin) move
-/// by at most 0.05 K. Measured with the calibration's final polish
-/// (Gauss–Newton with the priors, data σ inflated by the reduced χ²) and
-/// its basin check of the ball-valve film/capacity pair
-/// (`fit::polish_basins`): leaky-heavy 0.031 K, a pass (both runs in the
-/// ×0.5 basin; 0.10 K before the check, the nudged LM in the other basin:
-/// film ×3.28 → ×0.58, capacity ×2.46 → ×0.46). big-pump 0.172 K on
-/// this build (margin 2.290 → 2.118 K; the same without the basin check,
-/// which is not taken there; 0.039 K on an earlier build): a miss,
-/// asserted as the bound.
+/// by at most 0.05 K. Trained as the procedure prescribes
+/// (`commissioning_set`), the structural freedoms fitted. Measured on
+/// big-pump: **0.509 K, a miss** asserted as the bound (margin 1.276 →
+/// 1.300 K; the direct path flashed in both; the mix's under-prediction
+/// 0.404 → 0.913 K). Why: the calibration's polish stalls (a damped step
+/// that lowers nothing) at different points: 1483.4 after 8 steps on the
+/// original logs, 1455.7 still falling on the nudged ones, the case film
+/// pair moving along its product (film ×0.18 / churn ×83 against ×0.39 /
+/// ×51), with cap_case_oil 1.50 / 2.01, cap_pump 1.07 / 1.44,
+/// friction_case 0.90 / 1.22, film_port 0.92 / 1.73; and the direct fit's
+/// screening frees `loss_speed` (0.31) on one and holds it on the other.
+/// With 24 polish steps (`CalOptions::polish_iters`, `EXP_POLISH_ITERS=24`)
+/// the original still stalls at step 8 (1483.4), the nudged at step 14
+/// (1447.8): 0.515 K. Leaky-heavy with the structure: not re-run (0.031 K
+/// with the set before it, the earlier bench logs).
 #[test]
 #[ignore = "slow tier: two commissionings with margin validation and the direct path (~2 min)"]
 fn slow_commissioning_is_reproducible_at_the_last_digit_big_pump() {
