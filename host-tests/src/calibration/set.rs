@@ -109,6 +109,14 @@ pub const PROBE_SURFACE: [&str; 4] = ["probe_surface_motor", "probe_surface_pump
 /// wants the set as it was before them holds these.
 pub const STRUCTURAL: [&str; 6] = [FRICTION_CASE, FRICTION_SPEED, PROBE_SURFACE[0], PROBE_SURFACE[1], PROBE_SURFACE[2], PROBE_SURFACE[3]];
 
+/// The probe offsets need the drain thermocouple (`Needs::Sensor(t_drain_c)`;
+/// their own surface sensor too, without which the screening holds them:
+/// the offset then acts on nothing). Without the case oil's temperature the
+/// pump probe's offset trades with the pump's heat paths (measured on the rig
+/// emulator's nominal machine, no drain: pump probe 10.7 %, block 18.3 %,
+/// held-out pooled RMSE 0.84 -> 0.95 K); so the diagnosis, whose channels
+/// have no drain, does not fit them.
+///
 /// The probe offsets' θ: the fraction towards ambient is ln θ (θ = 1 on
 /// the metal), as [`CASE_CHURN_SPEED`]'s exponent is.
 const PROBE_WHY: &str = "a thermocouple cemented or clamped on a painted housing reads between its metal and the air: its junction's contact conductance against the leads' and the boundary layer's (a few W/(m·K) of lead in still air) puts it 1–10 % of metal − ambient towards the air, more on a shielded or lagged mount; slightly negative would be a probe pressed into a hotter spot than the lumped metal. Fraction ln θ within −0.05…+0.18, σ 0.05 on it (a well-mounted probe reads within 5 %)";
@@ -407,8 +415,8 @@ pub const PARAMS: [ParamDef; 30] = [
         lo: 0.95, hi: 1.2, prior_sigma_ln: 0.05,
         centre: "on its metal (fraction 0): the rig file has no probe model",
         why: PROBE_WHY,
-        needs: Needs::Sensor(Channel::TMotorC),
-        excitation: "the housing tens of kelvin above the air and the air moving (a soak, a cool-down): the offset scales with metal − ambient, a film or capacity does not",
+        needs: Needs::Sensor(Channel::TDrainC),
+        excitation: "the housing tens of kelvin above the air and the air moving (a soak, a cool-down), its own surface sensor logged beside a drain thermocouple (t_drain_c): the offset scales with metal − ambient, a film or capacity does not",
         stage: Stage::Thermal,
     },
     ParamDef {
@@ -418,8 +426,8 @@ pub const PARAMS: [ParamDef; 30] = [
         lo: 0.95, hi: 1.2, prior_sigma_ln: 0.05,
         centre: "on its metal (fraction 0): the rig file has no probe model",
         why: PROBE_WHY,
-        needs: Needs::Sensor(Channel::TPumpC),
-        excitation: "the housing tens of kelvin above the air and the air moving (a soak, a cool-down): the offset scales with metal − ambient, a film or capacity does not",
+        needs: Needs::Sensor(Channel::TDrainC),
+        excitation: "the housing tens of kelvin above the air and the air moving (a soak, a cool-down), its own surface sensor logged beside a drain thermocouple (t_drain_c): the offset scales with metal − ambient, a film or capacity does not",
         stage: Stage::Thermal,
     },
     ParamDef {
@@ -429,8 +437,8 @@ pub const PARAMS: [ParamDef; 30] = [
         lo: 0.95, hi: 1.2, prior_sigma_ln: 0.05,
         centre: "on its metal (fraction 0): the rig file has no probe model",
         why: PROBE_WHY,
-        needs: Needs::Sensor(Channel::TBlockC),
-        excitation: "the housing tens of kelvin above the air and the air moving (a soak, a cool-down): the offset scales with metal − ambient, a film or capacity does not",
+        needs: Needs::Sensor(Channel::TDrainC),
+        excitation: "the housing tens of kelvin above the air and the air moving (a soak, a cool-down), its own surface sensor logged beside a drain thermocouple (t_drain_c): the offset scales with metal − ambient, a film or capacity does not",
         stage: Stage::Thermal,
     },
     ParamDef {
@@ -440,8 +448,8 @@ pub const PARAMS: [ParamDef; 30] = [
         lo: 0.95, hi: 1.2, prior_sigma_ln: 0.05,
         centre: "on its metal (fraction 0): the rig file has no probe model",
         why: PROBE_WHY,
-        needs: Needs::Sensor(Channel::TBallvalveC),
-        excitation: "the housing tens of kelvin above the air and the air moving (a soak, a cool-down): the offset scales with metal − ambient, a film or capacity does not",
+        needs: Needs::Sensor(Channel::TDrainC),
+        excitation: "the housing tens of kelvin above the air and the air moving (a soak, a cool-down), its own surface sensor logged beside a drain thermocouple (t_drain_c): the offset scales with metal − ambient, a film or capacity does not",
         stage: Stage::Thermal,
     },
 ];

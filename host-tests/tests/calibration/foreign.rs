@@ -262,8 +262,14 @@ fn one_operating_point_is_refused_with_log_region_channel_and_bench_run() {
 /// screening frees `loss_speed` (0.31) on one and holds it on the other.
 /// With 24 polish steps (`CalOptions::polish_iters`, `EXP_POLISH_ITERS=24`)
 /// the original still stalls at step 8 (1483.4), the nudged at step 14
-/// (1447.8): 0.515 K. Leaky-heavy with the structure: not re-run (0.031 K
-/// with the set before it, the earlier bench logs).
+/// (1447.8): 0.515 K. Leaky-heavy: **0.226 K, a miss** (0.031 K with the set
+/// before the freedoms, on the earlier bench logs): the flashed path flips
+/// from the reduction (margin 1.301 K, mix 2.28 / 0.37 K) to the direct
+/// path (1.164 K, 2.31 / 0.59 K). The original took the basin check's
+/// reflected ball-valve pair (film ×2.14 / capacity ×1.16, objective 1342.7
+/// against LM's 1490.3), the nudged LM's (×0.99 / ×0.59, 1386.7 against
+/// 1398.9); the case film pair moved along its product as on big-pump
+/// (×0.22 / ×69 against ×0.52 / ×30). Neither polish converged.
 #[test]
 #[ignore = "slow tier: two commissionings with margin validation and the direct path (~2 min)"]
 fn slow_commissioning_is_reproducible_at_the_last_digit_big_pump() {
