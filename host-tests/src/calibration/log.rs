@@ -73,9 +73,40 @@ impl CalLog {
         let mut s = Series::new();
         for &ch in &self.channels {
             let v = out.sample(ch.name(), &self.run.time_s);
-            s.insert(ch, v.ok_or_else(|| format!("model has no channel {}", ch.name()))?);
+            let mut v = v.ok_or_else(|| format!("model has no channel {}", ch.name()))?;
+            let f = surface_probe_fraction(rig, ch);
+            if f != 0.0 {
+                let amb = self.ambient_at_rows().ok_or_else(|| format!("{}: no ambient to read the surface probes against", self.name))?;
+                for (x, a) in v.iter_mut().zip(amb) {
+                    *x -= f * (*x - a);
+                }
+            }
+            s.insert(ch, v);
         }
         Ok(s)
+    }
+
+    /// The replayed ambient (°C) at every row of the log.
+    fn ambient_at_rows(&self) -> Option<Vec<f64>> {
+        let r = self.replay_inputs()?;
+        let (ts, amb) = (&r.time_s, &r.ambient_c);
+        if ts.is_empty() || ts.len() != amb.len() {
+            return None;
+        }
+        Some(
+            self.run
+                .time_s
+                .iter()
+                .map(|&t| {
+                    let i = ts.partition_point(|&x| x <= t);
+                    match (i.checked_sub(1), ts.get(i)) {
+                        (Some(j), Some(&t1)) if t1 > ts[j] => amb[j] + (amb[i] - amb[j]) * (t - ts[j]) / (t1 - ts[j]),
+                        (Some(j), _) => amb[j],
+                        (None, _) => amb[0],
+                    }
+                })
+                .collect(),
+        )
     }
 
     /// Residuals (simulated − measured, K) at the fit points.
@@ -98,6 +129,19 @@ impl CalLog {
     /// Whether the log carries channel `ch`.
     pub fn has(&self, ch: Channel) -> bool {
         self.channels.contains(&ch)
+    }
+}
+
+/// The fraction towards ambient at which `rig` reads surface channel `ch`
+/// ([`crate::rig::SurfaceProbes`]); 0 for every other channel.
+pub fn surface_probe_fraction(rig: &Rig, ch: Channel) -> f64 {
+    let p = &rig.probes;
+    match ch {
+        Channel::TMotorC => p.motor,
+        Channel::TPumpC => p.pump,
+        Channel::TBlockC => p.main_block,
+        Channel::TBallvalveC => p.ball_block,
+        _ => 0.0,
     }
 }
 

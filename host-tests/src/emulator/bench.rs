@@ -196,3 +196,17 @@ pub fn bench_set(machine: &EmuMachine, seed: u64) -> Result<BenchSet, String> {
         ],
     })
 }
+
+/// The logs of `machine` as the commissioning procedure prescribes them
+/// (docs/commissioning.md, "What the user runs"): the speed-then-needle
+/// steps and a soak followed by low-speed holds
+/// ([`EmuScenario::SoakThenLowSpeedHolds`], which holds the pump below 100
+/// rpm so that the case film's speed law is fitted). Held out: the same
+/// servo and throttle-mix logs as [`bench_set`] (same seeds, unchanged).
+pub fn commissioning_set(machine: &EmuMachine, seed: u64) -> Result<BenchSet, String> {
+    let b = bench_set(machine, seed)?;
+    Ok(BenchSet {
+        train: vec![b.train[0].clone(), bench_log(machine, EmuScenario::SoakThenLowSpeedHolds, 1800.0, seed + 1)?],
+        holdout: b.holdout,
+    })
+}

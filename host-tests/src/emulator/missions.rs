@@ -40,6 +40,14 @@ pub enum EmuScenario {
     /// A throttle mix: speed (400–1200 rpm) and needle (10–60 bar) drawn
     /// afresh together at every step, every 90–200 s.
     ThrottleMix,
+    /// The commissioning procedure's second throttle run
+    /// (docs/commissioning.md): a soak (600–800 rpm at 40–55 bar) for half
+    /// the run, then holds of 150–250 s alternating between a low speed
+    /// (20–90 rpm, needle set for 30–50 bar: the pump making up little more
+    /// than its leakage, as in a servo's hold) and idle (300 rpm, needle
+    /// open to 5 bar), starting low. The low holds give the case film's
+    /// speed law a drain record near rest.
+    SoakThenLowSpeedHolds,
 }
 
 impl EmuScenario {
@@ -158,6 +166,17 @@ pub fn draw(scenario: EmuScenario, duration_s: f64, rng: &mut impl Rng) -> EmuMi
             let soak = 0.6 * d;
             m.speed = vec![(0.0, rng.random_range(600.0..800.0)), (soak, 300.0)];
             m.dp_bar = vec![(0.0, rng.random_range(40.0..55.0)), (soak, 5.0)];
+        }
+        EmuScenario::SoakThenLowSpeedHolds => {
+            let soak = 0.5 * d;
+            m.speed = vec![(0.0, rng.random_range(600.0..800.0))];
+            m.dp_bar = vec![(0.0, rng.random_range(40.0..55.0))];
+            let holds = steps(rng, d - soak, 150.0, 250.0, |_, _| 0.0);
+            for (k, &(t, _)) in holds.iter().enumerate() {
+                let (w, dp) = if k % 2 == 0 { (rng.random_range(20.0..90.0), rng.random_range(30.0..50.0)) } else { (300.0, 5.0) };
+                m.speed.push((soak + t, w));
+                m.dp_bar.push((soak + t, dp));
+            }
         }
         EmuScenario::ThrottleMix => {
             let times = steps(rng, d, 90.0, 200.0, |_, _| 0.0);

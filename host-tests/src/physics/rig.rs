@@ -177,15 +177,31 @@ pub struct FrictionPairs {
     pub slipper_swash: f64,
     /// Valve-plate share (assumed 0.2).
     pub valve_plate: f64,
+    /// Factor on the case oil's share of the rule above (the delivered oil's
+    /// and the housing's scaled down together so that the shares still add
+    /// up to 1): the leakage through the piston and slipper gaps carries
+    /// their films' heat into the case, which the rule does not count.
+    /// 1: the rule alone (the rig file; calibrated by `friction_case` from a
+    /// drain thermocouple).
+    #[serde(default = "one")]
+    pub case_share_scale: f64,
 }
 
 impl FrictionPairs {
     /// Shares of the C_v and C_p friction heat that enter (delivered oil,
-    /// case oil, housing metal); they add up to 1.
+    /// case oil, housing metal); they add up to 1. The case oil's share of
+    /// the pairs' rule times [`FrictionPairs::case_share_scale`] (at most
+    /// 0.95).
     pub fn shares(&self) -> (f64, f64, f64) {
         let sum = self.piston_bore + self.slipper_swash + self.valve_plate;
         let (p, s, v) = (self.piston_bore / sum, self.slipper_swash / sum, self.valve_plate / sum);
-        (p + 0.5 * v, 0.5 * s, 0.5 * s + 0.5 * v)
+        let (del, case, metal) = (p + 0.5 * v, 0.5 * s, 0.5 * s + 0.5 * v);
+        if self.case_share_scale == 1.0 {
+            return (del, case, metal);
+        }
+        let case_k = (case * self.case_share_scale).min(0.95);
+        let rest = (1.0 - case_k) / (1.0 - case);
+        (del * rest, case_k, metal * rest)
     }
 }
 
@@ -439,6 +455,37 @@ impl Outside {
     }
 }
 
+/// Where each surface thermocouple sits between its metal and the ambient
+/// air: the reading is `T_metal − f·(T_metal − T_ambient)` (a probe cemented
+/// or clamped on a housing, its leads and the air around it, reads part of
+/// the way towards the air). 0: the probe reads its metal (the rig file).
+/// A measurement model of the logged surface channels only: the reference's
+/// node temperatures and the firmware model do not change. Calibrated by
+/// the `probe_surface_*` parameters (`calibration::set`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SurfaceProbes {
+    /// Motor housing probe (Point 1, `t_motor_c`), fraction towards ambient.
+    #[serde(default)]
+    pub motor: f64,
+    /// Pump housing probe (Point 3, `t_pump_c`), fraction towards ambient.
+    #[serde(default)]
+    pub pump: f64,
+    /// Main valve block probe (Point 4, `t_block_c`), fraction towards ambient.
+    #[serde(default)]
+    pub main_block: f64,
+    /// Ball-valve block probe (Point 5, `t_ballvalve_c`), fraction towards ambient.
+    #[serde(default)]
+    pub ball_block: f64,
+}
+
+impl SurfaceProbes {
+    /// Whether every probe reads its metal (nothing to write in a rig file).
+    pub fn is_zero(&self) -> bool {
+        *self == SurfaceProbes::default()
+    }
+}
+
 /// Nuisance multipliers: the parameters a thermal engineer does not know on a
 /// new rig. All 1 in the paper rig. The diagnosis calibrates them.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -566,6 +613,10 @@ pub struct Rig {
     pub lng: Lng,
     /// Nuisance multipliers.
     pub nuisance: Nuisance,
+    /// Surface probes' reading towards ambient (a measurement model; zero:
+    /// on their metal).
+    #[serde(default, skip_serializing_if = "SurfaceProbes::is_zero")]
+    pub probes: SurfaceProbes,
     /// Model extensions.
     #[serde(default)]
     pub ext: Extensions,
@@ -614,7 +665,7 @@ impl Default for Rig {
                 eta_m: 0.443_590,
                 no_load_torque_nm: 0.3,
                 viscous_torque_coeff: 5.0e4,
-                friction_pairs: FrictionPairs { piston_bore: 0.5, slipper_swash: 0.3, valve_plate: 0.2 },
+                friction_pairs: FrictionPairs { piston_bore: 0.5, slipper_swash: 0.3, valve_plate: 0.2, case_share_scale: 1.0 },
                 split: None,
                 mass_kg: 20.0,
                 cp: 460.0,
@@ -678,6 +729,7 @@ impl Default for Rig {
             joints: None,
             lng: Lng::default(),
             nuisance: Nuisance { outer_scale: 1.0, inner_scale: 1.0, metal_capacity_scale: 1.0, oil_capacity_scale: 1.0 },
+            probes: SurfaceProbes::default(),
             ext: Extensions::default(),
             uncertain: Uncertain::paper_ranges(),
         }
@@ -754,6 +806,16 @@ impl Rig {
         for (name, v) in positive {
             if !(v.is_finite() && v > 0.0) {
                 return Err(RigError::Invalid(name, format!("must be > 0, got {v}")));
+            }
+        }
+        let cs = self.pump.friction_pairs.case_share_scale;
+        if !(cs.is_finite() && cs > 0.0) {
+            return Err(RigError::Invalid("pump.friction_pairs.case_share_scale", format!("must be > 0 (1: the sliding-pair rule alone), got {cs}")));
+        }
+        let pr = self.probes;
+        for (name, f) in [("probes.motor", pr.motor), ("probes.pump", pr.pump), ("probes.main_block", pr.main_block), ("probes.ball_block", pr.ball_block)] {
+            if !(f.is_finite() && (-0.5..0.5).contains(&f)) {
+                return Err(RigError::Invalid(name, format!("must be within -0.5..0.5 (the fraction of metal − ambient the probe reads towards ambient; 0: on the metal), got {f}")));
             }
         }
         if !(self.pump.case_churn.is_finite() && self.pump.case_churn > 0.0) {

@@ -8,7 +8,7 @@ use eha_sim::calibration::commission::{check_reduced_with, commission, commissio
 use eha_sim::calibration::paths::PathKind;
 use eha_sim::calibration::ident::{case_film_speed_range, drain_time_low_and_high_speed_s};
 use eha_sim::calibration::{CalLog, CalOptions};
-use eha_sim::emulator::bench::{bench_log, bench_set, big_pump, leaky_heavy, machines, BenchLog, EmuMachine};
+use eha_sim::emulator::bench::{bench_log, bench_set, commissioning_set, big_pump, leaky_heavy, machines, BenchLog, EmuMachine};
 use eha_sim::emulator::missions::EmuScenario;
 use eha_sim::measured::Channel;
 
@@ -48,6 +48,24 @@ fn bench_logs_carry_the_drain_thermocouple() {
                 assert!(top > 45.0, "{}: drain max {top:.1} °C", l.name);
             }
         }
+    }
+}
+
+/// The commissioning procedure's training set (`commissioning_set`: the
+/// soak log's idle replaced by low-speed holds) frees the churned case
+/// film's speed law; its held-out logs are `bench_set`'s.
+#[test]
+fn commissioning_set_frees_the_case_film_speed_law() {
+    for m in machines() {
+        let s = commissioning_set(&m, 3600).expect("bench");
+        let train: Vec<CalLog> = s.train.iter().map(cal).collect();
+        let (low, high) = drain_time_low_and_high_speed_s(&train);
+        let l = &s.train[1];
+        let t = l.truth.get(Channel::TDrainC).expect("truth");
+        let top = t.iter().flatten().copied().fold(f64::MIN, f64::max);
+        eprintln!("{}: training drain logs {low:.0} s below 100 rpm, {high:.0} s above 300 rpm; {} drain max {top:.1} °C", m.name, l.name);
+        assert!(case_film_speed_range(&train), "{}: the churned case film not freed", m.name);
+        assert!(top > 45.0, "{}: drain max {top:.1} °C", m.name);
     }
 }
 
@@ -110,13 +128,13 @@ fn report(m: &EmuMachine, c: &Commissioning, secs: f64) {
     }
 }
 
-/// Tolerance on a measured headline number, K: a 1e-9 K nudge of every
-/// temperature moved them by 0.031 K on leaky-heavy and 0.172 K on
-/// big-pump (`slow_commissioning_is_reproducible_at_the_last_digit_*`,
-/// this build); the commissioning is not converged to better than that
-/// (the polish stops after 8 steps with a predicted decrease of a few units
-/// of χ²). Big-pump's spread is above this tolerance: on another build its
-/// numbers may fall outside it (one did: margin 2.115 against 2.290 K).
+/// Tolerance on a measured headline number, K: the commissioning is not
+/// converged to better than that (the polish stalls after 8 steps with a
+/// predicted decrease of tens of units of χ²). Big-pump's spread under a
+/// 1e-9 K nudge of every temperature is far above it (0.51 K with the
+/// structural freedoms, 0.17 K before them:
+/// `slow_commissioning_is_reproducible_at_the_last_digit_big_pump`): on
+/// another build its numbers may fall outside this tolerance.
 const AS_MEASURED_K: f64 = 0.15;
 
 fn near(what: &str, got: f64, measured: f64) {
@@ -124,20 +142,24 @@ fn near(what: &str, got: f64, measured: f64) {
 }
 
 /// The reduction path without the margin (no validation, no direct
-/// path), on both machines. Measured (held-out servo, throttle mix;
-/// firmware drain vs the thermocouple, max |e| / under-prediction):
-/// big-pump flashable, 2.25 / 2.25 K and 3.87 / 2.29 K; leaky-heavy
-/// refused, the six-state model 0.626 K off the commissioned reference on
-/// the servo log, 3.10 / 3.10 K and 2.44 / 2.44 K. The training logs
-/// themselves are missed too (big-pump soak then idle: 2.7 K under, in the
-/// idle phase): the commissioned reference does not follow these machines'
-/// drain, the reduction does (≤ 0.2 K on every throttle log).
+/// path), on both machines, trained as the commissioning procedure
+/// prescribes (`commissioning_set`: the speed-then-needle steps and a soak
+/// followed by low-speed holds), every structural freedom of the set fitted
+/// (the churned case film, `friction_case` with `friction_speed`,
+/// `probe_surface_*`). Measured (held-out servo, throttle mix; firmware
+/// drain vs the thermocouple, max |e| / under-prediction): big-pump 0.814 /
+/// 0.691 K and 1.590 / 1.590 K, leaky-heavy 1.065 / 1.065 K and 1.667 /
+/// 1.667 K (the set before the freedoms, on the two throttle logs: 2.25 /
+/// 2.25 and 3.87 / 2.29 K; 3.10 / 3.10 and 2.44 / 2.44 K). Both refused:
+/// the six-state model departs from the commissioned reference on the
+/// servo log by 0.464 K (big-pump) and 1.053 K (leaky-heavy), bound 0.2 K.
+/// The misses stay asserted as measured: the structure does not close them.
 #[test]
 #[ignore = "slow tier: two commissionings on emulator bench logs (~40 s each)"]
 fn slow_commissioning_without_margin_on_foreign_machines() {
-    let measured = [(true, [(2.246, 2.246), (3.866, 2.292)]), (false, [(3.095, 3.095), (2.441, 2.441)])];
+    let measured = [(false, [(0.814, 0.691), (1.590, 1.590)]), (false, [(1.065, 1.065), (1.667, 1.667)])];
     for (m, (flash, want)) in machines().into_iter().zip(measured) {
-        let s = bench_set(&m, 3600).expect("bench");
+        let s = commissioning_set(&m, 3600).expect("bench");
         let train: Vec<CalLog> = s.train.iter().map(cal).collect();
         let hold: Vec<CalLog> = s.holdout.iter().map(cal).collect();
         let t0 = std::time::Instant::now();
@@ -154,39 +176,38 @@ fn slow_commissioning_without_margin_on_foreign_machines() {
 
 /// Commissioning as the user runs it: both paths (the reduction, the
 /// direct identification), each with its drain margin validated on a split
-/// of the training missions, and the safer on the held-out logs flashed.
-/// The acceptance is 1.0 K max |e| and ≤ 0.3 K under-prediction on
-/// the held-out logs with the margin counted. Measured at 4783c7b (max |e|
-/// / under vs the thermocouple, margin counted; servo, throttle mix):
-/// - big-pump: reduction chosen (the direct path under-predicts by 1.34 K
-///   with its 0.89 K margin); margin 2.29 K (after the split the soak log's
-///   idle phase is under-predicted by 2.09 K); 2.48 / 0.00 K and 6.04 /
-///   0.02 K: the under-prediction bound met, max |e| not. Direct path:
-///   1.34 / 1.34 K and 2.37 / 1.31 K.
-/// - leaky-heavy: reduction chosen (the direct path under-predicts by
-///   2.20 K with its 1.09 K margin, although the split preferred it, 2.04 K
-///   against 2.52 K); margin 2.52 K; 2.75 / 0.55 K and 3.47 / 0.00 K;
-///   refused for the reduction (0.567 K off the reference on the servo
-///   log), written only with `--accept-with-margin`.
-/// - Cost on the throttle mix (open loop): valve open 1488 → 1511 s, LNG
-///   3.01 → 3.07 kg (big-pump); 1541 → 1562 s, 1.94 → 1.97 kg
+/// of the training missions, and the safer on the held-out logs flashed;
+/// trained as the procedure prescribes (`commissioning_set`), the set's
+/// structural freedoms fitted. The acceptance is 1.0 K max |e| and
+/// ≤ 0.3 K under-prediction on the held-out logs with the margin counted.
+/// Measured (max |e| / under vs the thermocouple, margin counted; servo,
+/// throttle mix):
+/// - big-pump: direct path chosen (neither within 0.3 K under; the
+///   reduction under-predicts the mix by 0.65 K with its 0.94 K margin,
+///   the direct path by 0.40 K with its 1.28 K); 2.08 / 0.00 K and
+///   2.72 / 0.40 K (reduction: 1.75 / 0.00 and 1.86 / 0.65 K). Flashable.
+/// - leaky-heavy: reduction chosen, margin 1.30 K; 2.02 / 0.00 K and
+///   2.28 / 0.37 K (direct: 1.88 / 0.00 and 2.32 / 0.54 K); refused for the
+///   reduction (1.053 K off the reference on the servo log), written only
+///   with `--accept-with-margin`.
+/// - Not met: under-prediction 0.37–0.40 K on the mix, max |e| 2.0–2.7 K.
+///   The set before its structural freedoms, on the two throttle logs:
+///   margins 2.29 / 2.52 K, 2.48 / 0.00 and 6.04 / 0.02 K (big-pump),
+///   2.75 / 0.55 and 3.47 / 0.00 K (leaky-heavy).
+/// - Cost on the throttle mix (open loop, chosen path): valve open 1413 →
+///   1518 s, LNG 2.84 → 3.01 kg (big-pump); 1547 → 1559 s, 1.99 → 2.01 kg
 ///   (leaky-heavy); the servo logs stay below 40 °C.
-/// - Time (four logs: two 30-min training, a 20-min servo and a 30-min
-///   mix held out; both paths, the split's margins) with nothing else
-///   running on the 2 cores: big-pump 36.3 and 37.4 s (1 696 reference
-///   runs), leaky-heavy 41.2 s (1 898). Not a timing test.
-///
-/// The values asserted before (big-pump margin 2.115 K, 2.31 / 0.13 and
-/// 5.98 / 0.18 K) were one build's of an earlier commit; a 1e-9 K nudge of
-/// the logs moves big-pump by 0.17 K on this build
-/// (`slow_commissioning_is_reproducible_at_the_last_digit_big_pump`, which
-/// asserts the 0.05 K a reproducible result needs, and fails here).
+/// - Time with two other helpers' jobs on the 2 cores: 77 s (big-pump,
+///   2 516 reference runs) and 64 s (leaky-heavy, 1 794). Not a timing test.
 #[test]
 #[ignore = "slow tier: two commissionings with margin validation on emulator bench logs (~1 min each)"]
 fn slow_commissioning_with_margin_on_foreign_machines() {
-    let measured = [(2.290, [(2.483, 0.000), (6.044, 0.016)], [1488.0, 1511.0]), (2.516, [(2.748, 0.548), (3.466, 0.000)], [1541.0, 1562.0])];
-    for (m, (margin, want, open_s)) in machines().into_iter().zip(measured) {
-        let s = bench_set(&m, 3600).expect("bench");
+    let measured = [
+        (1.276, PathKind::Direct, [(2.080, 0.000), (2.725, 0.404)], [1413.0, 1518.0]),
+        (1.301, PathKind::Reduction, [(2.022, 0.000), (2.279, 0.366)], [1547.0, 1559.0]),
+    ];
+    for (m, (margin, path, want, open_s)) in machines().into_iter().zip(measured) {
+        let s = commissioning_set(&m, 3600).expect("bench");
         let train: Vec<CalLog> = s.train.iter().map(cal).collect();
         let hold: Vec<CalLog> = s.holdout.iter().map(cal).collect();
         let t0 = std::time::Instant::now();
@@ -195,7 +216,7 @@ fn slow_commissioning_with_margin_on_foreign_machines() {
         let h = headline(&m, &c, &s.holdout);
         near(&format!("{} margin", m.name), h.margin_k, margin);
         assert!(c.direct_path.is_ok(), "{}: the direct path did not run: {:?}", m.name, c.direct_path.as_ref().err());
-        assert_eq!(c.choice.chosen, PathKind::Reduction, "{}: {}", m.name, c.choice.why);
+        assert_eq!(c.choice.chosen, path, "{}: {}", m.name, c.choice.why);
         for (got, want) in h.measured.iter().zip(want) {
             near(&format!("{} held-out max |e| with margin", m.name), got.0, want.0);
             near(&format!("{} held-out under-prediction with margin", m.name), got.1, want.1);
@@ -228,15 +249,27 @@ fn one_operating_point_is_refused_with_log_region_channel_and_bench_run() {
 
 /// Every temperature of every log moved by 1e-9 K: the headline numbers
 /// (held-out max |e| and under-prediction of the flashed path, margin) move
-/// by at most 0.05 K. Measured with the calibration's final polish
-/// (Gauss–Newton with the priors, data σ inflated by the reduced χ²) and
-/// its basin check of the ball-valve film/capacity pair
-/// (`fit::polish_basins`): leaky-heavy 0.031 K, a pass (both runs in the
-/// ×0.5 basin; 0.10 K before the check, the nudged LM in the other basin:
-/// film ×3.28 → ×0.58, capacity ×2.46 → ×0.46). big-pump 0.172 K on
-/// this build (margin 2.290 → 2.118 K; the same without the basin check,
-/// which is not taken there; 0.039 K on an earlier build): a miss,
-/// asserted as the bound.
+/// by at most 0.05 K. Trained as the procedure prescribes
+/// (`commissioning_set`), the structural freedoms fitted. Measured on
+/// big-pump: **0.509 K, a miss** asserted as the bound (margin 1.276 →
+/// 1.300 K; the direct path flashed in both; the mix's under-prediction
+/// 0.404 → 0.913 K). Why: the calibration's polish stalls (a damped step
+/// that lowers nothing) at different points: 1483.4 after 8 steps on the
+/// original logs, 1455.7 still falling on the nudged ones, the case film
+/// pair moving along its product (film ×0.18 / churn ×83 against ×0.39 /
+/// ×51), with cap_case_oil 1.50 / 2.01, cap_pump 1.07 / 1.44,
+/// friction_case 0.90 / 1.22, film_port 0.92 / 1.73; and the direct fit's
+/// screening frees `loss_speed` (0.31) on one and holds it on the other.
+/// With 24 polish steps (`CalOptions::polish_iters`, `EXP_POLISH_ITERS=24`)
+/// the original still stalls at step 8 (1483.4), the nudged at step 14
+/// (1447.8): 0.515 K. Leaky-heavy: **0.226 K, a miss** (0.031 K with the set
+/// before the freedoms, on the earlier bench logs): the flashed path flips
+/// from the reduction (margin 1.301 K, mix 2.28 / 0.37 K) to the direct
+/// path (1.164 K, 2.31 / 0.59 K). The original took the basin check's
+/// reflected ball-valve pair (film ×2.14 / capacity ×1.16, objective 1342.7
+/// against LM's 1490.3), the nudged LM's (×0.99 / ×0.59, 1386.7 against
+/// 1398.9); the case film pair moved along its product as on big-pump
+/// (×0.22 / ×69 against ×0.52 / ×30). Neither polish converged.
 #[test]
 #[ignore = "slow tier: two commissionings with margin validation and the direct path (~2 min)"]
 fn slow_commissioning_is_reproducible_at_the_last_digit_big_pump() {
@@ -260,12 +293,17 @@ fn reproducible(m: EmuMachine) {
         l
     };
     {
-        let s = bench_set(&m, 3600).expect("bench");
+        let s = commissioning_set(&m, 3600).expect("bench");
         let run = |logs: &[BenchLog], hold: &[BenchLog]| {
             let train: Vec<CalLog> = logs.iter().map(cal).collect();
             let h: Vec<CalLog> = hold.iter().map(cal).collect();
             let t0 = std::time::Instant::now();
-            let c = commission(&m.rig_file(), &train, &h, &CalOptions::default()).expect("commissioning");
+            // `EXP_POLISH_ITERS`: an experiment knob (the polish's iterations).
+            let mut o = CalOptions::default();
+            if let Some(n) = std::env::var("EXP_POLISH_ITERS").ok().and_then(|v| v.parse().ok()) {
+                o.polish_iters = n;
+            }
+            let c = commission(&m.rig_file(), &train, &h, &o).expect("commissioning");
             eprintln!("{}: {:.1} s, flashable {}", m.name, t0.elapsed().as_secs_f64(), c.flashable());
             report(&m, &c, t0.elapsed().as_secs_f64());
             headline(&m, &c, hold)
@@ -306,6 +344,9 @@ fn slow_churned_case_film_with_a_low_speed_training_log() {
     let mut got = Vec::new();
     for held in [false, true] {
         let mut o = CalOptions::default();
+        // The churned film alone, as measured: the other structural
+        // freedoms held (measured together in the commissioning tests).
+        o.hold.extend(eha_sim::calibration::set::STRUCTURAL.map(|n| (n, "the churned film alone".to_string())));
         if held {
             o.hold.push((churn, "the gap law, for comparison".into()));
             o.hold.push((eha_sim::calibration::set::CASE_CHURN_SPEED, "the gap law, for comparison".into()));
@@ -330,4 +371,39 @@ fn slow_churned_case_film_with_a_low_speed_training_log() {
     }
     // The churned film's gain on the held-out mix's max |e|: ≥ 1 K.
     assert!(got[1].0 - got[0].0 >= 1.0, "mix max |e| {:.3} K churned, {:.3} K gap law", got[0].0, got[1].0);
+}
+
+/// Measurement by hand (prints, asserts nothing): one commissioning
+/// without the margin per machine, on `EXP_TRAIN` = `bench` (the two
+/// throttle logs of `bench_set`) or `procedure` (`commissioning_set`,
+/// default), with the parameters named in `EXP_HOLD` (comma-separated)
+/// held; `EXP_MACHINE` = `big-pump` or `leaky-heavy` for one machine;
+/// `EXP_MARGIN=1` with the margin and both paths.
+#[test]
+#[ignore = "measurement by hand: one commissioning per machine"]
+fn slow_structure_experiment() {
+    let hold: Vec<&'static str> = std::env::var("EXP_HOLD")
+        .unwrap_or_default()
+        .split(',')
+        .filter(|s| !s.is_empty())
+        .map(|s| eha_sim::calibration::set::PARAMS.iter().find(|p| p.name == s).unwrap_or_else(|| panic!("no parameter {s}")).name)
+        .collect();
+    let procedure = std::env::var("EXP_TRAIN").map_or(true, |v| v != "bench");
+    let margin = std::env::var("EXP_MARGIN").is_ok_and(|v| v == "1");
+    let only = std::env::var("EXP_MACHINE").ok();
+    for m in machines().into_iter().filter(|m| only.as_deref().is_none_or(|o| o == m.name)) {
+        let s = if procedure { commissioning_set(&m, 3600) } else { bench_set(&m, 3600) }.expect("bench");
+        let train: Vec<CalLog> = s.train.iter().map(cal).collect();
+        let hold_logs: Vec<CalLog> = s.holdout.iter().map(cal).collect();
+        let mut o = CalOptions::default();
+        for h in &hold {
+            o.hold.push((h, "EXP_HOLD".into()));
+        }
+        let t0 = std::time::Instant::now();
+        let c = commission_with(&m.rig_file(), &train, &hold_logs, &o, margin).expect("commissioning");
+        report(&m, &c, t0.elapsed().as_secs_f64());
+        let h = headline(&m, &c, &s.holdout);
+        let w: Vec<String> = c.holdout_without_margin().iter().map(|r| format!("{} {:.3}/{:.3}", r.log, r.vs_measured_max_k.unwrap_or(f64::NAN), r.vs_measured_under_k.unwrap_or(f64::NAN))).collect();
+        eprintln!("EXP {} train={} hold={:?} margin={}: without margin {}; with margin {:.3} K: {:.3?}", m.name, if procedure { "procedure" } else { "bench" }, hold, margin, w.join(", "), h.margin_k, h.measured);
+    }
 }

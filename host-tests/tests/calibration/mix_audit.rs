@@ -349,7 +349,11 @@ fn bisection_step(machine: &EmuMachine, switches: &[String]) -> (f64, f64, f64) 
     let hold: Vec<CalLog> = s.holdout.iter().map(|l| CalLog::new(&l.name, l.run.clone(), 120).expect("log")).collect();
     let mut base = m.rig_file();
     rig_like_reference(&mut base, switches);
-    let c = commission_with(&base, &train, &hold, &CalOptions::default(), false).expect("commission");
+    // The set as the bisection measured it: the structural freedoms it led
+    // to held (they are measured in foreign.rs).
+    let mut o = CalOptions::default();
+    o.hold.extend(eha_sim::calibration::set::STRUCTURAL.map(|n| (n, "the bisection's set".to_string())));
+    let c = commission_with(&base, &train, &hold, &o, false).expect("commission");
     let h = &c.holdout_with_margin;
     let v = |x: Option<f64>| x.expect("drain logged");
     (v(h[0].vs_measured_under_k), v(h[1].vs_measured_max_k), v(h[1].vs_measured_under_k))
