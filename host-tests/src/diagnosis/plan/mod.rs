@@ -15,7 +15,10 @@
 //! candidates that the calibration cannot take up, counted against the
 //! floor, and small when two candidates leave the same imprint. Its
 //! expected imprint ratio per candidate is reported alone and with the
-//! other candidates fitted too (separation).
+//! other candidates fitted too (separation). With [`Decision::Joint`]
+//! the plan is for the planned run diagnosed together with the user's log
+//! (one calibration, [`super::multi`]): the projection is off the shared
+//! physical set's sensitivities on both logs, D_s on the stacked imprints.
 //!
 //! This file holds the plan's search ([`plan`]) and what it returns; by
 //! topic beside it: `design.rs` (the bench's limits, the operating levels
