@@ -288,7 +288,7 @@ fn joint_case(seed: u64, duration_s: f64, decision: Decision) -> (f64, String, S
         let dir = std::path::Path::new(&dir).join(format!("{seed}-{duration_s:.0}-{:?}", p.decision));
         std::fs::create_dir_all(&dir).expect("dump dir");
         for (n, r) in [("log", &log), ("twin", &twin), ("planned", &plog), ("planned-twin", &ptwin)] {
-            r.write_file(&dir.join(format!("{n}.csv"))).expect("dump");
+            r.write_file(dir.join(format!("{n}.csv"))).expect("dump");
         }
     }
     let dj = diagnose_joint(&[&log, &plog]);
