@@ -360,7 +360,7 @@ fn six_joint(decision: Decision) -> Vec<(u64, f64, String, String)> {
 /// held-out check (pooled RMSE no better than the baseline's). Asserted as
 /// measured: none named at r ≥ 2, at most one lifted (1700's 2.01 sits on
 /// the line: the ratio moves with both calibrated baselines' last digits).
-/// ~15 min at load ~5.
+/// 558 s at load ~4.
 #[test]
 #[ignore]
 fn slow_planned_runs_decided_jointly() {
@@ -383,7 +383,7 @@ fn slow_planned_runs_decided_jointly() {
 /// r ≥ 2 (the acceptance asks half); one right name below r = 2; no wrong
 /// cause, no false discovery. Asserted as measured: no r ≥ 2 (largest 1.60,
 /// which moves with the baselines' last digits), 1708 named
-/// `churning-loss`. ~15 min at load ~5.
+/// `churning-loss`. 939 s at load ~5.
 #[test]
 #[ignore]
 fn slow_jointly_planned_runs_decided_jointly() {
