@@ -3,7 +3,7 @@
 //! mission.csv, plan.md and plan.json ([`super::plan`]).
 
 use super::model::{Candidate, Simulator};
-use super::plan::{leading, plan, Limits, DEFAULT_AIR_MPS, DEFAULT_MAX_TEMP_C};
+use super::plan::{leading, plan, Decision, Limits, DEFAULT_AIR_MPS, DEFAULT_MAX_TEMP_C};
 use super::reference::ReferenceModel;
 use crate::measured::MeasuredRun;
 use crate::rig::Rig;
@@ -59,6 +59,11 @@ pub struct PlanArgs {
     /// Largest temperature a logged channel may reach in the prediction, °C.
     #[arg(long, default_value_t = DEFAULT_MAX_TEMP_C)]
     pub max_temp_c: f64,
+    /// Plan for the joint decision: the planned run to be diagnosed
+    /// together with `--log` (`eha-sim diagnose LOG planned.csv`), one
+    /// calibration for both; default: the planned run diagnosed alone.
+    #[arg(long)]
+    pub joint: bool,
 }
 
 /// Parses `name` or `name=magnitude` (typical magnitude of `rig`'s model
@@ -119,7 +124,8 @@ pub fn run(a: &PlanArgs) -> anyhow::Result<()> {
     }
     let span = log.time_s[log.len() - 1] - log.time_s[0];
     let duration = a.duration_s.unwrap_or(span.max(1200.0));
-    let p = plan(&rig, &log, &cands, limits, duration).map_err(|e| anyhow::anyhow!(e))?;
+    let decision = if a.joint { Decision::Joint } else { Decision::Alone };
+    let p = plan(&rig, &log, &cands, limits, duration, decision).map_err(|e| anyhow::anyhow!(e))?;
     std::fs::create_dir_all(&a.out)?;
     std::fs::write(a.out.join("mission.csv"), p.design.csv())?;
     std::fs::write(a.out.join("plan.md"), p.markdown())?;

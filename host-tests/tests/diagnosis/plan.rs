@@ -4,7 +4,7 @@
 //! tier).
 
 use eha_sim::diagnosis::emu_sweep::default_cases;
-use eha_sim::diagnosis::plan::{leading, plan, Design, Limits, Plan};
+use eha_sim::diagnosis::plan::{leading, plan, Decision, Design, Limits, Plan};
 use eha_sim::diagnosis::reference::ReferenceModel;
 use eha_sim::diagnosis::{diagnose, Candidate, DiagnoseOptions, Simulator};
 use eha_sim::emulator::plant::{Hidden, Plant};
@@ -49,14 +49,43 @@ fn fly(d: &Design, c: &EmuCase, truth: &EmuTruth, ambient_c: f64) -> (MeasuredRu
 
 /// Imprint ratio (calibrated baseline's held-out misfit on `ch`, log over
 /// twin), the log's answer, the twin's, and the log's leading candidates
-/// ([`leading`], two).
-fn ratio(log: &MeasuredRun, twin: &MeasuredRun, ch: Channel) -> (f64, String, String, Vec<Candidate>) {
+/// ([`leading`], two), and the log's diagnosis.
+fn ratio(log: &MeasuredRun, twin: &MeasuredRun, ch: Channel) -> (f64, String, String, Vec<Candidate>, Box<eha_sim::diagnosis::Diagnosis>) {
     let o = DiagnoseOptions::default();
     let d = diagnose(log, &ReferenceModel::new(Rig::default(), log).expect("model"), &o).expect("diagnosis");
     let t = diagnose(twin, &ReferenceModel::new(Rig::default(), twin).expect("model"), &o).expect("twin diagnosis");
     let m = |x: &eha_sim::diagnosis::Diagnosis| x.before.channel(ch.name()).map(|c| c.heldout_rmse_k).expect("channel");
+    for (l, x) in [("log", &d), ("twin", &t)] {
+        eprintln!("  {}", summary(l, x));
+    }
     let causes: Vec<(String, f64, f64)> = d.posterior.causes.iter().map(|c| (c.cause.clone(), c.probability, c.log_bayes_factor)).collect();
-    (m(&d) / m(&t), d.answer().to_string(), t.answer().to_string(), leading(&causes, 2))
+    (m(&d) / m(&t), d.answer().to_string(), t.answer().to_string(), leading(&causes, 2), Box::new(d))
+}
+
+/// One line: answer, set, held-out misfit, posterior and the top of the ranking.
+pub fn summary(label: &str, d: &eha_sim::diagnosis::Diagnosis) -> String {
+    let p: Vec<String> = d.posterior.causes.iter().take(3).map(|c| format!("{} {:.2} lnB {:.1}", c.cause, c.probability, c.log_bayes_factor)).collect();
+    let r: Vec<String> = d
+        .ranking
+        .iter()
+        .take(4)
+        .map(|r| format!("{} dBIC {:.0} gain {:.0} % {} pooled {:.3} K{}", r.cause, r.delta_bic, 100.0 * r.heldout_gain, r.gain_channel, r.heldout_rmse_k, if r.qualifies { " qualifies" } else { "" }))
+        .collect();
+    let ch: Vec<String> = d.before.channels.iter().map(|c| format!("{} {:.3}", c.channel, c.heldout_rmse_k)).collect();
+    let top: Vec<String> = d.ranking.iter().find(|r| r.cause != "none").map_or(vec![], |r| r.channel_heldout_k.iter().map(|(c, v)| format!("{c} {v:.3}")).collect());
+    let own: Vec<String> = d.posterior.channels.iter().map(|c| format!("{} {:.3}/{:.3}={:.1}", c.channel, c.misfit_k, c.floor_k, c.imprint_ratio)).collect();
+    format!(
+        "{label}: {} ({} set, held-out {:.3} K [{}], {} runs; {})\n    ranking: {}\n    top candidate held-out [{}]; misfit/floor [{}]",
+        d.answer(),
+        d.nuisance_set,
+        d.before.heldout_rmse_k,
+        ch.join(", "),
+        d.sims,
+        p.join(", "),
+        r.join("; "),
+        top.join(", "),
+        own.join(", ")
+    )
 }
 
 /// The candidates at their typical magnitudes.
@@ -70,19 +99,19 @@ fn mean_ambient(log: &MeasuredRun) -> f64 {
     v.iter().sum::<f64>() / v.len() as f64
 }
 
-/// One case: the original log's ratio, the plan, the planned run's ratio
-/// and answer.
-fn planned_case(seed: u64, duration_s: f64) -> (f64, f64, String, Plan) {
+/// One case: the original log's ratio, the plan, the planned run's ratio,
+/// answer and diagnosis.
+fn planned_case(seed: u64, duration_s: f64) -> (f64, f64, String, Plan, Box<eha_sim::diagnosis::Diagnosis>) {
     let c = case(seed);
     let (log, truth) = generate(&c).expect("log");
     let (twin, _) = generate_twin(&c).expect("twin");
     let ch = truth.affected.expect("affected").0;
-    let (r0, a0, _, lead) = ratio(&log, &twin, ch);
+    let (r0, a0, _, lead, _) = ratio(&log, &twin, ch);
     let t = std::time::Instant::now();
-    let p = plan(&Rig::default(), &log, &typical(&log, &lead), Limits::for_rig(&Rig::default(), &log), duration_s).expect("plan");
+    let p = plan(&Rig::default(), &log, &typical(&log, &lead), Limits::for_rig(&Rig::default(), &log), duration_s, Decision::Alone).expect("plan");
     let secs = t.elapsed().as_secs_f64();
     let (plog, ptwin, pch) = fly(&p.design, &c, &truth, mean_ambient(&log));
-    let (r1, a1, t1, _) = ratio(&plog, &ptwin, pch);
+    let (r1, a1, t1, _, d1) = ratio(&plog, &ptwin, pch);
     let exp = p.expected.iter().find(|e| e.planned.candidate == c.hidden.name()).map(|e| (e.planned.best.1, e.on_log.as_ref().map(|r| r.best.1)));
     eprintln!(
         "{seed} {}: original r {r0:.2} on {} ({a0}; leading {lead:?}); plan {:.0} s: {} (D_s {:.3}); expected r̂ for the hidden candidate {exp:?}; planned r {r1:.2} on {} ({a1}; twin {t1})",
@@ -93,7 +122,7 @@ fn planned_case(seed: u64, duration_s: f64) -> (f64, f64, String, Plan) {
         p.d_s,
         pch.name()
     );
-    (r0, r1, a1, p)
+    (r0, r1, a1, p, d1)
 }
 
 /// The command's contract, `eha-sim plan` on a short emulator log (600 s,
@@ -104,6 +133,8 @@ fn planned_case(seed: u64, duration_s: f64) -> (f64, f64, String, Plan) {
 /// and the planned duration; `plan.json`'s chosen D_s the largest of the
 /// admissible family, every D_s finite, expected ratios ≥ 1. A candidate a
 /// throttle plan cannot excite is refused with exit ≠ 0 and a message.
+/// The same contract with `--joint` (planned for the joint decision with
+/// the log, `plan.json`'s `decision` "Joint").
 #[test]
 fn plan_command_writes_a_readable_mission_within_limits() {
     let c = EmuCase { hidden: Candidate::SensorLag, scenario: eha_sim::emulator::missions::EmuScenario::ConstantThrottle, seed: 1704, duration_s: 600.0 };
@@ -112,32 +143,39 @@ fn plan_command_writes_a_readable_mission_within_limits() {
     std::fs::create_dir_all(&dir).expect("dir");
     let path = dir.join("log.csv");
     log.write_file(&path).expect("write log");
-    let run = |extra: &[&str]| {
+    let run = |extra: &[&str], sub: &str| {
         let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_eha-sim"));
-        cmd.args(["plan", "--log"]).arg(&path).args(["--speed-rpm", "500,1500", "--drop-bar", "10,60", "--duration-s", "600", "--out"]).arg(dir.join("out")).args(extra);
+        cmd.args(["plan", "--log"]).arg(&path).args(["--speed-rpm", "500,1500", "--drop-bar", "10,60", "--duration-s", "600", "--out"]).arg(dir.join(sub)).args(extra);
         cmd.output().expect("eha-sim")
     };
-    let t = std::time::Instant::now();
-    let out = run(&["--candidates", "sensor-lag=120"]);
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    eprintln!("{:.1} s: {stdout}{}", t.elapsed().as_secs_f64(), String::from_utf8_lossy(&out.stderr));
-    assert!(out.status.success());
-    let m = read_mission_csv(&dir.join("out/mission.csv"), ValveRule::None).expect("mission reader");
-    assert_eq!(m.duration_s, 600.0);
-    for ((t, n), (_, s)) in m.speed_rpm.0.iter().zip(&m.needle_bar.0) {
-        let drop = s * (n / 500.0).powi(2);
-        // 1e-4 bar: the file's needle column has six decimals.
-        assert!((500.0..=1500.0).contains(n) && (10.0 - 1e-4..=60.0 + 1e-4).contains(&drop), "at {t} s: {n} rpm, {drop} bar");
+    for (sub, joint) in [("out", false), ("out-joint", true)] {
+        let t = std::time::Instant::now();
+        let mut args = vec!["--candidates", "sensor-lag=120"];
+        if joint {
+            args.push("--joint");
+        }
+        let out = run(&args, sub);
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        eprintln!("{sub}: {:.1} s: {stdout}{}", t.elapsed().as_secs_f64(), String::from_utf8_lossy(&out.stderr));
+        assert!(out.status.success());
+        let m = read_mission_csv(&dir.join(sub).join("mission.csv"), ValveRule::None).expect("mission reader");
+        assert_eq!(m.duration_s, 600.0);
+        for ((t, n), (_, s)) in m.speed_rpm.0.iter().zip(&m.needle_bar.0) {
+            let drop = s * (n / 500.0).powi(2);
+            // 1e-4 bar: the file's needle column has six decimals.
+            assert!((500.0..=1500.0).contains(n) && (10.0 - 1e-4..=60.0 + 1e-4).contains(&drop), "at {t} s: {n} rpm, {drop} bar");
+        }
+        let j: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join(sub).join("plan.json")).expect("plan.json")).expect("json");
+        assert_eq!(j["decision"], if joint { "Joint" } else { "Alone" });
+        let fam = j["family"].as_array().expect("family");
+        assert!(fam.iter().all(|f| f["d_s"].as_f64().is_some_and(f64::is_finite)), "{fam:?}");
+        let best = fam.iter().filter(|f| f["admissible"] == true).filter_map(|f| f["d_s"].as_f64()).fold(f64::NEG_INFINITY, f64::max);
+        assert_eq!(j["d_s"].as_f64(), Some(best));
+        for e in j["expected"].as_array().expect("expected") {
+            assert!(e["planned"]["best"][1].as_f64().is_some_and(|r| r >= 1.0) && e["planned_separated"].as_f64().is_some_and(|r| r >= 1.0), "{e}");
+        }
     }
-    let j: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("out/plan.json")).expect("plan.json")).expect("json");
-    let fam = j["family"].as_array().expect("family");
-    assert!(fam.iter().all(|f| f["d_s"].as_f64().is_some_and(f64::is_finite)), "{fam:?}");
-    let best = fam.iter().filter(|f| f["admissible"] == true).filter_map(|f| f["d_s"].as_f64()).fold(f64::NEG_INFINITY, f64::max);
-    assert_eq!(j["d_s"].as_f64(), Some(best));
-    for e in j["expected"].as_array().expect("expected") {
-        assert!(e["planned"]["best"][1].as_f64().is_some_and(|r| r >= 1.0) && e["planned_separated"].as_f64().is_some_and(|r| r >= 1.0), "{e}");
-    }
-    let bad = run(&["--candidates", "coulomb-friction"]);
+    let bad = run(&["--candidates", "coulomb-friction"], "out");
     let err = String::from_utf8_lossy(&bad.stderr);
     assert!(!bad.status.success() && err.contains("coulomb-friction") && err.contains("throttle"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
@@ -164,7 +202,7 @@ fn slow_planned_runs_lift_effects_above_the_floor() {
     let seeds = [1708, 1710, 1712, 1709, 1700, 1713];
     let mut rows = Vec::new();
     for s in seeds {
-        let (r0, r1, answer, p) = planned_case(s, 1200.0);
+        let (r0, r1, answer, p, _) = planned_case(s, 1200.0);
         rows.push((s, r0, r1, answer, p.design.name.clone()));
     }
     let below: Vec<_> = rows.iter().filter(|r| r.1 < 2.0).collect();
@@ -179,17 +217,178 @@ fn slow_planned_runs_lift_effects_above_the_floor() {
 }
 
 /// The same for one case with a planned run twice as long (2400 s):
-/// 1708 churning r 1.40 → 3.44 on t_pump_c with the third candidate start
-/// (1.35 with two), answered `none` (twin `none`; 87 s): lifted above
-/// r = 2 and then a **measured miss**. Asserted as measured: r ≥ 2.5 (the
-/// ratio moves with both calibrated baselines' last digits; it was 1.35),
-/// `none`, and never a wrong cause.
+/// 1708 churning r 1.40 → 3.44 on t_pump_c (0.465 K against the twin's
+/// 0.135 K), answered `none` (twin `none`; 211 s at load ~5): lifted above
+/// r = 2 and then a **measured miss**. The cause, measured and asserted:
+/// `churning-loss` passes every check but one — ΔBIC 408 (≥ 25), held-out
+/// t_pump_c −53 % (≥ 30 %, ≥ 0.05 K) — and its evidence would name it
+/// (ln BF 24.6 against `none`), but the pooled held-out RMSE of all five
+/// channels falls only 0.564 → 0.491 K (13 %, the rule asks 20 %): the
+/// other four channels misfit 0.26–0.73 K and the churning fit leaves
+/// them there. Not changed: on the same machine's effect-free 1200 s twin
+/// the same check is all that keeps `churning-loss` out (ΔBIC 75, t_pump_c
+/// −49 %, pooled 6 %, ln BF 16.3: it would be named at P ≈ 1), so no rule
+/// of the pooled gain's kind separates the two without a threshold tuned
+/// between 6 and 13 % on this one machine. Asserted as measured: r ≥ 2.5
+/// (the ratio moves with both calibrated baselines' last digits; it was
+/// 1.35 with two candidate starts), `none`, the churning fit qualifying on
+/// all but the pooled gain (< 20 %), never a wrong cause.
 #[test]
 #[ignore]
 fn slow_planned_run_twice_as_long() {
-    let (r0, r1, answer, p) = planned_case(1708, 2400.0);
+    let (r0, r1, answer, p, d) = planned_case(1708, 2400.0);
     eprintln!("1708, 2400 s plan: r {r0:.2} -> {r1:.2} ({answer}), {}", p.design.name);
     assert!(r1 >= 2.5, "measured r changed: {r1:.2} (measured 3.44)");
     assert!(["none", "unexplained", "churning-loss"].contains(&answer.as_str()), "wrong cause: {answer}");
     assert_eq!(answer, "none", "measured outcome changed (measured none at r 3.44)");
+    let o = DiagnoseOptions::default();
+    let ch = d.ranking.iter().find(|r| r.cause == "churning-loss").expect("churning fitted");
+    let pooled = 1.0 - ch.heldout_rmse_k / d.before.heldout_rmse_k;
+    assert!(
+        ch.delta_bic >= o.min_delta_bic && ch.heldout_gain >= o.min_heldout_gain && ch.gain_channel == "t_pump_c" && pooled < o.min_pooled_gain,
+        "the measured cause changed (ΔBIC 408, t_pump_c −53 %, pooled 13 %): ΔBIC {:.0}, {} {:.0} %, pooled {:.0} %",
+        ch.delta_bic,
+        ch.gain_channel,
+        100.0 * ch.heldout_gain,
+        100.0 * pooled
+    );
+}
+
+/// The joint diagnosis of `logs` (one machine), as `eha-sim diagnose a.csv
+/// b.csv` makes it: one calibration for every log.
+fn diagnose_joint(logs: &[&MeasuredRun]) -> eha_sim::diagnosis::Diagnosis {
+    use eha_sim::diagnosis::multi::{joint_reference, options_for};
+    let o = options_for(&DiagnoseOptions::default(), logs.len());
+    let files: Vec<String> = (1..=logs.len()).map(|k| format!("log {k}")).collect();
+    let (rows, joint) = joint_reference(&Rig::default(), logs, &files, o.train_fraction).expect("joint model");
+    diagnose(&rows, &joint, &o).expect("joint diagnosis")
+}
+
+/// One case decided jointly: the original log and the planned run of
+/// `duration_s` diagnosed together (one calibration), and the joint twin
+/// (the original's twin and the planned run's twin) likewise. Returns the
+/// joint imprint ratio r (the joint baseline's held-out misfit on the
+/// effect's channel — the planned run's, where the imprint is largest —
+/// pooled over both logs' held-out windows, log pair over twin pair), the
+/// joint answer and the joint twin's answer.
+fn joint_case(seed: u64, duration_s: f64, decision: Decision) -> (f64, String, String) {
+    let c = case(seed);
+    let (log, truth) = generate(&c).expect("log");
+    let (twin, _) = generate_twin(&c).expect("twin");
+    let ch = truth.affected.expect("affected").0;
+    let o = DiagnoseOptions::default();
+    let d0 = diagnose(&log, &ReferenceModel::new(Rig::default(), &log).expect("model"), &o).expect("diagnosis");
+    let causes: Vec<(String, f64, f64)> = d0.posterior.causes.iter().map(|c| (c.cause.clone(), c.probability, c.log_bayes_factor)).collect();
+    let lead = leading(&causes, 2);
+    let p = plan(&Rig::default(), &log, &typical(&log, &lead), Limits::for_rig(&Rig::default(), &log), duration_s, decision).expect("plan");
+    let exp: Vec<String> = p.expected.iter().map(|e| format!("{} r̂ {:.2} on {} (log {:.2})", e.planned.candidate, e.planned.best.1, e.planned.best.0, e.on_log.as_ref().map_or(f64::NAN, |r| r.best.1))).collect();
+    eprintln!("  plan ({:?}): {} (D_s {:.3}); expected {}", p.decision, p.design.name, p.d_s, exp.join(", "));
+    let (plog, ptwin, pch) = fly(&p.design, &c, &truth, mean_ambient(&log));
+    if let Ok(dir) = std::env::var("EHA_PLAN_DUMP") {
+        let dir = std::path::Path::new(&dir).join(format!("{seed}-{duration_s:.0}-{:?}", p.decision));
+        std::fs::create_dir_all(&dir).expect("dump dir");
+        for (n, r) in [("log", &log), ("twin", &twin), ("planned", &plog), ("planned-twin", &ptwin)] {
+            r.write_file(dir.join(format!("{n}.csv"))).expect("dump");
+        }
+    }
+    let dj = diagnose_joint(&[&log, &plog]);
+    let tj = diagnose_joint(&[&twin, &ptwin]);
+    for (l, x) in [("original", &d0), ("joint", &dj), ("joint twin", &tj)] {
+        eprintln!("  {}", summary(l, x));
+    }
+    let m = |x: &eha_sim::diagnosis::Diagnosis| x.before.channel(pch.name()).map(|c| c.heldout_rmse_k).expect("channel");
+    let r = m(&dj) / m(&tj);
+    eprintln!(
+        "{seed} {}: leading {lead:?}; plan {}; effect's channel {} (original's {}); joint r {r:.2} ({}; joint twin {})",
+        c.hidden.name(),
+        p.design.name,
+        pch.name(),
+        ch.name(),
+        dj.answer(),
+        tj.answer()
+    );
+    (r, dj.answer().to_string(), tj.answer().to_string())
+}
+
+/// One case of [`slow_planned_runs_lift_effects_above_the_floor`] decided
+/// jointly ([`joint_case`]), a by-hand measurement one case at a time: the
+/// seed from `EHA_PLAN_SEED` (default 1708), the plan's duration from
+/// `EHA_PLAN_DURATION_S` (default 1200 s), planned for the joint decision
+/// when `EHA_PLAN_JOINT=1` ([`Decision::Joint`]), else for the planned run
+/// alone; `EHA_PLAN_DUMP=DIR` writes the four logs as CSV.
+#[test]
+#[ignore]
+fn slow_joint_case() {
+    let seed = std::env::var("EHA_PLAN_SEED").ok().and_then(|s| s.parse().ok()).unwrap_or(1708);
+    let dur = std::env::var("EHA_PLAN_DURATION_S").ok().and_then(|s| s.parse().ok()).unwrap_or(1200.0);
+    let decision = if std::env::var("EHA_PLAN_JOINT").is_ok_and(|v| v == "1") { Decision::Joint } else { Decision::Alone };
+    let (r, a, t) = joint_case(seed, dur, decision);
+    eprintln!("JOINT {seed} {dur}: r {r:.2} {a} (twin {t})");
+}
+
+/// The six cases of [`slow_planned_runs_lift_effects_above_the_floor`]
+/// decided jointly ([`joint_case`], 1200 s plans made for `decision`):
+/// (seed, joint r, joint answer, joint twin's answer). Asserts what holds
+/// whatever the ratios: no wrong cause on a joint log, no discovery on a
+/// joint twin.
+fn six_joint(decision: Decision) -> Vec<(u64, f64, String, String)> {
+    let mut rows = Vec::new();
+    for s in [1708, 1710, 1712, 1709, 1700, 1713] {
+        let (r, a, t) = joint_case(s, 1200.0, decision);
+        rows.push((s, r, a, t));
+    }
+    let msg = format!("{rows:?}");
+    eprintln!("{decision:?}: {msg}");
+    for (s, _, a, t) in &rows {
+        assert!(["none", "unexplained", case(*s).hidden.name()].contains(&a.as_str()), "wrong cause on a joint log: {msg}");
+        assert!(["none", "unexplained"].contains(&t.as_str()), "false discovery on a joint twin: {msg}");
+    }
+    rows
+}
+
+/// The six cases decided jointly — the original log and the planned run
+/// (planned for the planned run alone, the same missions as
+/// [`slow_planned_runs_lift_effects_above_the_floor`]) diagnosed together,
+/// one calibration; r against the joint twin (the original's twin and the
+/// planned run's twin together). **Measured miss**: joint r 1708 1.86
+/// (`unexplained`), 1710 0.63 (`unexplained`), 1712 0.50 (`none`), 1709
+/// 0.74 (`unexplained`), 1700 2.01 (`unexplained`), 1713 1.22 (`none`);
+/// twins `none`, `none`, `none`, `unexplained`, `unexplained`, `none`. One
+/// case lifted to r ≥ 2 (1700, at the edge) and not named; no wrong cause,
+/// no false discovery. Where the candidate's evidence is large (1700
+/// winding ln BF 185, 1710 conduction 52) its fit fails the pooled
+/// held-out check (pooled RMSE no better than the baseline's). Asserted as
+/// measured: none named at r ≥ 2, at most one lifted (1700's 2.01 sits on
+/// the line: the ratio moves with both calibrated baselines' last digits).
+/// 558 s at load ~4.
+#[test]
+#[ignore]
+fn slow_planned_runs_decided_jointly() {
+    let rows = six_joint(Decision::Alone);
+    let lifted: Vec<_> = rows.iter().filter(|r| r.1 >= 2.0).collect();
+    let msg = format!("{rows:?}");
+    assert!(lifted.len() <= 1, "measured miss changed (1700 only, r 2.01): {msg}");
+    assert!(lifted.iter().all(|r| r.2 != case(r.0).hidden.name()), "measured miss changed (none named at r ≥ 2): {msg}");
+}
+
+/// The six cases with plans made for the joint decision
+/// ([`Decision::Joint`]: D_s on the stacked projected imprints of the log
+/// and the planned run) and decided jointly. Measured: joint r 1708 1.60
+/// (**`churning-loss`**, named right: ΔBIC 855, t_pump_c −50 %, pooled
+/// −32 %, ln BF 84.9), 1710 0.63 (`unexplained`; the same mission as
+/// planned alone), 1712 0.82 (`none`), 1709 1.36 (`unexplained`: churning
+/// ΔBIC 752, t_pump_c −76 %, pooled only −14 %), 1700 1.38
+/// (`unexplained`), 1713 1.02 (`none`); twins `none`, `none`, `none`,
+/// `unexplained`, `unexplained`, `none`. **Measured miss**: none lifted to
+/// r ≥ 2 (the acceptance asks half); one right name below r = 2; no wrong
+/// cause, no false discovery. Asserted as measured: no r ≥ 2 (largest 1.60,
+/// which moves with the baselines' last digits), 1708 named
+/// `churning-loss`. 939 s at load ~5.
+#[test]
+#[ignore]
+fn slow_jointly_planned_runs_decided_jointly() {
+    let rows = six_joint(Decision::Joint);
+    let msg = format!("{rows:?}");
+    assert!(rows.iter().all(|r| r.1 < 2.0), "measured miss changed (largest joint r 1.60): {msg}");
+    assert_eq!(rows[0].2, "churning-loss", "measured name changed (1708 named churning-loss at joint r 1.60): {msg}");
 }

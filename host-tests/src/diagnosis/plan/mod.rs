@@ -15,7 +15,10 @@
 //! candidates that the calibration cannot take up, counted against the
 //! floor, and small when two candidates leave the same imprint. Its
 //! expected imprint ratio per candidate is reported alone and with the
-//! other candidates fitted too (separation).
+//! other candidates fitted too (separation). With [`Decision::Joint`]
+//! the plan is for the planned run diagnosed together with the user's log
+//! (one calibration, [`super::multi`]): the projection is off the shared
+//! physical set's sensitivities on both logs, D_s on the stacked imprints.
 //!
 //! This file holds the plan's search ([`plan`]) and what it returns; by
 //! topic beside it: `design.rs` (the bench's limits, the operating levels
@@ -70,6 +73,8 @@ pub struct Evaluated {
 pub struct Plan {
     /// The chosen mission.
     pub design: Design,
+    /// How the planned run is to be decided (what the plan optimised).
+    pub decision: Decision,
     /// Its D_s criterion.
     pub d_s: f64,
     /// The leading candidates and their magnitudes: (candidate, parameter,
@@ -144,6 +149,19 @@ struct Projected {
     max_temp_c: f64,
 }
 
+/// How the planned run will be decided, which is what the plan optimises.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum Decision {
+    /// The planned run diagnosed on its own (its own calibration).
+    Alone,
+    /// The planned run diagnosed together with the user's log
+    /// (`eha-sim diagnose log.csv planned.csv`, [`super::multi`]): one
+    /// calibration for both, so the projection is off the stacked
+    /// sensitivities of both logs and the imprints are both logs' (D_s on
+    /// the stacked projected imprints).
+    Joint,
+}
+
 /// Projects the candidates `cands` (at their magnitudes) on the log `run`
 /// of `machine`: the physical set of `run` at the machine's calibrated
 /// values (nominal where `run` frees a parameter the user's log did not),
@@ -151,9 +169,30 @@ struct Projected {
 fn project(machine: &Machine, run: &MeasuredRun, cands: &[(Candidate, f64)]) -> Result<Projected, String> {
     let model = ReferenceModel::new(machine.rig.clone(), run).map_err(|e| e.to_string())?;
     let phys = model.physical_set().ok_or("the model has no physical set")?;
+    project_on(machine, &*phys, run, split_of(run), PER_CHANNEL, cands)
+}
+
+/// [`project`] for the joint decision: the user's `log` and the planned
+/// `run` on one table ([`super::multi::joint_reference`]), one physical set
+/// shared by both, points per channel per log, held out: both logs'
+/// held-out windows.
+fn project_joint(machine: &Machine, log: &MeasuredRun, run: &MeasuredRun, cands: &[(Candidate, f64)]) -> Result<Projected, String> {
+    let files = ["log".to_string(), "planned".to_string()];
+    let (rows, joint) = super::multi::joint_reference(&machine.rig, &[log, run], &files, DiagnoseOptions::default().train_fraction)?;
+    let phys = joint.physical_set().ok_or("the model has no physical set")?;
+    project_on(machine, &*phys, &rows, joint.layout().split_s, 2 * PER_CHANNEL, cands)
+}
+
+/// Largest value of a logged temperature channel of `run`, °C.
+fn max_logged_c(run: &MeasuredRun) -> f64 {
+    Channel::TEMPERATURES.iter().filter_map(|ch| run.get(*ch)).flat_map(|v| v.iter().flatten().copied()).fold(f64::NEG_INFINITY, f64::max)
+}
+
+/// The projection of `cands` with the physical set `phys` of the table
+/// `run` (split at `split`, `per_channel` evidence points per channel).
+fn project_on(machine: &Machine, phys: &dyn Simulator, run: &MeasuredRun, split: f64, per_channel: usize, cands: &[(Candidate, f64)]) -> Result<Projected, String> {
     let nuis: Vec<f64> = phys.nuisance().iter().map(|s| machine.values.iter().find(|(n, _)| *n == s.name).map_or(s.start, |(_, v)| *v)).collect();
-    let split = split_of(run);
-    let sens = Sensitivities::new(&*phys, run, &nuis, evidence_points(run, split, PER_CHANNEL), split)?;
+    let sens = Sensitivities::new(phys, run, &nuis, evidence_points(run, split, per_channel), split)?;
     let floors: Vec<ChannelFloor> = sens
         .channels()
         .into_iter()
@@ -164,7 +203,7 @@ fn project(machine: &Machine, run: &MeasuredRun, cands: &[(Candidate, f64)]) -> 
         })
         .collect();
     let imprints: Vec<DVector<f64>> =
-        cands.par_iter().map(|&(c, m)| sens.imprint(&*phys, &nuis, c, &[m])).collect::<Result<Vec<_>, String>>()?;
+        cands.par_iter().map(|&(c, m)| sens.imprint(phys, &nuis, c, &[m])).collect::<Result<Vec<_>, String>>()?;
     let lefts = imprints.iter().map(|s| sens.left(s, &[])).collect();
     let max_temp_c = Channel::TEMPERATURES
         .iter()
@@ -191,8 +230,8 @@ impl Projected {
 
 /// Designs the plan for `log` of a machine described by `rig`, to show
 /// and separate `cands` (candidate, magnitude), within `limits`, lasting
-/// `duration_s`.
-pub fn plan(rig: &Rig, log: &MeasuredRun, cands: &[(Candidate, f64)], limits: Limits, duration_s: f64) -> Result<Plan, String> {
+/// `duration_s`, for the planned run decided as `decision` says.
+pub fn plan(rig: &Rig, log: &MeasuredRun, cands: &[(Candidate, f64)], limits: Limits, duration_s: f64, decision: Decision) -> Result<Plan, String> {
     if cands.is_empty() {
         return Err("no candidates to plan for".into());
     }
@@ -210,7 +249,11 @@ pub fn plan(rig: &Rig, log: &MeasuredRun, cands: &[(Candidate, f64)], limits: Li
         .par_iter()
         .map(|d| {
             let run = predicted_log(&machine.calibrated, d)?;
-            let p = project(&machine, &run, cands)?;
+            let p = match decision {
+                Decision::Alone => project(&machine, &run, cands)?,
+                // The limit is the planned run's: the log was flown already.
+                Decision::Joint => Projected { max_temp_c: max_logged_c(&run), ..project_joint(&machine, log, &run, cands)? },
+            };
             let admissible = p.max_temp_c <= limits.max_temp_c && d.segments.iter().all(|l| limits.contains(l));
             Ok((Evaluated { name: d.name.clone(), d_s: p.d_s(), max_temp_c: p.max_temp_c, admissible }, p))
         })
@@ -257,5 +300,5 @@ pub fn plan(rig: &Rig, log: &MeasuredRun, cands: &[(Candidate, f64)], limits: Li
         })
         .collect();
     let candidates = cands.iter().flat_map(|&(c, m)| named(c, m).into_iter().map(move |(n, v, u)| (c.name().to_string(), n, v, u))).collect();
-    Ok(Plan { design: designs[k].clone(), d_s, candidates, expected, family: family_rows, limits, log_floors: machine.floors })
+    Ok(Plan { design: designs[k].clone(), decision, d_s, candidates, expected, family: family_rows, limits, log_floors: machine.floors })
 }

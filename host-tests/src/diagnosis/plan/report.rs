@@ -24,12 +24,19 @@ impl Plan {
     pub fn markdown(&self) -> String {
         let mut s = format!(
             "# Test plan\n\nMission: {} ({} segments, {:.0} s; `mission.csv`). D_s = {:.3} \
-             (det of the candidates' projected information against the floor, per candidate).\n\n\
+             (det of the candidates' projected information against the floor, per candidate). {}\n\n\
              | segment | start (s) | speed (rpm) | needle drop at that speed (bar) | needle setting at 500 rpm (bar) | ram air (m/s) |\n|---:|---:|---:|---:|---:|---:|\n",
             self.design.name,
             self.design.segments.len(),
             self.design.duration_s,
-            self.d_s
+            self.d_s,
+            match self.decision {
+                super::Decision::Alone => "Planned for the planned run diagnosed on its own.",
+                super::Decision::Joint => {
+                    "Planned for the joint decision: diagnose the planned run together with the log \
+                     (`eha-sim diagnose LOG planned.csv`, one calibration for both); r̂ planned is on both logs' held-out windows."
+                }
+            }
         );
         for (k, l) in self.design.segments.iter().enumerate() {
             let _ = writeln!(s, "| {} | {:.0} | {:.0} | {:.1} | {:.2} | {:.1} |", k + 1, k as f64 * self.design.hold_s, l.speed_rpm, l.drop_bar, l.needle_setting_bar(), l.air_mps);
