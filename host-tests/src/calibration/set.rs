@@ -408,51 +408,29 @@ pub const PARAMS: [ParamDef; 30] = [
         needs: Needs::Sensor(Channel::TBallvalveC),
         excitation: "needle throttling at several flows (line loss ∝ q², needle heat = the rest)",
         stage: Stage::Thermal,
-    },    ParamDef {
-        name: PROBE_SURFACE[0],
-        what: "where the motor housing probe (Point 1, t_motor_c) sits between its metal and the ambient air: it reads the fraction ln θ of metal − ambient towards the air",
-        fields: "probes.motor (= ln θ)",
-        lo: 0.95, hi: 1.2, prior_sigma_ln: 0.05,
-        centre: "on its metal (fraction 0): the rig file has no probe model",
-        why: PROBE_WHY,
-        needs: Needs::Sensor(Channel::TDrainC),
-        excitation: "the housing tens of kelvin above the air and the air moving (a soak, a cool-down), its own surface sensor logged beside a drain thermocouple (t_drain_c): the offset scales with metal − ambient, a film or capacity does not",
-        stage: Stage::Thermal,
     },
-    ParamDef {
-        name: PROBE_SURFACE[1],
-        what: "where the pump housing probe (Point 3, t_pump_c) sits between its metal and the ambient air: it reads the fraction ln θ of metal − ambient towards the air",
-        fields: "probes.pump (= ln θ)",
-        lo: 0.95, hi: 1.2, prior_sigma_ln: 0.05,
-        centre: "on its metal (fraction 0): the rig file has no probe model",
-        why: PROBE_WHY,
-        needs: Needs::Sensor(Channel::TDrainC),
-        excitation: "the housing tens of kelvin above the air and the air moving (a soak, a cool-down), its own surface sensor logged beside a drain thermocouple (t_drain_c): the offset scales with metal − ambient, a film or capacity does not",
-        stage: Stage::Thermal,
-    },
-    ParamDef {
-        name: PROBE_SURFACE[2],
-        what: "where the main valve block probe (Point 4, t_block_c) sits between its metal and the ambient air: it reads the fraction ln θ of metal − ambient towards the air",
-        fields: "probes.main_block (= ln θ)",
-        lo: 0.95, hi: 1.2, prior_sigma_ln: 0.05,
-        centre: "on its metal (fraction 0): the rig file has no probe model",
-        why: PROBE_WHY,
-        needs: Needs::Sensor(Channel::TDrainC),
-        excitation: "the housing tens of kelvin above the air and the air moving (a soak, a cool-down), its own surface sensor logged beside a drain thermocouple (t_drain_c): the offset scales with metal − ambient, a film or capacity does not",
-        stage: Stage::Thermal,
-    },
-    ParamDef {
-        name: PROBE_SURFACE[3],
-        what: "where the ball-valve block probe (Point 5, t_ballvalve_c) sits between its metal and the ambient air: it reads the fraction ln θ of metal − ambient towards the air",
-        fields: "probes.ball_block (= ln θ)",
-        lo: 0.95, hi: 1.2, prior_sigma_ln: 0.05,
-        centre: "on its metal (fraction 0): the rig file has no probe model",
-        why: PROBE_WHY,
-        needs: Needs::Sensor(Channel::TDrainC),
-        excitation: "the housing tens of kelvin above the air and the air moving (a soak, a cool-down), its own surface sensor logged beside a drain thermocouple (t_drain_c): the offset scales with metal − ambient, a film or capacity does not",
-        stage: Stage::Thermal,
-    },
+    surface_probe(PROBE_SURFACE[0], "where the motor housing probe (Point 1, t_motor_c) sits between its metal and the ambient air: it reads the fraction ln θ of metal − ambient towards the air", "probes.motor (= ln θ)"),
+    surface_probe(PROBE_SURFACE[1], "where the pump housing probe (Point 3, t_pump_c) sits between its metal and the ambient air: it reads the fraction ln θ of metal − ambient towards the air", "probes.pump (= ln θ)"),
+    surface_probe(PROBE_SURFACE[2], "where the main valve block probe (Point 4, t_block_c) sits between its metal and the ambient air: it reads the fraction ln θ of metal − ambient towards the air", "probes.main_block (= ln θ)"),
+    surface_probe(PROBE_SURFACE[3], "where the ball-valve block probe (Point 5, t_ballvalve_c) sits between its metal and the ambient air: it reads the fraction ln θ of metal − ambient towards the air", "probes.ball_block (= ln θ)"),
 ];
+
+/// The calibration parameter of a surface probe's reading offset: `name`,
+/// `what` it is and the rig field it sets; bounds, prior, needs and
+/// excitation are the same for every housing probe ([`PROBE_WHY`]).
+const fn surface_probe(name: &'static str, what: &'static str, fields: &'static str) -> ParamDef {
+    ParamDef {
+        name,
+        what,
+        fields,
+        lo: 0.95, hi: 1.2, prior_sigma_ln: 0.05,
+        centre: "on its metal (fraction 0): the rig file has no probe model",
+        why: PROBE_WHY,
+        needs: Needs::Sensor(Channel::TDrainC),
+        excitation: "the housing tens of kelvin above the air and the air moving (a soak, a cool-down), its own surface sensor logged beside a drain thermocouple (t_drain_c): the offset scales with metal − ambient, a film or capacity does not",
+        stage: Stage::Thermal,
+    }
+}
 
 /// Index of parameter `name` in [`PARAMS`].
 pub fn index(name: &str) -> Option<usize> {

@@ -10,6 +10,8 @@ use eha_sim::diagnosis::report::DiagnosisJson;
 use eha_sim::diagnosis::{diagnose, Candidate, DiagnoseOptions, ParamSpec, SimSeries, Simulator};
 use eha_sim::measured::{Channel, MeasuredRun};
 
+use crate::plan::summary;
+
 /// A toy machine: the pump temperature is a first-order (τ 300 s) response
 /// to a heat g1·ω + g2·ω² (ω the logged speed, krpm; g1, g2 in K: the two
 /// calibration parameters). At one constant speed a log determines only
@@ -148,25 +150,6 @@ fn diagnose_together(logs: &[&MeasuredRun]) -> eha_sim::diagnosis::Diagnosis {
 fn diagnose_alone(log: &MeasuredRun) -> eha_sim::diagnosis::Diagnosis {
     let model = eha_sim::diagnosis::reference::ReferenceModel::new(eha_sim::rig::Rig::default(), log).expect("model");
     diagnose(log, &model, &DiagnoseOptions::default()).expect("diagnosis")
-}
-
-fn summary(label: &str, d: &eha_sim::diagnosis::Diagnosis) -> String {
-    let p: Vec<String> = d.posterior.causes.iter().take(3).map(|c| format!("{} {:.2}", c.cause, c.probability)).collect();
-    let r: Vec<String> = d
-        .ranking
-        .iter()
-        .take(4)
-        .map(|r| format!("{} dBIC {:.0} gain {:.0} % {} pooled {:.3} K{}", r.cause, r.delta_bic, 100.0 * r.heldout_gain, r.gain_channel, r.heldout_rmse_k, if r.qualifies { " qualifies" } else { "" }))
-        .collect();
-    format!(
-        "{label}: {} ({} set, held-out {:.3} K, {} model runs; {})\n    ranking: {}",
-        d.answer(),
-        d.nuisance_set,
-        d.before.heldout_rmse_k,
-        d.sims,
-        p.join(", "),
-        r.join("; ")
-    )
 }
 
 /// Two emulator logs of one machine (the machine of seed 1704, a dead-end
