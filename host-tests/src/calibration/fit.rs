@@ -417,8 +417,8 @@ pub fn calibrate(base: &Rig, logs: &[CalLog], o: &CalOptions) -> Result<Calibrat
     })
 }
 
-/// Gauss–Newton iterations at most in [`polish`] from LM's end; twice as
-/// many from the reflected start of [`polish_basins`], which starts farther
+/// Gauss–Newton iterations at most in `polish` from LM's end; twice as
+/// many from the reflected start of `polish_basins`, which starts farther
 /// from an optimum (objective 37 509 against LM's 1 480 on leaky-heavy; 8
 /// iterations left it 5 units short of where 16 took it, and the 1e-9 K
 /// nudge then moved leaky-heavy's headline 0.057 K).
