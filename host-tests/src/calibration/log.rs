@@ -93,20 +93,7 @@ impl CalLog {
         if ts.is_empty() || ts.len() != amb.len() {
             return None;
         }
-        Some(
-            self.run
-                .time_s
-                .iter()
-                .map(|&t| {
-                    let i = ts.partition_point(|&x| x <= t);
-                    match (i.checked_sub(1), ts.get(i)) {
-                        (Some(j), Some(&t1)) if t1 > ts[j] => amb[j] + (amb[i] - amb[j]) * (t - ts[j]) / (t1 - ts[j]),
-                        (Some(j), _) => amb[j],
-                        (None, _) => amb[0],
-                    }
-                })
-                .collect(),
-        )
+        self.run.time_s.iter().map(|&t| crate::simulation::sim::interpolate(ts, amb, ts.partition_point(|&x| x <= t), t)).collect()
     }
 
     /// Residuals (simulated − measured, K) at the fit points.

@@ -176,7 +176,7 @@ impl SimOutput {
 
 /// Linear interpolation of `v` (sampled at `ts`) at `t`, where `i` is the
 /// number of `ts` at or before `t`; held at the ends.
-fn interpolate(ts: &[f64], v: &[f64], i: usize, t: f64) -> Option<f64> {
+pub(crate) fn interpolate(ts: &[f64], v: &[f64], i: usize, t: f64) -> Option<f64> {
     match (i.checked_sub(1).and_then(|j| ts.get(j).zip(v.get(j))), ts.get(i).zip(v.get(i))) {
         (Some((ta, a)), Some((tb, b))) => Some(a + (b - a) * (t - ta) / (tb - ta)),
         (Some((_, a)), None) => Some(*a),

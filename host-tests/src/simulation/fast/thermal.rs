@@ -131,17 +131,10 @@ impl Thermal {
         let a_old = self.a;
         let (mut fz, mut q) = ([0.0; NT], [0.0; NE]);
         rates(&self.z, &mut fz, &mut q);
-        let (mut fp, mut qp) = ([0.0; NT], [0.0; NE]);
         for j in 0..NT {
-            let mut zp = self.z;
-            let d = 1e-5 * (1.0 + self.z[j].abs());
-            zp[j] += d;
-            rates(&zp, &mut fp, &mut qp);
-            for i in 0..NT {
-                self.a[i][j] = (fp[i] - fz[i]) / d;
-            }
-            for i in 0..NE {
-                self.a_e[i][j] = (qp[i] - q[i]) / d;
+            let col = self.column(rates, j, &fz, &q);
+            for (i, x) in col.iter().enumerate() {
+                self.a[i][j] = *x;
             }
         }
         self.a_cols = transpose(&self.a);
@@ -160,24 +153,32 @@ impl Thermal {
         (self.fz, self.q) = (fz, q);
     }
 
+    /// Column `j` of the temperatures' Jacobian by a forward difference from
+    /// `fz`, `q` (the rates at z): returned; the energies' column is written
+    /// into `a_e` (one evaluation).
+    fn column(&mut self, rates: &mut impl Rates, j: usize, fz: &[f64; NT], q: &[f64; NE]) -> [f64; NT] {
+        let (mut fp, mut qp) = ([0.0; NT], [0.0; NE]);
+        let mut zp = self.z;
+        let d = 1e-5 * (1.0 + self.z[j].abs());
+        zp[j] += d;
+        rates(&zp, &mut fp, &mut qp);
+        for i in 0..NE {
+            self.a_e[i][j] = (qp[i] - q[i]) / d;
+        }
+        std::array::from_fn(|i| (fp[i] - fz[i]) / d)
+    }
+
     /// The columns `cols` of the Jacobian anew by forward differences
     /// (1 + cols.len() evaluations), kept as Â − A beside A: the φ-functions
     /// stay those of A, the corrector treats the difference implicitly.
     pub fn drift(&mut self, rates: &mut impl Rates, cols: &[usize]) {
         let (mut fz, mut q) = ([0.0; NT], [0.0; NE]);
         rates(&self.z, &mut fz, &mut q);
-        let (mut fp, mut qp) = ([0.0; NT], [0.0; NE]);
         let mut da = self.da_cols.unwrap_or([[0.0; NT]; NT]);
         for &j in cols {
-            let mut zp = self.z;
-            let d = 1e-5 * (1.0 + self.z[j].abs());
-            zp[j] += d;
-            rates(&zp, &mut fp, &mut qp);
-            for i in 0..NT {
-                da[j][i] = (fp[i] - fz[i]) / d - self.a[i][j];
-            }
-            for i in 0..NE {
-                self.a_e[i][j] = (qp[i] - q[i]) / d;
+            let col = self.column(rates, j, &fz, &q);
+            for (i, x) in col.iter().enumerate() {
+                da[j][i] = x - self.a[i][j];
             }
             if !self.da_idx[..self.da_n].contains(&j) {
                 self.da_idx[self.da_n] = j;
@@ -379,7 +380,9 @@ fn end_weights(pts: &[(f64, &[f64; NT])]) -> (f64, f64) {
 }
 
 /// Solves the leading n×n system m·x = b in place (Gaussian elimination
-/// with partial pivoting; b becomes x).
+/// with partial pivoting; b becomes x). Not `dense::Lu`: that factorises
+/// the whole NT×NT matrix, ~13³/3 operations a corrector for a system of
+/// the one or two drifting columns.
 fn solve_small(m: &mut [[f64; NT]; NT], b: &mut [f64; NT], n: usize) {
     for c in 0..n {
         let p = (c..n).max_by(|&i, &j| m[i][c].abs().total_cmp(&m[j][c].abs())).unwrap_or(c);
