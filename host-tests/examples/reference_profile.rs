@@ -10,11 +10,18 @@
 //!
 //! `DURATION_S=5` runs the fast path over the first 5 s only (the same
 //! plant and callbacks, ending there): where a run's work goes in time.
+//!
+//! `BENCH_ITERS=n` runs `sim::simulate_fast` n times per case instead, as
+//! one criterion iteration of `benches/reference_speed.rs` runs it (the
+//! plant's construction, its run and the output's assembly): callgrind with
+//! `--toggle-collect='*simulate_fast*'` counts what the bench times, and
+//! n = 1 against n = 2 separates the first run in a process (which fills
+//! the per-thread memos) from the later ones the bench repeats.
 
 use eha_sim::fast::{FastOptions, FastPlant};
 use eha_sim::rig::Rig;
 use eha_sim::scenario::Scenario;
-use eha_sim::sim::{simulate, SimOptions};
+use eha_sim::sim::{simulate, simulate_fast, SimOptions};
 
 fn main() {
     let which = std::env::args().nth(1);
@@ -26,8 +33,17 @@ fn main() {
     let fast_only = std::env::var_os("FAST_ONLY").is_some();
     let bdf_only = std::env::var_os("BDF_ONLY").is_some();
     let duration: Option<f64> = std::env::var("DURATION_S").ok().map(|s| s.parse().expect("DURATION_S: seconds"));
+    let bench_iters: Option<usize> = std::env::var("BENCH_ITERS").ok().map(|s| s.parse().expect("BENCH_ITERS: a count"));
     for (key, sc, opt) in cases {
         if which.as_deref().is_some_and(|w| w != key) {
+            continue;
+        }
+        if let Some(n) = bench_iters {
+            for _ in 0..n {
+                let out = simulate_fast(std::hint::black_box(&rig), std::hint::black_box(&sc), &opt).expect("runs");
+                std::hint::black_box(&out);
+            }
+            println!("case {key}: simulate_fast run {n} times");
             continue;
         }
         if !fast_only {
