@@ -1,29 +1,26 @@
 //! The φ-functions of exponential integrators for a small matrix A and a
-//! step h: E = e^{hA} and Φ_k = h·φ_k(hA) for k = 1, 2, 3, 4, where
+//! step h: E = e^{hA} and Φ_k = h·φ_k(hA) for k = 1, 2, 3, where
 //! φ_k(z) = ∫₀¹ e^{(1−θ)z} θ^{k−1}/(k−1)! dθ (φ₁(z) = (e^z − 1)/z, ...).
 //!
-//! The exact solution of z' = A·z + g₀ + τ·g₁ + τ²/2·g₂ + τ³/6·g₃ over one
-//! step is z(h) = E·z₀ + Φ₁·g₀ + h·Φ₂·g₁ + h²·Φ₃·g₂ + h³·Φ₄·g₃: with these
-//! five matrices a step of the linear thermal network is exact for forcing
-//! polynomial (up to cubic) in time.
+//! The exact solution of z' = A·z + g₀ + τ·g₁ + τ²/2·g₂ over one step is
+//! z(h) = E·z₀ + Φ₁·g₀ + h·Φ₂·g₁ + h²·Φ₃·g₂: with these four matrices a step
+//! of the linear thermal network is exact for forcing polynomial in time.
 //!
 //! Computed by a Taylor series at h/2^s (‖hA‖₁/2^s ≤ 1/2, degree 11:
 //! truncation below 2e-16) and s doublings,
 //! Φ₁(2h) = (E+I)·Φ₁, Φ₂(2h) = ((E+I)·Φ₂ + Φ₁)/2,
-//! Φ₃(2h) = ((E+I)·Φ₃ + Φ₂ + Φ₁/2)/4,
-//! Φ₄(2h) = ((E+I)·Φ₄ + Φ₃ + Φ₂/2 + Φ₁/6)/8, E(2h) = E²,
-//! which follow from splitting ∫₀^{2h} at h (in general
-//! Φ_k(2h) = ((E+I)·Φ_k + Σ_{j<k} Φ_j/(k−j)!)/2^{k−1}). Doubling is also how
-//! a stepper moves to twice the step at the cost of five products.
+//! Φ₃(2h) = ((E+I)·Φ₃ + Φ₂ + Φ₁/2)/4, E(2h) = E²,
+//! which follow from splitting ∫₀^{2h} at h. Doubling is also how a stepper
+//! moves to twice the step at the cost of four products.
 
 use super::dense::{identity, lin2, mul, mul_vec, norm1, transpose, zeros, Mat};
 
-/// Degree of the Taylor polynomial of φ₄.
+/// Degree of the Taylor polynomial of φ₃.
 const TAYLOR_DEGREE: usize = 11;
 /// Largest ‖hA‖₁ at which the Taylor polynomial is used.
 const TAYLOR_NORM: f64 = 0.5;
 
-/// E = e^{hA} and Φ_k = h·φ_k(hA), k = 1..4, for one step h.
+/// E = e^{hA} and Φ_k = h·φ_k(hA), k = 1..3, for one step h.
 #[derive(Debug, Clone, Copy)]
 pub struct Phi<const N: usize> {
     /// Step, s.
@@ -36,11 +33,9 @@ pub struct Phi<const N: usize> {
     pub p2: Mat<N>,
     /// h·φ₃(hA), s.
     pub p3: Mat<N>,
-    /// h·φ₄(hA), s.
-    pub p4: Mat<N>,
-    /// The transposes of p1 … p4 (their columns as rows), for
+    /// The transposes of p1, p2, p3 (their columns as rows), for
     /// matrix–vector products ([`super::dense::mul_vec_add_cols`]).
-    pub cols: [Mat<N>; 4],
+    pub cols: [Mat<N>; 3],
 }
 
 impl<const N: usize> Phi<N> {
@@ -50,7 +45,7 @@ impl<const N: usize> Phi<N> {
         if norm == 0.0 {
             // A = 0 (no Jacobian yet): E = I, Φ_k = h/k!·I.
             let id: Mat<N> = identity();
-            return Self::with_cols(h, id, [lin2(&id, h, &id, 0.0), lin2(&id, h / 2.0, &id, 0.0), lin2(&id, h / 6.0, &id, 0.0), lin2(&id, h / 24.0, &id, 0.0)]);
+            return Self::with_cols(h, id, lin2(&id, h, &id, 0.0), lin2(&id, h / 2.0, &id, 0.0), lin2(&id, h / 6.0, &id, 0.0));
         }
         let s = if norm > TAYLOR_NORM { (norm / TAYLOR_NORM).log2().ceil() as i32 } else { 0 };
         let h0 = h / 2f64.powi(s);
@@ -61,7 +56,7 @@ impl<const N: usize> Phi<N> {
         phi
     }
 
-    /// Taylor polynomials at a step with ‖hA‖₁ ≤ 1/2: φ₄ by Horner, then
+    /// Taylor polynomials at a step with ‖hA‖₁ ≤ 1/2: φ₃ by Horner, then
     /// φ_k = Z·φ_{k+1} + I/k! down to E = Z·φ₁ + I (Z = hA).
     fn taylor(a: &Mat<N>, h: f64) -> Self {
         let mut z = *a;
@@ -70,26 +65,25 @@ impl<const N: usize> Phi<N> {
                 *x *= h;
             }
         }
-        // 1/(j+4)! for j = 0..=TAYLOR_DEGREE.
+        // 1/(j+3)! for j = 0..=TAYLOR_DEGREE.
         let mut inv_fact = [0.0; TAYLOR_DEGREE + 1];
-        let mut f = 24.0;
+        let mut f = 6.0;
         for (j, c) in inv_fact.iter_mut().enumerate() {
             *c = 1.0 / f;
-            f *= (j + 5) as f64;
+            f *= (j + 4) as f64;
         }
         let id: Mat<N> = identity();
-        let mut p4 = lin2(&id, inv_fact[TAYLOR_DEGREE], &zeros(), 0.0);
+        let mut p3 = lin2(&id, inv_fact[TAYLOR_DEGREE], &zeros(), 0.0);
         for j in (0..TAYLOR_DEGREE).rev() {
-            p4 = lin2(&mul(&z, &p4), 1.0, &id, inv_fact[j]);
+            p3 = lin2(&mul(&z, &p3), 1.0, &id, inv_fact[j]);
         }
-        let p3 = lin2(&mul(&z, &p4), 1.0, &id, 1.0 / 6.0);
         let p2 = lin2(&mul(&z, &p3), 1.0, &id, 0.5);
         let p1 = lin2(&mul(&z, &p2), 1.0, &id, 1.0);
         let e = lin2(&mul(&z, &p1), 1.0, &id, 1.0);
-        Self::with_cols(h, e, [lin2(&p1, h, &id, 0.0), lin2(&p2, h, &id, 0.0), lin2(&p3, h, &id, 0.0), lin2(&p4, h, &id, 0.0)])
+        Self::with_cols(h, e, lin2(&p1, h, &id, 0.0), lin2(&p2, h, &id, 0.0), lin2(&p3, h, &id, 0.0))
     }
 
-    /// The same functions at twice the step (five matrix products).
+    /// The same functions at twice the step (four matrix products).
     pub fn doubled(&self) -> Self {
         let id: Mat<N> = identity();
         let ep = lin2(&self.e, 1.0, &id, 1.0);
@@ -97,32 +91,29 @@ impl<const N: usize> Phi<N> {
         let p2 = lin2(&mul(&ep, &self.p2), 0.5, &self.p1, 0.5);
         let mut p3 = lin2(&mul(&ep, &self.p3), 0.25, &self.p2, 0.25);
         p3 = lin2(&p3, 1.0, &self.p1, 0.125);
-        let mut p4 = lin2(&mul(&ep, &self.p4), 0.125, &self.p3, 0.125);
-        p4 = lin2(&p4, 1.0, &lin2(&self.p2, 1.0 / 16.0, &self.p1, 1.0 / 48.0), 1.0);
-        Self::with_cols(2.0 * self.h, mul(&self.e, &self.e), [p1, p2, p3, p4])
+        Self::with_cols(2.0 * self.h, mul(&self.e, &self.e), p1, p2, p3)
     }
 
-    fn with_cols(h: f64, e: Mat<N>, p: [Mat<N>; 4]) -> Self {
-        let [p1, p2, p3, p4] = p;
-        Self { h, e, p1, p2, p3, p4, cols: [transpose(&p1), transpose(&p2), transpose(&p3), transpose(&p4)] }
+    fn with_cols(h: f64, e: Mat<N>, p1: Mat<N>, p2: Mat<N>, p3: Mat<N>) -> Self {
+        Self { h, e, p1, p2, p3, cols: [transpose(&p1), transpose(&p2), transpose(&p3)] }
     }
 }
 
 /// Largest ‖τA‖₁ for which [`solve_linear`] is cheaper than the matrices.
 pub const VECTOR_NORM_MAX: f64 = 4.0;
 
-/// z(τ) of z' = A·z + c₀ + c₁·s + c₂·s²/2 + c₃·s³/6, z(0) = z₀, by Taylor series of
+/// z(τ) of z' = A·z + c₀ + c₁·s + c₂·s²/2, z(0) = z₀, by Taylor series of
 /// the solution on substeps with ‖δA‖₁ ≤ 1/2 (each term one product A·v;
 /// the series stops below 1e-17 of the sum): the action of the
 /// φ-functions on vectors, for steps too odd to cache their matrices (a
 /// schedule breakpoint, a flow reversal). Cost ~15·‖τA‖₁/0.5
 /// matrix–vector products.
-pub fn solve_linear<const N: usize>(a: &Mat<N>, tau: f64, z0: &[f64; N], c: [&[f64; N]; 4]) -> [f64; N] {
+pub fn solve_linear<const N: usize>(a: &Mat<N>, tau: f64, z0: &[f64; N], c: [&[f64; N]; 3]) -> [f64; N] {
     let n = ((norm1(a) * tau / TAYLOR_NORM).ceil() as usize).max(1);
     let d = tau / n as f64;
     let mut z = *z0;
-    // The forcing and its first three derivatives at the substep's start.
-    let (mut f0, mut f1, mut f2, f3) = (*c[0], *c[1], *c[2], *c[3]);
+    // The forcing and its first two derivatives at the substep's start.
+    let (mut f0, mut f1, f2) = (*c[0], *c[1], *c[2]);
     for _ in 0..n {
         // First derivative A·z + f, then each next one A times the last
         // plus the forcing's derivative of that order; the j-th term of
@@ -139,17 +130,12 @@ pub fn solve_linear<const N: usize>(a: &Mat<N>, tau: f64, z0: &[f64; N], c: [&[f
             let forcing = match j {
                 2 => Some(&f1),
                 3 => Some(&f2),
-                4 => Some(&f3),
                 _ => None,
             };
             let mut t = mul_vec(a, &term);
             let fac = d / j as f64;
             // d^(j−1)/(j−1)!: with the factor d/j below, d^j/j! times the forcing's derivative.
-            let dd = match j {
-                2 => d,
-                3 => 0.5 * d * d,
-                _ => d * d * d / 6.0,
-            };
+            let dd = if j == 2 { d } else { 0.5 * d * d };
             for i in 0..N {
                 t[i] = (t[i] + forcing.map_or(0.0, |f| f[i] * dd)) * fac;
             }
@@ -158,15 +144,14 @@ pub fn solve_linear<const N: usize>(a: &Mat<N>, tau: f64, z0: &[f64; N], c: [&[f
             for i in 0..N {
                 next[i] += term[i];
             }
-            if j > 4 && tn <= 1e-17 * zn {
+            if j > 3 && tn <= 1e-17 * zn {
                 break;
             }
         }
         z = next;
         for i in 0..N {
-            f0[i] += d * f1[i] + 0.5 * d * d * f2[i] + d * d * d / 6.0 * f3[i];
-            f1[i] += d * f2[i] + 0.5 * d * d * f3[i];
-            f2[i] += d * f3[i];
+            f0[i] += d * f1[i] + 0.5 * d * d * f2[i];
+            f1[i] += d * f2[i];
         }
     }
     z
@@ -177,26 +162,24 @@ mod tests {
     use super::*;
 
     /// The vector solution against the matrices: z(h) = E·z₀ + Φ₁·c₀ +
-    /// h·Φ₂·c₁ + h²·Φ₃·c₂ + h³·Φ₄·c₃ for the stiff 3×3 network of `doubling_equals_direct`, at
+    /// h·Φ₂·c₁ + h²·Φ₃·c₂ for the stiff 3×3 network of `doubling_equals_direct`, at
     /// ‖hA‖₁ from 0.02 to 4 (1e-12 relative).
     #[test]
     fn vector_solution_matches_the_matrices() {
         let a: Mat<3> = [[-2.0, 1.0, 0.5], [0.3, -0.9, 0.1], [0.0, 0.2, -0.05]];
-        let (z0, c0, c1, c2, c3) = ([20.0, 30.0, 25.0], [1.0, -0.5, 0.02], [0.1, 0.3, -0.2], [0.05, -0.02, 0.01], [-0.03, 0.01, 0.02]);
+        let (z0, c0, c1, c2) = ([20.0, 30.0, 25.0], [1.0, -0.5, 0.02], [0.1, 0.3, -0.2], [0.05, -0.02, 0.01]);
         for h in [0.007, 0.3, 1.4] {
             let p = Phi::new(&a, h);
-            let got = solve_linear(&a, h, &z0, [&c0, &c1, &c2, &c3]);
+            let got = solve_linear(&a, h, &z0, [&c0, &c1, &c2]);
             for i in 0..3 {
-                let want: f64 = (0..3)
-                    .map(|j| p.e[i][j] * z0[j] + p.p1[i][j] * c0[j] + h * p.p2[i][j] * c1[j] + h * h * p.p3[i][j] * c2[j] + h * h * h * p.p4[i][j] * c3[j])
-                    .sum();
+                let want: f64 = (0..3).map(|j| p.e[i][j] * z0[j] + p.p1[i][j] * c0[j] + h * p.p2[i][j] * c1[j] + h * h * p.p3[i][j] * c2[j]).sum();
                 assert!((got[i] - want).abs() < 1e-12 * want.abs(), "h {h}: {got:?} vs {want}");
             }
         }
     }
 
     /// Scalar closed forms: φ₁(z) = (e^z−1)/z, φ₂ = (e^z−1−z)/z²,
-    /// φ₃ = (e^z−1−z−z²/2)/z³, φ₄ = (e^z−1−z−z²/2−z³/6)/z⁴, for z from −200 (a stiff node over a long
+    /// φ₃ = (e^z−1−z−z²/2)/z³, for z from −200 (a stiff node over a long
     /// step: many doublings) to +0.3, to 1e-12 relative (round-off of
     /// the doublings; the closed forms lose digits near z = 0, where the
     /// bound is checked with series values instead).
@@ -205,18 +188,15 @@ mod tests {
         for (a, h) in [(-4.0, 50.0), (-0.8, 0.25), (-1e-4, 10.0), (0.03, 10.0), (-3.2, 1e-3)] {
             let p = Phi::<1>::new(&[[a]], h);
             let z: f64 = a * h;
-            let (e1, e2, e3, e4) = if z.abs() > 1e-2 {
+            let (e1, e2, e3) = if z.abs() > 1e-2 {
                 let ez = z.exp();
-                ((ez - 1.0) / z, (ez - 1.0 - z) / (z * z), (ez - 1.0 - z - z * z / 2.0) / (z * z * z), (ez - 1.0 - z - z * z / 2.0 - z * z * z / 6.0) / (z * z * z * z))
+                ((ez - 1.0) / z, (ez - 1.0 - z) / (z * z), (ez - 1.0 - z - z * z / 2.0) / (z * z * z))
             } else {
                 let s = |k: i32| (0..20).map(|j| z.powi(j) / (1..=(j + k)).map(f64::from).product::<f64>()).sum::<f64>();
-                (s(1), s(2), s(3), s(4))
+                (s(1), s(2), s(3))
             };
-            // φ₄'s closed form loses ~4 digits more at |z| ~ 0.3 (a difference of
-            // five terms over z⁴): checked to 1e-9 there.
-            let tol4 = if z.abs() > 1e-2 && z.abs() < 1.0 { 1e-9 } else { 1e-12 };
-            for (got, want, k, tol) in [(p.e[0][0], z.exp(), 0, 1e-12), (p.p1[0][0] / h, e1, 1, 1e-12), (p.p2[0][0] / h, e2, 2, 1e-12), (p.p3[0][0] / h, e3, 3, 1e-12), (p.p4[0][0] / h, e4, 4, tol4)] {
-                assert!((got - want).abs() <= tol * want.abs(), "z = {z}, phi_{k}: {got} vs {want}");
+            for (got, want, k) in [(p.e[0][0], z.exp(), 0), (p.p1[0][0] / h, e1, 1), (p.p2[0][0] / h, e2, 2), (p.p3[0][0] / h, e3, 3)] {
+                assert!((got - want).abs() <= 1e-12 * want.abs(), "z = {z}, phi_{k}: {got} vs {want}");
             }
         }
     }
@@ -269,7 +249,7 @@ mod tests {
         let a: Mat<3> = [[-2.0, 1.0, 0.5], [0.3, -0.9, 0.1], [0.0, 0.2, -0.05]];
         let p = Phi::new(&a, 0.8).doubled();
         let q = Phi::new(&a, 1.6);
-        for (m, n) in [(p.e, q.e), (p.p1, q.p1), (p.p2, q.p2), (p.p3, q.p3), (p.p4, q.p4)] {
+        for (m, n) in [(p.e, q.e), (p.p1, q.p1), (p.p2, q.p2), (p.p3, q.p3)] {
             for i in 0..3 {
                 for j in 0..3 {
                     assert!((m[i][j] - n[i][j]).abs() < 1e-13, "{m:?} vs {n:?}");

@@ -309,8 +309,7 @@ impl FastPlant {
         let mut stalled = 0u32;
         // The error below which the step doubles, and whether the last
         // accepted step was a doubling (see `GROW_ERR`).
-        let grow_max = std::env::var("FAST_GROW").ok().and_then(|v| v.parse().ok()).unwrap_or(GROW_ERR);
-        let mut grow_err = grow_max;
+        let mut grow_err = GROW_ERR;
         let mut just_grew = false;
         // Position since the grid's origin in units of the finest level:
         // step ends are origin + ticks·h_fine, free of accumulated round-off.
@@ -483,7 +482,7 @@ impl FastPlant {
                 ticks += 1u64 << (level - LEVEL_MIN);
                 let next = level + 1;
                 if just_grew {
-                    grow_err = (grow_err * 1.1).min(grow_max);
+                    grow_err = (grow_err * 1.1).min(GROW_ERR);
                 }
                 just_grew = false;
                 let grow = err <= grow_err;

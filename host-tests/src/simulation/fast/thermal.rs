@@ -60,15 +60,6 @@ const DRIFT_GATE: f64 = 0.05;
 /// (no level matrices for the exact solve), at most.
 const DRIFT_ITERS: u32 = 4;
 
-/// Order of the step: the predictor's polynomial in g runs through
-/// `order()` points (the stored g and g₀), the corrector's through
-/// order − 2 stored g, g₀ and g*. Experiment knob `FAST_ORDER` (3 or 4),
-/// read once.
-fn order() -> usize {
-    static ORDER: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
-    *ORDER.get_or_init(|| std::env::var("FAST_ORDER").ok().and_then(|v| v.parse().ok()).filter(|o| (3..=4).contains(o)).unwrap_or(4))
-}
-
 /// The scheme's state between steps.
 #[derive(Debug, Clone)]
 pub struct Thermal {
@@ -125,7 +116,7 @@ impl Thermal {
     /// A state at time `t`, temperatures `z` and energies `e` (call
     /// [`Thermal::jacobian`] first).
     pub fn new(t: f64, z: [f64; NT], e: [f64; NE]) -> Self {
-        Self { z, e, fz: [0.0; NT], q: [0.0; NE], t, hist: Vec::with_capacity(4), a: [[0.0; NT]; NT], a_cols: [[0.0; NT]; NT], a_e: [[0.0; NT]; NE], a_zero: true, da_cols: None, da_idx: [0; NT], da_n: 0, da_norm: 0.0 }
+        Self { z, e, fz: [0.0; NT], q: [0.0; NE], t, hist: Vec::with_capacity(3), a: [[0.0; NT]; NT], a_cols: [[0.0; NT]; NT], a_e: [[0.0; NT]; NE], a_zero: true, da_cols: None, da_idx: [0; NT], da_n: 0, da_norm: 0.0 }
     }
 
     /// Whether A is zero (no Jacobian taken yet).
@@ -216,33 +207,24 @@ impl Thermal {
         }
     }
 
-    /// z(h) of z' = A·z + g₀ + g'·s + g''·s²/2 + g'''·s³/6 from z₀
-    /// (A·z₀ + g₀ = f₀), by the level's matrices or the vector solution;
-    /// `d` = (g', g'', g''', how many of them are not zero).
-    fn linear(&self, phi: Option<&Phi<NT>>, h: f64, g0: &[f64; NT], d: &Derivs) -> [f64; NT] {
-        let (d1, d2, d3) = (&d.0[0], &d.0[1], &d.0[2]);
+    /// z(h) of z' = A·z + g₀ + g'·s + g''·s²/2 from z₀ (A·z₀ + g₀ = f₀),
+    /// by the level's matrices or the vector solution.
+    fn linear(&self, phi: Option<&Phi<NT>>, h: f64, g0: &[f64; NT], d: &([f64; NT], [f64; NT])) -> [f64; NT] {
         if self.a_zero {
             // A = 0: Φ_k = h/k!·I, f₀ = g₀.
-            let (c1, c2, c3) = (h * h / 2.0, h * h * h / 6.0, h * h * h * h / 24.0);
-            return std::array::from_fn(|i| self.z[i] + h * self.fz[i] + c1 * d1[i] + c2 * d2[i] + c3 * d3[i]);
+            let (c1, c2) = (h * h / 2.0, h * h * h / 6.0);
+            return std::array::from_fn(|i| self.z[i] + h * self.fz[i] + c1 * d.0[i] + c2 * d.1[i]);
         }
         match phi {
             Some(p) => {
-                // z₀ + Φ₁·f₀ + h·Φ₂·g' + h²·Φ₃·g'' + h³·Φ₄·g'''
+                // z₀ + Φ₁·f₀ + h·Φ₂·g' + h²·Φ₃·g''
                 let mut z = self.z;
                 mul_vec_add_cols(&p.cols[0], &self.fz, &mut z);
-                if d.1 >= 1 {
-                    mul_vec_add_cols(&p.cols[1], &d1.map(|x| x * h), &mut z);
-                }
-                if d.1 >= 2 {
-                    mul_vec_add_cols(&p.cols[2], &d2.map(|x| x * h * h), &mut z);
-                }
-                if d.1 >= 3 {
-                    mul_vec_add_cols(&p.cols[3], &d3.map(|x| x * h * h * h), &mut z);
-                }
+                mul_vec_add_cols(&p.cols[1], &d.0.map(|x| x * h), &mut z);
+                mul_vec_add_cols(&p.cols[2], &d.1.map(|x| x * h * h), &mut z);
                 z
             }
-            None => solve_linear(&self.a, h, &self.z, [g0, d1, d2, d3]),
+            None => solve_linear(&self.a, h, &self.z, [g0, &d.0, &d.1]),
         }
     }
 
@@ -252,8 +234,8 @@ impl Thermal {
         let az0 = mul_vec_cols(&self.a_cols, &self.z);
         let g0: [f64; NT] = std::array::from_fn(|i| self.fz[i] - az0[i]);
         // The polynomial through the stored g and g₀.
-        let mut pts: [(f64, &[f64; NT]); 4] = [(0.0, &g0); 4];
-        let n = self.hist.len().min(order() - 1);
+        let mut pts: [(f64, &[f64; NT]); 3] = [(0.0, &g0); 3];
+        let n = self.hist.len().min(2);
         for (k, (t, g, _)) in self.hist[self.hist.len() - n..].iter().enumerate() {
             pts[k] = (t - self.t, g);
         }
@@ -267,10 +249,10 @@ impl Thermal {
         let azp = mul_vec_cols(&self.a_cols, zp);
         let gp: [f64; NT] = std::array::from_fn(|i| fp[i] - azp[i]);
         // The polynomial through the latest stored g, g₀ and g*.
-        let mut pts: [(f64, &[f64; NT]); 4] = [(0.0, g0); 4];
-        let m = self.hist.len().min(order() - 2);
-        for (k, (t, g, _)) in self.hist[self.hist.len() - m..].iter().enumerate() {
-            pts[k] = (t - self.t, g);
+        let mut pts: [(f64, &[f64; NT]); 3] = [(0.0, g0); 3];
+        let m = self.hist.len().min(1);
+        if let Some((t, g, _)) = self.hist.last() {
+            pts[0] = (t - self.t, g);
         }
         pts[m] = (0.0, g0);
         pts[m + 1] = (h, &gp);
@@ -282,7 +264,7 @@ impl Thermal {
             // weights of the end point in g', g''); with δ = Σ_k (Â − A)_k·dz_k
             // over the drifting columns k, a k×k system.
             let n = self.da_n;
-            let [c1, c2, c3] = end_weights(&pts[..m + 2]);
+            let (c1, c2) = end_weights(&pts[..m + 2]);
             let exact = self.a_zero || phi.is_some();
             if exact {
                 let mut w = [[0.0; NT]; NT];
@@ -292,12 +274,9 @@ impl Thermal {
                         Some(p) if !self.a_zero => {
                             mul_vec_add_cols(&p.cols[1], &v.map(|x| x * h * c1), &mut w[k]);
                             mul_vec_add_cols(&p.cols[2], &v.map(|x| x * h * h * c2), &mut w[k]);
-                            if c3 != 0.0 {
-                                mul_vec_add_cols(&p.cols[3], &v.map(|x| x * h * h * h * c3), &mut w[k]);
-                            }
                         }
                         _ => {
-                            let s = h * h * c1 / 2.0 + h * h * h * c2 / 6.0 + h * h * h * h * c3 / 24.0;
+                            let s = h * h * c1 / 2.0 + h * h * h * c2 / 6.0;
                             w[k] = v.map(|x| x * s);
                         }
                     }
@@ -339,15 +318,7 @@ impl Thermal {
         }
         let f1 = std::array::from_fn(|i| fp[i] + adz[i]);
         let q1 = std::array::from_fn(|i| qp[i] + self.a_e[i].iter().zip(&dz).map(|(p, q)| p * q).sum::<f64>());
-        // Milne: the corrector's error constant over the difference of the
-        // two (predictor − corrector): order 2 (trapezoid against AB2)
-        // 1/12 of 5/12 + 1/12; order 3 1/24 of 3/8 + 1/24; order 4 19/720 of
-        // 251/720 + 19/720.
-        let milne = match m {
-            0 => 6.0,
-            1 => 10.0,
-            _ => 270.0 / 19.0,
-        };
+        let milne = if m == 1 { 10.0 } else { 6.0 };
         let (mut err_k, mut worst) = (0.0, 0);
         for (i, d) in dz.iter().enumerate() {
             if d.abs() / milne > err_k {
@@ -362,7 +333,7 @@ impl Thermal {
         for i in 0..NE {
             self.e[i] += 0.5 * t.h * (self.q[i] + t.q1[i]);
         }
-        if self.hist.len() >= order() - 1 {
+        if self.hist.len() == 2 {
             self.hist.remove(0);
         }
         self.hist.push((self.t, t.g0, self.z));
@@ -371,68 +342,41 @@ impl Thermal {
     }
 }
 
-/// g', g'', g''' at s = 0 of the polynomial through `pts` (s, g) (one
-/// point: constant; two: line; three: parabola; four: cubic), and how many
-/// of them the polynomial's degree leaves not zero.
-type Derivs = ([[f64; NT]; 3], usize);
-
-/// The weights w[r][k] of the k-th point's value in the (r+1)-th
-/// derivative at s = 0 of the polynomial through the points at `xs`
-/// (Lagrange: each basis polynomial's monomial coefficients).
-fn weights(xs: &[f64]) -> [[f64; 4]; 3] {
-    let mut w = [[0.0; 4]; 3];
-    for (k, &xk) in xs.iter().enumerate() {
-        let (mut c, mut den) = ([1.0, 0.0, 0.0, 0.0], 1.0);
-        for (j, &x) in xs.iter().enumerate() {
-            if j != k {
-                // c ← c·(s − x)
-                for r in (0..4).rev() {
-                    c[r] = if r > 0 { c[r - 1] } else { 0.0 } - x * c[r];
-                }
-                den *= xk - x;
-            }
-        }
-        (w[0][k], w[1][k], w[2][k]) = (c[1] / den, 2.0 * c[2] / den, 6.0 * c[3] / den);
-    }
-    w
-}
-
-/// g', g'', g''' at s = 0 of the polynomial through `pts` (s, g).
-fn derivatives(pts: &[(f64, &[f64; NT])]) -> Derivs {
-    let mut d = [[0.0; NT]; 3];
-    let n = pts.len();
-    if n < 2 {
-        return (d, 0);
-    }
-    let mut xs = [0.0; 4];
-    for (x, p) in xs.iter_mut().zip(pts) {
-        *x = p.0;
-    }
-    let w = weights(&xs[..n]);
-    for (r, dr) in d.iter_mut().enumerate().take(n - 1) {
-        for (k, (_, y)) in pts.iter().enumerate() {
-            let wk = w[r][k];
+/// g' and g'' at s = 0 of the polynomial through `pts` (s, g) (one point:
+/// constant; two: line; three: parabola), by divided differences.
+fn derivatives(pts: &[(f64, &[f64; NT])]) -> ([f64; NT], [f64; NT]) {
+    let (mut d1, mut d2) = ([0.0; NT], [0.0; NT]);
+    match pts {
+        [(x0, y0), (x1, y1)] => {
             for i in 0..NT {
-                dr[i] += wk * y[i];
+                d1[i] = (y1[i] - y0[i]) / (x1 - x0);
             }
         }
+        [(x0, y0), (x1, y1), (x2, y2)] => {
+            for i in 0..NT {
+                let d01 = (y1[i] - y0[i]) / (x1 - x0);
+                let d12 = (y2[i] - y1[i]) / (x2 - x1);
+                let d012 = (d12 - d01) / (x2 - x0);
+                d1[i] = d01 - d012 * (x0 + x1);
+                d2[i] = 2.0 * d012;
+            }
+        }
+        _ => {}
     }
-    (d, n - 1)
+    (d1, d2)
 }
 
-/// The weights of the last point's value in g', g'' and g''' at s = 0 of
+/// The weights of the last point's value in g' and g'' at s = 0 of
 /// [`derivatives`].
-fn end_weights(pts: &[(f64, &[f64; NT])]) -> [f64; 3] {
-    let n = pts.len();
-    if n < 2 {
-        return [0.0; 3];
+fn end_weights(pts: &[(f64, &[f64; NT])]) -> (f64, f64) {
+    match pts {
+        [(x0, _), (x1, _)] => (1.0 / (x1 - x0), 0.0),
+        [(x0, _), (x1, _), (x2, _)] => {
+            let d = 1.0 / ((x2 - x1) * (x2 - x0));
+            (-(x0 + x1) * d, 2.0 * d)
+        }
+        _ => (0.0, 0.0),
     }
-    let mut xs = [0.0; 4];
-    for (x, p) in xs.iter_mut().zip(pts) {
-        *x = p.0;
-    }
-    let w = weights(&xs[..n]);
-    [w[0][n - 1], w[1][n - 1], w[2][n - 1]]
 }
 
 /// Solves the leading n×n system m·x = b in place (Gaussian elimination
