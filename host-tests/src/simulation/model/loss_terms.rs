@@ -115,7 +115,11 @@ impl Model {
     /// every one of those faces belongs to the internals. The no-load term
     /// divides by [`crate::rig::PumpSplit::no_load_to_housing`].
     pub fn friction_heat(&self, op: &OpPoint, t_case: f64) -> FrictionHeat {
-        let fr = self.pump_friction(op, t_case);
+        self.friction_heat_of(&self.pump_friction(op, t_case))
+    }
+
+    /// [`Model::friction_heat`] of the pump friction `fr` already taken.
+    fn friction_heat_of(&self, fr: &losses::PumpFriction) -> FrictionHeat {
         let films = fr.viscous_w + fr.pressure_w;
         match &self.rig.pump.split {
             Some(s) => {
@@ -131,9 +135,20 @@ impl Model {
 
     /// All losses at an operating point and temperatures, W.
     pub fn losses(&self, t: f64, op: &OpPoint, temps: &[f64]) -> Losses {
+        self.loss_parts(t, op, temps).0
+    }
+
+    /// [`Model::losses`] with the two of its parts the heat balances use
+    /// again ([`Model::thermal_with`]): where the pump's friction heat goes
+    /// and the pump and valve flows (each taken once, not once for the
+    /// losses and once for the balances: the same calls on the same
+    /// arguments, so the same values to the last bit).
+    pub(super) fn loss_parts(&self, t: f64, op: &OpPoint, temps: &[f64]) -> (Losses, FrictionHeat, hydraulics::Flows) {
         let rig = &self.rig;
         let tc = |n: Node| temps[n as usize];
         let f = hydraulics::flows(rig, op, self.k_leak(tc(Node::Case)));
+        let fr = self.pump_friction(op, tc(Node::Case));
+        let fh = self.friction_heat_of(&fr);
         let dp = op.p_a - op.p_b;
         let (line, needle) = match (&self.drive, op.circuit) {
             (Drive::Mission(m), Circuit::Throttle) => {
@@ -153,7 +168,7 @@ impl Model {
             + f.check_a * (h.accumulator_pa - op.p_a)
             + f.check_b * (h.accumulator_pa - op.p_b);
         let coulomb = rig.ext.coulomb_friction.map_or(0.0, |fc| fc * (op.v / 1e-3).tanh() * op.v);
-        Losses {
+        let l = Losses {
             copper: losses::copper_w(
                 rig.motor.phases,
                 op.current_a,
@@ -164,8 +179,8 @@ impl Model {
             iron: rig.motor.iron.power_w(op.omega),
             bearing: rig.motor.bearing_friction_nm.map_or(0.0, |m| losses::bearing_w(m, op.omega)),
             leakage: f.leak_a * (op.p_a - op.p_case) + f.leak_b * (op.p_b - op.p_case),
-            mechanical: self.pump_friction(op, tc(Node::Case)).total_w(),
-            mech_metal: self.friction_heat(op, tc(Node::Case)).metal(),
+            mechanical: fr.total_w(),
+            mech_metal: fh.metal(),
             churning: rig.ext.churning_loss.map_or(0.0, |k| losses::churning_w(k, op.omega)),
             line,
             needle,
@@ -175,6 +190,7 @@ impl Model {
                 Circuit::Servo => rig.actuator.viscous_friction_n_s_per_m * op.v * op.v + coulomb,
                 Circuit::Throttle => 0.0,
             },
-        }
+        };
+        (l, fh, f)
     }
 }

@@ -176,9 +176,9 @@ impl Model {
     pub fn rhs(&self, t: f64, y: &[f64], dy: &mut [f64]) {
         let op = self.op_point(t, y);
         let temps = &y[T0..T0 + N_NODES];
-        let l = self.losses(t, &op, temps);
+        let (l, fh, f) = self.loss_parts(t, &op, temps);
         self.hydraulic_rhs_at(t, y, &op, dy);
-        let (q_in, q_amb, q_lng) = self.thermal(&op, &l, temps, &mut dy[T0..T0 + N_NODES]);
+        let (q_in, q_amb, q_lng) = self.thermal_with(&op, &l, &fh, &f, temps, &mut dy[T0..T0 + N_NODES]);
         dy[E_LOSS] = q_in;
         dy[E_AMB] = q_amb;
         dy[E_LNG] = q_lng;
@@ -190,8 +190,8 @@ impl Model {
     pub fn thermal_rhs(&self, t: f64, y: &[f64], dy: &mut [f64]) {
         let op = self.op_point(t, y);
         let temps = &y[T0..T0 + N_NODES];
-        let l = self.losses(t, &op, temps);
-        let (q_in, q_amb, q_lng) = self.thermal(&op, &l, temps, &mut dy[T0..T0 + N_NODES]);
+        let (l, fh, f) = self.loss_parts(t, &op, temps);
+        let (q_in, q_amb, q_lng) = self.thermal_with(&op, &l, &fh, &f, temps, &mut dy[T0..T0 + N_NODES]);
         dy[E_LOSS] = q_in;
         dy[E_AMB] = q_amb;
         dy[E_LNG] = q_lng;

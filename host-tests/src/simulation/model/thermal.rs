@@ -2,7 +2,7 @@
 //! 12–19, the advection ring, the LNG exchanger eqs. 20–22) and the energy
 //! integrals. Separate because it is the longest single part of the model.
 
-use super::{Losses, Model};
+use super::{FrictionHeat, Losses, Model};
 use crate::hydraulics::{self, OpPoint};
 use crate::network::{self, Node, N_NODES, NODES};
 use crate::scenario::Circuit;
@@ -15,6 +15,15 @@ impl Model {
     /// pump leakage, line and needle losses are not sources here, they follow
     /// from the oil's enthalpy h(T, p) at each node's pressure.
     pub fn thermal(&self, op: &OpPoint, l: &Losses, temps: &[f64], dt: &mut [f64]) -> (f64, f64, f64) {
+        let t_case = temps[Node::Case as usize];
+        let fh = self.friction_heat(op, t_case);
+        let f = hydraulics::flows(&self.rig, op, self.k_leak(t_case));
+        self.thermal_with(op, l, &fh, &f, temps, dt)
+    }
+
+    /// [`Model::thermal`] given the pump's friction heat `fh` and the flows
+    /// `f` at `op` and these temperatures (from [`Model::loss_parts`]).
+    pub(super) fn thermal_with(&self, op: &OpPoint, l: &Losses, fh: &FrictionHeat, f: &hydraulics::Flows, temps: &[f64], dt: &mut [f64]) -> (f64, f64, f64) {
         let rig = &self.rig;
         let oil = &rig.oil;
         let tc = |n: Node| temps[n as usize];
@@ -22,7 +31,6 @@ impl Model {
         let mut q_in = 0.0;
         // Heat sources (losses that are not a pressure drop of the ring) into their nodes.
         let hp = if op.p_a >= op.p_b { Node::Outlet } else { Node::Inlet };
-        let fh = self.friction_heat(op, tc(Node::Case));
         for (n, w) in [
             (Node::Winding, l.copper),
             (Node::Motor, l.iron + l.bearing),
@@ -95,7 +103,6 @@ impl Model {
         // compression αTΔp/(ρc_p)); in the servo circuit the actuator takes
         // m·Δp/ρ out of the oil it passes to the loop.
         let m_c = self.ring_mass_flow(qc.abs(), tc(Node::Loop));
-        let f = hydraulics::flows(rig, op, self.k_leak(tc(Node::Case)));
         let m_l = self.ring_mass_flow(hydraulics::soft_pos(f.leak_a, 1e-9) + hydraulics::soft_pos(f.leak_b, 1e-9), tc(Node::Loop));
         let forward = qc >= 0.0;
         let ring: &[Node] = match (op.circuit, forward) {
@@ -125,7 +132,12 @@ impl Model {
             Node::Case => op.p_case,
             _ => p_loop,
         };
-        let h = |n: Node| oil.enthalpy_tp(tc(n), pres(n));
+        // h(T, p) of the ring's nodes and the case oil, each taken once.
+        let mut h_node = [0.0f64; N_NODES];
+        for &n in ring.iter().chain(&[Node::Case]) {
+            h_node[n as usize] = oil.enthalpy_tp(tc(n), pres(n));
+        }
+        let h = |n: Node| h_node[n as usize];
         let hp_pos = ring.iter().position(|&n| n == hp).unwrap_or(0);
         let mut q_lng = 0.0;
         for k in 0..ring.len() {
