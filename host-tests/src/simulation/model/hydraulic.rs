@@ -33,11 +33,22 @@ impl HydraulicOil {
 impl Model {
     /// Hydraulic operating point at (t, y).
     pub fn op_point(&self, t: f64, y: &[f64]) -> OpPoint {
+        self.op_point_parts(t, y).0
+    }
+
+    /// [`Model::op_point`] with the pump friction a mission's motor current
+    /// was taken with (None in a replay, whose current is logged): the
+    /// losses take it again ([`Model::loss_parts`]); it does not depend on
+    /// the current.
+    pub(super) fn op_point_parts(&self, t: f64, y: &[f64]) -> (OpPoint, Option<losses::PumpFriction>) {
         let mut op = self.op_hydraulic(t, y);
+        let mut friction = None;
         if let Drive::Mission(_) = &self.drive {
-            op.current_a = self.motor_current(&op, y[t_ix(Node::Case)]);
+            let fr = self.pump_friction(&op, y[t_ix(Node::Case)]);
+            op.current_a = self.motor_current(&op, &fr);
+            friction = Some(fr);
         }
-        op
+        (op, friction)
     }
 
     /// [`Model::op_point`] without the motor current of a mission (zero
@@ -96,10 +107,10 @@ impl Model {
     }
 
     /// Motor current of a mission's operating point, A rms: the shaft
-    /// torque (pump load plus friction at the case-oil temperature
-    /// `t_case`) over the torque constant.
-    fn motor_current(&self, op: &OpPoint, t_case: f64) -> f64 {
-        let fr = self.pump_friction(op, t_case).total_w()
+    /// torque (pump load plus friction, `pump` the pump's at the case-oil
+    /// temperature) over the torque constant.
+    fn motor_current(&self, op: &OpPoint, pump: &losses::PumpFriction) -> f64 {
+        let fr = pump.total_w()
             + self.rig.ext.churning_loss.map_or(0.0, |k| losses::churning_w(k, op.omega))
             + self.rig.motor.bearing_friction_nm.map_or(0.0, |m| losses::bearing_w(m, op.omega));
         hydraulics::soft_abs(hydraulics::shaft_torque(&self.rig, op, fr), 1e-3) / self.rig.motor.torque_constant_nm_per_a

@@ -135,19 +135,21 @@ impl Model {
 
     /// All losses at an operating point and temperatures, W.
     pub fn losses(&self, t: f64, op: &OpPoint, temps: &[f64]) -> Losses {
-        self.loss_parts(t, op, temps).0
+        self.loss_parts(t, op, temps, None).0
     }
 
     /// [`Model::losses`] with the two of its parts the heat balances use
     /// again ([`Model::thermal_with`]): where the pump's friction heat goes
     /// and the pump and valve flows (each taken once, not once for the
     /// losses and once for the balances: the same calls on the same
-    /// arguments, so the same values to the last bit).
-    pub(super) fn loss_parts(&self, t: f64, op: &OpPoint, temps: &[f64]) -> (Losses, FrictionHeat, hydraulics::Flows) {
+    /// arguments, so the same values to the last bit). `friction`: the
+    /// pump friction at `op` and the case oil of `temps` if already taken
+    /// ([`Model::op_point_parts`]).
+    pub(super) fn loss_parts(&self, t: f64, op: &OpPoint, temps: &[f64], friction: Option<losses::PumpFriction>) -> (Losses, FrictionHeat, hydraulics::Flows) {
         let rig = &self.rig;
         let tc = |n: Node| temps[n as usize];
         let f = hydraulics::flows(rig, op, self.k_leak(tc(Node::Case)));
-        let fr = self.pump_friction(op, tc(Node::Case));
+        let fr = friction.unwrap_or_else(|| self.pump_friction(op, tc(Node::Case)));
         let fh = self.friction_heat_of(&fr);
         let dp = op.p_a - op.p_b;
         let (line, needle) = match (&self.drive, op.circuit) {

@@ -174,9 +174,9 @@ impl Model {
 
     /// Full right-hand side dy/dt = f(t, y).
     pub fn rhs(&self, t: f64, y: &[f64], dy: &mut [f64]) {
-        let op = self.op_point(t, y);
+        let (op, friction) = self.op_point_parts(t, y);
         let temps = &y[T0..T0 + N_NODES];
-        let (l, fh, f) = self.loss_parts(t, &op, temps);
+        let (l, fh, f) = self.loss_parts(t, &op, temps, friction);
         self.hydraulic_rhs_at(t, y, &op, dy);
         let (q_in, q_amb, q_lng) = self.thermal_with(&op, &l, &fh, &f, temps, &mut dy[T0..T0 + N_NODES]);
         dy[E_LOSS] = q_in;
@@ -188,9 +188,9 @@ impl Model {
     /// left as it is): the node temperatures' derivatives and the energy
     /// rates, the same to the last bit.
     pub fn thermal_rhs(&self, t: f64, y: &[f64], dy: &mut [f64]) {
-        let op = self.op_point(t, y);
+        let (op, friction) = self.op_point_parts(t, y);
         let temps = &y[T0..T0 + N_NODES];
-        let (l, fh, f) = self.loss_parts(t, &op, temps);
+        let (l, fh, f) = self.loss_parts(t, &op, temps, friction);
         let (q_in, q_amb, q_lng) = self.thermal_with(&op, &l, &fh, &f, temps, &mut dy[T0..T0 + N_NODES]);
         dy[E_LOSS] = q_in;
         dy[E_AMB] = q_amb;
