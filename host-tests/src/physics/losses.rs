@@ -50,7 +50,7 @@ pub fn bearing_w(friction_torque_nm: f64, omega: f64) -> f64 {
 
 /// Leakage-gap geometry of the axial piston pump, eqs. (5)–(7).
 /// The paper gives the equations but not the dimensions; the defaults are
-/// those of a 19 cm³/rev nine-piston pump and are marked in `rig.rs`.
+/// those of a 19 cm³/rev nine-piston pump and are marked in `rig/`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PumpGaps {

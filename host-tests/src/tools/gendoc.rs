@@ -34,7 +34,7 @@ pub struct Section {
 pub const SECTIONS: [Section; 5] = [
     Section { doc: "docs/results.md", tag: "uq-paper", source: "docs/data/uq-paper.json", render: render_uq_paper },
     Section { doc: "docs/results.md", tag: "fw-budget", source: ".ci/fw-budget.json", render: render_fw_budget },
-    Section { doc: "docs/rig-file.md", tag: "rig-file", source: "host-tests/src/physics/rig.rs", render: crate::tools::rigdoc::render },
+    Section { doc: "docs/rig-file.md", tag: "rig-file", source: "host-tests/src/physics/rig/mod.rs", render: crate::tools::rigdoc::render },
     Section { doc: "docs/failure-modes.md", tag: "failure-modes", source: "docs/data/faults.json", render: render_failure_modes },
     Section {
         doc: "docs/diagnosis.md",
