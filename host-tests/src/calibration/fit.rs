@@ -11,6 +11,8 @@
 
 use super::ident::{excitation_warnings, identifiability, Identifiability};
 use super::log::CalLog;
+use super::polish::{polish, polish_basins};
+pub use super::polish::{Polish, POLISH_MAX_ITERS, POLISH_RTOL, POLISH_TOL, SCALE_PAIR};
 use super::set::{apply, Needs, Stage, PARAMS, PROBE_OIL};
 use crate::lsq::FdProblem;
 use crate::rig::Rig;
@@ -55,6 +57,10 @@ pub struct CalOptions {
     /// (twice that from the reflected start of the basin check); default
     /// [`POLISH_MAX_ITERS`].
     pub polish_iters: usize,
+    /// Relative tolerance of the replay solver in the final polish
+    /// (default [`POLISH_RTOL`]; LM before it replays at
+    /// [`crate::simulation::replay::REPLAY_RTOL`]).
+    pub polish_rtol: f64,
 }
 
 impl Default for CalOptions {
@@ -70,6 +76,7 @@ impl Default for CalOptions {
             start: None,
             direct: Some(super::direct::DirectOptions::default()),
             polish_iters: POLISH_MAX_ITERS,
+            polish_rtol: POLISH_RTOL,
         }
     }
 }
@@ -162,7 +169,7 @@ pub(crate) struct Sigma {
 }
 
 /// Scaled data residuals of every log at full multiplier vector `theta`.
-fn data_residuals(base: &Rig, logs: &[CalLog], theta: &[f64], sigma: Sigma, runs: &AtomicUsize) -> Option<Vec<f64>> {
+pub(super) fn data_residuals(base: &Rig, logs: &[CalLog], theta: &[f64], sigma: Sigma, runs: &AtomicUsize) -> Option<Vec<f64>> {
     let rig = apply(base, theta);
     let parts: Option<Vec<Vec<f64>>> = logs
         .par_iter()
@@ -367,7 +374,10 @@ pub fn calibrate(base: &Rig, logs: &[CalLog], o: &CalOptions) -> Result<Calibrat
     // (measured on big-pump: with the basin check and a central-difference
     // retry in the split fit too, the nudge test's margin moved 1.956 ->
     // 2.253 K, against 2.290 -> 2.118 K with the plain polish there).
-    let (theta, polish) = if o.start.is_some() { polish(base, logs, lm_theta, &free, sigma, &runs) } else { polish_basins(base, logs, lm_theta, &free, sigma, &runs) };
+    // The polish replays at `polish_rtol` (POLISH_RTOL: what a tighter
+    // tolerance does, measured).
+    let fine: Vec<CalLog> = logs.iter().map(|l| l.with_rtol(o.polish_rtol)).collect();
+    let (theta, polish) = if o.start.is_some() { polish(base, &fine, lm_theta, &free, sigma, &runs) } else { polish_basins(base, &fine, lm_theta, &free, sigma, &runs) };
     // 4. Identifiability at the optimum.
     let (r1, j1) = jacobian_ln(base, logs, &theta, &free, sigma, &runs)
         .ok_or_else(|| CalError::Model("the calibrated rig".into(), "model failed in the final Jacobian".into()))?;
@@ -417,203 +427,3 @@ pub fn calibrate(base: &Rig, logs: &[CalLog], o: &CalOptions) -> Result<Calibrat
     })
 }
 
-/// Gauss–Newton iterations at most in `polish` from LM's end; twice as
-/// many from the reflected start of `polish_basins`, which starts farther
-/// from an optimum (objective 37 509 against LM's 1 480 on leaky-heavy; 8
-/// iterations left it 5 units short of where 16 took it, and the 1e-9 K
-/// nudge then moved leaky-heavy's headline 0.057 K).
-pub const POLISH_MAX_ITERS: usize = 8;
-
-/// `polish` stops when the predicted decrease of the objective (the
-/// Newton decrement gᵀH⁻¹g, in χ² units of the polish's σ, σ_d √s²; one
-/// unit is one data point off by one σ) falls below this.
-pub const POLISH_TOL: f64 = 0.01;
-
-/// Outcome of the final Gauss–Newton polish of a calibration.
-#[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
-pub struct Polish {
-    /// Objective (data χ² + prior rows) at each iterate, first = LM's end.
-    pub objective: Vec<f64>,
-    /// Predicted decrease (Newton decrement) at each iterate.
-    pub decrement: Vec<f64>,
-    /// Whether the last decrement is below [`POLISH_TOL`].
-    pub converged: bool,
-    /// Parameters held on a bound in the last step (active set).
-    pub on_bound: Vec<String>,
-    /// Reduced χ² at LM's end (≥ 1): the data rows' σ is σ_d √s² in the polish.
-    pub s2: f64,
-    /// Final objective of the polish from the other basin of [`SCALE_PAIR`]
-    /// (the one not taken), when both of the pair are free.
-    pub other_basin: Option<f64>,
-}
-
-/// A parameter within this of a bound (in ln θ) counts as on it in the polish.
-const BOUND_LN: f64 = 1e-3;
-
-/// The damped Gauss–Newton step (H + λ diag H) δ = −g over the parameters
-/// not `active`; a parameter whose step would leave its bounds joins the
-/// active set (held for this step) and the step is solved again.
-fn constrained_step(h: &DMatrix<f64>, g: &DVector<f64>, u: &DVector<f64>, free: &[usize], active: &mut [bool], lambda: f64, lnb: &dyn Fn(usize) -> (f64, f64)) -> Option<DVector<f64>> {
-    let n = free.len();
-    loop {
-        let idx: Vec<usize> = (0..n).filter(|&a| !active[a]).collect();
-        let m = idx.len();
-        let mut hr = DMatrix::from_fn(m, m, |x, y| h[(idx[x], idx[y])]);
-        for x in 0..m {
-            hr[(x, x)] *= 1.0 + lambda;
-        }
-        let gr = DVector::from_iterator(m, idx.iter().map(|&a| g[a]));
-        let sr = -hr.cholesky()?.solve(&gr);
-        let mut step = DVector::zeros(n);
-        let mut crossed = false;
-        for (x, &a) in idx.iter().enumerate() {
-            let (lo, hi) = lnb(free[a]);
-            let v = u[a] + sr[x];
-            if v < lo - BOUND_LN || v > hi + BOUND_LN {
-                active[a] = true;
-                crossed = true;
-            }
-            step[a] = sr[x];
-        }
-        if !crossed {
-            return Some(step);
-        }
-    }
-}
-
-/// Objective of the calibration at `theta`: data χ² plus the prior rows of
-/// the parameters `free`.
-fn objective(base: &Rig, logs: &[CalLog], theta: &[f64], free: &[usize], sigma: Sigma, runs: &AtomicUsize) -> Option<f64> {
-    let r = data_residuals(base, logs, theta, sigma, runs)?;
-    let prior: f64 = free.iter().map(|&k| (theta[k].ln() / PARAMS[k].prior_sigma_ln).powi(2)).sum();
-    Some(r.iter().map(|x| x * x).sum::<f64>() + prior)
-}
-
-/// Converges the regularised least squares from `theta` (LM's end) to its
-/// optimum: Gauss–Newton in ln θ on the parameters `free` with the prior
-/// rows (H = JᵀJ + Σ⁻¹, so a direction the logs do not inform is pulled to
-/// the rig file by its prior instead of left where the path put it), the
-/// bounds as an active set (a parameter on a bound whose gradient pushes it
-/// out is held there), a backtracking line search; until the predicted
-/// decrease is below [`POLISH_TOL`]. The LM fit before it
-/// stops where its evaluation budget or step tolerance stops it: measured
-/// on big-pump, a 1e-9 K nudge of the logs moved that point enough to move
-/// the held-out headline by 0.09 K.
-fn polish(base: &Rig, logs: &[CalLog], theta: Vec<f64>, free: &[usize], sigma: Sigma, runs: &AtomicUsize) -> (Vec<f64>, Polish) {
-    let mut out = Polish::default();
-    if free.is_empty() {
-        out.converged = true;
-        return (theta, out);
-    }
-    // The data rows in units of the misfit the model structure leaves: σ_d
-    // times √s², s² the reduced χ² at LM's end (at least 1). A model that
-    // cannot follow the machine (χ² per point ≫ 1) then leaves the
-    // directions its logs barely inform to the priors, instead of to the
-    // path LM took; a model that fits (s² = 1) keeps σ_d.
-    let Some(r0) = data_residuals(base, logs, &theta, sigma, runs) else { return (theta, out) };
-    out.s2 = (r0.iter().map(|x| x * x).sum::<f64>() / r0.len().saturating_sub(free.len()).max(1) as f64).max(1.0);
-    polish_at(base, logs, theta, free, sigma, runs, out, false)
-}
-
-/// The ball-valve block's oil film and heat capacity: their ratio (the
-/// block's time constant behind its oil) is what the logs determine; their
-/// common scale is not, and the objective has two basins along it (measured
-/// on leaky-heavy: film ×3.28 with capacity ×2.46, or ×0.58 with ×0.46, the
-/// ratio 0.75–0.79 in both; a 1e-9 K nudge of the logs sent LM to either).
-pub const SCALE_PAIR: (&str, &str) = ("film_ball", "cap_ball_block");
-
-/// [`polish`] from LM's end and, when both parameters of [`SCALE_PAIR`] are
-/// free, again from the same point with the pair's common scale reflected
-/// through the rig file (ln θ_a, ln θ_b each minus twice their mean: the
-/// ratio kept, the scale s → 1/s), with the same s². The lower objective
-/// (data χ² in the first polish's units plus the priors) is taken: the
-/// maximum a posteriori among the two basins, whichever of them LM
-/// reached first. Records the other basin's objective in
-/// [`Polish::other_basin`].
-fn polish_basins(base: &Rig, logs: &[CalLog], lm_theta: Vec<f64>, free: &[usize], sigma: Sigma, runs: &AtomicUsize) -> (Vec<f64>, Polish) {
-    let start = lm_theta.clone();
-    let (theta, p) = polish(base, logs, lm_theta, free, sigma, runs);
-    let pair = (super::set::index(SCALE_PAIR.0), super::set::index(SCALE_PAIR.1));
-    let (Some(a), Some(b)) = pair else { return (theta, p) };
-    if !(free.contains(&a) && free.contains(&b)) {
-        return (theta, p);
-    }
-    let mut mirror = start;
-    let mean = 0.5 * (mirror[a].ln() + mirror[b].ln());
-    for k in [a, b] {
-        let (lo, hi) = (PARAMS[k].lo.ln(), PARAMS[k].hi.ln());
-        mirror[k] = (mirror[k].ln() - 2.0 * mean).clamp(lo, hi).exp();
-    }
-    let (theta2, p2) = polish_at(base, logs, mirror, free, sigma, runs, Polish { s2: p.s2, ..Polish::default() }, true);
-    let (f1, f2) = (p.objective.last().copied().unwrap_or(f64::INFINITY), p2.objective.last().copied().unwrap_or(f64::INFINITY));
-    if f2 < f1 {
-        (theta2, Polish { other_basin: Some(f1), ..p2 })
-    } else {
-        (theta, Polish { other_basin: Some(f2), ..p })
-    }
-}
-
-/// The Gauss–Newton iterations of [`polish`] with `out.s2` set; `far`: the
-/// start is far from an optimum (the reflected start of [`polish_basins`]),
-/// twice [`POLISH_MAX_ITERS`].
-#[allow(clippy::too_many_arguments)]
-fn polish_at(base: &Rig, logs: &[CalLog], mut theta: Vec<f64>, free: &[usize], sigma: Sigma, runs: &AtomicUsize, mut out: Polish, far: bool) -> (Vec<f64>, Polish) {
-    let s2 = out.s2;
-    let lnb = |k: usize| (PARAMS[k].lo.ln(), PARAMS[k].hi.ln());
-    let sigma = Sigma { data_k: sigma.data_k * s2.sqrt(), ..sigma };
-    let Some(mut f) = objective(base, logs, &theta, free, sigma, runs) else { return (theta, out) };
-    let iters = if far { 2 * sigma.polish_iters } else { sigma.polish_iters };
-    for _ in 0..iters {
-        out.objective.push(f);
-        let Some((r, j)) = jacobian_ln(base, logs, &theta, free, sigma, runs) else { break };
-        let n = free.len();
-        let inv_var = DVector::from_iterator(n, free.iter().map(|&k| PARAMS[k].prior_sigma_ln.powi(-2)));
-        let u = DVector::from_iterator(n, free.iter().map(|&k| theta[k].ln()));
-        let g = j.transpose() * &r + u.component_mul(&inv_var);
-        let mut h = j.transpose() * &j;
-        for a in 0..n {
-            h[(a, a)] += inv_var[a];
-        }
-        // Active set: on a bound (within BOUND_LN) with the descent pointing
-        // out, then every parameter whose step would cross a bound, until
-        // the step stays inside (each is held where it is for this step).
-        let near = |a: usize, k: usize| {
-            let (lo, hi) = lnb(k);
-            (u[a] <= lo + BOUND_LN && g[a] > 0.0) || (u[a] >= hi - BOUND_LN && g[a] < 0.0)
-        };
-        let mut active: Vec<bool> = free.iter().enumerate().map(|(a, &k)| near(a, k)).collect();
-        out.on_bound = (0..n).filter(|&a| active[a]).map(|a| PARAMS[free[a]].name.to_string()).collect();
-        // Damped Gauss–Newton: H + λ diag(H), λ from 0 up while the step
-        // does not lower the objective.
-        let mut moved = false;
-        let mut dec0 = None;
-        for lambda in [0.0, 0.03, 0.3, 3.0, 30.0] {
-            let Some(step) = constrained_step(&h, &g, &u, free, &mut active, lambda, &lnb) else { break };
-            let dec = -g.dot(&step);
-            if dec0.is_none() {
-                out.decrement.push(dec);
-                dec0 = Some(dec);
-                if dec < POLISH_TOL {
-                    out.converged = true;
-                    break;
-                }
-            }
-            let mut th = theta.clone();
-            for (a, &k) in free.iter().enumerate() {
-                let (lo, hi) = lnb(k);
-                th[k] = (u[a] + step[a]).clamp(lo, hi).exp();
-            }
-            if let Some(f1) = objective(base, logs, &th, free, sigma, runs) {
-                if f1 < f {
-                    (theta, f, moved) = (th, f1, true);
-                    break;
-                }
-            }
-        }
-        if out.converged || !moved {
-            break;
-        }
-    }
-    out.objective.push(f);
-    (theta, out)
-}

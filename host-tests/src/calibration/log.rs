@@ -25,6 +25,9 @@ pub struct CalLog {
     pub points: Vec<(Channel, usize)>,
     scenario: Scenario,
     opts: SimOptions,
+    /// Relative tolerance of the replay solver ([`REPLAY_RTOL`] unless
+    /// [`CalLog::with_rtol`] set it).
+    pub rtol: f64,
 }
 
 /// The channels a log can be scored on: [`Channel::TEMPERATURES`] and
@@ -63,13 +66,18 @@ impl CalLog {
                 k += step;
             }
         }
-        Ok(CalLog { name: name.into(), run, channels, points, scenario: Scenario::Replay(inputs), opts })
+        Ok(CalLog { name: name.into(), run, channels, points, scenario: Scenario::Replay(inputs), opts, rtol: REPLAY_RTOL })
+    }
+
+    /// The same log replayed at solver tolerance `rtol`.
+    pub fn with_rtol(&self, rtol: f64) -> Self {
+        CalLog { rtol, ..self.clone() }
     }
 
     /// The reference model on `rig` driven by this log's inputs: every
     /// scored channel at every sample time.
     pub fn simulate(&self, rig: &Rig) -> Result<Series, String> {
-        let out = simulate_rtol(rig, &self.scenario, &self.opts, REPLAY_RTOL).map_err(|e| e.to_string())?;
+        let out = simulate_rtol(rig, &self.scenario, &self.opts, self.rtol).map_err(|e| e.to_string())?;
         let mut s = Series::new();
         for &ch in &self.channels {
             let v = out.sample(ch.name(), &self.run.time_s);

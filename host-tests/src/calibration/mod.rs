@@ -25,6 +25,7 @@ pub mod log;
 pub mod lsq;
 pub mod paper;
 pub mod paths;
+pub mod polish;
 pub mod replay;
 pub mod set;
 pub mod synthetic;

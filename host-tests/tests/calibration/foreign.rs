@@ -131,8 +131,8 @@ fn report(m: &EmuMachine, c: &Commissioning, secs: f64) {
 /// Tolerance on a measured headline number, K: the commissioning is not
 /// converged to better than that (the polish stalls after 8 steps with a
 /// predicted decrease of tens of units of χ²). Big-pump's spread under a
-/// 1e-9 K nudge of every temperature is far above it (0.51 K with the
-/// structural freedoms, 0.17 K before them:
+/// 1e-9 K nudge of every temperature is far above it (0.80 K with the
+/// structural freedoms and the path tie band, 0.17 K before the freedoms:
 /// `slow_commissioning_is_reproducible_at_the_last_digit_big_pump`): on
 /// another build its numbers may fall outside this tolerance.
 const AS_MEASURED_K: f64 = 0.15;
@@ -250,26 +250,27 @@ fn one_operating_point_is_refused_with_log_region_channel_and_bench_run() {
 /// Every temperature of every log moved by 1e-9 K: the headline numbers
 /// (held-out max |e| and under-prediction of the flashed path, margin) move
 /// by at most 0.05 K. Trained as the procedure prescribes
-/// (`commissioning_set`), the structural freedoms fitted. Measured on
-/// big-pump: **0.509 K, a miss** asserted as the bound (margin 1.276 →
-/// 1.300 K; the direct path flashed in both; the mix's under-prediction
-/// 0.404 → 0.913 K). Why: the calibration's polish stalls (a damped step
-/// that lowers nothing) at different points: 1483.4 after 8 steps on the
-/// original logs, 1455.7 still falling on the nudged ones, the case film
-/// pair moving along its product (film ×0.18 / churn ×83 against ×0.39 /
-/// ×51), with cap_case_oil 1.50 / 2.01, cap_pump 1.07 / 1.44,
-/// friction_case 0.90 / 1.22, film_port 0.92 / 1.73; and the direct fit's
-/// screening frees `loss_speed` (0.31) on one and holds it on the other.
-/// With 24 polish steps (`CalOptions::polish_iters`, `EXP_POLISH_ITERS=24`)
-/// the original still stalls at step 8 (1483.4), the nudged at step 14
-/// (1447.8): 0.515 K. Leaky-heavy: **0.226 K, a miss** (0.031 K with the set
-/// before the freedoms, on the earlier bench logs): the flashed path flips
-/// from the reduction (margin 1.301 K, mix 2.28 / 0.37 K) to the direct
-/// path (1.164 K, 2.31 / 0.59 K). The original took the basin check's
-/// reflected ball-valve pair (film ×2.14 / capacity ×1.16, objective 1342.7
-/// against LM's 1490.3), the nudged LM's (×0.99 / ×0.59, 1386.7 against
-/// 1398.9); the case film pair moved along its product as on big-pump
-/// (×0.22 / ×69 against ×0.52 / ×30). Neither polish converged.
+/// (`commissioning_set`), the structural freedoms fitted. **A miss on both
+/// machines**, asserted as the bound: big-pump 0.795 K (original: the
+/// direct path, margin 1.276 K, mix 2.73 / 0.40 K; nudged: the paths 0.91 /
+/// 0.96 K under, a tie under `paths::PATH_TIE_K`, the reduction kept, margin
+/// 0.963 K, mix 1.93 / 0.96 K; 0.509 K before the tie band, the direct path
+/// in both), leaky-heavy 0.226 K (the flashed path flips from the
+/// reduction, margin 1.301 K, mix 2.28 / 0.37 K, to the direct path, 1.164 K,
+/// 2.31 / 0.59 K; the reduction's own under-prediction 0.37 → 0.71 K, so the
+/// path choice's tie band `paths::PATH_TIE_K` cannot hold it).
+/// Why, measured (docs/commissioning.md, "Reproducibility"): the nudge
+/// changes no model output (`slow_replay_noise_at_the_last_digit`), only
+/// the optimiser's path; the replays' solver error (rtol 1e-5) leaves the
+/// objective jagged by ~10 χ² units near the optimum, where the polish
+/// stalls; polished at 1e-7 (`EXP_POLISH_RTOL=1e-7`, ~2× the time) big-pump
+/// converges on both logs but into two local minima 11.3 units apart
+/// (`film_port` 0.85 / 1.84, `cap_pump` 1.03 / 1.48, `cap_case_oil` 1.44 /
+/// 2.00, `friction_case` 0.86 / 1.23, `block_wall` 9.6 / 29.6, the case
+/// film pair along its product): 0.543 K (0.561 K at 1e-6). Leaky-heavy at
+/// 1e-7: no flip (a tie, the reduction in both) but 0.296 K, neither polish
+/// converged in its steps. A basin rule between the minima, on a polish
+/// that converges, is the missing piece.
 #[test]
 #[ignore = "slow tier: two commissionings with margin validation and the direct path (~2 min)"]
 fn slow_commissioning_is_reproducible_at_the_last_digit_big_pump() {
@@ -302,6 +303,10 @@ fn reproducible(m: EmuMachine) {
             let mut o = CalOptions::default();
             if let Some(n) = std::env::var("EXP_POLISH_ITERS").ok().and_then(|v| v.parse().ok()) {
                 o.polish_iters = n;
+            }
+            // `EXP_POLISH_RTOL`: an experiment knob (the polish's solver tolerance).
+            if let Some(x) = std::env::var("EXP_POLISH_RTOL").ok().and_then(|v| v.parse().ok()) {
+                o.polish_rtol = x;
             }
             let c = commission(&m.rig_file(), &train, &h, &o).expect("commissioning");
             eprintln!("{}: {:.1} s, flashable {}", m.name, t0.elapsed().as_secs_f64(), c.flashable());
@@ -405,5 +410,65 @@ fn slow_structure_experiment() {
         let h = headline(&m, &c, &s.holdout);
         let w: Vec<String> = c.holdout_without_margin().iter().map(|r| format!("{} {:.3}/{:.3}", r.log, r.vs_measured_max_k.unwrap_or(f64::NAN), r.vs_measured_under_k.unwrap_or(f64::NAN))).collect();
         eprintln!("EXP {} train={} hold={:?} margin={}: without margin {}; with margin {:.3} K: {:.3?}", m.name, if procedure { "procedure" } else { "bench" }, hold, margin, w.join(", "), h.margin_k, h.measured);
+    }
+}
+
+/// Measurement by hand (prints, asserts nothing): the replay solver's own
+/// noise on the training logs of the commissioning procedure, per solver
+/// tolerance: how far the model's fit points move when every logged
+/// temperature moves by 1e-9 K (max |Δ| over the points, K), and how far a
+/// forward-difference Jacobian column (0.05 in ln θ of `film_case`,
+/// `case_churn`, `film_port`) moves with it (max |Δ| / 0.05, K per unit ln θ);
+/// with the run time of one replay.
+#[test]
+#[ignore = "measurement by hand: replays at three solver tolerances"]
+fn slow_replay_noise_at_the_last_digit() {
+    use eha_sim::calibration::set::{apply, index, nominal};
+    let only = std::env::var("EXP_MACHINE").ok();
+    for m in machines().into_iter().filter(|m| only.as_deref().is_none_or(|o| o == m.name)) {
+        let s = commissioning_set(&m, 3600).expect("bench");
+        let rig = m.rig_file();
+        for rtol in [1e-5, 1e-6, 1e-7] {
+            for l in &s.train {
+                let a = cal(l).with_rtol(rtol);
+                let mut ln = l.clone();
+                for ch in Channel::TEMPERATURES.into_iter().chain([Channel::TDrainC]) {
+                    let v: Vec<Option<f64>> = ln.run.get(ch).expect("channel").iter().map(|x| x.map(|x| x + 1e-9)).collect();
+                    ln.run.set(ch, v);
+                }
+                let b = cal(&ln).with_rtol(rtol);
+                let t0 = std::time::Instant::now();
+                let ra = a.simulate(&rig).expect("sim");
+                let secs = t0.elapsed().as_secs_f64();
+                let rb = b.simulate(&rig).expect("sim");
+                let d = |x: &eha_sim::calibration::log::Series, y: &eha_sim::calibration::log::Series| {
+                    a.points.iter().map(|(ch, i)| (x[ch][*i] - y[ch][*i]).abs()).fold(0.0, f64::max)
+                };
+                let mut cols = Vec::new();
+                for name in ["film_case", "case_churn", "film_port"] {
+                    let mut th = nominal();
+                    th[index(name).expect("param")] = 0.05f64.exp();
+                    let r = apply(&rig, &th);
+                    let (pa, pb) = (a.simulate(&r).expect("sim"), b.simulate(&r).expect("sim"));
+                    let col = a.points.iter().map(|(ch, i)| ((pa[ch][*i] - ra[ch][*i]) - (pb[ch][*i] - rb[ch][*i])).abs() / 0.05).fold(0.0, f64::max);
+                    let size = a.points.iter().map(|(ch, i)| (pa[ch][*i] - ra[ch][*i]).abs() / 0.05).fold(0.0, f64::max);
+                    cols.push(format!("{name} {col:.2e} of {size:.2e}"));
+                }
+                eprintln!("NOISE {} {} rtol {rtol:.0e}: {secs:.2} s; points moved {:.2e} K; FD columns moved (K per ln) {}", m.name, l.name, d(&ra, &rb), cols.join(", "));
+                // The objective (Σ (r/0.2 K)²) along ln θ of film_port in
+                // steps of 1e-4: its second differences against the smooth
+                // curvature show the solver's noise.
+                let f: Vec<f64> = (0..11)
+                    .map(|i| {
+                        let mut th = nominal();
+                        th[index("film_port").expect("param")] = (1e-4 * i as f64).exp();
+                        let sim = a.simulate(&apply(&rig, &th)).expect("sim");
+                        a.residuals(&sim).iter().map(|x| (x / 0.2).powi(2)).sum::<f64>()
+                    })
+                    .collect();
+                let d2: Vec<String> = f.windows(3).map(|w| format!("{:.3}", w[0] - 2.0 * w[1] + w[2])).collect();
+                eprintln!("NOISE {} {} rtol {rtol:.0e}: objective {:.3} .. {:.3}, second differences {}", m.name, l.name, f[0], f[10], d2.join(" "));
+            }
+        }
     }
 }
