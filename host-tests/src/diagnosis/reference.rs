@@ -36,7 +36,13 @@ pub enum ReferenceError {
 /// and priors of [`crate::calibration::PARAMS`]) is the second tier, used
 /// when the global baseline misfits ([`Simulator::physical_set`]); it
 /// absorbs churning, forced convection and motor–pump conduction on the
-/// synthetic cases, hence not from the start.
+/// synthetic cases, hence not from the start. With
+/// [`ReferenceModel::with_structure`] the physical tier takes the pump's
+/// loss level from the motor current and frees the commissioning's
+/// structural freedoms instead ([`structural_set`]). The housing probes
+/// read towards the air by the rig's `probes` (the calibration's probe
+/// model, `calibration::log::read_surface_probe`), so a commissioned rig
+/// file is replayed as it was commissioned.
 ///
 /// Candidate parameters (ranges are the physically plausible ones):
 /// `alpha_per_k` 1e-4…1e-2 1/K (copper 3.9e-3; a fit at the upper bound
