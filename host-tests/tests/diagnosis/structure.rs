@@ -8,7 +8,7 @@
 //! docs/diagnosis.md, "What it can and cannot see".
 
 use eha_sim::calibration::commission::eta_m_from_current;
-use eha_sim::calibration::set::{index, STRUCTURAL};
+use eha_sim::calibration::set::STRUCTURAL;
 use eha_sim::calibration::CalLog;
 use eha_sim::diagnosis::reference::{nuisance_set, ReferenceModel};
 use eha_sim::diagnosis::{Candidate, Simulator};
