@@ -116,7 +116,7 @@ fn slow_imprint_ratio_above_two_housing_paths_and_churning_missed() {
 /// (lag, r 1.82, named at r 3.14 without), 1711 (conduction, r 1.06, was
 /// 6.36), 2709 (churning, r 0.55, was 4.73: its loss is in the current and
 /// so in `eta_m`). No twin names a cause. docs/diagnosis.md, "What it can
-/// and cannot see".
+/// and cannot see". 467 s at load 2–5 on two shared cores (2026-11-27).
 #[test]
 #[ignore = "slow tier: emulator cases with twins (minutes), the structure option"]
 fn slow_imprint_ratio_with_structure() {
