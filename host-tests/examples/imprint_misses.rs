@@ -4,7 +4,7 @@
 //! magnitude, with a larger budget, and with variants of the nuisance set;
 //! training and held-out RMSE on the affected channel and pooled.
 //!
-//! `cargo run --profile fast -p eha-sim --example imprint_misses -- SEED [twin] [VARIANT…]`
+//! `cargo run --profile fast -p eha-sim --example imprint_misses -- SEED [twin] [structure] [VARIANT…]`
 //! (seeds 1700–1717 and 2700–2717; ~20–60 s a case on two cores).
 
 use eha_sim::diagnosis::analysis::{fit_points, split_time_s};
@@ -92,7 +92,10 @@ fn main() {
             rig.blocks.sensor_to_block_w_per_k = g.parse().expect("g=W/K");
         }
     }
-    let model = ReferenceModel::new(rig, &run).expect("model").with_nuisance_set(free);
+    // `structure`: the physical tier with the commissioning's structure
+    // (`ReferenceModel::with_structure`; its own set, the `-PARAM` variants
+    // then do not apply).
+    let model = ReferenceModel::new(rig, &run).expect("model").with_nuisance_set(free).with_structure(&run, has("structure"));
     let sim = model.physical_set().expect("physical set");
     let names: Vec<String> = sim.nuisance().iter().map(|p| p.name.clone()).collect();
     println!("set: {}", names.join(" "));

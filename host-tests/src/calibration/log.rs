@@ -82,12 +82,9 @@ impl CalLog {
         for &ch in &self.channels {
             let v = out.sample(ch.name(), &self.run.time_s);
             let mut v = v.ok_or_else(|| format!("model has no channel {}", ch.name()))?;
-            let f = surface_probe_fraction(rig, ch);
-            if f != 0.0 {
+            if surface_probe_fraction(rig, ch) != 0.0 {
                 let amb = self.ambient_at_rows().ok_or_else(|| format!("{}: no ambient to read the surface probes against", self.name))?;
-                for (x, a) in v.iter_mut().zip(amb) {
-                    *x -= f * (*x - a);
-                }
+                read_surface_probe(rig, ch, &mut v, &amb);
             }
             s.insert(ch, v);
         }
@@ -96,12 +93,7 @@ impl CalLog {
 
     /// The replayed ambient (°C) at every row of the log.
     fn ambient_at_rows(&self) -> Option<Vec<f64>> {
-        let r = self.replay_inputs()?;
-        let (ts, amb) = (&r.time_s, &r.ambient_c);
-        if ts.is_empty() || ts.len() != amb.len() {
-            return None;
-        }
-        self.run.time_s.iter().map(|&t| crate::simulation::sim::interpolate(ts, amb, ts.partition_point(|&x| x <= t), t)).collect()
+        ambient_at(self.replay_inputs()?, &self.run.time_s)
     }
 
     /// Residuals (simulated − measured, K) at the fit points.
@@ -124,6 +116,30 @@ impl CalLog {
     /// Whether the log carries channel `ch`.
     pub fn has(&self, ch: Channel) -> bool {
         self.channels.contains(&ch)
+    }
+}
+
+/// The replayed ambient (°C) of `r` at `times` (s), linearly interpolated;
+/// `None` when the replay has no ambient series.
+pub fn ambient_at(r: &crate::scenario::ReplayInputs, times: &[f64]) -> Option<Vec<f64>> {
+    let (ts, amb) = (&r.time_s, &r.ambient_c);
+    if ts.is_empty() || ts.len() != amb.len() {
+        return None;
+    }
+    times.iter().map(|&t| crate::simulation::sim::interpolate(ts, amb, ts.partition_point(|&x| x <= t), t)).collect()
+}
+
+/// Surface channel `ch`'s simulated metal temperatures `v` (°C, one per
+/// row) as `rig`'s probe reads them: moved the fraction
+/// [`surface_probe_fraction`] towards the ambient `amb` (°C, same rows).
+/// The one place the probe model acts (the calibration's replay and the
+/// diagnosis's).
+pub fn read_surface_probe(rig: &Rig, ch: Channel, v: &mut [f64], amb: &[f64]) {
+    let f = surface_probe_fraction(rig, ch);
+    if f != 0.0 {
+        for (x, a) in v.iter_mut().zip(amb) {
+            *x -= f * (*x - a);
+        }
     }
 }
 

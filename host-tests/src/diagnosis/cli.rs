@@ -45,6 +45,13 @@ pub struct DiagnoseArgs {
     /// and per row).
     #[arg(long)]
     pub detectability: bool,
+    /// The physical tier with the commissioning's structure where the log
+    /// carries motor current under load (`true`/`false`; default
+    /// `DiagnoseOptions::structure`'s): the pump's `eta_m` from the
+    /// current, `pump_friction` held, the friction heat's placement and
+    /// speed law and the housing probes' reading towards the air fitted.
+    #[arg(long, value_name = "BOOL")]
+    pub structure: Option<bool>,
 }
 
 /// Runs `diagnose` and prints a one-line verdict; see the module doc for the
@@ -80,6 +87,7 @@ fn run_inner(args: &DiagnoseArgs) -> anyhow::Result<String> {
     }
     let mut o = DiagnoseOptions { train_fraction: args.train_fraction.clamp(0.1, 0.7), ..Default::default() };
     o.fit.max_sims = args.max_sims.max(4);
+    o.structure = args.structure.unwrap_or(o.structure);
     let files: Vec<String> = args.measured.iter().map(|f| f.display().to_string()).collect();
     let t = std::time::Instant::now();
     // One log: its own table and model; several: the logs on one table
@@ -94,7 +102,7 @@ fn run_inner(args: &DiagnoseArgs) -> anyhow::Result<String> {
     let (run, model): (&MeasuredRun, &dyn Simulator) = match &joint {
         Some((rows, m)) => (rows as &MeasuredRun, m as &dyn Simulator),
         None => {
-            single = ReferenceModel::new(rig, &runs[0]).map_err(|e| anyhow::anyhow!("{}: {e}", files[0]))?;
+            single = ReferenceModel::new(rig, &runs[0]).map_err(|e| anyhow::anyhow!("{}: {e}", files[0]))?.with_structure(&runs[0], o.structure);
             (&runs[0], &single as &dyn Simulator)
         }
     };

@@ -95,6 +95,11 @@ pub struct TwinCheck {
     /// The twin's evidence terms per structure.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub twin_terms: Vec<StructureTerms>,
+    /// The twin's calibrated baseline, held out: pooled, then per channel
+    /// (the log's structure floor on every channel), K. Empty in sweeps
+    /// written before it was kept.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub twin_heldout_k: Vec<(String, f64)>,
 }
 
 impl TwinCheck {

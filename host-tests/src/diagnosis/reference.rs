@@ -36,7 +36,13 @@ pub enum ReferenceError {
 /// and priors of [`crate::calibration::PARAMS`]) is the second tier, used
 /// when the global baseline misfits ([`Simulator::physical_set`]); it
 /// absorbs churning, forced convection and motor–pump conduction on the
-/// synthetic cases, hence not from the start.
+/// synthetic cases, hence not from the start. With
+/// [`ReferenceModel::with_structure`] the physical tier takes the pump's
+/// loss level from the motor current and frees the commissioning's
+/// structural freedoms instead ([`structural_set`]). The housing probes
+/// read towards the air by the rig's `probes` (the calibration's probe
+/// model, `calibration::log::read_surface_probe`), so a commissioned rig
+/// file is replayed as it was commissioned.
 ///
 /// Candidate parameters (ranges are the physically plausible ones):
 /// `alpha_per_k` 1e-4…1e-2 1/K (copper 3.9e-3; a fit at the upper bound
@@ -47,6 +53,12 @@ pub enum ReferenceError {
 /// 0.01…50 W/K, `air_speed_mps` 0.2…40 m/s.
 pub struct ReferenceModel {
     rig: Rig,
+    /// The physical tier's rig: `rig`, with the pump's `eta_m` from the
+    /// motor current under [`Self::with_structure`].
+    phys_rig: Rig,
+    /// `eta_m` from the current and the loaded rows it rests on, when the
+    /// physical tier takes it so ([`Self::with_structure`]).
+    eta_m_from_current: Option<(f64, usize)>,
     /// Indices into [`crate::calibration::PARAMS`] of the physical set for
     /// this run ([`nuisance_set`]).
     free: Vec<usize>,
@@ -71,7 +83,7 @@ impl ReferenceModel {
         let dt = (span / 400.0).clamp(0.5, 5.0);
         let opts = SimOptions { output_interval_s: dt, control_interval_s: dt };
         let free = nuisance_set(run);
-        let m = ReferenceModel { rig, free, physical: false, scenario: Scenario::Replay(inputs), times: run.time_s.clone(), opts };
+        let m = ReferenceModel { phys_rig: rig.clone(), rig, eta_m_from_current: None, free, physical: false, scenario: Scenario::Replay(inputs), times: run.time_s.clone(), opts };
         let n: Vec<f64> = m.nuisance().iter().map(|p| p.start).collect();
         m.simulate(&n, Candidate::None, &[]).map_err(ReferenceError::Model)?;
         Ok(m)
@@ -84,6 +96,32 @@ impl ReferenceModel {
     pub fn with_nuisance_set(mut self, free: Vec<usize>) -> Self {
         self.free = free;
         self
+    }
+
+    /// The physical tier with the commissioning's structure when `on` and
+    /// `run` (this model's log) carries motor current under load: the
+    /// pump's loss coefficient `eta_m` from the electrical balance
+    /// ([`calibration::commission::eta_m_from_current`], the one
+    /// implementation), `pump_friction` held there, and the structural
+    /// freedoms [`calibration::set::STRUCTURAL`] freed ([`structural_set`]).
+    /// Without current under load, or with `on` false, the model is
+    /// unchanged. The global tier is never changed.
+    pub fn with_structure(mut self, run: &MeasuredRun, on: bool) -> Self {
+        if !on {
+            return self;
+        }
+        let Ok(log) = calibration::CalLog::new("log", run.clone(), 1) else { return self };
+        let Some((eta, rows)) = calibration::commission::eta_m_from_current(&self.rig, &[log]) else { return self };
+        self.phys_rig.pump.eta_m = eta;
+        self.eta_m_from_current = Some((eta, rows));
+        self.free = structural_set(run, &self.free);
+        self
+    }
+
+    /// `eta_m` from the current and its loaded rows when the physical tier
+    /// takes it so ([`Self::with_structure`]); `None` otherwise.
+    pub fn eta_m_from_current(&self) -> Option<(f64, usize)> {
+        self.eta_m_from_current
     }
 
     /// Solver-step budget of one replay of this log ([`REPLAY_STEPS_PER_S`]).
@@ -102,7 +140,7 @@ impl ReferenceModel {
             for (&k, &v) in self.free.iter().zip(nuis) {
                 theta[k] = v;
             }
-            calibration::apply(&self.rig, &theta)
+            calibration::apply(&self.phys_rig, &theta)
         } else {
             let mut r = self.rig.clone();
             r.nuisance.outer_scale = nuis[0];
@@ -164,6 +202,28 @@ pub fn nuisance_set_of(run: &MeasuredRun, logs: &[&MeasuredRun]) -> Vec<usize> {
         .collect()
 }
 
+/// The physical set `free` (indices into [`calibration::PARAMS`]) with the
+/// pump's loss level taken from the current ([`ReferenceModel::with_structure`]):
+/// `pump_friction` left out, the friction heat's case share and speed law
+/// ([`calibration::set::FRICTION_CASE`], [`calibration::set::FRICTION_SPEED`])
+/// and the surface probes' reading towards ambient of every housing channel
+/// `run` logs added, in [`calibration::PARAMS`] order. The calibration
+/// frees these only with a drain thermocouple (their `Needs`); the
+/// diagnosis's channels have none, so here they rest on the housing
+/// sensors and the current alone.
+pub fn structural_set(run: &MeasuredRun, free: &[usize]) -> Vec<usize> {
+    use calibration::set::{index, FRICTION_CASE, FRICTION_SPEED, PROBE_SURFACE};
+    let logged = |ch: Channel| run.get(ch).is_some_and(|v| v.iter().any(Option::is_some));
+    let probes = [Channel::TMotorC, Channel::TPumpC, Channel::TBlockC, Channel::TBallvalveC];
+    let friction = index("pump_friction");
+    let mut out: Vec<usize> = free.iter().copied().filter(|&k| Some(k) != friction).collect();
+    let add = [FRICTION_CASE, FRICTION_SPEED].into_iter().chain(PROBE_SURFACE.iter().zip(probes).filter(|(_, ch)| logged(*ch)).map(|(n, _)| *n));
+    out.extend(add.filter_map(index));
+    out.sort_unstable();
+    out.dedup();
+    out
+}
+
 /// Solver-step budget of one replay, per second of log: a replay normally
 /// takes a few hundred steps for 20 minutes; a candidate run that makes the
 /// stiff solver crawl (measured: 58–96 thousand steps in 1.2–1.8 s for a
@@ -200,6 +260,8 @@ impl Simulator for ReferenceModel {
         (!self.physical).then(|| {
             Box::new(ReferenceModel {
                 rig: self.rig.clone(),
+                phys_rig: self.phys_rig.clone(),
+                eta_m_from_current: self.eta_m_from_current,
                 free: self.free.clone(),
                 physical: true,
                 scenario: self.scenario.clone(),
@@ -230,8 +292,17 @@ impl Simulator for ReferenceModel {
         let out = simulate_budget(&rig, &self.scenario, &self.opts, REPLAY_RTOL, Some(self.step_budget())).map_err(|e| e.to_string())?;
         let mut s = SimSeries::default();
         let sample = |name: &str| out.sample(name, &self.times);
+        // The housing probes read towards the air where the rig says so
+        // (the structural freedoms, [`Self::with_structure`]).
+        let amb = match &self.scenario {
+            Scenario::Replay(r) if rig.probes != crate::rig::SurfaceProbes::default() => calibration::log::ambient_at(r, &self.times),
+            _ => None,
+        };
         for ch in Channel::TEMPERATURES {
-            if let Some(v) = sample(ch.name()) {
+            if let Some(mut v) = sample(ch.name()) {
+                if let Some(a) = &amb {
+                    calibration::log::read_surface_probe(&rig, ch, &mut v, a);
+                }
                 s.channels.insert(ch, v);
             }
         }

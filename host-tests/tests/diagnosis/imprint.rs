@@ -19,8 +19,12 @@ use eha_sim::emulator::missions::EmuScenario::{self, ConstantThrottle, IdentRun,
 use eha_sim::emulator::EmuCase;
 
 fn run(hidden: &str, scenario: EmuScenario, seed: u64) -> EmuResult {
+    run_with(hidden, scenario, seed, &DiagnoseOptions::default())
+}
+
+fn run_with(hidden: &str, scenario: EmuScenario, seed: u64, o: &DiagnoseOptions) -> EmuResult {
     let c = EmuCase { hidden: Candidate::from_name(hidden).expect("candidate"), scenario, seed, duration_s: 1200.0 };
-    let r = run_emu_case_twin(c, &DiagnoseOptions::default(), true).expect("emulated log diagnoses");
+    let r = run_emu_case_twin(c, o, true).expect("emulated log diagnoses");
     eprintln!("{}", eha_sim::diagnosis::emu_sweep::table_row(&r));
     r
 }
@@ -95,4 +99,33 @@ fn slow_imprint_ratio_above_two_housing_paths_and_churning_missed() {
     // starts; with three the lag no longer qualifies there (measured:
     // `unexplained`, the case itself `unexplained` too, right below r = 2).
     assert_missed(&run("winding-resistance-temperature", IdentRun, 2700), "unexplained", 1.37);
+}
+
+/// The same seven cases with the physical tier's commissioning structure
+/// (`DiagnoseOptions::structure`: `eta_m` from the motor current,
+/// `pump_friction` held, the friction heat's case share and speed law and
+/// the housing probes' reading towards the air fitted), as measured
+/// (`eha-sim emulator-sweep --cases original,ident --only
+/// 1704,1705,1711,2704,2705,2709,2711 --no-oracle --structure true`).
+/// r is on the calibrated baseline, which changes with the set: named at
+/// r >= 2, all four: 1705 (no loaded current rows, unchanged, r 2.60),
+/// 2704 (r 2.98, t_oil_c 4.02 -> 2.27 K, a miss without), 2705 (r 3.18,
+/// 4.41 -> 2.09 K), 2711 (conduction, r 3.17, t_pump_c 3.24 -> 0.77 K, a
+/// miss without). Absorbed by the richer set, so below r = 2 and no cause
+/// is right by the rule, though the effects were seen without it: 1704
+/// (lag, r 1.82, named at r 3.14 without), 1711 (conduction, r 1.06, was
+/// 6.36), 2709 (churning, r 0.55, was 4.73: its loss is in the current and
+/// so in `eta_m`). No twin names a cause. docs/diagnosis.md, "What it can
+/// and cannot see". 467 s at load 2–5 on two shared cores (2026-11-27).
+#[test]
+#[ignore = "slow tier: emulator cases with twins (minutes), the structure option"]
+fn slow_imprint_ratio_with_structure() {
+    let o = DiagnoseOptions { structure: true, ..DiagnoseOptions::default() };
+    assert_named(&run_with("sensor-lag", SpeedSteps, 1705, &o), 2.60, 0.45);
+    assert_named(&run_with("sensor-lag", IdentRun, 2704, &o), 2.98, 2.27);
+    assert_named(&run_with("sensor-lag", IdentRun, 2705, &o), 3.18, 2.09);
+    assert_named(&run_with("motor-pump-conduction", IdentRun, 2711, &o), 3.17, 0.77);
+    assert_missed(&run_with("sensor-lag", ConstantThrottle, 1704, &o), "none", 1.82);
+    assert_missed(&run_with("motor-pump-conduction", LoadCycles, 1711, &o), "unexplained", 1.06);
+    assert_missed(&run_with("churning-loss", IdentRun, 2709, &o), "unexplained", 0.55);
 }

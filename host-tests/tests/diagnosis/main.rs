@@ -12,3 +12,4 @@ mod multi;
 mod plan;
 mod replay;
 mod stats;
+mod structure;

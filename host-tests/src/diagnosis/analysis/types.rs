@@ -94,7 +94,19 @@ pub struct DiagnoseOptions {
     /// The same once the diagnosis has escalated to the physical
     /// calibration set.
     pub physical_misfit: MisfitRule,
+    /// The physical tier with the commissioning's structure where the log
+    /// carries motor current under load: `eta_m` from the current,
+    /// `pump_friction` held, the structural freedoms freed
+    /// ([`crate::diagnosis::reference::ReferenceModel::with_structure`]).
+    /// Read where the reference model is built (`diagnose`'s command, the
+    /// emulator sweep), not by [`crate::diagnosis::analysis::diagnose`].
+    /// Default [`STRUCTURE_DEFAULT`].
+    pub structure: bool,
 }
+
+/// Default of [`DiagnoseOptions::structure`] (docs/diagnosis.md, "What it
+/// can and cannot see": the floor with and without it on the emulator).
+pub const STRUCTURE_DEFAULT: bool = false;
 
 impl Default for DiagnoseOptions {
     fn default() -> Self {
@@ -116,6 +128,7 @@ impl Default for DiagnoseOptions {
                 rise_fraction: PHYSICAL_MISFIT_RISE_FRACTION,
                 abs_k: PHYSICAL_MISFIT_ABS_K,
             },
+            structure: STRUCTURE_DEFAULT,
         }
     }
 }

@@ -71,6 +71,13 @@ pub struct EmuSweepArgs {
     /// its reliability table and counts.
     #[arg(long, value_enum)]
     pub measure: Option<DecisionRule>,
+    /// The physical tier with the commissioning's structure where the log
+    /// carries motor current under load (`true`/`false`; default
+    /// `DiagnoseOptions::structure`'s): the pump's `eta_m` from the
+    /// current, `pump_friction` held, the friction heat's placement and
+    /// speed law and the housing probes' reading towards the air fitted.
+    #[arg(long, value_name = "BOOL")]
+    pub structure: Option<bool>,
 }
 
 
@@ -125,7 +132,8 @@ pub fn run(a: &EmuSweepArgs) -> ExitCode {
                 let _ = twin.write_file(dir.join(format!("{}-{:?}-{}-twin.csv", c.hidden.name(), c.scenario, c.seed)));
             }
         }
-        match run_emu_case_with(*c, &DiagnoseOptions::default(), !a.no_twins, !a.no_oracle) {
+        let o = DiagnoseOptions { structure: a.structure.unwrap_or(DiagnoseOptions::default().structure), ..Default::default() };
+        match run_emu_case_with(*c, &o, !a.no_twins, !a.no_oracle) {
             Ok(r) => {
                 let line = serde_json::to_string(&r).unwrap_or_default() + "\n";
                 let appended = std::fs::OpenOptions::new().create(true).append(true).open(&lines).and_then(|mut f| {

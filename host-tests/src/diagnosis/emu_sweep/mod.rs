@@ -51,7 +51,7 @@ pub fn run_emu_case_with(case: EmuCase, o: &DiagnoseOptions, twin: bool, oracle:
     let t = std::time::Instant::now();
     let (main, twin_d) = rayon::join(
         || -> Result<(ReferenceModel, Diagnosis), String> {
-            let model = ReferenceModel::new(Rig::default(), &run).map_err(|e| e.to_string())?;
+            let model = ReferenceModel::new(Rig::default(), &run).map_err(|e| e.to_string())?.with_structure(&run, o.structure);
             let d = diagnose(&run, &model, o).map_err(|e| e.to_string())?;
             Ok((model, d))
         },
@@ -60,7 +60,7 @@ pub fn run_emu_case_with(case: EmuCase, o: &DiagnoseOptions, twin: bool, oracle:
                 return Ok(None);
             }
             let (trun, _) = crate::emulator::generate_twin(&case)?;
-            let tmodel = ReferenceModel::new(Rig::default(), &trun).map_err(|e| e.to_string())?;
+            let tmodel = ReferenceModel::new(Rig::default(), &trun).map_err(|e| e.to_string())?.with_structure(&trun, o.structure);
             diagnose(&trun, &tmodel, o).map(Some).map_err(|e| e.to_string())
         },
     );
@@ -101,6 +101,9 @@ pub fn run_emu_case_with(case: EmuCase, o: &DiagnoseOptions, twin: bool, oracle:
                 twin_channels: td.posterior.channels.clone(),
                 twin_terms: td.posterior.terms.clone(),
                 twin_measured: None,
+                twin_heldout_k: std::iter::once(("pooled".to_string(), td.before.heldout_rmse_k))
+                    .chain(td.before.channels.iter().map(|c| (c.channel.clone(), c.heldout_rmse_k)))
+                    .collect(),
             })
         }
         _ => None,

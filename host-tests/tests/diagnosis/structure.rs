@@ -1,0 +1,92 @@
+//! The physical tier with the commissioning's structure
+//! (`ReferenceModel::with_structure`, `DiagnoseOptions::structure`): the
+//! pump's `eta_m` from the motor current by the commissioning's own
+//! function, `pump_friction` held, the structural freedoms freed, and the
+//! housing probes read towards the air by the calibration's probe model.
+//! Fast tier: model construction and two replays of a 1200 s emulator log
+//! (~1 s). Its effect on the floor and on the r >= 2 cases:
+//! docs/diagnosis.md, "What it can and cannot see".
+
+use eha_sim::calibration::commission::eta_m_from_current;
+use eha_sim::calibration::set::STRUCTURAL;
+use eha_sim::calibration::CalLog;
+use eha_sim::diagnosis::reference::{nuisance_set, ReferenceModel};
+use eha_sim::diagnosis::{Candidate, Simulator};
+use eha_sim::emulator::missions::EmuScenario::{self, ConstantThrottle, SpeedSteps};
+use eha_sim::emulator::{generate, EmuCase};
+use eha_sim::measured::{Channel, MeasuredRun};
+use eha_sim::rig::Rig;
+
+fn log(scenario: EmuScenario, seed: u64) -> MeasuredRun {
+    generate(&EmuCase { hidden: Candidate::None, scenario, seed, duration_s: 1200.0 }).expect("emulator log").0
+}
+
+fn names(s: &dyn Simulator) -> Vec<String> {
+    s.nuisance().into_iter().map(|p| p.name).collect()
+}
+
+/// A loaded throttle log (1714): `eta_m` is the commissioning's value to
+/// the last bit (one implementation), the set loses `pump_friction` and
+/// gains the six structural parameters (four housing probes logged); off,
+/// the set is the log's own. A speed-step log at low load (1716): no
+/// loaded current rows, nothing changes.
+#[test]
+fn structure_takes_eta_from_the_current_and_frees_the_structural_set() {
+    let run = log(ConstantThrottle, 1714);
+    let rig = Rig::default();
+    let want = eta_m_from_current(&rig, &[CalLog::new("log", run.clone(), 1).expect("log")]).expect("current under load");
+    let on = ReferenceModel::new(rig.clone(), &run).expect("model").with_structure(&run, true);
+    assert_eq!(on.eta_m_from_current(), Some(want));
+    let set = names(&*on.physical_set().expect("physical"));
+    assert!(!set.iter().any(|n| n == "pump_friction"), "{set:?}");
+    for n in STRUCTURAL {
+        assert!(set.iter().any(|s| s == n), "{n} not freed: {set:?}");
+    }
+    let off = ReferenceModel::new(rig.clone(), &run).expect("model").with_structure(&run, false);
+    assert_eq!(off.eta_m_from_current(), None);
+    let base: Vec<String> = nuisance_set(&run).into_iter().map(|k| eha_sim::calibration::PARAMS[k].name.to_string()).collect();
+    assert_eq!(names(&*off.physical_set().expect("physical")), base);
+    assert!(base.iter().any(|n| n == "pump_friction"));
+
+    let quiet = log(SpeedSteps, 1716);
+    let m = ReferenceModel::new(rig, &quiet).expect("model").with_structure(&quiet, true);
+    assert_eq!(m.eta_m_from_current(), None, "speed steps at low load: no loaded rows");
+    let b: Vec<String> = nuisance_set(&quiet).into_iter().map(|k| eha_sim::calibration::PARAMS[k].name.to_string()).collect();
+    assert_eq!(names(&*m.physical_set().expect("physical")), b);
+}
+
+/// The pump probe's parameter at θ = e^0.1 reads t_pump_c 10 % of metal −
+/// ambient towards the air at every row where the housing is 5 K above
+/// it (fraction within 0.01 plus the logged ambient's 0.1 K of the
+/// difference: the probe acts on the replay's ambient, the check divides
+/// by the logged cell), and leaves the other channels alone.
+#[test]
+fn structure_probe_reads_towards_the_air() {
+    let run = log(ConstantThrottle, 1714);
+    let m = ReferenceModel::new(Rig::default(), &run).expect("model").with_structure(&run, true);
+    let p = m.physical_set().expect("physical");
+    let specs = p.nuisance();
+    let nom: Vec<f64> = specs.iter().map(|s| s.start).collect();
+    let mut moved = nom.clone();
+    let k = specs.iter().position(|s| s.name == "probe_surface_pump").expect("pump probe freed");
+    moved[k] = 0.1f64.exp();
+    let a = p.simulate(&nom, Candidate::None, &[]).expect("replay");
+    let b = p.simulate(&moved, Candidate::None, &[]).expect("replay");
+    let amb = run.get(Channel::AmbientC).expect("ambient");
+    let (va, vb) = (&a.channels[&Channel::TPumpC], &b.channels[&Channel::TPumpC]);
+    let mut checked = 0;
+    for i in 0..run.len() {
+        let Some(t_air) = amb[i] else { continue };
+        // The replay's ambient is the logged one interpolated (0.05 K noise):
+        // judge the fraction where the housing is well above the air.
+        if va[i] - t_air > 5.0 {
+            let f = (va[i] - vb[i]) / (va[i] - t_air);
+            assert!((f - 0.1).abs() < 0.01 + 0.1 * 0.1 / (va[i] - t_air), "row {i}: fraction {f:.4}");
+            checked += 1;
+        }
+    }
+    assert!(checked > 100, "{checked} rows with the housing 5 K above the air");
+    for ch in [Channel::TMotorC, Channel::TBlockC, Channel::TOilC] {
+        assert_eq!(a.channels[&ch], b.channels[&ch], "{}", ch.name());
+    }
+}
