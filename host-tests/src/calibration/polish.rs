@@ -19,7 +19,7 @@ use std::sync::atomic::AtomicUsize;
 /// from an optimum (objective 37 509 against LM's 1 480 on leaky-heavy; 8
 /// iterations left it 5 units short of where 16 took it, and the 1e-9 K
 /// nudge then moved leaky-heavy's headline 0.057 K).
-pub const POLISH_MAX_ITERS: usize = 16;
+pub const POLISH_MAX_ITERS: usize = 8;
 
 /// Relative tolerance of the replay solver in the polish by default: the
 /// replays' own ([`crate::simulation::replay::REPLAY_RTOL`], 1e-5).
@@ -35,7 +35,7 @@ pub const POLISH_MAX_ITERS: usize = 16;
 /// minima 11.3 units apart (1484.4 and 1473.1), and the nudge still moves
 /// the headline 0.54 K; a replay at 1e-7 takes ~5 times as long, so the
 /// default stays at 1e-5 (commissioning time).
-pub const POLISH_RTOL: f64 = 1e-6;
+pub const POLISH_RTOL: f64 = crate::simulation::replay::REPLAY_RTOL;
 
 /// `polish` stops when the predicted decrease of the objective (the
 /// Newton decrement gᵀH⁻¹g, in χ² units of the polish's σ, σ_d √s²; one
@@ -58,16 +58,6 @@ pub struct Polish {
     /// Final objective of the polish from the other basin of [`SCALE_PAIR`]
     /// (the one not taken), when both of the pair are free.
     pub other_basin: Option<f64>,
-    /// The weakest direction of the Hessian H = JᵀJ + Σ⁻¹ (ln θ, the
-    /// polish's units) at the first optimum of [`polish_basins`]: the
-    /// components of its unit vector with |v| ≥ 0.1, by parameter name.
-    pub weak_dir: Vec<(String, f64)>,
-    /// Posterior standard deviation along [`Polish::weak_dir`], ln θ
-    /// (1/√λ_min); the basin starts are ±[`WEAK_STEP_SD`] of it away.
-    pub weak_sd_ln: f64,
-    /// Final objectives of the polishes from the two starts along
-    /// [`Polish::weak_dir`] (+, −), χ² units of the polish.
-    pub weak_basins: Vec<f64>,
 }
 
 /// A parameter within this of a bound (in ln θ) counts as on it in the polish.
@@ -157,9 +147,9 @@ pub(super) fn polish_basins(base: &Rig, logs: &[CalLog], lm_theta: Vec<f64>, fre
     let start = lm_theta.clone();
     let (theta, p) = polish(base, logs, lm_theta, free, sigma, runs);
     let pair = (super::set::index(SCALE_PAIR.0), super::set::index(SCALE_PAIR.1));
-    let (Some(a), Some(b)) = pair else { return weak_basin(base, logs, theta, p, free, sigma, runs) };
+    let (Some(a), Some(b)) = pair else { return (theta, p) };
     if !(free.contains(&a) && free.contains(&b)) {
-        return weak_basin(base, logs, theta, p, free, sigma, runs);
+        return (theta, p);
     }
     let mut mirror = start;
     let mean = 0.5 * (mirror[a].ln() + mirror[b].ln());
@@ -169,54 +159,11 @@ pub(super) fn polish_basins(base: &Rig, logs: &[CalLog], lm_theta: Vec<f64>, fre
     }
     let (theta2, p2) = polish_at(base, logs, mirror, free, sigma, runs, Polish { s2: p.s2, ..Polish::default() }, true);
     let (f1, f2) = (p.objective.last().copied().unwrap_or(f64::INFINITY), p2.objective.last().copied().unwrap_or(f64::INFINITY));
-    let (theta, p) = if f2 < f1 { (theta2, Polish { other_basin: Some(f1), ..p2 }) } else { (theta, Polish { other_basin: Some(f2), ..p }) };
-    weak_basin(base, logs, theta, p, free, sigma, runs)
-}
-
-/// The basin starts of [`weak_basin`] lie this many posterior standard
-/// deviations along the Hessian's weakest direction from the optimum.
-pub const WEAK_STEP_SD: f64 = 2.0;
-
-/// From the optimum `theta` (objective `p`) of a polish: the Hessian
-/// H = JᵀJ + Σ⁻¹ there (ln θ, the polish's σ), its weakest eigenvector v
-/// (eigenvalue λ), and a polish from each of ln θ ± [`WEAK_STEP_SD`]·v/√λ
-/// (clamped to the bounds; the same s²); the lowest of the three
-/// objectives is kept (the maximum a posteriori among the basins along the
-/// direction the logs inform least, whichever LM reached).
-fn weak_basin(base: &Rig, logs: &[CalLog], theta: Vec<f64>, p: Polish, free: &[usize], sigma: Sigma, runs: &AtomicUsize) -> (Vec<f64>, Polish) {
-    let sig = Sigma { data_k: sigma.data_k * p.s2.sqrt(), ..sigma };
-    let Some((_, j)) = jacobian_ln(base, logs, &theta, free, sig, runs) else { return (theta, p) };
-    let n = free.len();
-    let mut h = j.transpose() * &j;
-    for (a, &k) in free.iter().enumerate() {
-        h[(a, a)] += PARAMS[k].prior_sigma_ln.powi(-2);
+    if f2 < f1 {
+        (theta2, Polish { other_basin: Some(f1), ..p2 })
+    } else {
+        (theta, Polish { other_basin: Some(f2), ..p })
     }
-    let e = h.symmetric_eigen();
-    let Some(i) = (0..n).min_by(|&x, &y| e.eigenvalues[x].total_cmp(&e.eigenvalues[y])) else { return (theta, p) };
-    let v = e.eigenvectors.column(i).into_owned();
-    let sd = 1.0 / e.eigenvalues[i].max(1e-12).sqrt();
-    let mut best = (theta.clone(), p.objective.last().copied().unwrap_or(f64::INFINITY), None::<Polish>);
-    let mut ends = Vec::new();
-    for sign in [1.0, -1.0] {
-        let mut start = theta.clone();
-        for (a, &k) in free.iter().enumerate() {
-            let (lo, hi) = (PARAMS[k].lo.ln(), PARAMS[k].hi.ln());
-            start[k] = (theta[k].ln() + sign * WEAK_STEP_SD * sd * v[a]).clamp(lo, hi).exp();
-        }
-        let (th, q) = polish_at(base, logs, start, free, sigma, runs, Polish { s2: p.s2, ..Polish::default() }, false);
-        let f = q.objective.last().copied().unwrap_or(f64::INFINITY);
-        ends.push(f);
-        if f < best.1 {
-            best = (th, f, Some(q));
-        }
-    }
-    let weak_dir = (0..n).filter(|&a| v[a].abs() >= 0.1).map(|a| (PARAMS[free[a]].name.to_string(), v[a])).collect();
-    let other_basin = p.other_basin;
-    let kept = match best.2 {
-        Some(q) => Polish { other_basin, ..q },
-        None => p,
-    };
-    (best.0, Polish { weak_dir, weak_sd_ln: sd, weak_basins: ends, ..kept })
 }
 
 /// The Gauss–Newton iterations of [`polish`] with `out.s2` set; `far`: the

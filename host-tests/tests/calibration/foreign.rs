@@ -101,7 +101,6 @@ fn report(m: &EmuMachine, c: &Commissioning, secs: f64) {
     let fitted: Vec<String> = c.cal.params.iter().filter(|p| p.status == eha_sim::calibration::Status::Fitted).map(|p| format!("{} {:.4}", p.name, p.value)).collect();
     eprintln!("  fitted: {}", fitted.join(", "));
     eprintln!("  polish: objective {:.3?} decrement {:?} converged {} on bound {:?}, other basin {:?}", c.cal.polish.objective, c.cal.polish.decrement, c.cal.polish.converged, c.cal.polish.on_bound, c.cal.polish.other_basin);
-    eprintln!("  weak direction (sd {:.3} ln): {:?}, basins {:?}", c.cal.polish.weak_sd_ln, c.cal.polish.weak_dir, c.cal.polish.weak_basins);
     for r in &c.reduced {
         eprintln!("  reduced {:40} vs ref max {:.3} | vs measured max {:?} under {:?}", r.log, r.vs_reference_max_k, r.vs_measured_max_k, r.vs_measured_under_k);
     }
