@@ -270,7 +270,11 @@ fn one_operating_point_is_refused_with_log_region_channel_and_bench_run() {
 /// film pair along its product): 0.543 K (0.561 K at 1e-6). Leaky-heavy at
 /// 1e-7: no flip (a tie, the reduction in both) but 0.296 K, neither polish
 /// converged in its steps. A basin rule between the minima, on a polish
-/// that converges, is the missing piece.
+/// that converges, is the missing piece. Tried and reverted: polishes from
+/// ±2 posterior σ along the optimum's weakest Hessian direction (the case
+/// film pair at a fixed product, not the gap: |cos| 0.09–0.60), polish at
+/// 1e-6 with 16 steps: big-pump 0.075 K, leaky-heavy 0.188 K, still two
+/// minima each, 94–205 s a commissioning at load ~4 (docs/commissioning.md).
 #[test]
 #[ignore = "slow tier: two commissionings with margin validation and the direct path (~2 min)"]
 fn slow_commissioning_is_reproducible_at_the_last_digit_big_pump() {
