@@ -120,7 +120,7 @@ fn slow_imprint_ratio_above_two_housing_paths_and_churning_missed() {
 #[test]
 #[ignore = "slow tier: emulator cases with twins (minutes), the structure option"]
 fn slow_imprint_ratio_with_structure() {
-    let o = DiagnoseOptions { structure: true, ..DiagnoseOptions::default() };
+    let o = DiagnoseOptions { structure: true.into(), ..DiagnoseOptions::default() };
     assert_named(&run_with("sensor-lag", SpeedSteps, 1705, &o), 2.60, 0.45);
     assert_named(&run_with("sensor-lag", IdentRun, 2704, &o), 2.98, 2.27);
     assert_named(&run_with("sensor-lag", IdentRun, 2705, &o), 3.18, 2.09);
