@@ -145,7 +145,7 @@ fn slow_imprint_ratio_with_structure() {
 /// 1711 (conduction, r 0.64, the pump's outer film and case film at their
 /// upper bounds), 2711 (conduction, r 1.88, answered `none`; named at r
 /// 3.17 under `full`). No twin names a cause. docs/diagnosis.md, "What it
-/// can and cannot see".
+/// can and cannot see". 261 s on two shared cores (2026-11-27, passes).
 #[test]
 #[ignore = "slow tier: emulator cases with twins (minutes), the structure option's no-case variant"]
 fn slow_imprint_ratio_with_structure_no_case() {
