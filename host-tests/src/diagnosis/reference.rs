@@ -6,6 +6,7 @@
 
 use super::model::{Candidate, ParamSpec, SimSeries, Simulator};
 use crate::calibration::{self, set::Needs};
+use super::analysis::Structure;
 use crate::measured::{Channel, MeasuredRun};
 use crate::rig::Rig;
 pub use crate::simulation::replay::{circuit_of, replay_inputs, ReplayError, REPLAY_RTOL, SERVO_MIN_TRAVEL_MM, THROTTLE_MAX_TRAVEL_MM};
@@ -98,23 +99,26 @@ impl ReferenceModel {
         self
     }
 
-    /// The physical tier with the commissioning's structure when `on` and
+    /// The physical tier with the commissioning's structure when `variant`
+    /// (a [`Structure`], or a bool: `true` is [`Structure::Full`]) is not
+    /// [`Structure::Off`] and
     /// `run` (this model's log) carries motor current under load: the
     /// pump's loss coefficient `eta_m` from the electrical balance
     /// ([`calibration::commission::eta_m_from_current`], the one
     /// implementation), `pump_friction` held there, and the structural
-    /// freedoms [`calibration::set::STRUCTURAL`] freed ([`structural_set`]).
-    /// Without current under load, or with `on` false, the model is
+    /// freedoms of `variant` freed ([`structural_set`]).
+    /// Without current under load, or with [`Structure::Off`], the model is
     /// unchanged. The global tier is never changed.
-    pub fn with_structure(mut self, run: &MeasuredRun, on: bool) -> Self {
-        if !on {
+    pub fn with_structure(mut self, run: &MeasuredRun, variant: impl Into<Structure>) -> Self {
+        let variant = variant.into();
+        if variant == Structure::Off {
             return self;
         }
         let Ok(log) = calibration::CalLog::new("log", run.clone(), 1) else { return self };
         let Some((eta, rows)) = calibration::commission::eta_m_from_current(&self.rig, &[log]) else { return self };
         self.phys_rig.pump.eta_m = eta;
         self.eta_m_from_current = Some((eta, rows));
-        self.free = structural_set(run, &self.free);
+        self.free = structural_set(run, &self.free, variant);
         self
     }
 
@@ -210,15 +214,22 @@ pub fn nuisance_set_of(run: &MeasuredRun, logs: &[&MeasuredRun]) -> Vec<usize> {
 /// `run` logs added, in [`calibration::PARAMS`] order. The calibration
 /// frees these only with a drain thermocouple (their `Needs`); the
 /// diagnosis's channels have none, so here they rest on the housing
-/// sensors and the current alone.
-pub fn structural_set(run: &MeasuredRun, free: &[usize]) -> Vec<usize> {
+/// sensors and the current alone. [`Structure::NoCase`] leaves out
+/// `friction_case` and `probe_surface_pump` (the two a drain thermocouple
+/// would separate); [`Structure::Off`] returns `free` unchanged.
+pub fn structural_set(run: &MeasuredRun, free: &[usize], variant: Structure) -> Vec<usize> {
     use calibration::set::{index, FRICTION_CASE, FRICTION_SPEED, PROBE_SURFACE};
+    if variant == Structure::Off {
+        return free.to_vec();
+    }
     let logged = |ch: Channel| run.get(ch).is_some_and(|v| v.iter().any(Option::is_some));
     let probes = [Channel::TMotorC, Channel::TPumpC, Channel::TBlockC, Channel::TBallvalveC];
     let friction = index("pump_friction");
     let mut out: Vec<usize> = free.iter().copied().filter(|&k| Some(k) != friction).collect();
     let add = [FRICTION_CASE, FRICTION_SPEED].into_iter().chain(PROBE_SURFACE.iter().zip(probes).filter(|(_, ch)| logged(*ch)).map(|(n, _)| *n));
-    out.extend(add.filter_map(index));
+    let no_case = variant == Structure::NoCase;
+    let kept = add.filter(|n| !(no_case && (*n == FRICTION_CASE || *n == PROBE_SURFACE[1])));
+    out.extend(kept.filter_map(index));
     out.sort_unstable();
     out.dedup();
     out

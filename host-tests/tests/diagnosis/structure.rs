@@ -8,7 +8,8 @@
 //! docs/diagnosis.md, "What it can and cannot see".
 
 use eha_sim::calibration::commission::eta_m_from_current;
-use eha_sim::calibration::set::STRUCTURAL;
+use eha_sim::calibration::set::{FRICTION_CASE, PROBE_SURFACE, STRUCTURAL};
+use eha_sim::diagnosis::analysis::Structure;
 use eha_sim::calibration::CalLog;
 use eha_sim::diagnosis::reference::{nuisance_set, ReferenceModel};
 use eha_sim::diagnosis::{Candidate, Simulator};
@@ -53,6 +54,22 @@ fn structure_takes_eta_from_the_current_and_frees_the_structural_set() {
     assert_eq!(m.eta_m_from_current(), None, "speed steps at low load: no loaded rows");
     let b: Vec<String> = nuisance_set(&quiet).into_iter().map(|k| eha_sim::calibration::PARAMS[k].name.to_string()).collect();
     assert_eq!(names(&*m.physical_set().expect("physical")), b);
+}
+
+/// The `no-case` variant on the same loaded log (1714): the same `eta_m`
+/// and the full variant's set without `friction_case` and
+/// `probe_surface_pump` (the two a drain thermocouple would separate),
+/// `friction_speed` and the other three housing probes still freed.
+#[test]
+fn structure_no_case_leaves_out_the_case_share_and_the_pump_probe() {
+    let run = log(ConstantThrottle, 1714);
+    let full = ReferenceModel::new(Rig::default(), &run).expect("model").with_structure(&run, Structure::Full);
+    let nc = ReferenceModel::new(Rig::default(), &run).expect("model").with_structure(&run, Structure::NoCase);
+    assert_eq!(nc.eta_m_from_current(), full.eta_m_from_current());
+    let want: Vec<String> = names(&*full.physical_set().expect("physical")).into_iter().filter(|n| n != FRICTION_CASE && n != PROBE_SURFACE[1]).collect();
+    let got = names(&*nc.physical_set().expect("physical"));
+    assert_eq!(got, want);
+    assert_eq!(got.len() + 2, names(&*full.physical_set().expect("physical")).len());
 }
 
 /// The pump probe's parameter at θ = e^0.1 reads t_pump_c 10 % of metal −

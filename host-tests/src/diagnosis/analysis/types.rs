@@ -101,12 +101,48 @@ pub struct DiagnoseOptions {
     /// Read where the reference model is built (`diagnose`'s command, the
     /// emulator sweep), not by [`crate::diagnosis::analysis::diagnose`].
     /// Default [`STRUCTURE_DEFAULT`].
-    pub structure: bool,
+    pub structure: Structure,
+}
+
+/// Which structural freedoms the physical tier takes where the log carries
+/// motor current under load ([`DiagnoseOptions::structure`],
+/// [`crate::diagnosis::reference::structural_set`]). On the command line
+/// `off` (alias `false`), `full` (alias `true`), `no-case`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Structure {
+    /// The physical tier as without current: nothing from the current.
+    #[value(alias = "false")]
+    Off,
+    /// `eta_m` from the current, `pump_friction` held, and every structural
+    /// freedom freed: `friction_case`, `friction_speed` and the surface
+    /// probe of every logged housing channel.
+    #[value(alias = "true")]
+    Full,
+    /// As [`Structure::Full`] but without `friction_case` and
+    /// `probe_surface_pump`: the friction heat's case share and the pump
+    /// probe's placement are separable only with a drain thermocouple
+    /// (their calibration `Needs`), which the diagnosis's logs lack; on the
+    /// housing sensors alone they trade with loop-oil capacity, the oil
+    /// probe and a sensor lag (docs/diagnosis.md, "What it can and cannot
+    /// see").
+    NoCase,
+}
+
+impl From<bool> for Structure {
+    /// `true` is [`Structure::Full`], `false` [`Structure::Off`].
+    fn from(on: bool) -> Self {
+        if on {
+            Structure::Full
+        } else {
+            Structure::Off
+        }
+    }
 }
 
 /// Default of [`DiagnoseOptions::structure`] (docs/diagnosis.md, "What it
 /// can and cannot see": the floor with and without it on the emulator).
-pub const STRUCTURE_DEFAULT: bool = false;
+pub const STRUCTURE_DEFAULT: Structure = Structure::Off;
 
 impl Default for DiagnoseOptions {
     fn default() -> Self {
