@@ -12,13 +12,13 @@
 use super::ident::{excitation_warnings, identifiability, Identifiability};
 use super::log::CalLog;
 use super::polish::{polish, polish_basins};
+use super::residuals::{data_residuals, jacobian_ln, Sigma};
 pub use super::polish::{Polish, POLISH_MAX_ITERS, POLISH_RTOL, POLISH_TOL, SCALE_PAIR};
 use super::set::{apply, Needs, Stage, PARAMS, PROBE_OIL};
 use crate::lsq::FdProblem;
 use crate::rig::Rig;
 use levenberg_marquardt::LevenbergMarquardt;
-use nalgebra::{DMatrix, DVector};
-use rayon::prelude::*;
+use nalgebra::DVector;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 
@@ -154,53 +154,6 @@ fn to_ln(z: f64, d: &super::set::ParamDef) -> f64 {
 fn to_z(ln: f64, d: &super::set::ParamDef) -> f64 {
     let u = ((ln - d.lo.ln()) / (d.hi / d.lo).ln()).clamp(0.0, 1.0);
     (2.0 * u - 1.0).asin().clamp(-1.5, 1.5)
-}
-
-/// Data σ: the common one, and the drain channel's weight on it.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Sigma {
-    /// σ of every channel, K.
-    pub(crate) data_k: f64,
-    /// `t_drain_c` residuals are multiplied by this as well.
-    pub(crate) drain_weight: f64,
-    /// Gauss–Newton iterations of the polish from LM's end
-    /// ([`CalOptions::polish_iters`]).
-    pub(crate) polish_iters: usize,
-}
-
-/// Scaled data residuals of every log at full multiplier vector `theta`.
-pub(super) fn data_residuals(base: &Rig, logs: &[CalLog], theta: &[f64], sigma: Sigma, runs: &AtomicUsize) -> Option<Vec<f64>> {
-    let rig = apply(base, theta);
-    let parts: Option<Vec<Vec<f64>>> = logs
-        .par_iter()
-        .map(|l| {
-            runs.fetch_add(1, Ordering::Relaxed);
-            let s = l.simulate(&rig).ok()?;
-            let r = l.residuals(&s);
-            let w = |ch: crate::measured::Channel| if ch == crate::measured::Channel::TDrainC { sigma.drain_weight } else { 1.0 };
-            r.iter().all(|x| x.is_finite()).then(|| r.into_iter().zip(&l.points).map(|(x, p)| x * w(p.0) / sigma.data_k).collect())
-        })
-        .collect();
-    Some(parts?.concat())
-}
-
-/// Jacobian of the scaled data residuals with respect to ln θ of the
-/// parameters `idx`, at `theta` (forward differences of 0.05 in ln θ,
-/// stepping inwards from an upper bound).
-pub(crate) fn jacobian_ln(base: &Rig, logs: &[CalLog], theta: &[f64], idx: &[usize], sigma: Sigma, runs: &AtomicUsize) -> Option<(DVector<f64>, DMatrix<f64>)> {
-    let r0 = DVector::from_vec(data_residuals(base, logs, theta, sigma, runs)?);
-    let cols: Option<Vec<DVector<f64>>> = idx
-        .par_iter()
-        .map(|&k| {
-            let d = &PARAMS[k];
-            let h = if (theta[k].ln() + 0.05) > d.hi.ln() { -0.05 } else { 0.05 };
-            let mut th = theta.to_vec();
-            th[k] = (theta[k].ln() + h).exp();
-            let r = DVector::from_vec(data_residuals(base, logs, &th, sigma, runs)?);
-            Some((r - &r0) / h)
-        })
-        .collect();
-    Some((r0.clone(), DMatrix::from_columns(&cols?)))
 }
 
 /// Levenberg–Marquardt starts at most (the first from the rig file, the

@@ -5,7 +5,8 @@
 //! - [`set`]: the declared parameters, their physical bounds, priors and
 //!   the single table mapping them onto rig fields;
 //! - [`log`]: a measured log prepared for replay and scoring;
-//! - [`fit`]: joint fit over several logs with prior rows;
+//! - [`fit`]: joint fit over several logs with prior rows, on the
+//!   objective of [`residuals`], ended by the Gauss–Newton [`polish`];
 //! - [`direct`]: the firmware model's own parameters fitted directly to
 //!   the logs from a reduction, with [`replay`] (the reduced model on a
 //!   log's inputs at the 10 ms tick);
@@ -27,6 +28,7 @@ pub mod paper;
 pub mod paths;
 pub mod polish;
 pub mod replay;
+pub mod residuals;
 pub mod set;
 pub mod synthetic;
 

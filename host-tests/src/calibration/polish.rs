@@ -7,7 +7,7 @@
 //! near the optimum is jagged by ~10 χ² units (the solver's own error),
 //! the size of the stalls measured there (a damped step lowering nothing).
 
-use super::fit::{data_residuals, jacobian_ln, Sigma};
+use super::residuals::{data_residuals, jacobian_ln, Sigma};
 use super::log::CalLog;
 use super::set::PARAMS;
 use crate::rig::Rig;
