@@ -102,8 +102,22 @@ fn fig15_attempt() -> Result<(), String> {
     );
     assert!(!pil_ev.is_empty(), "the valve opens within 120 s (paper: 110 s)");
     assert_eq!(prod_ev.len(), pil_ev.len(), "valve events: product {prod_ev:?}, PIL {pil_ev:?}");
+    // The product's estimate differs from the PIL's by at most `max_diff`
+    // at every guard tick (bounded below), so its valve switches where the
+    // PIL's estimate is within `max_diff` of its own value at the PIL's
+    // switch (the threshold), give or take a tick: with every sample on
+    // time that window is the PIL's tick itself. (With 21 late samples
+    // an opening was measured 9 ticks after the PIL's at 0.026 K.)
+    let pil_drain: Vec<f32> = pil.records.iter().map(|r| r.reply.out.drain_c).collect();
     for (a, b) in prod_ev.iter().zip(&pil_ev) {
-        assert!(a.1 == b.1 && a.0.abs_diff(b.0) <= 1, "valve event product {a:?} vs PIL {b:?}");
+        let at = pil_drain[b.0];
+        let near = |k: &usize| (pil_drain[*k] - at).abs() <= max_diff;
+        let lo = (0..=b.0).rev().take_while(near).last().unwrap_or(b.0);
+        let hi = (b.0..pil_drain.len()).take_while(near).last().unwrap_or(b.0);
+        assert!(
+            a.1 == b.1 && a.0 + 1 >= lo && a.0 <= hi + 1,
+            "valve event product {a:?} vs PIL {b:?}: outside PIL ticks {lo}..={hi}, where its drain is within {max_diff} K of {at} degC"
+        );
     }
     if missed == 0 {
         assert_eq!(max_diff, 0.0, "every tick got its sample: the estimate must be bit-identical to the PIL's");
