@@ -197,18 +197,17 @@ pub fn choose(reduction: &PathOutcome, direct: Result<&PathOutcome, &str>) -> Ch
         (Some(a), Some(b)) => format!("; after the split, margin counted, max |e| {a:.2} K (reduction, margin {ma:.2} K) and {b:.2} K (direct, margin {mb:.2} K)"),
         _ => String::new(),
     };
-    let direct_wins = match (reduction.holdout_worst(), d.holdout_worst()) {
+    let decision = match (reduction.holdout_worst(), d.holdout_worst()) {
         (Some((ea, ua)), Some((eb, ub))) => {
             let why = format!("on the held-out logs, margin counted, worst max |e| / under-prediction {ea:.2} / {ua:.2} K (reduction) and {eb:.2} / {ub:.2} K (direct); a path within {UNDER_OK_K} K under-prediction first, then the smaller max |e| (beyond it, the smaller under-prediction), the direct path only when better by more than {PATH_TIE_K} K{split}");
-            let wins = direct_wins((ea, ua), (eb, ub));
-            (wins, why)
+            (direct_wins((ea, ua), (eb, ub)), why)
         }
         _ => match after_split {
             (Some(a), Some(b)) => (b < a - PATH_TIE_K, format!("no held-out log with `t_drain_c`: the smaller max |e| after the split{split}")),
             _ => (false, "the paths cannot be compared".into()),
         },
     };
-    match direct_wins {
+    match decision {
         (true, why) => Choice { chosen: PathKind::Direct, why },
         (false, why) => keep(why),
     }
