@@ -36,11 +36,13 @@ mod default_consts;
 pub mod physics_checks;
 mod init;
 mod input;
+mod readout;
 mod rhs;
 mod ring;
 pub mod stability;
 mod sums;
 pub mod table;
+mod units;
 
 use crate::linalg::expm1m;
 use crate::num::Num;
@@ -53,17 +55,7 @@ pub use crate::params::{
 pub use input::{InputScales, ModelInputN, HA_PER_A, HBAR_PER_BAR, HRADS_PER_RPM};
 use ring::{Ring, RingIn};
 use sums::Sums;
-
-/// Pa per hbar.
-const PA_PER_HBAR: f64 = 1e7;
-/// L per m^3.
-const L_PER_M3: f64 = 1e3;
-/// kW per W.
-const KW_PER_W: f64 = 1e-3;
-/// Temperature unit of the radiation term's mean wall-air temperature, K.
-const RAD_T_K: f64 = 300.0;
-/// Longest transport delay of the exchanger's effect, model steps (the history is a `u32`).
-const MAX_DELAY_STEPS: i32 = 31;
+use units::{Consts, INV_N_F32, INV_N_F64, KW_PER_W, L_PER_M3, MAX_DELAY_STEPS, PA_PER_HBAR, RAD_T_K};
 
 /// Why a parameter set cannot be turned into a model of the chosen number type.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -91,74 +83,6 @@ pub enum ConfigError {
     /// The block's cooling bound at rest claims faster cooling than its own
     /// model ([`Model::check_physics`]).
     RestBound,
-}
-
-/// Constants in model units (built once).
-#[derive(Clone, Copy, Debug)]
-struct Consts<N> {
-    // tick: flows L/s, powers kW from hA, hbar, hrad/s, mm per tick
-    p_case: N,    // hbar
-    k_lf: N,      // leak flow, L/s per hbar
-    k_lp: N,      // leak power, kW per hbar^2
-    k_mech: N,    // kW per (hbar hrad/s)
-    k_q: N,       // pump flow, L/s per hrad/s
-    k_a: N,       // piston flow, L/s per mm/tick
-    k_dpq: N,     // kW per (hbar L/s)
-    r1: N,        // kW per (L/s)^2
-    r2: N,        // kW per (L/s)^3
-    w_dp: N,      // actuator heat weights: act = k_act (w_dp dp^2 + w_dx dx^2), kW
-    w_dx: N,
-    k_act: N,
-    k_lf_half: N, // k_lf / 2
-    k_cu: N,      // copper, kW per hA^2
-    k_sh: N,      // shaft power Kt I w, kW per (hA hrad/s)
-    k_hyd: N,     // hydraulic power D dp w, kW per (hbar hrad/s)
-    fe1: N,       // iron, kW per hrad/s
-    fe2: N,       // kW per (hrad/s)^2
-    fe15: N,      // kW per (hrad/s)^1.5
-    // step
-    inv_ticks: N, // 1 / TICKS_PER_STEP
-    q_scale: N,   // (N_TABLE-1) / sqrt(q_max), per sqrt(L/s)
-    w_scale: N,   // (N_TABLE-1) / sqrt(w_max), per sqrt(hrad/s)
-    rc0: N,       // rho c_p at 0 degC, kJ/(L K)
-    rc1: N,       // d(rho c_p)/dT, kJ/(L K^2)
-    rc2: N,       // curvature of rho c_p, kJ/(L K^3)
-    inv_v_case: N, // 1/L
-    inv_v_loop: N, // 1/L
-    inv_n: [N; TICKS_PER_STEP as usize + 1], // 1/n for partial steps (inv_n[0] = 0)
-    count: [N; TICKS_PER_STEP as usize + 1], // n
-    v_port: N,    // L
-    v_ball: N,    // L
-    inv_v_ring: N, // 1 / (V_loop + 2 V_port + V_ball), 1/L
-    inv_c: [N; N_STATES], // 1/C of the metal states, K/kJ (oil nodes unused)
-    f_out: N,     // share of the viscous and pressure friction into the delivered oil
-    f_case: N,    // share into the case oil
-    k_m0: N,      // pump no-load friction, kW per hrad/s
-    k_mv: N,      // pump viscous friction at 40 degC, kW per (hrad/s)^2
-    alpha: N,     // oil expansion, 1/K
-    g_case_slope: N, // relative slope of the case film with the case-oil temperature, 1/K
-    t_film: N,    // FILM_PROPERTY_C, degC
-    alpha_t0: N,  // alpha 273.15
-    lng_in: N,    // degC
-    t_scale: N,   // 1 / TEMP_TABLE_STEP_K, 1/K
-    inv_stride: N, // 1 / COARSE_STRIDE
-    re_q: [N; crate::params::N_DUCTS], // ducts' Re / 1e4 per L/s at 40 degC
-    g_wall: [N; 2], // walls behind the loop's and the ball passage's films, kW/K
-    re_lam: N,    // 0.23: Re = 2300, the end of the laminar range, / 1e4
-    inv_span: N,  // 1 / 0.77: the transition's width in Re / 1e4
-    re3: N,       // 3: Re = 3e4, / 1e4
-    inv_span3: N, // 1 / 7: from Re = 3e4 to 1e5, / 1e4
-    t_min: N,     // TEMP_TABLE_MIN_C, degC
-    tab_last: N,  // N_TABLE - 2 (the last interval's left point, grid units)
-    ga: [N; N_OUTER],   // outer, kW/K
-    gb: [N; N_OUTER],   // outer, kW/K^1.25
-    gr: [N; N_OUTER],   // outer radiation 4 eps sigma A (300 K)^3, kW/K per (T_m / 300 K)^3
-    h: N,         // s
-    inv_h: N,     // 1/s
-    half: N,
-    per_rad_t: N,   // 1 / 300 K
-    rad_offset: N,  // 273.15 / 300
-    one: N,
 }
 
 /// The reduced-order model in number type `N` (`f64`, `f32` or [`crate::num::Fx`]).
@@ -226,31 +150,6 @@ struct Slow<N> {
     /// `nu(40) / nu(T)` at the loop oil and at the ball-valve passage's oil
     /// ([`Model::duct_factors`]).
     duct: [N; 2],
-}
-
-/// `1/n` for partial model steps of `n` ticks (`[0]` = 0), f64 and rounded to f32.
-/// (Evaluated at compile time: an index out of range would fail the build.)
-const INV_N_F64: [f64; TICKS_PER_STEP as usize + 1] = inv_n_f64();
-#[allow(clippy::indexing_slicing)]
-const INV_N_F32: [f32; TICKS_PER_STEP as usize + 1] = {
-    let mut o = [0.0f32; TICKS_PER_STEP as usize + 1];
-    let mut j = 0;
-    while j < o.len() {
-        o[j] = INV_N_F64[j] as f32;
-        j += 1;
-    }
-    o
-};
-
-#[allow(clippy::indexing_slicing)]
-const fn inv_n_f64() -> [f64; TICKS_PER_STEP as usize + 1] {
-    let mut o = [0.0f64; TICKS_PER_STEP as usize + 1];
-    let mut j = 1;
-    while j < o.len() {
-        o[j] = 1.0 / j as f64;
-        j += 1;
-    }
-    o
 }
 
 /// Number of loss groups reported by [`Model::last_losses_kw`].
@@ -470,77 +369,4 @@ impl<N: Num> Model<N> {
         self.update(if lng_open { TICKS_PER_STEP } else { 0 });
     }
 
-    /// Predicted drain (case) oil temperature, degC.
-    #[inline(always)]
-    pub fn drain_c(&self) -> N {
-        self.temp.get(NODE_DRAIN).map_or(N::ZERO, |s| N::value(*s))
-    }
-
-    /// All node temperatures, degC, in node order.
-    pub fn temperatures_c(&self) -> [N; N_NODES] {
-        let mut t = [N::ZERO; N_NODES];
-        for (o, th) in t.iter_mut().zip(self.temp.iter()) {
-            *o = N::value(*th);
-        }
-        t
-    }
-
-    /// Quasi-steady ring links of the last step: inlet port, outlet port, ball-valve oil, degC.
-    pub fn links_c(&self) -> [N; 3] {
-        self.links
-    }
-
-    /// Ambient of the last step, degC.
-    pub fn ambient_c(&self) -> N {
-        self.ambient_c
-    }
-
-    /// Ticks accumulated towards the next model step.
-    pub fn pending_ticks(&self) -> u32 {
-        self.sums.ticks
-    }
-
-    /// Sum of the last step's losses (eqs. 1-11), kW: the dissipation `P_sum` of eq. (23).
-    pub fn last_total_kw(&self) -> N {
-        self.last_total_kw
-    }
-
-    /// Heat of the last step's pump-side losses (eqs. 5-11: leakage, mechanical, line,
-    /// throttling, actuator), kW: what heats the six nodes.
-    pub fn last_heat_kw(&self) -> N {
-        self.last_heat_kw
-    }
-
-    /// The shaft's (mechanical) loss of the last step from two independent sets of
-    /// sensors, kW: `(eq. 8 from the port pressures and the speed, the shaft power
-    /// Kt |I| |w| minus the hydraulic power D dp w from the current)`, with the sign of
-    /// the hydraulic power (`sign(dp w)`) applied to the shaft power (the current is
-    /// an rms magnitude). On consistent sensors both are eq. 8.
-    pub fn last_mech_pair_kw(&self) -> (N, N) {
-        self.last_mech_pair_kw
-    }
-
-    /// While set, every model step heats with the larger of the two mechanical-loss
-    /// estimates of [`Model::last_mech_pair_kw`] (the guard sets it while the sensors
-    /// disagree).
-    pub fn set_loss_max(&mut self, on: bool) {
-        self.loss_max = on;
-    }
-
-    /// Mean losses of the last step, kW: `[copper (eq. 1), iron (eq. 2), leakage
-    /// (eqs. 5-7), mechanical (eq. 8), throttling = line + needle (eqs. 10-11),
-    /// actuator leakage + seal friction]`.
-    pub fn last_losses_kw(&self) -> [N; N_LOSSES] {
-        self.last_losses_kw
-    }
-
-    /// Heat the outer surfaces gave to the air over the last step (eqs. 15, 16, 19), kW.
-    pub fn last_outer_kw(&self) -> N {
-        self.last_outer_kw
-    }
-
-    /// Heat the LNG exchanger removed from the oil over the last step, kW (0 when closed).
-    pub fn last_lng_kw(&self) -> N {
-        self.last_lng_kw
-    }
 }
