@@ -24,7 +24,7 @@ pub struct BootMemory {
     /// What the non-volatile store holds (none, valid, damaged).
     pub nv: NvLoad,
     /// The last-alive stamp in the clock's battery-backed register, s
-    /// ([`Board::rtc_alive`]; `None`: the board has none or it is empty).
+    /// ([`Board::rtc_alive`](super::Board::rtc_alive); `None`: the board has none or it is empty).
     pub alive_s: Option<u32>,
     /// The last-alive word says the non-volatile saves were failing: the
     /// flash record misses the machine's state since (a conservative

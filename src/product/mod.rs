@@ -202,7 +202,7 @@ pub struct AppOf<N: Num> {
 
 impl<N: Num> AppOf<N> {
     /// Boots: the reset cause, the thermal state (RAM records, else the
-    /// non-volatile one, see [`boot_restore`]), the guard, and the safe
+    /// non-volatile one, see [`boot_restore`](crate::memory::boot_restore)), the guard, and the safe
     /// outputs of a guard waiting for its first sample (valve open).
     pub fn boot<B: Board>(board: &mut B, cfg: &GuardConfig, mem: &BootMemory) -> Self {
         let mut slot = core::mem::MaybeUninit::uninit();
