@@ -29,7 +29,11 @@
 //! The record type and CRC are plain Rust and host-tested; only the static in the
 //! `.uninit.thermal` section (cortex-m-rt's NOLOAD `.uninit`) is target-only.
 
+mod crc;
+
 use crate::params::N_NODES;
+pub use crc::{crc32, crc32_update};
+use crc::crc32_words;
 
 /// Record magic: "EHAT".
 pub const MAGIC: u32 = 0x4548_4154;
@@ -81,65 +85,6 @@ pub struct ThermalRecord {
     pub crc: u32,
 }
 
-/// Nibble table of the reflected CRC-32 (IEEE, polynomial 0xEDB88320).
-/// Built at compile time (an out-of-range index would be a compile error).
-/// Not the `crc` crate: it offers a bitwise CRC-32 (the A/B record's CRC in
-/// every product tick then took the loop from ~5 000 to ~10 600
-/// instructions per tick, measured) or a 1 KiB table (960 B more, past the
-/// product image's 32 KiB flash); this 64-byte table does two lookups per byte.
-#[allow(clippy::indexing_slicing)]
-const CRC_NIBBLE: [u32; 16] = {
-    let mut t = [0u32; 16];
-    let mut i = 0;
-    while i < 16 {
-        let mut c = i as u32;
-        let mut k = 0;
-        while k < 4 {
-            c = if c & 1 != 0 {
-                (c >> 1) ^ 0xEDB8_8320
-            } else {
-                c >> 1
-            };
-            k += 1;
-        }
-        t[i] = c;
-        i += 1;
-    }
-    t
-};
-
-/// CRC-32 (IEEE 802.3, as zlib's `crc32`) update over `data`.
-#[inline(never)]
-pub fn crc32_update(mut crc: u32, data: &[u8]) -> u32 {
-    for b in data {
-        crc ^= *b as u32;
-        for _ in 0..2 {
-            let idx = (crc & 0xf) as usize;
-            crc = (crc >> 4) ^ CRC_NIBBLE.get(idx).copied().unwrap_or(0);
-        }
-    }
-    crc
-}
-
-/// [`crc32_update`] over the little-endian bytes of `words`: the whole word
-/// is XORed in and shifted through eight nibble steps (the same register
-/// as four bytes of two steps each, the CRC being linear).
-#[inline(never)]
-fn crc32_words(mut crc: u32, words: &[u32]) -> u32 {
-    for w in words {
-        crc ^= *w;
-        for _ in 0..8 {
-            let idx = (crc & 0xf) as usize;
-            crc = (crc >> 4) ^ CRC_NIBBLE.get(idx).copied().unwrap_or(0);
-        }
-    }
-    crc
-}
-
-/// CRC-32 of `data` (init and final xor 0xFFFFFFFF).
-pub fn crc32(data: &[u8]) -> u32 {
-    !crc32_update(0xFFFF_FFFF, data)
-}
 
 impl ThermalRecord {
     /// An all-zero record (not valid: no magic).
@@ -442,43 +387,4 @@ pub fn seq_newer(a: u32, b: u32) -> bool {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    extern crate std;
-
-    #[test]
-    fn crc32_check_value() {
-        // The standard CRC-32 check value of "123456789" is 0xCBF43926.
-        assert_eq!(crc32(b"123456789"), 0xCBF4_3926);
-    }
-
-    /// The word-wise record CRC is the CRC-32 of the record's bytes before
-    /// its `crc` field (the format's definition).
-    #[test]
-    fn record_crc_is_the_crc32_of_its_bytes() {
-        let mut r = ThermalRecord::new([1.5, -2.25, 40.0, 61.75, 0.0, f32::MIN_POSITIVE], 21.0, 123_456, 0x8000_0001, 0xDEAD_BEEF);
-        r.seq_flags = 0x0102_0304;
-        r.rtc_s = 77;
-        let mut bytes = std::vec::Vec::new();
-        for w in [r.lng_used_cj, r.tick, r.magic] {
-            bytes.extend_from_slice(&w.to_le_bytes());
-        }
-        bytes.extend_from_slice(&r.version.to_le_bytes());
-        bytes.extend_from_slice(&r.reserved.to_le_bytes());
-        bytes.extend_from_slice(&r.faults.to_le_bytes());
-        for t in r.temps_c {
-            bytes.extend_from_slice(&t.to_le_bytes());
-        }
-        for w in [r.ambient_c.to_bits(), r.seq_flags, r.rtc_s] {
-            bytes.extend_from_slice(&w.to_le_bytes());
-        }
-        assert_eq!(bytes.len(), RECORD_BYTES - 4);
-        assert_eq!(r.body_crc(), crc32(&bytes));
-    }
-
-    #[test]
-    fn record_has_no_padding() {
-        // 4 + 4 + 4 + 2 + 2 + 4 + 6*4 + 4 + 4 + 4 + 4 = 60 bytes of fields.
-        assert_eq!(core::mem::size_of::<ThermalRecord>(), RECORD_BYTES);
-    }
-}
+mod tests;
