@@ -4,6 +4,8 @@ extern crate std;
 use std::vec::Vec as StdVec;
 
 use super::*;
+use crate::memory::ThermalRecord;
+use crate::params_block::BLOCK_LEN;
 use crate::memory::Restore;
 use crate::params_block;
 use crate::protocol::Deframer;

@@ -8,6 +8,7 @@ extern crate std;
 
 use super::tests::{board, replies, sample, ticks};
 use super::*;
+use crate::memory::ThermalRecord;
 use crate::faults;
 use crate::memory::nv::NvPolicy;
 use crate::memory::Restore;
