@@ -52,6 +52,7 @@
 //! housings.
 
 pub mod bench;
+mod laws;
 pub mod logger;
 pub mod missions;
 pub mod params;
