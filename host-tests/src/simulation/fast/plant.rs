@@ -388,7 +388,7 @@ impl FastPlant {
             let mut h = t1 - self.t;
             // While A = 0 (the first run's explicit start) the step is a
             // polynomial in closed form (`Thermal::linear`): no level's
-            // matrices (7 of them, 9.5 kB, built and boxed per level).
+            // matrices (4 of them, 5.4 kB, built and boxed per level).
             let mut phi = if !odd && !th.is_zero() {
                 Some(self.phi(&mut ladder, &th, level, dt_s))
             } else if norm1(&th.a) * h > VECTOR_NORM_MAX {
@@ -569,20 +569,21 @@ impl FastPlant {
     }
 
     /// The φ-functions of a step level: cached, by doubling the level below, or anew.
-    /// (Boxed: a level is 4.6 kB and a run uses a dozen of the 33.)
+    /// (Boxed: a level is 5.4 kB and a run uses a dozen of the 33.)
     fn phi<'a>(&mut self, ladder: &'a mut [Option<Box<Phi<NT>>>], th: &Thermal, level: i32, dt: f64) -> &'a Phi<NT> {
         let i = (level - LEVEL_MIN) as usize;
         if ladder[i].is_none() {
             let h = dt * 2f64.powi(level);
-            let p = match i.checked_sub(1).and_then(|j| ladder[j].as_ref()) {
+            let (lower, upper) = ladder.split_at_mut(i);
+            let slot = &mut upper[0];
+            match lower.last().and_then(|b| b.as_deref()) {
                 // A = 0 before the first Jacobian: Phi::new is closed-form there.
-                Some(below) if !th.is_zero() => below.doubled(),
+                Some(below) if !th.is_zero() => *slot = Some(below.doubled_boxed()),
                 _ => {
                     self.stats.phi_builds += 1;
-                    Phi::new(&th.a, h)
+                    *slot = Some(Box::new(Phi::new(&th.a, h)));
                 }
-            };
-            ladder[i] = Some(Box::new(p));
+            }
         }
         ladder[i].as_deref().expect("just built")
     }
