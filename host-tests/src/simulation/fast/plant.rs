@@ -31,7 +31,7 @@ use super::thermal::{Thermal, NE, NT};
 use super::dense::norm1;
 use crate::hydraulics::ix;
 use crate::model::{Drive, Model, N_STATE, T0};
-use crate::plant::{breakpoints, model_for, snapshot, typical, Control, RuleEval, SimError, Snapshot, Stats};
+use crate::plant::{breakpoints, model_for, snapshot_stored, typical, Control, RuleEval, SimError, Snapshot, Stats};
 use crate::rig::Rig;
 use crate::scenario::{Scenario, ValveRule};
 
@@ -181,7 +181,9 @@ pub struct FastStats {
 pub struct FastPlant {
     model: Model,
     y: [f64; N_STATE],
-    y0: [f64; N_STATE],
+    /// Each node's stored energy in the initial state, J (the snapshots'
+    /// stored energy is relative to it: [`Model::stored_energy_from`]).
+    e0: [f64; crate::network::N_NODES],
     t: f64,
     opts: FastOptions,
     hyd: HydTrack,
@@ -227,7 +229,8 @@ impl FastPlant {
         yh.copy_from_slice(&y[..NH]);
         let ros = Rosenbrock::with_method(Tableau::ros34pw2(), HYD_JACOBIAN_STEPS, opts.hyd_rtol, atol, scale, opts.h_start_s);
         let hyd = HydTrack::new(ros, t, yh);
-        Ok(Self { model, y, y0: y, t, opts, hyd, thermal: None, jacobian_valve: false, stats: FastStats::default(), step_limit: None })
+        let e0 = model.node_energies(&y);
+        Ok(Self { model, y, e0, t, opts, hyd, thermal: None, jacobian_valve: false, stats: FastStats::default(), step_limit: None })
     }
 
     /// The model.
@@ -273,7 +276,7 @@ impl FastPlant {
 
     /// Snapshot of the current state.
     pub fn snapshot(&self) -> Snapshot {
-        snapshot(&self.model, self.t, &self.y, &self.y0)
+        snapshot_stored(&self.model, self.t, &self.y, self.model.stored_energy_from(&self.e0, &self.y))
     }
 
     /// The scenario's own valve rule.
@@ -572,7 +575,7 @@ impl FastPlant {
                     let yhc = if replay { yh0 } else { self.hyd.at(tc) };
                     self.y[..NH].copy_from_slice(&yhc);
                 }
-                let snap = snapshot(&self.model, tc, &self.y, &self.y0);
+                let snap = snapshot_stored(&self.model, tc, &self.y, self.model.stored_energy_from(&self.e0, &self.y));
                 ctl = on_step(&snap)?;
                 k += 1;
                 t_cb = t_start + k as f64 * dt_s;
