@@ -45,10 +45,17 @@ pub const MEASURED_COLUMNS: [&str; 14] = [
 /// Every channel of a snapshot as (name, value): the measured-format
 /// channels first (without `time_s`), then the internal ones.
 pub fn channels(s: &Snapshot) -> Vec<(&'static str, f64)> {
-    let op = &s.op;
     // One allocation: the measured columns, the other nodes, 11 losses, 8 more.
     let mut v = Vec::with_capacity(13 + NODES.len() + 19);
-    v.extend([
+    each_channel(s, |name, x| v.push((name, x)));
+    v
+}
+
+/// [`channels`] one by one, in the same order, without collecting them
+/// (a run's outputs push them straight into their columns).
+pub fn each_channel(s: &Snapshot, mut f: impl FnMut(&'static str, f64)) {
+    let op = &s.op;
+    for (name, x) in [
         ("speed_rpm", op.omega * 60.0 / (2.0 * std::f64::consts::PI)),
         ("current_a", op.current_a),
         ("p_a_bar", op.p_a * 1e-5),
@@ -62,15 +69,21 @@ pub fn channels(s: &Snapshot) -> Vec<(&'static str, f64)> {
         ("t_oil_c", s.temp(Node::Sensor)),
         ("lng_valve", if s.lng_open { 1.0 } else { 0.0 }),
         ("air_speed_mps", op.air_mps),
-    ]);
+    ] {
+        f(name, x);
+    }
     for n in NODES {
         if !matches!(n, Node::Motor | Node::Pump | Node::MainBlock | Node::BallBlock | Node::Sensor) {
-            v.push((n.channel(), s.temp(n)));
+            f(n.channel(), s.temp(n));
         }
     }
-    v.extend(s.losses.channels());
-    v.extend(s.losses.friction_split_channels());
-    v.extend([
+    for (name, x) in s.losses.channels() {
+        f(name, x);
+    }
+    for (name, x) in s.losses.friction_split_channels() {
+        f(name, x);
+    }
+    for (name, x) in [
         ("p_total_w", s.losses.total()),
         ("e_loss_j", s.e_loss_j),
         ("e_ambient_j", s.e_amb_j),
@@ -79,8 +92,9 @@ pub fn channels(s: &Snapshot) -> Vec<(&'static str, f64)> {
         ("lng_used_kg", s.lng_used_kg),
         ("velocity_mm_s", op.v * 1e3),
         ("q_path_l_min", op.q_path * 6e4),
-    ]);
-    v
+    ] {
+        f(name, x);
+    }
 }
 
 /// Result of an offline run.
@@ -316,16 +330,18 @@ fn run_plant(mut plant: impl Runner, scenario: &Scenario, opt: &SimOptions) -> R
     plant.run_dyn(dt, t_end, &mut |s| {
         let cmd = rule.command(s);
         if k.is_multiple_of(every) || s.t >= t_end - 1e-9 {
-            let ch = channels(s);
             if out.columns.is_empty() {
                 let n = ((t_end - s.t) / opt.output_interval_s).max(0.0) as usize + 2;
-                out.columns = ch.iter().map(|(name, _)| (name.to_string(), Vec::with_capacity(n))).collect();
+                out.columns = channels(s).iter().map(|(name, _)| (name.to_string(), Vec::with_capacity(n))).collect();
                 out.time_s.reserve(n);
             }
             out.time_s.push(s.t);
-            for ((_, col), (_, v)) in out.columns.iter_mut().zip(ch) {
-                col.push(v);
-            }
+            let mut cols = out.columns.iter_mut();
+            each_channel(s, |_, v| {
+                if let Some((_, col)) = cols.next() {
+                    col.push(v);
+                }
+            });
         }
         if let Some(open) = cmd {
             if open && !last_open {

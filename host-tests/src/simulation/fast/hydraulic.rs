@@ -166,6 +166,15 @@ impl HydTrack {
         }
         let i = self.pts.partition_point(|p| p.0 <= t).clamp(1, n - 1);
         let (a, b) = (&self.pts[i - 1], &self.pts[i]);
+        // At a point of the track its state (what the interpolant gives
+        // there to the bit: the basis is (1, 0, 0, 0) or (0, 0, 1, 0)); the
+        // thermal steps read the track at their ends, which are its points.
+        if t == a.0 {
+            return a.1;
+        }
+        if t == b.0 {
+            return b.1;
+        }
         let h = b.0 - a.0;
         let (a0, b0, a1, b1) = hermite(((t - a.0) / h).clamp(0.0, 1.0));
         std::array::from_fn(|k| a0 * a.1[k] + b0 * h * a.2[k] + a1 * b.1[k] + b1 * h * b.2[k])
@@ -211,7 +220,10 @@ impl HydTrack {
             let i = self.pts.partition_point(|p| p.0 < t);
             self.pts.truncate(i);
             self.pts.push((t, y, f));
-            self.last_branch = None;
+            // The branch values the last scan ended with at t stay (the
+            // same state; the oil of the step's end temperatures instead
+            // of the predicted ones moves them by a few millionths, and
+            // only their signs are read): the next scan starts from them.
         }
         self.path = TempPath::constant(*z, oil);
         let i = self.pts.partition_point(|p| p.0 <= t);

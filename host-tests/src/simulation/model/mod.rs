@@ -214,13 +214,23 @@ impl Model {
 
     /// Energy stored in the nodes relative to the state `y0`, J.
     pub fn stored_energy(&self, y0: &[f64], y: &[f64]) -> f64 {
+        self.stored_energy_from(&self.node_energies(y0), y)
+    }
+
+    /// Each node's stored energy at the state `y`, J (relative to the
+    /// network's 20 °C reference, `network::stored_j`).
+    pub fn node_energies(&self, y: &[f64]) -> [f64; N_NODES] {
+        std::array::from_fn(|i| network::stored_j(&self.rig, NODES[i], self.contents[i], y[T0 + i]))
+    }
+
+    /// [`Model::stored_energy`] relative to the node energies `e0` of the
+    /// initial state ([`Model::node_energies`], taken once a run): the
+    /// same differences summed in the same order.
+    pub fn stored_energy_from(&self, e0: &[f64; N_NODES], y: &[f64]) -> f64 {
         NODES
             .iter()
             .enumerate()
-            .map(|(i, n)| {
-                let c = self.contents[i];
-                network::stored_j(&self.rig, *n, c, y[T0 + i]) - network::stored_j(&self.rig, *n, c, y0[T0 + i])
-            })
+            .map(|(i, n)| network::stored_j(&self.rig, *n, self.contents[i], y[T0 + i]) - e0[i])
             .sum()
     }
 

@@ -155,6 +155,12 @@ impl RuleEval {
 
 /// Snapshot of state `y` at `t` (with `y0` the initial state for the stored energy).
 pub fn snapshot(model: &Model, t: f64, y: &[f64], y0: &[f64]) -> Snapshot {
+    snapshot_stored(model, t, y, model.stored_energy(y0, y))
+}
+
+/// [`snapshot`] with the stored energy given, J (a plant that keeps its
+/// initial node energies: [`Model::stored_energy_from`]).
+pub fn snapshot_stored(model: &Model, t: f64, y: &[f64], stored_j: f64) -> Snapshot {
     let op = model.op_point(t, y);
     let mut temps = [0.0; N_NODES];
     temps.copy_from_slice(&y[T0..T0 + N_NODES]);
@@ -168,7 +174,7 @@ pub fn snapshot(model: &Model, t: f64, y: &[f64], y0: &[f64]) -> Snapshot {
         e_loss_j: y[E_LOSS],
         e_amb_j: y[E_AMB],
         e_lng_j: y[E_LNG],
-        stored_j: model.stored_energy(y0, y),
+        stored_j,
         lng_used_kg: y[E_LNG] / model.rig.lng.heat_per_kg(),
     }
 }
