@@ -171,7 +171,8 @@ fn slow_imprint_ratio_with_structure_no_case() {
 /// below 2: the twin's t_oil_c floor rose, 1.05 -> 1.23 K). Below r = 2,
 /// no cause right by the rule: 1711 (conduction, r 1.81), 2709 (churning,
 /// r 0.75, named under `no-case`), 2711 (conduction, r 1.94). No twin
-/// names a cause. docs/diagnosis.md, "What it can and cannot see".
+/// names a cause. docs/diagnosis.md, "What it can and cannot see". 639 s
+/// at load 6–9 on two shared cores (2026-11-28, passes).
 #[test]
 #[ignore = "slow tier: emulator cases with twins (minutes), the structure option's no-case-held variant"]
 fn slow_imprint_ratio_with_structure_no_case_held() {
