@@ -4,7 +4,7 @@
 //! magnitude, with a larger budget, and with variants of the nuisance set;
 //! training and held-out RMSE on the affected channel and pooled.
 //!
-//! `cargo run --profile fast -p eha-sim --example imprint_misses -- SEED [twin] [structure] [VARIANT…]`
+//! `cargo run --profile fast -p eha-sim --example imprint_misses -- SEED [twin] [structure|no-case|no-case-held] [sigma=NAME:S|cal…] [VARIANT…]`
 //! (seeds 1700–1717 and 2700–2717; ~20–60 s a case on two cores).
 
 use eha_sim::diagnosis::analysis::{fit_points, split_time_s};
@@ -95,7 +95,27 @@ fn main() {
     // `structure`: the physical tier with the commissioning's structure
     // (`ReferenceModel::with_structure`; its own set, the `-PARAM` variants
     // then do not apply).
-    let model = ReferenceModel::new(rig, &run).expect("model").with_nuisance_set(free).with_structure(&run, has("structure"));
+    // `no-case`, `no-case-held`: the structure option's variants of those
+    // names instead of `full`.
+    // `sigma=NAME:S` replaces the physical tier's prior on NAME by σ S on
+    // ln θ (`sigma=NAME:cal` back to the calibration set's), after the
+    // structure option's own diagnosis-only priors.
+    use eha_sim::diagnosis::analysis::Structure;
+    let variant = if has("no-case-held") {
+        Structure::NoCaseHeld
+    } else if has("no-case") {
+        Structure::NoCase
+    } else if has("structure") {
+        Structure::Full
+    } else {
+        Structure::Off
+    };
+    let mut model = ReferenceModel::new(rig, &run).expect("model").with_nuisance_set(free).with_structure(&run, variant);
+    for a in &args {
+        if let Some((n, v)) = a.strip_prefix("sigma=").and_then(|x| x.split_once(':')) {
+            model = model.with_prior_sigma(n, if v == "cal" { None } else { Some(v.parse::<f64>().expect("sigma=NAME:S")) });
+        }
+    }
     let sim = model.physical_set().expect("physical set");
     let names: Vec<String> = sim.nuisance().iter().map(|p| p.name.clone()).collect();
     println!("set: {}", names.join(" "));

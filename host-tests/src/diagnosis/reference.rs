@@ -63,6 +63,10 @@ pub struct ReferenceModel {
     /// Indices into [`crate::calibration::PARAMS`] of the physical set for
     /// this run ([`nuisance_set`]).
     free: Vec<usize>,
+    /// Prior σ on ln θ replacing the calibration set's, by index into
+    /// [`crate::calibration::PARAMS`] ([`Self::with_prior_sigma`], an
+    /// experiment knob; empty in the product path).
+    priors: Vec<(usize, f64)>,
     /// Whether the nuisance set is the physical set (else the four global
     /// multipliers).
     physical: bool,
@@ -84,7 +88,7 @@ impl ReferenceModel {
         let dt = (span / 400.0).clamp(0.5, 5.0);
         let opts = SimOptions { output_interval_s: dt, control_interval_s: dt };
         let free = nuisance_set(run);
-        let m = ReferenceModel { phys_rig: rig.clone(), rig, eta_m_from_current: None, free, physical: false, scenario: Scenario::Replay(inputs), times: run.time_s.clone(), opts };
+        let m = ReferenceModel { phys_rig: rig.clone(), rig, eta_m_from_current: None, free, priors: Vec::new(), physical: false, scenario: Scenario::Replay(inputs), times: run.time_s.clone(), opts };
         let n: Vec<f64> = m.nuisance().iter().map(|p| p.start).collect();
         m.simulate(&n, Candidate::None, &[]).map_err(ReferenceError::Model)?;
         Ok(m)
@@ -119,6 +123,24 @@ impl ReferenceModel {
         self.phys_rig.pump.eta_m = eta;
         self.eta_m_from_current = Some((eta, rows));
         self.free = structural_set(run, &self.free, variant);
+        self
+    }
+
+    /// **Experiment knob** (not used by the product path): the same model
+    /// with the physical tier's prior on calibration parameter `name`
+    /// replaced by a log-normal of σ `sigma_ln` on ln θ around the rig file
+    /// (`None` drops the replacement, back to the calibration set's).
+    /// `examples/imprint_misses.rs` (`sigma=NAME:S`) measured with it that
+    /// priors of a physical width do not keep `cap_loop_oil` and
+    /// `probe_oil` off their bounds on the emulator's 1704 under the
+    /// structure option (docs/diagnosis.md, "What it can and cannot see").
+    /// An unknown name changes nothing.
+    pub fn with_prior_sigma(mut self, name: &str, sigma_ln: impl Into<Option<f64>>) -> Self {
+        let Some(k) = calibration::set::index(name) else { return self };
+        self.priors.retain(|(j, _)| *j != k);
+        if let Some(s) = sigma_ln.into() {
+            self.priors.push((k, s));
+        }
         self
     }
 
@@ -216,7 +238,8 @@ pub fn nuisance_set_of(run: &MeasuredRun, logs: &[&MeasuredRun]) -> Vec<usize> {
 /// diagnosis's channels have none, so here they rest on the housing
 /// sensors and the current alone. [`Structure::NoCase`] leaves out
 /// `friction_case` and `probe_surface_pump` (the two a drain thermocouple
-/// would separate); [`Structure::Off`] returns `free` unchanged.
+/// would separate); [`Structure::NoCaseHeld`] also holds [`HELD_OIL`] at the
+/// rig file; [`Structure::Off`] returns `free` unchanged.
 pub fn structural_set(run: &MeasuredRun, free: &[usize], variant: Structure) -> Vec<usize> {
     use calibration::set::{index, FRICTION_CASE, FRICTION_SPEED, PROBE_SURFACE};
     if variant == Structure::Off {
@@ -227,13 +250,28 @@ pub fn structural_set(run: &MeasuredRun, free: &[usize], variant: Structure) -> 
     let friction = index("pump_friction");
     let mut out: Vec<usize> = free.iter().copied().filter(|&k| Some(k) != friction).collect();
     let add = [FRICTION_CASE, FRICTION_SPEED].into_iter().chain(PROBE_SURFACE.iter().zip(probes).filter(|(_, ch)| logged(*ch)).map(|(n, _)| *n));
-    let no_case = variant == Structure::NoCase;
+    let no_case = matches!(variant, Structure::NoCase | Structure::NoCaseHeld);
     let kept = add.filter(|n| !(no_case && (*n == FRICTION_CASE || *n == PROBE_SURFACE[1])));
     out.extend(kept.filter_map(index));
+    if variant == Structure::NoCaseHeld {
+        let held: Vec<usize> = HELD_OIL.iter().filter_map(|n| index(n)).collect();
+        out.retain(|k| !held.contains(k));
+    }
     out.sort_unstable();
     out.dedup();
     out
 }
+
+/// The calibration parameters [`Structure::NoCaseHeld`] holds at the rig
+/// file: the loop oil's capacity and the oil probe's response time. Under
+/// the structure option they sit at their upper bounds (×3, ×5) on the
+/// emulator's 1704 and carry its dead-end pocket's lag (t_oil_c 0.21 K
+/// held out against 0.45 K without the option); priors narrower than the
+/// calibration set's did not move them (σ 0.05 on `cap_loop_oil` left it
+/// at ×2.9: holding both costs its baseline ≈ 170 K² of training
+/// residual, the prior row ≈ 18), so they are held. docs/diagnosis.md,
+/// "What it can and cannot see".
+pub const HELD_OIL: [&str; 2] = ["cap_loop_oil", calibration::set::PROBE_OIL];
 
 /// Solver-step budget of one replay, per second of log: a replay normally
 /// takes a few hundred steps for 20 minutes; a candidate run that makes the
@@ -262,7 +300,8 @@ impl Simulator for ReferenceModel {
             .iter()
             .map(|&k| {
                 let d = &calibration::PARAMS[k];
-                ParamSpec::new(d.name, "1", 1.0, d.lo, d.hi).with_prior(d.prior_sigma_ln)
+                let sigma = self.priors.iter().find(|(j, _)| *j == k).map_or(d.prior_sigma_ln, |p| p.1);
+                ParamSpec::new(d.name, "1", 1.0, d.lo, d.hi).with_prior(sigma)
             })
             .collect()
     }
@@ -274,6 +313,7 @@ impl Simulator for ReferenceModel {
                 phys_rig: self.phys_rig.clone(),
                 eta_m_from_current: self.eta_m_from_current,
                 free: self.free.clone(),
+                priors: self.priors.clone(),
                 physical: true,
                 scenario: self.scenario.clone(),
                 times: self.times.clone(),

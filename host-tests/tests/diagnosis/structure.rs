@@ -11,7 +11,7 @@ use eha_sim::calibration::commission::eta_m_from_current;
 use eha_sim::calibration::set::{FRICTION_CASE, PROBE_SURFACE, STRUCTURAL};
 use eha_sim::diagnosis::analysis::Structure;
 use eha_sim::calibration::CalLog;
-use eha_sim::diagnosis::reference::{nuisance_set, ReferenceModel};
+use eha_sim::diagnosis::reference::{nuisance_set, ReferenceModel, HELD_OIL};
 use eha_sim::diagnosis::{Candidate, Simulator};
 use eha_sim::emulator::missions::EmuScenario::{self, ConstantThrottle, SpeedSteps};
 use eha_sim::emulator::{generate, EmuCase};
@@ -70,6 +70,28 @@ fn structure_no_case_leaves_out_the_case_share_and_the_pump_probe() {
     let got = names(&*nc.physical_set().expect("physical"));
     assert_eq!(got, want);
     assert_eq!(got.len() + 2, names(&*full.physical_set().expect("physical")).len());
+}
+
+/// The `no-case-held` variant on the same loaded log (1714): the `no-case`
+/// set without `cap_loop_oil` and `probe_oil` (held at the rig file,
+/// `HELD_OIL`), the same `eta_m`; on the low-load speed-step log (1716)
+/// nothing changes, as with every variant.
+#[test]
+fn structure_no_case_held_holds_the_loop_oil_and_the_oil_probe() {
+    let run = log(ConstantThrottle, 1714);
+    let nc = ReferenceModel::new(Rig::default(), &run).expect("model").with_structure(&run, Structure::NoCase);
+    let held = ReferenceModel::new(Rig::default(), &run).expect("model").with_structure(&run, Structure::NoCaseHeld);
+    assert_eq!(held.eta_m_from_current(), nc.eta_m_from_current());
+    let want: Vec<String> = names(&*nc.physical_set().expect("physical")).into_iter().filter(|n| !HELD_OIL.contains(&n.as_str())).collect();
+    let got = names(&*held.physical_set().expect("physical"));
+    assert_eq!(got, want);
+    assert_eq!(got.len() + 2, names(&*nc.physical_set().expect("physical")).len(), "both held parameters were in the no-case set");
+
+    let quiet = log(SpeedSteps, 1716);
+    let m = ReferenceModel::new(Rig::default(), &quiet).expect("model").with_structure(&quiet, Structure::NoCaseHeld);
+    assert_eq!(m.eta_m_from_current(), None);
+    let b: Vec<String> = nuisance_set(&quiet).into_iter().map(|k| eha_sim::calibration::PARAMS[k].name.to_string()).collect();
+    assert_eq!(names(&*m.physical_set().expect("physical")), b);
 }
 
 /// The pump probe's parameter at θ = e^0.1 reads t_pump_c 10 % of metal −

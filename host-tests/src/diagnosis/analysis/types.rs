@@ -107,7 +107,7 @@ pub struct DiagnoseOptions {
 /// Which structural freedoms the physical tier takes where the log carries
 /// motor current under load ([`DiagnoseOptions::structure`],
 /// [`crate::diagnosis::reference::structural_set`]). On the command line
-/// `off` (alias `false`), `full` (alias `true`), `no-case`.
+/// `off` (alias `false`), `full` (alias `true`), `no-case`, `no-case-held`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Structure {
@@ -127,6 +127,14 @@ pub enum Structure {
     /// probe and a sensor lag (docs/diagnosis.md, "What it can and cannot
     /// see").
     NoCase,
+    /// As [`Structure::NoCase`], with the loop oil's capacity and the oil
+    /// probe's response time held at the rig file
+    /// ([`crate::diagnosis::reference::HELD_OIL`]): under the option they
+    /// carry a dead-end pocket's lag to their bounds (the emulator's 1704);
+    /// held, the lag is named there, but the emulator's 6 s thermowell is
+    /// then carried by the other parameters and the effect-free floor rises
+    /// on t_oil_c (docs/diagnosis.md, "What it can and cannot see").
+    NoCaseHeld,
 }
 
 impl From<bool> for Structure {

@@ -72,13 +72,15 @@ pub struct EmuSweepArgs {
     #[arg(long, value_enum)]
     pub measure: Option<DecisionRule>,
     /// The physical tier with the commissioning's structure where the log
-    /// carries motor current under load (`off`/`full`/`no-case`, `false`
+    /// carries motor current under load (`off`/`full`/`no-case`/`no-case-held`, `false`
     /// and `true` are `off` and `full`; default
     /// `DiagnoseOptions::structure`'s): the pump's `eta_m` from the
     /// current, `pump_friction` held, the friction heat's placement and
     /// speed law and the housing probes' reading towards the air fitted
     /// (`no-case`: without the friction heat's case share and the pump
-    /// probe's placement; [`crate::diagnosis::analysis::Structure`]).
+    /// probe's placement; `no-case-held`: also the loop oil's capacity and
+    /// the oil probe held at the rig file;
+    /// [`crate::diagnosis::analysis::Structure`]).
     #[arg(long, value_enum, value_name = "VARIANT")]
     pub structure: Option<crate::diagnosis::analysis::Structure>,
 }
