@@ -289,10 +289,12 @@ fn slow_commissioning_is_reproducible_at_the_last_digit_leaky_heavy() {
 }
 
 fn reproducible(m: EmuMachine) {
+    // `EXP_NUDGE_K`: an experiment knob (the nudge, K; the test's is 1e-9 K).
+    let dk: f64 = std::env::var("EXP_NUDGE_K").ok().and_then(|v| v.parse().ok()).unwrap_or(1e-9);
     let nudge = |l: &BenchLog| -> BenchLog {
         let mut l = l.clone();
         for ch in Channel::TEMPERATURES.into_iter().chain([Channel::TDrainC]) {
-            let v: Vec<Option<f64>> = l.run.get(ch).expect("channel").iter().map(|x| x.map(|x| x + 1e-9)).collect();
+            let v: Vec<Option<f64>> = l.run.get(ch).expect("channel").iter().map(|x| x.map(|x| x + dk)).collect();
             l.run.set(ch, v);
         }
         l
@@ -312,8 +314,12 @@ fn reproducible(m: EmuMachine) {
             if let Some(x) = std::env::var("EXP_POLISH_RTOL").ok().and_then(|v| v.parse().ok()) {
                 o.polish_rtol = x;
             }
+            // `EXP_LATTICE_LN`: an experiment knob (the θ lattice's spacing; 0: off).
+            if let Some(x) = std::env::var("EXP_LATTICE_LN").ok().and_then(|v| v.parse().ok()) {
+                o.lattice_ln = x;
+            }
             let c = commission(&m.rig_file(), &train, &h, &o).expect("commissioning");
-            eprintln!("{}: {:.1} s, flashable {}", m.name, t0.elapsed().as_secs_f64(), c.flashable());
+            eprintln!("{}: {:.1} s, flashable {}, eta_m {:?}", m.name, t0.elapsed().as_secs_f64(), c.flashable(), c.eta_m_from_current);
             report(&m, &c, t0.elapsed().as_secs_f64());
             headline(&m, &c, hold)
         };
