@@ -93,3 +93,31 @@ pub(crate) fn jacobian_ln(base: &Rig, logs: &[CalLog], theta: &[f64], idx: &[usi
         .collect();
     Some((r0.clone(), DMatrix::from_columns(&cols?)))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two vectors that differ in their last digits map to the same
+    /// lattice point; the lattice point maps to itself; it stays within
+    /// half a cell of the vector and within the bounds.
+    #[test]
+    fn lattice_absorbs_last_digits() {
+        let a: Vec<f64> = PARAMS.iter().enumerate().map(|(k, d)| (d.lo * d.hi).sqrt() * (1.0 + 0.013 * k as f64)).collect();
+        let b: Vec<f64> = a.iter().map(|x| x * (1.0 + 3e-15)).collect();
+        let (la, lb) = (on_lattice(&a, THETA_LATTICE_LN), on_lattice(&b, THETA_LATTICE_LN));
+        assert_eq!(la, lb);
+        assert_eq!(on_lattice(&la, THETA_LATTICE_LN), la);
+        for ((x, y), d) in a.iter().zip(&la).zip(PARAMS.iter()) {
+            let (lo, hi) = (d.lo.ln() - 1e-12, d.hi.ln() + 1e-12);
+            assert!(y.ln() >= lo && y.ln() <= hi, "{}: {y} outside its bounds", d.name);
+            if x.ln() >= lo && x.ln() <= hi {
+                assert!((x.ln() - y.ln()).abs() <= 0.5 * THETA_LATTICE_LN + 1e-12, "{}: {x} -> {y}", d.name);
+            }
+        }
+        let ones = vec![1.0; PARAMS.len()];
+        assert_eq!(on_lattice(&ones, THETA_LATTICE_LN), ones);
+        assert_eq!(on_lattice(&a, 0.0), a);
+        assert_eq!(on_lattice_value(0.2468190011, THETA_LATTICE_LN), on_lattice_value(0.2468190011 * (1.0 + 2e-15), THETA_LATTICE_LN));
+    }
+}
