@@ -32,9 +32,11 @@ pub const POLISH_MAX_ITERS: usize = 8;
 /// measured there. With [`CalOptions::polish_rtol`](super::CalOptions) 1e-7
 /// the polish converges (decrement 0.05 and 0.017 at its end on big-pump's
 /// original and nudged logs, against stalls at 3–90) but into two local
-/// minima 11.3 units apart (1484.4 and 1473.1), and the nudge still moves
-/// the headline 0.54 K; a replay at 1e-7 takes ~5 times as long, so the
-/// default stays at 1e-5 (commissioning time).
+/// minima 11.3 units apart (1484.4 and 1473.1), and the nudge still moved
+/// the headline 0.54 K (before the θ lattice, [`super::residuals::THETA_LATTICE_LN`],
+/// which makes the last-digit nudge move nothing but leaves both minima);
+/// a replay at 1e-7 takes ~5 times as long, so the default stays at 1e-5
+/// (commissioning time).
 pub const POLISH_RTOL: f64 = crate::simulation::replay::REPLAY_RTOL;
 
 /// `polish` stops when the predicted decrease of the objective (the
