@@ -202,7 +202,12 @@ fn fit(base: &Rig, train: &[CalLog], o: &CalOptions) -> Result<Fitted, Commissio
     // temperatures with the rest of the set.
     let mut base_e = base.clone();
     let mut o = o.clone();
-    let eta_e = eta_m_from_current(base, train);
+    // On the calibration's lattice (`residuals::THETA_LATTICE_LN`): η_m
+    // weighs the current's rows by the viscosity at the logged drain
+    // temperature, so a last-digit change of the logs changed the rig every
+    // model run starts from in its last digits, and the adaptive replays
+    // took other step sequences from the first run on.
+    let eta_e = eta_m_from_current(base, train).map(|(eta, n)| (super::residuals::on_lattice_value(eta, o.lattice_ln), n));
     if let Some((eta, n)) = eta_e {
         base_e.pump.eta_m = eta;
         o.hold.push(("pump_friction", format!("eta_m = {eta:.4} from the current of {n} loaded samples (electrical balance)")));

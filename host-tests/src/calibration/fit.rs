@@ -12,7 +12,8 @@
 use super::ident::{excitation_warnings, identifiability, Identifiability};
 use super::log::CalLog;
 use super::polish::{polish, polish_basins};
-use super::residuals::{data_residuals, jacobian_ln, Sigma};
+use super::residuals::{data_residuals, jacobian_ln, on_lattice, Sigma};
+pub use super::residuals::THETA_LATTICE_LN;
 pub use super::polish::{Polish, POLISH_MAX_ITERS, POLISH_RTOL, POLISH_TOL, SCALE_PAIR};
 use super::set::{apply, Needs, Stage, PARAMS, PROBE_OIL};
 use crate::lsq::FdProblem;
@@ -61,6 +62,10 @@ pub struct CalOptions {
     /// (default [`POLISH_RTOL`]; LM before it replays at
     /// [`crate::simulation::replay::REPLAY_RTOL`]).
     pub polish_rtol: f64,
+    /// Spacing in ln θ of the lattice every multiplier vector is evaluated
+    /// on (default [`THETA_LATTICE_LN`]; 0: off, the optimiser's vectors as
+    /// they come).
+    pub lattice_ln: f64,
 }
 
 impl Default for CalOptions {
@@ -77,6 +82,7 @@ impl Default for CalOptions {
             direct: Some(super::direct::DirectOptions::default()),
             polish_iters: POLISH_MAX_ITERS,
             polish_rtol: POLISH_RTOL,
+            lattice_ln: THETA_LATTICE_LN,
         }
     }
 }
@@ -166,7 +172,7 @@ pub fn calibrate(base: &Rig, logs: &[CalLog], o: &CalOptions) -> Result<Calibrat
         return Err(CalError::NoLogs);
     }
     let runs = AtomicUsize::new(0);
-    let sigma = Sigma { data_k: o.sigma_data_k, drain_weight: o.drain_weight, polish_iters: o.polish_iters };
+    let sigma = Sigma { data_k: o.sigma_data_k, drain_weight: o.drain_weight, polish_iters: o.polish_iters, lattice_ln: o.lattice_ln };
     let ones = super::set::nominal();
     for l in logs {
         l.simulate(base).map_err(|e| CalError::Model(l.name.clone(), e))?;
@@ -282,7 +288,7 @@ pub fn calibrate(base: &Rig, logs: &[CalLog], o: &CalOptions) -> Result<Calibrat
             for (j, &k) in list.iter().enumerate() {
                 th[k] = to_ln(z[j], &PARAMS[k]).exp();
             }
-            th
+            on_lattice(&th, o.lattice_ln)
         };
         let residual = |z: &[f64]| -> Option<DVector<f64>> {
             let th = theta_of(z);

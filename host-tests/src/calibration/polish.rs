@@ -7,7 +7,7 @@
 //! near the optimum is jagged by ~10 χ² units (the solver's own error),
 //! the size of the stalls measured there (a damped step lowering nothing).
 
-use super::residuals::{data_residuals, jacobian_ln, Sigma};
+use super::residuals::{data_residuals, jacobian_ln, on_lattice, Sigma};
 use super::log::CalLog;
 use super::set::PARAMS;
 use crate::rig::Rig;
@@ -32,9 +32,11 @@ pub const POLISH_MAX_ITERS: usize = 8;
 /// measured there. With [`CalOptions::polish_rtol`](super::CalOptions) 1e-7
 /// the polish converges (decrement 0.05 and 0.017 at its end on big-pump's
 /// original and nudged logs, against stalls at 3–90) but into two local
-/// minima 11.3 units apart (1484.4 and 1473.1), and the nudge still moves
-/// the headline 0.54 K; a replay at 1e-7 takes ~5 times as long, so the
-/// default stays at 1e-5 (commissioning time).
+/// minima 11.3 units apart (1484.4 and 1473.1), and the nudge still moved
+/// the headline 0.54 K (before the θ lattice, [`super::residuals::THETA_LATTICE_LN`],
+/// which makes the last-digit nudge move nothing but leaves both minima);
+/// a replay at 1e-7 takes ~5 times as long, so the default stays at 1e-5
+/// (commissioning time).
 pub const POLISH_RTOL: f64 = crate::simulation::replay::REPLAY_RTOL;
 
 /// `polish` stops when the predicted decrease of the objective (the
@@ -157,6 +159,7 @@ pub(super) fn polish_basins(base: &Rig, logs: &[CalLog], lm_theta: Vec<f64>, fre
         let (lo, hi) = (PARAMS[k].lo.ln(), PARAMS[k].hi.ln());
         mirror[k] = (mirror[k].ln() - 2.0 * mean).clamp(lo, hi).exp();
     }
+    let mirror = on_lattice(&mirror, sigma.lattice_ln);
     let (theta2, p2) = polish_at(base, logs, mirror, free, sigma, runs, Polish { s2: p.s2, ..Polish::default() }, true);
     let (f1, f2) = (p.objective.last().copied().unwrap_or(f64::INFINITY), p2.objective.last().copied().unwrap_or(f64::INFINITY));
     if f2 < f1 {
@@ -216,6 +219,7 @@ pub(super) fn polish_at(base: &Rig, logs: &[CalLog], mut theta: Vec<f64>, free: 
                 let (lo, hi) = lnb(k);
                 th[k] = (u[a] + step[a]).clamp(lo, hi).exp();
             }
+            let th = on_lattice(&th, sigma.lattice_ln);
             if let Some(f1) = objective(base, logs, &th, free, sigma, runs) {
                 if f1 < f {
                     (theta, f, moved) = (th, f1, true);

@@ -128,13 +128,16 @@ fn report(m: &EmuMachine, c: &Commissioning, secs: f64) {
     }
 }
 
-/// Tolerance on a measured headline number, K: the commissioning is not
-/// converged to better than that (the polish stalls after 8 steps with a
-/// predicted decrease of tens of units of χ²). Big-pump's spread under a
-/// 1e-9 K nudge of every temperature is far above it (0.80 K with the
-/// structural freedoms and the path tie band, 0.17 K before the freedoms:
-/// `slow_commissioning_is_reproducible_at_the_last_digit_big_pump`): on
-/// another build its numbers may fall outside this tolerance.
+/// Tolerance on a measured headline number, K. The commissioning is
+/// reproducible at the last digit of the logs on one build (the θ lattice,
+/// `calibration::residuals::THETA_LATTICE_LN`), but not converged (the
+/// polish ends its 8 steps with a predicted decrease of 70–370 units of χ²
+/// on big-pump's original and nudged logs) and the optimiser's path is chaotic above the lattice: a
+/// 1e-6 K nudge of every temperature moves big-pump's headline 0.44 K,
+/// and a build whose float rounding inside the model differs takes other
+/// solver step sequences, so another path (without the lattice, a 1e-9 K
+/// nudge moved it 0.795 K). On another build these numbers may fall outside
+/// this tolerance.
 const AS_MEASURED_K: f64 = 0.15;
 
 fn near(what: &str, got: f64, measured: f64) {
@@ -147,17 +150,22 @@ fn near(what: &str, got: f64, measured: f64) {
 /// followed by low-speed holds), every structural freedom of the set fitted
 /// (the churned case film, `friction_case` with `friction_speed`,
 /// `probe_surface_*`). Measured (held-out servo, throttle mix; firmware
-/// drain vs the thermocouple, max |e| / under-prediction): big-pump 0.814 /
-/// 0.691 K and 1.590 / 1.590 K, leaky-heavy 1.065 / 1.065 K and 1.667 /
-/// 1.667 K (the set before the freedoms, on the two throttle logs: 2.25 /
+/// drain vs the thermocouple, max |e| / under-prediction): big-pump 1.902 /
+/// 1.902 K and 1.738 / 1.738 K, leaky-heavy 1.046 / 1.046 K and 1.706 /
+/// 1.706 K (the set before the freedoms, on the two throttle logs: 2.25 /
 /// 2.25 and 3.87 / 2.29 K; 3.10 / 3.10 and 2.44 / 2.44 K). Both refused:
-/// the six-state model departs from the commissioned reference on the
-/// servo log by 0.464 K (big-pump) and 1.053 K (leaky-heavy), bound 0.2 K.
-/// The misses stay asserted as measured: the structure does not close them.
+/// the six-state model departs from the commissioned reference by 0.230 K
+/// on big-pump's soak log and by 1.205 K on leaky-heavy's servo log, bound
+/// 0.2 K. The misses stay asserted as measured: the structure does not
+/// close them. These are the fits on the θ lattice
+/// (`calibration::residuals::THETA_LATTICE_LN`); before it the same code
+/// ended elsewhere on the same logs (big-pump servo 0.814 / 0.691 K, mix
+/// 1.590 / 1.590 K): the optimiser's path, not the physics, moves these
+/// numbers by 0.3–1 K (docs/commissioning.md, "Reproducibility").
 #[test]
 #[ignore = "slow tier: two commissionings on emulator bench logs (~40 s each)"]
 fn slow_commissioning_without_margin_on_foreign_machines() {
-    let measured = [(false, [(0.814, 0.691), (1.590, 1.590)]), (false, [(1.065, 1.065), (1.667, 1.667)])];
+    let measured = [(false, [(1.902, 1.902), (1.738, 1.738)]), (false, [(1.046, 1.046), (1.706, 1.706)])];
     for (m, (flash, want)) in machines().into_iter().zip(measured) {
         let s = commissioning_set(&m, 3600).expect("bench");
         let train: Vec<CalLog> = s.train.iter().map(cal).collect();
@@ -182,29 +190,39 @@ fn slow_commissioning_without_margin_on_foreign_machines() {
 /// ≤ 0.3 K under-prediction on the held-out logs with the margin counted.
 /// Measured (max |e| / under vs the thermocouple, margin counted; servo,
 /// throttle mix):
-/// - big-pump: direct path chosen (neither within 0.3 K under; the
-///   reduction under-predicts the mix by 0.65 K with its 0.94 K margin,
-///   the direct path by 0.40 K with its 1.28 K); 2.08 / 0.00 K and
-///   2.72 / 0.40 K (reduction: 1.75 / 0.00 and 1.86 / 0.65 K). Flashable.
-/// - leaky-heavy: reduction chosen, margin 1.30 K; 2.02 / 0.00 K and
-///   2.28 / 0.37 K (direct: 1.88 / 0.00 and 2.32 / 0.54 K); refused for the
-///   reduction (1.053 K off the reference on the servo log), written only
-///   with `--accept-with-margin`.
-/// - Not met: under-prediction 0.37–0.40 K on the mix, max |e| 2.0–2.7 K.
+/// - big-pump: reduction chosen (neither within 0.3 K under; the
+///   reduction's worst under-prediction 0.94 K with its 0.96 K margin, the
+///   direct path's 1.01 K with its 1.31 K);
+///   1.16 / 0.94 K and 1.95 / 0.78 K (direct: 1.52 / 0.57 and
+///   2.85 / 1.01 K); refused for the reduction (0.230 K off the reference
+///   on the soak log), written only with `--accept-with-margin`.
+/// - leaky-heavy: reduction chosen, margin 1.04 K; 1.93 / 0.01 K and
+///   2.03 / 0.67 K (direct: 2.01 / 0.00 and 2.32 / 0.61 K, within the tie
+///   band); refused for the reduction (1.205 K off the reference on the
+///   servo log), written only with `--accept-with-margin`.
+/// - Not met: under-prediction 0.67–0.94 K, max |e| 1.9–2.0 K.
+///   These are the fits on the θ lattice
+///   (`calibration::residuals::THETA_LATTICE_LN`), reproducible at the last
+///   digit; before it the same code, on another optimiser path, gave
+///   big-pump the direct path, 2.08 / 0.00 and 2.72 / 0.40 K, and
+///   leaky-heavy 2.02 / 0.00 and 2.28 / 0.37 K: the path moves these
+///   numbers by 0.3–0.9 K (a 1e-6 K nudge of the logs moves big-pump's
+///   servo under-prediction 0.44 K; docs/commissioning.md, "Reproducibility").
 ///   The set before its structural freedoms, on the two throttle logs:
 ///   margins 2.29 / 2.52 K, 2.48 / 0.00 and 6.04 / 0.02 K (big-pump),
 ///   2.75 / 0.55 and 3.47 / 0.00 K (leaky-heavy).
-/// - Cost on the throttle mix (open loop, chosen path): valve open 1413 →
-///   1518 s, LNG 2.84 → 3.01 kg (big-pump); 1547 → 1559 s, 1.99 → 2.01 kg
+/// - Cost on the throttle mix (open loop, chosen path): valve open 1404 →
+///   1445 s, LNG 2.80 → 2.87 kg (big-pump); 1547 → 1557 s, 1.95 → 1.96 kg
 ///   (leaky-heavy); the servo logs stay below 40 °C.
-/// - Time with two other helpers' jobs on the 2 cores: 77 s (big-pump,
-///   2 516 reference runs) and 64 s (leaky-heavy, 1 794). Not a timing test.
+/// - Time with other helpers' jobs on the 2 cores: 24–43 s (big-pump,
+///   2 130 reference runs in the calibration) and 25–27 s (leaky-heavy,
+///   2 060) at load ~3; 72–92 s at load 6–7. Not a timing test.
 #[test]
 #[ignore = "slow tier: two commissionings with margin validation on emulator bench logs (~1 min each)"]
 fn slow_commissioning_with_margin_on_foreign_machines() {
     let measured = [
-        (1.276, PathKind::Direct, [(2.080, 0.000), (2.725, 0.404)], [1413.0, 1518.0]),
-        (1.301, PathKind::Reduction, [(2.022, 0.000), (2.279, 0.366)], [1547.0, 1559.0]),
+        (0.961, PathKind::Reduction, [(1.164, 0.941), (1.946, 0.777)], [1404.0, 1445.0]),
+        (1.035, PathKind::Reduction, [(1.926, 0.011), (2.032, 0.671)], [1547.0, 1557.0]),
     ];
     for (m, (margin, path, want, open_s)) in machines().into_iter().zip(measured) {
         let s = commissioning_set(&m, 3600).expect("bench");
@@ -248,33 +266,27 @@ fn one_operating_point_is_refused_with_log_region_channel_and_bench_run() {
 }
 
 /// Every temperature of every log moved by 1e-9 K: the headline numbers
-/// (held-out max |e| and under-prediction of the flashed path, margin) move
-/// by at most 0.05 K. Trained as the procedure prescribes
-/// (`commissioning_set`), the structural freedoms fitted. **A miss on both
-/// machines**, asserted as the bound: big-pump 0.795 K (original: the
-/// direct path, margin 1.276 K, mix 2.73 / 0.40 K; nudged: the paths 0.91 /
-/// 0.96 K under, a tie under `paths::PATH_TIE_K`, the reduction kept, margin
-/// 0.963 K, mix 1.93 / 0.96 K; 0.509 K before the tie band, the direct path
-/// in both), leaky-heavy 0.226 K (the flashed path flips from the
-/// reduction, margin 1.301 K, mix 2.28 / 0.37 K, to the direct path, 1.164 K,
-/// 2.31 / 0.59 K; the reduction's own under-prediction 0.37 → 0.71 K, so the
-/// path choice's tie band `paths::PATH_TIE_K` cannot hold it).
-/// Why, measured (docs/commissioning.md, "Reproducibility"): the nudge
-/// changes no model output (`slow_replay_noise_at_the_last_digit`), only
-/// the optimiser's path; the replays' solver error (rtol 1e-5) leaves the
-/// objective jagged by ~10 χ² units near the optimum, where the polish
-/// stalls; polished at 1e-7 (`EXP_POLISH_RTOL=1e-7`, ~2× the time) big-pump
-/// converges on both logs but into two local minima 11.3 units apart
-/// (`film_port` 0.85 / 1.84, `cap_pump` 1.03 / 1.48, `cap_case_oil` 1.44 /
-/// 2.00, `friction_case` 0.86 / 1.23, `block_wall` 9.6 / 29.6, the case
-/// film pair along its product): 0.543 K (0.561 K at 1e-6). Leaky-heavy at
-/// 1e-7: no flip (a tie, the reduction in both) but 0.296 K, neither polish
-/// converged in its steps. A basin rule between the minima, on a polish
-/// that converges, is the missing piece. Tried and reverted: polishes from
-/// ±2 posterior σ along the optimum's weakest Hessian direction (the case
-/// film pair at a fixed product, not the gap: |cos| 0.09–0.60), polish at
-/// 1e-6 with 16 steps: big-pump 0.075 K, leaky-heavy 0.188 K, still two
-/// minima each, 94–205 s a commissioning at load ~4 (docs/commissioning.md).
+/// (held-out max |e| and under-prediction of the flashed path against the
+/// thermocouple and the true drain, margin) move by at most 0.05 K (the
+/// issue's bound). Trained as the procedure prescribes
+/// (`commissioning_set`), the structural freedoms fitted. Measured: below
+/// 1e-4 K on both machines (the printed 0.0000 K; polish objectives equal
+/// to the printed digits, the same path chosen); 43 + 24 s (big-pump) and
+/// 25 + 27 s (leaky-heavy) at load ~3 on the 2 cores, 72–92 s each at
+/// load 6–7.
+/// Why it holds: the nudge changes no model output at the same multipliers
+/// (`slow_replay_noise_at_the_last_digit`); the calibration evaluates every
+/// multiplier vector on a lattice of 1e-4 in ln θ
+/// (`calibration::residuals::THETA_LATTICE_LN`) and takes η_m from the
+/// current on it, so the last-digit differences the nudge puts into the
+/// optimiser's steps give bit-identical model runs. Without the lattice
+/// (`EXP_LATTICE_LN=0`) the adaptive replays turned them into
+/// solver-error-sized output differences and another optimiser path:
+/// big-pump 0.795 K, leaky-heavy 0.226 K. What it does not hold: the
+/// objective still has several minima and the polish does not converge; a
+/// nudge of 1e-6 K (`EXP_NUDGE_K=1e-6`) moves big-pump's headline 0.436 K
+/// (servo under-prediction 0.941 → 0.505 K), as would another build
+/// (docs/commissioning.md, "Reproducibility").
 #[test]
 #[ignore = "slow tier: two commissionings with margin validation and the direct path (~2 min)"]
 fn slow_commissioning_is_reproducible_at_the_last_digit_big_pump() {
@@ -289,10 +301,12 @@ fn slow_commissioning_is_reproducible_at_the_last_digit_leaky_heavy() {
 }
 
 fn reproducible(m: EmuMachine) {
+    // `EXP_NUDGE_K`: an experiment knob (the nudge, K; the test's is 1e-9 K).
+    let dk: f64 = std::env::var("EXP_NUDGE_K").ok().and_then(|v| v.parse().ok()).unwrap_or(1e-9);
     let nudge = |l: &BenchLog| -> BenchLog {
         let mut l = l.clone();
         for ch in Channel::TEMPERATURES.into_iter().chain([Channel::TDrainC]) {
-            let v: Vec<Option<f64>> = l.run.get(ch).expect("channel").iter().map(|x| x.map(|x| x + 1e-9)).collect();
+            let v: Vec<Option<f64>> = l.run.get(ch).expect("channel").iter().map(|x| x.map(|x| x + dk)).collect();
             l.run.set(ch, v);
         }
         l
@@ -312,8 +326,12 @@ fn reproducible(m: EmuMachine) {
             if let Some(x) = std::env::var("EXP_POLISH_RTOL").ok().and_then(|v| v.parse().ok()) {
                 o.polish_rtol = x;
             }
+            // `EXP_LATTICE_LN`: an experiment knob (the θ lattice's spacing; 0: off).
+            if let Some(x) = std::env::var("EXP_LATTICE_LN").ok().and_then(|v| v.parse().ok()) {
+                o.lattice_ln = x;
+            }
             let c = commission(&m.rig_file(), &train, &h, &o).expect("commissioning");
-            eprintln!("{}: {:.1} s, flashable {}", m.name, t0.elapsed().as_secs_f64(), c.flashable());
+            eprintln!("{}: {:.1} s, flashable {}, eta_m {:?}", m.name, t0.elapsed().as_secs_f64(), c.flashable(), c.eta_m_from_current);
             report(&m, &c, t0.elapsed().as_secs_f64());
             headline(&m, &c, hold)
         };
@@ -326,7 +344,7 @@ fn reproducible(m: EmuMachine) {
             worst = worst.max((x.0 - y.0).abs()).max((x.1 - y.1).abs());
         }
         eprintln!("{}: headline numbers moved by at most {worst:.4} K", m.name);
-        assert!(worst <= 0.05, "{}: a 1e-9 K nudge moved the headline by {worst:.3} K", m.name);
+        assert!(worst <= 0.05, "{}: a {dk:e} K nudge moved the headline by {worst:.3} K", m.name);
     }
 }
 
@@ -336,11 +354,11 @@ fn reproducible(m: EmuMachine) {
 /// on the throttle mix; the same commissioning with the churned film held
 /// (the gap law) beside it. Measured (firmware drain vs the thermocouple,
 /// max |e| / under-prediction, without the margin): churned film fitted
-/// (film ×1.11, churn ×22.5, exponent −0.13), mix 2.446 / 2.446 K, the servo
-/// log (training) 0.947 K under; gap law 3.835 / 2.342 K, servo 2.284 K
-/// under. Max |e| falls, the under-prediction does not. Not settled at
-/// the last digit: with every temperature nudged by 1e-9 K the churned fit
-/// ended at film ×0.80, churn ×33.0 and the mix at 2.682 / 2.682 K.
+/// (film ×0.51, churn ×49.4, exponent −0.13), mix 2.590 / 2.590 K, the servo
+/// log (training) 0.874 K under; gap law 3.741 / 2.548 K, servo 2.310 K
+/// under (on the θ lattice; before it, on another optimiser path, film
+/// ×1.11 / churn ×22.5, mix 2.446 / 2.446 K, servo 0.947 K; gap law 3.835 /
+/// 2.342 K, servo 2.284 K). Max |e| falls, the under-prediction does not.
 #[test]
 #[ignore = "slow tier: two commissionings on emulator bench logs (~1 min each)"]
 fn slow_churned_case_film_with_a_low_speed_training_log() {
@@ -370,9 +388,10 @@ fn slow_churned_case_film_with_a_low_speed_training_log() {
         got.push((mix.vs_measured_max_k.expect("drain"), mix.vs_measured_under_k.expect("drain"), servo.vs_measured_under_k.expect("drain")));
     }
     eprintln!("churned film / gap law: mix (max, under), servo under: {got:.3?}");
-    // The churned fit moved 0.24 K under the last-digit nudge: its numbers
+    // The churned fit's path spread (0.24 K under a 1e-9 K nudge before the
+    // θ lattice; 0.14 K between the fits before and on it): its numbers
     // within 0.3 K; the gap law's within AS_MEASURED_K.
-    let want = [(2.446, 2.446, 0.947, 0.3), (3.835, 2.342, 2.284, AS_MEASURED_K)];
+    let want = [(2.590, 2.590, 0.874, 0.3), (3.741, 2.548, 2.310, AS_MEASURED_K)];
     for (g, w) in got.iter().zip(want) {
         for (what, x, y) in [("mix max |e|", g.0, w.0), ("mix under-prediction", g.1, w.1), ("servo (training) under-prediction", g.2, w.2)] {
             assert!((x - y).abs() <= w.3, "{what}: {x:.3} K, measured {y:.3} K (±{})", w.3);

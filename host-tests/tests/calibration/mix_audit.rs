@@ -363,15 +363,19 @@ fn bisection_step(machine: &EmuMachine, switches: &[String]) -> (f64, f64, f64) 
 /// held-out drain misses: structural bisection"), measured at this commit
 /// on this build: servo under-prediction, mix max |e| and under-prediction
 /// per machine, K, without the margin. Asserted within 0.25 K of the
-/// measured: the fit's basin moves with last-digit differences between
-/// builds (0.17 K measured on big-pump's nudge test); the conclusions drawn
-/// rest on differences of ≥ 0.6 K between rows.
+/// measured: the fit's basin moves with the optimiser's path, which a build
+/// with other float rounding in the model changes (big-pump as built moved
+/// 0.59 K between the fits before and on the θ lattice, the other rows
+/// ≤ 0.19 K); the conclusions drawn rest on differences of ≥ 0.6 K between
+/// rows.
 #[test]
-#[ignore = "slow: ten commissionings, 277 s on 2 shared cores"]
+#[ignore = "slow: ten commissionings, 167–277 s on 2 shared cores"]
 fn slow_structural_bisection_of_the_drain_misses() {
     // switches, big-pump (servo under, mix max, mix under), leaky-heavy (same)
     let rows: [(&str, [f64; 3], [f64; 3]); 5] = [
-        ("", [2.287, 3.754, 2.306], [3.063, 2.443, 2.443]),
+        // big-pump as built: mix under 2.306 K before the θ lattice, 2.893 K
+        // on it (another optimiser path; the other rows moved <= 0.19 K).
+        ("", [2.327, 3.694, 2.893], [3.063, 2.443, 2.443]),
         ("gapfilm", [0.632, 1.488, 1.488], [1.762, 1.751, 1.751]),
         ("split,nofric", [2.339, 4.034, 1.722], [3.151, 1.840, 1.840]),
         ("split,nofric,onepump,surface,oilprobe,drain,flange,blocks,emiss", [2.291, 3.969, 0.469], [3.055, 1.700, 1.516]),
