@@ -100,6 +100,7 @@ impl Model {
 
     /// Oil-to-metal conductance of a duct ([`network::duct_conductance`]),
     /// W/K, the laminar Nusselt number on its grid when the grids are set.
+    #[inline]
     fn duct_conductance(&self, q_m3_per_s: f64, d: f64, len: f64, area_scale: f64, t_oil: f64, nu: f64) -> f64 {
         match &self.lam_grid {
             Some(g) => network::duct_conductance_with(&self.rig, q_m3_per_s, d, len, area_scale, t_oil, nu, |x| g.nu(x)),
@@ -170,6 +171,16 @@ impl Model {
             Drive::Mission(m) => m.ambient_c.at(t),
             Drive::Replay(r) => r.op(&self.rig, t).ambient_c,
         }
+    }
+
+    /// The operating point at (t, y) ([`Model::op_point`]) and the losses
+    /// there at the node temperatures of `y` ([`Model::losses`]), W, with
+    /// the pump friction taken once (the losses took it again: the same
+    /// call on the same arguments, so the same values to the last bit).
+    pub fn op_point_losses(&self, t: f64, y: &[f64]) -> (hydraulics::OpPoint, Losses) {
+        let (op, friction) = self.op_point_parts(t, y);
+        let l = self.loss_parts(t, &op, &y[T0..T0 + N_NODES], friction).0;
+        (op, l)
     }
 
     /// Full right-hand side dy/dt = f(t, y).
