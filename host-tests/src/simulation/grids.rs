@@ -172,10 +172,12 @@ impl OuterGrid {
 /// Spacing of the viscosity's grid in units of the outer surfaces' one.
 pub const NU_GRID_FACTOR: f64 = 10.0;
 
-/// Cells kept by [`NuGrid`]: a 1024-step span (1024 K at 1 K), wider than
+/// Cells kept by [`NuGrid`]: a 256-step span (256 K at 1 K), wider than
 /// the spread of the oil nodes' temperatures, so two nodes never take
-/// turns at one slot.
-const NU_SLOTS: usize = 1024;
+/// turns at one slot. (A slot holds what its cell's points give, so the
+/// count moves the cost only, never a value: 1024 slots cost ~6 k
+/// instructions more a run to allocate and empty.)
+const NU_SLOTS: usize = 256;
 
 /// A memo slot of [`NuGrid`]: (cell index k, cubic coefficients in u = x − k).
 type NuCell = Cell<(i64, [f64; 4])>;
@@ -256,8 +258,10 @@ const _: () = assert!(NU_SLOTS.is_power_of_two(), "slots are indexed by a mask")
 /// Low bits of X's representation dropped for the laminar grid's index:
 /// 16 cells a binade (X's relative spacing 1/32–1/16).
 const LAM_SHIFT: u32 = 52 - 4;
-/// Cells and points kept by [`LaminarGrid`] (direct-mapped by index).
-const LAM_SLOTS: usize = 1024;
+/// Cells and points kept by [`LaminarGrid`] (direct-mapped by index): 32
+/// binades of X, wider than the 24 from 0.1 to 1e6. (The count moves the
+/// cost only, never a value: 1024 slots cost ~4 k instructions more a run.)
+const LAM_SLOTS: usize = 512;
 /// Below this X the laminar law is evaluated exactly (at X ≤ 0.081 it is
 /// its constant, the developing-flow term gone).
 const LAM_EXACT_BELOW: f64 = 0.1;
