@@ -71,13 +71,32 @@ pub struct Model {
     /// The pump gaps' conductance times viscosity (eqs. 5–7 are ∝ 1/μ),
     /// m³·Pa⁻¹·s⁻¹·Pa·s, taken once with the grids (the fast plant's).
     leak_geom: Option<f64>,
+    /// The motor's iron loss (eq. 2, a `powf`) at the last shaft speed it
+    /// was taken for: (ω's bits, W) ([`Model::iron_w`]).
+    iron_memo: Cell<(u64, f64)>,
 }
 
 impl Model {
     /// Build a model.
     pub fn new(rig: Rig, drive: Drive) -> Self {
         let contents = network::contents(&rig);
-        Self { rig, drive, lng_open: Cell::new(false), contents, outer_grid: None, nu_grid: None, lam_grid: None, leak_geom: None }
+        let iron_memo = Cell::new((0f64.to_bits(), rig.motor.iron.power_w(0.0)));
+        Self { rig, drive, lng_open: Cell::new(false), contents, outer_grid: None, nu_grid: None, lam_grid: None, leak_geom: None, iron_memo }
+    }
+
+    /// The motor's iron loss at shaft speed `omega` (eq. 2,
+    /// [`crate::losses::IronLoss::power_w`]), W: the value computed for the
+    /// same bits of ω when they repeat (a machine at a steady speed), so the
+    /// same to the last bit. (A `powf` in every heat balance and snapshot:
+    /// ~20 k instructions of a fast Case 1 run.)
+    pub fn iron_w(&self, omega: f64) -> f64 {
+        let (bits, w) = self.iron_memo.get();
+        if bits == omega.to_bits() {
+            return w;
+        }
+        let w = self.rig.motor.iron.power_w(omega);
+        self.iron_memo.set((omega.to_bits(), w));
+        w
     }
 
     /// Interpolate the outer surfaces' heat flows on a grid of `step_k`
