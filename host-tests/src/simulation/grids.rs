@@ -324,7 +324,27 @@ impl LaminarGrid {
     }
 
     /// The laminar Nusselt number at X = Re·Pr·d/L, interpolated.
+    ///
+    /// The kept cell's path only, the rest out of line (`nu_other`), as
+    /// in [`NuGrid::nu`].
+    #[inline]
     pub fn nu(&self, x: f64) -> f64 {
+        if (LAM_EXACT_BELOW..1e300).contains(&x) {
+            let k = x.to_bits() >> LAM_SHIFT;
+            let (kk, a, tm, x0, inv_w) = self.cells[(k as usize) & (LAM_SLOTS - 1)].get();
+            if kk == k {
+                let t = (x - x0) * inv_w;
+                return a[0] + t * (a[1] + (t - 1.0) * (a[2] + (t - tm) * a[3]));
+            }
+        }
+        self.nu_other(x)
+    }
+
+    /// [`LaminarGrid::nu`] beyond the kept cells: exact outside the grid's
+    /// range, a new cell.
+    #[cold]
+    #[inline(never)]
+    fn nu_other(&self, x: f64) -> f64 {
         if !(LAM_EXACT_BELOW..1e300).contains(&x) {
             return nu_laminar_x(x);
         }
