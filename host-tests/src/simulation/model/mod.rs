@@ -135,6 +135,9 @@ impl Model {
     }
 
     /// Kinematic viscosity of the oil at `t_oil` (its Walther line), m²/s.
+    /// (Inlined: ~1 700 calls a fast Case 1 run, each a kept cell of the
+    /// grid of ~20 instructions, which the call itself doubled.)
+    #[inline]
     pub fn nu(&self, t_oil: f64) -> f64 {
         match &self.nu_grid {
             Some(g) => g.nu(&self.rig.oil, t_oil),
