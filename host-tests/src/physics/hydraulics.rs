@@ -190,6 +190,7 @@ pub fn shaft_torque(rig: &Rig, op: &OpPoint, friction_w: f64) -> f64 {
 /// Speed command of the drive, rad/s: the mission's speed in Case 1; in
 /// Case 2 the position loop ω = (A·ẋ_ref + A·K_p·(x_ref − x))/D; both through
 /// the smooth [`speed_limit`].
+#[inline]
 pub fn speed_command(rig: &Rig, m: &Mission, t: f64, x: f64) -> f64 {
     let wmax = rig.motor.max_speed_rpm * 2.0 * PI / 60.0;
     let raw = match m.circuit {
@@ -206,6 +207,7 @@ pub fn speed_command(rig: &Rig, m: &Mission, t: f64, x: f64) -> f64 {
 /// Smooth speed limit: the identity up to 80 % of `wmax` (no nominal
 /// operating point is touched), then a tanh knee that tends to `wmax`;
 /// continuous with its first derivative, odd in `raw`, rad/s.
+#[inline]
 pub fn speed_limit(raw: f64, wmax: f64) -> f64 {
     let knee = 0.8 * wmax;
     let a = raw.abs();

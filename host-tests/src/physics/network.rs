@@ -142,6 +142,7 @@ pub fn duct_conductance(rig: &Rig, q_m3_per_s: f64, d: f64, len: f64, area_scale
 /// [`duct_conductance`] with the laminar Nusselt number of X = Re·Pr·d/L
 /// given ([`heat::nu_tube_with`]).
 #[allow(clippy::too_many_arguments)] // duct_conductance's arguments and the laminar law
+#[inline]
 pub fn duct_conductance_with(rig: &Rig, q_m3_per_s: f64, d: f64, len: f64, area_scale: f64, t_oil: f64, nu: f64, laminar: impl Fn(f64) -> f64) -> f64 {
     let re = heat::reynolds(q_m3_per_s, d, nu);
     let pr = rig.oil.prandtl(t_oil, nu);

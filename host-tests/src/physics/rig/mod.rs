@@ -216,6 +216,31 @@ impl Rig {
         Self::from_toml_str(&text, &path.display().to_string())
     }
 
+    /// A copy of the rig's physics without its list of uncertain parameters
+    /// ([`Rig::uncertain`]: the ranges `eha-sim uq` samples, read by no
+    /// model equation), what a simulation's model keeps. The list's names,
+    /// keys and sources are most of a clone's allocations: a plant built by
+    /// a full clone spent ~30 k instructions on it and its release (1.4 %
+    /// of a fast Case 1 run, `docs/reference-speed.md` section 3).
+    pub fn physics_clone(&self) -> Self {
+        let Rig { oil, motor, pump, blocks, hydraulics, actuator, outside, joints, lng, nuisance, probes, ext, uncertain: _ } = self;
+        Rig {
+            oil: oil.clone(),
+            motor: motor.clone(),
+            pump: pump.clone(),
+            blocks: blocks.clone(),
+            hydraulics: hydraulics.clone(),
+            actuator: actuator.clone(),
+            outside: outside.clone(),
+            joints: joints.clone(),
+            lng: lng.clone(),
+            nuisance: nuisance.clone(),
+            probes: probes.clone(),
+            ext: ext.clone(),
+            uncertain: Vec::new(),
+        }
+    }
+
     /// The rig as TOML text.
     pub fn to_toml(&self) -> String {
         toml::to_string_pretty(self).unwrap_or_default()

@@ -178,7 +178,7 @@ impl Model {
                 rig.ext.winding_resistance_temperature,
                 tc(Node::Winding),
             ),
-            iron: rig.motor.iron.power_w(op.omega),
+            iron: self.iron_w(op.omega),
             bearing: rig.motor.bearing_friction_nm.map_or(0.0, |m| losses::bearing_w(m, op.omega)),
             leakage: f.leak_a * (op.p_a - op.p_case) + f.leak_b * (op.p_b - op.p_case),
             mechanical: fr.total_w(),

@@ -71,13 +71,32 @@ pub struct Model {
     /// The pump gaps' conductance times viscosity (eqs. 5–7 are ∝ 1/μ),
     /// m³·Pa⁻¹·s⁻¹·Pa·s, taken once with the grids (the fast plant's).
     leak_geom: Option<f64>,
+    /// The motor's iron loss (eq. 2, a `powf`) at the last shaft speed it
+    /// was taken for: (ω's bits, W) ([`Model::iron_w`]).
+    iron_memo: Cell<(u64, f64)>,
 }
 
 impl Model {
     /// Build a model.
     pub fn new(rig: Rig, drive: Drive) -> Self {
         let contents = network::contents(&rig);
-        Self { rig, drive, lng_open: Cell::new(false), contents, outer_grid: None, nu_grid: None, lam_grid: None, leak_geom: None }
+        let iron_memo = Cell::new((0f64.to_bits(), rig.motor.iron.power_w(0.0)));
+        Self { rig, drive, lng_open: Cell::new(false), contents, outer_grid: None, nu_grid: None, lam_grid: None, leak_geom: None, iron_memo }
+    }
+
+    /// The motor's iron loss at shaft speed `omega` (eq. 2,
+    /// [`crate::losses::IronLoss::power_w`]), W: the value computed for the
+    /// same bits of ω when they repeat (a machine at a steady speed), so the
+    /// same to the last bit. (A `powf` in every heat balance and snapshot:
+    /// ~20 k instructions of a fast Case 1 run.)
+    pub fn iron_w(&self, omega: f64) -> f64 {
+        let (bits, w) = self.iron_memo.get();
+        if bits == omega.to_bits() {
+            return w;
+        }
+        let w = self.rig.motor.iron.power_w(omega);
+        self.iron_memo.set((omega.to_bits(), w));
+        w
     }
 
     /// Interpolate the outer surfaces' heat flows on a grid of `step_k`
@@ -100,6 +119,7 @@ impl Model {
 
     /// Oil-to-metal conductance of a duct ([`network::duct_conductance`]),
     /// W/K, the laminar Nusselt number on its grid when the grids are set.
+    #[inline]
     fn duct_conductance(&self, q_m3_per_s: f64, d: f64, len: f64, area_scale: f64, t_oil: f64, nu: f64) -> f64 {
         match &self.lam_grid {
             Some(g) => network::duct_conductance_with(&self.rig, q_m3_per_s, d, len, area_scale, t_oil, nu, |x| g.nu(x)),
@@ -115,6 +135,9 @@ impl Model {
     }
 
     /// Kinematic viscosity of the oil at `t_oil` (its Walther line), m²/s.
+    /// (Inlined: ~1 700 calls a fast Case 1 run, each a kept cell of the
+    /// grid of ~20 instructions, which the call itself doubled.)
+    #[inline]
     pub fn nu(&self, t_oil: f64) -> f64 {
         match &self.nu_grid {
             Some(g) => g.nu(&self.rig.oil, t_oil),
@@ -170,6 +193,16 @@ impl Model {
             Drive::Mission(m) => m.ambient_c.at(t),
             Drive::Replay(r) => r.op(&self.rig, t).ambient_c,
         }
+    }
+
+    /// The operating point at (t, y) ([`Model::op_point`]) and the losses
+    /// there at the node temperatures of `y` ([`Model::losses`]), W, with
+    /// the pump friction taken once (the losses took it again: the same
+    /// call on the same arguments, so the same values to the last bit).
+    pub fn op_point_losses(&self, t: f64, y: &[f64]) -> (hydraulics::OpPoint, Losses) {
+        let (op, friction) = self.op_point_parts(t, y);
+        let l = self.loss_parts(t, &op, &y[T0..T0 + N_NODES], friction).0;
+        (op, l)
     }
 
     /// Full right-hand side dy/dt = f(t, y).

@@ -275,7 +275,8 @@ pub(crate) fn model_for(rig: &Rig, scenario: &Scenario) -> Result<(Model, f64), 
         }
         other => Drive::Mission(other.mission().ok_or_else(|| SimError::Scenario("no mission".into()))?),
     };
-    let model = Model::new(rig.clone(), drive);
+    // The model keeps the rig's physics, not its `uq` ranges (`Rig::physics_clone`).
+    let model = Model::new(rig.physics_clone(), drive);
     let t = match &model.drive {
         Drive::Replay(r) => r.inputs().time_s.first().copied().unwrap_or(0.0),
         Drive::Mission(_) => 0.0,

@@ -161,10 +161,9 @@ pub fn snapshot(model: &Model, t: f64, y: &[f64], y0: &[f64]) -> Snapshot {
 /// [`snapshot`] with the stored energy given, J (a plant that keeps its
 /// initial node energies: [`Model::stored_energy_from`]).
 pub fn snapshot_stored(model: &Model, t: f64, y: &[f64], stored_j: f64) -> Snapshot {
-    let op = model.op_point(t, y);
+    let (op, losses) = model.op_point_losses(t, y);
     let mut temps = [0.0; N_NODES];
     temps.copy_from_slice(&y[T0..T0 + N_NODES]);
-    let losses = model.losses(t, &op, &temps);
     Snapshot {
         t,
         op,
