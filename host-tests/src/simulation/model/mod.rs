@@ -209,9 +209,9 @@ impl Model {
     pub fn rhs(&self, t: f64, y: &[f64], dy: &mut [f64]) {
         let (op, friction) = self.op_point_parts(t, y);
         let temps = &y[T0..T0 + N_NODES];
-        let (l, fh, f) = self.loss_parts(t, &op, temps, friction);
+        let (l, fh, f, line_dp) = self.loss_parts(t, &op, temps, friction);
         self.hydraulic_rhs_at(t, y, &op, dy);
-        let (q_in, q_amb, q_lng) = self.thermal_with(&op, &l, &fh, &f, temps, &mut dy[T0..T0 + N_NODES]);
+        let (q_in, q_amb, q_lng) = self.thermal_with(&op, &l, &fh, &f, line_dp, temps, &mut dy[T0..T0 + N_NODES]);
         dy[E_LOSS] = q_in;
         dy[E_AMB] = q_amb;
         dy[E_LNG] = q_lng;
@@ -223,8 +223,8 @@ impl Model {
     pub fn thermal_rhs(&self, t: f64, y: &[f64], dy: &mut [f64]) {
         let (op, friction) = self.op_point_parts(t, y);
         let temps = &y[T0..T0 + N_NODES];
-        let (l, fh, f) = self.loss_parts(t, &op, temps, friction);
-        let (q_in, q_amb, q_lng) = self.thermal_with(&op, &l, &fh, &f, temps, &mut dy[T0..T0 + N_NODES]);
+        let (l, fh, f, line_dp) = self.loss_parts(t, &op, temps, friction);
+        let (q_in, q_amb, q_lng) = self.thermal_with(&op, &l, &fh, &f, line_dp, temps, &mut dy[T0..T0 + N_NODES]);
         dy[E_LOSS] = q_in;
         dy[E_AMB] = q_amb;
         dy[E_LNG] = q_lng;
