@@ -158,7 +158,7 @@ impl Model {
         let mut line_dp = None;
         let (line, needle) = match (&self.drive, op.circuit) {
             (Drive::Mission(m), Circuit::Throttle) => {
-                let nk = hydraulics::needle_k(rig, m.needle_bar.at(t));
+                let nk = self.needle(m.needle_bar.at(t)).0;
                 let (l, n) = self.path_dp(op.q_path, tc(Node::BallOil), nk);
                 line_dp = op.q_path.is_sign_positive().then_some(l);
                 (l * op.q_path, n * op.q_path)

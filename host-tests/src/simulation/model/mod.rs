@@ -74,6 +74,11 @@ pub struct Model {
     /// The motor's iron loss (eq. 2, a `powf`) at the last shaft speed it
     /// was taken for: (ω's bits, W) ([`Model::iron_w`]).
     iron_memo: Cell<(u64, f64)>,
+    /// The throttle path's constants (π·d⁴, 2·a²), taken once.
+    path_geom: hydraulics::PathGeom,
+    /// The needle valve at the last setting it was taken for: (the
+    /// setting's bits in bar, k, 1/k²) ([`Model::needle`]).
+    needle_memo: Cell<(u64, Option<f64>, f64)>,
 }
 
 impl Model {
@@ -81,7 +86,26 @@ impl Model {
     pub fn new(rig: Rig, drive: Drive) -> Self {
         let contents = network::contents(&rig);
         let iron_memo = Cell::new((0f64.to_bits(), rig.motor.iron.power_w(0.0)));
-        Self { rig, drive, lng_open: Cell::new(false), contents, outer_grid: None, nu_grid: None, lam_grid: None, leak_geom: None, iron_memo }
+        let path_geom = hydraulics::PathGeom::new(&rig);
+        let k0 = hydraulics::needle_k(&rig, 0.0);
+        let needle_memo = Cell::new((0f64.to_bits(), k0, hydraulics::needle_inv_k2(k0)));
+        Self { rig, drive, lng_open: Cell::new(false), contents, outer_grid: None, nu_grid: None, lam_grid: None, leak_geom: None, iron_memo, path_geom, needle_memo }
+    }
+
+    /// The needle valve at setting `bar` ([`hydraulics::needle_k`]: its k,
+    /// and 1/k² of [`hydraulics::needle_inv_k2`]), the values computed for
+    /// the same bits of the setting when they repeat (a square root and
+    /// three divisions in every hydraulic evaluation otherwise).
+    #[inline]
+    fn needle(&self, bar: f64) -> (Option<f64>, f64) {
+        let (bits, k, inv) = self.needle_memo.get();
+        if bits == bar.to_bits() {
+            return (k, inv);
+        }
+        let k = hydraulics::needle_k(&self.rig, bar);
+        let inv = hydraulics::needle_inv_k2(k);
+        self.needle_memo.set((bar.to_bits(), k, inv));
+        (k, inv)
     }
 
     /// The motor's iron loss at shaft speed `omega` (eq. 2,
