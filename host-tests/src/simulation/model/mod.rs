@@ -79,6 +79,9 @@ pub struct Model {
     /// The needle valve at the last setting it was taken for: (the
     /// setting's bits in bar, k, 1/k²) ([`Model::needle`]).
     needle_memo: Cell<(u64, Option<f64>, f64)>,
+    /// The dynamic viscosity at the last temperature it was taken for:
+    /// (the temperature's bits, Pa·s) ([`Model::mu`]; NaN's bits: none).
+    mu_memo: Cell<(u64, f64)>,
 }
 
 impl Model {
@@ -89,7 +92,7 @@ impl Model {
         let path_geom = hydraulics::PathGeom::new(&rig);
         let k0 = hydraulics::needle_k(&rig, 0.0);
         let needle_memo = Cell::new((0f64.to_bits(), k0, hydraulics::needle_inv_k2(k0)));
-        Self { rig, drive, lng_open: Cell::new(false), contents, outer_grid: None, nu_grid: None, lam_grid: None, leak_geom: None, iron_memo, path_geom, needle_memo }
+        Self { rig, drive, lng_open: Cell::new(false), contents, outer_grid: None, nu_grid: None, lam_grid: None, leak_geom: None, iron_memo, path_geom, needle_memo, mu_memo: Cell::new((f64::NAN.to_bits(), f64::NAN)) }
     }
 
     /// The needle valve at setting `bar` ([`hydraulics::needle_k`]: its k,
@@ -132,6 +135,8 @@ impl Model {
         let step = step_k.filter(|&s| s > 0.0 && s.is_finite());
         self.outer_grid = step.map(OuterGrid::new);
         self.nu_grid = step.map(|s| NuGrid::new(s * NU_GRID_FACTOR));
+        // ν moves from the exact line to the grid (or back): μ anew.
+        self.mu_memo.set((f64::NAN.to_bits(), f64::NAN));
         self.lam_grid = step.map(|_| LaminarGrid::new());
         self.leak_geom = step.map(|_| self.rig.pump.gaps.conductance(1.0));
     }
@@ -171,8 +176,18 @@ impl Model {
 
     /// Dynamic viscosity of the oil at `t_oil` and 0 bar, Pa·s (ν·ρ, as
     /// [`crate::fluid::Oil::mu_pa_s`]).
+    ///
+    /// The value computed for the same bits of `t_oil` when they repeat (a
+    /// heat balance asks for the case oil's twice: the pump friction and
+    /// the leakage conductance), so the same to the last bit.
     pub fn mu(&self, t_oil: f64) -> f64 {
-        self.nu(t_oil) * self.rig.oil.rho(t_oil, 0.0)
+        let (bits, mu) = self.mu_memo.get();
+        if bits == t_oil.to_bits() {
+            return mu;
+        }
+        let mu = self.nu(t_oil) * self.rig.oil.rho(t_oil, 0.0);
+        self.mu_memo.set((t_oil.to_bits(), mu));
+        mu
     }
 
     /// Pump leakage conductance of eqs. (5)–(7) at the case-oil temperature
