@@ -208,7 +208,7 @@ pub fn simulate(rig: &Rig, scenario: &Scenario, opt: &SimOptions) -> Result<SimO
 pub fn simulate_rtol(rig: &Rig, scenario: &Scenario, opt: &SimOptions, rtol: f64) -> Result<SimOutput, SimError> {
     let mut plant = Plant::new(rig, scenario)?;
     plant.set_rtol(rtol);
-    run_plant(&mut plant, scenario, opt)
+    run_plant(plant, scenario, opt)
 }
 
 /// [`simulate`] on the multirate fast path ([`crate::fast`]) with its
@@ -221,10 +221,7 @@ pub fn simulate_fast(rig: &Rig, scenario: &Scenario, opt: &SimOptions) -> Result
 
 /// [`simulate_fast`] with explicit accuracy settings.
 pub fn simulate_fast_with(rig: &Rig, scenario: &Scenario, opt: &SimOptions, fo: FastOptions) -> Result<SimOutput, SimError> {
-    // Run in place (a plant is kilobytes: moved into the run it was a
-    // `memcpy` of its own).
-    let mut plant = FastPlant::with_options(rig, scenario, fo)?;
-    run_plant(&mut plant, scenario, opt)
+    run_plant(FastPlant::with_options(rig, scenario, fo)?, scenario, opt)
 }
 
 /// Which integrator runs the reference model.
@@ -265,7 +262,7 @@ pub fn simulate_budget(rig: &Rig, scenario: &Scenario, opt: &SimOptions, rtol: f
     plant.set_replay_tolerances(true);
     plant.set_rtol(rtol);
     plant.set_step_limit(step_limit);
-    run_plant(&mut plant, scenario, opt)
+    run_plant(plant, scenario, opt)
 }
 
 /// What [`run_plant`] needs of an integrator: the BDF [`Plant`] and the
@@ -307,7 +304,7 @@ impl Runner for FastPlant {
     }
 }
 
-fn run_plant(plant: &mut impl Runner, scenario: &Scenario, opt: &SimOptions) -> Result<SimOutput, SimError> {
+fn run_plant(mut plant: impl Runner, scenario: &Scenario, opt: &SimOptions) -> Result<SimOutput, SimError> {
     let name = match scenario.mission() {
         Some(m) => m.name,
         None => match scenario {

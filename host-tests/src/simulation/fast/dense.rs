@@ -32,27 +32,21 @@ pub fn mul<const N: usize>(a: &Mat<N>, b: &Mat<N>) -> Mat<N> {
     {
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU supports AVX2, checked just above.
-            // (The product into the caller's matrix: returned by value
-            // from the AVX2 function it was copied out through `memcpy`.)
-            let mut c = zeros();
-            unsafe { mul_avx2(a, b, &mut c) };
-            return c;
+            return unsafe { mul_avx2(a, b) };
         }
     }
-    let mut c = zeros();
-    mul_add_portable(a, b, &mut c);
-    c
+    mul_portable(a, b)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn mul_avx2<const N: usize>(a: &Mat<N>, b: &Mat<N>, c: &mut Mat<N>) {
-    mul_add_portable(a, b, c)
+fn mul_avx2<const N: usize>(a: &Mat<N>, b: &Mat<N>) -> Mat<N> {
+    mul_portable(a, b)
 }
 
-/// c += a·b, the products summed in the order of k.
 #[inline(always)]
-fn mul_add_portable<const N: usize>(a: &Mat<N>, b: &Mat<N>, c: &mut Mat<N>) {
+fn mul_portable<const N: usize>(a: &Mat<N>, b: &Mat<N>) -> Mat<N> {
+    let mut c = zeros();
     for (ci, ai) in c.iter_mut().zip(a) {
         for (aik, bk) in ai.iter().zip(b) {
             for (cij, bkj) in ci.iter_mut().zip(bk) {
@@ -60,6 +54,7 @@ fn mul_add_portable<const N: usize>(a: &Mat<N>, b: &Mat<N>, c: &mut Mat<N>) {
             }
         }
     }
+    c
 }
 
 /// The product a·x.
