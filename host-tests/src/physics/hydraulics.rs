@@ -129,10 +129,45 @@ pub fn path_flow(rig: &Rig, dp: f64, t_oil: f64, needle: Option<f64>) -> f64 {
 /// [`path_flow`] with the oil's density `rho` (kg/m³) and kinematic
 /// viscosity `nu` (m²/s) given instead of its temperature, m³/s.
 pub fn path_flow_props(rig: &Rig, dp: f64, rho: f64, nu: f64, needle: Option<f64>) -> f64 {
-    let line = &rig.hydraulics.path;
-    let a = line.area_m2();
-    let r1 = 128.0 * nu * rho * line.length_m / (PI * line.diameter_m.powi(4));
-    let r2 = rho * line.local_loss_coeff / (2.0 * a * a) + needle.map_or(0.0, |k| 1.0 / (k * k));
+    path_flow_geom(&PathGeom::new(rig), dp, rho, nu, needle_inv_k2(needle))
+}
+
+/// The needle orifice's term 1/k² of the throttle path's quadratic
+/// resistance (`needle`: its k from [`needle_k`], None: no orifice, 0),
+/// Pa·s²/m⁶.
+pub fn needle_inv_k2(needle: Option<f64>) -> f64 {
+    needle.map_or(0.0, |k| 1.0 / (k * k))
+}
+
+/// The throttle path's rig constants of [`path_flow_props`] (the line's
+/// length m, its local loss coefficient Σξ, π·d⁴ m⁴ and 2·a² m⁴), taken
+/// once by a model rather than in every hydraulic evaluation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PathGeom {
+    /// Line length, m.
+    pub length_m: f64,
+    /// Local loss coefficient Σξ.
+    pub loss_coeff: f64,
+    /// π·d⁴, m⁴.
+    pub pi_d4: f64,
+    /// 2·a² (a the line's cross-section), m⁴.
+    pub two_a2: f64,
+}
+
+impl PathGeom {
+    /// The constants of `rig`'s throttle path.
+    pub fn new(rig: &Rig) -> Self {
+        let line = &rig.hydraulics.path;
+        let a = line.area_m2();
+        Self { length_m: line.length_m, loss_coeff: line.local_loss_coeff, pi_d4: PI * line.diameter_m.powi(4), two_a2: 2.0 * a * a }
+    }
+}
+
+/// [`path_flow_props`] with the path's constants `g` and the needle's
+/// 1/k² ([`needle_inv_k2`]) given: the same operations, m³/s.
+pub fn path_flow_geom(g: &PathGeom, dp: f64, rho: f64, nu: f64, inv_k2: f64) -> f64 {
+    let r1 = 128.0 * nu * rho * g.length_m / g.pi_d4;
+    let r2 = rho * g.loss_coeff / g.two_a2 + inv_k2;
     let m = dp.abs();
     dp.signum() * 2.0 * m / (r1 + (r1 * r1 + 4.0 * r2 * m).sqrt())
 }

@@ -37,6 +37,13 @@ impl Schedule {
         if t <= first.0 {
             return first.1;
         }
+        // At or past the last point (every t of a constant schedule): what
+        // the search below gives there, without it.
+        if let Some(last) = pts.last() {
+            if t >= last.0 {
+                return last.1;
+            }
+        }
         // Last point with time <= t.
         let idx = pts.partition_point(|p| p.0 <= t);
         match (pts.get(idx.wrapping_sub(1)), pts.get(idx)) {

@@ -139,7 +139,8 @@ impl HydTrack {
         let Some(&(mut tt, mut y, mut f)) = self.pts.last() else { return Ok(()) };
         let t_left = left_of(t_max);
         let t_stop = if self.coupled { t.min(t_max) } else { t_max };
-        let path = self.path;
+        // (Borrowed: a copy of the path was a `memcpy` in every call.)
+        let path = &self.path;
         let mut fun = |t: f64, y: &[f64; NH], d: &mut [f64; NH]| model.hydraulic_rhs_oil(t.min(t_left), y, &path.oil_at(t), d);
         while tt < t - 1e-12 * t.abs().max(1.0) && tt < t_stop {
             tt = self.ros.step(&mut fun, tt, &mut y, &mut f, t_stop)?;

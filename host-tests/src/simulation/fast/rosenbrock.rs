@@ -274,30 +274,27 @@ impl<const N: usize> Rosenbrock<N> {
             // but a stiff steady state (a check valve holding a line at
             // the accumulator pressure) drifts under much longer steps
             // with an old one (measured: 0.01 bar in Case 1).
-            let jac = match self.jac {
-                Some((j, age, hj)) if age < self.jac_max_age && h <= 4.0 * hj && hj <= 4.0 * h => j,
-                _ => {
-                    let j = jacobian(f, t, y, f0, &self.scale, &mut self.stats);
-                    self.jac = Some((j, 0, h));
-                    self.lu = None;
-                    j
-                }
-            };
-            let lu = match self.lu {
-                Some((lu, hl)) if (h - hl).abs() <= 1e-12 * hl => lu,
-                _ => {
-                    let mut g = jac;
-                    for (i, row) in g.iter_mut().enumerate() {
-                        for x in row.iter_mut() {
-                            *x = -*x;
-                        }
-                        row[i] += 1.0 / (tab.gamma[0] * h);
+            // (Borrowed where kept, not copied: a step reads them only.)
+            let kept = matches!(self.jac, Some((_, age, hj)) if age < self.jac_max_age && h <= 4.0 * hj && hj <= 4.0 * h);
+            if !kept {
+                let j = jacobian(f, t, y, f0, &self.scale, &mut self.stats);
+                self.jac = Some((j, 0, h));
+                self.lu = None;
+            }
+            let lu_kept = matches!(self.lu, Some((_, hl)) if (h - hl).abs() <= 1e-12 * hl);
+            if !lu_kept {
+                let Some((jac, _, _)) = &self.jac else { unreachable!("a Jacobian was just taken") };
+                let mut g = *jac;
+                for (i, row) in g.iter_mut().enumerate() {
+                    for x in row.iter_mut() {
+                        *x = -*x;
                     }
-                    let lu = Lu::new(g).ok_or(RosError::Singular(t))?;
-                    self.lu = Some((lu, h));
-                    lu
+                    row[i] += 1.0 / (tab.gamma[0] * h);
                 }
-            };
+                let lu = Lu::new(g).ok_or(RosError::Singular(t))?;
+                self.lu = Some((lu, h));
+            }
+            let Some((lu, _)) = &self.lu else { unreachable!("an LU was just built") };
             let mut k = [[0.0; N]; S_MAX];
             let mut fs = *f0;
             for s in 0..tab.s {

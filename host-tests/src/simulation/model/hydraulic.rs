@@ -97,9 +97,9 @@ impl Model {
                     op.air_mps = m.air_speed_mps.at(t) + self.rig.ext.forced_convection.unwrap_or(0.0);
                 }
                 if m.circuit == Circuit::Throttle {
-                    let needle = hydraulics::needle_k(&self.rig, m.needle_bar.at(t));
+                    let (_, inv_k2) = self.needle(m.needle_bar.at(t));
                     let (rho, nu) = ball();
-                    op.q_path = hydraulics::path_flow_props(&self.rig, op.p_a - op.p_b, rho, nu, needle);
+                    op.q_path = hydraulics::path_flow_geom(&self.path_geom, op.p_a - op.p_b, rho, nu, inv_k2);
                 }
                 op
             }

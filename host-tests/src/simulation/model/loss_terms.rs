@@ -144,22 +144,28 @@ impl Model {
     /// losses and once for the balances: the same calls on the same
     /// arguments, so the same values to the last bit). `friction`: the
     /// pump friction at `op` and the case oil of `temps` if already taken
-    /// ([`Model::op_point_parts`]).
-    pub(super) fn loss_parts(&self, t: f64, op: &OpPoint, temps: &[f64], friction: Option<losses::PumpFriction>) -> (Losses, FrictionHeat, hydraulics::Flows) {
+    /// ([`Model::op_point_parts`]). The fourth part: the throttle path's
+    /// line pressure drop at |q_path| (Pa) when it was taken here (the
+    /// flow's sign bit clear, so the same call as the balances' on the same
+    /// argument bits), for [`Model::thermal_with`].
+    pub(super) fn loss_parts(&self, t: f64, op: &OpPoint, temps: &[f64], friction: Option<losses::PumpFriction>) -> (Losses, FrictionHeat, hydraulics::Flows, Option<f64>) {
         let rig = &self.rig;
         let tc = |n: Node| temps[n as usize];
         let f = hydraulics::flows(rig, op, self.k_leak(tc(Node::Case)));
         let fr = friction.unwrap_or_else(|| self.pump_friction(op, tc(Node::Case)));
         let fh = self.friction_heat_of(&fr);
         let dp = op.p_a - op.p_b;
+        let mut line_dp = None;
         let (line, needle) = match (&self.drive, op.circuit) {
             (Drive::Mission(m), Circuit::Throttle) => {
-                let nk = hydraulics::needle_k(rig, m.needle_bar.at(t));
+                let nk = self.needle(m.needle_bar.at(t)).0;
                 let (l, n) = self.path_dp(op.q_path, tc(Node::BallOil), nk);
+                line_dp = op.q_path.is_sign_positive().then_some(l);
                 (l * op.q_path, n * op.q_path)
             }
             (Drive::Replay(_), Circuit::Throttle) => {
                 let (l, _) = self.path_dp(op.q_path, tc(Node::BallOil), None);
+                line_dp = op.q_path.is_sign_positive().then_some(l);
                 let line = l * op.q_path;
                 (line, losses::throttle_w(dp, op.q_path) - line)
             }
@@ -193,6 +199,6 @@ impl Model {
                 Circuit::Throttle => 0.0,
             },
         };
-        (l, fh, f)
+        (l, fh, f, line_dp)
     }
 }

@@ -74,6 +74,14 @@ pub struct Model {
     /// The motor's iron loss (eq. 2, a `powf`) at the last shaft speed it
     /// was taken for: (ω's bits, W) ([`Model::iron_w`]).
     iron_memo: Cell<(u64, f64)>,
+    /// The throttle path's constants (π·d⁴, 2·a²), taken once.
+    path_geom: hydraulics::PathGeom,
+    /// The needle valve at the last setting it was taken for: (the
+    /// setting's bits in bar, k, 1/k²) ([`Model::needle`]).
+    needle_memo: Cell<(u64, Option<f64>, f64)>,
+    /// The dynamic viscosity at the last temperature it was taken for:
+    /// (the temperature's bits, Pa·s) ([`Model::mu`]; NaN's bits: none).
+    mu_memo: Cell<(u64, f64)>,
 }
 
 impl Model {
@@ -81,7 +89,26 @@ impl Model {
     pub fn new(rig: Rig, drive: Drive) -> Self {
         let contents = network::contents(&rig);
         let iron_memo = Cell::new((0f64.to_bits(), rig.motor.iron.power_w(0.0)));
-        Self { rig, drive, lng_open: Cell::new(false), contents, outer_grid: None, nu_grid: None, lam_grid: None, leak_geom: None, iron_memo }
+        let path_geom = hydraulics::PathGeom::new(&rig);
+        let k0 = hydraulics::needle_k(&rig, 0.0);
+        let needle_memo = Cell::new((0f64.to_bits(), k0, hydraulics::needle_inv_k2(k0)));
+        Self { rig, drive, lng_open: Cell::new(false), contents, outer_grid: None, nu_grid: None, lam_grid: None, leak_geom: None, iron_memo, path_geom, needle_memo, mu_memo: Cell::new((f64::NAN.to_bits(), f64::NAN)) }
+    }
+
+    /// The needle valve at setting `bar` ([`hydraulics::needle_k`]: its k,
+    /// and 1/k² of [`hydraulics::needle_inv_k2`]), the values computed for
+    /// the same bits of the setting when they repeat (a square root and
+    /// three divisions in every hydraulic evaluation otherwise).
+    #[inline]
+    fn needle(&self, bar: f64) -> (Option<f64>, f64) {
+        let (bits, k, inv) = self.needle_memo.get();
+        if bits == bar.to_bits() {
+            return (k, inv);
+        }
+        let k = hydraulics::needle_k(&self.rig, bar);
+        let inv = hydraulics::needle_inv_k2(k);
+        self.needle_memo.set((bar.to_bits(), k, inv));
+        (k, inv)
     }
 
     /// The motor's iron loss at shaft speed `omega` (eq. 2,
@@ -108,6 +135,8 @@ impl Model {
         let step = step_k.filter(|&s| s > 0.0 && s.is_finite());
         self.outer_grid = step.map(OuterGrid::new);
         self.nu_grid = step.map(|s| NuGrid::new(s * NU_GRID_FACTOR));
+        // ν moves from the exact line to the grid (or back): μ anew.
+        self.mu_memo.set((f64::NAN.to_bits(), f64::NAN));
         self.lam_grid = step.map(|_| LaminarGrid::new());
         self.leak_geom = step.map(|_| self.rig.pump.gaps.conductance(1.0));
     }
@@ -147,8 +176,18 @@ impl Model {
 
     /// Dynamic viscosity of the oil at `t_oil` and 0 bar, Pa·s (ν·ρ, as
     /// [`crate::fluid::Oil::mu_pa_s`]).
+    ///
+    /// The value computed for the same bits of `t_oil` when they repeat (a
+    /// heat balance asks for the case oil's twice: the pump friction and
+    /// the leakage conductance), so the same to the last bit.
     pub fn mu(&self, t_oil: f64) -> f64 {
-        self.nu(t_oil) * self.rig.oil.rho(t_oil, 0.0)
+        let (bits, mu) = self.mu_memo.get();
+        if bits == t_oil.to_bits() {
+            return mu;
+        }
+        let mu = self.nu(t_oil) * self.rig.oil.rho(t_oil, 0.0);
+        self.mu_memo.set((t_oil.to_bits(), mu));
+        mu
     }
 
     /// Pump leakage conductance of eqs. (5)–(7) at the case-oil temperature
@@ -209,9 +248,9 @@ impl Model {
     pub fn rhs(&self, t: f64, y: &[f64], dy: &mut [f64]) {
         let (op, friction) = self.op_point_parts(t, y);
         let temps = &y[T0..T0 + N_NODES];
-        let (l, fh, f) = self.loss_parts(t, &op, temps, friction);
+        let (l, fh, f, line_dp) = self.loss_parts(t, &op, temps, friction);
         self.hydraulic_rhs_at(t, y, &op, dy);
-        let (q_in, q_amb, q_lng) = self.thermal_with(&op, &l, &fh, &f, temps, &mut dy[T0..T0 + N_NODES]);
+        let (q_in, q_amb, q_lng) = self.thermal_with(&op, &l, &fh, &f, line_dp, temps, &mut dy[T0..T0 + N_NODES]);
         dy[E_LOSS] = q_in;
         dy[E_AMB] = q_amb;
         dy[E_LNG] = q_lng;
@@ -223,8 +262,8 @@ impl Model {
     pub fn thermal_rhs(&self, t: f64, y: &[f64], dy: &mut [f64]) {
         let (op, friction) = self.op_point_parts(t, y);
         let temps = &y[T0..T0 + N_NODES];
-        let (l, fh, f) = self.loss_parts(t, &op, temps, friction);
-        let (q_in, q_amb, q_lng) = self.thermal_with(&op, &l, &fh, &f, temps, &mut dy[T0..T0 + N_NODES]);
+        let (l, fh, f, line_dp) = self.loss_parts(t, &op, temps, friction);
+        let (q_in, q_amb, q_lng) = self.thermal_with(&op, &l, &fh, &f, line_dp, temps, &mut dy[T0..T0 + N_NODES]);
         dy[E_LOSS] = q_in;
         dy[E_AMB] = q_amb;
         dy[E_LNG] = q_lng;

@@ -18,12 +18,15 @@ impl Model {
         let t_case = temps[Node::Case as usize];
         let fh = self.friction_heat(op, t_case);
         let f = hydraulics::flows(&self.rig, op, self.k_leak(t_case));
-        self.thermal_with(op, l, &fh, &f, temps, dt)
+        self.thermal_with(op, l, &fh, &f, None, temps, dt)
     }
 
     /// [`Model::thermal`] given the pump's friction heat `fh` and the flows
-    /// `f` at `op` and these temperatures (from [`Model::loss_parts`]).
-    pub(super) fn thermal_with(&self, op: &OpPoint, l: &Losses, fh: &FrictionHeat, f: &hydraulics::Flows, temps: &[f64], dt: &mut [f64]) -> (f64, f64, f64) {
+    /// `f` at `op` and these temperatures (from [`Model::loss_parts`]), and
+    /// the throttle path's line pressure drop at |q_path| if it was taken
+    /// there (`line_dp`, Pa; None: taken here).
+    #[allow(clippy::too_many_arguments)] // the parts the losses took, each reused
+    pub(super) fn thermal_with(&self, op: &OpPoint, l: &Losses, fh: &FrictionHeat, f: &hydraulics::Flows, line_dp: Option<f64>, temps: &[f64], dt: &mut [f64]) -> (f64, f64, f64) {
         let rig = &self.rig;
         let oil = &rig.oil;
         let tc = |n: Node| temps[n as usize];
@@ -117,7 +120,7 @@ impl Model {
         // loop at the pump's suction pressure (the actuator does the work between).
         let p_suction = if forward { op.p_b } else { op.p_a };
         let line_dp = match op.circuit {
-            Circuit::Throttle => self.path_dp(op.q_path.abs(), tc(Node::BallOil), None).0.max(0.0),
+            Circuit::Throttle => line_dp.unwrap_or_else(|| self.path_dp(op.q_path.abs(), tc(Node::BallOil), None).0).max(0.0),
             Circuit::Servo => 0.0,
         };
         let (p_loop, p_ball) = match (op.circuit, forward) {
