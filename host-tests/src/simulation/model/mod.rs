@@ -56,7 +56,9 @@ pub enum Drive {
 /// The model: rig, drive and the LNG valve state.
 #[derive(Debug)]
 pub struct Model {
-    /// Rig parameters.
+    /// Rig parameters. Read-only after [`Model::new`]: the node contents,
+    /// the throttle path's constants and the memos (iron loss, needle, μ)
+    /// are taken from it there; build a new model for another rig.
     pub rig: Rig,
     /// Drive.
     pub drive: Drive,
