@@ -12,7 +12,8 @@
 //! the calibrated baseline's pooled held-out misfit are asserted as
 //! measured. docs/diagnosis.md, "What it can and cannot see".
 //!
-//! Slow tier only: 32 diagnoses, 3–50 s each on two shared cores.
+//! Slow tier only: 32 diagnoses, 3–50 s each; 475 s on two cores shared
+//! with another helper (2026-11-28, passes).
 
 use eha_sim::diagnosis::analysis::Structure;
 use eha_sim::diagnosis::emu_sweep::{default_cases, ident_cases};
