@@ -5,6 +5,7 @@
 
 mod cli;
 mod detect;
+mod effect_free;
 mod effects;
 mod emulator;
 mod imprint;
