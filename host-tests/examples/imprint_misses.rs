@@ -8,7 +8,7 @@
 //! (seeds 1700–1717 and 2700–2717; ~20–60 s a case on two cores).
 
 use eha_sim::diagnosis::analysis::{fit_points, split_time_s};
-use eha_sim::diagnosis::emu_sweep::{default_cases, ident_cases};
+use eha_sim::diagnosis::emu_sweep::case_of_seed;
 use eha_sim::diagnosis::fit::{fit, FitOptions, FitResult};
 use eha_sim::diagnosis::model::{SimSeries, Simulator};
 use eha_sim::diagnosis::reference::{nuisance_set, ReferenceModel};
@@ -69,8 +69,7 @@ fn main() {
     let seed: u64 = args[0].parse().expect("seed");
     let twin = args.iter().any(|a| a == "twin");
     let has = |v: &str| args.iter().any(|a| a == v);
-    let cases: Vec<_> = default_cases(1200.0, 1700).into_iter().chain(ident_cases(1200.0, 2700)).collect();
-    let case = *cases.iter().find(|c| c.seed == seed).expect("seed in the case sets");
+    let case = case_of_seed(1200.0, seed).expect("seed in the case sets");
     let (run, truth) = generate(&case).expect("case");
     let ch = truth.affected.map(|a| a.0).unwrap_or(Channel::TOilC);
     let run = if twin { generate_twin(&case).expect("twin").0 } else { run };

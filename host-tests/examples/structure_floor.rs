@@ -12,7 +12,7 @@
 //! effect-free twin, an effect-free case itself; ~10–60 s a log on two cores).
 
 use eha_sim::diagnosis::analysis::{fit_points, split_time_s};
-use eha_sim::diagnosis::emu_sweep::{default_cases, ident_cases};
+use eha_sim::diagnosis::emu_sweep::case_of_seed;
 use eha_sim::diagnosis::fit::{fit, FitOptions, FitResult};
 use eha_sim::diagnosis::reference::ReferenceModel;
 use eha_sim::diagnosis::stats::rmse;
@@ -41,9 +41,8 @@ fn main() {
     // least six Jacobians of the set).
     let max_sims = args.iter().find_map(|a| a.strip_prefix("sims=")).map_or(FitOptions::default().max_sims, |n| n.parse().expect("sims=N"));
     let seeds: Vec<u64> = args.iter().filter(|a| !a.contains('=')).map(|a| a.parse().expect("seed")).collect();
-    let cases: Vec<_> = default_cases(1200.0, 1700).into_iter().chain(ident_cases(1200.0, 2700)).collect();
     for seed in seeds {
-        let case = *cases.iter().find(|c| c.seed == seed).expect("seed in the case sets");
+        let case = case_of_seed(1200.0, seed).expect("seed in the case sets");
         let run = generate_twin(&case).expect("log").0;
         let split = split_time_s(&run, 0.7);
         let pts = fit_points(&run, split, 150);

@@ -12,10 +12,9 @@
 
 use clap::ValueEnum as _;
 use eha_sim::diagnosis::analysis::Structure;
-use eha_sim::diagnosis::emu_sweep::{default_cases, ident_cases};
+use eha_sim::diagnosis::emu_sweep::{case_of_seed, effect_free_log};
 use eha_sim::diagnosis::reference::ReferenceModel;
 use eha_sim::diagnosis::{diagnose, Candidate, DiagnoseOptions};
-use eha_sim::emulator::{generate, generate_twin};
 use eha_sim::rig::Rig;
 
 fn main() {
@@ -26,15 +25,11 @@ fn main() {
     };
     let structure = Structure::from_str(s, true).expect("structure: off, full, no-case or no-case-held");
     let o = DiagnoseOptions { structure, ..DiagnoseOptions::default() };
-    let cases: Vec<_> = default_cases(1200.0, 1700).into_iter().chain(ident_cases(1200.0, 2700)).collect();
     for seed in seeds.iter().map(|a| a.parse::<u64>().expect("seed")) {
-        let c = cases.iter().find(|c| c.seed == seed).expect("seed 1700–1717 or 2700–2717");
+        let c = case_of_seed(1200.0, seed).expect("seed 1700–1717 or 2700–2717");
         let t = std::time::Instant::now();
-        let (run, tag) = if c.hidden == Candidate::None {
-            (generate(c).expect("log").0, "effect-free case".to_string())
-        } else {
-            (generate_twin(c).expect("twin").0, format!("twin of {}", c.hidden.name()))
-        };
+        let run = effect_free_log(&c).expect("log");
+        let tag = if c.hidden == Candidate::None { "effect-free case".to_string() } else { format!("twin of {}", c.hidden.name()) };
         let model = ReferenceModel::new(Rig::default(), &run).expect("model").with_structure(&run, structure);
         let d = diagnose(&run, &model, &o).expect("diagnosis");
         let top = &d.posterior.causes[0];

@@ -335,7 +335,12 @@ pub fn calibrate(base: &Rig, logs: &[CalLog], o: &CalOptions) -> Result<Calibrat
     // 2.253 K, against 2.290 -> 2.118 K with the plain polish there).
     // The polish replays at `polish_rtol` (POLISH_RTOL: what a tighter
     // tolerance does, measured).
-    let fine: Vec<CalLog> = logs.iter().map(|l| l.with_rtol(o.polish_rtol)).collect();
+    // (The logs themselves when they already replay there: the default.)
+    let fine: std::borrow::Cow<[CalLog]> = if logs.iter().all(|l| l.rtol == o.polish_rtol) {
+        std::borrow::Cow::Borrowed(logs)
+    } else {
+        std::borrow::Cow::Owned(logs.iter().map(|l| l.with_rtol(o.polish_rtol)).collect())
+    };
     let (theta, polish) = if o.start.is_some() { polish(base, &fine, lm_theta, &free, sigma, &runs) } else { polish_basins(base, &fine, lm_theta, &free, sigma, &runs) };
     // 4. Identifiability at the optimum.
     let (r1, j1) = jacobian_ln(base, logs, &theta, &free, sigma, &runs)

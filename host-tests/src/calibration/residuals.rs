@@ -46,7 +46,13 @@ pub fn on_lattice_value(x: f64, step_ln: f64) -> f64 {
     if step_ln <= 0.0 || x <= 0.0 {
         return x;
     }
-    ((x.ln() / step_ln).round() * step_ln).exp()
+    lattice_point(x, step_ln, f64::NEG_INFINITY, f64::INFINITY)
+}
+
+/// The lattice point of spacing `step_ln` nearest to ln `x`, its index
+/// clamped to `[lo, hi]` (lattice indices).
+fn lattice_point(x: f64, step_ln: f64, lo: f64, hi: f64) -> f64 {
+    ((x.ln() / step_ln).round().clamp(lo, hi) * step_ln).exp()
 }
 
 /// `theta` with every ln θ rounded to the lattice of spacing `step_ln`, to
@@ -63,8 +69,7 @@ pub fn on_lattice(theta: &[f64], step_ln: f64) -> Vec<f64> {
         .iter()
         .zip(PARAMS.iter())
         .map(|(&t, d)| {
-            let (lo, hi) = ((d.lo.ln() / step_ln).ceil(), (d.hi.ln() / step_ln).floor());
-            ((t.ln() / step_ln).round().clamp(lo, hi) * step_ln).exp()
+            lattice_point(t, step_ln, (d.lo.ln() / step_ln).ceil(), (d.hi.ln() / step_ln).floor())
         })
         .collect()
 }

@@ -16,10 +16,9 @@
 //! with another helper (2026-11-28, passes).
 
 use eha_sim::diagnosis::analysis::Structure;
-use eha_sim::diagnosis::emu_sweep::{default_cases, ident_cases};
+use eha_sim::diagnosis::emu_sweep::{case_of_seed, effect_free_log};
 use eha_sim::diagnosis::reference::ReferenceModel;
-use eha_sim::diagnosis::{diagnose, Candidate, DiagnoseOptions};
-use eha_sim::emulator::{generate, generate_twin};
+use eha_sim::diagnosis::{diagnose, DiagnoseOptions};
 use eha_sim::rig::Rig;
 
 /// Seed, answer and the calibrated baseline's pooled held-out RMSE (K) of
@@ -70,11 +69,10 @@ const MEASURED: [(u64, &str, f64); 32] = [
 #[ignore = "slow tier: 32 emulator diagnoses (minutes), the structure option's no-case-held variant"]
 fn slow_effect_free_logs_name_no_cause_under_no_case_held() {
     let o = DiagnoseOptions { structure: Structure::NoCaseHeld, ..DiagnoseOptions::default() };
-    let cases: Vec<_> = default_cases(1200.0, 1700).into_iter().chain(ident_cases(1200.0, 2700)).collect();
     let mut wrong = Vec::new();
     for (seed, answer, pooled) in MEASURED {
-        let c = cases.iter().find(|c| c.seed == seed).expect("case of the sweep");
-        let run = if c.hidden == Candidate::None { generate(c) } else { generate_twin(c) }.expect("emulated log").0;
+        let c = case_of_seed(1200.0, seed).expect("case of the sweep");
+        let run = effect_free_log(&c).expect("emulated log");
         let model = ReferenceModel::new(Rig::default(), &run).expect("model").with_structure(&run, o.structure);
         let d = diagnose(&run, &model, &o).expect("diagnosis");
         let named = d.posterior.causes.iter().filter(|p| p.cause != "none" && p.cause != "unexplained").map(|p| p.probability).fold(0.0, f64::max);

@@ -5,7 +5,8 @@
 
 use crate::diagnosis::model::Candidate;
 use crate::emulator::missions::EmuScenario;
-use crate::emulator::EmuCase;
+use crate::emulator::{generate, generate_twin, EmuCase};
+use crate::measured::MeasuredRun;
 
 /// The default case set: two scenarios per candidate (each chosen to excite
 /// it) and four without a hidden effect; seeds `base + k`. The two
@@ -80,6 +81,21 @@ fn cases_from(list: &[(&str, EmuScenario)], duration_s: f64, base: u64) -> Vec<E
             duration_s,
         })
         .collect()
+}
+
+/// The case of `seed` in the first repetition of both case sets at
+/// `duration_s` (seeds 1700–1717 of [`default_cases`], 2700–2717 of
+/// [`ident_cases`]: what `emulator-sweep --cases original,ident` runs);
+/// `None` for another seed or a retired slot.
+pub fn case_of_seed(duration_s: f64, seed: u64) -> Option<EmuCase> {
+    default_cases(duration_s, 1700).into_iter().chain(ident_cases(duration_s, 2700)).find(|c| c.seed == seed)
+}
+
+/// The effect-free log of case `c` as the sweep diagnoses it: the case's
+/// own log when nothing is hidden, else its twin (same machine, mission
+/// and noise, without the effect).
+pub fn effect_free_log(c: &EmuCase) -> Result<MeasuredRun, String> {
+    if c.hidden == Candidate::None { generate(c) } else { generate_twin(c) }.map(|(run, _)| run)
 }
 
 /// Candidates that left the list (their effect is part of the baseline now):

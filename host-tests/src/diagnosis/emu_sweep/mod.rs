@@ -12,7 +12,7 @@ mod cases;
 mod cli;
 mod markdown;
 
-pub use cases::{default_cases, ident_cases, RETIRED};
+pub use cases::{case_of_seed, default_cases, effect_free_log, ident_cases, RETIRED};
 pub use cli::{run, CaseSet, EmuSweepArgs};
 pub use markdown::{document, miss_class, oracle_row, table_row};
 
