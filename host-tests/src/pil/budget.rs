@@ -1,6 +1,6 @@
 //! Firmware resource budgets: `eha-sim fw-budget` runs the benchmark image
 //! in QEMU under `-icount` (instruction counts, stack painting; see
-//! `boards/mps2/src/bin/eha-bench.rs`), reads the flash and static RAM of every image
+//! `boards/mps2/src/bin/eha-bench/`), reads the flash and static RAM of every image
 //! from its ELF, writes `out/fw-budget.json` and compares each figure with
 //! the committed budgets (`.ci/fw-budget.json`): a figure more than
 //! [`REGRESSION_MARGIN`] above its budget fails.
