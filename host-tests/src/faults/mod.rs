@@ -38,10 +38,13 @@ pub mod inject;
 pub mod limits;
 pub mod modes;
 mod campaign;
+mod commander;
+mod outcome;
 mod run;
 
 pub use campaign::{baselines, campaign, data_json, fast_campaign, fast_subset, jobs, run, run_jobs, table, unlisted_failures, write, FaultsArgs, Job};
-pub use run::{bit_names, run_case, run_one, runs_on_a_target};
+pub use outcome::bit_names;
+pub use run::{run_case, run_one, runs_on_a_target};
 
 use anyhow::Result;
 use serde::{Deserialize, Serialize};

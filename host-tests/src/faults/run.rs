@@ -4,11 +4,13 @@
 use anyhow::{bail, Context, Result};
 use eha_guard::memory::ThermalRecord;
 use eha_guard::product::mem_board::MemBoard;
-use eha_guard::product::wire::{command_key, AckResult, Cmd, Command, FromGuard};
+use eha_guard::product::wire::Cmd;
 use eha_guard::protocol::Request;
-use eha_guard::{faults as fbits, Faults, GuardConfig, Output, Sample};
+use eha_guard::{Faults, GuardConfig, Output, Sample};
 
+use super::commander::Commander;
 use super::inject::{corrupt_sample, Channel, Fault, Gauss, InputFault};
+use super::outcome::{action, bit_names, protected, DETECT_MASK};
 use super::{Case, FaultResult, Inputs, ScenarioSpec, Start, DETECT_S, MAX_CLOSED_C, MAX_UNDER_K, POWER_OFF_S, TICK_S, WRITE_FAIL_TO_POWER_LOSS_S};
 use crate::pil::sil::AppTarget;
 use crate::pil::Target;
@@ -107,95 +109,6 @@ pub fn runs_on_a_target(fault: Fault) -> bool {
             | Fault::FlashReadFail
             | Fault::CorruptStartClear
     )
-}
-
-/// A controller that arms and confirms a command (a clear or a refill)
-/// every `period` ticks from tick `from`, with the key of the default rig id.
-struct Commander {
-    arm: Cmd,
-    confirm: Cmd,
-    next: u64,
-    period: u64,
-    nonce: Option<u32>,
-    token: u16,
-    done: u32,
-}
-
-impl Commander {
-    fn new(arm: Cmd, confirm: Cmd, from: u64, period: u64) -> Self {
-        Commander { arm, confirm, next: from, period, nonce: None, token: 0x4000, done: 0 }
-    }
-
-    /// This tick's command frame, if any.
-    fn frame(&mut self, k: u64) -> Option<Vec<u8>> {
-        self.token = self.token.wrapping_add(1);
-        if let Some(n) = self.nonce.take() {
-            let arg = command_key(&[0; 16], n, self.confirm);
-            return Some(Command { token: self.token, cmd: self.confirm, arg }.encode().as_slice().to_vec());
-        }
-        if k >= self.next {
-            self.next = k + self.period;
-            return Some(Command { token: self.token, cmd: self.arm, arg: 0 }.encode().as_slice().to_vec());
-        }
-        None
-    }
-
-    /// The acknowledgements of the tick.
-    fn read(&mut self, others: &[FromGuard]) {
-        for f in others {
-            if let FromGuard::Ack(a) = f {
-                if a.cmd == self.arm && a.result == AckResult::Done {
-                    self.nonce = Some(a.value);
-                } else if a.cmd == self.confirm && a.result == AckResult::Done {
-                    self.done += 1;
-                }
-            }
-        }
-    }
-}
-
-/// The guard is protecting: a latched fault with the valve commanded open,
-/// or the estimate untrusted (alarm and derate held).
-fn protected(o: &Output) -> bool {
-    (o.faults.intersects(fbits::LATCHED) && o.valve_open) || o.faults.contains(fbits::UNTRUSTED)
-}
-
-/// The bits whose appearance counts as a detection.
-const DETECT_MASK: Faults = Faults::from_bits(
-    fbits::LATCHED.bits() | fbits::UNTRUSTED.bits() | fbits::NV_FAILED.bits() | fbits::NO_VALVE_FEEDBACK.bits() | fbits::LNG_LOW.bits(),
-);
-
-/// The named members of a fault set, `+`-separated (channels as
-/// `ch:<name>`).
-pub fn bit_names(f: Faults) -> String {
-    let dbg = format!("{f:?}");
-    let inner = dbg.trim_start_matches("Faults(").trim_end_matches(')');
-    let mut out: Vec<String> = inner.split(" | ").filter(|p| !p.starts_with("channels")).map(str::to_string).collect();
-    for c in Channel::ALL {
-        let ch = eha_guard::ChannelSet::channel(Channel::ALL.iter().position(|x| *x == c).unwrap_or(0));
-        if f.channel_set().contains(ch) {
-            out.push(format!("ch:{}", c.name()));
-        }
-    }
-    out.join(" + ")
-}
-
-fn action(o: &Output) -> String {
-    let mut a = Vec::new();
-    if o.valve_open {
-        a.push("valve open");
-    }
-    if o.alarm {
-        a.push("alarm");
-    }
-    if o.derate {
-        a.push("derate");
-    }
-    if a.is_empty() {
-        "none".into()
-    } else {
-        a.join(", ")
-    }
 }
 
 /// Run one case in one scenario from `start` on the host application.
