@@ -14,10 +14,12 @@ use std::process::{Command, Stdio};
 use std::time::Duration;
 
 use anyhow::{bail, Context, Result};
-use object::{Object, ObjectSection, SectionFlags};
 use serde::{Deserialize, Serialize};
 
 use super::firmware::{build_bin, workspace_root, Build, MPS2, STM32F4};
+
+mod elf;
+pub use elf::{elf_load_size, elf_sizes};
 
 /// Allowed growth over a committed budget (fraction): 10 %.
 pub const REGRESSION_MARGIN: f64 = 0.10;
@@ -117,42 +119,6 @@ fn run_product(elf: &Path) -> Result<ImageBudget> {
         stack_tick_b: Some(f64::from(st.stack_high_water_b)),
         ..Default::default()
     })
-}
-
-/// Flash (`.text` + `.rodata`) and static RAM of an ELF, bytes.
-pub fn elf_sizes(elf: &Path) -> Result<(u64, u64)> {
-    let data = std::fs::read(elf).with_context(|| format!("reading {}", elf.display()))?;
-    let file = object::File::parse(&*data).with_context(|| format!("parsing ELF {}", elf.display()))?;
-    let (mut flash, mut ram) = (0u64, 0u64);
-    for s in file.sections() {
-        let name = s.name().unwrap_or("");
-        let SectionFlags::Elf { sh_flags } = s.flags() else { continue };
-        let alloc = sh_flags & u64::from(object::elf::SHF_ALLOC) != 0;
-        let write = sh_flags & u64::from(object::elf::SHF_WRITE) != 0;
-        if name == ".text" || name == ".rodata" {
-            flash += s.size();
-        } else if alloc && write {
-            ram += s.size();
-        }
-    }
-    Ok((flash, ram))
-}
-
-/// Flash of the whole load image: every allocated section with file contents
-/// (vector table, code, constants, `.data`'s initial values), bytes.
-pub fn elf_load_size(elf: &Path) -> Result<u64> {
-    let data = std::fs::read(elf).with_context(|| format!("reading {}", elf.display()))?;
-    let file = object::File::parse(&*data).with_context(|| format!("parsing ELF {}", elf.display()))?;
-    let mut total = 0u64;
-    for s in file.sections() {
-        let SectionFlags::Elf { sh_flags } = s.flags() else { continue };
-        let alloc = sh_flags & u64::from(object::elf::SHF_ALLOC) != 0;
-        // (.bss and no-init RAM have no file contents: SHT_NOBITS)
-        if alloc && s.file_range().is_some() && s.address() < 0x2000_0000 || alloc && s.name().unwrap_or("") == ".data" {
-            total += s.size();
-        }
-    }
-    Ok(total)
 }
 
 /// The number after `key` in `line` (e.g. `mean 333.1`).
@@ -403,49 +369,4 @@ pub fn run(a: &BudgetArgs) -> Result<()> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn parses_the_bench_report() {
-        let text = "Guard::tick, every tick: instructions/tick min 243 mean 333.1 max 1157 (n = 5995)\n\
-                    Guard::new (constants, checks, stability): 3920773 instructions\n\
-                    stack high-water mark: boot+init 13576 bytes, tick loop 6288 bytes\nEHA-BENCH-DONE\n";
-        let b = parse_bench(text).expect("parses");
-        assert_eq!(b.instr_per_tick_mean, Some(333.1));
-        assert_eq!(b.instr_per_tick_max, Some(1157.0));
-        assert_eq!(b.guard_new_instr, Some(3920773.0));
-        assert_eq!((b.stack_boot_b, b.stack_tick_b), (Some(13576.0), Some(6288.0)));
-        assert!(parse_bench("Guard::new (constants, checks, stability): 1 instructions\n").is_err(), "no completion marker");
-    }
-
-    #[test]
-    fn flags_only_growth_beyond_the_margin() {
-        let b = |x: f64| ImageBudget { instr_per_tick_mean: Some(x), ..Default::default() };
-        let budget = BTreeMap::from([("a".to_string(), b(100.0))]);
-        assert!(regressions(&BTreeMap::from([("a".to_string(), b(110.0))]), &budget).is_empty());
-        assert_eq!(regressions(&BTreeMap::from([("a".to_string(), b(110.5))]), &budget).len(), 1);
-        assert_eq!(regressions(&BTreeMap::new(), &budget).len(), 1, "a budgeted image that was not measured fails");
-    }
-
-    /// The product image's absolute limits: the committed figures pass, one
-    /// byte over 40 KiB of flash fails, a loop over 1 500 instructions per
-    /// tick fails, a missing figure fails.
-    #[test]
-    fn product_limits_are_absolute() {
-        let ok = ImageBudget {
-            instr_per_tick_mean: Some(355.9),
-            guard_new_instr: Some(61_765.0),
-            stack_boot_b: Some(3056.0),
-            stack_tick_b: Some(1240.0),
-            flash_b: Some(31_132.0),
-            loop_instr_per_tick_mean: Some(1476.9),
-            ..Default::default()
-        };
-        let m = |b: ImageBudget| BTreeMap::from([("product-mps2".to_string(), b)]);
-        assert!(over_product_limits(&m(ok.clone())).is_empty());
-        assert_eq!(over_product_limits(&m(ImageBudget { flash_b: Some(40_961.0), ..ok.clone() })).len(), 1);
-        assert_eq!(over_product_limits(&m(ImageBudget { loop_instr_per_tick_mean: Some(1500.1), ..ok.clone() })).len(), 1);
-        assert_eq!(over_product_limits(&m(ImageBudget { stack_boot_b: None, ..ok })).len(), 1);
-    }
-}
+mod tests;
