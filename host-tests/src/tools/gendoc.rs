@@ -31,7 +31,7 @@ pub struct Section {
 }
 
 /// Every generated section.
-pub const SECTIONS: [Section; 5] = [
+pub const SECTIONS: [Section; 6] = [
     Section { doc: "docs/results.md", tag: "uq-paper", source: "docs/data/uq-paper.json", render: render_uq_paper },
     Section { doc: "docs/results.md", tag: "fw-budget", source: ".ci/fw-budget.json", render: render_fw_budget },
     Section { doc: "docs/rig-file.md", tag: "rig-file", source: "host-tests/src/physics/rig/mod.rs", render: crate::tools::rigdoc::render },
@@ -42,10 +42,17 @@ pub const SECTIONS: [Section; 5] = [
         source: "docs/data/emulator-sweep.json",
         render: render_emulator_sweep,
     },
+    Section {
+        doc: "docs/diagnosis.md",
+        tag: "emulator-sweep-1800",
+        source: "docs/data/emulator-sweep-1800.json",
+        render: render_emulator_sweep,
+    },
 ];
 
 /// The emulator sweep's tables (`eha-sim emulator-sweep`, the case sets
-/// it ran, its `emulator-sweep.json`).
+/// it ran, its `emulator-sweep.json`; the second seed set's under the
+/// default structure, `emulator-sweep-1800.json`).
 fn render_emulator_sweep(json: &str) -> Result<String> {
     let rows: Vec<crate::diagnosis::emu_sweep::EmuResult> = serde_json::from_str(json)?;
     Ok(crate::diagnosis::emu_sweep::document(&rows))

@@ -7,6 +7,7 @@ mod cli;
 mod detect;
 mod effect_free;
 mod effects;
+mod hidden;
 mod emulator;
 mod imprint;
 mod multi;

@@ -148,9 +148,14 @@ impl From<bool> for Structure {
     }
 }
 
-/// Default of [`DiagnoseOptions::structure`] (docs/diagnosis.md, "What it
-/// can and cannot see": the floor with and without it on the emulator).
-pub const STRUCTURE_DEFAULT: Structure = Structure::Off;
+/// Default of [`DiagnoseOptions::structure`]: [`Structure::NoCaseHeld`].
+/// On the emulator's original and identification case sets (every log with
+/// a hidden effect and every effect-free log, 2026-11-28) it names no wrong
+/// cause and no cause on an effect-free log, and names every cause
+/// [`Structure::Off`] names at imprint ratio ≥ 2 (docs/diagnosis.md,
+/// "Current numbers" and "What it can and cannot see"; its misses there
+/// are listed too).
+pub const STRUCTURE_DEFAULT: Structure = Structure::NoCaseHeld;
 
 impl Default for DiagnoseOptions {
     fn default() -> Self {
