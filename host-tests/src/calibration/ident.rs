@@ -35,9 +35,10 @@ pub struct Identifiability {
 }
 
 /// Identifiability from the scaled data Jacobian `j` (columns = `idx`,
-/// derivatives in ln θ), the prior widths of [`PARAMS`], residual variance
+/// derivatives in ln θ), the prior widths `prior_ln` (σ in ln θ of every
+/// [`PARAMS`] entry, indexed as it), residual variance
 /// factor `s2` (≥ 1) and the correlation threshold.
-pub fn identifiability(j: &DMatrix<f64>, idx: &[usize], _theta: &[f64], s2: f64, corr_threshold: f64) -> Identifiability {
+pub fn identifiability(j: &DMatrix<f64>, idx: &[usize], prior_ln: &[f64], s2: f64, corr_threshold: f64) -> Identifiability {
     let p = idx.len();
     let names: Vec<String> = idx.iter().map(|&k| PARAMS[k].name.to_string()).collect();
     if p == 0 {
@@ -45,7 +46,7 @@ pub fn identifiability(j: &DMatrix<f64>, idx: &[usize], _theta: &[f64], s2: f64,
     }
     let mut sv: Vec<f64> = j.clone().svd(false, false).singular_values.iter().copied().collect();
     sv.sort_by(|a, b| b.total_cmp(a));
-    let prior = DVector::from_iterator(p, idx.iter().map(|&k| PARAMS[k].prior_sigma_ln));
+    let prior = DVector::from_iterator(p, idx.iter().map(|&k| prior_ln[k]));
     let mut h = j.transpose() * j;
     for i in 0..p {
         h[(i, i)] += 1.0 / (prior[i] * prior[i]);

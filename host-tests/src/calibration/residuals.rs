@@ -22,6 +22,10 @@ pub(crate) struct Sigma {
     /// Spacing in ln θ of the lattice the model is evaluated on
     /// ([`on_lattice`]; 0: off).
     pub(crate) lattice_ln: f64,
+    /// Prior width σ in ln θ of every [`PARAMS`] entry
+    /// ([`CalOptions::prior_sigma`](super::CalOptions::prior_sigma) over
+    /// the set's own).
+    pub(crate) prior_ln: [f64; PARAMS.len()],
 }
 
 /// Spacing, in ln θ, of the lattice on which every multiplier vector of a
