@@ -443,13 +443,13 @@ impl FastPlant {
             } else {
                 None
             };
-            let (mut zp, mut g0) = th.predict(phi, h);
+            let mut pred = th.predict(phi, h);
             // The hydraulic states at the step's end, from their own track
             // (seeing the temperatures on the line to the predictor); a
             // branch switch of the heat balances inside ends the step there.
             let mut switch = None;
             if !replay {
-                self.hyd.set_line(&self.model, self.t, th.z, t1, zp);
+                self.hyd.set_line(&self.model, self.t, th.z, t1, pred.zp);
                 self.hyd.cover(&self.model, t1, seg_end).map_err(hyd_error)?;
                 if let Some((lo, hi)) = self.hyd.first_switch(&self.model, scan_from.max(self.t), t1) {
                     scan_from = hi;
@@ -468,7 +468,7 @@ impl FastPlant {
                         odd_phi2 = Phi::new(&th.a, h);
                         phi = Some(&odd_phi2);
                     }
-                    (zp, g0) = th.predict(phi, h);
+                    pred = th.predict(phi, h);
                 }
             }
             let seg_done = (partial || ends) && switch.is_none();
@@ -476,8 +476,8 @@ impl FastPlant {
             // At a breakpoint the segment's schedules end with their left limits.
             let t_eval = if seg_done { left_of(t1) } else { t1 };
             let (mut fp, mut qp) = ([0.0; NT], [0.0; NE]);
-            Self::rates(&self.model, &mut self.stats, t_eval, &yh1, &zp, &mut fp, &mut qp);
-            let trial = th.correct(phi, h, &zp, &g0, &fp, &qp);
+            Self::rates(&self.model, &mut self.stats, t_eval, &yh1, &pred.zp, &mut fp, &mut qp);
+            let trial = th.correct(phi, h, &pred, &fp, &qp);
             let tol = if self.t < loose_until { self.opts.tol_k * self.opts.start_tol_factor } else { self.opts.tol_k };
             let err = trial.err_k / tol;
             let hyd_h = if replay { f64::INFINITY } else { self.hyd.ros.h };
