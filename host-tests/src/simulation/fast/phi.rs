@@ -13,7 +13,7 @@
 //! which follow from splitting ∫₀^{2h} at h. Doubling is also how a stepper
 //! moves to twice the step at the cost of four products.
 
-use super::dense::{identity, lin2, mul, mul_rows, mul_vec, norm1, transpose, zeros, Mat};
+use super::dense::{identity, lin2, mul_rows, mul_vec, norm1, transpose, zeros, Mat};
 use std::mem::MaybeUninit;
 
 /// Degree of the Taylor polynomial of φ₃.
@@ -76,14 +76,30 @@ impl<const N: usize> Phi<N> {
             f *= (j + 4) as f64;
         }
         let id: Mat<N> = identity();
-        let mut p3 = lin2(&id, inv_fact[TAYLOR_DEGREE], &zeros(), 0.0);
+        // P·Z + c·I (as lin2(P·Z, 1, I, c)) into `out`, row by row.
+        let next = |p: &Mat<N>, c: f64, out: &mut Mat<N>| {
+            mul_rows(p, &z, |i, mut r| {
+                for (x, e) in r.iter_mut().zip(&id[i]) {
+                    *x = *x * 1.0 + e * c;
+                }
+                out[i] = r;
+            })
+        };
+        // Horner's steps alternate between two matrices (no copies).
+        let mut ping = [lin2(&id, inv_fact[TAYLOR_DEGREE], &zeros(), 0.0), zeros()];
+        let mut cur = 0;
         for j in (0..TAYLOR_DEGREE).rev() {
-            p3 = lin2(&mul(&p3, &z), 1.0, &id, inv_fact[j]);
+            let [a, b] = &mut ping;
+            let (src, dst) = if cur == 0 { (&*a, b) } else { (&*b, a) };
+            next(src, inv_fact[j], dst);
+            cur ^= 1;
         }
-        let p2 = lin2(&mul(&p3, &z), 1.0, &id, 0.5);
-        let p1 = lin2(&mul(&p2, &z), 1.0, &id, 1.0);
-        let et = lin2(&mul(&p1, &z), 1.0, &id, 1.0);
-        Self { h, et, cols: [lin2(&p1, h, &id, 0.0), lin2(&p2, h, &id, 0.0), lin2(&p3, h, &id, 0.0)] }
+        let p3 = &ping[cur];
+        let (mut p2, mut p1, mut et) = (zeros(), zeros(), zeros());
+        next(p3, 0.5, &mut p2);
+        next(&p2, 1.0, &mut p1);
+        next(&p1, 1.0, &mut et);
+        Self { h, et, cols: [lin2(&p1, h, &id, 0.0), lin2(&p2, h, &id, 0.0), lin2(p3, h, &id, 0.0)] }
     }
 
     /// The same functions at twice the step (four matrix products).
@@ -120,9 +136,14 @@ impl<const N: usize> Phi<N> {
     /// `out` is valid for writes of a `Phi<N>` (it may be uninitialised;
     /// every field is written, nothing is read from it).
     unsafe fn double_into(&self, out: *mut Self) {
-        let id: Mat<N> = identity();
         let [c1, c2, c3] = &self.cols;
-        let ep = lin2(&self.et, 1.0, &id, 1.0);
+        // E + I, as lin2(E, 1, I, 1).
+        let mut ep = self.et;
+        for (i, row) in ep.iter_mut().enumerate() {
+            for (j, x) in row.iter_mut().enumerate() {
+                *x = *x * 1.0 + f64::from(u8::from(i == j)) * 1.0;
+            }
+        }
         // SAFETY (all writes): rows of fields of `out`, in bounds (i < N).
         let row_of = |m: *mut Mat<N>, i: usize| unsafe { m.cast::<[f64; N]>().add(i) };
         let cols = unsafe { std::ptr::addr_of_mut!((*out).cols) }.cast::<Mat<N>>();
