@@ -236,7 +236,24 @@ impl<const N: usize> Rosenbrock<N> {
     where
         F: FnMut(f64, &[f64; N], &mut [f64; N]),
     {
+        // The stage count as a constant for the two tableaus here (the
+        // stage loops unrolled: the same operations in the same order,
+        // fewer instructions), the tableau's own count otherwise.
+        match self.tab.s {
+            4 => self.step_s::<F, 4>(f, t, y, f0, t_max),
+            6 => self.step_s::<F, 6>(f, t, y, f0, t_max),
+            _ => self.step_s::<F, 0>(f, t, y, f0, t_max),
+        }
+    }
+
+    /// [`Rosenbrock::step`] with `S` stages (0: `self.tab.s`).
+    #[inline(always)]
+    fn step_s<F, const S: usize>(&mut self, f: &mut F, t: f64, y: &mut [f64; N], f0: &mut [f64; N], t_max: f64) -> Result<f64, RosError>
+    where
+        F: FnMut(f64, &[f64; N], &mut [f64; N]),
+    {
         let tab = &self.tab;
+        let ns = if S == 0 { tab.s } else { S };
         let h_min = 1e-14 * t_max.abs().max(1.0);
         let h_try = self.h;
         // Near `t_max`, equal steps to it rather than full ones and a
@@ -297,7 +314,7 @@ impl<const N: usize> Rosenbrock<N> {
             let Some((lu, _)) = &self.lu else { unreachable!("an LU was just built") };
             let mut k = [[0.0; N]; S_MAX];
             let mut fs = *f0;
-            for s in 0..tab.s {
+            for s in 0..ns {
                 if s > 0 {
                     let mut ys = *y;
                     for (j, kj) in k.iter().enumerate().take(s) {
@@ -329,7 +346,7 @@ impl<const N: usize> Rosenbrock<N> {
             let mut err = 0.0;
             for i in 0..N {
                 let mut e = 0.0;
-                for ((m, es), ks) in tab.m.iter().zip(&tab.e).zip(&k).take(tab.s) {
+                for ((m, es), ks) in tab.m.iter().zip(&tab.e).zip(&k).take(ns) {
                     y1[i] += m * ks[i];
                     e += es * ks[i];
                 }
