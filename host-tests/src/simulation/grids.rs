@@ -115,10 +115,7 @@ impl OuterGrid {
     /// `t_wall` to the air, W: [`q_outer_exposed`] interpolated on the grid.
     #[allow(clippy::too_many_arguments)] // q_outer_exposed's arguments and the surface's index
     pub fn q(&self, i: usize, rig: &Rig, area: f64, shape: Shape, t_wall: f64, t_air: f64, air_mps: f64, ram_share: f64) -> f64 {
-        let exact = |t: f64| {
-            self.evals.set(self.evals.get() + 1);
-            q_outer_exposed(rig, area, shape, t, t_air, air_mps, ram_share)
-        };
+        let exact = |t: f64| self.exact(rig, area, shape, t, t_air, air_mps, ram_share);
         let x = t_wall / self.step_k;
         let Some(cell) = self.cells.get(i) else { return exact(t_wall) };
         if x.is_nan() || x.abs() >= 1e12 {
@@ -168,6 +165,18 @@ impl OuterGrid {
             cell.set(c);
         }
         c.q_lo + (x - k) * (c.q_hi - c.q_lo)
+    }
+
+    /// [`q_outer_exposed`], counted. Out of line (a cell's fill, ~250 calls
+    /// a fast Case 1 run against ~600 reads of kept cells): inlined, its
+    /// code had moved with the builds' inlining decisions, ±6 k instructions
+    /// of `OuterGrid::q` between builds of the same source.
+    #[cold]
+    #[inline(never)]
+    #[allow(clippy::too_many_arguments)] // q_outer_exposed's arguments
+    fn exact(&self, rig: &Rig, area: f64, shape: Shape, t: f64, t_air: f64, air_mps: f64, ram_share: f64) -> f64 {
+        self.evals.set(self.evals.get() + 1);
+        q_outer_exposed(rig, area, shape, t, t_air, air_mps, ram_share)
     }
 }
 
