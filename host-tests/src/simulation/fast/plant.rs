@@ -188,8 +188,10 @@ pub struct FastPlant {
     opts: FastOptions,
     hyd: HydTrack,
     /// The thermal scheme and its step levels, kept between runs, and the
-    /// valve state its Jacobian belongs to.
-    thermal: Option<(Thermal, Vec<Option<Box<Phi<NT>>>>)>,
+    /// valve state its Jacobian belongs to. Boxed: inline, its ~4.7 kB
+    /// made the plant a copy glibc does byte by byte (`rep movsb`), twice
+    /// in `sim::simulate_fast_with` (~10 k instructions a run).
+    thermal: Option<Box<(Thermal, Vec<Option<Box<Phi<NT>>>>)>>,
     jacobian_valve: bool,
     stats: FastStats,
     step_limit: Option<u64>,
@@ -320,8 +322,9 @@ impl FastPlant {
         // first milliseconds from rest) and takes the Jacobian once the step
         // has grown 64-fold; later runs keep theirs.
         let first_run = self.thermal.is_none();
-        let (mut th, mut ladder) =
-            self.thermal.take().unwrap_or_else(|| (Thermal::new(self.t, [0.0; NT], [0.0; NE]), (0..LEVELS).map(|_| None).collect()));
+        let mut kept =
+            self.thermal.take().unwrap_or_else(|| Box::new((Thermal::new(self.t, [0.0; NT], [0.0; NE]), (0..LEVELS).map(|_| None).collect())));
+        let (th, ladder) = &mut *kept;
         th.t = self.t;
         th.z = std::array::from_fn(|i| self.y[T0 + i]);
         th.e = std::array::from_fn(|i| self.y[T0 + NT + i]);
@@ -435,7 +438,7 @@ impl FastPlant {
             // polynomial in closed form (`Thermal::linear`): no level's
             // matrices (4 of them, 5.4 kB, built and boxed per level).
             let mut phi = if !odd && !th.is_zero() {
-                Some(self.phi(&mut ladder, &th, level, dt_s))
+                Some(self.phi(ladder, th, level, dt_s))
             } else if norm1(&th.a) * h > VECTOR_NORM_MAX {
                 self.stats.phi_builds += 1;
                 odd_phi = Phi::new(&th.a, h);
@@ -557,13 +560,13 @@ impl FastPlant {
                     }
                 }
             }
-            self.write_state(&yh, &th);
+            self.write_state(&yh, th);
             // Callbacks inside the step, on the interpolants.
             while !ctl.stop && t_cb <= t1 + 1e-9 && t_cb <= t_end + 1e-9 {
                 let at_end = (t_cb - t1).abs() <= 1e-9;
                 let tc = if at_end { t_cb } else { t_cb.min(t1) };
                 if at_end {
-                    self.write_state(&yh, &th);
+                    self.write_state(&yh, th);
                 } else {
                     let (a0, b0, a1, b1) = hermite((tc - t0) / h);
                     for i in 0..NT {
@@ -604,14 +607,14 @@ impl FastPlant {
                     continue 'outer;
                 }
             }
-            self.write_state(&yh, &th);
+            self.write_state(&yh, th);
             if !replay {
                 self.hyd.advance(&self.model, self.t, &th.z, seg_end);
             }
         }
         (self.hyd.ros.rtol, self.hyd.ros.atol) = (rtol0, atol0);
         self.stats.hydraulics = self.hyd.ros.stats;
-        self.thermal = Some((th, ladder));
+        self.thermal = Some(kept);
         Ok(())
     }
 
