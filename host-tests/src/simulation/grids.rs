@@ -115,17 +115,23 @@ impl OuterGrid {
     /// `t_wall` to the air, W: [`q_outer_exposed`] interpolated on the grid.
     #[allow(clippy::too_many_arguments)] // q_outer_exposed's arguments and the surface's index
     pub fn q(&self, i: usize, rig: &Rig, area: f64, shape: Shape, t_wall: f64, t_air: f64, air_mps: f64, ram_share: f64) -> f64 {
-        let exact = |t: f64| self.exact(rig, area, shape, t, t_air, air_mps, ram_share);
+        // (A macro, not a closure: the closure's captures were stored at
+        // every call, ~16 instructions, for the few calls that fill a cell.)
+        macro_rules! exact {
+            ($t:expr) => {
+                self.exact(rig, area, shape, $t, t_air, air_mps, ram_share)
+            };
+        }
         let x = t_wall / self.step_k;
-        let Some(cell) = self.cells.get(i) else { return exact(t_wall) };
+        let Some(cell) = self.cells.get(i) else { return exact!(t_wall) };
         if x.is_nan() || x.abs() >= 1e12 {
-            return exact(t_wall);
+            return exact!(t_wall);
         }
         let key = [area.to_bits(), t_air.to_bits(), air_mps.to_bits(), ram_share.to_bits()];
         let mut c = cell.get();
         if !c.seen || c.key != key {
             cell.set(GridCell { key, seen: true, ..GridCell::default() });
-            return exact(t_wall);
+            return exact!(t_wall);
         }
         // Far from the air: the cubic through four points of the coarse grid.
         let step_c = self.step_k * OUTER_COARSE_FACTOR;
@@ -144,7 +150,7 @@ impl OuterGrid {
                     if old.built && old.key == key && (0.0..4.0).contains(&d) {
                         old.q[d as usize]
                     } else {
-                        exact(kj * step_c)
+                        exact!(kj * step_c)
                     }
                 });
                 cc = CoarseCell { key, built: true, k: kc, q, c: cubic_through(q) };
@@ -155,7 +161,7 @@ impl OuterGrid {
         // SAFETY: |x| < 1e12 and not NaN (above).
         let k = unsafe { floor_i64(x) } as f64;
         if !c.built || k != c.k {
-            let at = |k: f64| exact(k * self.step_k);
+            let at = |k: f64| exact!(k * self.step_k);
             let (q_lo, q_hi) = match c.built {
                 true if k == c.k + 1.0 => (c.q_hi, at(k + 1.0)),
                 true if k == c.k - 1.0 => (at(k), c.q_lo),
