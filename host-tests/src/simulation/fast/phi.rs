@@ -137,12 +137,16 @@ impl<const N: usize> Phi<N> {
     /// every field is written, nothing is read from it).
     unsafe fn double_into(&self, out: *mut Self) {
         let [c1, c2, c3] = &self.cols;
-        // E + I, as lin2(E, 1, I, 1).
+        // E + I, as lin2(E, 1, I, 1) gives it: x·1 + δ·1 is x + 0 off the
+        // diagonal (which turns −0 into +0) and x + 1 on it.
         let mut ep = self.et;
-        for (i, row) in ep.iter_mut().enumerate() {
-            for (j, x) in row.iter_mut().enumerate() {
-                *x = *x * 1.0 + f64::from(u8::from(i == j)) * 1.0;
+        for row in ep.iter_mut() {
+            for x in row.iter_mut() {
+                *x += 0.0;
             }
+        }
+        for (i, row) in ep.iter_mut().enumerate() {
+            row[i] = self.et[i][i] + 1.0;
         }
         // SAFETY (all writes): rows of fields of `out`, in bounds (i < N).
         let row_of = |m: *mut Mat<N>, i: usize| unsafe { m.cast::<[f64; N]>().add(i) };
