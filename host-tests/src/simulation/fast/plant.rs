@@ -176,6 +176,10 @@ pub struct FastStats {
     pub hydraulics: RosStats,
 }
 
+/// The step levels' φ-functions, by level (boxed: a level is 5.4 kB and a
+/// run uses a dozen of the 33).
+type Ladder = Vec<Option<Box<Phi<NT>>>>;
+
 /// The multirate plant (see the module documentation).
 #[derive(Debug)]
 pub struct FastPlant {
@@ -191,7 +195,7 @@ pub struct FastPlant {
     /// valve state its Jacobian belongs to. Boxed: inline, its ~4.7 kB
     /// made the plant a copy glibc does byte by byte (`rep movsb`), twice
     /// in `sim::simulate_fast_with` (~10 k instructions a run).
-    thermal: Option<Box<(Thermal, Vec<Option<Box<Phi<NT>>>>)>>,
+    thermal: Option<Box<(Thermal, Ladder)>>,
     jacobian_valve: bool,
     stats: FastStats,
     step_limit: Option<u64>,
