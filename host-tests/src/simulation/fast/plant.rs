@@ -385,7 +385,7 @@ impl FastPlant {
             }
             if todo.jacobian || todo.fresh || todo.switch.is_some() || todo.drift {
                 let (t, yy) = match todo.switch {
-                    Some(ts) if !replay => (ts, self.hyd.at(ts)),
+                    Some(ts) if !replay => (ts, self.hyd.at(&self.model, ts)),
                     _ => (self.t, yh),
                 };
                 let (model, stats) = (&self.model, &mut self.stats);
@@ -479,7 +479,7 @@ impl FastPlant {
                 }
             }
             let seg_done = (partial || ends) && switch.is_none();
-            let yh1 = if replay { yh } else { self.hyd.at(t1) };
+            let yh1 = if replay { yh } else { self.hyd.at(&self.model, t1) };
             // At a breakpoint the segment's schedules end with their left limits.
             let t_eval = if seg_done { left_of(t1) } else { t1 };
             let (mut fp, mut qp) = ([0.0; NT], [0.0; NE]);
@@ -579,7 +579,7 @@ impl FastPlant {
                     for i in 0..NE {
                         self.y[T0 + NT + i] = a0 * e0[i] + b0 * h * q0[i] + a1 * th.e[i] + b1 * h * th.q[i];
                     }
-                    let yhc = if replay { yh0 } else { self.hyd.at(tc) };
+                    let yhc = if replay { yh0 } else { self.hyd.at(&self.model, tc) };
                     self.y[..NH].copy_from_slice(&yhc);
                 }
                 let snap = snapshot_stored(&self.model, tc, &self.y, self.model.stored_energy_from(&self.e0, &self.y));
