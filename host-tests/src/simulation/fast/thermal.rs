@@ -267,6 +267,42 @@ impl Thermal {
         Prediction { zp, g0, base }
     }
 
+    /// The corrector's exact drift solve (see `correct`) with at most `K`
+    /// drifting columns: z₁ += M·δ over them.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn drift_exact<const K: usize>(&self, phi: Option<&Phi<NT>>, h: f64, c1: f64, c2: f64, da: &[[f64; NT]; NT], zp: &[f64; NT], z1: &mut [f64; NT]) {
+        let n = self.da_n;
+        let mut w = [[0.0; NT]; K];
+        for k in 0..n {
+            let v = &da[self.da_idx[k]];
+            match phi {
+                Some(p) if !self.a_zero => {
+                    mul_vec_add_cols(&p.cols[1], &v.map(|x| x * h * c1), &mut w[k]);
+                    mul_vec_add_cols(&p.cols[2], &v.map(|x| x * h * h * c2), &mut w[k]);
+                }
+                _ => {
+                    let s = h * h * c1 / 2.0 + h * h * h * c2 / 6.0;
+                    w[k] = v.map(|x| x * s);
+                }
+            }
+        }
+        let mut mat = [[0.0; K]; K];
+        let mut x = [0.0; K];
+        for r in 0..n {
+            for c in 0..n {
+                mat[r][c] = f64::from(u8::from(r == c)) - w[c][self.da_idx[r]];
+            }
+            x[r] = z1[self.da_idx[r]] - zp[self.da_idx[r]];
+        }
+        solve_small(&mut mat, &mut x, n);
+        for k in 0..n {
+            for i in 0..NT {
+                z1[i] += w[k][i] * x[k];
+            }
+        }
+    }
+
     /// The corrector of the step predicted by [`Thermal::predict`] (`pred`,
     /// with the same `phi` and `h`), given the model's rates `fp`, `qp` at
     /// the predicted end.
@@ -293,33 +329,12 @@ impl Thermal {
             let (c1, c2) = end_weights(&pts[..m + 2]);
             let exact = self.a_zero || phi.is_some();
             if exact {
-                let mut w = [[0.0; NT]; NT];
-                for k in 0..n {
-                    let v = &da[self.da_idx[k]];
-                    match phi {
-                        Some(p) if !self.a_zero => {
-                            mul_vec_add_cols(&p.cols[1], &v.map(|x| x * h * c1), &mut w[k]);
-                            mul_vec_add_cols(&p.cols[2], &v.map(|x| x * h * h * c2), &mut w[k]);
-                        }
-                        _ => {
-                            let s = h * h * c1 / 2.0 + h * h * h * c2 / 6.0;
-                            w[k] = v.map(|x| x * s);
-                        }
-                    }
-                }
-                let mut mat = [[0.0; NT]; NT];
-                let mut x = [0.0; NT];
-                for r in 0..n {
-                    for c in 0..n {
-                        mat[r][c] = f64::from(u8::from(r == c)) - w[c][self.da_idx[r]];
-                    }
-                    x[r] = z1[self.da_idx[r]] - zp[self.da_idx[r]];
-                }
-                solve_small(&mut mat, &mut x, n);
-                for k in 0..n {
-                    for i in 0..NT {
-                        z1[i] += w[k][i] * x[k];
-                    }
+                // (The system's arrays as small as the drifting columns
+                // allow: zeroed whole, NT×NT, they were two `memset`s a try.)
+                if n <= DRIFT_SMALL {
+                    self.drift_exact::<DRIFT_SMALL>(phi, h, c1, c2, da, zp, &mut z1);
+                } else {
+                    self.drift_exact::<NT>(phi, h, c1, c2, da, zp, &mut z1);
                 }
             } else {
                 for _ in 0..DRIFT_ITERS {
@@ -405,11 +420,16 @@ fn end_weights(pts: &[(f64, &[f64; NT])]) -> (f64, f64) {
     }
 }
 
+/// Drifting columns up to which the corrector's drift solve takes
+/// K×K arrays (beyond it, NT×NT).
+const DRIFT_SMALL: usize = 4;
+
 /// Solves the leading n×n system m·x = b in place (Gaussian elimination
 /// with partial pivoting; b becomes x). Not `dense::Lu`: that factorises
 /// the whole NT×NT matrix, ~13³/3 operations a corrector for a system of
 /// the one or two drifting columns.
-fn solve_small(m: &mut [[f64; NT]; NT], b: &mut [f64; NT], n: usize) {
+#[inline(always)]
+fn solve_small<const K: usize>(m: &mut [[f64; K]; K], b: &mut [f64; K], n: usize) {
     for c in 0..n {
         let p = (c..n).max_by(|&i, &j| m[i][c].abs().total_cmp(&m[j][c].abs())).unwrap_or(c);
         m.swap(c, p);
