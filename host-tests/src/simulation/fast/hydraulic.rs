@@ -59,20 +59,31 @@ pub struct TempPath {
     z1: [f64; N_NODES],
     oil0: HydraulicOil,
     oil1: HydraulicOil,
+    /// t₁ − t₀ and oil1 − oil0, taken once a path (the same bits as in
+    /// every `weight` and `oil_at`, which took them at each evaluation).
+    dt: f64,
+    doil: HydraulicOil,
 }
 
 impl TempPath {
     /// Constant temperatures `z`, with the oil's properties there
     /// (`Model::hydraulic_oil(z)`).
     pub fn constant(z: [f64; N_NODES], oil: HydraulicOil) -> Self {
-        Self { t0: 0.0, z0: z, t1: 1.0, z1: z, oil0: oil, oil1: oil }
+        Self::line(0.0, z, 1.0, z, oil, oil)
+    }
+
+    /// The line through (t0, z0) and (t1, z1), with the oil's properties
+    /// `oil0`, `oil1` at its two points.
+    pub fn line(t0: f64, z0: [f64; N_NODES], t1: f64, z1: [f64; N_NODES], oil0: HydraulicOil, oil1: HydraulicOil) -> Self {
+        let doil = HydraulicOil { k_leak: oil1.k_leak - oil0.k_leak, rho_ball: oil1.rho_ball - oil0.rho_ball, nu_ball: oil1.nu_ball - oil0.nu_ball };
+        Self { t0, z0, t1, z1, oil0, oil1, dt: t1 - t0, doil }
     }
 
     /// Weight of the second point at `t` (held beyond the points: a
     /// hydraulic step past the thermal step must not extrapolate a transient).
     fn weight(&self, t: f64) -> f64 {
         if self.t1 > self.t0 {
-            ((t - self.t0) / (self.t1 - self.t0)).clamp(0.0, 1.0)
+            ((t - self.t0) / self.dt).clamp(0.0, 1.0)
         } else {
             0.0
         }
@@ -86,14 +97,16 @@ impl TempPath {
 
     /// The hydraulics' oil properties at `t`.
     pub fn oil_at(&self, t: f64) -> HydraulicOil {
-        self.oil0.lerp(&self.oil1, self.weight(t))
+        // `HydraulicOil::lerp` with the differences kept.
+        let (w, a, d) = (self.weight(t), &self.oil0, &self.doil);
+        HydraulicOil { k_leak: a.k_leak + w * d.k_leak, rho_ball: a.rho_ball + w * d.rho_ball, nu_ball: a.nu_ball + w * d.nu_ball }
     }
 }
 
 impl HydTrack {
     /// A track with `ros` as integrator, starting at (t, y).
     pub fn new(ros: Rosenbrock<NH>, t: f64, y: [f64; NH]) -> Self {
-        let path = TempPath { t0: 0.0, z0: [0.0; N_NODES], t1: 1.0, z1: [0.0; N_NODES], oil0: HydraulicOil::default(), oil1: HydraulicOil::default() };
+        let path = TempPath::constant([0.0; N_NODES], HydraulicOil::default());
         Self { ros, pts: vec![(t, y, [0.0; NH])], last_branch: None, path, coupled: false, pending: None }
     }
 
@@ -159,7 +172,7 @@ impl HydTrack {
     pub fn set_line(&mut self, model: &Model, t0: f64, z0: [f64; N_NODES], t1: f64, z1: [f64; N_NODES]) {
         self.fill(model);
         let oil0 = if self.path.z1 == z0 { self.path.oil1 } else { model.hydraulic_oil(&z0) };
-        self.path = TempPath { t0, z0, t1, z1, oil0, oil1: model.hydraulic_oil(&z1) };
+        self.path = TempPath::line(t0, z0, t1, z1, oil0, model.hydraulic_oil(&z1));
     }
 
     /// Integrates until the track covers `t` (at most up to `t_max`, a
