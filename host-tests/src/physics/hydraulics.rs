@@ -257,6 +257,8 @@ pub fn speed_limit(raw: f64, wmax: f64) -> f64 {
 /// Derivatives of the hydraulic states (`dy` = the derivative of the full
 /// state), given the operating point `op` and flows `f`.
 pub fn derivatives(rig: &Rig, m: &Mission, t: f64, op: &OpPoint, f: &Flows, dy: &mut [f64]) {
+    // One length check for the five writes.
+    let dy: &mut [f64; ix::N] = (&mut dy[..ix::N]).try_into().expect("the hydraulic derivatives");
     let act = &rig.actuator;
     let beta = rig.hydraulics.bulk_modulus_pa;
     let v_line = rig.hydraulics.line_volume_m3;

@@ -36,6 +36,12 @@ pub struct HydTrack {
     /// step; reaching one thermal step ahead on extrapolated temperatures,
     /// 1e-2 K and 4 k steps.)
     coupled: bool,
+    /// The time argument of the last point's f when the coupled step that
+    /// made it left f untaken (see [`Rosenbrock::step`]'s `lazy_end`): the
+    /// thermal step's end takes f there anew with the new temperatures
+    /// (`advance`), so it is taken here only where it is read
+    /// (`fill`), with the path it was integrated on.
+    pending: Option<f64>,
 }
 
 /// Node temperatures linear in time through two points, and the oil
@@ -53,20 +59,31 @@ pub struct TempPath {
     z1: [f64; N_NODES],
     oil0: HydraulicOil,
     oil1: HydraulicOil,
+    /// t₁ − t₀ and oil1 − oil0, taken once a path (the same bits as in
+    /// every `weight` and `oil_at`, which took them at each evaluation).
+    dt: f64,
+    doil: HydraulicOil,
 }
 
 impl TempPath {
     /// Constant temperatures `z`, with the oil's properties there
     /// (`Model::hydraulic_oil(z)`).
     pub fn constant(z: [f64; N_NODES], oil: HydraulicOil) -> Self {
-        Self { t0: 0.0, z0: z, t1: 1.0, z1: z, oil0: oil, oil1: oil }
+        Self::line(0.0, z, 1.0, z, oil, oil)
+    }
+
+    /// The line through (t0, z0) and (t1, z1), with the oil's properties
+    /// `oil0`, `oil1` at its two points.
+    pub fn line(t0: f64, z0: [f64; N_NODES], t1: f64, z1: [f64; N_NODES], oil0: HydraulicOil, oil1: HydraulicOil) -> Self {
+        let doil = HydraulicOil { k_leak: oil1.k_leak - oil0.k_leak, rho_ball: oil1.rho_ball - oil0.rho_ball, nu_ball: oil1.nu_ball - oil0.nu_ball };
+        Self { t0, z0, t1, z1, oil0, oil1, dt: t1 - t0, doil }
     }
 
     /// Weight of the second point at `t` (held beyond the points: a
     /// hydraulic step past the thermal step must not extrapolate a transient).
     fn weight(&self, t: f64) -> f64 {
         if self.t1 > self.t0 {
-            ((t - self.t0) / (self.t1 - self.t0)).clamp(0.0, 1.0)
+            ((t - self.t0) / self.dt).clamp(0.0, 1.0)
         } else {
             0.0
         }
@@ -80,15 +97,40 @@ impl TempPath {
 
     /// The hydraulics' oil properties at `t`.
     pub fn oil_at(&self, t: f64) -> HydraulicOil {
-        self.oil0.lerp(&self.oil1, self.weight(t))
+        // `HydraulicOil::lerp` with the differences kept.
+        let (w, a, d) = (self.weight(t), &self.oil0, &self.doil);
+        HydraulicOil { k_leak: a.k_leak + w * d.k_leak, rho_ball: a.rho_ball + w * d.rho_ball, nu_ball: a.nu_ball + w * d.nu_ball }
     }
 }
 
 impl HydTrack {
     /// A track with `ros` as integrator, starting at (t, y).
     pub fn new(ros: Rosenbrock<NH>, t: f64, y: [f64; NH]) -> Self {
-        let path = TempPath { t0: 0.0, z0: [0.0; N_NODES], t1: 1.0, z1: [0.0; N_NODES], oil0: HydraulicOil::default(), oil1: HydraulicOil::default() };
-        Self { ros, pts: vec![(t, y, [0.0; NH])], last_branch: None, path, coupled: false }
+        let path = TempPath::constant([0.0; N_NODES], HydraulicOil::default());
+        Self { ros, pts: vec![(t, y, [0.0; NH])], last_branch: None, path, coupled: false, pending: None }
+    }
+
+    /// The last point's f, when a step left it untaken (`pending`): with
+    /// the path the point was integrated on (every change of the path
+    /// fills it first), the same bits as the step's own evaluation.
+    fn fill(&mut self, model: &Model) {
+        if let Some(te) = self.pending.take() {
+            let p = self.pts.last_mut().expect("a pending point is the last");
+            model.hydraulic_rhs_oil(te, &p.1, &self.path.oil_at(p.0), &mut p.2);
+            self.ros.stats.evals += 1;
+        }
+    }
+
+    /// [`Self::fill`] when reading the track at `t` needs the last point's
+    /// f ([`Self::at`] reads it past the point before the last, at any
+    /// time but the last point's own).
+    fn fill_for(&mut self, model: &Model, t: f64) {
+        if self.pending.is_some() {
+            let n = self.pts.len();
+            if n >= 2 && t > self.pts[n - 2].0 && t != self.pts[n - 1].0 {
+                self.fill(model);
+            }
+        }
     }
 
     /// Restart at (t, y) with step `h0`: the first point's f is computed
@@ -101,6 +143,7 @@ impl HydTrack {
         self.path = TempPath::constant(*z, model.hydraulic_oil(z));
         self.pts.clear();
         self.pts.push((t, y, f));
+        self.pending = None;
         self.last_branch = None;
         self.ros.h = h0;
         self.ros.forget_jacobian();
@@ -127,8 +170,9 @@ impl HydTrack {
     /// (t0, z0) and (t1, z1) (the properties at z0 kept from the last path
     /// when it ended there).
     pub fn set_line(&mut self, model: &Model, t0: f64, z0: [f64; N_NODES], t1: f64, z1: [f64; N_NODES]) {
+        self.fill(model);
         let oil0 = if self.path.z1 == z0 { self.path.oil1 } else { model.hydraulic_oil(&z0) };
-        self.path = TempPath { t0, z0, t1, z1, oil0, oil1: model.hydraulic_oil(&z1) };
+        self.path = TempPath::line(t0, z0, t1, z1, oil0, model.hydraulic_oil(&z1));
     }
 
     /// Integrates until the track covers `t` (at most up to `t_max`, a
@@ -136,6 +180,7 @@ impl HydTrack {
     /// schedules are read as left limits at `t_max` (a step there belongs
     /// to the next segment).
     pub fn cover(&mut self, model: &Model, t: f64, t_max: f64) -> Result<(), RosError> {
+        self.fill(model);
         let Some(&(mut tt, mut y, mut f)) = self.pts.last() else { return Ok(()) };
         let t_left = left_of(t_max);
         let t_stop = if self.coupled { t.min(t_max) } else { t_max };
@@ -143,8 +188,13 @@ impl HydTrack {
         let path = &self.path;
         let mut fun = |t: f64, y: &[f64; NH], d: &mut [f64; NH]| model.hydraulic_rhs_oil(t.min(t_left), y, &path.oil_at(t), d);
         while tt < t - 1e-12 * t.abs().max(1.0) && tt < t_stop {
-            tt = self.ros.step(&mut fun, tt, &mut y, &mut f, t_stop)?;
+            // Coupled, a step to the thermal step's end leaves f there
+            // untaken (`pending`).
+            tt = self.ros.step(&mut fun, tt, &mut y, &mut f, t_stop, self.coupled)?;
             self.pts.push((tt, y, f));
+            if self.coupled && tt == t_stop {
+                self.pending = Some(tt.min(t_left));
+            }
         }
         Ok(())
     }
@@ -153,14 +203,23 @@ impl HydTrack {
     /// their integration past `t` (the step's start) goes.
     pub fn reject(&mut self, t: f64) {
         if self.coupled {
-            let i = self.pts.partition_point(|p| p.0 <= t);
+            let (n, i) = (self.pts.len(), self.pts.partition_point(|p| p.0 <= t));
             self.pts.truncate(i.max(1));
+            if self.pts.len() < n {
+                self.pending = None;
+            }
             self.last_branch = None;
         }
     }
 
     /// The hydraulic states at `t` (inside the track), cubic Hermite.
-    pub fn at(&self, t: f64) -> [f64; NH] {
+    pub fn at(&mut self, model: &Model, t: f64) -> [f64; NH] {
+        self.fill_for(model, t);
+        self.at_filled(t)
+    }
+
+    /// [`Self::at`] where the f it reads are all taken.
+    fn at_filled(&self, t: f64) -> [f64; NH] {
         let n = self.pts.len();
         if n < 2 {
             return self.pts.first().map_or([0.0; NH], |p| p.1);
@@ -187,6 +246,9 @@ impl HydTrack {
     /// temperatures): the track goes on from its interpolant at `t`, with
     /// f taken anew at the temperatures `z` of the step's end.
     pub fn advance(&mut self, model: &Model, t: f64, z: &[f64; N_NODES], t_max: f64) {
+        // A point left without f stays pending only at t, where it is
+        // replaced below.
+        self.fill_for(model, t);
         // The oil properties at z once, for f and for the path (the same
         // bits as `rhs`, which computes them from z).
         let oil = model.hydraulic_oil(z);
@@ -203,7 +265,7 @@ impl HydTrack {
             // (a Jacobian and ∂f/∂t of differences against it: with the
             // check every 16th step, Case 1's pump start took 52 rejected
             // hydraulic steps, some blowing up to 1e12 Pa, before it).
-            let (y, mut f) = (self.at(t), [0.0; NH]);
+            let (y, mut f) = (self.at_filled(t), [0.0; NH]);
             model.hydraulic_rhs_oil(t_f, &y, &oil, &mut f);
             self.ros.stats.evals += 1;
             self.check_coupling(model, z, t_f, &y, &f);
@@ -213,7 +275,7 @@ impl HydTrack {
             // The track ends at t (or past it before a callback's rewind):
             // f there anew with the step's end temperatures.
             let (y, f) = at_t.unwrap_or_else(|| {
-                let (y, mut f) = (self.at(t), [0.0; NH]);
+                let (y, mut f) = (self.at_filled(t), [0.0; NH]);
                 model.hydraulic_rhs_oil(t_f, &y, &oil, &mut f);
                 self.ros.stats.evals += 1;
                 (y, f)
@@ -221,6 +283,7 @@ impl HydTrack {
             let i = self.pts.partition_point(|p| p.0 < t);
             self.pts.truncate(i);
             self.pts.push((t, y, f));
+            self.pending = None;
             // The branch values the last scan ended with at t stay (the
             // same state; the oil of the step's end temperatures instead
             // of the predicted ones moves them by a few millionths, and
@@ -256,26 +319,26 @@ impl HydTrack {
     /// the covered track, as a bracket (t_lo, t_hi) narrower than 1e-7 s
     /// (relative to t), or None.
     pub fn first_switch(&mut self, model: &Model, t0: f64, t1: f64) -> Option<(f64, f64)> {
-        let path = self.path;
-        let val = |t: f64| branch_values(model, &path.oil_at(t), t, &self.at(t));
         let mut ta = t0;
         let mut va = match self.last_branch {
             Some((t, v)) if t == t0 => v,
-            _ => val(t0),
+            _ => self.branch_at(model, t0),
         };
-        let inner = self.pts.iter().map(|p| p.0).filter(|&t| t > t0 && t < t1);
-        let mut end = None;
-        for tb in inner.chain(std::iter::once(t1)) {
-            let vb = val(tb);
-            if tb == t1 {
-                end = Some((t1, vb));
-            }
+        // The track's points inside (t0, t1) (in order), then t1.
+        let mut k = self.pts.partition_point(|p| p.0 <= t0);
+        loop {
+            let tb = match self.pts.get(k) {
+                Some(p) if p.0 < t1 => p.0,
+                _ => t1,
+            };
+            k += 1;
+            let vb = self.branch_at(model, tb);
             if crossed(&va, &vb) {
                 let (mut lo, mut hi) = (ta, tb);
                 let width = 1e-7 * t1.abs().max(1.0);
                 while hi - lo > width {
                     let mid = 0.5 * (lo + hi);
-                    if crossed(&va, &val(mid)) {
+                    if crossed(&va, &self.branch_at(model, mid)) {
                         hi = mid;
                     } else {
                         lo = mid;
@@ -284,10 +347,18 @@ impl HydTrack {
                 self.last_branch = None;
                 return Some((lo, hi));
             }
+            if tb == t1 {
+                self.last_branch = Some((t1, vb));
+                return None;
+            }
             (ta, va) = (tb, vb);
         }
-        self.last_branch = end;
-        None
+    }
+
+    /// The branch values on the track at `t`.
+    fn branch_at(&mut self, model: &Model, t: f64) -> [f64; 3] {
+        let yh = self.at(model, t);
+        branch_values(model, &self.path.oil_at(t), t, &yh)
     }
 }
 

@@ -176,6 +176,10 @@ pub struct FastStats {
     pub hydraulics: RosStats,
 }
 
+/// The step levels' φ-functions, by level (boxed: a level is 5.4 kB and a
+/// run uses a dozen of the 33).
+type Ladder = Vec<Option<Box<Phi<NT>>>>;
+
 /// The multirate plant (see the module documentation).
 #[derive(Debug)]
 pub struct FastPlant {
@@ -188,8 +192,10 @@ pub struct FastPlant {
     opts: FastOptions,
     hyd: HydTrack,
     /// The thermal scheme and its step levels, kept between runs, and the
-    /// valve state its Jacobian belongs to.
-    thermal: Option<(Thermal, Vec<Option<Box<Phi<NT>>>>)>,
+    /// valve state its Jacobian belongs to. Boxed: inline, its ~4.7 kB
+    /// made the plant a copy glibc does byte by byte (`rep movsb`), twice
+    /// in `sim::simulate_fast_with` (~10 k instructions a run).
+    thermal: Option<Box<(Thermal, Ladder)>>,
     jacobian_valve: bool,
     stats: FastStats,
     step_limit: Option<u64>,
@@ -320,8 +326,9 @@ impl FastPlant {
         // first milliseconds from rest) and takes the Jacobian once the step
         // has grown 64-fold; later runs keep theirs.
         let first_run = self.thermal.is_none();
-        let (mut th, mut ladder) =
-            self.thermal.take().unwrap_or_else(|| (Thermal::new(self.t, [0.0; NT], [0.0; NE]), (0..LEVELS).map(|_| None).collect()));
+        let mut kept =
+            self.thermal.take().unwrap_or_else(|| Box::new((Thermal::new(self.t, [0.0; NT], [0.0; NE]), (0..LEVELS).map(|_| None).collect())));
+        let (th, ladder) = &mut *kept;
         th.t = self.t;
         th.z = std::array::from_fn(|i| self.y[T0 + i]);
         th.e = std::array::from_fn(|i| self.y[T0 + NT + i]);
@@ -378,7 +385,7 @@ impl FastPlant {
             }
             if todo.jacobian || todo.fresh || todo.switch.is_some() || todo.drift {
                 let (t, yy) = match todo.switch {
-                    Some(ts) if !replay => (ts, self.hyd.at(ts)),
+                    Some(ts) if !replay => (ts, self.hyd.at(&self.model, ts)),
                     _ => (self.t, yh),
                 };
                 let (model, stats) = (&self.model, &mut self.stats);
@@ -435,7 +442,7 @@ impl FastPlant {
             // polynomial in closed form (`Thermal::linear`): no level's
             // matrices (4 of them, 5.4 kB, built and boxed per level).
             let mut phi = if !odd && !th.is_zero() {
-                Some(self.phi(&mut ladder, &th, level, dt_s))
+                Some(self.phi(ladder, th, level, dt_s))
             } else if norm1(&th.a) * h > VECTOR_NORM_MAX {
                 self.stats.phi_builds += 1;
                 odd_phi = Phi::new(&th.a, h);
@@ -443,13 +450,13 @@ impl FastPlant {
             } else {
                 None
             };
-            let (mut zp, mut g0) = th.predict(phi, h);
+            let mut pred = th.predict(phi, h);
             // The hydraulic states at the step's end, from their own track
             // (seeing the temperatures on the line to the predictor); a
             // branch switch of the heat balances inside ends the step there.
             let mut switch = None;
             if !replay {
-                self.hyd.set_line(&self.model, self.t, th.z, t1, zp);
+                self.hyd.set_line(&self.model, self.t, th.z, t1, pred.zp);
                 self.hyd.cover(&self.model, t1, seg_end).map_err(hyd_error)?;
                 if let Some((lo, hi)) = self.hyd.first_switch(&self.model, scan_from.max(self.t), t1) {
                     scan_from = hi;
@@ -468,16 +475,16 @@ impl FastPlant {
                         odd_phi2 = Phi::new(&th.a, h);
                         phi = Some(&odd_phi2);
                     }
-                    (zp, g0) = th.predict(phi, h);
+                    pred = th.predict(phi, h);
                 }
             }
             let seg_done = (partial || ends) && switch.is_none();
-            let yh1 = if replay { yh } else { self.hyd.at(t1) };
+            let yh1 = if replay { yh } else { self.hyd.at(&self.model, t1) };
             // At a breakpoint the segment's schedules end with their left limits.
             let t_eval = if seg_done { left_of(t1) } else { t1 };
             let (mut fp, mut qp) = ([0.0; NT], [0.0; NE]);
-            Self::rates(&self.model, &mut self.stats, t_eval, &yh1, &zp, &mut fp, &mut qp);
-            let trial = th.correct(phi, h, &zp, &g0, &fp, &qp);
+            Self::rates(&self.model, &mut self.stats, t_eval, &yh1, &pred.zp, &mut fp, &mut qp);
+            let trial = th.correct(phi, h, &pred, &fp, &qp);
             let tol = if self.t < loose_until { self.opts.tol_k * self.opts.start_tol_factor } else { self.opts.tol_k };
             let err = trial.err_k / tol;
             let hyd_h = if replay { f64::INFINITY } else { self.hyd.ros.h };
@@ -557,13 +564,13 @@ impl FastPlant {
                     }
                 }
             }
-            self.write_state(&yh, &th);
+            self.write_state(&yh, th);
             // Callbacks inside the step, on the interpolants.
             while !ctl.stop && t_cb <= t1 + 1e-9 && t_cb <= t_end + 1e-9 {
                 let at_end = (t_cb - t1).abs() <= 1e-9;
                 let tc = if at_end { t_cb } else { t_cb.min(t1) };
                 if at_end {
-                    self.write_state(&yh, &th);
+                    self.write_state(&yh, th);
                 } else {
                     let (a0, b0, a1, b1) = hermite((tc - t0) / h);
                     for i in 0..NT {
@@ -572,7 +579,7 @@ impl FastPlant {
                     for i in 0..NE {
                         self.y[T0 + NT + i] = a0 * e0[i] + b0 * h * q0[i] + a1 * th.e[i] + b1 * h * th.q[i];
                     }
-                    let yhc = if replay { yh0 } else { self.hyd.at(tc) };
+                    let yhc = if replay { yh0 } else { self.hyd.at(&self.model, tc) };
                     self.y[..NH].copy_from_slice(&yhc);
                 }
                 let snap = snapshot_stored(&self.model, tc, &self.y, self.model.stored_energy_from(&self.e0, &self.y));
@@ -604,14 +611,14 @@ impl FastPlant {
                     continue 'outer;
                 }
             }
-            self.write_state(&yh, &th);
+            self.write_state(&yh, th);
             if !replay {
                 self.hyd.advance(&self.model, self.t, &th.z, seg_end);
             }
         }
         (self.hyd.ros.rtol, self.hyd.ros.atol) = (rtol0, atol0);
         self.stats.hydraulics = self.hyd.ros.stats;
-        self.thermal = Some((th, ladder));
+        self.thermal = Some(kept);
         Ok(())
     }
 

@@ -222,7 +222,7 @@ impl<const N: usize> Rosenbrock<N> {
         self.stats.evals += 1;
         on_point(t, y, &f0);
         while t1 - t > 1e-14 * t1.abs().max(1.0) {
-            t = self.step(&mut f, t, y, &mut f0, t1)?;
+            t = self.step(&mut f, t, y, &mut f0, t1, false)?;
             on_point(t, y, &f0);
         }
         Ok(())
@@ -232,11 +232,33 @@ impl<const N: usize> Rosenbrock<N> {
     /// before `t_max` (exactly at `t_max` when the step reaches it or would
     /// leave less than 5 % of itself). Updates `y` and `f0` to the new point
     /// and returns its time; the next step size is kept in `self.h`.
-    pub fn step<F>(&mut self, f: &mut F, t: f64, y: &mut [f64; N], f0: &mut [f64; N], t_max: f64) -> Result<f64, RosError>
+    ///
+    /// With `lazy_end`, a step that ends at `t_max` leaves f there to the
+    /// caller (`f0` all NaN, no evaluation): [`super::hydraulic::HydTrack`]
+    /// takes it only where it is read (the thermal step's end usually
+    /// takes it anew with the new temperatures).
+    pub fn step<F>(&mut self, f: &mut F, t: f64, y: &mut [f64; N], f0: &mut [f64; N], t_max: f64, lazy_end: bool) -> Result<f64, RosError>
+    where
+        F: FnMut(f64, &[f64; N], &mut [f64; N]),
+    {
+        // The stage count as a constant for the two tableaus here (the
+        // stage loops unrolled: the same operations in the same order,
+        // fewer instructions), the tableau's own count otherwise.
+        match self.tab.s {
+            4 => self.step_s::<F, 4>(f, t, y, f0, t_max, lazy_end),
+            6 => self.step_s::<F, 6>(f, t, y, f0, t_max, lazy_end),
+            _ => self.step_s::<F, 0>(f, t, y, f0, t_max, lazy_end),
+        }
+    }
+
+    /// [`Rosenbrock::step`] with `S` stages (0: `self.tab.s`).
+    #[inline(always)]
+    fn step_s<F, const S: usize>(&mut self, f: &mut F, t: f64, y: &mut [f64; N], f0: &mut [f64; N], t_max: f64, lazy_end: bool) -> Result<f64, RosError>
     where
         F: FnMut(f64, &[f64; N], &mut [f64; N]),
     {
         let tab = &self.tab;
+        let ns = if S == 0 { tab.s } else { S };
         let h_min = 1e-14 * t_max.abs().max(1.0);
         let h_try = self.h;
         // Near `t_max`, equal steps to it rather than full ones and a
@@ -297,7 +319,7 @@ impl<const N: usize> Rosenbrock<N> {
             let Some((lu, _)) = &self.lu else { unreachable!("an LU was just built") };
             let mut k = [[0.0; N]; S_MAX];
             let mut fs = *f0;
-            for s in 0..tab.s {
+            for s in 0..ns {
                 if s > 0 {
                     let mut ys = *y;
                     for (j, kj) in k.iter().enumerate().take(s) {
@@ -329,7 +351,7 @@ impl<const N: usize> Rosenbrock<N> {
             let mut err = 0.0;
             for i in 0..N {
                 let mut e = 0.0;
-                for ((m, es), ks) in tab.m.iter().zip(&tab.e).zip(&k).take(tab.s) {
+                for ((m, es), ks) in tab.m.iter().zip(&tab.e).zip(&k).take(ns) {
                     y1[i] += m * ks[i];
                     e += es * ks[i];
                 }
@@ -347,8 +369,12 @@ impl<const N: usize> Rosenbrock<N> {
             if err <= 1.0 && err.is_finite() {
                 let t1 = if h == t_max - t { t_max } else { t + h };
                 *y = y1;
-                f(t1, y, f0);
-                self.stats.evals += 1;
+                if lazy_end && t1 == t_max {
+                    *f0 = [f64::NAN; N];
+                } else {
+                    f(t1, y, f0);
+                    self.stats.evals += 1;
+                }
                 self.stats.steps += 1;
                 if let Some((_, age, _)) = &mut self.jac {
                     *age += 1;

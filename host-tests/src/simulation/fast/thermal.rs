@@ -93,6 +93,17 @@ pub struct Thermal {
     da_norm: f64,
 }
 
+/// A step predicted from the current state ([`Thermal::predict`]).
+#[derive(Debug, Clone, Copy)]
+pub struct Prediction {
+    /// Predicted temperatures z*, °C.
+    pub zp: [f64; NT],
+    /// g at the step's start (current A), K/s.
+    pub g0: [f64; NT],
+    /// z₀ + Φ₁·f₀ of the level's matrices (None: an odd step by vectors, or A = 0).
+    base: Option<[f64; NT]>,
+}
+
 /// A step tried from the current state.
 #[derive(Debug, Clone, Copy)]
 pub struct Trial {
@@ -208,8 +219,10 @@ impl Thermal {
     }
 
     /// z(h) of z' = A·z + g₀ + g'·s + g''·s²/2 from z₀ (A·z₀ + g₀ = f₀),
-    /// by the level's matrices or the vector solution.
-    fn linear(&self, phi: Option<&Phi<NT>>, h: f64, g0: &[f64; NT], d: &([f64; NT], [f64; NT])) -> [f64; NT] {
+    /// by the level's matrices or the vector solution. `base`: z₀ + Φ₁·f₀
+    /// of the level's matrices when already taken (the predictor's, shared
+    /// with the corrector: the same sums, so the same bits).
+    fn linear(&self, phi: Option<&Phi<NT>>, h: f64, g0: &[f64; NT], d: &([f64; NT], [f64; NT]), base: Option<&[f64; NT]>) -> [f64; NT] {
         if self.a_zero {
             // A = 0: Φ_k = h/k!·I, f₀ = g₀.
             let (c1, c2) = (h * h / 2.0, h * h * h / 6.0);
@@ -218,8 +231,10 @@ impl Thermal {
         match phi {
             Some(p) => {
                 // z₀ + Φ₁·f₀ + h·Φ₂·g' + h²·Φ₃·g''
-                let mut z = self.z;
-                mul_vec_add_cols(&p.cols[0], &self.fz, &mut z);
+                let mut z = match base {
+                    Some(b) => *b,
+                    None => self.base(p),
+                };
                 mul_vec_add_cols(&p.cols[1], &d.0.map(|x| x * h), &mut z);
                 mul_vec_add_cols(&p.cols[2], &d.1.map(|x| x * h * h), &mut z);
                 z
@@ -228,9 +243,16 @@ impl Thermal {
         }
     }
 
+    /// z₀ + Φ₁·f₀ of a level's matrices.
+    fn base(&self, p: &Phi<NT>) -> [f64; NT] {
+        let mut z = self.z;
+        mul_vec_add_cols(&p.cols[0], &self.fz, &mut z);
+        z
+    }
+
     /// The predictor of a step of `h` s (`phi`: the level's matrices, None:
-    /// an odd step): z* and g₀.
-    pub fn predict(&self, phi: Option<&Phi<NT>>, h: f64) -> ([f64; NT], [f64; NT]) {
+    /// an odd step): z*, g₀ and z₀ + Φ₁·f₀ for the corrector.
+    pub fn predict(&self, phi: Option<&Phi<NT>>, h: f64) -> Prediction {
         let az0 = mul_vec_cols(&self.a_cols, &self.z);
         let g0: [f64; NT] = std::array::from_fn(|i| self.fz[i] - az0[i]);
         // The polynomial through the stored g and g₀.
@@ -240,12 +262,52 @@ impl Thermal {
             pts[k] = (t - self.t, g);
         }
         pts[n] = (0.0, &g0);
-        (self.linear(phi, h, &g0, &derivatives(&pts[..=n])), g0)
+        let base = phi.filter(|_| !self.a_zero).map(|p| self.base(p));
+        let zp = self.linear(phi, h, &g0, &derivatives(&pts[..=n]), base.as_ref());
+        Prediction { zp, g0, base }
     }
 
-    /// The corrector of the step predicted by [`Thermal::predict`] (`zp`,
-    /// `g0`), given the model's rates `fp`, `qp` at the predicted end.
-    pub fn correct(&self, phi: Option<&Phi<NT>>, h: f64, zp: &[f64; NT], g0: &[f64; NT], fp: &[f64; NT], qp: &[f64; NE]) -> Trial {
+    /// The corrector's exact drift solve (see `correct`) with at most `K`
+    /// drifting columns: z₁ += M·δ over them.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn drift_exact<const K: usize>(&self, phi: Option<&Phi<NT>>, h: f64, c1: f64, c2: f64, da: &[[f64; NT]; NT], zp: &[f64; NT], z1: &mut [f64; NT]) {
+        let n = self.da_n;
+        let mut w = [[0.0; NT]; K];
+        for k in 0..n {
+            let v = &da[self.da_idx[k]];
+            match phi {
+                Some(p) if !self.a_zero => {
+                    mul_vec_add_cols(&p.cols[1], &v.map(|x| x * h * c1), &mut w[k]);
+                    mul_vec_add_cols(&p.cols[2], &v.map(|x| x * h * h * c2), &mut w[k]);
+                }
+                _ => {
+                    let s = h * h * c1 / 2.0 + h * h * h * c2 / 6.0;
+                    w[k] = v.map(|x| x * s);
+                }
+            }
+        }
+        let mut mat = [[0.0; K]; K];
+        let mut x = [0.0; K];
+        for r in 0..n {
+            for c in 0..n {
+                mat[r][c] = f64::from(u8::from(r == c)) - w[c][self.da_idx[r]];
+            }
+            x[r] = z1[self.da_idx[r]] - zp[self.da_idx[r]];
+        }
+        solve_small(&mut mat, &mut x, n);
+        for k in 0..n {
+            for i in 0..NT {
+                z1[i] += w[k][i] * x[k];
+            }
+        }
+    }
+
+    /// The corrector of the step predicted by [`Thermal::predict`] (`pred`,
+    /// with the same `phi` and `h`), given the model's rates `fp`, `qp` at
+    /// the predicted end.
+    pub fn correct(&self, phi: Option<&Phi<NT>>, h: f64, pred: &Prediction, fp: &[f64; NT], qp: &[f64; NE]) -> Trial {
+        let (zp, g0) = (&pred.zp, &pred.g0);
         let azp = mul_vec_cols(&self.a_cols, zp);
         let gp: [f64; NT] = std::array::from_fn(|i| fp[i] - azp[i]);
         // The polynomial through the latest stored g, g₀ and g*.
@@ -256,7 +318,7 @@ impl Thermal {
         }
         pts[m] = (0.0, g0);
         pts[m + 1] = (h, &gp);
-        let mut z1 = self.linear(phi, h, g0, &derivatives(&pts[..m + 2]));
+        let mut z1 = self.linear(phi, h, g0, &derivatives(&pts[..m + 2]), pred.base.as_ref());
         if let Some(da) = self.da_cols.as_ref().filter(|_| h * self.da_norm >= DRIFT_GATE) {
             // The corrector with g at its end linear in the drift:
             // g(z₁) = g* + (Â − A)·(z₁ − z*). z₁ is affine in g*: a change δ
@@ -267,33 +329,12 @@ impl Thermal {
             let (c1, c2) = end_weights(&pts[..m + 2]);
             let exact = self.a_zero || phi.is_some();
             if exact {
-                let mut w = [[0.0; NT]; NT];
-                for k in 0..n {
-                    let v = &da[self.da_idx[k]];
-                    match phi {
-                        Some(p) if !self.a_zero => {
-                            mul_vec_add_cols(&p.cols[1], &v.map(|x| x * h * c1), &mut w[k]);
-                            mul_vec_add_cols(&p.cols[2], &v.map(|x| x * h * h * c2), &mut w[k]);
-                        }
-                        _ => {
-                            let s = h * h * c1 / 2.0 + h * h * h * c2 / 6.0;
-                            w[k] = v.map(|x| x * s);
-                        }
-                    }
-                }
-                let mut mat = [[0.0; NT]; NT];
-                let mut x = [0.0; NT];
-                for r in 0..n {
-                    for c in 0..n {
-                        mat[r][c] = f64::from(u8::from(r == c)) - w[c][self.da_idx[r]];
-                    }
-                    x[r] = z1[self.da_idx[r]] - zp[self.da_idx[r]];
-                }
-                solve_small(&mut mat, &mut x, n);
-                for k in 0..n {
-                    for i in 0..NT {
-                        z1[i] += w[k][i] * x[k];
-                    }
+                // (The system's arrays as small as the drifting columns
+                // allow: zeroed whole, NT×NT, they were two `memset`s a try.)
+                if n <= DRIFT_SMALL {
+                    self.drift_exact::<DRIFT_SMALL>(phi, h, c1, c2, da, zp, &mut z1);
+                } else {
+                    self.drift_exact::<NT>(phi, h, c1, c2, da, zp, &mut z1);
                 }
             } else {
                 for _ in 0..DRIFT_ITERS {
@@ -302,7 +343,7 @@ impl Thermal {
                     let ge: [f64; NT] = std::array::from_fn(|i| gp[i] + c[i]);
                     let mut pe = pts;
                     pe[m + 1] = (h, &ge);
-                    let zn = self.linear(phi, h, g0, &derivatives(&pe[..m + 2]));
+                    let zn = self.linear(phi, h, g0, &derivatives(&pe[..m + 2]), pred.base.as_ref());
                     let moved = zn.iter().zip(&z1).fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
                     z1 = zn;
                     if moved < 1e-9 {
@@ -379,11 +420,16 @@ fn end_weights(pts: &[(f64, &[f64; NT])]) -> (f64, f64) {
     }
 }
 
+/// Drifting columns up to which the corrector's drift solve takes
+/// K×K arrays (beyond it, NT×NT).
+const DRIFT_SMALL: usize = 4;
+
 /// Solves the leading n×n system m·x = b in place (Gaussian elimination
 /// with partial pivoting; b becomes x). Not `dense::Lu`: that factorises
 /// the whole NT×NT matrix, ~13³/3 operations a corrector for a system of
 /// the one or two drifting columns.
-fn solve_small(m: &mut [[f64; NT]; NT], b: &mut [f64; NT], n: usize) {
+#[inline(always)]
+fn solve_small<const K: usize>(m: &mut [[f64; K]; K], b: &mut [f64; K], n: usize) {
     for c in 0..n {
         let p = (c..n).max_by(|&i, &j| m[i][c].abs().total_cmp(&m[j][c].abs())).unwrap_or(c);
         m.swap(c, p);

@@ -79,6 +79,8 @@ impl Model {
                 op
             }
             Drive::Mission(m) => {
+                // One length check for the five reads.
+                let y: &[f64; ix::N] = y[..ix::N].try_into().expect("the hydraulic states");
                 let mut op = OpPoint {
                     omega: y[ix::OMEGA],
                     p_a: y[ix::PA],
