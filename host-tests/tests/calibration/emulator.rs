@@ -147,8 +147,16 @@ fn emulator_machine_held_out_error_falls() {
 /// unchanged at 0.839 / 2.441 K (`block_wall` needs a log that moves speed
 /// and load independently: freed on the families it went to ×25 against
 /// three parameters on bounds and worsened their held-out pump channel).
+/// Those numbers with the set's prior widths and the polish at rtol 1e-5;
+/// re-run with calib11's defaults (priors ×0.5, polish at rtol 1e-6; one
+/// run, 29.3 s at load 3.0-3.7 on 2 shared cores): identification runs
+/// **0.599 / 0.614 K** (was 0.650 / 0.695), families 0.869 / 2.707 K (was
+/// 0.839 / 2.441: the identification-run miss 0.27 K larger, within the
+/// 0.3-0.9 K path spread docs/commissioning.md measures); the test prints
+/// only the pooled held-out numbers, the training, oil and `block_wall`
+/// figures above were not measured again.
 #[test]
-#[ignore = "slow tier: two calibrations on emulator logs"]
+#[ignore = "slow tier: two calibrations on emulator logs (~30 s)"]
 fn slow_identification_runs_commission_across_regimes() {
     let p = EmuParams::default();
     let base = Rig::default();
@@ -163,8 +171,8 @@ fn slow_identification_runs_commission_across_regimes() {
         .expect("calibration on identification runs");
     let (f, i) = (held(&fam), held(&ident));
     eprintln!("held out (pressure-speed steps, identification run): families {f:.3?} K, identification runs {i:.3?} K");
-    assert!(i.iter().all(|&e| e <= 0.75), "identification-run calibration held out {i:.3?} K (measured 0.650, 0.695)");
-    assert!(f[1] >= 1.1, "families' calibration on the identification run {:.3} K (measured 2.441)", f[1]);
+    assert!(i.iter().all(|&e| e <= 0.75), "identification-run calibration held out {i:.3?} K (measured 0.599, 0.614 with calib11's defaults; 0.650, 0.695 before)");
+    assert!(f[1] >= 1.1, "families' calibration on the identification run {:.3} K (measured 2.707 with calib11's defaults; 2.441 before)", f[1]);
 }
 
 /// The identification run is recognised as moving speed and load

@@ -390,13 +390,21 @@ fn reproducible(m: EmuMachine, nudge_k: f64) {
 /// The churned case film where the training set frees it: big-pump trained
 /// on its two throttle logs and the servo log (0–150 rpm holds), held out
 /// on the throttle mix; the same commissioning with the churned film held
-/// (the gap law) beside it. Measured (firmware drain vs the thermocouple,
-/// max |e| / under-prediction, without the margin): churned film fitted
-/// (film ×0.51, churn ×49.4, exponent −0.13), mix 2.590 / 2.590 K, the servo
-/// log (training) 0.874 K under; gap law 3.741 / 2.548 K, servo 2.310 K
-/// under (on the θ lattice; before it, on another optimiser path, film
-/// ×1.11 / churn ×22.5, mix 2.446 / 2.446 K, servo 0.947 K; gap law 3.835 /
-/// 2.342 K, servo 2.284 K). Max |e| falls, the under-prediction does not.
+/// (the gap law) beside it. Measured with calib11's calibration defaults
+/// (priors ×0.5, polish at rtol 1e-6; one run, 106.8 s for both at load
+/// 2.0-3.0 on 2 shared cores; firmware drain vs the thermocouple, max |e| /
+/// under-prediction, without the margin): churned film fitted (film ×0.83,
+/// churn ×29.9, exponent −0.12), mix 2.697 / 2.697 K, the servo log
+/// (training) 0.877 K under; gap law (`film_case` on its ×10 bound, polish
+/// not converged) 3.868 / 2.264 K, servo 2.266 K under. With the set's
+/// prior widths and polish at 1e-5 (on the θ lattice): film ×0.51, churn
+/// ×49.4, exponent −0.13, mix 2.590 / 2.590 K, servo 0.874 K; gap law
+/// 3.741 / 2.548 K, servo 2.310 K (the gap law's mix under-prediction moved
+/// 0.284 K with the defaults, outside `AS_MEASURED_K`: re-asserted as
+/// measured); before the lattice, on another optimiser path, film ×1.11 /
+/// churn ×22.5, mix 2.446 / 2.446 K, servo 0.947 K; gap law 3.835 /
+/// 2.342 K, servo 2.284 K. Max |e| falls, the under-prediction does not
+/// (with the defaults it rises, 2.264 → 2.697 K).
 #[test]
 #[ignore = "slow tier: two commissionings on emulator bench logs (~1 min each)"]
 fn slow_churned_case_film_with_a_low_speed_training_log() {
@@ -428,8 +436,10 @@ fn slow_churned_case_film_with_a_low_speed_training_log() {
     eprintln!("churned film / gap law: mix (max, under), servo under: {got:.3?}");
     // The churned fit's path spread (0.24 K under a 1e-9 K nudge before the
     // θ lattice; 0.14 K between the fits before and on it): its numbers
-    // within 0.3 K; the gap law's within AS_MEASURED_K.
-    let want = [(2.590, 2.590, 0.874, 0.3), (3.741, 2.548, 2.310, AS_MEASURED_K)];
+    // within 0.3 K; the gap law's within AS_MEASURED_K. Measured with
+    // calib11's defaults; before them (2.590, 2.590, 0.874) and
+    // (3.741, 2.548, 2.310).
+    let want = [(2.697, 2.697, 0.877, 0.3), (3.868, 2.264, 2.266, AS_MEASURED_K)];
     for (g, w) in got.iter().zip(want) {
         for (what, x, y) in [("mix max |e|", g.0, w.0), ("mix under-prediction", g.1, w.1), ("servo (training) under-prediction", g.2, w.2)] {
             assert!((x - y).abs() <= w.3, "{what}: {x:.3} K, measured {y:.3} K (±{})", w.3);
