@@ -262,129 +262,6 @@ fn one_operating_point_is_refused_with_log_region_channel_and_bench_run() {
     assert!(r.bench_run.contains("speed steps") && r.bench_run.contains("needle steps") && r.bench_run.contains("t_drain_c"), "{}", r.bench_run);
 }
 
-/// Every temperature of every log moved by 1e-9 K: the headline numbers
-/// (held-out max |e| and under-prediction of the flashed path against the
-/// thermocouple and the true drain, margin) move by at most 0.05 K (the
-/// issue's bound). Trained as the procedure prescribes
-/// (`commissioning_set`), the structural freedoms fitted. Measured with
-/// the defaults: below 1e-4 K on both machines (printed 0.0000 K; 52.5 +
-/// 53.3 s on big-pump, 33.9 + 34.1 s on leaky-heavy at load 2.5–5 on the
-/// 2 cores).
-/// Why it holds: the nudge changes no model output at the same multipliers
-/// (`slow_replay_noise_at_the_last_digit`); the calibration evaluates every
-/// multiplier vector on a lattice of 1e-4 in ln θ
-/// (`calibration::residuals::THETA_LATTICE_LN`) and takes η_m from the
-/// current on it, so the last-digit differences the nudge puts into the
-/// optimiser's steps give bit-identical model runs. Without the lattice
-/// (`EXP_LATTICE_LN=0`) the adaptive replays turned them into
-/// solver-error-sized output differences and another optimiser path:
-/// big-pump 0.795 K, leaky-heavy 0.226 K (with the set's own prior widths
-/// and the polish at 1e-5). A nudge that crosses lattice cells is
-/// [`slow_commissioning_is_reproducible_beyond_the_last_digit_big_pump`].
-#[test]
-#[ignore = "slow tier: two commissionings with margin validation and the direct path (~2-4 min)"]
-fn slow_commissioning_is_reproducible_at_the_last_digit_big_pump() {
-    reproducible(big_pump(), 1e-9);
-}
-
-/// [`slow_commissioning_is_reproducible_at_the_last_digit_big_pump`] on leaky-heavy.
-#[test]
-#[ignore = "slow tier: two commissionings with margin validation and the direct path (~2-4 min)"]
-fn slow_commissioning_is_reproducible_at_the_last_digit_leaky_heavy() {
-    reproducible(leaky_heavy(), 1e-9);
-}
-
-/// Every temperature of every log moved by 1e-6 K, ~1000 times the last
-/// digit: the optimiser's vectors then differ by more than the θ lattice's
-/// cells and its path above the lattice decides. The headline numbers (as
-/// in [`slow_commissioning_is_reproducible_at_the_last_digit_big_pump`])
-/// move by at most 0.05 K. Measured with the default priors at half the
-/// set's widths and the polish at rtol 1e-6 (`fit::PRIOR_SCALE`,
-/// `fit::POLISH_RTOL`): big-pump 0.045 K (the servo log's max |e|
-/// 1.623 → 1.578 K; polishes ending at 1629.10 and 1629.09), leaky-heavy
-/// 0.013 K (both the direct path). The code before (the set's widths,
-/// polish at 1e-5): big-pump 0.436 K. Time per commissioning on the 2
-/// cores: see docs/commissioning.md, "Reproducibility".
-#[test]
-#[ignore = "slow tier: two commissionings with margin validation and the direct path (~2-4 min)"]
-fn slow_commissioning_is_reproducible_beyond_the_last_digit_big_pump() {
-    reproducible(big_pump(), 1e-6);
-}
-
-/// [`slow_commissioning_is_reproducible_beyond_the_last_digit_big_pump`] on leaky-heavy.
-#[test]
-#[ignore = "slow tier: two commissionings with margin validation and the direct path (~2-4 min)"]
-fn slow_commissioning_is_reproducible_beyond_the_last_digit_leaky_heavy() {
-    reproducible(leaky_heavy(), 1e-6);
-}
-
-/// `EXP_PRIOR`: an experiment knob, prior widths (σ in ln θ) that replace
-/// the set's, as `name=σ,name=σ`.
-fn exp_priors() -> Vec<(&'static str, f64)> {
-    std::env::var("EXP_PRIOR")
-        .unwrap_or_default()
-        .split(',')
-        .filter(|s| !s.is_empty())
-        .map(|s| {
-            let (n, v) = s.split_once('=').unwrap_or_else(|| panic!("EXP_PRIOR entry {s}: name=sigma"));
-            let p = eha_sim::calibration::set::PARAMS.iter().find(|p| p.name == n).unwrap_or_else(|| panic!("no parameter {n}"));
-            (p.name, v.parse().unwrap_or_else(|_| panic!("EXP_PRIOR {s}")))
-        })
-        .collect()
-}
-
-fn reproducible(m: EmuMachine, nudge_k: f64) {
-    // `EXP_NUDGE_K`: an experiment knob (the nudge, K, instead of the test's).
-    let dk: f64 = std::env::var("EXP_NUDGE_K").ok().and_then(|v| v.parse().ok()).unwrap_or(nudge_k);
-    let nudge = |l: &BenchLog| -> BenchLog {
-        let mut l = l.clone();
-        for ch in Channel::TEMPERATURES.into_iter().chain([Channel::TDrainC]) {
-            let v: Vec<Option<f64>> = l.run.get(ch).expect("channel").iter().map(|x| x.map(|x| x + dk)).collect();
-            l.run.set(ch, v);
-        }
-        l
-    };
-    {
-        let s = commissioning_set(&m, 3600).expect("bench");
-        let run = |logs: &[BenchLog], hold: &[BenchLog]| {
-            let train: Vec<CalLog> = logs.iter().map(cal).collect();
-            let h: Vec<CalLog> = hold.iter().map(cal).collect();
-            let t0 = std::time::Instant::now();
-            // `EXP_POLISH_ITERS`: an experiment knob (the polish's iterations).
-            let mut o = CalOptions::default();
-            if let Some(n) = std::env::var("EXP_POLISH_ITERS").ok().and_then(|v| v.parse().ok()) {
-                o.polish_iters = n;
-            }
-            // `EXP_POLISH_RTOL`: an experiment knob (the polish's solver tolerance).
-            if let Some(x) = std::env::var("EXP_POLISH_RTOL").ok().and_then(|v| v.parse().ok()) {
-                o.polish_rtol = x;
-            }
-            // `EXP_LATTICE_LN`: an experiment knob (the θ lattice's spacing; 0: off).
-            if let Some(x) = std::env::var("EXP_LATTICE_LN").ok().and_then(|v| v.parse().ok()) {
-                o.lattice_ln = x;
-            }
-            o.prior_sigma.extend(exp_priors());
-            // `EXP_PRIOR_SCALE`: an experiment knob (factor on every prior width).
-            if let Some(x) = std::env::var("EXP_PRIOR_SCALE").ok().and_then(|v| v.parse().ok()) {
-                o.prior_scale = x;
-            }
-            let c = commission(&m.rig_file(), &train, &h, &o).expect("commissioning");
-            eprintln!("{}: {:.1} s, flashable {}, eta_m {:?}", m.name, t0.elapsed().as_secs_f64(), c.flashable(), c.eta_m_from_current);
-            report(&m, &c, t0.elapsed().as_secs_f64());
-            headline(&m, &c, hold)
-        };
-        let a = run(&s.train, &s.holdout);
-        let tn: Vec<BenchLog> = s.train.iter().map(nudge).collect();
-        let hn: Vec<BenchLog> = s.holdout.iter().map(nudge).collect();
-        let b = run(&tn, &hn);
-        let mut worst = (a.margin_k - b.margin_k).abs();
-        for (x, y) in a.measured.iter().zip(&b.measured).chain(a.truth.iter().zip(&b.truth)) {
-            worst = worst.max((x.0 - y.0).abs()).max((x.1 - y.1).abs());
-        }
-        eprintln!("{}: headline numbers moved by at most {worst:.4} K", m.name);
-        assert!(worst <= 0.05, "{}: a {dk:e} K nudge moved the headline by {worst:.3} K", m.name);
-    }
-}
 
 
 /// The churned case film where the training set frees it: big-pump trained
@@ -485,62 +362,19 @@ fn slow_structure_experiment() {
     }
 }
 
-/// Measurement by hand (prints, asserts nothing): the replay solver's own
-/// noise on the training logs of the commissioning procedure, per solver
-/// tolerance: how far the model's fit points move when every logged
-/// temperature moves by 1e-9 K (max |Δ| over the points, K), and how far a
-/// forward-difference Jacobian column (0.05 in ln θ of `film_case`,
-/// `case_churn`, `film_port`) moves with it (max |Δ| / 0.05, K per unit ln θ);
-/// with the run time of one replay.
-#[test]
-#[ignore = "measurement by hand: replays at three solver tolerances"]
-fn slow_replay_noise_at_the_last_digit() {
-    use eha_sim::calibration::set::{apply, index, nominal};
-    let only = std::env::var("EXP_MACHINE").ok();
-    for m in machines().into_iter().filter(|m| only.as_deref().is_none_or(|o| o == m.name)) {
-        let s = commissioning_set(&m, 3600).expect("bench");
-        let rig = m.rig_file();
-        for rtol in [1e-5, 1e-6, 1e-7] {
-            for l in &s.train {
-                let a = cal(l).with_rtol(rtol);
-                let mut ln = l.clone();
-                for ch in Channel::TEMPERATURES.into_iter().chain([Channel::TDrainC]) {
-                    let v: Vec<Option<f64>> = ln.run.get(ch).expect("channel").iter().map(|x| x.map(|x| x + 1e-9)).collect();
-                    ln.run.set(ch, v);
-                }
-                let b = cal(&ln).with_rtol(rtol);
-                let t0 = std::time::Instant::now();
-                let ra = a.simulate(&rig).expect("sim");
-                let secs = t0.elapsed().as_secs_f64();
-                let rb = b.simulate(&rig).expect("sim");
-                let d = |x: &eha_sim::calibration::log::Series, y: &eha_sim::calibration::log::Series| {
-                    a.points.iter().map(|(ch, i)| (x[ch][*i] - y[ch][*i]).abs()).fold(0.0, f64::max)
-                };
-                let mut cols = Vec::new();
-                for name in ["film_case", "case_churn", "film_port"] {
-                    let mut th = nominal();
-                    th[index(name).expect("param")] = 0.05f64.exp();
-                    let r = apply(&rig, &th);
-                    let (pa, pb) = (a.simulate(&r).expect("sim"), b.simulate(&r).expect("sim"));
-                    let col = a.points.iter().map(|(ch, i)| ((pa[ch][*i] - ra[ch][*i]) - (pb[ch][*i] - rb[ch][*i])).abs() / 0.05).fold(0.0, f64::max);
-                    let size = a.points.iter().map(|(ch, i)| (pa[ch][*i] - ra[ch][*i]).abs() / 0.05).fold(0.0, f64::max);
-                    cols.push(format!("{name} {col:.2e} of {size:.2e}"));
-                }
-                eprintln!("NOISE {} {} rtol {rtol:.0e}: {secs:.2} s; points moved {:.2e} K; FD columns moved (K per ln) {}", m.name, l.name, d(&ra, &rb), cols.join(", "));
-                // The objective (Σ (r/0.2 K)²) along ln θ of film_port in
-                // steps of 1e-4: its second differences against the smooth
-                // curvature show the solver's noise.
-                let f: Vec<f64> = (0..11)
-                    .map(|i| {
-                        let mut th = nominal();
-                        th[index("film_port").expect("param")] = (1e-4 * i as f64).exp();
-                        let sim = a.simulate(&apply(&rig, &th)).expect("sim");
-                        a.residuals(&sim).iter().map(|x| (x / 0.2).powi(2)).sum::<f64>()
-                    })
-                    .collect();
-                let d2: Vec<String> = f.windows(3).map(|w| format!("{:.3}", w[0] - 2.0 * w[1] + w[2])).collect();
-                eprintln!("NOISE {} {} rtol {rtol:.0e}: objective {:.3} .. {:.3}, second differences {}", m.name, l.name, f[0], f[10], d2.join(" "));
-            }
-        }
-    }
+/// `EXP_PRIOR`: an experiment knob, prior widths (σ in ln θ) that replace
+/// the set's, as `name=σ,name=σ`.
+fn exp_priors() -> Vec<(&'static str, f64)> {
+    std::env::var("EXP_PRIOR")
+        .unwrap_or_default()
+        .split(',')
+        .filter(|s| !s.is_empty())
+        .map(|s| {
+            let (n, v) = s.split_once('=').unwrap_or_else(|| panic!("EXP_PRIOR entry {s}: name=sigma"));
+            let p = eha_sim::calibration::set::PARAMS.iter().find(|p| p.name == n).unwrap_or_else(|| panic!("no parameter {n}"));
+            (p.name, v.parse().unwrap_or_else(|_| panic!("EXP_PRIOR {s}")))
+        })
+        .collect()
 }
+
+mod reproducible;
