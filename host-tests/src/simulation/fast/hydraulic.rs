@@ -75,8 +75,7 @@ impl TempPath {
     /// The line through (t0, z0) and (t1, z1), with the oil's properties
     /// `oil0`, `oil1` at its two points.
     pub fn line(t0: f64, z0: [f64; N_NODES], t1: f64, z1: [f64; N_NODES], oil0: HydraulicOil, oil1: HydraulicOil) -> Self {
-        let doil = HydraulicOil { k_leak: oil1.k_leak - oil0.k_leak, rho_ball: oil1.rho_ball - oil0.rho_ball, nu_ball: oil1.nu_ball - oil0.nu_ball };
-        Self { t0, z0, t1, z1, oil0, oil1, dt: t1 - t0, doil }
+        Self { t0, z0, t1, z1, oil0, oil1, dt: t1 - t0, doil: oil0.delta_to(&oil1) }
     }
 
     /// Weight of the second point at `t` (held beyond the points: a
@@ -97,9 +96,7 @@ impl TempPath {
 
     /// The hydraulics' oil properties at `t`.
     pub fn oil_at(&self, t: f64) -> HydraulicOil {
-        // `HydraulicOil::lerp` with the differences kept.
-        let (w, a, d) = (self.weight(t), &self.oil0, &self.doil);
-        HydraulicOil { k_leak: a.k_leak + w * d.k_leak, rho_ball: a.rho_ball + w * d.rho_ball, nu_ball: a.nu_ball + w * d.nu_ball }
+        self.oil0.along(&self.doil, self.weight(t))
     }
 }
 
@@ -115,9 +112,11 @@ impl HydTrack {
     /// fills it first), the same bits as the step's own evaluation.
     fn fill(&mut self, model: &Model) {
         if let Some(te) = self.pending.take() {
-            let p = self.pts.last_mut().expect("a pending point is the last");
-            model.hydraulic_rhs_oil(te, &p.1, &self.path.oil_at(p.0), &mut p.2);
-            self.ros.stats.evals += 1;
+            // (A pending point is the last: `cover` pushed it.)
+            if let Some(p) = self.pts.last_mut() {
+                model.hydraulic_rhs_oil(te, &p.1, &self.path.oil_at(p.0), &mut p.2);
+                self.ros.stats.evals += 1;
+            }
         }
     }
 

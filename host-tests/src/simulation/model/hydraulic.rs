@@ -22,11 +22,16 @@ pub struct HydraulicOil {
 }
 
 impl HydraulicOil {
-    /// Linear interpolation towards `other` at weight `w` ∈ [0, 1]
+    /// `other` − `self`, property by property.
+    pub fn delta_to(&self, other: &Self) -> Self {
+        Self { k_leak: other.k_leak - self.k_leak, rho_ball: other.rho_ball - self.rho_ball, nu_ball: other.nu_ball - self.nu_ball }
+    }
+
+    /// `self` + `w`·`d` property by property: with `d` = [`Self::delta_to`]
+    /// of `other`, the linear interpolation towards it at weight `w`
     /// (`self` at 0).
-    pub fn lerp(&self, other: &Self, w: f64) -> Self {
-        let l = |a: f64, b: f64| a + w * (b - a);
-        Self { k_leak: l(self.k_leak, other.k_leak), rho_ball: l(self.rho_ball, other.rho_ball), nu_ball: l(self.nu_ball, other.nu_ball) }
+    pub fn along(&self, d: &Self, w: f64) -> Self {
+        Self { k_leak: self.k_leak + w * d.k_leak, rho_ball: self.rho_ball + w * d.rho_ball, nu_ball: self.nu_ball + w * d.nu_ball }
     }
 }
 

@@ -75,26 +75,60 @@ pub struct Model {
     leak_geom: Option<f64>,
     /// The motor's iron loss (eq. 2, a `powf`) at the last shaft speed it
     /// was taken for: (ω's bits, W) ([`Model::iron_w`]).
-    iron_memo: Cell<(u64, f64)>,
+    iron_memo: BitsMemo<f64>,
     /// The throttle path's constants (π·d⁴, 2·a²), taken once.
     path_geom: hydraulics::PathGeom,
     /// The needle valve at the last setting it was taken for: (the
     /// setting's bits in bar, k, 1/k²) ([`Model::needle`]).
-    needle_memo: Cell<(u64, Option<f64>, f64)>,
+    needle_memo: BitsMemo<(Option<f64>, f64)>,
     /// The dynamic viscosity at the last temperature it was taken for:
     /// (the temperature's bits, Pa·s) ([`Model::mu`]; NaN's bits: none).
-    mu_memo: Cell<(u64, f64)>,
+    mu_memo: BitsMemo<f64>,
+}
+
+/// A one-entry memo keyed on an `f64` argument's bits: the value computed
+/// for the same bits again (so the same to the last bit), computed anew for
+/// any other argument. The model's iron loss, needle and μ memos.
+#[derive(Debug)]
+struct BitsMemo<T: Copy>(Cell<(u64, T)>);
+
+impl<T: Copy> BitsMemo<T> {
+    /// Holding `value`, the value at argument `x`.
+    fn new(x: f64, value: T) -> Self {
+        Self(Cell::new((x.to_bits(), value)))
+    }
+
+    /// The value at `x`: the kept one when `x`'s bits are the key,
+    /// otherwise `f()`, kept.
+    #[inline]
+    fn get_or(&self, x: f64, f: impl FnOnce() -> T) -> T {
+        let (bits, v) = self.0.get();
+        if bits == x.to_bits() {
+            return v;
+        }
+        let v = f();
+        self.0.set((x.to_bits(), v));
+        v
+    }
+}
+
+impl BitsMemo<f64> {
+    /// Holding nothing (NaN at NaN's bits: what a computation at that NaN
+    /// gives too).
+    fn empty() -> Self {
+        Self::new(f64::NAN, f64::NAN)
+    }
 }
 
 impl Model {
     /// Build a model.
     pub fn new(rig: Rig, drive: Drive) -> Self {
         let contents = network::contents(&rig);
-        let iron_memo = Cell::new((0f64.to_bits(), rig.motor.iron.power_w(0.0)));
+        let iron_memo = BitsMemo::new(0.0, rig.motor.iron.power_w(0.0));
         let path_geom = hydraulics::PathGeom::new(&rig);
         let k0 = hydraulics::needle_k(&rig, 0.0);
-        let needle_memo = Cell::new((0f64.to_bits(), k0, hydraulics::needle_inv_k2(k0)));
-        Self { rig, drive, lng_open: Cell::new(false), contents, outer_grid: None, nu_grid: None, lam_grid: None, leak_geom: None, iron_memo, path_geom, needle_memo, mu_memo: Cell::new((f64::NAN.to_bits(), f64::NAN)) }
+        let needle_memo = BitsMemo::new(0.0, (k0, hydraulics::needle_inv_k2(k0)));
+        Self { rig, drive, lng_open: Cell::new(false), contents, outer_grid: None, nu_grid: None, lam_grid: None, leak_geom: None, iron_memo, path_geom, needle_memo, mu_memo: BitsMemo::empty() }
     }
 
     /// The needle valve at setting `bar` ([`hydraulics::needle_k`]: its k,
@@ -103,14 +137,10 @@ impl Model {
     /// three divisions in every hydraulic evaluation otherwise).
     #[inline]
     fn needle(&self, bar: f64) -> (Option<f64>, f64) {
-        let (bits, k, inv) = self.needle_memo.get();
-        if bits == bar.to_bits() {
-            return (k, inv);
-        }
-        let k = hydraulics::needle_k(&self.rig, bar);
-        let inv = hydraulics::needle_inv_k2(k);
-        self.needle_memo.set((bar.to_bits(), k, inv));
-        (k, inv)
+        self.needle_memo.get_or(bar, || {
+            let k = hydraulics::needle_k(&self.rig, bar);
+            (k, hydraulics::needle_inv_k2(k))
+        })
     }
 
     /// The motor's iron loss at shaft speed `omega` (eq. 2,
@@ -119,13 +149,7 @@ impl Model {
     /// same to the last bit. (A `powf` in every heat balance and snapshot:
     /// ~20 k instructions of a fast Case 1 run.)
     pub fn iron_w(&self, omega: f64) -> f64 {
-        let (bits, w) = self.iron_memo.get();
-        if bits == omega.to_bits() {
-            return w;
-        }
-        let w = self.rig.motor.iron.power_w(omega);
-        self.iron_memo.set((omega.to_bits(), w));
-        w
+        self.iron_memo.get_or(omega, || self.rig.motor.iron.power_w(omega))
     }
 
     /// Interpolate the outer surfaces' heat flows on a grid of `step_k`
@@ -138,7 +162,7 @@ impl Model {
         self.outer_grid = step.map(OuterGrid::new);
         self.nu_grid = step.map(|s| NuGrid::new(s * NU_GRID_FACTOR));
         // ν moves from the exact line to the grid (or back): μ anew.
-        self.mu_memo.set((f64::NAN.to_bits(), f64::NAN));
+        self.mu_memo = BitsMemo::empty();
         self.lam_grid = step.map(|_| LaminarGrid::new());
         self.leak_geom = step.map(|_| self.rig.pump.gaps.conductance(1.0));
     }
@@ -183,13 +207,7 @@ impl Model {
     /// heat balance asks for the case oil's twice: the pump friction and
     /// the leakage conductance), so the same to the last bit.
     pub fn mu(&self, t_oil: f64) -> f64 {
-        let (bits, mu) = self.mu_memo.get();
-        if bits == t_oil.to_bits() {
-            return mu;
-        }
-        let mu = self.nu(t_oil) * self.rig.oil.rho(t_oil, 0.0);
-        self.mu_memo.set((t_oil.to_bits(), mu));
-        mu
+        self.mu_memo.get_or(t_oil, || self.nu(t_oil) * self.rig.oil.rho(t_oil, 0.0))
     }
 
     /// Pump leakage conductance of eqs. (5)–(7) at the case-oil temperature
