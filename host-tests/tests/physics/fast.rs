@@ -48,19 +48,21 @@ fn check(rig: &Rig, sc: &Scenario, opt: &SimOptions, regression_k: f64) -> SimOu
 
 /// Case 1 at 60 bar, 600 s, with the benchmark's 10 s outputs and with the
 /// default 1 s outputs (0.1 s callbacks, read from the interpolants).
-/// Measured 4.9e-4 K and 4.5e-4 K with the oil on its viscosity line and
-/// the start's looser tolerances (4.8e-4 and 5.5e-4 K before them; the 1 s
-/// outputs 3.4e-4 K before the Jacobian's drift refresh).
+/// Measured 6.1e-4 K and 1.14e-3 K at 2e-4 K per thermal step (the
+/// drain; 4.9e-4 and 4.5e-4 K at 1e-4 K per step until 2026-11-28, whose
+/// 10 s bound was 5e-4 K).
 #[test]
 fn case1_within_a_hundredth_of_a_kelvin() {
     let rig = Rig::default();
     let sc = Scenario::Case1 { needle_bar: 60.0, duration_s: 600.0 };
-    check(&rig, &sc, &SimOptions { output_interval_s: 10.0, control_interval_s: 10.0 }, 5e-4);
+    check(&rig, &sc, &SimOptions { output_interval_s: 10.0, control_interval_s: 10.0 }, 1.5e-3);
     check(&rig, &sc, &SimOptions::default(), 3e-3);
 }
 
-/// Case 2 (servo, 0.2 Hz), 600 s, 1 s outputs. Measured 6.4e-3 K (the
-/// winding, whose copper loss the steps integrate over 120 cycles).
+/// Case 2 (servo, 0.2 Hz), 600 s, 1 s outputs. Measured 7.8e-3 K at 2e-4 K
+/// per thermal step (6.4e-3 K at 1e-4 K; the winding, whose copper loss
+/// the steps integrate over 120 cycles); the spec, 0.01 K, is the nearer
+/// bound.
 #[test]
 fn case2_within_a_hundredth_of_a_kelvin() {
     check(&Rig::default(), &Scenario::Case2 { duration_s: 600.0 }, &SimOptions { output_interval_s: 1.0, control_interval_s: 1.0 }, 9e-3);
@@ -133,7 +135,8 @@ fn fig15_switches_with_the_bdf() {
 }
 
 /// The firmware suite's five random missions (throttle and servo), 600 s.
-/// Measured 4.0e-4, 2.3e-3, 2.4e-4, 3.4e-4, 1.8e-3 K.
+/// Measured 5.7e-4, 2.3e-3, 4.9e-4, 4.6e-4, 3.6e-3 K at 2e-4 K per thermal
+/// step (4.0e-4, 2.3e-3, 2.4e-4, 3.4e-4, 1.8e-3 K at 1e-4 K).
 #[test]
 fn random_missions_within_a_hundredth_of_a_kelvin() {
     let rig = Rig::default();
@@ -189,6 +192,8 @@ fn slow_twenty_long_random_missions_within_a_hundredth_of_a_kelvin() {
 /// The missions of the slow test where the fast path or the shipped BDF is
 /// more than 0.01 K from the BDF at rtol 1e-9, both at a stop or rest with
 /// the needle open. Measured with the oil on its viscosity line,
-/// fast / shipped BDF: seed 13 8.0e-3 / 1.06e-2 K, seed 21 4.6e-3 /
-/// 1.49e-2 K; the other 18 within 5.5e-3 K (fast) and 9.9e-3 K (shipped).
+/// fast / shipped BDF: seed 13 1.28e-2 / 1.06e-2 K, seed 21 5.2e-3 /
+/// 1.49e-2 K; the other 18 within 8.5e-3 K (fast, seed 9) and 9.9e-3 K
+/// (shipped). At 1e-4 K per thermal step (until 2026-11-28) seed 13's fast
+/// deviation was 8.0e-3 K and the others' within 5.5e-3 K.
 const DEGENERATE: [u64; 2] = [13, 21];
