@@ -1,5 +1,5 @@
-//! Cross-log check of the emulator misses (docs/diagnosis.md, "Why the
-//! misses are missed"): calibrate the physical set on one log of an
+//! Cross-log check of the emulator misses (docs/diagnosis-limits.md, "Why
+//! effects above the floor are missed"): calibrate the physical set on one log of an
 //! emulated machine, with and without the hidden effect's own candidate,
 //! and predict a second log of the same machine in another scenario. Does a
 //! second log separate what the calibration set absorbs on one?

@@ -9,8 +9,8 @@
 //! gain any diagnosis could show there is 1 − σ/√(σ² + left²) (the baseline
 //! misses by √(σ² + left²), the right candidate by σ): 50 % needs
 //! left ≥ √3·σ. This assumes the model's own structure; a rig that differs
-//! in structure adds its own misfit on top (docs/diagnosis.md, "Why the
-//! misses are missed"). The recalibration is a local fit from the
+//! in structure adds its own misfit on top (docs/diagnosis-limits.md, "Why
+//! effects above the floor are missed"). The recalibration is a local fit from the
 //! calibrated point: a fit that absorbs more would leave less, so "left" and
 //! the best gain are upper bounds (a low value is certain, a high one
 //! optimistic), and they need not grow with the magnitude.

@@ -32,7 +32,7 @@ pub const HOUSING_OUTER_PREFIX: &str = "h_out_";
 ///   (the same 20 % span rule) shows its v^0.8 law. In the physical tier
 ///   of an earlier emulator sweep a hidden motor–pump conduction on a
 ///   constant-throttle log (seed 1710) was named forced convection, and a
-///   hidden forced convection (seed 1712) gained 1 % (docs/diagnosis.md).
+///   hidden forced convection (seed 1712) gained 1 % (docs/diagnosis-numbers.md).
 ///   Under the four global multipliers (one outer scale for every housing)
 ///   the stream's per-housing pattern can still tell it apart.
 /// - `motor-pump-conduction` under the same set on a run with one operating

@@ -133,7 +133,8 @@ impl ReferenceModel {
     /// `examples/imprint_misses.rs` (`sigma=NAME:S`) measured with it that
     /// priors of a physical width do not keep `cap_loop_oil` and
     /// `probe_oil` off their bounds on the emulator's 1704 under the
-    /// structure option (docs/diagnosis.md, "What it can and cannot see").
+    /// structure option (docs/diagnosis-limits.md, "Why holds and not narrower
+    /// priors").
     /// An unknown name changes nothing.
     pub fn with_prior_sigma(mut self, name: &str, sigma_ln: impl Into<Option<f64>>) -> Self {
         let Some(k) = calibration::set::index(name) else { return self };
@@ -269,8 +270,8 @@ pub fn structural_set(run: &MeasuredRun, free: &[usize], variant: Structure) -> 
 /// held out against 0.45 K without the option); priors narrower than the
 /// calibration set's did not move them (σ 0.05 on `cap_loop_oil` left it
 /// at ×2.9: holding both costs its baseline ≈ 170 K² of training
-/// residual, the prior row ≈ 18), so they are held. docs/diagnosis.md,
-/// "What it can and cannot see".
+/// residual, the prior row ≈ 18), so they are held. docs/diagnosis-limits.md,
+/// "The structure option and why `no-case-held` is the default".
 pub const HELD_OIL: [&str; 2] = ["cap_loop_oil", calibration::set::PROBE_OIL];
 
 /// Solver-step budget of one replay, per second of log: a replay normally

@@ -37,13 +37,13 @@ pub const SECTIONS: [Section; 6] = [
     Section { doc: "docs/rig-file.md", tag: "rig-file", source: "host-tests/src/physics/rig/mod.rs", render: crate::tools::rigdoc::render },
     Section { doc: "docs/failure-modes.md", tag: "failure-modes", source: "docs/data/faults.json", render: render_failure_modes },
     Section {
-        doc: "docs/diagnosis.md",
+        doc: "docs/diagnosis-off.md",
         tag: "emulator-sweep",
         source: "docs/data/emulator-sweep.json",
         render: render_emulator_sweep,
     },
     Section {
-        doc: "docs/diagnosis.md",
+        doc: "docs/diagnosis-numbers.md",
         tag: "emulator-sweep-1800",
         source: "docs/data/emulator-sweep-1800.json",
         render: render_emulator_sweep,
@@ -51,8 +51,9 @@ pub const SECTIONS: [Section; 6] = [
 ];
 
 /// The emulator sweep's tables (`eha-sim emulator-sweep`, the case sets
-/// it ran, its `emulator-sweep.json`; the second seed set's under the
-/// default structure, `emulator-sweep-1800.json`).
+/// it ran under `--structure off`, its `emulator-sweep.json`, in
+/// docs/diagnosis-off.md; the second seed set's under the default
+/// structure, `emulator-sweep-1800.json`, in docs/diagnosis-numbers.md).
 fn render_emulator_sweep(json: &str) -> Result<String> {
     let rows: Vec<crate::diagnosis::emu_sweep::EmuResult> = serde_json::from_str(json)?;
     Ok(crate::diagnosis::emu_sweep::document(&rows))

@@ -10,7 +10,7 @@
 //! lowers the BIC by 33–132 on the loaded and servo logs but the pooled
 //! held-out misfit by at most 15 %, against the 20 % bar). The answers and
 //! the calibrated baseline's pooled held-out misfit are asserted as
-//! measured. docs/diagnosis.md, "What it can and cannot see".
+//! measured. docs/diagnosis-numbers.md, "Effect-free logs".
 //!
 //! Slow tier only: 32 diagnoses, 3–50 s each; 475 s on two cores shared
 //! with another helper (2026-11-28, passes).

@@ -27,8 +27,8 @@
 //!
 //! Seeds are fixed (one per case, chosen before the method changes and not
 //! re-drawn); how the method does over other draws is the sweep
-//! (`eha-sim diagnose-sweep`, hours on 2 cores), whose hit rates are in
-//! docs/diagnosis.md. Each case is ~600–1000 model runs of ~5 ms (throttle)
+//! (`eha-sim diagnose-sweep`, hours on 2 cores), whose last hit rates are in
+//! the history of docs/diagnosis.md (`git show 1d6b146:docs/diagnosis.md`). Each case is ~600–1000 model runs of ~5 ms (throttle)
 //! or ~60 ms (servo, logged at 0.1 s).
 
 use eha_sim::diagnosis::sweep::{run_case, CaseResult};
@@ -104,7 +104,7 @@ use SynthScenario::{
 /// Measured: named, 62 % on t_oil_c (held out 0.361 → 0.107 K). A lag on a
 /// monotonic warm-up looks like more oil capacity, so this case's gain has
 /// been near the bar and moved with the replay tolerances
-/// (docs/diagnosis.md, "Replay tolerances"): checked as a pass.
+/// (docs/diagnosis-cost.md, "Replay tolerances and speed"): checked as a pass.
 #[test]
 fn hidden_sensor_lag_is_named() {
     check(&[case("sensor-lag", Case1Pressure, Nuisance, 31)]);

@@ -3,7 +3,7 @@
 //! split, correlations, parameters (up to ×2.8 off the rig file) and sensor
 //! placement, one hidden effect or none. The diagnosis runs blind with the
 //! rig file as baseline. Every assertion is the outcome measured with
-//! `eha-sim emulator-sweep` (table in docs/diagnosis.md), so a test fails
+//! `eha-sim emulator-sweep` (tables in docs/diagnosis-off.md), so a test fails
 //! when the outcome changes either way; misses are asserted as misses.
 //!
 //! Fast tier: a `none` Case 1 log answered `none` (~10 s); slow tier

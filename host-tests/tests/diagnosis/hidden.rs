@@ -15,7 +15,7 @@
 //! cannot tell a housing path from the housings' outer transfer), 1712
 //! (a draught at constant air speed, r 2.44: its fit gains 12 %), 2712
 //! (a draught in an identification run, r 2.89: its fit gains 1 %;
-//! `sensor-lag` ΔBIC 110 but does not qualify). docs/diagnosis.md,
+//! `sensor-lag` ΔBIC 110 but does not qualify). docs/diagnosis-numbers.md,
 //! "Current numbers".
 //!
 //! Slow tier only: 17 diagnoses, 15–58 s each; 380 s on two shared cores

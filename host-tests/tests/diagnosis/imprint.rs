@@ -7,7 +7,8 @@
 //! (the calibrated baseline with the candidate at its typical magnitude,
 //! `diagnosis::analysis::typical_magnitude`): named where named, a miss
 //! asserted as a miss, so a change either way fails. Why each miss is
-//! missed: docs/diagnosis.md, "What it can and cannot see".
+//! missed: docs/diagnosis-limits.md, "Why effects above the floor are
+//! missed".
 //!
 //! Slow tier only: each case is a log and its twin diagnosed in parallel
 //! (with the oracle), 50–90 s a case on two shared cores; the two tests
@@ -89,7 +90,7 @@ fn slow_imprint_ratio_above_two_sensor_lag() {
 /// nuisance refitted, the conduction held at its true value fits the
 /// training window no better than at 0.4 W/K; churning's fit gains −6 % on
 /// t_pump_c against the baseline restarted from its own nuisance values):
-/// docs/diagnosis.md. Asserted as measured: no cause, no wrong cause, no
+/// docs/diagnosis-limits.md. Asserted as measured: no cause, no wrong cause, no
 /// discovery on the twins; and the twin of 2700, once a false discovery.
 #[test]
 #[ignore = "slow tier: emulator cases with twins (minutes), measured misses"]
@@ -118,8 +119,8 @@ fn slow_imprint_ratio_above_two_housing_paths_and_churning_missed() {
 /// is right by the rule, though the effects were seen without it: 1704
 /// (lag, r 1.82, named at r 3.14 without), 1711 (conduction, r 1.06, was
 /// 6.36), 2709 (churning, r 0.55, was 4.73: its loss is in the current and
-/// so in `eta_m`). No twin names a cause. docs/diagnosis.md, "What it can
-/// and cannot see". 467 s at load 2–5 on two shared cores (2026-11-27).
+/// so in `eta_m`). No twin names a cause. docs/diagnosis-limits.md, "The
+/// structure option". 467 s at load 2–5 on two shared cores (2026-11-27).
 #[test]
 #[ignore = "slow tier: emulator cases with twins (minutes), the structure option"]
 fn slow_imprint_ratio_with_structure() {
@@ -146,8 +147,8 @@ fn slow_imprint_ratio_with_structure() {
 /// (lag, r 1.70, loop-oil capacity and oil probe at their upper bounds),
 /// 1711 (conduction, r 0.64, the pump's outer film and case film at their
 /// upper bounds), 2711 (conduction, r 1.88, answered `none`; named at r
-/// 3.17 under `full`). No twin names a cause. docs/diagnosis.md, "What it
-/// can and cannot see". 261 s on two shared cores (2026-11-27, passes).
+/// 3.17 under `full`). No twin names a cause. docs/diagnosis-limits.md, "The
+/// structure option". 261 s on two shared cores (2026-11-27, passes).
 #[test]
 #[ignore = "slow tier: emulator cases with twins (minutes), the structure option's no-case variant"]
 fn slow_imprint_ratio_with_structure_no_case() {
@@ -173,7 +174,7 @@ fn slow_imprint_ratio_with_structure_no_case() {
 /// below 2: the twin's t_oil_c floor rose, 1.05 -> 1.23 K). Below r = 2,
 /// no cause right by the rule: 1711 (conduction, r 1.81), 2709 (churning,
 /// r 0.75, named under `no-case`), 2711 (conduction, r 1.94). No twin
-/// names a cause. docs/diagnosis.md, "What it can and cannot see". 639 s
+/// names a cause. docs/diagnosis-limits.md, "The structure option". 639 s
 /// at load 6–9 on two shared cores (2026-11-28, passes).
 #[test]
 #[ignore = "slow tier: emulator cases with twins (minutes), the structure option's no-case-held variant"]

@@ -5,7 +5,8 @@
 //! housing probes read towards the air by the calibration's probe model.
 //! Fast tier: model construction and two replays of a 1200 s emulator log
 //! (~1 s). Its effect on the floor and on the r >= 2 cases:
-//! docs/diagnosis.md, "What it can and cannot see".
+//! docs/diagnosis-limits.md, "The structure option and why `no-case-held`
+//! is the default".
 
 use eha_sim::calibration::commission::eta_m_from_current;
 use eha_sim::calibration::set::{FRICTION_CASE, PROBE_SURFACE, STRUCTURAL};

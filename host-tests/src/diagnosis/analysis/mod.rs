@@ -173,7 +173,8 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
     // stays in the baseline's basin with the candidate off, from (a) the
     // ~20-parameter physical set ends its budget far from the baseline's
     // values (measured on emulator logs whose effect stands well above the
-    // structure floor: docs/diagnosis.md, "What it can and cannot see").
+    // structure floor: docs/diagnosis-limits.md, "Why effects above the floor
+    // are missed").
     let starts: Vec<(Candidate, Start)> =
         Candidate::EXTENSIONS.iter().flat_map(|&c| [(c, Start::Nominal), (c, Start::BaseOff), (c, Start::BaseTypical)]).collect();
     sim.phase(Phase::Candidates { fits: starts.len(), may_escalate: may_escalate && sim.physical_set().is_some() });

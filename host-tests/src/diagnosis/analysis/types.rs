@@ -124,8 +124,8 @@ pub enum Structure {
     /// probe's placement are separable only with a drain thermocouple
     /// (their calibration `Needs`), which the diagnosis's logs lack; on the
     /// housing sensors alone they trade with loop-oil capacity, the oil
-    /// probe and a sensor lag (docs/diagnosis.md, "What it can and cannot
-    /// see").
+    /// probe and a sensor lag (docs/diagnosis-limits.md, "The structure
+    /// option and why `no-case-held` is the default").
     NoCase,
     /// As [`Structure::NoCase`], with the loop oil's capacity and the oil
     /// probe's response time held at the rig file
@@ -133,7 +133,8 @@ pub enum Structure {
     /// carry a dead-end pocket's lag to their bounds (the emulator's 1704);
     /// held, the lag is named there, but the emulator's 6 s thermowell is
     /// then carried by the other parameters and the effect-free floor rises
-    /// on t_oil_c (docs/diagnosis.md, "What it can and cannot see").
+    /// on t_oil_c (docs/diagnosis-limits.md, "The structure option and why
+    /// `no-case-held` is the default").
     NoCaseHeld,
 }
 
@@ -152,8 +153,8 @@ impl From<bool> for Structure {
 /// On the emulator's original and identification case sets (every log with
 /// a hidden effect and every effect-free log, 2026-11-28) it names no wrong
 /// cause and no cause on an effect-free log, and names every cause
-/// [`Structure::Off`] names at imprint ratio ≥ 2 (docs/diagnosis.md,
-/// "Current numbers" and "What it can and cannot see"; its misses there
+/// [`Structure::Off`] names at imprint ratio ≥ 2 (docs/diagnosis-numbers.md,
+/// "Current numbers", and docs/diagnosis-limits.md; its misses there
 /// are listed too).
 pub const STRUCTURE_DEFAULT: Structure = Structure::NoCaseHeld;
 

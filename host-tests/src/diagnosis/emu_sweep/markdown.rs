@@ -1,6 +1,7 @@
 //! The sweep's Markdown: one table row per result, the miss classes, the
 //! oracle rows and the whole document (`emulator-sweep.md`, and what
-//! `eha-sim docs` renders into docs/diagnosis.md). Separate because it is
+//! `eha-sim docs` renders into docs/diagnosis-numbers.md and
+//! docs/diagnosis-off.md). Separate because it is
 //! output, not diagnosis.
 
 use super::EmuResult;
@@ -72,7 +73,8 @@ pub fn oracle_row(r: &EmuResult) -> Option<String> {
 
 /// The sweep's Markdown (`emulator-sweep.md`): the answer table, its
 /// summary line, the hidden effects' own fits and their classes. Also what
-/// `eha-sim docs` renders into docs/diagnosis.md from the committed JSON.
+/// `eha-sim docs` renders into docs/diagnosis-numbers.md and
+/// docs/diagnosis-off.md from the committed JSON.
 pub fn document(ok: &[EmuResult]) -> String {
     let mut md = String::from(
         "| scenario (seed) | hidden | magnitude | answer | affected channel (imprint) | its held-out RMSE before → after (K) | pooled held-out RMSE nominal / calibrated → after (K) | calibrated held-out per channel, K (× noise σ, % of rise; **misfit**) | nuisance on a bound | s |\n|---|---|---|---|---|---|---|---|---|---:|\n",

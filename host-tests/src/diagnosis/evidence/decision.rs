@@ -119,7 +119,7 @@ fn finish(causes: Vec<(String, f64, f64)>) -> Vec<CauseProbability> {
 /// η 0.02–0.1): the smallest mean log-loss of the stated probability of
 /// the truth ("no cause" on an effect-free log or one whose effect stays
 /// below r = 2) over η ∈ 0.02…1 and leak ∈ 0…1; judged on the
-/// identification-run set, which did not choose it (docs/diagnosis.md).
+/// identification-run set, which did not choose it (docs/diagnosis-off.md).
 pub const LEARNING_RATE: f64 = 0.1;
 
 /// Share of its prior that [`DecisionRule::Tempered`] leaves a candidate

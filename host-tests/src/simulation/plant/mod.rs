@@ -97,7 +97,7 @@ impl Plant {
     /// swing with every flow reversal of a servo log, are held to
     /// [`REPLAY_PORT_ATOL_K`] instead of the relative tolerance. The logged
     /// channels then stay within about 0.01 K of a 1e-8 solution
-    /// (`docs/diagnosis.md`, speed), a tenth of the sensor noise.
+    /// (`docs/diagnosis-cost.md`), a tenth of the sensor noise.
     pub fn set_replay_tolerances(&mut self, on: bool) {
         self.replay_tolerances = on;
     }
