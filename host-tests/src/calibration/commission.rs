@@ -344,7 +344,11 @@ pub fn commission_with(base: &Rig, train: &[CalLog], holdout: &[CalLog], o: &Cal
             let p = f.params;
             (f, PathOutcome::from_checks(PathKind::Direct, p, direct_validation, dir_plain, dir_with))
         });
-    let choice = super::paths::choose(&reduction, direct.as_ref().map(|d| &d.1).map_err(String::as_str));
+    let refused = (!reduced_ok).then(|| {
+        let r = reduced.iter().max_by(|a, b| a.vs_reference_max_k.total_cmp(&b.vs_reference_max_k));
+        r.map_or_else(String::new, |r| format!("the six-state model {:.3} K off the commissioned reference on {}, bound {REDUCED_BOUND_K} K", r.vs_reference_max_k, r.log))
+    });
+    let choice = super::paths::choose(&reduction, direct.as_ref().map(|d| &d.1).map_err(String::as_str), refused.as_deref());
     let (direct_fit, direct_path) = match direct {
         Ok((f, p)) => (Some(f), Ok(p)),
         Err(e) => (None, Err(e)),

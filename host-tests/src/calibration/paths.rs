@@ -183,12 +183,24 @@ pub fn direct_wins(a: (f64, f64), b: (f64, f64)) -> bool {
 /// Measured on leaky-heavy: the split preferred the direct path (2.13 K
 /// against 2.43 K) while it under-predicted the held-out servo log by
 /// 2.24 K with its margin, the reduction by 0.67 K.
-pub fn choose(reduction: &PathOutcome, direct: Result<&PathOutcome, &str>) -> Choice {
+///
+/// `reduction_refused` (why the reduction's block cannot be flashed: the
+/// six-state model departs from the commissioned reference) makes the
+/// direct path the choice whenever it has a margin within the block's
+/// bound: a refused block is not an alternative, and the direct path is
+/// the one the second path exists for (identified on the logs,
+/// its margin validated against the measured drain). Both paths' held-out
+/// numbers stay in the report.
+pub fn choose(reduction: &PathOutcome, direct: Result<&PathOutcome, &str>, reduction_refused: Option<&str>) -> Choice {
     let keep = |why: String| Choice { chosen: PathKind::Reduction, why };
     let d = match direct {
         Ok(d) => d,
         Err(e) => return keep(format!("the direct path did not run ({e})")),
     };
+    if let (Some(refused), Some(mb)) = (reduction_refused, d.margin_k()) {
+        let worst = d.holdout_worst().map_or(String::new(), |(e, u)| format!("; on the held-out logs, margin counted, max |e| {e:.2} K, under-prediction {u:.2} K"));
+        return Choice { chosen: PathKind::Direct, why: format!("the reduction's block is refused ({refused}); the direct path has a validated margin of {mb:.2} K within the block's bound{worst}") };
+    }
     let (Some(ma), Some(mb)) = (reduction.margin_k(), d.margin_k()) else {
         return keep("the paths cannot be compared: no margin validated within the block's bound on one of them (it needs `t_drain_c` in every training log)".into());
     };
@@ -231,5 +243,50 @@ mod tests {
         assert!(!direct_wins((1.0, 0.35), (1.0, 0.29)), "0.06 K across the 0.3 K bound is a tie");
         assert!(direct_wins((1.0, 0.45), (1.0, 0.29)));
         assert!(!direct_wins((1.0, 0.2), (0.1, 0.35)), "within 0.3 K beats beyond it");
+    }
+
+    /// A check of `log` with the given measured max |e| and under-prediction, K.
+    fn check(log: &str, max_k: f64, under_k: f64) -> ReducedCheck {
+        let region = super::super::check::Region { t_s: (0.0, 1.0), speed_rpm: (0.0, 1.0), dp_bar: (0.0, 1.0), drain_c: (20.0, 40.0), servo: false };
+        ReducedCheck {
+            log: log.into(),
+            margin_k: 0.0,
+            vs_reference_max_k: 0.0,
+            vs_reference_under_k: 0.0,
+            vs_reference_region: region.clone(),
+            vs_measured_max_k: Some(max_k),
+            vs_measured_under_k: Some(under_k),
+            vs_measured_over_k: Some(max_k - under_k),
+            vs_measured_rmse_k: Some(max_k / 2.0),
+            vs_measured_region: Some(region),
+            valve_open_s: 0.0,
+            lng_kg: 0.0,
+        }
+    }
+
+    /// A path with a validated margin `margin_k` and one held-out log.
+    fn path(kind: PathKind, margin_k: f64, holdout: (f64, f64)) -> PathOutcome {
+        let validation = MarginValidation { folds: vec![check("train", margin_k, margin_k - 0.2)], allowance_k: 0.2, margin_k };
+        let with = vec![check("mix", holdout.0, holdout.1)];
+        PathOutcome::from_checks(kind, eha_guard::params::DEFAULT, Some(validation), with.clone(), with)
+    }
+
+    /// A refused reduction is not an alternative: the direct path is chosen
+    /// whenever it has a margin within the block's bound, even where the
+    /// reduction's held-out numbers are better (big-pump, 2026-11-28: the
+    /// reduction 1.89 / 0.64 K refused at 0.444 K off the reference, the
+    /// direct path 2.79 / 0.70 K); without a margin the reduction is kept
+    /// (and stays refused).
+    #[test]
+    fn a_refused_reduction_falls_back_to_the_direct_path() {
+        let red = path(PathKind::Reduction, 0.97, (1.89, 0.64));
+        let dir = path(PathKind::Direct, 1.32, (2.79, 0.70));
+        assert_eq!(choose(&red, Ok(&dir), None).chosen, PathKind::Reduction, "not refused: the held-out rule (0.06 K apart is a tie)");
+        let c = choose(&red, Ok(&dir), Some("0.444 K off the reference on servo"));
+        assert_eq!(c.chosen, PathKind::Direct);
+        assert!(c.why.contains("refused") && c.why.contains("1.32 K"), "{}", c.why);
+        let beyond = path(PathKind::Direct, MARGIN_MAX_K + 1.0, (2.79, 0.70));
+        assert_eq!(choose(&red, Ok(&beyond), Some("off")).chosen, PathKind::Reduction, "no margin within the bound");
+        assert_eq!(choose(&red, Err("did not converge"), Some("off")).chosen, PathKind::Reduction);
     }
 }

@@ -80,12 +80,12 @@ const SWITCH_DROP: i32 = 1;
 /// interval 2.52 / 2.47 M (two refreshes, at 65 s and 250 s, here).
 const DRIFT_MOVE_K: f64 = 20.0;
 
-/// Accuracy and step settings of the multirate scheme.
 /// Local error bound of one thermal step under a thermostat valve rule, K
 /// ([`FastOptions::for_scenario`]; Fig. 15's switches each within 1 s of
 /// the BDF's at this bound).
 pub const THERMOSTAT_TOL_K: f64 = 1e-5;
 
+/// Accuracy and step settings of the multirate scheme.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FastOptions {
     /// Local error bound of one thermal step on every node, K.
