@@ -270,12 +270,13 @@ fn like_ref() -> Vec<String> {
     parse_switches(&std::env::var("EXP_LIKE_REF").unwrap_or_default())
 }
 
-/// A comma-separated switch list (`all`: [`ALL_SWITCHES`]).
-fn parse_switches(v: &str) -> Vec<String> {
-    if v == "all" {
-        return ALL_SWITCHES.map(String::from).to_vec();
-    }
-    v.split(',').filter(|s| !s.is_empty()).map(String::from).collect()
+/// A comma-separated switch list (`all` in it: [`ALL_SWITCHES`], so
+/// `all,ports` is the control and one more).
+pub(super) fn parse_switches(v: &str) -> Vec<String> {
+    v.split(',')
+        .filter(|s| !s.is_empty())
+        .flat_map(|s| if s == "all" { ALL_SWITCHES.map(String::from).to_vec() } else { vec![s.to_string()] })
+        .collect()
 }
 
 /// Structural bisection: each named switch makes the emulator machine like
@@ -292,7 +293,15 @@ fn parse_switches(v: &str) -> Vec<String> {
 /// by the reference's gap law (`RefLaw::CaseGapFilm`);
 /// `filmomeganu` the rotating cylinder's film as a function of ω/ν
 /// (`RefLaw::CaseFilmOmegaNu`); `nodrag` no iron-loss drag in
-/// the motor current (`RefLaw::NoIronDrag`); `nofric` and
+/// the motor current (`RefLaw::NoIronDrag`); beyond the control's ten
+/// (`all`): `ports` the port oil as two nodes (`RefLaw::TwoPorts`), `duct`
+/// the duct films by the reference's law (`RefLaw::DuctLaw`; `ductblocks`
+/// the block films' only, `RefLaw::DuctLawBlocks`), `wall` the
+/// reference's block wall behind the block films (`RefLaw::BlockWall`),
+/// `outer` the reference's outer-surface correlations (`RefLaw::OuterLaw`),
+/// `mount` the main block's 2 W/K bench mount (`RefLaw::Mount`), `boost`
+/// the rig file's 5 bar boost (the reference's case pressure, 4 bar in the
+/// machine); `nofric` and
 /// `nowall` act on the
 /// rig file ([`rig_like_reference`]).
 fn like_reference(p: &mut eha_sim::emulator::params::EmuParams, switches: &[String]) {
@@ -313,9 +322,16 @@ fn like_reference(p: &mut eha_sim::emulator::params::EmuParams, switches: &[Stri
                 p.g_ball_block = 0.0;
             }
             "emiss" => p.emissivity = 0.85,
+            "boost" => p.boost_pa = 5e5,
             "gapfilm" => p.like_reference = p.like_reference.with(RefLaw::CaseGapFilm),
             "filmomeganu" => p.like_reference = p.like_reference.with(RefLaw::CaseFilmOmegaNu),
             "nodrag" => p.like_reference = p.like_reference.with(RefLaw::NoIronDrag),
+            "ports" => p.like_reference = p.like_reference.with(RefLaw::TwoPorts),
+            "duct" => p.like_reference = p.like_reference.with(RefLaw::DuctLaw),
+            "ductblocks" => p.like_reference = p.like_reference.with(RefLaw::DuctLawBlocks),
+            "wall" => p.like_reference = p.like_reference.with(RefLaw::BlockWall),
+            "outer" => p.like_reference = p.like_reference.with(RefLaw::OuterLaw),
+            "mount" => p.like_reference = p.like_reference.with(RefLaw::Mount),
             "nofric" | "nowall" => {}
             other => panic!("unknown structural switch `{other}`"),
         }
@@ -342,6 +358,12 @@ fn rig_like_reference(r: &mut Rig, switches: &[String]) {
 /// under-prediction, mix max |e|, mix under-prediction), K, firmware drain
 /// against the thermocouple.
 fn bisection_step(machine: &EmuMachine, switches: &[String]) -> (f64, f64, f64) {
+    bisection_run(machine, switches, false)
+}
+
+/// [`bisection_step`], with the held-out mix added to the training set
+/// when `train_mix` (still scored: can the reference follow it at all?).
+pub(super) fn bisection_run(machine: &EmuMachine, switches: &[String], train_mix: bool) -> (f64, f64, f64) {
     let mut m = machine.clone();
     like_reference(&mut m.params, switches);
     let s = eha_sim::emulator::bench::bench_set(&m, 3600).expect("bench");
@@ -349,6 +371,10 @@ fn bisection_step(machine: &EmuMachine, switches: &[String]) -> (f64, f64, f64) 
     let hold: Vec<CalLog> = s.holdout.iter().map(|l| CalLog::new(&l.name, l.run.clone(), 120).expect("log")).collect();
     let mut base = m.rig_file();
     rig_like_reference(&mut base, switches);
+    let mut train = train;
+    if train_mix {
+        train.push(hold[1].clone());
+    }
     // The set as the bisection measured it: the structural freedoms it led
     // to held (they are measured in foreign.rs).
     let mut o = CalOptions::default();
