@@ -1,6 +1,8 @@
 //! The emulated machine: a quasi-static hydraulic operating point (the
 //! hydraulics settle in milliseconds, the temperatures in minutes), the
-//! losses of eqs. (1)–(11) placed in a 14-node thermal network of its own,
+//! losses of eqs. (1)–(11) placed in a 14-node thermal network of its own
+//! (a 15th, the inlet port's oil, only with the experiment switch
+//! `RefLaw::TwoPorts`),
 //! the sensors as first-order states, integrated by Heun's method with a
 //! step bounded by the network's fastest time constant.
 

@@ -23,7 +23,7 @@ use eha_sim::emulator::bench::machines;
 /// runs with both switches (0.81–0.84 K) against six without (1.15–1.32 K)
 /// confirm, and on the held-out row not moving (1.32 → 1.39 K).
 #[test]
-#[ignore = "slow: five commissionings, ~3-4 min on 2 shared cores"]
+#[ignore = "slow: five commissionings, 125 s on 2 shared cores"]
 fn slow_the_block_films_carry_part_of_the_control_miss() {
     let rows: [(&str, &str, bool, [f64; 3]); 5] = [
         ("big-pump", "all", true, [0.571, 1.271, 1.271]),
