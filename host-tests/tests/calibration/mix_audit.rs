@@ -6,7 +6,8 @@
 //! printed, not a test of a number: run by hand (`-- --ignored --nocapture
 //! slow_mix_heat_audit`; `MIXAUDIT_SERIES=1` prints the mix's time series,
 //! the commissioned rig is cached in the temp dir, `MIXAUDIT_FRESH=1`
-//! commissions again; the machine variants of [`slow_mix_experiment`] apply).
+//! commissions again; the machine variants of [`slow_mix_experiment`] apply,
+//! and its `EXP_TRAIN_MIX`).
 
 use eha_sim::calibration::commission::commission_with;
 use eha_sim::calibration::{CalLog, CalOptions};
@@ -30,7 +31,11 @@ fn commissioned(m: &EmuMachine) -> Rig {
         }
     }
     let s = eha_sim::emulator::bench::bench_set(m, 3600).expect("bench");
-    let train: Vec<CalLog> = s.train.iter().map(|l| CalLog::new(&l.name, l.run.clone(), 120).expect("log")).collect();
+    let mut train: Vec<CalLog> = s.train.iter().map(|l| CalLog::new(&l.name, l.run.clone(), 120).expect("log")).collect();
+    if std::env::var("EXP_TRAIN_MIX").is_ok() {
+        // the held-out mix trained too (tag the cache with MIXAUDIT_TAG)
+        train.push(CalLog::new(&s.holdout[1].name, s.holdout[1].run.clone(), 120).expect("log"));
+    }
     let mut o = CalOptions::default();
     for name in holds.split(',').filter(|n| !n.is_empty()) {
         let k = eha_sim::calibration::set::index(name).expect("parameter");
