@@ -182,6 +182,7 @@ fn slow_mix_heat_audit() {
 /// (or `all`) the structural switches of [`like_reference`];
 /// `EXP_TRAIN_MIX=1` / `EXP_TRAIN_SERVO=1` add the held-out mix / servo log
 /// to the training set (still scored: can the reference follow it at all?);
+/// `EXP_TRAIN_OTHER_MIX=seed` adds another throttle mix of that seed;
 /// `EXP_MACHINE` picks one machine. Prints the held-out numbers without the
 /// margin (firmware drain vs thermocouple).
 #[test]
@@ -225,6 +226,12 @@ fn slow_mix_experiment() {
         if std::env::var("EXP_TRAIN_MIX").is_ok() {
             // the held-out mix in the training set too: can the reference follow it at all?
             train.push(hold[1].clone());
+        }
+        if let Some(seed) = env("EXP_TRAIN_OTHER_MIX") {
+            // another throttle mix (its own draw, this seed) in the training set:
+            // does a mix-like training log carry the held-out mix?
+            let l = bench_log(&m, EmuScenario::ThrottleMix, 1800.0, seed as u64).expect("log");
+            train.push(CalLog::new(&l.name, l.run.clone(), 120).expect("log"));
         }
         if std::env::var("EXP_TRAIN_SERVO").is_ok() {
             // the held-out servo log in the training set too (frees the churned case film)
@@ -363,12 +370,13 @@ fn rig_like_reference(r: &mut Rig, switches: &[String]) {
 /// under-prediction, mix max |e|, mix under-prediction), K, firmware drain
 /// against the thermocouple.
 fn bisection_step(machine: &EmuMachine, switches: &[String]) -> (f64, f64, f64) {
-    bisection_run(machine, switches, false)
+    bisection_run(machine, switches, false, None)
 }
 
 /// [`bisection_step`], with the held-out mix added to the training set
-/// when `train_mix` (still scored: can the reference follow it at all?).
-pub(super) fn bisection_run(machine: &EmuMachine, switches: &[String], train_mix: bool) -> (f64, f64, f64) {
+/// when `train_mix` (still scored: can the reference follow it at all?),
+/// and another throttle mix of seed `other_mix` (1800 s) when given.
+pub(super) fn bisection_run(machine: &EmuMachine, switches: &[String], train_mix: bool, other_mix: Option<u64>) -> (f64, f64, f64) {
     let mut m = machine.clone();
     like_reference(&mut m.params, switches);
     let s = eha_sim::emulator::bench::bench_set(&m, 3600).expect("bench");
@@ -379,6 +387,10 @@ pub(super) fn bisection_run(machine: &EmuMachine, switches: &[String], train_mix
     let mut train = train;
     if train_mix {
         train.push(hold[1].clone());
+    }
+    if let Some(seed) = other_mix {
+        let l = bench_log(&m, EmuScenario::ThrottleMix, 1800.0, seed).expect("log");
+        train.push(CalLog::new(&l.name, l.run.clone(), 120).expect("log"));
     }
     // The set as the bisection measured it: the structural freedoms it led
     // to held (they are measured in foreign.rs).
