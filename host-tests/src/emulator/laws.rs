@@ -78,12 +78,52 @@ impl Plant<'_> {
         (lambda * l / d + xi) * 0.5 * oil_rho(t_c) * vel * vel
     }
 
+    /// Film conductance of oil flowing at `q` m³/s through a duct
+    /// `dct` = (diameter, length, wetted area), the oil at node temperature
+    /// `t_c`, W/K: the machine's Hausen/Gnielinski law
+    /// ([`props::duct_film`]); with [`RefLaw::DuctLaw`] the reference's
+    /// Nusselt law on the same area (with [`RefLaw::DuctLawBlocks`] on a
+    /// `block` film only).
+    pub(super) fn duct(&self, dct: [f64; 3], q: f64, t_c: f64, block: bool) -> f64 {
+        let nu = self.nu(t_c);
+        let lr = self.p.like_reference;
+        if !(lr.has(RefLaw::DuctLaw) || block && lr.has(RefLaw::DuctLawBlocks)) {
+            return props::duct_film(q, dct[0], dct[1], dct[2], nu, t_c);
+        }
+        let [d, l, area] = dct;
+        let re = crate::physics::heat::reynolds(q, d, nu);
+        let pr = nu * oil_rho(t_c) * oil_cp(t_c) / props::oil_k(t_c);
+        crate::physics::heat::nu_tube_with(re, pr, d / l, crate::physics::heat::nu_laminar_x) * props::oil_k(t_c) / d * area
+    }
+
+    /// A block film `g` (W/K) behind which the block of outer area `a_out`
+    /// (m²) sits: `g` itself, or with [`RefLaw::BlockWall`] in series with
+    /// the reference's wall (eq. 18: 45 W/(m·K) steel, 30 mm, on a face of
+    /// side √(a_out/6)), W/K.
+    pub(super) fn block_film(&self, g: f64, a_out: f64) -> f64 {
+        if !self.p.like_reference.has(RefLaw::BlockWall) {
+            return g;
+        }
+        crate::physics::heat::series(g, crate::physics::heat::g_plane_wall(45.0, (a_out / 6.0).sqrt(), 0.03))
+    }
+
     /// Heat lost by a surface `s` = (area, height, diameter) at `t_w` to
     /// ambient `t_a` with air speed `air`: sides (80 %, Churchill–Chu
     /// vertical), top and bottom faces (10 % each, McAdams), each mixed
-    /// with Churchill–Bernstein cross flow, plus radiation, W.
-    pub(super) fn outer_w(&self, s: [f64; 3], t_w: f64, t_a: f64, air: f64) -> f64 {
+    /// with Churchill–Bernstein cross flow, plus radiation, W. With
+    /// [`RefLaw::OuterLaw`] the reference's correlations instead
+    /// (`cube`: a block, eq. 16 on the side √(area/6); otherwise a
+    /// horizontal cylinder of the diameter, eq. 15; the flat plate's forced
+    /// convection over 0.352 m mixed in).
+    pub(super) fn outer_w(&self, s: [f64; 3], cube: bool, t_w: f64, t_a: f64, air: f64) -> f64 {
         let [a, hgt, d] = s;
+        if self.p.like_reference.has(RefLaw::OuterLaw) {
+            use crate::physics::heat as h;
+            let p_air = 101_325.0;
+            let free = if cube { h::h_free_cube(t_w, t_a, p_air, (a / 6.0).sqrt()) } else { h::h_free_cylinder(t_w, t_a, p_air, d) };
+            let conv = if air > 0.0 { h::h_mixed(free, h::h_forced_plate(air, 0.352, t_a, p_air)) } else { free };
+            return conv * a * (t_w - t_a) + props::radiation_w(self.p.emissivity, a, t_w, t_a);
+        }
         let forced = if air > 0.0 { props::h_cross_flow(air, d, 0.5 * (t_w + t_a)) } else { 0.0 };
         let side = props::h_mixed(props::h_free_vertical(t_w, t_a, hgt), forced);
         let top = props::h_mixed(props::h_free_horizontal(t_w, t_a, d, true), forced);

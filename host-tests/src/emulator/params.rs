@@ -135,20 +135,48 @@ pub enum RefLaw {
     /// No iron-loss drag torque in the motor current (the reference's shaft
     /// torque has none: its iron loss heats the housing without a torque).
     NoIronDrag,
+    /// The port oil as the reference's two nodes (inlet and outlet passage,
+    /// half the volume and half the duct area each; the delivered oil's
+    /// heat, the leakage and the throttle path leave from the outlet)
+    /// instead of one well-mixed node at the outlet's temperature.
+    TwoPorts,
+    /// The oil films in the ducts (port, manifold, block, ball-valve,
+    /// cylinder) by the reference's Nusselt law (eqs. 13/14:
+    /// `heat::nu_tube_with` with `heat::nu_laminar_x`) on the machine's own
+    /// areas, instead of Hausen/Gnielinski.
+    DuctLaw,
+    /// [`RefLaw::DuctLaw`] on the manifold, block and ball-valve films
+    /// only (the port and cylinder films keep the machine's law).
+    DuctLawBlocks,
+    /// The manifold, block and ball-valve films in series with the
+    /// reference's block wall (eq. 18: steel 45 W/(m·K), 30 mm, on a face
+    /// of side √(A/6) of the block's outer area A), as the reference's
+    /// `network::block_path` has them.
+    BlockWall,
+    /// The outer surfaces by the reference's correlations: free convection
+    /// of a horizontal cylinder (eq. 15; motor, pump, cylinder) or a cube
+    /// (eq. 16, side √(A/6); the blocks), mixed with the flat plate's forced
+    /// convection over the rig file's 0.352 m run, instead of Churchill–Chu
+    /// vertical sides, McAdams faces and Churchill–Bernstein.
+    OuterLaw,
+    /// The main block mounted on the bench through 2 W/K to the air
+    /// temperature, as the rig file's `blocks.mount_w_per_k` (the machine
+    /// has no mount).
+    Mount,
 }
 
 /// A set of [`RefLaw`]s ([`EmuParams::like_reference`]); empty by default.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct LikeReference(u8);
+pub struct LikeReference(u16);
 
 impl LikeReference {
     /// The set with `law` added.
     pub fn with(self, law: RefLaw) -> Self {
-        Self(self.0 | 1 << law as u8)
+        Self(self.0 | 1 << law as u16)
     }
     /// Whether `law` is replaced by the reference's.
     pub fn has(self, law: RefLaw) -> bool {
-        self.0 & 1 << law as u8 != 0
+        self.0 & 1 << law as u16 != 0
     }
 }
 

@@ -1,11 +1,13 @@
 //! The emulated machine: a quasi-static hydraulic operating point (the
 //! hydraulics settle in milliseconds, the temperatures in minutes), the
-//! losses of eqs. (1)–(11) placed in a 14-node thermal network of its own,
+//! losses of eqs. (1)–(11) placed in a 14-node thermal network of its own
+//! (a 15th, the inlet port's oil, only with the experiment switch
+//! `RefLaw::TwoPorts`),
 //! the sensors as first-order states, integrated by Heun's method with a
 //! step bounded by the network's fastest time constant.
 
 use super::missions::{linear_at, step_at, EmuMission};
-use super::params::EmuParams;
+use super::params::{EmuParams, RefLaw};
 use super::props::{self, oil_cp, oil_rho};
 use crate::physics::candidates::Candidate;
 use std::f64::consts::PI;
@@ -42,10 +44,14 @@ pub enum N {
     CylOil,
     /// Dead-end sensor pocket (only coupled with hidden `sensor-lag`).
     Pocket,
+    /// Oil in the inlet port passage: a node of its own only with the
+    /// experiment switch `RefLaw::TwoPorts` (then [`N::PortOil`] is the
+    /// outlet's); otherwise coupled to nothing and never read.
+    InletOil,
 }
 
 /// Number of nodes.
-pub const NN: usize = 14;
+pub const NN: usize = 15;
 /// State: node temperatures, five sensor states, the drain-port
 /// thermocouple ([`DRAIN_SENSOR`]), piston position.
 pub const NS: usize = NN + 7;
@@ -199,13 +205,14 @@ impl Plant<'_> {
     pub fn capacities(&self, y: &[f64]) -> [f64; NN] {
         let p = self.p;
         let oil = |v: f64, i: N| v * oil_rho(y[i as usize]) * oil_cp(y[i as usize]);
+        let two = p.like_reference.has(RefLaw::TwoPorts);
         [
             p.c_stator,
             p.c_motor_case,
             p.c_pump[0],
             p.c_pump[1],
             oil(p.v_case, N::CaseOil),
-            oil(p.v_port, N::PortOil),
+            oil(if two { 0.5 * p.v_port } else { p.v_port }, N::PortOil),
             p.c_manifold,
             oil(p.v_loop, N::LoopOil),
             p.c_block,
@@ -214,6 +221,7 @@ impl Plant<'_> {
             p.cyl[0],
             oil(p.cyl[1], N::CylOil),
             oil(p.pocket[0], N::Pocket),
+            oil(0.5 * p.v_port, N::InletOil),
         ]
     }
 
@@ -268,12 +276,21 @@ impl Plant<'_> {
             acc.link(y, N::CaseOil, wall, self.case_film(o.omega, a, nu_case, tn(N::CaseOil)));
         }
         let q_geo = d_rad * o.omega.abs();
-        let duct = |dct: [f64; 3], flow: f64, n: N| props::duct_film(flow.max(1e-7), dct[0], dct[1], dct[2], self.nu(tn(n)), tn(n));
-        acc.link(y, N::PortOil, N::EndCap, duct(p.port_duct, q_geo, N::PortOil));
-        acc.link(y, N::LoopOil, N::Manifold, duct(p.plate_duct, q_geo, N::LoopOil));
-        acc.link(y, N::LoopOil, N::Block, duct(p.block_duct, q_geo, N::LoopOil));
+        let duct = |dct: [f64; 3], flow: f64, n: N| self.duct(dct, flow.max(1e-7), tn(n), matches!(n, N::LoopOil | N::BallOil));
+        let two = p.like_reference.has(RefLaw::TwoPorts);
+        if two {
+            // the reference's two port nodes, each on half the passages
+            let half = [p.port_duct[0], p.port_duct[1], 0.5 * p.port_duct[2]];
+            acc.link(y, N::PortOil, N::EndCap, duct(half, q_geo, N::PortOil));
+            acc.link(y, N::InletOil, N::EndCap, duct(half, q_geo, N::InletOil));
+        } else {
+            acc.link(y, N::PortOil, N::EndCap, duct(p.port_duct, q_geo, N::PortOil));
+        }
+        let [s_manifold, s_block, s_ball] = [p.surfaces[3][0], p.surfaces[4][0], p.surfaces[5][0]];
+        acc.link(y, N::LoopOil, N::Manifold, self.block_film(duct(p.plate_duct, q_geo, N::LoopOil), s_manifold));
+        acc.link(y, N::LoopOil, N::Block, self.block_film(duct(p.block_duct, q_geo, N::LoopOil), s_block));
         let q_ball = if self.m.scenario.is_servo() { 0.0 } else { o.q_path };
-        acc.link(y, N::BallOil, N::Ball, duct(p.ball_duct, q_ball, N::BallOil));
+        acc.link(y, N::BallOil, N::Ball, self.block_film(duct(p.ball_duct, q_ball, N::BallOil), s_ball));
         let q_cyl = 1526.81e-6 * o.v.abs();
         acc.link(y, N::CylOil, N::Cylinder, duct([0.063, 0.1, p.cyl[2]], q_cyl, N::CylOil));
         // Sensor pocket: dead end with `sensor-lag`, otherwise a small
@@ -290,23 +307,41 @@ impl Plant<'_> {
         let rho_cp = |n: N| oil_rho(tn(n)) * oil_cp(tn(n));
         acc.flow(y, N::PortOil, N::CaseOil, o.q_leak * rho_cp(N::PortOil));
         acc.flow(y, N::CaseOil, N::LoopOil, o.q_leak * rho_cp(N::CaseOil));
+        // The pump's suction: the loop oil straight into the (outlet) port
+        // node, or through the inlet port's node (`RefLaw::TwoPorts`).
+        let suction = |acc: &mut Acc, q: f64| {
+            if two {
+                acc.flow(y, N::LoopOil, N::InletOil, q * rho_cp(N::LoopOil));
+                acc.flow(y, N::InletOil, N::PortOil, q * rho_cp(N::InletOil));
+            } else {
+                acc.flow(y, N::LoopOil, N::PortOil, q * rho_cp(N::LoopOil));
+            }
+        };
         if self.m.scenario.is_servo() {
-            acc.flow(y, N::LoopOil, N::PortOil, o.q_leak * rho_cp(N::LoopOil));
+            suction(&mut acc, o.q_leak);
             // Oil swinging between pump, manifold and chambers.
             let g_pump = q_geo * rho_cp(N::PortOil);
             acc.link(y, N::PortOil, N::LoopOil, g_pump);
+            if two {
+                acc.link(y, N::InletOil, N::LoopOil, q_geo * rho_cp(N::InletOil));
+            }
             acc.link(y, N::LoopOil, N::CylOil, 0.5 * q_cyl * rho_cp(N::LoopOil));
         } else {
-            acc.flow(y, N::LoopOil, N::PortOil, (o.q_path + o.q_leak) * rho_cp(N::LoopOil));
+            suction(&mut acc, o.q_path + o.q_leak);
             acc.flow(y, N::PortOil, N::BallOil, o.q_path * rho_cp(N::PortOil));
             acc.flow(y, N::BallOil, N::LoopOil, o.q_path * rho_cp(N::BallOil));
         }
         // Outer surfaces.
         let outer = [N::MotorCase, N::Barrel, N::EndCap, N::Manifold, N::Block, N::Ball, N::Cylinder];
         for (k, n) in outer.iter().enumerate() {
-            let w = self.outer_w(p.surfaces[k], tn(*n), amb, o.air);
+            let w = self.outer_w(p.surfaces[k], (3..6).contains(&k), tn(*n), amb, o.air);
             acc.q[*n as usize] -= w;
             acc.g[*n as usize] += (w / (tn(*n) - amb)).abs().min(50.0);
+        }
+        if p.like_reference.has(RefLaw::Mount) {
+            // the rig file's bench mount of the main block, 2 W/K
+            acc.q[N::Block as usize] -= 2.0 * (tn(N::Block) - amb);
+            acc.g[N::Block as usize] += 2.0;
         }
         let c = self.capacities(y);
         let mut rate: f64 = 0.0;

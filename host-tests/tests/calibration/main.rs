@@ -8,4 +8,5 @@ mod direct;
 mod emulator;
 mod foreign;
 mod mix_audit;
+mod mix_structure;
 mod recovery;

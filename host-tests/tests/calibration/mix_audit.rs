@@ -6,7 +6,8 @@
 //! printed, not a test of a number: run by hand (`-- --ignored --nocapture
 //! slow_mix_heat_audit`; `MIXAUDIT_SERIES=1` prints the mix's time series,
 //! the commissioned rig is cached in the temp dir, `MIXAUDIT_FRESH=1`
-//! commissions again; the machine variants of [`slow_mix_experiment`] apply).
+//! commissions again; the machine variants of [`slow_mix_experiment`] apply,
+//! and its `EXP_TRAIN_MIX`).
 
 use eha_sim::calibration::commission::commission_with;
 use eha_sim::calibration::{CalLog, CalOptions};
@@ -30,7 +31,11 @@ fn commissioned(m: &EmuMachine) -> Rig {
         }
     }
     let s = eha_sim::emulator::bench::bench_set(m, 3600).expect("bench");
-    let train: Vec<CalLog> = s.train.iter().map(|l| CalLog::new(&l.name, l.run.clone(), 120).expect("log")).collect();
+    let mut train: Vec<CalLog> = s.train.iter().map(|l| CalLog::new(&l.name, l.run.clone(), 120).expect("log")).collect();
+    if std::env::var("EXP_TRAIN_MIX").is_ok() {
+        // the held-out mix trained too (tag the cache with MIXAUDIT_TAG)
+        train.push(CalLog::new(&s.holdout[1].name, s.holdout[1].run.clone(), 120).expect("log"));
+    }
     let mut o = CalOptions::default();
     for name in holds.split(',').filter(|n| !n.is_empty()) {
         let k = eha_sim::calibration::set::index(name).expect("parameter");
@@ -177,6 +182,7 @@ fn slow_mix_heat_audit() {
 /// (or `all`) the structural switches of [`like_reference`];
 /// `EXP_TRAIN_MIX=1` / `EXP_TRAIN_SERVO=1` add the held-out mix / servo log
 /// to the training set (still scored: can the reference follow it at all?);
+/// `EXP_TRAIN_OTHER_MIX=seed` adds another throttle mix of that seed;
 /// `EXP_MACHINE` picks one machine. Prints the held-out numbers without the
 /// margin (firmware drain vs thermocouple).
 #[test]
@@ -220,6 +226,12 @@ fn slow_mix_experiment() {
         if std::env::var("EXP_TRAIN_MIX").is_ok() {
             // the held-out mix in the training set too: can the reference follow it at all?
             train.push(hold[1].clone());
+        }
+        if let Some(seed) = env("EXP_TRAIN_OTHER_MIX") {
+            // another throttle mix (its own draw, this seed) in the training set:
+            // does a mix-like training log carry the held-out mix?
+            let l = bench_log(&m, EmuScenario::ThrottleMix, 1800.0, seed as u64).expect("log");
+            train.push(CalLog::new(&l.name, l.run.clone(), 120).expect("log"));
         }
         if std::env::var("EXP_TRAIN_SERVO").is_ok() {
             // the held-out servo log in the training set too (frees the churned case film)
@@ -270,12 +282,13 @@ fn like_ref() -> Vec<String> {
     parse_switches(&std::env::var("EXP_LIKE_REF").unwrap_or_default())
 }
 
-/// A comma-separated switch list (`all`: [`ALL_SWITCHES`]).
-fn parse_switches(v: &str) -> Vec<String> {
-    if v == "all" {
-        return ALL_SWITCHES.map(String::from).to_vec();
-    }
-    v.split(',').filter(|s| !s.is_empty()).map(String::from).collect()
+/// A comma-separated switch list (`all` in it: [`ALL_SWITCHES`], so
+/// `all,ports` is the control and one more).
+pub(super) fn parse_switches(v: &str) -> Vec<String> {
+    v.split(',')
+        .filter(|s| !s.is_empty())
+        .flat_map(|s| if s == "all" { ALL_SWITCHES.map(String::from).to_vec() } else { vec![s.to_string()] })
+        .collect()
 }
 
 /// Structural bisection: each named switch makes the emulator machine like
@@ -292,7 +305,15 @@ fn parse_switches(v: &str) -> Vec<String> {
 /// by the reference's gap law (`RefLaw::CaseGapFilm`);
 /// `filmomeganu` the rotating cylinder's film as a function of ω/ν
 /// (`RefLaw::CaseFilmOmegaNu`); `nodrag` no iron-loss drag in
-/// the motor current (`RefLaw::NoIronDrag`); `nofric` and
+/// the motor current (`RefLaw::NoIronDrag`); beyond the control's ten
+/// (`all`): `ports` the port oil as two nodes (`RefLaw::TwoPorts`), `duct`
+/// the duct films by the reference's law (`RefLaw::DuctLaw`; `ductblocks`
+/// the block films' only, `RefLaw::DuctLawBlocks`), `wall` the
+/// reference's block wall behind the block films (`RefLaw::BlockWall`),
+/// `outer` the reference's outer-surface correlations (`RefLaw::OuterLaw`),
+/// `mount` the main block's 2 W/K bench mount (`RefLaw::Mount`), `boost`
+/// the rig file's 5 bar boost (the reference's case pressure, 4 bar in the
+/// machine); `nofric` and
 /// `nowall` act on the
 /// rig file ([`rig_like_reference`]).
 fn like_reference(p: &mut eha_sim::emulator::params::EmuParams, switches: &[String]) {
@@ -313,9 +334,16 @@ fn like_reference(p: &mut eha_sim::emulator::params::EmuParams, switches: &[Stri
                 p.g_ball_block = 0.0;
             }
             "emiss" => p.emissivity = 0.85,
+            "boost" => p.boost_pa = 5e5,
             "gapfilm" => p.like_reference = p.like_reference.with(RefLaw::CaseGapFilm),
             "filmomeganu" => p.like_reference = p.like_reference.with(RefLaw::CaseFilmOmegaNu),
             "nodrag" => p.like_reference = p.like_reference.with(RefLaw::NoIronDrag),
+            "ports" => p.like_reference = p.like_reference.with(RefLaw::TwoPorts),
+            "duct" => p.like_reference = p.like_reference.with(RefLaw::DuctLaw),
+            "ductblocks" => p.like_reference = p.like_reference.with(RefLaw::DuctLawBlocks),
+            "wall" => p.like_reference = p.like_reference.with(RefLaw::BlockWall),
+            "outer" => p.like_reference = p.like_reference.with(RefLaw::OuterLaw),
+            "mount" => p.like_reference = p.like_reference.with(RefLaw::Mount),
             "nofric" | "nowall" => {}
             other => panic!("unknown structural switch `{other}`"),
         }
@@ -342,6 +370,13 @@ fn rig_like_reference(r: &mut Rig, switches: &[String]) {
 /// under-prediction, mix max |e|, mix under-prediction), K, firmware drain
 /// against the thermocouple.
 fn bisection_step(machine: &EmuMachine, switches: &[String]) -> (f64, f64, f64) {
+    bisection_run(machine, switches, false, None)
+}
+
+/// [`bisection_step`], with the held-out mix added to the training set
+/// when `train_mix` (still scored: can the reference follow it at all?),
+/// and another throttle mix of seed `other_mix` (1800 s) when given.
+pub(super) fn bisection_run(machine: &EmuMachine, switches: &[String], train_mix: bool, other_mix: Option<u64>) -> (f64, f64, f64) {
     let mut m = machine.clone();
     like_reference(&mut m.params, switches);
     let s = eha_sim::emulator::bench::bench_set(&m, 3600).expect("bench");
@@ -349,6 +384,14 @@ fn bisection_step(machine: &EmuMachine, switches: &[String]) -> (f64, f64, f64) 
     let hold: Vec<CalLog> = s.holdout.iter().map(|l| CalLog::new(&l.name, l.run.clone(), 120).expect("log")).collect();
     let mut base = m.rig_file();
     rig_like_reference(&mut base, switches);
+    let mut train = train;
+    if train_mix {
+        train.push(hold[1].clone());
+    }
+    if let Some(seed) = other_mix {
+        let l = bench_log(&m, EmuScenario::ThrottleMix, 1800.0, seed).expect("log");
+        train.push(CalLog::new(&l.name, l.run.clone(), 120).expect("log"));
+    }
     // The set as the bisection measured it: the structural freedoms it led
     // to held (they are measured in foreign.rs).
     let mut o = CalOptions::default();
