@@ -7,6 +7,7 @@ mod commission;
 mod direct;
 mod emulator;
 mod foreign;
+mod like_ref;
 mod mix_audit;
 mod mix_structure;
 mod recovery;
