@@ -27,6 +27,7 @@ pub mod cli;
 pub mod emu_result;
 pub mod emu_sweep;
 pub mod emu_tables;
+pub mod emu_calibration;
 
 pub use analysis::{diagnose, DiagnoseError, DiagnoseOptions, Diagnosis};
 pub use model::{Candidate, ParamSpec, Phase, SimSeries, Simulator};

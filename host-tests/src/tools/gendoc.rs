@@ -24,14 +24,15 @@ pub struct Section {
     pub doc: &'static str,
     /// Marker tag.
     pub tag: &'static str,
-    /// The committed JSON it is rendered from.
+    /// The committed JSON it is rendered from (several `, `-separated: the
+    /// renderer gets a JSON array of their texts, in this order).
     pub source: &'static str,
     /// JSON text → Markdown.
     pub render: fn(&str) -> Result<String>,
 }
 
 /// Every generated section.
-pub const SECTIONS: [Section; 6] = [
+pub const SECTIONS: [Section; 8] = [
     Section { doc: "docs/results.md", tag: "uq-paper", source: "docs/data/uq-paper.json", render: render_uq_paper },
     Section { doc: "docs/results.md", tag: "fw-budget", source: ".ci/fw-budget.json", render: render_fw_budget },
     Section { doc: "docs/rig-file.md", tag: "rig-file", source: "host-tests/src/physics/rig/mod.rs", render: crate::tools::rigdoc::render },
@@ -48,12 +49,48 @@ pub const SECTIONS: [Section; 6] = [
         source: "docs/data/emulator-sweep-1800.json",
         render: render_emulator_sweep,
     },
+    Section {
+        doc: "docs/diagnosis-numbers.md",
+        tag: "emulator-sweep-2800",
+        source: "docs/data/emulator-sweep-2800.json",
+        render: render_emulator_sweep,
+    },
+    Section {
+        doc: "docs/diagnosis-numbers.md",
+        tag: "reliability-default",
+        source: "docs/data/emulator-sweep-hidden-no-case-held.json, docs/data/emulator-sweep-1800.json, docs/data/emulator-sweep-2800.json, docs/data/imprint-ratios-no-case-held.json",
+        render: render_reliability,
+    },
 ];
+
+/// Labels of the sweeps of the `reliability-default` section, in its
+/// sources' order.
+const RELIABILITY_SETS: [&str; 3] = ["1700s/2700s (17 case logs, no twins)", "1800–1817 (with twins)", "2800–2817 (with twins)"];
+
+/// The reliability of the stated probabilities under the default structure
+/// and what an effective sample size does to it
+/// ([`crate::diagnosis::emu_calibration`]): its sources' texts as a JSON
+/// array, the sweeps' then the imprint ratios (seed → r) of the cases run
+/// without twins.
+fn render_reliability(json: &str) -> Result<String> {
+    let mut parts: Vec<serde_json::Value> = serde_json::from_str(json)?;
+    let ratios: BTreeMap<u64, f64> = match parts.pop() {
+        Some(v) => serde_json::from_value::<BTreeMap<String, f64>>(v)?.into_iter().filter_map(|(k, r)| Some((k.parse().ok()?, r))).collect(),
+        None => BTreeMap::new(),
+    };
+    let mut sets = Vec::new();
+    for (i, v) in parts.into_iter().enumerate() {
+        let rows: Vec<crate::diagnosis::emu_sweep::EmuResult> = serde_json::from_value(v)?;
+        sets.push((RELIABILITY_SETS.get(i).copied().unwrap_or("more"), rows));
+    }
+    Ok(crate::diagnosis::emu_calibration::document(&sets, &ratios))
+}
 
 /// The emulator sweep's tables (`eha-sim emulator-sweep`, the case sets
 /// it ran under `--structure off`, its `emulator-sweep.json`, in
 /// docs/diagnosis-off.md; the second seed set's under the default
-/// structure, `emulator-sweep-1800.json`, in docs/diagnosis-numbers.md).
+/// structure, `emulator-sweep-1800.json` and `emulator-sweep-2800.json`,
+/// in docs/diagnosis-numbers.md).
 fn render_emulator_sweep(json: &str) -> Result<String> {
     let rows: Vec<crate::diagnosis::emu_sweep::EmuResult> = serde_json::from_str(json)?;
     Ok(crate::diagnosis::emu_sweep::document(&rows))
@@ -100,7 +137,10 @@ pub fn run(root: &Path, check: bool) -> Result<Vec<PathBuf>> {
             Some(t) => t.clone(),
             None => std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?,
         };
-        let json = std::fs::read_to_string(root.join(s.source)).with_context(|| format!("reading {}", s.source))?;
+        // Several sources (", "-separated) reach the renderer as one JSON array of their texts.
+        let read = |src: &str| std::fs::read_to_string(root.join(src)).with_context(|| format!("reading {src}"));
+        let srcs: Vec<&str> = s.source.split(", ").collect();
+        let json = if srcs.len() == 1 { read(s.source)? } else { format!("[{}]", srcs.iter().map(|x| read(x)).collect::<Result<Vec<_>>>()?.join(",")) };
         let body = (s.render)(&json).with_context(|| format!("rendering {} from {}", s.tag, s.source))?;
         docs.insert(s.doc, splice(&text, s.doc, s.tag, s.source, &body)?);
     }
