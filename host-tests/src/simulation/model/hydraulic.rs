@@ -60,8 +60,7 @@ impl Model {
     /// there): what the hydraulic derivatives need.
     pub fn op_hydraulic(&self, t: f64, y: &[f64]) -> OpPoint {
         let ball = || {
-            let t_ball = y[t_ix(Node::BallOil)];
-            (self.rig.oil.rho(t_ball, 0.0), self.nu(t_ball))
+            self.ball_oil(y[t_ix(Node::BallOil)])
         };
         self.op_hydraulic_with(t, y, true, ball)
     }
@@ -137,8 +136,8 @@ impl Model {
     /// The oil properties through which the node temperatures `temps`
     /// enter the hydraulic derivatives ([`Model::hydraulic_rhs_oil`]).
     pub fn hydraulic_oil(&self, temps: &[f64]) -> HydraulicOil {
-        let t_ball = temps[Node::BallOil as usize];
-        HydraulicOil { k_leak: self.k_leak(temps[Node::Case as usize]), rho_ball: self.rig.oil.rho(t_ball, 0.0), nu_ball: self.nu(t_ball) }
+        let (rho_ball, nu_ball) = self.ball_oil(temps[Node::BallOil as usize]);
+        HydraulicOil { k_leak: self.k_leak(temps[Node::Case as usize]), rho_ball, nu_ball }
     }
 
     /// The hydraulic operating point of a mission at the hydraulic states

@@ -57,7 +57,7 @@ pub enum Drive {
 #[derive(Debug)]
 pub struct Model {
     /// Rig parameters. Read-only after [`Model::new`]: the node contents,
-    /// the throttle path's constants and the memos (iron loss, needle, μ)
+    /// the throttle path's constants and the memos (iron loss, needle, μ, ball-valve oil)
     /// are taken from it there; build a new model for another rig.
     pub rig: Rig,
     /// Drive.
@@ -84,6 +84,9 @@ pub struct Model {
     /// The dynamic viscosity at the last temperature it was taken for:
     /// (the temperature's bits, Pa·s) ([`Model::mu`]; NaN's bits: none).
     mu_memo: BitsMemo<f64>,
+    /// The ball-valve oil's (density kg/m³, kinematic viscosity m²/s) at
+    /// the last temperature they were taken for ([`Model::ball_oil`]).
+    ball_memo: BitsMemo<(f64, f64)>,
 }
 
 /// A one-entry memo keyed on an `f64` argument's bits: the value computed
@@ -128,7 +131,7 @@ impl Model {
         let path_geom = hydraulics::PathGeom::new(&rig);
         let k0 = hydraulics::needle_k(&rig, 0.0);
         let needle_memo = BitsMemo::new(0.0, (k0, hydraulics::needle_inv_k2(k0)));
-        Self { rig, drive, lng_open: Cell::new(false), contents, outer_grid: None, nu_grid: None, lam_grid: None, leak_geom: None, iron_memo, path_geom, needle_memo, mu_memo: BitsMemo::empty() }
+        Self { rig, drive, lng_open: Cell::new(false), contents, outer_grid: None, nu_grid: None, lam_grid: None, leak_geom: None, iron_memo, path_geom, needle_memo, mu_memo: BitsMemo::empty(), ball_memo: BitsMemo::new(f64::NAN, (f64::NAN, f64::NAN)) }
     }
 
     /// The needle valve at setting `bar` ([`hydraulics::needle_k`]: its k,
@@ -161,8 +164,10 @@ impl Model {
         let step = step_k.filter(|&s| s > 0.0 && s.is_finite());
         self.outer_grid = step.map(OuterGrid::new);
         self.nu_grid = step.map(|s| NuGrid::new(s * NU_GRID_FACTOR));
-        // ν moves from the exact line to the grid (or back): μ anew.
+        // ν moves from the exact line to the grid (or back): μ and the
+        // ball-valve oil anew.
         self.mu_memo = BitsMemo::empty();
+        self.ball_memo = BitsMemo::new(f64::NAN, (f64::NAN, f64::NAN));
         self.lam_grid = step.map(|_| LaminarGrid::new());
         self.leak_geom = step.map(|_| self.rig.pump.gaps.conductance(1.0));
     }
@@ -183,10 +188,22 @@ impl Model {
     }
 
     /// Pressure drops of the throttle path ([`hydraulics::path_dp`]) with
-    /// the oil at `t_oil`: its viscosity from [`Model::nu`] (on the grid
-    /// when the grids are set), Pa.
+    /// the ball-valve oil at `t_oil`: its properties from
+    /// [`Model::ball_oil`], Pa.
     fn path_dp(&self, q: f64, t_oil: f64, needle: Option<f64>) -> (f64, f64) {
-        hydraulics::path_dp_props(&self.rig, q, self.rig.oil.rho(t_oil, 0.0), self.nu(t_oil), needle)
+        let (rho, nu) = self.ball_oil(t_oil);
+        hydraulics::path_dp_props(&self.rig, q, rho, nu, needle)
+    }
+
+    /// The ball-valve oil's density at 0 bar (kg/m³) and kinematic
+    /// viscosity ([`Model::nu`], m²/s) at `t_oil`: kept for the last
+    /// temperature's bits (a heat balance asks for them at the same
+    /// temperature up to five times: the operating point, the losses, the
+    /// ball duct's film, the throttle path's drop), so the same values to
+    /// the last bit.
+    #[inline]
+    pub(crate) fn ball_oil(&self, t_oil: f64) -> (f64, f64) {
+        self.ball_memo.get_or(t_oil, || (self.rig.oil.rho(t_oil, 0.0), self.nu(t_oil)))
     }
 
     /// Kinematic viscosity of the oil at `t_oil` (its Walther line), m²/s.

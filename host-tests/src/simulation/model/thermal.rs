@@ -88,7 +88,7 @@ impl Model {
         }
         let g_loop = self.duct_conductance(qc, b.loop_d_m, b.loop_len_m, b.loop_area_scale, tc(Node::Loop), self.nu(tc(Node::Loop)));
         link(&mut q, Node::Loop, Node::MainBlock, network::block_path(rig, g_loop, b.main_area_m2));
-        let g_ball = self.duct_conductance(qc, b.ball_d_m, b.ball_len_m, 1.0, tc(Node::BallOil), self.nu(tc(Node::BallOil)));
+        let g_ball = self.duct_conductance(qc, b.ball_d_m, b.ball_len_m, 1.0, tc(Node::BallOil), self.ball_oil(tc(Node::BallOil)).1);
         link(&mut q, Node::BallOil, Node::BallBlock, network::block_path(rig, g_ball, b.ball_area_m2));
         // Manifold sensor pocket: in the flowing manifold in the baseline; in
         // a dead-end branch (Figs. 9–10) with `sensor-lag`.
