@@ -181,12 +181,17 @@ impl Oil {
     /// 20 °C to `t_c`, exact for the linear ρ and c_p (a cubic), so that the
     /// nodes' capacity [`Oil::rho_cp`] and the stored energy agree to round-off.
     pub fn volumetric_enthalpy(&self, t_c: f64) -> f64 {
+        self.enthalpy_cubic().at(t_c)
+    }
+
+    /// The coefficients of [`Oil::volumetric_enthalpy`]'s cubic, taken once
+    /// (a run's snapshots take the stored energy of every oil node).
+    pub fn enthalpy_cubic(&self) -> EnthalpyCubic {
         // rho = r0 + r1 (T - 20), cp = c0 + c1 (T - 20), both exact linear laws
         let r0 = self.rho(20.0, 0.0);
         let r1 = -self.rho15_kg_per_m3 * self.expansion_per_k;
         let (c0, c1) = (self.cp20_j_per_kg_k, self.cp_slope_j_per_kg_k2);
-        let d = t_c - 20.0;
-        r0 * c0 * d + 0.5 * (r0 * c1 + r1 * c0) * d * d + r1 * c1 * d * d * d / 3.0
+        EnthalpyCubic { a: r0 * c0, b: 0.5 * (r0 * c1 + r1 * c0), c: r1 * c1 }
     }
 
     /// Lowest oil temperature at which the model's laws are used inside
@@ -304,6 +309,28 @@ pub fn air_at(t_c: f64, p_pa: f64) -> AirProps {
     let k = 0.02414 + 7.4e-5 * t_c;
     let cp = 1005.0 + 0.02 * t_c;
     AirProps { nu: mu / rho, k, pr: mu * cp / k, beta: 1.0 / t_k }
+}
+
+/// The oil's heat stored per unit volume relative to 20 °C as a cubic in
+/// d = T − 20 K ([`Oil::enthalpy_cubic`]): a·d + b·d² + c·d³/3, J/m³.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EnthalpyCubic {
+    /// ρ₀·c₀ at 20 °C, J/(m³·K).
+    a: f64,
+    /// (ρ₀·c₁ + ρ₁·c₀)/2, J/(m³·K²).
+    b: f64,
+    /// ρ₁·c₁, J/(m³·K³).
+    c: f64,
+}
+
+impl EnthalpyCubic {
+    /// [`Oil::volumetric_enthalpy`] at `t_c` °C, J/m³ (the same operations
+    /// in the same order, so the same bits).
+    #[inline]
+    pub fn at(&self, t_c: f64) -> f64 {
+        let d = t_c - 20.0;
+        self.a * d + self.b * d * d + self.c * d * d * d / 3.0
+    }
 }
 
 #[cfg(test)]

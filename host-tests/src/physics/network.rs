@@ -126,8 +126,15 @@ pub fn capacity_j_per_k(rig: &Rig, n: Node, content: (f64, f64), t_c: f64) -> f6
 /// Heat stored in node `n` at `t_c` relative to 20 °C, J (consistent with
 /// [`capacity_j_per_k`]: its derivative in `t_c`).
 pub fn stored_j(rig: &Rig, n: Node, content: (f64, f64), t_c: f64) -> f64 {
+    stored_j_with(&rig.oil.enthalpy_cubic(), n, content, t_c)
+}
+
+/// [`stored_j`] with the oil's enthalpy cubic `oil` taken once
+/// ([`crate::fluid::Oil::enthalpy_cubic`]), J.
+#[inline]
+pub fn stored_j_with(oil: &crate::fluid::EnthalpyCubic, n: Node, content: (f64, f64), t_c: f64) -> f64 {
     if n.is_oil() {
-        content.0 * rig.oil.volumetric_enthalpy(t_c)
+        content.0 * oil.at(t_c)
     } else {
         content.0 * content.1 * (t_c - 20.0)
     }

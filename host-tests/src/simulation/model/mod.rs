@@ -78,6 +78,9 @@ pub struct Model {
     iron_memo: BitsMemo<f64>,
     /// The throttle path's constants (π·d⁴, 2·a²), taken once.
     path_geom: hydraulics::PathGeom,
+    /// The oil's stored heat per volume as a cubic, taken once (the
+    /// snapshots' stored energy: [`Model::stored_energy_from`]).
+    enthalpy: crate::fluid::EnthalpyCubic,
     /// The needle valve at the last setting it was taken for: (the
     /// setting's bits in bar, k, 1/k²) ([`Model::needle`]).
     needle_memo: BitsMemo<(Option<f64>, f64)>,
@@ -129,9 +132,10 @@ impl Model {
         let contents = network::contents(&rig);
         let iron_memo = BitsMemo::new(0.0, rig.motor.iron.power_w(0.0));
         let path_geom = hydraulics::PathGeom::new(&rig);
+        let enthalpy = rig.oil.enthalpy_cubic();
         let k0 = hydraulics::needle_k(&rig, 0.0);
         let needle_memo = BitsMemo::new(0.0, (k0, hydraulics::needle_inv_k2(k0)));
-        Self { rig, drive, lng_open: Cell::new(false), contents, outer_grid: None, nu_grid: None, lam_grid: None, leak_geom: None, iron_memo, path_geom, needle_memo, mu_memo: BitsMemo::empty(), ball_memo: BitsMemo::new(f64::NAN, (f64::NAN, f64::NAN)) }
+        Self { rig, drive, lng_open: Cell::new(false), contents, outer_grid: None, nu_grid: None, lam_grid: None, leak_geom: None, iron_memo, path_geom, enthalpy, needle_memo, mu_memo: BitsMemo::empty(), ball_memo: BitsMemo::new(f64::NAN, (f64::NAN, f64::NAN)) }
     }
 
     /// The needle valve at setting `bar` ([`hydraulics::needle_k`]: its k,
@@ -329,7 +333,7 @@ impl Model {
     /// Each node's stored energy at the state `y`, J (relative to the
     /// network's 20 °C reference, `network::stored_j`).
     pub fn node_energies(&self, y: &[f64]) -> [f64; N_NODES] {
-        std::array::from_fn(|i| network::stored_j(&self.rig, NODES[i], self.contents[i], y[T0 + i]))
+        std::array::from_fn(|i| network::stored_j_with(&self.enthalpy, NODES[i], self.contents[i], y[T0 + i]))
     }
 
     /// [`Model::stored_energy`] relative to the node energies `e0` of the
@@ -339,7 +343,7 @@ impl Model {
         NODES
             .iter()
             .enumerate()
-            .map(|(i, n)| network::stored_j(&self.rig, *n, self.contents[i], y[T0 + i]) - e0[i])
+            .map(|(i, n)| network::stored_j_with(&self.enthalpy, *n, self.contents[i], y[T0 + i]) - e0[i])
             .sum()
     }
 
