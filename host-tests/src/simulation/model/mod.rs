@@ -340,10 +340,14 @@ impl Model {
     /// initial state ([`Model::node_energies`], taken once a run): the
     /// same differences summed in the same order.
     pub fn stored_energy_from(&self, e0: &[f64; N_NODES], y: &[f64]) -> f64 {
+        // One length check for the thirteen reads.
+        let z: &[f64; N_NODES] = y[T0..T0 + N_NODES].try_into().expect("the node temperatures");
         NODES
             .iter()
-            .enumerate()
-            .map(|(i, n)| network::stored_j_with(&self.enthalpy, *n, self.contents[i], y[T0 + i]) - e0[i])
+            .zip(&self.contents)
+            .zip(z)
+            .zip(e0)
+            .map(|(((n, c), t), e)| network::stored_j_with(&self.enthalpy, *n, *c, *t) - e)
             .sum()
     }
 
