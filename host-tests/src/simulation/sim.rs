@@ -331,17 +331,26 @@ fn run_plant(mut plant: impl Runner, scenario: &Scenario, opt: &SimOptions) -> R
         let cmd = rule.command(s);
         if k.is_multiple_of(every) || s.t >= t_end - 1e-9 {
             if out.columns.is_empty() {
+                // The first output names the columns as it fills them (one
+                // pass over the channels, no list of them).
                 let n = ((t_end - s.t) / opt.output_interval_s).max(0.0) as usize + 2;
-                out.columns = channels(s).iter().map(|(name, _)| (name.to_string(), Vec::with_capacity(n))).collect();
+                out.columns.reserve_exact(13 + NODES.len() + 19);
                 out.time_s.reserve(n);
-            }
-            out.time_s.push(s.t);
-            let mut cols = out.columns.iter_mut();
-            each_channel(s, |_, v| {
-                if let Some((_, col)) = cols.next() {
+                out.time_s.push(s.t);
+                each_channel(s, |name, v| {
+                    let mut col = Vec::with_capacity(n);
                     col.push(v);
-                }
-            });
+                    out.columns.push((name.to_string(), col));
+                });
+            } else {
+                out.time_s.push(s.t);
+                let mut cols = out.columns.iter_mut();
+                each_channel(s, |_, v| {
+                    if let Some((_, col)) = cols.next() {
+                        col.push(v);
+                    }
+                });
+            }
         }
         if let Some(open) = cmd {
             if open && !last_open {
