@@ -304,7 +304,7 @@ impl HydTrack {
 /// 1e-10 m³/s, 1e-4 rad/s) are a machine at rest, not a reversal.
 fn branch_values(model: &Model, oil: &HydraulicOil, t: f64, yh: &[f64; NH]) -> [f64; 3] {
     let op = model.op_hydraulic_oil(t, yh, oil);
-    [op.p_a - op.p_b, op.circulation(&model.rig), op.omega]
+    [op.p_a - op.p_b, op.circulation(model.rig()), op.omega]
 }
 
 const BRANCH_THRESHOLDS: [f64; 3] = [1.0, 1e-10, 1e-4];

@@ -56,10 +56,12 @@ pub enum Drive {
 /// The model: rig, drive and the LNG valve state.
 #[derive(Debug)]
 pub struct Model {
-    /// Rig parameters. Read-only after [`Model::new`]: the node contents,
-    /// the throttle path's constants and the memos (iron loss, needle, μ, ball-valve oil)
-    /// are taken from it there; build a new model for another rig.
-    pub rig: Rig,
+    /// Rig parameters ([`Model::rig`]). Private: the node contents, the
+    /// throttle path's constants, the enthalpy cubic and the memos (iron
+    /// loss, needle, μ, ball-valve oil) are taken from it in
+    /// [`Model::new`], so a changed rig would leave them stale; build a new
+    /// model for another rig.
+    rig: Rig,
     /// Drive.
     pub drive: Drive,
     /// LNG valve open (set between solver segments).
@@ -136,6 +138,12 @@ impl Model {
         let k0 = hydraulics::needle_k(&rig, 0.0);
         let needle_memo = BitsMemo::new(0.0, (k0, hydraulics::needle_inv_k2(k0)));
         Self { rig, drive, lng_open: Cell::new(false), contents, outer_grid: None, nu_grid: None, lam_grid: None, leak_geom: None, iron_memo, path_geom, enthalpy, needle_memo, mu_memo: BitsMemo::empty(), ball_memo: BitsMemo::new(f64::NAN, (f64::NAN, f64::NAN)) }
+    }
+
+    /// The rig the model was built for (read-only: see [`Model::new`]).
+    #[inline]
+    pub fn rig(&self) -> &Rig {
+        &self.rig
     }
 
     /// The needle valve at setting `bar` ([`hydraulics::needle_k`]: its k,

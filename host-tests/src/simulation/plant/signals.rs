@@ -133,7 +133,7 @@ impl RuleEval {
     pub(crate) fn for_model(model: &Model) -> Self {
         RuleEval {
             rule: model.valve_rule(),
-            lng: model.rig.lng,
+            lng: model.rig().lng,
             replay: match &model.drive {
                 Drive::Replay(r) => Some(r.clone()),
                 Drive::Mission(_) => None,
@@ -174,6 +174,6 @@ pub fn snapshot_stored(model: &Model, t: f64, y: &[f64], stored_j: f64) -> Snaps
         e_amb_j: y[E_AMB],
         e_lng_j: y[E_LNG],
         stored_j,
-        lng_used_kg: y[E_LNG] / model.rig.lng.heat_per_kg(),
+        lng_used_kg: y[E_LNG] / model.rig().lng.heat_per_kg(),
     }
 }
