@@ -42,11 +42,14 @@ pub const MEASURED_COLUMNS: [&str; 14] = [
     "air_speed_mps",
 ];
 
+/// About how many channels [`each_channel`] gives (the measured columns, the
+/// other nodes, 11 losses, 8 more): a capacity, so one allocation.
+const CHANNEL_COUNT_HINT: usize = 13 + NODES.len() + 19;
+
 /// Every channel of a snapshot as (name, value): the measured-format
 /// channels first (without `time_s`), then the internal ones.
 pub fn channels(s: &Snapshot) -> Vec<(&'static str, f64)> {
-    // One allocation: the measured columns, the other nodes, 11 losses, 8 more.
-    let mut v = Vec::with_capacity(13 + NODES.len() + 19);
+    let mut v = Vec::with_capacity(CHANNEL_COUNT_HINT);
     each_channel(s, |name, x| v.push((name, x)));
     v
 }
@@ -334,7 +337,7 @@ fn run_plant(mut plant: impl Runner, scenario: &Scenario, opt: &SimOptions) -> R
                 // The first output names the columns as it fills them (one
                 // pass over the channels, no list of them).
                 let n = ((t_end - s.t) / opt.output_interval_s).max(0.0) as usize + 2;
-                out.columns.reserve_exact(13 + NODES.len() + 19);
+                out.columns.reserve_exact(CHANNEL_COUNT_HINT);
                 out.time_s.reserve(n);
                 out.time_s.push(s.t);
                 each_channel(s, |name, v| {

@@ -21,7 +21,14 @@ use eha_sim::rig::Rig;
 use eha_sim::scenario::Scenario;
 use eha_sim::sim::{simulate_rtol, SimOptions};
 pub(super) use super::like_ref::parse_switches;
+use super::foreign::cal;
 use super::like_ref::{like_ref, like_reference, rig_like_reference, variant};
+
+/// Another throttle mix of `seed` (its own draw of speeds and loads,
+/// 1800 s) on machine `m`, as a calibration log: a mix-like training log.
+fn other_mix_log(m: &EmuMachine, seed: u64) -> CalLog {
+    cal(&bench_log(m, EmuScenario::ThrottleMix, 1800.0, seed).expect("log"))
+}
 
 fn commissioned(m: &EmuMachine) -> Rig {
     let holds = std::env::var("EXP_HOLD").unwrap_or_default();
@@ -33,10 +40,10 @@ fn commissioned(m: &EmuMachine) -> Rig {
         }
     }
     let s = eha_sim::emulator::bench::bench_set(m, 3600).expect("bench");
-    let mut train: Vec<CalLog> = s.train.iter().map(|l| CalLog::new(&l.name, l.run.clone(), 120).expect("log")).collect();
+    let mut train: Vec<CalLog> = s.train.iter().map(cal).collect();
     if std::env::var("EXP_TRAIN_MIX").is_ok() {
         // the held-out mix trained too (tag the cache with MIXAUDIT_TAG)
-        train.push(CalLog::new(&s.holdout[1].name, s.holdout[1].run.clone(), 120).expect("log"));
+        train.push(cal(&s.holdout[1]));
     }
     let mut o = CalOptions::default();
     for name in holds.split(',').filter(|n| !n.is_empty()) {
@@ -64,7 +71,7 @@ const COLS: [&str; 14] = [
 fn audit(m: &EmuMachine, rig: &Rig, scenario: EmuScenario, dur: f64, seed: u64) {
     let (mission, trace) = bench_trace(m, scenario, dur, seed);
     let log = bench_log(m, scenario, dur, seed).expect("log");
-    let cal = CalLog::new(&log.name, log.run.clone(), 120).expect("cal");
+    let cal = cal(&log);
     let inputs = cal.replay_inputs().expect("replay").clone();
     let out = simulate_rtol(rig, &Scenario::Replay(inputs.clone()), &SimOptions { output_interval_s: 2.0, control_interval_s: 2.0 }, 1e-6).expect("sim");
     let model = Model::new(rig.clone(), Drive::Replay(ReplayDrive::new(inputs.clone())));
@@ -196,8 +203,8 @@ fn slow_mix_experiment() {
         }
         variant(&mut m);
         let s = eha_sim::emulator::bench::bench_set(&m, 3600).expect("bench");
-        let train: Vec<CalLog> = s.train.iter().map(|l| CalLog::new(&l.name, l.run.clone(), 120).expect("log")).collect();
-        let hold: Vec<CalLog> = s.holdout.iter().map(|l| CalLog::new(&l.name, l.run.clone(), 120).expect("log")).collect();
+        let train: Vec<CalLog> = s.train.iter().map(cal).collect();
+        let hold: Vec<CalLog> = s.holdout.iter().map(cal).collect();
         let mut o = CalOptions::default();
         for name in std::env::var("EXP_HOLD").unwrap_or_default().split(',').filter(|n| !n.is_empty()) {
             let k = eha_sim::calibration::set::index(name).expect("parameter");
@@ -232,8 +239,7 @@ fn slow_mix_experiment() {
         if let Some(seed) = env("EXP_TRAIN_OTHER_MIX") {
             // another throttle mix (its own draw, this seed) in the training set:
             // does a mix-like training log carry the held-out mix?
-            let l = bench_log(&m, EmuScenario::ThrottleMix, 1800.0, seed as u64).expect("log");
-            train.push(CalLog::new(&l.name, l.run.clone(), 120).expect("log"));
+            train.push(other_mix_log(&m, seed as u64));
         }
         if std::env::var("EXP_TRAIN_SERVO").is_ok() {
             // the held-out servo log in the training set too (frees the churned case film)
@@ -267,8 +273,8 @@ pub(super) fn bisection_run(machine: &EmuMachine, switches: &[String], train_mix
     let mut m = machine.clone();
     like_reference(&mut m.params, switches);
     let s = eha_sim::emulator::bench::bench_set(&m, 3600).expect("bench");
-    let train: Vec<CalLog> = s.train.iter().map(|l| CalLog::new(&l.name, l.run.clone(), 120).expect("log")).collect();
-    let hold: Vec<CalLog> = s.holdout.iter().map(|l| CalLog::new(&l.name, l.run.clone(), 120).expect("log")).collect();
+    let train: Vec<CalLog> = s.train.iter().map(cal).collect();
+    let hold: Vec<CalLog> = s.holdout.iter().map(cal).collect();
     let mut base = m.rig_file();
     rig_like_reference(&mut base, switches);
     let mut train = train;
@@ -276,8 +282,7 @@ pub(super) fn bisection_run(machine: &EmuMachine, switches: &[String], train_mix
         train.push(hold[1].clone());
     }
     if let Some(seed) = other_mix {
-        let l = bench_log(&m, EmuScenario::ThrottleMix, 1800.0, seed).expect("log");
-        train.push(CalLog::new(&l.name, l.run.clone(), 120).expect("log"));
+        train.push(other_mix_log(&m, seed));
     }
     // The set as the bisection measured it: the structural freedoms it led
     // to held (they are measured in foreign.rs).

@@ -96,7 +96,8 @@ pub struct Model {
 
 /// A one-entry memo keyed on an `f64` argument's bits: the value computed
 /// for the same bits again (so the same to the last bit), computed anew for
-/// any other argument. The model's iron loss, needle and μ memos.
+/// any other argument. The model's iron loss, needle, μ and ball-valve oil
+/// memos.
 #[derive(Debug)]
 struct BitsMemo<T: Copy>(Cell<(u64, T)>);
 
@@ -120,11 +121,25 @@ impl<T: Copy> BitsMemo<T> {
     }
 }
 
-impl BitsMemo<f64> {
-    /// Holding nothing (NaN at NaN's bits: what a computation at that NaN
-    /// gives too).
+/// A memo's value that stands for "nothing kept": NaN in every field (what
+/// a computation at the NaN key gives too).
+trait Unset: Copy {
+    /// The all-NaN value.
+    const NAN: Self;
+}
+
+impl Unset for f64 {
+    const NAN: Self = f64::NAN;
+}
+
+impl Unset for (f64, f64) {
+    const NAN: Self = (f64::NAN, f64::NAN);
+}
+
+impl<T: Unset> BitsMemo<T> {
+    /// Holding nothing: [`Unset::NAN`] at NaN's bits.
     fn empty() -> Self {
-        Self::new(f64::NAN, f64::NAN)
+        Self::new(f64::NAN, T::NAN)
     }
 }
 
@@ -137,7 +152,7 @@ impl Model {
         let enthalpy = rig.oil.enthalpy_cubic();
         let k0 = hydraulics::needle_k(&rig, 0.0);
         let needle_memo = BitsMemo::new(0.0, (k0, hydraulics::needle_inv_k2(k0)));
-        Self { rig, drive, lng_open: Cell::new(false), contents, outer_grid: None, nu_grid: None, lam_grid: None, leak_geom: None, iron_memo, path_geom, enthalpy, needle_memo, mu_memo: BitsMemo::empty(), ball_memo: BitsMemo::new(f64::NAN, (f64::NAN, f64::NAN)) }
+        Self { rig, drive, lng_open: Cell::new(false), contents, outer_grid: None, nu_grid: None, lam_grid: None, leak_geom: None, iron_memo, path_geom, enthalpy, needle_memo, mu_memo: BitsMemo::empty(), ball_memo: BitsMemo::empty() }
     }
 
     /// The rig the model was built for (read-only: see [`Model::new`]).
@@ -179,7 +194,7 @@ impl Model {
         // ν moves from the exact line to the grid (or back): μ and the
         // ball-valve oil anew.
         self.mu_memo = BitsMemo::empty();
-        self.ball_memo = BitsMemo::new(f64::NAN, (f64::NAN, f64::NAN));
+        self.ball_memo = BitsMemo::empty();
         self.lam_grid = step.map(|_| LaminarGrid::new());
         self.leak_geom = step.map(|_| self.rig.pump.gaps.conductance(1.0));
     }
@@ -348,8 +363,8 @@ impl Model {
     /// initial state ([`Model::node_energies`], taken once a run): the
     /// same differences summed in the same order.
     pub fn stored_energy_from(&self, e0: &[f64; N_NODES], y: &[f64]) -> f64 {
-        // One length check for the thirteen reads.
-        let z: &[f64; N_NODES] = y[T0..T0 + N_NODES].try_into().expect("the node temperatures");
+        // One bounds check for the thirteen reads.
+        let z = &y[T0..T0 + N_NODES];
         NODES
             .iter()
             .zip(&self.contents)

@@ -12,7 +12,8 @@ use eha_sim::emulator::bench::{bench_log, bench_set, commissioning_set, big_pump
 use eha_sim::emulator::missions::EmuScenario;
 use eha_sim::measured::Channel;
 
-fn cal(l: &BenchLog) -> CalLog {
+/// A bench log as a calibration log (120 fit points per channel).
+pub(super) fn cal(l: &BenchLog) -> CalLog {
     CalLog::new(&l.name, l.run.clone(), 120).expect("cal log")
 }
 
