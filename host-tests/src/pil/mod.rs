@@ -17,6 +17,7 @@ pub mod drill;
 pub mod firmware;
 pub mod plot;
 pub mod product;
+pub mod error;
 pub mod qemu;
 pub mod reference;
 pub mod cli;
@@ -29,7 +30,8 @@ use eha_guard::product::wire::{FromGuard, Status, TickReply};
 use eha_guard::protocol::Request;
 
 pub use firmware::{build_bin, build_firmware, Build};
-pub use qemu::{PilError, QemuOptions, QemuSession};
+pub use error::PilError;
+pub use qemu::{QemuOptions, QemuSession};
 
 /// What the firmware can measure, plus the plant's true drain temperature.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
