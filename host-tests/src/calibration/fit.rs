@@ -251,6 +251,20 @@ pub fn calibrate(base: &Rig, logs: &[CalLog], o: &CalOptions) -> Result<Calibrat
             });
         }
     }
+    // 1c'. The ducts' turbulent level needs the passages' flow in the
+    // transition, hot: below Re 2300 it acts on nothing.
+    if !super::ident::duct_transition_range(logs, base) {
+        let (secs, top) = super::ident::duct_transition_time_s(logs, base);
+        let k = super::set::index(super::set::DUCT_TURBULENT).expect("calibration parameter");
+        held[k].get_or_insert_with(|| {
+            format!(
+                "the logs with the block and oil sensors spend {secs:.0} s with the main-block passage's flow above Re {:.0} (needs {:.0} s; highest Re {top:.0}); would need: {}",
+                super::ident::DUCT_TRANSITION_RE,
+                super::ident::DUCT_TRANSITION_MIN_S,
+                PARAMS[k].excitation
+            )
+        });
+    }
     for (name, why) in &o.hold {
         if let Some(k) = super::set::index(name) {
             held[k].get_or_insert_with(|| why.clone());

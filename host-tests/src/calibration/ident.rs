@@ -224,3 +224,51 @@ pub fn case_film_speed_range(logs: &[CalLog]) -> bool {
     let (low, high) = drain_time_low_and_high_speed_s(logs);
     low >= CASE_FILM_MIN_S && high >= CASE_FILM_MIN_S
 }
+
+/// Reynolds number of the main-block passage's flow above which the duct
+/// film's transition blend (eqs. 13/14, 2300–10⁴) carries enough of the
+/// turbulent law for its level to show: at 3000 the turbulent end is 9 %
+/// of the blend's weight and 40–50 % of the film (oil Pr 200–400).
+pub const DUCT_TRANSITION_RE: f64 = 3000.0;
+
+/// Time the training logs must spend with the passage's flow above
+/// [`DUCT_TRANSITION_RE`] for the turbulent level (`set::DUCT_TURBULENT`)
+/// to be fitted, s: a few of the block's film time constants after each
+/// speed step, not one excursion.
+pub const DUCT_TRANSITION_MIN_S: f64 = 300.0;
+
+/// Seconds the logs carrying the main block's surface sensor and the oil
+/// probe spend with the main-block passage's Reynolds number above
+/// [`DUCT_TRANSITION_RE`], and the largest Reynolds number they reach:
+/// the pump's delivery D·|ω| (the rig file's displacement, the logged
+/// speed) through the passage (`blocks.loop_d_m`), ν at the logged oil
+/// temperature (`t_oil_c`) on the rig's viscosity line. Each row weighted
+/// by the time to the next.
+pub fn duct_transition_time_s(logs: &[CalLog], rig: &crate::rig::Rig) -> (f64, f64) {
+    let d = rig.blocks.loop_d_m;
+    let disp = rig.displacement_m3_per_rad();
+    let (mut secs, mut top) = (0.0, 0.0f64);
+    for l in logs.iter().filter(|l| l.has(Channel::TBlockC) && l.has(Channel::TOilC)) {
+        let x = Inputs::of(&l.run);
+        let oil = l.run.get(Channel::TOilC).map(|v| v.to_vec()).unwrap_or_default();
+        let t = &l.run.time_s;
+        for i in 0..t.len().saturating_sub(1) {
+            let (Some(w), Some(Some(t_oil))) = (x.speed(i), oil.get(i)) else { continue };
+            let q = disp * w.abs() * std::f64::consts::PI / 30.0;
+            let re = crate::heat::reynolds(q, d, rig.oil.nu_m2_per_s(*t_oil));
+            top = top.max(re);
+            if re > DUCT_TRANSITION_RE {
+                secs += t[i + 1] - t[i];
+            }
+        }
+    }
+    (secs, top)
+}
+
+/// Whether the training logs run the main-block passage's flow through the
+/// duct law's transition ([`duct_transition_time_s`] ≥
+/// [`DUCT_TRANSITION_MIN_S`]): otherwise the turbulent level acts on
+/// nothing the logs see, and is held at the rig file.
+pub fn duct_transition_range(logs: &[CalLog], rig: &crate::rig::Rig) -> bool {
+    duct_transition_time_s(logs, rig).0 >= DUCT_TRANSITION_MIN_S
+}

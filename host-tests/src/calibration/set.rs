@@ -80,6 +80,10 @@ pub const RIG_FILE: &str = "the rig file's value";
 /// Name of the valve blocks' wall-conduction parameter.
 pub const BLOCK_WALL: &str = "block_wall";
 
+/// Name of the duct films' turbulent level
+/// ([`crate::rig::Blocks::duct_turbulent_scale`]).
+pub const DUCT_TURBULENT: &str = "duct_turbulent";
+
 /// Name of the forced-convection (ram-air) coefficient's parameter.
 pub const H_FORCED: &str = "h_forced";
 
@@ -122,7 +126,7 @@ pub const STRUCTURAL: [&str; 6] = [FRICTION_CASE, FRICTION_SPEED, PROBE_SURFACE[
 const PROBE_WHY: &str = "a thermocouple cemented or clamped on a painted housing reads between its metal and the air: its junction's contact conductance against the leads' and the boundary layer's (a few W/(m·K) of lead in still air) puts it 1–10 % of metal − ambient towards the air, more on a shielded or lagged mount; slightly negative would be a probe pressed into a hotter spot than the lumped metal. Fraction ln θ within −0.05…+0.18, σ 0.05 on it (a well-mounted probe reads within 5 %)";
 
 /// The calibration set, in fit order.
-pub const PARAMS: [ParamDef; 30] = [
+pub const PARAMS: [ParamDef; 31] = [
     ParamDef {
         name: "h_out_motor",
         what: "outer heat transfer of the motor housing (free convection + radiation)",
@@ -253,6 +257,17 @@ pub const PARAMS: [ParamDef; 30] = [
         why: "how a lumped block's temperature connects to its passages is a modelling choice, not a measured value: a plane wall of a sixth of the block's face gives 90 W/K; the conduction shape factor of drilled passages (2πkL/ln(r_o/r_i), 1–2 m of Ø10 mm bores with r_o/r_i 3–10) 120–500 W/K; a block lumped with its passage walls none (θ → ∞). In series with a film that grows with flow and falls with viscosity, the wall caps the oil's coupling to the block at high flow and hot oil (measured on the rig emulator: 68 W/K at 2000 rpm and 70 °C against its 216 W/K of films). σ 1.5 in ln covers ×0.05…×20 at 2σ; the bound ×100 is the no-wall limit",
         needs: Needs::SensorWithJointExcitation(Channel::TBlockC),
         excitation: "an identification run: speed (flow) and needle drop (heat input) stepped independently, the oil tens of kelvin above the block, hot and cold (the film changes with flow and viscosity, the wall does not)",
+        stage: Stage::Thermal,
+    },
+    ParamDef {
+        name: DUCT_TURBULENT,
+        what: "turbulent level of the oil ducts' films: factor on eq. (14)'s Nusselt number, above Re 10⁴ and at the turbulent end of the 2300–10⁴ blend (so on the film's rise through the transition)",
+        fields: "blocks.duct_turbulent_scale",
+        lo: 0.5, hi: 4.0, prior_sigma_ln: 0.5,
+        centre: "the rig file's law: eqs. (13)/(14) blended linearly in Re between 2300 and 10⁴ (Gnielinski 1995), eq. 14 as printed",
+        why: "where a duct flow turns turbulent depends on its inlet: drilled passages with bends, cross-drillings and valve seats trip it at Re 2300–4000, a smooth long tube near 10⁴; at Re 4000–5300 (oil Pr ~260) a flow turbulent from 4000 has 1.2–1.4 times the film of the 10⁴ blend (×1.4 at 4000). Eq. (14) itself scatters ±10–20 %. σ 0.5 in ln covers ×0.37…×2.7 at 2σ; bounds ×0.5…×4",
+        needs: Needs::Sensor(Channel::TBlockC),
+        excitation: "speed steps at 850–1200 rpm with the needle set for 40–60 bar after a warm-up, the oil hot (the main-block passage's flow at Re above 3000 for ≥ 5 min), the block and oil sensors logged",
         stage: Stage::Thermal,
     },
     ParamDef {
@@ -462,6 +477,7 @@ pub fn apply(base: &Rig, theta: &[f64]) -> Rig {
             CASE_CHURN => r.pump.case_churn *= t,
             CASE_CHURN_SPEED => r.pump.case_churn_speed_exp += t.ln(),
             BLOCK_WALL => r.blocks.wall_m /= t,
+            DUCT_TURBULENT => r.blocks.duct_turbulent_scale *= t,
             "cap_motor" => {
                 let w = r.motor.winding_mass_kg;
                 r.motor.mass_kg = w + t * (r.motor.mass_kg - w);

@@ -197,9 +197,10 @@ impl ReferenceModel {
 /// loss coefficients that only speed and pressure steps separate when the
 /// run has one operating point (the calibration's rule), without the
 /// needle split on servo runs (no throttling; the circuit by
-/// [`circuit_of`]), and without `block_wall`
+/// [`circuit_of`]), without `block_wall`
 /// unless the run moves speed and load independently (its
-/// [`Needs::SensorWithJointExcitation`]).
+/// [`Needs::SensorWithJointExcitation`]), and without
+/// [`calibration::set::DUCT_TURBULENT`] (a commissioning freedom).
 pub fn nuisance_set(run: &MeasuredRun) -> Vec<usize> {
     nuisance_set_of(run, &[run])
 }
@@ -225,6 +226,10 @@ pub fn nuisance_set_of(run: &MeasuredRun, logs: &[&MeasuredRun]) -> Vec<usize> {
         })
         .filter(|(_, d)| !(one_point && ["leak_gap", "iron_loss", "winding_r", "needle_split"].contains(&d.name)))
         .filter(|(_, d)| !(servo && d.name == "needle_split"))
+        // the ducts' turbulent level is a commissioning freedom (freed when
+        // the logs run the block flow through the transition hot); the
+        // diagnosis's admission and probabilities were measured without it
+        .filter(|(_, d)| d.name != calibration::set::DUCT_TURBULENT)
         .map(|(k, _)| k)
         .collect()
 }

@@ -199,14 +199,29 @@ pub fn bench_set(machine: &EmuMachine, seed: u64) -> Result<BenchSet, String> {
 
 /// The logs of `machine` as the commissioning procedure prescribes them
 /// (docs/commissioning.md, "What the user runs"): the speed-then-needle
-/// steps and a soak followed by low-speed holds
+/// steps, a soak followed by low-speed holds
 /// ([`EmuScenario::SoakThenLowSpeedHolds`], which holds the pump below 100
-/// rpm so that the case film's speed law is fitted). Held out: the same
-/// servo and throttle-mix logs as [`bench_set`] (same seeds, unchanged).
+/// rpm so that the case film's speed law is fitted) and the hot-flow run
+/// ([`EmuScenario::WarmThenHotSpeedSteps`], seed `seed + 4`: speed steps
+/// at 850–1200 rpm and ~50 bar with the oil hot, where the passages' flow
+/// reaches the duct law's transition). Held out: the same servo and
+/// throttle-mix logs as [`bench_set`] (same seeds, unchanged).
 pub fn commissioning_set(machine: &EmuMachine, seed: u64) -> Result<BenchSet, String> {
     let b = bench_set(machine, seed)?;
     Ok(BenchSet {
-        train: vec![b.train[0].clone(), bench_log(machine, EmuScenario::SoakThenLowSpeedHolds, 1800.0, seed + 1)?],
+        train: vec![
+            b.train[0].clone(),
+            bench_log(machine, EmuScenario::SoakThenLowSpeedHolds, 1800.0, seed + 1)?,
+            bench_log(machine, EmuScenario::WarmThenHotSpeedSteps, 1800.0, seed + 4)?,
+        ],
         holdout: b.holdout,
     })
+}
+
+/// [`commissioning_set`] without the hot-flow run (the procedure's two
+/// training logs before 2026-11-28), for comparison.
+pub fn commissioning_set_two(machine: &EmuMachine, seed: u64) -> Result<BenchSet, String> {
+    let mut s = commissioning_set(machine, seed)?;
+    s.train.truncate(2);
+    Ok(s)
 }

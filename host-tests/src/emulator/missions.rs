@@ -48,6 +48,13 @@ pub enum EmuScenario {
     /// open to 5 bar), starting low. The low holds give the case film's
     /// speed law a drain record near rest.
     SoakThenLowSpeedHolds,
+    /// The commissioning procedure's hot-flow run (docs/commissioning.md):
+    /// a warm-up at 1150 rpm with the needle set for 50 bar for the first
+    /// sixth of the run, then speed steps (850–1200 rpm every 150–250 s)
+    /// at one needle setting drawn for 40–50 bar. One input moves at a
+    /// time; the oil runs hot through the passages at the flows where the
+    /// duct films turn turbulent (Re 3000–6000 on a 25–30 cm³/rev pump).
+    WarmThenHotSpeedSteps,
 }
 
 impl EmuScenario {
@@ -177,6 +184,13 @@ pub fn draw(scenario: EmuScenario, duration_s: f64, rng: &mut impl Rng) -> EmuMi
                 m.speed.push((soak + t, w));
                 m.dp_bar.push((soak + t, dp));
             }
+        }
+        EmuScenario::WarmThenHotSpeedSteps => {
+            let warm = d / 6.0;
+            let dp = rng.random_range(40.0..50.0);
+            let speeds = steps(rng, d - warm, 150.0, 250.0, |r, _| r(850.0, 1200.0));
+            m.speed = std::iter::once((0.0, 1150.0)).chain(speeds.into_iter().map(|(t, v)| (warm + t, v))).collect();
+            m.dp_bar = vec![(0.0, 50.0), (warm, dp)];
         }
         EmuScenario::ThrottleMix => {
             let times = steps(rng, d, 90.0, 200.0, |_, _| 0.0);

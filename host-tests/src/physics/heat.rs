@@ -59,13 +59,23 @@ pub fn nu_tube(re: f64, pr: f64, d_over_l: f64) -> f64 {
 /// [`nu_tube`] with the laminar Nusselt number of X = Re·Pr·d/L given
 /// (exact: [`nu_laminar_x`]; the fast plant's interpolation of it).
 pub fn nu_tube_with(re: f64, pr: f64, d_over_l: f64, laminar: impl Fn(f64) -> f64) -> f64 {
+    nu_tube_turb(re, pr, d_over_l, laminar, 1.0)
+}
+
+/// [`nu_tube_with`] with the turbulent law (eq. 14) times `turb_scale`,
+/// above 10⁴ and in the blend's turbulent end (`Rig`'s
+/// `blocks.duct_turbulent_scale`, calibrated by `duct_turbulent`): the
+/// blend stays linear in Re between its values at 2300 and 10⁴, as the
+/// firmware's anchors read it. 1: [`nu_tube_with`] exactly.
+#[inline]
+pub fn nu_tube_turb(re: f64, pr: f64, d_over_l: f64, laminar: impl Fn(f64) -> f64, turb_scale: f64) -> f64 {
     if re <= 2300.0 {
         laminar(re * pr * d_over_l)
     } else if re >= 1e4 {
-        nu_turbulent(re, pr, d_over_l)
+        turb_scale * nu_turbulent(re, pr, d_over_l)
     } else {
         let gamma = (re - 2300.0) / (1e4 - 2300.0);
-        (1.0 - gamma) * laminar(2300.0 * pr * d_over_l) + gamma * nu_turbulent(1e4, pr, d_over_l)
+        (1.0 - gamma) * laminar(2300.0 * pr * d_over_l) + gamma * turb_scale * nu_turbulent(1e4, pr, d_over_l)
     }
 }
 

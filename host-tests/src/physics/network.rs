@@ -141,7 +141,8 @@ pub fn stored_j_with(oil: &crate::fluid::EnthalpyCubic, n: Node, content: (f64, 
 }
 
 /// Oil-to-metal conductance of a duct: forced convection by eqs. (13)/(14)
-/// (h = Nu·k/d, eq. 12) on the wetted area π·d·L·scale, W/K.
+/// (h = Nu·k/d, eq. 12; eq. 14 times the rig's
+/// `blocks.duct_turbulent_scale`) on the wetted area π·d·L·scale, W/K.
 pub fn duct_conductance(rig: &Rig, q_m3_per_s: f64, d: f64, len: f64, area_scale: f64, t_oil: f64, nu: f64) -> f64 {
     duct_conductance_with(rig, q_m3_per_s, d, len, area_scale, t_oil, nu, heat::nu_laminar_x)
 }
@@ -153,7 +154,7 @@ pub fn duct_conductance(rig: &Rig, q_m3_per_s: f64, d: f64, len: f64, area_scale
 pub fn duct_conductance_with(rig: &Rig, q_m3_per_s: f64, d: f64, len: f64, area_scale: f64, t_oil: f64, nu: f64, laminar: impl Fn(f64) -> f64) -> f64 {
     let re = heat::reynolds(q_m3_per_s, d, nu);
     let pr = rig.oil.prandtl(t_oil, nu);
-    let h = heat::nu_tube_with(re, pr, d / len, laminar) * rig.oil.k(t_oil) / d;
+    let h = heat::nu_tube_turb(re, pr, d / len, laminar, rig.blocks.duct_turbulent_scale) * rig.oil.k(t_oil) / d;
     h * std::f64::consts::PI * d * len * area_scale * rig.nuisance.inner_scale
 }
 

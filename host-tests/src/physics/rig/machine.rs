@@ -43,7 +43,7 @@ pub struct Motor {
 }
 
 /// Serde default of a factor that is 1 unless the rig file says otherwise.
-fn one() -> f64 {
+pub(super) fn one() -> f64 {
     1.0
 }
 

@@ -167,6 +167,7 @@ impl Default for Rig {
                 mount_w_per_k: 2.0,
                 wall_m: 0.03,
                 steel_k: 45.0,
+                duct_turbulent_scale: 1.0,
             },
             hydraulics: Hydraulics {
                 bulk_modulus_pa: 7.0e8,
@@ -308,6 +309,10 @@ impl Rig {
             if !(f.is_finite() && (-0.5..0.5).contains(&f)) {
                 return Err(RigError::Invalid(name, format!("must be within -0.5..0.5 (the fraction of metal − ambient the probe reads towards ambient; 0: on the metal), got {f}")));
             }
+        }
+        let dts = self.blocks.duct_turbulent_scale;
+        if !(dts.is_finite() && dts > 0.0) {
+            return Err(RigError::Invalid("blocks.duct_turbulent_scale", format!("must be > 0 (1: eq. 14 as printed), got {dts}")));
         }
         if !(self.pump.case_churn.is_finite() && self.pump.case_churn > 0.0) {
             return Err(RigError::Invalid("pump.case_churn", format!("must be > 0 (1: the gap law alone), got {}", self.pump.case_churn)));

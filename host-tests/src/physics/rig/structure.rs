@@ -102,6 +102,13 @@ pub struct Blocks {
     pub wall_m: f64,
     /// Steel conductivity, W/(m·K).
     pub steel_k: f64,
+    /// Factor on the turbulent Nusselt number of every oil duct's film
+    /// (eq. 14, Gnielinski), and so on its share of the transition blend
+    /// between Re 2300 and 10⁴ (`crate::heat::nu_tube_turb`): 1, the
+    /// paper's law (the rig file; calibrated by `duct_turbulent` when the
+    /// logs run the passages' flow through the transition hot).
+    #[serde(default = "super::machine::one")]
+    pub duct_turbulent_scale: f64,
 }
 
 /// Hydraulic circuit: lines, pressures, valves.

@@ -6,7 +6,7 @@
 
 use eha_sim::calibration::commission::{check_reduced_with, commission, commission_with, Commissioning};
 use eha_sim::calibration::paths::PathKind;
-use eha_sim::calibration::ident::{case_film_speed_range, drain_time_low_and_high_speed_s};
+use eha_sim::calibration::ident::{case_film_speed_range, drain_time_low_and_high_speed_s, duct_transition_range, duct_transition_time_s};
 use eha_sim::calibration::{CalLog, CalOptions};
 use eha_sim::emulator::bench::{bench_log, bench_set, commissioning_set, big_pump, leaky_heavy, machines, BenchLog, EmuMachine};
 use eha_sim::emulator::missions::EmuScenario;
@@ -53,20 +53,33 @@ fn bench_logs_carry_the_drain_thermocouple() {
 }
 
 /// The commissioning procedure's training set (`commissioning_set`: the
-/// soak log's idle replaced by low-speed holds) frees the churned case
-/// film's speed law; its held-out logs are `bench_set`'s.
+/// soak log's idle replaced by low-speed holds, and the hot-flow run)
+/// frees the churned case film's speed law, and on big-pump the ducts'
+/// turbulent level (`duct_transition_range`: the main-block passage's flow
+/// above Re 3000 for ≥ 300 s; measured 1032 s, Re up to 5100), not on
+/// leaky-heavy (×0.8 displacement: 0 s, Re up to 2600); without the
+/// hot-flow run neither machine frees it (big-pump 0 s, Re up to 2900).
+/// Its held-out logs are `bench_set`'s.
 #[test]
 fn commissioning_set_frees_the_case_film_speed_law() {
-    for m in machines() {
+    for (m, frees_duct) in machines().into_iter().zip([true, false]) {
         let s = commissioning_set(&m, 3600).expect("bench");
         let train: Vec<CalLog> = s.train.iter().map(cal).collect();
         let (low, high) = drain_time_low_and_high_speed_s(&train);
-        let l = &s.train[1];
-        let t = l.truth.get(Channel::TDrainC).expect("truth");
-        let top = t.iter().flatten().copied().fold(f64::MIN, f64::max);
-        eprintln!("{}: training drain logs {low:.0} s below 100 rpm, {high:.0} s above 300 rpm; {} drain max {top:.1} °C", m.name, l.name);
+        let rig = m.rig_file();
+        let (re_s, re_top) = duct_transition_time_s(&train, &rig);
+        let (re_s2, re_top2) = duct_transition_time_s(&train[..2], &rig);
+        for l in &s.train[1..] {
+            let t = l.truth.get(Channel::TDrainC).expect("truth");
+            let top = t.iter().flatten().copied().fold(f64::MIN, f64::max);
+            let oil = l.truth.get(Channel::TOilC).expect("oil").iter().flatten().copied().fold(f64::MIN, f64::max);
+            eprintln!("{}: {} drain max {top:.1} °C, oil max {oil:.1} °C", m.name, l.name);
+            assert!(top > 45.0, "{}: drain max {top:.1} °C", m.name);
+        }
+        eprintln!("{}: training drain logs {low:.0} s below 100 rpm, {high:.0} s above 300 rpm; passage Re > 3000 for {re_s:.0} s (top {re_top:.0}), without the hot-flow run {re_s2:.0} s (top {re_top2:.0})", m.name);
         assert!(case_film_speed_range(&train), "{}: the churned case film not freed", m.name);
-        assert!(top > 45.0, "{}: drain max {top:.1} °C", m.name);
+        assert_eq!(duct_transition_range(&train, &rig), frees_duct, "{}: the ducts' turbulent level", m.name);
+        assert!(!duct_transition_range(&train[..2], &rig), "{}: freed without the hot-flow run", m.name);
     }
 }
 
