@@ -8,7 +8,7 @@ use eha_sim::calibration::commission::{check_reduced_with, commission, commissio
 use eha_sim::calibration::paths::PathKind;
 use eha_sim::calibration::ident::{case_film_speed_range, drain_time_low_and_high_speed_s, duct_transition_range, duct_transition_time_s};
 use eha_sim::calibration::{CalLog, CalOptions};
-use eha_sim::emulator::bench::{bench_log, bench_set, commissioning_set, big_pump, leaky_heavy, machines, BenchLog, EmuMachine};
+use eha_sim::emulator::bench::{bench_log, bench_set, commissioning_set, commissioning_set_hot, big_pump, leaky_heavy, machines, BenchLog, EmuMachine};
 use eha_sim::emulator::missions::EmuScenario;
 use eha_sim::measured::Channel;
 
@@ -53,33 +53,34 @@ fn bench_logs_carry_the_drain_thermocouple() {
 }
 
 /// The commissioning procedure's training set (`commissioning_set`: the
-/// soak log's idle replaced by low-speed holds, and the hot-flow run)
-/// frees the churned case film's speed law, and on big-pump the ducts'
-/// turbulent level (`duct_transition_range`: the main-block passage's flow
-/// above Re 3000 for ≥ 300 s; measured 1032 s, Re up to 5100), not on
-/// leaky-heavy (×0.8 displacement: 0 s, Re up to 2600); without the
-/// hot-flow run neither machine frees it (big-pump 0 s, Re up to 2900).
-/// Its held-out logs are `bench_set`'s.
+/// soak log's idle replaced by low-speed holds) frees the churned case
+/// film's speed law; its held-out logs are `bench_set`'s. With the hot-flow
+/// run (`commissioning_set_hot`) the main-block passage's flow is above
+/// Re 3000 for ≥ 300 s on big-pump (`duct_transition_range`; measured
+/// 1500 s, Re up to 6200, drain up to 80.9 °C), not on leaky-heavy (×0.8
+/// displacement: 0 s, Re up to 1960, drain up to 70.7 °C); without it on
+/// neither (big-pump Re up to 2480, leaky-heavy 820).
 #[test]
 fn commissioning_set_frees_the_case_film_speed_law() {
     for (m, frees_duct) in machines().into_iter().zip([true, false]) {
-        let s = commissioning_set(&m, 3600).expect("bench");
+        let s = commissioning_set_hot(&m, 3600).expect("bench");
         let train: Vec<CalLog> = s.train.iter().map(cal).collect();
-        let (low, high) = drain_time_low_and_high_speed_s(&train);
+        let (low, high) = drain_time_low_and_high_speed_s(&train[..2]);
         let rig = m.rig_file();
         let (re_s, re_top) = duct_transition_time_s(&train, &rig);
         let (re_s2, re_top2) = duct_transition_time_s(&train[..2], &rig);
         for l in &s.train[1..] {
             let t = l.truth.get(Channel::TDrainC).expect("truth");
             let top = t.iter().flatten().copied().fold(f64::MIN, f64::max);
-            let oil = l.truth.get(Channel::TOilC).expect("oil").iter().flatten().copied().fold(f64::MIN, f64::max);
-            eprintln!("{}: {} drain max {top:.1} °C, oil max {oil:.1} °C", m.name, l.name);
-            assert!(top > 45.0, "{}: drain max {top:.1} °C", m.name);
+            eprintln!("{}: {} drain max {top:.1} °C", m.name, l.name);
+            assert!(top > 45.0 && top < 85.0, "{}: drain max {top:.1} °C", m.name);
         }
         eprintln!("{}: training drain logs {low:.0} s below 100 rpm, {high:.0} s above 300 rpm; passage Re > 3000 for {re_s:.0} s (top {re_top:.0}), without the hot-flow run {re_s2:.0} s (top {re_top2:.0})", m.name);
-        assert!(case_film_speed_range(&train), "{}: the churned case film not freed", m.name);
+        assert!(case_film_speed_range(&train[..2]), "{}: the churned case film not freed", m.name);
         assert_eq!(duct_transition_range(&train, &rig), frees_duct, "{}: the ducts' turbulent level", m.name);
         assert!(!duct_transition_range(&train[..2], &rig), "{}: freed without the hot-flow run", m.name);
+        let c = commissioning_set(&m, 3600).expect("bench");
+        assert_eq!(c.train.len(), 2, "the procedure's default set");
     }
 }
 
@@ -260,6 +261,54 @@ fn slow_commissioning_with_margin_on_foreign_machines() {
     }
 }
 
+/// The procedure's training set with the hot-flow run as a third log
+/// (`commissioning_set_hot`: speed steps at 850–1200 rpm and 40–50 bar
+/// after a warm-up, drain up to 81 / 71 °C), the calibration's defaults
+/// (the ducts' turbulent level held, `fit::DUCT_TURBULENT_HELD`); the
+/// same held-out logs. Measured (max |e| / under vs the thermocouple,
+/// margin counted; servo, throttle mix; one commissioning per machine,
+/// 169 s and 125 s wall at load 4–5, 135 s and 110 s CPU with the bench
+/// logs):
+/// - big-pump: the reduction refused (0.446 K off the reference on the
+///   servo log), direct path, margin 1.116 K: 1.807 / 0.000 and
+///   2.676 / 0.372 K (the two-log set: 2.017 / 0.000 and 2.786 / 0.699 K,
+///   margin 1.319 K); valve open on the mix 1425 → 1513 s, LNG 2.854 →
+///   3.001 kg. With `duct_turbulent` freed (it fitted ×1.80): margin
+///   1.020 K, 1.483 / 0.000 and 2.500 / 1.143 K.
+/// - leaky-heavy (`duct_turbulent` held by the excitation rule too: the
+///   passage flow stays below Re 2000): the reduction refused (0.573 K on
+///   the servo log), direct path, margin 0.826 K: 1.109 / 0.380 and
+///   2.020 / 1.137 K (two-log set: 1.838 / 0.000 and 2.339 / 0.568 K,
+///   margin 1.196 K); valve 1547 → 1555 s, LNG 1.953 → 1.966 kg.
+/// The hot log halves big-pump's held-out under-prediction and doubles
+/// leaky-heavy's; the acceptance (1.0 / 0.3 K) is met on neither.
+#[test]
+#[ignore = "slow tier: two commissionings with margin validation on three training logs (~2–3 min each)"]
+fn slow_commissioning_with_the_hot_flow_run() {
+    let measured = [
+        (1.116, PathKind::Direct, [(1.807, 0.000), (2.676, 0.372)], [1425.0, 1513.0]),
+        (0.826, PathKind::Direct, [(1.109, 0.380), (2.020, 1.137)], [1547.0, 1555.0]),
+    ];
+    for (m, (margin, path, want, open_s)) in machines().into_iter().zip(measured) {
+        let s = commissioning_set_hot(&m, 3600).expect("bench");
+        let train: Vec<CalLog> = s.train.iter().map(cal).collect();
+        let hold: Vec<CalLog> = s.holdout.iter().map(cal).collect();
+        let t0 = std::time::Instant::now();
+        let c = commission(&m.rig_file(), &train, &hold, &CalOptions::default()).expect("commissioning");
+        report(&m, &c, t0.elapsed().as_secs_f64());
+        let h = headline(&m, &c, &s.holdout);
+        near(&format!("{} margin", m.name), h.margin_k, margin);
+        assert_eq!(c.choice.chosen, path, "{}: {}", m.name, c.choice.why);
+        assert!(c.flashable(), "{}: {:?}", m.name, c.refusal().map(|r| r.to_string()));
+        for (got, want) in h.measured.iter().zip(want) {
+            near(&format!("{} held-out max |e| with margin", m.name), got.0, want.0);
+            near(&format!("{} held-out under-prediction with margin", m.name), got.1, want.1);
+        }
+        let (a, b) = (&c.holdout_without_margin()[1], &c.holdout_with_margin[1]);
+        assert!((a.valve_open_s - open_s[0]).abs() <= 20.0 && (b.valve_open_s - open_s[1]).abs() <= 20.0, "{}: valve open {:.0} -> {:.0} s", m.name, a.valve_open_s, b.valve_open_s);
+    }
+}
+
 /// A training set that cannot identify the machine: one operating point
 /// (500 rpm, one needle setting, 20 min) on big-pump. Refused, and the
 /// refusal names the log, its operating region, the channel and the bench
@@ -345,9 +394,10 @@ fn slow_churned_case_film_with_a_low_speed_training_log() {
 
 /// Measurement by hand (prints, asserts nothing): one commissioning
 /// without the margin per machine, on `EXP_TRAIN` = `bench` (the two
-/// throttle logs of `bench_set`) or `procedure` (`commissioning_set`,
-/// default), with the parameters named in `EXP_HOLD` (comma-separated)
-/// held; `EXP_MACHINE` = `big-pump` or `leaky-heavy` for one machine;
+/// throttle logs of `bench_set`), `hot` (`commissioning_set_hot`) or
+/// `procedure` (`commissioning_set`, default), with the parameters named in
+/// `EXP_HOLD` (comma-separated) held and those in `EXP_FREE` taken out of
+/// the default holds (e.g. `duct_turbulent`); `EXP_MACHINE` = `big-pump` or `leaky-heavy` for one machine;
 /// `EXP_MARGIN=1` with the margin and both paths.
 #[test]
 #[ignore = "measurement by hand: one commissioning per machine"]
@@ -358,14 +408,22 @@ fn slow_structure_experiment() {
         .filter(|s| !s.is_empty())
         .map(|s| eha_sim::calibration::set::PARAMS.iter().find(|p| p.name == s).unwrap_or_else(|| panic!("no parameter {s}")).name)
         .collect();
-    let procedure = std::env::var("EXP_TRAIN").map_or(true, |v| v != "bench");
+    let train_kind = std::env::var("EXP_TRAIN").unwrap_or_default();
+    let procedure = train_kind != "bench";
     let margin = std::env::var("EXP_MARGIN").is_ok_and(|v| v == "1");
     let only = std::env::var("EXP_MACHINE").ok();
     for m in machines().into_iter().filter(|m| only.as_deref().is_none_or(|o| o == m.name)) {
-        let s = if procedure { commissioning_set(&m, 3600) } else { bench_set(&m, 3600) }.expect("bench");
+        let s = match train_kind.as_str() {
+            "bench" => bench_set(&m, 3600),
+            "hot" => commissioning_set_hot(&m, 3600),
+            _ => commissioning_set(&m, 3600),
+        }
+        .expect("bench");
         let train: Vec<CalLog> = s.train.iter().map(cal).collect();
         let hold_logs: Vec<CalLog> = s.holdout.iter().map(cal).collect();
         let mut o = CalOptions::default();
+        let free: Vec<String> = std::env::var("EXP_FREE").unwrap_or_default().split(',').filter(|s| !s.is_empty()).map(String::from).collect();
+        o.hold.retain(|h| !free.iter().any(|f| f == h.0));
         for h in &hold {
             o.hold.push((h, "EXP_HOLD".into()));
         }
@@ -375,7 +433,7 @@ fn slow_structure_experiment() {
         report(&m, &c, t0.elapsed().as_secs_f64());
         let h = headline(&m, &c, &s.holdout);
         let w: Vec<String> = c.holdout_without_margin().iter().map(|r| format!("{} {:.3}/{:.3}", r.log, r.vs_measured_max_k.unwrap_or(f64::NAN), r.vs_measured_under_k.unwrap_or(f64::NAN))).collect();
-        eprintln!("EXP {} train={} hold={:?} margin={}: without margin {}; with margin {:.3} K: {:.3?}", m.name, if procedure { "procedure" } else { "bench" }, hold, margin, w.join(", "), h.margin_k, h.measured);
+        eprintln!("EXP {} train={} hold={:?} margin={}: without margin {}; with margin {:.3} K: {:.3?}", m.name, if procedure { train_kind.as_str() } else { "bench" }, hold, margin, w.join(", "), h.margin_k, h.measured);
     }
 }
 
