@@ -231,6 +231,10 @@ fn slow_commissioning_without_margin_on_foreign_machines() {
 ///   (leaky-heavy); the servo logs stay below 40 °C.
 /// - Time: see `slow_commissioning_is_reproducible_beyond_the_last_digit_big_pump`.
 ///   Not a timing test.
+/// - Re-run for big-pump with `duct_turbulent` in the set (held by default,
+///   calib14): margin 1.319 K, 2.017 / 0.000 and 2.786 / 0.699 K, unchanged
+///   to the printed digit (73.4 s at load ~4). With the hot-flow run as a
+///   third training log: `slow_commissioning_with_the_hot_flow_run`.
 #[test]
 #[ignore = "slow tier: two commissionings with margin validation on emulator bench logs (~1 min each)"]
 fn slow_commissioning_with_margin_on_foreign_machines() {

@@ -74,7 +74,10 @@ fn reproducible(m: EmuMachine, nudge_k: f64) {
         l
     };
     {
-        let s = commissioning_set(&m, 3600).expect("bench");
+        // `EXP_TRAIN=hot`: an experiment knob (the three-log set with the
+        // hot-flow run, `commissioning_set_hot`).
+        let hot = std::env::var("EXP_TRAIN").is_ok_and(|v| v == "hot");
+        let s = if hot { super::commissioning_set_hot(&m, 3600) } else { commissioning_set(&m, 3600) }.expect("bench");
         let run = |logs: &[BenchLog], hold: &[BenchLog]| {
             let train: Vec<CalLog> = logs.iter().map(cal).collect();
             let h: Vec<CalLog> = hold.iter().map(cal).collect();
