@@ -24,12 +24,13 @@ use super::*;
 ///   the servo log), direct path, margin 0.826 K: 1.109 / 0.380 and
 ///   2.020 / 1.137 K (two-log set: 1.838 / 0.000 and 2.339 / 0.568 K,
 ///   margin 1.196 K); valve 1547 → 1555 s, LNG 1.953 → 1.966 kg.
+///
 /// The acceptance (1.0 / 0.3 K) is met on neither. Not reproducible on
 /// this set: a 1e-6 K nudge of the logs moved big-pump's headline 0.51 K
 /// (margin 1.556 K, 2.110 / 0.000 and 2.903 / 0.883 K;
 /// `EXP_TRAIN=hot` on
 /// `slow_commissioning_is_reproducible_beyond_the_last_digit_big_pump`),
-/// so big-pump's 0.70 → 0.37 K is within the path spread. The rows below
+/// so big-pump's 0.70 → 0.37 K is within the path spread. The rows above
 /// are one build's, deterministic on it.
 #[test]
 #[ignore = "slow tier: two commissionings with margin validation on three training logs (~2–3 min each)"]
