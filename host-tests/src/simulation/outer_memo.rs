@@ -67,7 +67,8 @@ pub(crate) fn q_outer_exposed_kept(rig: &Rig, area: f64, shape: Shape, t_wall: f
             *m = vec![[0; WORDS + 1]; SLOTS];
         }
         let s = &mut m[i];
-        if s[..WORDS] != key {
+        // (Not `s[..WORDS] != key`: a slice comparison calls `memcmp`.)
+        if key.iter().zip(s.iter()).fold(0, |d, (a, b)| d | (a ^ b)) != 0 {
             s[..WORDS].copy_from_slice(&key);
             s[WORDS] = q_outer_exposed(rig, area, shape, t_wall, t_air, air_mps, ram_share).to_bits();
         }
