@@ -114,7 +114,7 @@ impl OuterGrid {
     }
 
     /// Heat flow of surface `i` (the index in `surfaces`) from the wall at
-    /// `t_wall` to the air, W: [`q_outer_exposed`] interpolated on the grid.
+    /// `t_wall` to the air, W: [`q_outer_exposed`](crate::network::q_outer_exposed) interpolated on the grid.
     #[allow(clippy::too_many_arguments)] // q_outer_exposed's arguments and the surface's index
     pub fn q(&self, i: usize, rig: &Rig, area: f64, shape: Shape, t_wall: f64, t_air: f64, air_mps: f64, ram_share: f64) -> f64 {
         // (A macro, not a closure: the closure's captures were stored at
@@ -175,7 +175,7 @@ impl OuterGrid {
         c.q_lo + (x - k) * (c.q_hi - c.q_lo)
     }
 
-    /// [`q_outer_exposed`], counted, through the per-thread table of the
+    /// [`q_outer_exposed`](crate::network::q_outer_exposed), counted, through the per-thread table of the
     /// values computed before (`outer_memo`: the same bits). Out of line (a cell's fill, ~250 calls
     /// a fast Case 1 run against ~600 reads of kept cells): inlined, its
     /// code had moved with the builds' inlining decisions, ±6 k instructions
