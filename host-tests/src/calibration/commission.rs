@@ -156,7 +156,7 @@ impl Commissioning {
             });
         }
         if !self.reduced_ok && self.choice.chosen == PathKind::Reduction {
-            let r = self.reduced.iter().max_by(|a, b| a.vs_reference_max_k.total_cmp(&b.vs_reference_max_k))?;
+            let r = farthest_from_reference(&self.reduced)?;
             return Some(Refusal {
                 reason: format!("the six-state firmware model departs from the commissioned reference by {:.3} K (bound {REDUCED_BOUND_K} K)", r.vs_reference_max_k),
                 log: r.log.clone(),
@@ -170,6 +170,13 @@ impl Commissioning {
         }
         None
     }
+}
+
+/// The reduced model's check farthest from the commissioned reference (the
+/// largest drain `vs_reference_max_k`, K; `None` without checks): the log a
+/// refusal names.
+fn farthest_from_reference(reduced: &[ReducedCheck]) -> Option<&ReducedCheck> {
+    reduced.iter().max_by(|a, b| a.vs_reference_max_k.total_cmp(&b.vs_reference_max_k))
 }
 
 /// Start of the warning that no training log opens the LNG valve: the
@@ -345,7 +352,7 @@ pub fn commission_with(base: &Rig, train: &[CalLog], holdout: &[CalLog], o: &Cal
             (f, PathOutcome::from_checks(PathKind::Direct, p, direct_validation, dir_plain, dir_with))
         });
     let refused = (!reduced_ok).then(|| {
-        let r = reduced.iter().max_by(|a, b| a.vs_reference_max_k.total_cmp(&b.vs_reference_max_k));
+        let r = farthest_from_reference(&reduced);
         r.map_or_else(String::new, |r| format!("the six-state model {:.3} K off the commissioned reference on {}, bound {REDUCED_BOUND_K} K", r.vs_reference_max_k, r.log))
     });
     let choice = super::paths::choose(&reduction, direct.as_ref().map(|d| &d.1).map_err(String::as_str), refused.as_deref());

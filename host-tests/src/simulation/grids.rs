@@ -44,7 +44,9 @@
 
 use crate::fluid::Oil;
 use crate::heat::nu_laminar_x;
-use crate::network::{q_outer_exposed, Shape};
+#[cfg(test)]
+use crate::network::q_outer_exposed;
+use crate::network::Shape;
 use crate::rig::Rig;
 use std::cell::Cell;
 
@@ -112,7 +114,7 @@ impl OuterGrid {
     }
 
     /// Heat flow of surface `i` (the index in `surfaces`) from the wall at
-    /// `t_wall` to the air, W: [`q_outer_exposed`] interpolated on the grid.
+    /// `t_wall` to the air, W: [`q_outer_exposed`](crate::network::q_outer_exposed) interpolated on the grid.
     #[allow(clippy::too_many_arguments)] // q_outer_exposed's arguments and the surface's index
     pub fn q(&self, i: usize, rig: &Rig, area: f64, shape: Shape, t_wall: f64, t_air: f64, air_mps: f64, ram_share: f64) -> f64 {
         // (A macro, not a closure: the closure's captures were stored at
@@ -173,7 +175,8 @@ impl OuterGrid {
         c.q_lo + (x - k) * (c.q_hi - c.q_lo)
     }
 
-    /// [`q_outer_exposed`], counted. Out of line (a cell's fill, ~250 calls
+    /// [`q_outer_exposed`](crate::network::q_outer_exposed), counted, through the per-thread table of the
+    /// values computed before (`outer_memo`: the same bits). Out of line (a cell's fill, ~250 calls
     /// a fast Case 1 run against ~600 reads of kept cells): inlined, its
     /// code had moved with the builds' inlining decisions, ±6 k instructions
     /// of `OuterGrid::q` between builds of the same source.
@@ -182,7 +185,7 @@ impl OuterGrid {
     #[allow(clippy::too_many_arguments)] // q_outer_exposed's arguments
     fn exact(&self, rig: &Rig, area: f64, shape: Shape, t: f64, t_air: f64, air_mps: f64, ram_share: f64) -> f64 {
         self.evals.set(self.evals.get() + 1);
-        q_outer_exposed(rig, area, shape, t, t_air, air_mps, ram_share)
+        super::outer_memo::q_outer_exposed_kept(rig, area, shape, t, t_air, air_mps, ram_share)
     }
 }
 
@@ -222,8 +225,15 @@ pub struct NuGrid {
 }
 
 impl NuGrid {
-    /// A grid of `step_k` kelvin (> 0).
+    /// A grid of `step_k` kelvin (> 0): the slots the last grid of the
+    /// same step dropped on this thread left (their values are the grid
+    /// points' of an oil's grade, kept with the grade), or empty ones.
     pub fn new(step_k: f64) -> Self {
+        if let Some((bits, grade, cells, points)) = NU_POOL.take() {
+            if bits == step_k.to_bits() {
+                return Self { step_k, per_step: 1.0 / step_k, grade: Cell::new(grade), cells, points, evals: Cell::new(0) };
+            }
+        }
         let cells = (0..NU_SLOTS).map(|_| Cell::new((i64::MIN, [0.0; 4]))).collect();
         let points = (0..NU_SLOTS).map(|_| Cell::new((i64::MIN, 0.0))).collect();
         Self { step_k, per_step: 1.0 / step_k, grade: Cell::new((u64::MAX, u64::MAX)), cells, points, evals: Cell::new(0) }
@@ -295,6 +305,26 @@ impl NuGrid {
 
 const _: () = assert!(NU_SLOTS.is_power_of_two(), "slots are indexed by a mask");
 
+/// A dropped [`NuGrid`]'s step's bits, grade and slots.
+type NuSlots = (u64, (u64, u64), Box<[NuCell]>, Box<[Cell<(i64, f64)>]>);
+
+thread_local! {
+    /// The slots of the last [`NuGrid`] dropped on this thread, for the
+    /// next one of the same step: the grid points are functions of the
+    /// grade and the step alone, so a later run (a bench's, a sweep's)
+    /// reads the values the earlier one computed (~20 k instructions of
+    /// `log10` and `pow` a Case 1 run) and its allocation.
+    static NU_POOL: Cell<Option<NuSlots>> = const { Cell::new(None) };
+}
+
+impl Drop for NuGrid {
+    fn drop(&mut self) {
+        let (cells, points) = (std::mem::take(&mut self.cells), std::mem::take(&mut self.points));
+        // (try_with: nothing to keep while the thread's locals are going.)
+        let _ = NU_POOL.try_with(|p| p.set(Some((self.step_k.to_bits(), self.grade.get(), cells, points))));
+    }
+}
+
 /// Low bits of X's representation dropped for the laminar grid's index:
 /// 16 cells a binade (X's relative spacing 1/32–1/16).
 const LAM_SHIFT: u32 = 52 - 4;
@@ -335,8 +365,13 @@ impl Default for LaminarGrid {
 }
 
 impl LaminarGrid {
-    /// An empty grid.
+    /// A grid with the slots the last grid dropped on this thread left
+    /// (the law has no parameter: its points are the same for every rig),
+    /// or empty ones.
     pub fn new() -> Self {
+        if let Some((cells, points)) = LAM_POOL.take() {
+            return Self { cells, points, evals: Cell::new(0) };
+        }
         let cells = (0..LAM_SLOTS).map(|_| Cell::new((u64::MAX, [0.0; 4], 0.0, 0.0, 0.0))).collect();
         let points = (0..LAM_SLOTS).map(|_| Cell::new((u64::MAX, 0.0))).collect();
         Self { cells, points, evals: Cell::new(0) }
@@ -407,6 +442,25 @@ impl LaminarGrid {
 }
 
 const _: () = assert!(LAM_SLOTS.is_power_of_two(), "slots are indexed by a mask");
+
+/// A dropped [`LaminarGrid`]'s slots.
+type LamSlots = (Box<[LamCell]>, Box<[Cell<(u64, f64)>]>);
+
+thread_local! {
+    /// The slots of the last [`LaminarGrid`] dropped on this thread, for
+    /// the next one: a later run (a bench's, a sweep's) reads the points
+    /// and cells the earlier one computed (two `cbrt` a point, ~40 k
+    /// instructions a Case 1 run) and skips the allocation.
+    static LAM_POOL: Cell<Option<LamSlots>> = const { Cell::new(None) };
+}
+
+impl Drop for LaminarGrid {
+    fn drop(&mut self) {
+        let (cells, points) = (std::mem::take(&mut self.cells), std::mem::take(&mut self.points));
+        // (try_with: nothing to keep while the thread's locals are going.)
+        let _ = LAM_POOL.try_with(|p| p.set(Some((cells, points))));
+    }
+}
 
 /// The cubic through (−1, v[0]), (0, v[1]), (1, v[2]), (2, v[3]) in powers
 /// of u (Lagrange on four uniform points).

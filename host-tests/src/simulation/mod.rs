@@ -16,6 +16,7 @@ pub mod fast;
 pub mod grids;
 pub mod missions;
 pub mod model;
+mod outer_memo;
 pub mod plant;
 pub mod replay;
 pub mod scenario;

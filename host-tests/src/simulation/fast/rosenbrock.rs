@@ -361,7 +361,7 @@ impl<const N: usize> Rosenbrock<N> {
             let err = (err / N as f64).sqrt();
             // err^(1/elo), without a `pow` for the two tableaus here.
             let root = match tab.elo {
-                3.0 => err.cbrt(),
+                3.0 => cbrt_factor(err),
                 4.0 => err.sqrt().sqrt(),
                 e => err.powf(1.0 / e),
             };
@@ -428,8 +428,44 @@ where
     jac
 }
 
+/// ∛x for the step-size factor, relative error below 1e-13 (test below):
+/// a first guess from the exponent's bits divided by three, then two
+/// Halley steps (cubic convergence: ~3 % → ~3e-5 → ~1e-14). ~25
+/// instructions against ~130 of the software `cbrt` (the step sizes only
+/// need a few digits; ~125 roots a Case 1 run). Beyond 1e±300, zero, ∞ and
+/// NaN: `f64::cbrt`.
+#[inline]
+fn cbrt_factor(x: f64) -> f64 {
+    if !(1e-300..1e300).contains(&x) {
+        return x.cbrt();
+    }
+    let mut y = f64::from_bits(x.to_bits() / 3 + 0x2A9F_7893_782D_A1CE);
+    for _ in 0..2 {
+        let y3 = y * y * y;
+        y *= (y3 + 2.0 * x) / (2.0 * y3 + x);
+    }
+    y
+}
+
 #[cfg(test)]
 mod tests {
+    /// [`super::cbrt_factor`] within 1e-13 of `f64::cbrt` from 1e-300 to
+    /// 1e300 (log-spaced, 60 001 points) and exact beyond.
+    #[test]
+    fn cbrt_factor_is_the_cube_root() {
+        let mut worst = 0.0f64;
+        for j in 0..=60_000 {
+            let x = 10f64.powf(-300.0 + j as f64 * 1e-2);
+            let (a, b) = (super::cbrt_factor(x), x.cbrt());
+            worst = worst.max((a / b - 1.0).abs());
+        }
+        assert!(worst < 1e-13, "{worst:e}");
+        for x in [0.0, 1e-310, f64::INFINITY] {
+            assert_eq!(super::cbrt_factor(x), x.cbrt());
+        }
+        assert!(super::cbrt_factor(f64::NAN).is_nan());
+    }
+
     use super::*;
 
     /// Convergence order on y' = −y + sin t (exact solution known): halving

@@ -200,6 +200,10 @@ impl Model {
     }
 
     /// Exact evaluations behind the grids so far: (outer surfaces, viscosities).
+    /// The outer surfaces' count is of the grid's points, some of them read
+    /// from the per-thread table of earlier runs; the viscosities' counts
+    /// only the points this grid computed (a grid built after another on
+    /// the same thread starts with that one's points).
     pub fn grid_evals(&self) -> (u64, u64) {
         (self.outer_grid.as_ref().map_or(0, |g| g.evals.get()), self.nu_grid.as_ref().map_or(0, |g| g.evals.get()))
     }
