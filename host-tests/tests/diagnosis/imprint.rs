@@ -170,12 +170,17 @@ fn slow_imprint_ratio_with_structure_no_case() {
 /// 1704,1711,2704,2705,2709,2711 --no-oracle --structure no-case-held`;
 /// 1705 has no loaded current rows, unchanged). Named: 1704 (lag, r 6.18,
 /// t_oil_c 0.93 -> 0.18 K; absorbed under `full` and `no-case`), 1705
-/// (r 2.60), 2704 (r 3.09, 4.92 -> 3.19 K) and 2705 (lag named at r 1.82,
-/// below 2: the twin's t_oil_c floor rose, 1.05 -> 1.23 K). Below r = 2,
-/// no cause right by the rule: 1711 (conduction, r 1.81), 2709 (churning,
-/// r 0.75, named under `no-case`), 2711 (conduction, r 1.94). No twin
-/// names a cause. docs/diagnosis-limits.md, "The structure option". 639 s
-/// at load 6–9 on two shared cores (2026-11-28, passes).
+/// (r 2.60), 2704 (r 3.09, 4.92 -> 3.19 K). Below r = 2, no cause right
+/// by the rule: 2705 (lag, r 1.82: the twin's t_oil_c floor rose, 1.05 ->
+/// 1.23 K; `unexplained` since the per-channel held-out check counts only
+/// the channels a candidate touches — the lag's fit makes t_oil_c worse
+/// held out, 2.23 -> 3.25 K, and was named before on its gain elsewhere),
+/// 1711 (conduction, r 1.81), 2709 (churning, r 0.75, named under
+/// `no-case`), 2711 (conduction, r 1.94). No twin names a cause.
+/// docs/diagnosis-limits.md, "The structure option". 639 s at load 6–9 on
+/// two shared cores (2026-11-28, passes); re-measured with the
+/// touched-channel rule by the sweep command above with 1705 and 1708
+/// added (2026-11-28, diag14: the same answers but 2705's).
 #[test]
 #[ignore = "slow tier: emulator cases with twins (minutes), the structure option's no-case-held variant"]
 fn slow_imprint_ratio_with_structure_no_case_held() {
@@ -183,7 +188,7 @@ fn slow_imprint_ratio_with_structure_no_case_held() {
     assert_named(&run_with("sensor-lag", ConstantThrottle, 1704, &o), 6.18, 0.18);
     assert_named(&run_with("sensor-lag", SpeedSteps, 1705, &o), 2.60, 0.45);
     assert_named(&run_with("sensor-lag", IdentRun, 2704, &o), 3.09, 3.19);
-    assert_named(&run_with("sensor-lag", IdentRun, 2705, &o), 1.82, 3.25);
+    assert_missed(&run_with("sensor-lag", IdentRun, 2705, &o), "unexplained", 1.82);
     assert_missed(&run_with("motor-pump-conduction", LoadCycles, 1711, &o), "unexplained", 1.81);
     assert_missed(&run_with("churning-loss", IdentRun, 2709, &o), "unexplained", 0.75);
     assert_missed(&run_with("motor-pump-conduction", IdentRun, 2711, &o), "unexplained", 1.94);
