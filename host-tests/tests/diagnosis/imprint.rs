@@ -139,23 +139,27 @@ fn slow_imprint_ratio_with_structure() {
 /// share and the pump probe's placement, which only a drain thermocouple
 /// separates), as measured (`eha-sim emulator-sweep --cases original,ident
 /// --only 1704,1705,1711,2704,2705,2709,2711 --no-oracle --structure
-/// no-case`). Named at r >= 2, all four: 1705 (unchanged, r 2.60), 2704
-/// (r 2.52, t_oil_c 3.38 -> 2.00 K), 2705 (r 2.35; t_oil_c held out rises
-/// 2.46 -> 2.80 K with the lag while the pooled falls 2.21 -> 1.55 K),
-/// 2709 (churning, r 6.97, t_pump_c 2.16 -> 0.74 K: absorbed under `full`,
+/// no-case`). Named at r >= 2, three of four: 1705 (unchanged, r 2.60),
+/// 2704 (r 2.52, t_oil_c 3.38 -> 2.00 K), 2709 (churning, r 6.97, t_pump_c 2.16 -> 0.74 K: absorbed under `full`,
 /// a miss under `off`). Below r = 2, no cause right by the rule: 1704
 /// (lag, r 1.70, loop-oil capacity and oil probe at their upper bounds),
 /// 1711 (conduction, r 0.64, the pump's outer film and case film at their
 /// upper bounds), 2711 (conduction, r 1.88, answered `none`; named at r
 /// 3.17 under `full`). No twin names a cause. docs/diagnosis-limits.md, "The
 /// structure option". 261 s on two shared cores (2026-11-27, passes).
+/// Missed at r >= 2 since the per-channel held-out check counts only the
+/// channels a candidate touches: 2705 (r 2.35, `unexplained`; its lag
+/// makes t_oil_c worse held out, 2.46 -> 2.80 K, and was named on the
+/// pooled 2.21 -> 1.55 K; `eha-sim emulator-sweep --cases ident --only
+/// 2705 --no-oracle --structure no-case`, 2026-11-28, diag14; the other
+/// six not re-run under this variant).
 #[test]
 #[ignore = "slow tier: emulator cases with twins (minutes), the structure option's no-case variant"]
 fn slow_imprint_ratio_with_structure_no_case() {
     let o = DiagnoseOptions { structure: Structure::NoCase, ..DiagnoseOptions::default() };
     assert_named(&run_with("sensor-lag", SpeedSteps, 1705, &o), 2.60, 0.45);
     assert_named(&run_with("sensor-lag", IdentRun, 2704, &o), 2.52, 2.00);
-    assert_named(&run_with("sensor-lag", IdentRun, 2705, &o), 2.35, 2.80);
+    assert_missed(&run_with("sensor-lag", IdentRun, 2705, &o), "unexplained", 2.35);
     assert_named(&run_with("churning-loss", IdentRun, 2709, &o), 6.97, 0.74);
     assert_missed(&run_with("sensor-lag", ConstantThrottle, 1704, &o), "none", 1.70);
     assert_missed(&run_with("motor-pump-conduction", LoadCycles, 1711, &o), "unexplained", 0.64);
