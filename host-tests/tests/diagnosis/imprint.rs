@@ -139,23 +139,27 @@ fn slow_imprint_ratio_with_structure() {
 /// share and the pump probe's placement, which only a drain thermocouple
 /// separates), as measured (`eha-sim emulator-sweep --cases original,ident
 /// --only 1704,1705,1711,2704,2705,2709,2711 --no-oracle --structure
-/// no-case`). Named at r >= 2, all four: 1705 (unchanged, r 2.60), 2704
-/// (r 2.52, t_oil_c 3.38 -> 2.00 K), 2705 (r 2.35; t_oil_c held out rises
-/// 2.46 -> 2.80 K with the lag while the pooled falls 2.21 -> 1.55 K),
-/// 2709 (churning, r 6.97, t_pump_c 2.16 -> 0.74 K: absorbed under `full`,
+/// no-case`). Named at r >= 2, three of four: 1705 (unchanged, r 2.60),
+/// 2704 (r 2.52, t_oil_c 3.38 -> 2.00 K), 2709 (churning, r 6.97, t_pump_c 2.16 -> 0.74 K: absorbed under `full`,
 /// a miss under `off`). Below r = 2, no cause right by the rule: 1704
 /// (lag, r 1.70, loop-oil capacity and oil probe at their upper bounds),
 /// 1711 (conduction, r 0.64, the pump's outer film and case film at their
 /// upper bounds), 2711 (conduction, r 1.88, answered `none`; named at r
 /// 3.17 under `full`). No twin names a cause. docs/diagnosis-limits.md, "The
 /// structure option". 261 s on two shared cores (2026-11-27, passes).
+/// Missed at r >= 2 since the per-channel held-out check counts only the
+/// channels a candidate touches: 2705 (r 2.35, `unexplained`; its lag
+/// makes t_oil_c worse held out, 2.46 -> 2.80 K, and was named on the
+/// pooled 2.21 -> 1.55 K; `eha-sim emulator-sweep --cases ident --only
+/// 2705 --no-oracle --structure no-case`, 2026-11-28, diag14; the other
+/// six not re-run under this variant).
 #[test]
 #[ignore = "slow tier: emulator cases with twins (minutes), the structure option's no-case variant"]
 fn slow_imprint_ratio_with_structure_no_case() {
     let o = DiagnoseOptions { structure: Structure::NoCase, ..DiagnoseOptions::default() };
     assert_named(&run_with("sensor-lag", SpeedSteps, 1705, &o), 2.60, 0.45);
     assert_named(&run_with("sensor-lag", IdentRun, 2704, &o), 2.52, 2.00);
-    assert_named(&run_with("sensor-lag", IdentRun, 2705, &o), 2.35, 2.80);
+    assert_missed(&run_with("sensor-lag", IdentRun, 2705, &o), "unexplained", 2.35);
     assert_named(&run_with("churning-loss", IdentRun, 2709, &o), 6.97, 0.74);
     assert_missed(&run_with("sensor-lag", ConstantThrottle, 1704, &o), "none", 1.70);
     assert_missed(&run_with("motor-pump-conduction", LoadCycles, 1711, &o), "unexplained", 0.64);
@@ -170,12 +174,17 @@ fn slow_imprint_ratio_with_structure_no_case() {
 /// 1704,1711,2704,2705,2709,2711 --no-oracle --structure no-case-held`;
 /// 1705 has no loaded current rows, unchanged). Named: 1704 (lag, r 6.18,
 /// t_oil_c 0.93 -> 0.18 K; absorbed under `full` and `no-case`), 1705
-/// (r 2.60), 2704 (r 3.09, 4.92 -> 3.19 K) and 2705 (lag named at r 1.82,
-/// below 2: the twin's t_oil_c floor rose, 1.05 -> 1.23 K). Below r = 2,
-/// no cause right by the rule: 1711 (conduction, r 1.81), 2709 (churning,
-/// r 0.75, named under `no-case`), 2711 (conduction, r 1.94). No twin
-/// names a cause. docs/diagnosis-limits.md, "The structure option". 639 s
-/// at load 6–9 on two shared cores (2026-11-28, passes).
+/// (r 2.60), 2704 (r 3.09, 4.92 -> 3.19 K). Below r = 2, no cause right
+/// by the rule: 2705 (lag, r 1.82: the twin's t_oil_c floor rose, 1.05 ->
+/// 1.23 K; `unexplained` since the per-channel held-out check counts only
+/// the channels a candidate touches — the lag's fit makes t_oil_c worse
+/// held out, 2.23 -> 3.25 K, and was named before on its gain elsewhere),
+/// 1711 (conduction, r 1.81), 2709 (churning, r 0.75, named under
+/// `no-case`), 2711 (conduction, r 1.94). No twin names a cause.
+/// docs/diagnosis-limits.md, "The structure option". 639 s at load 6–9 on
+/// two shared cores (2026-11-28, passes); re-measured with the
+/// touched-channel rule by the sweep command above with 1705 and 1708
+/// added (2026-11-28, diag14: the same answers but 2705's).
 #[test]
 #[ignore = "slow tier: emulator cases with twins (minutes), the structure option's no-case-held variant"]
 fn slow_imprint_ratio_with_structure_no_case_held() {
@@ -183,7 +192,7 @@ fn slow_imprint_ratio_with_structure_no_case_held() {
     assert_named(&run_with("sensor-lag", ConstantThrottle, 1704, &o), 6.18, 0.18);
     assert_named(&run_with("sensor-lag", SpeedSteps, 1705, &o), 2.60, 0.45);
     assert_named(&run_with("sensor-lag", IdentRun, 2704, &o), 3.09, 3.19);
-    assert_named(&run_with("sensor-lag", IdentRun, 2705, &o), 1.82, 3.25);
+    assert_missed(&run_with("sensor-lag", IdentRun, 2705, &o), "unexplained", 1.82);
     assert_missed(&run_with("motor-pump-conduction", LoadCycles, 1711, &o), "unexplained", 1.81);
     assert_missed(&run_with("churning-loss", IdentRun, 2709, &o), "unexplained", 0.75);
     assert_missed(&run_with("motor-pump-conduction", IdentRun, 2711, &o), "unexplained", 1.94);
