@@ -341,7 +341,7 @@ pub fn report_markdown_logs(d: &Diagnosis, source: &str, pngs: &[String], logs: 
         let _ = writeln!(s, "\nModel runs by phase: {}.", p.join(", "));
     }
     let _ = writeln!(s, "\n## Ranking (BIC on the training window, held-out check)\n");
-    let _ = writeln!(s, "| cause | BIC | ΔBIC vs none | RMSE train (K) | RMSE held-out (K) | best channel gain | qualifies | fitted |");
+    let _ = writeln!(s, "| cause | BIC | ΔBIC vs none | RMSE train (K) | RMSE held-out (K) | gain where it acts (best touched channel) | qualifies | fitted |");
     let _ = writeln!(s, "|---|---:|---:|---:|---:|---|---|---|");
     for r in &d.ranking {
         let p: Vec<String> = r.params.iter().map(|(n, v, u)| format!("{n}={} {u}", num(*v))).collect();
