@@ -250,7 +250,7 @@ pub fn duct_transition_time_s(logs: &[CalLog], rig: &crate::rig::Rig) -> (f64, f
     let (mut secs, mut top) = (0.0, 0.0f64);
     for l in logs.iter().filter(|l| l.has(Channel::TBlockC) && l.has(Channel::TOilC)) {
         let x = Inputs::of(&l.run);
-        let oil = l.run.get(Channel::TOilC).map(|v| v.to_vec()).unwrap_or_default();
+        let oil = l.run.get(Channel::TOilC).unwrap_or_default();
         let t = &l.run.time_s;
         for i in 0..t.len().saturating_sub(1) {
             let (Some(w), Some(Some(t_oil))) = (x.speed(i), oil.get(i)) else { continue };

@@ -339,14 +339,12 @@ fn run_plant(mut plant: impl Runner, scenario: &Scenario, opt: &SimOptions) -> R
                 let n = ((t_end - s.t) / opt.output_interval_s).max(0.0) as usize + 2;
                 out.columns.reserve_exact(CHANNEL_COUNT_HINT);
                 out.time_s.reserve(n);
-                out.time_s.push(s.t);
                 each_channel(s, |name, v| {
                     let mut col = Vec::with_capacity(n);
                     col.push(v);
                     out.columns.push((name.to_string(), col));
                 });
             } else {
-                out.time_s.push(s.t);
                 let mut cols = out.columns.iter_mut();
                 each_channel(s, |_, v| {
                     if let Some((_, col)) = cols.next() {
@@ -354,6 +352,7 @@ fn run_plant(mut plant: impl Runner, scenario: &Scenario, opt: &SimOptions) -> R
                     }
                 });
             }
+            out.time_s.push(s.t);
         }
         if let Some(open) = cmd {
             if open && !last_open {

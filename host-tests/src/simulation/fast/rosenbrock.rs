@@ -449,6 +449,8 @@ fn cbrt_factor(x: f64) -> f64 {
 
 #[cfg(test)]
 mod tests {
+    use super::*;
+
     /// [`super::cbrt_factor`] within 1e-13 of `f64::cbrt` from 1e-300 to
     /// 1e300 (log-spaced, 60 001 points) and exact beyond.
     #[test]
@@ -465,8 +467,6 @@ mod tests {
         }
         assert!(super::cbrt_factor(f64::NAN).is_nan());
     }
-
-    use super::*;
 
     /// Convergence order on y' = −y + sin t (exact solution known): halving
     /// a fixed step must cut the error at t = 2 by ~2⁴ (order 4; 12–20

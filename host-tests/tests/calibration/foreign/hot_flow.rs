@@ -39,22 +39,7 @@ fn slow_commissioning_with_the_hot_flow_run() {
         (1.116, PathKind::Direct, [(1.807, 0.000), (2.676, 0.372)], [1425.0, 1513.0]),
         (0.826, PathKind::Direct, [(1.109, 0.380), (2.020, 1.137)], [1547.0, 1555.0]),
     ];
-    for (m, (margin, path, want, open_s)) in machines().into_iter().zip(measured) {
-        let s = commissioning_set_hot(&m, 3600).expect("bench");
-        let train: Vec<CalLog> = s.train.iter().map(cal).collect();
-        let hold: Vec<CalLog> = s.holdout.iter().map(cal).collect();
-        let t0 = std::time::Instant::now();
-        let c = commission(&m.rig_file(), &train, &hold, &CalOptions::default()).expect("commissioning");
-        report(&m, &c, t0.elapsed().as_secs_f64());
-        let h = headline(&m, &c, &s.holdout);
-        near(&format!("{} margin", m.name), h.margin_k, margin);
-        assert_eq!(c.choice.chosen, path, "{}: {}", m.name, c.choice.why);
-        assert!(c.flashable(), "{}: {:?}", m.name, c.refusal().map(|r| r.to_string()));
-        for (got, want) in h.measured.iter().zip(want) {
-            near(&format!("{} held-out max |e| with margin", m.name), got.0, want.0);
-            near(&format!("{} held-out under-prediction with margin", m.name), got.1, want.1);
-        }
-        let (a, b) = (&c.holdout_without_margin()[1], &c.holdout_with_margin[1]);
-        assert!((a.valve_open_s - open_s[0]).abs() <= 20.0 && (b.valve_open_s - open_s[1]).abs() <= 20.0, "{}: valve open {:.0} -> {:.0} s", m.name, a.valve_open_s, b.valve_open_s);
+    for (m, row) in machines().into_iter().zip(measured) {
+        commission_as_measured(&m, &commissioning_set_hot(&m, 3600).expect("bench"), row);
     }
 }
