@@ -131,7 +131,7 @@ pub(super) fn polish(base: &Rig, logs: &[CalLog], theta: Vec<f64>, free: &[usize
     // directions its logs barely inform to the priors, instead of to the
     // path LM took; a model that fits (s² = 1) keeps σ_d.
     let Some(r0) = data_residuals(base, logs, &theta, sigma, runs) else { return (theta, out) };
-    out.s2 = (r0.iter().map(|x| x * x).sum::<f64>() / r0.len().saturating_sub(free.len()).max(1) as f64).max(1.0);
+    out.s2 = sigma.polish_s2.unwrap_or_else(|| (r0.iter().map(|x| x * x).sum::<f64>() / r0.len().saturating_sub(free.len()).max(1) as f64).max(1.0));
     polish_at(base, logs, theta, free, sigma, runs, out, false)
 }
 

@@ -26,6 +26,9 @@ pub(crate) struct Sigma {
     /// ([`CalOptions::prior_sigma`](super::CalOptions::prior_sigma) over
     /// the set's own).
     pub(crate) prior_ln: [f64; PARAMS.len()],
+    /// The polish's reduced χ² s² when fixed by the caller
+    /// ([`CalOptions::polish_s2`](super::CalOptions::polish_s2)).
+    pub(crate) polish_s2: Option<f64>,
 }
 
 /// Spacing, in ln θ, of the lattice on which every multiplier vector of a

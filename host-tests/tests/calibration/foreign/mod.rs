@@ -425,5 +425,6 @@ fn exp_priors() -> Vec<(&'static str, f64)> {
         .collect()
 }
 
+mod basins;
 mod hot_flow;
 mod reproducible;

@@ -1,0 +1,49 @@
+//! Measurement by hand: the local minima of the three-log fit
+//! (`commissioning_set_hot`) on big-pump, polished from given multiplier
+//! vectors (docs/commissioning.md, "The hot-flow run").
+
+use super::*;
+use eha_sim::calibration::commission::eta_m_from_current;
+use eha_sim::calibration::residuals::on_lattice_value;
+use eha_sim::calibration::set::{index, nominal};
+use eha_sim::calibration::{calibrate, PARAMS};
+
+/// Polishes the calibration of big-pump's three-log set (original logs)
+/// from each start in `EXP_STARTS` (`;`-separated lists of `name value`
+/// pairs, `,`-separated; the rest at the rig file) for `EXP_POLISH_ITERS`
+/// (default 30) Gauss–Newton iterations without LM before it, and prints
+/// where each ends: objective trail, decrements, data χ² (σ 0.2 K), the
+/// prior sum and the multipliers.
+#[test]
+#[ignore = "measurement by hand: polishes of the three-log fit from given starts"]
+fn slow_three_log_minima() {
+    let m = big_pump();
+    let s = commissioning_set_hot(&m, 3600).expect("bench");
+    let train: Vec<CalLog> = s.train.iter().map(cal).collect();
+    let mut base = m.rig_file();
+    let mut o = CalOptions::default();
+    if let Some((eta, n)) = eta_m_from_current(&base, &train) {
+        base.pump.eta_m = on_lattice_value(eta, o.lattice_ln);
+        o.hold.push(("pump_friction", format!("eta_m from {n} samples")));
+    }
+    o.max_evals = 0;
+    o.polish_iters = std::env::var("EXP_POLISH_ITERS").ok().and_then(|v| v.parse().ok()).unwrap_or(30);
+    o.polish_s2 = std::env::var("EXP_S2").ok().and_then(|v| v.parse().ok());
+    let starts = std::env::var("EXP_STARTS").expect("EXP_STARTS");
+    for (i, st) in starts.split(';').enumerate() {
+        let mut th = nominal();
+        for pair in st.split(',').map(str::trim).filter(|p| !p.is_empty()) {
+            let (n, v) = pair.split_once(' ').expect("name value");
+            th[index(n.trim()).unwrap_or_else(|| panic!("{n}"))] = v.trim().parse().expect("value");
+        }
+        o.start = Some(th);
+        let t0 = std::time::Instant::now();
+        let c = calibrate(&base, &train, &o).expect("calibrate");
+        let prior: f64 = c.params.iter().zip(PARAMS.iter()).filter(|(p, _)| p.status == eha_sim::calibration::Status::Fitted).map(|(p, d)| (p.value.ln() / (o.prior_scale * d.prior_sigma_ln)).powi(2)).sum();
+        eprintln!("START {i}: {:.0} s, {} runs; polish objective {:.3?}", t0.elapsed().as_secs_f64(), c.model_runs, c.polish.objective);
+        eprintln!("  decrement {:.3?} converged {} on bound {:?} s2 {:.4}", c.polish.decrement, c.polish.converged, c.polish.on_bound, c.polish.s2);
+        eprintln!("  data chi2 {:.2} prior {:.3}", c.chi2_before_after.1, prior);
+        let v: Vec<String> = c.params.iter().filter(|p| p.status == eha_sim::calibration::Status::Fitted).map(|p| format!("{} {:.4}", p.name, p.value)).collect();
+        eprintln!("  END {}", v.join(", "));
+    }
+}
