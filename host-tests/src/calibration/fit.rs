@@ -150,9 +150,10 @@ pub const PROBE_HELD: &str = "held at the rig file unless asked (`commission --f
 /// hot-flow run (`emulator::bench::commissioning_set_hot`) it fitted ×1.80
 /// on the emulator's big-pump and the held-out throttle mix's
 /// under-prediction (margin counted) rose 0.37 → 1.14 K against the same
-/// logs with it held (one fit each; a 1e-6 K nudge moved the held fit
-/// 0.51 K on those logs, so the difference is one path's, not shown to be
-/// bias; docs/commissioning.md, "The hot-flow run").
+/// logs with it held (one fit each, before the continuation over the logs,
+/// [`CONTINUATION_LOGS`], when a 1e-6 K nudge moved the held fit 0.51 K
+/// on those logs: the difference is one path's, not shown to be bias;
+/// not re-measured since; docs/commissioning.md, "The hot-flow run").
 pub const DUCT_TURBULENT_HELD: &str = "held at the rig file unless asked: freed on a bench whose passages run in the transition it fitted ×1.80 and the held-out mix's under-prediction rose 0.37 → 1.14 K (docs/commissioning.md)";
 
 /// Status of one parameter after calibration.
