@@ -12,7 +12,8 @@ use super::*;
 /// continued from the first two logs' fit, `fit::CONTINUATION_LOGS`); the
 /// same held-out logs. Measured (max |e| / under vs the thermocouple,
 /// margin counted; servo, throttle mix; 2026-11-28, 198 s and 184 s wall
-/// per commissioning at load 5–6 on the 2 cores):
+/// per commissioning at load 5–6 on the 2 cores, 130 s and 114 s at load
+/// 1–3, 4 887 and 5 166 reference runs in the calibration):
 /// - big-pump: the reduction refused (0.458 K off the reference on the
 ///   servo log), direct path, margin 1.121 K: 1.768 / 0.000 and
 ///   2.703 / 0.391 K (the two-log set: 2.017 / 0.000 and 2.786 / 0.699 K,
