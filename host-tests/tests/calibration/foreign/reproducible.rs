@@ -64,10 +64,9 @@ fn slow_commissioning_is_reproducible_beyond_the_last_digit_leaky_heavy() {
 
 /// The three-log set with the hot-flow run (`commissioning_set_hot`),
 /// every logged temperature moved by 1e-6 K: the headline numbers move by
-/// at most 0.05 K. Measured (2026-11-28, with `EXP_TRAIN=hot` on
-/// [`slow_commissioning_is_reproducible_beyond_the_last_digit_big_pump`],
-/// the same code path): 0.028 K (margin 1.121 → 1.118 K, the mix's
-/// under-prediction 0.391 → 0.419 K). Why it holds: the fit continues from
+/// at most 0.05 K. Measured (2026-11-28): 0.028 K (margin 1.121 → 1.118 K,
+/// the mix's under-prediction 0.391 → 0.419 K; 64 + 75 s wall at load
+/// ~1–3). Why it holds: the fit continues from
 /// the first two logs' fit (`fit::CONTINUATION_LOGS`); from the rig file
 /// LM reached one of two basins (data χ² 9 214 against 15 359 at a common
 /// s², `basins::slow_three_log_minima`) and the nudge moved 0.51 K.
@@ -79,7 +78,7 @@ fn slow_hot_set_is_reproducible_beyond_the_last_digit_big_pump() {
 
 /// [`slow_hot_set_is_reproducible_beyond_the_last_digit_big_pump`] on
 /// leaky-heavy: measured 0.027 K (margin 0.833 → 0.835 K, the mix's
-/// under-prediction 1.046 → 1.073 K).
+/// under-prediction 1.046 → 1.073 K; 121 + 103 s wall).
 #[test]
 #[ignore = "slow tier: two commissionings on three training logs with margin validation and the direct path (~4-7 min)"]
 fn slow_hot_set_is_reproducible_beyond_the_last_digit_leaky_heavy() {
