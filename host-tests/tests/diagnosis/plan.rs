@@ -6,6 +6,7 @@
 use eha_sim::diagnosis::emu_sweep::default_cases;
 use eha_sim::diagnosis::plan::{leading, plan, Decision, Design, Limits, Plan};
 use eha_sim::diagnosis::reference::ReferenceModel;
+use eha_sim::diagnosis::analysis::Structure;
 use eha_sim::diagnosis::{diagnose, Candidate, DiagnoseOptions, Simulator};
 use eha_sim::emulator::plant::{Hidden, Plant};
 use eha_sim::emulator::{generate, generate_twin, log_mission, logger, EmuCase, EmuTruth};
@@ -13,6 +14,19 @@ use eha_sim::measured::{Channel, MeasuredRun};
 use eha_sim::rig::Rig;
 use eha_sim::scenario::{read_mission_csv, ValveRule};
 use rand::SeedableRng;
+
+/// The reference model of one log as these tests diagnose it: the rig
+/// file's, under the structure `EHA_PLAN_STRUCTURE` names (`off`, `full`,
+/// `no-case`, `no-case-held`), **`off` when unset** — every number these
+/// tests assert was measured so, while `eha-sim diagnose` on one log
+/// applies the default [`Structure::NoCaseHeld`] (under which the original
+/// logs of 1710 and 1712 stand at r ≥ 2, docs/diagnosis-limits.md). The
+/// joint diagnoses (`multi::joint_reference`) take no structure, as the
+/// command does with several logs.
+fn model_of(log: &MeasuredRun) -> ReferenceModel {
+    let s = std::env::var("EHA_PLAN_STRUCTURE").ok().map_or(Structure::Off, |v| <Structure as clap::ValueEnum>::from_str(&v, true).expect("EHA_PLAN_STRUCTURE"));
+    ReferenceModel::new(Rig::default(), log).expect("model").with_structure(log, s)
+}
 
 /// The emulator case of `seed` in the original case set (1200 s logs).
 fn case(seed: u64) -> EmuCase {
@@ -52,8 +66,8 @@ fn fly(d: &Design, c: &EmuCase, truth: &EmuTruth, ambient_c: f64) -> (MeasuredRu
 /// ([`leading`], two), and the log's diagnosis.
 fn ratio(log: &MeasuredRun, twin: &MeasuredRun, ch: Channel) -> (f64, String, String, Vec<Candidate>, Box<eha_sim::diagnosis::Diagnosis>) {
     let o = DiagnoseOptions::default();
-    let d = diagnose(log, &ReferenceModel::new(Rig::default(), log).expect("model"), &o).expect("diagnosis");
-    let t = diagnose(twin, &ReferenceModel::new(Rig::default(), twin).expect("model"), &o).expect("twin diagnosis");
+    let d = diagnose(log, &model_of(log), &o).expect("diagnosis");
+    let t = diagnose(twin, &model_of(twin), &o).expect("twin diagnosis");
     let m = |x: &eha_sim::diagnosis::Diagnosis| x.before.channel(ch.name()).map(|c| c.heldout_rmse_k).expect("channel");
     for (l, x) in [("log", &d), ("twin", &t)] {
         eprintln!("  {}", summary(l, x));
@@ -187,15 +201,21 @@ fn plan_command_writes_a_readable_mission_within_limits() {
 /// the same machine with the same hidden effect, and its twin without.
 ///
 /// **Measured miss** (the acceptance asks that at least half be lifted to
-/// r ≥ 2 and then named): none of the six is lifted. Original → planned r:
-/// 1708 churning 1.40 → 1.96, 1710 conduction 1.84 → 0.76, 1712 draught
-/// 1.39 → 0.16, 1709 churning 0.40 → 0.49, 1700 winding 0.99 → 1.07, 1713
-/// draught 0.87 → 0.91 (33 min). The plans' own projections said so: the
-/// hidden candidate, where it was among the leading two, had r̂ 1.00–1.01
+/// r ≥ 2 and then named). Re-measured on 2026-11-28 under the
+/// touched-channel rule (528 s at load ~3–4; the same six missions as on
+/// 2026-11-27), original → planned r: 1708 churning 1.40 → **2.28**
+/// (`unexplained`; churning ΔBIC 677 but t_pump_c −17 %, pooled −1 %),
+/// 1710 conduction 2.08 → 0.84, 1712 draught 1.39 → 0.16, 1709 churning
+/// 0.38 → 0.49, 1700 winding 0.61 → 1.04, 1713 draught 0.87 → 0.80; twins
+/// `unexplained` ×4, `none` ×2. Of the five below r = 2 on the log (1710
+/// now stands at 2.08 there, answered `none`) one is lifted, 1708, and not
+/// named. (2026-11-27, 33 min: 1.96, 0.76 from 1.84, 0.16, 0.49, 1.07
+/// from 0.99, 0.91: none lifted.) The plans' own projections said so: the
+/// hidden candidate, where it was among the leading two, had r̂ 1.00–1.03
 /// on the planned run (the physical set absorbs it on every mission of the
-/// family), and the planned runs' twins misfit more than the logs' own
-/// (four of six `unexplained`). Asserted as measured (fails when a case is
-/// lifted), and that no planned run gets a wrong cause.
+/// family). Diagnosed under `--structure off` ([`model_of`]). Asserted as
+/// measured: at least four below r = 2, no case other than 1708 lifted,
+/// none named at r ≥ 2, no wrong cause on a planned run.
 #[test]
 #[ignore]
 fn slow_planned_runs_lift_effects_above_the_floor() {
@@ -210,7 +230,8 @@ fn slow_planned_runs_lift_effects_above_the_floor() {
     let msg = format!("{rows:?}");
     eprintln!("{} of {} below r 2 lifted to ≥ 2: {msg}", lifted.len(), below.len());
     assert!(below.len() >= 4, "{msg}");
-    assert_eq!(lifted.len(), 0, "measured miss changed: {msg}");
+    assert!(lifted.iter().all(|r| r.0 == 1708), "measured miss changed (1708 only lifted, r 2.28): {msg}");
+    assert!(lifted.iter().all(|r| r.3 != case(r.0).hidden.name()), "measured miss changed (1708 lifted, not named): {msg}");
     for r in &rows {
         assert!(["none", "unexplained", case(r.0).hidden.name()].contains(&r.3.as_str()), "wrong cause on the planned run: {msg}");
     }
@@ -218,7 +239,8 @@ fn slow_planned_runs_lift_effects_above_the_floor() {
 
 /// The same for one case with a planned run twice as long (2400 s):
 /// 1708 churning r 1.40 → 3.44 on t_pump_c (0.465 K against the twin's
-/// 0.135 K), answered `none` (twin `none`; 211 s at load ~5): lifted above
+/// 0.135 K), answered `none` (twin `none`; 211 s at load ~5; re-measured
+/// to the digit on 2026-11-28 under the touched-channel rule, 196 s): lifted above
 /// r = 2 and then a **measured miss**. The cause, measured and asserted:
 /// `churning-loss` passes every check but one — ΔBIC 408 (≥ 25), held-out
 /// t_pump_c −53 % (≥ 30 %, ≥ 0.05 K) — and its evidence would name it
@@ -277,7 +299,7 @@ fn joint_case(seed: u64, duration_s: f64, decision: Decision) -> (f64, String, S
     let (twin, _) = generate_twin(&c).expect("twin");
     let ch = truth.affected.expect("affected").0;
     let o = DiagnoseOptions::default();
-    let d0 = diagnose(&log, &ReferenceModel::new(Rig::default(), &log).expect("model"), &o).expect("diagnosis");
+    let d0 = diagnose(&log, &model_of(&log), &o).expect("diagnosis");
     let causes: Vec<(String, f64, f64)> = d0.posterior.causes.iter().map(|c| (c.cause.clone(), c.probability, c.log_bayes_factor)).collect();
     let lead = leading(&causes, 2);
     let p = plan(&Rig::default(), &log, &typical(&log, &lead), Limits::for_rig(&Rig::default(), &log), duration_s, decision).expect("plan");
@@ -357,7 +379,10 @@ fn six_joint(decision: Decision) -> Vec<(u64, f64, String, String)> {
 /// case lifted to r ≥ 2 (1700, at the edge) and not named; no wrong cause,
 /// no false discovery. Where the candidate's evidence is large (1700
 /// winding ln BF 185, 1710 conduction 52) its fit fails the pooled
-/// held-out check (pooled RMSE no better than the baseline's). Asserted as
+/// held-out check (pooled RMSE no better than the baseline's).
+/// Re-measured case by case on 2026-11-28 under the touched-channel rule
+/// ([`slow_joint_case`]): the same answers, 1708's joint r 1.81, the
+/// others to the digit. Asserted as
 /// measured: none named at r ≥ 2, at most one lifted (1700's 2.01 sits on
 /// the line: the ratio moves with both calibrated baselines' last digits).
 /// 558 s at load ~4.
@@ -381,14 +406,18 @@ fn slow_planned_runs_decided_jointly() {
 /// (`unexplained`), 1713 1.02 (`none`); twins `none`, `none`, `none`,
 /// `unexplained`, `unexplained`, `none`. **Measured miss**: none lifted to
 /// r ≥ 2 (the acceptance asks half); one right name below r = 2; no wrong
-/// cause, no false discovery. Asserted as measured: no r ≥ 2 (largest 1.60,
-/// which moves with the baselines' last digits), 1708 named
-/// `churning-loss`. 939 s at load ~5.
+/// cause, no false discovery. Re-measured case by case on 2026-11-28
+/// under the touched-channel rule ([`slow_joint_case`], same missions,
+/// same answers): 1708 1.60 `churning-loss` to the digit, 1709 1.30
+/// (churning ΔBIC 585, t_pump_c −75 %, pooled −12 %), 1712 0.89, 1700
+/// 1.62, 1710 and 1713 to the digit. Asserted as measured: no r ≥ 2
+/// (largest 1.62, which moves with the baselines' last digits), 1708
+/// named `churning-loss`. 939 s at load ~5 when first measured.
 #[test]
 #[ignore]
 fn slow_jointly_planned_runs_decided_jointly() {
     let rows = six_joint(Decision::Joint);
     let msg = format!("{rows:?}");
-    assert!(rows.iter().all(|r| r.1 < 2.0), "measured miss changed (largest joint r 1.60): {msg}");
+    assert!(rows.iter().all(|r| r.1 < 2.0), "measured miss changed (largest joint r 1.62): {msg}");
     assert_eq!(rows[0].2, "churning-loss", "measured name changed (1708 named churning-loss at joint r 1.60): {msg}");
 }
