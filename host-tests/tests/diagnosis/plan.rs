@@ -6,6 +6,7 @@
 use eha_sim::diagnosis::emu_sweep::default_cases;
 use eha_sim::diagnosis::plan::{leading, plan, Decision, Design, Limits, Plan};
 use eha_sim::diagnosis::reference::ReferenceModel;
+use eha_sim::diagnosis::analysis::Structure;
 use eha_sim::diagnosis::{diagnose, Candidate, DiagnoseOptions, Simulator};
 use eha_sim::emulator::plant::{Hidden, Plant};
 use eha_sim::emulator::{generate, generate_twin, log_mission, logger, EmuCase, EmuTruth};
@@ -13,6 +14,24 @@ use eha_sim::measured::{Channel, MeasuredRun};
 use eha_sim::rig::Rig;
 use eha_sim::scenario::{read_mission_csv, ValveRule};
 use rand::SeedableRng;
+
+/// The structure of the single-log diagnoses: the one `EHA_PLAN_STRUCTURE`
+/// names (`off`, `full`, `no-case`, `no-case-held`), **`off` when unset** —
+/// the tests measured before 2026-11-28 ran so, while `eha-sim diagnose`
+/// on one log applies the default [`Structure::NoCaseHeld`] (under which
+/// the original logs of 1710 and 1712 stand at r ≥ 2,
+/// docs/diagnosis-limits.md). The joint diagnoses
+/// (`multi::joint_reference`) take no structure, as the command does with
+/// several logs.
+fn structure() -> Structure {
+    std::env::var("EHA_PLAN_STRUCTURE").ok().map_or(Structure::Off, |v| <Structure as clap::ValueEnum>::from_str(&v, true).expect("EHA_PLAN_STRUCTURE"))
+}
+
+/// The reference model of one log as these tests diagnose it: the rig
+/// file's under structure `s`.
+fn model_of(log: &MeasuredRun, s: Structure) -> ReferenceModel {
+    ReferenceModel::new(Rig::default(), log).expect("model").with_structure(log, s)
+}
 
 /// The emulator case of `seed` in the original case set (1200 s logs).
 fn case(seed: u64) -> EmuCase {
@@ -50,10 +69,10 @@ fn fly(d: &Design, c: &EmuCase, truth: &EmuTruth, ambient_c: f64) -> (MeasuredRu
 /// Imprint ratio (calibrated baseline's held-out misfit on `ch`, log over
 /// twin), the log's answer, the twin's, and the log's leading candidates
 /// ([`leading`], two), and the log's diagnosis.
-fn ratio(log: &MeasuredRun, twin: &MeasuredRun, ch: Channel) -> (f64, String, String, Vec<Candidate>, Box<eha_sim::diagnosis::Diagnosis>) {
+fn ratio(log: &MeasuredRun, twin: &MeasuredRun, ch: Channel, s: Structure) -> (f64, String, String, Vec<Candidate>, Box<eha_sim::diagnosis::Diagnosis>) {
     let o = DiagnoseOptions::default();
-    let d = diagnose(log, &ReferenceModel::new(Rig::default(), log).expect("model"), &o).expect("diagnosis");
-    let t = diagnose(twin, &ReferenceModel::new(Rig::default(), twin).expect("model"), &o).expect("twin diagnosis");
+    let d = diagnose(log, &model_of(log, s), &o).expect("diagnosis");
+    let t = diagnose(twin, &model_of(twin, s), &o).expect("twin diagnosis");
     let m = |x: &eha_sim::diagnosis::Diagnosis| x.before.channel(ch.name()).map(|c| c.heldout_rmse_k).expect("channel");
     for (l, x) in [("log", &d), ("twin", &t)] {
         eprintln!("  {}", summary(l, x));
@@ -99,19 +118,20 @@ fn mean_ambient(log: &MeasuredRun) -> f64 {
     v.iter().sum::<f64>() / v.len() as f64
 }
 
-/// One case: the original log's ratio, the plan, the planned run's ratio,
-/// answer and diagnosis.
-fn planned_case(seed: u64, duration_s: f64) -> (f64, f64, String, Plan, Box<eha_sim::diagnosis::Diagnosis>) {
+/// One case, single-log diagnoses under structure `s`: the original log's
+/// ratio, the planned run's ratio, its answer, the plan, the planned run's
+/// diagnosis and its twin's answer.
+fn planned_case(seed: u64, duration_s: f64, s: Structure) -> (f64, f64, String, Plan, Box<eha_sim::diagnosis::Diagnosis>, String) {
     let c = case(seed);
     let (log, truth) = generate(&c).expect("log");
     let (twin, _) = generate_twin(&c).expect("twin");
     let ch = truth.affected.expect("affected").0;
-    let (r0, a0, _, lead, _) = ratio(&log, &twin, ch);
+    let (r0, a0, _, lead, _) = ratio(&log, &twin, ch, s);
     let t = std::time::Instant::now();
     let p = plan(&Rig::default(), &log, &typical(&log, &lead), Limits::for_rig(&Rig::default(), &log), duration_s, Decision::Alone).expect("plan");
     let secs = t.elapsed().as_secs_f64();
     let (plog, ptwin, pch) = fly(&p.design, &c, &truth, mean_ambient(&log));
-    let (r1, a1, t1, _, d1) = ratio(&plog, &ptwin, pch);
+    let (r1, a1, t1, _, d1) = ratio(&plog, &ptwin, pch, s);
     let exp = p.expected.iter().find(|e| e.planned.candidate == c.hidden.name()).map(|e| (e.planned.best.1, e.on_log.as_ref().map(|r| r.best.1)));
     eprintln!(
         "{seed} {}: original r {r0:.2} on {} ({a0}; leading {lead:?}); plan {:.0} s: {} (D_s {:.3}); expected r̂ for the hidden candidate {exp:?}; planned r {r1:.2} on {} ({a1}; twin {t1})",
@@ -122,7 +142,7 @@ fn planned_case(seed: u64, duration_s: f64) -> (f64, f64, String, Plan, Box<eha_
         p.d_s,
         pch.name()
     );
-    (r0, r1, a1, p, d1)
+    (r0, r1, a1, p, d1, t1)
 }
 
 /// The command's contract, `eha-sim plan` on a short emulator log (600 s,
@@ -187,38 +207,87 @@ fn plan_command_writes_a_readable_mission_within_limits() {
 /// the same machine with the same hidden effect, and its twin without.
 ///
 /// **Measured miss** (the acceptance asks that at least half be lifted to
-/// r ≥ 2 and then named): none of the six is lifted. Original → planned r:
-/// 1708 churning 1.40 → 1.96, 1710 conduction 1.84 → 0.76, 1712 draught
-/// 1.39 → 0.16, 1709 churning 0.40 → 0.49, 1700 winding 0.99 → 1.07, 1713
-/// draught 0.87 → 0.91 (33 min). The plans' own projections said so: the
-/// hidden candidate, where it was among the leading two, had r̂ 1.00–1.01
+/// r ≥ 2 and then named). Re-measured on 2026-11-28 under the
+/// touched-channel rule (528 s at load ~3–4; the same six missions as on
+/// 2026-11-27), original → planned r: 1708 churning 1.40 → **2.28**
+/// (`unexplained`; churning ΔBIC 677 but t_pump_c −17 %, pooled −1 %),
+/// 1710 conduction 2.08 → 0.84, 1712 draught 1.39 → 0.16, 1709 churning
+/// 0.38 → 0.49, 1700 winding 0.61 → 1.04, 1713 draught 0.87 → 0.80; twins
+/// `unexplained` ×4, `none` ×2. Of the five below r = 2 on the log (1710
+/// now stands at 2.08 there, answered `none`) one is lifted, 1708, and not
+/// named. (2026-11-27, 33 min: 1.96, 0.76 from 1.84, 0.16, 0.49, 1.07
+/// from 0.99, 0.91: none lifted.) The plans' own projections said so: the
+/// hidden candidate, where it was among the leading two, had r̂ 1.00–1.03
 /// on the planned run (the physical set absorbs it on every mission of the
-/// family), and the planned runs' twins misfit more than the logs' own
-/// (four of six `unexplained`). Asserted as measured (fails when a case is
-/// lifted), and that no planned run gets a wrong cause.
+/// family). Diagnosed under `--structure off` ([`structure`]). Asserted as
+/// measured: at least four below r = 2, no case other than 1708 lifted,
+/// none named at r ≥ 2, no wrong cause on a planned run, no discovery on
+/// its twin ([`six_alone`]).
 #[test]
 #[ignore]
 fn slow_planned_runs_lift_effects_above_the_floor() {
-    let seeds = [1708, 1710, 1712, 1709, 1700, 1713];
+    let (_, below, lifted, msg) = six_alone(structure());
+    assert!(below.len() >= 4, "{msg}");
+    assert!(lifted.iter().all(|r| r.0 == 1708), "measured miss changed (1708 only lifted, r 2.28): {msg}");
+    assert!(lifted.iter().all(|r| r.3 != case(r.0).hidden.name()), "measured miss changed (1708 lifted, not named): {msg}");
+}
+
+/// One row of [`six_alone`]: seed, r on the original log, r on the
+/// planned run, its answer, the mission, the planned twin's answer.
+type AloneRow = (u64, f64, f64, String, String, String);
+
+/// The six cases planned for alone and diagnosed alone under structure
+/// `s`: every row, those below r = 2 on the original log, those of them
+/// lifted to r ≥ 2, and the rows printed. Asserts what holds whatever the
+/// ratios: no wrong cause on a planned run, no discovery on its twin.
+fn six_alone(s: Structure) -> (Vec<AloneRow>, Vec<AloneRow>, Vec<AloneRow>, String) {
     let mut rows = Vec::new();
-    for s in seeds {
-        let (r0, r1, answer, p, _) = planned_case(s, 1200.0);
-        rows.push((s, r0, r1, answer, p.design.name.clone()));
+    for seed in [1708, 1710, 1712, 1709, 1700, 1713] {
+        let (r0, r1, answer, p, _, twin) = planned_case(seed, 1200.0, s);
+        rows.push((seed, r0, r1, answer, p.design.name.clone(), twin));
     }
-    let below: Vec<_> = rows.iter().filter(|r| r.1 < 2.0).collect();
-    let lifted: Vec<_> = below.iter().filter(|r| r.2 >= 2.0).collect();
+    let below: Vec<AloneRow> = rows.iter().filter(|r| r.1 < 2.0).cloned().collect();
+    let lifted: Vec<AloneRow> = below.iter().filter(|r| r.2 >= 2.0).cloned().collect();
     let msg = format!("{rows:?}");
     eprintln!("{} of {} below r 2 lifted to ≥ 2: {msg}", lifted.len(), below.len());
-    assert!(below.len() >= 4, "{msg}");
-    assert_eq!(lifted.len(), 0, "measured miss changed: {msg}");
     for r in &rows {
         assert!(["none", "unexplained", case(r.0).hidden.name()].contains(&r.3.as_str()), "wrong cause on the planned run: {msg}");
+        assert!(["none", "unexplained"].contains(&r.5.as_str()), "false discovery on a planned run's twin: {msg}");
     }
+    (rows, below, lifted, msg)
+}
+
+/// [`slow_planned_runs_lift_effects_above_the_floor`] with the single-log
+/// diagnoses under the command's default structure
+/// ([`Structure::NoCaseHeld`]), measured on 2026-11-28 (651 s at load
+/// ~3–4). Original → planned r (answer; twin): 1708 1.72 (`churning-loss`,
+/// a right name below 2) → **4.14** (`unexplained`; churning ΔBIC 359 but
+/// t_pump_c −13 %; twin `unexplained`), 1710 2.81 (`none`, a miss at
+/// r ≥ 2) → 1.78, 1712 2.50 (`none`, a miss) → 1.23, 1709 0.99 →
+/// **5.21 `churning-loss`** (500 rpm/10 bar ↔ 2000 rpm/10 bar every
+/// 300 s; ΔBIC 591, t_pump_c −68 %, pooled 0.513 → 0.220 K, ln BF 37.3;
+/// twin `none`), 1700 1.47 → 1.32, 1713 0.49 → **3.50** (`none`; twin
+/// `none`). Of the four below r = 2 on the log, three are lifted (the
+/// acceptance's half is met) and one of them is named (1709; the
+/// acceptance asks the lifted be named: **measured miss** for 1708 and
+/// 1713); no wrong cause, no false discovery on the six planned twins.
+/// Asserted as measured: four below, 1708, 1709 and 1713 lifted, 1709
+/// named `churning-loss`, the other two not named.
+#[test]
+#[ignore]
+fn slow_planned_runs_default_structure() {
+    let (_, below, lifted, msg) = six_alone(Structure::NoCaseHeld);
+    let seeds = |v: &[AloneRow]| v.iter().map(|r| r.0).collect::<Vec<_>>();
+    assert_eq!(seeds(&below), [1708, 1709, 1700, 1713], "measured set below r 2 changed: {msg}");
+    assert_eq!(seeds(&lifted), [1708, 1709, 1713], "measured lift changed: {msg}");
+    let named: Vec<u64> = lifted.iter().filter(|r| r.3 == case(r.0).hidden.name()).map(|r| r.0).collect();
+    assert_eq!(named, [1709], "measured names changed (1709 only): {msg}");
 }
 
 /// The same for one case with a planned run twice as long (2400 s):
 /// 1708 churning r 1.40 → 3.44 on t_pump_c (0.465 K against the twin's
-/// 0.135 K), answered `none` (twin `none`; 211 s at load ~5): lifted above
+/// 0.135 K), answered `none` (twin `none`; 211 s at load ~5; re-measured
+/// to the digit on 2026-11-28 under the touched-channel rule, 196 s): lifted above
 /// r = 2 and then a **measured miss**. The cause, measured and asserted:
 /// `churning-loss` passes every check but one — ΔBIC 408 (≥ 25), held-out
 /// t_pump_c −53 % (≥ 30 %, ≥ 0.05 K) — and its evidence would name it
@@ -236,7 +305,7 @@ fn slow_planned_runs_lift_effects_above_the_floor() {
 #[test]
 #[ignore]
 fn slow_planned_run_twice_as_long() {
-    let (r0, r1, answer, p, d) = planned_case(1708, 2400.0);
+    let (r0, r1, answer, p, d, _) = planned_case(1708, 2400.0, structure());
     eprintln!("1708, 2400 s plan: r {r0:.2} -> {r1:.2} ({answer}), {}", p.design.name);
     assert!(r1 >= 2.5, "measured r changed: {r1:.2} (measured 3.44)");
     assert!(["none", "unexplained", "churning-loss"].contains(&answer.as_str()), "wrong cause: {answer}");
@@ -252,6 +321,29 @@ fn slow_planned_run_twice_as_long() {
         100.0 * ch.heldout_gain,
         100.0 * pooled
     );
+}
+
+/// [`slow_planned_run_twice_as_long`] with the single-log diagnoses under
+/// the command's default structure ([`Structure::NoCaseHeld`]), measured
+/// on 2026-11-28 (240 s at load ~3–4). The original 1708 log is then
+/// named `churning-loss` already (r 1.72, below 2: a right name), the
+/// plan for its two leading candidates (churning, sensor lag) is 500
+/// rpm/10 bar ↔ 2000 rpm/10 bar every 300 s, and the planned run is
+/// lifted to **r 6.13** on t_pump_c (1.054 K against the twin's 0.172 K)
+/// and **named `churning-loss`**: ΔBIC 705, t_pump_c −64 %, pooled 0.847 →
+/// 0.591 K (30 %), ln BF 50.2; its twin `none` (churning ΔBIC −6); the
+/// original's twin `none` (churning kept out by the pooled check, 6 %, as
+/// under `off`). Asserted as measured: r ≥ 4 (well above 2; the ratio
+/// moves with both calibrated baselines' last digits), named
+/// `churning-loss`, twin `none`.
+#[test]
+#[ignore]
+fn slow_planned_run_twice_as_long_default_structure() {
+    let (r0, r1, answer, p, _, twin) = planned_case(1708, 2400.0, Structure::NoCaseHeld);
+    eprintln!("1708, 2400 s plan, no-case-held: r {r0:.2} -> {r1:.2} ({answer}; twin {twin}), {}", p.design.name);
+    assert!(r1 >= 4.0, "measured r changed: {r1:.2} (measured 6.13)");
+    assert_eq!(answer, "churning-loss", "measured name changed (churning-loss at r 6.13)");
+    assert_eq!(twin, "none", "false discovery on the twin (measured none)");
 }
 
 /// The joint diagnosis of `logs` (one machine), as `eha-sim diagnose a.csv
@@ -277,7 +369,7 @@ fn joint_case(seed: u64, duration_s: f64, decision: Decision) -> (f64, String, S
     let (twin, _) = generate_twin(&c).expect("twin");
     let ch = truth.affected.expect("affected").0;
     let o = DiagnoseOptions::default();
-    let d0 = diagnose(&log, &ReferenceModel::new(Rig::default(), &log).expect("model"), &o).expect("diagnosis");
+    let d0 = diagnose(&log, &model_of(&log, structure()), &o).expect("diagnosis");
     let causes: Vec<(String, f64, f64)> = d0.posterior.causes.iter().map(|c| (c.cause.clone(), c.probability, c.log_bayes_factor)).collect();
     let lead = leading(&causes, 2);
     let p = plan(&Rig::default(), &log, &typical(&log, &lead), Limits::for_rig(&Rig::default(), &log), duration_s, decision).expect("plan");
@@ -357,7 +449,10 @@ fn six_joint(decision: Decision) -> Vec<(u64, f64, String, String)> {
 /// case lifted to r ≥ 2 (1700, at the edge) and not named; no wrong cause,
 /// no false discovery. Where the candidate's evidence is large (1700
 /// winding ln BF 185, 1710 conduction 52) its fit fails the pooled
-/// held-out check (pooled RMSE no better than the baseline's). Asserted as
+/// held-out check (pooled RMSE no better than the baseline's).
+/// Re-measured case by case on 2026-11-28 under the touched-channel rule
+/// ([`slow_joint_case`]): the same answers, 1708's joint r 1.81, the
+/// others to the digit. Asserted as
 /// measured: none named at r ≥ 2, at most one lifted (1700's 2.01 sits on
 /// the line: the ratio moves with both calibrated baselines' last digits).
 /// 558 s at load ~4.
@@ -381,14 +476,18 @@ fn slow_planned_runs_decided_jointly() {
 /// (`unexplained`), 1713 1.02 (`none`); twins `none`, `none`, `none`,
 /// `unexplained`, `unexplained`, `none`. **Measured miss**: none lifted to
 /// r ≥ 2 (the acceptance asks half); one right name below r = 2; no wrong
-/// cause, no false discovery. Asserted as measured: no r ≥ 2 (largest 1.60,
-/// which moves with the baselines' last digits), 1708 named
-/// `churning-loss`. 939 s at load ~5.
+/// cause, no false discovery. Re-measured case by case on 2026-11-28
+/// under the touched-channel rule ([`slow_joint_case`], same missions,
+/// same answers): 1708 1.60 `churning-loss` to the digit, 1709 1.30
+/// (churning ΔBIC 585, t_pump_c −75 %, pooled −12 %), 1712 0.89, 1700
+/// 1.62, 1710 and 1713 to the digit. Asserted as measured: no r ≥ 2
+/// (largest 1.62, which moves with the baselines' last digits), 1708
+/// named `churning-loss`. 939 s at load ~5 when first measured.
 #[test]
 #[ignore]
 fn slow_jointly_planned_runs_decided_jointly() {
     let rows = six_joint(Decision::Joint);
     let msg = format!("{rows:?}");
-    assert!(rows.iter().all(|r| r.1 < 2.0), "measured miss changed (largest joint r 1.60): {msg}");
+    assert!(rows.iter().all(|r| r.1 < 2.0), "measured miss changed (largest joint r 1.62): {msg}");
     assert_eq!(rows[0].2, "churning-loss", "measured name changed (1708 named churning-loss at joint r 1.60): {msg}");
 }
