@@ -1,0 +1,151 @@
+//! Test plans decided jointly: the original log and the planned run
+//! diagnosed together (`eha-sim diagnose log.csv planned.csv`, one
+//! calibration), planned alone or for the joint decision (`--joint`).
+
+use super::*;
+
+/// The joint diagnosis of `logs` (one machine), as `eha-sim diagnose a.csv
+/// b.csv` makes it: one calibration for every log.
+fn diagnose_joint(logs: &[&MeasuredRun]) -> eha_sim::diagnosis::Diagnosis {
+    use eha_sim::diagnosis::multi::{joint_reference, options_for};
+    let o = options_for(&DiagnoseOptions::default(), logs.len());
+    let files: Vec<String> = (1..=logs.len()).map(|k| format!("log {k}")).collect();
+    let (rows, joint) = joint_reference(&Rig::default(), logs, &files, o.train_fraction).expect("joint model");
+    diagnose(&rows, &joint, &o).expect("joint diagnosis")
+}
+
+/// One case decided jointly: the original log and the planned run of
+/// `duration_s` diagnosed together (one calibration), and the joint twin
+/// (the original's twin and the planned run's twin) likewise. Returns the
+/// joint imprint ratio r (the joint baseline's held-out misfit on the
+/// effect's channel — the planned run's, where the imprint is largest —
+/// pooled over both logs' held-out windows, log pair over twin pair), the
+/// joint answer and the joint twin's answer.
+fn joint_case(seed: u64, duration_s: f64, decision: Decision) -> (f64, String, String) {
+    let c = case(seed);
+    let (log, truth) = generate(&c).expect("log");
+    let (twin, _) = generate_twin(&c).expect("twin");
+    let ch = truth.affected.expect("affected").0;
+    let o = DiagnoseOptions::default();
+    let d0 = diagnose(&log, &model_of(&log, structure()), &o).expect("diagnosis");
+    let causes: Vec<(String, f64, f64)> = d0.posterior.causes.iter().map(|c| (c.cause.clone(), c.probability, c.log_bayes_factor)).collect();
+    let lead = leading(&causes, 2);
+    let p = plan(&Rig::default(), &log, &typical(&log, &lead), Limits::for_rig(&Rig::default(), &log), duration_s, decision).expect("plan");
+    let exp: Vec<String> = p.expected.iter().map(|e| format!("{} r̂ {:.2} on {} (log {:.2})", e.planned.candidate, e.planned.best.1, e.planned.best.0, e.on_log.as_ref().map_or(f64::NAN, |r| r.best.1))).collect();
+    eprintln!("  plan ({:?}): {} (D_s {:.3}); expected {}", p.decision, p.design.name, p.d_s, exp.join(", "));
+    let (plog, ptwin, pch) = fly(&p.design, &c, &truth, mean_ambient(&log));
+    if let Ok(dir) = std::env::var("EHA_PLAN_DUMP") {
+        let dir = std::path::Path::new(&dir).join(format!("{seed}-{duration_s:.0}-{:?}", p.decision));
+        std::fs::create_dir_all(&dir).expect("dump dir");
+        for (n, r) in [("log", &log), ("twin", &twin), ("planned", &plog), ("planned-twin", &ptwin)] {
+            r.write_file(dir.join(format!("{n}.csv"))).expect("dump");
+        }
+    }
+    let dj = diagnose_joint(&[&log, &plog]);
+    let tj = diagnose_joint(&[&twin, &ptwin]);
+    for (l, x) in [("original", &d0), ("joint", &dj), ("joint twin", &tj)] {
+        eprintln!("  {}", summary(l, x));
+    }
+    let m = |x: &eha_sim::diagnosis::Diagnosis| x.before.channel(pch.name()).map(|c| c.heldout_rmse_k).expect("channel");
+    let r = m(&dj) / m(&tj);
+    eprintln!(
+        "{seed} {}: leading {lead:?}; plan {}; effect's channel {} (original's {}); joint r {r:.2} ({}; joint twin {})",
+        c.hidden.name(),
+        p.design.name,
+        pch.name(),
+        ch.name(),
+        dj.answer(),
+        tj.answer()
+    );
+    (r, dj.answer().to_string(), tj.answer().to_string())
+}
+
+/// One case of [`slow_planned_runs_lift_effects_above_the_floor`] decided
+/// jointly ([`joint_case`]), a by-hand measurement one case at a time: the
+/// seed from `EHA_PLAN_SEED` (default 1708), the plan's duration from
+/// `EHA_PLAN_DURATION_S` (default 1200 s), planned for the joint decision
+/// when `EHA_PLAN_JOINT=1` ([`Decision::Joint`]), else for the planned run
+/// alone; `EHA_PLAN_DUMP=DIR` writes the four logs as CSV.
+#[test]
+#[ignore]
+fn slow_joint_case() {
+    let seed = std::env::var("EHA_PLAN_SEED").ok().and_then(|s| s.parse().ok()).unwrap_or(1708);
+    let dur = std::env::var("EHA_PLAN_DURATION_S").ok().and_then(|s| s.parse().ok()).unwrap_or(1200.0);
+    let decision = if std::env::var("EHA_PLAN_JOINT").is_ok_and(|v| v == "1") { Decision::Joint } else { Decision::Alone };
+    let (r, a, t) = joint_case(seed, dur, decision);
+    eprintln!("JOINT {seed} {dur}: r {r:.2} {a} (twin {t})");
+}
+
+/// The six cases of [`slow_planned_runs_lift_effects_above_the_floor`]
+/// decided jointly ([`joint_case`], 1200 s plans made for `decision`):
+/// (seed, joint r, joint answer, joint twin's answer). Asserts what holds
+/// whatever the ratios: no wrong cause on a joint log, no discovery on a
+/// joint twin.
+fn six_joint(decision: Decision) -> Vec<(u64, f64, String, String)> {
+    let mut rows = Vec::new();
+    for s in [1708, 1710, 1712, 1709, 1700, 1713] {
+        let (r, a, t) = joint_case(s, 1200.0, decision);
+        rows.push((s, r, a, t));
+    }
+    let msg = format!("{rows:?}");
+    eprintln!("{decision:?}: {msg}");
+    for (s, _, a, t) in &rows {
+        assert!(["none", "unexplained", case(*s).hidden.name()].contains(&a.as_str()), "wrong cause on a joint log: {msg}");
+        assert!(["none", "unexplained"].contains(&t.as_str()), "false discovery on a joint twin: {msg}");
+    }
+    rows
+}
+
+/// The six cases decided jointly — the original log and the planned run
+/// (planned for the planned run alone, the same missions as
+/// [`slow_planned_runs_lift_effects_above_the_floor`]) diagnosed together,
+/// one calibration; r against the joint twin (the original's twin and the
+/// planned run's twin together). **Measured miss**: joint r 1708 1.86
+/// (`unexplained`), 1710 0.63 (`unexplained`), 1712 0.50 (`none`), 1709
+/// 0.74 (`unexplained`), 1700 2.01 (`unexplained`), 1713 1.22 (`none`);
+/// twins `none`, `none`, `none`, `unexplained`, `unexplained`, `none`. One
+/// case lifted to r ≥ 2 (1700, at the edge) and not named; no wrong cause,
+/// no false discovery. Where the candidate's evidence is large (1700
+/// winding ln BF 185, 1710 conduction 52) its fit fails the pooled
+/// held-out check (pooled RMSE no better than the baseline's).
+/// Re-measured case by case on 2026-11-28 under the touched-channel rule
+/// ([`slow_joint_case`]): the same answers, 1708's joint r 1.81, the
+/// others to the digit. Asserted as
+/// measured: none named at r ≥ 2, at most one lifted (1700's 2.01 sits on
+/// the line: the ratio moves with both calibrated baselines' last digits).
+/// 558 s at load ~4.
+#[test]
+#[ignore]
+fn slow_planned_runs_decided_jointly() {
+    let rows = six_joint(Decision::Alone);
+    let lifted: Vec<_> = rows.iter().filter(|r| r.1 >= 2.0).collect();
+    let msg = format!("{rows:?}");
+    assert!(lifted.len() <= 1, "measured miss changed (1700 only, r 2.01): {msg}");
+    assert!(lifted.iter().all(|r| r.2 != case(r.0).hidden.name()), "measured miss changed (none named at r ≥ 2): {msg}");
+}
+
+/// The six cases with plans made for the joint decision
+/// ([`Decision::Joint`]: D_s on the stacked projected imprints of the log
+/// and the planned run) and decided jointly. Measured: joint r 1708 1.60
+/// (**`churning-loss`**, named right: ΔBIC 855, t_pump_c −50 %, pooled
+/// −32 %, ln BF 84.9), 1710 0.63 (`unexplained`; the same mission as
+/// planned alone), 1712 0.82 (`none`), 1709 1.36 (`unexplained`: churning
+/// ΔBIC 752, t_pump_c −76 %, pooled only −14 %), 1700 1.38
+/// (`unexplained`), 1713 1.02 (`none`); twins `none`, `none`, `none`,
+/// `unexplained`, `unexplained`, `none`. **Measured miss**: none lifted to
+/// r ≥ 2 (the acceptance asks half); one right name below r = 2; no wrong
+/// cause, no false discovery. Re-measured case by case on 2026-11-28
+/// under the touched-channel rule ([`slow_joint_case`], same missions,
+/// same answers): 1708 1.60 `churning-loss` to the digit, 1709 1.30
+/// (churning ΔBIC 585, t_pump_c −75 %, pooled −12 %), 1712 0.89, 1700
+/// 1.62, 1710 and 1713 to the digit. Asserted as measured: no r ≥ 2
+/// (largest 1.62, which moves with the baselines' last digits), 1708
+/// named `churning-loss`. 939 s at load ~5 when first measured.
+#[test]
+#[ignore]
+fn slow_jointly_planned_runs_decided_jointly() {
+    let rows = six_joint(Decision::Joint);
+    let msg = format!("{rows:?}");
+    assert!(rows.iter().all(|r| r.1 < 2.0), "measured miss changed (largest joint r 1.62): {msg}");
+    assert_eq!(rows[0].2, "churning-loss", "measured name changed (1708 named churning-loss at joint r 1.60): {msg}");
+}
