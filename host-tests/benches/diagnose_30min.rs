@@ -9,7 +9,7 @@
 //! (`diagnosis::progress`, hidden here) showed at 25, 50 and 75 % against
 //! the time actually left (`DIAG30_ONLY=throttle|servo|emulator` runs one log,
 //! `DIAG30_XCORR_STEP_S` sets the cross-correlation's lag step); run with
-//! `cargo bench --profile fast -p eha-sim --bench diagnose_30min`.
+//! `cargo bench --profile speed -p eha-sim --bench diagnose_30min`.
 //! (One run per log: a diagnosis is a minute-scale job, so the statistics of
 //! criterion's repeated sampling would cost ten times that.)
 

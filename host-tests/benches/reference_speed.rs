@@ -8,7 +8,7 @@
 //! pools of 1 and 2 threads: 16 Case 1 runs and 4 Case 2 runs of rigs with
 //! different outer-convection scales, as a sweep or an uncertainty band
 //! would run them. Run with
-//! `cargo bench --profile fast -p eha-sim --bench reference_speed`.
+//! `cargo bench --profile speed -p eha-sim --bench reference_speed`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use eha_sim::network::NODES;

@@ -4,7 +4,7 @@
 //! control (`sim::simulate_budget`: replay tolerances, `REPLAY_RTOL`) and,
 //! for comparison, every state under control (`sim::simulate_rtol`). Prints
 //! the solver steps and model evaluations of each; run with
-//! `cargo bench --profile fast -p eha-sim --bench replay`.
+//! `cargo bench --profile speed -p eha-sim --bench replay`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use eha_sim::diagnosis::reference::{replay_inputs, REPLAY_RTOL};

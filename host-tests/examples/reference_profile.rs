@@ -7,6 +7,9 @@
 //! an argument).
 //!
 //! `cargo run --profile fast -p eha-sim --example reference_profile -- 2`
+//! (the counters; instruction counts are taken of the `speed` profile's
+//! binary, `target/speed/examples/reference_profile`: eha-sim in one
+//! codegen unit, the same inlining whatever else changes)
 //!
 //! `DURATION_S=5` runs the fast path over the first 5 s only (the same
 //! plant and callbacks, ending there): where a run's work goes in time.
