@@ -1,4 +1,4 @@
-//! Measurement by hand: the local minima of the three-log fit
+//! The local minima of the three-log fit
 //! (`commissioning_set_hot`) on big-pump, polished from given multiplier
 //! vectors (docs/commissioning.md, "The hot-flow run").
 
@@ -8,14 +8,22 @@ use eha_sim::calibration::residuals::on_lattice_value;
 use eha_sim::calibration::set::{index, nominal};
 use eha_sim::calibration::{calibrate, PARAMS};
 
+/// The two basins of docs/commissioning.md ("The hot-flow run"), their
+/// end points' largest moves to two digits: the original run's, then the
+/// nudged run's.
+const BASINS: &str = "film_ball 3.8, cap_ball_block 2.2, cap_case_oil 1.44, friction_case 0.86, h_out_pump 1.6, film_port 0.71; \
+    film_ball 1.4, cap_ball_block 0.87, cap_case_oil 3.0, friction_case 2.1, h_out_pump 2.4, film_port 1.35";
+
 /// Polishes the calibration of big-pump's three-log set (original logs)
 /// from each start in `EXP_STARTS` (`;`-separated lists of `name value`
-/// pairs, `,`-separated; the rest at the rig file) for `EXP_POLISH_ITERS`
+/// pairs, `,`-separated; the rest at the rig file; unset: [`BASINS`], the
+/// two basins' end points to two digits, at `EXP_S2` 4.30 unless set) for `EXP_POLISH_ITERS`
 /// (default 30) Gauss–Newton iterations without LM before it, and prints
 /// where each ends: objective trail, decrements, data χ² (σ 0.2 K), the
-/// prior sum and the multipliers.
+/// prior sum and the multipliers. With the default starts it asserts that
+/// they end in two basins (below).
 #[test]
-#[ignore = "measurement by hand: polishes of the three-log fit from given starts"]
+#[ignore = "slow tier: polishes of the three-log fit from given starts (~75 s)"]
 fn slow_three_log_minima() {
     let m = big_pump();
     let s = commissioning_set_hot(&m, 3600).expect("bench");
@@ -28,8 +36,12 @@ fn slow_three_log_minima() {
     }
     o.max_evals = 0;
     o.polish_iters = std::env::var("EXP_POLISH_ITERS").ok().and_then(|v| v.parse().ok()).unwrap_or(30);
-    o.polish_s2 = std::env::var("EXP_S2").ok().and_then(|v| v.parse().ok());
-    let starts = std::env::var("EXP_STARTS").expect("EXP_STARTS");
+    let given = std::env::var("EXP_STARTS").ok();
+    let default_s2 = if given.is_none() { Some(4.30) } else { None };
+    o.polish_s2 = std::env::var("EXP_S2").ok().and_then(|v| v.parse().ok()).or(default_s2);
+    let by_default = given.is_none();
+    let starts = given.unwrap_or_else(|| BASINS.to_string());
+    let mut chi2 = Vec::new();
     for (i, st) in starts.split(';').enumerate() {
         let mut th = nominal();
         for pair in st.split(',').map(str::trim).filter(|p| !p.is_empty()) {
@@ -43,7 +55,15 @@ fn slow_three_log_minima() {
         eprintln!("START {i}: {:.0} s, {} runs; polish objective {:.3?}", t0.elapsed().as_secs_f64(), c.model_runs, c.polish.objective);
         eprintln!("  decrement {:.3?} converged {} on bound {:?} s2 {:.4}", c.polish.decrement, c.polish.converged, c.polish.on_bound, c.polish.s2);
         eprintln!("  data chi2 {:.2} prior {:.3}", c.chi2_before_after.1, prior);
+        chi2.push(c.chi2_before_after.1);
         let v: Vec<String> = c.params.iter().filter(|p| p.status == eha_sim::calibration::Status::Fitted).map(|p| format!("{} {:.4}", p.name, p.value)).collect();
         eprintln!("  END {}", v.join(", "));
+    }
+    // From [`BASINS`] the two polishes stay apart: measured data χ² 10 601
+    // and 19 497 (2026-11-28, 75 s at load ~2; the second with
+    // `cap_case_oil` on its ×3 bound). One minimum would give a ratio near
+    // 1; 1.5 asks for two basins with room for the polish's stall.
+    if by_default {
+        assert!(chi2[1] > 1.5 * chi2[0], "the two basins' data chi2 {:.0} and {:.0}: not two basins apart (measured 10 601 and 19 497)", chi2[0], chi2[1]);
     }
 }
