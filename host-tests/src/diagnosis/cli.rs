@@ -104,10 +104,15 @@ fn run_inner(args: &DiagnoseArgs) -> anyhow::Result<String> {
         None
     };
     let single;
+    let mut structure_note = None;
     let (run, model): (&MeasuredRun, &dyn Simulator) = match &joint {
         Some((rows, m)) => (rows as &MeasuredRun, m as &dyn Simulator),
         None => {
             single = ReferenceModel::new(rig, &runs[0]).map_err(|e| anyhow::anyhow!("{}: {e}", files[0]))?.with_structure(&runs[0], o.structure);
+            structure_note = structure_not_applied(o.structure, single.eta_m_from_current().is_some());
+            if let Some(n) = &structure_note {
+                eprintln!("note: {}: {n}", files[0]);
+            }
             (&runs[0], &single as &dyn Simulator)
         }
     };
@@ -127,6 +132,10 @@ fn run_inner(args: &DiagnoseArgs) -> anyhow::Result<String> {
                 super::multi::write_outputs(&d, &parts, &refs, &files, &args.out)?;
             }
             None => write_outputs(&d, run, &files[0], &args.out)?,
+        }
+        if let Some(n) = &structure_note {
+            use std::io::Write as _;
+            std::fs::OpenOptions::new().append(true).open(args.out.join("report.md"))?.write_all(format!("\n**Note:** {n}\n").as_bytes())?;
         }
         let mut detect_line = None;
         if args.detectability {
@@ -162,6 +171,20 @@ fn run_inner(args: &DiagnoseArgs) -> anyhow::Result<String> {
     outcome
 }
 
+/// The note a single-log diagnosis prints (and appends to report.md) when
+/// the structure asked for could not be applied: without motor current
+/// under load the pump's `eta_m` cannot come from the electrical balance
+/// and the physical tier stays the rig file's, as under `--structure off`
+/// ([`ReferenceModel::with_structure`]). `None` when applied or not asked.
+pub fn structure_not_applied(asked: crate::diagnosis::analysis::Structure, applied: bool) -> Option<String> {
+    use crate::diagnosis::analysis::Structure;
+    if asked == Structure::Off || applied {
+        return None;
+    }
+    let name = clap::ValueEnum::to_possible_value(&asked).map_or_else(|| format!("{asked:?}"), |v| v.get_name().to_string());
+    Some(format!("structure `{name}` not applied: the log has no motor current under load, so the pump's eta_m cannot come from the electrical balance; diagnosed as under `--structure off`"))
+}
+
 /// The detectability of `run` against its structure floor around the
 /// calibrated point of the tier whose answer stands in `d`: the floors are
 /// the diagnosis's own channel numbers, the points the evidence's.
@@ -180,4 +203,20 @@ pub fn detectability_against_floor(
     let pts = super::analysis::evidence_points(run, d.split_time_s, o.points_per_channel);
     super::detect::with_answer_tier(model, d, |a| super::projection::floor_detectability(a.sim, run, a.nuisance, pts, a.split, floors))
         .map_err(|e| anyhow::anyhow!("detectability: {e}"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::structure_not_applied;
+    use crate::diagnosis::analysis::Structure;
+
+    /// The note names the structure by its command-line spelling, and only
+    /// when a structure was asked for and could not be applied.
+    #[test]
+    fn structure_note_only_when_asked_and_not_applied() {
+        assert_eq!(structure_not_applied(Structure::Off, false), None);
+        assert_eq!(structure_not_applied(Structure::NoCaseHeld, true), None);
+        let n = structure_not_applied(Structure::NoCaseHeld, false).expect("note");
+        assert!(n.contains("`no-case-held` not applied") && n.contains("--structure off"), "{n}");
+    }
 }
