@@ -203,10 +203,19 @@ type Fitted = (Rig, Calibration, Option<(f64, usize)>);
 /// the logs carry it: the rig it started from, the calibration and that
 /// `eta_m`.
 fn fit(base: &Rig, train: &[CalLog], o: &CalOptions) -> Result<Fitted, CommissionError> {
-    // The pump's friction coefficient from the electrical balance when the
-    // logs carry current under load (identified directly, and the firmware's
-    // sensor cross-check then agrees with this machine); else from the
-    // temperatures with the rest of the set.
+    let (base_e, o, eta_e) = with_eta_m_from_current(base, train, o);
+    let cal = calibrate(&base_e, train, &o)?;
+    Ok((base_e, cal, eta_e))
+}
+
+/// The rig and options the commissioning calibrates with: the pump's
+/// friction coefficient η_m from the electrical balance when the logs
+/// carry current under load ([`eta_m_from_current`]; identified directly,
+/// and the firmware's sensor cross-check then agrees with this machine),
+/// `pump_friction` held there; else the rig and options unchanged (η_m from
+/// the temperatures with the rest of the set). Returns η_m and its sample
+/// count when taken from the current.
+pub fn with_eta_m_from_current(base: &Rig, train: &[CalLog], o: &CalOptions) -> (Rig, CalOptions, Option<(f64, usize)>) {
     let mut base_e = base.clone();
     let mut o = o.clone();
     // On the calibration's lattice (`residuals::THETA_LATTICE_LN`): η_m
@@ -219,8 +228,7 @@ fn fit(base: &Rig, train: &[CalLog], o: &CalOptions) -> Result<Fitted, Commissio
         base_e.pump.eta_m = eta;
         o.hold.push(("pump_friction", format!("eta_m = {eta:.4} from the current of {n} loaded samples (electrical balance)")));
     }
-    let cal = calibrate(&base_e, train, &o)?;
-    Ok((base_e, cal, eta_e))
+    (base_e, o, eta_e)
 }
 
 /// The first `frac` of `log`'s span as a log of its own.

@@ -134,8 +134,7 @@ fn run_inner(args: &DiagnoseArgs) -> anyhow::Result<String> {
             None => write_outputs(&d, run, &files[0], &args.out)?,
         }
         if let Some(n) = &structure_note {
-            use std::io::Write as _;
-            std::fs::OpenOptions::new().append(true).open(args.out.join("report.md"))?.write_all(format!("\n**Note:** {n}\n").as_bytes())?;
+            append_to_report(&args.out, &format!("\n**Note:** {n}\n"))?;
         }
         let mut detect_line = None;
         if args.detectability {
@@ -144,9 +143,7 @@ fn run_inner(args: &DiagnoseArgs) -> anyhow::Result<String> {
             let p = d.nuisance_before.len();
             progress.extend((1 + p + super::detect::MULTIPLES.len() * Candidate::EXTENSIONS.len()) as u64, "detectability");
             let fd = detectability_against_floor(&progress, &d, run, &o)?;
-            // A section appended to the report just written.
-            use std::io::Write as _;
-            std::fs::OpenOptions::new().append(true).open(args.out.join("report.md"))?.write_all(fd.markdown().as_bytes())?;
+            append_to_report(&args.out, &fd.markdown())?;
             std::fs::write(args.out.join("detectability.json"), serde_json::to_string_pretty(&fd)? + "\n")?;
             detect_line = Some(fd.summary());
         }
@@ -169,6 +166,12 @@ fn run_inner(args: &DiagnoseArgs) -> anyhow::Result<String> {
     let outcome = work();
     progress.finish();
     outcome
+}
+
+/// Appends `text` to the report just written in `out` (`report.md`).
+fn append_to_report(out: &std::path::Path, text: &str) -> std::io::Result<()> {
+    use std::io::Write as _;
+    std::fs::OpenOptions::new().append(true).open(out.join("report.md"))?.write_all(text.as_bytes())
 }
 
 /// The note a single-log diagnosis prints (and appends to report.md) when

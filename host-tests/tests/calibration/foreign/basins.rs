@@ -3,8 +3,7 @@
 //! vectors (docs/commissioning.md, "The hot-flow run").
 
 use super::*;
-use eha_sim::calibration::commission::eta_m_from_current;
-use eha_sim::calibration::residuals::on_lattice_value;
+use eha_sim::calibration::commission::with_eta_m_from_current;
 use eha_sim::calibration::set::{index, nominal};
 use eha_sim::calibration::{calibrate, PARAMS};
 
@@ -28,12 +27,7 @@ fn slow_three_log_minima() {
     let m = big_pump();
     let s = commissioning_set_hot(&m, 3600).expect("bench");
     let train: Vec<CalLog> = s.train.iter().map(cal).collect();
-    let mut base = m.rig_file();
-    let mut o = CalOptions::default();
-    if let Some((eta, n)) = eta_m_from_current(&base, &train) {
-        base.pump.eta_m = on_lattice_value(eta, o.lattice_ln);
-        o.hold.push(("pump_friction", format!("eta_m from {n} samples")));
-    }
+    let (base, mut o, _) = with_eta_m_from_current(&m.rig_file(), &train, &CalOptions::default());
     o.max_evals = 0;
     o.polish_iters = std::env::var("EXP_POLISH_ITERS").ok().and_then(|v| v.parse().ok()).unwrap_or(30);
     let given = std::env::var("EXP_STARTS").ok();

@@ -28,8 +28,7 @@ fn joint_case(seed: u64, duration_s: f64, decision: Decision) -> (f64, String, S
     let ch = truth.affected.expect("affected").0;
     let o = DiagnoseOptions::default();
     let d0 = diagnose(&log, &model_of(&log, structure()), &o).expect("diagnosis");
-    let causes: Vec<(String, f64, f64)> = d0.posterior.causes.iter().map(|c| (c.cause.clone(), c.probability, c.log_bayes_factor)).collect();
-    let lead = leading(&causes, 2);
+    let lead = leading_of(&d0);
     let p = plan(&Rig::default(), &log, &typical(&log, &lead), Limits::for_rig(&Rig::default(), &log), duration_s, decision).expect("plan");
     let exp: Vec<String> = p.expected.iter().map(|e| format!("{} r̂ {:.2} on {} (log {:.2})", e.planned.candidate, e.planned.best.1, e.planned.best.0, e.on_log.as_ref().map_or(f64::NAN, |r| r.best.1))).collect();
     eprintln!("  plan ({:?}): {} (D_s {:.3}); expected {}", p.decision, p.design.name, p.d_s, exp.join(", "));
@@ -46,8 +45,7 @@ fn joint_case(seed: u64, duration_s: f64, decision: Decision) -> (f64, String, S
     for (l, x) in [("original", &d0), ("joint", &dj), ("joint twin", &tj)] {
         eprintln!("  {}", summary(l, x));
     }
-    let m = |x: &eha_sim::diagnosis::Diagnosis| x.before.channel(pch.name()).map(|c| c.heldout_rmse_k).expect("channel");
-    let r = m(&dj) / m(&tj);
+    let r = heldout_k(&dj, pch) / heldout_k(&tj, pch);
     eprintln!(
         "{seed} {}: leading {lead:?}; plan {}; effect's channel {} (original's {}); joint r {r:.2} ({}; joint twin {})",
         c.hidden.name(),
@@ -83,7 +81,7 @@ fn slow_joint_case() {
 /// joint twin.
 fn six_joint(decision: Decision) -> Vec<(u64, f64, String, String)> {
     let mut rows = Vec::new();
-    for s in [1708, 1710, 1712, 1709, 1700, 1713] {
+    for s in SIX {
         let (r, a, t) = joint_case(s, 1200.0, decision);
         rows.push((s, r, a, t));
     }
