@@ -55,6 +55,9 @@ pub struct Commissioning {
     /// `eta_m` from the training logs' current and the rows used
     /// ([`eta_m_from_current`]); `None`: fitted from the temperatures.
     pub eta_m_from_current: Option<(f64, usize)>,
+    /// Why `eta_m` was not taken from the current ([`EtaMBalance::refusal`]);
+    /// `None` when it was.
+    pub eta_m_refusal: Option<String>,
     /// The drain margin from validation on a split of the training
     /// missions, when every training log carries `t_drain_c`.
     pub margin: Option<MarginValidation>,
@@ -273,6 +276,7 @@ pub fn commission(base: &Rig, train: &[CalLog], holdout: &[CalLog], o: &CalOptio
 /// [`commission`]; `with_margin` false skips the margin validation (one
 /// calibration instead of two).
 pub fn commission_with(base: &Rig, train: &[CalLog], holdout: &[CalLog], o: &CalOptions, with_margin: bool) -> Result<Commissioning, CommissionError> {
+    let eta_m_refusal = eta_m_balance(base, train).refusal();
     let (base_e, mut cal, eta_e) = fit(base, train, o)?;
     let base = &base_e;
     if !train.iter().any(cycles_valve) {
@@ -398,6 +402,7 @@ pub fn commission_with(base: &Rig, train: &[CalLog], holdout: &[CalLog], o: &Cal
         train_regions,
         excitation_ok,
         eta_m_from_current: eta_e,
+        eta_m_refusal,
         margin,
         holdout_with_margin,
         reduction_path: reduction,
@@ -420,8 +425,8 @@ pub fn commission_with(base: &Rig, train: &[CalLog], holdout: &[CalLog], o: &Cal
 /// friction of oil at 20 °C, 2.2 times its 40 °C value, went into `eta_m`, and the
 /// firmware, whose friction follows the oil, saw its own
 /// cross-check disagree within a second.)
-/// `(eta_m, rows)`; `None` without current or load, or outside 0.01..2.
-pub fn eta_m_from_current(rig: &Rig, logs: &[CalLog]) -> Option<(f64, usize)> {
+/// [`EtaMBalance::NoLoadedRows`] without current or load.
+pub fn eta_m_balance(rig: &Rig, logs: &[CalLog]) -> EtaMBalance {
     use crate::measured::Channel;
     let kt = rig.motor.torque_constant_nm_per_a;
     let d = rig.displacement_m3_per_rad();
@@ -451,6 +456,58 @@ pub fn eta_m_from_current(rig: &Rig, logs: &[CalLog]) -> Option<(f64, usize)> {
     let top = rows.iter().map(|r| r.1).fold(0.0, f64::max);
     let used: Vec<_> = rows.into_iter().filter(|r| top > 0.0 && r.1 >= 0.2 * top).collect();
     let (num, den) = used.iter().fold((0.0, 0.0), |(a, b), (f, m)| (a + f * m, b + m * m));
-    let eta = num / den;
-    (den > 0.0 && (0.01..2.0).contains(&eta)).then_some((eta, used.len()))
+    if den > 0.0 {
+        EtaMBalance::Fitted { eta_m: num / den, rows: used.len() }
+    } else {
+        EtaMBalance::NoLoadedRows
+    }
+}
+
+/// The plausible range of `eta_m` from the balance: outside it the rig
+/// file's no-load and viscous friction leave the load-proportional share a
+/// value no pump has (negative on logs whose load hardly varies).
+pub const ETA_M_PLAUSIBLE: std::ops::Range<f64> = 0.01..2.0;
+
+/// The electrical balance's `eta_m` before the plausibility check
+/// ([`eta_m_balance`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum EtaMBalance {
+    /// No row with current, speed and both port pressures under load.
+    NoLoadedRows,
+    /// The least-squares `eta_m` (dimensionless, eq. 8) over `rows` loaded rows.
+    Fitted {
+        /// The fitted coefficient.
+        eta_m: f64,
+        /// Loaded rows used.
+        rows: usize,
+    },
+}
+
+impl EtaMBalance {
+    /// `(eta_m, rows)` when fitted within [`ETA_M_PLAUSIBLE`].
+    pub fn plausible(self) -> Option<(f64, usize)> {
+        match self {
+            Self::Fitted { eta_m, rows } if ETA_M_PLAUSIBLE.contains(&eta_m) => Some((eta_m, rows)),
+            _ => None,
+        }
+    }
+
+    /// Why the balance's `eta_m` is not used, in one clause; `None` when it is.
+    pub fn refusal(self) -> Option<String> {
+        match self {
+            Self::NoLoadedRows => Some("no log has motor current under load (current, speed and both port pressures)".into()),
+            Self::Fitted { eta_m, rows } if !ETA_M_PLAUSIBLE.contains(&eta_m) => Some(format!(
+                "the electrical balance of {rows} loaded samples gives eta_m = {eta_m:.3}, outside the plausible {}..{} (the logs' load does not separate the pressure-proportional friction from the rig file's no-load and viscous terms)",
+                ETA_M_PLAUSIBLE.start, ETA_M_PLAUSIBLE.end
+            )),
+            Self::Fitted { .. } => None,
+        }
+    }
+}
+
+/// [`eta_m_balance`] within [`ETA_M_PLAUSIBLE`]: `(eta_m, rows)`; `None`
+/// without loaded rows or outside the range ([`EtaMBalance::refusal`] says
+/// which).
+pub fn eta_m_from_current(rig: &Rig, logs: &[CalLog]) -> Option<(f64, usize)> {
+    eta_m_balance(rig, logs).plausible()
 }

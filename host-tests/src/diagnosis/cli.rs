@@ -109,7 +109,7 @@ fn run_inner(args: &DiagnoseArgs) -> anyhow::Result<String> {
         Some((rows, m)) => (rows as &MeasuredRun, m as &dyn Simulator),
         None => {
             single = ReferenceModel::new(rig, &runs[0]).map_err(|e| anyhow::anyhow!("{}: {e}", files[0]))?.with_structure(&runs[0], o.structure);
-            structure_note = structure_not_applied(o.structure, single.eta_m_from_current().is_some());
+            structure_note = structure_not_applied(o.structure, single.structure_refusal());
             if let Some(n) = &structure_note {
                 eprintln!("note: {}: {n}", files[0]);
             }
@@ -175,17 +175,16 @@ fn append_to_report(out: &std::path::Path, text: &str) -> std::io::Result<()> {
 }
 
 /// The note a single-log diagnosis prints (and appends to report.md) when
-/// the structure asked for could not be applied: without motor current
-/// under load the pump's `eta_m` cannot come from the electrical balance
-/// and the physical tier stays the rig file's, as under `--structure off`
-/// ([`ReferenceModel::with_structure`]). `None` when applied or not asked.
-pub fn structure_not_applied(asked: crate::diagnosis::analysis::Structure, applied: bool) -> Option<String> {
+/// the structure asked for could not be applied: the pump's `eta_m` did
+/// not come from the electrical balance (`refusal`, from
+/// [`ReferenceModel::structure_refusal`]: no loaded current, or an
+/// implausible value) and the physical tier stays the rig file's, as under
+/// `--structure off`. `None` when applied or not asked.
+pub fn structure_not_applied(asked: crate::diagnosis::analysis::Structure, refusal: Option<&str>) -> Option<String> {
     use crate::diagnosis::analysis::Structure;
-    if asked == Structure::Off || applied {
-        return None;
-    }
+    let why = refusal.filter(|_| asked != Structure::Off)?;
     let name = clap::ValueEnum::to_possible_value(&asked).map_or_else(|| format!("{asked:?}"), |v| v.get_name().to_string());
-    Some(format!("structure `{name}` not applied: the log has no motor current under load, so the pump's eta_m cannot come from the electrical balance; diagnosed as under `--structure off`"))
+    Some(format!("structure `{name}` not applied: {why}, so the pump's eta_m does not come from the electrical balance; diagnosed as under `--structure off`"))
 }
 
 /// The detectability of `run` against its structure floor around the
@@ -217,9 +216,9 @@ mod tests {
     /// when a structure was asked for and could not be applied.
     #[test]
     fn structure_note_only_when_asked_and_not_applied() {
-        assert_eq!(structure_not_applied(Structure::Off, false), None);
-        assert_eq!(structure_not_applied(Structure::NoCaseHeld, true), None);
-        let n = structure_not_applied(Structure::NoCaseHeld, false).expect("note");
-        assert!(n.contains("`no-case-held` not applied") && n.contains("--structure off"), "{n}");
+        assert_eq!(structure_not_applied(Structure::Off, Some("why")), None);
+        assert_eq!(structure_not_applied(Structure::NoCaseHeld, None), None);
+        let n = structure_not_applied(Structure::NoCaseHeld, Some("no log has motor current under load")).expect("note");
+        assert!(n.contains("`no-case-held` not applied: no log has motor current") && n.contains("--structure off"), "{n}");
     }
 }

@@ -60,6 +60,9 @@ pub struct ReferenceModel {
     /// `eta_m` from the current and the loaded rows it rests on, when the
     /// physical tier takes it so ([`Self::with_structure`]).
     eta_m_from_current: Option<(f64, usize)>,
+    /// Why the structure asked for was not applied (`eta_m` not from the
+    /// current); `None` when applied or not asked.
+    structure_refusal: Option<String>,
     /// Indices into [`crate::calibration::PARAMS`] of the physical set for
     /// this run ([`nuisance_set`]).
     free: Vec<usize>,
@@ -88,7 +91,7 @@ impl ReferenceModel {
         let dt = (span / 400.0).clamp(0.5, 5.0);
         let opts = SimOptions { output_interval_s: dt, control_interval_s: dt };
         let free = nuisance_set(run);
-        let m = ReferenceModel { phys_rig: rig.clone(), rig, eta_m_from_current: None, free, priors: Vec::new(), physical: false, scenario: Scenario::Replay(inputs), times: run.time_s.clone(), opts };
+        let m = ReferenceModel { phys_rig: rig.clone(), rig, eta_m_from_current: None, structure_refusal: None, free, priors: Vec::new(), physical: false, scenario: Scenario::Replay(inputs), times: run.time_s.clone(), opts };
         let n: Vec<f64> = m.nuisance().iter().map(|p| p.start).collect();
         m.simulate(&n, Candidate::None, &[]).map_err(ReferenceError::Model)?;
         Ok(m)
@@ -111,15 +114,26 @@ impl ReferenceModel {
     /// ([`calibration::commission::eta_m_from_current`], the one
     /// implementation), `pump_friction` held there, and the structural
     /// freedoms of `variant` freed ([`structural_set`]).
-    /// Without current under load, or with [`Structure::Off`], the model is
-    /// unchanged. The global tier is never changed.
+    /// Without current under load, with an implausible `eta_m` from it
+    /// ([`Self::structure_refusal`] says which), or with [`Structure::Off`],
+    /// the model is unchanged. The global tier is never changed.
     pub fn with_structure(mut self, run: &MeasuredRun, variant: impl Into<Structure>) -> Self {
         let variant = variant.into();
         if variant == Structure::Off {
             return self;
         }
-        let Ok(log) = calibration::CalLog::new("log", run.clone(), 1) else { return self };
-        let Some((eta, rows)) = calibration::commission::eta_m_from_current(&self.rig, &[log]) else { return self };
+        let log = match calibration::CalLog::new("log", run.clone(), 1) {
+            Ok(l) => l,
+            Err(e) => {
+                self.structure_refusal = Some(format!("the log cannot be read for the electrical balance: {e}"));
+                return self;
+            }
+        };
+        let balance = calibration::commission::eta_m_balance(&self.rig, &[log]);
+        let Some((eta, rows)) = balance.plausible() else {
+            self.structure_refusal = balance.refusal();
+            return self;
+        };
         self.phys_rig.pump.eta_m = eta;
         self.eta_m_from_current = Some((eta, rows));
         self.free = structural_set(run, &self.free, variant);
@@ -149,6 +163,14 @@ impl ReferenceModel {
     /// takes it so ([`Self::with_structure`]); `None` otherwise.
     pub fn eta_m_from_current(&self) -> Option<(f64, usize)> {
         self.eta_m_from_current
+    }
+
+    /// Why [`Self::with_structure`] left the model unchanged although a
+    /// structure was asked for (no loaded current, or an `eta_m` from it
+    /// outside [`calibration::commission::ETA_M_PLAUSIBLE`]); `None` when it
+    /// was applied or not asked.
+    pub fn structure_refusal(&self) -> Option<&str> {
+        self.structure_refusal.as_deref()
     }
 
     /// Solver-step budget of one replay of this log ([`REPLAY_STEPS_PER_S`]).
@@ -318,6 +340,7 @@ impl Simulator for ReferenceModel {
                 rig: self.rig.clone(),
                 phys_rig: self.phys_rig.clone(),
                 eta_m_from_current: self.eta_m_from_current,
+                structure_refusal: self.structure_refusal.clone(),
                 free: self.free.clone(),
                 priors: self.priors.clone(),
                 physical: true,

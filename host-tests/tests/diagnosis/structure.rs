@@ -8,7 +8,7 @@
 //! docs/diagnosis-limits.md, "The structure option and why `no-case-held`
 //! is the default".
 
-use eha_sim::calibration::commission::eta_m_from_current;
+use eha_sim::calibration::commission::{eta_m_balance, eta_m_from_current, EtaMBalance};
 use eha_sim::calibration::set::{FRICTION_CASE, PROBE_SURFACE, STRUCTURAL};
 use eha_sim::diagnosis::analysis::Structure;
 use eha_sim::calibration::CalLog;
@@ -30,8 +30,8 @@ fn names(s: &dyn Simulator) -> Vec<String> {
 /// A loaded throttle log (1714): `eta_m` is the commissioning's value to
 /// the last bit (one implementation), the set loses `pump_friction` and
 /// gains the six structural parameters (four housing probes logged); off,
-/// the set is the log's own. A speed-step log at low load (1716): no
-/// loaded current rows, nothing changes.
+/// the set is the log's own. A speed-step log at one low load (1716): the
+/// balance's eta_m is implausible, nothing changes and the model says why.
 #[test]
 fn structure_takes_eta_from_the_current_and_frees_the_structural_set() {
     let run = log(ConstantThrottle, 1714);
@@ -50,9 +50,19 @@ fn structure_takes_eta_from_the_current_and_frees_the_structural_set() {
     assert_eq!(names(&*off.physical_set().expect("physical")), base);
     assert!(base.iter().any(|n| n == "pump_friction"));
 
+    // Speed steps at one low load (1716): 596 loaded rows, but the balance
+    // gives eta_m -0.079 (measured), outside the plausible range, so the
+    // structure is not applied and the refusal says why.
     let quiet = log(SpeedSteps, 1716);
+    let balance = eta_m_balance(&rig, &[CalLog::new("log", quiet.clone(), 1).expect("log")]);
+    match balance {
+        EtaMBalance::Fitted { eta_m, rows } => assert!(rows > 500 && eta_m < 0.0, "{balance:?}"),
+        EtaMBalance::NoLoadedRows => panic!("1716 has loaded rows"),
+    }
     let m = ReferenceModel::new(rig, &quiet).expect("model").with_structure(&quiet, true);
-    assert_eq!(m.eta_m_from_current(), None, "speed steps at low load: no loaded rows");
+    assert_eq!(m.eta_m_from_current(), None, "implausible eta_m: not applied");
+    assert!(m.structure_refusal().is_some_and(|r| r.contains("outside the plausible")), "{:?}", m.structure_refusal());
+    assert_eq!(on.structure_refusal(), None);
     let b: Vec<String> = nuisance_set(&quiet).into_iter().map(|k| eha_sim::calibration::PARAMS[k].name.to_string()).collect();
     assert_eq!(names(&*m.physical_set().expect("physical")), b);
 }
