@@ -222,3 +222,24 @@ pub fn commissioning_set_hot(machine: &EmuMachine, seed: u64) -> Result<BenchSet
     s.train.push(bench_log(machine, EmuScenario::WarmThenHotSpeedSteps, 1800.0, seed + 4)?);
     Ok(s)
 }
+
+/// A two-log training set of `machine` from the given one-at-a-time
+/// scenarios (1800 s each, seeds `seed` and `seed + 1`, the seeds of
+/// [`commissioning_set`]'s two logs), held out on [`bench_set`]'s servo and
+/// throttle-mix logs. For comparing training procedures on the same
+/// held-out logs (docs/commissioning.md, "Training logs over the
+/// operating envelope").
+pub fn commissioning_set_of(machine: &EmuMachine, seed: u64, train: [EmuScenario; 2]) -> Result<BenchSet, String> {
+    Ok(BenchSet {
+        train: vec![bench_log(machine, train[0], 1800.0, seed)?, bench_log(machine, train[1], 1800.0, seed + 1)?],
+        holdout: holdout_logs(machine, seed)?,
+    })
+}
+
+/// The held-out servo (1200 s) and throttle-mix (1800 s) logs of
+/// [`bench_set`] drawn with `seed` (seeds `seed + 2`, `seed + 3`). With
+/// `seed + 10` in place of the set's seed: a second held-out draw, to check
+/// a training procedure chosen on the first.
+pub fn holdout_logs(machine: &EmuMachine, seed: u64) -> Result<Vec<BenchLog>, String> {
+    Ok(vec![bench_log(machine, EmuScenario::ServoHoldMove, 1200.0, seed + 2)?, bench_log(machine, EmuScenario::ThrottleMix, 1800.0, seed + 3)?])
+}
