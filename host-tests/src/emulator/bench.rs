@@ -203,6 +203,9 @@ pub fn bench_set(machine: &EmuMachine, seed: u64) -> Result<BenchSet, String> {
 /// ([`EmuScenario::SoakThenLowSpeedHolds`], which holds the pump below 100
 /// rpm so that the case film's speed law is fitted). Held out: the same
 /// servo and throttle-mix logs as [`bench_set`] (same seeds, unchanged).
+/// Two-log variants that reach the envelope's high-speed, high-load corner
+/// ([`commissioning_set_of`]) were measured and not adopted
+/// (docs/commissioning.md, "Training logs over the operating envelope").
 pub fn commissioning_set(machine: &EmuMachine, seed: u64) -> Result<BenchSet, String> {
     let b = bench_set(machine, seed)?;
     Ok(BenchSet {
