@@ -55,6 +55,23 @@ pub enum EmuScenario {
     /// time; the oil runs hot through the passages at the flows where the
     /// duct films turn turbulent (Re 3000–6000 on a 25–30 cm³/rev pump).
     WarmThenHotSpeedSteps,
+    /// A one-at-a-time throttle run over the operating envelope's speed
+    /// axis at both ends of its load axis: speed steps (400–1200 rpm every
+    /// 150–250 s) at a needle set for 20 bar for the first half, then the
+    /// same steps at a needle set for 50 bar. Only the speed moves within a
+    /// half; the four corners of 400–1200 rpm × 20–50 bar are visited.
+    SpeedStepsAtTwoNeedles,
+    /// A one-at-a-time throttle run along the envelope's low-load and
+    /// high-speed edges: speed steps (400–1200 rpm every 150–250 s) at a
+    /// needle set for 20 bar for the first half, then needle steps (10–60
+    /// bar every 150–250 s) at 1100 rpm ([`EmuScenario::SpeedThenNeedleSteps`]
+    /// with its needle steps moved from 700 rpm to the high speed).
+    SpeedThenHighSpeedNeedleSteps,
+    /// [`EmuScenario::SoakThenLowSpeedHolds`] with the soak at the
+    /// envelope's hot corner: 1000–1200 rpm with the needle set for 45–55
+    /// bar for half the run (the oil heats to the temperatures a long high
+    /// load gives), then the same low-speed holds alternating with idle.
+    HotSoakThenLowSpeedHolds,
 }
 
 impl EmuScenario {
@@ -174,10 +191,26 @@ pub fn draw(scenario: EmuScenario, duration_s: f64, rng: &mut impl Rng) -> EmuMi
             m.speed = vec![(0.0, rng.random_range(600.0..800.0)), (soak, 300.0)];
             m.dp_bar = vec![(0.0, rng.random_range(40.0..55.0)), (soak, 5.0)];
         }
-        EmuScenario::SoakThenLowSpeedHolds => {
+        EmuScenario::SpeedStepsAtTwoNeedles => {
+            let half = 0.5 * d;
+            m.speed = steps(rng, half, 150.0, 250.0, |r, _| r(400.0, 1200.0));
+            let high = steps(rng, d - half, 150.0, 250.0, |r, _| r(400.0, 1200.0));
+            m.speed.extend(high.into_iter().map(|(t, v)| (half + t, v)));
+            m.dp_bar = vec![(0.0, 20.0), (half, 50.0)];
+        }
+        EmuScenario::SpeedThenHighSpeedNeedleSteps => {
+            let half = 0.5 * d;
+            m.speed = steps(rng, half, 150.0, 250.0, |r, _| r(400.0, 1200.0));
+            m.dp_bar = vec![(0.0, 20.0)];
+            let needle = steps(rng, d - half, 150.0, 250.0, |r, _| r(10.0, 60.0));
+            m.speed.push((half, 1100.0));
+            m.dp_bar.extend(needle.into_iter().map(|(t, v)| (half + t, v)));
+        }
+        EmuScenario::SoakThenLowSpeedHolds | EmuScenario::HotSoakThenLowSpeedHolds => {
             let soak = 0.5 * d;
-            m.speed = vec![(0.0, rng.random_range(600.0..800.0))];
-            m.dp_bar = vec![(0.0, rng.random_range(40.0..55.0))];
+            let (w, dp) = if scenario == EmuScenario::HotSoakThenLowSpeedHolds { ((1000.0, 1200.0), (45.0, 55.0)) } else { ((600.0, 800.0), (40.0, 55.0)) };
+            m.speed = vec![(0.0, rng.random_range(w.0..w.1))];
+            m.dp_bar = vec![(0.0, rng.random_range(dp.0..dp.1))];
             let holds = steps(rng, d - soak, 150.0, 250.0, |_, _| 0.0);
             for (k, &(t, _)) in holds.iter().enumerate() {
                 let (w, dp) = if k % 2 == 0 { (rng.random_range(20.0..90.0), rng.random_range(30.0..50.0)) } else { (300.0, 5.0) };
@@ -258,5 +291,30 @@ mod tests {
         let shared = m.speed[1..].iter().filter(|s| m.dp_bar.iter().chain(&m.air).any(|o| o.0 == s.0)).count();
         assert_eq!(shared, 0, "a speed step coincides with another input's step");
         assert!(EmuScenario::IdentRun.logs_air() && !EmuScenario::IdentRun.is_servo());
+    }
+
+    /// The envelope variants of the procedure's first training log move one
+    /// input at a time (speed and needle share only the start and the
+    /// half-way switch) within their ranges; the hot soak keeps the
+    /// low-speed holds (which, as the procedure's, set speed and needle
+    /// together at each hold).
+    #[test]
+    fn envelope_training_runs_move_one_input_at_a_time() {
+        use rand::SeedableRng;
+        let d = 1800.0;
+        for sc in [EmuScenario::SpeedStepsAtTwoNeedles, EmuScenario::SpeedThenHighSpeedNeedleSteps, EmuScenario::HotSoakThenLowSpeedHolds] {
+            let m = draw(sc, d, &mut rand_chacha::ChaCha8Rng::seed_from_u64(3600));
+            let shared = m.speed.iter().filter(|s| m.dp_bar.iter().any(|p| p.0 == s.0)).filter(|s| s.0 != 0.0 && s.0 != 0.5 * d).count();
+            let one_at_a_time = sc == EmuScenario::HotSoakThenLowSpeedHolds || shared == 0;
+            assert!(one_at_a_time, "{sc:?}: {shared} steps move speed and needle together");
+            assert!(m.speed.iter().all(|s| (0.0..=1200.0).contains(&s.1)) && m.dp_bar.iter().all(|p| (5.0..=60.0).contains(&p.1)), "{sc:?}");
+        }
+        let m = draw(EmuScenario::SpeedStepsAtTwoNeedles, d, &mut rand_chacha::ChaCha8Rng::seed_from_u64(1));
+        assert_eq!(m.dp_bar, vec![(0.0, 20.0), (900.0, 50.0)]);
+        let m = draw(EmuScenario::SpeedThenHighSpeedNeedleSteps, d, &mut rand_chacha::ChaCha8Rng::seed_from_u64(1));
+        assert!(m.speed.iter().filter(|s| s.0 >= 900.0).all(|s| s.1 == 1100.0));
+        let m = draw(EmuScenario::HotSoakThenLowSpeedHolds, d, &mut rand_chacha::ChaCha8Rng::seed_from_u64(1));
+        assert!((1000.0..1200.0).contains(&m.speed[0].1) && (45.0..55.0).contains(&m.dp_bar[0].1));
+        assert!(m.speed.iter().any(|s| s.1 < 100.0), "no low-speed hold");
     }
 }

@@ -426,5 +426,6 @@ fn exp_priors() -> Vec<(&'static str, f64)> {
 }
 
 mod basins;
+mod envelope;
 mod hot_flow;
 mod reproducible;
