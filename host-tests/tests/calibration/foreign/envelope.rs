@@ -1,4 +1,4 @@
-//! Training logs over the operating envelope (issue 36): the procedure's
+//! Training logs over the operating envelope: the procedure's
 //! two one-at-a-time logs against variants that reach the envelope's
 //! high-load, high-speed corner, scored on the held-out logs of the bench
 //! set and on a second held-out draw (seed + 10) that no choice saw
