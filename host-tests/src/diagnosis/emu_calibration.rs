@@ -273,7 +273,7 @@ mod tests {
     /// P 0 without a leak and gets a share with one.
     #[test]
     fn powered_scales_the_evidence_and_the_gate_holds_without_leak() {
-        let p = |c: &str, b: f64, pr: f64| ProbabilityJson { cause: c.into(), probability: 0.0, log_bayes_factor: b, prior: pr };
+        let p = |c: &str, b: f64, pr: f64| ProbabilityJson { cause: c.into(), probability: 0.0, log_bayes_factor: b, prior: pr, heldout_touched: None, heldout_untouched: None, identifiable: None };
         let probs = [p("none", 0.0, 0.25), p("unexplained", -20.0, 0.25), p("sensor-lag", 20.0, 1.0 / 12.0), p("churning-loss", 30.0, 0.0)];
         let q = powered(&probs, 1.0, 0.0);
         assert!(q[2].probability > 0.999 && q[3].probability < 1e-200, "{q:?}");
