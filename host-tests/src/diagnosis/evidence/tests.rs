@@ -82,6 +82,11 @@ const CHANNELS: [(Channel, f64); 5] =
 /// `sensor-lag` fit removes; `block_extra_k` adds a smooth misfit to
 /// t_block_c that nothing explains. Returns the posterior.
 fn toy(imprint_k: f64, block_extra_k: f64, seed: u64) -> Posterior {
+    toy_split(imprint_k, block_extra_k, seed, f64::INFINITY)
+}
+
+/// [`toy`] with the points from `split` (s) on held out.
+fn toy_split(imprint_k: f64, block_extra_k: f64, seed: u64, split: f64) -> Posterior {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
     let rows: Vec<f64> = (0..141).map(|i| 6.0 * i as f64).collect();
     let mut run = MeasuredRun::new(rows.clone());
@@ -133,7 +138,7 @@ fn toy(imprint_k: f64, block_extra_k: f64, seed: u64) -> Posterior {
         &chan,
         &|_| true,
         &|_| true,
-        f64::INFINITY,
+        split,
         DISCREPANCY_TAU_S,
     )
 }
@@ -201,6 +206,33 @@ fn the_posterior_from_stored_terms_is_the_diagnosis_own() {
             let d = q.iter().find(|x| x.cause == c.cause).unwrap();
             assert!((d.log_bayes_factor - c.log_bayes_factor).abs() < 0.1 + 1e-3 * c.log_bayes_factor.abs(), "{imprint}/{block} {}: {} against {}", c.cause, d.log_bayes_factor, c.log_bayes_factor);
             assert!((d.probability - c.probability).abs() < 0.01, "{imprint}/{block} {}: {} against {}", c.cause, d.probability, c.probability);
+        }
+    }
+}
+
+/// The re-statement of a stored posterior under the held-out likelihood
+/// ([`crate::diagnosis::emu_calibration::restate_heldout`], from the
+/// numbers diagnosis.json carries) is [`DecisionRule::HeldOut`] decided
+/// from the terms, to rounding (1e-9): on the toy with the last 240 s
+/// held out. And the lag, which removes the oil imprint, predicts the
+/// held-out oil better than `none` (its held-out part on the touched
+/// channel > 0) with a 1 K imprint.
+#[test]
+fn the_heldout_restatement_is_the_heldout_rule() {
+    use crate::diagnosis::report::ProbabilityJson;
+    for (imprint, block) in [(1.0, 0.0), (0.2, 3.0), (0.0, 0.0)] {
+        let p = toy_split(imprint, block, 5, 600.0);
+        let stored: Vec<ProbabilityJson> = p.causes.iter().map(ProbabilityJson::from).collect();
+        let again = crate::diagnosis::emu_calibration::restate_heldout(&stored).unwrap();
+        let rule = posterior_from_terms(&p.terms, DecisionRule::HeldOut);
+        for c in &rule {
+            let d = again.iter().find(|x| x.cause == c.cause).unwrap();
+            assert!((d.log_bayes_factor - c.log_bayes_factor).abs() < 1e-9 * c.log_bayes_factor.abs().max(1.0), "{}: {} against {}", c.cause, d.log_bayes_factor, c.log_bayes_factor);
+            assert!((d.probability - c.probability).abs() < 1e-9, "{}: {} against {}", c.cause, d.probability, c.probability);
+        }
+        if imprint == 1.0 {
+            let lag = p.causes.iter().find(|c| c.cause == "sensor-lag").unwrap();
+            assert!(lag.heldout_touched > 0.0, "held-out on t_oil_c {}", lag.heldout_touched);
         }
     }
 }
