@@ -87,7 +87,7 @@ pub enum Variant {
     /// ([`restate_heldout`]); only on records that carry the held-out parts.
     HeldOut,
     /// [`Variant::HeldOut`] with every ln Bayes factor times a power η
-    /// fitted on the first set of the document ([`fit_power`]).
+    /// fitted on the first set of the document (`fit_power`).
     HeldOutTempered,
 }
 
@@ -170,7 +170,7 @@ pub fn restate_heldout(probs: &[ProbabilityJson]) -> Option<Vec<ProbabilityJson>
     Some(restated(probs, &prior, &|p| p.log_bayes_factor - if names_a_cause(&p.cause) { p.heldout_untouched.unwrap_or(0.0) } else { 0.0 }))
 }
 
-/// Powers η tried by [`fit_power`]: 0.05 to 1 in steps of 0.05.
+/// Powers η tried by `fit_power`: 0.05 to 1 in steps of 0.05.
 pub fn power_grid() -> Vec<f64> {
     (1..=20).map(|k| 0.05 * k as f64).collect()
 }
