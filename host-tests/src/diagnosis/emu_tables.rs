@@ -284,7 +284,7 @@ mod tests {
     use super::*;
 
     fn p(c: &str, x: f64) -> ProbabilityJson {
-        ProbabilityJson { cause: c.into(), probability: x, log_bayes_factor: 0.0, prior: 0.25 }
+        ProbabilityJson { cause: c.into(), probability: x, log_bayes_factor: 0.0, prior: 0.25, heldout_touched: None, heldout_untouched: None, identifiable: None }
     }
 
     /// A named cause is one statement; otherwise the two most probable,

@@ -27,11 +27,31 @@ pub struct ProbabilityJson {
     pub log_bayes_factor: f64,
     /// Prior probability (0: the log cannot identify the candidate).
     pub prior: f64,
+    /// Held-out predictive log density on the channels the structure
+    /// touches against `none`'s, nats (part of the Bayes factor); `None`
+    /// in records written before it was kept.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub heldout_touched: Option<f64>,
+    /// The same on the channels it does not touch.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub heldout_untouched: Option<f64>,
+    /// Whether the log can tell the structure apart (its identifiability
+    /// rule); `None` in records written before it was kept.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub identifiable: Option<bool>,
 }
 
 impl From<&super::evidence::CauseProbability> for ProbabilityJson {
     fn from(c: &super::evidence::CauseProbability) -> Self {
-        ProbabilityJson { cause: c.cause.clone(), probability: c.probability, log_bayes_factor: c.log_bayes_factor, prior: c.prior }
+        ProbabilityJson {
+            cause: c.cause.clone(),
+            probability: c.probability,
+            log_bayes_factor: c.log_bayes_factor,
+            prior: c.prior,
+            heldout_touched: Some(c.heldout_touched),
+            heldout_untouched: Some(c.heldout_untouched),
+            identifiable: Some(c.identifiable),
+        }
     }
 }
 

@@ -271,6 +271,8 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
         &|c| sim.extension_params(c),
         &chan,
         &|c| ranking.iter().any(|r| r.qualifies && r.cause == c.name()),
+        &|c| ranking.iter().any(|r| r.note.is_empty() && r.cause == c.name()),
+        split,
         DISCREPANCY_TAU_S,
     );
     log.mark("evidence", 0);

@@ -23,6 +23,14 @@ pub enum DecisionRule {
     /// [`LEAK`] of its prior; `none` and `unexplained` share the no-cause
     /// mass by the pooled rule's Bayes factor ([`tempered_causes`]).
     Tempered,
+    /// The pooled rule without the held-out admission gate: every
+    /// identifiable candidate keeps its prior, and its held-out performance
+    /// enters only as a likelihood — the predictive log density of the
+    /// held-out points of the channels it touches, at their floor
+    /// amplitudes, against `none`'s there; the held-out points of the
+    /// channels it does not touch are left out of its Bayes factor
+    /// ([`heldout_causes`]; measured, not adopted: see [`DECISION_RULE`]).
+    HeldOut,
 }
 
 /// The rule the diagnosis decides with. [`DecisionRule::PerChannel`]
@@ -41,11 +49,65 @@ pub fn posterior_from_terms(terms: &[StructureTerms], rule: DecisionRule) -> Vec
     if terms.is_empty() {
         return Vec::new();
     }
-    match rule {
+    let mut out = match rule {
         DecisionRule::Pooled => finish(gated_causes(terms, false)),
         DecisionRule::PerChannel => finish(gated_causes(terms, true)),
         DecisionRule::Tempered => finish(tempered_causes(terms)),
+        DecisionRule::HeldOut => finish(heldout_causes(terms)),
+    };
+    annotate(&mut out, terms);
+    out
+}
+
+/// (held-out density on the touched channels, on the untouched ones) of
+/// structure `t` against the baseline `base`, nats, at `t`'s amplitudes
+/// ([`CauseProbability::heldout_touched`]); (0, 0) when the terms carry no
+/// held-out part (sweeps stored before it was kept).
+pub fn heldout_parts(base: &StructureTerms, t: &StructureTerms) -> (f64, f64) {
+    let touched = touched_names(&t.cause);
+    let (mut on, mut off) = (0.0, 0.0);
+    for c in &t.channels {
+        let Some(b) = base.channels.iter().find(|b| b.channel == c.channel) else { continue };
+        if c.heldout_log_lik.len() != c.log_lik.len() || b.heldout_log_lik.len() != b.log_lik.len() {
+            continue;
+        }
+        let d = grid_at(&c.heldout_log_lik, c.amp_k) - grid_at(&b.heldout_log_lik, c.amp_k);
+        if touched.contains(&c.channel.as_str()) {
+            on += d;
+        } else {
+            off += d;
+        }
     }
+    (on, off)
+}
+
+/// Fills every cause's held-out parts and identifiability from `terms`.
+fn annotate(causes: &mut [CauseProbability], terms: &[StructureTerms]) {
+    let Some(base) = terms.first() else { return };
+    for c in causes.iter_mut() {
+        if let Some(t) = terms[1..].iter().find(|t| t.cause == c.cause) {
+            (c.heldout_touched, c.heldout_untouched) = heldout_parts(base, t);
+            c.identifiable = t.identifiable;
+        } else {
+            c.identifiable = true;
+        }
+    }
+}
+
+/// (cause, prior, ln Bayes factor against `none`) under
+/// [`DecisionRule::HeldOut`]: the pooled rule's Bayes factor less the
+/// held-out part on the channels a candidate does not touch, and the prior
+/// of every identifiable candidate (no admission gate).
+pub fn heldout_causes(terms: &[StructureTerms]) -> Vec<(String, f64, f64)> {
+    let Some(base) = terms.first() else { return Vec::new() };
+    let cand_prior = (1.0 - 2.0 * PRIOR_NO_CAUSE) / Candidate::EXTENSIONS.len() as f64;
+    gated_causes(terms, false)
+        .into_iter()
+        .map(|(cause, prior, b)| match terms[1..].iter().find(|t| t.cause == cause) {
+            Some(t) => (cause, if t.identifiable { cand_prior } else { 0.0 }, b - heldout_parts(base, t).1),
+            None => (cause, prior, b),
+        })
+        .collect()
 }
 
 /// The names of the channels candidate `cause`'s physics touches
@@ -106,7 +168,15 @@ fn finish(causes: Vec<(String, f64, f64)>) -> Vec<CauseProbability> {
     let mut out: Vec<CauseProbability> = causes
         .into_iter()
         .zip(p)
-        .map(|((cause, prior, log_bayes_factor), probability)| CauseProbability { cause, prior, log_bayes_factor, probability })
+        .map(|((cause, prior, log_bayes_factor), probability)| CauseProbability {
+            cause,
+            prior,
+            log_bayes_factor,
+            probability,
+            heldout_touched: 0.0,
+            heldout_untouched: 0.0,
+            identifiable: true,
+        })
         .collect();
     out.sort_by(|a, b| b.probability.total_cmp(&a.probability));
     out

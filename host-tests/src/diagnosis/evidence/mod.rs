@@ -200,6 +200,20 @@ pub struct CauseProbability {
     pub log_bayes_factor: f64,
     /// Posterior probability.
     pub probability: f64,
+    /// Held-out predictive log density of this structure's residual on the
+    /// channels its physics touches, minus `none`'s on the same channels,
+    /// at the touched channels' floor amplitudes, nats
+    /// ([`Whitener::predictive_log_density`]; 0 for `none` and
+    /// `unexplained`). Part of [`Self::log_bayes_factor`].
+    pub heldout_touched: f64,
+    /// The same on the channels it does not touch, at their own misfit
+    /// amplitudes: what its joint nuisance refit predicts better or worse
+    /// there. Part of [`Self::log_bayes_factor`].
+    pub heldout_untouched: f64,
+    /// Whether the log can tell this structure apart from the nuisance
+    /// physics ([`crate::diagnosis::identify`]; true for `none` and
+    /// `unexplained`).
+    pub identifiable: bool,
 }
 
 /// One channel's numbers behind the probabilities.
@@ -266,6 +280,12 @@ pub struct ChannelTerms {
     /// Log-likelihood of the residual (training and held-out evidence
     /// points) at each grid amplitude.
     pub log_lik: Vec<f64>,
+    /// The held-out part of [`Self::log_lik`]: the predictive log density of
+    /// the held-out points given the training points at each grid amplitude
+    /// ([`Whitener::predictive_log_density`]); empty in sweeps stored
+    /// before it was kept.
+    #[serde(default)]
+    pub heldout_log_lik: Vec<f64>,
     /// The calibrated baseline's own RMS misfit of this channel on the
     /// training points (at least the noise), K.
     #[serde(default)]
@@ -298,6 +318,15 @@ pub struct StructureTerms {
     pub base_occam_own: f64,
     /// Per channel.
     pub channels: Vec<ChannelTerms>,
+    /// Whether the log can tell the structure apart from the nuisance
+    /// physics (its identifiability rule; true for the baseline).
+    #[serde(default = "yes")]
+    pub identifiable: bool,
+}
+
+/// `true` (serde's default of [`StructureTerms::identifiable`]).
+fn yes() -> bool {
+    true
 }
 
 /// One channel's whitening filters on the amplitude grid
@@ -309,10 +338,13 @@ struct GridWhiteners {
     range: std::ops::Range<usize>,
     noise_k: f64,
     filters: Vec<Whitener>,
+    /// Training points of the channel (they come first in its range).
+    n_train: usize,
 }
 
-/// [`GridWhiteners`] of every channel of `pts`.
-fn grid_whiteners(run: &MeasuredRun, pts: &[Point], noise: &dyn Fn(Channel) -> f64, tau_s: f64) -> Vec<GridWhiteners> {
+/// [`GridWhiteners`] of every channel of `pts`; `split` the time from
+/// which a point is held out.
+fn grid_whiteners(run: &MeasuredRun, pts: &[Point], noise: &dyn Fn(Channel) -> f64, tau_s: f64, split: f64) -> Vec<GridWhiteners> {
     let grid = amplitude_grid();
     channel_runs(pts)
         .into_iter()
@@ -320,7 +352,8 @@ fn grid_whiteners(run: &MeasuredRun, pts: &[Point], noise: &dyn Fn(Channel) -> f
             let times: Vec<f64> = pts[range.clone()].iter().map(|(_, i)| run.time_s[*i]).collect();
             let noise_k = noise(ch);
             let filters = grid.iter().map(|a| Whitener::new(&times, *a, noise_k, tau_s)).collect();
-            GridWhiteners { channel: ch, range, noise_k, filters }
+            let n_train = times.iter().filter(|t| **t < split).count();
+            GridWhiteners { channel: ch, range, noise_k, filters, n_train }
         })
         .collect()
 }
@@ -340,7 +373,7 @@ fn channel_terms(
     grid.iter()
         .map(|g| {
             let y = &r[g.range.clone()];
-            let (log_lik, rho) = g
+            let (log_lik, rho): (Vec<f64>, Vec<f64>) = g
                 .filters
                 .iter()
                 .map(|w| {
@@ -348,7 +381,8 @@ fn channel_terms(
                     (w.log_lik_of_whitened(&v), lag1(&v))
                 })
                 .unzip();
-            ChannelTerms { channel: g.channel.name().into(), noise_k: g.noise_k, amp_k: amp(g.channel), own_k: own(g.channel), log_lik, rho }
+            let heldout_log_lik = g.filters.iter().map(|w| w.predictive_log_density(y, g.n_train)).collect();
+            ChannelTerms { channel: g.channel.name().into(), noise_k: g.noise_k, amp_k: amp(g.channel), own_k: own(g.channel), log_lik, heldout_log_lik, rho }
         })
         .collect()
 }
@@ -369,8 +403,10 @@ impl Posterior {
 /// against the calibrated baseline `base`, on the training points `pts`.
 /// `chan` gives each channel's (noise σ, rise) in K; `admitted` says
 /// whether a candidate is admitted (else its prior is 0): in the diagnosis,
-/// whether the log can tell it apart and its fit passes the held-out checks.
-/// `nuisance` and `ext` are the parameter specs of the model.
+/// whether the log can tell it apart and its fit passes the held-out checks;
+/// `identifiable` whether the log can tell it apart. Points of `all_pts`
+/// from `split` (s) on are held out. `nuisance` and `ext` are the
+/// parameter specs of the model.
 #[allow(clippy::too_many_arguments)]
 pub fn posterior_of(
     run: &MeasuredRun,
@@ -382,6 +418,8 @@ pub fn posterior_of(
     ext: &dyn Fn(Candidate) -> Vec<ParamSpec>,
     chan: &[(Channel, f64, f64)],
     admitted: &dyn Fn(Candidate) -> bool,
+    identifiable: &dyn Fn(Candidate) -> bool,
+    split: f64,
     tau_s: f64,
 ) -> Posterior {
     let r = super::fit::residuals_at(run, &base.series, pts).unwrap_or_default();
@@ -425,7 +463,7 @@ pub fn posterior_of(
     let occam = |o: Option<f64>| o.unwrap_or(f64::NEG_INFINITY);
     // The baseline's at the own-misfit amplitudes: the same for every candidate.
     let base_occam_own = occam(log_occam(run, pts, all_pts, base, nuisance, &own, &noise, tau_s));
-    let grid = grid_whiteners(run, all_pts, &noise, tau_s);
+    let grid = grid_whiteners(run, all_pts, &noise, tau_s, split);
     let mut terms = vec![StructureTerms {
         cause: "none".into(),
         prior: PRIOR_NO_CAUSE,
@@ -434,6 +472,7 @@ pub fn posterior_of(
         occam_own: 0.0,
         base_occam_own: 0.0,
         channels: channel_terms(run, all_pts, base, &own_floor, &own, &grid),
+        identifiable: true,
     }];
     for f in fits {
         let touched: Vec<String> = touched_channels(f.candidate).iter().map(|c| c.name().to_string()).collect();
@@ -448,6 +487,7 @@ pub fn posterior_of(
             occam_own: occam(log_occam(run, pts, all_pts, f, &specs, &own, &noise, tau_s)),
             base_occam_own,
             channels: channel_terms(run, all_pts, f, &amp, &own, &grid),
+            identifiable: identifiable(f.candidate),
         });
     }
     let causes = posterior_from_terms(&terms, DECISION_RULE);

@@ -55,6 +55,19 @@ impl Whitener {
             - self.sd.iter().map(|s| s.ln()).sum::<f64>()
             - 0.5 * w.len() as f64 * (2.0 * std::f64::consts::PI).ln()
     }
+
+    /// Predictive log density of the samples `from..` of `y` given the
+    /// samples before them, ln p(y[from..] | y[..from]), nats: the sum of
+    /// the Kalman filter's one-step predictive log densities over the later
+    /// samples (the filter carries the discrepancy's state across the split;
+    /// equal to ln p(y) − ln p(y[..from]) of the dense Gaussian).
+    pub fn predictive_log_density(&self, y: &[f64], from: usize) -> f64 {
+        let w = self.whiten(y);
+        let from = from.min(w.len());
+        -0.5 * w[from..].iter().map(|x| x * x).sum::<f64>()
+            - self.sd[from..w.len()].iter().map(|s| s.ln()).sum::<f64>()
+            - 0.5 * (w.len() - from) as f64 * (2.0 * std::f64::consts::PI).ln()
+    }
 }
 /// Lag-1 autocorrelation of `w` (0 for fewer than three values).
 pub fn lag1(w: &[f64]) -> f64 {
