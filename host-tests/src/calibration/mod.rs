@@ -20,6 +20,7 @@ pub mod check;
 pub mod cli;
 pub mod commission;
 pub mod direct;
+pub mod eta_m;
 pub mod fit;
 pub mod ident;
 pub mod log;
