@@ -11,3 +11,4 @@ mod like_ref;
 mod mix_audit;
 mod mix_structure;
 mod recovery;
+mod reduce_servo;
