@@ -1,5 +1,5 @@
 //! By hand: where the six-state reduction departs from the commissioned
-//! reference on the emulator machines' logs (issue 36, item 2). Two
+//! reference on the emulator machines' logs. Two
 //! commands, not tests of the fast tier: the first commissions each machine
 //! without the margin and writes the commissioned rig to
 //! `$REDUCE_DIR/<machine>.toml` (default `/tmp/reduce16`); the second
