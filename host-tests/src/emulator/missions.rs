@@ -178,12 +178,14 @@ pub fn draw(scenario: EmuScenario, duration_s: f64, rng: &mut impl Rng) -> EmuMi
             m.dp_bar = steps(rng, d, 60.0, 240.0, |r, _| r(10.0, 100.0));
             m.air = steps(rng, d, 60.0, 240.0, |r, _| if r(0.0, 1.0) < 0.35 { 0.0 } else { r(5.0, 25.0) });
         }
-        EmuScenario::SpeedThenNeedleSteps => {
+        EmuScenario::SpeedThenNeedleSteps | EmuScenario::SpeedThenHighSpeedNeedleSteps => {
+            // the needle steps at 700 rpm up to 50 bar, or at 1100 rpm up to 60 bar
+            let (needle_rpm, dp_max) = if scenario == EmuScenario::SpeedThenHighSpeedNeedleSteps { (1100.0, 60.0) } else { (700.0, 50.0) };
             let half = 0.5 * d;
             m.speed = steps(rng, half, 150.0, 250.0, |r, _| r(400.0, 1200.0));
             m.dp_bar = vec![(0.0, 20.0)];
-            let needle = steps(rng, d - half, 150.0, 250.0, |r, _| r(10.0, 50.0));
-            m.speed.push((half, 700.0));
+            let needle = steps(rng, d - half, 150.0, 250.0, |r, _| r(10.0, dp_max));
+            m.speed.push((half, needle_rpm));
             m.dp_bar.extend(needle.into_iter().map(|(t, v)| (half + t, v)));
         }
         EmuScenario::SoakThenIdle => {
@@ -197,14 +199,6 @@ pub fn draw(scenario: EmuScenario, duration_s: f64, rng: &mut impl Rng) -> EmuMi
             let high = steps(rng, d - half, 150.0, 250.0, |r, _| r(400.0, 1200.0));
             m.speed.extend(high.into_iter().map(|(t, v)| (half + t, v)));
             m.dp_bar = vec![(0.0, 20.0), (half, 50.0)];
-        }
-        EmuScenario::SpeedThenHighSpeedNeedleSteps => {
-            let half = 0.5 * d;
-            m.speed = steps(rng, half, 150.0, 250.0, |r, _| r(400.0, 1200.0));
-            m.dp_bar = vec![(0.0, 20.0)];
-            let needle = steps(rng, d - half, 150.0, 250.0, |r, _| r(10.0, 60.0));
-            m.speed.push((half, 1100.0));
-            m.dp_bar.extend(needle.into_iter().map(|(t, v)| (half + t, v)));
         }
         EmuScenario::SoakThenLowSpeedHolds | EmuScenario::HotSoakThenLowSpeedHolds => {
             let soak = 0.5 * d;

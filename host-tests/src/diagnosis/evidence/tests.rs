@@ -1,6 +1,7 @@
 //! Tests of the evidence: the filter against the dense likelihood, the
 //! floors, the decision rules.
 
+use nalgebra::DMatrix;
 use super::*;
 use crate::diagnosis::model::SimSeries;
 use rand::{Rng, SeedableRng};
