@@ -266,7 +266,7 @@ fn report(args: &CommissionArgs, c: &Commissioning) -> String {
             let _ = writeln!(s, "Pump friction `eta_m` (eq. 8) = {eta:.4} from the electrical balance of {n} loaded samples (shaft power from the current minus the hydraulic power), held in the thermal fit: the firmware's sensor cross-check then agrees with this machine.\n");
         }
         None => {
-            let why = c.eta_m_refusal.as_deref().unwrap_or("not taken from the current");
+            let why = c.eta_m_balance.refusal().unwrap_or_else(|| "not taken from the current".into());
             let _ = writeln!(s, "**Pump friction `eta_m` from the temperatures only** ({why}): the firmware's sensor cross-check may disagree with this machine and latch SENSOR_DISAGREE (fail-safe). Log `current_a` under a load that varies (e.g. the needle steps at speed).\n");
         }
     }

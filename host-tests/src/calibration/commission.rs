@@ -56,9 +56,9 @@ pub struct Commissioning {
     /// `eta_m` from the training logs' current and the rows used
     /// ([`eta_m_from_current`]); `None`: fitted from the temperatures.
     pub eta_m_from_current: Option<(f64, usize)>,
-    /// Why `eta_m` was not taken from the current ([`EtaMBalance::refusal`]);
-    /// `None` when it was.
-    pub eta_m_refusal: Option<String>,
+    /// The training logs' electrical balance behind `eta_m_from_current`
+    /// ([`EtaMBalance::refusal`] says why it was not used).
+    pub eta_m_balance: EtaMBalance,
     /// The drain margin from validation on a split of the training
     /// missions, when every training log carries `t_drain_c`.
     pub margin: Option<MarginValidation>,
@@ -198,18 +198,20 @@ fn cycles_valve(log: &CalLog) -> bool {
     open && closed
 }
 
-/// What [`fit`] gives: the rig it started from, the calibration, and η_m
+/// What [`fit`] gives: the rig it started from, the calibration, η_m
 /// identified from the current with the number of samples it rests on
-/// (`None`: from the temperatures).
-type Fitted = (Rig, Calibration, Option<(f64, usize)>);
+/// (`None`: from the temperatures), and the electrical balance it came
+/// from (which says why when it was not used).
+type Fitted = (Rig, Calibration, Option<(f64, usize)>, EtaMBalance);
 
 /// The calibration of `base` on `train` with `eta_m` from the current when
 /// the logs carry it: the rig it started from, the calibration and that
 /// `eta_m`.
 fn fit(base: &Rig, train: &[CalLog], o: &CalOptions) -> Result<Fitted, CommissionError> {
-    let (base_e, o, eta_e) = with_eta_m_from_current(base, train, o);
+    let balance = eta_m_balance(base, train);
+    let (base_e, o, eta_e) = with_eta_m(base, balance, o);
     let cal = calibrate(&base_e, train, &o)?;
-    Ok((base_e, cal, eta_e))
+    Ok((base_e, cal, eta_e, balance))
 }
 
 /// The rig and options the commissioning calibrates with: the pump's
@@ -220,6 +222,11 @@ fn fit(base: &Rig, train: &[CalLog], o: &CalOptions) -> Result<Fitted, Commissio
 /// the temperatures with the rest of the set). Returns η_m and its sample
 /// count when taken from the current.
 pub fn with_eta_m_from_current(base: &Rig, train: &[CalLog], o: &CalOptions) -> (Rig, CalOptions, Option<(f64, usize)>) {
+    with_eta_m(base, eta_m_balance(base, train), o)
+}
+
+/// [`with_eta_m_from_current`] from the logs' electrical `balance`.
+fn with_eta_m(base: &Rig, balance: EtaMBalance, o: &CalOptions) -> (Rig, CalOptions, Option<(f64, usize)>) {
     let mut base_e = base.clone();
     let mut o = o.clone();
     // On the calibration's lattice (`residuals::THETA_LATTICE_LN`): η_m
@@ -227,7 +234,7 @@ pub fn with_eta_m_from_current(base: &Rig, train: &[CalLog], o: &CalOptions) -> 
     // temperature, so a last-digit change of the logs changed the rig every
     // model run starts from in its last digits, and the adaptive replays
     // took other step sequences from the first run on.
-    let eta_e = eta_m_from_current(base, train).map(|(eta, n)| (super::residuals::on_lattice_value(eta, o.lattice_ln), n));
+    let eta_e = balance.plausible().map(|(eta, n)| (super::residuals::on_lattice_value(eta, o.lattice_ln), n));
     if let Some((eta, n)) = eta_e {
         base_e.pump.eta_m = eta;
         o.hold.push(("pump_friction", format!("eta_m = {eta:.4} from the current of {n} loaded samples (electrical balance)")));
@@ -257,7 +264,7 @@ pub fn split_fit(base: &Rig, train: &[CalLog], o: &CalOptions, start: Option<&[f
     }
     let heads: Vec<CalLog> = train.iter().map(|l| head_of(l, SPLIT_FRACTION, o.points_per_channel)).collect::<Result<_, _>>().map_err(CommissionError::Run)?;
     let o = CalOptions { start: start.map(<[f64]>::to_vec), ..o.clone() };
-    let (_, cal, _) = fit(base, &heads, &o)?;
+    let (_, cal, _, _) = fit(base, &heads, &o)?;
     Ok(reduce(&cal.rig).map(|reduction| Split { heads, rig: cal.rig, reduction }))
 }
 
@@ -277,8 +284,7 @@ pub fn commission(base: &Rig, train: &[CalLog], holdout: &[CalLog], o: &CalOptio
 /// [`commission`]; `with_margin` false skips the margin validation (one
 /// calibration instead of two).
 pub fn commission_with(base: &Rig, train: &[CalLog], holdout: &[CalLog], o: &CalOptions, with_margin: bool) -> Result<Commissioning, CommissionError> {
-    let eta_m_refusal = eta_m_balance(base, train).refusal();
-    let (base_e, mut cal, eta_e) = fit(base, train, o)?;
+    let (base_e, mut cal, eta_e, eta_m_balance) = fit(base, train, o)?;
     let base = &base_e;
     if !train.iter().any(cycles_valve) {
         cal.warnings.push(format!(
@@ -403,7 +409,7 @@ pub fn commission_with(base: &Rig, train: &[CalLog], holdout: &[CalLog], o: &Cal
         train_regions,
         excitation_ok,
         eta_m_from_current: eta_e,
-        eta_m_refusal,
+        eta_m_balance,
         margin,
         holdout_with_margin,
         reduction_path: reduction,

@@ -77,24 +77,27 @@ pub enum EtaMBalance {
 }
 
 impl EtaMBalance {
-    /// `(eta_m, rows)` when fitted within [`ETA_M_PLAUSIBLE`].
-    pub fn plausible(self) -> Option<(f64, usize)> {
+    /// `(eta_m, rows)` when fitted within [`ETA_M_PLAUSIBLE`]; else why it is
+    /// not used, in one clause.
+    pub fn checked(self) -> Result<(f64, usize), String> {
         match self {
-            Self::Fitted { eta_m, rows } if ETA_M_PLAUSIBLE.contains(&eta_m) => Some((eta_m, rows)),
-            _ => None,
-        }
-    }
-
-    /// Why the balance's `eta_m` is not used, in one clause; `None` when it is.
-    pub fn refusal(self) -> Option<String> {
-        match self {
-            Self::NoLoadedRows => Some("no log has motor current under load (current, speed and both port pressures)".into()),
-            Self::Fitted { eta_m, rows } if !ETA_M_PLAUSIBLE.contains(&eta_m) => Some(format!(
+            Self::Fitted { eta_m, rows } if ETA_M_PLAUSIBLE.contains(&eta_m) => Ok((eta_m, rows)),
+            Self::Fitted { eta_m, rows } => Err(format!(
                 "the electrical balance of {rows} loaded samples gives eta_m = {eta_m:.3}, outside the plausible {}..{} (the logs' load does not separate the pressure-proportional friction from the rig file's no-load and viscous terms)",
                 ETA_M_PLAUSIBLE.start, ETA_M_PLAUSIBLE.end
             )),
-            Self::Fitted { .. } => None,
+            Self::NoLoadedRows => Err("no log has motor current under load (current, speed and both port pressures)".into()),
         }
+    }
+
+    /// `(eta_m, rows)` when fitted within [`ETA_M_PLAUSIBLE`] ([`Self::checked`]).
+    pub fn plausible(self) -> Option<(f64, usize)> {
+        self.checked().ok()
+    }
+
+    /// Why the balance's `eta_m` is not used ([`Self::checked`]); `None` when it is.
+    pub fn refusal(self) -> Option<String> {
+        self.checked().err()
     }
 }
 

@@ -113,28 +113,25 @@ impl Variant {
 /// The posterior re-computed from `probs`' ln Bayes factors times `w`,
 /// with a candidate of prior 0 given `leak` of an admitted candidate's.
 pub fn powered(probs: &[ProbabilityJson], w: f64, leak: f64) -> Vec<ProbabilityJson> {
-    let cand_prior = (1.0 - 2.0 * super::evidence::PRIOR_NO_CAUSE) / Candidate::EXTENSIONS.len() as f64;
-    let prior = |p: &ProbabilityJson| if p.prior == 0.0 && names_a_cause(&p.cause) { leak * cand_prior } else { p.prior };
+    let prior = |p: &ProbabilityJson| if p.prior == 0.0 && names_a_cause(&p.cause) { leak * super::evidence::CANDIDATE_PRIOR } else { p.prior };
     let l: Vec<f64> = probs.iter().map(|p| w * p.log_bayes_factor + prior(p).max(1e-300).ln()).collect();
-    let m = l.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    let s: f64 = l.iter().map(|x| (x - m).exp()).sum();
-    probs.iter().zip(&l).map(|(p, x)| ProbabilityJson { probability: (x - m).exp() / s, prior: prior(p), ..p.clone() }).collect()
+    probs.iter().zip(normalised(&l)).map(|(p, probability)| ProbabilityJson { probability, prior: prior(p), ..p.clone() }).collect()
 }
 
-/// A candidate's prior when nothing gates it.
-fn candidate_prior() -> f64 {
-    (1.0 - 2.0 * super::evidence::PRIOR_NO_CAUSE) / Candidate::EXTENSIONS.len() as f64
+/// The probabilities of the log-weights `l` (ln prior + ln Bayes factor), normalised.
+fn normalised(l: &[f64]) -> Vec<f64> {
+    let m = l.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let s: f64 = l.iter().map(|x| (x - m).exp()).sum();
+    l.iter().map(|x| (x - m).exp() / s).collect()
 }
 
 /// `probs` re-stated with priors `prior` and ln Bayes factors `lbf`, normalised.
 fn restated(probs: &[ProbabilityJson], prior: &dyn Fn(&ProbabilityJson) -> f64, lbf: &dyn Fn(&ProbabilityJson) -> f64) -> Vec<ProbabilityJson> {
     let l: Vec<f64> = probs.iter().map(|p| lbf(p) + prior(p).max(1e-300).ln()).collect();
-    let m = l.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    let s: f64 = l.iter().map(|x| (x - m).exp()).sum();
     let mut out: Vec<ProbabilityJson> = probs
         .iter()
-        .zip(&l)
-        .map(|(p, x)| ProbabilityJson { probability: (x - m).exp() / s, prior: prior(p), log_bayes_factor: lbf(p), ..p.clone() })
+        .zip(normalised(&l))
+        .map(|(p, probability)| ProbabilityJson { probability, prior: prior(p), log_bayes_factor: lbf(p), ..p.clone() })
         .collect();
     out.sort_by(|a, b| b.probability.total_cmp(&a.probability));
     out
@@ -145,7 +142,7 @@ fn restated(probs: &[ProbabilityJson], prior: &dyn Fn(&ProbabilityJson) -> f64, 
 /// stored ln Bayes factors.
 pub fn restate_no_gate(probs: &[ProbabilityJson]) -> Vec<ProbabilityJson> {
     let prior = |p: &ProbabilityJson| match names_a_cause(&p.cause) {
-        true if p.identifiable != Some(false) => candidate_prior(),
+        true if p.identifiable != Some(false) => super::evidence::CANDIDATE_PRIOR,
         true => 0.0,
         false => p.prior,
     };
@@ -163,7 +160,7 @@ pub fn restate_heldout(probs: &[ProbabilityJson]) -> Option<Vec<ProbabilityJson>
         return None;
     }
     let prior = |p: &ProbabilityJson| match names_a_cause(&p.cause) {
-        true if p.identifiable == Some(true) => candidate_prior(),
+        true if p.identifiable == Some(true) => super::evidence::CANDIDATE_PRIOR,
         true => 0.0,
         false => p.prior,
     };

@@ -57,12 +57,9 @@ pub struct ReferenceModel {
     /// The physical tier's rig: `rig`, with the pump's `eta_m` from the
     /// motor current under [`Self::with_structure`].
     phys_rig: Rig,
-    /// `eta_m` from the current and the loaded rows it rests on, when the
-    /// physical tier takes it so ([`Self::with_structure`]).
-    eta_m_from_current: Option<(f64, usize)>,
-    /// Why the structure asked for was not applied (`eta_m` not from the
-    /// current); `None` when applied or not asked.
-    structure_refusal: Option<String>,
+    /// Whether the commissioning's structure was asked for and applied
+    /// ([`Self::with_structure`]).
+    structure: StructureState,
     /// Indices into [`crate::calibration::PARAMS`] of the physical set for
     /// this run ([`nuisance_set`]).
     free: Vec<usize>,
@@ -78,6 +75,18 @@ pub struct ReferenceModel {
     opts: SimOptions,
 }
 
+/// The commissioning's structure on a [`ReferenceModel`]'s physical tier.
+#[derive(Debug, Clone, PartialEq)]
+enum StructureState {
+    /// Not asked (`--structure off`): the rig file's physical tier.
+    NotAsked,
+    /// Applied: `eta_m` from the current over `rows` loaded rows.
+    Applied { eta_m: f64, rows: usize },
+    /// Asked and not applied, and why (no loaded current, an implausible
+    /// `eta_m`, an unreadable log): the rig file's physical tier.
+    Refused(String),
+}
+
 impl ReferenceModel {
     /// Builds the replay model of `run` on `rig`, checking that the baseline
     /// runs.
@@ -91,7 +100,7 @@ impl ReferenceModel {
         let dt = (span / 400.0).clamp(0.5, 5.0);
         let opts = SimOptions { output_interval_s: dt, control_interval_s: dt };
         let free = nuisance_set(run);
-        let m = ReferenceModel { phys_rig: rig.clone(), rig, eta_m_from_current: None, structure_refusal: None, free, priors: Vec::new(), physical: false, scenario: Scenario::Replay(inputs), times: run.time_s.clone(), opts };
+        let m = ReferenceModel { phys_rig: rig.clone(), rig, structure: StructureState::NotAsked, free, priors: Vec::new(), physical: false, scenario: Scenario::Replay(inputs), times: run.time_s.clone(), opts };
         let n: Vec<f64> = m.nuisance().iter().map(|p| p.start).collect();
         m.simulate(&n, Candidate::None, &[]).map_err(ReferenceError::Model)?;
         Ok(m)
@@ -122,21 +131,17 @@ impl ReferenceModel {
         if variant == Structure::Off {
             return self;
         }
-        let log = match calibration::CalLog::new("log", run.clone(), 1) {
-            Ok(l) => l,
-            Err(e) => {
-                self.structure_refusal = Some(format!("the log cannot be read for the electrical balance: {e}"));
-                return self;
+        let taken = calibration::CalLog::new("log", run.clone(), 1)
+            .map_err(|e| format!("the log cannot be read for the electrical balance: {e}"))
+            .and_then(|log| calibration::commission::eta_m_balance(&self.rig, &[log]).checked());
+        match taken {
+            Ok((eta_m, rows)) => {
+                self.phys_rig.pump.eta_m = eta_m;
+                self.structure = StructureState::Applied { eta_m, rows };
+                self.free = structural_set(run, &self.free, variant);
             }
-        };
-        let balance = calibration::commission::eta_m_balance(&self.rig, &[log]);
-        let Some((eta, rows)) = balance.plausible() else {
-            self.structure_refusal = balance.refusal();
-            return self;
-        };
-        self.phys_rig.pump.eta_m = eta;
-        self.eta_m_from_current = Some((eta, rows));
-        self.free = structural_set(run, &self.free, variant);
+            Err(why) => self.structure = StructureState::Refused(why),
+        }
         self
     }
 
@@ -162,7 +167,10 @@ impl ReferenceModel {
     /// `eta_m` from the current and its loaded rows when the physical tier
     /// takes it so ([`Self::with_structure`]); `None` otherwise.
     pub fn eta_m_from_current(&self) -> Option<(f64, usize)> {
-        self.eta_m_from_current
+        match self.structure {
+            StructureState::Applied { eta_m, rows } => Some((eta_m, rows)),
+            _ => None,
+        }
     }
 
     /// Why [`Self::with_structure`] left the model unchanged although a
@@ -170,7 +178,10 @@ impl ReferenceModel {
     /// outside [`calibration::commission::ETA_M_PLAUSIBLE`]); `None` when it
     /// was applied or not asked.
     pub fn structure_refusal(&self) -> Option<&str> {
-        self.structure_refusal.as_deref()
+        match &self.structure {
+            StructureState::Refused(why) => Some(why),
+            _ => None,
+        }
     }
 
     /// Solver-step budget of one replay of this log ([`REPLAY_STEPS_PER_S`]).
@@ -339,8 +350,7 @@ impl Simulator for ReferenceModel {
             Box::new(ReferenceModel {
                 rig: self.rig.clone(),
                 phys_rig: self.phys_rig.clone(),
-                eta_m_from_current: self.eta_m_from_current,
-                structure_refusal: self.structure_refusal.clone(),
+                structure: self.structure.clone(),
                 free: self.free.clone(),
                 priors: self.priors.clone(),
                 physical: true,

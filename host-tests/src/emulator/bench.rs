@@ -190,10 +190,7 @@ pub fn bench_set(machine: &EmuMachine, seed: u64) -> Result<BenchSet, String> {
             bench_log(machine, EmuScenario::SpeedThenNeedleSteps, 1800.0, seed)?,
             bench_log(machine, EmuScenario::SoakThenIdle, 1800.0, seed + 1)?,
         ],
-        holdout: vec![
-            bench_log(machine, EmuScenario::ServoHoldMove, 1200.0, seed + 2)?,
-            bench_log(machine, EmuScenario::ThrottleMix, 1800.0, seed + 3)?,
-        ],
+        holdout: holdout_logs(machine, seed)?,
     })
 }
 

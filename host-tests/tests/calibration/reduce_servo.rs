@@ -29,7 +29,7 @@ use eha_sim::plant::{Control, Plant, Sensors};
 use eha_sim::rig::Rig;
 use eha_sim::scenario::Scenario;
 use eha_sim::simulation::replay::replay_inputs;
-use eha_guard::model::{Model, ModelInputN};
+use eha_guard::model::{table, Model, ModelInputN};
 use std::io::Write;
 
 fn dir() -> std::path::PathBuf {
@@ -110,10 +110,9 @@ fn slow_reduce_servo_locate() {
                         // the firmware's table read as it reads it: at w nu(40)/nu(T), k(T) by the slope
                         let nu40 = rig.oil.nu_m2_per_s(40.0);
                         let x = w.abs() * nu40 / rig.oil.nu_m2_per_s(tc);
-                        let uu = (x / p.speed_table_max_rad_s).sqrt() * (eha_guard::model::N_TABLE - 1) as f64;
-                        let j = (uu.floor() as usize).min(eha_guard::model::N_TABLE - 2);
-                        let fr = uu - j as f64;
-                        let g_tab = p.g_case_w_per_k[j] + (p.g_case_w_per_k[j + 1] - p.g_case_w_per_k[j]) * fr;
+                        let n = eha_guard::model::N_TABLE;
+                        let at = table::locate_ext(x, (n - 1) as f64 / p.speed_table_max_rad_s.sqrt(), (n - 2) as f64);
+                        let g_tab = table::value(&p.g_case_w_per_k, &at);
                         let g_fw = g_tab * (1.0 + p.case_film_slope_per_k * (tc - 40.0));
                         let ls = model.last_losses_kw();
                         writeln!(

@@ -100,11 +100,10 @@ fn annotate(causes: &mut [CauseProbability], terms: &[StructureTerms]) {
 /// of every identifiable candidate (no admission gate).
 pub fn heldout_causes(terms: &[StructureTerms]) -> Vec<(String, f64, f64)> {
     let Some(base) = terms.first() else { return Vec::new() };
-    let cand_prior = (1.0 - 2.0 * PRIOR_NO_CAUSE) / Candidate::EXTENSIONS.len() as f64;
     gated_causes(terms, false)
         .into_iter()
         .map(|(cause, prior, b)| match terms[1..].iter().find(|t| t.cause == cause) {
-            Some(t) => (cause, if t.identifiable { cand_prior } else { 0.0 }, b - heldout_parts(base, t).1),
+            Some(t) => (cause, if t.identifiable { CANDIDATE_PRIOR } else { 0.0 }, b - heldout_parts(base, t).1),
             None => (cause, prior, b),
         })
         .collect()
@@ -231,7 +230,6 @@ pub fn tempered_causes(terms: &[StructureTerms]) -> Vec<(String, f64, f64)> {
     // ln of `none`'s share of the no-cause block: −ln(1 + e^(ηu)).
     let ln_pn = -log_sum_exp(0.0, LEARNING_RATE * u);
     let mut causes = Vec::new();
-    let cand_prior = (1.0 - 2.0 * PRIOR_NO_CAUSE) / Candidate::EXTENSIONS.len() as f64;
     for t in &terms[1..] {
         let touched = touched_names(&t.cause);
         let l: f64 = t
@@ -250,7 +248,7 @@ pub fn tempered_causes(terms: &[StructureTerms]) -> Vec<(String, f64, f64)> {
         // amplitudes (at the structure's own where a stored sweep lacks them).
         let occam = if t.occam_own != 0.0 || t.base_occam_own != 0.0 { t.occam_own - t.base_occam_own } else { t.occam - t.base_occam };
         let b = LEARNING_RATE * (l + occam);
-        let prior = if t.prior > 0.0 { t.prior } else { LEAK * cand_prior };
+        let prior = if t.prior > 0.0 { t.prior } else { LEAK * CANDIDATE_PRIOR };
         // Against `none`, whose evidence is 2·pn of the no-cause block's.
         let b = b - 2f64.ln() - ln_pn;
         causes.push((t.cause.clone(), prior, if b.is_nan() { f64::NEG_INFINITY } else { b }));

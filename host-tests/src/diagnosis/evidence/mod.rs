@@ -73,6 +73,10 @@ pub const NAME_PROBABILITY: f64 = 0.9;
 /// posterior is normalised over what is admitted).
 pub const PRIOR_NO_CAUSE: f64 = 0.25;
 
+/// Prior probability of an admitted candidate: a sixth of what `none` and
+/// `unexplained` leave.
+pub const CANDIDATE_PRIOR: f64 = (1.0 - 2.0 * PRIOR_NO_CAUSE) / Candidate::EXTENSIONS.len() as f64;
+
 /// One structure's posterior.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct CauseProbability {
@@ -257,15 +261,14 @@ fn channel_terms(
     grid.iter()
         .map(|g| {
             let y = &r[g.range.clone()];
-            let (log_lik, rho): (Vec<f64>, Vec<f64>) = g
-                .filters
-                .iter()
-                .map(|w| {
-                    let v = w.whiten(y);
-                    (w.log_lik_of_whitened(&v), lag1(&v))
-                })
-                .unzip();
-            let heldout_log_lik = g.filters.iter().map(|w| w.predictive_log_density(y, g.n_train)).collect();
+            // One whitening per amplitude: the likelihood, its held-out part, ρ.
+            let (mut log_lik, mut heldout_log_lik, mut rho) = (Vec::new(), Vec::new(), Vec::new());
+            for w in &g.filters {
+                let v = w.whiten(y);
+                log_lik.push(w.log_lik_of_whitened(&v));
+                heldout_log_lik.push(w.predictive_of_whitened(&v, g.n_train));
+                rho.push(lag1(&v));
+            }
             ChannelTerms { channel: g.channel.name().into(), noise_k: g.noise_k, amp_k: amp(g.channel), own_k: own(g.channel), log_lik, heldout_log_lik, rho }
         })
         .collect()
@@ -365,7 +368,7 @@ pub fn posterior_of(
         specs.extend(ext(f.candidate));
         terms.push(StructureTerms {
             cause: f.candidate.name().into(),
-            prior: if admitted(f.candidate) { (1.0 - 2.0 * PRIOR_NO_CAUSE) / Candidate::EXTENSIONS.len() as f64 } else { 0.0 },
+            prior: if admitted(f.candidate) { CANDIDATE_PRIOR } else { 0.0 },
             occam: occam(log_occam(run, pts, all_pts, f, &specs, &amp, &noise, tau_s)),
             base_occam: occam(log_occam(run, pts, all_pts, base, nuisance, &amp, &noise, tau_s)),
             occam_own: occam(log_occam(run, pts, all_pts, f, &specs, &own, &noise, tau_s)),

@@ -51,9 +51,7 @@ impl Whitener {
 
     /// Gaussian log-likelihood from the whitened innovations `w` of [`Self::whiten`].
     pub fn log_lik_of_whitened(&self, w: &[f64]) -> f64 {
-        -0.5 * w.iter().map(|x| x * x).sum::<f64>()
-            - self.sd.iter().map(|s| s.ln()).sum::<f64>()
-            - 0.5 * w.len() as f64 * (2.0 * std::f64::consts::PI).ln()
+        self.predictive_of_whitened(w, 0)
     }
 
     /// Predictive log density of the samples `from..` of `y` given the
@@ -62,7 +60,12 @@ impl Whitener {
     /// samples (the filter carries the discrepancy's state across the split;
     /// equal to ln p(y) − ln p(y[..from]) of the dense Gaussian).
     pub fn predictive_log_density(&self, y: &[f64], from: usize) -> f64 {
-        let w = self.whiten(y);
+        self.predictive_of_whitened(&self.whiten(y), from)
+    }
+
+    /// [`Self::predictive_log_density`] from the whitened innovations `w`
+    /// of [`Self::whiten`] (`from` 0: the whole log-likelihood).
+    pub fn predictive_of_whitened(&self, w: &[f64], from: usize) -> f64 {
         let from = from.min(w.len());
         -0.5 * w[from..].iter().map(|x| x * x).sum::<f64>()
             - self.sd[from..w.len()].iter().map(|s| s.ln()).sum::<f64>()
