@@ -8,14 +8,17 @@
 //! - [`dense`]: fixed-size matrices (products, LU);
 //! - [`phi`]: e^{hA} and the φ-functions of exponential integrators;
 //! - [`rosenbrock`]: RODAS4 for small stiff systems;
+//! - [`options`]: [`FastOptions`] and [`FastStats`];
 //! - [`plant`]: [`FastPlant`], the run/callback contract of
 //!   [`crate::plant::Plant`] on the multirate scheme.
 
 pub mod dense;
 pub mod hydraulic;
+pub mod options;
 pub mod phi;
 pub mod plant;
 pub mod rosenbrock;
 pub mod thermal;
 
-pub use plant::{FastOptions, FastPlant, FastStats};
+pub use options::{FastOptions, FastStats, THERMOSTAT_TOL_K};
+pub use plant::FastPlant;
