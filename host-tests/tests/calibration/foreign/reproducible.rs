@@ -9,9 +9,9 @@ use super::*;
 /// thermocouple and the true drain, margin) move by at most 0.05 K (the
 /// issue's bound). Trained as the procedure prescribes
 /// (`commissioning_set`), the structural freedoms fitted. Measured with
-/// the defaults: below 1e-4 K on both machines (printed 0.0000 K; 52.5 +
-/// 53.3 s on big-pump, 33.9 + 34.1 s on leaky-heavy at load 2.5–5 on the
-/// 2 cores).
+/// the defaults, on the fixed reference (ref17): below 1e-4 K on both
+/// machines (printed 0.0000 K; 94.0 + 67.8 s on big-pump, 79.1 + 90.0 s
+/// on leaky-heavy at load 4–6.6 on the 2 cores, 260 s user for the four).
 /// Why it holds: the nudge changes no model output at the same multipliers
 /// (`slow_replay_noise_at_the_last_digit`); the calibration evaluates every
 /// multiplier vector on a lattice of 1e-4 in ln θ
