@@ -71,7 +71,8 @@ fn slow_commissioning_is_reproducible_beyond_the_last_digit_leaky_heavy() {
 
 /// The three-log set with the hot-flow run (`commissioning_set_hot`),
 /// every logged temperature moved by 1e-6 K: the headline numbers move by
-/// at most 0.05 K. Measured (2026-11-28): 0.028 K (margin 1.121 → 1.118 K,
+/// at most 0.05 K. Measured (2026-11-28, before the reference's fix
+/// ref17; not re-run since): 0.028 K (margin 1.121 → 1.118 K,
 /// the mix's under-prediction 0.391 → 0.419 K; 64 + 75 s wall at load
 /// ~1–3). Why it holds: the fit continues from
 /// the first two logs' fit (`fit::CONTINUATION_LOGS`); from the rig file
