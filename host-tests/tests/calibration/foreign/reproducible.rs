@@ -71,8 +71,9 @@ fn slow_commissioning_is_reproducible_beyond_the_last_digit_leaky_heavy() {
 
 /// The three-log set with the hot-flow run (`commissioning_set_hot`),
 /// every logged temperature moved by 1e-6 K: the headline numbers move by
-/// at most 0.05 K. Measured (2026-11-28, before the reference's fix
-/// ref17; not re-run since): 0.028 K (margin 1.121 → 1.118 K,
+/// at most 0.05 K. Measured on the fixed reference (ref17): 0.045 K
+/// (margin 1.132 → 1.160 K, the servo log's max |e| 1.651 → 1.609 K;
+/// 65.5 + 62.8 s wall at load ~4); before the fix 0.028 K (margin 1.121 → 1.118 K,
 /// the mix's under-prediction 0.391 → 0.419 K; 64 + 75 s wall at load
 /// ~1–3). Why it holds: the fit continues from
 /// the first two logs' fit (`fit::CONTINUATION_LOGS`); from the rig file
@@ -85,7 +86,9 @@ fn slow_hot_set_is_reproducible_beyond_the_last_digit_big_pump() {
 }
 
 /// [`slow_hot_set_is_reproducible_beyond_the_last_digit_big_pump`] on
-/// leaky-heavy: measured 0.027 K (margin 0.833 → 0.835 K, the mix's
+/// leaky-heavy: measured 0.031 K on the fixed reference (margin 0.822 →
+/// 0.823 K, the mix's under-prediction 1.104 → 1.073 K; 56.5 + 54.3 s
+/// wall); before it 0.027 K (margin 0.833 → 0.835 K, the mix's
 /// under-prediction 1.046 → 1.073 K; 121 + 103 s wall).
 #[test]
 #[ignore = "slow tier: two commissionings on three training logs with margin validation and the direct path (~4-7 min)"]
