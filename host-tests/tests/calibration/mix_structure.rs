@@ -19,22 +19,33 @@ use eha_sim::emulator::bench::machines;
 /// build gives the same numbers; another float rounding moves the fit's
 /// basin (the rows hold to ≤ 0.05 K under a 1e-6 K nudge of the logs,
 /// docs/commissioning.md "Reproducibility", but up to 0.59 K between
-/// optimiser paths of other builds). The conclusion rests on 0.44 K
-/// between the control and `duct,wall` with the mix trained, which four
-/// runs with both switches (0.81–0.84 K) against six without (1.15–1.32 K)
-/// confirm, on the held-out row not moving (1.32 → 1.39 K), and on
-/// another mix in the training set closing it with `duct,wall` only
-/// (control 1.37, `duct,wall` 0.78 K).
+/// optimiser paths of other builds). The conclusion rests on 0.46 K
+/// between the control and `duct,wall` with the mix trained (under-
+/// prediction 1.192 against 0.728 K), which four runs with both switches
+/// (0.81–0.84 K) against six without (1.15–1.32 K) confirmed before the
+/// reference's fix, on the held-out row not moving (1.447 K with
+/// `duct,wall`, the control's 1.32 K in the bisection), and on another
+/// mix in the training set closing it with `duct,wall` only (control
+/// 1.277, `duct,wall` 0.676 K). Measured on the fixed reference (ref17;
+/// 492 s wall, 314 s user at load 5–6); the rows before it (old → new):
+/// big-pump control trained [0.571, 1.271, 1.271] → [0.576, 1.347,
+/// 1.192], `duct,wall` trained [0.548, 0.833, 0.833] → [0.546, 0.728,
+/// 0.728], held out [0.549, 1.385, 1.385] → [0.547, 1.447, 1.447], the
+/// other mix [0.592, 1.369, 1.369] → [0.592, 1.412, 1.277] and
+/// [0.555, 0.784, 0.784] → [0.553, 0.676, 0.676]; leaky-heavy control
+/// [0.758, 0.682, 0.682] → [0.734, 0.492, 0.492], `duct,wall` [0.796,
+/// 0.777, 0.777] → [0.768, 1.241, 0.642] (its max |e| an over-prediction,
+/// 0.46 K outside the tolerance: re-asserted as measured).
 #[test]
 #[ignore = "slow: seven commissionings, 278 s on 2 shared cores"]
 fn slow_the_block_films_carry_part_of_the_control_miss() {
     // machine, switches, held-out mix trained, another mix (seed) trained, measured
     let rows: [(&str, &str, bool, Option<u64>, [f64; 3]); 7] = [
-        ("big-pump", "all", true, None, [0.571, 1.271, 1.271]),
-        ("big-pump", "all,duct,wall", true, None, [0.548, 0.833, 0.833]),
-        ("big-pump", "all,duct,wall", false, None, [0.549, 1.385, 1.385]),
-        ("big-pump", "all", false, Some(OTHER_MIX), [0.592, 1.369, 1.369]),
-        ("big-pump", "all,duct,wall", false, Some(OTHER_MIX), [0.555, 0.784, 0.784]),
+        ("big-pump", "all", true, None, [0.576, 1.347, 1.192]),
+        ("big-pump", "all,duct,wall", true, None, [0.546, 0.728, 0.728]),
+        ("big-pump", "all,duct,wall", false, None, [0.547, 1.447, 1.447]),
+        ("big-pump", "all", false, Some(OTHER_MIX), [0.592, 1.412, 1.277]),
+        ("big-pump", "all,duct,wall", false, Some(OTHER_MIX), [0.553, 0.676, 0.676]),
         ("leaky-heavy", "all", true, None, LH_CTRL),
         ("leaky-heavy", "all,duct,wall", true, None, LH_DUCT_WALL),
     ];
@@ -53,9 +64,9 @@ fn slow_the_block_films_carry_part_of_the_control_miss() {
 }
 
 /// Leaky-heavy, the control with the mix trained (measured, K).
-const LH_CTRL: [f64; 3] = [0.758, 0.682, 0.682];
+const LH_CTRL: [f64; 3] = [0.734, 0.492, 0.492];
 /// Leaky-heavy, the control and `duct,wall` with the mix trained (measured, K).
-const LH_DUCT_WALL: [f64; 3] = [0.796, 0.777, 0.777];
+const LH_DUCT_WALL: [f64; 3] = [0.768, 1.241, 0.642];
 
 /// Seed of the other throttle mix (its own draw of speeds and loads, not
 /// the held-out log's 3603) added to the training set.

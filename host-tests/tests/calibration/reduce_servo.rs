@@ -6,24 +6,27 @@
 //! replays every log of the set through that rig's reference and its
 //! reduction and writes a per-tick CSV `<machine>-<k>.csv` (every 10th
 //! tick: port pressures, speed, reference and firmware nodes, both case
-//! films, losses, port links) beside it. `EXP_CHECK_GAIN` (m³/s/Pa) and
+//! films, losses, port links) beside it, and `<machine>-<k>-log.csv` (the
+//! log's drain thermocouple and the emulator's true drain, per log row). `EXP_CHECK_GAIN` (m³/s/Pa) and
 //! `EXP_ACC_BAR` change the commissioned rig's check valves and
 //! accumulator before both run (experiments).
 //!
 //! Measured (docs/commissioning.md, "Where the reduction departs"): the
-//! departure builds in the servo log's pressure holds (4–18 rpm, |Δp|
-//! 49 bar), not in the case film (the table reads it 4–20 % high there,
-//! 0.1–0.3 W; the L2-filled table, `EXP_GCASE_L2`, did not help): three
-//! ring heat terms booked differently — the reference replay's check
-//! valves (5–25 W into the loop oil on every log, the logged low side at
-//! ~4 bar against the rig's 5 bar accumulator), the reference's servo ring
-//! at rest (reverse holds lose the leakage's pump work from the loop), the
-//! firmware's throttled flow residual (reverse holds 10–22 W).
+//! departure built in the servo log's pressure holds (4–18 rpm, |Δp|
+//! 49 bar), not in the case film, from three ring heat terms booked
+//! differently — the reference replay's check valves and the reference's
+//! servo ring at rest (both fixed in the reference, ref17), and the
+//! firmware's throttled flow residual (`src/model/sums.rs`, fw17). With
+//! the reference fixed, the departures (speed/needle steps, soak with
+//! holds, servo, mix) are big-pump 0.039 / 0.072 / 0.177 / 0.074 K,
+//! leaky-heavy 0.057 / 0.070 / 0.353 / 0.058 K (before: 0.138 / 0.281 /
+//! 0.444 / 0.183 and 0.196 / 0.288 / 1.180 / 0.224 K).
 
 use super::foreign::cal;
 use eha_sim::calibration::commission::commission_with;
 use eha_sim::calibration::{CalLog, CalOptions};
 use eha_sim::emulator::bench::{commissioning_set, machines};
+use eha_sim::measured::Channel;
 use eha_sim::network::{self, Node};
 use eha_sim::plant::{Control, Plant, Sensors};
 use eha_sim::rig::Rig;
@@ -133,6 +136,14 @@ fn slow_reduce_servo_locate() {
                 })
                 .expect("run");
             eprintln!("{} log {k} {}: reduced vs reference drain max {max_e:.3} K", m.name, log.name);
+            // the log's drain thermocouple and the emulator's true drain, per log row
+            let mut g = std::io::BufWriter::new(std::fs::File::create(dir().join(format!("{}-{k}-log.csv", m.name))).expect("csv"));
+            writeln!(g, "t,drain_tc,drain_true").unwrap();
+            let (tc, tt) = (l.run.get(Channel::TDrainC).expect("t_drain_c"), l.truth.get(Channel::TDrainC).expect("truth"));
+            for (i, t) in l.run.time_s.iter().enumerate() {
+                let f = |x: Option<f64>| x.map_or(String::new(), |x| format!("{x:.4}"));
+                writeln!(g, "{t:.2},{},{}", f(tc[i]), f(tt[i])).unwrap();
+            }
         }
     }
 }

@@ -53,11 +53,12 @@ fn slow_three_log_minima() {
         let v: Vec<String> = c.params.iter().filter(|p| p.status == eha_sim::calibration::Status::Fitted).map(|p| format!("{} {:.4}", p.name, p.value)).collect();
         eprintln!("  END {}", v.join(", "));
     }
-    // From [`BASINS`] the two polishes stay apart: measured data χ² 10 601
-    // and 19 497 (2026-11-28, 75 s at load ~2; the second with
+    // From [`BASINS`] the two polishes stay apart: measured data χ² 11 105
+    // and 20 029 on the fixed reference (ref17; 129 s at load 5–6; before
+    // it 10 601 and 19 497, 75 s at load ~2; the second with
     // `cap_case_oil` on its ×3 bound). One minimum would give a ratio near
     // 1; 1.5 asks for two basins with room for the polish's stall.
     if by_default {
-        assert!(chi2[1] > 1.5 * chi2[0], "the two basins' data chi2 {:.0} and {:.0}: not two basins apart (measured 10 601 and 19 497)", chi2[0], chi2[1]);
+        assert!(chi2[1] > 1.5 * chi2[0], "the two basins' data chi2 {:.0} and {:.0}: not two basins apart (measured 11 105 and 20 029)", chi2[0], chi2[1]);
     }
 }
