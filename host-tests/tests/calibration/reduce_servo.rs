@@ -18,7 +18,8 @@
 //! valves (5–25 W into the loop oil on every log, the logged low side at
 //! ~4 bar against the rig's 5 bar accumulator), the reference's servo ring
 //! at rest (reverse holds lose the leakage's pump work from the loop), the
-//! firmware's throttled flow residual (reverse holds 10–22 W).
+//! firmware's throttled flow residual (reverse holds 10–22 W; fixed in the
+//! firmware since: the delivery past the high-pressure port's leakage).
 
 use super::foreign::cal;
 use eha_sim::calibration::commission::commission_with;
