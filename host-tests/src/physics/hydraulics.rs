@@ -213,6 +213,30 @@ pub fn flows(rig: &Rig, op: &OpPoint, k_leak: f64) -> Flows {
     }
 }
 
+/// The check valves' flow limited to the loop's make-up need, for a replay.
+///
+/// A replay imposes the logged port pressures, so the check valves' orifice
+/// law against the rig file's accumulator pressure says nothing about the
+/// machine: a charge pressure 1 bar off the rig file's (a bench at 4 bar, the
+/// file at 5) would let ~0.1 L/s of make-up oil through that nothing needs
+/// and book 5–25 W of valve heat in the loop oil. What the log does fix is
+/// the need: the loop loses `leak_a + leak_b` to the case and the check
+/// valves can pass no more than that (a soft minimum, width 1e-9 m³/s, so the
+/// right-hand side stays smooth in the case oil's temperature). The two
+/// valves keep their shares of the orifice law's flow.
+pub fn limit_check_to_makeup(f: &mut Flows) {
+    let w = 1e-9;
+    let total = f.check_a + f.check_b;
+    if total <= 0.0 {
+        return;
+    }
+    let need = soft_pos(f.leak_a + f.leak_b, w);
+    let q = 0.5 * (total + need - ((total - need) * (total - need) + w * w).sqrt());
+    let scale = (q / total).clamp(0.0, 1.0);
+    f.check_a *= scale;
+    f.check_b *= scale;
+}
+
 /// Motor shaft torque: pump load D·Δp plus the friction torques of eq. (8),
 /// churning and bearings (opposing the motion), N·m.
 pub fn shaft_torque(rig: &Rig, op: &OpPoint, friction_w: f64) -> f64 {

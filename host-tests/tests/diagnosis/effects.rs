@@ -101,13 +101,19 @@ use SynthScenario::{
 // ---- fast tier: one case per candidate (throttle runs), and the none guards.
 
 /// Dead-end oil sensor: a lag of minutes on t_oil_c, visible in any run.
-/// Measured: named, 62 % on t_oil_c (held out 0.361 → 0.107 K). A lag on a
-/// monotonic warm-up looks like more oil capacity, so this case's gain has
-/// been near the bar and moved with the replay tolerances
-/// (docs/diagnosis-cost.md, "Replay tolerances and speed"): checked as a pass.
+/// Measured: named (ΔBIC 1 212), 31 % on t_oil_c (held out 0.175 → 0.121 K;
+/// pooled 0.261 → 0.107 K). Asserted as measured: named, the gain under the
+/// 50 % bar. It was 62 % (0.361 → 0.107 K pooled) while the replay booked the
+/// check valves' orifice flow against the logged, quantised low-side
+/// pressure; limited to the make-up flow (`hydraulics::limit_check_to_makeup`)
+/// the calibrated baseline fits this log better (0.361 → 0.261 K pooled) and
+/// the lag's imprint on it is smaller. A lag on a monotonic warm-up looks
+/// like more oil capacity, so this case's gain has been near the bar and
+/// moved with the replay tolerances (docs/diagnosis-cost.md, "Replay
+/// tolerances and speed").
 #[test]
 fn hidden_sensor_lag_is_named() {
-    check(&[case("sensor-lag", Case1Pressure, Nuisance, 31)]);
+    check_miss(&[(case("sensor-lag", Case1Pressure, Nuisance, 31), "sensor-lag", Some(0.5))]);
 }
 
 /// Copper resistance rising with temperature: extra heat ∝ I²·(T_w − 25 °C)

@@ -59,13 +59,15 @@ fn case1_within_a_hundredth_of_a_kelvin() {
     check(&rig, &sc, &SimOptions::default(), 3e-3);
 }
 
-/// Case 2 (servo, 0.2 Hz), 600 s, 1 s outputs. Measured 7.8e-3 K at 2e-4 K
-/// per thermal step (6.4e-3 K at 1e-4 K; the winding, whose copper loss
-/// the steps integrate over 120 cycles); the spec, 0.01 K, is the nearer
-/// bound.
+/// Case 2 (servo, 0.2 Hz), 600 s, 1 s outputs. Measured 9.57e-3 K on the
+/// winding, whose copper loss the steps integrate over 120 cycles (7.8e-3 K
+/// at 2e-4 K per thermal step, 6.4e-3 K at 1e-4 K, before the servo ring
+/// took the pump's delivery direction while the piston's flow is under the
+/// leakage: one more switch of the ring near each reversal for the steps to
+/// cross); the spec, 0.01 K, is the bound.
 #[test]
 fn case2_within_a_hundredth_of_a_kelvin() {
-    check(&Rig::default(), &Scenario::Case2 { duration_s: 600.0 }, &SimOptions { output_interval_s: 1.0, control_interval_s: 1.0 }, 9e-3);
+    check(&Rig::default(), &Scenario::Case2 { duration_s: 600.0 }, &SimOptions { output_interval_s: 1.0, control_interval_s: 1.0 }, SPEC_K);
 }
 
 /// Fig. 15 (Case 1 at 60 bar with the LNG thermostat on the loop oil),

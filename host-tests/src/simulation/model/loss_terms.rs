@@ -151,7 +151,10 @@ impl Model {
     pub(super) fn loss_parts(&self, t: f64, op: &OpPoint, temps: &[f64], friction: Option<losses::PumpFriction>) -> (Losses, FrictionHeat, hydraulics::Flows, Option<f64>) {
         let rig = &self.rig;
         let tc = |n: Node| temps[n as usize];
-        let f = hydraulics::flows(rig, op, self.k_leak(tc(Node::Case)));
+        let mut f = hydraulics::flows(rig, op, self.k_leak(tc(Node::Case)));
+        if let Drive::Replay(_) = self.drive {
+            hydraulics::limit_check_to_makeup(&mut f);
+        }
         let fr = friction.unwrap_or_else(|| self.pump_friction(op, tc(Node::Case)));
         let fh = self.friction_heat_of(&fr);
         let dp = op.p_a - op.p_b;

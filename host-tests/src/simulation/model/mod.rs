@@ -10,6 +10,8 @@
 //! `replay_drive.rs` (interpolation in measured inputs).
 
 mod hydraulic;
+#[cfg(test)]
+mod hold_tests;
 mod loss_terms;
 mod replay_drive;
 mod thermal;

@@ -110,8 +110,22 @@ impl Model {
         // compression αTΔp/(ρc_p)); in the servo circuit the actuator takes
         // m·Δp/ρ out of the oil it passes to the loop.
         let m_c = self.ring_mass_flow(qc.abs(), tc(Node::Loop));
-        let m_l = self.ring_mass_flow(hydraulics::soft_pos(f.leak_a, 1e-9) + hydraulics::soft_pos(f.leak_b, 1e-9), tc(Node::Loop));
-        let forward = qc >= 0.0;
+        let q_leak = hydraulics::soft_pos(f.leak_a, 1e-9) + hydraulics::soft_pos(f.leak_b, 1e-9);
+        let m_l = self.ring_mass_flow(q_leak, tc(Node::Loop));
+        // The ring's direction: the throttle path's flow; in the servo circuit
+        // the piston's flow while it exceeds the leakage, and below that (a
+        // hold: the piston still, the pump turning slowly to make up the
+        // loaded port's leakage) the pump's delivery (the sign of ω; at a
+        // standstill towards the high port): the leakage passes the pump in
+        // its delivery direction (taken from the piston alone, a reverse hold
+        // lost the pump's work on it). The switch at |A·ẋ| = the leakage flow
+        // keeps the jump in the ring's flows at the leakage's size.
+        let forward = match op.circuit {
+            Circuit::Throttle => qc >= 0.0,
+            Circuit::Servo if qc.abs() > q_leak => qc > 0.0,
+            Circuit::Servo if op.omega != 0.0 => op.omega > 0.0,
+            Circuit::Servo => op.p_a >= op.p_b,
+        };
         let ring: &[Node] = match (op.circuit, forward) {
             (Circuit::Throttle, true) => &[Node::Loop, Node::Inlet, Node::Outlet, Node::BallOil],
             (Circuit::Throttle, false) => &[Node::Loop, Node::BallOil, Node::Outlet, Node::Inlet],
