@@ -104,8 +104,14 @@ impl<N: Num> Sums<N> {
         s.leak_lps = s.leak_lps.add(dpa.add(dpa.abs()).add(dpb).add(dpb.abs()));
         // eq. (8): |dp| |w|
         s.mech_kw = s.mech_kw.add(dp.abs().mul(aw));
-        // pump delivery into A, piston flow, throttled remainder (eqs. 10-11)
-        let q_pump = k.k_q.mul(u.speed_hrads).sub(k_lf_t.mul(dpa));
+        // pump delivery A-ward past the leakage of the high-pressure port (A when
+        // dp >= 0, else B; the low port's leakage is made up by its check valve),
+        // piston flow, throttled remainder (eqs. 5-7, 10-11): the path flow of a
+        // throttle circuit, ~0 in a servo hold. (Port A's leakage taken in either
+        // direction left a reverse servo hold's pump flow as throttled flow: the
+        // leakage's heat booked twice, 10-22 W.)
+        let q_geo = k.k_q.mul(u.speed_hrads);
+        let q_pump = if dp < N::ZERO { q_geo.add(k_lf_t.mul(dpb)) } else { q_geo.sub(k_lf_t.mul(dpa)) };
         let q_act = k.k_a.mul(u.dpos_mm);
         let q_thr = q_pump.sub(q_act);
         let aq_thr = q_thr.abs();

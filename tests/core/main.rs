@@ -1,6 +1,7 @@
 //! Host tests of the firmware core (`eha-guard` built for the host): the
 //! reduced model's accuracy and discretisation, the protection layer's
-//! properties (proptest), and the over-temperature alarm and derate.
+//! properties (proptest), the over-temperature alarm and derate, and the
+//! pump's flow bookkeeping in a pressure hold.
 
 mod alarm;
 mod crosscheck;
@@ -13,6 +14,7 @@ mod protection_cases;
 mod protection_props;
 mod rate;
 mod records;
+mod servo_hold;
 mod stall;
 mod startup;
 mod untrusted;

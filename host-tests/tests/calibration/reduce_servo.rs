@@ -16,7 +16,7 @@
 //! 49 bar), not in the case film, from three ring heat terms booked
 //! differently — the reference replay's check valves and the reference's
 //! servo ring at rest (both fixed in the reference, ref17), and the
-//! firmware's throttled flow residual (`src/model/sums.rs`, fw17). With
+//! firmware's throttled flow residual (`src/model/sums.rs`, fixed since: the delivery past the high-pressure port's leakage). With
 //! the reference fixed, the departures (speed/needle steps, soak with
 //! holds, servo, mix) are big-pump 0.039 / 0.072 / 0.177 / 0.074 K,
 //! leaky-heavy 0.057 / 0.070 / 0.353 / 0.058 K (before: 0.138 / 0.281 /
