@@ -18,6 +18,14 @@
 //! `sensor-lag` ΔBIC 110 but does not qualify). docs/diagnosis-numbers.md,
 //! "Current numbers".
 //!
+//! Re-measured on the fixed reference (b36ffe3's replay; 2026-11-28,
+//! diag17) for 1710, 1712 and 2712 only, the three that were at r ≥ 2:
+//! 1710 `none` (t_pump_c 0.376 → 0.297 K held out, twin 0.13 K, r 2.28: a
+//! miss), 1712 `none` (0.268 → 0.246 K, twin 0.10 K, r 2.46: a miss),
+//! 2712 `unexplained` (1.793 → 1.796 K; its twin's floor rose 0.62 →
+//! 3.07 K, so r 0.59). The other 14 rows are the measurements before the
+//! fix, not re-run (docs/diagnosis-numbers.md, "On the fixed reference").
+//!
 //! Slow tier only: 17 diagnoses, 15–58 s each; 380 s on two shared cores
 //! (2026-11-28, passes).
 
@@ -34,8 +42,8 @@ const MEASURED: [(u64, &str, f64, f64); 17] = [
     (1707, "none", 0.194, 0.34),
     (1708, "churning-loss", 0.448, 0.26),
     (1709, "unexplained", 0.461, 0.47),
-    (1710, "none", 0.376, 0.13),
-    (1712, "none", 0.268, 0.11),
+    (1710, "none", 0.297, 0.13),
+    (1712, "none", 0.246, 0.10),
     (1713, "none", 0.228, 0.33),
     (2700, "unexplained", 0.341, 0.24),
     (2701, "unexplained", 0.508, 0.49),
@@ -43,7 +51,7 @@ const MEASURED: [(u64, &str, f64, f64); 17] = [
     (2707, "none", 0.247, 0.16),
     (2708, "unexplained", 2.900, 2.06),
     (2710, "unexplained", 0.971, 0.64),
-    (2712, "unexplained", 1.793, 0.62),
+    (2712, "unexplained", 1.796, 3.07),
     (2713, "none", 0.646, 0.55),
 ];
 
