@@ -23,9 +23,12 @@ use super::*;
 /// - leaky-heavy (`duct_turbulent` held by the excitation rule too: the
 ///   passage flow stays below Re 2000): the reduction refused (0.307 K on
 ///   the servo log; 0.871 K before), direct path, margin 0.822 K:
-///   1.360 / 0.354 and 2.042 / 1.104 K (two-log set: 1.750 / 0.000 and
+///   1.092 / 0.355 and 2.042 / 1.104 K since the firmware throttles
+///   nothing in a reverse servo hold (1.360 / 0.354 K on the servo log
+///   with the old bookkeeping; two-log set: 1.471 / 0.000 and
 ///   2.334 / 0.617 K, margin 1.191 K); valve 1548 → 1555 s, LNG 1.956 →
-///   1.968 kg.
+///   1.968 kg. Big-pump's row re-run with the firmware's fix passes
+///   within the 0.15 K (its servo row not printed again).
 /// - Before the fix: 1.121 K, 1.768 / 0.000, 2.703 / 0.391 K and
 ///   0.833 K, 1.278 / 0.340, 2.068 / 1.046 K.
 ///
@@ -41,7 +44,7 @@ use super::*;
 fn slow_commissioning_with_the_hot_flow_run() {
     let measured = [
         (1.132, PathKind::Direct, [(1.651, 0.000), (2.763, 0.391)], [1426.0, 1514.0]),
-        (0.822, PathKind::Direct, [(1.360, 0.354), (2.042, 1.104)], [1548.0, 1555.0]),
+        (0.822, PathKind::Direct, [(1.092, 0.355), (2.042, 1.104)], [1548.0, 1555.0]),
     ];
     for (m, row) in machines().into_iter().zip(measured) {
         commission_as_measured(&m, &commissioning_set_hot(&m, 3600).expect("bench"), row);
