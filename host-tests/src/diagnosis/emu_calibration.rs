@@ -418,8 +418,8 @@ mod tests {
     ///   top bin of 1800–1817 4 statements, 100 % observed; of 2800–2817
     ///   17, 65 % observed: not calibrated, and a false discovery: not
     ///   adopted.
-    /// - Since 2800–2817 was re-measured on the fixed reference (b36ffe3,
-    ///   diag17; the other two sets not yet): no gate 4 wrong causes and 5
+    /// - Since 2800–2817 was re-measured on the fixed reference (b36ffe3;
+    ///   the other two sets not yet): no gate 4 wrong causes and 5
     ///   false discoveries; the held-out likelihood 2 and 6, top bin 33
     ///   statements, 48 % observed; tempered on 2800–2817 top bin 14, 64 %.
     #[test]

@@ -154,7 +154,7 @@ fn emulator_machine_held_out_error_falls() {
 /// 0.839 / 2.441: the identification-run miss 0.27 K larger, within the
 /// 0.3-0.9 K path spread docs/commissioning.md measures); the test prints
 /// only the pooled held-out numbers, the training, oil and `block_wall`
-/// figures above were not measured again. On the fixed reference (ref17;
+/// figures above were not measured again. On the fixed reference (b36ffe3;
 /// 88.0 s wall, 56.6 s user at load 5–6): identification runs
 /// **0.498 / 0.502 K**, families 0.827 / 2.624 K.
 #[test]

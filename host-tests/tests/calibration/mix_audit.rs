@@ -308,7 +308,7 @@ pub(super) fn bisection_run(machine: &EmuMachine, switches: &[String], train_mix
 /// under-prediction; within the 0.3-0.9 K path spread, over this test's
 /// 0.25 K), big-pump as built's mix under-prediction 2.893 → 2.651 K and
 /// `split,nofric`'s 1.722 → 1.488 K, the rest ≤ 0.1 K. Re-measured on the
-/// fixed reference (ref17; 459.9 s wall, 307.4 s user at load 5–6): the
+/// fixed reference (b36ffe3; 459.9 s wall, 307.4 s user at load 5–6): the
 /// rows moved ≤ 0.21 K except leaky-heavy's control, whose mix went
 /// 0.799 → 0.519 K (outside 0.25 K), re-asserted as measured.
 #[test]
@@ -325,7 +325,7 @@ fn slow_structural_bisection_of_the_drain_misses() {
         // 1.345], [0.778, 0.793, 0.793]. Big-pump as built: mix under
         // 2.306 K before the θ lattice, 2.893 K on it, 2.651 K with the
         // defaults (other optimiser paths).
-        // Measured on the fixed reference (ref17); before it (calib11's
+        // Measured on the fixed reference (b36ffe3); before it (calib11's
         // defaults): as built [2.331, 3.680, 2.651], [3.079, 2.473, 2.473];
         // gapfilm [0.630, 1.991, 1.991], [1.772, 1.715, 1.715];
         // split,nofric [2.321, 4.039, 1.488], [3.150, 1.936, 1.936]; the

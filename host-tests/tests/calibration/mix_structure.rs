@@ -26,7 +26,7 @@ use eha_sim::emulator::bench::machines;
 /// reference's fix, on the held-out row not moving (1.447 K with
 /// `duct,wall`, the control's 1.32 K in the bisection), and on another
 /// mix in the training set closing it with `duct,wall` only (control
-/// 1.277, `duct,wall` 0.676 K). Measured on the fixed reference (ref17;
+/// 1.277, `duct,wall` 0.676 K). Measured on the fixed reference (b36ffe3;
 /// 492 s wall, 314 s user at load 5–6); the rows before it (old → new):
 /// big-pump control trained [0.571, 1.271, 1.271] → [0.576, 1.347,
 /// 1.192], `duct,wall` trained [0.548, 0.833, 0.833] → [0.546, 0.728,

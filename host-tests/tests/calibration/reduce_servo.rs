@@ -15,7 +15,7 @@
 //! departure built in the servo log's pressure holds (4–18 rpm, |Δp|
 //! 49 bar), not in the case film, from three ring heat terms booked
 //! differently — the reference replay's check valves and the reference's
-//! servo ring at rest (both fixed in the reference, ref17), and the
+//! servo ring at rest (both fixed in the reference, b36ffe3), and the
 //! firmware's throttled flow residual (`src/model/sums.rs`, fixed since: the delivery past the high-pressure port's leakage). With
 //! the reference fixed, the departures (speed/needle steps, soak with
 //! holds, servo, mix) are big-pump 0.039 / 0.072 / 0.177 / 0.074 K,

@@ -12,8 +12,8 @@
 //! the calibrated baseline's pooled held-out misfit are asserted as
 //! measured. docs/diagnosis-numbers.md, "Effect-free logs".
 //!
-//! Re-measured on the fixed reference (b36ffe3's replay; 2026-11-28,
-//! diag17), each as measured then: 1714–1717, 2714–2717 and the twins of
+//! Re-measured on the fixed reference (b36ffe3's replay; 2026-11-28
+//! evening), each as measured then: 1714–1717, 2714–2717 and the twins of
 //! 1710, 1712, 2712 (`twin_floor`), the twins of 1704, 1705, 1711, 2704,
 //! 2705, 2709, 2711 (their `emulator-sweep` runs with twins); still no
 //! cause named. 2712's twin moved `none` 0.497 K → `unexplained` 2.486 K,

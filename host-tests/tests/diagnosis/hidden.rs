@@ -18,8 +18,8 @@
 //! `sensor-lag` ΔBIC 110 but does not qualify). docs/diagnosis-numbers.md,
 //! "Current numbers".
 //!
-//! Re-measured on the fixed reference (b36ffe3's replay; 2026-11-28,
-//! diag17) for 1710, 1712 and 2712 only, the three that were at r ≥ 2:
+//! Re-measured on the fixed reference (b36ffe3's replay; 2026-11-28
+//! evening) for 1710, 1712 and 2712 only, the three that were at r ≥ 2:
 //! 1710 `none` (t_pump_c 0.376 → 0.297 K held out, twin 0.13 K, r 2.28: a
 //! miss), 1712 `none` (0.268 → 0.246 K, twin 0.10 K, r 2.46: a miss),
 //! 2712 `unexplained` (1.793 → 1.796 K; its twin's floor rose 0.62 →

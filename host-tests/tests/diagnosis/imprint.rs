@@ -185,7 +185,7 @@ fn slow_imprint_ratio_with_structure_no_case() {
 /// two shared cores (2026-11-28, passes); re-measured with the
 /// touched-channel rule by the sweep command above with 1705 and 1708
 /// added (2026-11-28, diag14: the same answers but 2705's). Re-measured on
-/// the fixed reference (b36ffe3's replay; 2026-11-28, diag17, the same
+/// the fixed reference (b36ffe3's replay; 2026-11-28, the same
 /// command, 331 s for the seven): the same answers; 1704 r 6.01 (t_oil_c
 /// 0.90 -> 0.33 K), 1705 r 3.29 (0.76 -> 0.37), 2704 r 3.95 (6.59 -> 1.45);
 /// 2705 `unexplained` at r 3.32 now (its twin's t_oil_c floor fell to

@@ -54,7 +54,7 @@ fn slow_three_log_minima() {
         eprintln!("  END {}", v.join(", "));
     }
     // From [`BASINS`] the two polishes stay apart: measured data χ² 11 105
-    // and 20 029 on the fixed reference (ref17; 129 s at load 5–6; before
+    // and 20 029 on the fixed reference (b36ffe3; 129 s at load 5–6; before
     // it 10 601 and 19 497, 75 s at load ~2; the second with
     // `cap_case_oil` on its ×3 bound). One minimum would give a ratio near
     // 1; 1.5 asks for two basins with room for the polish's stall.

@@ -11,7 +11,7 @@ use super::*;
 /// (the ducts' turbulent level held, `fit::DUCT_TURBULENT_HELD`; the fit
 /// continued from the first two logs' fit, `fit::CONTINUATION_LOGS`); the
 /// same held-out logs. Measured (max |e| / under vs the thermocouple,
-/// margin counted; servo, throttle mix) on the fixed reference (ref17;
+/// margin counted; servo, throttle mix) on the fixed reference (b36ffe3;
 /// 175.2 s and 144.2 s wall per commissioning at load 5–6 on the 2 cores,
 /// 4 141 and 3 800 reference runs in the calibration; 219.7 s user for
 /// both):

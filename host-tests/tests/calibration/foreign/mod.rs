@@ -217,7 +217,7 @@ fn slow_commissioning_without_margin_on_foreign_machines() {
 /// polish at rtol 1e-6 (`fit::PRIOR_SCALE`, `fit::POLISH_RTOL`), on the
 /// reference with the replay's check valves limited to the make-up flow
 /// and the servo ring's direction in holds from the pump's delivery
-/// (2026-11-28, ref17; the rows before it in CHANGELOG):
+/// (2026-11-28, b36ffe3; the rows before it in CHANGELOG):
 /// - big-pump: the reduction's block now holds (0.177 K off the reference
 ///   on the servo log, bound 0.2 K; was 0.444 K) and both paths are
 ///   validated; the held-out rule flashes the direct path, both beyond
@@ -318,7 +318,7 @@ fn one_operating_point_is_refused_with_log_region_channel_and_bench_run() {
 /// The churned case film where the training set frees it: big-pump trained
 /// on its two throttle logs and the servo log (0–150 rpm holds), held out
 /// on the throttle mix; the same commissioning with the churned film held
-/// (the gap law) beside it. Measured on the fixed reference (ref17; the
+/// (the gap law) beside it. Measured on the fixed reference (b36ffe3; the
 /// calibration's defaults, priors ×0.5 and polish at rtol 1e-6; 180.9 s
 /// wall for both with other helpers' jobs on the 2 cores; firmware drain
 /// vs the thermocouple, max |e| / under-prediction, without the margin):
@@ -362,7 +362,7 @@ fn slow_churned_case_film_with_a_low_speed_training_log() {
     // The churned fit's path spread (0.24 K under a 1e-9 K nudge before the
     // θ lattice; 0.14 K between the fits before and on it): its numbers
     // within 0.3 K; the gap law's within AS_MEASURED_K. Measured on the
-    // fixed reference (ref17) with calib11's defaults.
+    // fixed reference (b36ffe3) with calib11's defaults.
     let want = [(2.463, 2.463, 0.865, 0.3), (3.803, 2.471, 2.324, AS_MEASURED_K)];
     for (g, w) in got.iter().zip(want) {
         for (what, x, y) in [("mix max |e|", g.0, w.0), ("mix under-prediction", g.1, w.1), ("servo (training) under-prediction", g.2, w.2)] {

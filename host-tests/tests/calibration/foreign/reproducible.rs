@@ -9,7 +9,7 @@ use super::*;
 /// thermocouple and the true drain, margin) move by at most 0.05 K (the
 /// issue's bound). Trained as the procedure prescribes
 /// (`commissioning_set`), the structural freedoms fitted. Measured with
-/// the defaults, on the fixed reference (ref17): below 1e-4 K on both
+/// the defaults, on the fixed reference (b36ffe3): below 1e-4 K on both
 /// machines (printed 0.0000 K; 94.0 + 67.8 s on big-pump, 79.1 + 90.0 s
 /// on leaky-heavy at load 4–6.6 on the 2 cores, 260 s user for the four).
 /// Why it holds: the nudge changes no model output at the same multipliers
@@ -41,7 +41,7 @@ fn slow_commissioning_is_reproducible_at_the_last_digit_leaky_heavy() {
 /// cells and its path above the lattice decides. The goal: the headline
 /// numbers (as in
 /// [`slow_commissioning_is_reproducible_at_the_last_digit_big_pump`]) move
-/// by at most 0.05 K. **Not met since the reference's fix (ref17); a
+/// by at most 0.05 K. **Not met since the reference's fix (b36ffe3); a
 /// measured miss, asserted as measured (±0.05 K)**. With the defaults
 /// (priors at half the set's widths, polish at rtol 1e-6) and the
 /// firmware's servo-hold fix: big-pump **0.907 K**: the direct path's mix
@@ -73,7 +73,7 @@ fn slow_commissioning_is_reproducible_beyond_the_last_digit_leaky_heavy() {
 
 /// The three-log set with the hot-flow run (`commissioning_set_hot`),
 /// every logged temperature moved by 1e-6 K: the headline numbers move by
-/// at most 0.05 K. Measured on the fixed reference (ref17): 0.045 K
+/// at most 0.05 K. Measured on the fixed reference (b36ffe3): 0.045 K
 /// (margin 1.132 → 1.160 K, the servo log's max |e| 1.651 → 1.609 K;
 /// 65.5 + 62.8 s wall at load ~4); before the fix 0.028 K (margin 1.121 → 1.118 K,
 /// the mix's under-prediction 0.391 → 0.419 K; 64 + 75 s wall at load
