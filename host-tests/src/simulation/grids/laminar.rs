@@ -59,7 +59,7 @@ impl LaminarGrid {
     /// The laminar Nusselt number at X = Re·Pr·d/L, interpolated.
     ///
     /// The kept cell's path only, the rest out of line (`nu_other`), as
-    /// in [`NuGrid::nu`].
+    /// in [`super::NuGrid::nu`].
     #[inline]
     pub fn nu(&self, x: f64) -> f64 {
         if (LAM_EXACT_BELOW..1e300).contains(&x) {
