@@ -16,9 +16,9 @@
 //! twin `none` 0.497 K → `unexplained` 2.486 K, 1711's 1.130 → 1.578 K.
 //! docs/diagnosis-numbers.md, "Effect-free logs".
 //!
-//! Slow tier only: 32 diagnoses, 10–63 s each; 475 s on two cores shared
-//! with another helper before the fix (2026-11-28, passed); the test
-//! itself not re-run after it (`twin_floor` runs the same diagnosis).
+//! Slow tier only: 32 diagnoses, 10–63 s each. Passes on the fixed
+//! reference (2026-11-28; with `hidden.rs`'s test, one test thread,
+//! 1467 s for both at load 5–6).
 
 use eha_sim::diagnosis::analysis::Structure;
 use eha_sim::diagnosis::emu_sweep::{case_of_seed, effect_free_log};

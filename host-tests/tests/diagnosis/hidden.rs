@@ -19,10 +19,10 @@
 //! 0.62 → 3.07 K); 2713 `none` → `unexplained`. docs/diagnosis-numbers.md,
 //! "The other 17 logs with a hidden effect".
 //!
-//! Slow tier only: 17 diagnoses, 17–63 s each; 380 s on two shared cores
-//! before the fix (2026-11-28, passed); the values below are the
-//! `emulator-sweep` run's, which diagnoses each log as this test does
-//! (the test itself not re-run after the fix).
+//! Slow tier only: 17 diagnoses, 17–63 s each; the values below are the
+//! `emulator-sweep` run's, which diagnoses each log as this test does.
+//! Passes on the fixed reference (2026-11-28; with `effect_free.rs`'s
+//! test, one test thread, 1467 s for both at load 5–6).
 
 use eha_sim::diagnosis::emu_sweep::{case_of_seed, run_emu_case_with};
 use eha_sim::diagnosis::DiagnoseOptions;
