@@ -232,20 +232,23 @@ fn slow_emulator_forced_convection_at_one_point_is_not_named_conduction() {
 /// An identification run with nothing hidden (seed 2714: speed, load and
 /// ram air stepped independently, the campaign a thermal engineer would
 /// design): the emulator's structure shows and the answer is `unexplained`,
-/// not `none` and not a false discovery. Measured: the physical set (with
-/// `block_wall`, which this log frees) fits the training window to 0.415 K
-/// pooled and misses the held-out window by 0.929 K: t_pump_c 1.258 K
-/// (reads colder than the model), t_block_c 1.043 K (warmer), t_oil_c
-/// 1.198 K; the block's residuals follow the motor–pump temperature
-/// difference (ρ 0.88) and the report sends the user to metal paths from
-/// the pump to the motor flange and the valve block, the pump's mounting on
-/// the block — the emulator's bolted pump end cap ↔ manifold plate, a metal
-/// path the reference does not have. With `block_wall` held the same log
-/// gave training 0.920 K, held-out 2.019 K, t_block_c 3.735 K (the wall
-/// takes the oil's share of the floor, the pump–block path is left).
-/// Tolerances: held-out pooled ≥ 0.7 K, the block ≥ 0.8 K and the pump ≥
-/// 0.9 K flagged as misfits (a structure floor 7–9σ above the 0.1 K noise,
-/// each about a quarter below the measured value), training ≤ 0.45 K.
+/// not `none` and not a false discovery. The model is built without
+/// `with_structure`, so this is the physical set as under `off`.
+/// Measured on the fixed reference (b36ffe3's replay; 2026-11-28): the
+/// physical set fits the training window to 0.468 K pooled and misses the
+/// held-out window by 1.140 K: t_pump_c 1.903 K (reads colder than the
+/// model) and t_oil_c 1.103 K (warmer) flagged as misfits, t_block_c
+/// 0.882 K no longer flagged; the oil's residuals follow the motor–pump
+/// temperature difference (ρ +0.68) and the report sends the user to metal
+/// paths from the pump to the motor flange and the valve block — the
+/// emulator's bolted pump end cap ↔ manifold plate, a metal path the
+/// reference does not have. Before the fix: training 0.415 K, held-out
+/// 0.929 K, t_pump_c 1.258 K, t_block_c 1.043 K and t_oil_c 1.198 K
+/// flagged, the advice naming the pump's mounting on the block.
+/// Tolerances: held-out pooled ≥ 0.85 K, the pump ≥ 1.4 K and the oil
+/// ≥ 0.8 K flagged as misfits (a structure floor 8–14σ above the 0.1 K
+/// noise, each about a quarter below the measured value), training ≤
+/// 0.50 K (7 % above the measured value, as 0.45 K was above 0.415 K).
 #[test]
 #[ignore = "slow tier: emulator identification run, measured structure floor"]
 fn slow_emulator_identification_run_none_is_unexplained() {
@@ -261,12 +264,12 @@ fn slow_emulator_identification_run_none_is_unexplained() {
         eprintln!("  advice:\n{}", u.check.join("\n"));
     }
     assert_eq!(j.cause, "unexplained", "measured outcome changed");
-    assert!(d.before.heldout_rmse_k >= 0.7, "pooled held-out {:.3} K (measured 0.929)", d.before.heldout_rmse_k);
-    assert!(d.before.train_rmse_k <= 0.45, "pooled training {:.3} K (measured 0.415)", d.before.train_rmse_k);
+    assert!(d.before.heldout_rmse_k >= 0.85, "pooled held-out {:.3} K (measured 1.140)", d.before.heldout_rmse_k);
+    assert!(d.before.train_rmse_k <= 0.50, "pooled training {:.3} K (measured 0.468)", d.before.train_rmse_k);
     let ch = |n: &str| d.adequacy.channels.iter().find(|c| c.channel == n).expect("channel");
-    let (block, pump) = (ch("t_block_c"), ch("t_pump_c"));
-    assert!(block.misfit && block.heldout_rmse_k >= 0.8, "t_block_c {:.3} K (measured 1.043)", block.heldout_rmse_k);
-    assert!(pump.misfit && pump.heldout_rmse_k >= 0.9, "t_pump_c {:.3} K (measured 1.258)", pump.heldout_rmse_k);
+    let (pump, oil) = (ch("t_pump_c"), ch("t_oil_c"));
+    assert!(pump.misfit && pump.heldout_rmse_k >= 1.4, "t_pump_c {:.3} K (measured 1.903)", pump.heldout_rmse_k);
+    assert!(oil.misfit && oil.heldout_rmse_k >= 0.8, "t_oil_c {:.3} K (measured 1.103)", oil.heldout_rmse_k);
     let check = j.unexplained.expect("unexplained section").check.join("\n");
-    assert!(check.contains("mounting") && check.contains("flange"), "advice:\n{check}");
+    assert!(check.contains("flange") && check.contains("valve block"), "advice:\n{check}");
 }

@@ -8,26 +8,21 @@
 //! misfit on the affected channel over its twin's under the same variant
 //! (the twins' floors as `effect_free.rs` measured them, quoted below).
 //!
-//! Measured: no wrong cause; 1708's churning named (r 1.72, t_pump_c
-//! 0.45 → 0.21 K held out); three misses at r ≥ 2, each asserted as
-//! measured: 1710 (conduction at one operating point, r 2.89: its fit
-//! gains 68 % on t_pump_c but ΔBIC 11.8 < 25 and one operating point
-//! cannot tell a housing path from the housings' outer transfer), 1712
-//! (a draught at constant air speed, r 2.44: its fit gains 12 %), 2712
-//! (a draught in an identification run, r 2.89: its fit gains 1 %;
-//! `sensor-lag` ΔBIC 110 but does not qualify). docs/diagnosis-numbers.md,
-//! "Current numbers".
+//! Measured on the fixed reference (b36ffe3's replay; 2026-11-28
+//! evening, all 17): no wrong cause, no cause named; three misses at
+//! r ≥ 2, each asserted as measured: 1708 (churning in speed steps,
+//! r 2.39: its fit gains 47 % on t_pump_c but 19 % pooled, under the
+//! 20 % bar; it was named at r 1.72 before the fix), 1710 (conduction at
+//! one operating point, r 2.28: one operating point cannot tell a housing
+//! path from the housings' outer transfer), 1712 (a draught at constant
+//! air speed, r 2.46). 2712 fell to r 0.59 by its twin's floor (t_pump_c
+//! 0.62 → 3.07 K); 2713 `none` → `unexplained`. docs/diagnosis-numbers.md,
+//! "The other 17 logs with a hidden effect".
 //!
-//! Re-measured on the fixed reference (b36ffe3's replay; 2026-11-28
-//! evening) for 1710, 1712 and 2712 only, the three that were at r ≥ 2:
-//! 1710 `none` (t_pump_c 0.376 → 0.297 K held out, twin 0.13 K, r 2.28: a
-//! miss), 1712 `none` (0.268 → 0.246 K, twin 0.10 K, r 2.46: a miss),
-//! 2712 `unexplained` (1.793 → 1.796 K; its twin's floor rose 0.62 →
-//! 3.07 K, so r 0.59). The other 14 rows are the measurements before the
-//! fix, not re-run (docs/diagnosis-numbers.md, "On the fixed reference").
-//!
-//! Slow tier only: 17 diagnoses, 15–58 s each; 380 s on two shared cores
-//! (2026-11-28, passes).
+//! Slow tier only: 17 diagnoses, 17–63 s each; the values below are the
+//! `emulator-sweep` run's, which diagnoses each log as this test does.
+//! Passes on the fixed reference (2026-11-28; with `effect_free.rs`'s
+//! test, one test thread, 1467 s for both at load 5–6).
 
 use eha_sim::diagnosis::emu_sweep::{case_of_seed, run_emu_case_with};
 use eha_sim::diagnosis::DiagnoseOptions;
@@ -36,23 +31,23 @@ use eha_sim::diagnosis::DiagnoseOptions;
 /// channel (K) and the same on the log's effect-free twin under
 /// `no-case-held` (K, `effect_free.rs`'s run), as measured.
 const MEASURED: [(u64, &str, f64, f64); 17] = [
-    (1700, "unexplained", 0.748, 0.51),
-    (1701, "unexplained", 0.446, 0.40),
-    (1706, "none", 0.139, 0.22),
-    (1707, "none", 0.194, 0.34),
-    (1708, "churning-loss", 0.448, 0.26),
-    (1709, "unexplained", 0.461, 0.47),
+    (1700, "unexplained", 0.410, 0.52),
+    (1701, "unexplained", 0.393, 0.44),
+    (1706, "none", 0.127, 0.14),
+    (1707, "none", 0.158, 0.14),
+    (1708, "none", 0.478, 0.20),
+    (1709, "unexplained", 0.199, 0.25),
     (1710, "none", 0.297, 0.13),
     (1712, "none", 0.246, 0.10),
-    (1713, "none", 0.228, 0.33),
-    (2700, "unexplained", 0.341, 0.24),
-    (2701, "unexplained", 0.508, 0.49),
-    (2706, "none", 0.200, 0.18),
-    (2707, "none", 0.247, 0.16),
-    (2708, "unexplained", 2.900, 2.06),
-    (2710, "unexplained", 0.971, 0.64),
+    (1713, "none", 0.322, 0.40),
+    (2700, "unexplained", 0.138, 0.16),
+    (2701, "unexplained", 0.343, 0.54),
+    (2706, "none", 0.130, 0.13),
+    (2707, "none", 0.185, 0.22),
+    (2708, "unexplained", 2.680, 1.99),
+    (2710, "unexplained", 0.702, 1.25),
     (2712, "unexplained", 1.796, 3.07),
-    (2713, "none", 0.646, 0.55),
+    (2713, "unexplained", 0.549, 0.75),
 ];
 
 /// Each log: the answer as measured (a named cause only where measured, and
