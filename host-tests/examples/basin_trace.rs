@@ -1,14 +1,18 @@
 //! Where the physical tier's calibrated baseline comes from on one
 //! emulator log: the baseline from the rig file, every candidate's three
 //! starts (as `diagnose` fits them), and the two restarts of the baseline
-//! from the two candidate fits of least training residual; for each fit the
-//! training residual (K²) and the held-out RMSE pooled and per channel (K),
-//! and the calibration parameters that moved by more than ×/÷1.35. The
-//! diagnosis keeps the baseline of least training residual.
+//! from the two candidate fits of least training residual (with
+//! `nominal-restarts` also from every candidate's nominal-start fit, as
+//! `analysis::NOMINAL_RESTARTS` adds); for each fit the training residual
+//! (K²) and the prior rows' share of the fit's objective (K²), the
+//! held-out RMSE pooled and per channel (K), and the calibration
+//! parameters that moved by more than ×/÷1.35. The diagnosis keeps the
+//! baseline of least training residual. Fits as the diagnosis makes them,
+//! not its whole procedure (no refits after a restart).
 //!
-//! `cargo run --profile fast -p eha-sim --example basin_trace -- SEED [twin] [STRUCTURE]`
+//! `cargo run --profile fast -p eha-sim --example basin_trace -- SEED [twin] [STRUCTURE] [nominal-restarts]`
 //! (STRUCTURE `off`/`full`/`no-case`/`no-case-held`, default the latter;
-//! ~60–120 s a log on two shared cores).
+//! 36–60 s a log on two shared cores, 2026-11-28).
 
 use clap::ValueEnum as _;
 use eha_sim::diagnosis::analysis::{fit_from, fit_points, fit_typical, split_time_s, DiagnoseOptions, Structure};
@@ -39,7 +43,19 @@ fn held(run: &MeasuredRun, s: &SimSeries, channels: &[Channel], split: f64) -> f
     rmse(&ho).unwrap_or(f64::NAN)
 }
 
-fn line(tag: &str, run: &MeasuredRun, f: &FitResult, split: f64, names: &[String], starts: &[f64]) {
+/// The prior rows' share of the fit's objective, K² (what LM minimises
+/// besides the data residual `rss`; `fit::PRIOR_DATA_SIGMA_K`).
+fn prior_cost(sim: &dyn Simulator, f: &FitResult) -> f64 {
+    let mut specs = sim.nuisance();
+    specs.extend(sim.extension_params(f.candidate));
+    specs
+        .iter()
+        .zip(f.nuisance.iter().chain(&f.ext))
+        .filter_map(|(s, v)| s.prior_sigma_ln.map(|sig| (eha_sim::diagnosis::fit::PRIOR_DATA_SIGMA_K * (v / s.start).ln() / sig).powi(2)))
+        .sum()
+}
+
+fn line(sim: &dyn Simulator, tag: &str, run: &MeasuredRun, f: &FitResult, split: f64, names: &[String], starts: &[f64]) {
     let per: Vec<String> = Channel::TEMPERATURES
         .iter()
         .filter(|c| run.get(**c).is_some())
@@ -52,8 +68,9 @@ fn line(tag: &str, run: &MeasuredRun, f: &FitResult, split: f64, names: &[String
         .map(|(n, (v, s))| format!("{n}×{:.2}", v / s))
         .collect();
     println!(
-        "{tag:<34} rss {:>8.1} | held pooled {:.3} | {} | ext {:?} | moved: {}",
+        "{tag:<34} rss {:>8.1} + prior {:.2} | held pooled {:.3} | {} | ext {:?} | moved: {}",
         f.rss,
+        prior_cost(sim, f),
         held(run, &f.series, &Channel::TEMPERATURES, split),
         per.join(" "),
         f.ext.iter().map(|x| format!("{x:.3e}")).collect::<Vec<_>>(),
@@ -82,7 +99,7 @@ fn main() {
     let pts = fit_points(&run, split, o.points_per_channel);
     let t = std::time::Instant::now();
     let base = fit_deferred(&*sim, &run, &pts, Candidate::None, &nominal, None, o.fit).expect("baseline");
-    line("baseline from the rig file", &run, &base, split, &names, &nominal);
+    line(&*sim, "baseline from the rig file", &run, &base, split, &names, &nominal);
     let starts: Vec<(Candidate, usize)> = Candidate::EXTENSIONS.iter().flat_map(|&c| [(c, 0), (c, 1), (c, 2)]).collect();
     let fits: Vec<Option<FitResult>> = starts
         .par_iter()
@@ -94,7 +111,7 @@ fn main() {
         .collect();
     for ((c, s), f) in starts.iter().zip(&fits) {
         if let Some(f) = f {
-            line(&format!("{} {}", c.name(), ["nominal", "base-off", "base-typ"][*s]), &run, f, split, &names, &nominal);
+            line(&*sim, &format!("{} {}", c.name(), ["nominal", "base-off", "base-typ"][*s]), &run, f, split, &names, &nominal);
         }
     }
     let mut best: Vec<&FitResult> =
@@ -102,7 +119,7 @@ fn main() {
     best.sort_by(|a, b| a.rss.total_cmp(&b.rss));
     for (k, f) in best.iter().take(2).enumerate() {
         if let Some(r) = fit_deferred(&*sim, &run, &pts, Candidate::None, &f.nuisance, None, o.fit) {
-            line(&format!("restart {k} from {}", f.candidate.name()), &run, &r, split, &names, &nominal);
+            line(&*sim, &format!("restart {k} from {}", f.candidate.name()), &run, &r, split, &names, &nominal);
         }
     }
     // `nominal-restarts`: the baseline restarted from every candidate's
@@ -113,7 +130,7 @@ fn main() {
             from.par_iter().map(|f| fit_deferred(&*sim, &run, &pts, Candidate::None, &f.nuisance, None, o.fit)).collect();
         for (f, r) in from.iter().zip(rs) {
             if let Some(r) = r {
-                line(&format!("restart from {} nominal", f.candidate.name()), &run, &r, split, &names, &nominal);
+                line(&*sim, &format!("restart from {} nominal", f.candidate.name()), &run, &r, split, &names, &nominal);
             }
         }
     }

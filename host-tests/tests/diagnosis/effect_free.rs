@@ -21,6 +21,20 @@
 //! 1706–1709, 1713, 2700, 2701, 2706–2708, 2710, 2713) are the measurements
 //! before the fix, not re-run (docs/diagnosis-numbers.md).
 //!
+//! Re-measured with the physical tier's baseline restarted also from every
+//! candidate's nominal-start fit (`analysis::NOMINAL_RESTARTS`; 2026-11-28,
+//! basin18), each as measured then: 1714–1717, 2714–2717 and the twins of
+//! 2704, 2708, 2709, 2713 (`twin_floor`), the twins of 1704, 1705, 1711,
+//! 2705, 2711, 2712 (their `emulator-sweep` runs with twins); still no
+//! cause named. 2712's
+//! twin 2.486 → 0.852 K (its restarts had stayed in the baseline's own
+//! basin; docs/diagnosis-limits.md, "The calibration's basins"), 2705's
+//! 1.099 → 1.333 K, 2714's 0.825 → 0.726 K, 2715's 0.968 → 1.106 K; the
+//! others within 4 % of the fixed reference's value (2708's and 2713's
+//! twins, last measured before the fix: 1.622 → 1.381 K, 1.963 →
+//! 2.012 K). The twins of 1700, 1701, 1706–1710, 1712, 1713, 2700, 2701,
+//! 2706, 2707, 2710 not re-run with it.
+//!
 //! Slow tier only: 32 diagnoses, 3–50 s each; 475 s on two cores shared
 //! with another helper (2026-11-28, passes).
 
@@ -36,8 +50,8 @@ use eha_sim::rig::Rig;
 const MEASURED: [(u64, &str, f64); 32] = [
     (1700, "unexplained", 1.860),
     (1701, "unexplained", 0.816),
-    (1704, "none", 0.154),
-    (1705, "none", 0.237),
+    (1704, "none", 0.156),
+    (1705, "none", 0.235),
     (1706, "none", 0.161),
     (1707, "none", 0.228),
     (1708, "none", 0.407),
@@ -53,18 +67,18 @@ const MEASURED: [(u64, &str, f64); 32] = [
     (2700, "unexplained", 0.649),
     (2701, "unexplained", 0.927),
     (2704, "unexplained", 1.347),
-    (2705, "unexplained", 1.099),
+    (2705, "unexplained", 1.333),
     (2706, "none", 0.147),
     (2707, "none", 0.206),
-    (2708, "unexplained", 1.622),
+    (2708, "unexplained", 1.381),
     (2709, "unexplained", 1.389),
     (2710, "unexplained", 0.791),
     (2711, "unexplained", 1.045),
-    (2712, "unexplained", 2.486),
-    (2713, "unexplained", 1.963),
-    (2714, "unexplained", 0.825),
-    (2715, "unexplained", 0.968),
-    (2716, "unexplained", 1.120),
+    (2712, "unexplained", 0.852),
+    (2713, "unexplained", 2.012),
+    (2714, "unexplained", 0.726),
+    (2715, "unexplained", 1.106),
+    (2716, "unexplained", 1.106),
     (2717, "none", 0.187),
 ];
 

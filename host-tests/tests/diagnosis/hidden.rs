@@ -25,6 +25,11 @@
 //! 2712 `unexplained` (1.793 → 1.796 K; its twin's floor rose 0.62 →
 //! 3.07 K, so r 0.59). The other 14 rows are the measurements before the
 //! fix, not re-run (docs/diagnosis-numbers.md, "On the fixed reference").
+//! With the physical tier's baseline restarted also from every candidate's
+//! nominal-start fit (`analysis::NOMINAL_RESTARTS`; basin18, `--only 2712`
+//! with its twin, 134 s): 2712 `unexplained`, t_pump_c 1.97 K held out,
+//! its twin's 0.64 K (pooled 2.486 → 0.852 K), so **r 3.10: a miss at
+//! r ≥ 2 again** (the draught's fit ΔBIC −3.5, gain −2 %).
 //!
 //! Slow tier only: 17 diagnoses, 15–58 s each; 380 s on two shared cores
 //! (2026-11-28, passes).
@@ -51,7 +56,7 @@ const MEASURED: [(u64, &str, f64, f64); 17] = [
     (2707, "none", 0.247, 0.16),
     (2708, "unexplained", 2.900, 2.06),
     (2710, "unexplained", 0.971, 0.64),
-    (2712, "unexplained", 1.796, 3.07),
+    (2712, "unexplained", 1.970, 0.64),
     (2713, "none", 0.646, 0.55),
 ];
 

@@ -190,15 +190,22 @@ fn slow_imprint_ratio_with_structure_no_case() {
 /// 0.90 -> 0.33 K), 1705 r 3.29 (0.76 -> 0.37), 2704 r 3.95 (6.59 -> 1.45);
 /// 2705 `unexplained` at r 3.32 now (its twin's t_oil_c floor fell to
 /// 0.89 K): a measured miss at r >= 2; 1711 r 0.91, 2709 r 0.46, 2711
-/// r 0.48 (their twins' t_pump_c floors rose). Asserted as measured then.
+/// r 0.48 (their twins' t_pump_c floors rose). Re-measured with the
+/// physical tier's baseline restarted also from every candidate's
+/// nominal-start fit (`analysis::NOMINAL_RESTARTS`; basin18, the same
+/// command in three runs, 46–134 s a case with its twin): the same answers;
+/// 1704 r 6.01 → 4.70 (its own baseline fits t_oil_c better, 0.90 →
+/// 0.68 K; named 0.68 → 0.33), 1705 r 3.29 → 3.91 (twin 0.23 → 0.195 K),
+/// 2705 r 3.32 → 2.23 (twin t_oil_c 0.89 → 1.32 K; still a miss at
+/// r ≥ 2), 2704, 1711, 2709, 2711 unchanged. Asserted as measured then.
 #[test]
 #[ignore = "slow tier: emulator cases with twins (minutes), the structure option's no-case-held variant"]
 fn slow_imprint_ratio_with_structure_no_case_held() {
     let o = DiagnoseOptions { structure: Structure::NoCaseHeld, ..DiagnoseOptions::default() };
-    assert_named(&run_with("sensor-lag", ConstantThrottle, 1704, &o), 6.01, 0.33);
-    assert_named(&run_with("sensor-lag", SpeedSteps, 1705, &o), 3.29, 0.37);
+    assert_named(&run_with("sensor-lag", ConstantThrottle, 1704, &o), 4.70, 0.33);
+    assert_named(&run_with("sensor-lag", SpeedSteps, 1705, &o), 3.91, 0.37);
     assert_named(&run_with("sensor-lag", IdentRun, 2704, &o), 3.95, 1.45);
-    assert_missed(&run_with("sensor-lag", IdentRun, 2705, &o), "unexplained", 3.32);
+    assert_missed(&run_with("sensor-lag", IdentRun, 2705, &o), "unexplained", 2.23);
     assert_missed(&run_with("motor-pump-conduction", LoadCycles, 1711, &o), "unexplained", 0.91);
     assert_missed(&run_with("churning-loss", IdentRun, 2709, &o), "unexplained", 0.46);
     assert_missed(&run_with("motor-pump-conduction", IdentRun, 2711, &o), "unexplained", 0.48);
