@@ -6,9 +6,10 @@
 //! on any of these logs is a false discovery. Half the time of a sweep
 //! with twins (the case's own log is not diagnosed).
 //!
-//! `cargo run --profile fast -p eha-sim --example twin_floor -- STRUCTURE SEED…`
-//! (STRUCTURE `off`/`full`/`no-case`/`no-case-held`; seeds 1700–1717 and
-//! 2700–2717; 3–50 s a log on two shared cores, 2026-11-28).
+//! `cargo run --profile fast -p eha-sim --example twin_floor -- STRUCTURE [nominal-restarts] SEED…`
+//! (STRUCTURE `off`/`full`/`no-case`/`no-case-held`; `nominal-restarts`:
+//! `DiagnoseOptions::nominal_restarts`; seeds 1700–1717 and 2700–2717;
+//! 3–50 s a log on two shared cores, 2026-11-28).
 
 use clap::ValueEnum as _;
 use eha_sim::diagnosis::analysis::Structure;
@@ -20,11 +21,13 @@ use eha_sim::rig::Rig;
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let Some((s, seeds)) = args.split_first() else {
-        eprintln!("usage: twin_floor STRUCTURE SEED…");
+        eprintln!("usage: twin_floor STRUCTURE [nominal-restarts] SEED…");
         std::process::exit(2);
     };
     let structure = Structure::from_str(s, true).expect("structure: off, full, no-case or no-case-held");
-    let o = DiagnoseOptions { structure, ..DiagnoseOptions::default() };
+    let nominal_restarts = seeds.first().is_some_and(|a| a == "nominal-restarts");
+    let seeds = &seeds[usize::from(nominal_restarts)..];
+    let o = DiagnoseOptions { structure, nominal_restarts, ..DiagnoseOptions::default() };
     for seed in seeds.iter().map(|a| a.parse::<u64>().expect("seed")) {
         let c = case_of_seed(1200.0, seed).expect("seed 1700–1717 or 2700–2717");
         let t = std::time::Instant::now();

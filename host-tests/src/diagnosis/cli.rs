@@ -57,6 +57,12 @@ pub struct DiagnoseArgs {
     /// [`crate::diagnosis::analysis::Structure`]).
     #[arg(long, value_enum, value_name = "VARIANT")]
     pub structure: Option<crate::diagnosis::analysis::Structure>,
+    /// Restart the physical tier's calibrated baseline also from every
+    /// candidate's nominal-start fit (a wider search of the same
+    /// objective, ~20 % more model runs; docs/diagnosis-limits.md, "The
+    /// calibration's basins").
+    #[arg(long)]
+    pub nominal_restarts: bool,
 }
 
 /// Runs `diagnose` and prints a one-line verdict; see the module doc for the
@@ -93,6 +99,7 @@ fn run_inner(args: &DiagnoseArgs) -> anyhow::Result<String> {
     let mut o = DiagnoseOptions { train_fraction: args.train_fraction.clamp(0.1, 0.7), ..Default::default() };
     o.fit.max_sims = args.max_sims.max(4);
     o.structure = args.structure.unwrap_or(o.structure);
+    o.nominal_restarts = args.nominal_restarts;
     let files: Vec<String> = args.measured.iter().map(|f| f.display().to_string()).collect();
     let t = std::time::Instant::now();
     // One log: its own table and model; several: the logs on one table

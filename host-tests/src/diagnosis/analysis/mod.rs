@@ -22,6 +22,7 @@ pub use candidates::*;
 pub use types::*;
 use candidates::{cross_correlations, in_physical_tier, rank, Start};
 
+
 /// Records phases of one tier: the runs and the time since the last mark.
 struct PhaseLog {
     tier: &'static str,
@@ -214,7 +215,24 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
     if ranking.iter().any(|r| r.qualifies) || !escalate {
         let mut by_rss: Vec<&FitResult> = fits.iter().collect();
         by_rss.sort_by(|a, b| a.rss.total_cmp(&b.rss));
-        let starts: Vec<Vec<f64>> = by_rss.iter().take(2).map(|f| f.nuisance.clone()).collect();
+        let mut starts: Vec<Vec<f64>> = by_rss.iter().take(2).map(|f| f.nuisance.clone()).collect();
+        // In the physical tier also from every candidate's nominal-start
+        // fit (`DiagnoseOptions::nominal_restarts`): the two fits of least residual mostly
+        // sit in the calibrated baseline's own basin (they start from it),
+        // while a nominal-start fit, whatever its own residual, may have
+        // carried the ~20-parameter set into a basin where the baseline
+        // fits far better. Measured on the effect-free twin of emulator
+        // log 2712: the two restarts ended at 144 K² (held out 2.49 K
+        // pooled); restarted from `motor-pump-conduction`'s nominal-start
+        // fit (538 K² with the path on) the baseline reached 91 K² (held
+        // out 0.85 K) (docs/diagnosis-limits.md, "The calibration's basins").
+        if o.nominal_restarts && !escalate {
+            for g in all.chunks(STARTS_PER_CANDIDATE) {
+                if let Some(f) = g[0].as_ref().filter(|f| !starts.contains(&f.nuisance)) {
+                    starts.push(f.nuisance.clone());
+                }
+            }
+        }
         sim.phase(Phase::Restarts { fits: starts.len() });
         let restarts: Vec<FitResult> =
             starts.par_iter().filter_map(|v| fit_deferred(sim, run, &pts, Candidate::None, v, None, o.fit)).collect();

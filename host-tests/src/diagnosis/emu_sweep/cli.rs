@@ -83,6 +83,11 @@ pub struct EmuSweepArgs {
     /// [`crate::diagnosis::analysis::Structure`]).
     #[arg(long, value_enum, value_name = "VARIANT")]
     pub structure: Option<crate::diagnosis::analysis::Structure>,
+    /// Every diagnosis with `DiagnoseOptions::nominal_restarts` (the
+    /// physical tier's baseline restarted also from every candidate's
+    /// nominal-start fit).
+    #[arg(long)]
+    pub nominal_restarts: bool,
 }
 
 
@@ -137,7 +142,11 @@ pub fn run(a: &EmuSweepArgs) -> ExitCode {
                 let _ = twin.write_file(dir.join(format!("{}-{:?}-{}-twin.csv", c.hidden.name(), c.scenario, c.seed)));
             }
         }
-        let o = DiagnoseOptions { structure: a.structure.unwrap_or(DiagnoseOptions::default().structure), ..Default::default() };
+        let o = DiagnoseOptions {
+            structure: a.structure.unwrap_or(DiagnoseOptions::default().structure),
+            nominal_restarts: a.nominal_restarts,
+            ..Default::default()
+        };
         match run_emu_case_with(*c, &o, !a.no_twins, !a.no_oracle) {
             Ok(r) => {
                 let line = serde_json::to_string(&r).unwrap_or_default() + "\n";
