@@ -84,6 +84,11 @@ pub struct CalOptions {
     /// fit on all of them starts from its multipliers; 0: off, every fit
     /// from the rig file.
     pub continuation_logs: usize,
+    /// `commission` only (the calibration itself ignores it): how the
+    /// drain margin is validated on the training logs' starts besides after
+    /// the split ([`super::check::HeadFold`]; default
+    /// [`super::check::HEAD_FOLD_DEFAULT`]).
+    pub margin_head_fold: super::check::HeadFold,
 }
 
 /// Default factor on every prior width of the set in the fit
@@ -135,6 +140,7 @@ impl Default for CalOptions {
             prior_scale: PRIOR_SCALE,
             polish_s2: None,
             continuation_logs: CONTINUATION_LOGS,
+            margin_head_fold: super::check::HEAD_FOLD_DEFAULT,
         }
     }
 }

@@ -140,6 +140,8 @@ fn reproducible_on(m: EmuMachine, nudge_k: f64, hot_set: bool, as_measured_k: Op
                 o.lattice_ln = x;
             }
             o.prior_sigma.extend(exp_priors());
+            o.margin_head_fold = super::exp_head_fold();
+            super::exp_direct_polish(&mut o);
             // `EXP_PRIOR_SCALE`: an experiment knob (factor on every prior width).
             if let Some(x) = std::env::var("EXP_PRIOR_SCALE").ok().and_then(|v| v.parse().ok()) {
                 o.prior_scale = x;
