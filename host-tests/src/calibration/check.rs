@@ -1,7 +1,8 @@
 //! The reduced model's checks shared by both commissioning paths: the
 //! firmware model (f64) replayed on a log against the commissioned reference
 //! and the measured drain, the operating region of its largest errors, and
-//! the margin from a split of the training missions.
+//! the margin from folds of the training missions (scored after the
+//! split, and on the logs' starts).
 
 use super::fit::CalError;
 use super::log::CalLog;
