@@ -35,7 +35,7 @@ pub mod simulation;
 pub mod tools;
 
 pub use calibration::{lsq, paper as calibrate};
-pub use physics::{cooling, fluid, heat, hydraulics, losses, network, rig};
+pub use physics::{air, cooling, fluid, heat, hydraulics, losses, network, rig};
 pub use simulation::{equilibrium, fast, missions, model, plant, scenario, sim};
 pub use data::{measured, plot};
 pub use tools::{cli, gendoc, params_block, reader_checks, reduce, uq};

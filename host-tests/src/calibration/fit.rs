@@ -101,7 +101,7 @@ pub struct CalOptions {
 /// the optimiser's path: a 1e-6 K nudge of every logged temperature moved
 /// big-pump's held-out headline 0.436 K. With 0.5 and the polish at
 /// [`POLISH_RTOL`] 1e-6 the same nudge moves it 0.045 K (big-pump) and
-/// 0.013 K (leaky-heavy) (docs/commissioning.md, "Reproducibility", with
+/// 0.013 K (leaky-heavy) (docs/commissioning-foreign.md, "Reproducibility", with
 /// what the bias costs on the held-out logs). 0.5 alone (polish at 1e-5):
 /// 0.072 / 0.162 K; 0.4: big-pump 0.890 K (the path choice flipped);
 /// the seven tightened alone (σ 0.15–0.5): big-pump 1.067 K.
@@ -147,7 +147,7 @@ impl Default for CalOptions {
 
 /// Why `commission` holds the oil probe's response time unless asked: a
 /// free probe lag also takes up oil-model structure, which generalises
-/// worse to held-out missions (measured in docs/commissioning.md). The
+/// worse to held-out missions (measured in docs/commissioning-foreign.md). The
 /// diagnosis's physical set fits it: there it only has to explain one log.
 pub const PROBE_HELD: &str = "held at the rig file unless asked (`commission --fit-oil-probe`): a free probe lag also takes up oil-model structure and generalises worse held out";
 
@@ -159,8 +159,8 @@ pub const PROBE_HELD: &str = "held at the rig file unless asked (`commission --f
 /// logs with it held (one fit each, before the continuation over the logs,
 /// [`CONTINUATION_LOGS`], when a 1e-6 K nudge moved the held fit 0.51 K
 /// on those logs: the difference is one path's, not shown to be bias;
-/// not re-measured since; docs/commissioning.md, "The hot-flow run").
-pub const DUCT_TURBULENT_HELD: &str = "held at the rig file unless asked: freed on a bench whose passages run in the transition it fitted ×1.80 and the held-out mix's under-prediction rose 0.37 → 1.14 K (docs/commissioning.md)";
+/// not re-measured since; docs/commissioning-foreign.md, "The hot-flow run").
+pub const DUCT_TURBULENT_HELD: &str = "held at the rig file unless asked: freed on a bench whose passages run in the transition it fitted ×1.80 and the held-out mix's under-prediction rose 0.37 → 1.14 K (docs/commissioning-foreign.md)";
 
 /// Status of one parameter after calibration.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]

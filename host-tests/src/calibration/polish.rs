@@ -41,7 +41,7 @@ pub const POLISH_MAX_ITERS: usize = 8;
 /// end big-pump's original and nudged (1e-6 K) polishes at 1629.10 and
 /// 1629.09 (decrements 2–8 at the end), and move the headline ≤ 0.045 K on
 /// both emulator machines; the tightened priors at 1e-5 moved it 0.072 /
-/// 0.162 K (docs/commissioning.md, "Reproducibility").
+/// 0.162 K (docs/commissioning-foreign.md, "Reproducibility").
 pub const POLISH_RTOL: f64 = 1e-6;
 
 /// `polish` stops when the predicted decrease of the objective (the

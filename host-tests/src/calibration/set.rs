@@ -107,7 +107,7 @@ pub const FRICTION_SPEED: &str = "friction_speed";
 pub const PROBE_SURFACE: [&str; 4] = ["probe_surface_motor", "probe_surface_pump", "probe_surface_block", "probe_surface_ball"];
 
 /// The rig-level structural freedoms the held-out drain misses' bisection
-/// named (docs/commissioning.md): the pump friction heat's placement and
+/// named (docs/commissioning-foreign.md): the pump friction heat's placement and
 /// speed law, the surface probes' reading towards ambient. Fitted by
 /// `commission` (the pump's loss level from the current); a caller that
 /// wants the set as it was before them holds these.

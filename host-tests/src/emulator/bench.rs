@@ -195,14 +195,14 @@ pub fn bench_set(machine: &EmuMachine, seed: u64) -> Result<BenchSet, String> {
 }
 
 /// The logs of `machine` as the commissioning procedure prescribes them
-/// (docs/commissioning.md, "What the user runs"): the speed-then-needle
+/// (docs/commissioning.md, "Bench procedure"): the speed-then-needle
 /// steps and a soak followed by low-speed holds
 /// ([`EmuScenario::SoakThenLowSpeedHolds`], which holds the pump below 100
 /// rpm so that the case film's speed law is fitted). Held out: the same
 /// servo and throttle-mix logs as [`bench_set`] (same seeds, unchanged).
 /// Two-log variants that reach the envelope's high-speed, high-load corner
 /// ([`commissioning_set_of`]) were measured and not adopted
-/// (docs/commissioning.md, "Training logs over the operating envelope").
+/// (docs/commissioning-foreign.md, "Training logs over the operating envelope").
 pub fn commissioning_set(machine: &EmuMachine, seed: u64) -> Result<BenchSet, String> {
     let b = bench_set(machine, seed)?;
     Ok(BenchSet {
@@ -216,7 +216,7 @@ pub fn commissioning_set(machine: &EmuMachine, seed: u64) -> Result<BenchSet, St
 /// 850–1200 rpm and 40–50 bar with the oil hot, where big-pump's passage
 /// flow reaches the duct law's transition). Measured, not the procedure's
 /// default: it lowers big-pump's held-out under-prediction and raises
-/// leaky-heavy's (docs/commissioning.md, "The hot-flow run").
+/// leaky-heavy's (docs/commissioning-foreign.md, "The hot-flow run").
 pub fn commissioning_set_hot(machine: &EmuMachine, seed: u64) -> Result<BenchSet, String> {
     let mut s = commissioning_set(machine, seed)?;
     s.train.push(bench_log(machine, EmuScenario::WarmThenHotSpeedSteps, 1800.0, seed + 4)?);
@@ -227,7 +227,7 @@ pub fn commissioning_set_hot(machine: &EmuMachine, seed: u64) -> Result<BenchSet
 /// scenarios (1800 s each, seeds `seed` and `seed + 1`, the seeds of
 /// [`commissioning_set`]'s two logs), held out on [`bench_set`]'s servo and
 /// throttle-mix logs. For comparing training procedures on the same
-/// held-out logs (docs/commissioning.md, "Training logs over the
+/// held-out logs (docs/commissioning-foreign.md, "Training logs over the
 /// operating envelope").
 pub fn commissioning_set_of(machine: &EmuMachine, seed: u64, train: [EmuScenario; 2]) -> Result<BenchSet, String> {
     Ok(BenchSet {

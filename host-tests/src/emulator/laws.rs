@@ -1,7 +1,7 @@
 //! The emulated machine's own laws, apart from its network: the oil's
 //! viscosity, the pump's leakage gaps, the iron loss and its drag, the case
 //! film, the hoses' pressure drop and the outer surfaces' heat loss (its
-//! correlations, not the reference's: docs/commissioning.md lists where
+//! correlations, not the reference's: docs/commissioning-foreign.md lists where
 //! they differ).
 
 use super::params::RefLaw;

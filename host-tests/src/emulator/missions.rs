@@ -48,7 +48,7 @@ pub enum EmuScenario {
     /// open to 5 bar), starting low. The low holds give the case film's
     /// speed law a drain record near rest.
     SoakThenLowSpeedHolds,
-    /// The commissioning procedure's hot-flow run (docs/commissioning.md):
+    /// The commissioning procedure's hot-flow run (docs/commissioning-foreign.md):
     /// a warm-up at 1150 rpm with the needle set for 50 bar for the first
     /// sixth of the run, then speed steps (850–1200 rpm every 150–250 s)
     /// at one needle setting drawn for 40–50 bar. One input moves at a

@@ -41,7 +41,7 @@
 //!
 //! Experiment switches ([`params::EmuParams::like_reference`], empty in
 //! every machine) replace one law at a time by the reference's, for the
-//! structural bisection of a commissioning miss (docs/commissioning.md).
+//! structural bisection of a commissioning miss (docs/commissioning-foreign.md).
 //!
 //! The hidden effects are the diagnosis candidates, implemented here from
 //! the paper: R(T) = R25(1 + α(T − 25 °C)) (eq. 1); the manifold oil sensor in a dead-end pocket

@@ -113,7 +113,7 @@ pub struct EmuParams {
     /// Structural experiment switches: the laws of the machine replaced by
     /// the reference model's (none in every machine: the emulator as
     /// built). For the by-hand structural bisection of a commissioning miss
-    /// (docs/commissioning.md), never set in a test's machine.
+    /// (docs/commissioning-foreign.md), never set in a test's machine.
     pub like_reference: LikeReference,
 }
 

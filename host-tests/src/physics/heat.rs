@@ -5,7 +5,8 @@
 //! doc says so. All areas m², lengths m, temperatures °C, results W/(m²·K),
 //! W/K or W.
 
-use crate::fluid::{air_at, G_M_PER_S2, KELVIN_OFFSET};
+use crate::air::air_at;
+use crate::fluid::{G_M_PER_S2, KELVIN_OFFSET};
 
 /// Stefan–Boltzmann constant, W/(m²·K⁴) (eq. 19).
 pub const SIGMA_W_PER_M2_K4: f64 = 5.670_374e-8;
@@ -246,7 +247,7 @@ mod tests {
     /// W/(m²·K); 3 % covers the property fits.
     #[test]
     fn churchill_chu_cylinder_magnitude() {
-        let h = h_free_cylinder(50.0, 20.0, crate::fluid::P_SEA_LEVEL_PA, 0.1);
+        let h = h_free_cylinder(50.0, 20.0, crate::air::P_SEA_LEVEL_PA, 0.1);
         assert!((h - 5.03).abs() / 5.03 < 0.03, "{h}");
     }
 

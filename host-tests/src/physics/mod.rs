@@ -12,6 +12,7 @@
 //! - [`candidates`]: the model extensions a diagnosis tries, with their
 //!   realistic magnitudes.
 
+pub mod air;
 pub mod candidates;
 pub mod cooling;
 pub mod fluid;

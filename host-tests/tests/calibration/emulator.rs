@@ -152,7 +152,7 @@ fn emulator_machine_held_out_error_falls() {
 /// run, 29.3 s at load 3.0-3.7 on 2 shared cores): identification runs
 /// **0.599 / 0.614 K** (was 0.650 / 0.695), families 0.869 / 2.707 K (was
 /// 0.839 / 2.441: the identification-run miss 0.27 K larger, within the
-/// 0.3-0.9 K path spread docs/commissioning.md measures); the test prints
+/// 0.3-0.9 K path spread docs/commissioning-foreign.md measures); the test prints
 /// only the pooled held-out numbers, the training, oil and `block_wall`
 /// figures above were not measured again. On the fixed reference (b36ffe3;
 /// 88.0 s wall, 56.6 s user at load 5–6): identification runs

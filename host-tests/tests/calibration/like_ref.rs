@@ -1,6 +1,6 @@
 //! The experiment switches of the structural bisection: each makes the
 //! emulator machine (or the user's rig file) like the reference in one
-//! respect (docs/commissioning.md, "The held-out drain misses: structural
+//! respect (docs/commissioning-foreign.md, "The held-out drain misses: structural
 //! bisection"). Experiment knobs only; the product path reads none of them.
 
 use eha_sim::emulator::bench::EmuMachine;
@@ -48,7 +48,7 @@ pub(super) fn parse_switches(v: &str) -> Vec<String> {
 }
 
 /// Structural bisection: each named switch makes the emulator machine like
-/// the reference in one respect (docs/commissioning.md, "The held-out drain
+/// the reference in one respect (docs/commissioning-foreign.md, "The held-out drain
 /// misses: structural bisection"): `split` the mechanical loss placed by the
 /// reference's sliding-pair rule (delivered oil 0.6, case 0.15, metal 0.25);
 /// `onepump` barrel and end cap one node (9 → 2000 W/K); `surface` the

@@ -175,7 +175,7 @@ fn slow_mix_heat_audit() {
 }
 
 /// Emulator-side and calibration-side experiments on the mix's miss, by
-/// environment (docs/commissioning.md, "The held-out drain misses:
+/// environment (docs/commissioning-foreign.md, "The held-out drain misses:
 /// structural bisection"): on the emulator machines
 /// `EXP_MECH_RULE=1` places the mechanical loss by the reference's
 /// sliding-pair rule (delivered 0.6, case 0.15, metal 0.25);
@@ -294,7 +294,7 @@ pub(super) fn bisection_run(machine: &EmuMachine, switches: &[String], train_mix
     (v(h[0].vs_measured_under_k), v(h[1].vs_measured_max_k), v(h[1].vs_measured_under_k))
 }
 
-/// The structural bisection's headline steps (docs/commissioning.md, "The
+/// The structural bisection's headline steps (docs/commissioning-foreign.md, "The
 /// held-out drain misses: structural bisection"), measured at this commit
 /// on this build: servo under-prediction, mix max |e| and under-prediction
 /// per machine, K, without the margin. Asserted within 0.25 K of the

@@ -1,5 +1,5 @@
 //! What carries big-pump's drain miss that the structural bisection's ten
-//! switches leave (docs/commissioning.md, "The held-out drain misses:
+//! switches leave (docs/commissioning-foreign.md, "The held-out drain misses:
 //! structural bisection", the rows beyond the control): the control (all
 //! ten switched) plus the emulator-side switches of the differences the ten
 //! do not cover (`ports`, `duct`, `wall`, `outer`, `mount`, `boost`;
@@ -18,7 +18,7 @@ use eha_sim::emulator::bench::machines;
 /// (`mix_audit::slow_structural_bisection_of_the_drain_misses`): the same
 /// build gives the same numbers; another float rounding moves the fit's
 /// basin (the rows hold to ≤ 0.05 K under a 1e-6 K nudge of the logs,
-/// docs/commissioning.md "Reproducibility", but up to 0.59 K between
+/// docs/commissioning-foreign.md "Reproducibility", but up to 0.59 K between
 /// optimiser paths of other builds). The conclusion rests on 0.46 K
 /// between the control and `duct,wall` with the mix trained (under-
 /// prediction 1.192 against 0.728 K), which four runs with both switches

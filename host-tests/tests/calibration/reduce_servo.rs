@@ -11,7 +11,7 @@
 //! `EXP_ACC_BAR` change the commissioned rig's check valves and
 //! accumulator before both run (experiments).
 //!
-//! Measured (docs/commissioning.md, "Where the reduction departs"): the
+//! Measured (docs/commissioning-foreign.md, "Where the reduction departs"): the
 //! departure built in the servo log's pressure holds (4–18 rpm, |Δp|
 //! 49 bar), not in the case film, from three ring heat terms booked
 //! differently — the reference replay's check valves and the reference's

@@ -189,6 +189,6 @@ pub struct Outside {
 impl Outside {
     /// Static pressure of the air, Pa (ISA at [`Outside::altitude_m`]).
     pub fn air_pressure_pa(&self) -> f64 {
-        crate::fluid::isa_pressure_pa(self.altitude_m)
+        crate::air::isa_pressure_pa(self.altitude_m)
     }
 }

@@ -21,6 +21,12 @@
 
 use super::dense::{Lu, Mat};
 
+mod tableau;
+#[cfg(test)]
+mod tests;
+
+pub use tableau::{Tableau, RODAS4};
+
 /// Steps to `t_max` up to which they are made equal (see `Rosenbrock::step`):
 /// then they reuse one factorisation. Measured (`FastPlant::run`): Case 2
 /// 211.9 → 205.8 M instructions, Case 1 unchanged; made equal at any
@@ -28,114 +34,7 @@ use super::dense::{Lu, Mat};
 const EQUAL_STEPS_MAX: u32 = 4;
 
 /// Most stages of a tableau here.
-const S_MAX: usize = 6;
-
-/// A Rosenbrock tableau in the form above (a, c strictly lower triangular).
-#[derive(Debug, Clone, Copy)]
-pub struct Tableau {
-    /// Stages.
-    pub s: usize,
-    /// Stage abscissae α_i.
-    pub alpha: [f64; S_MAX],
-    /// γ_i = Σ_j γ_ij (γ₁ = γ, the diagonal).
-    pub gamma: [f64; S_MAX],
-    /// a_ij, i > j.
-    pub a: [[f64; S_MAX]; S_MAX],
-    /// c_ij, i > j.
-    pub c: [[f64; S_MAX]; S_MAX],
-    /// Solution weights.
-    pub m: [f64; S_MAX],
-    /// Error weights.
-    pub e: [f64; S_MAX],
-    /// Order of the error estimate plus one (the step-size exponent).
-    pub elo: f64,
-}
-
-/// RODAS4 (Hairer & Wanner 1996): 6 stages, order 4(3), L-stable.
-pub const RODAS4: Tableau = {
-    let a7 = 1.221224509226641;
-    let a8 = 6.019134481288629;
-    let a9 = 12.53708332932087;
-    let a10 = -0.687886036105895;
-    Tableau {
-        s: 6,
-        alpha: [0.0, 0.386, 0.21, 0.63, 1.0, 1.0],
-        gamma: [0.25, -0.1043, 0.1035, -0.03620000000000023, 0.0, 0.0],
-        a: [
-            [0.0; 6],
-            [1.544, 0.0, 0.0, 0.0, 0.0, 0.0],
-            [0.9466785280815826, 0.2557011698983284, 0.0, 0.0, 0.0, 0.0],
-            [3.314825187068521, 2.896124015972201, 0.9986419139977817, 0.0, 0.0, 0.0],
-            [a7, a8, a9, a10, 0.0, 0.0],
-            [a7, a8, a9, a10, 1.0, 0.0],
-        ],
-        c: [
-            [0.0; 6],
-            [-5.6688, 0.0, 0.0, 0.0, 0.0, 0.0],
-            [-2.430093356833875, -0.2063599157091915, 0.0, 0.0, 0.0, 0.0],
-            [-0.1073529058151375, -9.594562251023355, -20.47028614809616, 0.0, 0.0, 0.0],
-            [7.496443313967647, -10.24680431464352, -33.99990352819905, 11.7089089320616, 0.0, 0.0],
-            [8.083246795921522, -7.981132988064893, -31.52159432874371, 16.31930543123136, -6.058818238834054, 0.0],
-        ],
-        m: [a7, a8, a9, a10, 1.0, 1.0],
-        e: [0.0, 0.0, 0.0, 0.0, 0.0, 1.0],
-        elo: 4.0,
-    }
-};
-
-impl Tableau {
-    /// The tableau of a method given as (α, Γ, b, b̂) with
-    /// (I − hγ_ii·J)·k_i = h·f(y + Σ α_ij k_j) + h·J·Σ_{j<i} γ_ij k_j,
-    /// y₁ = y + Σ b_j k_j (the Butcher-like form of Hairer & Wanner (7.4),
-    /// as PETSc's TSRosW tables list them): a = α·Γ⁻¹, c = diag(1/γ) − Γ⁻¹,
-    /// m = b·Γ⁻¹, e = (b − b̂)·Γ⁻¹ (Hairer & Wanner (7.17)).
-    #[allow(clippy::needless_range_loop)] // triangular index arithmetic reads plainer with indices
-    pub fn from_butcher<const S: usize>(alpha: [[f64; S]; S], gam: [[f64; S]; S], b: [f64; S], bh: [f64; S], elo: f64) -> Self {
-        // Γ⁻¹ of the lower triangular Γ by forward substitution.
-        let mut gi = [[0.0; S]; S];
-        for j in 0..S {
-            for i in j..S {
-                let s: f64 = (j..i).map(|k| gam[i][k] * gi[k][j]).sum();
-                gi[i][j] = (if i == j { 1.0 } else { 0.0 } - s) / gam[i][i];
-            }
-        }
-        let mut t = Tableau { s: S, alpha: [0.0; S_MAX], gamma: [0.0; S_MAX], a: [[0.0; S_MAX]; S_MAX], c: [[0.0; S_MAX]; S_MAX], m: [0.0; S_MAX], e: [0.0; S_MAX], elo };
-        for i in 0..S {
-            t.alpha[i] = (0..i).map(|j| alpha[i][j]).sum();
-            t.gamma[i] = (0..=i).map(|j| gam[i][j]).sum();
-            for j in 0..i {
-                t.a[i][j] = (0..S).map(|k| alpha[i][k] * gi[k][j]).sum();
-                t.c[i][j] = -gi[i][j];
-            }
-            t.m[i] = (0..S).map(|k| b[k] * gi[k][i]).sum();
-            t.e[i] = (0..S).map(|k| (b[k] - bh[k]) * gi[k][i]).sum();
-        }
-        t
-    }
-
-    /// ROS34PW2 (Rang & Angermann, BIT 45, 2005), coefficients as PETSc's
-    /// TSROSWRA34PW2 lists them: 4 stages, order 3 (embedded 2) for any
-    /// Jacobian approximation, L-stable, stiffly accurate.
-    #[allow(clippy::excessive_precision)] // the coefficients as published, 17 digits
-    pub fn ros34pw2() -> Self {
-        let g = 4.3586652150845900e-01;
-        let alpha = [
-            [0.0, 0.0, 0.0, 0.0],
-            [8.7173304301691801e-01, 0.0, 0.0, 0.0],
-            [8.4457060015369423e-01, -1.1299064236484185e-01, 0.0, 0.0],
-            [0.0, 0.0, 1.0, 0.0],
-        ];
-        let gam = [
-            [g, 0.0, 0.0, 0.0],
-            [-8.7173304301691801e-01, g, 0.0, 0.0],
-            [-9.0338057013044082e-01, 5.4180672388095326e-02, g, 0.0],
-            [2.4212380706095346e-01, -1.2232505839045147e+00, 5.4526025533510214e-01, g],
-        ];
-        let b = [2.4212380706095346e-01, -1.2232505839045147e+00, 1.5452602553351020e+00, 4.3586652150845900e-01];
-        let bh = [3.7810903145819369e-01, -9.6042292212423178e-02, 5.0000000000000000e-01, 2.1793326075422950e-01];
-        Self::from_butcher(alpha, gam, b, bh, 3.0)
-    }
-}
+pub(crate) const S_MAX: usize = 6;
 
 /// Counters of a Rosenbrock integrator.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -445,110 +344,4 @@ fn cbrt_factor(x: f64) -> f64 {
         y *= (y3 + 2.0 * x) / (2.0 * y3 + x);
     }
     y
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// [`super::cbrt_factor`] within 1e-13 of `f64::cbrt` from 1e-300 to
-    /// 1e300 (log-spaced, 60 001 points) and exact beyond.
-    #[test]
-    fn cbrt_factor_is_the_cube_root() {
-        let mut worst = 0.0f64;
-        for j in 0..=60_000 {
-            let x = 10f64.powf(-300.0 + j as f64 * 1e-2);
-            let (a, b) = (super::cbrt_factor(x), x.cbrt());
-            worst = worst.max((a / b - 1.0).abs());
-        }
-        assert!(worst < 1e-13, "{worst:e}");
-        for x in [0.0, 1e-310, f64::INFINITY] {
-            assert_eq!(super::cbrt_factor(x), x.cbrt());
-        }
-        assert!(super::cbrt_factor(f64::NAN).is_nan());
-    }
-
-    /// Convergence order on y' = −y + sin t (exact solution known): halving
-    /// a fixed step must cut the error at t = 2 by ~2⁴ (order 4; 12–20
-    /// accepted around 16). A wrong tableau coefficient breaks the order.
-    #[test]
-    fn rodas4_is_fourth_order_on_a_nonstiff_problem() {
-        // y' = -y + sin(t) exact: y = Ce^{-t} + (sin t - cos t)/2.
-        let run = |h: f64| {
-            let mut r = Rosenbrock::<1>::new(1.0, [1.0], [1.0], h);
-            let mut y = [1.0];
-            // tolerances so loose that no step is rejected or enlarged:
-            // fixed steps h by integrating interval by interval.
-            let n = (2.0 / h).round() as usize;
-            for k in 0..n {
-                r.h = h;
-                r.integrate(|t, y, d| d[0] = -y[0] + t.sin(), k as f64 * h, &mut y, (k + 1) as f64 * h, |_, _, _| {}).expect("ok");
-            }
-            let t: f64 = 2.0;
-            let c = 1.0 + 0.5;
-            (y[0] - (c * (-t).exp() + (t.sin() - t.cos()) / 2.0)).abs()
-        };
-        let (e1, e2) = (run(0.1), run(0.05));
-        let ratio = e1 / e2;
-        assert!((12.0..20.0).contains(&ratio), "errors {e1:e} {e2:e}, ratio {ratio}");
-    }
-
-    /// The conversion from the Butcher-like form, checked on RODAS3: PETSc's
-    /// (α, Γ, b) table gives KPP's (a, c, m) (a₃₁ = a₄₁ = 2, a₄₃ = 1,
-    /// c₂₁ = 4, c₃₁ = 1, c₃₂ = −1, c₄₁ = 1, c₄₂ = −1, c₄₃ = −8/3,
-    /// m = (2, 0, 1, 1), γ = (1/2, 3/2, 0, 0), α = (0, 0, 1, 1)).
-    #[test]
-    fn butcher_form_converts_to_kpp_form() {
-        let alpha = [[0.0; 4], [0.0; 4], [1.0, 0.0, 0.0, 0.0], [0.75, -0.25, 0.5, 0.0]];
-        let gam = [[0.5, 0.0, 0.0, 0.0], [1.0, 0.5, 0.0, 0.0], [-0.25, -0.25, 0.5, 0.0], [1.0 / 12.0, 1.0 / 12.0, -2.0 / 3.0, 0.5]];
-        let t = Tableau::from_butcher(alpha, gam, [5.0 / 6.0, -1.0 / 6.0, -1.0 / 6.0, 0.5], [0.75, -0.25, 0.5, 0.0], 3.0);
-        let close = |a: f64, b: f64| (a - b).abs() < 1e-13;
-        assert!(close(t.a[2][0], 2.0) && close(t.a[3][0], 2.0) && close(t.a[3][2], 1.0) && close(t.a[1][0], 0.0), "{:?}", t.a);
-        let c = [(1, 0, 4.0), (2, 0, 1.0), (2, 1, -1.0), (3, 0, 1.0), (3, 1, -1.0), (3, 2, -8.0 / 3.0)];
-        assert!(c.iter().all(|&(i, j, v)| close(t.c[i][j], v)), "{:?}", t.c);
-        assert!([2.0, 0.0, 1.0, 1.0].iter().zip(&t.m).all(|(a, b)| close(*a, *b)), "{:?}", t.m);
-        assert!([0.5, 1.5, 0.0, 0.0].iter().zip(&t.gamma).all(|(a, b)| close(*a, *b)) && [0.0, 0.0, 1.0, 1.0].iter().zip(&t.alpha).all(|(a, b)| close(*a, *b)));
-    }
-
-    /// ROS34PW2 is a W-method: with the Jacobian of the first step kept for
-    /// the whole run (stale on a nonlinear problem) it stays third order on
-    /// y' = −y² + sin t: halving the step cuts the error by ~2³ (6–10).
-    #[test]
-    fn ros34pw2_keeps_third_order_with_a_stale_jacobian() {
-        let run = |h: f64| {
-            let mut r = Rosenbrock::<1>::with_method(Tableau::ros34pw2(), u32::MAX, 1.0, [1.0], [1.0], h);
-            let mut y = [1.0];
-            let n = (4.0 / h).round() as usize;
-            for k in 0..n {
-                r.h = h;
-                r.integrate(|t, y, d| d[0] = -y[0] * y[0] + t.sin(), k as f64 * h, &mut y, (k + 1) as f64 * h, |_, _, _| {}).expect("ok");
-            }
-            y[0]
-        };
-        let exact = {
-            // Reference by RODAS4 at a tiny tolerance.
-            let mut r = Rosenbrock::<1>::new(1e-13, [1e-13], [1.0], 1e-4);
-            let mut y = [1.0];
-            r.integrate(|t, y, d| d[0] = -y[0] * y[0] + t.sin(), 0.0, &mut y, 4.0, |_, _, _| {}).expect("ok");
-            y[0]
-        };
-        let (e1, e2) = ((run(0.1) - exact).abs(), (run(0.05) - exact).abs());
-        assert!((6.0..10.0).contains(&(e1 / e2)), "errors {e1:e} {e2:e}, ratio {}", e1 / e2);
-    }
-
-    /// Adaptive integration of a stiff forced system (λ = −5000 1/s, the
-    /// check-valve time scale): y' = −5000·(y − sin t) + cos t has the
-    /// solution y = sin t from y(0) = 0. At tolerances 1e-6 the error at
-    /// t = 10 s stays below 1e-6, and the steps are set by the forcing,
-    /// not by the stiff eigenvalue (an explicit method would need
-    /// 10 s / 0.4 ms = 25 000 steps; measured here: 93).
-    #[test]
-    fn rodas4_adaptive_on_a_stiff_forced_problem() {
-        let mut r = Rosenbrock::<1>::new(1e-6, [1e-6], [1.0], 1e-4);
-        let mut y = [0.0];
-        r.integrate(|t, y, d| d[0] = -5000.0 * (y[0] - t.sin()) + t.cos(), 0.0, &mut y, 10.0, |_, _, _| {}).expect("ok");
-        println!("{:?}, error {:.2e}", r.stats, (y[0] - 10f64.sin()).abs());
-        assert!((y[0] - 10f64.sin()).abs() < 1e-6, "y = {} vs {}", y[0], 10f64.sin());
-        assert!(r.stats.steps < 1000, "{:?}", r.stats);
-    }
 }

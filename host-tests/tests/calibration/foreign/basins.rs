@@ -1,13 +1,13 @@
 //! The local minima of the three-log fit
 //! (`commissioning_set_hot`) on big-pump, polished from given multiplier
-//! vectors (docs/commissioning.md, "The hot-flow run").
+//! vectors (docs/commissioning-foreign.md, "Reproducibility").
 
 use super::*;
 use eha_sim::calibration::commission::with_eta_m_from_current;
 use eha_sim::calibration::set::{index, nominal};
 use eha_sim::calibration::{calibrate, PARAMS};
 
-/// The two basins of docs/commissioning.md ("The hot-flow run"), their
+/// The two basins of docs/commissioning-foreign.md ("Reproducibility"), their
 /// end points' largest moves to two digits: the original run's, then the
 /// nudged run's.
 const BASINS: &str = "film_ball 3.8, cap_ball_block 2.2, cap_case_oil 1.44, friction_case 0.86, h_out_pump 1.6, film_port 0.71; \

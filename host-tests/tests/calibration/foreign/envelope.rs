@@ -2,7 +2,7 @@
 //! two one-at-a-time logs against variants that reach the envelope's
 //! high-load, high-speed corner, scored on the held-out logs of the bench
 //! set and on a second held-out draw (seed + 10) that no choice saw
-//! (docs/commissioning.md, "Training logs over the operating envelope").
+//! (docs/commissioning-foreign.md, "Training logs over the operating envelope").
 
 use super::{cal, headline, report};
 use eha_sim::calibration::commission::{check_reduced_with, commission};

@@ -185,7 +185,7 @@ fn near(what: &str, got: f64, measured: f64) {
 /// same to 4 digits); leaky-heavy 1.058 / 1.058 and 1.567 / 1.567 K,
 /// refused at 0.358 K (the old bookkeeping 1.057 K, 0.353 K). The misses
 /// stay asserted as measured: the structure does not close them
-/// (docs/commissioning.md, "Reproducibility").
+/// (docs/commissioning-foreign.md, "Reproducibility").
 #[test]
 #[ignore = "slow tier: two commissionings on emulator bench logs (~40 s each)"]
 fn slow_commissioning_without_margin_on_foreign_machines() {
