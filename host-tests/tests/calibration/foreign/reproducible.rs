@@ -23,6 +23,10 @@ use super::*;
 /// big-pump 0.795 K, leaky-heavy 0.226 K (with the set's own prior widths
 /// and the polish at 1e-5). A nudge that crosses lattice cells is
 /// [`slow_commissioning_is_reproducible_beyond_the_last_digit_big_pump`].
+/// With the margin's head folds (2026-11-28 night, the default): big-pump
+/// again below 1e-4 K (printed 0.0000 K; 190.4 + 166.6 s wall, 261 s user
+/// at load 4–6); leaky-heavy too (0.0000 K; 112.7 + 102.3 s wall, 339 s
+/// user).
 #[test]
 #[ignore = "slow tier: two commissionings with margin validation and the direct path (~2-4 min)"]
 fn slow_commissioning_is_reproducible_at_the_last_digit_big_pump() {
