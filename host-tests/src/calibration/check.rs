@@ -357,27 +357,7 @@ pub enum Part {
     Head,
 }
 
-/// How the margin validation scores the training logs' starts (the
-/// second kind of fold, [`Part::Head`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
-pub enum HeadFold {
-    /// Not scored: the first fold alone (after the split), the code
-    /// before 2026-11-28 night. It never scores a start from rest.
-    Off,
-    /// One fold fitted on the last [`SPLIT_FRACTION`] of every training
-    /// log, scored on every log's start. Its fit sees no start from rest
-    /// at all (the commissioning sees every training log's).
-    Tails,
-    /// One fold per training log: fitted on the other logs whole and on
-    /// the last [`SPLIT_FRACTION`] of this one, scored on this log's
-    /// start. Like the commissioning on a new log, its fit has seen the
-    /// other logs' starts from rest, not the scored one. One calibration
-    /// per training log.
-    LeaveOneOut,
-}
-
-/// Default of [`super::fit::CalOptions::margin_head_fold`].
-pub const HEAD_FOLD_DEFAULT: HeadFold = HeadFold::LeaveOneOut;
+pub use super::fit::{HeadFold, HEAD_FOLD_DEFAULT};
 
 /// The time splitting `log` for a fold scoring `part`, s.
 pub fn split_time_s(log: &CalLog, part: Part) -> f64 {

@@ -17,7 +17,7 @@ use std::sync::{Arc, Mutex};
 
 /// A training log prepared for the fit: its tick inputs and fit points
 /// (tick, node, measured °C, σ K).
-pub(super) struct Prepared {
+struct Prepared {
     inputs: TickInputs,
     ticks: Vec<usize>,
     points: Vec<(usize, usize, f64, f64)>,
@@ -45,11 +45,6 @@ fn prepare(log: &CalLog, o: &DirectOptions) -> Result<Prepared, String> {
     }
     let ticks = points.iter().map(|p| p.0).collect();
     Ok(Prepared { inputs, ticks, points })
-}
-
-/// Scaled residuals of every log with parameters `p` (the polish's data rows).
-pub(super) fn objective_parts(p: &ReducedParams, logs: &[Prepared], runs: &AtomicUsize) -> Option<Vec<f64>> {
-    residuals(p, logs, runs)
 }
 
 /// Scaled residuals of every log with parameters `p`.
@@ -197,7 +192,12 @@ pub fn identify_direct(p0: &ReducedParams, train: &[CalLog], o: &DirectOptions) 
     let theta = best.into_inner().map(|b| b.1).unwrap_or(ones.clone());
     // 3b. Converge from LM's end (`polish`): LM's end depends on its path.
     let (theta, polish) = if o.polish && !free.is_empty() {
-        let (th, pol) = super::polish::polish(p0, &logs, theta, &free, &ranges, &runs);
+        let rows = |th: &[f64]| -> Option<DVector<f64>> {
+            let mut r = residuals(&apply(p0, th)?, &logs, &runs)?;
+            r.extend(free.iter().map(|&k| th[k].ln() / DIRECT_PARAMS[k].prior_sigma_ln));
+            Some(DVector::from_vec(r))
+        };
+        let (th, pol) = super::polish::polish(rows, theta, &free, &ranges);
         (th, Some(pol))
     } else {
         (theta, None)

@@ -7,12 +7,8 @@
 //! the objective is smooth in θ and a Newton-type iteration can converge
 //! to a point that is a function of the data.
 
-use super::fit::{objective_parts, Prepared};
-use super::{apply, DIRECT_PARAMS};
-use eha_guard::model::ReducedParams;
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
-use std::sync::atomic::AtomicUsize;
 
 /// Step in ln θ of the polish's forward differences: small against the
 /// curvature (the replay has no solver noise to rise above).
@@ -38,16 +34,14 @@ pub struct DirectPolish {
     pub converged: bool,
 }
 
-/// Full objective (data rows and prior rows) at `theta`, with its rows.
-fn rows(p0: &ReducedParams, logs: &[Prepared], theta: &[f64], free: &[usize], runs: &AtomicUsize) -> Option<DVector<f64>> {
-    let mut r = objective_parts(&apply(p0, theta)?, logs, runs)?;
-    r.extend(free.iter().map(|&k| theta[k].ln() / DIRECT_PARAMS[k].prior_sigma_ln));
-    Some(DVector::from_vec(r))
-}
-
-/// Polishes `theta` (LM's end) over the `free` parameters within `ranges`.
-pub fn polish(p0: &ReducedParams, logs: &[Prepared], mut theta: Vec<f64>, free: &[usize], ranges: &[(f64, f64)], runs: &AtomicUsize) -> (Vec<f64>, DirectPolish) {
-    let Some(mut r) = rows(p0, logs, &theta, free, runs) else {
+/// Polishes `theta` (LM's end) over the `free` parameters within `ranges`;
+/// `rows(θ)`: every scaled residual, data rows then the prior rows
+/// (`None` where the firmware model rejects θ).
+pub fn polish<F>(rows: F, mut theta: Vec<f64>, free: &[usize], ranges: &[(f64, f64)]) -> (Vec<f64>, DirectPolish)
+where
+    F: Fn(&[f64]) -> Option<DVector<f64>> + Sync,
+{
+    let Some(mut r) = rows(&theta) else {
         return (theta, DirectPolish { objective: (f64::INFINITY, f64::INFINITY), iters: 0, last_decrement: f64::INFINITY, converged: false });
     };
     let f0 = r.norm_squared();
@@ -60,7 +54,7 @@ pub fn polish(p0: &ReducedParams, logs: &[Prepared], mut theta: Vec<f64>, free: 
                 let h = if theta[k].ln() + POLISH_STEP_LN > ranges[k].1.ln() { -POLISH_STEP_LN } else { POLISH_STEP_LN };
                 let mut th = theta.clone();
                 th[k] = (theta[k].ln() + h).exp();
-                Some((rows(p0, logs, &th, free, runs)? - &r) / h)
+                Some((rows(&th)? - &r) / h)
             })
             .collect();
         let Some(cols) = cols else { break };
@@ -103,7 +97,7 @@ pub fn polish(p0: &ReducedParams, logs: &[Prepared], mut theta: Vec<f64>, free: 
             for (i, &k) in free.iter().enumerate() {
                 th[k] = (theta[k].ln() + alpha * step[i]).clamp(ranges[k].0.ln(), ranges[k].1.ln()).exp();
             }
-            if let Some(rn) = rows(p0, logs, &th, free, runs) {
+            if let Some(rn) = rows(&th) {
                 if rn.norm_squared() < r.norm_squared() {
                     theta = th;
                     r = rn;
