@@ -1,7 +1,8 @@
 //! The reduced model's checks shared by both commissioning paths: the
 //! firmware model (f64) replayed on a log against the commissioned reference
 //! and the measured drain, the operating region of its largest errors, and
-//! the margin from a split of the training missions.
+//! the margin from folds of the training missions (scored after the
+//! split, and on the logs' starts).
 
 use super::fit::CalError;
 use super::log::CalLog;
@@ -189,6 +190,13 @@ struct Probe {
 /// commissioning scores up to three models with two margins on each
 /// held-out log.
 pub fn check_reduced_many(rig: &Rig, log: &CalLog, models: &[(&ReducedParams, &[f64])], score_from_s: f64) -> Result<Vec<Vec<ReducedCheck>>, String> {
+    check_reduced_window(rig, log, models, (score_from_s, f64::INFINITY))
+}
+
+/// [`check_reduced_many`] with the measured drain scored only in the
+/// window `[from, until)`, s (the margin's folds: after the split, or
+/// before it).
+pub fn check_reduced_window(rig: &Rig, log: &CalLog, models: &[(&ReducedParams, &[f64])], (score_from_s, score_until_s): (f64, f64)) -> Result<Vec<Vec<ReducedCheck>>, String> {
     let inputs = replay_inputs(&log.run, &log.name).map_err(|e| e.to_string())?;
     let t_end = log.run.time_s[log.run.len() - 1];
     let mut plant = Plant::new(rig, &Scenario::Replay(inputs)).map_err(|e| e.to_string())?;
@@ -222,7 +230,7 @@ pub fn check_reduced_many(rig: &Rig, log: &CalLog, models: &[(&ReducedParams, &[
                 prev_x = s.position_mm;
             }
             rows.push((s.t, s.speed_rpm.abs(), (s.p_a_bar - s.p_b_bar).abs(), s.t_drain_c));
-            let meas = if has_drain && k > 0 && s.t >= score_from_s { log.run.value_at(Channel::TDrainC, s.t) } else { None };
+            let meas = if has_drain && k > 0 && s.t >= score_from_s && s.t < score_until_s { log.run.value_at(Channel::TDrainC, s.t) } else { None };
             let u = ModelInputN::from_wire_f64(s.current_a, s.p_a_bar, s.p_b_bar, s.speed_rpm, s.position_mm - prev_x, s.ambient_c);
             for pr in &mut probes {
                 let drain = pr.model.drain_c();
@@ -330,21 +338,53 @@ pub enum CommissionError {
     Run(String),
 }
 
-/// Share of every training log the margin validation's fit sees; the
-/// firmware from that fit is scored on the rest.
+/// Share of every training log the margin validation's fits see: the
+/// first fold fits the first [`SPLIT_FRACTION`] of every training log and
+/// scores the rest; the second ([`Part::Head`]) fits the last
+/// [`SPLIT_FRACTION`] and scores the first 1 − [`SPLIT_FRACTION`], the
+/// log's start from rest (a cold start) included.
 pub const SPLIT_FRACTION: f64 = 0.6;
 
-/// The split of the training missions that validates a margin: the first
-/// [`SPLIT_FRACTION`] of every training log, the reference calibrated on
-/// them and its reduction.
+/// Which part of every training log a fold of the margin validation
+/// scores (the fold's fits see only the other part's measurements).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum Part {
+    /// After the split at [`SPLIT_FRACTION`] of the span (fitted on the heads).
+    Tail,
+    /// Before the split at 1 − [`SPLIT_FRACTION`] of the span: the log's
+    /// start from rest (fitted on the tails; their replays run from the
+    /// log's start, so the state at the split is the model's own).
+    Head,
+}
+
+pub use super::fit::{HeadFold, HEAD_FOLD_DEFAULT};
+
+/// The time splitting `log` for a fold scoring `part`, s.
+pub fn split_time_s(log: &CalLog, part: Part) -> f64 {
+    let t = &log.run.time_s;
+    let frac = match part {
+        Part::Tail => SPLIT_FRACTION,
+        Part::Head => 1.0 - SPLIT_FRACTION,
+    };
+    t[0] + frac * (t[t.len() - 1] - t[0])
+}
+
+/// One fold of the training missions that validates a margin: the logs
+/// its fits see, the reference calibrated on them and its reduction.
 #[derive(Debug, Clone)]
 pub struct Split {
-    /// The heads of the training logs.
+    /// The logs the fold's fits see: the heads of the training logs
+    /// ([`Part::Tail`] scored), or the whole logs with fit points after
+    /// their split only ([`Part::Head`] scored).
     pub heads: Vec<CalLog>,
-    /// The reference calibrated on the heads.
+    /// The reference calibrated on them.
     pub rig: Rig,
     /// Its reduction.
     pub reduction: ReducedParams,
+    /// The part of every training log this fold scores.
+    pub scored: Part,
+    /// The one training log (index) the fold scores; `None`: every one.
+    pub only: Option<usize>,
 }
 
 /// The firmware parameters `p` fitted on the split's heads, replayed over
@@ -356,22 +396,46 @@ pub fn score_split(split: &Split, train: &[CalLog], p: &ReducedParams) -> Result
 }
 
 /// [`score_split`] for several firmware parameter sets on one replay of
-/// `split.rig` per training log; one validation per set, in order.
+/// `split.rig` per training log; one validation per set, in order. A
+/// [`Part::Head`] fold scores before the split; its checks' log names
+/// carry " (start, fitted on the rest)".
 pub fn score_split_many(split: &Split, train: &[CalLog], ps: &[&ReducedParams]) -> Result<Vec<MarginValidation>, CommissionError> {
     let mut folds: Vec<Vec<ReducedCheck>> = vec![Vec::new(); ps.len()];
     let models: Vec<(&ReducedParams, &[f64])> = ps.iter().map(|&p| (p, &[0.0][..])).collect();
-    for (l, h) in train.iter().zip(&split.heads) {
-        let t_split = h.run.time_s[h.run.len() - 1];
-        let checks = check_reduced_many(&split.rig, l, &models, t_split).map_err(CommissionError::Run)?;
+    for (i, (l, h)) in train.iter().zip(&split.heads).enumerate() {
+        if split.only.is_some_and(|o| o != i) {
+            continue;
+        }
+        // After the head's last row; before the time the tail's fit points start.
+        let window = match split.scored {
+            Part::Tail => (h.run.time_s[h.run.len() - 1], f64::INFINITY),
+            Part::Head => (f64::NEG_INFINITY, h.fit_from_s),
+        };
+        let checks = check_reduced_window(&split.rig, l, &models, window).map_err(CommissionError::Run)?;
         for (f, mut c) in folds.iter_mut().zip(checks) {
-            f.push(c.remove(0));
+            let mut c = c.remove(0);
+            if split.scored == Part::Head {
+                c.log = format!("{} {HEAD_FOLD_TAG}", c.log);
+            }
+            f.push(c);
         }
     }
-    Ok(folds
-        .into_iter()
-        .map(|folds| {
-            let worst = folds.iter().filter_map(|f| f.vs_measured_under_k).fold(0.0, f64::max);
-            MarginValidation { folds, allowance_k: MARGIN_ALLOWANCE_K, margin_k: worst + MARGIN_ALLOWANCE_K }
-        })
-        .collect())
+    Ok(folds.into_iter().map(margin_of).collect())
+}
+
+/// Tag on the log name of a [`Part::Head`] fold's check.
+pub const HEAD_FOLD_TAG: &str = "(start, fitted on the rest)";
+
+/// The margin validated by `folds`: their largest under-prediction of the
+/// measured drain plus [`MARGIN_ALLOWANCE_K`].
+pub fn margin_of(folds: Vec<ReducedCheck>) -> MarginValidation {
+    let worst = folds.iter().filter_map(|f| f.vs_measured_under_k).fold(0.0, f64::max);
+    MarginValidation { folds, allowance_k: MARGIN_ALLOWANCE_K, margin_k: worst + MARGIN_ALLOWANCE_K }
+}
+
+/// The validation over every fold of `vs` (one path's folds, each
+/// scored by [`score_split_many`]): their checks together, the margin from
+/// the worst of them.
+pub fn merge_folds(vs: Vec<MarginValidation>) -> MarginValidation {
+    margin_of(vs.into_iter().flat_map(|v| v.folds).collect())
 }

@@ -217,7 +217,7 @@ fn plot_log(dir: &Path, base: &Rig, c: &Commissioning, l: &CalLog) -> anyhow::Re
 fn paths_section(s: &mut String, c: &Commissioning) {
     let _ = writeln!(s, "## Path: {}\n\nChosen because {}. (The held-out logs decide between two blocks, each fitted without them.)\n", c.choice.chosen.name(), c.choice.why);
     let f = |x: Option<f64>| x.map_or("–".into(), |v| format!("{v:.3}"));
-    let _ = writeln!(s, "| path | margin K | after the split, margin counted: max \\|e\\| K | held out, margin counted: worst max \\|e\\| K | worst under K |\n|---|---:|---:|---:|---:|");
+    let _ = writeln!(s, "| path | margin K | on the folds' scored parts, margin counted: max \\|e\\| K | held out, margin counted: worst max \\|e\\| K | worst under K |\n|---|---:|---:|---:|---:|");
     for p in std::iter::once(&c.reduction_path).chain(c.direct_path.as_ref().ok()) {
         let w = p.holdout_worst();
         let _ = writeln!(s, "| {} | {} | {} | {} | {} |", p.kind.name(), f(p.margin_k()), f(p.validation_max_k()), f(w.map(|w| w.0)), f(w.map(|w| w.1)));
@@ -240,7 +240,8 @@ fn margin_section(s: &mut String, c: &Commissioning) {
         let _ = writeln!(s, "Not computed: it needs `t_drain_c` in every training log and a validation fit the firmware model accepts.\n");
         return;
     };
-    let _ = writeln!(s, "Fitted on the first {:.0} % of every training log (the chosen path), and scored on the rest:\n\n| training log | firmware after the split: max \\|e\\| K | under K | where the under-prediction is largest |\n|---|---:|---:|---|", 100.0 * super::commission::SPLIT_FRACTION);
+    let pct = 100.0 * super::commission::SPLIT_FRACTION;
+    let _ = writeln!(s, "Fitted on the first {pct:.0} % of every training log (the chosen path) and scored on the rest; and (rows marked {}) fitted on the last {pct:.0} % and scored on the log's start (its cold start):\n\n| training log | firmware on the scored part: max \\|e\\| K | under K | where the under-prediction is largest |\n|---|---:|---:|---|", super::commission::HEAD_FOLD_TAG);
     let f = |x: Option<f64>| x.map_or("–".into(), |v| format!("{v:.3}"));
     for r in &m.folds {
         let _ = writeln!(s, "| {} | {} | {} | {} |", r.log, f(r.vs_measured_max_k), f(r.vs_measured_under_k), r.vs_measured_region.as_ref().map_or("–".into(), |g| g.to_string()));

@@ -15,8 +15,8 @@ use super::paths::{Choice, PathKind, PathOutcome};
 pub use super::eta_m::{eta_m_balance, eta_m_from_current, EtaMBalance, ETA_M_PLAUSIBLE};
 pub use super::check::{
     check_reduced_many,
-    check_reduced, check_reduced_with, score_split, score_split_many, CommissionError, MarginValidation, ReducedCheck, Region, Split, MARGIN_ALLOWANCE_K,
-    MARGIN_MAX_K, REDUCED_BOUND_K, SPLIT_FRACTION,
+    check_reduced, check_reduced_with, check_reduced_window, merge_folds, score_split, score_split_many, split_time_s, CommissionError, MarginValidation, Part, ReducedCheck, Region, Split, HeadFold, HEAD_FOLD_DEFAULT, HEAD_FOLD_TAG,
+    MARGIN_ALLOWANCE_K, MARGIN_MAX_K, REDUCED_BOUND_K, SPLIT_FRACTION,
 };
 use eha_guard::model::ReducedParams;
 
@@ -265,14 +265,77 @@ pub fn split_fit(base: &Rig, train: &[CalLog], o: &CalOptions, start: Option<&[f
     let heads: Vec<CalLog> = train.iter().map(|l| head_of(l, SPLIT_FRACTION, o.points_per_channel)).collect::<Result<_, _>>().map_err(CommissionError::Run)?;
     let o = CalOptions { start: start.map(<[f64]>::to_vec), ..o.clone() };
     let (_, cal, _, _) = fit(base, &heads, &o)?;
-    Ok(reduce(&cal.rig).map(|reduction| Split { heads, rig: cal.rig, reduction }))
+    Ok(reduce(&cal.rig).map(|reduction| Split { heads, rig: cal.rig, reduction, scored: Part::Tail, only: None }))
 }
 
-/// Validation of the reduction path's firmware drain over a split of the
-/// training missions ([`split_fit`], [`score_split`] of its reduction).
+/// A fold scored on training logs' starts (their first 1 − [`SPLIT_FRACTION`],
+/// from rest: the cold start the first fold never scores): the calibration
+/// on the training logs with the scored logs' fit points after their split
+/// only, and its reduction. `only`: the one log scored (the others are fitted
+/// whole, [`HeadFold::LeaveOneOut`]); `None`: every log scored
+/// ([`HeadFold::Tails`]). The fit's replays run from each log's start (the
+/// state at the split is the model's own, driven by the logged inputs); the
+/// scored logs' fit points, and the current rows η_m is taken from, lie
+/// after their split only, so no measured temperature of a scored part
+/// enters the fit. (The excitation rules that decide which parameters are
+/// free look at the whole logs' inputs.) `None` as [`split_fit`]. `start`:
+/// as there.
+pub fn head_fold_fit(base: &Rig, train: &[CalLog], o: &CalOptions, start: Option<&[f64]>, only: Option<usize>) -> Result<Option<Split>, CommissionError> {
+    if train.is_empty() || !train.iter().all(|l| l.has(Channel::TDrainC)) {
+        return Ok(None);
+    }
+    let scored = |i: usize| only.is_none_or(|o| o == i);
+    let t_split: Vec<f64> = train.iter().enumerate().map(|(i, l)| if scored(i) { split_time_s(l, Part::Head) } else { f64::NEG_INFINITY }).collect();
+    let fitted: Vec<CalLog> = train.iter().zip(&t_split).map(|(l, &t)| if t.is_finite() { l.fitted_from(t, o.points_per_channel) } else { l.clone() }).collect();
+    let tails: Vec<CalLog> =
+        train.iter().zip(&t_split).map(|(l, &t)| if t.is_finite() { tail_of(l, t, o.points_per_channel) } else { Ok(l.clone()) }).collect::<Result<_, _>>().map_err(CommissionError::Run)?;
+    let o = CalOptions { start: start.map(<[f64]>::to_vec), ..o.clone() };
+    let (base_e, o, _) = with_eta_m(base, eta_m_balance(base, &tails), &o);
+    let cal = calibrate(&base_e, &fitted, &o)?;
+    Ok(reduce(&cal.rig).map(|reduction| Split { heads: fitted, rig: cal.rig, reduction, scored: Part::Head, only }))
+}
+
+/// The rows of `log` from `t0_s` on as a log of its own (for the
+/// electrical balance of the head fold; never replayed).
+fn tail_of(log: &CalLog, t0_s: f64, points_per_channel: usize) -> Result<CalLog, String> {
+    let r = &log.run;
+    let n = r.time_s.partition_point(|&t| t < t0_s);
+    let mut tail = r.clone();
+    tail.time_s.drain(..n);
+    tail.channels.values_mut().for_each(|v| {
+        v.drain(..n);
+    });
+    CalLog::new(&log.name, tail, points_per_channel)
+}
+
+/// The margin's folds: [`split_fit`] and, with
+/// [`CalOptions::margin_head_fold`], [`head_fold_fit`] (when it gives a
+/// block the firmware accepts).
+pub fn margin_folds(base: &Rig, train: &[CalLog], o: &CalOptions, start: Option<&[f64]>) -> Result<Vec<Split>, CommissionError> {
+    let Some(first) = split_fit(base, train, o, start)? else { return Ok(Vec::new()) };
+    let mut v = vec![first];
+    match o.margin_head_fold {
+        HeadFold::Off => {}
+        HeadFold::Tails => v.extend(head_fold_fit(base, train, o, start, None)?),
+        HeadFold::LeaveOneOut => {
+            for i in 0..train.len() {
+                v.extend(head_fold_fit(base, train, o, start, Some(i))?);
+            }
+        }
+    }
+    Ok(v)
+}
+
+/// Validation of the reduction path's firmware drain over the folds of
+/// the training missions ([`margin_folds`], [`score_split`] of each fold's
+/// reduction, merged).
 pub fn validate_margin(base: &Rig, train: &[CalLog], o: &CalOptions, start: Option<&[f64]>) -> Result<Option<MarginValidation>, CommissionError> {
-    let Some(split) = split_fit(base, train, o, start)? else { return Ok(None) };
-    score_split(&split, train, &split.reduction).map(Some)
+    let folds = margin_folds(base, train, o, start)?;
+    if folds.is_empty() {
+        return Ok(None);
+    }
+    let vs = folds.iter().map(|s| score_split(s, train, &s.reduction)).collect::<Result<Vec<_>, _>>()?;
+    Ok(Some(merge_folds(vs)))
 }
 
 /// Commissions `base` on `train`, validates on `holdout`, with the drain
@@ -316,25 +379,38 @@ pub fn commission_with(base: &Rig, train: &[CalLog], holdout: &[CalLog], o: &Cal
     // the rig file, a 1e-9 K nudge of the logs moved big-pump's margin by
     // 0.17 K (the heads fit wanders along its ill-determined directions);
     // from there, by 0.043 K.
-    let split = if with_margin { split_fit(base, train, o, Some(&cal.theta))? } else { None };
+    let splits = if with_margin { margin_folds(base, train, o, Some(&cal.theta))? } else { Vec::new() };
+    let n_folds = match o.margin_head_fold {
+        HeadFold::Off => 1,
+        HeadFold::Tails => 2,
+        HeadFold::LeaveOneOut => 1 + train.len(),
+    };
+    if with_margin && !splits.is_empty() && splits.len() < n_folds {
+        cal.warnings.push(format!("{} of the margin's folds scored on a training log's start gave no block the firmware accepts: those starts are not validated", n_folds - splits.len()));
+    }
     // The second path: the firmware model's own parameters identified from
-    // the logs, from the reduction; validated on the same split.
+    // the logs, from the reduction; validated on the same folds.
     let direct = match (&o.direct, with_margin) {
-        (Some(d), true) => super::paths::direct_fits(&params, train, split.as_ref(), d),
+        (Some(d), true) => super::paths::direct_fits(&params, train, &splits, d),
         (Some(_), false) => Err("not asked: no margin validation to compare the paths on".into()),
         (None, _) => Err("switched off".into()),
     };
-    // Both paths' folds after the split on one replay of each training log.
-    let (margin, direct_validation) = match &split {
-        Some(s) => {
+    // Both paths' folds on one replay of each training log per fold.
+    let (margin, direct_validation) = if splits.is_empty() {
+        (None, None)
+    } else {
+        let (mut red, mut dir) = (Vec::new(), Vec::new());
+        for (i, s) in splits.iter().enumerate() {
             let mut ps = vec![&s.reduction];
-            if let Ok((_, Some(h))) = &direct {
-                ps.push(h);
+            if let Ok((_, hs)) = &direct {
+                ps.extend(hs.get(i));
             }
             let mut v = score_split_many(s, train, &ps)?.into_iter();
-            (v.next(), v.next())
+            red.extend(v.next());
+            dir.extend(v.next());
         }
-        None => (None, None),
+        let dir_ok = dir.len() == splits.len();
+        (Some(merge_folds(red)), dir_ok.then(|| merge_folds(dir)))
     };
     if with_margin && margin.is_none() {
         cal.warnings.push("no drain margin: it needs `t_drain_c` in every training log, and a validation fit (first 60 % of every training log) that the firmware model accepts".into());

@@ -84,6 +84,10 @@ pub struct CalOptions {
     /// fit on all of them starts from its multipliers; 0: off, every fit
     /// from the rig file.
     pub continuation_logs: usize,
+    /// `commission` only (the calibration itself ignores it): how the
+    /// drain margin is validated on the training logs' starts besides after
+    /// the split ([`HeadFold`]; default [`HEAD_FOLD_DEFAULT`]).
+    pub margin_head_fold: HeadFold,
 }
 
 /// Default factor on every prior width of the set in the fit
@@ -135,9 +139,32 @@ impl Default for CalOptions {
             prior_scale: PRIOR_SCALE,
             polish_s2: None,
             continuation_logs: CONTINUATION_LOGS,
+            margin_head_fold: HEAD_FOLD_DEFAULT,
         }
     }
 }
+
+/// How the margin validation scores the training logs' starts (the
+/// second kind of fold, [`super::check::Part::Head`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum HeadFold {
+    /// Not scored: the first fold alone (after the split), the code
+    /// before 2026-11-28 night. It never scores a start from rest.
+    Off,
+    /// One fold fitted on the last [`super::check::SPLIT_FRACTION`] of every training
+    /// log, scored on every log's start. Its fit sees no start from rest
+    /// at all (the commissioning sees every training log's).
+    Tails,
+    /// One fold per training log: fitted on the other logs whole and on
+    /// the last [`super::check::SPLIT_FRACTION`] of this one, scored on this log's
+    /// start. Like the commissioning on a new log, its fit has seen the
+    /// other logs' starts from rest, not the scored one. One calibration
+    /// per training log.
+    LeaveOneOut,
+}
+
+/// Default of [`CalOptions::margin_head_fold`].
+pub const HEAD_FOLD_DEFAULT: HeadFold = HeadFold::LeaveOneOut;
 
 /// Why `commission` holds the oil probe's response time unless asked: a
 /// free probe lag also takes up oil-model structure, which generalises

@@ -28,6 +28,9 @@ pub struct CalLog {
     /// Relative tolerance of the replay solver ([`REPLAY_RTOL`] unless
     /// [`CalLog::with_rtol`] set it).
     pub rtol: f64,
+    /// Time from which the fits take their points, s (−∞: the whole log;
+    /// [`CalLog::fitted_from`]). The replay always runs from the log's start.
+    pub fit_from_s: f64,
 }
 
 /// The channels a log can be scored on: [`Channel::TEMPERATURES`] and
@@ -56,17 +59,19 @@ impl CalLog {
         let dt = (span / 400.0).clamp(0.5, 5.0);
         let opts = SimOptions { output_interval_s: dt, control_interval_s: dt };
         let channels = scored_channels(&run);
-        let mut points = Vec::new();
-        for &ch in &channels {
-            let rows: Vec<usize> = (0..run.len()).filter(|&i| run.get(ch).is_some_and(|v| v[i].is_some())).collect();
-            let step = (rows.len() as f64 / points_per_channel.max(1) as f64).max(1.0);
-            let mut k = 0.0;
-            while (k as usize) < rows.len() {
-                points.push((ch, rows[k as usize]));
-                k += step;
-            }
-        }
-        Ok(CalLog { name: name.into(), run, channels, points, scenario: Scenario::Replay(inputs), opts, rtol: REPLAY_RTOL })
+        let points = thinned_points(&run, &channels, points_per_channel, f64::NEG_INFINITY);
+        Ok(CalLog { name: name.into(), run, channels, points, scenario: Scenario::Replay(inputs), opts, rtol: REPLAY_RTOL, fit_from_s: f64::NEG_INFINITY })
+    }
+
+    /// The same log with its fit points (at most `points_per_channel` per
+    /// channel, thinned as [`CalLog::new`] does) taken from `t0_s` on only;
+    /// the replay still runs from the log's start, so the state at `t0_s`
+    /// is the model's own. The margin's head fold fits these
+    /// (`calibration::commission`): its fits see no measured temperature
+    /// before `t0_s`.
+    pub fn fitted_from(&self, t0_s: f64, points_per_channel: usize) -> Self {
+        let points = thinned_points(&self.run, &self.channels, points_per_channel, t0_s);
+        CalLog { points, fit_from_s: t0_s, ..self.clone() }
     }
 
     /// The same log replayed at solver tolerance `rtol`.
@@ -117,6 +122,22 @@ impl CalLog {
     pub fn has(&self, ch: Channel) -> bool {
         self.channels.contains(&ch)
     }
+}
+
+/// Fit points of `run`'s `channels`: per channel its rows with a sample at
+/// or after `t0_s` (s), uniformly thinned to at most `points_per_channel`.
+fn thinned_points(run: &MeasuredRun, channels: &[Channel], points_per_channel: usize, t0_s: f64) -> Vec<(Channel, usize)> {
+    let mut points = Vec::new();
+    for &ch in channels {
+        let rows: Vec<usize> = (0..run.len()).filter(|&i| run.time_s[i] >= t0_s && run.get(ch).is_some_and(|v| v[i].is_some())).collect();
+        let step = (rows.len() as f64 / points_per_channel.max(1) as f64).max(1.0);
+        let mut k = 0.0;
+        while (k as usize) < rows.len() {
+            points.push((ch, rows[k as usize]));
+            k += step;
+        }
+    }
+    points
 }
 
 /// The replayed ambient (°C) of `r` at `times` (s), linearly interpolated;

@@ -119,19 +119,20 @@ pub fn plain_and_with(mut checks: Vec<ReducedCheck>) -> (ReducedCheck, ReducedCh
 }
 
 /// The direct path's identifications: on the training logs from the
-/// reduction `p0`, and (with a split) on the split's heads from the split's
-/// reduction, whose parameters the split then scores. `Err`: why it did
-/// not run, or the firmware model rejects what it found.
-pub fn direct_fits(p0: &ReducedParams, train: &[CalLog], split: Option<&Split>, o: &DirectOptions) -> Result<(DirectFit, Option<ReducedParams>), String> {
+/// reduction `p0`, and on each margin fold's logs (`Split::heads`) from
+/// that fold's reduction, whose parameters the fold then scores (one per
+/// fold, in order). `Err`: why it did not run, or the firmware model
+/// rejects what it found.
+pub fn direct_fits(p0: &ReducedParams, train: &[CalLog], splits: &[Split], o: &DirectOptions) -> Result<(DirectFit, Vec<ReducedParams>), String> {
     let fit = identify_direct(p0, train, o).map_err(|e| e.to_string())?;
-    let heads = match split {
-        Some(s) => Some(identify_direct(&s.reduction, &s.heads, o).map_err(|e| format!("on the split's heads: {e}"))?.params),
-        None => None,
-    };
-    for p in std::iter::once(&fit.params).chain(heads.as_ref()) {
+    let folds = splits
+        .iter()
+        .map(|s| identify_direct(&s.reduction, &s.heads, o).map(|f| f.params).map_err(|e| format!("on the margin fold's logs ({:?} scored): {e}", s.scored)))
+        .collect::<Result<Vec<_>, _>>()?;
+    for p in std::iter::once(&fit.params).chain(&folds) {
         eha_guard::model::Model::<f64>::new(p).map_err(|e| format!("the firmware model rejects the identified parameters: {e:?}"))?;
     }
-    Ok((fit, heads))
+    Ok((fit, folds))
 }
 
 /// Which path is flashed, and why.

@@ -121,7 +121,7 @@ fn report(m: &EmuMachine, c: &Commissioning, secs: f64) {
     }
     if let Some(v) = &c.margin {
         for f in &v.folds {
-            eprintln!("  after the split: {}: max {:?} under {:?} at {:?}", f.log, f.vs_measured_max_k, f.vs_measured_under_k, f.vs_measured_region.as_ref().map(|g| g.to_string()));
+            eprintln!("  fold: {}: max {:?} under {:?} at {:?}", f.log, f.vs_measured_max_k, f.vs_measured_under_k, f.vs_measured_region.as_ref().map(|g| g.to_string()));
         }
     }
     eprintln!("  chosen: {:?}: {}", c.choice.chosen, c.choice.why);
@@ -139,7 +139,7 @@ fn report(m: &EmuMachine, c: &Commissioning, secs: f64) {
     }
     if let Some(f) = &c.direct_fit {
         let v: Vec<String> = f.results.iter().filter(|r| r.held.is_none()).map(|r| format!("{} {:.3}{}", r.name, r.value, if r.at_bound { "*" } else { "" })).collect();
-        eprintln!("  direct fit: {} runs, chi2 {:.0} -> {:.0}; {}", f.model_runs, f.chi2_before_after.0, f.chi2_before_after.1, v.join(", "));
+        eprintln!("  direct fit: {} runs, chi2 {:.0} -> {:.0}; {}; polish {:?}", f.model_runs, f.chi2_before_after.0, f.chi2_before_after.1, v.join(", "), f.polish);
     }
     for (a, b) in c.holdout_without_margin().iter().zip(&c.holdout_with_margin) {
         eprintln!("  cost {}: valve open {:.0} -> {:.0} s, LNG {:.3} -> {:.3} kg", a.log, a.valve_open_s, b.valve_open_s, a.lng_kg, b.lng_kg);
@@ -243,6 +243,22 @@ fn slow_commissioning_without_margin_on_foreign_machines() {
 ///   1.191 K, 1.471 / 0.000 and 2.334 / 0.617 K (old bookkeeping 1.750 K
 ///   on the servo log), valve 1550 → 1560 s. Not met: under-prediction
 ///   0.54–0.62 K, max |e| 2.3–2.8 K.
+/// - **With the margin's head folds** (2026-11-28 night, the default
+///   `check::HEAD_FOLD_DEFAULT`: besides the fold fitted on the first
+///   60 % of every training log and scored after it, one fold per
+///   training log fitted on the other logs whole and on this log's last
+///   60 %, scored on its first 40 %, the start from rest): big-pump's
+///   soak start (t 13–71 s, 640 rpm, 48 bar, drain 27–34 °C) is 1.52 K
+///   under, so the margin rises 0.906 → **1.722 K** (the reduction's) and
+///   both paths come within 0.3 K under on the held-out logs; the
+///   reduction (smaller max |e|) is flashed: **2.201 / 0.000 and
+///   2.676 / 0.000 K** (the direct path, margin 1.712 K:
+///   2.237 / 0.000, 3.176 / 0.152 K); the mix's valve 1405 → 1519 s, LNG
+///   2.798 → 2.990 kg. Leaky-heavy's starts are 0.31–0.33 K under (the
+///   direct path's), below its after-split 0.99 K: margin 1.191 K and its
+///   numbers unchanged, 1.471 / 0.000 and 2.334 / 0.617 K (the mix's hot
+///   corner; valve 1550 → 1560 s). Under-prediction met on big-pump, not on leaky-heavy; max
+///   |e| met on neither.
 /// - Time: see `slow_commissioning_is_reproducible_beyond_the_last_digit_big_pump`.
 ///   Not a timing test.
 /// - With the hot-flow run as a third training log:
@@ -251,7 +267,7 @@ fn slow_commissioning_without_margin_on_foreign_machines() {
 #[ignore = "slow tier: two commissionings with margin validation on emulator bench logs (~1 min each)"]
 fn slow_commissioning_with_margin_on_foreign_machines() {
     let measured = [
-        (1.319, PathKind::Direct, [(1.838, 0.000), (2.782, 0.541)], [1412.0, 1519.0]),
+        (1.722, PathKind::Reduction, [(2.201, 0.000), (2.676, 0.000)], [1405.0, 1519.0]),
         (1.191, PathKind::Direct, [(1.471, 0.000), (2.334, 0.617)], [1550.0, 1560.0]),
     ];
     for (m, row) in machines().into_iter().zip(measured) {
@@ -409,12 +425,36 @@ fn slow_structure_experiment() {
             o.hold.push((h, "EXP_HOLD".into()));
         }
         o.prior_sigma.extend(exp_priors());
+        o.margin_head_fold = exp_head_fold();
+        exp_direct_polish(&mut o);
         let t0 = std::time::Instant::now();
         let c = commission_with(&m.rig_file(), &train, &hold_logs, &o, margin).expect("commissioning");
         report(&m, &c, t0.elapsed().as_secs_f64());
         let h = headline(&m, &c, &s.holdout);
         let w: Vec<String> = c.holdout_without_margin().iter().map(|r| format!("{} {:.3}/{:.3}", r.log, r.vs_measured_max_k.unwrap_or(f64::NAN), r.vs_measured_under_k.unwrap_or(f64::NAN))).collect();
         eprintln!("EXP {} train={} hold={:?} margin={}: without margin {}; with margin {:.3} K: {:.3?}", m.name, if procedure { train_kind.as_str() } else { "bench" }, hold, margin, w.join(", "), h.margin_k, h.measured);
+    }
+}
+
+/// `EXP_HEAD_FOLD`: an experiment knob, how the margin scores the
+/// training logs' starts (`off`, `tails`, `loo`; default the calibration's).
+pub(super) fn exp_head_fold() -> eha_sim::calibration::check::HeadFold {
+    use eha_sim::calibration::check::{HeadFold, HEAD_FOLD_DEFAULT};
+    match std::env::var("EXP_HEAD_FOLD").as_deref() {
+        Ok("off") => HeadFold::Off,
+        Ok("tails") => HeadFold::Tails,
+        Ok("loo") => HeadFold::LeaveOneOut,
+        _ => HEAD_FOLD_DEFAULT,
+    }
+}
+
+/// `EXP_DIRECT_POLISH=1`: an experiment knob, the direct fit with its
+/// Gauss–Newton polish (`DirectOptions::polish`, off by default).
+pub(super) fn exp_direct_polish(o: &mut CalOptions) {
+    if std::env::var("EXP_DIRECT_POLISH").is_ok_and(|v| v == "1") {
+        if let Some(d) = o.direct.as_mut() {
+            d.polish = true;
+        }
     }
 }
 
