@@ -13,10 +13,9 @@ use crate::scenario::Circuit;
 use crate::simulation::replay::circuit_of;
 use super::paths::{Choice, PathKind, PathOutcome};
 pub use super::eta_m::{eta_m_balance, eta_m_from_current, EtaMBalance, ETA_M_PLAUSIBLE};
-pub use super::check::{
-    check_reduced_many,
-    check_reduced, check_reduced_with, check_reduced_window, merge_folds, score_split, score_split_many, split_time_s, CommissionError, MarginValidation, Part, ReducedCheck, Region, Split, HeadFold, HEAD_FOLD_DEFAULT, HEAD_FOLD_TAG,
-    MARGIN_ALLOWANCE_K, MARGIN_MAX_K, REDUCED_BOUND_K, SPLIT_FRACTION,
+pub use super::check::{check_reduced, check_reduced_many, check_reduced_with, check_reduced_window, CommissionError, ReducedCheck, Region, MARGIN_MAX_K, REDUCED_BOUND_K};
+pub use super::margin::{
+    merge_folds, score_split, score_split_many, split_time_s, HeadFold, MarginValidation, Part, Split, HEAD_FOLD_DEFAULT, HEAD_FOLD_TAG, MARGIN_ALLOWANCE_K, SPLIT_FRACTION,
 };
 use eha_guard::model::ReducedParams;
 

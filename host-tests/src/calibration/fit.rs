@@ -145,18 +145,18 @@ impl Default for CalOptions {
 }
 
 /// How the margin validation scores the training logs' starts (the
-/// second kind of fold, [`super::check::Part::Head`]).
+/// second kind of fold, [`super::margin::Part::Head`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 pub enum HeadFold {
     /// Not scored: the first fold alone (after the split), the code
     /// before 2026-11-28 night. It never scores a start from rest.
     Off,
-    /// One fold fitted on the last [`super::check::SPLIT_FRACTION`] of every training
+    /// One fold fitted on the last [`super::margin::SPLIT_FRACTION`] of every training
     /// log, scored on every log's start. Its fit sees no start from rest
     /// at all (the commissioning sees every training log's).
     Tails,
     /// One fold per training log: fitted on the other logs whole and on
-    /// the last [`super::check::SPLIT_FRACTION`] of this one, scored on this log's
+    /// the last [`super::margin::SPLIT_FRACTION`] of this one, scored on this log's
     /// start. Like the commissioning on a new log, its fit has seen the
     /// other logs' starts from rest, not the scored one. One calibration
     /// per training log.

@@ -24,6 +24,7 @@ pub mod eta_m;
 pub mod fit;
 pub mod ident;
 pub mod log;
+pub mod margin;
 pub mod lsq;
 pub mod paper;
 pub mod paths;

@@ -3,13 +3,14 @@
 //! (`reduce`), and the firmware model's own parameters identified directly
 //! from the logs, starting from that reduction ([`super::direct`]). Each
 //! path's firmware is validated on the split of the training missions
-//! (fitted on the first [`super::check::SPLIT_FRACTION`] of every
+//! (fitted on the first [`super::margin::SPLIT_FRACTION`] of every
 //! training log, scored against the measured drain after it) with its own
 //! margin, and both are scored on the held-out logs with that margin; the
 //! block comes from the path that is safer there ([`choose`]), and the
 //! report gives both paths' numbers.
 
-use super::check::{check_reduced_many, CommissionError, MarginValidation, ReducedCheck, Split, MARGIN_MAX_K};
+use super::check::{check_reduced_many, CommissionError, ReducedCheck, MARGIN_MAX_K};
+use super::margin::{MarginValidation, Split};
 use super::direct::{identify_direct, DirectFit, DirectOptions};
 use super::log::CalLog;
 use crate::rig::Rig;

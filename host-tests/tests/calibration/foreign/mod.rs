@@ -244,7 +244,7 @@ fn slow_commissioning_without_margin_on_foreign_machines() {
 ///   on the servo log), valve 1550 → 1560 s. Not met: under-prediction
 ///   0.54–0.62 K, max |e| 2.3–2.8 K.
 /// - **With the margin's head folds** (2026-11-28 night, the default
-///   `check::HEAD_FOLD_DEFAULT`: besides the fold fitted on the first
+///   `margin::HEAD_FOLD_DEFAULT`: besides the fold fitted on the first
 ///   60 % of every training log and scored after it, one fold per
 ///   training log fitted on the other logs whole and on this log's last
 ///   60 %, scored on its first 40 %, the start from rest): big-pump's
@@ -438,8 +438,8 @@ fn slow_structure_experiment() {
 
 /// `EXP_HEAD_FOLD`: an experiment knob, how the margin scores the
 /// training logs' starts (`off`, `tails`, `loo`; default the calibration's).
-pub(super) fn exp_head_fold() -> eha_sim::calibration::check::HeadFold {
-    use eha_sim::calibration::check::{HeadFold, HEAD_FOLD_DEFAULT};
+pub(super) fn exp_head_fold() -> eha_sim::calibration::margin::HeadFold {
+    use eha_sim::calibration::margin::{HeadFold, HEAD_FOLD_DEFAULT};
     match std::env::var("EXP_HEAD_FOLD").as_deref() {
         Ok("off") => HeadFold::Off,
         Ok("tails") => HeadFold::Tails,

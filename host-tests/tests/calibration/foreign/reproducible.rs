@@ -62,7 +62,7 @@ fn slow_commissioning_is_reproducible_at_the_last_digit_leaky_heavy() {
 /// direct path's fit is not converged to 0.05 K, and a path choice within
 /// two such spreads can flip.
 ///
-/// With the margin's head folds (2026-11-28 night, `check::HeadFold::LeaveOneOut`,
+/// With the margin's head folds (2026-11-28 night, `margin::HeadFold::LeaveOneOut`,
 /// the default): big-pump **0.058 K** (4:31 wall and 264 s user for the
 /// two commissionings at load 5–6): both paths now within 0.3 K under on
 /// the held-out logs, the reduction flashed both times for its smaller max
