@@ -241,15 +241,18 @@ fn with_eta_m(base: &Rig, balance: EtaMBalance, o: &CalOptions) -> (Rig, CalOpti
     (base_e, o, eta_e)
 }
 
-/// The first `frac` of `log`'s span as a log of its own.
-fn head_of(log: &CalLog, frac: f64, points_per_channel: usize) -> Result<CalLog, String> {
-    let r = &log.run;
-    let t_split = r.time_s[0] + frac * (r.time_s[r.len() - 1] - r.time_s[0]);
-    let n = r.time_s.partition_point(|&t| t <= t_split);
-    let mut head = r.clone();
-    head.time_s.truncate(n);
-    head.channels.values_mut().for_each(|v| v.truncate(n));
-    CalLog::new(&log.name, head, points_per_channel)
+/// Rows `rows` of `log` as a log of its own.
+fn rows_of(log: &CalLog, rows: std::ops::Range<usize>, points_per_channel: usize) -> Result<CalLog, String> {
+    let mut run = log.run.clone();
+    run.time_s = run.time_s[rows.clone()].to_vec();
+    run.channels.values_mut().for_each(|v| *v = v[rows.clone()].to_vec());
+    CalLog::new(&log.name, run, points_per_channel)
+}
+
+/// The first [`SPLIT_FRACTION`] of `log`'s span as a log of its own.
+fn head_of(log: &CalLog, points_per_channel: usize) -> Result<CalLog, String> {
+    let t_split = split_time_s(log, Part::Tail);
+    rows_of(log, 0..log.run.time_s.partition_point(|&t| t <= t_split), points_per_channel)
 }
 
 /// The calibration on the first [`SPLIT_FRACTION`] of every training log
@@ -261,7 +264,7 @@ pub fn split_fit(base: &Rig, train: &[CalLog], o: &CalOptions, start: Option<&[f
     if train.is_empty() || !train.iter().all(|l| l.has(Channel::TDrainC)) {
         return Ok(None);
     }
-    let heads: Vec<CalLog> = train.iter().map(|l| head_of(l, SPLIT_FRACTION, o.points_per_channel)).collect::<Result<_, _>>().map_err(CommissionError::Run)?;
+    let heads: Vec<CalLog> = train.iter().map(|l| head_of(l, o.points_per_channel)).collect::<Result<_, _>>().map_err(CommissionError::Run)?;
     let o = CalOptions { start: start.map(<[f64]>::to_vec), ..o.clone() };
     let (_, cal, _, _) = fit(base, &heads, &o)?;
     Ok(reduce(&cal.rig).map(|reduction| Split { heads, rig: cal.rig, reduction, scored: Part::Tail, only: None }))
@@ -283,11 +286,11 @@ pub fn head_fold_fit(base: &Rig, train: &[CalLog], o: &CalOptions, start: Option
     if train.is_empty() || !train.iter().all(|l| l.has(Channel::TDrainC)) {
         return Ok(None);
     }
-    let scored = |i: usize| only.is_none_or(|o| o == i);
-    let t_split: Vec<f64> = train.iter().enumerate().map(|(i, l)| if scored(i) { split_time_s(l, Part::Head) } else { f64::NEG_INFINITY }).collect();
-    let fitted: Vec<CalLog> = train.iter().zip(&t_split).map(|(l, &t)| if t.is_finite() { l.fitted_from(t, o.points_per_channel) } else { l.clone() }).collect();
+    // The split of each scored log; `None`: fitted whole.
+    let t_split: Vec<Option<f64>> = train.iter().enumerate().map(|(i, l)| only.is_none_or(|o| o == i).then(|| split_time_s(l, Part::Head))).collect();
+    let fitted: Vec<CalLog> = train.iter().zip(&t_split).map(|(l, t)| t.map_or_else(|| l.clone(), |t| l.fitted_from(t, o.points_per_channel))).collect();
     let tails: Vec<CalLog> =
-        train.iter().zip(&t_split).map(|(l, &t)| if t.is_finite() { tail_of(l, t, o.points_per_channel) } else { Ok(l.clone()) }).collect::<Result<_, _>>().map_err(CommissionError::Run)?;
+        train.iter().zip(&t_split).map(|(l, t)| t.map_or_else(|| Ok(l.clone()), |t| tail_of(l, t, o.points_per_channel))).collect::<Result<_, _>>().map_err(CommissionError::Run)?;
     let o = CalOptions { start: start.map(<[f64]>::to_vec), ..o.clone() };
     let (base_e, o, _) = with_eta_m(base, eta_m_balance(base, &tails), &o);
     let cal = calibrate(&base_e, &fitted, &o)?;
@@ -297,14 +300,8 @@ pub fn head_fold_fit(base: &Rig, train: &[CalLog], o: &CalOptions, start: Option
 /// The rows of `log` from `t0_s` on as a log of its own (for the
 /// electrical balance of the head fold; never replayed).
 fn tail_of(log: &CalLog, t0_s: f64, points_per_channel: usize) -> Result<CalLog, String> {
-    let r = &log.run;
-    let n = r.time_s.partition_point(|&t| t < t0_s);
-    let mut tail = r.clone();
-    tail.time_s.drain(..n);
-    tail.channels.values_mut().for_each(|v| {
-        v.drain(..n);
-    });
-    CalLog::new(&log.name, tail, points_per_channel)
+    let t = &log.run.time_s;
+    rows_of(log, t.partition_point(|&t| t < t0_s)..t.len(), points_per_channel)
 }
 
 /// The margin's folds: [`split_fit`] and, with
@@ -379,11 +376,7 @@ pub fn commission_with(base: &Rig, train: &[CalLog], holdout: &[CalLog], o: &Cal
     // 0.17 K (the heads fit wanders along its ill-determined directions);
     // from there, by 0.043 K.
     let splits = if with_margin { margin_folds(base, train, o, Some(&cal.theta))? } else { Vec::new() };
-    let n_folds = match o.margin_head_fold {
-        HeadFold::Off => 1,
-        HeadFold::Tails => 2,
-        HeadFold::LeaveOneOut => 1 + train.len(),
-    };
+    let n_folds = 1 + o.margin_head_fold.head_folds(train.len());
     if with_margin && !splits.is_empty() && splits.len() < n_folds {
         cal.warnings.push(format!("{} of the margin's folds scored on a training log's start gave no block the firmware accepts: those starts are not validated", n_folds - splits.len()));
     }

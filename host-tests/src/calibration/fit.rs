@@ -163,6 +163,17 @@ pub enum HeadFold {
     LeaveOneOut,
 }
 
+impl HeadFold {
+    /// Folds scored on the starts of `n_logs` training logs.
+    pub fn head_folds(self, n_logs: usize) -> usize {
+        match self {
+            HeadFold::Off => 0,
+            HeadFold::Tails => 1,
+            HeadFold::LeaveOneOut => n_logs,
+        }
+    }
+}
+
 /// Default of [`CalOptions::margin_head_fold`].
 pub const HEAD_FOLD_DEFAULT: HeadFold = HeadFold::LeaveOneOut;
 

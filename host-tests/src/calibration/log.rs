@@ -130,14 +130,17 @@ fn thinned_points(run: &MeasuredRun, channels: &[Channel], points_per_channel: u
     let mut points = Vec::new();
     for &ch in channels {
         let rows: Vec<usize> = (0..run.len()).filter(|&i| run.time_s[i] >= t0_s && run.get(ch).is_some_and(|v| v[i].is_some())).collect();
-        let step = (rows.len() as f64 / points_per_channel.max(1) as f64).max(1.0);
-        let mut k = 0.0;
-        while (k as usize) < rows.len() {
-            points.push((ch, rows[k as usize]));
-            k += step;
-        }
+        points.extend(thin(&rows, points_per_channel).map(|i| (ch, i)));
     }
     points
+}
+
+/// `rows` uniformly thinned to at most `n`: from the first, every `step`-th
+/// (step = len/n, at least 1, accumulated), all of them when there are no
+/// more than `n`.
+pub(super) fn thin(rows: &[usize], n: usize) -> impl Iterator<Item = usize> + '_ {
+    let step = (rows.len() as f64 / n.max(1) as f64).max(1.0);
+    std::iter::successors(Some(0.0f64), move |k| Some(k + step)).take_while(|&k| (k as usize) < rows.len()).map(|k| rows[k as usize])
 }
 
 /// The replayed ambient (°C) of `r` at `times` (s), linearly interpolated;

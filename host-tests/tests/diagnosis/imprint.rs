@@ -217,9 +217,8 @@ fn slow_imprint_ratio_with_structure_no_case_held() {
 #[ignore = "slow tier: one emulator case with its twin (~2 min)"]
 fn slow_nominal_restarts_find_the_twin_of_2712_a_better_basin() {
     let o = DiagnoseOptions { structure: Structure::NoCaseHeld, nominal_restarts: true, ..DiagnoseOptions::default() };
-    let c = eha_sim::diagnosis::emu_sweep::case_of_seed(1200.0, 2712).expect("seed 2712");
-    let r = run_emu_case_twin(c, &o, true).expect("emulated log diagnoses");
-    eprintln!("{}", eha_sim::diagnosis::emu_sweep::table_row(&r));
+    // (2712: the forced convection in an identification run, `ident_cases`.)
+    let r = run_with("forced-convection", IdentRun, 2712, &o);
     assert_missed(&r, "unexplained", 3.10);
     let t = r.twin.as_ref().expect("twin diagnosed");
     // The twin's t_pump_c held out: 3.07 K under the default, 0.64 K here.

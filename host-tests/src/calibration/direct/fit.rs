@@ -33,14 +33,10 @@ fn prepare(log: &CalLog, o: &DirectOptions) -> Result<Prepared, String> {
         // every row with a sample, after the first (the model's start)
         // (from the log's `fit_from_s` on: the margin's head fold)
         let rows: Vec<usize> = (1..log.run.len()).filter(|&i| col[i].is_some() && log.run.time_s[i] >= log.fit_from_s).collect();
-        let step = (rows.len() as f64 / o.points_per_channel.max(1) as f64).max(1.0);
-        let mut k = 0.0;
-        while (k as usize) < rows.len() {
-            let i = rows[k as usize];
+        for i in crate::calibration::log::thin(&rows, o.points_per_channel) {
             if let Some(y) = col[i] {
                 points.push((inputs.tick_of(log.run.time_s[i]), node, y, sigma));
             }
-            k += step;
         }
     }
     let ticks = points.iter().map(|p| p.0).collect();
@@ -190,18 +186,6 @@ pub fn identify_direct(p0: &ReducedParams, train: &[CalLog], o: &DirectOptions) 
         }
     }
     let theta = best.into_inner().map(|b| b.1).unwrap_or(ones.clone());
-    // 3b. Converge from LM's end (`polish`): LM's end depends on its path.
-    let (theta, polish) = if o.polish && !free.is_empty() {
-        let rows = |th: &[f64]| -> Option<DVector<f64>> {
-            let mut r = residuals(&apply(p0, th)?, &logs, &runs)?;
-            r.extend(free.iter().map(|&k| th[k].ln() / DIRECT_PARAMS[k].prior_sigma_ln));
-            Some(DVector::from_vec(r))
-        };
-        let (th, pol) = super::polish::polish(rows, theta, &free, &ranges);
-        (th, Some(pol))
-    } else {
-        (theta, None)
-    };
     let params = apply(p0, &theta).ok_or_else(|| DirectError::Model("the firmware model rejects the fitted parameters".into()))?;
     // 4. Identifiability at the optimum.
     let (r1, j1) = jacobian_ln(p0, &logs, &theta, &free, &runs).ok_or_else(|| DirectError::Model("the reduced model failed in the final Jacobian".into()))?;
@@ -257,7 +241,6 @@ pub fn identify_direct(p0: &ReducedParams, train: &[CalLog], o: &DirectOptions) 
         n_points,
         model_runs: runs.load(Ordering::Relaxed),
         train: train_scores,
-        polish,
     })
 }
 

@@ -22,10 +22,8 @@
 
 mod fit;
 mod params;
-mod polish;
 
 pub use fit::{identify_direct, score};
-pub use polish::{DirectPolish, POLISH_MAX_ITERS, POLISH_STEP_LN, POLISH_TOL};
 pub use params::{apply, index, range, DirectParam, Target, DIRECT_PARAMS, W_FLOOR_RAD_S, W_REF_RAD_S};
 
 use super::log::ChannelError;
@@ -55,16 +53,6 @@ pub struct DirectOptions {
     pub corr_threshold: f64,
     /// Parameters held at the reduction by the caller (names of [`DIRECT_PARAMS`]).
     pub hold: Vec<&'static str>,
-    /// Gauss–Newton polish from LM's end towards the optimum
-    /// ([`DirectPolish`]); default false (LM's end). Measured with it on
-    /// (2026-11-28, the procedure's logs): on leaky-heavy it converged in
-    /// one step (objective 1173.95 → 1173.94); on big-pump it did not
-    /// (6 steps, predicted decrease 20.7 → 5.0 while the objective fell
-    /// only 2885.94 → 2885.64: the steps' predictions fail, a sign of an
-    /// objective rough at the 1e-4 difference step), at +200 model runs
-    /// (~+26 s CPU) per fit; so not a result that stops depending on LM's
-    /// path, and off.
-    pub polish: bool,
 }
 
 /// Parameters held at the reduction by default, and why: measured on the
@@ -93,7 +81,6 @@ impl Default for DirectOptions {
             hold_ratio: 0.7,
             corr_threshold: 0.9,
             hold: DEFAULT_HOLD.to_vec(),
-            polish: false,
         }
     }
 }
@@ -161,8 +148,6 @@ pub struct DirectFit {
     pub model_runs: usize,
     /// Errors on every training log, before and after.
     pub train: Vec<LogScore>,
-    /// The polish from LM's end (`None`: not run).
-    pub polish: Option<DirectPolish>,
 }
 
 /// Errors of a direct identification.

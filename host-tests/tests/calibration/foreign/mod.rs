@@ -139,7 +139,7 @@ fn report(m: &EmuMachine, c: &Commissioning, secs: f64) {
     }
     if let Some(f) = &c.direct_fit {
         let v: Vec<String> = f.results.iter().filter(|r| r.held.is_none()).map(|r| format!("{} {:.3}{}", r.name, r.value, if r.at_bound { "*" } else { "" })).collect();
-        eprintln!("  direct fit: {} runs, chi2 {:.0} -> {:.0}; {}; polish {:?}", f.model_runs, f.chi2_before_after.0, f.chi2_before_after.1, v.join(", "), f.polish);
+        eprintln!("  direct fit: {} runs, chi2 {:.0} -> {:.0}; {}", f.model_runs, f.chi2_before_after.0, f.chi2_before_after.1, v.join(", "));
     }
     for (a, b) in c.holdout_without_margin().iter().zip(&c.holdout_with_margin) {
         eprintln!("  cost {}: valve open {:.0} -> {:.0} s, LNG {:.3} -> {:.3} kg", a.log, a.valve_open_s, b.valve_open_s, a.lng_kg, b.lng_kg);
@@ -426,7 +426,6 @@ fn slow_structure_experiment() {
         }
         o.prior_sigma.extend(exp_priors());
         o.margin_head_fold = exp_head_fold();
-        exp_direct_polish(&mut o);
         let t0 = std::time::Instant::now();
         let c = commission_with(&m.rig_file(), &train, &hold_logs, &o, margin).expect("commissioning");
         report(&m, &c, t0.elapsed().as_secs_f64());
@@ -445,16 +444,6 @@ pub(super) fn exp_head_fold() -> eha_sim::calibration::margin::HeadFold {
         Ok("tails") => HeadFold::Tails,
         Ok("loo") => HeadFold::LeaveOneOut,
         _ => HEAD_FOLD_DEFAULT,
-    }
-}
-
-/// `EXP_DIRECT_POLISH=1`: an experiment knob, the direct fit with its
-/// Gauss–Newton polish (`DirectOptions::polish`, off by default).
-pub(super) fn exp_direct_polish(o: &mut CalOptions) {
-    if std::env::var("EXP_DIRECT_POLISH").is_ok_and(|v| v == "1") {
-        if let Some(d) = o.direct.as_mut() {
-            d.polish = true;
-        }
     }
 }
 

@@ -69,7 +69,8 @@ fn slow_commissioning_is_reproducible_at_the_last_digit_leaky_heavy() {
 /// |e| (2.68 against 3.28 K; nudged 2.67 against 3.11 K), margin 1.722 →
 /// 1.699 K, the servo log's max |e| 2.201 → 2.144 K. The direct path
 /// itself still moves (its mix under-prediction 0.04 → 0.37 K): its LM fit
-/// is not converged (`DirectOptions::polish`, measured and off), but its
+/// is not converged (a Gauss–Newton polish of it was measured and removed:
+/// CHANGELOG), but its
 /// spread no longer decides the choice. Leaky-heavy **0.078 K** (the direct
 /// path both times; margin 1.191 → 1.186 K, the servo log's true-drain max
 /// |e| 1.116 → 1.193 K; 6:33 wall, 309 s user).
@@ -159,7 +160,6 @@ fn reproducible_on(m: EmuMachine, nudge_k: f64, hot_set: bool, as_measured_k: Op
             }
             o.prior_sigma.extend(exp_priors());
             o.margin_head_fold = super::exp_head_fold();
-            super::exp_direct_polish(&mut o);
             // `EXP_PRIOR_SCALE`: an experiment knob (factor on every prior width).
             if let Some(x) = std::env::var("EXP_PRIOR_SCALE").ok().and_then(|v| v.parse().ok()) {
                 o.prior_scale = x;
