@@ -52,6 +52,10 @@ pub struct ReducedCheck {
     /// LNG the guard would book for those seconds (the model's total loss
     /// while open, eq. 23, Table 6 latent and sensible heat), kg.
     pub lng_kg: f64,
+    /// The drain error against the measured drain per operating cell
+    /// (split by the training envelope in the report; not in the JSON).
+    #[serde(skip)]
+    pub cells: super::envelope::CellErrors,
 }
 
 /// An operating region of a log: ranges over the ticks that matter.
@@ -291,6 +295,7 @@ pub fn check_reduced_window(rig: &Rig, log: &CalLog, models: &[(&ReducedParams, 
                         vs_measured_region: (has_drain && a.under > 0.0).then(|| region_of(&rows, &pr.e_under[j], servo)),
                         valve_open_s: a.open_ticks * 0.01,
                         lng_kg: a.open_j / j_per_kg,
+                        cells: super::envelope::CellErrors::from_ticks(&rows, &pr.e_under[j], 0.01, servo),
                     }
                 })
                 .collect()

@@ -20,6 +20,8 @@ pub mod check;
 pub mod cli;
 pub mod commission;
 pub mod direct;
+pub mod envelope;
+pub mod envelope_report;
 pub mod eta_m;
 pub mod fit;
 pub mod ident;
