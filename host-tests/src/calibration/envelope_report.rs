@@ -50,7 +50,7 @@ pub fn envelope_section(s: &mut String, c: &Commissioning) {
     let env = &c.envelope;
     let _ = writeln!(
         s,
-        "## Training envelope\n\nCells of {SPEED_CELL_RPM:.0} rpm × {DP_CELL_BAR:.0} bar (|speed| × |p_a − p_b|) where the training logs dwell ≥ {MIN_DWELL_S:.0} s: {}.\n",
+        "## Training envelope\n\nCells of {SPEED_CELL_RPM:.0} rpm × {DP_CELL_BAR:.0} bar (|speed| × |p_a − p_b|, centred on multiples of the widths) where the training logs dwell ≥ {MIN_DWELL_S:.0} s: {}.\n",
         env.describe()
     );
     let _ = writeln!(s, "Firmware drain against the measured drain inside and outside the envelope (held out: with the block's margin; folds: the margin's validation, margin 0, scored part only):\n\n| log | kind | margin K | s outside (of total) | inside: max \\|e\\| / under K | outside: max \\|e\\| / under K | where it reads low outside |\n|---|---|---:|---:|---:|---:|---|");
@@ -107,15 +107,14 @@ mod tests {
         r.set(Channel::PABar, vec![Some(22.0); 300]);
         r.set(Channel::PBBar, vec![Some(2.0); 300]);
         let env = Envelope::of_runs([&r]);
-        // Inside 0.05 K low; outside at 950–1050 rpm × 45 bar, 0.4 K low at t 10–19 s.
+        // Inside 0.05 K low; outside at 970–1028 rpm × 45 bar, 0.4 K low at t 10–19 s.
         let rows: Vec<_> = (0..40).map(|k| (f64::from(k), if k < 10 { 700.0 } else { 950.0 + f64::from(k) * 2.0 }, if k < 10 { 20.0 } else { 45.0 }, 50.0)).collect();
         let under: Vec<f64> = (0..40).map(|k| if k < 10 { 0.05 } else if k < 20 { 0.4 } else { -0.1 }).collect();
         let c = check(CellErrors::from_ticks(&rows, &under, 1.0, false), 0.8);
         let l = not_validated(&env, &c).expect("outside reads lower than inside");
         assert!(l.starts_with(NOT_VALIDATED), "{l}");
-        // The 900–1000 rpm cell holds ticks 10–24 (15 s); ticks 25–39 are in
-        // the next cell and not low.
-        assert!(l.contains("970–988 rpm × Δp 45–45 bar: log `mix.csv` spends 15 s there (t 10–19 s) and reads 0.40 K low with the 0.80 K margin"), "{l}");
+        // The 950–1050 rpm cell holds ticks 10–39 (30 s).
+        assert!(l.contains("970–988 rpm × Δp 45–45 bar: log `mix.csv` spends 30 s there (t 10–19 s) and reads 0.40 K low with the 0.80 K margin"), "{l}");
         // Reading lower inside than outside: no line.
         let under: Vec<f64> = (0..40).map(|k| if k < 10 { 0.5 } else { 0.4 }).collect();
         assert_eq!(not_validated(&env, &check(CellErrors::from_ticks(&rows, &under, 1.0, false), 0.8)), None);
