@@ -4,16 +4,19 @@
 //! (docs/commissioning.md, "The training envelope"). Reporting only: the
 //! block, its margin and every fit are unchanged by it.
 //!
-//! The grid is [`SPEED_CELL_RPM`] × [`DP_CELL_BAR`]: the spacing of the
-//! bench procedure's steps (speed 400–1200 rpm and needle 10–50 bar, each
-//! stepped every 3–4 min over 30 min, so ~100 rpm and ~5 bar a step), so each
-//! step of the procedure lands in a cell of its own and the held-out mix's
-//! points between the steps fall in cells the training never held. The
-//! cells are centred on multiples of the widths (700 rpm: 650–750 rpm;
-//! 20 bar: 17.5–22.5 bar): with edges on the multiples, the sensor noise
-//! of a hold at 20 bar split its dwell between two cells, neither reaching
-//! the threshold (measured on leaky-heavy's procedure: the 20-bar speed
-//! steps at 400 and 800–1000 rpm left uncovered). A cell is covered when
+//! The grid is [`SPEED_CELL_RPM`] × [`DP_CELL_BAR`], about 6 × 6 cells
+//! over the rig's range (0–1250 rpm, 0–60 bar): two of the bench
+//! procedure's steps per cell (speed 400–1200 rpm and needle 10–50 bar,
+//! each stepped every 3–4 min, ~100 rpm and ~5 bar a step), so the firmware
+//! counts as validated between adjacent trained steps but not beyond them.
+//! The edges sit off the procedure's values (speed at 50 + 200 k rpm, Δp at
+//! 5 + 10 k bar), so a hold at 700 rpm or 20 bar lies inside a cell: with
+//! edges on such values the sensor noise split a hold's dwell between two
+//! cells, neither reaching the threshold. Measured and not kept: 100 rpm ×
+//! 5 bar cells (centred on the multiples) left leaky-heavy's held-out
+//! throttle mix 1798 of 1800 s outside (its speed and Δp are drawn
+//! together, and rarely land on the training's cross of one-at-a-time
+//! steps), so inside-against-outside said nothing. A cell is covered when
 //! the training logs together dwell in it at least [`MIN_DWELL_S`].
 
 use super::check::Region;
@@ -21,11 +24,19 @@ use super::log::CalLog;
 use crate::measured::{Channel, MeasuredRun};
 use std::collections::BTreeMap;
 
-/// Width of a grid cell in |pump speed|, rpm (the procedure's speed step).
-pub const SPEED_CELL_RPM: f64 = 100.0;
+/// Width of a grid cell in |pump speed|, rpm (two of the procedure's speed steps).
+pub const SPEED_CELL_RPM: f64 = 200.0;
 
-/// Width of a grid cell in |p_a − p_b|, bar (the procedure's needle step).
-pub const DP_CELL_BAR: f64 = 5.0;
+/// Where the speed cells' edges sit, rpm: at `SPEED_EDGE_RPM + k ×
+/// SPEED_CELL_RPM` (the first cell is 0–50 rpm).
+pub const SPEED_EDGE_RPM: f64 = 50.0;
+
+/// Width of a grid cell in |p_a − p_b|, bar (two of the procedure's needle steps).
+pub const DP_CELL_BAR: f64 = 10.0;
+
+/// Where the pressure cells' edges sit, bar: at `DP_EDGE_BAR + k ×
+/// DP_CELL_BAR` (the first cell is 0–5 bar).
+pub const DP_EDGE_BAR: f64 = 5.0;
 
 /// Dwell the training logs need in a cell for it to count as covered, s:
 /// about 1.5 case-oil time constants (37–41 s measured on the emulator
@@ -38,13 +49,13 @@ pub const MIN_DWELL_S: f64 = 60.0;
 /// a hole in the log, not time spent at the earlier row's point).
 pub const MAX_ROW_GAP_S: f64 = 10.0;
 
-/// A grid cell: indices of |speed| / [`SPEED_CELL_RPM`] and
-/// |Δp| / [`DP_CELL_BAR`] (rounded: cell `k` spans `(k ± 0.5) × width`).
+/// A grid cell: cell `k` of a width `w` with edges at `e + j w` spans
+/// `e + (k − 1) w` to `e + k w` (cell 0 from 0 to `e`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize)]
 pub struct Cell {
-    /// Speed index: the cell is centred on `speed × SPEED_CELL_RPM`, rpm.
+    /// Speed index ([`SPEED_CELL_RPM`], [`SPEED_EDGE_RPM`]).
     pub speed: u32,
-    /// Pressure index: the cell is centred on `dp × DP_CELL_BAR`, bar.
+    /// Pressure index ([`DP_CELL_BAR`], [`DP_EDGE_BAR`]).
     pub dp: u32,
 }
 
@@ -52,7 +63,17 @@ pub struct Cell {
 /// when either is not finite.
 pub fn cell_of(speed_rpm: f64, dp_bar: f64) -> Option<Cell> {
     (speed_rpm.is_finite() && dp_bar.is_finite())
-        .then(|| Cell { speed: (speed_rpm.abs() / SPEED_CELL_RPM).round() as u32, dp: (dp_bar.abs() / DP_CELL_BAR).round() as u32 })
+        .then(|| Cell { speed: index(speed_rpm, SPEED_CELL_RPM, SPEED_EDGE_RPM), dp: index(dp_bar, DP_CELL_BAR, DP_EDGE_BAR) })
+}
+
+/// The cell index of `x` on a grid of width `w` with edges at `e + k w`.
+fn index(x: f64, w: f64, e: f64) -> u32 {
+    ((x.abs() + w - e) / w).floor() as u32
+}
+
+/// The lower edge of cell `k` of width `w`, edges at `e + j w` (≥ 0).
+fn edge(k: u32, w: f64, e: f64) -> f64 {
+    (e + (f64::from(k) - 1.0) * w).max(0.0)
 }
 
 /// The operating region the training logs cover.
@@ -105,7 +126,7 @@ impl Envelope {
     }
 
     /// Compact text: per pressure band, the covered speed ranges (adjacent
-    /// cells merged), e.g. `Δp 17.5–22.5 bar: 350–1250 rpm`; then the drain range.
+    /// cells merged), e.g. `Δp 15–25 bar: 250–1250 rpm`; then the drain range.
     pub fn describe(&self) -> String {
         let mut rows: BTreeMap<u32, Vec<u32>> = BTreeMap::new();
         for c in self.covered() {
@@ -121,8 +142,8 @@ impl Envelope {
                         _ => runs.push((s, s)),
                     }
                 }
-                let sp = runs.iter().map(|&(a, b)| format!("{:.0}–{:.0}", edge(a, SPEED_CELL_RPM), edge(b + 1, SPEED_CELL_RPM))).collect::<Vec<_>>().join(", ");
-                format!("Δp {}–{} bar: {sp} rpm", edge(dp, DP_CELL_BAR), edge(dp + 1, DP_CELL_BAR))
+                let sp = runs.iter().map(|&(a, b)| format!("{:.0}–{:.0}", edge(a, SPEED_CELL_RPM, SPEED_EDGE_RPM), edge(b + 1, SPEED_CELL_RPM, SPEED_EDGE_RPM))).collect::<Vec<_>>().join(", ");
+                format!("Δp {}–{} bar: {sp} rpm", edge(dp, DP_CELL_BAR, DP_EDGE_BAR), edge(dp + 1, DP_CELL_BAR, DP_EDGE_BAR))
             })
             .collect();
         if parts.is_empty() {
@@ -137,11 +158,6 @@ impl Envelope {
         let (inside, outside): (Vec<_>, Vec<_>) = errors.0.iter().partition(|(c, _)| self.covers(**c));
         (Side::of(&inside), Side::of(&outside))
     }
-}
-
-/// The lower edge of cell `k` of width `w` (≥ 0).
-fn edge(k: u32, w: f64) -> f64 {
-    ((f64::from(k) - 0.5) * w).max(0.0)
 }
 
 /// The firmware's drain error against the measured drain in one cell.
@@ -266,26 +282,27 @@ mod tests {
     fn known_dwell_gives_known_cells_signs_ignored_and_bad_rows_skipped() {
         // 0–300 s at 700 rpm, Δp +20 bar (10 s of empty speed and one NaN
         // p_a row inside); 300–330 s at 1000 rpm, 40 bar (a pass: 30 s);
-        // 330–599 s at −420 rpm, Δp −35 bar (reversed pump, 269 s: the last
+        // 330–599 s at −420 rpm, Δp −30 bar (reversed pump, 269 s: the last
         // row has no next row to credit).
         let r = run(600, |t| {
-            let (n, pa, pb) = if t < 300.0 { (700.0, 25.0, 5.0) } else if t < 330.0 { (1000.0, 45.0, 5.0) } else { (-420.0, 5.0, 40.0) };
+            let (n, pa, pb) = if t < 300.0 { (700.0, 25.0, 5.0) } else if t < 330.0 { (1000.0, 45.0, 5.0) } else { (-420.0, 5.0, 35.0) };
             let n = (!(100.0..110.0).contains(&t)).then_some(n);
             let pa = if t == 120.0 { f64::NAN } else { pa };
             let drain = if t == 50.0 { Some(f64::NAN) } else { (t != 60.0).then_some(20.0 + t / 20.0) };
             (n, Some(pa), Some(pb), drain)
         });
         let e = Envelope::of_runs([&r]);
-        let a = Cell { speed: 7, dp: 4 };
-        let b = Cell { speed: 10, dp: 8 };
-        let c = Cell { speed: 4, dp: 7 };
+        let a = Cell { speed: 4, dp: 2 };
+        let b = Cell { speed: 5, dp: 4 };
+        let c = Cell { speed: 2, dp: 3 };
         assert_eq!(e.dwell_s.len(), 3);
         assert!((e.dwell_s[&a] - 289.0).abs() < 1e-9, "{:?}", e.dwell_s);
         assert!((e.dwell_s[&b] - 30.0).abs() < 1e-9);
         assert!((e.dwell_s[&c] - 269.0).abs() < 1e-9);
         assert_eq!(e.covered(), vec![c, a], "the 30 s pass does not cover its cell");
         assert_eq!(e.drain_c, Some((20.0, 20.0 + 599.0 / 20.0)));
-        assert_eq!(e.describe(), "Δp 17.5–22.5 bar: 650–750 rpm; Δp 32.5–37.5 bar: 350–450 rpm; drain 20.0–50.0 °C");
+        assert_eq!(e.describe(), "Δp 15–25 bar: 650–850 rpm; Δp 25–35 bar: 250–450 rpm; drain 20.0–50.0 °C");
+        assert_eq!((cell_of(49.0, 4.9), cell_of(50.0, 5.0)), (Some(Cell { speed: 0, dp: 0 }), Some(Cell { speed: 1, dp: 1 })));
         assert_eq!(cell_of(-750.0, -22.0), cell_of(750.0, 22.0));
         assert_eq!(cell_of(f64::NAN, 1.0), None);
     }

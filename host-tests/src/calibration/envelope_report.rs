@@ -6,7 +6,7 @@
 
 use super::check::{ReducedCheck, Region};
 use super::commission::Commissioning;
-use super::envelope::{Envelope, Side, DP_CELL_BAR, MIN_DWELL_S, SPEED_CELL_RPM};
+use super::envelope::{Envelope, Side, DP_CELL_BAR, DP_EDGE_BAR, MIN_DWELL_S, SPEED_CELL_RPM, SPEED_EDGE_RPM};
 use std::fmt::Write as _;
 
 /// Start of the line saying that the margin is not validated where a log
@@ -50,7 +50,7 @@ pub fn envelope_section(s: &mut String, c: &Commissioning) {
     let env = &c.envelope;
     let _ = writeln!(
         s,
-        "## Training envelope\n\nCells of {SPEED_CELL_RPM:.0} rpm × {DP_CELL_BAR:.0} bar (|speed| × |p_a − p_b|, centred on multiples of the widths) where the training logs dwell ≥ {MIN_DWELL_S:.0} s: {}.\n",
+        "## Training envelope\n\nCells of {SPEED_CELL_RPM:.0} rpm × {DP_CELL_BAR:.0} bar (|speed| × |p_a − p_b|, edges at {SPEED_EDGE_RPM:.0} + k × {SPEED_CELL_RPM:.0} rpm and {DP_EDGE_BAR:.0} + k × {DP_CELL_BAR:.0} bar) where the training logs dwell ≥ {MIN_DWELL_S:.0} s: {}.\n",
         env.describe()
     );
     let _ = writeln!(s, "Firmware drain against the measured drain inside and outside the envelope (held out: with the block's margin; folds: the margin's validation, margin 0, scored part only):\n\n| log | kind | margin K | s outside (of total) | inside: max \\|e\\| / under K | outside: max \\|e\\| / under K | where it reads low outside |\n|---|---|---:|---:|---:|---:|---|");
@@ -113,7 +113,7 @@ mod tests {
         let c = check(CellErrors::from_ticks(&rows, &under, 1.0, false), 0.8);
         let l = not_validated(&env, &c).expect("outside reads lower than inside");
         assert!(l.starts_with(NOT_VALIDATED), "{l}");
-        // The 950–1050 rpm cell holds ticks 10–39 (30 s).
+        // The 850–1050 rpm × 45–55 bar cell holds ticks 10–39 (30 s).
         assert!(l.contains("970–988 rpm × Δp 45–45 bar: log `mix.csv` spends 30 s there (t 10–19 s) and reads 0.40 K low with the 0.80 K margin"), "{l}");
         // Reading lower inside than outside: no line.
         let under: Vec<f64> = (0..40).map(|k| if k < 10 { 0.5 } else { 0.4 }).collect();
