@@ -19,7 +19,7 @@
 //! steps), so inside-against-outside said nothing. A cell is covered when
 //! the training logs together dwell in it at least [`MIN_DWELL_S`].
 
-use super::check::Region;
+use super::region::Region;
 use super::log::CalLog;
 use crate::measured::{Channel, MeasuredRun};
 use std::collections::BTreeMap;

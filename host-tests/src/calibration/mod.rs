@@ -31,6 +31,7 @@ pub mod lsq;
 pub mod paper;
 pub mod paths;
 pub mod polish;
+pub mod region;
 pub mod replay;
 pub mod residuals;
 pub mod set;
