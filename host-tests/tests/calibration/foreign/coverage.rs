@@ -12,7 +12,7 @@ use eha_sim::emulator::bench::{commissioning_set, leaky_heavy};
 /// (direct) block with its 1.191 K margin on the held-out throttle mix: the
 /// under-prediction lies outside the training envelope, in the hot corner
 /// the procedure never holds, and the report says the margin is not
-/// validated there. Measured (c8e4be5 + the 200 rpm × 10 bar grid, 111.8 s
+/// validated there. Measured (5806964, 111.8 s
 /// wall on the shared cores): envelope `Δp 0–5 bar: 0–50 rpm; Δp 5–15 bar:
 /// 0–50, 250–450 rpm; Δp 15–25 bar: 50–250, 450–1250 rpm; Δp 25–35 bar:
 /// 650–850 rpm; Δp 35–45 bar: 450–850 rpm; Δp 45–55 bar: 450–650 rpm; drain
