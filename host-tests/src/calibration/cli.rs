@@ -110,6 +110,9 @@ pub fn run(args: &CommissionArgs) -> ExitCode {
             for w in &c.cal.warnings {
                 eprintln!("{w}");
             }
+            for l in c.holdout_with_margin.iter().filter_map(|r| super::envelope_report::not_validated(&c.envelope, r)) {
+                eprintln!("note: {l}");
+            }
             println!("{} | {:.1} s | {}", headline(&c), t.elapsed().as_secs_f64(), args.out.join("report.md").display());
             if c.flashable() {
                 ExitCode::SUCCESS
@@ -281,6 +284,7 @@ fn report(args: &CommissionArgs, c: &Commissioning) -> String {
     let _ = writeln!(s, "\n(Against the measured `t_drain_c`, which carries the thermocouple's noise; open loop: the logged LNG valve, if any, drives the exchanger; the commissioned firmware with the drain margin below added. Held-out logs without `t_drain_c` show –.)\n");
     paths_section(&mut s, c);
     margin_section(&mut s, c);
+    super::envelope_report::envelope_section(&mut s, c);
     if !c.cal.warnings.is_empty() {
         let _ = writeln!(s, "## Warnings\n");
         for w in &c.cal.warnings {

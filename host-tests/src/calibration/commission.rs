@@ -49,6 +49,9 @@ pub struct Commissioning {
     pub reduced_ok: bool,
     /// Operating region of each training log ([`log_region`]).
     pub train_regions: Vec<Region>,
+    /// The operating cells the training logs cover, and their drain range
+    /// ([`super::envelope::Envelope`]; reporting only).
+    pub envelope: super::envelope::Envelope,
     /// Whether some training log has more than one operating point (else the
     /// loss coefficients are not separable and the block is not flashable).
     pub excitation_ok: bool,
@@ -475,6 +478,7 @@ pub fn commission_with(base: &Rig, train: &[CalLog], holdout: &[CalLog], o: &Cal
         default_on_holdout,
         reduced_ok,
         train_regions,
+        envelope: super::envelope::Envelope::of_logs(train),
         excitation_ok,
         eta_m_from_current: eta_e,
         eta_m_balance,

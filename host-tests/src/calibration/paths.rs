@@ -263,6 +263,7 @@ mod tests {
             vs_measured_region: Some(region),
             valve_open_s: 0.0,
             lng_kg: 0.0,
+            cells: Default::default(),
         }
     }
 

@@ -50,6 +50,8 @@ fn commission_cli_writes_outputs_and_a_block_that_checks() {
     let in_report = num_after(&report, "Margin **");
     let in_block = num_after(&String::from_utf8_lossy(&chk.stdout), "drain margin ");
     assert!(in_report > 0.0 && (in_block - in_report).abs() <= 0.006, "block margin {in_block} K, report {in_report} K");
+    // The training envelope and the held-out log's error inside/outside it.
+    assert!(report.contains("## Training envelope") && report.contains("rpm") && report.contains("| c.csv | held out |"), "envelope section in the report");
     let params = std::fs::read_to_string(out.join("params.rs")).expect("params");
     assert!(params.contains("pub const DEFAULT: ReducedParams"), "params.rs renders the firmware parameters");
     // A bad value: file:line:column from the reader, exit 2.

@@ -463,6 +463,7 @@ fn exp_priors() -> Vec<(&'static str, f64)> {
 }
 
 mod basins;
+mod coverage;
 mod envelope;
 mod hot_flow;
 mod reproducible;
