@@ -427,8 +427,10 @@ fn slow_structure_experiment() {
         o.prior_sigma.extend(exp_priors());
         o.margin_head_fold = exp_head_fold();
         let t0 = std::time::Instant::now();
+        let hits0 = eha_sim::calibration::memo::hits();
         let c = commission_with(&m.rig_file(), &train, &hold_logs, &o, margin).expect("commissioning");
         report(&m, &c, t0.elapsed().as_secs_f64());
+        eprintln!("EXP {}: {} model runs answered from the memo (calibration::memo)", m.name, eha_sim::calibration::memo::hits() - hits0);
         let h = headline(&m, &c, &s.holdout);
         let w: Vec<String> = c.holdout_without_margin().iter().map(|r| format!("{} {:.3}/{:.3}", r.log, r.vs_measured_max_k.unwrap_or(f64::NAN), r.vs_measured_under_k.unwrap_or(f64::NAN))).collect();
         eprintln!("EXP {} train={} hold={:?} margin={}: without margin {}; with margin {:.3} K: {:.3?}", m.name, if procedure { train_kind.as_str() } else { "bench" }, hold, margin, w.join(", "), h.margin_k, h.measured);
