@@ -122,35 +122,6 @@ impl CalLog {
     pub fn has(&self, ch: Channel) -> bool {
         self.channels.contains(&ch)
     }
-
-    /// Feeds the replay's scenario and output options to `h` (the memo's
-    /// key, [`super::memo`]): a replay's inputs by their bits, another
-    /// scenario by its `Debug` text.
-    pub(super) fn hash_replay(&self, h: &mut impl std::hash::Hasher) {
-        use std::hash::Hash;
-        let f = |h: &mut dyn std::hash::Hasher, v: &[f64]| {
-            h.write_usize(v.len());
-            v.iter().for_each(|x| h.write_u64(x.to_bits()));
-        };
-        match &self.scenario {
-            Scenario::Replay(r) => {
-                // Every field (a new one fails to compile here).
-                let crate::scenario::ReplayInputs { name, circuit, time_s, speed_rpm, current_a, p_a_bar, p_b_bar, ambient_c, position_mm, air_speed_mps, lng_valve } = r;
-                name.hash(h);
-                format!("{circuit:?}").hash(h);
-                for v in [time_s, speed_rpm, current_a, p_a_bar, p_b_bar, ambient_c] {
-                    f(h, v);
-                }
-                for v in [position_mm, air_speed_mps, lng_valve] {
-                    v.is_some().hash(h);
-                    f(h, v.as_deref().unwrap_or(&[]));
-                }
-            }
-            s => format!("{s:?}").hash(h),
-        }
-        self.opts.output_interval_s.to_bits().hash(h);
-        self.opts.control_interval_s.to_bits().hash(h);
-    }
 }
 
 /// Fit points of `run`'s `channels`: per channel its rows with a sample at

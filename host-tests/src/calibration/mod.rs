@@ -25,7 +25,6 @@ pub mod fit;
 pub mod ident;
 pub mod log;
 pub mod margin;
-pub mod memo;
 pub mod lsq;
 pub mod paper;
 pub mod paths;

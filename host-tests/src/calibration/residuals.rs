@@ -88,7 +88,8 @@ pub(crate) fn data_residuals(base: &Rig, logs: &[CalLog], theta: &[f64], sigma: 
         .par_iter()
         .map(|l| {
             runs.fetch_add(1, Ordering::Relaxed);
-            let r = super::memo::residuals(&rig, l, || l.simulate(&rig).ok().map(|s| l.residuals(&s)))?;
+            let s = l.simulate(&rig).ok()?;
+            let r = l.residuals(&s);
             let w = |ch: crate::measured::Channel| if ch == crate::measured::Channel::TDrainC { sigma.drain_weight } else { 1.0 };
             r.iter().all(|x| x.is_finite()).then(|| r.into_iter().zip(&l.points).map(|(x, p)| x * w(p.0) / sigma.data_k).collect())
         })
