@@ -18,20 +18,8 @@ use eha_sim::diagnosis::reference::ReferenceModel;
 use eha_sim::diagnosis::synth::{generate, Mismatch, SynthCase, SynthScenario};
 use eha_sim::diagnosis::{diagnose, Candidate, DiagnoseOptions};
 use eha_sim::rig::Rig;
+use eha_sim::tools::cpu::process_cpu_s;
 use std::time::Instant;
-
-/// CPU time of this process so far (user + system), s, from
-/// /proc/self/stat (Linux; 0 elsewhere): less sensitive to other
-/// processes' load than the wall time.
-fn cpu_s() -> f64 {
-    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
-    let after = stat.rsplit_once(')').map_or("", |x| x.1);
-    let f: Vec<&str> = after.split_whitespace().collect();
-    // Fields 14 and 15 of the file (clock ticks, 100 per s): the 12th and
-    // 13th after the `)`.
-    let tick = |k: usize| f.get(k).and_then(|x| x.parse::<f64>().ok()).unwrap_or(0.0);
-    (tick(11) + tick(12)) / 100.0
-}
 
 fn main() {
     let cases = [
@@ -56,7 +44,7 @@ fn main() {
                 generate(&EmuCase { hidden, scenario: EmuScenario::SpeedSteps, seed: 1716, duration_s: 1800.0 }).expect("emulate").0
             }
         };
-        let (t, cpu0) = (Instant::now(), cpu_s());
+        let (t, cpu0) = (Instant::now(), process_cpu_s());
         let model = ReferenceModel::new(Rig::default(), &run).expect("model");
         // DIAG30_XCORR_STEP_S: the cross-correlation's lag resolution
         // (0 = every sample, the former cost), for before/after numbers.
@@ -71,7 +59,7 @@ fn main() {
         println!(
             "{name}: {} rows, {secs:.1} s wall, {:.1} s CPU, {} model runs, cause {} (hidden {}), held-out {:.3} -> {:.3} K",
             run.len(),
-            cpu_s() - cpu0,
+            process_cpu_s() - cpu0,
             d.sims,
             d.cause.name(),
             hidden.name(),

@@ -59,22 +59,16 @@ pub struct ReducedCheck {
 }
 
 pub use super::region::Region;
-
-/// One replay tick kept for the regions: t, speed, Δp, reference drain.
-type TickRow = (f64, f64, f64, f64);
+use super::region::TickRow;
 
 /// Ranges of the rows whose `e` is at least half of the largest (all rows
 /// when the largest is not positive).
 fn region_of(rows: &[TickRow], e: &[f64], servo: bool) -> Region {
     let top = e.iter().copied().fold(0.0, f64::max);
-    let mut r = Region { t_s: (f64::MAX, f64::MIN), speed_rpm: (f64::MAX, f64::MIN), dp_bar: (f64::MAX, f64::MIN), drain_c: (f64::MAX, f64::MIN), servo };
-    let widen = |a: &mut (f64, f64), x: f64| *a = (a.0.min(x), a.1.max(x));
+    let mut r = Region::empty(servo);
     for (row, &ek) in rows.iter().zip(e) {
         if top <= 0.0 || ek >= 0.5 * top {
-            widen(&mut r.t_s, row.0);
-            widen(&mut r.speed_rpm, row.1);
-            widen(&mut r.dp_bar, row.2);
-            widen(&mut r.drain_c, row.3);
+            r.widen(row);
         }
     }
     r

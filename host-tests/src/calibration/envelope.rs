@@ -19,7 +19,7 @@
 //! steps), so inside-against-outside said nothing. A cell is covered when
 //! the training logs together dwell in it at least [`MIN_DWELL_S`].
 
-use super::region::Region;
+use super::region::{Region, TickRow};
 use super::log::CalLog;
 use crate::measured::{Channel, MeasuredRun};
 use std::collections::BTreeMap;
@@ -186,7 +186,7 @@ impl CellErrors {
     /// reference drain °C), each `dt_s` long, and the under-prediction of
     /// the measured drain at each (K, −∞ or NaN where not scored).
     /// Ticks with a non-finite speed or Δp are skipped.
-    pub fn from_ticks(rows: &[(f64, f64, f64, f64)], under: &[f64], dt_s: f64, servo: bool) -> Self {
+    pub fn from_ticks(rows: &[TickRow], under: &[f64], dt_s: f64, servo: bool) -> Self {
         let mut m: BTreeMap<Cell, CellError> = BTreeMap::new();
         let cells: Vec<Option<Cell>> = rows.iter().map(|r| cell_of(r.1, r.2)).collect();
         for (c, &u) in cells.iter().zip(under) {
@@ -202,21 +202,11 @@ impl CellErrors {
         for ((c, &u), r) in cells.iter().zip(under).zip(rows) {
             let Some(e) = c.and_then(|c| m.get_mut(&c)) else { continue };
             if e.max_under_k > 0.0 && u >= 0.5 * e.max_under_k {
-                let g = e.low.get_or_insert(Region { t_s: (r.0, r.0), speed_rpm: (r.1, r.1), dp_bar: (r.2, r.2), drain_c: (r.3, r.3), servo });
-                widen(g, r);
+                e.low.get_or_insert(Region::empty(servo)).widen(r);
             }
         }
         CellErrors(m)
     }
-}
-
-/// `g` widened to hold tick `r` (t, speed, Δp, drain).
-fn widen(g: &mut Region, r: &(f64, f64, f64, f64)) {
-    let w = |a: &mut (f64, f64), x: f64| *a = (a.0.min(x), a.1.max(x));
-    w(&mut g.t_s, r.0);
-    w(&mut g.speed_rpm, r.1);
-    w(&mut g.dp_bar, r.2);
-    w(&mut g.drain_c, r.3);
 }
 
 /// One side (inside or outside the envelope) of a check's drain errors.
@@ -248,13 +238,7 @@ impl Side {
             let (Some(top), Some(g)) = (max_under_k, &e.low) else { continue };
             if top > 0.0 && e.max_under_k >= 0.5 * top {
                 low_dwell_s += e.dwell_s;
-                match &mut low {
-                    None => low = Some(g.clone()),
-                    Some(l) => {
-                        widen(l, &(g.t_s.0, g.speed_rpm.0, g.dp_bar.0, g.drain_c.0));
-                        widen(l, &(g.t_s.1, g.speed_rpm.1, g.dp_bar.1, g.drain_c.1));
-                    }
-                }
+                low.get_or_insert(Region::empty(g.servo)).join(g);
             }
         }
         Side { dwell_s: cells.iter().map(|c| c.1.dwell_s).sum(), scored_s: scored.iter().map(|e| e.scored_s).sum(), max_abs_k, max_under_k, low, low_dwell_s }

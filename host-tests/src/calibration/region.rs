@@ -36,7 +36,32 @@ impl std::fmt::Display for Region {
     }
 }
 
+/// One replay tick kept for the regions: t s, |speed| rpm, |Δp| bar,
+/// reference drain °C.
+pub type TickRow = (f64, f64, f64, f64);
+
 impl Region {
+    /// The empty region (every range from +max to −max), to be widened.
+    pub fn empty(servo: bool) -> Self {
+        let e = (f64::MAX, f64::MIN);
+        Region { t_s: e, speed_rpm: e, dp_bar: e, drain_c: e, servo }
+    }
+
+    /// Widened to hold tick `r`.
+    pub fn widen(&mut self, r: &TickRow) {
+        let w = |a: &mut (f64, f64), x: f64| *a = (a.0.min(x), a.1.max(x));
+        w(&mut self.t_s, r.0);
+        w(&mut self.speed_rpm, r.1);
+        w(&mut self.dp_bar, r.2);
+        w(&mut self.drain_c, r.3);
+    }
+
+    /// Widened to hold `other` too.
+    pub fn join(&mut self, other: &Region) {
+        self.widen(&(other.t_s.0, other.speed_rpm.0, other.dp_bar.0, other.drain_c.0));
+        self.widen(&(other.t_s.1, other.speed_rpm.1, other.dp_bar.1, other.drain_c.1));
+    }
+
     /// The bench run that would put this region into the training set with
     /// the drain logged.
     pub fn bench_run(&self) -> String {

@@ -5,6 +5,7 @@
 
 use super::{commission_as_measured, near};
 use eha_sim::calibration::envelope_report::{not_validated, NOT_VALIDATED};
+use eha_sim::calibration::commission::Commissioning;
 use eha_sim::calibration::paths::PathKind;
 use eha_sim::emulator::bench::{big_pump, commissioning_set, leaky_heavy};
 
@@ -32,11 +33,7 @@ fn slow_held_out_miss_lies_outside_the_training_envelope() {
     let s = commissioning_set(&m, 3600).expect("bench");
     // The headline as `slow_commissioning_with_margin_on_foreign_machines` measured it.
     let c = commission_as_measured(&m, &s, (1.191, PathKind::Direct, [(1.471, 0.000), (2.334, 0.617)], [1550.0, 1560.0]));
-    eprintln!("envelope: {}", c.envelope.describe());
-    for r in c.holdout_with_margin.iter().chain(c.margin.iter().flat_map(|v| &v.folds)) {
-        let (i, o) = c.envelope.split(&r.cells);
-        eprintln!("{} (margin {:.3} K): inside {:.0} s max |e| {:?} under {:?}; outside {:.0} s max |e| {:?} under {:?}, low {:?} ({:.0} s)", r.log, r.margin_k, i.dwell_s, i.max_abs_k, i.max_under_k, o.dwell_s, o.max_abs_k, o.max_under_k, o.low, o.low_dwell_s);
-    }
+    print_split(&c);
     let mix = &c.holdout_with_margin[1];
     let (inside, outside) = c.envelope.split(&mix.cells);
     let under = |d: &eha_sim::calibration::envelope::Side| d.max_under_k.expect("scored");
@@ -78,11 +75,7 @@ fn slow_big_pump_margin_comes_from_inside_the_training_envelope() {
     let m = big_pump();
     let s = commissioning_set(&m, 3600).expect("bench");
     let c = commission_as_measured(&m, &s, (1.722, PathKind::Reduction, [(2.201, 0.000), (2.676, 0.000)], [1405.0, 1519.0]));
-    eprintln!("envelope: {}", c.envelope.describe());
-    for r in c.holdout_with_margin.iter().chain(c.margin.iter().flat_map(|v| &v.folds)) {
-        let (i, o) = c.envelope.split(&r.cells);
-        eprintln!("{} (margin {:.3} K): inside {:.0} s max |e| {:?} under {:?}; outside {:.0} s max |e| {:?} under {:?}, low {:?} ({:.0} s)", r.log, r.margin_k, i.dwell_s, i.max_abs_k, i.max_under_k, o.dwell_s, o.max_abs_k, o.max_under_k, o.low, o.low_dwell_s);
-    }
+    print_split(&c);
     for h in &c.holdout_with_margin {
         assert_eq!(not_validated(&c.envelope, h), None, "{}", h.log);
     }
@@ -98,4 +91,14 @@ fn slow_big_pump_margin_comes_from_inside_the_training_envelope() {
     eprintln!("worst fold {}: in {:?} out {:?}", worst.log, wi.max_under_k, wo.max_under_k);
     near("the worst fold's under-prediction inside the envelope", under(&wi), 1.522);
     assert_eq!(wo.max_under_k, None, "the worst fold scored nothing outside the envelope");
+}
+
+/// Prints `c`'s envelope and each held-out log's and margin fold's drain
+/// error inside and outside it.
+fn print_split(c: &Commissioning) {
+    eprintln!("envelope: {}", c.envelope.describe());
+    for r in c.holdout_with_margin.iter().chain(c.margin.iter().flat_map(|v| &v.folds)) {
+        let (i, o) = c.envelope.split(&r.cells);
+        eprintln!("{} (margin {:.3} K): inside {:.0} s max |e| {:?} under {:?}; outside {:.0} s max |e| {:?} under {:?}, low {:?} ({:.0} s)", r.log, r.margin_k, i.dwell_s, i.max_abs_k, i.max_under_k, o.dwell_s, o.max_abs_k, o.max_under_k, o.low, o.low_dwell_s);
+    }
 }

@@ -427,25 +427,14 @@ fn slow_structure_experiment() {
         o.prior_sigma.extend(exp_priors());
         o.margin_head_fold = exp_head_fold();
         let t0 = std::time::Instant::now();
-        let cpu0 = process_cpu_s();
+        let cpu0 = eha_sim::tools::cpu::process_cpu_s();
         let c = commission_with(&m.rig_file(), &train, &hold_logs, &o, margin).expect("commissioning");
         report(&m, &c, t0.elapsed().as_secs_f64());
-        eprintln!("EXP {}: commissioning CPU {:.1} s (user + system, all threads)", m.name, process_cpu_s() - cpu0);
+        eprintln!("EXP {}: commissioning CPU {:.1} s (user + system, all threads)", m.name, eha_sim::tools::cpu::process_cpu_s() - cpu0);
         let h = headline(&m, &c, &s.holdout);
         let w: Vec<String> = c.holdout_without_margin().iter().map(|r| format!("{} {:.3}/{:.3}", r.log, r.vs_measured_max_k.unwrap_or(f64::NAN), r.vs_measured_under_k.unwrap_or(f64::NAN))).collect();
         eprintln!("EXP {} train={} hold={:?} margin={}: without margin {}; with margin {:.3} K: {:.3?}", m.name, if procedure { train_kind.as_str() } else { "bench" }, hold, margin, w.join(", "), h.margin_k, h.measured);
     }
-}
-
-/// CPU time of this process so far (user + system, every thread), s, from
-/// `/proc/self/stat` at 100 ticks a second (Linux); NaN elsewhere.
-fn process_cpu_s() -> f64 {
-    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
-    // Fields after the command's closing parenthesis; utime and stime are
-    // the 14th and 15th of the whole line.
-    let rest = stat.rsplit_once(')').map_or("", |r| r.1);
-    let f: Vec<f64> = rest.split_whitespace().skip(11).take(2).filter_map(|x| x.parse().ok()).collect();
-    if f.len() == 2 { (f[0] + f[1]) / 100.0 } else { f64::NAN }
 }
 
 /// `EXP_HEAD_FOLD`: an experiment knob, how the margin scores the
