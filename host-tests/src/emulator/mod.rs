@@ -52,9 +52,12 @@
 //! housings.
 
 pub mod bench;
+mod budget;
 mod laws;
 pub mod logger;
 pub mod missions;
+mod network;
+mod op;
 pub mod params;
 pub mod plant;
 pub mod props;

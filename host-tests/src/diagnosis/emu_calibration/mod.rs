@@ -4,13 +4,24 @@
 //! re-computed from each log's stored ln Bayes factors and priors without
 //! refitting (docs/diagnosis-numbers.md, "Reliability of the stated
 //! probabilities"). Measured, not the product's rule.
+//!
+//! By topic: `fraction` the effective sample fractions (from a residual's
+//! Ljung–Box p or the discrepancy's length scale), `restate` the
+//! re-statements of a stored posterior ([`Variant`]); this file the logs
+//! of the stored sweeps, the fitted power, the measurement of a variant
+//! and the document.
+
+mod fraction;
+mod restate;
+
+pub use fraction::{fraction_from_length_scale, fraction_from_ljung_box};
+pub use restate::{power_grid, powered, restate_heldout, restate_no_gate, Variant};
 
 use super::emu_result::EmuResult;
 use super::emu_tables::{reliability_of, statements, Bin, Diagnosed};
-use super::evidence::{effective_fraction, names_a_cause, DISCREPANCY_TAU_S, NAME_PROBABILITY};
+use super::evidence::{names_a_cause, NAME_PROBABILITY};
 use super::model::Candidate;
 use super::report::ProbabilityJson;
-use super::stats::chi2_sf;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
@@ -23,154 +34,6 @@ pub const LB_LAGS: usize = 20;
 
 /// Training share of a log of the stored sweeps (`DiagnoseOptions::train_fraction`).
 pub const TRAIN_FRACTION: f64 = 0.7;
-
-/// The χ² quantile with survival probability `p` and `k` degrees of
-/// freedom (bisection on [`chi2_sf`]; `p` ≤ 1e-300 gives the search's top).
-fn chi2_isf(p: f64, k: f64) -> f64 {
-    let (mut lo, mut hi) = (0.0, 1e5);
-    for _ in 0..200 {
-        let m = 0.5 * (lo + hi);
-        if chi2_sf(m, k) > p {
-            lo = m;
-        } else {
-            hi = m;
-        }
-    }
-    0.5 * (lo + hi)
-}
-
-/// The effective sample fraction n_eff/n of a residual of `n` points
-/// whose Ljung–Box statistic over `lags` lags has p value `p`: the
-/// statistic's excess over its white-noise mean, Q − lags ≈ n·Σρ_k², is
-/// read as an AR(1) whose Σρ^(2k) = ρ²/(1 − ρ²) matches it, and n_eff/n =
-/// (1 − ρ)/(1 + ρ) ([`effective_fraction`]). 1 for a residual the test
-/// finds white (Q ≤ lags); a white residual's chance excess reads as
-/// correlation (at n = 150 a 1σ excess, √(2·lags), gives 0.67), so the
-/// fraction errs low.
-pub fn fraction_from_ljung_box(p: f64, n: usize, lags: usize) -> f64 {
-    let q = chi2_isf(p, lags as f64);
-    let s = (q - lags as f64).max(0.0) / n.max(1) as f64;
-    effective_fraction((s / (1.0 + s)).sqrt())
-}
-
-/// The effective sample fraction if the whitening removed none of the
-/// discrepancy's correlation: an Ornstein–Uhlenbeck process of time
-/// constant τ ([`DISCREPANCY_TAU_S`]) has integrated autocorrelation time
-/// 2τ, so samples `dt_s` apart count as dt/(2τ) independent ones (at most 1).
-pub fn fraction_from_length_scale(dt_s: f64) -> f64 {
-    (dt_s / (2.0 * DISCREPANCY_TAU_S)).min(1.0)
-}
-
-/// How a log's stored posterior is re-stated.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Variant {
-    /// As stored (the product).
-    Stored,
-    /// Every ln Bayes factor times the smallest channel fraction of
-    /// [`fraction_from_ljung_box`] (the whitened residual's own correlation).
-    LjungBox,
-    /// Every ln Bayes factor times [`fraction_from_length_scale`] at the
-    /// fit points' spacing.
-    LengthScale,
-    /// [`Variant::LjungBox`], and a candidate that failed the held-out
-    /// checks keeps a tenth of a candidate's prior (the tempered rule's
-    /// `LEAK`, fitted under `off`, not refitted) instead of none.
-    LjungBoxLeak,
-    /// No admission gate: every candidate keeps a candidate's prior (the
-    /// identifiable ones where the record says which; every one in records
-    /// that do not), with its stored ln Bayes factor.
-    NoGate,
-    /// The held-out likelihood instead of the gate
-    /// ([`super::evidence::DecisionRule::HeldOut`]): no gate, identifiable
-    /// candidates at a candidate's prior, and each candidate's ln Bayes
-    /// factor less its held-out part on the channels it does not touch
-    /// ([`restate_heldout`]); only on records that carry the held-out parts.
-    HeldOut,
-    /// [`Variant::HeldOut`] with every ln Bayes factor times a power η
-    /// fitted on the first set of the document (`fit_power`).
-    HeldOutTempered,
-}
-
-impl Variant {
-    /// Every variant, in the table's order.
-    pub const ALL: [Variant; 7] =
-        [Variant::Stored, Variant::LjungBox, Variant::LengthScale, Variant::LjungBoxLeak, Variant::NoGate, Variant::HeldOut, Variant::HeldOutTempered];
-
-    /// Label in the table.
-    pub fn label(self) -> &'static str {
-        match self {
-            Variant::Stored => "as stated (the product)",
-            Variant::LjungBox => "power n_eff/n from the whitened residual (Ljung–Box)",
-            Variant::LengthScale => "power dt/2τ (discrepancy length scale)",
-            Variant::LjungBoxLeak => "Ljung–Box power + leak 0.1 through the gate",
-            Variant::NoGate => "no gate (stored ln BF, every candidate's prior)",
-            Variant::HeldOut => "held-out likelihood instead of the gate",
-            Variant::HeldOutTempered => "held-out likelihood, tempered (η fitted on 1700s/2700s)",
-        }
-    }
-}
-
-/// The posterior re-computed from `probs`' ln Bayes factors times `w`,
-/// with a candidate of prior 0 given `leak` of an admitted candidate's.
-pub fn powered(probs: &[ProbabilityJson], w: f64, leak: f64) -> Vec<ProbabilityJson> {
-    let prior = |p: &ProbabilityJson| if p.prior == 0.0 && names_a_cause(&p.cause) { leak * super::evidence::CANDIDATE_PRIOR } else { p.prior };
-    let l: Vec<f64> = probs.iter().map(|p| w * p.log_bayes_factor + prior(p).max(1e-300).ln()).collect();
-    probs.iter().zip(normalised(&l)).map(|(p, probability)| ProbabilityJson { probability, prior: prior(p), ..p.clone() }).collect()
-}
-
-/// The probabilities of the log-weights `l` (ln prior + ln Bayes factor), normalised.
-fn normalised(l: &[f64]) -> Vec<f64> {
-    let m = l.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    let s: f64 = l.iter().map(|x| (x - m).exp()).sum();
-    l.iter().map(|x| (x - m).exp() / s).collect()
-}
-
-/// `probs` re-stated with priors `prior` and ln Bayes factors `lbf`, normalised.
-fn restated(probs: &[ProbabilityJson], prior: &dyn Fn(&ProbabilityJson) -> f64, lbf: &dyn Fn(&ProbabilityJson) -> f64) -> Vec<ProbabilityJson> {
-    let l: Vec<f64> = probs.iter().map(|p| lbf(p) + prior(p).max(1e-300).ln()).collect();
-    let mut out: Vec<ProbabilityJson> = probs
-        .iter()
-        .zip(normalised(&l))
-        .map(|(p, probability)| ProbabilityJson { probability, prior: prior(p), log_bayes_factor: lbf(p), ..p.clone() })
-        .collect();
-    out.sort_by(|a, b| b.probability.total_cmp(&a.probability));
-    out
-}
-
-/// The stored posterior without the admission gate: every candidate that
-/// the record does not mark unidentifiable at a candidate's prior, the
-/// stored ln Bayes factors.
-pub fn restate_no_gate(probs: &[ProbabilityJson]) -> Vec<ProbabilityJson> {
-    let prior = |p: &ProbabilityJson| match names_a_cause(&p.cause) {
-        true if p.identifiable != Some(false) => super::evidence::CANDIDATE_PRIOR,
-        true => 0.0,
-        false => p.prior,
-    };
-    restated(probs, &prior, &|p| p.log_bayes_factor)
-}
-
-/// The stored posterior re-stated under
-/// [`super::evidence::DecisionRule::HeldOut`]: identifiable candidates at a
-/// candidate's prior, each candidate's ln Bayes factor less its held-out
-/// part on the channels it does not touch (so its held-out evidence is the
-/// predictive density where its physics acts). `None` when the record does
-/// not carry the held-out parts (sweeps written before they were kept).
-pub fn restate_heldout(probs: &[ProbabilityJson]) -> Option<Vec<ProbabilityJson>> {
-    if probs.iter().any(|p| names_a_cause(&p.cause) && (p.heldout_untouched.is_none() || p.identifiable.is_none())) {
-        return None;
-    }
-    let prior = |p: &ProbabilityJson| match names_a_cause(&p.cause) {
-        true if p.identifiable == Some(true) => super::evidence::CANDIDATE_PRIOR,
-        true => 0.0,
-        false => p.prior,
-    };
-    Some(restated(probs, &prior, &|p| p.log_bayes_factor - if names_a_cause(&p.cause) { p.heldout_untouched.unwrap_or(0.0) } else { 0.0 }))
-}
-
-/// Powers η tried by `fit_power`: 0.05 to 1 in steps of 0.05.
-pub fn power_grid() -> Vec<f64> {
-    (1..=20).map(|k| 0.05 * k as f64).collect()
-}
 
 /// The stated probability of the truth in `probs`: of the hidden effect
 /// `truth` when it stands clear of the floor (`ratio` ≥ 2), else of "no
@@ -331,59 +194,6 @@ pub fn document(sets: &[(&str, Vec<EmuResult>)], ratios: &BTreeMap<u64, f64>) ->
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// An AR(1) sequence of lag-1 correlation 0.5 has n_eff/n = 1/3; read
-    /// back from its own Ljung–Box p (2000 points, 20 lags) it comes out
-    /// within 0.06 (the statistic sums the first 20 ρ_k², which an AR(1)
-    /// of 0.5 has all but exhausted; the rest is the estimate's scatter at
-    /// 2000 points). A white sequence reads at least what a 3σ chance
-    /// excess of its statistic gives (0.82; measured 0.84 on this draw).
-    #[test]
-    fn effective_fraction_from_the_ljung_box_p_of_an_ar1() {
-        let mut rng = 0x9e37_79b9_7f4a_7c15u64;
-        let mut gauss = || {
-            let mut u = || {
-                rng ^= rng << 13;
-                rng ^= rng >> 7;
-                rng ^= rng << 17;
-                (rng >> 11) as f64 / (1u64 << 53) as f64
-            };
-            let (a, b) = (u().max(1e-300), u());
-            (-2.0 * a.ln()).sqrt() * (2.0 * std::f64::consts::PI * b).cos()
-        };
-        let n = 2000;
-        let (mut x, mut ar, mut white) = (0.0, Vec::new(), Vec::new());
-        for _ in 0..n {
-            x = 0.5 * x + (0.75f64).sqrt() * gauss();
-            ar.push(Some(x));
-            white.push(Some(gauss()));
-        }
-        let p = crate::diagnosis::stats::ljung_box(&ar, 20).p_value;
-        let f = fraction_from_ljung_box(p, n, 20);
-        assert!((f - 1.0 / 3.0).abs() < 0.06, "AR(1) 0.5: n_eff/n {f}");
-        let p = crate::diagnosis::stats::ljung_box(&white, 20).p_value;
-        let fw = fraction_from_ljung_box(p, n, 20);
-        // A white series' Q exceeds its mean by chance, which the back-out
-        // reads as correlation: at a 3σ excess (3·√(2·20)) n_eff/n is 0.82.
-        let s3 = 3.0 * 40f64.sqrt() / n as f64;
-        let bound = effective_fraction((s3 / (1.0 + s3)).sqrt());
-        assert!(fw >= bound && fw <= 1.0, "white: {fw} (3σ bound {bound})");
-    }
-
-    /// A power scales every ln Bayes factor; a prior-0 candidate stays at
-    /// P 0 without a leak and gets a share with one.
-    #[test]
-    fn powered_scales_the_evidence_and_the_gate_holds_without_leak() {
-        let p = |c: &str, b: f64, pr: f64| ProbabilityJson { cause: c.into(), probability: 0.0, log_bayes_factor: b, prior: pr, heldout_touched: None, heldout_untouched: None, identifiable: None };
-        let probs = [p("none", 0.0, 0.25), p("unexplained", -20.0, 0.25), p("sensor-lag", 20.0, 1.0 / 12.0), p("churning-loss", 30.0, 0.0)];
-        let q = powered(&probs, 1.0, 0.0);
-        assert!(q[2].probability > 0.999 && q[3].probability < 1e-200, "{q:?}");
-        let q = powered(&probs, 0.1, 0.0);
-        // ln odds lag : none = 2 + ln(1/3).
-        let odds = q[2].probability / q[0].probability;
-        assert!((odds.ln() - (2.0 + (1.0f64 / 3.0).ln())).abs() < 1e-9);
-        assert!(powered(&probs, 0.1, 0.1)[3].probability > 0.0);
-    }
 
     /// The stored sweeps (docs/data/) as `eha-sim docs` reads them:
     /// (label, records) per set, and the imprint ratios of the cases run
