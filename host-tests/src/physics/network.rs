@@ -169,7 +169,7 @@ pub fn case_gap_h(rig: &Rig, omega: f64, t_oil: f64, nu: f64) -> f64 {
     let e = p.case_gap_m;
     let r_mean = p.rotor_radius_m + 0.5 * e;
     let ta = omega * omega * r_mean * e.powi(3) / (nu * nu);
-    heat::nu_taylor_couette(ta) * rig.oil.k(t_oil) / (2.0 * e) * case_churn_factor(rig, omega, t_oil, nu)
+    heat::nu_taylor_couette(ta) * rig.oil.k(t_oil) / (2.0 * e) * case_churn_factor(rig, omega, nu)
 }
 
 /// Reference speed of the churned case film ([`crate::rig::Pump::case_churn`]
@@ -186,28 +186,16 @@ pub const CASE_CHURN_ONSET_RAD_S: f64 = 10.0;
 /// Oil temperature of the churned film's reference speeds, °C.
 pub const CASE_CHURN_REF_C: f64 = 40.0;
 
-/// Factor of the churned case on the gap's film: 1 + s·(θ·rⁿ − 1)·p, with
+/// Factor of the churned case on the gap's film: 1 + s·(θ·rⁿ − 1), with
 /// θ = [`crate::rig::Pump::case_churn`], n =
 /// [`crate::rig::Pump::case_churn_speed_exp`], r the gap's Reynolds number
 /// ω·r·e/ν over its value at [`CASE_CHURN_REF_RAD_S`] with the oil at
-/// [`CASE_CHURN_REF_C`], the blend s = r²/(r² + r₀²), r₀ the same ratio
-/// at [`CASE_CHURN_ONSET_RAD_S`], and p = (Pr/Pr_ref)^⅓ the Prandtl factor
-/// ([`case_churn_prandtl_factor`]): the churned law on the gap law at
+/// [`CASE_CHURN_REF_C`], and the blend s = r²/(r² + r₀²), r₀ the same ratio
+/// at [`CASE_CHURN_ONSET_RAD_S`]: the churned law θ·rⁿ on the gap law at
 /// speed, the gap law (Nu = 2 across the gap, conduction: a lower bound) at
-/// rest. Exactly 1 for the rig file's θ = 1, n = 0 (the gap law alone, at
-/// any temperature: it is continuous there, the churned part being θ·rⁿ − 1).
-///
-/// Why p: forced convection from a liquid to a wall goes as Nu ∝ Reⁿ·Pr^⅓
-/// (the laminar plate, Pohlhausen, [`heat::nu_flat_plate_laminar`]: a slipper
-/// swept through the case oil; a cylinder rotating in a liquid at rest,
-/// Becker 1963, water and oils at 0.7 < Pr < 670: Nu = 0.133·Re^⅔·Pr^⅓;
-/// Incropera & DeWitt ch. 7, the Pr^⅓ of every external-flow law for
-/// Pr ≳ 0.6). With Pr = ν·ρc_p/k the film's viscosity dependence at one
-/// speed is then ν^−(n−⅓), weaker than the ν^−n of rⁿ alone: rⁿ fitted on
-/// speed steps would over-read the film in hot oil and under-read it cold.
-/// Not a function of ω/ν alone (the reduction tabulates the ω/ν part over
-/// speed at 40 °C and carries the rest in a temperature slope).
-pub fn case_churn_factor(rig: &Rig, omega: f64, t_oil: f64, nu: f64) -> f64 {
+/// rest. Exactly 1 for the rig file's θ = 1, n = 0. A function of ω/ν alone,
+/// as the gap law is (the reduction tabulates it over speed at 40 °C).
+pub fn case_churn_factor(rig: &Rig, omega: f64, nu: f64) -> f64 {
     let p = &rig.pump;
     if p.case_churn == 1.0 && p.case_churn_speed_exp == 0.0 {
         return 1.0;
@@ -218,15 +206,7 @@ pub fn case_churn_factor(rig: &Rig, omega: f64, t_oil: f64, nu: f64) -> f64 {
     }
     let r0 = CASE_CHURN_ONSET_RAD_S / CASE_CHURN_REF_RAD_S;
     let s = r * r / (r * r + r0 * r0);
-    1.0 + s * (p.case_churn * r.powf(p.case_churn_speed_exp) - 1.0) * case_churn_prandtl_factor(rig, t_oil, nu)
-}
-
-/// Prandtl factor of the churned case film, (Pr/Pr_ref)^⅓ (dimensionless):
-/// Pr of the case oil at `t_oil` °C with `nu` m²/s over Pr at
-/// [`CASE_CHURN_REF_C`] ([`crate::fluid::Oil::prandtl`]); 1 at 40 °C.
-pub fn case_churn_prandtl_factor(rig: &Rig, t_oil: f64, nu: f64) -> f64 {
-    let pr_ref = rig.oil.prandtl(CASE_CHURN_REF_C, rig.oil.nu_m2_per_s(CASE_CHURN_REF_C));
-    (rig.oil.prandtl(t_oil, nu) / pr_ref).cbrt()
+    1.0 + s * (p.case_churn * r.powf(p.case_churn_speed_exp) - 1.0)
 }
 
 /// Case-oil film to the pump housing: [`case_gap_h`] on the case's inner
@@ -335,29 +315,21 @@ pub fn block_path(rig: &Rig, film_w_per_k: f64, block_area_m2: f64) -> f64 {
 mod tests {
     use super::*;
 
-    /// The churned case film: exactly the gap law for the rig file (at any
-    /// temperature) and at rest; θ at the reference speed with the oil at
-    /// 40 °C (to the blend, 1 %); at one ω/ν the churned part scales with
-    /// (Pr/Pr₄₀)^⅓, ~0.8 at 55 °C.
+    /// The churned case film: exactly the gap law for the rig file and at
+    /// rest; θ at the reference speed with the oil at 40 °C (to the blend,
+    /// 1 %); a function of ω/ν alone.
     #[test]
     fn case_churn_is_the_gap_law_at_the_centre_and_at_rest() {
         let mut rig = Rig::default();
-        let nu = |t: f64| rig.oil.nu_m2_per_s(t);
-        let nu40 = nu(CASE_CHURN_REF_C);
-        assert_eq!(case_churn_factor(&rig, CASE_CHURN_REF_RAD_S, 40.0, nu40), 1.0);
-        assert_eq!(case_churn_factor(&rig, 30.0, 70.0, nu(70.0)), 1.0);
-        let nu55 = nu(55.0);
+        let nu40 = rig.oil.nu_m2_per_s(CASE_CHURN_REF_C);
+        assert_eq!(case_churn_factor(&rig, CASE_CHURN_REF_RAD_S, nu40), 1.0);
         rig.pump.case_churn = 30.0;
         rig.pump.case_churn_speed_exp = 0.6;
-        assert_eq!(case_churn_factor(&rig, 0.0, 40.0, nu40), 1.0);
-        let at_ref = case_churn_factor(&rig, CASE_CHURN_REF_RAD_S, 40.0, nu40);
+        assert_eq!(case_churn_factor(&rig, 0.0, nu40), 1.0);
+        let at_ref = case_churn_factor(&rig, CASE_CHURN_REF_RAD_S, nu40);
         assert!((at_ref / 30.0 - 1.0).abs() < 0.011, "{at_ref}");
-        // the same ω/ν at 40 and 55 °C: the churned parts differ by the Prandtl factor
-        let w55 = 50.0 * nu55 / nu40;
-        let (a, b) = (case_churn_factor(&rig, 50.0, 40.0, nu40), case_churn_factor(&rig, w55, 55.0, nu55));
-        let p = case_churn_prandtl_factor(&rig, 55.0, nu55);
-        assert!(((b - 1.0) / (a - 1.0) / p - 1.0).abs() < 1e-12, "{a} {b} {p}");
-        assert!((0.7..0.9).contains(&p), "{p}");
-        assert!(case_churn_factor(&rig, 1.0, 40.0, nu40) < 1.1);
+        let (a, b) = (case_churn_factor(&rig, 50.0, nu40), case_churn_factor(&rig, 25.0, nu40 / 2.0));
+        assert!((a - b).abs() < 1e-12 * a);
+        assert!(case_churn_factor(&rig, 1.0, nu40) < 1.1);
     }
 }

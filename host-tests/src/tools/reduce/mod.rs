@@ -71,19 +71,11 @@ pub fn reduce_without_jacobian(rig: &Rig) -> ReducedParams {
     let duct = |q: f64, dd: f64, len: f64, scale: f64| network::duct_conductance(rig, q, dd, len, scale, t40, nu);
     // the case gap (Taylor-Couette): Nu depends on the Taylor number (w / nu)^2 only, so
     // the table over speed at 40 degC read at w nu(40)/nu(T) is exact in nu; its k(T)
-    // by the relative slope below, and with it what the table cannot carry: the churned
-    // film's Prandtl factor, the reference's churn factor at T with nu(T) over its value
-    // at the equivalent speed at 40 degC (exactly 0 for the gap law alone)
+    // by the relative slope below
     let g_case = table(w_max, |w| network::case_film_w_per_k(rig, w, t40, nu));
     let w_nom = 500.0 * PI / 30.0;
-    let mut gap_rig = rig.clone();
-    (gap_rig.pump.case_churn, gap_rig.pump.case_churn_speed_exp) = (1.0, 0.0);
-    let gc = |t: f64| network::case_film_w_per_k(&gap_rig, w_nom, t, nu);
-    let churn = |t: f64| {
-        let nu_t = oil.nu_m2_per_s(t);
-        network::case_churn_factor(rig, w_nom, t, nu_t) / network::case_churn_factor(rig, w_nom * nu / nu_t, t40, nu)
-    };
-    let case_film_slope = (gc(t40 + 1.0) - gc(t40 - 1.0)) / (2.0 * gc(t40)) + (churn(t40 + 1.0) - churn(t40 - 1.0)) / 2.0;
+    let gc = |t: f64| network::case_film_w_per_k(rig, w_nom, t, nu);
+    let case_film_slope = (gc(t40 + 1.0) - gc(t40 - 1.0)) / (2.0 * gc(t40));
     let g_port = table(q_max, |q| duct(q, p.port_d_m, p.port_len_m, p.port_area_scale));
     let g_loop = table(q_max, |q| network::block_path(rig, duct(q, b.loop_d_m, b.loop_len_m, b.loop_area_scale), b.main_area_m2));
     let g_ball = table(q_max, |q| network::block_path(rig, duct(q, b.ball_d_m, b.ball_len_m, 1.0), b.ball_area_m2));
