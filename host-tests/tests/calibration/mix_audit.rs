@@ -33,13 +33,13 @@ fn other_mix_log(m: &EmuMachine, seed: u64) -> CalLog {
 fn commissioned(m: &EmuMachine) -> Rig {
     let holds = std::env::var("EXP_HOLD").unwrap_or_default();
     let tag = std::env::var("MIXAUDIT_TAG").unwrap_or_default();
-    let path = std::env::temp_dir().join(format!("mixaudit-{}{}{}.toml", m.name, holds, tag));
+    let path = std::env::temp_dir().join(format!("mixaudit-{}{}{}{}.toml", m.name, holds, tag, if procedure() { "-procedure" } else { "" }));
     if std::env::var("MIXAUDIT_FRESH").is_err() {
         if let Ok(r) = Rig::from_toml_file(&path) {
             return r;
         }
     }
-    let s = eha_sim::emulator::bench::bench_set(m, 3600).expect("bench");
+    let s = if procedure() { eha_sim::emulator::bench::commissioning_set(m, 3600) } else { eha_sim::emulator::bench::bench_set(m, 3600) }.expect("bench");
     let mut train: Vec<CalLog> = s.train.iter().map(cal).collect();
     if std::env::var("EXP_TRAIN_MIX").is_ok() {
         // the held-out mix trained too (tag the cache with MIXAUDIT_TAG)
@@ -55,6 +55,14 @@ fn commissioned(m: &EmuMachine) -> Rig {
     let c = commission_with(&base, &train, &[], &o, false).expect("commission");
     std::fs::write(&path, c.cal.rig.to_toml()).expect("write rig");
     c.cal.rig
+}
+
+/// `MIXAUDIT_TRAIN=procedure`: commission on the procedure's training set
+/// (`commissioning_set`: speed-then-needle steps, soak then low-speed
+/// holds, every structural freedom) instead of `bench_set`'s two throttle
+/// logs, and audit its soak log.
+fn procedure() -> bool {
+    std::env::var("MIXAUDIT_TRAIN").is_ok_and(|v| v == "procedure")
 }
 
 #[derive(Default, Clone, Copy)]
@@ -120,12 +128,14 @@ fn audit(m: &EmuMachine, rig: &Rig, scenario: EmuScenario, dur: f64, seed: u64) 
             *a += x;
         }
         let _ = Node::Case;
-        if scenario == EmuScenario::ThrottleMix && (*t as i64) % if *t < 300.0 { 4 } else { 10 } == 0 {
+        let series_of = if std::env::var("MIXAUDIT_SERIES").is_ok_and(|v| v == "soak") { EmuScenario::SoakThenLowSpeedHolds } else { EmuScenario::ThrottleMix };
+        if scenario == series_of && (*t as i64) % if *t < 300.0 { 4 } else { 10 } == 0 {
             let cap = model.capacity(Node::Case, tc);
             series.push(format!(
-                "{t:6.0} {rpm:6.0} {bar:5.1} emu case {:6.2} wall {:6.2} barrel {:6.2} end {:6.2} | ref case {tc:6.2} pump {tp:6.2} meas_pump {:6.2} | err {:6.2} | Q {:6.1}/{:6.1} G {:5.1}/{:5.1} tau_case {:5.1}/{:5.1}",
+                "{t:6.0} {rpm:6.0} {bar:5.1} emu case {:6.2} wall {:6.2} barrel {:6.2} end {:6.2} | ref case {tc:6.2} pump {tp:6.2} meas_pump {:6.2} | err {:6.2} | Q {:6.1}/{:6.1} G {:5.1}/{:5.1} tau_case {:5.1}/{:5.1} | mech→case {:5.1}/{:5.1} (ref viscous part {:5.1}, ref friction total {:5.1}) leak {:5.1}/{:5.1} inflow {:5.1}/{:5.1}",
                 e.case_c, e.wall_c, y[2], y[3], log.run.value_at(eha_sim::measured::Channel::TPumpC, *t).unwrap_or(f64::NAN), tc - e.case_c,
-                e.mech_w + e.leak_w + e.inflow_w, fh.case + leak + inflow, e.film_w_per_k, g, plant.capacities(y)[4] / e.film_w_per_k, cap / g
+                e.mech_w + e.leak_w + e.inflow_w, fh.case + leak + inflow, e.film_w_per_k, g, plant.capacities(y)[4] / e.film_w_per_k, cap / g,
+                e.mech_w, fh.case, fcase * fr.viscous_w, fr.viscous_w + fr.pressure_w, e.leak_w, leak, e.inflow_w, inflow
             ));
         }
     }
@@ -169,7 +179,8 @@ fn slow_mix_heat_audit() {
         variant(&mut m);
         let rig = commissioned(&m);
         audit(&m, &rig, EmuScenario::SpeedThenNeedleSteps, 1800.0, 3600);
-        audit(&m, &rig, EmuScenario::SoakThenIdle, 1800.0, 3601);
+        let soak = if procedure() { EmuScenario::SoakThenLowSpeedHolds } else { EmuScenario::SoakThenIdle };
+        audit(&m, &rig, soak, 1800.0, 3601);
         audit(&m, &rig, EmuScenario::ThrottleMix, 1800.0, 3603);
     }
 }

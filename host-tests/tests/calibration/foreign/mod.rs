@@ -119,6 +119,11 @@ fn report(m: &EmuMachine, c: &Commissioning, secs: f64) {
     for r in &c.reduced {
         eprintln!("  reduced {:40} vs ref max {:.3} | vs measured max {:?} under {:?}", r.log, r.vs_reference_max_k, r.vs_measured_max_k, r.vs_measured_under_k);
     }
+    for h in &c.holdout {
+        for e in h.commissioned.iter().filter(|e| e.channel == "t_drain_c") {
+            eprintln!("  reference held out {:32} drain vs thermocouple: rmse {:.3} max {:.3} under {:.3} K", h.log, e.rmse_k, e.max_abs_k, e.max_under_k);
+        }
+    }
     if let Some(v) = &c.margin {
         for f in &v.folds {
             eprintln!("  fold: {}: max {:?} under {:?} at {:?}", f.log, f.vs_measured_max_k, f.vs_measured_under_k, f.vs_measured_region.as_ref().map(|g| g.to_string()));
@@ -395,7 +400,9 @@ fn slow_churned_case_film_with_a_low_speed_training_log() {
 /// `procedure` (`commissioning_set`, default), with the parameters named in
 /// `EXP_HOLD` (comma-separated) held and those in `EXP_FREE` taken out of
 /// the default holds (e.g. `duct_turbulent`); `EXP_MACHINE` = `big-pump` or `leaky-heavy` for one machine;
-/// `EXP_MARGIN=1` with the margin and both paths.
+/// `EXP_MARGIN=1` with the margin and both paths; `EXP_RIG_CASE_SHARE=k`
+/// scales the rig file's case share of the friction heat (the fit's start
+/// and prior centre for `friction_case`).
 #[test]
 #[ignore = "measurement by hand: one commissioning per machine"]
 fn slow_structure_experiment() {
@@ -428,7 +435,12 @@ fn slow_structure_experiment() {
         o.margin_head_fold = exp_head_fold();
         let t0 = std::time::Instant::now();
         let cpu0 = eha_sim::tools::cpu::process_cpu_s();
-        let c = commission_with(&m.rig_file(), &train, &hold_logs, &o, margin).expect("commissioning");
+        let mut base = m.rig_file();
+        if let Some(k) = std::env::var("EXP_RIG_CASE_SHARE").ok().and_then(|v| v.parse::<f64>().ok()) {
+            // the user's rig file with the sliding-pair rule's case share scaled (prior centre and start)
+            base.pump.friction_pairs.case_share_scale *= k;
+        }
+        let c = commission_with(&base, &train, &hold_logs, &o, margin).expect("commissioning");
         report(&m, &c, t0.elapsed().as_secs_f64());
         eprintln!("EXP {}: commissioning CPU {:.1} s (user + system, all threads)", m.name, eha_sim::tools::cpu::process_cpu_s() - cpu0);
         let h = headline(&m, &c, &s.holdout);
