@@ -249,7 +249,7 @@ fn rows_of(log: &CalLog, rows: std::ops::Range<usize>, points_per_channel: usize
     let mut run = log.run.clone();
     run.time_s = run.time_s[rows.clone()].to_vec();
     run.channels.values_mut().for_each(|v| *v = v[rows.clone()].to_vec());
-    CalLog::new(&log.name, run, points_per_channel)
+    CalLog::new(&log.name, run, points_per_channel).map(|l| l.with_thinning(log.thinning, points_per_channel))
 }
 
 /// The first [`SPLIT_FRACTION`] of `log`'s span as a log of its own.
@@ -346,6 +346,7 @@ pub fn commission(base: &Rig, train: &[CalLog], holdout: &[CalLog], o: &CalOptio
 /// [`commission`]; `with_margin` false skips the margin validation (one
 /// calibration instead of two).
 pub fn commission_with(base: &Rig, train: &[CalLog], holdout: &[CalLog], o: &CalOptions, with_margin: bool) -> Result<Commissioning, CommissionError> {
+    let train = &super::thinning::rethinned(train, o.commission_thinning, o.points_per_channel);
     let (base_e, mut cal, eta_e, eta_m_balance) = fit(base, train, o)?;
     let base = &base_e;
     if !train.iter().any(cycles_valve) {

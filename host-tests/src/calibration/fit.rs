@@ -88,6 +88,8 @@ pub struct CalOptions {
     /// drain margin is validated on the training logs' starts besides after
     /// the split ([`HeadFold`]; default [`HEAD_FOLD_DEFAULT`]).
     pub margin_head_fold: HeadFold,
+    /// `commission` only (the calibration itself fits the logs' points as given): how the training logs' fit points are thinned ([`super::thinning::Thinning`]).
+    pub commission_thinning: super::thinning::Thinning,
 }
 
 /// Default factor on every prior width of the set in the fit
@@ -140,6 +142,7 @@ impl Default for CalOptions {
             polish_s2: None,
             continuation_logs: CONTINUATION_LOGS,
             margin_head_fold: HEAD_FOLD_DEFAULT,
+            commission_thinning: super::thinning::Thinning::Uniform,
         }
     }
 }
