@@ -147,12 +147,11 @@ fn thinned_points(run: &MeasuredRun, channels: &[Channel], points_per_channel: u
     points
 }
 
-/// `rows` uniformly thinned to at most `n`: from the first, every `step`-th
-/// (step = len/n, at least 1, accumulated), all of them when there are no
-/// more than `n`.
-pub(super) fn thin(rows: &[usize], n: usize) -> impl Iterator<Item = usize> + '_ {
-    let step = (rows.len() as f64 / n.max(1) as f64).max(1.0);
-    std::iter::successors(Some(0.0f64), move |k| Some(k + step)).take_while(|&k| (k as usize) < rows.len()).map(|k| rows[k as usize])
+/// `logs` with their fit points re-thinned by `rule` (at most
+/// `points_per_channel` per channel); a log already thinned by `rule` is
+/// kept as it is. The commissioning's entry ([`super::commission::commission_with`]).
+pub fn rethinned(logs: &[CalLog], rule: Thinning, points_per_channel: usize) -> Vec<CalLog> {
+    logs.iter().map(|l| if l.thinning == rule { l.clone() } else { l.with_thinning(rule, points_per_channel) }).collect()
 }
 
 /// The replayed ambient (°C) of `r` at `times` (s), linearly interpolated;

@@ -9,7 +9,7 @@ use crate::measured::{Channel, MeasuredRun};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 pub enum Thinning {
     /// Every `len/n`-th row from the first: points evenly in time
-    /// ([`super::log::thin`]).
+    /// ([`thin`]).
     Uniform,
     /// Points evenly in the arc length s = ½ t/T + ½ V(t)/V(T) of
     /// [`motion_arc`]: half of them spread in time (the steady parts, where
@@ -83,7 +83,7 @@ pub fn motion_arc(run: &MeasuredRun, ch: Channel, rows: &[usize]) -> Vec<f64> {
 /// there are no more than `n`).
 pub fn thin_rows(run: &MeasuredRun, ch: Channel, rows: &[usize], n: usize, rule: Thinning) -> Vec<usize> {
     match rule {
-        Thinning::Uniform => super::log::thin(rows, n).collect(),
+        Thinning::Uniform => thin(rows, n).collect(),
         Thinning::Motion if rows.len() <= n.max(1) => rows.to_vec(),
         Thinning::Motion => {
             // n targets evenly in s from 0; each the first row at or past its
@@ -106,11 +106,12 @@ pub fn thin_rows(run: &MeasuredRun, ch: Channel, rows: &[usize], n: usize, rule:
     }
 }
 
-/// `logs` with their fit points re-thinned by `rule` (at most
-/// `points_per_channel` per channel); a log already thinned by `rule` is
-/// kept as it is. The commissioning's entry ([`super::commission::commission_with`]).
-pub fn rethinned(logs: &[super::log::CalLog], rule: Thinning, points_per_channel: usize) -> Vec<super::log::CalLog> {
-    logs.iter().map(|l| if l.thinning == rule { l.clone() } else { l.with_thinning(rule, points_per_channel) }).collect()
+/// `rows` uniformly thinned to at most `n`: from the first, every `step`-th
+/// (step = len/n, at least 1, accumulated), all of them when there are no
+/// more than `n`.
+pub fn thin(rows: &[usize], n: usize) -> impl Iterator<Item = usize> + '_ {
+    let step = (rows.len() as f64 / n.max(1) as f64).max(1.0);
+    std::iter::successors(Some(0.0f64), move |k| Some(k + step)).take_while(|&k| (k as usize) < rows.len()).map(|k| rows[k as usize])
 }
 
 #[cfg(test)]

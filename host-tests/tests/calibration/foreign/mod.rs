@@ -467,7 +467,7 @@ fn exp_thinning() -> eha_sim::calibration::thinning::Thinning {
 /// Prints how many `t_drain_c` fit points each training log has in its
 /// first 60, 120 and 300 s under the commissioning's thinning.
 fn print_starts_points(m: &EmuMachine, train: &[CalLog], o: &CalOptions) {
-    for l in eha_sim::calibration::thinning::rethinned(train, o.commission_thinning, o.points_per_channel) {
+    for l in eha_sim::calibration::log::rethinned(train, o.commission_thinning, o.points_per_channel) {
         let t0 = l.run.time_s[0];
         let n = |dt: f64| l.points.iter().filter(|&&(ch, i)| ch == Channel::TDrainC && l.run.time_s[i] - t0 < dt).count();
         let all = l.points.iter().filter(|p| p.0 == Channel::TDrainC).count();
