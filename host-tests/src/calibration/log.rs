@@ -8,6 +8,8 @@ use crate::rig::Rig;
 use crate::scenario::Scenario;
 use crate::sim::{simulate_rtol, SimOptions};
 use std::collections::BTreeMap;
+pub use super::thinning::Thinning;
+use super::thinning::thin_rows;
 
 /// Simulated channels at a log's sample times, °C.
 pub type Series = BTreeMap<Channel, Vec<f64>>;
@@ -21,8 +23,11 @@ pub struct CalLog {
     pub run: MeasuredRun,
     /// Channels with at least one sample: the temperatures and `t_drain_c`.
     pub channels: Vec<Channel>,
-    /// Fit points: (channel, row), uniformly thinned per channel.
+    /// Fit points: (channel, row), thinned per channel by `thinning`.
     pub points: Vec<(Channel, usize)>,
+    /// The rule `points` were thinned by ([`Thinning::Uniform`] unless
+    /// [`CalLog::with_thinning`] set it); [`CalLog::fitted_from`] keeps it.
+    pub thinning: Thinning,
     scenario: Scenario,
     opts: SimOptions,
     /// Relative tolerance of the replay solver ([`REPLAY_RTOL`] unless
@@ -59,18 +64,25 @@ impl CalLog {
         let dt = (span / 400.0).clamp(0.5, 5.0);
         let opts = SimOptions { output_interval_s: dt, control_interval_s: dt };
         let channels = scored_channels(&run);
-        let points = thinned_points(&run, &channels, points_per_channel, f64::NEG_INFINITY);
-        Ok(CalLog { name: name.into(), run, channels, points, scenario: Scenario::Replay(inputs), opts, rtol: REPLAY_RTOL, fit_from_s: f64::NEG_INFINITY })
+        let points = thinned_points(&run, &channels, points_per_channel, f64::NEG_INFINITY, Thinning::Uniform);
+        Ok(CalLog { name: name.into(), run, channels, points, thinning: Thinning::Uniform, scenario: Scenario::Replay(inputs), opts, rtol: REPLAY_RTOL, fit_from_s: f64::NEG_INFINITY })
     }
 
     /// The same log with its fit points (at most `points_per_channel` per
-    /// channel, thinned as [`CalLog::new`] does) taken from `t0_s` on only;
+    /// channel, from its `fit_from_s` on) thinned by `rule`.
+    pub fn with_thinning(&self, rule: Thinning, points_per_channel: usize) -> Self {
+        let points = thinned_points(&self.run, &self.channels, points_per_channel, self.fit_from_s, rule);
+        CalLog { points, thinning: rule, ..self.clone() }
+    }
+
+    /// The same log with its fit points (at most `points_per_channel` per
+    /// channel, thinned by its own rule) taken from `t0_s` on only;
     /// the replay still runs from the log's start, so the state at `t0_s`
     /// is the model's own. The margin's head fold fits these
     /// (`calibration::commission`): its fits see no measured temperature
     /// before `t0_s`.
     pub fn fitted_from(&self, t0_s: f64, points_per_channel: usize) -> Self {
-        let points = thinned_points(&self.run, &self.channels, points_per_channel, t0_s);
+        let points = thinned_points(&self.run, &self.channels, points_per_channel, t0_s, self.thinning);
         CalLog { points, fit_from_s: t0_s, ..self.clone() }
     }
 
@@ -125,22 +137,21 @@ impl CalLog {
 }
 
 /// Fit points of `run`'s `channels`: per channel its rows with a sample at
-/// or after `t0_s` (s), uniformly thinned to at most `points_per_channel`.
-fn thinned_points(run: &MeasuredRun, channels: &[Channel], points_per_channel: usize, t0_s: f64) -> Vec<(Channel, usize)> {
+/// or after `t0_s` (s), thinned by `rule` to at most `points_per_channel`.
+fn thinned_points(run: &MeasuredRun, channels: &[Channel], points_per_channel: usize, t0_s: f64, rule: Thinning) -> Vec<(Channel, usize)> {
     let mut points = Vec::new();
     for &ch in channels {
         let rows: Vec<usize> = (0..run.len()).filter(|&i| run.time_s[i] >= t0_s && run.get(ch).is_some_and(|v| v[i].is_some())).collect();
-        points.extend(thin(&rows, points_per_channel).map(|i| (ch, i)));
+        points.extend(thin_rows(run, ch, &rows, points_per_channel, rule).into_iter().map(|i| (ch, i)));
     }
     points
 }
 
-/// `rows` uniformly thinned to at most `n`: from the first, every `step`-th
-/// (step = len/n, at least 1, accumulated), all of them when there are no
-/// more than `n`.
-pub(super) fn thin(rows: &[usize], n: usize) -> impl Iterator<Item = usize> + '_ {
-    let step = (rows.len() as f64 / n.max(1) as f64).max(1.0);
-    std::iter::successors(Some(0.0f64), move |k| Some(k + step)).take_while(|&k| (k as usize) < rows.len()).map(|k| rows[k as usize])
+/// `logs` with their fit points re-thinned by `rule` (at most
+/// `points_per_channel` per channel); a log already thinned by `rule` is
+/// kept as it is. The commissioning's entry ([`super::commission::commission_with`]).
+pub fn rethinned(logs: &[CalLog], rule: Thinning, points_per_channel: usize) -> Vec<CalLog> {
+    logs.iter().map(|l| if l.thinning == rule { l.clone() } else { l.with_thinning(rule, points_per_channel) }).collect()
 }
 
 /// The replayed ambient (°C) of `r` at `times` (s), linearly interpolated;

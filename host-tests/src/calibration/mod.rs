@@ -36,6 +36,7 @@ pub mod replay;
 pub mod residuals;
 pub mod set;
 pub mod synthetic;
+pub mod thinning;
 
 pub use fit::{calibrate, CalError, CalOptions, Calibration, ParamResult, Status};
 pub use log::{channel_errors, CalLog, ChannelError};

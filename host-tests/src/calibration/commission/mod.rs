@@ -53,6 +53,7 @@ pub fn commission(base: &Rig, train: &[CalLog], holdout: &[CalLog], o: &CalOptio
 /// [`commission`]; `with_margin` false skips the margin validation (one
 /// calibration instead of two).
 pub fn commission_with(base: &Rig, train: &[CalLog], holdout: &[CalLog], o: &CalOptions, with_margin: bool) -> Result<Commissioning, CommissionError> {
+    let train = &crate::calibration::log::rethinned(train, o.commission_thinning, o.points_per_channel);
     let (base_e, mut cal, eta_e, eta_m_balance) = fit(base, train, o)?;
     let base = &base_e;
     if !train.iter().any(cycles_valve) {

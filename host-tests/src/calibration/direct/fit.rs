@@ -31,9 +31,10 @@ fn prepare(log: &CalLog, o: &DirectOptions) -> Result<Prepared, String> {
         let sigma = if ch == Channel::TDrainC { o.sigma_drain_k } else { o.sigma_other_k };
         let col = log.run.get(ch).unwrap_or(&[]);
         // every row with a sample, after the first (the model's start)
-        // (from the log's `fit_from_s` on: the margin's head fold)
+        // (from the log's `fit_from_s` on: the margin's head fold), thinned
+        // by the log's rule (the commissioning's, `CalLog::thinning`)
         let rows: Vec<usize> = (1..log.run.len()).filter(|&i| col[i].is_some() && log.run.time_s[i] >= log.fit_from_s).collect();
-        for i in crate::calibration::log::thin(&rows, o.points_per_channel) {
+        for i in crate::calibration::thinning::thin_rows(&log.run, ch, &rows, o.points_per_channel, log.thinning) {
             if let Some(y) = col[i] {
                 points.push((inputs.tick_of(log.run.time_s[i]), node, y, sigma));
             }

@@ -72,6 +72,10 @@ pub struct CalOptions {
     /// drain margin is validated on the training logs' starts besides after
     /// the split ([`HeadFold`]; default [`HEAD_FOLD_DEFAULT`]).
     pub margin_head_fold: HeadFold,
+    /// `commission` only (the calibration itself fits the logs' points as
+    /// given): how the training logs' fit points are thinned
+    /// ([`crate::calibration::thinning::Thinning`]).
+    pub commission_thinning: crate::calibration::thinning::Thinning,
 }
 
 /// Default factor on every prior width of the set in the fit
@@ -124,6 +128,7 @@ impl Default for CalOptions {
             polish_s2: None,
             continuation_logs: CONTINUATION_LOGS,
             margin_head_fold: HEAD_FOLD_DEFAULT,
+            commission_thinning: crate::calibration::thinning::Thinning::Uniform,
         }
     }
 }

@@ -402,7 +402,8 @@ fn slow_churned_case_film_with_a_low_speed_training_log() {
 /// the default holds (e.g. `duct_turbulent`); `EXP_MACHINE` = `big-pump` or `leaky-heavy` for one machine;
 /// `EXP_MARGIN=1` with the margin and both paths; `EXP_RIG_CASE_SHARE=k`
 /// scales the rig file's case share of the friction heat (the fit's start
-/// and prior centre for `friction_case`).
+/// and prior centre for `friction_case`); `EXP_THINNING` the training
+/// logs' fit points ([`exp_thinning`]).
 #[test]
 #[ignore = "measurement by hand: one commissioning per machine"]
 fn slow_structure_experiment() {
@@ -433,6 +434,8 @@ fn slow_structure_experiment() {
         }
         o.prior_sigma.extend(exp_priors());
         o.margin_head_fold = exp_head_fold();
+        o.commission_thinning = exp_thinning();
+        print_starts_points(&m, &train, &o);
         let t0 = std::time::Instant::now();
         let cpu0 = eha_sim::tools::cpu::process_cpu_s();
         let mut base = m.rig_file();
@@ -446,6 +449,29 @@ fn slow_structure_experiment() {
         let h = headline(&m, &c, &s.holdout);
         let w: Vec<String> = c.holdout_without_margin().iter().map(|r| format!("{} {:.3}/{:.3}", r.log, r.vs_measured_max_k.unwrap_or(f64::NAN), r.vs_measured_under_k.unwrap_or(f64::NAN))).collect();
         eprintln!("EXP {} train={} hold={:?} margin={}: without margin {}; with margin {:.3} K: {:.3?}", m.name, if procedure { train_kind.as_str() } else { "bench" }, hold, margin, w.join(", "), h.margin_k, h.measured);
+    }
+}
+
+/// `EXP_THINNING`: an experiment knob, the commissioning's thinning of
+/// the training logs' fit points (`uniform`, `motion`; default the
+/// calibration's).
+fn exp_thinning() -> eha_sim::calibration::thinning::Thinning {
+    use eha_sim::calibration::thinning::Thinning;
+    match std::env::var("EXP_THINNING").as_deref() {
+        Ok("uniform") => Thinning::Uniform,
+        Ok("motion") => Thinning::Motion,
+        _ => CalOptions::default().commission_thinning,
+    }
+}
+
+/// Prints how many `t_drain_c` fit points each training log has in its
+/// first 60, 120 and 300 s under the commissioning's thinning.
+fn print_starts_points(m: &EmuMachine, train: &[CalLog], o: &CalOptions) {
+    for l in eha_sim::calibration::log::rethinned(train, o.commission_thinning, o.points_per_channel) {
+        let t0 = l.run.time_s[0];
+        let n = |dt: f64| l.points.iter().filter(|&&(ch, i)| ch == Channel::TDrainC && l.run.time_s[i] - t0 < dt).count();
+        let all = l.points.iter().filter(|p| p.0 == Channel::TDrainC).count();
+        eprintln!("EXP {} {} thinning {:?}: drain points {all}, in the first 60/120/300 s {}/{}/{}", m.name, l.name, o.commission_thinning, n(60.0), n(120.0), n(300.0));
     }
 }
 
