@@ -1,0 +1,117 @@
+//! The commissioning experiment run by hand: one commissioning per
+//! machine with the knobs (`EXP_*`) that the measurements in
+//! docs/commissioning-foreign.md name. Prints; asserts nothing.
+
+use super::{cal, headline, report};
+use eha_sim::calibration::commission::commission_with;
+use eha_sim::calibration::{CalLog, CalOptions};
+use eha_sim::emulator::bench::{bench_set, commissioning_set, commissioning_set_hot, machines, EmuMachine};
+use eha_sim::measured::Channel;
+
+/// Measurement by hand (prints, asserts nothing): one commissioning
+/// without the margin per machine, on `EXP_TRAIN` = `bench` (the two
+/// throttle logs of `bench_set`), `hot` (`commissioning_set_hot`) or
+/// `procedure` (`commissioning_set`, default), with the parameters named in
+/// `EXP_HOLD` (comma-separated) held and those in `EXP_FREE` taken out of
+/// the default holds (e.g. `duct_turbulent`); `EXP_MACHINE` = `big-pump` or `leaky-heavy` for one machine;
+/// `EXP_MARGIN=1` with the margin and both paths; `EXP_RIG_CASE_SHARE=k`
+/// scales the rig file's case share of the friction heat (the fit's start
+/// and prior centre for `friction_case`); `EXP_THINNING` the training
+/// logs' fit points ([`exp_thinning`]).
+#[test]
+#[ignore = "measurement by hand: one commissioning per machine"]
+fn slow_structure_experiment() {
+    let hold: Vec<&'static str> = std::env::var("EXP_HOLD")
+        .unwrap_or_default()
+        .split(',')
+        .filter(|s| !s.is_empty())
+        .map(|s| eha_sim::calibration::set::PARAMS.iter().find(|p| p.name == s).unwrap_or_else(|| panic!("no parameter {s}")).name)
+        .collect();
+    let train_kind = std::env::var("EXP_TRAIN").unwrap_or_default();
+    let procedure = train_kind != "bench";
+    let margin = std::env::var("EXP_MARGIN").is_ok_and(|v| v == "1");
+    let only = std::env::var("EXP_MACHINE").ok();
+    for m in machines().into_iter().filter(|m| only.as_deref().is_none_or(|o| o == m.name)) {
+        let s = match train_kind.as_str() {
+            "bench" => bench_set(&m, 3600),
+            "hot" => commissioning_set_hot(&m, 3600),
+            _ => commissioning_set(&m, 3600),
+        }
+        .expect("bench");
+        let train: Vec<CalLog> = s.train.iter().map(cal).collect();
+        let hold_logs: Vec<CalLog> = s.holdout.iter().map(cal).collect();
+        let mut o = CalOptions::default();
+        let free: Vec<String> = std::env::var("EXP_FREE").unwrap_or_default().split(',').filter(|s| !s.is_empty()).map(String::from).collect();
+        o.hold.retain(|h| !free.iter().any(|f| f == h.0));
+        for h in &hold {
+            o.hold.push((h, "EXP_HOLD".into()));
+        }
+        o.prior_sigma.extend(exp_priors());
+        o.margin_head_fold = exp_head_fold();
+        o.commission_thinning = exp_thinning();
+        print_starts_points(&m, &train, &o);
+        let t0 = std::time::Instant::now();
+        let cpu0 = eha_sim::tools::cpu::process_cpu_s();
+        let mut base = m.rig_file();
+        if let Some(k) = std::env::var("EXP_RIG_CASE_SHARE").ok().and_then(|v| v.parse::<f64>().ok()) {
+            // the user's rig file with the sliding-pair rule's case share scaled (prior centre and start)
+            base.pump.friction_pairs.case_share_scale *= k;
+        }
+        let c = commission_with(&base, &train, &hold_logs, &o, margin).expect("commissioning");
+        report(&m, &c, t0.elapsed().as_secs_f64());
+        eprintln!("EXP {}: commissioning CPU {:.1} s (user + system, all threads)", m.name, eha_sim::tools::cpu::process_cpu_s() - cpu0);
+        let h = headline(&m, &c, &s.holdout);
+        let w: Vec<String> = c.holdout_without_margin().iter().map(|r| format!("{} {:.3}/{:.3}", r.log, r.vs_measured_max_k.unwrap_or(f64::NAN), r.vs_measured_under_k.unwrap_or(f64::NAN))).collect();
+        eprintln!("EXP {} train={} hold={:?} margin={}: without margin {}; with margin {:.3} K: {:.3?}", m.name, if procedure { train_kind.as_str() } else { "bench" }, hold, margin, w.join(", "), h.margin_k, h.measured);
+    }
+}
+
+/// `EXP_THINNING`: an experiment knob, the commissioning's thinning of
+/// the training logs' fit points (`uniform`, `motion`; default the
+/// calibration's).
+fn exp_thinning() -> eha_sim::calibration::thinning::Thinning {
+    use eha_sim::calibration::thinning::Thinning;
+    match std::env::var("EXP_THINNING").as_deref() {
+        Ok("uniform") => Thinning::Uniform,
+        Ok("motion") => Thinning::Motion,
+        _ => CalOptions::default().commission_thinning,
+    }
+}
+
+/// Prints how many `t_drain_c` fit points each training log has in its
+/// first 60, 120 and 300 s under the commissioning's thinning.
+fn print_starts_points(m: &EmuMachine, train: &[CalLog], o: &CalOptions) {
+    for l in eha_sim::calibration::log::rethinned(train, o.commission_thinning, o.points_per_channel) {
+        let t0 = l.run.time_s[0];
+        let n = |dt: f64| l.points.iter().filter(|&&(ch, i)| ch == Channel::TDrainC && l.run.time_s[i] - t0 < dt).count();
+        let all = l.points.iter().filter(|p| p.0 == Channel::TDrainC).count();
+        eprintln!("EXP {} {} thinning {:?}: drain points {all}, in the first 60/120/300 s {}/{}/{}", m.name, l.name, o.commission_thinning, n(60.0), n(120.0), n(300.0));
+    }
+}
+
+/// `EXP_HEAD_FOLD`: an experiment knob, how the margin scores the
+/// training logs' starts (`off`, `tails`, `loo`; default the calibration's).
+pub(super) fn exp_head_fold() -> eha_sim::calibration::margin::HeadFold {
+    use eha_sim::calibration::margin::{HeadFold, HEAD_FOLD_DEFAULT};
+    match std::env::var("EXP_HEAD_FOLD").as_deref() {
+        Ok("off") => HeadFold::Off,
+        Ok("tails") => HeadFold::Tails,
+        Ok("loo") => HeadFold::LeaveOneOut,
+        _ => HEAD_FOLD_DEFAULT,
+    }
+}
+
+/// `EXP_PRIOR`: an experiment knob, prior widths (σ in ln θ) that replace
+/// the set's, as `name=σ,name=σ`.
+pub(super) fn exp_priors() -> Vec<(&'static str, f64)> {
+    std::env::var("EXP_PRIOR")
+        .unwrap_or_default()
+        .split(',')
+        .filter(|s| !s.is_empty())
+        .map(|s| {
+            let (n, v) = s.split_once('=').unwrap_or_else(|| panic!("EXP_PRIOR entry {s}: name=sigma"));
+            let p = eha_sim::calibration::set::PARAMS.iter().find(|p| p.name == n).unwrap_or_else(|| panic!("no parameter {n}"));
+            (p.name, v.parse().unwrap_or_else(|_| panic!("EXP_PRIOR {s}")))
+        })
+        .collect()
+}
