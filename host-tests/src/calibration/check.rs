@@ -11,6 +11,7 @@ use crate::rig::Rig;
 use crate::scenario::{Circuit, Scenario};
 use crate::simulation::replay::{circuit_of, replay_inputs};
 use eha_guard::model::{Model, ModelInputN, ReducedParams};
+use eha_guard::params::S_PER_TICK;
 
 /// Largest drain margin the parameter block accepts, K (the firmware's
 /// bounds table, `drain_margin_k`).
@@ -168,7 +169,7 @@ pub fn check_reduced_window(rig: &Rig, log: &CalLog, models: &[(&ReducedParams, 
     let (open_c, close_c) = (f64::from(cfg.open_c), f64::from(cfg.close_c));
     let mut open = false;
     plant
-        .run(0.01, t_end, |snap| {
+        .run(S_PER_TICK, t_end, |snap| {
             let s = Sensors::from(snap);
             if k == 0 {
                 probes.iter_mut().for_each(|pr| pr.model.set_uniform(s.ambient_c));
@@ -202,7 +203,7 @@ pub fn check_reduced_window(rig: &Rig, log: &CalLog, models: &[(&ReducedParams, 
                     v.update_with(est, false, open_c, close_c, cfg.dwell_ticks);
                     if v.is_open() {
                         a.open_ticks += 1.0;
-                        a.open_j += total_kw * 1e3 * 0.01;
+                        a.open_j += total_kw * 1e3 * S_PER_TICK;
                     }
                 }
                 if pr.model.tick_n(&u) {
@@ -235,9 +236,9 @@ pub fn check_reduced_window(rig: &Rig, log: &CalLog, models: &[(&ReducedParams, 
                         vs_measured_over_k: meas(a.over),
                         vs_measured_rmse_k: meas((a.ss / n.max(1) as f64).sqrt()),
                         vs_measured_region: (has_drain && a.under > 0.0).then(|| region_of(&rows, &pr.e_under[j], servo)),
-                        valve_open_s: a.open_ticks * 0.01,
+                        valve_open_s: a.open_ticks * S_PER_TICK,
                         lng_kg: a.open_j / j_per_kg,
-                        cells: super::envelope::CellErrors::from_ticks(&rows, &pr.e_under[j], 0.01, servo),
+                        cells: super::envelope::CellErrors::from_ticks(&rows, &pr.e_under[j], S_PER_TICK, servo),
                     }
                 })
                 .collect()

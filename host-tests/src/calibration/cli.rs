@@ -110,7 +110,7 @@ pub fn run(args: &CommissionArgs) -> ExitCode {
             for w in &c.cal.warnings {
                 eprintln!("{w}");
             }
-            for l in c.holdout_with_margin.iter().filter_map(|r| super::envelope_report::not_validated(&c.envelope, r)) {
+            for l in super::envelope_report::not_validated_lines(&c) {
                 eprintln!("note: {l}");
             }
             println!("{} | {:.1} s | {}", headline(&c), t.elapsed().as_secs_f64(), args.out.join("report.md").display());

@@ -4,7 +4,8 @@
 //! margin is not validated (docs/commissioning.md, "The training
 //! envelope").
 
-use super::check::{ReducedCheck, Region};
+use super::check::ReducedCheck;
+use super::region::Region;
 use super::commission::Commissioning;
 use super::envelope::{Envelope, Side, DP_CELL_BAR, DP_EDGE_BAR, MIN_DWELL_S, SPEED_CELL_RPM, SPEED_EDGE_RPM};
 use std::fmt::Write as _;
@@ -35,6 +36,12 @@ pub fn not_validated(env: &Envelope, check: &ReducedCheck) -> Option<String> {
     })
 }
 
+/// The [`not_validated`] lines of `c`'s held-out logs (the block's margin
+/// counted): the report's and the command line's.
+pub fn not_validated_lines(c: &Commissioning) -> Vec<String> {
+    c.holdout_with_margin.iter().filter_map(|r| not_validated(&c.envelope, r)).collect()
+}
+
 /// A table row of `check` split by `env`.
 fn row(s: &mut String, env: &Envelope, kind: &str, check: &ReducedCheck) {
     let (i, o) = env.split(&check.cells);
@@ -60,7 +67,7 @@ pub fn envelope_section(s: &mut String, c: &Commissioning) {
     for r in c.margin.iter().flat_map(|m| &m.folds) {
         row(s, env, "fold", r);
     }
-    let lines: Vec<String> = c.holdout_with_margin.iter().filter_map(|r| not_validated(env, r)).collect();
+    let lines = not_validated_lines(c);
     if lines.is_empty() {
         let _ = writeln!(s, "\nNo held-out log reads lower outside the envelope than inside it with the margin counted.\n");
     } else {

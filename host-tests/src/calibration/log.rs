@@ -58,14 +58,19 @@ impl CalLog {
     /// Prepares `run` (named `name`) with at most `points_per_channel` fit
     /// points per channel. Errors when an input column is empty.
     pub fn new(name: &str, run: MeasuredRun, points_per_channel: usize) -> Result<Self, String> {
+        Self::new_thinned(name, run, points_per_channel, Thinning::Uniform)
+    }
+
+    /// As [`CalLog::new`], the fit points thinned by `rule`.
+    pub fn new_thinned(name: &str, run: MeasuredRun, points_per_channel: usize, rule: Thinning) -> Result<Self, String> {
         let inputs = replay_inputs(&run, name).map_err(|e| format!("{name}: {e}"))?;
         let span = run.time_s[run.len() - 1] - run.time_s[0];
         // Output every ~1/400 of the run (as the diagnosis replay does).
         let dt = (span / 400.0).clamp(0.5, 5.0);
         let opts = SimOptions { output_interval_s: dt, control_interval_s: dt };
         let channels = scored_channels(&run);
-        let points = thinned_points(&run, &channels, points_per_channel, f64::NEG_INFINITY, Thinning::Uniform);
-        Ok(CalLog { name: name.into(), run, channels, points, thinning: Thinning::Uniform, scenario: Scenario::Replay(inputs), opts, rtol: REPLAY_RTOL, fit_from_s: f64::NEG_INFINITY })
+        let points = thinned_points(&run, &channels, points_per_channel, f64::NEG_INFINITY, rule);
+        Ok(CalLog { name: name.into(), run, channels, points, thinning: rule, scenario: Scenario::Replay(inputs), opts, rtol: REPLAY_RTOL, fit_from_s: f64::NEG_INFINITY })
     }
 
     /// The same log with its fit points (at most `points_per_channel` per

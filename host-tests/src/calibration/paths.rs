@@ -249,7 +249,7 @@ mod tests {
 
     /// A check of `log` with the given measured max |e| and under-prediction, K.
     fn check(log: &str, max_k: f64, under_k: f64) -> ReducedCheck {
-        let region = super::super::check::Region { t_s: (0.0, 1.0), speed_rpm: (0.0, 1.0), dp_bar: (0.0, 1.0), drain_c: (20.0, 40.0), servo: false };
+        let region = super::super::region::Region { t_s: (0.0, 1.0), speed_rpm: (0.0, 1.0), dp_bar: (0.0, 1.0), drain_c: (20.0, 40.0), servo: false };
         ReducedCheck {
             log: log.into(),
             margin_k: 0.0,

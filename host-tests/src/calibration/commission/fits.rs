@@ -62,7 +62,7 @@ fn rows_of(log: &CalLog, rows: std::ops::Range<usize>, points_per_channel: usize
     let mut run = log.run.clone();
     run.time_s = run.time_s[rows.clone()].to_vec();
     run.channels.values_mut().for_each(|v| *v = v[rows.clone()].to_vec());
-    CalLog::new(&log.name, run, points_per_channel).map(|l| l.with_thinning(log.thinning, points_per_channel))
+    CalLog::new_thinned(&log.name, run, points_per_channel, log.thinning)
 }
 
 /// The first [`SPLIT_FRACTION`](crate::calibration::margin::SPLIT_FRACTION) of `log`'s span as a log of its own.

@@ -3,7 +3,8 @@
 //! ([`Refusal`]), and the operating region of a training log
 //! ([`log_region`]).
 
-use crate::calibration::check::{ReducedCheck, Region, REDUCED_BOUND_K};
+use crate::calibration::check::{ReducedCheck, REDUCED_BOUND_K};
+use crate::calibration::region::Region;
 use crate::calibration::eta_m::EtaMBalance;
 use crate::calibration::fit::Calibration;
 use crate::calibration::log::{CalLog, ChannelError};
