@@ -47,6 +47,51 @@
 // Version of the UART protocol of [`wire`] (`eha_guard::protocol::PROTOCOL_VERSION`).
 #define EHA_PROTOCOL_VERSION 2
 
+// Fault bit: an input outside its plausible range.
+#define EHA_FAULT_RANGE (1 << 0)
+
+// Fault bit: an input changed faster than its rate limit.
+#define EHA_FAULT_RATE (1 << 1)
+
+// Fault bit: an input was NaN or infinite.
+#define EHA_FAULT_NON_FINITE (1 << 2)
+
+// Fault bit: no sample for `stale_ticks` ticks (every input at its worst case).
+#define EHA_FAULT_STALE (1 << 3)
+
+// Fault bit: the thermal record was damaged at boot.
+#define EHA_FAULT_MEMORY_CORRUPT (1 << 4)
+
+// Fault bit: no usable parameters: model disabled, fail-safe, never cleared.
+#define EHA_FAULT_CONFIG (1 << 5)
+
+// Fault bit: the valve pin or its position switch disagreed with the command.
+#define EHA_FAULT_ACTUATOR (1 << 6)
+
+// Status bit: LNG remaining below its low threshold, or no supply pressure.
+#define EHA_FAULT_LNG_LOW (1 << 7)
+
+// Shift of the latched bad-channel mask in the fault word.
+#define EHA_FAULT_CHANNEL_SHIFT 8
+
+// Fault bit: current and pressures/speed disagree (analytic redundancy).
+#define EHA_FAULT_SENSOR_DISAGREE (1 << 14)
+
+// Status bit: the estimate is not trusted (alarm and derate held).
+#define EHA_FAULT_UNTRUSTED (1 << 15)
+
+// Status bit: a non-volatile save failed (derate).
+#define EHA_FAULT_NV_FAILED (1 << 16)
+
+// Status bit: cooling credited on the LNG budget alone (no supply pressure).
+#define EHA_FAULT_LNG_UNCONFIRMED (1 << 17)
+
+// Status bit: no valve position reported, no cooling credited.
+#define EHA_FAULT_NO_VALVE_FEEDBACK (1 << 18)
+
+// Status bit: the estimate is still forgetting an unknown start.
+#define EHA_FAULT_RECOVERING (1 << 19)
+
 // Bytes of storage a guard needs (at least; `eha_guard_init` checks the
 // size it is given against the exact need of this build).
 #define EHA_GUARD_STORAGE_SIZE 3840
@@ -117,51 +162,6 @@
 // The block was refused (its header, CRC or alignment, or values the
 // model rejects): CONFIG, fail-safe.
 #define EHA_PARAMS_INVALID 2
-
-// Fault bit: an input outside its plausible range.
-#define EHA_FAULT_RANGE (1 << 0)
-
-// Fault bit: an input changed faster than its rate limit.
-#define EHA_FAULT_RATE (1 << 1)
-
-// Fault bit: an input was NaN or infinite.
-#define EHA_FAULT_NON_FINITE (1 << 2)
-
-// Fault bit: no sample for `stale_ticks` ticks (every input at its worst case).
-#define EHA_FAULT_STALE (1 << 3)
-
-// Fault bit: the thermal record was damaged at boot.
-#define EHA_FAULT_MEMORY_CORRUPT (1 << 4)
-
-// Fault bit: no usable parameters: model disabled, fail-safe, never cleared.
-#define EHA_FAULT_CONFIG (1 << 5)
-
-// Fault bit: the valve pin or its position switch disagreed with the command.
-#define EHA_FAULT_ACTUATOR (1 << 6)
-
-// Status bit: LNG remaining below its low threshold, or no supply pressure.
-#define EHA_FAULT_LNG_LOW (1 << 7)
-
-// Shift of the latched bad-channel mask in the fault word.
-#define EHA_FAULT_CHANNEL_SHIFT 8
-
-// Fault bit: current and pressures/speed disagree (analytic redundancy).
-#define EHA_FAULT_SENSOR_DISAGREE (1 << 14)
-
-// Status bit: the estimate is not trusted (alarm and derate held).
-#define EHA_FAULT_UNTRUSTED (1 << 15)
-
-// Status bit: a non-volatile save failed (derate).
-#define EHA_FAULT_NV_FAILED (1 << 16)
-
-// Status bit: cooling credited on the LNG budget alone (no supply pressure).
-#define EHA_FAULT_LNG_UNCONFIRMED (1 << 17)
-
-// Status bit: no valve position reported, no cooling credited.
-#define EHA_FAULT_NO_VALVE_FEEDBACK (1 << 18)
-
-// Status bit: the estimate is still forgetting an unknown start.
-#define EHA_FAULT_RECOVERING (1 << 19)
 
 // Bytes of storage a deframer needs (at least).
 #define EHA_WIRE_DEFRAMER_SIZE 88

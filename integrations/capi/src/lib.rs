@@ -26,10 +26,12 @@
 #![warn(missing_docs)]
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used, clippy::panic, clippy::indexing_slicing))]
 
+pub mod fault_bits;
 pub mod guard;
 pub mod types;
 pub mod wire;
 
+pub use fault_bits::*;
 pub use types::*;
 
 /// Version of the guard library (`eha_guard`), `MAJOR`.
