@@ -17,7 +17,10 @@ use eha_sim::measured::Channel;
 /// `EXP_MARGIN=1` with the margin and both paths; `EXP_RIG_CASE_SHARE=k`
 /// scales the rig file's case share of the friction heat (the fit's start
 /// and prior centre for `friction_case`); `EXP_THINNING` the training
-/// logs' fit points ([`exp_thinning`]).
+/// logs' fit points ([`exp_thinning`]); `EXP_VISCOUS_CASE=1` gives the
+/// viscous friction its own case share, set at the rule's 0.15 and freed
+/// (`friction_viscous_case`; docs/commissioning-foreign.md, "The viscous
+/// friction's case share").
 #[test]
 #[ignore = "measurement by hand: one commissioning per machine"]
 fn slow_structure_experiment() {
@@ -57,8 +60,16 @@ fn slow_structure_experiment() {
             // the user's rig file with the sliding-pair rule's case share scaled (prior centre and start)
             base.pump.friction_pairs.case_share_scale *= k;
         }
+        if std::env::var("EXP_VISCOUS_CASE").is_ok_and(|v| v == "1") {
+            // the viscous term's own case share, at the sliding-pair rule's (prior centre and start)
+            let fp = &mut base.pump.friction_pairs;
+            fp.viscous_case_share = Some(fp.rule_shares().1);
+        }
         let c = commission_with(&base, &train, &hold_logs, &o, margin).expect("commissioning");
         report(&m, &c, t0.elapsed().as_secs_f64());
+        let fp = &c.cal.rig.pump.friction_pairs;
+        let st = c.cal.params.iter().find(|p| p.name == eha_sim::calibration::set::FRICTION_VISCOUS_CASE).map(|p| format!("{:.4} {:?}", p.value, p.status));
+        eprintln!("EXP {}: case shares: pressure {:.4}, viscous {:.4} (friction_viscous_case {})", m.name, fp.shares().1, fp.viscous_shares().1, st.unwrap_or_default());
         eprintln!("EXP {}: commissioning CPU {:.1} s (user + system, all threads)", m.name, eha_sim::tools::cpu::process_cpu_s() - cpu0);
         let h = headline(&m, &c, &s.holdout);
         let w: Vec<String> = c.holdout_without_margin().iter().map(|r| format!("{} {:.3}/{:.3}", r.log, r.vs_measured_max_k.unwrap_or(f64::NAN), r.vs_measured_under_k.unwrap_or(f64::NAN))).collect();
