@@ -119,12 +119,6 @@ pub fn calibrate(base: &Rig, logs: &[CalLog], o: &CalOptions) -> Result<Calibrat
             )
         });
     }
-    // 1c''. The viscous friction's own case share acts only on a rig that
-    // sets it (a measured option, off in the rig files).
-    if base.pump.friction_pairs.viscous_case_share.is_none() {
-        let k = super::set::index(super::set::FRICTION_VISCOUS_CASE).expect("calibration parameter");
-        held[k].get_or_insert_with(|| "the rig sets no case share of its own for the viscous friction (pump.friction_pairs.viscous_case_share): it divides as the pressure term's".into());
-    }
     for (name, why) in &o.hold {
         if let Some(k) = super::set::index(name) {
             held[k].get_or_insert_with(|| why.clone());
@@ -143,7 +137,7 @@ pub fn calibrate(base: &Rig, logs: &[CalLog], o: &CalOptions) -> Result<Calibrat
     // the rig emulator's nominal machine (no drain) fitted its pump probe
     // 10.7 %, its block's 18.3 % (bound), held-out pooled RMSE 0.84 -> 0.95 K.
     let pf = super::set::index("pump_friction").expect("param");
-    let structural = [super::set::FRICTION_CASE, super::set::FRICTION_SPEED, super::set::FRICTION_VISCOUS_CASE].into_iter().chain(super::set::PROBE_SURFACE);
+    let structural = [super::set::FRICTION_CASE, super::set::FRICTION_SPEED].into_iter().chain(super::set::PROBE_SURFACE);
     for name in structural {
         let k = super::set::index(name).expect("param");
         if held[pf].is_none() {
@@ -173,12 +167,6 @@ pub fn calibrate(base: &Rig, logs: &[CalLog], o: &CalOptions) -> Result<Calibrat
         if held[a].is_none() && held[b].is_some() {
             held[a] = Some(format!("fitted only together with {} (held: {})", PARAMS[b].name, held[b].as_deref().unwrap_or("")));
         }
-    }
-    // The viscous term's own case share only with the speed law that sets
-    // the viscous heat it places.
-    let fv = super::set::index(super::set::FRICTION_VISCOUS_CASE).expect("param");
-    if held[fv].is_none() && held[fs].is_some() {
-        held[fv] = Some(format!("fitted only together with {} (held: {})", PARAMS[fs].name, held[fs].as_deref().unwrap_or("")));
     }
     let free: Vec<usize> = (0..PARAMS.len()).filter(|&k| held[k].is_none()).collect();
     // 2c. Continuation over the logs: the fit of the first logs starts
@@ -293,11 +281,9 @@ pub fn calibrate(base: &Rig, logs: &[CalLog], o: &CalOptions) -> Result<Calibrat
         })
         .collect();
     let mut warnings = excitation_warnings(logs);
-    // Held by the caller (o.hold) is not "not identifiable": its status says
-    // why; nor is the viscous case share on a rig that does not set it.
-    let off = |k: usize| k == fv && base.pump.friction_pairs.viscous_case_share.is_none();
+    // Held by the caller (o.hold) is not "not identifiable": its status says why.
     let unident: Vec<&str> =
-        (0..PARAMS.len()).filter(|&k| held[k].is_some() && !o.hold.iter().any(|h| h.0 == PARAMS[k].name) && !off(k)).map(|k| PARAMS[k].name).collect();
+        (0..PARAMS.len()).filter(|&k| held[k].is_some() && !o.hold.iter().any(|h| h.0 == PARAMS[k].name)).map(|k| PARAMS[k].name).collect();
     if !warnings.is_empty() && !unident.is_empty() {
         warnings.push(format!("held at the rig file (not identifiable from these logs): {}", unident.join(", ")));
     }

@@ -102,11 +102,6 @@ pub const FRICTION_CASE: &str = "friction_case";
 /// viscous terms of the extended eq. 8).
 pub const FRICTION_SPEED: &str = "friction_speed";
 
-/// Name of the factor on the case oil's own share of the pump's viscous
-/// friction heat ([`crate::rig::FrictionPairs::viscous_case_share`]; acts
-/// only on a rig that sets it, and is held otherwise).
-pub const FRICTION_VISCOUS_CASE: &str = "friction_viscous_case";
-
 /// Names of the surface probes' reading-towards-ambient parameters
 /// ([`crate::rig::SurfaceProbes`]): motor, pump, main block, ball block.
 pub const PROBE_SURFACE: [&str; 4] = ["probe_surface_motor", "probe_surface_pump", "probe_surface_block", "probe_surface_ball"];
@@ -186,11 +181,6 @@ pub fn apply(base: &Rig, theta: &[f64]) -> Rig {
                 r.pump.no_load_torque_nm *= t;
                 r.pump.viscous_torque_coeff *= t;
             }
-            FRICTION_VISCOUS_CASE => {
-                if let Some(v) = r.pump.friction_pairs.viscous_case_share.as_mut() {
-                    *v = (*v * t).min(0.95);
-                }
-            }
             n if n == PROBE_SURFACE[0] => r.probes.motor += t.ln(),
             n if n == PROBE_SURFACE[1] => r.probes.pump += t.ln(),
             n if n == PROBE_SURFACE[2] => r.probes.main_block += t.ln(),
@@ -219,9 +209,7 @@ mod tests {
     /// products stay as in the rig file, to 1e-12 relative).
     #[test]
     fn mapping_is_identity_at_one_and_film_ball_is_isolated() {
-        // the viscous case share set (at the rule's), so that its factor acts
-        let mut rig = Rig::default();
-        rig.pump.friction_pairs.viscous_case_share = Some(rig.pump.friction_pairs.rule_shares().1);
+        let rig = Rig::default();
         assert_eq!(apply(&rig, &nominal()), rig);
         for k in 0..PARAMS.len() {
             let mut th = nominal();

@@ -2,7 +2,7 @@
 //! the rig field(s) it changes, why, and the excitation that identifies it
 //! (the mapping itself is `super::apply`).
 
-use super::{Needs, ParamDef, Stage, BLOCK_WALL, CASE_CHURN, CASE_CHURN_SPEED, DUCT_TURBULENT, FRICTION_CASE, FRICTION_SPEED, FRICTION_VISCOUS_CASE, H_FORCED, PROBE_OIL, PROBE_SURFACE, RIG_FILE};
+use super::{Needs, ParamDef, Stage, BLOCK_WALL, CASE_CHURN, CASE_CHURN_SPEED, DUCT_TURBULENT, FRICTION_CASE, FRICTION_SPEED, H_FORCED, PROBE_OIL, PROBE_SURFACE, RIG_FILE};
 use crate::measured::Channel;
 
 /// The probe offsets need the drain thermocouple (`Needs::Sensor(t_drain_c)`;
@@ -18,7 +18,7 @@ use crate::measured::Channel;
 const PROBE_WHY: &str = "a thermocouple cemented or clamped on a painted housing reads between its metal and the air: its junction's contact conductance against the leads' and the boundary layer's (a few W/(m·K) of lead in still air) puts it 1–10 % of metal − ambient towards the air, more on a shielded or lagged mount; slightly negative would be a probe pressed into a hotter spot than the lumped metal. Fraction ln θ within −0.05…+0.18, σ 0.05 on it (a well-mounted probe reads within 5 %)";
 
 /// The calibration set, in fit order.
-pub const PARAMS: [ParamDef; 32] = [
+pub const PARAMS: [ParamDef; 31] = [
     ParamDef {
         name: "h_out_motor",
         what: "outer heat transfer of the motor housing (free convection + radiation)",
@@ -270,17 +270,6 @@ pub const PARAMS: [ParamDef; 32] = [
         why: "no-load torques of 15–30 cm³/rev axial-piston pumps are 0.1–1 N·m and Wilson's viscous coefficient scatters by ×3 between designs; a pump whose loss is nearly all pressure-proportional (well-lubricated slippers, low-drag seal) has ×0.05. σ 1 in ln: the rig file's split between the speed and pressure terms is a guess. When η_m comes from the current it is taken with the rig file's T₀ and C_v (the current then carries this factor's difference as iron or bearing drag outside the pump's heat)",
         needs: Needs::Sensor(Channel::TDrainC),
         excitation: "speed steps at a low pressure drop and needle steps at one speed with a drain thermocouple (t_drain_c): the speed terms' heat follows ω and μ, the pressure term Δp",
-        stage: Stage::Thermal,
-    },
-    ParamDef {
-        name: FRICTION_VISCOUS_CASE,
-        what: "the case oil's own share of the pump's viscous friction heat (the C_v·μ·D·ω² term of the extended eq. 8), as a factor on the rig's pump.friction_pairs.viscous_case_share (the rule's 0.15 when set for the experiment); the pressure term keeps friction_case's share",
-        fields: "pump.friction_pairs.viscous_case_share (only when the rig sets it; held otherwise)",
-        lo: 1.0 / 3.0, hi: 0.95 / 0.15, prior_sigma_ln: 1.0,
-        centre: "the rig's viscous case share; set at the sliding-pair rule's 0.15 (half the slipper film's heat to the case oil), the pressure term's rule",
-        why: "the rotating group churns and shears the flooded case, so its viscous (churning) heat may arise in the case oil more than the pressure friction does; 0.05–0.95 of the viscous heat with the rule's 0.15 (×1/3–6.3; the case share clamped at 0.95). σ 1 in ln: nothing but the rule places the churning heat. A measured option, not in the default set (docs/commissioning-foreign.md, \"The viscous friction's case share\"). Fitted only with friction_speed, which sets the viscous heat it places",
-        needs: Needs::Sensor(Channel::TDrainC),
-        excitation: "speed steps at a low pressure drop and pressure steps at one speed with a drain thermocouple (t_drain_c), from cold: the drain's early rise per watt of viscous against pressure friction",
         stage: Stage::Thermal,
     },
     ParamDef {

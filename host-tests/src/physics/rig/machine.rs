@@ -146,60 +146,23 @@ pub struct FrictionPairs {
     /// drain thermocouple).
     #[serde(default = "one")]
     pub case_share_scale: f64,
-    /// The case oil's own share of the viscous friction heat (the C_v term
-    /// of the extended eq. 8), absolute, 0–0.95 (clamped there); the rest
-    /// of the viscous heat divides between the delivered oil and the housing
-    /// in the rule's proportions. Why: the rotating group churns and shears
-    /// the flooded case, so a pump's viscous heat may arise in the case oil
-    /// more than its pressure friction does. `None` (the rig files): the
-    /// viscous heat divides as the pressure term's
-    /// ([`FrictionPairs::shares`]). A measured option (calibrated by
-    /// `friction_viscous_case` only when set; docs/commissioning-foreign.md,
-    /// "The viscous friction's case share"). The six-state reduction
-    /// (firmware) has one case share for both terms and carries
-    /// [`FrictionPairs::shares`], not this.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub viscous_case_share: Option<f64>,
 }
 
 impl FrictionPairs {
-    /// The sliding-pair rule's shares (delivered oil, case oil, housing
-    /// metal) without [`FrictionPairs::case_share_scale`]; they add up to 1
-    /// (the rule's case share is 0.15 with the rig file's pairs).
-    pub fn rule_shares(&self) -> (f64, f64, f64) {
-        let sum = self.piston_bore + self.slipper_swash + self.valve_plate;
-        let (p, s, v) = (self.piston_bore / sum, self.slipper_swash / sum, self.valve_plate / sum);
-        (p + 0.5 * v, 0.5 * s, 0.5 * s + 0.5 * v)
-    }
-
     /// Shares of the C_v and C_p friction heat that enter (delivered oil,
     /// case oil, housing metal); they add up to 1. The case oil's share of
     /// the pairs' rule times [`FrictionPairs::case_share_scale`] (at most
-    /// 0.95). With [`FrictionPairs::viscous_case_share`] set these are the
-    /// C_p term's alone ([`FrictionPairs::viscous_shares`] the C_v term's).
+    /// 0.95).
     pub fn shares(&self) -> (f64, f64, f64) {
-        let (del, case, metal) = self.rule_shares();
+        let sum = self.piston_bore + self.slipper_swash + self.valve_plate;
+        let (p, s, v) = (self.piston_bore / sum, self.slipper_swash / sum, self.valve_plate / sum);
+        let (del, case, metal) = (p + 0.5 * v, 0.5 * s, 0.5 * s + 0.5 * v);
         if self.case_share_scale == 1.0 {
             return (del, case, metal);
         }
         let case_k = (case * self.case_share_scale).min(0.95);
         let rest = (1.0 - case_k) / (1.0 - case);
         (del * rest, case_k, metal * rest)
-    }
-
-    /// Shares of the viscous (C_v) friction heat that enter (delivered oil,
-    /// case oil, housing metal); they add up to 1. [`FrictionPairs::shares`]
-    /// without [`FrictionPairs::viscous_case_share`]; with it the case oil
-    /// gets that share (clamped to 0–0.95) and the delivered oil and housing
-    /// the rest in the rule's proportions.
-    pub fn viscous_shares(&self) -> (f64, f64, f64) {
-        let Some(c) = self.viscous_case_share else {
-            return self.shares();
-        };
-        let (del, case, metal) = self.rule_shares();
-        let case_v = c.clamp(0.0, 0.95);
-        let rest = (1.0 - case_v) / (1.0 - case);
-        (del * rest, case_v, metal * rest)
     }
 }
 

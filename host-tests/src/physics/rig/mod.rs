@@ -131,7 +131,7 @@ impl Default for Rig {
                 eta_m: 0.443_590,
                 no_load_torque_nm: 0.3,
                 viscous_torque_coeff: 5.0e4,
-                friction_pairs: FrictionPairs { piston_bore: 0.5, slipper_swash: 0.3, valve_plate: 0.2, case_share_scale: 1.0, viscous_case_share: None },
+                friction_pairs: FrictionPairs { piston_bore: 0.5, slipper_swash: 0.3, valve_plate: 0.2, case_share_scale: 1.0 },
                 split: None,
                 mass_kg: 20.0,
                 cp: 460.0,
@@ -303,11 +303,6 @@ impl Rig {
         let cs = self.pump.friction_pairs.case_share_scale;
         if !(cs.is_finite() && cs > 0.0) {
             return Err(RigError::Invalid("pump.friction_pairs.case_share_scale", format!("must be > 0 (1: the sliding-pair rule alone), got {cs}")));
-        }
-        if let Some(v) = self.pump.friction_pairs.viscous_case_share {
-            if !(v.is_finite() && (0.0..=0.95).contains(&v)) {
-                return Err(RigError::Invalid("pump.friction_pairs.viscous_case_share", format!("must be within 0..0.95 (the case oil's share of the viscous friction heat), got {v}")));
-            }
         }
         let pr = self.probes;
         for (name, f) in [("probes.motor", pr.motor), ("probes.pump", pr.pump), ("probes.main_block", pr.main_block), ("probes.ball_block", pr.ball_block)] {

@@ -72,33 +72,3 @@ fn pump_as_built_round_trip() {
     r.set_override("pump.split=none").expect("clear");
     assert!(r.pump.split.is_none());
 }
-
-/// The friction shares add up to 1 (rule, scaled rule, the viscous term's
-/// own); without a viscous case share the viscous term's shares are the
-/// rule's to the bit; the rule's case share is 0.15 (half the slipper
-/// film's 0.3); a set share survives the TOML round trip and an unset one
-/// is not written.
-#[test]
-fn friction_shares_add_up_and_unset_viscous_share_is_the_rule() {
-    let mut fp = Rig::default().pump.friction_pairs;
-    let sum = |s: (f64, f64, f64)| s.0 + s.1 + s.2;
-    assert!((fp.rule_shares().1 - 0.15).abs() < 1e-15);
-    for scale in [1.0, 0.3, 0.84, 4.0, 10.0] {
-        fp.case_share_scale = scale;
-        fp.viscous_case_share = None;
-        assert_eq!(fp.viscous_shares(), fp.shares());
-        assert!((sum(fp.shares()) - 1.0).abs() < 1e-12, "scale {scale}");
-        for v in [0.0, 0.05, 0.15, 0.6, 0.95, 1.2] {
-            fp.viscous_case_share = Some(v);
-            let s = fp.viscous_shares();
-            assert!((sum(s) - 1.0).abs() < 1e-12, "scale {scale} share {v}: {s:?}");
-            assert_eq!(s.1, v.min(0.95));
-        }
-    }
-    assert!(!Rig::default().to_toml().contains("viscous_case_share"));
-    let mut rig = Rig::default();
-    rig.pump.friction_pairs.viscous_case_share = Some(0.4);
-    assert_eq!(Rig::from_toml_str(&rig.to_toml(), "rt").expect("round trip"), rig);
-    rig.pump.friction_pairs.viscous_case_share = Some(1.2);
-    assert!(rig.validate().is_err());
-}

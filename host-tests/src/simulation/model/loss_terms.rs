@@ -105,9 +105,7 @@ impl Model {
     ///
     /// One pump node (the baseline): the no-load term (bearings, shaft seal)
     /// heats the housing, the viscous and pressure terms divide by
-    /// [`crate::rig::FrictionPairs::shares`] (the viscous term by
-    /// [`crate::rig::FrictionPairs::viscous_shares`] when the rig gives it
-    /// its own case share).
+    /// [`crate::rig::FrictionPairs::shares`].
     ///
     /// The pump as it is built ([`crate::rig::Pump::split`]): the viscous and
     /// pressure terms arise in the three lubricating films (piston/bore,
@@ -129,15 +127,8 @@ impl Model {
                 FrictionHeat { internals: films + fr.no_load_w - to_housing, housing: to_housing, ..FrictionHeat::default() }
             }
             None => {
-                let pairs = &self.rig.pump.friction_pairs;
-                let (f_del, f_case, f_metal) = pairs.shares();
-                if pairs.viscous_case_share.is_none() {
-                    return FrictionHeat { delivered: f_del * films, case: f_case * films, housing: fr.no_load_w + f_metal * films, internals: 0.0 };
-                }
-                // the viscous term by its own case share, the pressure term by the rule's
-                let (v_del, v_case, v_metal) = pairs.viscous_shares();
-                let (v, p) = (fr.viscous_w, fr.pressure_w);
-                FrictionHeat { delivered: f_del * p + v_del * v, case: f_case * p + v_case * v, housing: fr.no_load_w + f_metal * p + v_metal * v, internals: 0.0 }
+                let (f_del, f_case, f_metal) = self.rig.pump.friction_pairs.shares();
+                FrictionHeat { delivered: f_del * films, case: f_case * films, housing: fr.no_load_w + f_metal * films, internals: 0.0 }
             }
         }
     }

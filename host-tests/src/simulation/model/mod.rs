@@ -11,8 +11,6 @@
 
 mod hydraulic;
 #[cfg(test)]
-mod friction_tests;
-#[cfg(test)]
 mod hold_tests;
 mod loss_terms;
 mod replay_drive;

@@ -162,10 +162,6 @@ pub fn reduce_without_jacobian(rig: &Rig) -> ReducedParams {
         eta_m: p.eta_m,
         no_load_torque_nm: p.no_load_torque_nm,
         viscous_w_s2_per_rad2: p.viscous_torque_coeff * mu40 * d,
-        // the firmware has one case share for the viscous and pressure
-        // friction: a rig's own viscous case share
-        // (`FrictionPairs::viscous_case_share`) is not carried, the pressure
-        // term's shares are (the departure check measures what that costs)
         mech_to_outlet: p.friction_pairs.shares().0,
         mech_to_case: p.friction_pairs.shares().1,
         case_film_slope_per_k: case_film_slope,

@@ -17,10 +17,7 @@ use eha_sim::measured::Channel;
 /// `EXP_MARGIN=1` with the margin and both paths; `EXP_RIG_CASE_SHARE=k`
 /// scales the rig file's case share of the friction heat (the fit's start
 /// and prior centre for `friction_case`); `EXP_THINNING` the training
-/// logs' fit points ([`exp_thinning`]); `EXP_VISCOUS_CASE=1` gives the
-/// viscous friction its own case share, set at the rule's 0.15 and freed
-/// (`friction_viscous_case`; docs/commissioning-foreign.md, "The viscous
-/// friction's case share"), `EXP_VISCOUS_CASE_SHARE=s` at `s` instead.
+/// logs' fit points ([`exp_thinning`]).
 #[test]
 #[ignore = "measurement by hand: one commissioning per machine"]
 fn slow_structure_experiment() {
@@ -60,48 +57,13 @@ fn slow_structure_experiment() {
             // the user's rig file with the sliding-pair rule's case share scaled (prior centre and start)
             base.pump.friction_pairs.case_share_scale *= k;
         }
-        if std::env::var("EXP_VISCOUS_CASE").is_ok_and(|v| v == "1") {
-            // the viscous term's own case share, at the sliding-pair rule's (prior centre and start)
-            let fp = &mut base.pump.friction_pairs;
-            let s = std::env::var("EXP_VISCOUS_CASE_SHARE").ok().map(|v| v.parse::<f64>().expect("EXP_VISCOUS_CASE_SHARE"));
-            fp.viscous_case_share = Some(s.unwrap_or(fp.rule_shares().1));
-        }
         let c = commission_with(&base, &train, &hold_logs, &o, margin).expect("commissioning");
         report(&m, &c, t0.elapsed().as_secs_f64());
-        let fp = &c.cal.rig.pump.friction_pairs;
-        let st = c.cal.params.iter().find(|p| p.name == eha_sim::calibration::set::FRICTION_VISCOUS_CASE).map(|p| format!("{:.4} {:?}", p.value, p.status));
-        eprintln!("EXP {}: case shares: pressure {:.4}, viscous {:.4} (friction_viscous_case {})", m.name, fp.shares().1, fp.viscous_shares().1, st.unwrap_or_default());
-        print_soak_start_friction(&m, &c.cal.rig, &train);
         eprintln!("EXP {}: commissioning CPU {:.1} s (user + system, all threads)", m.name, eha_sim::tools::cpu::process_cpu_s() - cpu0);
         let h = headline(&m, &c, &s.holdout);
         let w: Vec<String> = c.holdout_without_margin().iter().map(|r| format!("{} {:.3}/{:.3}", r.log, r.vs_measured_max_k.unwrap_or(f64::NAN), r.vs_measured_under_k.unwrap_or(f64::NAN))).collect();
         eprintln!("EXP {} train={} hold={:?} margin={}: without margin {}; with margin {:.3} K: {:.3?}", m.name, if procedure { train_kind.as_str() } else { "bench" }, hold, margin, w.join(", "), h.margin_k, h.measured);
     }
-}
-
-/// Prints the commissioned rig's pump friction by term and its heat into
-/// the case oil at t 30 s of the soak training log (big-pump's cold start,
-/// docs/commissioning-foreign.md), the film viscosity at the logged drain.
-fn print_soak_start_friction(m: &EmuMachine, rig: &eha_sim::rig::Rig, train: &[CalLog]) {
-    use eha_sim::model::{Drive, Model, ReplayDrive};
-    let Some(soak) = train.iter().find(|l| l.name.contains("Soak")) else { return };
-    let inputs = soak.replay_inputs().expect("replay").clone();
-    let model = Model::new(rig.clone(), Drive::Replay(ReplayDrive::new(inputs.clone())));
-    let t = soak.run.time_s[0] + 30.0;
-    let op = ReplayDrive::new(inputs).op(rig, t);
-    let i = soak.run.time_s.iter().position(|&x| x >= t).expect("30 s");
-    let tc = soak.run.get(Channel::TDrainC).and_then(|v| v[i]).expect("drain");
-    let (fr, fh) = (model.pump_friction(&op, tc), model.friction_heat(&op, tc));
-    let rpm = op.omega * 30.0 / std::f64::consts::PI;
-    eprintln!(
-        "EXP {}: soak start t 30 s ({rpm:.0} rpm, {:.0} bar, drain {tc:.1} °C): friction viscous {:.1} W, pressure {:.1} W, no-load {:.1} W; into the case oil {:.1} W",
-        m.name,
-        (op.p_a - op.p_b) * 1e-5,
-        fr.viscous_w,
-        fr.pressure_w,
-        fr.no_load_w,
-        fh.case
-    );
 }
 
 /// `EXP_THINNING`: an experiment knob, the commissioning's thinning of
