@@ -16,8 +16,10 @@ use eha_sim::measured::Channel;
 /// the default holds (e.g. `duct_turbulent`); `EXP_MACHINE` = `big-pump` or `leaky-heavy` for one machine;
 /// `EXP_MARGIN=1` with the margin and both paths; `EXP_RIG_CASE_SHARE=k`
 /// scales the rig file's case share of the friction heat (the fit's start
-/// and prior centre for `friction_case`); `EXP_THINNING` the training
-/// logs' fit points ([`exp_thinning`]).
+/// and prior centre for `friction_case`), `EXP_RIG_CASE_OIL=k` and
+/// `EXP_RIG_CASE_AREA=k` the case oil's volume and the case film's area
+/// (start, prior centre and bounds of `cap_case_oil`, `film_case`);
+/// `EXP_THINNING` the training logs' fit points ([`exp_thinning`]).
 #[test]
 #[ignore = "measurement by hand: one commissioning per machine"]
 fn slow_structure_experiment() {
@@ -56,6 +58,14 @@ fn slow_structure_experiment() {
         if let Some(k) = std::env::var("EXP_RIG_CASE_SHARE").ok().and_then(|v| v.parse::<f64>().ok()) {
             // the user's rig file with the sliding-pair rule's case share scaled (prior centre and start)
             base.pump.friction_pairs.case_share_scale *= k;
+        }
+        // the user's rig file with the case oil's volume and the case film's area scaled
+        // (the fit's start, prior centre and bounds for `cap_case_oil`, `film_case`)
+        if let Some(k) = std::env::var("EXP_RIG_CASE_OIL").ok().and_then(|v| v.parse::<f64>().ok()) {
+            base.pump.case_oil_m3 *= k;
+        }
+        if let Some(k) = std::env::var("EXP_RIG_CASE_AREA").ok().and_then(|v| v.parse::<f64>().ok()) {
+            base.pump.case_inner_area_m2 *= k;
         }
         let c = commission_with(&base, &train, &hold_logs, &o, margin).expect("commissioning");
         report(&m, &c, t0.elapsed().as_secs_f64());
