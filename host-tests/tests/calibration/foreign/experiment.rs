@@ -19,7 +19,8 @@ use eha_sim::measured::Channel;
 /// and prior centre for `friction_case`), `EXP_RIG_CASE_OIL=k` and
 /// `EXP_RIG_CASE_AREA=k` the case oil's volume and the case film's area
 /// (start, prior centre and bounds of `cap_case_oil`, `film_case`);
-/// `EXP_THINNING` the training logs' fit points ([`exp_thinning`]).
+/// `EXP_THINNING` the training logs' fit points ([`exp_thinning`]);
+/// `EXP_DRAIN_WEIGHT=w` the drain residuals' weight (`CalOptions::drain_weight`).
 #[test]
 #[ignore = "measurement by hand: one commissioning per machine"]
 fn slow_structure_experiment() {
@@ -49,6 +50,9 @@ fn slow_structure_experiment() {
             o.hold.push((h, "EXP_HOLD".into()));
         }
         o.prior_sigma.extend(exp_priors());
+        if let Some(w) = std::env::var("EXP_DRAIN_WEIGHT").ok().and_then(|v| v.parse::<f64>().ok()) {
+            o.drain_weight = w;
+        }
         o.margin_head_fold = exp_head_fold();
         o.commission_thinning = exp_thinning();
         print_starts_points(&m, &train, &o);
