@@ -52,7 +52,7 @@ pub fn run_emu_case_with(case: EmuCase, o: &DiagnoseOptions, twin: bool, oracle:
 /// Every candidate's reach on the diagnosed log `run` ([`EmuResult::reach`];
 /// empty when the projection fails, with a message on stderr).
 fn reach_of(model: &ReferenceModel, d: &Diagnosis, run: &crate::measured::MeasuredRun, o: &DiagnoseOptions) -> Vec<super::gate_obs::Reach> {
-    match super::cli::detectability_against_floor(model, d, run, o) {
+    match super::projection::against_floor(model, d, run, o) {
         Ok(fd) => super::gate_obs::reaches(&fd),
         Err(e) => {
             eprintln!("reach: {e}");
