@@ -203,14 +203,7 @@ pub fn detectability_against_floor(
     run: &MeasuredRun,
     o: &DiagnoseOptions,
 ) -> anyhow::Result<super::projection::FloorDetectability> {
-    let floors: Vec<super::evidence::ChannelFloor> = d
-        .posterior
-        .channels
-        .iter()
-        .map(|c| super::evidence::ChannelFloor { channel: c.channel.clone(), noise_k: c.noise_k, rise_k: c.rise_k, misfit_k: c.misfit_k })
-        .collect();
-    let pts = super::analysis::evidence_points(run, d.split_time_s, o.points_per_channel);
-    super::detect::with_answer_tier(model, d, |a| super::projection::floor_detectability(a.sim, run, a.nuisance, pts, a.split, floors))
+    super::projection::against_floor(model, d, run, o)
         .map_err(|e| anyhow::anyhow!("detectability: {e}"))
 }
 

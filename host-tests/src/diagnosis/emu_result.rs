@@ -65,6 +65,12 @@ pub struct EmuResult {
     /// rules offline); left out of the committed JSON.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub evidence_terms: Vec<StructureTerms>,
+    /// Every candidate's expected imprint ratio at the magnitudes the
+    /// `--detectability` projection tried, around the tier whose answer
+    /// stands (`emulator-sweep --detectability`; empty otherwise): what the
+    /// gate-as-observation re-statement needs ([`super::gate_obs`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub reach: Vec<super::gate_obs::Reach>,
     /// Wall time of the diagnosis, s.
     pub seconds: f64,
 }
@@ -100,6 +106,9 @@ pub struct TwinCheck {
     /// written before it was kept.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub twin_heldout_k: Vec<(String, f64)>,
+    /// The twin's [`EmuResult::reach`].
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub twin_reach: Vec<super::gate_obs::Reach>,
 }
 
 impl TwinCheck {

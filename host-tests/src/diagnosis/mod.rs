@@ -28,6 +28,7 @@ pub mod emu_result;
 pub mod emu_sweep;
 pub mod emu_tables;
 pub mod emu_calibration;
+pub mod gate_obs;
 
 pub use analysis::{diagnose, DiagnoseError, DiagnoseOptions, Diagnosis};
 pub use model::{Candidate, ParamSpec, Phase, SimSeries, Simulator};

@@ -305,6 +305,16 @@ pub fn floor_detectability(sim: &dyn Simulator, run: &MeasuredRun, nuisance: &[f
     Ok(FloorDetectability { rows, confusability, floors })
 }
 
+/// [`floor_detectability`] of `run` around the calibrated point of the tier
+/// whose answer stands in `d`, its floors the diagnosis's own channel
+/// numbers, its points the evidence's.
+pub fn against_floor(model: &dyn Simulator, d: &super::Diagnosis, run: &MeasuredRun, o: &super::DiagnoseOptions) -> Result<FloorDetectability, String> {
+    let floor = |c: &super::evidence::ChannelEvidence| ChannelFloor { channel: c.channel.clone(), noise_k: c.noise_k, rise_k: c.rise_k, misfit_k: c.misfit_k };
+    let floors: Vec<ChannelFloor> = d.posterior.channels.iter().map(floor).collect();
+    let pts = super::analysis::evidence_points(run, d.split_time_s, o.points_per_channel);
+    super::detect::with_answer_tier(model, d, |a| floor_detectability(a.sim, run, a.nuisance, pts, a.split, floors))
+}
+
 impl FloorDetectability {
     /// Per candidate, the smallest magnitude tried whose expected ratio
     /// reaches [`SHOWABLE_RATIO`] (with its channel), or `None`.

@@ -32,7 +32,7 @@ pub struct Section {
 }
 
 /// Every generated section.
-pub const SECTIONS: [Section; 8] = [
+pub const SECTIONS: [Section; 9] = [
     Section { doc: "docs/results.md", tag: "uq-paper", source: "docs/data/uq-paper.json", render: render_uq_paper },
     Section { doc: "docs/results.md", tag: "fw-budget", source: ".ci/fw-budget.json", render: render_fw_budget },
     Section { doc: "docs/rig-file.md", tag: "rig-file", source: "host-tests/src/physics/rig/mod.rs", render: crate::tools::rigdoc::render },
@@ -61,7 +61,21 @@ pub const SECTIONS: [Section; 8] = [
         source: "docs/data/emulator-sweep-hidden-no-case-held.json, docs/data/emulator-sweep-1800.json, docs/data/emulator-sweep-2800.json, docs/data/imprint-ratios-no-case-held.json",
         render: render_reliability,
     },
+    Section {
+        doc: "docs/diagnosis-gate.md",
+        tag: "reliability-gate",
+        source: "docs/data/emulator-sweep-1800.json",
+        render: render_gate,
+    },
 ];
+
+/// The gate's rejection as an observation against the product's
+/// probabilities ([`crate::diagnosis::emu_calibration::gate_document`]) on
+/// the sweep that carries every log's detectability.
+fn render_gate(json: &str) -> Result<String> {
+    let rows: Vec<crate::diagnosis::emu_sweep::EmuResult> = serde_json::from_str(json)?;
+    Ok(crate::diagnosis::emu_calibration::gate_document(&[("1800–1817 (with twins)", rows)]))
+}
 
 /// Labels of the sweeps of the `reliability-default` section, in its
 /// sources' order.

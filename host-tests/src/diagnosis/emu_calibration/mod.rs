@@ -7,14 +7,17 @@
 //!
 //! By topic: `fraction` the effective sample fractions (from a residual's
 //! Ljung–Box p or the discrepancy's length scale), `restate` the
-//! re-statements of a stored posterior ([`Variant`]); this file the logs
+//! re-statements of a stored posterior ([`Variant`]), `gate` the table of
+//! the gate's rejection as an observation; this file the logs
 //! of the stored sweeps, the fitted power, the measurement of a variant
 //! and the document.
 
 mod fraction;
+mod gate;
 mod restate;
 
 pub use fraction::{fraction_from_length_scale, fraction_from_ljung_box};
+pub use gate::{calibrated, gate_document};
 pub use restate::{power_grid, powered, restate_heldout, restate_no_gate, Variant};
 
 use super::emu_result::EmuResult;
@@ -65,6 +68,9 @@ struct Log {
     probs: Vec<ProbabilityJson>,
     w_lb: f64,
     w_len: f64,
+    /// The log's recorded detectability (empty when the sweep did not
+    /// record it).
+    reach: Vec<super::gate_obs::Reach>,
 }
 
 /// Every case log and twin of `rows`; r from the twin, else from `ratios`
@@ -78,10 +84,15 @@ fn logs(rows: &[EmuResult], ratios: &BTreeMap<u64, f64>) -> Vec<Log> {
         };
         let ratio = r.twin.as_ref().map(|t| t.ratio()).or_else(|| ratios.get(&r.case.seed).copied());
         let truth = r.case.hidden.name();
-        out.push(Log { seed: r.case.seed, twin: false, truth, ratio, probs: r.probabilities.clone(), w_lb: w_lb(r.evidence_channels.as_slice()), w_len: fraction_from_length_scale(dt) });
+        out.push(Log { seed: r.case.seed, twin: false, truth, ratio, probs: r.probabilities.clone(),
+            w_lb: w_lb(r.evidence_channels.as_slice()),
+            w_len: fraction_from_length_scale(dt),
+            reach: r.reach.clone(),
+        });
         if let Some(t) = r.twin.as_ref().filter(|t| !t.twin_probabilities.is_empty()) {
             let (probs, w) = (t.twin_probabilities.clone(), w_lb(t.twin_channels.as_slice()));
-            out.push(Log { seed: r.case.seed, twin: true, truth: Candidate::None.name(), ratio: None, probs, w_lb: w, w_len: fraction_from_length_scale(dt) });
+            let reach = t.twin_reach.clone();
+            out.push(Log { seed: r.case.seed, twin: true, truth: Candidate::None.name(), ratio: None, probs, w_lb: w, w_len: fraction_from_length_scale(dt), reach });
         }
     }
     out
@@ -100,6 +111,8 @@ fn measure(logs: &[Log], v: Variant, eta: Option<f64>) -> Option<(Vec<Bin>, Stri
             Variant::NoGate => Some(restate_no_gate(&l.probs)),
             Variant::HeldOut => restate_heldout(&l.probs),
             Variant::HeldOutTempered => Some(powered(&restate_heldout(&l.probs)?, eta?, 0.0)),
+            Variant::GateObserved if l.reach.is_empty() => None,
+            Variant::GateObserved => super::gate_obs::restate_gate_observed(&l.probs, &|c| super::gate_obs::p_fail_of(&l.reach, c)),
         })
         .collect::<Option<_>>()?;
     let named: Vec<Option<String>> = restated

@@ -33,10 +33,18 @@ pub enum Variant {
     /// [`Variant::HeldOut`] with every ln Bayes factor times a power η
     /// fitted on the first set of the document (`fit_power`).
     HeldOutTempered,
+    /// The gate's rejection as an observation
+    /// ([`crate::diagnosis::gate_obs::restate_gate_observed`]): a candidate
+    /// that failed keeps a candidate's prior times P(fail | c) from the
+    /// log's recorded detectability, with the no-cause block's evidence;
+    /// nothing fitted. Only on records that carry the detectability.
+    GateObserved,
 }
 
 impl Variant {
-    /// Every variant, in the table's order.
+    /// Every variant of the reliability table, in its order
+    /// ([`Variant::GateObserved`] has its own table: it needs the
+    /// detectability, which one stored sweep carries).
     pub const ALL: [Variant; 7] =
         [Variant::Stored, Variant::LjungBox, Variant::LengthScale, Variant::LjungBoxLeak, Variant::NoGate, Variant::HeldOut, Variant::HeldOutTempered];
 
@@ -50,6 +58,7 @@ impl Variant {
             Variant::NoGate => "no gate (stored ln BF, every candidate's prior)",
             Variant::HeldOut => "held-out likelihood instead of the gate",
             Variant::HeldOutTempered => "held-out likelihood, tempered (η fitted on 1700s/2700s)",
+            Variant::GateObserved => "the gate's rejection as an observation (P(fail \\| c) from the detectability)",
         }
     }
 }

@@ -3,7 +3,7 @@
 //! table and JSON written at the end). Separate because it is the command,
 //! not the diagnosis of a case.
 
-use super::{default_cases, document, ident_cases, measure, redecide, run_emu_case_with, EmuResult};
+use super::{default_cases, document, ident_cases, measure, redecide, run_emu_case_reach, EmuResult};
 use crate::diagnosis::analysis::DiagnoseOptions;
 use crate::diagnosis::evidence::DecisionRule;
 use crate::diagnosis::model::Candidate;
@@ -88,6 +88,12 @@ pub struct EmuSweepArgs {
     /// nominal-start fit).
     #[arg(long)]
     pub nominal_restarts: bool,
+    /// Also record every candidate's `--detectability` projection on each
+    /// log and twin (r̂ at 1, 4, 16 × its typical magnitude;
+    /// `EmuResult::reach`, ~1 s a log): what the gate-as-observation
+    /// re-statement needs (`diagnosis::gate_obs`).
+    #[arg(long)]
+    pub detectability: bool,
 }
 
 
@@ -147,7 +153,7 @@ pub fn run(a: &EmuSweepArgs) -> ExitCode {
             nominal_restarts: a.nominal_restarts,
             ..Default::default()
         };
-        match run_emu_case_with(*c, &o, !a.no_twins, !a.no_oracle) {
+        match run_emu_case_reach(*c, &o, !a.no_twins, !a.no_oracle, a.detectability) {
             Ok(r) => {
                 let line = serde_json::to_string(&r).unwrap_or_default() + "\n";
                 let appended = std::fs::OpenOptions::new().create(true).append(true).open(&lines).and_then(|mut f| {

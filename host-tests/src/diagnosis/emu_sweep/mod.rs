@@ -46,26 +46,51 @@ fn probabilities(d: &Diagnosis) -> Vec<ProbabilityJson> {
 /// into the calibrated reference model ([`EmuResult::hidden_detect`]). The
 /// log and its twin are diagnosed in parallel.
 pub fn run_emu_case_with(case: EmuCase, o: &DiagnoseOptions, twin: bool, oracle: bool) -> Result<EmuResult, String> {
+    run_emu_case_reach(case, o, twin, oracle, false)
+}
+
+/// Every candidate's reach on the diagnosed log `run` ([`EmuResult::reach`];
+/// empty when the projection fails, with a message on stderr).
+fn reach_of(model: &ReferenceModel, d: &Diagnosis, run: &crate::measured::MeasuredRun, o: &DiagnoseOptions) -> Vec<super::gate_obs::Reach> {
+    match super::projection::against_floor(model, d, run, o) {
+        Ok(fd) => super::gate_obs::reaches(&fd),
+        Err(e) => {
+            eprintln!("reach: {e}");
+            Vec::new()
+        }
+    }
+}
+
+/// [`run_emu_case_with`]; with `reach`, also every candidate's
+/// detectability projection on the log and its twin ([`EmuResult::reach`],
+/// ~1 s a log after the calibration).
+pub fn run_emu_case_reach(case: EmuCase, o: &DiagnoseOptions, twin: bool, oracle: bool, reach: bool) -> Result<EmuResult, String> {
     let (run, truth) = generate(&case)?;
     let want_twin = twin && truth.affected.is_some();
     let t = std::time::Instant::now();
     let (main, twin_d) = rayon::join(
-        || -> Result<(ReferenceModel, Diagnosis), String> {
+        || -> Result<(ReferenceModel, Diagnosis, Vec<super::gate_obs::Reach>), String> {
             let model = ReferenceModel::new(Rig::default(), &run).map_err(|e| e.to_string())?.with_structure(&run, o.structure);
             let d = diagnose(&run, &model, o).map_err(|e| e.to_string())?;
-            Ok((model, d))
+            let r = if reach { reach_of(&model, &d, &run, o) } else { Vec::new() };
+            Ok((model, d, r))
         },
-        || -> Result<Option<Diagnosis>, String> {
+        || -> Result<Option<(Diagnosis, Vec<super::gate_obs::Reach>)>, String> {
             if !want_twin {
                 return Ok(None);
             }
             let (trun, _) = crate::emulator::generate_twin(&case)?;
             let tmodel = ReferenceModel::new(Rig::default(), &trun).map_err(|e| e.to_string())?.with_structure(&trun, o.structure);
-            diagnose(&trun, &tmodel, o).map(Some).map_err(|e| e.to_string())
+            let td = diagnose(&trun, &tmodel, o).map_err(|e| e.to_string())?;
+            let r = if reach { reach_of(&tmodel, &td, &trun, o) } else { Vec::new() };
+            Ok(Some((td, r)))
         },
     );
-    let (model, d) = main?;
-    let td = twin_d?;
+    let (model, d, reach) = main?;
+    let (td, twin_reach) = match twin_d? {
+        Some((td, r)) => (Some(td), r),
+        None => (None, Vec::new()),
+    };
     let affected = truth.affected.map(|(c, v)| (c.name().to_string(), v));
     let affected_heldout_k =
         affected.as_ref().and_then(|(c, _)| Some((d.before.channel(c)?.heldout_rmse_k, d.after.channel(c)?.heldout_rmse_k)));
@@ -104,6 +129,7 @@ pub fn run_emu_case_with(case: EmuCase, o: &DiagnoseOptions, twin: bool, oracle:
                 twin_heldout_k: std::iter::once(("pooled".to_string(), td.before.heldout_rmse_k))
                     .chain(td.before.channels.iter().map(|c| (c.channel.clone(), c.heldout_rmse_k)))
                     .collect(),
+                twin_reach: twin_reach.clone(),
             })
         }
         _ => None,
@@ -132,6 +158,7 @@ pub fn run_emu_case_with(case: EmuCase, o: &DiagnoseOptions, twin: bool, oracle:
         tier: d.nuisance_set.clone(),
         measured: None,
         evidence_terms: d.posterior.terms.clone(),
+        reach,
         seconds,
     })
 }
