@@ -143,12 +143,54 @@ pub fn restate_gate_observed(probs: &[ProbabilityJson], p_fail: &dyn Fn(&str) ->
     Some(out)
 }
 
+/// The `report.md` section of `diagnose --detectability`: the stated
+/// posterior `stated` beside its restatement `restated`
+/// ([`restate_gate_observed`]) with each rejected candidate's P(fail | c)
+/// from `reach`, and what the restatement measured on the emulator.
+pub fn markdown(stated: &[ProbabilityJson], restated: &[ProbabilityJson], reach: &[Reach]) -> String {
+    use std::fmt::Write as _;
+    let mut s = String::from(
+        "\n## Probabilities with the gate's rejection as an observation\n\n\
+         The posterior above gives a candidate that failed the held-out checks prior 0, as if the checks never missed \
+         an effect. Here it keeps its prior times P(fail | c), the share of its magnitude prior over which this log's \
+         expected imprint ratio (the section above) stays below 2, and the no-cause evidence. The answer is the same. \
+         How often such statements were right on the emulator, against the posterior above: docs/diagnosis-gate.md \
+         (closer to the stated values than the posterior above, not within 10 points in every bin).\n\n\
+         | cause | posterior above | gate as an observation | P(fail \\| c) |\n|---|---:|---:|---:|\n",
+    );
+    for q in restated {
+        let st = stated.iter().find(|p| p.cause == q.cause);
+        let p = st.map_or(0.0, |p| p.probability);
+        // P(fail | c) only where the gate rejected c (an admitted candidate passed it)
+        let f = match st {
+            Some(x) if names_a_cause(&q.cause) && x.prior > 0.0 => "admitted".into(),
+            _ if names_a_cause(&q.cause) => p_fail_of(reach, &q.cause).map_or("–".into(), |f| format!("{f:.2}")),
+            _ => "–".into(),
+        };
+        let _ = writeln!(s, "| `{}` | {p:.3} | {:.3} | {f} |", q.cause, q.probability);
+    }
+    s
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     fn reach(ratio: [f64; 3]) -> Reach {
         Reach { candidate: "sensor-lag".into(), magnitude: vec![1.0, 4.0, 16.0], ratio: ratio.to_vec() }
+    }
+
+    /// The report section: one row per structure, the rejected candidate's
+    /// P(fail | c) from its reach, an admitted one marked as such.
+    #[test]
+    fn markdown_lists_both_posteriors() {
+        let p = |c: &str, prob: f64, prior: f64| ProbabilityJson { cause: c.into(), probability: prob, log_bayes_factor: 0.0, prior, heldout_touched: None, heldout_untouched: None, identifiable: None };
+        let stated = vec![p("churning-loss", 0.95, CANDIDATE_PRIOR), p("none", 0.05, 0.25), p("sensor-lag", 0.0, 0.0)];
+        let lag = Reach { candidate: "sensor-lag".into(), magnitude: vec![30.0, 120.0, 480.0], ratio: vec![1.0, 1.0, 1.0] };
+        let restated = restate_gate_observed(&stated, &|c| p_fail_of(std::slice::from_ref(&lag), c)).unwrap();
+        let md = markdown(&stated, &restated, &[lag]);
+        assert!(md.contains("| `churning-loss` | 0.950 |") && md.contains("| admitted |"), "{md}");
+        assert!(md.contains("| `sensor-lag` | 0.000 |") && md.contains("| 1.00 |"), "{md}");
     }
 
     /// P(fail | c) on known r̂: below 2 everywhere → 1, at or above

@@ -64,7 +64,7 @@ pub const SECTIONS: [Section; 9] = [
     Section {
         doc: "docs/diagnosis-gate.md",
         tag: "reliability-gate",
-        source: "docs/data/emulator-sweep-1800.json",
+        source: "docs/data/emulator-sweep-1800.json, docs/data/emulator-sweep-2800.json",
         render: render_gate,
     },
 ];
@@ -72,9 +72,12 @@ pub const SECTIONS: [Section; 9] = [
 /// The gate's rejection as an observation against the product's
 /// probabilities ([`crate::diagnosis::emu_calibration::gate_document`]) on
 /// the sweep that carries every log's detectability.
+/// Its sources' texts as a JSON array (the two seed sets with twins); a
+/// third row group pools them.
 fn render_gate(json: &str) -> Result<String> {
-    let rows: Vec<crate::diagnosis::emu_sweep::EmuResult> = serde_json::from_str(json)?;
-    Ok(crate::diagnosis::emu_calibration::gate_document(&[("1800–1817 (with twins)", rows)]))
+    let [a, b]: [Vec<crate::diagnosis::emu_sweep::EmuResult>; 2] = serde_json::from_str(json)?;
+    let both: Vec<_> = a.iter().chain(&b).cloned().collect();
+    Ok(crate::diagnosis::emu_calibration::gate_document(&[("1800–1817 (with twins)", a), ("2800–2817 (with twins)", b), ("both sets", both)]))
 }
 
 /// Labels of the sweeps of the `reliability-default` section, in its
