@@ -7,13 +7,15 @@
 //! Split by topic: this file holds the commissioning itself
 //! ([`commission`]); `outcome` what it gives and whether its block may be
 //! flashed ([`Commissioning`], [`Refusal`]); `fits` the calibrations it
-//! runs (its own with η_m from the current, the margin's folds).
+//! runs (its own with η_m from the current, the margin's folds); `stages`
+//! the steps of [`commission_with`] that stand on their own.
 
 mod fits;
 mod outcome;
+mod stages;
 
 use super::fit::CalOptions;
-use super::log::{channel_errors, CalLog};
+use super::log::CalLog;
 use crate::reduce::reduce;
 use crate::rig::Rig;
 use super::paths::{PathKind, PathOutcome};
@@ -56,25 +58,8 @@ pub fn commission_with(base: &Rig, train: &[CalLog], holdout: &[CalLog], o: &Cal
     let train = &crate::calibration::log::rethinned(train, o.commission_thinning, o.points_per_channel);
     let (base_e, mut cal, eta_e, eta_m_balance) = fit(base, train, o)?;
     let base = &base_e;
-    if !train.iter().any(cycles_valve) {
-        cal.warnings.push(format!(
-            "{NO_COOLING} (no `lng_valve` column that is both 0 and 1): the exchanger's cooling credit in the firmware is not checked against this machine; run a loaded mission with the valve cycling (docs/commissioning.md)"
-        ));
-    }
-    if !train.iter().any(|l| super::ident::independent_speed_and_load(&l.run)) {
-        cal.warnings.push(format!(
-            "{} (none has shaft speed and pressure drop each spreading by >= {:.0} % with |correlation| < {}): one-at-a-time missions let the calibration absorb the machine's structure into values that hold only for them; add an identification run (docs/commissioning.md)",
-            super::ident::NO_JOINT_EXCITATION,
-            100.0 * super::ident::ONE_POINT_SPREAD,
-            super::ident::JOINT_MAX_CORRELATION
-        ));
-    }
-    let mut scores = Vec::new();
-    for l in holdout {
-        let a = l.simulate(base).map_err(CommissionError::Run)?;
-        let b = l.simulate(&cal.rig).map_err(CommissionError::Run)?;
-        scores.push(HoldoutScore { log: l.name.clone(), as_given: channel_errors(l, &a), commissioned: channel_errors(l, &b) });
-    }
+    stages::training_warnings(train, &mut cal.warnings);
+    let scores = stages::holdout_scores(base, &cal.rig, holdout)?;
     if let Some(why) = crate::reduce::unsupported_structure(&cal.rig) {
         return Err(CommissionError::Reduce(why.into()));
     }
@@ -99,22 +84,7 @@ pub fn commission_with(base: &Rig, train: &[CalLog], holdout: &[CalLog], o: &Cal
         (None, _) => Err("switched off".into()),
     };
     // Both paths' folds on one replay of each training log per fold.
-    let (margin, direct_validation) = if splits.is_empty() {
-        (None, None)
-    } else {
-        let (mut red, mut dir) = (Vec::new(), Vec::new());
-        for (i, s) in splits.iter().enumerate() {
-            let mut ps = vec![&s.reduction];
-            if let Ok((_, hs)) = &direct {
-                ps.extend(hs.get(i));
-            }
-            let mut v = score_split_many(s, train, &ps)?.into_iter();
-            red.extend(v.next());
-            dir.extend(v.next());
-        }
-        let dir_ok = dir.len() == splits.len();
-        (Some(merge_folds(red)), dir_ok.then(|| merge_folds(dir)))
-    };
+    let (margin, direct_validation) = stages::score_folds(&splits, train, direct.as_ref().ok().map(|(_, hs)| hs.as_slice()))?;
     if with_margin && margin.is_none() {
         cal.warnings.push("no drain margin: it needs `t_drain_c` in every training log, and a validation fit (first 60 % of every training log) that the firmware model accepts".into());
     }
@@ -128,19 +98,7 @@ pub fn commission_with(base: &Rig, train: &[CalLog], holdout: &[CalLog], o: &Cal
     if let Ok((f, _)) = &direct {
         models.push((&f.params, &dir_m));
     }
-    let (mut red_plain, mut red_with, mut default_on_holdout, mut dir_plain, mut dir_with) = (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    for l in holdout {
-        let mut c = check_reduced_many(&cal.rig, l, &models, f64::NEG_INFINITY).map_err(CommissionError::Run)?.into_iter();
-        let (p, w) = super::paths::plain_and_with(c.next().expect("the reduction's checks"));
-        red_plain.push(p);
-        red_with.push(w);
-        default_on_holdout.push(c.next().expect("the default's check").remove(0));
-        if let Some(d) = c.next() {
-            let (p, w) = super::paths::plain_and_with(d);
-            dir_plain.push(p);
-            dir_with.push(w);
-        }
-    }
+    let stages::HoldoutChecks { red_plain, red_with, default: default_on_holdout, dir_plain, dir_with } = stages::holdout_checks(&cal.rig, holdout, &models)?;
     reduced.extend(red_plain.iter().cloned());
     let reduced_ok = reduced.iter().all(|r| r.vs_reference_max_k <= REDUCED_BOUND_K);
     let reduction = PathOutcome::from_checks(PathKind::Reduction, params, margin, red_plain, red_with);
