@@ -11,8 +11,10 @@
 //!
 //! Split by topic: this file holds the fit itself ([`calibrate`]);
 //! `options` its settings and their defaults ([`CalOptions`], [`HeadFold`]),
-//! `outcome` what it gives ([`Calibration`], [`ParamResult`], [`CalError`]).
+//! `outcome` what it gives ([`Calibration`], [`ParamResult`], [`CalError`]);
+//! `holds` what the logs cannot move before any fit.
 
+mod holds;
 mod options;
 mod outcome;
 
@@ -22,7 +24,7 @@ use super::polish::{polish, polish_basins};
 use super::residuals::{data_residuals, jacobian_ln, on_lattice, Sigma};
 pub use super::residuals::THETA_LATTICE_LN;
 pub use super::polish::{Polish, POLISH_MAX_ITERS, POLISH_RTOL, POLISH_TOL, SCALE_PAIR};
-use super::set::{apply, Needs, Stage, PARAMS};
+use super::set::{apply, Stage, PARAMS};
 use crate::lsq::FdProblem;
 use crate::rig::Rig;
 use levenberg_marquardt::LevenbergMarquardt;
@@ -61,89 +63,8 @@ pub fn calibrate(base: &Rig, logs: &[CalLog], o: &CalOptions) -> Result<Calibrat
     for l in logs {
         l.simulate(base).map_err(|e| CalError::Model(l.name.clone(), e))?;
     }
-    // 1. Which parameters have the sensor they need in at least one log.
-    let mut held: Vec<Option<String>> = PARAMS
-        .iter()
-        .map(|d| match d.needs {
-            Needs::Sensor(ch) if !logs.iter().any(|l| l.has(ch)) => {
-                Some(format!("no log carries `{}`; would need: {}", ch.name(), d.excitation))
-            }
-            Needs::Input(ch) if !logs.iter().any(|l| super::log::input_above_zero(&l.run, ch)) => {
-                Some(format!("no log has `{}` above 0; would need: {}", ch.name(), d.excitation))
-            }
-            Needs::SensorWithJointExcitation(ch)
-                if !logs.iter().any(|l| l.has(ch) && super::ident::independent_speed_and_load(&l.run)) =>
-            {
-                Some(format!("no log with `{}` moves speed and load independently; would need: {}", ch.name(), d.excitation))
-            }
-            _ => None,
-        })
-        .collect();
-    // 1b. One operating point in every log: losses that differ only in how
-    // they scale with speed and pressure are a single constant heat there;
-    // `pump_friction` stands for the pump's, the others are held.
-    if super::ident::all_one_point(logs) {
-        for name in ["leak_gap", "iron_loss", "winding_r", "needle_split"] {
-            let k = super::set::index(name).expect("calibration parameter");
-            held[k].get_or_insert_with(|| format!("every log has one operating point; would need: {}", PARAMS[k].excitation));
-        }
-    }
-    // 1c. The churned case film needs the drain both near rest and at
-    // speed: without, its level and the gap's floor trade freely.
-    if !super::ident::case_film_speed_range(logs) {
-        let (low, high) = super::ident::drain_time_low_and_high_speed_s(logs);
-        for name in [super::set::CASE_CHURN, super::set::CASE_CHURN_SPEED] {
-            let k = super::set::index(name).expect("calibration parameter");
-            held[k].get_or_insert_with(|| {
-                format!(
-                    "the logs with `t_drain_c` spend {low:.0} s below {:.0} rpm and {high:.0} s above {:.0} rpm (needs {:.0} s of each); would need: {}",
-                    super::ident::CASE_FILM_LOW_RPM,
-                    super::ident::CASE_FILM_HIGH_RPM,
-                    super::ident::CASE_FILM_MIN_S,
-                    PARAMS[k].excitation
-                )
-            });
-        }
-    }
-    // 1c'. The ducts' turbulent level needs the passages' flow in the
-    // transition, hot: below Re 2300 it acts on nothing.
-    if !super::ident::duct_transition_range(logs, base) {
-        let (secs, top) = super::ident::duct_transition_time_s(logs, base);
-        let k = super::set::index(super::set::DUCT_TURBULENT).expect("calibration parameter");
-        held[k].get_or_insert_with(|| {
-            format!(
-                "the logs with the block and oil sensors spend {secs:.0} s with the main-block passage's flow above Re {:.0} (needs {:.0} s; highest Re {top:.0}); would need: {}",
-                super::ident::DUCT_TRANSITION_RE,
-                super::ident::DUCT_TRANSITION_MIN_S,
-                PARAMS[k].excitation
-            )
-        });
-    }
-    for (name, why) in &o.hold {
-        if let Some(k) = super::set::index(name) {
-            held[k].get_or_insert_with(|| why.clone());
-        }
-    }
-    // 1d. The pump's structural freedoms (where its friction heat goes, how
-    // that friction scales with speed, where the surface probes read) only
-    // beside a loss level that the temperatures do not fit as well
-    // (`commission` takes `pump_friction` from the current): with the level
-    // free, each trades with the pump housing's triad (h_out_pump,
-    // film_case, pump_friction, whose common scale the temperatures pin only
-    // to ~20 %). Measured with the level fitted: the recovery test (truth:
-    // the rule, probes on their metal) fitted friction_case 1.13,
-    // friction_speed 1.23 and moved the triad's ratio 0.16 in ln; the probes
-    // alone fitted −1 … −4 % and moved cap_pump 0.84 -> 1.01 (truth 0.80);
-    // the rig emulator's nominal machine (no drain) fitted its pump probe
-    // 10.7 %, its block's 18.3 % (bound), held-out pooled RMSE 0.84 -> 0.95 K.
-    let pf = super::set::index("pump_friction").expect("param");
-    let structural = [super::set::FRICTION_CASE, super::set::FRICTION_SPEED].into_iter().chain(super::set::PROBE_SURFACE);
-    for name in structural {
-        let k = super::set::index(name).expect("param");
-        if held[pf].is_none() {
-            held[k].get_or_insert_with(|| "fitted only with the pump's loss level from the current (`pump_friction` held by `commission` when `current_a` is logged): with the level fitted from the temperatures too, it trades with the pump housing's heat paths".into());
-        }
-    }
+    // 1. Held before any fit, from what the logs carry and how they run.
+    let mut held = holds::held_by_the_logs(base, logs, o);
     // 2. Screening at the rig file: hold what the data do not identify.
     let cand: Vec<usize> = (0..PARAMS.len()).filter(|&k| held[k].is_none()).collect();
     let (r0, j0) = jacobian_ln(base, logs, &ones, &cand, sigma, &runs)
@@ -258,28 +179,7 @@ pub fn calibrate(base: &Rig, logs: &[CalLog], o: &CalOptions) -> Result<Calibrat
     let n = r1.len();
     let s2 = (chi2_after / (n.saturating_sub(free.len()).max(1)) as f64).max(1.0);
     let ident = identifiability(&j1, &free, &prior_ln, s2, o.corr_threshold);
-    let params = PARAMS
-        .iter()
-        .enumerate()
-        .map(|(k, d)| {
-            let ln = theta[k].ln();
-            let at_bound = (ln - d.lo.ln()).abs() < 0.01 || (d.hi.ln() - ln).abs() < 0.01;
-            match &held[k] {
-                Some(why) => ParamResult { name: d.name.into(), value: 1.0, interval95: (1.0, 1.0), at_bound: false, status: Status::Held(why.clone()) },
-                None => {
-                    let j = free.iter().position(|&f| f == k).unwrap_or(0);
-                    let sd = ident.sd_ln[j];
-                    ParamResult {
-                        name: d.name.into(),
-                        value: theta[k],
-                        interval95: ((ln - 1.96 * sd).exp(), (ln + 1.96 * sd).exp()),
-                        at_bound,
-                        status: Status::Fitted,
-                    }
-                }
-            }
-        })
-        .collect();
+    let params = outcome::param_results(&theta, &held, &free, &ident.sd_ln);
     let mut warnings = excitation_warnings(logs);
     // Held by the caller (o.hold) is not "not identifiable": its status says why.
     let unident: Vec<&str> =

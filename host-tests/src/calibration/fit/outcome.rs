@@ -3,6 +3,7 @@
 
 use crate::calibration::ident::Identifiability;
 use crate::calibration::polish::Polish;
+use crate::calibration::set::PARAMS;
 use crate::rig::Rig;
 
 /// Status of one parameter after calibration.
@@ -63,4 +64,33 @@ pub enum CalError {
     /// The model does not run on a log with the rig as given.
     #[error("reference model fails on {0}: {1}")]
     Model(String, String),
+}
+
+/// Every parameter's result: a held one at 1 with its reason, a fitted one
+/// at `theta` with its 95 % interval from `sd_ln` (the free parameters'
+/// posterior sd in ln, in the order of `free`) and whether it sits within
+/// 1 % of a bound.
+pub(super) fn param_results(theta: &[f64], held: &[Option<String>], free: &[usize], sd_ln: &[f64]) -> Vec<ParamResult> {
+    PARAMS
+        .iter()
+        .enumerate()
+        .map(|(k, d)| {
+            let ln = theta[k].ln();
+            let at_bound = (ln - d.lo.ln()).abs() < 0.01 || (d.hi.ln() - ln).abs() < 0.01;
+            match &held[k] {
+                Some(why) => ParamResult { name: d.name.into(), value: 1.0, interval95: (1.0, 1.0), at_bound: false, status: Status::Held(why.clone()) },
+                None => {
+                    let j = free.iter().position(|&f| f == k).unwrap_or(0);
+                    let sd = sd_ln[j];
+                    ParamResult {
+                        name: d.name.into(),
+                        value: theta[k],
+                        interval95: ((ln - 1.96 * sd).exp(), (ln + 1.96 * sd).exp()),
+                        at_bound,
+                        status: Status::Fitted,
+                    }
+                }
+            }
+        })
+        .collect()
 }
