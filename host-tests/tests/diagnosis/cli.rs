@@ -113,3 +113,29 @@ fn worked_example_is_diagnosed_as_sensor_lag() {
         assert!(std::fs::metadata(dir.join(f)).unwrap().len() > 1000, "{f}");
     }
 }
+
+/// `--detectability` on the worked example: the floor projection's
+/// `detectability.json`, and the posterior restated with the gate's
+/// rejection as an observation (`gate-observed.json`, a report section).
+/// The restatement changes no answer: the lag it names carries a Bayes
+/// factor so large against `none` (ln B ≫ 10) that the rejected
+/// candidates, given the no-cause block's evidence, take < 1e-6 of the
+/// mass; the restated probabilities still sum to one.
+#[test]
+fn worked_example_with_detectability_restates_the_posterior() {
+    let dir = std::env::temp_dir().join(format!("diag-det-{}", std::process::id()));
+    let out = exe().arg("diagnose").arg(example()).arg("--detectability").arg("--out").arg(&dir).output().unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let read = |f: &str| -> serde_json::Value { serde_json::from_str(&std::fs::read_to_string(dir.join(f)).unwrap()).unwrap() };
+    let stated = read("diagnosis.json")["probabilities"].as_array().unwrap().clone();
+    let restated = read("gate-observed.json").as_array().unwrap().clone();
+    assert!(read("detectability.json")["rows"].as_array().is_some_and(|r| !r.is_empty()));
+    assert_eq!(restated.len(), stated.len());
+    let sum: f64 = restated.iter().map(|x| x["probability"].as_f64().unwrap()).sum();
+    assert!((sum - 1.0).abs() < 1e-9, "restated probabilities sum to {sum}");
+    assert_eq!(restated[0]["cause"], "sensor-lag");
+    let (p0, q0) = (stated[0]["probability"].as_f64().unwrap(), restated[0]["probability"].as_f64().unwrap());
+    assert!((p0 - q0).abs() < 1e-6 && q0 >= 0.9, "stated {p0}, restated {q0}");
+    let report = std::fs::read_to_string(dir.join("report.md")).unwrap();
+    assert!(report.contains("## Probabilities with the gate's rejection as an observation"));
+}
