@@ -7,7 +7,8 @@
 //! reduction and writes a per-tick CSV `<machine>-<k>.csv` (every 10th
 //! tick: port pressures, speed, reference and firmware nodes, both case
 //! films, losses, port links) beside it, and `<machine>-<k>-log.csv` (the
-//! log's drain thermocouple and the emulator's true drain, per log row). `EXP_CHECK_GAIN` (m³/s/Pa) and
+//! log's drain thermocouple, the emulator's true drain and the logged pump
+//! probe, per log row). `EXP_CHECK_GAIN` (m³/s/Pa) and
 //! `EXP_ACC_BAR` change the commissioned rig's check valves and
 //! accumulator before both run (experiments).
 //!
@@ -138,11 +139,12 @@ fn slow_reduce_servo_locate() {
             eprintln!("{} log {k} {}: reduced vs reference drain max {max_e:.3} K", m.name, log.name);
             // the log's drain thermocouple and the emulator's true drain, per log row
             let mut g = std::io::BufWriter::new(std::fs::File::create(dir().join(format!("{}-{k}-log.csv", m.name))).expect("csv"));
-            writeln!(g, "t,drain_tc,drain_true").unwrap();
+            writeln!(g, "t,drain_tc,drain_true,pump_probe").unwrap();
             let (tc, tt) = (l.run.get(Channel::TDrainC).expect("t_drain_c"), l.truth.get(Channel::TDrainC).expect("truth"));
+            let tp = l.run.get(Channel::TPumpC);
             for (i, t) in l.run.time_s.iter().enumerate() {
                 let f = |x: Option<f64>| x.map_or(String::new(), |x| format!("{x:.4}"));
-                writeln!(g, "{t:.2},{},{}", f(tc[i]), f(tt[i])).unwrap();
+                writeln!(g, "{t:.2},{},{},{}", f(tc[i]), f(tt[i]), f(tp.and_then(|v| v[i]))).unwrap();
             }
         }
     }
