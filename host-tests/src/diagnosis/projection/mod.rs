@@ -18,6 +18,8 @@
 //! √3·f) is where a diagnosis must name the cause. Bounds are ignored and
 //! the calibration is taken as linear, so r̂ is an estimate, not a bound.
 
+mod report;
+
 use super::adequacy::{channel_noise_k, rms_rise_k};
 use super::evidence::{floor_for, touched_channels, ChannelFloor};
 use super::fit::{residuals_at, Point, PRIOR_DATA_SIGMA_K};
@@ -25,7 +27,6 @@ use super::model::{Candidate, ParamSpec, SimSeries, Simulator};
 use crate::measured::{Channel, MeasuredRun};
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
-mod report;
 
 /// Step of the sensitivities in ln value (the fit's own step,
 /// [`super::fit::FitOptions::fd_step`]).
