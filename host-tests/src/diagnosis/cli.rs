@@ -153,7 +153,7 @@ fn run_inner(args: &DiagnoseArgs) -> anyhow::Result<String> {
             append_to_report(&args.out, &fd.markdown())?;
             std::fs::write(args.out.join("detectability.json"), serde_json::to_string_pretty(&fd)? + "\n")?;
             // the posterior restated with the gate's rejection as an observation
-            let stated: Vec<super::report::ProbabilityJson> = d.posterior.causes.iter().map(super::report::ProbabilityJson::from).collect();
+            let stated = super::report::ProbabilityJson::of(&d);
             let reach = super::gate_obs::reaches(&fd);
             if let Some(restated) = super::gate_obs::restate_gate_observed(&stated, &|c| super::gate_obs::p_fail_of(&reach, c)) {
                 append_to_report(&args.out, &super::gate_obs::markdown(&stated, &restated, &reach))?;

@@ -114,7 +114,7 @@ mod tests {
         assert_eq!(dec_before, dec_after);
         for l in &set {
             let p = restate_gate_observed(&l.probs, &|c| p_fail_of(&l.reach, c)).unwrap();
-            let named = |p: &[crate::diagnosis::report::ProbabilityJson]| p.iter().find(|c| names_a_cause(&c.cause) && c.probability >= 0.9).map(|c| c.cause.clone());
+            let named = |p: &[crate::diagnosis::report::ProbabilityJson]| p.iter().find(|c| names_a_cause(&c.cause) && c.probability >= crate::diagnosis::evidence::NAME_PROBABILITY).map(|c| c.cause.clone());
             assert_eq!(named(&p), named(&l.probs), "seed {}", l.seed);
         }
     }

@@ -37,11 +37,6 @@ pub fn run_emu_case_twin(case: EmuCase, o: &DiagnoseOptions, twin: bool) -> Resu
     run_emu_case_with(case, o, twin, true)
 }
 
-/// The posterior of `d` as `diagnosis.json` writes it.
-fn probabilities(d: &Diagnosis) -> Vec<ProbabilityJson> {
-    d.posterior.causes.iter().map(ProbabilityJson::from).collect()
-}
-
 /// [`run_emu_case_twin`]; with `oracle`, also the hidden effect injected
 /// into the calibrated reference model ([`EmuResult::hidden_detect`]). The
 /// log and its twin are diagnosed in parallel.
@@ -122,7 +117,7 @@ pub fn run_emu_case_reach(case: EmuCase, o: &DiagnoseOptions, twin: bool, oracle
                 misfit_k: a,
                 twin_misfit_k: b,
                 twin_answer: td.answer().into(),
-                twin_probabilities: probabilities(&td),
+                twin_probabilities: ProbabilityJson::of(&td),
                 twin_channels: td.posterior.channels.clone(),
                 twin_terms: td.posterior.terms.clone(),
                 twin_measured: None,
@@ -152,7 +147,7 @@ pub fn run_emu_case_reach(case: EmuCase, o: &DiagnoseOptions, twin: bool, oracle
         best_candidate: best,
         hidden_fit,
         hidden_detect,
-        probabilities: probabilities(&d),
+        probabilities: ProbabilityJson::of(&d),
         ranking: d.ranking.iter().map(|r| (r.cause.clone(), r.delta_bic, r.heldout_gain, r.qualifies)).collect(),
         evidence_channels: d.posterior.channels.clone(),
         tier: d.nuisance_set.clone(),

@@ -39,6 +39,13 @@ pub struct ProbabilityJson {
     pub identifiable: Option<bool>,
 }
 
+impl ProbabilityJson {
+    /// The posterior of `d` as `diagnosis.json` writes it.
+    pub fn of(d: &Diagnosis) -> Vec<ProbabilityJson> {
+        d.posterior.causes.iter().map(ProbabilityJson::from).collect()
+    }
+}
+
 impl From<&crate::diagnosis::evidence::CauseProbability> for ProbabilityJson {
     fn from(c: &crate::diagnosis::evidence::CauseProbability) -> Self {
         ProbabilityJson {
@@ -195,12 +202,7 @@ impl DiagnosisJson {
                 .iter()
                 .map(|r| RankingJson { cause: r.cause.clone(), bic: r.bic, heldout_rmse_k: r.heldout_rmse_k })
                 .collect(),
-            probabilities: d
-                .posterior
-                .causes
-                .iter()
-                .map(ProbabilityJson::from)
-                .collect(),
+            probabilities: ProbabilityJson::of(d),
             channels: d.posterior.channels.clone(),
             unexplained: d.unexplained.then(|| UnexplainedJson {
                 misfit_channels: d

@@ -50,7 +50,7 @@ fn slow_structure_experiment() {
             o.hold.push((h, "EXP_HOLD".into()));
         }
         o.prior_sigma.extend(exp_priors());
-        if let Some(w) = std::env::var("EXP_DRAIN_WEIGHT").ok().and_then(|v| v.parse::<f64>().ok()) {
+        if let Some(w) = env_f64("EXP_DRAIN_WEIGHT") {
             o.drain_weight = w;
         }
         o.margin_head_fold = exp_head_fold();
@@ -59,16 +59,16 @@ fn slow_structure_experiment() {
         let t0 = std::time::Instant::now();
         let cpu0 = eha_sim::tools::cpu::process_cpu_s();
         let mut base = m.rig_file();
-        if let Some(k) = std::env::var("EXP_RIG_CASE_SHARE").ok().and_then(|v| v.parse::<f64>().ok()) {
+        if let Some(k) = env_f64("EXP_RIG_CASE_SHARE") {
             // the user's rig file with the sliding-pair rule's case share scaled (prior centre and start)
             base.pump.friction_pairs.case_share_scale *= k;
         }
         // the user's rig file with the case oil's volume and the case film's area scaled
         // (the fit's start, prior centre and bounds for `cap_case_oil`, `film_case`)
-        if let Some(k) = std::env::var("EXP_RIG_CASE_OIL").ok().and_then(|v| v.parse::<f64>().ok()) {
+        if let Some(k) = env_f64("EXP_RIG_CASE_OIL") {
             base.pump.case_oil_m3 *= k;
         }
-        if let Some(k) = std::env::var("EXP_RIG_CASE_AREA").ok().and_then(|v| v.parse::<f64>().ok()) {
+        if let Some(k) = env_f64("EXP_RIG_CASE_AREA") {
             base.pump.case_inner_area_m2 *= k;
         }
         let c = commission_with(&base, &train, &hold_logs, &o, margin).expect("commissioning");
@@ -157,4 +157,10 @@ fn slow_joint_move_channels() {
             eprintln!("EXP joint {k:?} {:40} {:10} rmse {:.3} -> {:.3}, under {:.3} -> {:.3}", l.name, x.channel, x.rmse_k, y.rmse_k, x.max_under_k, y.max_under_k);
         }
     }
+}
+
+/// An experiment knob's number: the environment variable `name` parsed as
+/// f64, `None` when unset or not a number.
+fn env_f64(name: &str) -> Option<f64> {
+    std::env::var(name).ok().and_then(|v| v.parse::<f64>().ok())
 }
