@@ -20,7 +20,11 @@ use eha_sim::measured::Channel;
 /// `EXP_RIG_CASE_AREA=k` the case oil's volume and the case film's area
 /// (start, prior centre and bounds of `cap_case_oil`, `film_case`);
 /// `EXP_THINNING` the training logs' fit points ([`exp_thinning`]);
-/// `EXP_DRAIN_WEIGHT=w` the drain residuals' weight (`CalOptions::drain_weight`).
+/// `EXP_DRAIN_WEIGHT=w` the drain residuals' weight (`CalOptions::drain_weight`);
+/// `EXP_RIG_JOINT_MANIFOLD=k` a pump housing → main block metal path of k ×
+/// the a-priori one (`Joints::a_priori`, 2.0 W/K; k = 0 the path open,
+/// the same numbers as without it), held: the firmware cannot carry it, so
+/// the reference's calibration and every log's channel errors only.
 #[test]
 #[ignore = "measurement by hand: one commissioning per machine"]
 fn slow_structure_experiment() {
@@ -70,6 +74,27 @@ fn slow_structure_experiment() {
         }
         if let Some(k) = env_f64("EXP_RIG_CASE_AREA") {
             base.pump.case_inner_area_m2 *= k;
+        }
+        if let Some(k) = env_f64("EXP_RIG_JOINT_MANIFOLD") {
+            // a pump housing -> main block metal path of k times the a-priori 2.0 W/K (held)
+            let mut j = eha_sim::rig::Joints::a_priori();
+            j.pump_motor.contact_w_per_m2_k = 0.0;
+            j.pump_manifold.k_w_per_m_k *= k;
+            j.pump_manifold.contact_w_per_m2_k *= k;
+            base.joints = Some(j);
+            // the firmware cannot carry a joint: the reference's calibration and its held-out drain only
+            let tr = eha_sim::calibration::log::rethinned(&train, o.commission_thinning, o.points_per_channel);
+            let (b, o2, _) = eha_sim::calibration::commission::with_eta_m_from_current(&base, &tr, &o);
+            let cal = eha_sim::calibration::calibrate(&b, &tr, &o2).expect("calibration");
+            let fitted: Vec<String> = eha_sim::calibration::set::PARAMS.iter().zip(&cal.theta).map(|(p, t)| format!("{} {t:.3}", p.name)).collect();
+            eprintln!("EXP {} joint ×{}: objective {:.3}; {}", m.name, env_f64("EXP_RIG_JOINT_MANIFOLD").unwrap_or(0.0), cal.chi2_before_after.1, fitted.join(", "));
+            for l in tr.iter().chain(&hold_logs) {
+                let s = l.simulate(&cal.rig).expect("replay");
+                for e in eha_sim::calibration::log::channel_errors(l, &s) {
+                    eprintln!("EXP {} joint {}: {} rmse {:.3} max {:.3} under {:.3}", m.name, l.name, e.channel, e.rmse_k, e.max_abs_k, e.max_under_k);
+                }
+            }
+            continue;
         }
         let c = commission_with(&base, &train, &hold_logs, &o, margin).expect("commissioning");
         report(&m, &c, t0.elapsed().as_secs_f64());
