@@ -197,12 +197,15 @@ pub struct Bin {
     pub n: usize,
     /// Mean stated probability.
     pub stated: f64,
-    /// Fraction of the statements that are true (the hidden effect, or no
-    /// cause on an effect-free log).
+    /// Fraction of the statements that are true, the truth being the hidden
+    /// effect at any r ("no cause" on an effect-free log).
     pub observed: f64,
-    /// The same with "no cause" also counted true on a log whose effect
-    /// stays below r = 2 (the rule by which the answer is judged).
-    pub observed_lenient: f64,
+    /// Fraction true with the truth the answers are judged by: the hidden
+    /// effect when it stands clear of the floor (r ≥ 2), else "no cause".
+    /// One truth per log, so a log's statements' probabilities and their
+    /// truths add up alike: below r = 2 "no cause" is true and the effect's
+    /// own statement false.
+    pub observed_at_floor: f64,
 }
 
 /// The reliability bins over every diagnosed log of `ok`.
@@ -216,13 +219,14 @@ pub fn reliability_of(logs: &[Diagnosed]) -> Vec<Bin> {
     for d in logs {
         let truth = if d.truth == "none" { "no cause" } else { d.truth };
         let faint = d.ratio.is_some_and(|r| r < 2.0);
+        let at_floor = if faint { "no cause" } else { truth };
         for (s, p) in statements(d.probabilities) {
-            st.push((p, s == truth, s == truth || (faint && s == "no cause")));
+            st.push((p, s == truth, s == at_floor));
         }
     }
     BINS.iter()
         .map(|&(lo, hi)| {
-            let b: Vec<&(f64, bool, bool)> = st.iter().filter(|(p, _, _)| *p >= lo && *p < hi).collect();
+            let b: Vec<&(f64, bool, bool)> = st.iter().filter(|(p, ..)| *p >= lo && *p < hi).collect();
             let n = b.len();
             let mean = |f: &dyn Fn(&(f64, bool, bool)) -> f64| if n == 0 { f64::NAN } else { b.iter().map(|x| f(x)).sum::<f64>() / n as f64 };
             Bin {
@@ -230,7 +234,7 @@ pub fn reliability_of(logs: &[Diagnosed]) -> Vec<Bin> {
                 n,
                 stated: mean(&|x| x.0),
                 observed: mean(&|x| f64::from(u8::from(x.1))),
-                observed_lenient: mean(&|x| f64::from(u8::from(x.2))),
+                observed_at_floor: mean(&|x| f64::from(u8::from(x.2))),
             }
         })
         .collect()
@@ -246,25 +250,25 @@ pub fn reliability_table(ok: &[EmuResult]) -> String {
     let mut md = String::from(
         "\n**Reliability of the stated probabilities** over every diagnosed log (case logs and twins): each report's \
          statements — the named cause, or else the two most probable, with `none` and `unexplained` merged into \
-         \"no cause\" — binned by stated probability; observed = the fraction that is true (the hidden effect; \
-         \"no cause\" on an effect-free log), and the same counting \"no cause\" right also on a log whose effect \
-         stays below r = 2. Calibrated: within 10 points in every bin with ≥ 5 statements.\n",
+         \"no cause\" — binned by stated probability; observed = the fraction that is true (the hidden effect at any \
+         r; \"no cause\" on an effect-free log), and the same with the truth the answers are judged by (the hidden \
+         effect at r ≥ 2, else \"no cause\"). Calibrated: within 10 points in every bin with ≥ 5 statements.\n",
     );
     md += &bins_markdown(&bins);
     md
 }
 
 /// The reliability bins as a Markdown table; "within 10 points" judged on
-/// the observed column that counts "no cause" right below r = 2 (the rule
-/// the answers are judged by) and on the strict one.
+/// the strict observed column and on the one with the answers' truth
+/// (the effect at r ≥ 2, else "no cause").
 pub fn bins_markdown(bins: &[Bin]) -> String {
     let mut md = String::from(
-        "\n| stated P | statements | mean stated | observed | observed, r < 2 effects as no cause | within 10 points (strict / r < 2 as no cause) |\n|---|---:|---:|---:|---:|---|\n",
+        "\n| stated P | statements | mean stated | observed | observed, truth at the floor (the effect at r ≥ 2, else no cause) | within 10 points (strict / at the floor) |\n|---|---:|---:|---:|---:|---|\n",
     );
     for b in bins {
         let pct = |x: f64| if x.is_nan() { "–".to_string() } else { format!("{:.0} %", 100.0 * x) };
         let within = |o: f64| if (b.stated - o).abs() <= 0.1 { "yes" } else { "**no**" };
-        let ok = if b.n < 5 { "(< 5)".to_string() } else { format!("{} / {}", within(b.observed), within(b.observed_lenient)) };
+        let ok = if b.n < 5 { "(< 5)".to_string() } else { format!("{} / {}", within(b.observed), within(b.observed_at_floor)) };
         let _ = writeln!(
             md,
             "| {:.2}–{:.2} | {} | {} | {} | {} | {ok} |",
@@ -273,7 +277,7 @@ pub fn bins_markdown(bins: &[Bin]) -> String {
             b.n,
             pct(b.stated),
             pct(b.observed),
-            pct(b.observed_lenient)
+            pct(b.observed_at_floor)
         );
     }
     md

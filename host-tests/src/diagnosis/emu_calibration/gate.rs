@@ -13,11 +13,11 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
 /// Whether every bin of `bins` with at least 5 statements is within 10
-/// points of what is observed (strictly; and with "no cause" right below
-/// r = 2).
+/// points of what is observed (strictly; and with the answers' truth,
+/// the effect at r ≥ 2, else "no cause": [`Bin::observed_at_floor`]).
 pub fn calibrated(bins: &[Bin]) -> (bool, bool) {
     let full: Vec<&Bin> = bins.iter().filter(|b| b.n >= 5).collect();
-    (full.iter().all(|b| (b.stated - b.observed).abs() <= 0.10), full.iter().all(|b| (b.stated - b.observed_lenient).abs() <= 0.10))
+    (full.iter().all(|b| (b.stated - b.observed).abs() <= 0.10), full.iter().all(|b| (b.stated - b.observed_at_floor).abs() <= 0.10))
 }
 
 /// The stated probability of "no cause" in a log's posterior.
@@ -39,9 +39,9 @@ pub fn gate_document(sets: &[(&str, Vec<EmuResult>)]) -> String {
             match measure(set, v, None) {
                 Some((bins, dec)) => {
                     let cells: Vec<String> = bins.iter().map(cell).collect();
-                    let (strict, lenient) = calibrated(&bins);
+                    let (strict, at_floor) = calibrated(&bins);
                     let yn = |b: bool| if b { "yes" } else { "no" };
-                    let _ = writeln!(md, "| {label} | {} | {} | {dec} | {} | {} ({} with r < 2 as no cause) |", set.len(), v.label(), cells.join(" | "), yn(strict), yn(lenient));
+                    let _ = writeln!(md, "| {label} | {} | {} | {dec} | {} | {} ({} at the floor) |", set.len(), v.label(), cells.join(" | "), yn(strict), yn(at_floor));
                 }
                 None => {
                     let _ = writeln!(md, "| {label} | {} | {} | not stored (re-run the sweep with `--detectability`) |{}", set.len(), v.label(), " – |".repeat(8));
@@ -49,7 +49,7 @@ pub fn gate_document(sets: &[(&str, Vec<EmuResult>)]) -> String {
             }
         }
     }
-    md += "\nCells: statements · mean stated → observed (observed with r < 2 effects counted as no cause), per cent.\n";
+    md += "\nCells: statements · mean stated → observed (observed with the answers' truth: the effect at r ≥ 2, else no cause), per cent.\n";
     for (label, set) in &per {
         if set.iter().any(|l| l.reach.is_empty()) {
             continue;
@@ -86,13 +86,15 @@ mod tests {
 
     /// The gate-as-observation table from the stored 1800–1817 sweep (re-run
     /// with `--detectability`), as measured; nothing fitted.
-    /// - The product: 25 statements at P < 0.10 (16 % observed), 28 at
-    ///   P ≥ 0.99 (68 %; 96 % with r < 2 as no cause).
+    /// - The product: 25 statements at P < 0.10 (16 % observed strictly,
+    ///   4 % with the answers' truth, the effect at r ≥ 2, else no cause),
+    ///   28 at P ≥ 0.99 (68 %; 96 % with the answers' truth).
     /// - Gate observed: "no cause" at 0.50–0.70 on the 25 logs with no
     ///   admitted candidate (mean 53 % stated, 64 % observed strictly, 96 %
-    ///   with r < 2 as no cause), 24 statements at P < 0.10 (9 → 17 %):
-    ///   within 10 points in the low bin, 10.8 points off in the middle one,
-    ///   so not calibrated by the 10-point rule.
+    ///   with the answers' truth), 24 statements at P < 0.10 (9 → 17 %
+    ///   strictly, 4 % with the answers' truth): not calibrated by the
+    ///   10-point rule either way (the middle bin 10.8 points off strictly,
+    ///   43 with the answers' truth).
     /// - The decisions are the product's on every log (3 of 4 named at
     ///   r ≥ 2, 0 wrong, 0 false of 16): a rejected candidate's probability
     ///   is at most 1/12 of the whole.
@@ -105,9 +107,9 @@ mod tests {
         assert!(set.iter().all(|l| !l.reach.is_empty()), "every log carries its detectability");
         let (before, dec_before) = measure(&set, Variant::Stored, None).unwrap();
         let (after, dec_after) = measure(&set, Variant::GateObserved, None).unwrap();
-        let pct = |b: &Bin| (b.n, (1000.0 * b.stated).round() as i64, (1000.0 * b.observed).round() as i64, (1000.0 * b.observed_lenient).round() as i64);
-        assert_eq!((pct(&before[0]), pct(&before[6])), ((25, 0, 160, 160), (28, 1000, 679, 964)));
-        assert_eq!(pct(&after[0]), (24, 88, 167, 167));
+        let pct = |b: &Bin| (b.n, (1000.0 * b.stated).round() as i64, (1000.0 * b.observed).round() as i64, (1000.0 * b.observed_at_floor).round() as i64);
+        assert_eq!((pct(&before[0]), pct(&before[6])), ((25, 0, 160, 40), (28, 1000, 679, 964)));
+        assert_eq!(pct(&after[0]), (24, 88, 167, 42));
         assert_eq!(pct(&after[3]), (25, 532, 640, 960));
         assert_eq!((after[1].n, after[6].n), (1, 3));
         assert_eq!(calibrated(&after), (false, false));
