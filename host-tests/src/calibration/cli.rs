@@ -5,7 +5,7 @@
 //! 0.2 K bound on every log, 1 when it does not (the report says why), 2 on
 //! bad input (file:line:column from the measured-data reader).
 
-use super::commission::{commission, Commissioning, REDUCED_BOUND_K};
+use super::commission::{commission, Commissioning, TrainingSpread, REDUCED_BOUND_K};
 use super::fit::{CalOptions, Status};
 use super::log::CalLog;
 use crate::measured::{Channel, MeasuredRun};
@@ -260,6 +260,24 @@ fn margin_section(s: &mut String, c: &Commissioning) {
     }
 }
 
+/// The flashed block on the logs it was commissioned on, and the floor
+/// that spread puts under any constant margin ([`TrainingSpread`]).
+fn training_section(s: &mut String, c: &Commissioning) {
+    let _ = writeln!(s, "## The firmware on its own training logs (in-sample, no margin)\n\n| training log | under K | over K | RMSE K |\n|---|---:|---:|---:|");
+    let f = |x: Option<f64>| x.map_or("–".into(), |v| format!("{v:.3}"));
+    for r in &c.train_chosen {
+        let _ = writeln!(s, "| {} | {} | {} | {} |", r.log, f(r.vs_measured_under_k), f(r.vs_measured_over_k), f(r.vs_measured_rmse_k));
+    }
+    match TrainingSpread::of(&c.train_chosen) {
+        Some(t) => {
+            let _ = writeln!(s, "\nNo constant margin brings the firmware's max |e| on these logs below **{:.2} K** (half of the {:.2} K between its largest under- and over-prediction; a margin of {:+.2} K would reach it), and none does better on logs the model has not seen: below that the model itself has to follow the drain more closely (a structure, not a margin; docs/commissioning-foreign.md).\n", t.floor_k(), t.under_k + t.over_k, t.centring_margin_k());
+        }
+        None => {
+            let _ = writeln!(s, "\nNo floor follows: the error does not take both signs on the training logs (or they carry no `t_drain_c`).\n");
+        }
+    }
+}
+
 fn report(args: &CommissionArgs, c: &Commissioning) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "# Commissioning report\n\nRig file: `{}`; training: {}; held out: {}.\n", args.rig_path().display(),
@@ -284,6 +302,7 @@ fn report(args: &CommissionArgs, c: &Commissioning) -> String {
     let _ = writeln!(s, "\n(Against the measured `t_drain_c`, which carries the thermocouple's noise; open loop: the logged LNG valve, if any, drives the exchanger; the commissioned firmware with the drain margin below added. Held-out logs without `t_drain_c` show –.)\n");
     paths_section(&mut s, c);
     margin_section(&mut s, c);
+    training_section(&mut s, c);
     super::envelope_report::envelope_section(&mut s, c);
     if !c.cal.warnings.is_empty() {
         let _ = writeln!(s, "## Warnings\n");

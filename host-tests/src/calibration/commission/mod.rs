@@ -27,7 +27,7 @@ pub use super::margin::{
 use eha_guard::model::ReducedParams;
 
 pub use fits::{head_fold_fit, margin_folds, split_fit, validate_margin, with_eta_m_from_current};
-pub use outcome::{log_region, Commissioning, HoldoutScore, Refusal};
+pub use outcome::{log_region, Commissioning, HoldoutScore, Refusal, TrainingSpread};
 use fits::fit;
 use outcome::farthest_from_reference;
 
@@ -135,6 +135,12 @@ pub fn commission_with(base: &Rig, train: &[CalLog], holdout: &[CalLog], o: &Cal
     // block's bound), so the report and the flashed block cannot disagree.
     let holdout_with_margin = chosen.holdout_with_margin.clone();
     let margin = chosen.validation.clone();
+    // The flashed block on its own training logs (the reduction's are
+    // checked already).
+    let train_chosen = match choice.chosen {
+        PathKind::Reduction => reduced[..train.len()].to_vec(),
+        PathKind::Direct => train.iter().map(|l| check_reduced(&cal.rig, &chosen.params, l)).collect::<Result<_, _>>().map_err(CommissionError::Run)?,
+    };
     let train_regions = train.iter().map(log_region).collect();
     Ok(Commissioning {
         cal,
@@ -154,5 +160,6 @@ pub fn commission_with(base: &Rig, train: &[CalLog], holdout: &[CalLog], o: &Cal
         direct_path,
         direct_fit,
         choice,
+        train_chosen,
     })
 }

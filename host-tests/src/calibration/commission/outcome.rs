@@ -73,6 +73,45 @@ pub struct Commissioning {
     /// Which path the block (`params`, `margin`, `holdout_with_margin`)
     /// comes from, and why.
     pub choice: Choice,
+    /// The flashed block's firmware without the margin on the training
+    /// logs it was commissioned on (in-sample, against `t_drain_c`).
+    pub train_chosen: Vec<ReducedCheck>,
+}
+
+/// How far any constant drain margin can bring the firmware's error on
+/// logs it was fitted to: with e = estimate − thermocouple spanning
+/// [e_min, e_max] over every log, a margin m leaves max |e + m| ≥
+/// (e_max − e_min)/2, reached at m = −(e_max + e_min)/2. A floor for the
+/// held-out logs too: a margin cannot do better on logs the model did not
+/// see than on those it was fitted to.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TrainingSpread {
+    /// Largest under-prediction over the logs, −e_min, K.
+    pub under_k: f64,
+    /// Largest over-prediction over the logs, e_max, K.
+    pub over_k: f64,
+}
+
+impl TrainingSpread {
+    /// The spread of `checks` (margin 0) against their measured drain;
+    /// `None` unless the error takes both signs over them: the checks keep
+    /// under- and over-prediction floored at 0, so a one-signed error's
+    /// other end is not known and no floor follows.
+    pub fn of(checks: &[ReducedCheck]) -> Option<Self> {
+        let max = |f: fn(&ReducedCheck) -> Option<f64>| checks.iter().filter_map(f).fold(None, |a: Option<f64>, x| Some(a.map_or(x, |a| a.max(x))));
+        let (under_k, over_k) = (max(|c| c.vs_measured_under_k)?, max(|c| c.vs_measured_over_k)?);
+        (under_k > 0.0 && over_k > 0.0).then_some(TrainingSpread { under_k, over_k })
+    }
+
+    /// The least max |e| any constant margin leaves on these logs, K.
+    pub fn floor_k(&self) -> f64 {
+        0.5 * (self.under_k + self.over_k)
+    }
+
+    /// The constant margin that reaches [`TrainingSpread::floor_k`], K.
+    pub fn centring_margin_k(&self) -> f64 {
+        0.5 * (self.under_k - self.over_k)
+    }
 }
 
 /// Why a block is not flashable: which log, which operating region, which
@@ -179,4 +218,44 @@ impl Commissioning {
 /// refusal names.
 pub(super) fn farthest_from_reference(reduced: &[ReducedCheck]) -> Option<&ReducedCheck> {
     reduced.iter().max_by(|a, b| a.vs_reference_max_k.total_cmp(&b.vs_reference_max_k))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A training log's check with the measured under- and over-prediction, K.
+    fn check(under_k: f64, over_k: f64) -> ReducedCheck {
+        let region = Region { t_s: (0.0, 1.0), speed_rpm: (0.0, 1.0), dp_bar: (0.0, 1.0), drain_c: (20.0, 40.0), servo: false };
+        ReducedCheck {
+            log: "train".into(),
+            margin_k: 0.0,
+            vs_reference_max_k: 0.0,
+            vs_reference_under_k: 0.0,
+            vs_reference_region: region.clone(),
+            vs_measured_max_k: Some(under_k.max(over_k)),
+            vs_measured_under_k: Some(under_k),
+            vs_measured_over_k: Some(over_k),
+            vs_measured_rmse_k: Some(0.1),
+            vs_measured_region: Some(region),
+            valve_open_s: 0.0,
+            lng_kg: 0.0,
+            cells: Default::default(),
+        }
+    }
+
+    /// Errors from −1.27 K (one log) to +1.16 K (the other): no margin
+    /// leaves less than 1.215 K, reached at +0.055 K (the arithmetic of
+    /// big-pump's training logs, docs/commissioning-foreign.md); a
+    /// one-signed error gives no floor (its other end was floored at 0).
+    #[test]
+    fn the_training_spread_floors_any_constant_margin() {
+        let t = TrainingSpread::of(&[check(0.85, 0.55), check(1.27, 1.16)]).unwrap();
+        assert!((t.floor_k() - 1.215).abs() < 1e-12 && (t.centring_margin_k() - 0.055).abs() < 1e-12, "{t:?}");
+        // the margin that reaches it leaves exactly the floor at both ends
+        let m = t.centring_margin_k();
+        assert!(((1.16 + m) - t.floor_k()).abs() < 1e-12 && ((1.27 - m) - t.floor_k()).abs() < 1e-12);
+        assert_eq!(TrainingSpread::of(&[check(0.0, 0.9), check(0.0, 0.4)]), None);
+        assert_eq!(TrainingSpread::of(&[]), None);
+    }
 }

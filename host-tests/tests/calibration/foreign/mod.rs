@@ -119,6 +119,12 @@ fn report(m: &EmuMachine, c: &Commissioning, secs: f64) {
     for r in &c.reduced {
         eprintln!("  reduced {:40} vs ref max {:.3} | vs measured max {:?} under {:?}", r.log, r.vs_reference_max_k, r.vs_measured_max_k, r.vs_measured_under_k);
     }
+    for r in &c.train_chosen {
+        eprintln!("  flashed block in-sample {:32} under {:.3} over {:.3}", r.log, r.vs_measured_under_k.unwrap_or(f64::NAN), r.vs_measured_over_k.unwrap_or(f64::NAN));
+    }
+    if let Some(t) = eha_sim::calibration::commission::TrainingSpread::of(&c.train_chosen) {
+        eprintln!("  training spread: no constant margin below {:.3} K (at {:+.3} K)", t.floor_k(), t.centring_margin_k());
+    }
     for h in &c.holdout {
         for e in h.commissioned.iter().filter(|e| e.channel == "t_drain_c") {
             eprintln!("  reference held out {:32} drain vs thermocouple: rmse {:.3} max {:.3} under {:.3} K", h.log, e.rmse_k, e.max_abs_k, e.max_under_k);
@@ -268,6 +274,12 @@ fn slow_commissioning_without_margin_on_foreign_machines() {
 ///   Not a timing test.
 /// - With the hot-flow run as a third training log:
 ///   `slow_commissioning_with_the_hot_flow_run`.
+/// - **Why no margin meets 1.0 K** (2026-11-29, asserted): the flashed
+///   block on its own training logs (in-sample, no margin) spans
+///   −1.275…+1.159 K on big-pump (the soak log) and −1.218…+1.284 K on
+///   leaky-heavy, so no constant margin leaves less than **1.217 K** and
+///   **1.251 K** max |e| even on the logs it was fitted to
+///   (`TrainingSpread`, the report's in-sample section).
 #[test]
 #[ignore = "slow tier: two commissionings with margin validation on emulator bench logs (~1 min each)"]
 fn slow_commissioning_with_margin_on_foreign_machines() {
@@ -275,9 +287,12 @@ fn slow_commissioning_with_margin_on_foreign_machines() {
         (1.722, PathKind::Reduction, [(2.201, 0.000), (2.676, 0.000)], [1405.0, 1519.0]),
         (1.191, PathKind::Direct, [(1.471, 0.000), (2.334, 0.617)], [1550.0, 1560.0]),
     ];
-    for (m, row) in machines().into_iter().zip(measured) {
+    let floors_k = [1.217, 1.251];
+    for ((m, row), floor_k) in machines().into_iter().zip(measured).zip(floors_k) {
         let s = commissioning_set(&m, 3600).expect("bench");
         let c = commission_as_measured(&m, &s, row);
+        let t = eha_sim::calibration::commission::TrainingSpread::of(&c.train_chosen).expect("the in-sample error takes both signs");
+        near(&format!("{} in-sample floor under any constant margin", m.name), t.floor_k(), floor_k);
         assert!(c.direct_path.is_ok(), "{}: the direct path did not run: {:?}", m.name, c.direct_path.as_ref().err());
         // The margin opens the valve earlier, never later (open loop).
         let (a, b) = (&c.holdout_without_margin()[1], &c.holdout_with_margin[1]);
