@@ -24,7 +24,11 @@ use eha_sim::measured::Channel;
 /// `EXP_RIG_JOINT_MANIFOLD=k` a pump housing → main block metal path of k ×
 /// the a-priori one (`Joints::a_priori`, 2.0 W/K; k = 0 the path open,
 /// the same numbers as without it), held: the firmware cannot carry it, so
-/// the reference's calibration and every log's channel errors only.
+/// the reference's calibration and every log's channel errors only;
+/// `EXP_DIRECT_SIGMA_OTHER=k` the direct path's data σ of the channels
+/// other than the drain (K; 0.5 by default) and `EXP_DIRECT_FREE` its
+/// default holds taken out (with `EXP_MARGIN=1`, which runs the direct
+/// path; its block's in-sample floor under any margin is printed).
 #[test]
 #[ignore = "measurement by hand: one commissioning per machine"]
 fn slow_structure_experiment() {
@@ -58,6 +62,14 @@ fn slow_structure_experiment() {
             o.drain_weight = w;
         }
         o.margin_head_fold = exp_head_fold();
+        if let Some(d) = o.direct.as_mut() {
+            // the direct path's data weights and holds (EXP_DIRECT_SIGMA_OTHER, EXP_DIRECT_FREE)
+            if let Some(s) = env_f64("EXP_DIRECT_SIGMA_OTHER") {
+                d.sigma_other_k = s;
+            }
+            let free: Vec<String> = std::env::var("EXP_DIRECT_FREE").unwrap_or_default().split(',').filter(|s| !s.is_empty()).map(String::from).collect();
+            d.hold.retain(|h| !free.iter().any(|f| f == h));
+        }
         o.commission_thinning = exp_thinning();
         print_starts_points(&m, &train, &o);
         let t0 = std::time::Instant::now();
@@ -99,6 +111,13 @@ fn slow_structure_experiment() {
         let c = commission_with(&base, &train, &hold_logs, &o, margin).expect("commissioning");
         report(&m, &c, t0.elapsed().as_secs_f64());
         eprintln!("EXP {}: commissioning CPU {:.1} s (user + system, all threads)", m.name, eha_sim::tools::cpu::process_cpu_s() - cpu0);
+        if let Ok(d) = &c.direct_path {
+            // the direct block on the training logs (in-sample) and its floor under any margin
+            let checks: Vec<_> = train.iter().map(|l| eha_sim::calibration::commission::check_reduced(&c.cal.rig, &d.params, l).expect("check")).collect();
+            let t = eha_sim::calibration::commission::TrainingSpread::of(&checks);
+            let held: Vec<String> = d.holdout.iter().map(|r| format!("{} {:.3}/{:.3}", r.log, r.vs_measured_max_k.unwrap_or(f64::NAN), r.vs_measured_under_k.unwrap_or(f64::NAN))).collect();
+            eprintln!("EXP {} direct: in-sample floor {:?} K; held out without margin {}", m.name, t.map(|t| t.floor_k()), held.join(", "));
+        }
         let h = headline(&m, &c, &s.holdout);
         let w: Vec<String> = c.holdout_without_margin().iter().map(|r| format!("{} {:.3}/{:.3}", r.log, r.vs_measured_max_k.unwrap_or(f64::NAN), r.vs_measured_under_k.unwrap_or(f64::NAN))).collect();
         eprintln!("EXP {} train={} hold={:?} margin={}: without margin {}; with margin {:.3} K: {:.3?}", m.name, if procedure { train_kind.as_str() } else { "bench" }, hold, margin, w.join(", "), h.margin_k, h.measured);
