@@ -208,10 +208,13 @@ pub fn document(sets: &[(&str, Vec<EmuResult>)], ratios: &BTreeMap<u64, f64>) ->
 mod tests {
     use super::*;
 
+    /// The stored sweeps, (label, records) per set.
+    type Sets = Vec<(&'static str, Vec<EmuResult>)>;
+
     /// The stored sweeps (docs/data/) as `eha-sim docs` reads them:
     /// (label, records) per set, and the imprint ratios of the cases run
     /// without twins.
-    fn stored() -> (Vec<(&'static str, Vec<EmuResult>)>, BTreeMap<u64, f64>) {
+    fn stored() -> (Sets, BTreeMap<u64, f64>) {
         let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/data");
         let read = |f: &str| std::fs::read_to_string(dir.join(f)).unwrap();
         let sets = [

@@ -226,17 +226,17 @@ impl Rig {
     pub fn physics_clone(&self) -> Self {
         let Rig { oil, motor, pump, blocks, hydraulics, actuator, outside, joints, lng, nuisance, probes, ext, uncertain: _ } = self;
         Rig {
-            oil: oil.clone(),
+            oil: *oil,
             motor: motor.clone(),
             pump: pump.clone(),
             blocks: blocks.clone(),
             hydraulics: hydraulics.clone(),
             actuator: actuator.clone(),
             outside: outside.clone(),
-            joints: joints.clone(),
-            lng: lng.clone(),
+            joints: *joints,
+            lng: *lng,
             nuisance: nuisance.clone(),
-            probes: probes.clone(),
+            probes: *probes,
             ext: ext.clone(),
             uncertain: Vec::new(),
         }
