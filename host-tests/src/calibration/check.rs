@@ -62,6 +62,31 @@ pub struct ReducedCheck {
 pub use super::region::Region;
 use super::region::TickRow;
 
+#[cfg(test)]
+impl ReducedCheck {
+    /// A check for unit tests: log `log`; against the measured drain (max
+    /// |e|, under-, over-prediction), K, RMSE half the max (`None`: no
+    /// drain logged); no margin, nothing else scored, one placeholder region.
+    pub(crate) fn for_test(log: &str, measured: Option<(f64, f64, f64)>) -> Self {
+        let region = Region { t_s: (0.0, 1.0), speed_rpm: (0.0, 1.0), dp_bar: (0.0, 1.0), drain_c: (20.0, 40.0), servo: false };
+        ReducedCheck {
+            log: log.into(),
+            margin_k: 0.0,
+            vs_reference_max_k: 0.0,
+            vs_reference_under_k: 0.0,
+            vs_reference_region: region.clone(),
+            vs_measured_max_k: measured.map(|m| m.0),
+            vs_measured_under_k: measured.map(|m| m.1),
+            vs_measured_over_k: measured.map(|m| m.2),
+            vs_measured_rmse_k: measured.map(|m| m.0 / 2.0),
+            vs_measured_region: Some(region),
+            valve_open_s: 0.0,
+            lng_kg: 0.0,
+            cells: Default::default(),
+        }
+    }
+}
+
 /// Ranges of the rows whose `e` is at least half of the largest (all rows
 /// when the largest is not positive).
 fn region_of(rows: &[TickRow], e: &[f64], servo: bool) -> Region {

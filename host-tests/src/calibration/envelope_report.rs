@@ -88,23 +88,9 @@ mod tests {
     /// A held-out check with the margin `margin_k` whose drain errors are
     /// `cells`.
     fn check(cells: CellErrors, margin_k: f64) -> ReducedCheck {
-        let region = Region { t_s: (0.0, 1.0), speed_rpm: (0.0, 1.0), dp_bar: (0.0, 1.0), drain_c: (20.0, 40.0), servo: false };
-        ReducedCheck {
-            log: "mix.csv".into(),
-            margin_k,
-            vs_reference_max_k: 0.0,
-            vs_reference_under_k: 0.0,
-            vs_reference_region: region.clone(),
-            vs_measured_max_k: None,
-            vs_measured_under_k: None,
-            vs_measured_over_k: None,
-            vs_measured_rmse_k: None,
-            vs_measured_region: Some(region),
-            valve_open_s: 0.0,
-            lng_kg: 0.0,
-            cells,
-        }
+        ReducedCheck { margin_k, cells, ..ReducedCheck::for_test("mix.csv", None) }
     }
+
 
     #[test]
     fn the_line_names_the_region_the_time_and_the_miss_only_when_outside_reads_lower() {

@@ -249,23 +249,9 @@ mod tests {
 
     /// A check of `log` with the given measured max |e| and under-prediction, K.
     fn check(log: &str, max_k: f64, under_k: f64) -> ReducedCheck {
-        let region = super::super::region::Region { t_s: (0.0, 1.0), speed_rpm: (0.0, 1.0), dp_bar: (0.0, 1.0), drain_c: (20.0, 40.0), servo: false };
-        ReducedCheck {
-            log: log.into(),
-            margin_k: 0.0,
-            vs_reference_max_k: 0.0,
-            vs_reference_under_k: 0.0,
-            vs_reference_region: region.clone(),
-            vs_measured_max_k: Some(max_k),
-            vs_measured_under_k: Some(under_k),
-            vs_measured_over_k: Some(max_k - under_k),
-            vs_measured_rmse_k: Some(max_k / 2.0),
-            vs_measured_region: Some(region),
-            valve_open_s: 0.0,
-            lng_kg: 0.0,
-            cells: Default::default(),
-        }
+        ReducedCheck::for_test(log, Some((max_k, under_k, max_k - under_k)))
     }
+
 
     /// A path with a validated margin `margin_k` and one held-out log.
     fn path(kind: PathKind, margin_k: f64, holdout: (f64, f64)) -> PathOutcome {

@@ -226,23 +226,9 @@ mod tests {
 
     /// A training log's check with the measured under- and over-prediction, K.
     fn check(under_k: f64, over_k: f64) -> ReducedCheck {
-        let region = Region { t_s: (0.0, 1.0), speed_rpm: (0.0, 1.0), dp_bar: (0.0, 1.0), drain_c: (20.0, 40.0), servo: false };
-        ReducedCheck {
-            log: "train".into(),
-            margin_k: 0.0,
-            vs_reference_max_k: 0.0,
-            vs_reference_under_k: 0.0,
-            vs_reference_region: region.clone(),
-            vs_measured_max_k: Some(under_k.max(over_k)),
-            vs_measured_under_k: Some(under_k),
-            vs_measured_over_k: Some(over_k),
-            vs_measured_rmse_k: Some(0.1),
-            vs_measured_region: Some(region),
-            valve_open_s: 0.0,
-            lng_kg: 0.0,
-            cells: Default::default(),
-        }
+        ReducedCheck::for_test("train", Some((under_k.max(over_k), under_k, over_k)))
     }
+
 
     /// Errors from −1.27 K (one log) to +1.16 K (the other): no margin
     /// leaves less than 1.215 K, reached at +0.055 K (the arithmetic of
