@@ -157,7 +157,10 @@ fn headline(c: &Commissioning) -> String {
         .iter()
         .filter_map(|r| Some(format!("{}: firmware drain max |e| {:.2} K, under {:.2} K vs measured", r.log, r.vs_measured_max_k?, r.vs_measured_under_k?)))
         .collect();
-    let m = c.margin.as_ref().map_or("no margin (needs t_drain_c in every training log)".to_string(), |m| format!("margin {:.2} K", m.margin_k));
+    let mut m = c.margin.as_ref().map_or("no margin (needs t_drain_c in every training log)".to_string(), |m| format!("margin {:.2} K", m.margin_k));
+    if let Some(t) = TrainingSpread::of(&c.train_chosen) {
+        m += &format!(" (no margin brings max |e| below {:.2} K even on the training logs)", t.floor_k());
+    }
     if h.is_empty() { "held-out logs carry no t_drain_c: no firmware drain accuracy".into() } else { format!("{m}; {}", h.join("; ")) }
 }
 
