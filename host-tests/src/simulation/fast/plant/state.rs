@@ -102,7 +102,7 @@ impl RunState {
     /// Lowers the level until the position is a multiple of its step (a
     /// level is usable only there) and returns where that step ends, s.
     pub(super) fn level_end(&mut self) -> f64 {
-        while self.level > LEVEL_MIN && self.ticks % (1u64 << (self.level - LEVEL_MIN)) != 0 {
+        while self.level > LEVEL_MIN && !self.ticks.is_multiple_of(1u64 << (self.level - LEVEL_MIN)) {
             self.level -= 1;
         }
         self.origin + (self.ticks + (1u64 << (self.level - LEVEL_MIN))) as f64 * self.h_fine
@@ -121,7 +121,7 @@ impl RunState {
         self.just_grew = false;
         let grow = err <= self.grow_err;
         let room = next <= LEVEL_MAX && 2.0 * h <= opts.h_max_s && 2.0 * h <= opts.alias_ratio * hyd_h;
-        if grow && room && self.ticks % (1u64 << (next - LEVEL_MIN)) == 0 {
+        if grow && room && self.ticks.is_multiple_of(1u64 << (next - LEVEL_MIN)) {
             self.level = next;
             self.stalled = 0;
             self.just_grew = true;
