@@ -27,9 +27,14 @@
 //! The plant is split by topic: this file holds the plant, its
 //! construction and its accessors; `steps` the step-size control's
 //! constants and bookkeeping; `run` the stepping itself
-//! ([`FastPlant::run`]).
+//! ([`FastPlant::run`]: its start and loop), with `state` the run's
+//! mutable state, `attempt` one thermal step and `callbacks` the
+//! callbacks inside a step.
 
+mod attempt;
+mod callbacks;
 mod run;
+mod state;
 mod steps;
 
 use super::hydraulic::{HydTrack, NH};
