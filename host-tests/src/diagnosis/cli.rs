@@ -105,13 +105,18 @@ fn run_inner(args: &DiagnoseArgs) -> anyhow::Result<String> {
     // One log: its own table and model; several: the logs on one table
     // and one model per log sharing the parameters.
     let refs: Vec<&MeasuredRun> = runs.iter().collect();
+    let mut structure_note = None;
     let joint = if runs.len() > 1 {
-        Some(super::multi::joint_reference(&rig, &refs, &files, o.train_fraction).map_err(|e| anyhow::anyhow!(e))?)
+        let (rows, m, refusal) = super::multi::joint_reference(&rig, &refs, &files, o.train_fraction, o.structure).map_err(|e| anyhow::anyhow!(e))?;
+        structure_note = structure_not_applied(o.structure, refusal.as_deref());
+        if let Some(n) = &structure_note {
+            eprintln!("note: {}: {n}", files.join(" + "));
+        }
+        Some((rows, m))
     } else {
         None
     };
     let single;
-    let mut structure_note = None;
     let (run, model): (&MeasuredRun, &dyn Simulator) = match &joint {
         Some((rows, m)) => (rows as &MeasuredRun, m as &dyn Simulator),
         None => {

@@ -193,22 +193,31 @@ impl Simulator for MultiModel<'_> {
 /// The reference model of one machine's logs `runs` on `rig`: the logs on
 /// one table ([`combine`] at `train_fraction`), one replay model per log
 /// calibrating the parameters the logs share
-/// ([`super::reference::nuisance_set_of`]). Errors name the log (`files`).
+/// ([`super::reference::nuisance_set_of`]), with the physical tier's
+/// `structure` as one log's diagnosis takes it
+/// ([`ReferenceModel::with_structure_of`](super::reference::ReferenceModel::with_structure_of):
+/// `eta_m` from all the logs' current). The third part: why the structure
+/// asked for was not applied (`None`: applied, or not asked). Errors name
+/// the log (`files`).
 pub fn joint_reference(
     rig: &crate::rig::Rig,
     runs: &[&MeasuredRun],
     files: &[String],
     train_fraction: f64,
-) -> Result<(MeasuredRun, MultiModel<'static>), String> {
+    structure: super::analysis::Structure,
+) -> Result<(MeasuredRun, MultiModel<'static>, Option<String>), String> {
     let (rows, layout) = combine(runs, train_fraction)?;
     let free = super::reference::nuisance_set_of(&rows, runs);
     let mut models: Vec<Box<dyn Simulator>> = Vec::with_capacity(runs.len());
+    let mut refusal = None;
     for (k, run) in runs.iter().enumerate() {
         let name = files.get(k).cloned().unwrap_or_else(|| format!("log {}", k + 1));
         let m = super::reference::ReferenceModel::new(rig.clone(), run).map_err(|e| format!("{name}: {e}"))?;
-        models.push(Box::new(m.with_nuisance_set(free.clone())));
+        let m = m.with_nuisance_set(free.clone()).with_structure_of(&rows, runs, structure);
+        refusal = m.structure_refusal().map(String::from);
+        models.push(Box::new(m));
     }
-    Ok((rows, MultiModel::new(models, layout)?))
+    Ok((rows, MultiModel::new(models, layout)?, refusal))
 }
 
 /// Each log's part of the joint diagnosis `d` of `runs` laid out by

@@ -178,7 +178,8 @@ fn project(machine: &Machine, run: &MeasuredRun, cands: &[(Candidate, f64)]) -> 
 /// held-out windows.
 fn project_joint(machine: &Machine, log: &MeasuredRun, run: &MeasuredRun, cands: &[(Candidate, f64)]) -> Result<Projected, String> {
     let files = ["log".to_string(), "planned".to_string()];
-    let (rows, joint) = super::multi::joint_reference(&machine.rig, &[log, run], &files, DiagnoseOptions::default().train_fraction)?;
+    // as `project` builds one log's model: the rig file's physical tier
+    let (rows, joint, _) = super::multi::joint_reference(&machine.rig, &[log, run], &files, DiagnoseOptions::default().train_fraction, super::analysis::Structure::Off)?;
     let phys = joint.physical_set().ok_or("the model has no physical set")?;
     project_on(machine, &*phys, &rows, joint.layout().split_s, 2 * PER_CHANNEL, cands)
 }

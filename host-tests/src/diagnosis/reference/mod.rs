@@ -130,19 +130,31 @@ impl ReferenceModel {
     /// Without current under load, with an implausible `eta_m` from it
     /// ([`Self::structure_refusal`] says which), or with [`Structure::Off`],
     /// the model is unchanged. The global tier is never changed.
-    pub fn with_structure(mut self, run: &MeasuredRun, variant: impl Into<Structure>) -> Self {
+    pub fn with_structure(self, run: &MeasuredRun, variant: impl Into<Structure>) -> Self {
+        self.with_structure_of(run, &[run], variant)
+    }
+
+    /// [`Self::with_structure`] for one of several logs of a machine
+    /// diagnosed together: `eta_m` from the electrical balance of all of
+    /// `logs`, the structural freedoms by the channels of their table
+    /// `rows` — the same for every log's model, so that they share one
+    /// parameter vector ([`super::multi::joint_reference`]).
+    pub fn with_structure_of(mut self, rows: &MeasuredRun, logs: &[&MeasuredRun], variant: impl Into<Structure>) -> Self {
         let variant = variant.into();
         if variant == Structure::Off {
             return self;
         }
-        let taken = calibration::CalLog::new("log", run.clone(), 1)
+        let taken = logs
+            .iter()
+            .map(|r| calibration::CalLog::new("log", (*r).clone(), 1))
+            .collect::<Result<Vec<_>, _>>()
             .map_err(|e| format!("the log cannot be read for the electrical balance: {e}"))
-            .and_then(|log| calibration::commission::eta_m_balance(&self.rig, &[log]).checked());
+            .and_then(|cal| calibration::commission::eta_m_balance(&self.rig, &cal).checked());
         match taken {
-            Ok((eta_m, rows)) => {
+            Ok((eta_m, n)) => {
                 self.phys_rig.pump.eta_m = eta_m;
-                self.structure = StructureState::Applied { eta_m, rows };
-                self.free = structural_set(run, &self.free, variant);
+                self.structure = StructureState::Applied { eta_m, rows: n };
+                self.free = structural_set(rows, &self.free, variant);
             }
             Err(why) => self.structure = StructureState::Refused(why),
         }

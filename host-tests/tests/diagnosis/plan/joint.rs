@@ -10,7 +10,7 @@ fn diagnose_joint(logs: &[&MeasuredRun]) -> eha_sim::diagnosis::Diagnosis {
     use eha_sim::diagnosis::multi::{joint_reference, options_for};
     let o = options_for(&DiagnoseOptions::default(), logs.len());
     let files: Vec<String> = (1..=logs.len()).map(|k| format!("log {k}")).collect();
-    let (rows, joint) = joint_reference(&Rig::default(), logs, &files, o.train_fraction).expect("joint model");
+    let (rows, joint, _) = joint_reference(&Rig::default(), logs, &files, o.train_fraction, structure()).expect("joint model");
     diagnose(&rows, &joint, &o).expect("joint diagnosis")
 }
 
