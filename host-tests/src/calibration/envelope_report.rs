@@ -91,7 +91,6 @@ mod tests {
         ReducedCheck { margin_k, cells, ..ReducedCheck::for_test("mix.csv", None) }
     }
 
-
     #[test]
     fn the_line_names_the_region_the_time_and_the_miss_only_when_outside_reads_lower() {
         // Trained 300 s at 700 rpm × 20 bar.

@@ -252,7 +252,6 @@ mod tests {
         ReducedCheck::for_test(log, Some((max_k, under_k, max_k - under_k)))
     }
 
-
     /// A path with a validated margin `margin_k` and one held-out log.
     fn path(kind: PathKind, margin_k: f64, holdout: (f64, f64)) -> PathOutcome {
         let validation = MarginValidation { folds: vec![check("train", margin_k, margin_k - 0.2)], allowance_k: 0.2, margin_k };

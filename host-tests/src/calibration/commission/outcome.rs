@@ -229,7 +229,6 @@ mod tests {
         ReducedCheck::for_test("train", Some((under_k.max(over_k), under_k, over_k)))
     }
 
-
     /// Errors from −1.27 K (one log) to +1.16 K (the other): no margin
     /// leaves less than 1.215 K, reached at +0.055 K (the arithmetic of
     /// big-pump's training logs, docs/commissioning-foreign.md); a
