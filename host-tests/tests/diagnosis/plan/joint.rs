@@ -75,8 +75,8 @@ fn slow_joint_case() {
     eprintln!("JOINT {seed} {dur}: r {r:.2} {a} (twin {t})");
 }
 
-/// 1708 (churning, r 1.72 on its log under the default structure and
-/// named there below r = 2) with a 1200 s run planned for it alone and
+/// 1708 (churning, r 2.35 on its log under the default structure and
+/// answered `none` there: a miss at r ≥ 2) with a 1200 s run planned for it alone and
 /// both logs diagnosed together under the default structure, as `eha-sim
 /// diagnose log.csv planned.csv` does since 2026-11-29: measured r 5.58,
 /// `churning-loss` named (ln B 22.1 against `none`), the joint twin
