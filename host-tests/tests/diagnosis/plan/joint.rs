@@ -128,7 +128,10 @@ fn six_joint(decision: Decision) -> Vec<(u64, f64, String, String)> {
 /// others to the digit. Asserted as
 /// measured: none named at r ≥ 2, at most one lifted (1700's 2.01 sits on
 /// the line: the ratio moves with both calibrated baselines' last digits).
-/// 558 s at load ~4.
+/// 558 s at load ~4. Re-run on 2026-11-29 after the reference's fix
+/// (b36ffe3), 367 s, passing: joint r 1708 1.85 (`churning-loss`, right
+/// below r = 2), 1710 0.72, 1712 1.22, 1709 1.83, 1700 1.15, 1713 0.92;
+/// none lifted; twins `none` ×4, `unexplained` ×2.
 #[test]
 #[ignore]
 fn slow_planned_runs_decided_jointly() {
