@@ -158,7 +158,10 @@ fn slow_planned_runs_decided_jointly() {
 /// (churning ΔBIC 585, t_pump_c −75 %, pooled −12 %), 1712 0.89, 1700
 /// 1.62, 1710 and 1713 to the digit. Asserted as measured: no r ≥ 2
 /// (largest 1.62, which moves with the baselines' last digits), 1708
-/// named `churning-loss`. 939 s at load ~5 when first measured.
+/// named `churning-loss`. 939 s at load ~5 when first measured. Re-run on
+/// 2026-11-29 after the reference's fix (b36ffe3), 397 s, passing: joint r
+/// 1708 1.77 (`churning-loss`), 1710 0.68, 1712 1.02, 1709 0.71, 1700
+/// 0.87, 1713 0.84; twins `none` ×4, `unexplained` ×2.
 #[test]
 #[ignore]
 fn slow_jointly_planned_runs_decided_jointly() {
