@@ -105,13 +105,10 @@ fn run_inner(args: &DiagnoseArgs) -> anyhow::Result<String> {
     // One log: its own table and model; several: the logs on one table
     // and one model per log sharing the parameters.
     let refs: Vec<&MeasuredRun> = runs.iter().collect();
-    let mut structure_note = None;
+    let mut refusal = None;
     let joint = if runs.len() > 1 {
-        let (rows, m, refusal) = super::multi::joint_reference(&rig, &refs, &files, o.train_fraction, o.structure).map_err(|e| anyhow::anyhow!(e))?;
-        structure_note = structure_not_applied(o.structure, refusal.as_deref());
-        if let Some(n) = &structure_note {
-            eprintln!("note: {}: {n}", files.join(" + "));
-        }
+        let (rows, m, why) = super::multi::joint_reference(&rig, &refs, &files, o.train_fraction, o.structure).map_err(|e| anyhow::anyhow!(e))?;
+        refusal = why;
         Some((rows, m))
     } else {
         None
@@ -121,13 +118,14 @@ fn run_inner(args: &DiagnoseArgs) -> anyhow::Result<String> {
         Some((rows, m)) => (rows as &MeasuredRun, m as &dyn Simulator),
         None => {
             single = ReferenceModel::new(rig, &runs[0]).map_err(|e| anyhow::anyhow!("{}: {e}", files[0]))?.with_structure(&runs[0], o.structure);
-            structure_note = structure_not_applied(o.structure, single.structure_refusal());
-            if let Some(n) = &structure_note {
-                eprintln!("note: {}: {n}", files[0]);
-            }
+            refusal = single.structure_refusal().map(String::from);
             (&runs[0], &single as &dyn Simulator)
         }
     };
+    let structure_note = structure_not_applied(o.structure, refusal.as_deref());
+    if let Some(n) = &structure_note {
+        eprintln!("note: {}: {n}", files.join(" + "));
+    }
     if joint.is_some() {
         o = super::multi::options_for(&o, runs.len());
     }

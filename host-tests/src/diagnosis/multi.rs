@@ -194,9 +194,11 @@ impl Simulator for MultiModel<'_> {
 /// one table ([`combine`] at `train_fraction`), one replay model per log
 /// calibrating the parameters the logs share
 /// ([`super::reference::nuisance_set_of`]), with the physical tier's
-/// `structure` as one log's diagnosis takes it
-/// ([`ReferenceModel::with_structure_of`](super::reference::ReferenceModel::with_structure_of):
-/// `eta_m` from all the logs' current). The third part: why the structure
+/// `structure` as one log's diagnosis takes it, the electrical balance
+/// taken once over every log's current
+/// ([`super::reference::structure_balance`],
+/// [`ReferenceModel::with_structure_taken`](super::reference::ReferenceModel::with_structure_taken)).
+/// The third part: why the structure
 /// asked for was not applied (`None`: applied, or not asked). Errors name
 /// the log (`files`).
 pub fn joint_reference(
@@ -209,11 +211,16 @@ pub fn joint_reference(
     let (rows, layout) = combine(runs, train_fraction)?;
     let free = super::reference::nuisance_set_of(&rows, runs);
     let mut models: Vec<Box<dyn Simulator>> = Vec::with_capacity(runs.len());
+    let taken = (structure != super::analysis::Structure::Off).then(|| super::reference::structure_balance(rig, runs));
     let mut refusal = None;
     for (k, run) in runs.iter().enumerate() {
         let name = files.get(k).cloned().unwrap_or_else(|| format!("log {}", k + 1));
         let m = super::reference::ReferenceModel::new(rig.clone(), run).map_err(|e| format!("{name}: {e}"))?;
-        let m = m.with_nuisance_set(free.clone()).with_structure_of(&rows, runs, structure);
+        let m = m.with_nuisance_set(free.clone());
+        let m = match &taken {
+            Some(t) => m.with_structure_taken(&rows, structure, t),
+            None => m,
+        };
         refusal = m.structure_refusal().map(String::from);
         models.push(Box::new(m));
     }

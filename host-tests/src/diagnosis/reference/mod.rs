@@ -91,6 +91,18 @@ enum StructureState {
     Refused(String),
 }
 
+/// The electrical balance behind the structure option over `logs` (one
+/// machine's): `eta_m` and its loaded rows from their current together
+/// ([`calibration::commission::eta_m_balance`], the one implementation),
+/// or why not (an unreadable log, no load, an implausible `eta_m`).
+pub fn structure_balance(rig: &Rig, logs: &[&MeasuredRun]) -> Result<(f64, usize), String> {
+    logs.iter()
+        .map(|r| calibration::CalLog::new("log", (*r).clone(), 1))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| format!("the log cannot be read for the electrical balance: {e}"))
+        .and_then(|cal| calibration::commission::eta_m_balance(rig, &cal).checked())
+}
+
 impl ReferenceModel {
     /// Builds the replay model of `run` on `rig`, checking that the baseline
     /// runs.
@@ -131,26 +143,25 @@ impl ReferenceModel {
     /// ([`Self::structure_refusal`] says which), or with [`Structure::Off`],
     /// the model is unchanged. The global tier is never changed.
     pub fn with_structure(self, run: &MeasuredRun, variant: impl Into<Structure>) -> Self {
-        self.with_structure_of(run, &[run], variant)
-    }
-
-    /// [`Self::with_structure`] for one of several logs of a machine
-    /// diagnosed together: `eta_m` from the electrical balance of all of
-    /// `logs`, the structural freedoms by the channels of their table
-    /// `rows` — the same for every log's model, so that they share one
-    /// parameter vector ([`super::multi::joint_reference`]).
-    pub fn with_structure_of(mut self, rows: &MeasuredRun, logs: &[&MeasuredRun], variant: impl Into<Structure>) -> Self {
         let variant = variant.into();
         if variant == Structure::Off {
             return self;
         }
-        let taken = logs
-            .iter()
-            .map(|r| calibration::CalLog::new("log", (*r).clone(), 1))
-            .collect::<Result<Vec<_>, _>>()
-            .map_err(|e| format!("the log cannot be read for the electrical balance: {e}"))
-            .and_then(|cal| calibration::commission::eta_m_balance(&self.rig, &cal).checked());
-        match taken {
+        let taken = structure_balance(&self.rig, &[run]);
+        self.with_structure_taken(run, variant, &taken)
+    }
+
+    /// [`Self::with_structure`] with the electrical balance already taken
+    /// (`taken`, [`structure_balance`]: `eta_m` and its loaded rows, or why
+    /// not) and the structural freedoms by the channels of `rows`: one of
+    /// several logs of a machine diagnosed together, every log's model
+    /// with the same balance and set, so that they share one parameter
+    /// vector ([`super::multi::joint_reference`]).
+    pub fn with_structure_taken(mut self, rows: &MeasuredRun, variant: Structure, taken: &Result<(f64, usize), String>) -> Self {
+        if variant == Structure::Off {
+            return self;
+        }
+        match taken.clone() {
             Ok((eta_m, n)) => {
                 self.phys_rig.pump.eta_m = eta_m;
                 self.structure = StructureState::Applied { eta_m, rows: n };

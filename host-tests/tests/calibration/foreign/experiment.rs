@@ -32,10 +32,8 @@ use eha_sim::measured::Channel;
 #[test]
 #[ignore = "measurement by hand: one commissioning per machine"]
 fn slow_structure_experiment() {
-    let hold: Vec<&'static str> = std::env::var("EXP_HOLD")
-        .unwrap_or_default()
-        .split(',')
-        .filter(|s| !s.is_empty())
+    let hold: Vec<&'static str> = env_list("EXP_HOLD")
+        .iter()
         .map(|s| eha_sim::calibration::set::PARAMS.iter().find(|p| p.name == s).unwrap_or_else(|| panic!("no parameter {s}")).name)
         .collect();
     let train_kind = std::env::var("EXP_TRAIN").unwrap_or_default();
@@ -52,7 +50,7 @@ fn slow_structure_experiment() {
         let train: Vec<CalLog> = s.train.iter().map(cal).collect();
         let hold_logs: Vec<CalLog> = s.holdout.iter().map(cal).collect();
         let mut o = CalOptions::default();
-        let free: Vec<String> = std::env::var("EXP_FREE").unwrap_or_default().split(',').filter(|s| !s.is_empty()).map(String::from).collect();
+        let free = env_list("EXP_FREE");
         o.hold.retain(|h| !free.iter().any(|f| f == h.0));
         for h in &hold {
             o.hold.push((h, "EXP_HOLD".into()));
@@ -67,7 +65,7 @@ fn slow_structure_experiment() {
             if let Some(s) = env_f64("EXP_DIRECT_SIGMA_OTHER") {
                 d.sigma_other_k = s;
             }
-            let free: Vec<String> = std::env::var("EXP_DIRECT_FREE").unwrap_or_default().split(',').filter(|s| !s.is_empty()).map(String::from).collect();
+            let free = env_list("EXP_DIRECT_FREE");
             d.hold.retain(|h| !free.iter().any(|f| f == h));
         }
         o.commission_thinning = exp_thinning();
@@ -99,7 +97,7 @@ fn slow_structure_experiment() {
             let (b, o2, _) = eha_sim::calibration::commission::with_eta_m_from_current(&base, &tr, &o);
             let cal = eha_sim::calibration::calibrate(&b, &tr, &o2).expect("calibration");
             let fitted: Vec<String> = eha_sim::calibration::set::PARAMS.iter().zip(&cal.theta).map(|(p, t)| format!("{} {t:.3}", p.name)).collect();
-            eprintln!("EXP {} joint ×{}: objective {:.3}; {}", m.name, env_f64("EXP_RIG_JOINT_MANIFOLD").unwrap_or(0.0), cal.chi2_before_after.1, fitted.join(", "));
+            eprintln!("EXP {} joint ×{k}: objective {:.3}; {}", m.name, cal.chi2_before_after.1, fitted.join(", "));
             for l in tr.iter().chain(&hold_logs) {
                 let s = l.simulate(&cal.rig).expect("replay");
                 for e in eha_sim::calibration::log::channel_errors(l, &s) {
@@ -113,7 +111,12 @@ fn slow_structure_experiment() {
         eprintln!("EXP {}: commissioning CPU {:.1} s (user + system, all threads)", m.name, eha_sim::tools::cpu::process_cpu_s() - cpu0);
         if let Ok(d) = &c.direct_path {
             // the direct block on the training logs (in-sample) and its floor under any margin
-            let checks: Vec<_> = train.iter().map(|l| eha_sim::calibration::commission::check_reduced(&c.cal.rig, &d.params, l).expect("check")).collect();
+            // (the flashed block's are in the commissioning when it is the direct one)
+            let checks: Vec<_> = if c.choice.chosen == eha_sim::calibration::paths::PathKind::Direct {
+                c.train_chosen.clone()
+            } else {
+                train.iter().map(|l| eha_sim::calibration::commission::check_reduced(&c.cal.rig, &d.params, l).expect("check")).collect()
+            };
             let t = eha_sim::calibration::commission::TrainingSpread::of(&checks);
             let held: Vec<String> = d.holdout.iter().map(|r| format!("{} {:.3}/{:.3}", r.log, r.vs_measured_max_k.unwrap_or(f64::NAN), r.vs_measured_under_k.unwrap_or(f64::NAN))).collect();
             eprintln!("EXP {} direct: in-sample floor {:?} K; held out without margin {}", m.name, t.map(|t| t.floor_k()), held.join(", "));
@@ -205,6 +208,12 @@ fn slow_joint_move_channels() {
 
 /// An experiment knob's number: the environment variable `name` parsed as
 /// f64, `None` when unset or not a number.
+/// The comma-separated names in the environment variable `name` (empty
+/// when unset).
+fn env_list(name: &str) -> Vec<String> {
+    std::env::var(name).unwrap_or_default().split(',').filter(|s| !s.is_empty()).map(String::from).collect()
+}
+
 fn env_f64(name: &str) -> Option<f64> {
     std::env::var(name).ok().and_then(|v| v.parse::<f64>().ok())
 }
