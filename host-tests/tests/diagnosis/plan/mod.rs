@@ -247,6 +247,48 @@ fn slow_planned_runs_lift_effects_above_the_floor() {
     assert!(lifted.iter().all(|r| r.3 != case(r.0).hidden.name()), "measured miss changed (1708 lifted, not named): {msg}");
 }
 
+/// One case planned for alone and decided alone ([`planned_case`]), a
+/// by-hand measurement: the seed from `EHA_PLAN_SEED` (default 1709), the
+/// plan's duration from `EHA_PLAN_DURATION_S` (default 1200 s), the
+/// structure from `EHA_PLAN_STRUCTURE` ([`structure`]).
+#[test]
+#[ignore]
+fn slow_alone_case() {
+    let seed = std::env::var("EHA_PLAN_SEED").ok().and_then(|s| s.parse().ok()).unwrap_or(1709);
+    let dur = std::env::var("EHA_PLAN_DURATION_S").ok().and_then(|s| s.parse().ok()).unwrap_or(1200.0);
+    let (r0, r1, a, p, _, t) = planned_case(seed, dur, structure());
+    eprintln!("ALONE {seed} {dur}: r {r0:.2} -> {r1:.2} {a} (twin {t}), {}", p.design.name);
+}
+
+/// A false discovery found on a planned run's twin, and the rule that
+/// removed it. 1709's machine (its planned run of 2400 s under the default
+/// structure: 500 rpm at 10 ↔ 100 bar every 300 s) flown **without** its
+/// hidden effect: measured 2026-11-29, the global set named
+/// `motor-pump-conduction` at P 1.00 (t_motor_c held out 0.825 → 0.255 K,
+/// pooled 0.875 → 0.685 K) while t_oil_c stayed 1.18 K off after it — a
+/// cause standing in for structure the global set lacks. Since a global
+/// cause must also leave the log within the strict rule (else the physical
+/// set decides; `diagnosis::analysis`), the answer is `none` on the
+/// physical set (pooled held out 0.558 K). Asserted: no cause named, the
+/// physical set answering, its pooled misfit as measured ±0.05 K.
+#[test]
+#[ignore = "slow tier: one emulator diagnosis of a 2400 s log, ~1.5 min"]
+fn slow_planned_twin_of_1709_names_no_cause() {
+    use eha_sim::diagnosis::plan::Level;
+    let c = case(1709);
+    let (log, truth) = generate(&c).expect("log");
+    let (a, b) = (Level { speed_rpm: 500.0, drop_bar: 10.0, air_mps: 0.0 }, Level { speed_rpm: 500.0, drop_bar: 100.0, air_mps: 0.0 });
+    let segments = (0..8).map(|k| if k % 2 == 0 { a } else { b }).collect();
+    let d = Design { name: "500 rpm/10 bar ↔ 500 rpm/100 bar every 300 s".into(), hold_s: 300.0, segments, duration_s: 2400.0, ambient_c: mean_ambient(&log) };
+    let (_, twin, _) = fly(&d, &c, &truth, mean_ambient(&log));
+    let t = diagnose(&twin, &model_of(&twin, Structure::NoCaseHeld), &DiagnoseOptions::default()).expect("twin diagnosis");
+    eprintln!("{}", summary("planned twin", &t));
+    let answer = t.answer().to_string();
+    assert!(["none", "unexplained"].contains(&answer.as_str()), "false discovery: {answer}");
+    assert_eq!(t.nuisance_set, "physical", "the global cause is confirmed or refused by the physical set");
+    assert!((t.before.heldout_rmse_k - 0.558).abs() <= 0.05, "pooled held out {:.3} K (measured 0.558)", t.before.heldout_rmse_k);
+}
+
 /// One row of [`six_alone`]: seed, r on the original log, r on the
 /// planned run, its answer, the mission, the planned twin's answer.
 type AloneRow = (u64, f64, f64, String, String, String);
