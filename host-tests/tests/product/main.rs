@@ -21,7 +21,7 @@ use std::time::{Duration, Instant};
 
 use eha_guard::product::wire::{Cmd, FromGuard, Pins, ResetCause};
 use eha_guard::trace::RestoreKind;
-use eha_sim::pil::product::{product_elf, run_closed_loop, ProductSession};
+use eha_sim::pil::product::{product_elf, run_closed_loop, ProductSample, ProductSession};
 use eha_sim::pil::{firmware_for_tests, require_qemu, run_pil, Build, LoopOptions, QemuOptions};
 use eha_sim::plant::Plant;
 use eha_sim::rig::Rig;
