@@ -142,6 +142,13 @@ fn planned_case(seed: u64, duration_s: f64, s: Structure) -> (f64, f64, String, 
     let (twin, _) = generate_twin(&c).expect("twin");
     let ch = truth.affected.expect("affected").0;
     let (r0, a0, _, lead, _) = ratio(&log, &twin, ch, s);
+    // `EHA_PLAN_ALL=1` (by hand): plan for every candidate a throttle run
+    // can excite, not the log's leading two.
+    let lead = if std::env::var("EHA_PLAN_ALL").is_ok_and(|v| v == "1") {
+        Candidate::EXTENSIONS.iter().copied().filter(|&c| c != Candidate::CoulombFriction).collect()
+    } else {
+        lead
+    };
     let t = std::time::Instant::now();
     let p = plan(&Rig::default(), &log, &typical(&log, &lead), Limits::for_rig(&Rig::default(), &log), duration_s, Decision::Alone).expect("plan");
     let secs = t.elapsed().as_secs_f64();
@@ -250,7 +257,8 @@ fn slow_planned_runs_lift_effects_above_the_floor() {
 /// One case planned for alone and decided alone ([`planned_case`]), a
 /// by-hand measurement: the seed from `EHA_PLAN_SEED` (default 1709), the
 /// plan's duration from `EHA_PLAN_DURATION_S` (default 1200 s), the
-/// structure from `EHA_PLAN_STRUCTURE` ([`structure`]).
+/// structure from `EHA_PLAN_STRUCTURE` ([`structure`]); `EHA_PLAN_ALL=1`
+/// plans for every candidate a throttle run can excite.
 #[test]
 #[ignore]
 fn slow_alone_case() {
