@@ -308,16 +308,15 @@ fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, es
     // them lets the physical set absorb effects the global set leaves to be
     // named (see [`diagnose`]).
     //
-    // Confirmation: a cause named with the global set must also explain the
-    // log to the strict rule. Where the global set plus the cause still
+    // Confirmation, the same rule on a named cause: the answer's fit (the
+    // baseline, or the baseline with the named cause) must explain the
+    // log to the strict rule. Where the global set plus a cause still
     // misfits, the cause stood in for a structure the four multipliers
     // lack (measured: motor–pump conduction named at P 1.00 on an
     // effect-free 2400 s emulator log, t_oil_c 1.18 K after it), and the
     // physical set decides. On a machine built like the model the named
     // cause leaves the noise (the synthetic suite), and nothing changes.
-    let strict_misfit = |m: &Metrics, f: &FitResult| assess(run, split, m, &xcorr, (&nuis_specs, &f.nuisance), o.physical_misfit).misfits;
-    let unconfirmed = winner.is_some() && strict_misfit(&m_after, &after_fit);
-    if escalate && ((winner.is_none() && strict_misfit(&m_before, &base)) || unconfirmed) {
+    if escalate && assess(run, split, &m_after, &xcorr, (&nuis_specs, &after_fit.nuisance), o.physical_misfit).misfits {
         if let Some(d) = in_physical_tier(run, sim, o, sims, &log.phases) {
             return d;
         }

@@ -161,13 +161,13 @@ impl ReferenceModel {
         if variant == Structure::Off {
             return self;
         }
-        match taken.clone() {
-            Ok((eta_m, n)) => {
+        match taken {
+            &Ok((eta_m, n)) => {
                 self.phys_rig.pump.eta_m = eta_m;
                 self.structure = StructureState::Applied { eta_m, rows: n };
                 self.free = structural_set(rows, &self.free, variant);
             }
-            Err(why) => self.structure = StructureState::Refused(why),
+            Err(why) => self.structure = StructureState::Refused(why.clone()),
         }
         self
     }

@@ -206,14 +206,14 @@ fn slow_joint_move_channels() {
     }
 }
 
-/// An experiment knob's number: the environment variable `name` parsed as
-/// f64, `None` when unset or not a number.
 /// The comma-separated names in the environment variable `name` (empty
 /// when unset).
 fn env_list(name: &str) -> Vec<String> {
     std::env::var(name).unwrap_or_default().split(',').filter(|s| !s.is_empty()).map(String::from).collect()
 }
 
+/// An experiment knob's number: the environment variable `name` parsed as
+/// f64, `None` when unset or not a number.
 fn env_f64(name: &str) -> Option<f64> {
     std::env::var(name).ok().and_then(|v| v.parse::<f64>().ok())
 }

@@ -287,8 +287,9 @@ fn slow_planned_twin_of_1709_names_no_cause() {
     let (log, truth) = generate(&c).expect("log");
     let (a, b) = (Level { speed_rpm: 500.0, drop_bar: 10.0, air_mps: 0.0 }, Level { speed_rpm: 500.0, drop_bar: 100.0, air_mps: 0.0 });
     let segments = (0..8).map(|k| if k % 2 == 0 { a } else { b }).collect();
-    let d = Design { name: "500 rpm/10 bar ↔ 500 rpm/100 bar every 300 s".into(), hold_s: 300.0, segments, duration_s: 2400.0, ambient_c: mean_ambient(&log) };
-    let (_, twin, _) = fly(&d, &c, &truth, mean_ambient(&log));
+    let ambient_c = mean_ambient(&log);
+    let d = Design { name: "500 rpm/10 bar ↔ 500 rpm/100 bar every 300 s".into(), hold_s: 300.0, segments, duration_s: 2400.0, ambient_c };
+    let (_, twin, _) = fly(&d, &c, &truth, ambient_c);
     let t = diagnose(&twin, &model_of(&twin, Structure::NoCaseHeld), &DiagnoseOptions::default()).expect("twin diagnosis");
     eprintln!("{}", summary("planned twin", &t));
     let answer = t.answer().to_string();
