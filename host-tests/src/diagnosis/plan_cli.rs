@@ -32,8 +32,9 @@ pub struct PlanArgs {
     #[arg(long)]
     pub log: std::path::PathBuf,
     /// Leading candidates, `name` or `name=magnitude` (the parameter's unit),
-    /// comma-separated; default: the two leading ones of `--diagnosis`, else
-    /// every candidate a throttle run can excite, at typical magnitudes.
+    /// comma-separated; default: the two leading ones of `--diagnosis` (all
+    /// when it admitted none, `plan::leading`), else every candidate a
+    /// throttle run can excite, at typical magnitudes.
     #[arg(long, value_delimiter = ',')]
     pub candidates: Vec<String>,
     /// `diagnosis.json` of the log (`eha-sim diagnose`): its two leading
@@ -133,12 +134,13 @@ pub fn run(a: &PlanArgs) -> anyhow::Result<()> {
     println!("mission: {} (D_s {:.3}) -> {}", p.design.name, p.d_s, a.out.join("mission.csv").display());
     for e in &p.expected {
         println!(
-            "  {}: expected r {:.2} on {} (separated {:.2}; on the log {})",
+            "  {}: expected r {:.2} on {} (separated {:.2}; on the log {}){}",
             e.planned.candidate,
             e.planned.best.1,
             e.planned.best.0,
             e.planned_separated,
-            e.on_log.as_ref().map_or("–".into(), |r| format!("{:.2}", r.best.1))
+            e.on_log.as_ref().map_or("–".into(), |r| format!("{:.2}", r.best.1)),
+            e.refused.as_ref().map_or(String::new(), |w| format!("; not nameable on it: {w}"))
         );
     }
     if let Some(w) = p.warning() {

@@ -210,3 +210,48 @@ pub fn family(limits: &Limits, duration_s: f64, ambient_c: f64) -> Vec<Design> {
     }
     out
 }
+
+/// The three-level family within `limits`: every triple of distinct levels
+/// among the same five as [`family`] (the envelope's corners and centre),
+/// cycled in both orders with each hold time of [`HOLDS_S`]; with a fan,
+/// each also with the air toggled as in [`family`]. A third level lets a
+/// mission visit one speed at two oil temperatures (reached through the
+/// other two levels), which two alternating levels settle into one cycle.
+pub fn family_three(limits: &Limits, duration_s: f64, ambient_c: f64) -> Vec<Design> {
+    let (s0, s1) = limits.speed_rpm;
+    let (d0, d1) = limits.drop_bar;
+    let levels = [(s0, d0), (s0, d1), (s1, d0), (s1, d1), (0.5 * (s0 + s1), 0.5 * (d0 + d1))];
+    let airs: Vec<Option<f64>> = match limits.air_mps {
+        Some(a) => vec![None, Some(a)],
+        None => vec![None],
+    };
+    let mut out = Vec::new();
+    for i in 0..levels.len() {
+        for j in i + 1..levels.len() {
+            for k in j + 1..levels.len() {
+                for order in [[i, j, k], [i, k, j]] {
+                    for hold in HOLDS_S {
+                        for air in &airs {
+                            let n = (duration_s / hold).ceil() as usize;
+                            let segments = (0..n)
+                                .map(|m| {
+                                    let (s, d) = levels[order[m % 3]];
+                                    let a = air.map_or(0.0, |a| if (m / 2) % 2 == 1 { a } else { 0.0 });
+                                    Level { speed_rpm: s, drop_bar: d, air_mps: a }
+                                })
+                                .collect();
+                            let names: Vec<String> = order.iter().map(|&o| format!("{:.0} rpm/{:.0} bar", levels[o].0, levels[o].1)).collect();
+                            let name = format!(
+                                "{} → … every {hold:.0} s{}",
+                                names.join(" → "),
+                                air.map_or(String::new(), |a| format!(", air 0/{a:.0} m/s every {:.0} s", 2.0 * hold))
+                            );
+                            out.push(Design { name, hold_s: hold, segments, duration_s, ambient_c });
+                        }
+                    }
+                }
+            }
+        }
+    }
+    out
+}

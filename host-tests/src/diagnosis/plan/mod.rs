@@ -4,13 +4,15 @@
 //! The log's calibration (the physical set, [`super::reference`]) gives the
 //! model of this machine and its structure floor per channel as misfit per
 //! rise ([`super::projection::channel_floors`]). Every mission of a small
-//! family — two operating levels (shaft speed, needle drop at that speed,
-//! logged ram air where the bench has a fan) held alternately for 150 or
+//! family — two or three operating levels (shaft speed, needle drop at that
+//! speed, logged ram air where the bench has a fan) held in turn for 150 or
 //! 300 s, within the bench's [`Limits`] — is flown by the calibrated model;
 //! its log is replayed as the diagnosis will replay it, and the candidates'
 //! imprints are projected off the calibration's sensitivities
-//! ([`super::projection::Sensitivities`]). The mission chosen is
-//! D_s-optimal: it maximises det(Lᵀ W L)^(1/k), L the k candidates' projected
+//! ([`super::projection::Sensitivities`]). The mission chosen lifts the
+//! most candidates to an expected ratio r̂ ≥ 2 (the ratio at which a
+//! diagnosis must name a cause), then brings the others closest to it,
+//! then is D_s-optimal: det(Lᵀ W L)^(1/k), L the k candidates' projected
 //! imprints, W = 1/floor² of each point's channel — information about the
 //! candidates that the calibration cannot take up, counted against the
 //! floor, and small when two candidates leave the same imprint. Its
@@ -28,7 +30,7 @@
 mod design;
 mod report;
 
-pub use design::{family, Design, Level, Limits, DEFAULT_AIR_MPS, DEFAULT_DROP_BAR, DEFAULT_MAX_TEMP_C, DEFAULT_SPEED_RPM, HOLDS_S};
+pub use design::{family, family_three, Design, Level, Limits, DEFAULT_AIR_MPS, DEFAULT_DROP_BAR, DEFAULT_MAX_TEMP_C, DEFAULT_SPEED_RPM, HOLDS_S};
 pub use report::leading;
 
 use super::analysis::{evidence_points, fit_points, split_time_s, DiagnoseOptions};
@@ -36,7 +38,7 @@ use super::evidence::{floor_for, ChannelFloor};
 use super::fit::{fit, FitOptions};
 use super::model::{Candidate, Simulator};
 use super::adequacy::rms_rise_k;
-use super::projection::{channel_floors, row, ProjectedRow, Sensitivities};
+use super::projection::{channel_floors, row, ProjectedRow, Sensitivities, SHOWABLE_RATIO};
 use super::reference::{nuisance_set, ReferenceModel};
 use crate::measured::{Channel, MeasuredRun};
 use crate::rig::Rig;
@@ -53,6 +55,18 @@ pub struct Expected {
     pub planned_separated: f64,
     /// The same candidate against the floor on the user's log.
     pub on_log: Option<ProjectedRow>,
+    /// Why the diagnosis could not name it on the planned run (its
+    /// identifiability rule, [`super::identify::identifiable`]), if so:
+    /// then the plan counted it at r̂ 1 whatever its imprint.
+    pub refused: Option<String>,
+}
+
+/// Why the diagnosis's identifiability rule refuses candidate `c` on the
+/// planned run `run` under the physical set (which calibrates each
+/// housing's outer transfer), if it does. Checked on the planned run alone,
+/// also for [`Decision::Joint`].
+fn refused(c: Candidate, run: &MeasuredRun) -> Option<String> {
+    super::identify::identifiable(c, run, split_of(run), true).err().map(str::to_string)
 }
 
 /// One member of the family as evaluated.
@@ -66,6 +80,10 @@ pub struct Evaluated {
     pub max_temp_c: f64,
     /// Within the limits (temperatures included).
     pub admissible: bool,
+    /// Each candidate's expected imprint ratio on this mission, alone
+    /// (its largest-imprint channel), in the plan's candidate order; 1 where
+    /// the diagnosis could not name it on this mission ([`Expected::refused`]).
+    pub expected_ratio: Vec<f64>,
 }
 
 /// A test plan.
@@ -229,10 +247,49 @@ impl Projected {
     }
 }
 
+/// How a mission is ranked: first by how many candidates it is expected
+/// to lift to [`SHOWABLE_RATIO`] (the ratio at which a diagnosis must name
+/// a cause), then by how close it brings the others (Σ ln min(r̂, 2)), then
+/// by D_s (separation). D_s alone, measured on the emulator (2026-11-29,
+/// docs/test-plans.md), let a candidate that no mission can show (its
+/// projected imprint tiny everywhere) decide the determinant and chose
+/// missions on which no candidate reached r̂ 2 while the family had one
+/// that lifted the hidden effect to r 7.
+#[derive(Debug, Clone, Copy)]
+struct Showing {
+    shown: usize,
+    closeness: f64,
+    d_s: f64,
+}
+
+impl Showing {
+    fn of(e: &Evaluated) -> Self {
+        let shown = e.expected_ratio.iter().filter(|&&r| r >= SHOWABLE_RATIO).count();
+        let closeness = e.expected_ratio.iter().map(|r| r.clamp(1.0, SHOWABLE_RATIO).ln()).sum();
+        Showing { shown, closeness, d_s: e.d_s }
+    }
+
+    fn better_than(&self, o: &Self) -> bool {
+        (self.shown, self.closeness, self.d_s).partial_cmp(&(o.shown, o.closeness, o.d_s)).is_some_and(|c| c.is_gt())
+    }
+}
+
 /// Designs the plan for `log` of a machine described by `rig`, to show
 /// and separate `cands` (candidate, magnitude), within `limits`, lasting
-/// `duration_s`, for the planned run decided as `decision` says.
+/// `duration_s`, for the planned run decided as `decision` says: the best
+/// ([`Showing`]) of the two- and three-level families ([`family`],
+/// [`family_three`]).
 pub fn plan(rig: &Rig, log: &MeasuredRun, cands: &[(Candidate, f64)], limits: Limits, duration_s: f64, decision: Decision) -> Result<Plan, String> {
+    plan_among(rig, log, cands, limits, decision, |ambient_c| {
+        let mut d = family(&limits, duration_s, ambient_c);
+        d.extend(family_three(&limits, duration_s, ambient_c));
+        d
+    })
+}
+
+/// [`plan`] choosing among the missions `designs` makes for the log's
+/// mean ambient (°C), e.g. [`family_three`] or a user's own.
+pub fn plan_among(rig: &Rig, log: &MeasuredRun, cands: &[(Candidate, f64)], limits: Limits, decision: Decision, designs: impl FnOnce(f64) -> Vec<Design>) -> Result<Plan, String> {
     if cands.is_empty() {
         return Err("no candidates to plan for".into());
     }
@@ -245,7 +302,7 @@ pub fn plan(rig: &Rig, log: &MeasuredRun, cands: &[(Candidate, f64)], limits: Li
         let x: Vec<f64> = v.iter().flatten().copied().collect();
         x.iter().sum::<f64>() / x.len().max(1) as f64
     });
-    let designs = family(&limits, duration_s, ambient_c);
+    let designs = designs(ambient_c);
     let evaluated: Vec<Result<(Evaluated, Projected), String>> = designs
         .par_iter()
         .map(|d| {
@@ -256,30 +313,39 @@ pub fn plan(rig: &Rig, log: &MeasuredRun, cands: &[(Candidate, f64)], limits: Li
                 Decision::Joint => Projected { max_temp_c: max_logged_c(&run), ..project_joint(&machine, log, &run, cands)? },
             };
             let admissible = p.max_temp_c <= limits.max_temp_c && d.segments.iter().all(|l| limits.contains(l));
-            Ok((Evaluated { name: d.name.clone(), d_s: p.d_s(), max_temp_c: p.max_temp_c, admissible }, p))
+            // A candidate the diagnosis could not name on this mission (its
+            // identifiability rule) is credited nothing here.
+            let expected_ratio = cands
+                .iter()
+                .enumerate()
+                .map(|(i, &(c, _))| if refused(c, &run).is_some() { 1.0 } else { row(&p.sens, &p.floors, c, &[], &p.imprints[i], &p.lefts[i]).best.1 })
+                .collect();
+            Ok((Evaluated { name: d.name.clone(), d_s: p.d_s(), max_temp_c: p.max_temp_c, admissible, expected_ratio }, p))
         })
         .collect();
-    let mut best: Option<(usize, f64)> = None;
+    let mut best: Option<(usize, Showing)> = None;
     let mut family_rows = Vec::new();
     let mut projections = Vec::new();
     for (k, e) in evaluated.into_iter().enumerate() {
         match e {
             Ok((ev, p)) => {
-                if ev.admissible && best.is_none_or(|b| ev.d_s > b.1) {
-                    best = Some((k, ev.d_s));
+                let key = Showing::of(&ev);
+                if ev.admissible && best.as_ref().is_none_or(|b| key.better_than(&b.1)) {
+                    best = Some((k, key));
                 }
                 family_rows.push(ev);
                 projections.push(Some(p));
             }
             Err(msg) => {
-                family_rows.push(Evaluated { name: format!("{} (failed: {msg})", designs[k].name), d_s: 0.0, max_temp_c: f64::NAN, admissible: false });
+                family_rows.push(Evaluated { name: format!("{} (failed: {msg})", designs[k].name), d_s: 0.0, max_temp_c: f64::NAN, admissible: false, expected_ratio: vec![] });
                 projections.push(None);
             }
         }
     }
-    let (k, d_s) = best.ok_or("no mission of the family is within the limits")?;
+    let (k, Showing { d_s, .. }) = best.ok_or("no mission of the family is within the limits")?;
     let p = projections[k].take().ok_or("the chosen mission has no projection")?;
     let on_log = project(&machine, log, cands).ok();
+    let chosen_run = predicted_log(&machine.calibrated, &designs[k]).ok();
     // The candidates' parameter names and units (one model of the log, not one per name).
     let ext_model = ReferenceModel::new(rig.clone(), log).ok();
     let named = |c: Candidate, m: f64| -> Vec<(String, f64, String)> {
@@ -297,6 +363,7 @@ pub fn plan(rig: &Rig, log: &MeasuredRun, cands: &[(Candidate, f64)], limits: Li
                 planned: row(&p.sens, &p.floors, c, &mag, &p.imprints[i], &p.lefts[i]),
                 planned_separated: sep_row.best.1,
                 on_log: on_log.as_ref().map(|q| row(&q.sens, &q.floors, c, &mag, &q.imprints[i], &q.lefts[i])),
+                refused: chosen_run.as_ref().and_then(|r| refused(c, r)),
             }
         })
         .collect();

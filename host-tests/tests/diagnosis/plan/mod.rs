@@ -172,8 +172,10 @@ fn planned_case(seed: u64, duration_s: f64, s: Structure) -> (f64, f64, String, 
 /// rpm and 10–60 bar: exit 0; `mission.csv` read by the project's mission
 /// reader (`scenario::read_mission_csv`) with every row within the limits
 /// (the drop at the running speed is the 500 rpm setting × (speed/500)²)
-/// and the planned duration; `plan.json`'s chosen D_s the largest of the
-/// admissible family, every D_s finite, expected ratios ≥ 1. A candidate a
+/// and the planned duration; `plan.json`'s chosen mission first of the
+/// admissible family by the plan's rule (candidates at r̂ ≥ 2, then
+/// Σ ln min(r̂, 2), then D_s), three-level missions among them, every D_s
+/// finite, expected ratios ≥ 1. A candidate a
 /// throttle plan cannot excite is refused with exit ≠ 0 and a message.
 /// The same contract with `--joint` (planned for the joint decision with
 /// the log, `plan.json`'s `decision` "Joint").
@@ -211,8 +213,15 @@ fn plan_command_writes_a_readable_mission_within_limits() {
         assert_eq!(j["decision"], if joint { "Joint" } else { "Alone" });
         let fam = j["family"].as_array().expect("family");
         assert!(fam.iter().all(|f| f["d_s"].as_f64().is_some_and(f64::is_finite)), "{fam:?}");
-        let best = fam.iter().filter(|f| f["admissible"] == true).filter_map(|f| f["d_s"].as_f64()).fold(f64::NEG_INFINITY, f64::max);
-        assert_eq!(j["d_s"].as_f64(), Some(best));
+        // The chosen mission ranks first: candidates at r̂ ≥ 2, then Σ ln min(r̂, 2), then D_s.
+        let key = |f: &serde_json::Value| {
+            let r: Vec<f64> = f["expected_ratio"].as_array().expect("expected_ratio").iter().filter_map(|x| x.as_f64()).collect();
+            (r.iter().filter(|&&x| x >= 2.0).count(), r.iter().map(|x| x.clamp(1.0, 2.0).ln()).sum::<f64>(), f["d_s"].as_f64().expect("d_s"))
+        };
+        let chosen = fam.iter().find(|f| f["name"] == j["design"]["name"]).expect("the chosen mission in the family");
+        assert_eq!(chosen["d_s"].as_f64(), j["d_s"].as_f64());
+        assert!(fam.iter().filter(|f| f["admissible"] == true).all(|f| key(f) <= key(chosen)), "{fam:?}");
+        assert!(fam.iter().any(|f| f["name"].as_str().is_some_and(|n| n.contains('→'))), "no three-level mission in the family");
         for e in j["expected"].as_array().expect("expected") {
             assert!(e["planned"]["best"][1].as_f64().is_some_and(|r| r >= 1.0) && e["planned_separated"].as_f64().is_some_and(|r| r >= 1.0), "{e}");
         }
@@ -307,8 +316,13 @@ type AloneRow = (u64, f64, f64, String, String, String);
 /// lifted to r ≥ 2, and the rows printed. Asserts what holds whatever the
 /// ratios: no wrong cause on a planned run, no discovery on its twin.
 fn six_alone(s: Structure) -> (Vec<AloneRow>, Vec<AloneRow>, Vec<AloneRow>, String) {
+    cases_alone(&SIX, s)
+}
+
+/// [`six_alone`] for the cases `seeds`.
+fn cases_alone(seeds: &[u64], s: Structure) -> (Vec<AloneRow>, Vec<AloneRow>, Vec<AloneRow>, String) {
     let mut rows = Vec::new();
-    for seed in SIX {
+    for &seed in seeds {
         let (r0, r1, answer, p, _, twin) = planned_case(seed, 1200.0, s);
         rows.push((seed, r0, r1, answer, p.design.name.clone(), twin));
     }
@@ -325,67 +339,177 @@ fn six_alone(s: Structure) -> (Vec<AloneRow>, Vec<AloneRow>, Vec<AloneRow>, Stri
 
 /// [`slow_planned_runs_lift_effects_above_the_floor`] with the single-log
 /// diagnoses under the command's default structure
-/// ([`Structure::NoCaseHeld`]), re-measured on 2026-11-29 (287 s; the
-/// values asserted before had been measured before the reference's fix,
-/// b36ffe3). Original → planned r (answer; twin): 1708 2.35 (`none`, a
-/// miss at r ≥ 2) → **3.66 `churning-loss`** (twin `unexplained`), 1710
-/// 2.28 (a miss) → 0.61, 1712 2.38 (a miss) → 1.01, 1709 0.80 → 0.63
-/// (its log's leading two are winding and conduction, so the plan
-/// separates those), 1700 0.79 → 0.96, 1713 0.80 → 1.57. Of the three
-/// below r = 2 on the log none is lifted: the acceptance's item is a
-/// **measured miss (0 of 3)**; no wrong cause, no false discovery on the
-/// six planned twins. Asserted as measured: 1709, 1700 and 1713 below,
-/// none lifted, 1708's planned run named `churning-loss`.
+/// ([`Structure::NoCaseHeld`]). Re-measured 2026-11-29 evening (339 s)
+/// after the plan's choice changed (the most candidates at r̂ ≥ 2 over the
+/// two- and three-level families; every candidate when the log admitted
+/// none, as all six logs here do). Original → planned r (answer; twin):
+/// 1708 2.35 (`none`, a miss at r ≥ 2) → 2.35 **`churning-loss`**
+/// (`unexplained`), 1710 2.28 (a miss) → 0.19, 1712 2.38 (a miss) →
+/// 0.47, 1709 0.80 → **7.23 `churning-loss`** (`none`), 1700 0.79 → 1.18,
+/// 1713 0.80 → **6.51** `unexplained` (`unexplained`). Of the three below
+/// r = 2 on the log two are lifted (1709, 1713) and one named (1709).
+/// (With D_s alone over the log's leading two, before: 1708 → 3.66 named,
+/// 1710 0.61, 1712 1.01, 1709 0.63, 1700 0.96, 1713 1.57: none of the
+/// three lifted.) Asserted as measured: 1709, 1700 and 1713 below, 1709
+/// and 1713 lifted, 1708 and 1709 named, no wrong cause, no false
+/// discovery.
 #[test]
 #[ignore]
 fn slow_planned_runs_default_structure() {
     let (rows, below, lifted, msg) = six_alone(Structure::NoCaseHeld);
     let seeds = |v: &[AloneRow]| v.iter().map(|r| r.0).collect::<Vec<_>>();
     assert_eq!(seeds(&below), [1709, 1700, 1713], "measured set below r 2 changed: {msg}");
-    assert_eq!(seeds(&lifted), Vec::<u64>::new(), "measured lift changed: {msg}");
+    assert_eq!(seeds(&lifted), [1709, 1713], "measured lift changed: {msg}");
     let named: Vec<u64> = rows.iter().filter(|r| r.3 == case(r.0).hidden.name()).map(|r| r.0).collect();
-    assert_eq!(named, [1708], "measured names changed (1708's planned run only): {msg}");
+    assert_eq!(named, [1708, 1709], "measured names changed: {msg}");
 }
 
 /// The same for one case with a planned run twice as long (2400 s),
-/// under `off` (the tests' `structure()`): re-measured 2026-11-29 (80 s;
-/// the values asserted before had been measured before the reference's
-/// fix, b36ffe3, and the test then failed). 1708 churning r 1.91 on its
-/// log → **6.25** on the planned run (500 rpm/10 bar ↔ 2000 rpm/10 bar
-/// every 300 s), **named `churning-loss`** (ΔBIC 560, t_pump_c −66 %,
-/// pooled 0.748 → 0.554 K, 26 %, ln B 34.3 against `none`); its twin
-/// `none`. (Before the fix: r 3.44, `none`, the pooled check at 13 %.)
-/// Asserted as measured: r ≥ 4 (the ratio moves with both calibrated
-/// baselines' last digits), named, twin `none`.
+/// under `off` (the tests' `structure()`). Re-measured 2026-11-29 evening
+/// (97 s) after the plan's choice changed (the most candidates at r̂ ≥ 2,
+/// three-level missions searched, every candidate planned for when the
+/// log admitted none): the plan is 500 rpm/10 bar → 1250 rpm/55 bar →
+/// 2000 rpm/10 bar every 150 s (churning r̂ 1.12; no candidate reaches 2
+/// on any mission of the 2400 s family, churning at most 1.25), and 1708
+/// (churning, r 1.91 on its log) stands at **r 1.99**, named
+/// **`churning-loss`** (right, just below r = 2), twin `unexplained`.
+/// Before, with D_s over the log's leading two, the plan was 500 rpm/10
+/// bar ↔ 2000 rpm/10 bar every 300 s (churning r̂ 1.11 there) and the run
+/// stood at r 6.25, named: the r̂ of a 2400 s mission does not predict
+/// which lifts (docs/test-plans.md). Asserted as measured: r within
+/// 1.5–2.5, named, twin not a discovery.
 #[test]
 #[ignore]
 fn slow_planned_run_twice_as_long() {
     let (r0, r1, answer, p, _, twin) = planned_case(1708, 2400.0, structure());
     eprintln!("1708, 2400 s plan: r {r0:.2} -> {r1:.2} ({answer}; twin {twin}), {}", p.design.name);
-    assert!(r1 >= 4.0, "measured r changed: {r1:.2} (measured 6.25)");
-    assert_eq!(answer, "churning-loss", "measured outcome changed (named at r 6.25)");
-    assert_eq!(twin, "none", "false discovery on the twin (measured none)");
+    assert!((1.5..=2.5).contains(&r1), "measured r changed: {r1:.2} (measured 1.99)");
+    assert_eq!(answer, "churning-loss", "measured outcome changed (named at r 1.99)");
+    assert!(["none", "unexplained"].contains(&twin.as_str()), "false discovery on the twin: {twin}");
 }
 
 /// [`slow_planned_run_twice_as_long`] with the single-log diagnoses under
-/// the command's default structure ([`Structure::NoCaseHeld`]),
-/// re-measured 2026-11-29 (76 s; the values asserted before predate the
-/// reference's fix, b36ffe3). The original 1708 log is a miss at r 2.35
-/// (`none`); the plan for its two leading candidates (churning, sensor
-/// lag) is 500 rpm/10 bar ↔ 2000 rpm/10 bar every 300 s, and the planned
-/// run stands at **r 8.04** on t_pump_c and is answered **`unexplained`**
-/// (P 0.97): `churning-loss` passes every check (ΔBIC 691, t_pump_c
-/// −63 %, pooled 0.916 → 0.613 K, 33 %) but its evidence loses to the
-/// discrepancy alone (ln B 2.3 against `unexplained`'s 4.8): a **measured
-/// miss**, by the evidence, not the admission. Its twin `none`. (Before
-/// the fix: r 6.13, named.) Asserted as measured: r ≥ 4, `unexplained`,
-/// twin `none`.
+/// the command's default structure ([`Structure::NoCaseHeld`]).
+/// Re-measured 2026-11-29 evening (89 s) after the plan's choice changed:
+/// the original 1708 log is a miss at r 2.35 (`none`, no candidate
+/// admitted, so every candidate is planned for); the plan is the same
+/// three-level mission as under `off`, and the planned run stands at
+/// **r 1.49**, `unexplained`, twin `unexplained`: **not lifted** where the
+/// old plan (500 rpm/10 bar ↔ 2000 rpm/10 bar every 300 s, for the log's
+/// leading churning and lag) had lifted it to r 8.04 (`unexplained` too:
+/// churning passed every check, its evidence lost to the discrepancy).
+/// A measured regression of the new rule on a case above the floor on
+/// its log, kept because on the cases below it the rule lifts 3 of 5
+/// where the old lifted 0 of 3 (docs/test-plans.md). Asserted as
+/// measured: r < 2, no cause named, twin not a discovery.
 #[test]
 #[ignore]
 fn slow_planned_run_twice_as_long_default_structure() {
     let (r0, r1, answer, p, _, twin) = planned_case(1708, 2400.0, Structure::NoCaseHeld);
     eprintln!("1708, 2400 s plan, no-case-held: r {r0:.2} -> {r1:.2} ({answer}; twin {twin}), {}", p.design.name);
-    assert!(r1 >= 4.0, "measured r changed: {r1:.2} (measured 8.04)");
-    assert_eq!(answer, "unexplained", "measured answer changed (unexplained at r 8.04)");
-    assert_eq!(twin, "none", "false discovery on the twin (measured none)");
+    assert!(r1 < 2.0, "measured r changed: {r1:.2} (measured 1.49)");
+    assert!(["none", "unexplained"].contains(&answer.as_str()), "measured answer changed (unexplained at r 1.49): {answer}");
+    assert!(["none", "unexplained"].contains(&twin.as_str()), "false discovery on the twin: {twin}");
+}
+
+/// By hand (prints, asserts nothing): what the two- and three-level
+/// families can show of one case's hidden effect. For the seed in
+/// `EHA_PLAN_SEED` (default 1709), under `EHA_PLAN_STRUCTURE`, the plan
+/// for every throttle candidate at its typical magnitude is evaluated on
+/// both families ([`family`], [`family_three`]); each design's expected
+/// ratio for the hidden candidate is printed, and the design of each family
+/// with the largest one (an oracle's choice: the hidden cause is told) is
+/// flown by the machine with and without the effect and diagnosed alone:
+/// the bound of what the family can lift. `EHA_PLAN_FLY=0`: the
+/// families' tables only (a `ROW` line per admissible design: seed,
+/// family, D_s, every candidate's expected ratio, the mission).
+#[test]
+#[ignore]
+fn slow_family_bound_case() {
+    use eha_sim::diagnosis::plan::{family, family_three, plan_among};
+    let seed = std::env::var("EHA_PLAN_SEED").ok().and_then(|s| s.parse().ok()).unwrap_or(1709);
+    let dur = std::env::var("EHA_PLAN_DURATION_S").ok().and_then(|s| s.parse().ok()).unwrap_or(1200.0);
+    let s = structure();
+    let c = case(seed);
+    let (log, truth) = generate(&c).expect("log");
+    let (twin, _) = generate_twin(&c).expect("twin");
+    let (r0, a0, _, _, _) = ratio(&log, &twin, truth.affected.expect("affected").0, s);
+    let cands: Vec<Candidate> = Candidate::EXTENSIONS.iter().copied().filter(|&k| k != Candidate::CoulombFriction).collect();
+    let hidden = cands.iter().position(|&k| k == c.hidden).expect("a throttle candidate");
+    let limits = Limits::for_rig(&Rig::default(), &log);
+    let families: [(&str, fn(&Limits, f64, f64) -> Vec<Design>); 2] = [("two-level", family), ("three-level", family_three)];
+    for (label, fam) in families {
+        let t = std::time::Instant::now();
+        let mut designs = Vec::new();
+        let p = plan_among(&Rig::default(), &log, &typical(&log, &cands), limits, Decision::Alone, |a| {
+            designs = fam(&limits, dur, a);
+            designs.clone()
+        })
+        .expect("plan");
+        let mut rows: Vec<(f64, usize)> = p.family.iter().enumerate().filter(|(_, e)| e.admissible).map(|(k, e)| (e.expected_ratio[hidden], k)).collect();
+        rows.sort_by(|a, b| b.0.total_cmp(&a.0));
+        for (r, k) in rows.iter().take(5) {
+            eprintln!("  {seed} {label}: r̂ {r:.2} {}", p.family[*k].name);
+        }
+        for e in p.family.iter().filter(|e| e.admissible) {
+            let r: Vec<String> = e.expected_ratio.iter().map(|r| format!("{r:.3}")).collect();
+            eprintln!("ROW {seed} {label} {:.4e} {} | {}", e.d_s, r.join(" "), e.name);
+        }
+        let Some(&(rhat, k)) = rows.first() else { continue };
+        if std::env::var("EHA_PLAN_FLY").is_ok_and(|v| v == "0") {
+            continue;
+        }
+        let (plog, ptwin, pch) = fly(&designs[k], &c, &truth, mean_ambient(&log));
+        let (r1, a1, t1, _, _) = ratio(&plog, &ptwin, pch, s);
+        eprintln!(
+            "BOUND {seed} {} {label} ({} designs, {} admissible, {:.0} s): log r {r0:.2} ({a0}); best r̂ {rhat:.2}: {}; flown r {r1:.2} on {} ({a1}; twin {t1})",
+            c.hidden.name(),
+            p.family.len(),
+            rows.len(),
+            t.elapsed().as_secs_f64(),
+            p.family[k].name,
+            pch.name()
+        );
+    }
+}
+
+/// The original emulator set's throttle cases below r = 2 on their log
+/// under the command's default structure (docs/diagnosis-numbers.md:
+/// 1700 and 1701 winding, 1709 churning, 1711 conduction, 1713 draught;
+/// the Coulomb cases 1706 and 1707 need a servo run, which a throttle plan
+/// cannot give), each planned for as the command plans (the log's leading
+/// candidates: every throttle candidate here, as none of the five logs
+/// admitted one; the most candidates at r̂ ≥ 2 over the two- and
+/// three-level families), flown, and decided alone.
+///
+/// Measured 2026-11-29 (~12 min), original → planned r (answer; twin):
+/// 1700 0.79 → 1.18 (`none`; `unexplained`), 1701 0.89 → 1.00 (`none`;
+/// `none`), 1709 0.80 → **7.23 `churning-loss`** (`none`; 500 rpm/10 bar
+/// ↔ 2000 rpm/10 bar every 300 s), 1711 0.91 → **2.72** `none` (`none`;
+/// the same mission: conduction qualifies on ΔBIC 70 and 67 % on
+/// t_pump_c but the pooled held-out gain is 19.9 %, under the 20 % bar),
+/// 1713 0.80 → **6.51** `unexplained` (`unexplained`; 500/10 → 500/100 →
+/// 1250 rpm/55 bar every 300 s, no fan: a draught is not identifiable
+/// without a logged air span, and every fan mission leaves it at r̂ ≤ 1.10).
+/// **Lifted 3 of 5, named 1 of 5**: the acceptance's "lifted, and then
+/// named" for at least half is not met. The winding's law is not
+/// showable by any mission of either family (r̂ ≤ 1.11). Asserted as
+/// measured: all five below, lifted exactly 1709, 1711 and 1713, named
+/// 1709 only, no wrong cause, no false discovery ([`cases_alone`]).
+/// `EHA_PLAN_SEEDS` (comma-separated) runs another list and asserts only
+/// the last two.
+#[test]
+#[ignore = "slow tier: five emulator cases planned, flown and diagnosed with their twins, ~12 min"]
+fn slow_planned_runs_below_the_floor_default_structure() {
+    let custom = std::env::var("EHA_PLAN_SEEDS").ok();
+    let seeds: Vec<u64> = custom.as_deref().map_or(vec![1700, 1701, 1709, 1711, 1713], |v| v.split(',').map(|x| x.parse().expect("seed")).collect());
+    let (rows, below, lifted, msg) = cases_alone(&seeds, Structure::NoCaseHeld);
+    let ids = |v: &[AloneRow]| v.iter().map(|r| r.0).collect::<Vec<_>>();
+    let named: Vec<u64> = lifted.iter().filter(|r| r.3 == case(r.0).hidden.name()).map(|r| r.0).collect();
+    eprintln!("BELOW {} rows, {} below r 2 on the log, lifted {:?}, lifted and named {named:?}", rows.len(), below.len(), ids(&lifted));
+    if custom.is_none() {
+        assert_eq!(ids(&below), [1700, 1701, 1709, 1711, 1713], "measured set below r 2 changed: {msg}");
+        assert_eq!(ids(&lifted), [1709, 1711, 1713], "measured lift changed: {msg}");
+        assert_eq!(named, [1709], "measured names changed: {msg}");
+    }
 }
