@@ -169,41 +169,50 @@ impl Design {
 /// Hold times of the family, s.
 pub const HOLDS_S: [f64; 2] = [150.0, 300.0];
 
-/// The mission family within `limits`: every pair of distinct levels among
-/// the four corners of the speed × drop envelope and its centre, alternated
-/// with each hold time of [`HOLDS_S`]; with a fan, each also with the air
-/// toggled between 0 and the largest every second segment (a quarter
-/// period out of phase with the levels).
-pub fn family(limits: &Limits, duration_s: f64, ambient_c: f64) -> Vec<Design> {
+/// The five operating levels of the families (speed rpm, drop bar): the
+/// envelope's four corners and its centre; and the air settings (none, or
+/// toggled up to the largest when the bench has a fan).
+fn levels_and_airs(limits: &Limits) -> ([(f64, f64); 5], Vec<Option<f64>>) {
     let (s0, s1) = limits.speed_rpm;
     let (d0, d1) = limits.drop_bar;
-    let levels = [(s0, d0), (s0, d1), (s1, d0), (s1, d1), (0.5 * (s0 + s1), 0.5 * (d0 + d1))];
-    let airs: Vec<Option<f64>> = match limits.air_mps {
+    let airs = match limits.air_mps {
         Some(a) => vec![None, Some(a)],
         None => vec![None],
     };
+    ([(s0, d0), (s0, d1), (s1, d0), (s1, d1), (0.5 * (s0 + s1), 0.5 * (d0 + d1))], airs)
+}
+
+/// The mission holding `order`'s levels in turn for `hold` s each, with the
+/// air (if any) toggled between 0 and `air` every second segment (a
+/// quarter period out of phase with two levels).
+fn cycled(order: &[(f64, f64)], hold: f64, air: Option<f64>, duration_s: f64, ambient_c: f64) -> Design {
+    let n = (duration_s / hold).ceil() as usize;
+    let segments = (0..n)
+        .map(|m| {
+            let (s, d) = order[m % order.len()];
+            let a = air.map_or(0.0, |a| if (m / 2) % 2 == 1 { a } else { 0.0 });
+            Level { speed_rpm: s, drop_bar: d, air_mps: a }
+        })
+        .collect();
+    let names: Vec<String> = order.iter().map(|(s, d)| format!("{s:.0} rpm/{d:.0} bar")).collect();
+    let levels = if order.len() == 2 { names.join(" ↔ ") } else { format!("{} → …", names.join(" → ")) };
+    let air = air.map_or(String::new(), |a| format!(", air 0/{a:.0} m/s every {:.0} s", 2.0 * hold));
+    Design { name: format!("{levels} every {hold:.0} s{air}"), hold_s: hold, segments, duration_s, ambient_c }
+}
+
+/// The mission family within `limits`: every pair of distinct levels among
+/// the four corners of the speed × drop envelope and its centre,
+/// alternated with each hold time of [`HOLDS_S`]; with a fan, each also
+/// with the air toggled between 0 and the largest every second segment (a
+/// quarter period out of phase with the levels).
+pub fn family(limits: &Limits, duration_s: f64, ambient_c: f64) -> Vec<Design> {
+    let (levels, airs) = levels_and_airs(limits);
     let mut out = Vec::new();
     for i in 0..levels.len() {
         for j in i + 1..levels.len() {
             for hold in HOLDS_S {
-                for air in &airs {
-                    let n = (duration_s / hold).ceil() as usize;
-                    let segments = (0..n)
-                        .map(|k| {
-                            let (s, d) = if k % 2 == 0 { levels[i] } else { levels[j] };
-                            let a = air.map_or(0.0, |a| if (k / 2) % 2 == 1 { a } else { 0.0 });
-                            Level { speed_rpm: s, drop_bar: d, air_mps: a }
-                        })
-                        .collect();
-                    let name = format!(
-                        "{:.0} rpm/{:.0} bar ↔ {:.0} rpm/{:.0} bar every {hold:.0} s{}",
-                        levels[i].0,
-                        levels[i].1,
-                        levels[j].0,
-                        levels[j].1,
-                        air.map_or(String::new(), |a| format!(", air 0/{a:.0} m/s every {:.0} s", 2.0 * hold))
-                    );
-                    out.push(Design { name, hold_s: hold, segments, duration_s, ambient_c });
+                for &air in &airs {
+                    out.push(cycled(&[levels[i], levels[j]], hold, air, duration_s, ambient_c));
                 }
             }
         }
@@ -213,40 +222,20 @@ pub fn family(limits: &Limits, duration_s: f64, ambient_c: f64) -> Vec<Design> {
 
 /// The three-level family within `limits`: every triple of distinct levels
 /// among the same five as [`family`] (the envelope's corners and centre),
-/// cycled in both orders with each hold time of [`HOLDS_S`]; with a fan,
-/// each also with the air toggled as in [`family`]. A third level lets a
-/// mission visit one speed at two oil temperatures (reached through the
+/// held in turn in both orders with each hold time of [`HOLDS_S`]; with a
+/// fan, each also with the air toggled as in [`family`]. A third level lets
+/// a mission visit one speed at two oil temperatures (reached through the
 /// other two levels), which two alternating levels settle into one cycle.
 pub fn family_three(limits: &Limits, duration_s: f64, ambient_c: f64) -> Vec<Design> {
-    let (s0, s1) = limits.speed_rpm;
-    let (d0, d1) = limits.drop_bar;
-    let levels = [(s0, d0), (s0, d1), (s1, d0), (s1, d1), (0.5 * (s0 + s1), 0.5 * (d0 + d1))];
-    let airs: Vec<Option<f64>> = match limits.air_mps {
-        Some(a) => vec![None, Some(a)],
-        None => vec![None],
-    };
+    let (levels, airs) = levels_and_airs(limits);
     let mut out = Vec::new();
     for i in 0..levels.len() {
         for j in i + 1..levels.len() {
             for k in j + 1..levels.len() {
                 for order in [[i, j, k], [i, k, j]] {
                     for hold in HOLDS_S {
-                        for air in &airs {
-                            let n = (duration_s / hold).ceil() as usize;
-                            let segments = (0..n)
-                                .map(|m| {
-                                    let (s, d) = levels[order[m % 3]];
-                                    let a = air.map_or(0.0, |a| if (m / 2) % 2 == 1 { a } else { 0.0 });
-                                    Level { speed_rpm: s, drop_bar: d, air_mps: a }
-                                })
-                                .collect();
-                            let names: Vec<String> = order.iter().map(|&o| format!("{:.0} rpm/{:.0} bar", levels[o].0, levels[o].1)).collect();
-                            let name = format!(
-                                "{} → … every {hold:.0} s{}",
-                                names.join(" → "),
-                                air.map_or(String::new(), |a| format!(", air 0/{a:.0} m/s every {:.0} s", 2.0 * hold))
-                            );
-                            out.push(Design { name, hold_s: hold, segments, duration_s, ambient_c });
+                        for &air in &airs {
+                            out.push(cycled(&order.map(|o| levels[o]), hold, air, duration_s, ambient_c));
                         }
                     }
                 }
@@ -254,4 +243,31 @@ pub fn family_three(limits: &Limits, duration_s: f64, ambient_c: f64) -> Vec<Des
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The families' sizes (pairs and ordered triples of five levels, two
+    /// holds, ×2 with a fan) and their schedules: two levels alternate,
+    /// three are held in turn, the air toggles every second segment.
+    #[test]
+    fn families_hold_their_levels_in_turn() {
+        let mut l = Limits { speed_rpm: (500.0, 2000.0), drop_bar: (10.0, 100.0), air_mps: None, max_temp_c: 80.0 };
+        assert_eq!((family(&l, 1200.0, 20.0).len(), family_three(&l, 1200.0, 20.0).len()), (20, 40));
+        l.air_mps = Some(20.0);
+        let (two, three) = (family(&l, 1200.0, 20.0), family_three(&l, 1200.0, 20.0));
+        assert_eq!((two.len(), three.len()), (40, 80));
+        let d = &two[1];
+        assert_eq!(d.name, "500 rpm/10 bar ↔ 500 rpm/100 bar every 150 s, air 0/20 m/s every 300 s");
+        let speeds_drops_airs: Vec<(f64, f64, f64)> = d.segments.iter().map(|s| (s.speed_rpm, s.drop_bar, s.air_mps)).collect();
+        assert_eq!(speeds_drops_airs.len(), 8);
+        assert_eq!(&speeds_drops_airs[..4], [(500.0, 10.0, 0.0), (500.0, 100.0, 0.0), (500.0, 10.0, 20.0), (500.0, 100.0, 20.0)]);
+        let t = &three[0];
+        assert_eq!(t.name, "500 rpm/10 bar → 500 rpm/100 bar → 2000 rpm/10 bar → … every 150 s");
+        let drops: Vec<f64> = t.segments.iter().map(|s| s.drop_bar).collect();
+        assert_eq!(drops, [10.0, 100.0, 10.0, 10.0, 100.0, 10.0, 10.0, 100.0]);
+        assert_eq!(t.segments[2].speed_rpm, 2000.0);
+    }
 }

@@ -31,7 +31,7 @@ mod design;
 mod report;
 
 pub use design::{family, family_three, Design, Level, Limits, DEFAULT_AIR_MPS, DEFAULT_DROP_BAR, DEFAULT_MAX_TEMP_C, DEFAULT_SPEED_RPM, HOLDS_S};
-pub use report::leading;
+pub use report::{leading, LEADING_MIN_P};
 
 use super::analysis::{evidence_points, fit_points, split_time_s, DiagnoseOptions};
 use super::evidence::{floor_for, ChannelFloor};
@@ -277,7 +277,8 @@ impl Showing {
 /// Designs the plan for `log` of a machine described by `rig`, to show
 /// and separate `cands` (candidate, magnitude), within `limits`, lasting
 /// `duration_s`, for the planned run decided as `decision` says: the best
-/// ([`Showing`]) of the two- and three-level families ([`family`],
+/// (the most candidates at r̂ ≥ 2, then the others closest to it, then
+/// D_s) of the two- and three-level families ([`family`],
 /// [`family_three`]).
 pub fn plan(rig: &Rig, log: &MeasuredRun, cands: &[(Candidate, f64)], limits: Limits, duration_s: f64, decision: Decision) -> Result<Plan, String> {
     plan_among(rig, log, cands, limits, decision, |ambient_c| {

@@ -76,19 +76,23 @@ fn slow_joint_case() {
 }
 
 /// 1708 (churning, r 2.35 on its log under the default structure and
-/// answered `none` there: a miss at r ≥ 2) with a 1200 s run planned for it alone and
-/// both logs diagnosed together under the default structure, as `eha-sim
-/// diagnose log.csv planned.csv` does since 2026-11-29: measured r 5.58,
-/// `churning-loss` named (ln B 22.1 against `none`), the joint twin
-/// `none`. Tolerance on r ±0.5 (the ratios moved by up to 0.3 with the
-/// code merged between the plan tables' measurements; 2 is the line that
-/// matters).
+/// answered `none` there: a miss at r ≥ 2) with a 1200 s run planned for
+/// it alone and both logs diagnosed together under the default structure,
+/// as `eha-sim diagnose log.csv planned.csv` does. Re-measured 2026-11-29
+/// evening after the plan's choice changed (every candidate planned for,
+/// the log admitting none; the mission 500 rpm/10 bar → 2000 rpm/10 bar →
+/// 500 rpm/100 bar every 300 s, churning r̂ 2.16): joint r 1.63,
+/// `churning-loss` named (right), the joint twin `unexplained`. (The old
+/// plan, 2000 rpm/10 bar ↔ 1250 rpm/55 bar: joint r 5.58, named, twin
+/// `none`.) Tolerance on r ±0.5 (the ratios moved by up to 0.3 with the
+/// code merged between the plan tables' measurements).
 #[test]
 #[ignore = "slow tier: four emulator diagnoses, ~1 min"]
 fn slow_planned_run_decided_together_default_structure() {
     let (r, a, t) = joint_case(1708, 1200.0, Decision::Alone, Structure::NoCaseHeld);
-    assert_eq!((a.as_str(), t.as_str()), ("churning-loss", "none"), "r {r:.2}");
-    assert!((r - 5.58).abs() <= 0.5, "joint r {r:.2}, measured 5.58");
+    assert_eq!(a, "churning-loss", "r {r:.2}");
+    assert!(["none", "unexplained"].contains(&t.as_str()), "false discovery on the joint twin: {t}");
+    assert!((r - 1.63).abs() <= 0.5, "joint r {r:.2}, measured 1.63");
 }
 
 /// The six cases of [`slow_planned_runs_lift_effects_above_the_floor`]
@@ -131,14 +135,20 @@ fn six_joint(decision: Decision) -> Vec<(u64, f64, String, String)> {
 /// 558 s at load ~4. Re-run on 2026-11-29 after the reference's fix
 /// (b36ffe3), 367 s, passing: joint r 1708 1.85 (`churning-loss`, right
 /// below r = 2), 1710 0.72, 1712 1.22, 1709 1.83, 1700 1.15, 1713 0.92;
-/// none lifted; twins `none` ×4, `unexplained` ×2.
+/// none lifted; twins `none` ×4, `unexplained` ×2. Re-run on 2026-11-29
+/// evening after the plan's choice changed (the plans of
+/// [`slow_planned_runs_lift_effects_above_the_floor`]), 415 s, passing:
+/// joint r 1708 **3.67** (`none`: a miss at r ≥ 2), 1710 1.20, 1712 1.06,
+/// 1709 0.18 (alone the same planned run stands at 7.23 and is named:
+/// with the original log in the calibration its imprint is taken up),
+/// 1700 1.30, 1713 1.89; twins `none` ×4, `unexplained` ×2.
 #[test]
 #[ignore]
 fn slow_planned_runs_decided_jointly() {
     let rows = six_joint(Decision::Alone);
     let lifted: Vec<_> = rows.iter().filter(|r| r.1 >= 2.0).collect();
     let msg = format!("{rows:?}");
-    assert!(lifted.len() <= 1, "measured miss changed (1700 only, r 2.01): {msg}");
+    assert!(lifted.len() <= 1, "measured miss changed (1708 only, r 3.67): {msg}");
     assert!(lifted.iter().all(|r| r.2 != case(r.0).hidden.name()), "measured miss changed (none named at r ≥ 2): {msg}");
 }
 
@@ -156,17 +166,26 @@ fn slow_planned_runs_decided_jointly() {
 /// under the touched-channel rule ([`slow_joint_case`], same missions,
 /// same answers): 1708 1.60 `churning-loss` to the digit, 1709 1.30
 /// (churning ΔBIC 585, t_pump_c −75 %, pooled −12 %), 1712 0.89, 1700
-/// 1.62, 1710 and 1713 to the digit. Asserted as measured: no r ≥ 2
-/// (largest 1.62, which moves with the baselines' last digits), 1708
-/// named `churning-loss`. 939 s at load ~5 when first measured. Re-run on
+/// 1.62, 1710 and 1713 to the digit. 939 s at load ~5 when first
+/// measured. Re-run on
 /// 2026-11-29 after the reference's fix (b36ffe3), 397 s, passing: joint r
 /// 1708 1.77 (`churning-loss`), 1710 0.68, 1712 1.02, 1709 0.71, 1700
 /// 0.87, 1713 0.84; twins `none` ×4, `unexplained` ×2.
+/// Re-run on 2026-11-29 evening after the plan's choice changed (the most
+/// candidates at r̂ ≥ 2 over the two- and three-level families, D_s on
+/// the stacked imprints the last tie-break; every candidate planned for),
+/// 528 s: joint r 1708 **2.95** (`none`: a miss at r ≥ 2), 1710 0.66,
+/// 1712 0.89, 1709 0.88, 1700 0.82, 1713 **3.05 `forced-convection`**
+/// (named right: the original AirSteps log gives the joint table the air
+/// span a draught needs); twins `none` ×4, `unexplained` ×2. Asserted as
+/// measured: lifted exactly 1708 and 1713, named 1713 only.
 #[test]
 #[ignore]
 fn slow_jointly_planned_runs_decided_jointly() {
     let rows = six_joint(Decision::Joint);
     let msg = format!("{rows:?}");
-    assert!(rows.iter().all(|r| r.1 < 2.0), "measured miss changed (largest joint r 1.62): {msg}");
-    assert_eq!(rows[0].2, "churning-loss", "measured name changed (1708 named churning-loss at joint r 1.60): {msg}");
+    let lifted: Vec<u64> = rows.iter().filter(|r| r.1 >= 2.0).map(|r| r.0).collect();
+    assert_eq!(lifted, [1708, 1713], "measured lift changed: {msg}");
+    let named: Vec<u64> = rows.iter().filter(|r| r.2 == case(r.0).hidden.name()).map(|r| r.0).collect();
+    assert_eq!(named, [1713], "measured names changed: {msg}");
 }
