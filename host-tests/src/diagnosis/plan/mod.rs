@@ -250,11 +250,12 @@ impl Projected {
 /// How a mission is ranked: first by how many candidates it is expected
 /// to lift to [`SHOWABLE_RATIO`] (the ratio at which a diagnosis must name
 /// a cause), then by how close it brings the others (Σ ln min(r̂, 2)), then
-/// by D_s (separation). D_s alone, measured on the emulator (2026-11-29,
-/// docs/test-plans.md), let a candidate that no mission can show (its
-/// projected imprint tiny everywhere) decide the determinant and chose
-/// missions on which no candidate reached r̂ 2 while the family had one
-/// that lifted the hidden effect to r 7.
+/// by D_s (separation). D_s alone is a product over the candidates'
+/// directions: one candidate shown very strongly buys as much as several
+/// shown at all (measured on the emulator, 2026-11-29, docs/test-plans.md:
+/// for 1709 it chose a mission showing the probe lag at r̂ 7.3 and the
+/// hidden churning at 1.00 while the family held one at 2.07 for it, which
+/// lifted it to r 7.2 and had it named).
 #[derive(Debug, Clone, Copy)]
 struct Showing {
     shown: usize,
