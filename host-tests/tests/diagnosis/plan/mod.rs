@@ -484,7 +484,7 @@ fn slow_family_bound_case() {
 /// admitted one; the most candidates at r̂ ≥ 2 over the two- and
 /// three-level families), flown, and decided alone.
 ///
-/// Measured 2026-11-29 (~12 min), original → planned r (answer; twin):
+/// Measured 2026-11-29 (480 s), original → planned r (answer; twin):
 /// 1700 0.79 → 1.18 (`none`; `unexplained`), 1701 0.89 → 1.00 (`none`;
 /// `none`), 1709 0.80 → **7.23 `churning-loss`** (`none`; 500 rpm/10 bar
 /// ↔ 2000 rpm/10 bar every 300 s), 1711 0.91 → **2.72** `none` (`none`;
@@ -501,7 +501,7 @@ fn slow_family_bound_case() {
 /// `EHA_PLAN_SEEDS` (comma-separated) runs another list and asserts only
 /// the last two.
 #[test]
-#[ignore = "slow tier: five emulator cases planned, flown and diagnosed with their twins, ~12 min"]
+#[ignore = "slow tier: five emulator cases planned, flown and diagnosed with their twins, ~8 min"]
 fn slow_planned_runs_below_the_floor_default_structure() {
     let custom = std::env::var("EHA_PLAN_SEEDS").ok();
     let seeds: Vec<u64> = custom.as_deref().map_or(vec![1700, 1701, 1709, 1711, 1713], |v| v.split(',').map(|x| x.parse().expect("seed")).collect());
