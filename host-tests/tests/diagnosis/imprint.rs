@@ -65,19 +65,20 @@ impl Checks {
     /// A measured miss: no cause named (`unexplained` or `none`, as
     /// measured), in particular no wrong cause, and no discovery on the twin.
     fn missed(&mut self, r: &EmuResult, answer: &str, ratio: f64) {
-        if r.answer != answer {
-            self.0.push(format!("{}: answer {} (measured {answer})", r.case.seed, r.answer));
-        }
-        self.ratio_and_twin(r, ratio, None);
+        self.missed_with_twin(r, answer, ratio, None);
     }
 
     /// [`Self::missed`] with a measured false discovery on the twin: its
     /// answer `twin_cause`.
     fn missed_twin_named(&mut self, r: &EmuResult, answer: &str, ratio: f64, twin_cause: &str) {
+        self.missed_with_twin(r, answer, ratio, Some(twin_cause));
+    }
+
+    fn missed_with_twin(&mut self, r: &EmuResult, answer: &str, ratio: f64, twin_cause: Option<&str>) {
         if r.answer != answer {
             self.0.push(format!("{}: answer {} (measured {answer})", r.case.seed, r.answer));
         }
-        self.ratio_and_twin(r, ratio, Some(twin_cause));
+        self.ratio_and_twin(r, ratio, twin_cause);
     }
 
     /// r within 20 % of `ratio`; the twin's answer `twin_cause` when given

@@ -305,7 +305,7 @@ pub fn plan_among(rig: &Rig, log: &MeasuredRun, cands: &[(Candidate, f64)], limi
         x.iter().sum::<f64>() / x.len().max(1) as f64
     });
     let designs = designs(ambient_c);
-    let evaluated: Vec<Result<(Evaluated, Projected), String>> = designs
+    let evaluated: Vec<Result<(Evaluated, Projected, Vec<Option<String>>), String>> = designs
         .par_iter()
         .map(|d| {
             let run = predicted_log(&machine.calibrated, d)?;
@@ -316,13 +316,16 @@ pub fn plan_among(rig: &Rig, log: &MeasuredRun, cands: &[(Candidate, f64)], limi
             };
             let admissible = p.max_temp_c <= limits.max_temp_c && d.segments.iter().all(|l| limits.contains(l));
             // A candidate the diagnosis could not name on this mission (its
-            // identifiability rule) is credited nothing here.
+            // identifiability rule) is credited nothing here; the reasons are
+            // kept for the chosen mission's report.
+            let refusals: Vec<Option<String>> = cands.iter().map(|&(c, _)| refused(c, &run)).collect();
             let expected_ratio = cands
                 .iter()
+                .zip(&refusals)
                 .enumerate()
-                .map(|(i, &(c, _))| if refused(c, &run).is_some() { 1.0 } else { row(&p.sens, &p.floors, c, &[], &p.imprints[i], &p.lefts[i]).best.1 })
+                .map(|(i, (&(c, _), why))| if why.is_some() { 1.0 } else { row(&p.sens, &p.floors, c, &[], &p.imprints[i], &p.lefts[i]).best.1 })
                 .collect();
-            Ok((Evaluated { name: d.name.clone(), d_s: p.d_s(), max_temp_c: p.max_temp_c, admissible, expected_ratio }, p))
+            Ok((Evaluated { name: d.name.clone(), d_s: p.d_s(), max_temp_c: p.max_temp_c, admissible, expected_ratio }, p, refusals))
         })
         .collect();
     let mut best: Option<(usize, Showing)> = None;
@@ -330,13 +333,13 @@ pub fn plan_among(rig: &Rig, log: &MeasuredRun, cands: &[(Candidate, f64)], limi
     let mut projections = Vec::new();
     for (k, e) in evaluated.into_iter().enumerate() {
         match e {
-            Ok((ev, p)) => {
+            Ok((ev, p, refusals)) => {
                 let key = Showing::of(&ev);
                 if ev.admissible && best.as_ref().is_none_or(|b| key.better_than(&b.1)) {
                     best = Some((k, key));
                 }
                 family_rows.push(ev);
-                projections.push(Some(p));
+                projections.push(Some((p, refusals)));
             }
             Err(msg) => {
                 family_rows.push(Evaluated { name: format!("{} (failed: {msg})", designs[k].name), d_s: 0.0, max_temp_c: f64::NAN, admissible: false, expected_ratio: vec![] });
@@ -345,9 +348,8 @@ pub fn plan_among(rig: &Rig, log: &MeasuredRun, cands: &[(Candidate, f64)], limi
         }
     }
     let (k, Showing { d_s, .. }) = best.ok_or("no mission of the family is within the limits")?;
-    let p = projections[k].take().ok_or("the chosen mission has no projection")?;
+    let (p, refusals) = projections[k].take().ok_or("the chosen mission has no projection")?;
     let on_log = project(&machine, log, cands).ok();
-    let chosen_run = predicted_log(&machine.calibrated, &designs[k]).ok();
     // The candidates' parameter names and units (one model of the log, not one per name).
     let ext_model = ReferenceModel::new(rig.clone(), log).ok();
     let named = |c: Candidate, m: f64| -> Vec<(String, f64, String)> {
@@ -365,7 +367,7 @@ pub fn plan_among(rig: &Rig, log: &MeasuredRun, cands: &[(Candidate, f64)], limi
                 planned: row(&p.sens, &p.floors, c, &mag, &p.imprints[i], &p.lefts[i]),
                 planned_separated: sep_row.best.1,
                 on_log: on_log.as_ref().map(|q| row(&q.sens, &q.floors, c, &mag, &q.imprints[i], &q.lefts[i])),
-                refused: chosen_run.as_ref().and_then(|r| refused(c, r)),
+                refused: refusals[i].clone(),
             }
         })
         .collect();

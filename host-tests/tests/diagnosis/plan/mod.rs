@@ -253,11 +253,11 @@ fn plan_command_writes_a_readable_mission_within_limits() {
 /// 2026-11-28 1708 only, to 2.28, not named.) Asserted as measured: all
 /// six below r = 2 on the log, lifted exactly 1708, 1709 and 1713, named
 /// 1708 and 1709, no wrong cause on a planned run, no discovery on its
-/// twin ([`six_alone`]).
+/// twin ([`cases_alone`]).
 #[test]
 #[ignore]
 fn slow_planned_runs_lift_effects_above_the_floor() {
-    let (_, below, lifted, msg) = six_alone(structure());
+    let (_, below, lifted, msg) = cases_alone(&SIX, structure());
     let ids = |v: &[AloneRow]| v.iter().map(|r| r.0).collect::<Vec<_>>();
     assert_eq!(ids(&below), SIX, "measured set below r 2 changed: {msg}");
     assert_eq!(ids(&lifted), [1708, 1709, 1713], "measured lift changed: {msg}");
@@ -309,19 +309,15 @@ fn slow_planned_twin_of_1709_names_no_cause() {
     assert!((t.before.heldout_rmse_k - 0.558).abs() <= 0.05, "pooled held out {:.3} K (measured 0.558)", t.before.heldout_rmse_k);
 }
 
-/// One row of [`six_alone`]: seed, r on the original log, r on the
+/// One row of [`cases_alone`]: seed, r on the original log, r on the
 /// planned run, its answer, the mission, the planned twin's answer.
 type AloneRow = (u64, f64, f64, String, String, String);
 
-/// The six cases planned for alone and diagnosed alone under structure
-/// `s`: every row, those below r = 2 on the original log, those of them
-/// lifted to r ≥ 2, and the rows printed. Asserts what holds whatever the
-/// ratios: no wrong cause on a planned run, no discovery on its twin.
-fn six_alone(s: Structure) -> (Vec<AloneRow>, Vec<AloneRow>, Vec<AloneRow>, String) {
-    cases_alone(&SIX, s)
-}
-
-/// [`six_alone`] for the cases `seeds`.
+/// The cases `seeds` planned for alone and diagnosed alone under
+/// structure `s`: every row, those below r = 2 on the original log, those
+/// of them lifted to r ≥ 2, and the rows printed. Asserts what holds
+/// whatever the ratios: no wrong cause on a planned run, no discovery on
+/// its twin.
 fn cases_alone(seeds: &[u64], s: Structure) -> (Vec<AloneRow>, Vec<AloneRow>, Vec<AloneRow>, String) {
     let mut rows = Vec::new();
     for &seed in seeds {
@@ -358,7 +354,7 @@ fn cases_alone(seeds: &[u64], s: Structure) -> (Vec<AloneRow>, Vec<AloneRow>, Ve
 #[test]
 #[ignore]
 fn slow_planned_runs_default_structure() {
-    let (rows, below, lifted, msg) = six_alone(Structure::NoCaseHeld);
+    let (rows, below, lifted, msg) = cases_alone(&SIX, Structure::NoCaseHeld);
     let seeds = |v: &[AloneRow]| v.iter().map(|r| r.0).collect::<Vec<_>>();
     assert_eq!(seeds(&below), [1709, 1700, 1713], "measured set below r 2 changed: {msg}");
     assert_eq!(seeds(&lifted), [1709, 1713], "measured lift changed: {msg}");
