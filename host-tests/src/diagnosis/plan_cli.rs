@@ -34,7 +34,10 @@ pub struct PlanArgs {
     /// Leading candidates, `name` or `name=magnitude` (the parameter's unit),
     /// comma-separated; default: the two leading ones of `--diagnosis` (all
     /// when it admitted none, `plan::leading`), else every candidate a
-    /// throttle run can excite, at typical magnitudes.
+    /// throttle run can excite; without `=magnitude`, at the model's fit
+    /// start of each (30 s lag, 1 W/K flange path, 3 m/s draught, …: at or
+    /// below the low end of the physical range the diagnosis calls typical;
+    /// docs/test-plans.md says what planning for the middle did).
     #[arg(long, value_delimiter = ',')]
     pub candidates: Vec<String>,
     /// `diagnosis.json` of the log (`eha-sim diagnose`): its two leading
@@ -67,8 +70,8 @@ pub struct PlanArgs {
     pub joint: bool,
 }
 
-/// Parses `name` or `name=magnitude` (typical magnitude of `rig`'s model
-/// when absent).
+/// Parses `name` or `name=magnitude` (the fit start of `rig`'s model's
+/// parameter for it when absent).
 fn parse_candidate(s: &str, model: &ReferenceModel) -> Result<(Candidate, f64), String> {
     let (name, value) = match s.split_once('=') {
         Some((n, v)) => (n.trim(), Some(v.trim().parse::<f64>().map_err(|e| format!("candidate `{s}`: magnitude: {e}"))?)),

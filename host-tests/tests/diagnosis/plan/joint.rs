@@ -34,13 +34,7 @@ fn joint_case(seed: u64, duration_s: f64, decision: Decision, s: Structure) -> (
     let exp: Vec<String> = p.expected.iter().map(|e| format!("{} r̂ {:.2} on {} (log {:.2})", e.planned.candidate, e.planned.best.1, e.planned.best.0, e.on_log.as_ref().map_or(f64::NAN, |r| r.best.1))).collect();
     eprintln!("  plan ({:?}): {} (D_s {:.3}); expected {}", p.decision, p.design.name, p.d_s, exp.join(", "));
     let (plog, ptwin, pch) = fly(&p.design, &c, &truth, mean_ambient(&log));
-    if let Ok(dir) = std::env::var("EHA_PLAN_DUMP") {
-        let dir = std::path::Path::new(&dir).join(format!("{seed}-{duration_s:.0}-{:?}", p.decision));
-        std::fs::create_dir_all(&dir).expect("dump dir");
-        for (n, r) in [("log", &log), ("twin", &twin), ("planned", &plog), ("planned-twin", &ptwin)] {
-            r.write_file(dir.join(format!("{n}.csv"))).expect("dump");
-        }
-    }
+    dump(seed, &format!("{duration_s:.0}-{:?}", p.decision), &[("log", &log), ("twin", &twin), ("planned", &plog), ("planned-twin", &ptwin)]);
     let dj = diagnose_joint(&[&log, &plog], s);
     let tj = diagnose_joint(&[&twin, &ptwin], s);
     for (l, x) in [("original", &d0), ("joint", &dj), ("joint twin", &tj)] {

@@ -122,10 +122,33 @@ pub fn summary(label: &str, d: &eha_sim::diagnosis::Diagnosis) -> String {
     )
 }
 
-/// The candidates at their typical magnitudes.
+/// `EHA_PLAN_DUMP=DIR` (by hand): writes `logs` as CSV under
+/// `DIR/{seed}-{label}/`, to be diagnosed with the command.
+fn dump(seed: u64, label: &str, logs: &[(&str, &MeasuredRun)]) {
+    if let Ok(dir) = std::env::var("EHA_PLAN_DUMP") {
+        let dir = std::path::Path::new(&dir).join(format!("{seed}-{label}"));
+        std::fs::create_dir_all(&dir).expect("dump dir");
+        for (n, r) in logs {
+            r.write_file(dir.join(format!("{n}.csv"))).expect("dump");
+        }
+    }
+}
+
+/// The candidates at the magnitudes `eha-sim plan` takes when none is
+/// given: the model's fit start of each (below the middle of the physical
+/// range that the diagnosis's `typical_magnitude` takes; planning for that
+/// instead was measured and not kept, docs/test-plans.md; by hand with
+/// `EHA_PLAN_MAGNITUDE=typical`).
 fn typical(log: &MeasuredRun, cands: &[Candidate]) -> Vec<(Candidate, f64)> {
     let model = ReferenceModel::new(Rig::default(), log).expect("model");
-    cands.iter().map(|&c| (c, model.extension_params(c)[0].start)).collect()
+    let middle = std::env::var("EHA_PLAN_MAGNITUDE").is_ok_and(|v| v == "typical");
+    cands
+        .iter()
+        .map(|&c| {
+            let spec = &model.extension_params(c)[0];
+            (c, if middle { eha_sim::diagnosis::analysis::typical_magnitude(c, spec) } else { spec.start })
+        })
+        .collect()
 }
 
 fn mean_ambient(log: &MeasuredRun) -> f64 {
@@ -153,8 +176,15 @@ fn planned_case(seed: u64, duration_s: f64, s: Structure) -> (f64, f64, String, 
     let p = plan(&Rig::default(), &log, &typical(&log, &lead), Limits::for_rig(&Rig::default(), &log), duration_s, Decision::Alone).expect("plan");
     let secs = t.elapsed().as_secs_f64();
     let (plog, ptwin, pch) = fly(&p.design, &c, &truth, mean_ambient(&log));
+    dump(seed, "alone", &[("log", &log), ("twin", &twin), ("planned", &plog), ("planned-twin", &ptwin)]);
     let (r1, a1, t1, _, d1) = ratio(&plog, &ptwin, pch, s);
     let exp = p.expected.iter().find(|e| e.planned.candidate == c.hidden.name()).map(|e| (e.planned.best.1, e.on_log.as_ref().map(|r| r.best.1)));
+    // What the plan predicted per channel for the hidden candidate
+    // (imprint, left, floor; K), to set beside the flown run and its twin.
+    if let Some(e) = p.expected.iter().find(|e| e.planned.candidate == c.hidden.name()) {
+        let ch: Vec<String> = e.planned.channels.iter().map(|x| format!("{} {:.3}/{:.3}/{:.3}", x.channel, x.imprint_k, x.left_k, x.floor_k)).collect();
+        eprintln!("  predicted for {} (imprint/left/floor K): {}", c.hidden.name(), ch.join(", "));
+    }
     eprintln!(
         "{seed} {}: original r {r0:.2} on {} ({a0}; leading {lead:?}); plan {:.0} s: {} (D_s {:.3}); expected r̂ for the hidden candidate {exp:?}; planned r {r1:.2} on {} ({a1}; twin {t1})",
         c.hidden.name(),
@@ -178,7 +208,9 @@ fn planned_case(seed: u64, duration_s: f64, s: Structure) -> (f64, f64, String, 
 /// finite, expected ratios ≥ 1. A candidate a
 /// throttle plan cannot excite is refused with exit ≠ 0 and a message.
 /// The same contract with `--joint` (planned for the joint decision with
-/// the log, `plan.json`'s `decision` "Joint").
+/// the log, `plan.json`'s `decision` "Joint"), the lag named without a
+/// magnitude: planned for at the model's fit start, 30 s (`plan.json`'s
+/// `candidates`).
 #[test]
 fn plan_command_writes_a_readable_mission_within_limits() {
     let c = EmuCase { hidden: Candidate::SensorLag, scenario: eha_sim::emulator::missions::EmuScenario::ConstantThrottle, seed: 1704, duration_s: 600.0 };
@@ -194,7 +226,7 @@ fn plan_command_writes_a_readable_mission_within_limits() {
     };
     for (sub, joint) in [("out", false), ("out-joint", true)] {
         let t = std::time::Instant::now();
-        let mut args = vec!["--candidates", "sensor-lag=120"];
+        let mut args = vec!["--candidates", if joint { "sensor-lag" } else { "sensor-lag=120" }];
         if joint {
             args.push("--joint");
         }
@@ -211,6 +243,8 @@ fn plan_command_writes_a_readable_mission_within_limits() {
         }
         let j: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join(sub).join("plan.json")).expect("plan.json")).expect("json");
         assert_eq!(j["decision"], if joint { "Joint" } else { "Alone" });
+        let lag_s = if joint { 30.0 } else { 120.0 };
+        assert_eq!(j["candidates"][0][2].as_f64(), Some(lag_s), "{}", j["candidates"]);
         let fam = j["family"].as_array().expect("family");
         assert!(fam.iter().all(|f| f["d_s"].as_f64().is_some_and(f64::is_finite)), "{fam:?}");
         // The chosen mission ranks first: candidates at r̂ ≥ 2, then Σ ln min(r̂, 2), then D_s.
@@ -269,7 +303,9 @@ fn slow_planned_runs_lift_effects_above_the_floor() {
 /// by-hand measurement: the seed from `EHA_PLAN_SEED` (default 1709), the
 /// plan's duration from `EHA_PLAN_DURATION_S` (default 1200 s), the
 /// structure from `EHA_PLAN_STRUCTURE` ([`structure`]); `EHA_PLAN_ALL=1`
-/// plans for every candidate a throttle run can excite.
+/// plans for every candidate a throttle run can excite;
+/// `EHA_PLAN_MAGNITUDE=typical` plans for the middle of each physical
+/// range ([`typical`]); `EHA_PLAN_DUMP=DIR` writes the four logs ([`dump`]).
 #[test]
 #[ignore]
 fn slow_alone_case() {
@@ -494,8 +530,17 @@ fn slow_family_bound_case() {
 /// showable by any mission of either family (r̂ ≤ 1.11). Asserted as
 /// measured: all five below, lifted exactly 1709, 1711 and 1713, named
 /// 1709 only, no wrong cause, no false discovery ([`cases_alone`]).
-/// `EHA_PLAN_SEEDS` (comma-separated) runs another list and asserts only
-/// the last two.
+/// Planned for the middle of each cause's physical range instead
+/// (`EHA_PLAN_MAGNITUDE=typical`, 2026-11-29, 284 s): 1700 → 0.74, 1701 →
+/// 1.22, 1709 → **8.40** `unexplained` (500/10 → 500/100 → 2000 rpm/10 bar
+/// every 300 s; the calibration takes the churning up on the training
+/// window, its fit goes to 3e-7), 1711 → **2.97** `unexplained`, 1713 →
+/// **6.51** `unexplained`, twins `unexplained` but 1701's: lifted 3, named
+/// 0; the hidden candidate's r̂ nearer the flown r (1709 2.58, 1711 3.58,
+/// 1713 4.01 against 2.07, 1.15, 2.01 at the fit starts). Not kept.
+/// `EHA_PLAN_SEEDS` (comma-separated) runs another list, and
+/// `EHA_PLAN_MAGNITUDE=typical` plans for the middle of each physical
+/// range ([`typical`]); either asserts only what holds whatever the ratios.
 #[test]
 #[ignore = "slow tier: five emulator cases planned, flown and diagnosed with their twins, ~8 min"]
 fn slow_planned_runs_below_the_floor_default_structure() {
@@ -505,7 +550,7 @@ fn slow_planned_runs_below_the_floor_default_structure() {
     let ids = |v: &[AloneRow]| v.iter().map(|r| r.0).collect::<Vec<_>>();
     let named: Vec<u64> = lifted.iter().filter(|r| r.3 == case(r.0).hidden.name()).map(|r| r.0).collect();
     eprintln!("BELOW {} rows, {} below r 2 on the log, lifted {:?}, lifted and named {named:?}", rows.len(), below.len(), ids(&lifted));
-    if custom.is_none() {
+    if custom.is_none() && std::env::var("EHA_PLAN_MAGNITUDE").is_err() {
         assert_eq!(ids(&below), [1700, 1701, 1709, 1711, 1713], "measured set below r 2 changed: {msg}");
         assert_eq!(ids(&lifted), [1709, 1711, 1713], "measured lift changed: {msg}");
         assert_eq!(named, [1709], "measured names changed: {msg}");
