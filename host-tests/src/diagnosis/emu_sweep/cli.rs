@@ -94,6 +94,11 @@ pub struct EmuSweepArgs {
     /// re-statement needs (`diagnosis::gate_obs`).
     #[arg(long)]
     pub detectability: bool,
+    /// Model runs allowed per least-squares fit, as `diagnose --max-sims`
+    /// (the physical set's fits get at least six Jacobians whatever it
+    /// says).
+    #[arg(long, default_value_t = crate::diagnosis::fit::FitOptions::default().max_sims)]
+    pub max_sims: usize,
 }
 
 
@@ -151,6 +156,7 @@ pub fn run(a: &EmuSweepArgs) -> ExitCode {
         let o = DiagnoseOptions {
             structure: a.structure.unwrap_or(DiagnoseOptions::default().structure),
             nominal_restarts: a.nominal_restarts,
+            fit: crate::diagnosis::fit::FitOptions { max_sims: a.max_sims.max(4), ..Default::default() },
             ..Default::default()
         };
         match run_emu_case_reach(*c, &o, !a.no_twins, !a.no_oracle, a.detectability) {
