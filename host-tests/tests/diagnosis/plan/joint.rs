@@ -30,7 +30,7 @@ fn joint_case(seed: u64, duration_s: f64, decision: Decision, s: Structure) -> (
     let o = DiagnoseOptions::default();
     let d0 = diagnose(&log, &model_of(&log, s), &o).expect("diagnosis");
     let lead = leading_of(&d0);
-    let p = plan(&Rig::default(), &log, &typical(&log, &lead), Limits::for_rig(&Rig::default(), &log), duration_s, decision).expect("plan");
+    let p = plan(&Rig::default(), &log, &magnitudes(&log, &lead), Limits::for_rig(&Rig::default(), &log), duration_s, decision).expect("plan");
     let exp: Vec<String> = p.expected.iter().map(|e| format!("{} r̂ {:.2} on {} (log {:.2})", e.planned.candidate, e.planned.best.1, e.planned.best.0, e.on_log.as_ref().map_or(f64::NAN, |r| r.best.1))).collect();
     eprintln!("  plan ({:?}): {} (D_s {:.3}); expected {}", p.decision, p.design.name, p.d_s, exp.join(", "));
     let (plog, ptwin, pch) = fly(&p.design, &c, &truth, mean_ambient(&log));

@@ -139,7 +139,7 @@ fn dump(seed: u64, label: &str, logs: &[(&str, &MeasuredRun)]) {
 /// range that the diagnosis's `typical_magnitude` takes; planning for that
 /// instead was measured and not kept, docs/test-plans.md; by hand with
 /// `EHA_PLAN_MAGNITUDE=typical`).
-fn typical(log: &MeasuredRun, cands: &[Candidate]) -> Vec<(Candidate, f64)> {
+fn magnitudes(log: &MeasuredRun, cands: &[Candidate]) -> Vec<(Candidate, f64)> {
     let model = ReferenceModel::new(Rig::default(), log).expect("model");
     let middle = std::env::var("EHA_PLAN_MAGNITUDE").is_ok_and(|v| v == "typical");
     cands
@@ -173,7 +173,7 @@ fn planned_case(seed: u64, duration_s: f64, s: Structure) -> (f64, f64, String, 
         lead
     };
     let t = std::time::Instant::now();
-    let p = plan(&Rig::default(), &log, &typical(&log, &lead), Limits::for_rig(&Rig::default(), &log), duration_s, Decision::Alone).expect("plan");
+    let p = plan(&Rig::default(), &log, &magnitudes(&log, &lead), Limits::for_rig(&Rig::default(), &log), duration_s, Decision::Alone).expect("plan");
     let secs = t.elapsed().as_secs_f64();
     let (plog, ptwin, pch) = fly(&p.design, &c, &truth, mean_ambient(&log));
     dump(seed, "alone", &[("log", &log), ("twin", &twin), ("planned", &plog), ("planned-twin", &ptwin)]);
@@ -268,7 +268,7 @@ fn plan_command_writes_a_readable_mission_within_limits() {
 
 /// On the emulator: effects the original 1200 s log left below r = 2,
 /// planned for as the command plans (the log's leading candidates, at
-/// typical magnitudes, every throttle candidate when the log admitted none;
+/// the model's fit starts ([`magnitudes`]), every throttle candidate when the log admitted none;
 /// the hidden one is not told), the planned mission flown by the same
 /// machine with the same hidden effect, and its twin without; diagnosed
 /// under `--structure off` ([`structure`]).
@@ -305,7 +305,7 @@ fn slow_planned_runs_lift_effects_above_the_floor() {
 /// structure from `EHA_PLAN_STRUCTURE` ([`structure`]); `EHA_PLAN_ALL=1`
 /// plans for every candidate a throttle run can excite;
 /// `EHA_PLAN_MAGNITUDE=typical` plans for the middle of each physical
-/// range ([`typical`]); `EHA_PLAN_DUMP=DIR` writes the four logs ([`dump`]).
+/// range ([`magnitudes`]); `EHA_PLAN_DUMP=DIR` writes the four logs ([`dump`]).
 #[test]
 #[ignore]
 fn slow_alone_case() {
@@ -449,7 +449,7 @@ fn slow_planned_run_twice_as_long_default_structure() {
 /// By hand (prints, asserts nothing): what the two- and three-level
 /// families can show of one case's hidden effect. For the seed in
 /// `EHA_PLAN_SEED` (default 1709), under `EHA_PLAN_STRUCTURE`, the plan
-/// for every throttle candidate at its typical magnitude is evaluated on
+/// for every throttle candidate at its fit start ([`magnitudes`]) is evaluated on
 /// both families ([`family`], [`family_three`]); each design's expected
 /// ratio for the hidden candidate is printed, and the design of each family
 /// with the largest one (an oracle's choice: the hidden cause is told) is
@@ -475,7 +475,7 @@ fn slow_family_bound_case() {
     for (label, fam) in families {
         let t = std::time::Instant::now();
         let mut designs = Vec::new();
-        let p = plan_among(&Rig::default(), &log, &typical(&log, &cands), limits, Decision::Alone, |a| {
+        let p = plan_among(&Rig::default(), &log, &magnitudes(&log, &cands), limits, Decision::Alone, |a| {
             designs = fam(&limits, dur, a);
             designs.clone()
         })
@@ -540,7 +540,7 @@ fn slow_family_bound_case() {
 /// 1713 4.01 against 2.07, 1.15, 2.01 at the fit starts). Not kept.
 /// `EHA_PLAN_SEEDS` (comma-separated) runs another list, and
 /// `EHA_PLAN_MAGNITUDE=typical` plans for the middle of each physical
-/// range ([`typical`]); either asserts only what holds whatever the ratios.
+/// range ([`magnitudes`]); either asserts only what holds whatever the ratios.
 #[test]
 #[ignore = "slow tier: five emulator cases planned, flown and diagnosed with their twins, ~8 min"]
 fn slow_planned_runs_below_the_floor_default_structure() {
