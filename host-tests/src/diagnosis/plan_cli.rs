@@ -135,10 +135,14 @@ pub fn run(a: &PlanArgs) -> anyhow::Result<()> {
     std::fs::write(a.out.join("plan.md"), p.markdown())?;
     std::fs::write(a.out.join("plan.json"), serde_json::to_string_pretty(&p)? + "\n")?;
     println!("mission: {} (D_s {:.3}) -> {}", p.design.name, p.d_s, a.out.join("mission.csv").display());
+    // Each candidate with the magnitude planned for: r̂ follows it
+    // (docs/test-plans.md, "What stands between lifted and named").
     for e in &p.expected {
+        let mag: Vec<String> = e.planned.magnitude.iter().map(|(n, v, u)| format!("{n} {v:.3e} {u}")).collect();
         println!(
-            "  {}: expected r {:.2} on {} (separated {:.2}; on the log {}){}",
+            "  {} at {}: expected r {:.2} on {} (separated {:.2}; on the log {}){}",
             e.planned.candidate,
+            mag.join(", "),
             e.planned.best.1,
             e.planned.best.0,
             e.planned_separated,

@@ -210,7 +210,7 @@ fn planned_case(seed: u64, duration_s: f64, s: Structure) -> (f64, f64, String, 
 /// The same contract with `--joint` (planned for the joint decision with
 /// the log, `plan.json`'s `decision` "Joint"), the lag named without a
 /// magnitude: planned for at the model's fit start, 30 s (`plan.json`'s
-/// `candidates`).
+/// `candidates`, and the printed expectation names it).
 #[test]
 fn plan_command_writes_a_readable_mission_within_limits() {
     let c = EmuCase { hidden: Candidate::SensorLag, scenario: eha_sim::emulator::missions::EmuScenario::ConstantThrottle, seed: 1704, duration_s: 600.0 };
@@ -245,6 +245,8 @@ fn plan_command_writes_a_readable_mission_within_limits() {
         assert_eq!(j["decision"], if joint { "Joint" } else { "Alone" });
         let lag_s = if joint { 30.0 } else { 120.0 };
         assert_eq!(j["candidates"][0][2].as_f64(), Some(lag_s), "{}", j["candidates"]);
+        // The printed expectation names the magnitude it holds for.
+        assert!(stdout.contains(&format!("sensor-lag at sensor_tau_s {lag_s:.3e} s: expected r")), "{stdout}");
         let fam = j["family"].as_array().expect("family");
         assert!(fam.iter().all(|f| f["d_s"].as_f64().is_some_and(f64::is_finite)), "{fam:?}");
         // The chosen mission ranks first: candidates at r̂ ≥ 2, then Σ ln min(r̂, 2), then D_s.
