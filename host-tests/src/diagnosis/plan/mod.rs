@@ -247,6 +247,10 @@ impl Projected {
     }
 }
 
+/// One mission as evaluated: its row, its projection, and why the
+/// diagnosis could not name each candidate on it (if so).
+type Evaluation = Result<(Evaluated, Projected, Vec<Option<String>>), String>;
+
 /// How a mission is ranked: first by how many candidates it is expected
 /// to lift to [`SHOWABLE_RATIO`] (the ratio at which a diagnosis must name
 /// a cause), then by how close it brings the others (Σ ln min(r̂, 2)), then
@@ -305,7 +309,7 @@ pub fn plan_among(rig: &Rig, log: &MeasuredRun, cands: &[(Candidate, f64)], limi
         x.iter().sum::<f64>() / x.len().max(1) as f64
     });
     let designs = designs(ambient_c);
-    let evaluated: Vec<Result<(Evaluated, Projected, Vec<Option<String>>), String>> = designs
+    let evaluated: Vec<Evaluation> = designs
         .par_iter()
         .map(|d| {
             let run = predicted_log(&machine.calibrated, d)?;

@@ -473,7 +473,8 @@ fn slow_family_bound_case() {
     let cands: Vec<Candidate> = Candidate::EXTENSIONS.iter().copied().filter(|&k| k != Candidate::CoulombFriction).collect();
     let hidden = cands.iter().position(|&k| k == c.hidden).expect("a throttle candidate");
     let limits = Limits::for_rig(&Rig::default(), &log);
-    let families: [(&str, fn(&Limits, f64, f64) -> Vec<Design>); 2] = [("two-level", family), ("three-level", family_three)];
+    type Family = fn(&Limits, f64, f64) -> Vec<Design>;
+    let families: [(&str, Family); 2] = [("two-level", family), ("three-level", family_three)];
     for (label, fam) in families {
         let t = std::time::Instant::now();
         let mut designs = Vec::new();
