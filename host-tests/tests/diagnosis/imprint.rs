@@ -74,6 +74,7 @@ impl Checks {
         self.missed_with_twin(r, answer, ratio, Some(twin_cause));
     }
 
+    /// The body of both: the answer as measured, then r and the twin.
     fn missed_with_twin(&mut self, r: &EmuResult, answer: &str, ratio: f64, twin_cause: Option<&str>) {
         if r.answer != answer {
             self.0.push(format!("{}: answer {} (measured {answer})", r.case.seed, r.answer));

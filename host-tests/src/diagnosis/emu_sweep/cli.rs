@@ -95,8 +95,8 @@ pub struct EmuSweepArgs {
     #[arg(long)]
     pub detectability: bool,
     /// Model runs allowed per least-squares fit, as `diagnose --max-sims`
-    /// (the physical set's fits get at least six Jacobians whatever it
-    /// says).
+    /// (every fit gets at least six Jacobians whatever it says,
+    /// `fit::fit_deferred`).
     #[arg(long, default_value_t = crate::diagnosis::fit::FitOptions::default().max_sims)]
     pub max_sims: usize,
 }
@@ -156,7 +156,7 @@ pub fn run(a: &EmuSweepArgs) -> ExitCode {
         let o = DiagnoseOptions {
             structure: a.structure.unwrap_or(DiagnoseOptions::default().structure),
             nominal_restarts: a.nominal_restarts,
-            fit: crate::diagnosis::fit::FitOptions { max_sims: a.max_sims.max(4), ..Default::default() },
+            fit: crate::diagnosis::fit::FitOptions { max_sims: a.max_sims, ..Default::default() },
             ..Default::default()
         };
         match run_emu_case_reach(*c, &o, !a.no_twins, !a.no_oracle, a.detectability) {

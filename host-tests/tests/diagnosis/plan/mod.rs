@@ -178,10 +178,11 @@ fn planned_case(seed: u64, duration_s: f64, s: Structure) -> (f64, f64, String, 
     let (plog, ptwin, pch) = fly(&p.design, &c, &truth, mean_ambient(&log));
     dump(seed, "alone", &[("log", &log), ("twin", &twin), ("planned", &plog), ("planned-twin", &ptwin)]);
     let (r1, a1, t1, _, d1) = ratio(&plog, &ptwin, pch, s);
-    let exp = p.expected.iter().find(|e| e.planned.candidate == c.hidden.name()).map(|e| (e.planned.best.1, e.on_log.as_ref().map(|r| r.best.1)));
+    let hidden = p.expected.iter().find(|e| e.planned.candidate == c.hidden.name());
+    let exp = hidden.map(|e| (e.planned.best.1, e.on_log.as_ref().map(|r| r.best.1)));
     // What the plan predicted per channel for the hidden candidate
     // (imprint, left, floor; K), to set beside the flown run and its twin.
-    if let Some(e) = p.expected.iter().find(|e| e.planned.candidate == c.hidden.name()) {
+    if let Some(e) = hidden {
         let ch: Vec<String> = e.planned.channels.iter().map(|x| format!("{} {:.3}/{:.3}/{:.3}", x.channel, x.imprint_k, x.left_k, x.floor_k)).collect();
         eprintln!("  predicted for {} (imprint/left/floor K): {}", c.hidden.name(), ch.join(", "));
     }
