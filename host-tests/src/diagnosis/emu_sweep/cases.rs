@@ -83,12 +83,17 @@ fn cases_from(list: &[(&str, EmuScenario)], duration_s: f64, base: u64) -> Vec<E
         .collect()
 }
 
-/// The case of `seed` in the first repetition of both case sets at
-/// `duration_s` (seeds 1700–1717 of [`default_cases`], 2700–2717 of
-/// [`ident_cases`]: what `emulator-sweep --cases original,ident` runs);
-/// `None` for another seed or a retired slot.
+/// The case of `seed` in the first three repetitions of both case sets at
+/// `duration_s` (seeds 1700–1717, 1800–1817, 1900–1917 of
+/// [`default_cases`], 2700–2717, 2800–2817, 2900–2917 of [`ident_cases`]:
+/// what `emulator-sweep --cases original,ident --seeds 3` runs); `None` for
+/// another seed or a retired slot.
 pub fn case_of_seed(duration_s: f64, seed: u64) -> Option<EmuCase> {
-    default_cases(duration_s, 1700).into_iter().chain(ident_cases(duration_s, 2700)).find(|c| c.seed == seed)
+    let set = |base: u64| (base..base + 100).contains(&seed).then_some(base);
+    let (orig, ident) = ((1..=3).find_map(|k| set(1600 + 100 * k)), (1..=3).find_map(|k| set(2600 + 100 * k)));
+    orig.map(|b| default_cases(duration_s, b))
+        .or_else(|| ident.map(|b| ident_cases(duration_s, b)))
+        .and_then(|v| v.into_iter().find(|c| c.seed == seed))
 }
 
 /// The effect-free log of case `c` as the sweep diagnoses it: the case's

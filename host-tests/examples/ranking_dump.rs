@@ -1,0 +1,77 @@
+//! Every candidate's fit on emulator logs, as the diagnosis ranks it, for
+//! measuring an admission rule offline: for each seed the case's log (its
+//! hidden effect in) and its effect-free log (the twin, or the case itself
+//! when nothing is hidden), diagnosed under the default options; one JSON
+//! line per log with the answer, the whole ranking (ΔBIC, the gain where
+//! the candidate acts, the pooled and per-channel held-out RMSE, whether it
+//! qualifies and why not), the evidence's per-channel floors and the
+//! posterior.
+//!
+//! `cargo run --profile fast -p eha-sim --example ranking_dump -- [--affected] OUT.jsonl SEED…`
+//! (`--affected`: only print each case's affected channel, the one its
+//! imprint ratio is taken on, without diagnosing)
+//! (seeds of the case sets, 1700–1717, 1800–1817, 1900–1917, 2700–2717,
+//! 2800–2817, 2900–2917; the case's own log is skipped when nothing is hidden; lines
+//! are appended, so a stopped run is resumed by passing the seeds left).
+
+use eha_sim::diagnosis::emu_sweep::case_of_seed;
+use eha_sim::diagnosis::reference::ReferenceModel;
+use eha_sim::diagnosis::{diagnose, Candidate, DiagnoseOptions};
+use eha_sim::emulator::{generate, generate_twin, EmuCase};
+use eha_sim::measured::MeasuredRun;
+use eha_sim::rig::Rig;
+use std::io::Write as _;
+
+fn line(seed: u64, kind: &str, c: &EmuCase, run: &MeasuredRun, o: &DiagnoseOptions) -> serde_json::Value {
+    let model = ReferenceModel::new(Rig::default(), run).expect("model").with_structure(run, o.structure);
+    let t = std::time::Instant::now();
+    let d = diagnose(run, &model, o).expect("diagnosis");
+    serde_json::json!({
+        "seed": seed,
+        "kind": kind,
+        "scenario": format!("{:?}", c.scenario),
+        "hidden": c.hidden.name(),
+        "answer": d.answer(),
+        "tier": d.nuisance_set,
+        "ranking": d.ranking,
+        "floors": d.posterior.channels.iter().map(|e| serde_json::json!({"channel": e.channel, "misfit_k": e.misfit_k, "floor_k": e.floor_k, "noise_k": e.noise_k})).collect::<Vec<_>>(),
+        "posterior": d.posterior.causes.iter().map(|p| (p.cause.clone(), p.probability, p.log_bayes_factor, p.prior)).collect::<Vec<_>>(),
+        "seconds": t.elapsed().as_secs_f64(),
+    })
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let affected_only = args.first().is_some_and(|a| a == "--affected");
+    let args = &args[usize::from(affected_only)..];
+    let Some((out, seeds)) = args.split_first() else {
+        eprintln!("usage: ranking_dump [--affected] OUT.jsonl SEED…");
+        std::process::exit(2);
+    };
+    let o = DiagnoseOptions::default();
+    let mut f = std::fs::OpenOptions::new().create(true).append(true).open(out).expect("output file");
+    for seed in seeds.iter().map(|a| a.parse::<u64>().expect("seed")) {
+        let Some(c) = case_of_seed(1200.0, seed) else {
+            eprintln!("{seed}: not a case of the sets (a retired slot?), skipped");
+            continue;
+        };
+        let mut logs = vec![];
+        if c.hidden != Candidate::None {
+            let (run, truth) = generate(&c).expect("log");
+            // The channel the effect changes most (the imprint ratio's).
+            eprintln!("{seed} affected {:?}", truth.affected.map(|a| a.0.name()));
+            if affected_only {
+                continue;
+            }
+            logs.push(("case", run));
+            logs.push(("twin", generate_twin(&c).expect("twin").0));
+        } else if !affected_only {
+            logs.push(("effect-free", generate(&c).expect("log").0));
+        }
+        for (kind, run) in logs {
+            let v = line(seed, kind, &c, &run, &o);
+            eprintln!("{seed} {kind}: {} ({:.0} s)", v["answer"], v["seconds"].as_f64().unwrap_or(f64::NAN));
+            writeln!(f, "{v}").expect("write");
+        }
+    }
+}
