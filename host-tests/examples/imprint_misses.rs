@@ -5,7 +5,8 @@
 //! training and held-out RMSE on the affected channel and pooled.
 //!
 //! `cargo run --profile fast -p eha-sim --example imprint_misses -- SEED [twin] [structure|no-case|no-case-held] [sigma=NAME:S|cal…] [VARIANT…]`
-//! (seeds 1700–1717 and 2700–2717; ~20–60 s a case on two cores).
+//! (seeds 1700–1717, 2700–2717 and their repetitions 18xx, 19xx, 28xx,
+//! 29xx; ~3–60 s a case on two cores).
 
 use eha_sim::diagnosis::analysis::{fit_points, split_time_s};
 use eha_sim::diagnosis::emu_sweep::case_of_seed;

@@ -106,3 +106,25 @@ pub fn effect_free_log(c: &EmuCase) -> Result<MeasuredRun, String> {
 /// Candidates that left the list (their effect is part of the baseline now):
 /// their slots in the case sets keep their seeds unused.
 pub const RETIRED: [&str; 1] = ["viscosity-temperature"];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each repetition's seeds find their own set's case (the scenario and
+    /// hidden effect of the same slot, the seed itself); retired slots and
+    /// seeds outside the three repetitions find none.
+    #[test]
+    fn case_of_seed_finds_three_repetitions_of_both_sets() {
+        for (base, set) in [(1700, default_cases(1200.0, 1700)), (2700, ident_cases(1200.0, 2700))] {
+            for c in &set {
+                for rep in 0..3 {
+                    let found = case_of_seed(1200.0, c.seed + 100 * rep).expect("a case of the repetition");
+                    assert_eq!((found.seed, found.scenario, found.hidden), (c.seed + 100 * rep, c.scenario, c.hidden), "set {base}");
+                }
+            }
+        }
+        assert!(case_of_seed(1200.0, 1702).is_none(), "a retired slot");
+        assert!(case_of_seed(1200.0, 2000).is_none() && case_of_seed(1200.0, 1699).is_none() && case_of_seed(1200.0, 3000).is_none());
+    }
+}
