@@ -89,6 +89,8 @@ fn cases_from(list: &[(&str, EmuScenario)], duration_s: f64, base: u64) -> Vec<E
 /// what `emulator-sweep --cases original,ident --seeds 3` runs); `None` for
 /// another seed or a retired slot.
 pub fn case_of_seed(duration_s: f64, seed: u64) -> Option<EmuCase> {
+    // The repetition's base (1700/1800/1900, 2700/2800/2900) whose
+    // hundred holds `seed`, then the slot within it.
     let set = |base: u64| (base..base + 100).contains(&seed).then_some(base);
     let (orig, ident) = ((1..=3).find_map(|k| set(1600 + 100 * k)), (1..=3).find_map(|k| set(2600 + 100 * k)));
     orig.map(|b| default_cases(duration_s, b))
