@@ -1,0 +1,111 @@
+//! The third repetition of both emulator case sets (1900–1917,
+//! 2900–2917), which no admission rule or threshold was set with: every
+//! case log, its effect-free twin and every effect-free case, diagnosed
+//! as `emulator-sweep` diagnoses them under the default options, each
+//! answer asserted as measured (2026-11-29, `--example ranking_dump`,
+//! `docs/data/ranking-1900-2900.jsonl`; docs/diagnosis-numbers.md, "A
+//! third seed set"): **named at r ≥ 2 1 of 9** (2905's lag), 2904's lag
+//! named at r 1.98, **no wrong cause, no false discovery** on the 32
+//! effect-free logs. The misses stay asserted as misses: a change that
+//! names one of them (or names anything on an effect-free log) fails
+//! here and must be measured on the whole set.
+//!
+//! Slow tier only: 56 diagnoses, 8–16 s each (passes as committed: 676 s
+//! wall on a quiet 2-core machine, 2026-11-29).
+
+use eha_sim::diagnosis::emu_sweep::case_of_seed;
+use eha_sim::diagnosis::reference::ReferenceModel;
+use eha_sim::diagnosis::{diagnose, Candidate, DiagnoseOptions};
+use eha_sim::emulator::{generate, generate_twin};
+use eha_sim::rig::Rig;
+
+/// Seed, log ("case": the hidden effect in; "twin": the same without it;
+/// "effect-free": a case that hides nothing), answer and the calibrated
+/// baseline's pooled held-out RMSE (K), as measured.
+const MEASURED: [(u64, &str, &str, f64); 56] = [
+    (1900, "case", "unexplained", 1.362),
+    (1900, "twin", "unexplained", 1.255),
+    (1901, "case", "unexplained", 1.208),
+    (1901, "twin", "unexplained", 1.235),
+    (1904, "case", "none", 0.453),
+    (1904, "twin", "none", 0.503),
+    (1905, "case", "none", 0.385),
+    (1905, "twin", "none", 0.292),
+    (1906, "case", "none", 0.131),
+    (1906, "twin", "none", 0.137),
+    (1907, "case", "none", 0.128),
+    (1907, "twin", "none", 0.129),
+    (1908, "case", "unexplained", 0.636),
+    (1908, "twin", "unexplained", 0.660),
+    (1909, "case", "unexplained", 1.548),
+    (1909, "twin", "unexplained", 1.674),
+    (1910, "case", "unexplained", 0.346),
+    (1910, "twin", "none", 0.208),
+    (1911, "case", "unexplained", 0.988),
+    (1911, "twin", "unexplained", 0.918),
+    (1912, "case", "none", 0.205),
+    (1912, "twin", "none", 0.129),
+    (1913, "case", "none", 0.188),
+    (1913, "twin", "none", 0.247),
+    (1914, "effect-free", "none", 0.346),
+    (1915, "effect-free", "unexplained", 0.871),
+    (1916, "effect-free", "unexplained", 0.886),
+    (1917, "effect-free", "none", 0.133),
+    (2900, "case", "unexplained", 0.831),
+    (2900, "twin", "unexplained", 0.540),
+    (2901, "case", "none", 0.440),
+    (2901, "twin", "none", 0.415),
+    (2904, "case", "sensor-lag", 1.481),
+    (2904, "twin", "unexplained", 0.636),
+    (2905, "case", "sensor-lag", 2.146),
+    (2905, "twin", "none", 0.507),
+    (2906, "case", "none", 0.138),
+    (2906, "twin", "none", 0.140),
+    (2907, "case", "none", 0.164),
+    (2907, "twin", "none", 0.179),
+    (2908, "case", "unexplained", 0.744),
+    (2908, "twin", "unexplained", 0.893),
+    (2909, "case", "unexplained", 1.080),
+    (2909, "twin", "unexplained", 2.539),
+    (2910, "case", "unexplained", 1.005),
+    (2910, "twin", "unexplained", 1.067),
+    (2911, "case", "unexplained", 1.930),
+    (2911, "twin", "none", 0.722),
+    (2912, "case", "unexplained", 1.049),
+    (2912, "twin", "unexplained", 1.074),
+    (2913, "case", "none", 0.575),
+    (2913, "twin", "unexplained", 0.711),
+    (2914, "effect-free", "unexplained", 1.185),
+    (2915, "effect-free", "unexplained", 1.003),
+    (2916, "effect-free", "unexplained", 1.103),
+    (2917, "effect-free", "none", 0.156),
+];
+
+/// Every log above: the answer as measured, and the pooled held-out
+/// misfit within 20 % of the measured value (the calibrated baselines move
+/// with the fits' last digits, as in `effect_free.rs`). All logs run
+/// before the assertion, so one run lists every change.
+#[test]
+#[ignore = "slow tier: 56 emulator diagnoses (~11 min), the third seed set as measured"]
+fn slow_third_seed_set_answers_as_measured() {
+    let o = DiagnoseOptions::default();
+    let mut changed = Vec::new();
+    for (seed, kind, answer, pooled) in MEASURED {
+        let c = case_of_seed(1200.0, seed).expect("a case of the third repetition");
+        let run = match kind {
+            "twin" => generate_twin(&c),
+            _ => generate(&c),
+        }
+        .expect("emulated log")
+        .0;
+        assert_eq!(kind == "effect-free", c.hidden == Candidate::None, "{seed}: the table's kind");
+        let model = ReferenceModel::new(Rig::default(), &run).expect("model").with_structure(&run, o.structure);
+        let d = diagnose(&run, &model, &o).expect("diagnosis");
+        let p = d.before.heldout_rmse_k;
+        eprintln!("{seed} {kind}: {} (measured {answer}), pooled held out {p:.3} K (measured {pooled})", d.answer());
+        if d.answer() != answer || (p / pooled - 1.0).abs() > 0.2 {
+            changed.push(format!("{seed} {kind}: {} pooled {p:.3} K (measured {answer}, {pooled} K)", d.answer()));
+        }
+    }
+    assert!(changed.is_empty(), "changed against the measurement: {changed:#?}");
+}
