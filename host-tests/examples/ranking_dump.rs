@@ -14,10 +14,10 @@
 //! passing the seeds left). `--affected`: only print each case's affected
 //! channel, the one its imprint ratio is taken on, without diagnosing.
 
-use eha_sim::diagnosis::emu_sweep::case_of_seed;
+use eha_sim::diagnosis::emu_sweep::{case_of_seed, effect_free_log};
 use eha_sim::diagnosis::reference::ReferenceModel;
 use eha_sim::diagnosis::{diagnose, Candidate, DiagnoseOptions};
-use eha_sim::emulator::{generate, generate_twin, EmuCase};
+use eha_sim::emulator::{generate, EmuCase};
 use eha_sim::measured::MeasuredRun;
 use eha_sim::rig::Rig;
 use std::io::Write as _;
@@ -91,9 +91,9 @@ fn main() {
                 continue;
             }
             logs.push(("case", run));
-            logs.push(("twin", generate_twin(&c).expect("twin").0));
+            logs.push(("twin", effect_free_log(&c).expect("twin")));
         } else if !affected_only {
-            logs.push(("effect-free", generate(&c).expect("log").0));
+            logs.push(("effect-free", effect_free_log(&c).expect("log")));
         }
         for (kind, run) in logs {
             let v = line(seed, kind, &c, &run, &o);

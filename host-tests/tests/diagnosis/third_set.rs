@@ -13,10 +13,10 @@
 //! Slow tier only: 56 diagnoses, 8–16 s each (passes as committed: 676 s
 //! wall on a quiet 2-core machine, 2026-11-29).
 
-use eha_sim::diagnosis::emu_sweep::case_of_seed;
+use eha_sim::diagnosis::emu_sweep::{case_of_seed, effect_free_log};
 use eha_sim::diagnosis::reference::ReferenceModel;
 use eha_sim::diagnosis::{diagnose, Candidate, DiagnoseOptions};
-use eha_sim::emulator::{generate, generate_twin};
+use eha_sim::emulator::generate;
 use eha_sim::rig::Rig;
 
 /// Seed, log ("case": the hidden effect in; "twin": the same without it;
@@ -92,12 +92,7 @@ fn slow_third_seed_set_answers_as_measured() {
     let mut changed = Vec::new();
     for (seed, kind, answer, pooled) in MEASURED {
         let c = case_of_seed(1200.0, seed).expect("a case of the third repetition");
-        let run = match kind {
-            "twin" => generate_twin(&c),
-            _ => generate(&c),
-        }
-        .expect("emulated log")
-        .0;
+        let run = if kind == "case" { generate(&c).map(|r| r.0) } else { effect_free_log(&c) }.expect("emulated log");
         assert_eq!(kind == "effect-free", c.hidden == Candidate::None, "{seed}: the table's kind");
         let model = ReferenceModel::new(Rig::default(), &run).expect("model").with_structure(&run, o.structure);
         let d = diagnose(&run, &model, &o).expect("diagnosis");

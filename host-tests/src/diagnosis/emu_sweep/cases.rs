@@ -89,13 +89,16 @@ fn cases_from(list: &[(&str, EmuScenario)], duration_s: f64, base: u64) -> Vec<E
 /// what `emulator-sweep --cases original,ident --seeds 3` runs); `None` for
 /// another seed or a retired slot.
 pub fn case_of_seed(duration_s: f64, seed: u64) -> Option<EmuCase> {
-    // The repetition's base (1700/1800/1900, 2700/2800/2900) whose
-    // hundred holds `seed`, then the slot within it.
-    let set = |base: u64| (base..base + 100).contains(&seed).then_some(base);
-    let (orig, ident) = ((1..=3).find_map(|k| set(1600 + 100 * k)), (1..=3).find_map(|k| set(2600 + 100 * k)));
-    orig.map(|b| default_cases(duration_s, b))
-        .or_else(|| ident.map(|b| ident_cases(duration_s, b)))
-        .and_then(|v| v.into_iter().find(|c| c.seed == seed))
+    // The repetition whose hundred holds `seed`, then the slot within it.
+    let holds = |base: &u64| (*base..*base + 100).contains(&seed);
+    let set = if let Some(b) = [1700, 1800, 1900].into_iter().find(holds) {
+        default_cases(duration_s, b)
+    } else if let Some(b) = [2700, 2800, 2900].into_iter().find(holds) {
+        ident_cases(duration_s, b)
+    } else {
+        return None;
+    };
+    set.into_iter().find(|c| c.seed == seed)
 }
 
 /// The effect-free log of case `c` as the sweep diagnoses it: the case's
