@@ -132,6 +132,17 @@ pub fn diagnose(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions) -> 
     diagnose_tier(run, sim, o, true)
 }
 
+/// The physical tier alone ([`Simulator::physical_set`], or `sim` itself
+/// when it has none), without the global tier first: a diagnosis about a
+/// machine whose parameters are already calibrated, where the priors of the
+/// physical set, not four free multipliers, say how far it may have moved.
+pub fn diagnose_physical(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions) -> Result<Diagnosis, DiagnoseError> {
+    match sim.physical_set() {
+        Some(p) => diagnose_tier(run, &*p, o, false),
+        None => diagnose_tier(run, sim, o, false),
+    }
+}
+
 fn diagnose_tier(run: &MeasuredRun, sim: &dyn Simulator, o: &DiagnoseOptions, escalate: bool) -> Result<Diagnosis, DiagnoseError> {
     if !Channel::TEMPERATURES.iter().any(|c| run.get(*c).is_some_and(|v| v.iter().any(Option::is_some))) {
         return Err(DiagnoseError::NoTemperature);
