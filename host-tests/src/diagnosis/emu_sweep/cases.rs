@@ -83,17 +83,17 @@ fn cases_from(list: &[(&str, EmuScenario)], duration_s: f64, base: u64) -> Vec<E
         .collect()
 }
 
-/// The case of `seed` in the first three repetitions of both case sets at
-/// `duration_s` (seeds 1700–1717, 1800–1817, 1900–1917 of
-/// [`default_cases`], 2700–2717, 2800–2817, 2900–2917 of [`ident_cases`]:
-/// what `emulator-sweep --cases original,ident --seeds 3` runs); `None` for
-/// another seed or a retired slot.
+/// The case of `seed` in the first four repetitions of both case sets at
+/// `duration_s` (seeds 1700–1717 … 2000–2017 of [`default_cases`],
+/// 2700–2717 … 3000–3017 of [`ident_cases`]: what `emulator-sweep --cases
+/// original,ident --seeds 4` runs); `None` for another seed or a retired
+/// slot.
 pub fn case_of_seed(duration_s: f64, seed: u64) -> Option<EmuCase> {
     // The repetition whose hundred holds `seed`, then the slot within it.
     let holds = |base: &u64| (*base..*base + 100).contains(&seed);
-    let set = if let Some(b) = [1700, 1800, 1900].into_iter().find(holds) {
+    let set = if let Some(b) = [1700, 1800, 1900, 2000].into_iter().find(holds) {
         default_cases(duration_s, b)
-    } else if let Some(b) = [2700, 2800, 2900].into_iter().find(holds) {
+    } else if let Some(b) = [2700, 2800, 2900, 3000].into_iter().find(holds) {
         ident_cases(duration_s, b)
     } else {
         return None;
@@ -118,18 +118,18 @@ mod tests {
 
     /// Each repetition's seeds find their own set's case (the scenario and
     /// hidden effect of the same slot, the seed itself); retired slots and
-    /// seeds outside the three repetitions find none.
+    /// seeds outside the four repetitions find none.
     #[test]
-    fn case_of_seed_finds_three_repetitions_of_both_sets() {
+    fn case_of_seed_finds_four_repetitions_of_both_sets() {
         for (base, set) in [(1700, default_cases(1200.0, 1700)), (2700, ident_cases(1200.0, 2700))] {
             for c in &set {
-                for rep in 0..3 {
+                for rep in 0..4 {
                     let found = case_of_seed(1200.0, c.seed + 100 * rep).expect("a case of the repetition");
                     assert_eq!((found.seed, found.scenario, found.hidden), (c.seed + 100 * rep, c.scenario, c.hidden), "set {base}");
                 }
             }
         }
         assert!(case_of_seed(1200.0, 1702).is_none(), "a retired slot");
-        assert!(case_of_seed(1200.0, 2000).is_none() && case_of_seed(1200.0, 1699).is_none() && case_of_seed(1200.0, 3000).is_none());
+        assert!(case_of_seed(1200.0, 2100).is_none() && case_of_seed(1200.0, 1699).is_none() && case_of_seed(1200.0, 3100).is_none());
     }
 }
