@@ -16,7 +16,7 @@
 //!
 //! Slow tier only: 56 diagnoses a set, 6–18 s each (the third set's test
 //! passes as committed: 676 s wall on a quiet 2-core machine, 2026-11-29;
-//! the fourth's table is the dump's own run, 651 s).
+//! the fourth's, 656 s).
 
 use eha_sim::diagnosis::emu_sweep::{case_of_seed, effect_free_log};
 use eha_sim::diagnosis::reference::ReferenceModel;
