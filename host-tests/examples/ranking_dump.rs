@@ -8,8 +8,8 @@
 //! posterior.
 //!
 //! `cargo run --profile fast -p eha-sim --example ranking_dump -- [--affected] OUT.jsonl SEED…`
-//! (seeds of the case sets, 1700–1717, 1800–1817, 1900–1917, 2700–2717,
-//! 2800–2817, 2900–2917; a case that hides nothing is its own effect-free
+//! (seeds of the case sets, 1700–1717 … 2000–2017, 2700–2717 …
+//! 3000–3017; a case that hides nothing is its own effect-free
 //! log, one line; lines are appended, so a stopped run is resumed by
 //! passing the seeds left). `--affected`: only print each case's affected
 //! channel, the one its imprint ratio is taken on, without diagnosing.

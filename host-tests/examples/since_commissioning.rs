@@ -1,7 +1,8 @@
 //! **Experiment** (not a product path): the diagnosis about a commissioned
 //! machine. Each emulator case's machine is first calibrated on an
-//! effect-free identification run of its own (another mission and noise,
-//! the physical tier with the default structure, on the whole run); the
+//! effect-free run of its own (an identification run, or the case's own
+//! scenario; another mission and noise; the physical tier with the default
+//! structure, on the whole run); the
 //! case's log, its effect-free twin, or the effect-free case itself is then
 //! diagnosed in the physical tier alone about that calibration, every freed
 //! parameter held by a log-normal prior of σ `SIGMA` (ln) around its
