@@ -13,7 +13,6 @@
 //! (`--same-scenario`: the commissioning run flies the case's own scenario,
 //! another seed, instead of an identification run).
 
-use eha_sim::calibration::{self, set};
 use eha_sim::diagnosis::analysis::{diagnose_physical, fit_points};
 use eha_sim::diagnosis::emu_sweep::{case_of_seed, effect_free_log};
 use eha_sim::diagnosis::fit::{fit, FitOptions};
@@ -42,26 +41,19 @@ struct Commissioned {
 /// Calibrates the physical tier on `run`, all of it, from the rig file.
 fn commission(run: &MeasuredRun, o: &DiagnoseOptions) -> Commissioned {
     let model = ReferenceModel::new(Rig::default(), run).expect("model").with_structure(run, o.structure);
-    let eta_m = model.eta_m_from_current().map(|e| e.0);
     let phys = model.physical_set().expect("a physical tier");
     let specs = phys.nuisance();
     let pts = fit_points(run, f64::INFINITY, o.points_per_channel);
     let start: Vec<f64> = specs.iter().map(|s| s.start).collect();
     let f = fit(&*phys, run, &pts, Candidate::None, &start, None, FitOptions { max_sims: 300, ..o.fit }).expect("commissioning fit");
-    let mut theta = set::nominal();
-    let mut free = vec![];
-    for (s, &v) in specs.iter().zip(&f.nuisance) {
-        let k = set::index(&s.name).expect("a calibration parameter");
-        theta[k] = v;
-        free.push(k);
+    Commissioned {
+        rig: model.physical_rig(&f.nuisance),
+        free: model.physical_free().to_vec(),
+        names: specs.iter().map(|s| s.name.clone()).collect(),
+        eta_m: model.eta_m_from_current().map(|e| e.0),
+        rms_k: (f.rss / f.n as f64).sqrt(),
+        theta: f.nuisance,
     }
-    let mut base = Rig::default();
-    if let Some(e) = eta_m {
-        base.pump.eta_m = e;
-    }
-    let rig = calibration::apply(&base, &theta);
-    let names = specs.iter().map(|s| s.name.clone()).collect();
-    Commissioned { rig, free, names, theta: f.nuisance, eta_m, rms_k: (f.rss / f.n as f64).sqrt() }
 }
 
 #[derive(serde::Serialize)]

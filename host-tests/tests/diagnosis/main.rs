@@ -15,4 +15,4 @@ mod plan;
 mod replay;
 mod stats;
 mod structure;
-mod third_set;
+mod unseen_sets;

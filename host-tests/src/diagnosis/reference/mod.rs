@@ -220,14 +220,29 @@ impl ReferenceModel {
         (REPLAY_STEPS_PER_S * span).max(10_000.0) as u64
     }
 
+    /// The physical tier's rig with its calibration parameters at `nuis`
+    /// (in the order of [`Self::physical_free`], the rest at the rig file),
+    /// `eta_m` from the current where [`Self::with_structure`] took it;
+    /// whichever tier this model calibrates.
+    pub fn physical_rig(&self, nuis: &[f64]) -> Rig {
+        let mut theta = calibration::set::nominal();
+        for (&k, &v) in self.free.iter().zip(nuis) {
+            theta[k] = v;
+        }
+        calibration::apply(&self.phys_rig, &theta)
+    }
+
+    /// Indices into [`crate::calibration::PARAMS`] of the physical tier's
+    /// calibration parameters on this log (what [`Self::with_nuisance_set`]
+    /// takes).
+    pub fn physical_free(&self) -> &[usize] {
+        &self.free
+    }
+
     /// The rig with nuisance values `nuis` and candidate `c` at `ext`.
     pub fn rig_for(&self, nuis: &[f64], c: Candidate, ext: &[f64]) -> Rig {
         let mut r = if self.physical {
-            let mut theta = calibration::set::nominal();
-            for (&k, &v) in self.free.iter().zip(nuis) {
-                theta[k] = v;
-            }
-            calibration::apply(&self.phys_rig, &theta)
+            self.physical_rig(nuis)
         } else {
             let mut r = self.rig.clone();
             r.nuisance.outer_scale = nuis[0];
