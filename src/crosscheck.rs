@@ -58,6 +58,9 @@ pub struct CrossCheck<N> {
     run: u32,
     /// The last complete window disagreed.
     disagree: bool,
+    /// The model step in progress has ticks whose channels were substituted
+    /// (a clear mid-step): it and its window are dropped.
+    tainted: bool,
 }
 
 /// What one model step of the cross-check found.
@@ -89,6 +92,7 @@ impl<N: Num> CrossCheck<N> {
             acc: N::ZERO,
             run: 0,
             disagree: false,
+            tainted: false,
         })
     }
 
@@ -97,7 +101,7 @@ impl<N: Num> CrossCheck<N> {
     /// window with an unusable step is dropped (the disagreement state holds).
     #[inline(always)]
     pub fn step(&mut self, from_pressure: N, from_current: N, usable: bool) -> Verdict {
-        if !usable {
+        if !usable | core::mem::replace(&mut self.tainted, false) {
             self.n = 0;
             self.acc = N::ZERO;
             return Verdict::None;
@@ -130,6 +134,14 @@ impl<N: Num> CrossCheck<N> {
     /// The last complete window disagreed.
     pub fn disagrees(&self) -> bool {
         self.disagree
+    }
+
+    /// The model step in progress mixes substituted and measured ticks (the
+    /// channels were cleared mid-step): its window is dropped at the step's end,
+    /// as a window with an unusable step is. Without it, the worst-case current
+    /// of the ticks before a clear made one window disagree by kilowatts.
+    pub fn taint_step(&mut self) {
+        self.tainted = true;
     }
 
     /// Restarts the count of disagreeing windows (after a clear: a disagreement that

@@ -135,6 +135,10 @@ impl<N: Num> GuardOf<N> {
         if let Some(c) = self.core.get_mut() {
             if let Some(cc) = c.cc.as_mut() {
                 cc.restart_count();
+                // the step in progress summed the cleared channels' worst cases
+                if c.model.pending_ticks() > 0 && bits.channel_set().intersects(CROSS_CHANNELS) {
+                    cc.taint_step();
+                }
                 c.model.set_loss_max(cc.disagrees());
             }
         }
