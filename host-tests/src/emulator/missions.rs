@@ -148,10 +148,16 @@ fn steps(rng: &mut impl Rng, d: f64, lo: f64, hi: f64, mut value: impl FnMut(&mu
     out
 }
 
+/// A mission's ambient (`EmuMission::ambient`): mean 15–27 °C, a
+/// 0.2–0.8 K swing of 40 min period at a random phase.
+pub fn draw_ambient(rng: &mut impl Rng) -> [f64; 3] {
+    [rng.random_range(15.0..27.0), rng.random_range(0.2..0.8), rng.random_range(0.0..std::f64::consts::TAU)]
+}
+
 /// Draws the profile of `scenario` for `duration_s` seconds.
 pub fn draw(scenario: EmuScenario, duration_s: f64, rng: &mut impl Rng) -> EmuMission {
     let d = duration_s;
-    let ambient = [rng.random_range(15.0..27.0), rng.random_range(0.2..0.8), rng.random_range(0.0..std::f64::consts::TAU)];
+    let ambient = draw_ambient(rng);
     let mut m = EmuMission { scenario, duration_s, ambient, speed: vec![(0.0, 500.0)], dp_bar: vec![(0.0, 60.0)], x_ref: vec![], air: vec![(0.0, 0.0)] };
     match scenario {
         EmuScenario::ConstantThrottle => m.dp_bar = vec![(0.0, [20.0, 40.0, 60.0][rng.random_range(0..3)])],
