@@ -21,6 +21,9 @@ use eha_sim::emulator::generate;
 use eha_sim::measured::Channel;
 use eha_sim::rig::Rig;
 
+/// One side of an (emulator, reference) imprint pair.
+type Of = fn(&(f64, f64)) -> f64;
+
 fn main() {
     let o = DiagnoseOptions::default();
     for seed in std::env::args().skip(1).map(|a| a.parse::<u64>().expect("seed")) {
@@ -58,20 +61,21 @@ fn main() {
                     .filter_map(|i| Some((a[i]? - b[i]?, y1[i] - y0[i])))
                     .collect();
                 let n = pairs.len().max(1) as f64;
-                let rms = |v: &dyn Fn(&(f64, f64)) -> f64| (pairs.iter().map(|p| v(p).powi(2)).sum::<f64>() / n).sqrt();
-                let mean = |v: &dyn Fn(&(f64, f64)) -> f64| pairs.iter().map(v).sum::<f64>() / n;
-                let (e, m) = (|p: &(f64, f64)| p.0, |p: &(f64, f64)| p.1);
+                let rms = |f: Of| (pairs.iter().map(|p| f(p).powi(2)).sum::<f64>() / n).sqrt();
+                let mean = |f: Of| pairs.iter().map(f).sum::<f64>() / n;
+                let e: Of = |p| p.0;
+                let m: Of = |p| p.1;
                 let mm: f64 = pairs.iter().map(|p| p.1 * p.1).sum();
                 let scale = if mm > 0.0 { pairs.iter().map(|p| p.0 * p.1).sum::<f64>() / mm } else { 0.0 };
-                let left = rms(&|p: &(f64, f64)| p.0 - scale * p.1) / rms(&e).max(1e-12);
+                let left = (pairs.iter().map(|p| (p.0 - scale * p.1).powi(2)).sum::<f64>() / n).sqrt() / rms(e).max(1e-12);
                 println!(
                     "  {:<14} {:<8} {:.3} / {:+.3}  {:.3} / {:+.3}  {:+.2}  {:.0} %",
                     ch.name(),
                     name,
-                    rms(&e),
-                    mean(&e),
-                    rms(&m),
-                    mean(&m),
+                    rms(e),
+                    mean(e),
+                    rms(m),
+                    mean(m),
                     scale,
                     100.0 * left
                 );

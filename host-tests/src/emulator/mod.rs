@@ -107,7 +107,7 @@ pub struct EmuTruth {
 
 /// Generates the log of `c`.
 pub fn generate(c: &EmuCase) -> Result<(MeasuredRun, EmuTruth), String> {
-    generate_on(c, None, false)
+    generate_on(c, None, false, None)
 }
 
 /// The effect-free twin of case `c`: the same machine, mission, sensor
@@ -115,7 +115,7 @@ pub fn generate(c: &EmuCase) -> Result<(MeasuredRun, EmuTruth), String> {
 /// `affected` is `None`, its magnitude the one the log hides). The
 /// diagnosis's misfit on the twin is the structure floor of that very log.
 pub fn generate_twin(c: &EmuCase) -> Result<(MeasuredRun, EmuTruth), String> {
-    generate_on(c, None, true)
+    generate_on(c, None, true, None)
 }
 
 /// The log of case `c` flown by another case's machine: `machine` is that
@@ -123,7 +123,7 @@ pub fn generate_twin(c: &EmuCase) -> Result<(MeasuredRun, EmuTruth), String> {
 /// noise and dropouts are `c`'s. Two logs of one machine in two scenarios,
 /// as a test campaign would take them.
 pub fn generate_on_machine(c: &EmuCase, machine: &EmuTruth) -> Result<(MeasuredRun, EmuTruth), String> {
-    generate_on(c, Some((&machine.params, machine.magnitude)), false)
+    generate_on(c, Some((&machine.params, machine.magnitude)), false, None)
 }
 
 /// Case `c`'s bench test repeated on its machine with nothing hidden, on
@@ -132,25 +132,15 @@ pub fn generate_on_machine(c: &EmuCase, machine: &EmuTruth) -> Result<(MeasuredR
 /// drawn from `day_seed` (an acceptance test re-run while the machine was
 /// healthy). The truth's magnitude is `c`'s draw, `affected` `None`.
 pub fn generate_repeat(c: &EmuCase, day_seed: u64) -> Result<(MeasuredRun, EmuTruth), String> {
-    let mut rng = ChaCha8Rng::seed_from_u64(c.seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ 0x17);
-    let mut m = missions::draw(c.scenario, c.duration_s, &mut rng);
-    let p = params::EmuParams::draw(&mut rng);
-    let (lo, hi) = magnitude_range(c.hidden);
-    let magnitude = if hi > lo { rng.random_range(lo..hi) } else { lo };
-    let mut day = ChaCha8Rng::seed_from_u64(day_seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ 0x5a);
-    m.ambient = missions::draw_ambient(&mut day);
-    let trace = Plant { p: &p, m: &m, h: Hidden { effect: Candidate::None, magnitude } }.run(c.scenario.log_interval_s());
-    if trace.iter().any(|r| r.1.iter().any(|v| !v.is_finite())) {
-        return Err(format!("emulator diverged on {c:?} repeated"));
-    }
-    let run = log_mission(&trace, &m, &mut day);
-    run.validate("emulator").map_err(|e| e.to_string())?;
-    Ok((run, EmuTruth { magnitude, params: p, affected: None }))
+    generate_on(c, None, true, Some(day_seed))
 }
 
-fn generate_on(c: &EmuCase, machine: Option<(&params::EmuParams, f64)>, twin: bool) -> Result<(MeasuredRun, EmuTruth), String> {
+/// `c`'s log: on `machine` (else `c`'s own draw), without the hidden effect
+/// when `twin`, on another day when `day_seed` (the ambient and the
+/// logger's noise and dropouts drawn from it).
+fn generate_on(c: &EmuCase, machine: Option<(&params::EmuParams, f64)>, twin: bool, day_seed: Option<u64>) -> Result<(MeasuredRun, EmuTruth), String> {
     let mut rng = ChaCha8Rng::seed_from_u64(c.seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ 0x17);
-    let m = missions::draw(c.scenario, c.duration_s, &mut rng);
+    let mut m = missions::draw(c.scenario, c.duration_s, &mut rng);
     let p = params::EmuParams::draw(&mut rng);
     let (lo, hi) = magnitude_range(c.hidden);
     let magnitude = if hi > lo { rng.random_range(lo..hi) } else { lo };
@@ -159,6 +149,10 @@ fn generate_on(c: &EmuCase, machine: Option<(&params::EmuParams, f64)>, twin: bo
         Some((q, mag)) => (q.clone(), mag),
         None => (p, magnitude),
     };
+    let mut day = day_seed.map(|d| ChaCha8Rng::seed_from_u64(d.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ 0x5a));
+    if let Some(d) = day.as_mut() {
+        m.ambient = missions::draw_ambient(d);
+    }
     let dt = c.scenario.log_interval_s();
     let hidden = if twin { Candidate::None } else { c.hidden };
     let plant = Plant { p: &p, m: &m, h: Hidden { effect: hidden, magnitude } };
@@ -185,7 +179,7 @@ fn generate_on(c: &EmuCase, machine: Option<(&params::EmuParams, f64)>, twin: bo
             })
             .max_by(|a, b| a.1.total_cmp(&b.1))
     };
-    let run = log_mission(&trace, &m, &mut rng);
+    let run = log_mission(&trace, &m, day.as_mut().unwrap_or(&mut rng));
     run.validate("emulator").map_err(|e| e.to_string())?;
     Ok((run, EmuTruth { magnitude, params: p, affected }))
 }
